@@ -1,0 +1,1 @@
+"""NC program template engine: templates in PostgreSQL, instantiated by a decision table."""

@@ -1,0 +1,5 @@
+"""Errors a user can act on: one line that names the thing and what to do."""
+
+
+class EngineError(Exception):
+    """A handled error. The CLI prints its message on one line and exits 1."""
