@@ -1,0 +1,90 @@
+"""Group-technology classification of a gear that names no class (design notes §6).
+
+The decision is a tuple of rules asked in order; the first rule answered "yes" names the
+leaf class, and a gear that answers "no" to all of them is `DEFAULT_CLASS`. Adding a rule
+is adding a row to `RULES`, not another branch. Classes that geometry alone does not tell
+apart (worm_wheel, duplex) are not classified: the gear CSV names them explicitly.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Callable, Collection, Mapping
+
+from .errors import EngineError
+
+DEFAULT_CLASS = "spur"
+
+
+@dataclass(frozen=True)
+class Rule:
+    """If `field` of the gear is given and `holds` for its value, the gear is `gear_class`."""
+
+    question: str
+    field: str
+    holds: Callable[[float], bool]
+    gear_class: str
+
+
+RULES: tuple[Rule, ...] = (
+    Rule("is a cone angle given and not 0?", "cone_angle", lambda value: value != 0, "taper"),
+    Rule("is a crowning given and greater than 0?", "crowning", lambda value: value > 0, "crowned"),
+    Rule("is the helix angle not 0?", "helix_angle", lambda value: value != 0, "helical"),
+)
+
+
+@dataclass(frozen=True)
+class Classification:
+    """The leaf class a gear falls in, and the questions and answers that led there."""
+
+    gear_class: str
+    path: list[tuple[str, str]] = field(default_factory=list)
+
+    def explain(self) -> str:
+        """One line: `question? no → question? yes → helical`."""
+        steps = [f"{question} {answer}" for question, answer in self.path]
+        return " → ".join(steps + [self.gear_class])
+
+
+def given_number(gear: Mapping[str, Any], name: str) -> float | None:
+    """The gear's value of `name` as a float, or None when it is absent or empty."""
+    value = gear.get(name)
+    if value is None or (isinstance(value, str) and not value.strip()):
+        return None
+    return float(value)
+
+
+def _answer(rule: Rule, gear: Mapping[str, Any]) -> str:
+    value = given_number(gear, rule.field)
+    if value is None:
+        return "no (not given)"
+    return f"{'yes' if rule.holds(value) else 'no'} ({rule.field} = {value:g})"
+
+
+def classify(gear: Mapping[str, Any]) -> Classification:
+    """The leaf class of `gear` (a mapping of gear CSV column names to values) by `RULES`.
+
+    Each step of `.path` is (question, answer); an answer starts with "yes" or "no" and
+    names the value it looked at."""
+    path: list[tuple[str, str]] = []
+    for rule in RULES:
+        answer = _answer(rule, gear)
+        path.append((rule.question, answer))
+        if answer.startswith("yes"):
+            return Classification(rule.gear_class, path)
+    return Classification(DEFAULT_CLASS, path)
+
+
+def not_installed_message(gear_id: Any, gear_class: str) -> str:
+    """What to say when a gear is classified into a class the database does not have."""
+    return (f"gear {gear_id}: classified as {gear_class}, but no gear class '{gear_class}' is "
+            f"installed; give gear_class explicitly or add the class "
+            f"(engine template import --class {gear_class} …)")
+
+
+def classify_installed(gear: Mapping[str, Any], installed: Collection[str]) -> Classification:
+    """`classify(gear)`, raising EngineError when the class found is not in `installed`."""
+    classification = classify(gear)
+    if classification.gear_class not in installed:
+        gear_id = gear.get("gear_id", gear.get("id", "?"))
+        raise EngineError(not_installed_message(gear_id, classification.gear_class))
+    return classification
