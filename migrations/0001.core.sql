@@ -35,8 +35,12 @@ CREATE TABLE component (
     CONSTRAINT component_not_empty CHECK (nullif(btrim(o), '') IS NOT NULL
                                           OR nullif(btrim(s), '') IS NOT NULL)
 );
-CREATE INDEX component_body ON component (t, md5(coalesce(o, '') || chr(1) || coalesce(p_calc, '')
-                                          || chr(1) || coalesce(s, '') || chr(1) || coalesce(p_emit, '')));
+-- Identity of a body: equal keys mean equal (t, o, p_calc, s, p_emit), NULLs included.
+CREATE FUNCTION component_body_key(t text, o text, p_calc text, s text, p_emit text)
+RETURNS text LANGUAGE sql IMMUTABLE PARALLEL SAFE
+RETURN md5(concat_ws(',', quote_literal(t), quote_nullable(o), quote_nullable(p_calc),
+                     quote_nullable(s), quote_nullable(p_emit)));
+CREATE INDEX component_body ON component (component_body_key(t, o, p_calc, s, p_emit));
 
 -- A class's assembled template: row id (the paper's ID, evaluation order), module number N,
 -- and the component that holds the row's body.
@@ -51,11 +55,15 @@ CREATE INDEX assembly_component ON assembly (component_id);
 
 -- Every class's assembled template as the paper's table (design notes §10).
 CREATE VIEW template_view AS
-SELECT a.gear_class, a.id, c.t, a.n, c.p_calc, c.s, c.o, c.p_emit,
-       count(DISTINCT a.gear_class) OVER (PARTITION BY c.t, c.o, c.p_calc, c.s, c.p_emit)::integer
-           AS shared_by
+WITH body_use AS (
+    SELECT component_body_key(c.t, c.o, c.p_calc, c.s, c.p_emit) AS body,
+           count(DISTINCT a.gear_class)::integer AS classes
+    FROM assembly a JOIN component c ON c.id = a.component_id
+    GROUP BY 1)
+SELECT a.gear_class, a.id, c.t, a.n, c.p_calc, c.s, c.o, c.p_emit, u.classes AS shared_by
 FROM assembly a
-JOIN component c ON c.id = a.component_id;
+JOIN component c ON c.id = a.component_id
+JOIN body_use u ON u.body = component_body_key(c.t, c.o, c.p_calc, c.s, c.p_emit);
 
 -- Machines and their limits. No program exceeding a limit is stored or written.
 CREATE TABLE machine (

@@ -1,0 +1,177 @@
+"""Commands for gears, instantiation, templates and lint (registered on engine.cli.main)."""
+from __future__ import annotations
+
+import re
+import sys
+
+import click
+
+from .cli import connection, emit_json, main
+from .errors import EngineError
+
+RANGE = re.compile(r"^\s*(\d+)\s*(?:-\s*(\d+))?\s*$")
+
+
+@main.group()
+def gears():
+    """Workpieces: import them from CSV (columns of design notes §9)."""
+
+
+@gears.command("import")
+@click.argument("csv_file", type=click.Path(dir_okay=False))
+@click.option("--json", "as_json", is_flag=True, help="Print one JSON object: {imported: N}.")
+@click.pass_context
+def gears_import(ctx, csv_file, as_json):
+    """Import gears from CSV_FILE; any bad row stops the whole file (nothing stored)."""
+    from .gears import import_gears
+
+    with connection(ctx) as conn:
+        count = import_gears(conn, csv_file)
+    emit_json({"imported": count}) if as_json else click.echo(f"imported {count} gear(s) from {csv_file}")
+
+
+def parse_range(text: str) -> tuple[int, int]:
+    match = RANGE.match(text)
+    if not match:
+        raise EngineError(f"--gears {text!r} is not a range like 1-5000 or 42")
+    first = int(match.group(1))
+    last = int(match.group(2) or first)
+    if last < first:
+        raise EngineError(f"--gears {text!r}: the range ends before it starts")
+    return first, last
+
+
+@main.command()
+@click.option("--gear", "gear_id", type=int, help="Gear id: compute a new job and its program.")
+@click.option("--job", "job_id", type=int, help="Stored job id: instantiate again with its (edited) parameters.")
+@click.option("--gears", "gear_range", help="Batch: gear ids FIRST-LAST (all stored, or none).")
+@click.option("--all", "all_gears", is_flag=True, help="Batch: every gear.")
+@click.option("--out", type=click.Path(), help="Write the .MPF file here (a directory for batches).")
+@click.option("--machine", help="Machine record (default hobber-840d).")
+@click.option("--cuts", type=click.IntRange(1, 2), help="1 = single cut, 2 = rough then finish (default by module).")
+@click.option("--coolant/--no-coolant", default=True, show_default=True, help="Coolant M8/M9.")
+@click.option("--shift-y", type=float, default=0.0, help="Hob shift position Y for this part, mm.")
+@click.option("--hob-speed", type=int, help="Override the hob speed n0, r/min.")
+@click.option("--json", "as_json", is_flag=True, help="Print one JSON object (program_id, path, lines, ...).")
+@click.pass_context
+def instantiate(ctx, gear_id, job_id, gear_range, all_gears, out, machine, cuts, coolant, shift_y,
+                hob_speed, as_json):
+    """Produce the NC program of a gear (or a stored job, or a batch of gears).
+
+    The program is checked against the machine's limits, stored with the template
+    version it came from, printed (single program) and written to --out.
+    """
+    from .hobbing.choices import Choices
+    from .instantiate import instantiate_gear, instantiate_gears, instantiate_job
+
+    chosen = [name for name, value in (("--gear", gear_id), ("--job", job_id), ("--gears", gear_range),
+                                       ("--all", all_gears)) if value]
+    if len(chosen) != 1:
+        raise EngineError("give exactly one of --gear ID, --job ID, --gears FIRST-LAST, --all")
+    choices = Choices(cuts=cuts, coolant=coolant, shift_y=shift_y)
+    overrides = {"hob_speed": hob_speed}
+    with connection(ctx) as conn:
+        if gear_id is not None:
+            program = instantiate_gear(conn, gear_id, machine=machine, choices=choices, overrides=overrides, out=out)
+        elif job_id is not None:
+            program = instantiate_job(conn, job_id, out=out)
+        else:
+            first, last = parse_range(gear_range) if gear_range else (None, None)
+            programs = instantiate_gears(conn, first, last, machine=machine, choices=choices,
+                                         overrides=overrides, out=out)
+            return _report_batch(programs, out, as_json)
+    _report_program(program, as_json)
+
+
+def _report_program(program, as_json: bool) -> None:
+    if as_json:
+        emit_json({"program_id": program.program_id, "job_id": program.job_id, "name": program.name,
+                   "path": program.path, "lines": len(program.lines), "gear_class": program.gear_class,
+                   "template_version": program.template_version, "template_hash": program.template_hash})
+        return
+    if program.path is None:
+        click.echo(program.text, nl=False)
+    click.echo(f"program {program.program_id} (job {program.job_id}, {len(program.lines)} lines) "
+               f"from {program.gear_class} v{program.template_version}"
+               + (f" written to {program.path}" if program.path else ""), err=True)
+
+
+def _report_batch(programs, out, as_json: bool) -> None:
+    lines = sum(len(program.lines) for program in programs)
+    if as_json:
+        emit_json({"programs": len(programs), "lines": lines, "path": out,
+                   "program_ids": [programs[0].program_id, programs[-1].program_id]})
+    else:
+        click.echo(f"stored {len(programs)} program(s), {lines} lines"
+                   + (f", written to {out}" if out else ""))
+
+
+@main.group()
+def template():
+    """Templates of gear classes: list, export and import as CSV (id,t,n,p_calc,s,o,p_emit)."""
+
+
+@template.command("list")
+@click.pass_context
+def template_list(ctx):
+    """Every gear class with its parent, template version and number of rows."""
+    from .templates import list_classes
+
+    with connection(ctx) as conn:
+        for name, parent, version, rows, description in list_classes(conn):
+            click.echo(f"{name:14} parent={parent or '-':12} v{version:<3} {rows:3} rows  {description}")
+
+
+@template.command("export")
+@click.option("--class", "gear_class", required=True, help="Gear class name.")
+@click.option("--out", type=click.Path(dir_okay=False), help="Write to this file instead of stdout.")
+@click.pass_context
+def template_export(ctx, gear_class, out):
+    """Print the class's assembled template as CSV."""
+    from .templates import export_csv, load_template
+
+    with connection(ctx) as conn:
+        text = export_csv(load_template(conn, gear_class))
+    if out:
+        with open(out, "w", encoding="utf-8", newline="") as file:
+            file.write(text)
+    else:
+        click.echo(text, nl=False)
+
+
+@template.command("import")
+@click.option("--class", "gear_class", required=True, help="Gear class name (created if new).")
+@click.option("--parent", help="Parent class in the tree, for a new class.")
+@click.argument("csv_file", type=click.Path(dir_okay=False))
+@click.pass_context
+def template_import(ctx, gear_class, parent, csv_file):
+    """Replace the class's rows with CSV_FILE; every expression is checked first (all or nothing)."""
+    from .templates import ensure_class, read_csv, replace_template
+
+    rows = read_csv(csv_file)
+    with connection(ctx) as conn:
+        with conn.transaction():
+            created = ensure_class(conn, gear_class, parent)
+            changed = replace_template(conn, gear_class, rows)
+        version = conn.execute("SELECT template_version FROM gear_class WHERE name = %s", (gear_class,)).fetchone()[0]
+    state = "created" if created else ("replaced" if changed else "unchanged (identical rows)")
+    click.echo(f"class {gear_class}: {state}, {len(rows)} rows, version {version}")
+
+
+@main.command()
+@click.option("--json", "as_json", is_flag=True, help="Print one JSON object: {errors: [...]}.")
+@click.pass_context
+def lint(ctx, as_json):
+    """Check every expression of every template: parses, is allowed, names known parameters."""
+    from .lint import lint_all
+
+    with connection(ctx) as conn:
+        problems = lint_all(conn)
+    if as_json:
+        emit_json({"errors": [str(problem) for problem in problems]})
+    else:
+        for problem in problems:
+            click.echo(str(problem))
+        click.echo(f"{len(problems)} problem(s)", err=True)
+    if problems:
+        sys.exit(1)

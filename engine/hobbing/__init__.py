@@ -1,0 +1,1 @@
+"""Hobbing models: gear + hob + machine + process choices → the parameters of a template."""

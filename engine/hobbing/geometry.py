@@ -1,0 +1,69 @@
+"""Hobbing geometry (reference/hobbing.md §B). Lengths in mm, angles in degrees."""
+from __future__ import annotations
+
+import math
+
+ADDENDUM_FACTOR = 1.0     # tip = d + 2·m
+DEDENDUM_FACTOR = 1.25    # root = d − 2·1.25·m
+TOOTH_DEPTH_FACTOR = ADDENDUM_FACTOR + DEDENDUM_FACTOR   # h = 2.25·m
+
+
+def reference_diameter(module: float, teeth: int, helix_angle: float = 0.0) -> float:
+    return module * teeth / math.cos(math.radians(helix_angle))
+
+
+def hob_reference_diameter(hob_tip_diameter: float, module: float) -> float:
+    """d_m0 ≈ d_a0 − 2·1.25·m_n (§B1)."""
+    return hob_tip_diameter - 2 * DEDENDUM_FACTOR * module
+
+
+def lead_angle(module: float, starts: int, hob_tip_diameter: float) -> float:
+    """Hob lead angle γ: sin γ = z0·m_n/d_m0 (§B1)."""
+    return math.degrees(math.asin(starts * module / hob_reference_diameter(hob_tip_diameter, module)))
+
+
+def signed(angle: float, hand: str | None) -> float:
+    """Right hand positive, left hand negative."""
+    return -angle if hand == "L" else angle
+
+
+def swivel_angle(helix_angle: float, gear_hand: str | None, lead: float, hob_hand: str) -> float:
+    """η = β − γ for the same hand, β + γ for opposite hands, γ for spur gears (§B2);
+    signed: right-hand helix positive. The sign on the A axis is the machine's."""
+    return signed(helix_angle, gear_hand) - signed(lead, hob_hand)
+
+
+def full_depth_centre_distance(root_diameter: float, hob_tip_diameter: float) -> float:
+    """a = (d_f2 + d_a0)/2 (§B3)."""
+    return (root_diameter + hob_tip_diameter) / 2
+
+
+def cut_depth(tip_diameter: float, hob_tip_diameter: float, centre_distance: float) -> float:
+    """Radial depth h of a cut at this centre distance, from the gear tip."""
+    return (tip_diameter + hob_tip_diameter) / 2 - centre_distance
+
+
+def approach_length(depth: float, hob_tip_diameter: float, tip_diameter: float, swivel: float) -> float:
+    """Run-in E from the face to where the hob at this depth first touches (§B7):
+    spur √(h·(d_a0 − h)); with a swivel η the conservative bound
+    √(h·(d_a0 − h))/cos η + tan η·√(h·(d_a2 − h))."""
+    eta = math.radians(abs(swivel))
+    spur = math.sqrt(depth * (hob_tip_diameter - depth))
+    if eta == 0:
+        return spur
+    return spur / math.cos(eta) + math.tan(eta) * math.sqrt(depth * (tip_diameter - depth))
+
+
+def overrun_length(module: float, depth: float, pressure_angle: float, swivel: float) -> float:
+    """Run-out U beyond the far face: about 1–2·m_n, plus the axial projection of the
+    generating zone (h/tan α_n)·sin η for a swivelled hob (§B8)."""
+    base = max(2.0, 1.5 * module)
+    extra = depth / math.tan(math.radians(pressure_angle)) * math.sin(math.radians(abs(swivel)))
+    return base + extra
+
+
+def differential_factor(module: float, teeth: int, helix_angle: float, gear_hand: str | None) -> float:
+    """Extra table rotation in degrees of C per mm of Z: ±360·sin β/(π·m_n·z2) (§B9),
+    positive for a right-hand helix."""
+    magnitude = 360 * math.sin(math.radians(helix_angle)) / (math.pi * module * teeth)
+    return signed(magnitude, gear_hand)

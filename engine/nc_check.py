@@ -1,0 +1,90 @@
+"""Checks an emitted 840D hobbing program against its machine and its own working area,
+before anything is stored or written (design notes §6, §7)."""
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+from .errors import EngineError
+from .records import Machine
+
+_COMMENT = re.compile(r";.*$")
+_CALL = re.compile(r"\([^)]*\)")
+_WORD = re.compile(r"(?<![A-Z_$])([XYZSG])\s*=?\s*([-+]?(?:\d+\.?\d*|\.\d+))")
+AXES = ("X", "Y", "Z")
+
+
+class LimitError(EngineError):
+    """A program exceeds a machine or working-area limit; nothing is stored."""
+
+
+@dataclass
+class _State:
+    lower: dict | None = None
+    upper: dict | None = None
+    limits_on: bool = False
+
+
+def check_program(lines: list[str], machine: Machine, program_name: str = "program") -> None:
+    state = _State()
+    for number, line in enumerate(lines, start=1):
+        problem = _check_line(line, machine, state)
+        if problem:
+            raise LimitError(f"{program_name} line {number} {line.strip()!r}: {problem}; nothing stored")
+
+
+def _words(line: str) -> list[tuple[str, float]]:
+    code = _CALL.sub("", _COMMENT.sub("", line)).upper()
+    if code.startswith("%"):
+        return []
+    return [(letter, float(value)) for letter, value in _WORD.findall(code)]
+
+
+def _check_line(line: str, machine: Machine, state: _State) -> str | None:
+    words = _words(line)
+    codes = {value for letter, value in words if letter == "G"}
+    axes = {letter: value for letter, value in words if letter in AXES}
+    if "WALIMON" in line.upper():
+        state.limits_on = True
+    if 91 in codes:
+        return "incremental G91 moves cannot be verified; program absolute positions (G90)"
+    if codes & {25, 26}:
+        return _set_limit(25 in codes, axes, machine, state)
+    for letter, value in words:
+        if letter == "S" and value > machine.spindle_max:
+            return f"spindle speed S{value:g} exceeds the machine's {machine.spindle_max:g} r/min"
+    if axes:
+        return _check_move(axes, machine, state)
+    return None
+
+
+def _set_limit(is_lower: bool, axes: dict, machine: Machine, state: _State) -> str | None:
+    for axis, value in axes.items():
+        problem = _outside_travel(axis, value, machine)
+        if problem:
+            return "working-area limit " + problem
+    if is_lower:
+        state.lower = axes
+    else:
+        state.upper = axes
+    return None
+
+
+def _check_move(axes: dict, machine: Machine, state: _State) -> str | None:
+    if not state.limits_on or state.lower is None or state.upper is None:
+        return "motion before G25/G26 and WALIMON set the working area"
+    for axis, value in axes.items():
+        problem = _outside_travel(axis, value, machine)
+        if problem:
+            return problem
+        low, high = state.lower.get(axis), state.upper.get(axis)
+        if (low is not None and value < low) or (high is not None and value > high):
+            return f"{axis}{value:g} lies outside the working area G25/G26 {axis} {low:g}…{high:g}"
+    return None
+
+
+def _outside_travel(axis: str, value: float, machine: Machine) -> str | None:
+    low, high = getattr(machine, f"{axis.lower()}_min"), getattr(machine, f"{axis.lower()}_max")
+    if value < low or value > high:
+        return f"{axis}{value:g} exceeds the travel of {machine.name} ({axis} {low:g}…{high:g})"
+    return None

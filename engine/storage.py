@@ -1,0 +1,60 @@
+"""Storing jobs and programs: one at a time, or a batch through COPY."""
+from __future__ import annotations
+
+from psycopg.types.json import Jsonb
+
+INSERT_JOB = """
+INSERT INTO job (gear_id, gear_class, machine, hob_id, params, module_params)
+VALUES (%s, %s, %s, %s, %s, %s) RETURNING id"""
+INSERT_PROGRAM = """
+INSERT INTO program (job_id, gear_class, template_version, template_hash, name, lines, row_ids)
+VALUES (%s, %s, %s, %s, %s, %s, %s) RETURNING id"""
+COPY_JOB = "COPY job (id, gear_id, gear_class, machine, hob_id, params, module_params) FROM STDIN"
+COPY_PROGRAM = ("COPY program (id, job_id, gear_class, template_version, template_hash, name, lines, row_ids) "
+                "FROM STDIN")
+
+
+def store_one(conn, planned, existing_job: int | None, path: str | None):
+    from .instantiate import Program
+
+    job_id = existing_job
+    if job_id is None:
+        job_id = conn.execute(INSERT_JOB, (planned.gear_id, planned.gear_class, planned.machine, planned.hob_id,
+                                           Jsonb(planned.params), Jsonb(planned.module_params))).fetchone()[0]
+    program_id = conn.execute(INSERT_PROGRAM, _program_values(job_id, planned)).fetchone()[0]
+    return _program(program_id, job_id, planned, path)
+
+
+def store_many(conn, planned: list, out=None) -> list:
+    """All jobs and programs in one transaction, through COPY (the batch path)."""
+    from .outputs import write_program_files
+
+    with write_program_files(planned, out) as paths, conn.transaction():
+        job_ids = _next_ids(conn, "job_id_seq", len(planned))
+        program_ids = _next_ids(conn, "program_id_seq", len(planned))
+        with conn.cursor().copy(COPY_JOB) as copy:
+            for job_id, item in zip(job_ids, planned):
+                copy.write_row((job_id, item.gear_id, item.gear_class, item.machine, item.hob_id,
+                                Jsonb(item.params), Jsonb(item.module_params)))
+        with conn.cursor().copy(COPY_PROGRAM) as copy:
+            for program_id, job_id, item in zip(program_ids, job_ids, planned):
+                copy.write_row((program_id, *_program_values(job_id, item)))
+    return [_program(p, j, item, paths.get(item.name)) for p, j, item in zip(program_ids, job_ids, planned)]
+
+
+def _next_ids(conn, sequence: str, count: int) -> list[int]:
+    rows = conn.execute("SELECT nextval(%s::regclass) FROM generate_series(1, %s)", (sequence, count))
+    return [row[0] for row in rows]
+
+
+def _program_values(job_id: int, planned) -> tuple:
+    template = planned.template
+    return (job_id, planned.gear_class, template.version, template.hash, planned.name,
+            planned.result.lines, planned.result.row_ids)
+
+
+def _program(program_id: int, job_id: int, planned, path):
+    from .instantiate import Program
+
+    return Program(program_id, job_id, planned.name, planned.result.lines, planned.gear_class,
+                   planned.template.version, planned.template.hash, path)
