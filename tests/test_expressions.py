@@ -1,0 +1,104 @@
+"""Template expressions: what users write works; what an attacker writes is refused
+before it runs, or stopped by a limit, with a message that names the problem."""
+import pytest
+
+from engine.errors import EngineError
+from engine.expressions import (MAX_INT_BITS, MAX_STRING_LENGTH, compile_expression, compile_statements,
+                                evaluate_with_asteval, evaluation_globals)
+
+
+def evaluate(text, **scope):
+    compiled = compile_expression(text)
+    return eval(compiled.code, evaluation_globals(compiled.is_sql), scope)
+
+
+@pytest.mark.parametrize("text, scope, expected", [
+    ('f"G25 X{Xmin:.2f}"', {"Xmin": 74.0}, "G25 X74.00"),
+    ('"G25 X" + str(Xmin)', {"Xmin": 74}, "G25 X74"),
+    ("round(sqrt(h * (da0 - h)), 3)", {"h": 4.5, "da0": 70}, 17.168),  # √294.75 = 17.1683,
+    ('f"EGON(C,\\"FINE\\",B,{-z0},{z2})"', {"z0": 1, "z2": 19}, 'EGON(C,"FINE",B,-1,19)'),
+    ("ctr_px == 'T' and shift != 0", {"ctr_px": "T", "shift": 2}, True),
+    ("x if x > 0 else -x", {"x": -3}, 3),
+    ("f'{x:>{w}}'", {"x": 7, "w": 4}, "   7"),
+])
+def test_python_expressions_evaluate_as_python_does(text, scope, expected):
+    assert evaluate(text, **scope) == expected
+
+
+@pytest.mark.parametrize("text, scope, expected", [
+    ("ctr_px = 'T' AND shift <> 0", {"ctr_px": "T", "shift": 2}, True),
+    ("ctr_px = 'T' AND shift <> 0", {"ctr_px": "T", "shift": 0}, False),
+    ("ctr_px = 'T' AND shift <> 0", {"ctr_px": None, "shift": 2}, False),   # NULL is not true
+    ("teeth / 2 = 9", {"teeth": 19}, True),                                 # SQL integer division
+])
+def test_sql_conditions_are_translated_with_sql_semantics(text, scope, expected):
+    assert evaluate(text, **scope) is expected
+
+
+def test_statements_are_assignments_in_order():
+    statements = compile_statements("a = 1; b = a + 2\nc = f'{b}'")
+    assert [name for name, _ in statements] == ["a", "b", "c"]
+
+
+@pytest.mark.parametrize("text", [
+    "open('/etc/passwd')",
+    "__import__('os')",
+    "().__class__.__bases__[0].__subclasses__()",
+    "(lambda: 1)()",
+    "[x for x in range(10)]",
+    "x := 1",
+    "eval('1')",
+    "exec('1')",
+    "getattr(x, 'y')",
+    "f'{x!r}'",
+    "globals()",
+    "_secret",
+])
+def test_hostile_expressions_are_refused_before_running(text):
+    with pytest.raises(EngineError):
+        compile_expression(text)
+
+
+@pytest.mark.parametrize("text", ["while True: pass", "import os", "for i in range(9): x = i",
+                                  "def f(): pass", "x += 1", "a.b = 1", "print(1)"])
+def test_only_assignments_are_statements(text):
+    with pytest.raises(EngineError):
+        compile_statements(text)
+
+
+@pytest.mark.parametrize("text, limit", [
+    ("9**9**9", f"{MAX_INT_BITS} bits"),
+    ("'a'*10**9", f"{MAX_STRING_LENGTH} characters"),
+    ("10**9*'a'", f"{MAX_STRING_LENGTH} characters"),
+    ("1 << 10**6", f"{MAX_INT_BITS} bits"),
+    ("f'{1:>999999999}'", "format width"),
+    ("'%0999999999d' % 1", "f-string"),
+    ("2**4000 * 2**4000", f"{MAX_INT_BITS} bits"),
+])
+def test_expressions_that_would_exhaust_memory_or_time_stop_at_a_limit(text, limit):
+    with pytest.raises(ValueError, match=limit):
+        evaluate(text)
+
+
+def test_string_doubling_cannot_grow_without_bound():
+    statements = compile_statements("s = s + s")
+    scope = {"s": "x" * 1024}
+    globals_ = evaluation_globals()
+    with pytest.raises(ValueError, match="characters"):
+        for _ in range(64):
+            scope["s"] = eval(statements[0][1].code, globals_, scope)
+    assert len(scope["s"]) <= MAX_STRING_LENGTH
+
+
+def test_oversized_expression_text_is_refused():
+    with pytest.raises(EngineError, match="longer than"):
+        compile_expression("1+" * 3000 + "1")
+
+
+@pytest.mark.parametrize("text", [
+    'f"G1 X{cut_x:.3f} F{feed:.1f}"', "round(cut_x * 2, 2)", "min(cut_x, feed) > 10",
+    "'ROUGH' if feed > 30 else 'FINISH'", "360 * sin(radians(15)) / (pi * 2 * 30)",
+])
+def test_compiled_evaluation_agrees_with_the_asteval_interpreter(text):
+    scope = {"cut_x": 51.5, "feed": 41.8}
+    assert evaluate(text, **scope) == evaluate_with_asteval(text, scope)
