@@ -44,8 +44,8 @@ Semantics
 * AND, OR, CASE and COALESCE evaluate their operands left to right and stop as
   soon as the result is known (as PostgreSQL does in practice), so
   ``b <> 0 AND a / b > 1`` and ``CASE WHEN b = 0 THEN 0 ELSE a / b END`` do
-  not divide by zero.  Operands after the first are passed to the helper as
-  thunks built by ``_sql_defer``.
+  not divide by zero.  Operands after the first that might raise are passed to
+  the helper as thunks built by ``_sql_defer``.
 * No implicit casts: text never equals a number and a boolean never equals a
   number (the result is FALSE); ordering comparisons between them raise
   TypeError.  AND/OR/NOT and CASE WHEN conditions need boolean operands,
@@ -297,25 +297,57 @@ def _sql_in(value, *items):
     return result
 
 
+class _LikePattern:
+    """A LIKE pattern split at its ``%`` wildcards into fixed-length segments.
+
+    Matching the first segment at the start, the last at the end and each middle
+    segment at its leftmost position in between is exact for such patterns and
+    takes O(len(value) * len(pattern)), unlike one backtracking regex with
+    several ``.*`` (which can take exponential time).
+    """
+
+    __slots__ = ("whole", "first", "middle", "last", "last_length")
+
+    def __init__(self, segments, flags):
+        compiled = [re.compile("".join(parts), flags | re.DOTALL) for parts in segments]
+        self.whole = len(compiled) == 1  # no % at all
+        self.first, self.middle, self.last = compiled[0], compiled[1:-1], compiled[-1]
+        self.last_length = len(segments[-1])
+
+    def matches(self, value):
+        if self.whole:
+            return self.first.fullmatch(value) is not None
+        found = self.first.match(value)
+        if found is None:
+            return False
+        position, tail = found.end(), len(value) - self.last_length
+        for segment in self.middle:
+            found = segment.search(value, position, tail)
+            if found is None:
+                return False
+            position = found.end()
+        return position <= tail and self.last.fullmatch(value, tail) is not None
+
+
 @functools.lru_cache(maxsize=512)
-def _like_regex(pattern, escape, flags):
+def _like_pattern(pattern, escape, flags):
     if len(escape) > 1:
         raise ValueError(f"invalid escape string {escape!r}: use one character or ''")
-    parts = []
+    segments = [[]]  # each segment: regex parts, one per character matched
     chars = iter(pattern)
     for char in chars:
         if escape and char == escape:
             literal = next(chars, None)
             if literal is None:
                 raise ValueError("LIKE pattern must not end with escape character")
-            parts.append(re.escape(literal))
+            segments[-1].append(re.escape(literal))
         elif char == "%":
-            parts.append(".*")
+            segments.append([])
         elif char == "_":
-            parts.append(".")
+            segments[-1].append(".")
         else:
-            parts.append(re.escape(char))
-    return re.compile("".join(parts), flags | re.DOTALL)
+            segments[-1].append(re.escape(char))
+    return _LikePattern(segments, flags)
 
 
 def _like(value, pattern, escape, flags, op):
@@ -324,7 +356,7 @@ def _like(value, pattern, escape, flags, op):
     for operand in (value, pattern, escape):
         if not isinstance(operand, str):
             raise TypeError(f"operator {op} needs text, got {_describe(operand)}")
-    return _like_regex(pattern, escape, flags).fullmatch(value) is not None
+    return _like_pattern(pattern, escape, flags).matches(value)
 
 
 def _sql_like(value, pattern, escape="\\"):
@@ -523,7 +555,9 @@ SQL_RUNTIME: dict[str, Callable] = {
 }
 
 _LAZY = frozenset({"_sql_and", "_sql_or", "_sql_case", "_sql_coalesce"})
-_DEFERRABLE = {name: (fn, name not in _LAZY) for name, fn in SQL_RUNTIME.items() if name != "_sql_defer"}
+_DEFERRABLE = {
+    name: (fn, name not in _LAZY) for name, fn in SQL_RUNTIME.items() if name != "_sql_defer"
+}
 
 
 # --------------------------------------------------------------------------
@@ -552,14 +586,29 @@ def _render(node):
 def _name(identifier):
     name = identifier.this
     if not isinstance(name, str) or not name.isidentifier() or keyword.iskeyword(name):
-        raise EngineError(f'identifier "{name}" in condition is not a valid parameter name; use a Python identifier')
+        raise EngineError(
+            f'identifier "{name}" in condition is not a valid parameter name; use a Python identifier'
+        )
     if name.startswith(_RESERVED_PREFIX):
         raise EngineError(f"identifier {name} in condition uses the reserved prefix {_RESERVED_PREFIX}")
     return ast.Name(id=name, ctx=ast.Load())
 
 
+# Helpers that cannot raise and are cheap: in a lazy position they are called
+# directly instead of being wrapped in a thunk, when their arguments are too.
+_CANNOT_RAISE = frozenset({
+    "_sql_eq", "_sql_ne", "_sql_is_null", "_sql_is_true", "_sql_is_false",
+    "_sql_distinct", "_sql_not_distinct", "_sql_in", "_sql_nullif",
+})
+
+
+def _is_direct(node):
+    """A leaf, or a direct call (only ever made to a helper that cannot raise)."""
+    return not isinstance(node, ast.Call) or node.func.id != "_sql_defer"
+
+
 def _call(helper, args, lazy):
-    if lazy:
+    if lazy and not (helper in _CANNOT_RAISE and all(_is_direct(arg) for arg in args)):
         return ast.Call(
             func=ast.Name(id="_sql_defer", ctx=ast.Load()),
             args=[ast.Constant(helper), *args],
@@ -710,7 +759,9 @@ def _case(node, lazy):
     for branch in node.args.get("ifs") or []:
         if not isinstance(branch, exp.If) or branch.args.get("false") is not None:
             raise EngineError(f"unsupported CASE branch in condition: {_render(branch)}")
-        test = branch.this if subject is None else exp.EQ(this=subject.copy(), expression=branch.this.copy())
+        test = branch.this
+        if subject is not None:  # simple CASE: compare the subject with each WHEN value
+            test = exp.EQ(this=subject.copy(), expression=branch.this.copy())
         parts += [test, branch.args["true"]]
     if not parts:
         raise EngineError(f"CASE needs at least one WHEN branch: {_render(node)}")
@@ -777,7 +828,8 @@ _HANDLERS: dict[type, tuple[Callable, frozenset]] = {
     exp.Round: (_round, frozenset({"this", "decimals"})),
     **{cls: (_binary(helper), _OPERANDS) for cls, helper in _BINARY.items()},
     **{cls: (_unary(helper), frozenset({"this"})) for cls, helper in _UNARY.items()},
-    **{cls: (_variadic(helper), frozenset({"this", "expressions"})) for cls, helper in _VARIADIC.items()},
+    **{cls: (_variadic(helper), frozenset({"this", "expressions"}))
+       for cls, helper in _VARIADIC.items()},
 }
 
 
@@ -797,7 +849,8 @@ def _reject(node):
 
 def _check_args(node, consumed):
     for key, value in node.args.items():
-        if key not in consumed and (isinstance(value, exp.Expression) or (isinstance(value, list) and value)):
+        operand = isinstance(value, exp.Expression) or (isinstance(value, list) and value)
+        if operand and key not in consumed:
             raise EngineError(f"unsupported SQL in condition: {_render(node)} (part {key!r})")
 
 
@@ -825,7 +878,8 @@ def _parse_error_message(error):
         return _short(str(error).splitlines()[0] if str(error) else type(error).__name__, 100)
     token = _short(details.get("highlight") or "", 30)
     column = max(1, (details.get("col") or 1) - len(details.get("highlight") or "") + 1)
-    where = f"at column {column}" if details.get("line", 1) <= 1 else f"at line {details['line']} column {column}"
+    line = details.get("line") or 1
+    where = f"at column {column}" if line <= 1 else f"at line {line} column {column}"
     description = details.get("description") or ""
     if description.startswith("Invalid expression / Unexpected token"):
         return f"unexpected token {token!r} {where}"
