@@ -114,6 +114,9 @@ def _check_machine_fits(gear: Gear, machine: Machine) -> None:
 
 
 def _check_table_speed(gear: Gear, starts: int, hob_speed: float, machine: Machine) -> None:
+    if hob_speed > machine.spindle_max:
+        raise LimitError(f"gear {gear.id}: hob speed {hob_speed:g} r/min exceeds {machine.name}'s hob spindle "
+                         f"maximum {machine.spindle_max:g} r/min; nothing stored")
     table_speed = hob_speed * starts / gear.teeth
     if machine.table_speed_max is not None and table_speed > machine.table_speed_max:
         raise LimitError(f"gear {gear.id}: table speed {table_speed:.1f} r/min exceeds {machine.name}'s "

@@ -81,28 +81,36 @@ def status(conn, directory: Path = MIGRATIONS_DIR) -> list[MigrationState]:
 
 
 def migrate(conn, directory: Path = MIGRATIONS_DIR) -> list[Migration]:
-    """Apply every pending migration; return those applied. Refuses if an applied file changed."""
-    with conn.transaction():
-        conn.execute(CREATE_LEDGER)
+    """Apply every pending migration; return those applied. Refuses if an applied file changed.
+    Each migration commits on its own, so the connection must not be inside a transaction."""
+    from psycopg.pq import TransactionStatus
+
+    if conn.info.transaction_status != TransactionStatus.IDLE:
+        conn.commit()  # our own reads so far (status queries); migrations need real transactions
+    autocommit, conn.autocommit = conn.autocommit, True
     conn.execute("SELECT pg_advisory_lock(%s)", (MIGRATION_LOCK_KEY,))
     try:
-        states = status(conn, directory)
-        changed = [s.migration.path.name for s in states if s.changed]
-        if changed:
-            raise EngineError(
-                f"applied migration {changed[0]} was edited since it ran (checksum differs); "
-                "restore the file and put the change in a new migration"
-            )
-        done = []
-        for state in states:
-            if state.applied_at is None:
-                _apply(conn, state.migration)
-                done.append(state.migration)
-        return done
+        conn.execute(CREATE_LEDGER)  # under the lock: IF NOT EXISTS alone is not race-free
+        return _apply_pending(conn, directory)
     finally:
         conn.execute("SELECT pg_advisory_unlock(%s)", (MIGRATION_LOCK_KEY,))
-        if not conn.autocommit:
-            conn.commit()
+        conn.autocommit = autocommit
+
+
+def _apply_pending(conn, directory: Path) -> list[Migration]:
+    states = status(conn, directory)
+    changed = [s.migration.path.name for s in states if s.changed]
+    if changed:
+        raise EngineError(
+            f"applied migration {changed[0]} was edited since it ran (checksum differs); "
+            "restore the file and put the change in a new migration"
+        )
+    done = []
+    for state in states:
+        if state.applied_at is None:
+            _apply(conn, state.migration)
+            done.append(state.migration)
+    return done
 
 
 def _apply(conn, migration: Migration) -> None:

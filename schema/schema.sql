@@ -1,0 +1,159 @@
+-- The current schema, readable in one place. Migrations in ../migrations/ produce exactly
+-- this (tests/test_migrations.py compares the catalogs). Change both together.
+
+-- Core schema: gear classes, the module library (components + each class's assembly),
+-- machines, hobs, gears, jobs and the programs instantiated from them.
+
+-- The six control modules of the paper, in assembly order (design notes §4).
+CREATE TABLE module_type (
+    code     text PRIMARY KEY,
+    position integer NOT NULL UNIQUE,
+    title    text NOT NULL
+);
+INSERT INTO module_type (code, position, title) VALUES
+    ('main',      1, 'main program: start, end, working-area limits'),
+    ('prep',      2, 'preparation: positioning, swivel, tool, clamping'),
+    ('sync',      3, 'synchronous motion: electronic gearbox coupling'),
+    ('shift',     4, 'hob shift along its axis'),
+    ('cutcond',   5, 'cutting conditions: spindle, coolant'),
+    ('cutmotion', 6, 'cutting motion: infeed, axial pass, retract');
+
+-- Group-technology tree of gear classes. Leaf classes carry templates.
+CREATE TABLE gear_class (
+    name             text PRIMARY KEY CHECK (name ~ '^[a-z][a-z0-9_]*$'),
+    parent           text REFERENCES gear_class (name),
+    description      text NOT NULL DEFAULT '',
+    template_version integer NOT NULL DEFAULT 0 CHECK (template_version >= 0)
+);
+
+-- A component is the body of a template row (T, O, P_calc, S, P_emit). A body used by
+-- several classes is stored once and referenced from each class's assembly.
+CREATE TABLE component (
+    id     bigserial PRIMARY KEY,
+    t      text NOT NULL REFERENCES module_type (code),
+    o      text,
+    p_calc text,
+    s      text,
+    p_emit text,
+    CONSTRAINT component_not_empty CHECK (nullif(btrim(o), '') IS NOT NULL
+                                          OR nullif(btrim(s), '') IS NOT NULL)
+);
+-- Identity of a body: equal keys mean equal (t, o, p_calc, s, p_emit), NULLs included.
+CREATE FUNCTION component_body_key(t text, o text, p_calc text, s text, p_emit text)
+RETURNS text LANGUAGE sql IMMUTABLE PARALLEL SAFE
+RETURN md5(concat_ws(',', quote_literal(t), quote_nullable(o), quote_nullable(p_calc),
+                     quote_nullable(s), quote_nullable(p_emit)));
+CREATE INDEX component_body ON component (component_body_key(t, o, p_calc, s, p_emit));
+
+-- A class's assembled template: row id (the paper's ID, evaluation order), module number N,
+-- and the component that holds the row's body.
+CREATE TABLE assembly (
+    gear_class   text NOT NULL REFERENCES gear_class (name) ON DELETE CASCADE,
+    id           integer NOT NULL CHECK (id >= 0),
+    n            integer NOT NULL DEFAULT 1 CHECK (n >= 0),
+    component_id bigint NOT NULL REFERENCES component (id),
+    PRIMARY KEY (gear_class, id)
+);
+CREATE INDEX assembly_component ON assembly (component_id);
+
+-- Every class's assembled template as the paper's table (design notes §10).
+CREATE VIEW template_view AS
+WITH body_use AS (
+    SELECT component_body_key(c.t, c.o, c.p_calc, c.s, c.p_emit) AS body,
+           count(DISTINCT a.gear_class)::integer AS classes
+    FROM assembly a JOIN component c ON c.id = a.component_id
+    GROUP BY 1)
+SELECT a.gear_class, a.id, c.t, a.n, c.p_calc, c.s, c.o, c.p_emit, u.classes AS shared_by
+FROM assembly a
+JOIN component c ON c.id = a.component_id
+JOIN body_use u ON u.body = component_body_key(c.t, c.o, c.p_calc, c.s, c.p_emit);
+
+-- Machines and their limits. No program exceeding a limit is stored or written.
+CREATE TABLE machine (
+    name            text PRIMARY KEY,
+    kind            text NOT NULL CHECK (kind IN ('hobber', 'lathe')),
+    dialect         text NOT NULL,
+    x_min           numeric NOT NULL,
+    x_max           numeric NOT NULL,
+    y_min           numeric NOT NULL DEFAULT 0,
+    y_max           numeric NOT NULL DEFAULT 0,
+    z_min           numeric NOT NULL,
+    z_max           numeric NOT NULL,
+    spindle_max     numeric NOT NULL CHECK (spindle_max > 0),  -- hob spindle (hobber) or main spindle, r/min
+    table_speed_max numeric,                                   -- r/min of C, hobbers only
+    module_max      numeric,                                   -- mm, hobbers only
+    CHECK (x_min < x_max AND y_min <= y_max AND z_min < z_max)
+);
+
+-- Hob library.
+CREATE TABLE hob (
+    id             text PRIMARY KEY,
+    module         numeric NOT NULL CHECK (module > 0),
+    pressure_angle numeric NOT NULL DEFAULT 20 CHECK (pressure_angle > 0 AND pressure_angle < 45),
+    starts         integer NOT NULL CHECK (starts > 0),
+    tip_diameter   numeric NOT NULL CHECK (tip_diameter > 0),
+    length         numeric NOT NULL CHECK (length > 0),
+    hand           text NOT NULL CHECK (hand IN ('L', 'R')),
+    accuracy_class text NOT NULL,
+    material       text NOT NULL DEFAULT 'HSS',
+    coating        text NOT NULL DEFAULT ''
+);
+
+-- Workpieces (design notes §9 columns).
+CREATE TABLE gear (
+    id             integer PRIMARY KEY CHECK (id > 0),
+    gear_class     text REFERENCES gear_class (name),
+    module         numeric NOT NULL CHECK (module > 0),
+    teeth          integer NOT NULL CHECK (teeth > 0),
+    pressure_angle numeric NOT NULL DEFAULT 20 CHECK (pressure_angle > 0 AND pressure_angle < 45),
+    helix_angle    numeric NOT NULL DEFAULT 0 CHECK (helix_angle >= 0 AND helix_angle < 60),
+    hand           text CHECK (hand IN ('L', 'R')),
+    face_width     numeric NOT NULL CHECK (face_width > 0),
+    tip_diameter   numeric CHECK (tip_diameter > 0),
+    root_diameter  numeric CHECK (root_diameter > 0),
+    cone_angle     numeric,
+    crowning       numeric,
+    material       text,
+    hardness       numeric,
+    quality_grade  integer CHECK (quality_grade BETWEEN 1 AND 12),
+    quantity       integer CHECK (quantity > 0),
+    CHECK (helix_angle = 0 OR hand IS NOT NULL)
+);
+
+-- A job: one workpiece on one machine with every parameter its template needs, as computed
+-- by the class's model (and possibly edited afterwards in SQL).
+-- params: {"name": value}; module_params: {"cutmotion:1": {"name": value}} (scope of module T,N).
+CREATE TABLE job (
+    id            bigserial PRIMARY KEY,
+    gear_id       integer REFERENCES gear (id),
+    gear_class    text NOT NULL REFERENCES gear_class (name),
+    machine       text NOT NULL REFERENCES machine (name),
+    hob_id        text REFERENCES hob (id),
+    params        jsonb NOT NULL CHECK (jsonb_typeof(params) = 'object'),
+    module_params jsonb NOT NULL DEFAULT '{}' CHECK (jsonb_typeof(module_params) = 'object'),
+    created_at    timestamptz NOT NULL DEFAULT now()
+);
+CREATE INDEX job_gear ON job (gear_id);
+
+-- One row per instantiation: the result table (emitted lines, with the template row that
+-- emitted each) and the template version and hash it came from.
+CREATE TABLE program (
+    id               bigserial PRIMARY KEY,
+    job_id           bigint NOT NULL REFERENCES job (id) ON DELETE CASCADE,
+    gear_class       text NOT NULL REFERENCES gear_class (name),
+    template_version integer NOT NULL,
+    template_hash    text NOT NULL,
+    name             text NOT NULL,
+    lines            text[] NOT NULL,
+    row_ids          integer[] NOT NULL,
+    created_at       timestamptz NOT NULL DEFAULT now(),
+    CHECK (cardinality(lines) = cardinality(row_ids))
+);
+CREATE INDEX program_job ON program (job_id);
+
+-- The paper's result table, one row per emitted NC line.
+CREATE VIEW result_line AS
+SELECT p.id AS program_id, l.line_no::integer AS line_no, p.row_ids[l.line_no] AS template_row_id,
+       l.text
+FROM program p,
+     unnest(p.lines) WITH ORDINALITY AS l (text, line_no);
