@@ -99,10 +99,21 @@ def safe_mod(left, right):
 _FORMAT_NUMBERS = re.compile(r"\d+")
 
 
-def safe_format(value, spec: str) -> str:
-    """format() with the width and precision of the spec bounded."""
+def _check_format_spec(spec: str) -> None:
     if any(int(number) > MAX_FORMAT_WIDTH for number in _FORMAT_NUMBERS.findall(spec)):
         raise ValueError(f"format width or precision above {MAX_FORMAT_WIDTH} in {spec!r}")
+
+
+def _constant_spec(spec: ast.JoinedStr) -> str | None:
+    """The text of a format spec without replacement fields, else None."""
+    if all(isinstance(part, ast.Constant) for part in spec.values):
+        return "".join(part.value for part in spec.values)
+    return None
+
+
+def safe_format(value, spec: str) -> str:
+    """format() with the width and precision of the spec bounded."""
+    _check_format_spec(spec)
     return format(value, spec)
 
 
@@ -281,7 +292,12 @@ class _GuardOperators(ast.NodeTransformer):
         if node.conversion != -1:
             raise ExpressionError("conversions (!r, !s, !a) are not allowed in f-strings")
         spec = node.format_spec
-        if spec is None:
+        if spec is None or _constant_spec(spec) is not None:
+            if spec is not None:
+                try:
+                    _check_format_spec(_constant_spec(spec))  # fixed spec: checked once, here
+                except ValueError as error:
+                    raise ExpressionError(str(error)) from None
             node.value = self.visit(node.value)
             return node
         value = ast.Call(ast.Name("_safe_format", ast.Load()), [self.visit(node.value), spec], [])

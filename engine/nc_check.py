@@ -34,28 +34,36 @@ def check_program(lines: list[str], machine: Machine, program_name: str = "progr
 
 
 def _words(line: str) -> list[tuple[str, float]]:
-    code = _CALL.sub("", _COMMENT.sub("", line)).upper()
-    if code.startswith("%"):
+    if line.startswith(("%", ";")):
         return []
+    code = line.upper()
+    if ";" in code:
+        code = _COMMENT.sub("", code)
+    if "(" in code:
+        code = _CALL.sub("", code)
     return [(letter, float(value)) for letter, value in _WORD.findall(code)]
 
 
 def _check_line(line: str, machine: Machine, state: _State) -> str | None:
     words = _words(line)
-    codes = {value for letter, value in words if letter == "G"}
-    axes = {letter: value for letter, value in words if letter in AXES}
-    if "WALIMON" in line.upper():
-        state.limits_on = True
+    if not words:
+        if "WALIMON" in line.upper():
+            state.limits_on = True
+        return None
+    codes, axes = set(), {}
+    for letter, value in words:
+        if letter == "G":
+            codes.add(value)
+        elif letter == "S":
+            if value > machine.spindle_max:
+                return f"spindle speed S{value:g} exceeds the machine's {machine.spindle_max:g} r/min"
+        else:
+            axes[letter] = value
     if 91 in codes:
         return "incremental G91 moves cannot be verified; program absolute positions (G90)"
-    if codes & {25, 26}:
+    if 25 in codes or 26 in codes:
         return _set_limit(25 in codes, axes, machine, state)
-    for letter, value in words:
-        if letter == "S" and value > machine.spindle_max:
-            return f"spindle speed S{value:g} exceeds the machine's {machine.spindle_max:g} r/min"
-    if axes:
-        return _check_move(axes, machine, state)
-    return None
+    return _check_move(axes, machine, state) if axes else None
 
 
 def _set_limit(is_lower: bool, axes: dict, machine: Machine, state: _State) -> str | None:

@@ -11,7 +11,8 @@ INSERT INTO program (job_id, gear_class, template_version, template_hash, name, 
 VALUES (%s, %s, %s, %s, %s, %s, %s) RETURNING id"""
 COPY_JOB = "COPY job (id, gear_id, gear_class, machine, hob_id, params, module_params) FROM STDIN"
 COPY_PROGRAM = ("COPY program (id, job_id, gear_class, template_version, template_hash, name, lines, row_ids) "
-                "FROM STDIN")
+                "FROM STDIN (FORMAT BINARY)")
+PROGRAM_TYPES = ("int8", "int8", "text", "int4", "text", "text", "text[]", "int4[]")
 
 
 def store_one(conn, planned, existing_job: int | None, path: str | None):
@@ -37,6 +38,7 @@ def store_many(conn, planned: list, out=None) -> list:
                 copy.write_row((job_id, item.gear_id, item.gear_class, item.machine, item.hob_id,
                                 Jsonb(item.params), Jsonb(item.module_params)))
         with conn.cursor().copy(COPY_PROGRAM) as copy:
+            copy.set_types(PROGRAM_TYPES)
             for program_id, job_id, item in zip(program_ids, job_ids, planned):
                 copy.write_row((program_id, *_program_values(job_id, item)))
     return [_program(p, j, item, paths.get(item.name)) for p, j, item in zip(program_ids, job_ids, planned)]

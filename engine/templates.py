@@ -10,6 +10,7 @@ import hashlib
 import io
 import json
 from dataclasses import astuple, dataclass
+from functools import cached_property
 from pathlib import Path
 
 from .errors import EngineError
@@ -35,7 +36,7 @@ class Template:
     version: int
     rows: tuple[TemplateRow, ...]
 
-    @property
+    @cached_property
     def hash(self) -> str:
         """Content hash of the assembled rows: what a program records next to the version."""
         return rows_hash(self.rows)
