@@ -169,3 +169,23 @@ def test_demo_runs_on_the_embedded_server_from_nothing(tmp_path):
                         "p = pathlib.Path(sys.argv[1]); "
                         "(p / 'postmaster.pid').exists() and s.PostgresServer(p, cleanup_mode='stop')._cleanup()",
                         str(tmp_path / "pgdata")], capture_output=True, timeout=60)
+
+
+def test_libpq_variables_choose_the_server_when_no_url_is_given(fresh_database_url):
+    from psycopg.conninfo import conninfo_to_dict
+
+    params = conninfo_to_dict(fresh_database_url)
+    environment = {k: v for k, v in os.environ.items() if k != "DATABASE_URL" and not k.startswith("PG")}
+    environment.update({"PGHOST": params["host"], "PGDATABASE": params["dbname"],
+                        "PGUSER": params.get("user", "postgres"), "PGPORT": str(params.get("port", 5432))})
+    result = subprocess.run([sys.executable, "-m", "engine", "db", "status"], env=environment,
+                            capture_output=True, text=True, timeout=60)
+    assert result.returncode == 0, result.stderr
+    assert "applied  0001.core.sql" in result.stdout
+
+
+def test_an_unreachable_server_is_one_line_and_exit_1():
+    result = CliRunner().invoke(main, ["--database-url", "postgresql://nobody@127.0.0.1:1/none", "db", "status"])
+    assert result.exit_code == 1
+    assert result.stderr.startswith("error: cannot connect to postgresql://nobody@127.0.0.1:1/none")
+    assert len(result.stderr.strip().splitlines()) == 1

@@ -146,3 +146,11 @@ def test_result_table_view_lists_lines_with_their_template_rows(conn):
                         "ORDER BY line_no", (program.program_id,)).fetchall()
     assert [text for _, _, text in rows] == program.lines
     assert rows[0][:2] == (1, 10)
+
+
+def test_the_wall_clock_budget_stops_a_runaway_instantiation(conn):
+    rows = [(i, "main", 1, None, "x = sqrt(2) * i", 'f"{x:.3f}"', None) for i in range(1, 200)]
+    template = make_template(conn, "t_budget", rows)
+    assert len(template.run({"i": 1}).lines) == 199
+    with pytest.raises(TemplateError, match="exceeded"):
+        template.run({"i": 1}, deadline_seconds=0.0)
