@@ -1,0 +1,60 @@
+"""Shared by the benchmarks: the server's admin URL, a private database that is always
+dropped, medians and the PASS/MISS wording. Benchmarks report; they never fail on a target."""
+from __future__ import annotations
+
+import argparse
+import contextlib
+import os
+import statistics
+import uuid
+
+DEFAULT_ADMIN_URL = "postgresql://postgres@127.0.0.1:5432/postgres"
+
+
+def add_database_argument(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--database-url", default=os.environ.get("DATABASE_URL") or DEFAULT_ADMIN_URL,
+        help="admin URL of the PostgreSQL server; the benchmark creates (and drops) its own database "
+             "there (default: DATABASE_URL, else %(default)s)")
+
+
+def url_of(server_url: str, database: str) -> str:
+    from psycopg.conninfo import conninfo_to_dict, make_conninfo
+
+    params = conninfo_to_dict(server_url)
+    params["dbname"] = database
+    return make_conninfo(**params)
+
+
+@contextlib.contextmanager
+def bench_database(server_url: str, prefix: str, *, seeded: bool = True):
+    """Create a uniquely named database (migrated and seeded), yield its URL, drop it
+    at the end even when the benchmark fails."""
+    import psycopg
+    from psycopg import sql
+
+    name = f"{prefix}_{uuid.uuid4().hex[:10]}"
+    with psycopg.connect(server_url, autocommit=True) as admin:
+        admin.execute(sql.SQL("CREATE DATABASE {}").format(sql.Identifier(name)))
+    try:
+        url = url_of(server_url, name)
+        if seeded:
+            from engine.migrate import migrate
+            from engine.seed import seed
+
+            with psycopg.connect(url) as conn:
+                migrate(conn)
+                seed(conn)
+                conn.commit()
+        yield url
+    finally:
+        with psycopg.connect(server_url, autocommit=True) as admin:
+            admin.execute(sql.SQL("DROP DATABASE IF EXISTS {} WITH (FORCE)").format(sql.Identifier(name)))
+
+
+def median(values) -> float:
+    return statistics.median(values)
+
+
+def verdict(ok: bool) -> str:
+    return "PASS" if ok else "MISS"

@@ -1,0 +1,378 @@
+"""Batch throughput: `instantiate_gears` (the library path behind `engine instantiate --gears`)
+over 10,000 gears stored in PostgreSQL, against a plain Jinja2 pipeline that reads the same
+gear rows, computes the same jobs with the same model, hob and cutting-data code, renders the
+same lines from bench/jinja/*.j2 and stores jobs and programs with the same COPY statements.
+Repetitions alternate; stored jobs/programs are truncated before each one.
+Targets: ours/Jinja2 >= 1 and ours >= 5,000 programs/s.
+
+    python bench/batch.py [--reps 3] [--count 10000] [--profile] [--database-url URL]
+
+Exit status 0 also when a target is missed (a benchmark reports, it does not fail); 1 when
+the Jinja2 templates do not produce our programs line for line (the comparison would be
+meaningless) or a pipeline fails.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import random
+import subprocess
+import sys
+import time
+from decimal import Decimal
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+
+from _common import add_database_argument, bench_database, median, verdict  # noqa: E402
+from engine.cutting_data import default_cutting_data  # noqa: E402
+from engine.hobs import choose_hob  # noqa: E402
+from engine.instantiate import Planner, _check_machine_fits, _check_table_speed  # noqa: E402
+from engine.nc_check import check_program  # noqa: E402
+
+FIRST_ID = 100_000
+TARGET_RATE = 5_000          # programs/s
+TARGET_RATIO = 1.0           # ours / Jinja2
+SAMPLE = 50                  # gears whose Jinja2 output is compared line by line before timing
+RANDOM_SEED = 20261122
+
+MATERIALS = ("45", "C45", "20CrMnTi", "40Cr")   # the rows of engine.cutting_data.CUTTING_SPEED
+# Seeded hobs (seed_templates/hobs.csv): module -> (hands, best accuracy class). Grade <= 7
+# needs an AA hob (engine.hobs.REQUIRED_CLASS_BY_GRADE): only m 2, 2.5, 3 have one.
+MODULES_BY_GRADE = {6: ("2", "2.5", "3"), 7: ("2", "2.5", "3"), 8: ("1.5", "2", "2.5", "3", "4")}
+LEFT_HAND_HOB_MODULES = {"2", "3"}               # A-class left-hand hobs (grade 8 only)
+
+GEAR_COLUMNS = ("id", "gear_class", "module", "teeth", "pressure_angle", "helix_angle", "hand", "face_width",
+                "tip_diameter", "root_diameter", "cone_angle", "crowning", "material", "hardness",
+                "quality_grade", "quantity")
+
+# Which template row emits each line of the standard code (seed_templates/classes/*.csv, same
+# ids in both classes) and the p_emit condition that decides it: the Jinja2 pipeline stores
+# row_ids like the decision table does (program.row_ids is NOT NULL).
+ROW_IDS = ((10, None), (20, None), (30, None), (40, None), (50, None), (60, None), (70, None), (80, None),
+           (90, None), (100, None), (110, None), (120, None), (130, None), (140, None), (150, None),
+           (160, "shift"), (170, None), (180, "coolant"),
+           (190, "cut1"), (200, "cut1"), (210, "cut1"), (220, "cut1"), (230, "cut1"),
+           (240, "cut2"), (250, "cut2"), (260, "cut2"), (270, "cut2"), (280, "cut2"),
+           (290, "coolant"), (300, None), (310, None), (320, None))
+
+# Same id allocation as engine.storage; the COPY statements are engine.storage's own.
+NEXT_IDS = "SELECT nextval(%s::regclass) FROM generate_series(1, %s)"
+
+
+# --- the data ------------------------------------------------------------------------------
+
+def generate_gears(first: int, count: int) -> list[tuple]:
+    """Plausible spur and helical gears the seeded hob library and hobber-840d can cut."""
+    from engine.gears import derived_diameters
+
+    rng = random.Random(RANDOM_SEED)
+    thousandth = Decimal("0.001")
+    rows = []
+    for index in range(count):
+        grade = rng.choice((6, 7, 8, 8))
+        module_text = rng.choice(MODULES_BY_GRADE[grade])
+        module = Decimal(module_text)
+        teeth = rng.randint(17, 80)
+        if index % 2:
+            gear_class, beta = "helical", Decimal(rng.choice((15, 20)))
+            hands = ("R", "L") if grade == 8 and module_text in LEFT_HAND_HOB_MODULES else ("R",)
+            hand = rng.choice(hands)
+        else:
+            gear_class, beta, hand = "spur", Decimal(0), None
+        tip, root = derived_diameters(module, teeth, beta)
+        rows.append((first + index, gear_class, module, teeth, Decimal(20), beta, hand, Decimal(rng.randint(10, 40)),
+                     tip.quantize(thousandth), root.quantize(thousandth), None, None, rng.choice(MATERIALS),
+                     Decimal(rng.randint(170, 280)), grade, rng.randint(1, 200)))
+    return rows
+
+
+def insert_gears(conn, rows: list[tuple]) -> None:
+    with conn.cursor().copy(f"COPY gear ({', '.join(GEAR_COLUMNS)}) FROM STDIN") as copy:
+        for row in rows:
+            copy.write_row(row)
+    conn.commit()
+
+
+def truncate(conn) -> None:
+    conn.execute("TRUNCATE program, job")
+    conn.commit()
+
+
+# --- our path ------------------------------------------------------------------------------
+
+def run_ours(conn, first: int, last: int) -> tuple[float, int]:
+    from engine.instantiate import instantiate_gears
+
+    start = time.perf_counter()
+    programs = instantiate_gears(conn, first, last)
+    conn.commit()
+    return time.perf_counter() - start, len(programs)
+
+
+# --- the plain Jinja2 pipeline -------------------------------------------------------------
+
+def jinja_environment():
+    import jinja2
+
+    environment = jinja2.Environment(loader=jinja2.FileSystemLoader(HERE / "jinja"), autoescape=False,
+                                     trim_blocks=True, lstrip_blocks=True, keep_trailing_newline=True,
+                                     undefined=jinja2.StrictUndefined, auto_reload=False)
+    environment.globals.update(sin=math.sin, radians=math.radians, pi=math.pi)
+    return environment
+
+
+class JinjaPipeline:
+    """Planner.plan with Jinja2 in place of the decision table, then the same COPY storage."""
+
+    def __init__(self, environment, check: bool = True):
+        self.environment = environment
+        self.check = check
+        self._row_ids: dict[tuple, list[int]] = {}
+
+    def row_ids(self, params: dict, module_params: dict) -> list[int]:
+        flags = {"shift": bool(params["shift_on"] and params["shift_y"] != 0), "coolant": bool(params["coolant"]),
+                 "cut1": bool(module_params["cutmotion:1"]["cut_on"]),
+                 "cut2": bool(module_params["cutmotion:2"]["cut_on"])}
+        key = tuple(flags.values())
+        found = self._row_ids.get(key)
+        if found is None:
+            found = self._row_ids[key] = [row for row, condition in ROW_IDS if condition is None or flags[condition]]
+        return found
+
+    def plan(self, planner, gear, templates: dict) -> tuple:
+        machine = planner.machine
+        _check_machine_fits(gear, machine)
+        hob = choose_hob(gear, planner.hobs).hob
+        cutting = default_cutting_data(gear.module, gear.material, bool(hob.coating), hob.tip_diameter,
+                                       machine.spindle_max).with_overrides(**planner.overrides)
+        job = planner.model(gear.gear_class).job(gear, gear.gear_class, hob, machine, cutting, planner.choices)
+        _check_table_speed(gear, hob.starts, cutting.hob_speed, machine)
+        jinja_template, version, template_hash = templates[gear.gear_class]
+        params, module_params = job.params, job.module_params
+        text = jinja_template.render({**params, "template_version": version, "module_params": module_params})
+        lines = text.splitlines()
+        name = str(params.get("program_name", f"JOB_{gear.id}"))
+        if self.check:
+            check_program(lines, machine, name)
+        return (gear.id, gear.gear_class, machine.name, hob.id, params, module_params, version, template_hash,
+                name, lines, self.row_ids(params, module_params))
+
+    def templates(self, conn) -> dict:
+        from engine.templates import load_template
+
+        found = {}
+        for gear_class in ("spur", "helical"):
+            template = load_template(conn, gear_class)   # version and hash, stored with each program
+            found[gear_class] = (self.environment.get_template(f"{gear_class}.j2"), template.version, template.hash)
+        return found
+
+    def run(self, conn, first: int, last: int) -> list[tuple]:
+        from engine.records import load_gears
+
+        planner = Planner(conn)
+        templates = self.templates(conn)
+        planned = [self.plan(planner, gear, templates) for gear in load_gears(conn, first, last)]
+        store(conn, planned)
+        return planned
+
+
+def store(conn, planned: list[tuple]) -> None:
+    """Stored the way engine.storage.store_many does: its COPY statements (and binary types, if any)."""
+    from psycopg.types.json import Jsonb
+
+    from engine import storage
+
+    with conn.transaction():
+        job_ids = [row[0] for row in conn.execute(NEXT_IDS, ("job_id_seq", len(planned)))]
+        program_ids = [row[0] for row in conn.execute(NEXT_IDS, ("program_id_seq", len(planned)))]
+        with conn.cursor().copy(storage.COPY_JOB) as copy:
+            if getattr(storage, "JOB_TYPES", None):
+                copy.set_types(storage.JOB_TYPES)
+            for job_id, item in zip(job_ids, planned):
+                gear_id, gear_class, machine, hob_id, params, module_params = item[:6]
+                copy.write_row((job_id, gear_id, gear_class, machine, hob_id, Jsonb(params), Jsonb(module_params)))
+        with conn.cursor().copy(storage.COPY_PROGRAM) as copy:
+            if getattr(storage, "PROGRAM_TYPES", None):
+                copy.set_types(storage.PROGRAM_TYPES)
+            for program_id, job_id, item in zip(program_ids, job_ids, planned):
+                copy.write_row((program_id, job_id, item[1], *item[6:]))
+
+
+def run_jinja(conn, pipeline: JinjaPipeline, first: int, last: int) -> tuple[float, int]:
+    start = time.perf_counter()
+    planned = pipeline.run(conn, first, last)
+    conn.commit()
+    return time.perf_counter() - start, len(planned)
+
+
+# --- checks, profile, CLI ------------------------------------------------------------------
+
+def same_programs(conn, pipeline: JinjaPipeline, gear_ids: list[int]) -> bool:
+    """Our program and the Jinja2 one, line for line and row id for row id."""
+    from engine.records import load_gear
+
+    planner = Planner(conn)
+    templates = pipeline.templates(conn)
+    for gear_id in gear_ids:
+        gear = load_gear(conn, gear_id)
+        ours = planner.plan(gear).result
+        theirs = pipeline.plan(planner, gear, templates)
+        lines, row_ids = theirs[9], theirs[10]
+        if ours.lines != lines or ours.row_ids != row_ids:
+            print(f"MISMATCH gear {gear_id} ({gear.gear_class}): the Jinja2 template does not produce our program; "
+                  "the throughput comparison would be meaningless.")
+            for number in range(max(len(ours.lines), len(lines))):
+                a = ours.lines[number] if number < len(ours.lines) else "<none>"
+                b = lines[number] if number < len(lines) else "<none>"
+                if a != b:
+                    print(f"  line {number + 1}: ours   {a!r}\n  line {number + 1}: jinja2 {b!r}")
+                    break
+            else:
+                print(f"  lines equal; row ids differ: ours {ours.row_ids} jinja2 {row_ids}")
+            conn.rollback()
+            return False
+    conn.rollback()
+    return True
+
+
+def sample_ids(rows: list[tuple]) -> list[int]:
+    """SAMPLE gears spread over the batch, both classes, plus one of each kind that is rare."""
+    step = max(2, 2 * len(rows) // SAMPLE)   # even indexes are spur gears, odd ones helical
+    chosen = {rows[index][0] for start in (0, 1) for index in range(start, len(rows), step)}
+    kinds = {(row[1], row[2], row[6]) for row in rows if row[0] in chosen}
+    for row in rows:   # and the first gear of every (class, module, hand) combination not yet in
+        if (row[1], row[2], row[6]) not in kinds:
+            kinds.add((row[1], row[2], row[6]))
+            chosen.add(row[0])
+    return sorted(chosen)
+
+
+def profile_ours(conn, first: int, last: int, top: int) -> None:
+    import cProfile
+    import pstats
+
+    from engine.records import load_gears
+    from engine.storage import store_many
+
+    truncate(conn)
+    start = time.perf_counter()
+    planner = Planner(conn)
+    gears = load_gears(conn, first, last)
+    loaded = time.perf_counter()
+    planned = [planner.plan(gear) for gear in gears]
+    computed = time.perf_counter()
+    store_many(conn, planned)
+    conn.commit()
+    stored = time.perf_counter()
+    count = len(planned)
+    print(f"\nphases of our path (one run, {count} gears): load {(loaded - start) * 1000:.0f} ms, "
+          f"plan {(computed - loaded) * 1000:.0f} ms ({(computed - loaded) / count * 1e6:.0f} µs/gear), "
+          f"store {(stored - computed) * 1000:.0f} ms ({(stored - computed) / count * 1e6:.0f} µs/gear)")
+
+    truncate(conn)
+    from engine.instantiate import instantiate_gears
+
+    profiler = cProfile.Profile()
+    profiler.enable()
+    instantiate_gears(conn, first, last)
+    conn.commit()
+    profiler.disable()
+    for order in ("cumulative", "tottime"):
+        print(f"\ncProfile of instantiate_gears ({count} gears), top {top} by {order}:")
+        pstats.Stats(profiler, stream=sys.stdout).strip_dirs().sort_stats(order).print_stats(top)
+
+
+def run_cli_once(url: str, first: int, last: int) -> tuple[float, int]:
+    from latency import engine_command
+
+    command = [engine_command(), "--database-url", url, "instantiate", "--gears", f"{first}-{last}", "--json"]
+    start = time.perf_counter()
+    completed = subprocess.run(command, capture_output=True, text=True)
+    seconds = time.perf_counter() - start
+    if completed.returncode != 0:
+        raise RuntimeError(f"engine CLI exited {completed.returncode}: {completed.stderr.strip()[:500]}")
+    return seconds, json.loads(completed.stdout)["programs"]
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    add_database_argument(parser)
+    parser.add_argument("--reps", type=int, default=3, help="alternated repetitions of each pipeline (default 3)")
+    parser.add_argument("--count", type=int, default=10_000, help="gears in the batch (default 10000)")
+    parser.add_argument("--no-cli", action="store_true", help="skip the one run through the `engine` CLI")
+    parser.add_argument("--profile", action="store_true",
+                        help="also time the phases of our path and print cProfile hotspots")
+    parser.add_argument("--top", type=int, default=25, help="rows of each cProfile listing (default 25)")
+    args = parser.parse_args(argv)
+
+    import psycopg
+
+    first, last = FIRST_ID, FIRST_ID + args.count - 1
+    pipeline = JinjaPipeline(jinja_environment())
+    unchecked = JinjaPipeline(pipeline.environment, check=False)
+    with bench_database(args.database_url, "bench_batch") as url, psycopg.connect(url) as conn:
+        rows = generate_gears(first, args.count)
+        insert_gears(conn, rows)
+        spur = sum(row[1] == "spur" for row in rows)
+        print(f"batch: {args.count} gears ({spur} spur, {args.count - spur} helical) ids {first}..{last}, "
+              f"{args.reps} alternated repetitions, interpreter {sys.executable}")
+
+        sample = sample_ids(rows)
+        if not same_programs(conn, pipeline, sample):
+            return 1
+        print(f"check: the Jinja2 pipeline renders our programs exactly for {len(sample)} sampled gears "
+              "(lines and row ids)")
+
+        runs = {"ours": run_ours, "jinja2": lambda c, a, b: run_jinja(c, pipeline, a, b),
+                "jinja2-nocheck": lambda c, a, b: run_jinja(c, unchecked, a, b)}
+        for run in runs.values():   # warm-up, untimed: caches, compiled templates, table files
+            truncate(conn)
+            run(conn, first, last)
+        stored = conn.execute("SELECT count(*) FROM program WHERE job_id IN (SELECT id FROM job)").fetchone()[0]
+        conn.rollback()
+        if stored != args.count:
+            print(f"error: expected {args.count} stored programs, found {stored}")
+            return 1
+
+        times = {name: [] for name in runs}
+        for repetition in range(args.reps):
+            order = list(runs) if repetition % 2 == 0 else list(reversed(runs))
+            for name in order:
+                truncate(conn)
+                seconds, count = runs[name](conn, first, last)
+                assert count == args.count, (name, count)
+                times[name].append(seconds)
+
+        cli = None
+        if not args.no_cli:
+            truncate(conn)
+            cli = run_cli_once(url, first, last)
+
+        if args.profile:
+            profile_ours(conn, first, last, args.top)
+
+    rate = {name: args.count / median(values) for name, values in times.items()}
+    best = {name: args.count / min(values) for name, values in times.items()}
+    print()
+    labels = {"ours": "ours: instantiate_gears + commit",
+              "jinja2": "jinja2: same plan, render, limit check, COPY",
+              "jinja2-nocheck": "jinja2 without the limit check (information)"}
+    for name, label in labels.items():
+        print(f"{label:45s}: median {rate[name]:6.0f} programs/s (best {best[name]:.0f}; "
+              f"{', '.join(f'{s:.2f}' for s in times[name])} s)")
+    if cli is not None:
+        seconds, count = cli
+        print(f"engine instantiate --gears {first}-{last} --json (CLI, once, with process start): "
+              f"{seconds:.2f} s = {count / seconds:.0f} programs/s")
+    ratio = rate["ours"] / rate["jinja2"]
+    print(f"ratio ours/jinja2 = {ratio:.2f} (target >= {TARGET_RATIO:g}): {verdict(ratio >= TARGET_RATIO)}")
+    print(f"ratio ours/jinja2-nocheck = {rate['ours'] / rate['jinja2-nocheck']:.2f} (information)")
+    print(f"ours {rate['ours']:.0f} programs/s (target >= {TARGET_RATE}): {verdict(rate['ours'] >= TARGET_RATE)}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
