@@ -96,14 +96,13 @@ def _report_program(program, as_json: bool) -> None:
                + (f" written to {program.path}" if program.path else ""), err=True)
 
 
-def _report_batch(programs, out, as_json: bool) -> None:
-    lines = sum(len(program.lines) for program in programs)
+def _report_batch(batch, out, as_json: bool) -> None:
     if as_json:
-        emit_json({"programs": len(programs), "lines": lines, "path": out,
-                   "program_ids": [programs[0].program_id, programs[-1].program_id]})
+        emit_json({"programs": batch.programs, "lines": batch.lines, "path": out,
+                   "program_ids": [batch.first_program_id, batch.last_program_id]})
     else:
-        click.echo(f"stored {len(programs)} program(s), {lines} lines"
-                   + (f", written to {out}" if out else ""))
+        click.echo(f"stored {batch.programs} program(s) {batch.first_program_id}…{batch.last_program_id}, "
+                   f"{batch.lines} lines" + (f", written to {out}" if out else ""))
 
 
 @main.group()

@@ -9,12 +9,15 @@ Any failure aborts the whole instantiation with an error naming class, row, colu
 """
 from __future__ import annotations
 
+import ast
 import time
+from functools import partial
 from dataclasses import dataclass, field
 
 from .errors import EngineError
-from .expressions import (MAX_SECONDS_PER_INSTANTIATION, Compiled, ExpressionError,
+from .expressions import (MAX_SECONDS_PER_INSTANTIATION, MAX_STRING_LENGTH, Compiled, ExpressionError,
                           compile_expression, compile_statements, evaluation_globals)
+from .nc_check import words
 from .templates import Template, TemplateRow
 
 MODULE_ORDER = ("main", "prep", "sync", "shift", "cutcond", "cutmotion")
@@ -41,7 +44,7 @@ class CompiledRow:
         return self.row.t, self.row.n
 
 
-@dataclass
+@dataclass(slots=True)
 class Result:
     """The result table of one instantiation: emitted lines and the row id of each."""
     lines: list[str] = field(default_factory=list)
@@ -54,59 +57,99 @@ def module_key(t: str, n: int) -> str:
 
 
 class CompiledTemplate:
-    """A template parsed and compiled once; `run` evaluates it for one job."""
+    """A template parsed, checked and compiled once; `run` evaluates it for one job."""
 
     def __init__(self, template: Template):
+        from .template_code import build
+
         self.template = template
         self.rows = tuple(_compile_row(template.gear_class, row) for row in template.rows)
         uses_sql = any(c.is_sql for r in self.rows for c in _expressions_of(r))
-        self.globals = evaluation_globals(uses_sql)
+        self.globals = {**evaluation_globals(uses_sql), "_text": _text, "_clock": time.perf_counter}
+        self.code, self.places = build(self.rows, template.gear_class)
+        # Lines a row always emits the same, parsed for the limit check once per template.
+        self.constant_words = {row.row.id: words(row.o.tree.value) for row in self.rows
+                               if row.o is not None and isinstance(row.o.tree, ast.Constant)
+                               and isinstance(row.o.tree.value, str)}
 
     def run(self, params: dict, module_params: dict | None = None,
             deadline_seconds: float = MAX_SECONDS_PER_INSTANTIATION) -> Result:
-        module_params = module_params or {}
-        deadline = time.perf_counter() + deadline_seconds
-        result, intermediates = Result(), {}
-        scope, current_module = None, None
-        for row in self.rows:
-            if row.module != current_module:
-                current_module = row.module
-                scope = {**params, **module_params.get(module_key(*current_module), {}), **intermediates}
-            if time.perf_counter() > deadline:
-                raise self._error(row, "o", f"instantiation exceeded {deadline_seconds} s")
-            self._run_row(row, scope, intermediates, result)
+        result = Result()
+        scope = dict(params)
+        scope["template_version"] = self.template.version
+        scope["_mp"] = module_params = module_params or {}
+        scope["_prev"] = False
+        scope["_i"] = intermediates = {}
+        scope["_enter"] = _module_switcher(scope, params, module_params, intermediates)
+        scope["_deadline"] = time.perf_counter() + deadline_seconds
+        scope["_timeout"] = partial(_timeout, deadline_seconds)
+        scope["_lines_append"], scope["_rows_append"] = result.lines.append, result.row_ids.append
+        try:
+            exec(self.code, self.globals, scope)
+        except TemplateError:
+            raise
+        except Exception as error:  # an expression's own failure, reported with its place
+            raise self._error_at(error) from None
         return result
 
-    def _run_row(self, row: CompiledRow, scope: dict, intermediates: dict, result: Result) -> None:
-        if row.s:
-            if row.p_calc is not None and not self._evaluate(row, "p_calc", row.p_calc, scope):
-                return  # paper step 4: compute condition false skips the whole row
-            for name, statement in row.s:
-                value = self._evaluate(row, "s", statement, scope)
-                scope[name] = intermediates[name] = value
-        if row.o is None:
-            return
-        text = self._evaluate(row, "o", row.o, scope)
-        if not isinstance(text, str):
-            raise self._error(row, "o", f"gives {type(text).__name__} {text!r}, not text "
-                                        "(write an f-string with a format, e.g. f\"X{x:.3f}\")")
-        if row.p_emit is None or self._evaluate(row, "p_emit", row.p_emit, scope):
-            result.lines.append(text)
-            result.row_ids.append(row.row.id)
-
-    def _evaluate(self, row: CompiledRow, column: str, compiled: Compiled, scope: dict):
-        try:
-            return eval(compiled.code, self.globals, scope)
-        except NameError as error:
-            name = getattr(error, "name", None) or str(error)
-            raise self._error(row, column, f"unknown parameter {name!r}", compiled.text) from None
-        except Exception as error:  # an expression's own failure, reported with its place
+    def _error_at(self, error: Exception) -> TemplateError:
+        place = self.places[_line_in_template(error.__traceback__, self.code.co_filename)]
+        if isinstance(error, NameError):
+            problem = f"unknown parameter {getattr(error, 'name', None) or error!r}"
+        elif isinstance(error, _NotText):
+            problem = str(error)
+        else:
             problem = f"{type(error).__name__}: {error}"
-            raise self._error(row, column, problem, compiled.text) from None
+        return TemplateError(self.template.gear_class, place.row_id, place.column, place.text, problem)
 
-    def _error(self, row: CompiledRow, column: str, problem: str, text: str | None = None):
-        text = text if text is not None else (getattr(row.row, column) or "")
-        return TemplateError(self.template.gear_class, row.row.id, column, text, problem)
+
+class _NotText(Exception):
+    pass
+
+
+def _text(value):
+    """`o` must give text (a bare number would print in whatever form Python chooses), of
+    bounded length."""
+    if type(value) is not str:
+        raise _NotText(f"gives {type(value).__name__} {value!r}, not text "
+                       "(write an f-string with a format, e.g. f\"X{x:.3f}\")")
+    if len(value) > MAX_STRING_LENGTH:
+        raise _NotText(f"gives a line longer than {MAX_STRING_LENGTH} characters")
+    return value
+
+
+def _line_in_template(traceback, filename: str) -> int:
+    line = 0
+    while traceback is not None:
+        if traceback.tb_frame.f_code.co_filename == filename:
+            line = traceback.tb_lineno
+        traceback = traceback.tb_next
+    return line
+
+
+def _timeout(budget: float):
+    raise TimeoutError(f"instantiation exceeded {budget} s")
+
+
+def _module_switcher(scope: dict, params: dict, module_params: dict, intermediates: dict):
+    """`_enter(key)`: module (T, N) parameters in, the previous module's out; intermediates stay."""
+    previous: list = []
+
+    def enter(key: str) -> None:
+        for name in previous:
+            if name not in intermediates:
+                if name in params:
+                    scope[name] = params[name]
+                else:
+                    scope.pop(name, None)
+        current = module_params.get(key)
+        previous[:] = current or ()
+        scope["_prev"] = bool(current)
+        if current:
+            for name, value in current.items():
+                if name not in intermediates:
+                    scope[name] = value
+    return enter
 
 
 def _compile_row(gear_class: str, row: TemplateRow) -> CompiledRow:

@@ -165,6 +165,7 @@ class Compiled:
     code: Any                  # code object, eval()-able
     names: frozenset[str]      # parameter/variable names it reads
     is_sql: bool = False
+    tree: Any = None           # the checked and guarded expression node (for whole-template code)
 
 
 class ExpressionError(EngineError):
@@ -185,7 +186,7 @@ def compile_expression(text: str) -> Compiled:
     if is_sql:
         tree = ast.Expression(body=ast.Call(ast.Name("_sql_truth", ast.Load()), [tree.body], []))
     ast.fix_missing_locations(tree)
-    return Compiled(text, compile(tree, "<template>", "eval"), names, is_sql)
+    return Compiled(text, compile(tree, "<template>", "eval"), names, is_sql, tree.body)
 
 
 def compile_statements(text: str) -> list[tuple[str, Compiled]]:

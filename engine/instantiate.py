@@ -5,6 +5,8 @@ table → machine-limit check → job and program stored in one transaction → 
 """
 from __future__ import annotations
 
+import contextlib
+import gc
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -23,7 +25,7 @@ from .templates import Template, load_template
 DEFAULT_HOBBING_MACHINE = "hobber-840d"
 
 
-@dataclass(frozen=True)
+@dataclass(slots=True)
 class Planned:
     """A job computed in memory, with its program, not yet stored."""
     gear_id: int | None
@@ -101,9 +103,10 @@ class Planner:
 
 def run_template(template: Template, params: dict, module_params: dict, machine: Machine) -> Result:
     """Evaluate the decision table and check the program against the machine."""
-    scope = {**params, "template_version": template.version}
-    result = compiled_template(template).run(scope, module_params)
-    check_program(result.lines, machine, str(params.get("program_name", "program")))
+    compiled = compiled_template(template)
+    result = compiled.run(params, module_params)
+    check_program(result.lines, machine, str(params.get("program_name", "program")), result.row_ids,
+                  compiled.constant_words)
     return result
 
 
@@ -146,25 +149,42 @@ def instantiate_job(conn, job_id: int, out: str | Path | None = None) -> Program
 
 def instantiate_gears(conn, first: int | None = None, last: int | None = None, *,
                       machine: str | None = None, choices: Choices = Choices(), overrides=None,
-                      out: str | Path | None = None, progress=None) -> list[Program]:
+                      out: str | Path | None = None, progress=None):
     """All gears with first ≤ id ≤ last: all programs stored, or none (the first failure names its gear)."""
     planner = Planner(conn, machine, choices, overrides)
     gears = load_gears(conn, first, last)
     if not gears:
         raise EngineError(f"no gears with ids in {first or 'the start'}…{last or 'the end'}")
-    planned = []
-    for gear in gears:
-        try:
-            planned.append(planner.plan(gear))
-        except EngineError as error:
-            message = str(error)
-            prefix = "" if message.startswith(f"gear {gear.id}") else f"gear {gear.id}: "
-            raise type(error)(f"{prefix}{message} (batch stopped, nothing stored)") from None
-        if progress:
-            progress(1)
     from .storage import store_many
 
-    return store_many(conn, planned, out)
+    with _no_cycle_collection():
+        planned = [_plan_in_batch(planner, gear, progress) for gear in gears]
+        return store_many(conn, planned, out)
+
+
+def _plan_in_batch(planner: Planner, gear: Gear, progress) -> Planned:
+    try:
+        planned = planner.plan(gear)
+    except EngineError as error:
+        message = str(error)
+        prefix = "" if message.startswith(f"gear {gear.id}") else f"gear {gear.id}: "
+        raise type(error)(f"{prefix}{message} (batch stopped, nothing stored)") from None
+    if progress:
+        progress(1)
+    return planned
+
+
+@contextlib.contextmanager
+def _no_cycle_collection():
+    """A batch allocates many objects and keeps them all until they are stored, which makes
+    Python's cycle collector rescan them again and again; they form no cycles."""
+    was_enabled = gc.isenabled()
+    gc.disable()
+    try:
+        yield
+    finally:
+        if was_enabled:
+            gc.enable()
 
 
 def _store_and_write(conn, planned: list[Planned], out, existing_job: int | None = None) -> list[Program]:

@@ -25,12 +25,21 @@ class _State:
     limits_on: bool = False
 
 
-def check_program(lines: list[str], machine: Machine, program_name: str = "program") -> None:
+def check_program(lines: list[str], machine: Machine, program_name: str = "program",
+                  row_ids: list[int] | None = None, known_words: dict | None = None) -> None:
+    """`known_words`: words of lines a template always emits the same (by row id), parsed once
+    per template instead of once per program."""
     state = _State()
     for number, line in enumerate(lines, start=1):
-        problem = _check_line(line, machine, state)
+        words = known_words.get(row_ids[number - 1]) if known_words else None
+        problem = _check_line(line, _words(line) if words is None else words, machine, state)
         if problem:
             raise LimitError(f"{program_name} line {number} {line.strip()!r}: {problem}; nothing stored")
+
+
+def words(line: str) -> list[tuple[str, float]]:
+    """The address words of a block that the check reads: (letter, value) for X, Y, Z, S, G."""
+    return _words(line)
 
 
 def _words(line: str) -> list[tuple[str, float]]:
@@ -44,8 +53,7 @@ def _words(line: str) -> list[tuple[str, float]]:
     return [(letter, float(value)) for letter, value in _WORD.findall(code)]
 
 
-def _check_line(line: str, machine: Machine, state: _State) -> str | None:
-    words = _words(line)
+def _check_line(line: str, words: list, machine: Machine, state: _State) -> str | None:
     if not words:
         if "WALIMON" in line.upper():
             state.limits_on = True

@@ -1,6 +1,8 @@
 """Storing jobs and programs: one at a time, or a batch through COPY."""
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 from psycopg.types.json import Jsonb
 
 INSERT_JOB = """
@@ -26,7 +28,7 @@ def store_one(conn, planned, existing_job: int | None, path: str | None):
     return _program(program_id, job_id, planned, path)
 
 
-def store_many(conn, planned: list, out=None) -> list:
+def store_many(conn, planned: list, out=None) -> "Batch":
     """All jobs and programs in one transaction, through COPY (the batch path)."""
     from .outputs import write_program_files
 
@@ -41,7 +43,22 @@ def store_many(conn, planned: list, out=None) -> list:
             copy.set_types(PROGRAM_TYPES)
             for program_id, job_id, item in zip(program_ids, job_ids, planned):
                 copy.write_row((program_id, *_program_values(job_id, item)))
-    return [_program(p, j, item, paths.get(item.name)) for p, j, item in zip(program_ids, job_ids, planned)]
+    return Batch(len(planned), sum(len(item.result.lines) for item in planned),
+                 min(program_ids), max(program_ids), out)
+
+
+@dataclass(frozen=True)
+class Batch:
+    """What a batch stored: how many programs and lines, the lowest and highest program id
+    (other sessions may draw ids in between), and where files went."""
+    programs: int
+    lines: int
+    first_program_id: int
+    last_program_id: int
+    path: str | None
+
+    def __len__(self) -> int:
+        return self.programs
 
 
 def _next_ids(conn, sequence: str, count: int) -> list[int]:
