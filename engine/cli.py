@@ -5,7 +5,6 @@ Exit codes: 0 ok, 1 a handled error (one line on stderr), 2 unexpected (--traceb
 from __future__ import annotations
 
 import json
-import sys
 from contextlib import contextmanager
 
 import click

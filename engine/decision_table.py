@@ -51,11 +51,6 @@ class Result:
     row_ids: list[int] = field(default_factory=list)
 
 
-def module_key(t: str, n: int) -> str:
-    """How module parameters are keyed in a job: 'cutmotion:1'."""
-    return f"{t}:{n}"
-
-
 class CompiledTemplate:
     """A template parsed, checked and compiled once; `run` evaluates it for one job."""
 

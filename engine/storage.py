@@ -18,8 +18,6 @@ PROGRAM_TYPES = ("int8", "int8", "text", "int4", "text", "text", "text[]", "int4
 
 
 def store_one(conn, planned, existing_job: int | None, path: str | None):
-    from .instantiate import Program
-
     job_id = existing_job
     if job_id is None:
         job_id = conn.execute(INSERT_JOB, (planned.gear_id, planned.gear_class, planned.machine, planned.hob_id,
@@ -32,7 +30,7 @@ def store_many(conn, planned: list, out=None) -> "Batch":
     """All jobs and programs in one transaction, through COPY (the batch path)."""
     from .outputs import write_program_files
 
-    with write_program_files(planned, out) as paths, conn.transaction():
+    with write_program_files(planned, out), conn.transaction():
         job_ids = _next_ids(conn, "job_id_seq", len(planned))
         program_ids = _next_ids(conn, "program_id_seq", len(planned))
         with conn.cursor().copy(COPY_JOB) as copy:
