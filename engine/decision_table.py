@@ -58,7 +58,7 @@ class CompiledTemplate:
         from .template_code import build
 
         self.template = template
-        self.rows = tuple(_compile_row(template.gear_class, row) for row in template.rows)
+        self.rows = tuple(compile_row(template.gear_class, row) for row in template.rows)
         uses_sql = any(c.is_sql for r in self.rows for c in _expressions_of(r))
         self.globals = {**evaluation_globals(uses_sql), "_text": _text, "_clock": time.perf_counter}
         self.code, self.places = build(self.rows, template.gear_class)
@@ -147,7 +147,7 @@ def _module_switcher(scope: dict, params: dict, module_params: dict, intermediat
     return enter
 
 
-def _compile_row(gear_class: str, row: TemplateRow) -> CompiledRow:
+def compile_row(gear_class: str, row: TemplateRow) -> CompiledRow:
     def compiled(column: str, compile_function):
         text = getattr(row, column)
         if text is None:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from .decision_table import MODULE_ORDER, TemplateError, _compile_row
+from .decision_table import MODULE_ORDER, TemplateError, compile_row
 from .errors import EngineError
 from .templates import TemplateRow, load_template
 
@@ -35,7 +35,7 @@ def structural_problems(gear_class: str, rows: list[TemplateRow]) -> list[LintPr
                      for column, message in _row_structure(row)]
         if row.t in MODULE_ORDER and row.id >= 0:
             try:
-                _compile_row(gear_class, row)
+                compile_row(gear_class, row)
             except TemplateError as error:
                 problems.append(LintProblem(gear_class, row.id, error.column, str(error).split(": ", 1)[1]))
     return problems
@@ -70,7 +70,7 @@ def lint_class(conn, gear_class: str) -> list[LintProblem]:
 def _unknown_names(gear_class: str, rows, model):
     assigned: set[str] = set()
     for row in rows:
-        compiled = _compile_row(gear_class, row)
+        compiled = compile_row(gear_class, row)
         known = model.parameter_names(row.t, row.n) | assigned
         for column, expression in _in_evaluation_order(compiled):
             for name in sorted(expression.names - known):
