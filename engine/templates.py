@@ -47,19 +47,20 @@ def rows_hash(rows) -> str:
     return hashlib.sha256(payload.encode()).hexdigest()[:16]
 
 
+# A class's rows: its own and those it inherits from its ancestors (nearest wins by id).
 LOAD_ROWS = """
-SELECT a.id, c.t, a.n, c.p_calc, c.s, c.o, c.p_emit
-FROM assembly a JOIN component c ON c.id = a.component_id
-WHERE a.gear_class = %s ORDER BY a.id"""
+SELECT r.id, c.t, r.n, c.p_calc, c.s, c.o, c.p_emit
+FROM class_template(%s) r JOIN component c ON c.id = r.component_id
+ORDER BY r.id"""
 
 # One statement, so version and rows come from one snapshot even while an editor or the
 # nightly refactor commits.
 LOAD_TEMPLATE = """
-SELECT g.template_version, a.id, c.t, a.n, c.p_calc, c.s, c.o, c.p_emit
+SELECT g.template_version, r.id, c.t, r.n, c.p_calc, c.s, c.o, c.p_emit
 FROM gear_class g
-LEFT JOIN assembly a ON a.gear_class = g.name
-LEFT JOIN component c ON c.id = a.component_id
-WHERE g.name = %s ORDER BY a.id"""
+LEFT JOIN LATERAL class_template(g.name) r ON true
+LEFT JOIN component c ON c.id = r.component_id
+WHERE g.name = %s ORDER BY r.id"""
 
 
 def load_template(conn, gear_class: str) -> Template:
@@ -76,8 +77,8 @@ def load_template(conn, gear_class: str) -> Template:
 def list_classes(conn) -> list[tuple]:
     """(name, parent, template_version, row count, description) of every class."""
     return conn.execute("""
-        SELECT g.name, g.parent, g.template_version, count(a.id)::int, g.description
-        FROM gear_class g LEFT JOIN assembly a ON a.gear_class = g.name
+        SELECT g.name, g.parent, g.template_version, count(r.id)::int, g.description
+        FROM gear_class g LEFT JOIN LATERAL class_template(g.name) r ON true
         GROUP BY g.name ORDER BY g.name""").fetchall()
 
 
@@ -97,25 +98,59 @@ def _class_exists(conn, name: str) -> bool:
 
 def replace_template(conn, gear_class: str, rows: list[TemplateRow]) -> bool:
     """Make `rows` the class's template, reusing identical component bodies.
-    Returns True if anything changed (the class's version is then bumped)."""
+
+    A derived class (one whose ancestors have rows) stores only the rows that differ from
+    what it inherits; inherited rows the file leaves out stay inherited. Returns True if
+    anything changed; the class's version and its descendants' versions are then bumped."""
     from .lint import check_rows
 
-    check_rows(gear_class, rows)
     with conn.transaction():
         conn.execute("SELECT 1 FROM gear_class WHERE name = %s FOR UPDATE", (gear_class,))
-        current = tuple(TemplateRow(*row) for row in conn.execute(LOAD_ROWS, (gear_class,)))
-        if current == tuple(rows):
+        inherited = {row.id: row for row in inherited_rows(conn, gear_class)}
+        own = [row for row in rows if inherited.get(row.id) != row]
+        check_rows(gear_class, merge_rows(inherited.values(), own))
+        current = tuple(TemplateRow(*row) for row in conn.execute(OWN_ROWS, (gear_class,)))
+        if current == tuple(own):
             return False
         old_components = [r[0] for r in conn.execute(
             "DELETE FROM assembly WHERE gear_class = %s RETURNING component_id", (gear_class,))]
-        for row in rows:
+        for row in own:
             component_id = _component_for(conn, row)
             conn.execute("INSERT INTO assembly (gear_class, id, n, component_id) VALUES (%s, %s, %s, %s)",
                          (gear_class, row.id, row.n, component_id))
         _delete_orphans(conn, old_components)
-        conn.execute("UPDATE gear_class SET template_version = template_version + 1 WHERE name = %s",
-                     (gear_class,))
+        conn.execute(BUMP_VERSIONS, (gear_class,))
     return True
+
+
+OWN_ROWS = """
+SELECT a.id, c.t, a.n, c.p_calc, c.s, c.o, c.p_emit
+FROM assembly a JOIN component c ON c.id = a.component_id
+WHERE a.gear_class = %s ORDER BY a.id"""
+
+# The class and every class below it: their assembled templates change together.
+BUMP_VERSIONS = """
+WITH RECURSIVE below(name, depth) AS (
+    SELECT name, 0 FROM gear_class WHERE name = %s
+    UNION ALL
+    SELECT g.name, b.depth + 1 FROM gear_class g JOIN below b ON g.parent = b.name WHERE b.depth < 50)
+UPDATE gear_class SET template_version = template_version + 1
+WHERE name IN (SELECT name FROM below)"""
+
+
+def inherited_rows(conn, gear_class: str) -> list[TemplateRow]:
+    """The rows the class would have with no rows of its own: its parent's assembled template."""
+    parent = conn.execute("SELECT parent FROM gear_class WHERE name = %s", (gear_class,)).fetchone()
+    if parent is None or parent[0] is None:
+        return []
+    return [TemplateRow(*row) for row in conn.execute(LOAD_ROWS, (parent[0],))]
+
+
+def merge_rows(inherited, own) -> list[TemplateRow]:
+    """Own rows override inherited rows with the same id; the result in id order."""
+    merged = {row.id: row for row in inherited}
+    merged.update((row.id, row) for row in own)
+    return [merged[row_id] for row_id in sorted(merged)]
 
 
 FIND_COMPONENT = """

@@ -57,14 +57,36 @@ CREATE TABLE assembly (
 CREATE INDEX assembly_component ON assembly (component_id);
 
 -- Every class's assembled template as the paper's table (design notes §10).
+-- A class inherits its parent's assembled rows and adds (or overrides, by row id) only
+-- what differs: a duplex class derives from its unit class. Inner nodes of the
+-- group-technology tree have no rows, so for them this changes nothing.
+CREATE FUNCTION class_template(class_name text)
+RETURNS TABLE (id integer, n integer, component_id bigint, owner text)
+LANGUAGE sql STABLE
+AS $$
+    WITH RECURSIVE lineage(name, parent, depth) AS (
+        SELECT g.name, g.parent, 0 FROM gear_class g WHERE g.name = class_name
+        UNION ALL
+        SELECT g.name, g.parent, l.depth + 1
+        FROM gear_class g JOIN lineage l ON g.name = l.parent
+        WHERE l.depth < 50)
+    SELECT DISTINCT ON (a.id) a.id, a.n, a.component_id, a.gear_class
+    FROM lineage l JOIN assembly a ON a.gear_class = l.name
+    ORDER BY a.id, l.depth
+$$;
+
 CREATE VIEW template_view AS
-WITH body_use AS (
+WITH assembled AS (
+    SELECT g.name AS gear_class, r.id, r.n, r.component_id, r.owner
+    FROM gear_class g CROSS JOIN LATERAL class_template(g.name) r),
+body_use AS (
     SELECT component_body_key(c.t, c.o, c.p_calc, c.s, c.p_emit) AS body,
            count(DISTINCT a.gear_class)::integer AS classes
-    FROM assembly a JOIN component c ON c.id = a.component_id
+    FROM assembled a JOIN component c ON c.id = a.component_id
     GROUP BY 1)
-SELECT a.gear_class, a.id, c.t, a.n, c.p_calc, c.s, c.o, c.p_emit, u.classes AS shared_by
-FROM assembly a
+SELECT a.gear_class, a.id, c.t, a.n, c.p_calc, c.s, c.o, c.p_emit, u.classes AS shared_by,
+       a.owner AS inherited_from
+FROM assembled a
 JOIN component c ON c.id = a.component_id
 JOIN body_use u ON u.body = component_body_key(c.t, c.o, c.p_calc, c.s, c.p_emit);
 
@@ -96,7 +118,9 @@ CREATE TABLE hob (
     hand           text NOT NULL CHECK (hand IN ('L', 'R')),
     accuracy_class text NOT NULL,
     material       text NOT NULL DEFAULT 'HSS',
-    coating        text NOT NULL DEFAULT ''
+    coating        text NOT NULL DEFAULT '',
+    -- A worm-wheel hob is made for its worm; it never cuts cylindrical gears, nor the reverse.
+    purpose        text NOT NULL DEFAULT 'cylindrical' CHECK (purpose IN ('cylindrical', 'worm_wheel'))
 );
 
 -- Workpieces (design notes §9 columns).
@@ -117,7 +141,9 @@ CREATE TABLE gear (
     hardness       numeric,
     quality_grade  integer CHECK (quality_grade BETWEEN 1 AND 12),
     quantity       integer CHECK (quantity > 0),
-    CHECK (helix_angle = 0 OR hand IS NOT NULL)
+    CHECK (helix_angle = 0 OR hand IS NOT NULL),
+    CONSTRAINT gear_cone_angle CHECK (cone_angle > -45 AND cone_angle < 45),
+    CONSTRAINT gear_crowning CHECK (crowning >= 0 AND crowning < 1)
 );
 
 -- A job: one workpiece on one machine with every parameter its template needs, as computed
@@ -131,7 +157,10 @@ CREATE TABLE job (
     hob_id        text REFERENCES hob (id),
     params        jsonb NOT NULL CHECK (jsonb_typeof(params) = 'object'),
     module_params jsonb NOT NULL DEFAULT '{}' CHECK (jsonb_typeof(module_params) = 'object'),
-    created_at    timestamptz NOT NULL DEFAULT now()
+    created_at    timestamptz NOT NULL DEFAULT now(),
+    -- the cutting data chosen for the job and where they came from; confirmed jobs become cases
+    cutting       jsonb NOT NULL DEFAULT '{}' CHECK (jsonb_typeof(cutting) = 'object'),
+    confirmed_at  timestamptz
 );
 CREATE INDEX job_gear ON job (gear_id);
 
@@ -157,3 +186,37 @@ SELECT p.id AS program_id, l.line_no::integer AS line_no, p.row_ids[l.line_no] A
        l.text
 FROM program p,
      unnest(p.lines) WITH ORDINALITY AS l (text, line_no);
+
+-- Further toothed units of a multi-unit (duplex) gear; unit 1 is the gear row itself.
+-- One hob cuts all units, so module and pressure angle are the gear's.
+CREATE TABLE gear_unit (
+    gear_id       integer NOT NULL REFERENCES gear (id) ON DELETE CASCADE,
+    unit          integer NOT NULL CHECK (unit >= 2),
+    teeth         integer NOT NULL CHECK (teeth > 0),
+    face_width    numeric NOT NULL CHECK (face_width > 0),
+    tip_diameter  numeric CHECK (tip_diameter > 0),
+    root_diameter numeric CHECK (root_diameter > 0),
+    z_top         numeric NOT NULL CHECK (z_top < 0),   -- Z of the unit's upper face, mm
+    PRIMARY KEY (gear_id, unit)
+);
+
+-- The machining history: one case per cut of a proven job (paper §4).
+CREATE TABLE cutting_case (
+    id               bigserial PRIMARY KEY,
+    module           numeric NOT NULL CHECK (module > 0),
+    teeth            integer NOT NULL CHECK (teeth > 0),
+    material         text NOT NULL,
+    hardness         numeric,                                  -- HB
+    quality_grade    integer CHECK (quality_grade BETWEEN 1 AND 12),
+    hob_material     text NOT NULL,
+    hob_coating      text NOT NULL DEFAULT '',
+    hob_starts       integer NOT NULL CHECK (hob_starts > 0),
+    hob_tip_diameter numeric NOT NULL CHECK (hob_tip_diameter > 0),
+    cut              text NOT NULL CHECK (cut IN ('rough', 'finish')),
+    hob_speed        numeric NOT NULL CHECK (hob_speed > 0),   -- r/min
+    axial_feed       numeric NOT NULL CHECK (axial_feed > 0),  -- mm/min
+    radial_feed      numeric NOT NULL CHECK (radial_feed > 0), -- mm/min
+    source           text NOT NULL DEFAULT '',
+    job_id           bigint REFERENCES job (id) ON DELETE SET NULL,
+    created_at       timestamptz NOT NULL DEFAULT now()
+);
