@@ -83,7 +83,7 @@ from sqlglot import exp
 from sqlglot.errors import ParseError, SqlglotError, TokenError
 from sqlglot.tokens import TokenType
 
-from .errors import EngineError
+from ..errors import EngineError
 
 __all__ = ["SQL_RUNTIME", "translate"]
 
