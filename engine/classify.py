@@ -1,9 +1,12 @@
 """Group-technology classification of a gear that names no class (design notes §6).
 
-The decision is a tuple of rules asked in order; the first rule answered "yes" names the
+The tree is walked as a tuple of rules asked in order — face-width variation first (cone,
+crowning), then the generating line (helix) —; the first rule answered "yes" names the
 leaf class, and a gear that answers "no" to all of them is `DEFAULT_CLASS`. Adding a rule
-is adding a row to `RULES`, not another branch. Classes that geometry alone does not tell
-apart (worm_wheel, duplex) are not classified: the gear CSV names them explicitly.
+is adding a row to `RULES`, not another branch. Features no class combines (`CONFLICTS`)
+are refused with the reason. Classes that the gear columns alone do not tell apart
+(worm_wheel: the tooth profile comes from the worm; duplex: further units are imported
+after the gear) are not classified: the gear CSV names them explicitly.
 """
 from __future__ import annotations
 
@@ -32,17 +35,25 @@ RULES: tuple[Rule, ...] = (
 )
 
 
+# (fields both given and not 0, why no class fits them together)
+CONFLICTS: tuple[tuple[tuple[str, str], str], ...] = (
+    (("cone_angle", "crowning"), "no class hobs a crowned taper gear (cone angle and crowning both given)"),
+)
+
+
 @dataclass(frozen=True)
 class Classification:
-    """The leaf class a gear falls in, and the questions and answers that led there."""
+    """The leaf class a gear falls in (None: no class fits, see `problem`), and the
+    questions and answers that led there."""
 
-    gear_class: str
+    gear_class: str | None
     path: list[tuple[str, str]] = field(default_factory=list)
+    problem: str | None = None
 
     def explain(self) -> str:
         """One line: `question? no → question? yes → helical`."""
         steps = [f"{question} {answer}" for question, answer in self.path]
-        return " → ".join(steps + [self.gear_class])
+        return " → ".join(steps + [self.gear_class or f"no class: {self.problem}"])
 
 
 def given_number(gear: Mapping[str, Any], name: str) -> float | None:
@@ -66,6 +77,11 @@ def classify(gear: Mapping[str, Any]) -> Classification:
     Each step of `.path` is (question, answer); an answer starts with "yes" or "no" and
     names the value it looked at."""
     path: list[tuple[str, str]] = []
+    for (first, second), reason in CONFLICTS:
+        values = (given_number(gear, first), given_number(gear, second))
+        if all(values):
+            path.append((f"are {first} and {second} both given?", f"yes ({values[0]:g}, {values[1]:g})"))
+            return Classification(None, path, reason)
     for rule in RULES:
         answer = _answer(rule, gear)
         path.append((rule.question, answer))
@@ -84,7 +100,9 @@ def not_installed_message(gear_id: Any, gear_class: str) -> str:
 def classify_installed(gear: Mapping[str, Any], installed: Collection[str]) -> Classification:
     """`classify(gear)`, raising EngineError when the class found is not in `installed`."""
     classification = classify(gear)
+    gear_id = gear.get("gear_id", gear.get("id", "?"))
+    if classification.gear_class is None:
+        raise EngineError(f"gear {gear_id}: {classification.problem}; give gear_class explicitly")
     if classification.gear_class not in installed:
-        gear_id = gear.get("gear_id", gear.get("id", "?"))
         raise EngineError(not_installed_message(gear_id, classification.gear_class))
     return classification

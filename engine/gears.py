@@ -112,8 +112,8 @@ COLUMNS: tuple[Column, ...] = (
     Column("face_width", parse_number, required=True, **POSITIVE),
     Column("tip_diameter", parse_number, **POSITIVE),
     Column("root_diameter", parse_number, **POSITIVE),
-    Column("cone_angle", parse_number, check=lambda v: -90 < v < 90, rule="is outside (-90, 90)"),
-    Column("crowning", parse_number, check=lambda v: v >= 0, rule="must not be negative"),
+    Column("cone_angle", parse_number, check=lambda v: -45 < v < 45, rule="is outside (-45, 45)"),
+    Column("crowning", parse_number, check=lambda v: 0 <= v < 1, rule="is outside [0, 1) mm"),
     Column("material", parse_text),
     Column("hardness", parse_number, **POSITIVE),
     Column("quality_grade", parse_whole, check=lambda v: 1 <= v <= 12, rule="is outside 1..12"),
@@ -235,7 +235,7 @@ def _parse_row(names: list[str], cells: list[str]) -> tuple[dict[str, Any], list
 
 
 # --- cross-column checks and completion of a parsed gear ---------------------------------
-# Each step gets the gear and the installed classes {name: is_leaf}, may
+# Each step gets the gear and the installed classes {name: has a template}, may
 # fill in what was not given, and returns a problem or None.
 
 def _apply_defaults(gear: dict[str, Any], classes: dict[str, bool]) -> str | None:
@@ -246,25 +246,29 @@ def _apply_defaults(gear: dict[str, Any], classes: dict[str, bool]) -> str | Non
 
 
 def _leaf_list(classes: dict[str, bool]) -> str:
-    return ", ".join(sorted(name for name, is_leaf in classes.items() if is_leaf))
+    return ", ".join(sorted(name for name, has_template in classes.items() if has_template))
 
 
 def _check_given_class(gear: dict[str, Any], classes: dict[str, bool]) -> str | None:
-    """A class named in the file must be an installed leaf."""
+    """A class named in the file must be installed and have template rows (own or inherited);
+    inner nodes of the tree have none."""
     given = gear["gear_class"]
     if given is None or classes.get(given):
         return None
     if given not in classes:
         return f"gear class '{given}' does not exist; known leaf classes: {_leaf_list(classes)}"
-    return (f"gear class '{given}' is not a leaf class (it has sub-classes); "
-            f"known leaf classes: {_leaf_list(classes)}")
+    return (f"gear class '{given}' is not a leaf class (an inner node of the tree, without template "
+            f"rows); known leaf classes: {_leaf_list(classes)}")
 
 
 def _classify(gear: dict[str, Any], classes: dict[str, bool]) -> str | None:
     """A gear without a class gets the one `classify` finds, which must be installed."""
     if gear["gear_class"] is not None:
         return None
-    found = classify(gear).gear_class
+    classification = classify(gear)
+    if classification.gear_class is None:
+        return f"{classification.problem}; give gear_class explicitly"
+    found = classification.gear_class
     gear["gear_class"] = found
     return None if classes.get(found) else not_installed_message(gear["gear_id"], found)
 
@@ -331,7 +335,7 @@ def _raise_problems(path: Path, problems: list[tuple[int, str]]) -> None:
 def read_gears(path: str | Path, classes: dict[str, bool]) -> list[dict[str, Any]]:
     """Every gear of the CSV file at `path`, checked and completed (defaults, class,
     diameters), keyed by column name. `classes` maps each installed gear class to whether
-    it is a leaf. Raises GearImportError listing every problem, or EngineError."""
+    it has template rows (a class gears can be in). Raises GearImportError listing every problem, or EngineError."""
     path = Path(path)
     records = _read_records(path)
     if len(records) < 2:
@@ -351,11 +355,11 @@ def read_gears(path: str | Path, classes: dict[str, bool]) -> list[dict[str, Any
 # --- storing -----------------------------------------------------------------------------
 
 def installed_classes(conn: psycopg.Connection) -> dict[str, bool]:
-    """{gear class name: whether it is a leaf of the class tree}."""
+    """{gear class name: whether it has template rows, its own or inherited}: the classes a
+    gear can be in (leaves, and unit classes that others derive from, like spur)."""
     rows = conn.execute(
-        "SELECT g.name, NOT EXISTS (SELECT 1 FROM gear_class c WHERE c.parent = g.name) "
-        "FROM gear_class g").fetchall()
-    return {name: is_leaf for name, is_leaf in rows}
+        "SELECT g.name, EXISTS (SELECT 1 FROM class_template(g.name)) FROM gear_class g").fetchall()
+    return {name: has_template for name, has_template in rows}
 
 
 _COLUMN_LIST = sql.SQL(", ").join(sql.Identifier(column.column) for column in COLUMNS)

@@ -90,10 +90,12 @@ class Planner:
         if gear.gear_class is None:
             raise EngineError(f"gear {gear.id} has no gear class; re-import it to classify it")
         _check_machine_fits(gear, self.machine)
-        hob = choose_hob(gear, self.hobs).hob
+        model = self.model(gear.gear_class)
+        hob = choose_hob(gear, self.hobs, purpose=model.hob_purpose,
+                         shift_travel=model.shift_travel(self.choices)).hob
         cutting = default_cutting_data(gear.module, gear.material, bool(hob.coating), hob.tip_diameter,
                                        self.machine.spindle_max).with_overrides(**self.overrides)
-        job = self.model(gear.gear_class).job(gear, gear.gear_class, hob, self.machine, cutting, self.choices)
+        job = model.job(gear, gear.gear_class, hob, self.machine, cutting, self.choices)
         _check_table_speed(gear, hob.starts, cutting.hob_speed, self.machine)
         template = self.template(gear.gear_class)
         result = run_template(template, job.params, job.module_params, self.machine)

@@ -1,10 +1,20 @@
 """Which hobbing model serves which gear class: the nearest ancestor that has one."""
 from __future__ import annotations
 
+from .hobbing.crowned import CrownedModel
 from .hobbing.cylindrical import CylindricalModel
+from .hobbing.duplex import DuplexModel
+from .hobbing.taper import TaperModel
+from .hobbing.worm_wheel import WormWheelModel
 
+# The hobbing model of a node of the group-technology tree serves it and every class below
+# it that has no model of its own.
 MODELS = {
     "cylindrical": CylindricalModel(),
+    "duplex": DuplexModel(),
+    "taper": TaperModel(),
+    "crowned": CrownedModel(),
+    "worm_wheel": WormWheelModel(),
 }
 
 CLASS_ANCESTRY = """

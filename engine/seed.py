@@ -39,6 +39,7 @@ def seed(conn, directory: Path = SEED_DIR) -> SeedReport:
             report.count(table + "s", _insert_missing(conn, table, key, _read(directory / file_name)))
         _seed_templates(conn, directory, report)
         _seed_gears(conn, directory, report)
+        _seed_units(conn, directory, report)
     return report
 
 
@@ -65,7 +66,12 @@ def _insert_missing(conn, table: str, key: str, rows: list[dict]) -> int:
 
 
 def _seed_templates(conn, directory: Path, report: SeedReport) -> None:
-    for path in sorted((directory / "classes").glob("*.csv")):
+    """Parents before the classes derived from them (the tree order of gear_classes.csv), so
+    a derived class stores only the rows that differ from what it inherits."""
+    order = [row["name"] for row in _read(directory / "gear_classes.csv")]
+    paths = sorted((directory / "classes").glob("*.csv"),
+                   key=lambda path: (order.index(path.stem) if path.stem in order else len(order), path.stem))
+    for path in paths:
         has_rows = conn.execute("SELECT 1 FROM assembly WHERE gear_class = %s LIMIT 1", (path.stem,)).fetchone()
         if not has_rows:
             ensure_class(conn, path.stem)
@@ -94,3 +100,14 @@ def _seed_gears(conn, directory: Path, report: SeedReport) -> None:
             writer.writeheader()
             writer.writerows(missing)
         report.count("gears", import_gears(conn, subset))
+
+
+def _seed_units(conn, directory: Path, report: SeedReport) -> None:
+    """Further units of the sample multi-unit gears, where the gear has none yet."""
+    from .gear_units import import_units
+
+    source = directory / "gear_units.csv"
+    with_units = {row[0] for row in conn.execute("SELECT DISTINCT gear_id FROM gear_unit")}
+    rows = [row for row in _read(source) if int(row["gear_id"]) not in with_units]
+    if rows:
+        report.count("gear units", import_units(conn, source, only_gears={int(r["gear_id"]) for r in rows}))

@@ -3,7 +3,19 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from ..errors import EngineError
+
 SINGLE_CUT_MAX_MODULE = 3.0   # m_n ≤ about 3: one cut to full depth is common (§B14)
+
+# Axial pass direction per cut (rough, finish). Climb: the hob enters at the top face and
+# feeds down; conventional: it enters below the blank and feeds up (§B13). The paper's
+# example uses conventional for roughing and climb for finishing (逆—顺铣).
+FEED_MODES = {
+    "climb": (True, True),
+    "conventional": (False, False),
+    "conventional-climb": (False, True),
+}
+WORM_FEEDS = ("radial", "tangential")
 
 
 @dataclass(frozen=True)
@@ -11,8 +23,22 @@ class Choices:
     cuts: int | None = None            # 1 = finish only, 2 = rough then finish; None = by module
     finish_stock: float | None = None  # radial stock left by the rough cut, mm
     coolant: bool = True
-    climb: bool = True
+    feed_mode: str = "climb"
     shift_y: float = 0.0               # hob shift position for this part, mm (0 = no shift)
+    shift_per_part: float = 0.0        # shift step per part, mm (0 = no shifting from part to part)
+    tailstock: bool = True             # clamp the workpiece with the tailstock (the paper's example)
+    worm_feed: str = "radial"          # worm wheels: radial plunge or tangential feed along Y
+
+    def __post_init__(self):
+        if self.feed_mode not in FEED_MODES:
+            raise EngineError(f"feed mode {self.feed_mode!r} is not one of {', '.join(FEED_MODES)}")
+        if self.worm_feed not in WORM_FEEDS:
+            raise EngineError(f"worm feed {self.worm_feed!r} is not one of {', '.join(WORM_FEEDS)}")
+        if self.shift_per_part < 0:
+            raise EngineError(f"shift per part {self.shift_per_part:g} mm must not be negative")
+        if self.shift_per_part and self.shift_y:
+            raise EngineError("give either a fixed shift position (--shift-y) or a shift per part "
+                              "(--shift-per-part), not both")
 
     def cut_count(self, module: float) -> int:
         if self.cuts is not None:
@@ -24,3 +50,13 @@ class Choices:
         if self.finish_stock is not None:
             return self.finish_stock
         return min(1.0, max(0.3, 0.15 * module))
+
+    def climb(self, cut_number: int, cut_count: int) -> bool:
+        """Whether cut `cut_number` (1 = rough, 2 = finish) runs climb; a single cut takes the
+        roughing direction (the paper's single rough cut, conventional-climb mode)."""
+        rough, finish = FEED_MODES[self.feed_mode]
+        return rough if cut_number == 1 or cut_count == 1 else finish
+
+    @property
+    def shifting(self) -> bool:
+        return self.shift_y != 0 or self.shift_per_part > 0

@@ -1,0 +1,65 @@
+"""Hobbing model of worm wheels (reference §A5, §B10). The hob copies the mating worm, its
+axis lies in the wheel's mid-plane at a shaft angle of 90° (A = 0), and there is no axial
+pass. Radial: X plunges to the full-depth centre distance and dwells while the table turns.
+Tangential: the centre distance is set in air, the hob feeds along its own axis (Y) through
+the wheel, and the table gets the extra rotation 360·cos γ/(π·m_n·z2) degrees per mm of Y."""
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+from ..cutting_data import per_minute
+from . import geometry
+from .cylindrical import CylindricalModel, JobParameters, Setup
+from .passes import APPROACH_SAFETY, feeds, plan_cuts, working_area
+
+DWELL_TABLE_TURNS = 2.0   # table revolutions at full depth after a radial plunge (enveloping cuts)
+
+
+class WormWheelModel(CylindricalModel):
+    hob_purpose = "worm_wheel"
+    class_parameters = frozenset({"z_mid", "tangential", "y_start", "y_end", "tangential_factor"})
+    cut_parameters = frozenset({"cut_name", "cut_x", "cut_on", "feed_radial", "dwell", "feed_tangential"})
+
+    def shift_travel(self, choices) -> float:
+        return 0.0   # a worm-wheel hob is not shifted; the tangential pass uses its whole length
+
+    def setup(self, gear, hob) -> Setup:
+        setup = super().setup(gear, hob)
+        return Setup(setup.lead, 0.0, setup.full_depth, setup.reach, setup.x_retract)
+
+    def job(self, gear, gear_class, hob, machine, cutting, choices) -> JobParameters:
+        setup = self.setup(gear, hob)
+        tangential = choices.worm_feed == "tangential"
+        cuts = plan_cuts(gear.module, setup.full_depth, replace(choices, cuts=1) if tangential else choices)
+        table_speed = cutting.hob_speed * hob.starts / gear.teeth
+        module_params = {f"cutmotion:{cut.number}": {
+            "cut_name": cut.name, "cut_x": round(cut.centre_distance, 3), "cut_on": cut.on,
+            "dwell": round(DWELL_TABLE_TURNS * 60 / table_speed, 1),
+            "feed_radial": feeds(cut, cutting, hob.starts, gear.teeth)["feed_radial"],
+            "feed_tangential": round(per_minute(cutting.axial_feed_rough, cutting.hob_speed, hob.starts,
+                                                gear.teeth), 1)} for cut in cuts}
+        y_clear = round(tangential_clearance(gear, hob, setup.full_depth), 3) if tangential else 0.0
+        params = {**self.base_params(gear, gear_class, hob, machine, cutting, choices, setup),
+                  "shift_on": False, "shift_y": 0.0, "shift_per_part": 0.0, "shift_min": 0.0, "shift_max": 0.0,
+                  "z_mid": round(-gear.face_width / 2, 3), "tangential": tangential,
+                  "y_start": y_clear, "y_end": -y_clear,
+                  "tangential_factor": round(tangential_factor(gear, hob, setup.lead), 6)}
+        xs = [setup.x_retract] + [cut["cut_x"] for cut in module_params.values() if cut["cut_on"]]
+        params.update(working_area(xs, [0.0, y_clear, -y_clear], [params["z_mid"]]))
+        return JobParameters(params, module_params)
+
+
+def tangential_clearance(gear, hob, centre_distance: float) -> float:
+    """Y where the whole hob is clear of the wheel: the half-chord of the wheel's tip circle
+    at the hob's tip-cylinder distance, plus half the hob length and a safety margin."""
+    tip_radius, hob_radius = gear.tip_diameter / 2, hob.tip_diameter / 2
+    reach = math.sqrt(max(0.0, tip_radius ** 2 - (centre_distance - hob_radius) ** 2))
+    return reach + hob.length / 2 + APPROACH_SAFETY
+
+
+def tangential_factor(gear, hob, lead: float) -> float:
+    """Extra table rotation per mm of Y, degrees: 360·cos γ/(π·m_n·z2) (§A5); positive for
+    a right-hand hob (check the sign on the machine with a dry run)."""
+    size = 360 * math.cos(math.radians(lead)) / (math.pi * gear.module * gear.teeth)
+    return geometry.signed(size, hob.hand)
