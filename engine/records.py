@@ -50,6 +50,7 @@ class Hob:
     accuracy_class: str
     material: str
     coating: str
+    purpose: str
 
 
 @dataclass(frozen=True)

@@ -22,6 +22,13 @@ def lead_angle(module: float, starts: int, hob_tip_diameter: float) -> float:
     return math.degrees(math.asin(starts * module / hob_reference_diameter(hob_tip_diameter, module)))
 
 
+def generating_length(module: float, pressure_angle: float) -> float:
+    """Axial length of the hob that generates the tooth: 2·h/tan α_n + π·m_n with
+    h = 2.25·m_n (§B15); the hob must be this long plus the shift and its margins."""
+    depth = TOOTH_DEPTH_FACTOR * module
+    return 2 * depth / math.tan(math.radians(pressure_angle)) + math.pi * module
+
+
 def signed(angle: float, hand: str | None) -> float:
     """Right hand positive, left hand negative."""
     return -angle if hand == "L" else angle
