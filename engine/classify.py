@@ -29,6 +29,7 @@ class Rule:
 
 
 RULES: tuple[Rule, ...] = (
+    Rule("has it further toothed units?", "units", lambda value: value > 0, "duplex"),
     Rule("is a cone angle given and not 0?", "cone_angle", lambda value: value != 0, "taper"),
     Rule("is a crowning given and greater than 0?", "crowning", lambda value: value > 0, "crowned"),
     Rule("is the helix angle not 0?", "helix_angle", lambda value: value != 0, "helical"),
@@ -106,3 +107,56 @@ def classify_installed(gear: Mapping[str, Any], installed: Collection[str]) -> C
     if classification.gear_class not in installed:
         raise EngineError(not_installed_message(gear_id, classification.gear_class))
     return classification
+
+
+@dataclass(frozen=True)
+class GearClassReport:
+    """What `engine classify --gear ID` says: the stored class, the automatic decision path,
+    and the hobbing model and hob the gear gets."""
+
+    gear_id: int
+    stored_class: str | None
+    classification: Classification
+    model_class: str | None
+    hob: str | None
+
+    def lines(self) -> list[str]:
+        automatic = self.classification.gear_class
+        said = [f"gear {self.gear_id}: class {self.stored_class}",
+                f"  decision path: {self.classification.explain()}"]
+        if self.stored_class != automatic:
+            said.append(f"  the gear file named class {self.stored_class} explicitly "
+                        f"(the tree alone gives {automatic or 'no class'})")
+        said.append(f"  hobbing model: {self.model_class or 'none: no class on the path up has a model'}")
+        said.append(f"  hob: {self.hob}")
+        return said
+
+
+GEAR_FEATURES = """
+SELECT g.id, g.gear_class, g.cone_angle, g.crowning, g.helix_angle,
+       (SELECT count(*) FROM gear_unit u WHERE u.gear_id = g.id)
+FROM gear g WHERE g.id = %s"""
+
+
+def explain_gear(conn, gear_id: int) -> GearClassReport:
+    """Classify a stored gear again and say how; also the model and hob it gets."""
+    from .hobs import choose_hob
+    from .models import MODELS, ancestry
+    from .records import load_gear, load_hobs
+
+    row = conn.execute(GEAR_FEATURES, (gear_id,)).fetchone()
+    if row is None:
+        raise EngineError(f"gear {gear_id} does not exist; import it with `engine gears import FILE.csv`")
+    features = dict(zip(("gear_id", "gear_class", "cone_angle", "crowning", "helix_angle", "units"), row))
+    classification = classify(features)
+    lineage = ancestry(conn, row[1]) if row[1] else []
+    model_class = next((name for name in lineage if name in MODELS), None)
+    hob = None
+    if model_class:
+        model = MODELS[model_class]
+        try:
+            chosen = choose_hob(load_gear(conn, gear_id), load_hobs(conn), purpose=model.hob_purpose)
+            hob = chosen.reason
+        except EngineError as error:
+            hob = f"none fits: {error}"
+    return GearClassReport(gear_id, row[1], classification, model_class, hob)

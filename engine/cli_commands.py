@@ -30,6 +30,35 @@ def gears_import(ctx, csv_file, as_json):
     emit_json({"imported": count}) if as_json else click.echo(f"imported {count} gear(s) from {csv_file}")
 
 
+@gears.command("units")
+@click.argument("csv_file", type=click.Path(dir_okay=False))
+@click.pass_context
+def gears_units(ctx, csv_file):
+    """Import further toothed units of multi-unit (duplex) gears from CSV_FILE.
+
+    Columns: gear_id, unit (2, 3, ...), teeth, face_width, tip_diameter, root_diameter,
+    z_top (Z of the unit's upper face; the gear's top face is Z = 0). The units of each
+    gear in the file replace its units; any bad row stops the whole file."""
+    from .gear_units import import_units
+
+    with connection(ctx) as conn:
+        count = import_units(conn, csv_file)
+    click.echo(f"imported {count} unit(s) from {csv_file}")
+
+
+@main.command()
+@click.option("--gear", "gear_id", type=int, required=True, help="Gear id.")
+@click.pass_context
+def classify(ctx, gear_id):
+    """Explain a gear's class: the group-technology decision path (face-width variation,
+    generating line, units), the class stored, its hobbing model and the hob it gets."""
+    from .classify import explain_gear
+
+    with connection(ctx) as conn:
+        report = explain_gear(conn, gear_id)
+    click.echo("\n".join(report.lines()))
+
+
 def parse_range(text: str) -> tuple[int, int]:
     match = RANGE.match(text)
     if not match:
@@ -51,11 +80,18 @@ def parse_range(text: str) -> tuple[int, int]:
 @click.option("--cuts", type=click.IntRange(1, 2), help="1 = single cut, 2 = rough then finish (default by module).")
 @click.option("--coolant/--no-coolant", default=True, show_default=True, help="Coolant M8/M9.")
 @click.option("--shift-y", type=float, default=0.0, help="Hob shift position Y for this part, mm.")
+@click.option("--shift-per-part", type=float, default=0.0,
+              help="Shift the hob by this many mm every part (R11 counts), wrapping within the hob's usable length.")
+@click.option("--feed-mode", type=click.Choice(["climb", "conventional", "conventional-climb"]), default="climb",
+              show_default=True, help="Axial pass direction; conventional-climb: rough conventional, finish climb.")
+@click.option("--tailstock/--no-tailstock", default=True, show_default=True, help="Tailstock clamp M20/M21.")
+@click.option("--worm-feed", type=click.Choice(["radial", "tangential"]), default="radial", show_default=True,
+              help="Worm wheels: radial plunge, or tangential feed along Y.")
 @click.option("--hob-speed", type=int, help="Override the hob speed n0, r/min.")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object (program_id, path, lines, ...).")
 @click.pass_context
 def instantiate(ctx, gear_id, job_id, gear_range, all_gears, out, machine, cuts, coolant, shift_y,
-                hob_speed, as_json):
+                shift_per_part, feed_mode, tailstock, worm_feed, hob_speed, as_json):
     """Produce the NC program of a gear (or a stored job, or a batch of gears).
 
     The program is checked against the machine's limits, stored with the template
@@ -68,7 +104,8 @@ def instantiate(ctx, gear_id, job_id, gear_range, all_gears, out, machine, cuts,
                                        ("--all", all_gears)) if value]
     if len(chosen) != 1:
         raise EngineError("give exactly one of --gear ID, --job ID, --gears FIRST-LAST, --all")
-    choices = Choices(cuts=cuts, coolant=coolant, shift_y=shift_y)
+    choices = Choices(cuts=cuts, coolant=coolant, shift_y=shift_y, shift_per_part=shift_per_part,
+                      feed_mode=feed_mode, tailstock=tailstock, worm_feed=worm_feed)
     overrides = {"hob_speed": hob_speed}
     with connection(ctx) as conn:
         if gear_id is not None:

@@ -140,11 +140,11 @@ def test_lint_passes_on_the_seed_and_names_an_unknown_parameter(run):
     assert result.exit_code == 0 and json.loads(result.stdout) == {"errors": []}
     with psycopg.connect(run.url) as conn:
         conn.execute("""UPDATE component SET o = 'f"G0 X{x_retrakt:.3f}"' WHERE id =
-                        (SELECT component_id FROM assembly WHERE gear_class = 'spur' AND id = 120)""")
+                        (SELECT component_id FROM assembly WHERE gear_class = 'spur' AND id = 1250)""")
         conn.commit()
     result = run("lint")
     assert result.exit_code == 1
-    assert "class spur row 120 column o: unknown parameter 'x_retrakt'" in result.stdout
+    assert "class spur row 1250 column o: unknown parameter 'x_retrakt'" in result.stdout
 
 
 def test_db_status_and_seed_are_idempotent(run):
