@@ -127,3 +127,6 @@ def seed_command(ctx):
 from . import cli_commands  # noqa: E402,F401  (registers the remaining commands on `main`)
 from .cli_hobs import hobs  # noqa: E402
 main.add_command(hobs)
+from .cli_cases import cases, suggest  # noqa: E402  (cutting data from the machining history)
+main.add_command(suggest)
+main.add_command(cases)

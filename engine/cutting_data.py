@@ -28,8 +28,13 @@ class CuttingData:
     hob_speed: int                # n0, r/min of B
     axial_feed_rough: float       # mm per workpiece revolution
     axial_feed_finish: float
-    radial_feed: float            # mm per workpiece revolution
+    radial_feed: float            # mm per workpiece revolution (rough cut, and finish unless given)
     source: str
+    radial_feed_finish: float | None = None   # mm per workpiece revolution; None = radial_feed
+
+    @property
+    def finish_radial_feed(self) -> float:
+        return self.radial_feed if self.radial_feed_finish is None else self.radial_feed_finish
 
     def with_overrides(self, **overrides) -> "CuttingData":
         given = {name: value for name, value in overrides.items() if value is not None}
@@ -37,8 +42,8 @@ class CuttingData:
 
 
 def hob_speed(cutting_speed: float, hob_tip_diameter: float, spindle_max: float) -> int:
-    """n0 = 1000·v/(π·d_a0), never above the machine's hob spindle limit (§B4)."""
-    return int(min(1000 * cutting_speed / (math.pi * hob_tip_diameter), spindle_max))
+    """n0 = 1000·v/(π·d_a0) to the nearest r/min, never above the machine's hob spindle limit (§B4)."""
+    return min(round(1000 * cutting_speed / (math.pi * hob_tip_diameter)), math.floor(spindle_max))
 
 
 def default_cutting_data(module: float, material: str | None, coated: bool,
