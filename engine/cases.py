@@ -157,9 +157,18 @@ def propose(ranked: pd.DataFrame, cut: str, defaults: CuttingData) -> KindPropos
 
 def suggest(conn, gear: Gear, hob: Hob, machine: Machine, *, top: int = 3) -> Suggestion:
     """Cutting data for this gear, hob and machine from the `top` nearest cases per cut kind."""
+    return suggest_from(load_case_base(conn), gear, hob, machine, top=top)
+
+
+def load_case_base(conn) -> pd.DataFrame:
+    """The history with the transfer columns, read once for many suggestions (a batch)."""
+    return with_transfer_columns(list_cases(conn))
+
+
+def suggest_from(cases: pd.DataFrame, gear: Gear, hob: Hob, machine: Machine, *, top: int = 3) -> Suggestion:
+    """`suggest` over a case base already read (`load_case_base`)."""
     if top < 1:
         raise EngineError(f"top {top}: ask for at least 1 case per cut kind")
-    cases = with_transfer_columns(list_cases(conn))
     defaults = default_cutting_data(gear.module, gear.material, bool(hob.coating), hob.tip_diameter,
                                     machine.spindle_max)
     ranked = {cut: nearest(cases, query_of(gear, hob, cut), top) for cut in CUT_KINDS}
@@ -184,7 +193,10 @@ def suggest_for_gear(conn, gear_id: int, machine_name: str | None = None, *, top
     if machine.kind != "hobber":
         raise EngineError(f"machine {machine.name} is a {machine.kind}, not a hobbing machine; "
                           f"use --machine {DEFAULT_HOBBING_MACHINE}")
-    choice = choose_hob(gear, load_hobs(conn))
+    from .models import model_for_class
+
+    model = model_for_class(conn, gear.gear_class) if gear.gear_class else None
+    choice = choose_hob(gear, load_hobs(conn), purpose=model.hob_purpose if model else "cylindrical")
     suggestion = suggest(conn, gear, choice.hob, machine, top=top)
     return replace(suggestion, hob_reason=choice.reason)
 

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 
-from .cutting_data import default_cutting_data
+from .cases import CUT_KINDS_BY_COUNT, job_cutting_record, load_case_base, suggest_from
 from .decision_table import Result, compiled_template
 from .errors import EngineError
 from .hobbing.choices import Choices
@@ -36,6 +36,7 @@ class Planned:
     module_params: dict
     template: Template
     result: Result
+    cutting: dict | None = None      # job.cutting: the cutting data chosen and their source
 
     @property
     def name(self) -> str:
@@ -68,6 +69,8 @@ class Planner:
             raise EngineError(f"machine {self.machine.name} is a {self.machine.kind}, not a hobbing machine; "
                               f"use --machine {DEFAULT_HOBBING_MACHINE}")
         self.hobs = load_hobs(conn)
+        self.case_base = load_case_base(conn)
+        self._cutting: dict[tuple, tuple] = {}
         self.choices = choices
         self.overrides = overrides or {}
         self._templates: dict[str, Template] = {}
@@ -93,14 +96,24 @@ class Planner:
         model = self.model(gear.gear_class)
         hob = choose_hob(gear, self.hobs, purpose=model.hob_purpose,
                          shift_travel=model.shift_travel(self.choices)).hob
-        cutting = default_cutting_data(gear.module, gear.material, bool(hob.coating), hob.tip_diameter,
-                                       self.machine.spindle_max).with_overrides(**self.overrides)
+        cutting, case_ids = self.cutting_data(gear, hob)
         job = model.job(gear, gear.gear_class, hob, self.machine, cutting, self.choices)
         _check_table_speed(gear, hob.starts, cutting.hob_speed, self.machine)
         template = self.template(gear.gear_class)
         result = run_template(template, job.params, job.module_params, self.machine)
+        kinds = CUT_KINDS_BY_COUNT[self.choices.cut_count(gear.module)]
+        record = job_cutting_record(cutting, gear, hob, kinds, case_ids)
         return Planned(gear.id, gear.gear_class, self.machine.name, hob.id, job.params,
-                       job.module_params, template, result)
+                       job.module_params, template, result, record)
+
+    def cutting_data(self, gear: Gear, hob) -> tuple:
+        """Cutting data from the nearest cases of the machining history (overrides applied),
+        and the ids of the cases they came from; gears alike share one suggestion."""
+        key = (gear.module, gear.teeth, gear.material, gear.hardness, gear.quality_grade, hob.id)
+        if key not in self._cutting:
+            suggestion = suggest_from(self.case_base, gear, hob, self.machine)
+            self._cutting[key] = (suggestion.cutting.with_overrides(**self.overrides), suggestion.case_ids())
+        return self._cutting[key]
 
 
 def run_template(template: Template, params: dict, module_params: dict, machine: Machine) -> Result:

@@ -40,6 +40,7 @@ def seed(conn, directory: Path = SEED_DIR) -> SeedReport:
         _seed_templates(conn, directory, report)
         _seed_gears(conn, directory, report)
         _seed_units(conn, directory, report)
+        _seed_cases(conn, directory, report)
     return report
 
 
@@ -111,3 +112,10 @@ def _seed_units(conn, directory: Path, report: SeedReport) -> None:
     rows = [row for row in _read(source) if int(row["gear_id"]) not in with_units]
     if rows:
         report.count("gear units", import_units(conn, source, only_gears={int(r["gear_id"]) for r in rows}))
+
+
+def _seed_cases(conn, directory: Path, report: SeedReport) -> None:
+    """The machining history's seed cases (the paper's example among them)."""
+    from .cases import seed_cases
+
+    report.count("cases", seed_cases(conn, directory / "cases.csv"))

@@ -6,12 +6,12 @@ from dataclasses import dataclass
 from psycopg.types.json import Jsonb
 
 INSERT_JOB = """
-INSERT INTO job (gear_id, gear_class, machine, hob_id, params, module_params)
-VALUES (%s, %s, %s, %s, %s, %s) RETURNING id"""
+INSERT INTO job (gear_id, gear_class, machine, hob_id, params, module_params, cutting)
+VALUES (%s, %s, %s, %s, %s, %s, %s) RETURNING id"""
 INSERT_PROGRAM = """
 INSERT INTO program (job_id, gear_class, template_version, template_hash, name, lines, row_ids)
 VALUES (%s, %s, %s, %s, %s, %s, %s) RETURNING id"""
-COPY_JOB = "COPY job (id, gear_id, gear_class, machine, hob_id, params, module_params) FROM STDIN"
+COPY_JOB = "COPY job (id, gear_id, gear_class, machine, hob_id, params, module_params, cutting) FROM STDIN"
 COPY_PROGRAM = ("COPY program (id, job_id, gear_class, template_version, template_hash, name, lines, row_ids) "
                 "FROM STDIN (FORMAT BINARY)")
 PROGRAM_TYPES = ("int8", "int8", "text", "int4", "text", "text", "text[]", "int4[]")
@@ -21,7 +21,8 @@ def store_one(conn, planned, existing_job: int | None, path: str | None):
     job_id = existing_job
     if job_id is None:
         job_id = conn.execute(INSERT_JOB, (planned.gear_id, planned.gear_class, planned.machine, planned.hob_id,
-                                           Jsonb(planned.params), Jsonb(planned.module_params))).fetchone()[0]
+                                           Jsonb(planned.params), Jsonb(planned.module_params),
+                                           Jsonb(planned.cutting or {}))).fetchone()[0]
     program_id = conn.execute(INSERT_PROGRAM, _program_values(job_id, planned)).fetchone()[0]
     return _program(program_id, job_id, planned, path)
 
@@ -36,7 +37,7 @@ def store_many(conn, planned: list, out=None) -> "Batch":
         with conn.cursor().copy(COPY_JOB) as copy:
             for job_id, item in zip(job_ids, planned):
                 copy.write_row((job_id, item.gear_id, item.gear_class, item.machine, item.hob_id,
-                                Jsonb(item.params), Jsonb(item.module_params)))
+                                Jsonb(item.params), Jsonb(item.module_params), Jsonb(item.cutting or {})))
         with conn.cursor().copy(COPY_PROGRAM) as copy:
             copy.set_types(PROGRAM_TYPES)
             for program_id, job_id, item in zip(program_ids, job_ids, planned):

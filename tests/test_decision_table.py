@@ -145,7 +145,7 @@ def test_result_table_view_lists_lines_with_their_template_rows(conn):
     rows = conn.execute("SELECT line_no, template_row_id, text FROM result_line WHERE program_id = %s "
                         "ORDER BY line_no", (program.program_id,)).fetchall()
     assert [text for _, _, text in rows] == program.lines
-    assert rows[0][:2] == (1, 10)
+    assert rows[0][:2] == (1, 100)
 
 
 def test_the_wall_clock_budget_stops_a_runaway_instantiation(conn):

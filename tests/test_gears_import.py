@@ -107,21 +107,23 @@ def test_classification_of_an_empty_gear_class_with_its_explanation():
     helical = classify({"helix_angle": Decimal(15), "cone_angle": None, "crowning": None})
     assert helical.gear_class == "helical"
     assert [question for question, _ in helical.path] == [rule.question for rule in RULES]
-    assert [answer.split()[0] for _, answer in helical.path] == ["no", "no", "yes"]
+    assert [answer.split()[0] for _, answer in helical.path] == ["no", "no", "no", "yes"]
     assert helical.path[-1][1] == "yes (helix_angle = 15)"
     assert helical.explain().endswith("yes (helix_angle = 15) → helical")
 
     spur = classify({"helix_angle": 0})
     assert spur.gear_class == "spur"
     assert [answer for _, answer in spur.path] == [
-        "no (not given)", "no (not given)", "no (helix_angle = 0)"]
+        "no (not given)", "no (not given)", "no (not given)", "no (helix_angle = 0)"]
 
 
 @pytest.mark.parametrize("gear, expected, steps", [
-    ({"cone_angle": 3, "helix_angle": 15}, "taper", 1),
-    ({"cone_angle": 0, "crowning": "0.02"}, "crowned", 2),
-    ({"crowning": 0, "helix_angle": 0}, "spur", 3),
-    ({"crowning": "", "helix_angle": "12.5"}, "helical", 3),
+    ({"units": 1, "cone_angle": 0}, "duplex", 1),
+    ({"cone_angle": 3, "helix_angle": 15}, "taper", 2),
+    ({"cone_angle": 0, "crowning": "0.02"}, "crowned", 3),
+    ({"crowning": 0, "helix_angle": 0}, "spur", 4),
+    ({"crowning": "", "helix_angle": "12.5"}, "helical", 4),
+    ({"units": 0, "crowning": "", "helix_angle": "12.5"}, "helical", 4),
 ])
 def test_classification_rules_in_order(gear, expected, steps):
     classification = classify(gear)

@@ -320,7 +320,7 @@ def test_match_says_which_property_no_hob_has(run):
 
 def test_match_takes_a_worm_wheel_hob_for_a_worm_wheel_class(run):
     execute(run.url,
-            "INSERT INTO gear_class (name, parent) VALUES ('worm_wheel', 'gear'), ('worm_wheel_radial', 'worm_wheel')",
+            "INSERT INTO gear_class (name, parent) VALUES ('worm_wheel_radial', 'worm_wheel')",
             "INSERT INTO gear (id, gear_class, module, teeth, helix_angle, hand, face_width, quality_grade) "
             "VALUES (9002, 'worm_wheel_radial', 3, 40, 4.05, 'R', 30, 8)")
     result = run("hobs", "match", "--gear", 9002)
