@@ -87,3 +87,17 @@ def empty_database_url(server_url) -> str:
     url = _create(server_url, name)
     yield url
     _drop(server_url, name)
+
+
+@pytest.fixture
+def run(fresh_database_url):
+    """Invoke the CLI in-process on a private copy of the seeded database: run("instantiate",
+    "--gear", 42) → click's Result (exit_code, stdout, stderr); run.url is the database."""
+    from click.testing import CliRunner
+
+    from engine.cli import main
+
+    def invoke(*args):
+        return CliRunner().invoke(main, ["--database-url", fresh_database_url, *map(str, args)])
+    invoke.url = fresh_database_url
+    return invoke

@@ -9,7 +9,10 @@ the engine they check. It understands the subset the hobbing templates write:
 * axis words X/Y/Z/A/B/C as `X12.5` or `A=-1.763`, S, F (modal), M codes (`M3`, also `M1=3`);
 * calls `NAME(arg, …)` such as `EGDEF(C,B,1,Z,1)`, `EGON(C,"FINE",B,-1,19)`, `EGOFS(C)`,
   whose arguments are kept as written (quotes removed from strings);
-* bare keywords (`WALIMON`, `WALIMOF`, …).
+* bare keywords (`WALIMON`, `WALIMOF`, …);
+* R-parameter statements (`R11=R11+2.5`, `IF (R11<-20) OR (R11>20)`, `ENDIF`) as blocks
+  without motion, kept in `Block.statement`; an axis set from a parameter (`G0 Y=R11`)
+  has no known value (`Block.params` holds its name).
 
 `read_program(text)` returns a `Program`: its blocks, the moves (mode, start, end, feed,
 block index) with the modal position tracked from block to block, and an index of events
@@ -30,11 +33,15 @@ _TOKEN = re.compile(
     r"""\s*(?:
         (?P<call>[A-Z_][A-Z0-9_]*)\s*\((?P<args>[^()]*)\)       # NAME(args)
       | (?P<eq>[A-Z][A-Z0-9_]*)\s*=\s*(?P<eqval>""" + _NUMBER + r""")  # A=-1.5, M1=3, S1=300
+      | (?P<eqparam>[XYZ])\s*=\s*(?P<param>R\d+)                     # Y=R11: position from an R parameter
       | (?P<addr>[A-Z])(?P<val>""" + _NUMBER + r""")           # X12.5, G0, M30
       | (?P<word>[A-Z_][A-Z0-9_]*)                              # WALIMON
     )""",
     re.VERBOSE,
 )
+
+
+_STATEMENT = re.compile(r"^(R\d+\s*=|IF\b|ENDIF\b|ELSE\b)")
 
 
 class ReadError(ValueError):
@@ -63,6 +70,8 @@ class Block:
     calls: list[Call] = field(default_factory=list)
     keywords: list[str] = field(default_factory=list)
     comment: str | None = None
+    statement: str | None = None   # R11=R11+2.5, IF …, ENDIF
+    params: dict[str, str] = field(default_factory=dict)   # axis → R parameter (Y=R11)
 
     @property
     def axes(self) -> dict[str, float]:
@@ -138,6 +147,9 @@ def _parse_block(index: int, line_no: int, line: str) -> Block | None:
     if not code_up:
         return None
     block = Block(index=index, line_no=line_no, text=line, comment=comment)
+    if _STATEMENT.match(code_up):
+        block.statement = code.strip()
+        return block
     pos = 0
     while pos < len(code_up):
         if code_up[pos].isspace():
@@ -147,7 +159,9 @@ def _parse_block(index: int, line_no: int, line: str) -> Block | None:
         if not match or match.end() == pos:
             raise ReadError(f"line {line_no + 1}: cannot read {code[pos:]!r} in {line!r}")
         pos = match.end()
-        if match["call"]:
+        if match["eqparam"]:
+            block.params[match["eqparam"]] = match["param"]
+        elif match["call"]:
             # the original case of the arguments is kept (strings like "FINE")
             start, end = match.span("args")
             block.calls.append(Call(match["call"], _split_args(code[start:end])))
@@ -217,6 +231,11 @@ def read_program(text: str) -> Program:
             event(k, i)
         for w in block.words:
             event(w, i)
+        for axis in block.params:          # G0 Y=R11: the position is known only at run time
+            position[axis] = None
+            event(f"{axis}=R", i)
+        if block.statement:
+            event(block.statement.split("=")[0].split()[0].upper(), i)
 
         motion = [g for g in block.g if g in MOTION]
         if motion:

@@ -9,10 +9,8 @@ from dataclasses import replace
 import psycopg
 from psycopg import sql
 import pytest
-from click.testing import CliRunner
 
 from engine.cases import confirm_job, job_cutting_record, list_cases, seed_cases, suggest
-from engine.cli import main
 from engine.cutting_data import per_minute
 from engine.errors import EngineError
 from engine.paths import SEED_DIR
@@ -207,15 +205,6 @@ def test_the_seed_holds_the_paper_case_alone_at_its_features():
     assert {r["cut"] for r in rows} == {"rough", "finish"} and {"45", "20CrMnTi", "40Cr"} <= {r["material"] for r in rows}
 
 
-@pytest.fixture
-def run(fresh_database_url):
-    with psycopg.connect(fresh_database_url) as conn:
-        seed_cases(conn)
-
-    def invoke(*args):
-        return CliRunner().invoke(main, ["--database-url", fresh_database_url, *map(str, args)])
-    invoke.url = fresh_database_url
-    return invoke
 
 
 def test_cli_suggest_prints_the_hob_cases_and_proposal(run):

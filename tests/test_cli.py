@@ -13,14 +13,6 @@ from click.testing import CliRunner
 from engine.cli import main
 
 
-@pytest.fixture
-def run(fresh_database_url):
-    runner = CliRunner()
-
-    def invoke(*args):
-        return runner.invoke(main, ["--database-url", fresh_database_url, *map(str, args)])
-    invoke.url = fresh_database_url
-    return invoke
 
 
 def stored_counts(url):

@@ -8,9 +8,7 @@ from pathlib import Path
 
 import psycopg
 import pytest
-from click.testing import CliRunner
 
-from engine.cli import main
 from engine.errors import EngineError
 from engine.hobs import choose_hob
 from engine.records import Gear, Hob
@@ -154,14 +152,6 @@ def test_a_wrong_purpose_or_a_negative_shift_is_refused():
 
 # --- the command line ---------------------------------------------------------------------
 
-@pytest.fixture
-def run(fresh_database_url):
-    runner = CliRunner()
-
-    def invoke(*args):
-        return runner.invoke(main, ["--database-url", fresh_database_url, *map(str, args)])
-    invoke.url = fresh_database_url
-    return invoke
 
 
 def hob_rows(url) -> list[tuple]:

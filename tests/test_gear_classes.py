@@ -1,0 +1,302 @@
+"""The geometry of the programs of every gear class (issue 3), checked against formulas of
+reference/hobbing.md computed here from the gear, hob and machine rows read with SQL, and
+read with tests/nc_reader.py (no engine code reads the programs).
+
+Seeded gears: 50 the paper's taper gear (m2 z19 d_a 42.5 δ 6.5° 40Cr grade 7), 51 crowned
+(m2.5 z32 b30 C_β 0.02), 53 worm wheel (m3 z40 β 4.05° R), 54 duplex (m2 z30 b20 over a
+unit z19 b15 at Z-75), 43 helical R and 44 helical L, 45 spur m4 (two cuts).
+"""
+from __future__ import annotations
+
+import math
+
+import pytest
+
+from engine.errors import EngineError
+from engine.hobbing.choices import Choices
+from engine.instantiate import instantiate_gear
+
+from nc_reader import read_program
+
+ROUND = 0.0015   # mm: the program writes 3 decimals; a difference of two rounded values
+
+
+def gear(conn, gear_id):
+    row = conn.execute("SELECT module, teeth, pressure_angle, helix_angle, hand, face_width, tip_diameter, "
+                       "root_diameter, cone_angle, crowning FROM gear WHERE id = %s", (gear_id,)).fetchone()
+    keys = ("mn", "z2", "alpha", "beta", "hand", "b", "da2", "df2", "cone", "crowning")
+    return {k: (float(v) if v is not None and k != "hand" else v) for k, v in zip(keys, row)}
+
+
+def hob_of(conn, program):
+    hob_id = next(line.split()[2] for line in program.lines if line.startswith("; HOB "))
+    row = conn.execute("SELECT module, starts, tip_diameter, hand, length FROM hob WHERE id = %s",
+                       (hob_id,)).fetchone()
+    return dict(zip(("mn", "z0", "da0", "hand", "length"), (float(row[0]), row[1], float(row[2]), row[3],
+                                                              float(row[4]))))
+
+
+def lead_angle(hob):
+    """§B1: sin γ = z0·m/(d_a0 − 2.5·m)."""
+    return math.degrees(math.asin(hob["z0"] * hob["mn"] / (hob["da0"] - 2.5 * hob["mn"])))
+
+
+def program_of(conn, gear_id, **choices):
+    program = instantiate_gear(conn, gear_id, choices=Choices(**choices))
+    return program, read_program(program.text)
+
+
+def cutting_moves(nc):
+    """G1 moves, in order."""
+    return nc.moves_in("G1")
+
+
+# ---------------------------------------------------------------- taper (the paper's gear)
+
+def test_taper_x_follows_z_along_the_cone(conn):
+    program, nc = program_of(conn, 50)
+    g, hob = gear(conn, 50), hob_of(conn, program)
+    slope = math.tan(math.radians(g["cone"]))
+    slanted = [m for m in cutting_moves(nc) if {"X", "Z"} <= m.changed]
+    assert slanted, "the taper pass must move X and Z together (G1 X… Z…)"
+    for move in slanted:
+        dz = move.end["Z"] - move.start["Z"]
+        assert abs((move.end["X"] - move.start["X"]) / dz - slope) < 2 * ROUND / abs(dz)
+        # the pass crosses both faces: from above Z = 0 to below Z = -b (climb)
+        assert move.start["Z"] > 0 and move.end["Z"] < -g["b"]
+    # at the top face (Z = 0) the last cut is at full depth (d_f2 + d_a0)/2 (§B3, §7)
+    last = slanted[-1]
+    x_at_top = last.start["X"] + (0 - last.start["Z"]) * slope
+    assert abs(x_at_top - (g["df2"] + hob["da0"]) / 2) < 0.01
+
+
+def test_taper_feed_along_the_slant_keeps_the_axial_feed(conn):
+    program, nc = program_of(conn, 50)
+    slanted = [m for m in cutting_moves(nc) if {"X", "Z"} <= m.changed][-1]
+    axial = slanted.feed * math.cos(math.radians(gear(conn, 50)["cone"]))
+    assert abs(axial - 105.0) < 0.1   # the paper's 105 mm/min axial, from the seeded case
+
+
+def test_the_papers_example_reproduced(conn):
+    """m2 z19 40Cr grade 7, 1-start AA hob, rough, no shift, coolant, tailstock (§D): the
+    seeded case gives 246 r/min, 105 axial and 36 radial mm/min."""
+    program, nc = program_of(conn, 50)
+    hob = hob_of(conn, program)
+    assert hob["z0"] == 1 and "AA" in next(line for line in program.lines if line.startswith("; HOB "))
+    assert nc.block_with("M3").words["S"] == 246
+    infeed = next(m for m in cutting_moves(nc) if m.changed == {"X"})
+    assert infeed.feed == 36.0
+    assert nc.index("M8") is not None and nc.index("M20") is not None   # coolant on, tailstock clamp
+    assert not any("Y" in m.changed for m in nc.moves)                    # no shift
+    job = conn.execute("SELECT cutting FROM job WHERE id = %s", (program.job_id,)).fetchone()[0]
+    assert job["hob_speed"] == 246 and job["rough"] == {"axial_feed": 105.0, "radial_feed": 36.0}
+    assert job["case_ids"], "the job records which cases its cutting data came from"
+
+
+# ---------------------------------------------------------------- crowned
+
+def crown_points(nc, face_width):
+    """(Z, X) of the G1 points on the face, in pass order."""
+    return [(m.end["Z"], m.end["X"]) for m in cutting_moves(nc)
+            if m.end["Z"] is not None and -face_width - 1e-9 <= m.end["Z"] <= 1e-9 and "Z" in m.changed]
+
+
+def test_crowning_is_a_symmetric_parabola_deepest_at_the_faces(conn):
+    program, nc = program_of(conn, 51)
+    g, hob = gear(conn, 51), hob_of(conn, program)
+    points = crown_points(nc, g["b"])
+    assert len(points) - 1 >= 20, "at least 20 segments across the face"
+    full_depth = (g["df2"] + hob["da0"]) / 2
+    crown = g["crowning"] / math.sin(math.radians(g["alpha"]))      # Δa = C_β / sin α_n
+    by_z = {round(z, 3): x for z, x in points}
+    mid = -g["b"] / 2
+    assert abs(by_z[round(mid, 3)] - full_depth) < 0.01             # right depth at mid-face
+    assert abs(by_z[0.0] - (full_depth - crown)) < ROUND
+    assert abs(by_z[round(-g["b"], 3)] - (full_depth - crown)) < ROUND
+    for z, x in points:                                              # symmetric about mid-face
+        mirror = round(2 * mid - z, 3)
+        assert mirror in by_z and abs(by_z[mirror] - x) < ROUND
+        expected = full_depth - crown * (2 * (z - mid) / g["b"]) ** 2   # §B11
+        assert abs(x - expected) < ROUND
+    assert max(x for _, x in points) == by_z[round(mid, 3)]         # largest centre distance mid-face
+
+
+# ---------------------------------------------------------------- worm wheel
+
+def test_worm_wheel_plunges_radially_without_z(conn):
+    program, nc = program_of(conn, 53)
+    g, hob = gear(conn, 53), hob_of(conn, program)
+    z_values = {m.end["Z"] for m in nc.moves}
+    assert z_values == {-g["b"] / 2}, "the hob stays in the wheel's mid-plane"
+    assert all("Z" not in m.changed for m in nc.moves if m.start["Z"] is not None)
+    plunge = [m for m in cutting_moves(nc) if m.changed == {"X"}]
+    assert abs(plunge[-1].end["X"] - (g["df2"] + hob["da0"]) / 2) < 0.01
+    assert nc.block_with("A").words["A"] == 0                          # shaft angle 90°
+    assert nc.index("G4") is not None and nc.index("G4") > nc.index("move G1")   # dwell at depth
+    egon = nc.block_with("EGON").call("EGON")
+    assert egon.args[:5] == ("C", "FINE", "B", str(-hob["z0"] if hob["hand"] == "R" else hob["z0"]), "40")
+    assert len(egon.args) == 5, "no differential term: no axial pass"
+
+
+def test_worm_wheel_tangential_feed_along_y_with_the_table_coupled(conn):
+    program, nc = program_of(conn, 53, worm_feed="tangential")
+    g, hob = gear(conn, 53), hob_of(conn, program)
+    full_depth = (g["df2"] + hob["da0"]) / 2
+    assert all("Z" not in m.changed for m in nc.moves if m.start["Z"] is not None)
+    tangential = [m for m in cutting_moves(nc) if m.changed == {"Y"}]
+    assert len(tangential) == 1
+    move = tangential[0]
+    assert abs(move.start["X"] - full_depth) < 0.01                   # centre distance fixed first
+    assert move.start["Y"] > 0 > move.end["Y"]
+    # the whole hob is clear of the wheel at both ends (half-chord at the tip + half the hob)
+    chord = math.sqrt((g["da2"] / 2) ** 2 - (full_depth - hob["da0"] / 2) ** 2)
+    assert min(move.start["Y"], -move.end["Y"]) >= chord + hob["length"] / 2
+    assert nc.block_with("EGDEF").call("EGDEF").args == ("C", "B", "1", "Y", "1")
+    egon = nc.block_with("EGON").call("EGON").args
+    expected = 360 * math.cos(math.radians(lead_angle(hob))) / (math.pi * g["mn"] * g["z2"])   # §A5
+    assert egon[5] == "Y" and abs(float(egon[6]) - expected) < 1e-6 and egon[7] == "1"
+
+
+# ---------------------------------------------------------------- duplex
+
+def test_duplex_cuts_both_units_with_their_own_parameters(conn):
+    program, nc = program_of(conn, 54)
+    g, hob = gear(conn, 54), hob_of(conn, program)
+    unit = conn.execute("SELECT teeth, face_width, tip_diameter, z_top FROM gear_unit WHERE gear_id = 54"
+                        ).fetchone()
+    teeth2, b2, da2_2, z_top = unit[0], float(unit[1]), float(unit[2]), float(unit[3])
+    couplings = [block.call("EGON").args for block in nc.blocks if block.call("EGON")]
+    assert [args[4] for args in couplings] == [str(int(g["z2"])), str(teeth2)]
+    passes = [m for m in cutting_moves(nc) if m.changed == {"Z"}]
+    assert len(passes) == 2
+    first, second = passes
+    assert abs(first.start["X"] - (g["df2"] + hob["da0"]) / 2) < 0.01
+    assert abs(second.start["X"] - (da2_2 - 4.5 * g["mn"] + hob["da0"]) / 2) < 0.01
+    assert first.start["Z"] > 0 and first.end["Z"] < -g["b"]               # across unit 1
+    assert first.end["Z"] > z_top                                          # ... and not into unit 2
+    assert second.start["Z"] > z_top and second.end["Z"] < z_top - b2       # across unit 2
+    # feeds per workpiece revolution are the same; per minute they follow each unit's teeth
+    assert abs(second.feed / first.feed - g["z2"] / teeth2) < 0.01
+    egon_blocks = [block.index for block in nc.blocks if block.call("EGON")]
+    assert egon_blocks[1] > first.block and egon_blocks[1] < second.block
+
+
+def test_duplex_refuses_units_too_close_for_the_hob(conn):
+    conn.execute("UPDATE gear_unit SET z_top = -30 WHERE gear_id = 54")
+    with pytest.raises(EngineError, match="wider gap"):
+        instantiate_gear(conn, 54)
+
+
+def test_duplex_inherits_spur_rows_and_stores_only_its_own(conn):
+    own = conn.execute("SELECT count(*) FROM assembly WHERE gear_class = 'duplex'").fetchone()[0]
+    spur = conn.execute("SELECT count(*) FROM assembly WHERE gear_class = 'spur'").fetchone()[0]
+    assembled = conn.execute("SELECT count(*), count(*) FILTER (WHERE inherited_from = 'spur') "
+                             "FROM template_view WHERE gear_class = 'duplex'").fetchone()
+    assert assembled == (own + spur, spur) and own < spur
+    conn.execute("""UPDATE component SET o = 'f"G0 X{x_retract:.3f} Z{z_start:.3f} ; SPUR"' WHERE id =
+                    (SELECT component_id FROM assembly WHERE gear_class = 'spur' AND id = 1250)""")
+    program = instantiate_gear(conn, 54)
+    assert sum(line.endswith("; SPUR") for line in program.lines) == 1, "spur's edit reaches duplex"
+
+
+# ---------------------------------------------------------------- helical differential, feed modes
+
+@pytest.mark.parametrize("gear_id", [43, 44])
+@pytest.mark.parametrize("feed_mode", ["climb", "conventional"])
+def test_helical_differential_has_the_hands_sign_in_either_feed_mode(conn, gear_id, feed_mode):
+    program, nc = program_of(conn, gear_id, feed_mode=feed_mode)
+    g = gear(conn, gear_id)
+    size = 360 * math.sin(math.radians(g["beta"])) / (math.pi * g["mn"] * g["z2"])   # §B9
+    egon = nc.block_with("EGON").call("EGON").args
+    assert egon[5] == "Z" and abs(float(egon[6]) - (size if g["hand"] == "R" else -size)) < 1e-6
+
+
+def test_conventional_enters_below_the_blank_and_feeds_up(conn):
+    program, nc = program_of(conn, 42, feed_mode="conventional")
+    g, hob = gear(conn, 42), hob_of(conn, program)
+    axial = [m for m in cutting_moves(nc) if m.changed == {"Z"}][-1]
+    infeed = [m for m in cutting_moves(nc) if m.changed == {"X"}][-1]
+    h = (g["da2"] + hob["da0"]) / 2 - infeed.end["X"]
+    approach = math.sqrt(h * (hob["da0"] - h))                       # §B7 spur
+    assert infeed.end["Z"] <= -g["b"] - approach                       # infeed in air below the blank
+    assert axial.end["Z"] > 0 > axial.start["Z"]
+
+
+def test_conventional_climb_roughs_up_and_finishes_down(conn):
+    program, nc = program_of(conn, 45, feed_mode="conventional-climb")
+    rough, finish = [m for m in cutting_moves(nc) if m.changed == {"Z"}]
+    assert rough.end["Z"] > rough.start["Z"] and finish.end["Z"] < finish.start["Z"]
+    assert finish.start["X"] < rough.start["X"]
+
+
+def test_tailstock_and_coolant_are_rows_switched_by_the_job(conn):
+    program, nc = program_of(conn, 42, tailstock=False, coolant=False)
+    assert not {"M20", "M21", "M8", "M9"} & set(nc.events)
+    program, nc = program_of(conn, 42)
+    assert nc.index("M20") < nc.index("motion") and nc.index("M21") > nc.indexes("motion")[-1]
+
+
+# ---------------------------------------------------------------- shifting
+
+def test_shift_per_part_walks_within_the_usable_hob_length(conn):
+    program, nc = program_of(conn, 42, shift_per_part=2.5)
+    g, hob = gear(conn, 42), hob_of(conn, program)
+    generating = 2 * 2.25 * g["mn"] / math.tan(math.radians(g["alpha"])) + math.pi * g["mn"]   # §B15
+    half = (hob["length"] - generating - 2 * 5.0) / 2
+    statements = [block.statement for block in nc.blocks if block.statement]
+    assert statements[0].startswith("R11=R11+2.500")
+    assert statements[1] == f"IF (R11<{-half:.3f}) OR (R11>{half:.3f})"
+    assert nc.index("Y=R") is not None and nc.index("Y=R") < nc.index("move G1")
+    limits = nc.block_with("G25").words["Y"], nc.block_with("G26").words["Y"]
+    assert limits[0] <= -half and limits[1] >= half
+
+
+def test_a_shift_step_of_whole_axial_pitches_is_refused(conn):
+    program = instantiate_gear(conn, 42)
+    hob = hob_of(conn, program)
+    pitch = math.pi * hob["mn"] / math.cos(math.radians(lead_angle(hob)))
+    with pytest.raises(EngineError, match="axial pitch"):
+        instantiate_gear(conn, 42, choices=Choices(shift_per_part=round(2 * pitch, 3)))
+    with pytest.raises(EngineError, match="no hob has length"):   # the hob is too short for the step
+        instantiate_gear(conn, 42, choices=Choices(shift_per_part=80))
+
+
+# ---------------------------------------------------------------- classification and refusals
+
+def test_classify_explains_the_path(run):
+    out = run("classify", "--gear", 50).stdout
+    assert out.splitlines()[0] == "gear 50: class taper"
+    assert "yes (cone_angle = 6.5) → taper" in out and "H-M2-AA-R1" in out
+    out = run("classify", "--gear", 53).stdout
+    assert "named class worm_wheel explicitly" in out and "H-WW-M3-R1" in out
+    out = run("classify", "--gear", 54).stdout
+    assert "has it further toothed units? yes" in out and "→ duplex" in out
+
+
+def test_a_gear_no_class_fits_is_refused_with_the_reason(run, tmp_path):
+    path = tmp_path / "gears.csv"
+    path.write_text("gear_id,module,teeth,face_width,cone_angle,crowning\n900,2,19,20,6.5,0.02\n")
+    result = run("gears", "import", path)
+    assert result.exit_code == 1
+    assert "line 2: no class hobs a crowned taper gear" in result.stderr + result.stdout
+
+
+def test_a_gear_no_hob_fits_is_refused_with_the_property(run, tmp_path):
+    path = tmp_path / "gears.csv"
+    path.write_text("gear_id,module,teeth,face_width\n901,1.25,40,12\n")
+    assert run("gears", "import", path).exit_code == 0
+    result = run("instantiate", "--gear", 901)
+    assert result.exit_code == 1 and "Traceback" not in result.stderr
+    assert "no hob" in result.stderr and "module 1.25" in result.stderr
+    assert len(result.stderr.strip().splitlines()) == 1
+
+
+def test_suggest_for_the_papers_gear_proposes_its_published_data(run):
+    import json
+
+    out = run("suggest", "--gear", 50, "--json")
+    assert out.exit_code == 0, out.output
+    proposal = json.loads(out.stdout)
+    text = json.dumps(proposal)
+    assert '"hob_speed": 246' in text and "105.0" in text and "36.0" in text
+    assert "8.11 mm per workpiece rev is above the typical" in text
