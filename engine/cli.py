@@ -125,3 +125,5 @@ def seed_command(ctx):
 
 
 from . import cli_commands  # noqa: E402,F401  (registers the remaining commands on `main`)
+from .cli_nc import import_nc_command  # noqa: E402
+main.add_command(import_nc_command)
