@@ -130,3 +130,5 @@ main.add_command(hobs)
 from .cli_cases import cases, suggest  # noqa: E402  (cutting data from the machining history)
 main.add_command(suggest)
 main.add_command(cases)
+from .cli_nc import import_nc_command  # noqa: E402
+main.add_command(import_nc_command)

@@ -1,0 +1,197 @@
+"""Tokenising one NC line into units (design notes §5), losslessly.
+
+`detokenise(tokenise(line)) == line` for every string: each rule consumes at least one
+character and a token's text is exactly what it consumed. The kinds:
+
+* word    an address or keyword: `G`, `X`, `g`, `EGON`, `IF`, `sub`, `$` (LinuxCNC spindle)
+* number  `01`, `250.`, `-.4`, `0.0500`; `address` names the word it belongs to
+          (`G01` → address G; `A=-1.763` → address A; in `[2.5 / #<s>]` none)
+* param   an NC parameter (variable) reference: `#1`, `#<_x>`, `#<_hal[a.b]>`, and the
+          Sinumerik R parameter in `R1=5` and `X=R1+2`
+* name    an identifier with digits or underscores: `CYCLE800`, `_X_HOME`, `$AA_IM`
+* label   a block label at the start of a block: `N10`, `O100`, `O<turning>`, `MARKE1:`
+* comment `; to the end`, `(…)` with nested parentheses (`((…))`), unclosed to the end
+* string  `"DRILL 8.5"`
+* symbol  `=`, `[`, `]`, `,`, `+`, `%`, … ; `(` and `)` of a call or grouping
+* space   blanks, tabs, carriage returns
+* text    anything else (EMCO's back-quotes, stray bytes)
+
+`(` opens a comment unless it follows a word or name directly (`EGON(`, `MSG(`) or an
+operator (`=(`), where it is Sinumerik's call or grouping parenthesis. A sign belongs to a
+number unless it follows a value (number, param, name, string, `]`, `)`) with no blank in
+between: `X-170` and `01 -1000` are negative numbers, `#14-#3` and `#13-5` are subtractions.
+"""
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, replace
+from decimal import Decimal
+
+WORD, NUMBER, PARAM, NAME, LABEL = "word", "number", "param", "name", "label"
+COMMENT, STRING, SYMBOL, SPACE, TEXT = "comment", "string", "symbol", "space", "text"
+
+AXIS_LETTERS = frozenset("XYZABCUVW")
+_VALUE_KINDS = frozenset({NUMBER, PARAM, NAME, STRING})
+_OPERATORS = frozenset("=+-*/(,[<>")
+
+
+@dataclass(frozen=True, slots=True)
+class Token:
+    kind: str
+    text: str
+    address: str | None = None   # numbers only: the word (upper case) whose value it is
+
+
+@dataclass
+class _Context:
+    tokens: list
+
+    def previous(self) -> Token | None:
+        """The last token that is not blank."""
+        for token in reversed(self.tokens):
+            if token.kind != SPACE:
+                return token
+        return None
+
+    def spaced(self) -> bool:
+        return bool(self.tokens) and self.tokens[-1].kind == SPACE
+
+    def at_block_start(self) -> bool:
+        return all(t.kind == SPACE or t.text == "/" for t in self.tokens)
+
+    def after_value(self) -> bool:
+        previous = self.previous()
+        return previous is not None and (previous.kind in _VALUE_KINDS or previous.text in (")", "]"))
+
+    def in_expression(self) -> bool:
+        previous = self.previous()
+        return previous is not None and previous.kind == SYMBOL and previous.text in _OPERATORS
+
+    def opens_group(self) -> bool:
+        previous = self.previous()
+        if previous is None:
+            return False
+        if previous.kind in (WORD, NAME) and not self.spaced():
+            return True
+        return self.in_expression()
+
+
+def _regex(pattern: str, when=lambda context: True):
+    compiled = re.compile(pattern, re.ASCII)
+
+    def match(line: str, position: int, context: _Context) -> int | None:
+        found = compiled.match(line, position)
+        return found.end() if found and found.end() > position and when(context) else None
+    return match
+
+
+def _paren_comment(line: str, position: int, context: _Context) -> int | None:
+    """A `(…)` comment with nested parentheses; unclosed, it runs to the end of the line."""
+    if line[position] != "(" or context.opens_group():
+        return None
+    depth = 0
+    for index in range(position, len(line)):
+        depth += {"(": 1, ")": -1}.get(line[index], 0)
+        if depth == 0:
+            return index + 1
+    return len(line)
+
+
+def _word_or_name(line: str, position: int, context: _Context) -> tuple[str, int] | None:
+    found = re.compile(r"\$?[A-Za-z_]+").match(line, position)
+    if not found:
+        return (WORD, position + 1) if line[position] == "$" else None
+    letters, end = found.group(), found.end()
+    digits_follow = end < len(line) and line[end] in "0123456789"
+    if "_" in letters or letters.startswith("$") or (len(letters) > 1 and digits_follow):
+        return NAME, re.compile(r"[A-Za-z0-9_]*").match(line, end).end()
+    return WORD, end
+
+
+_NUMBER = r"(?:\d+\.?\d*|\.\d+)"
+
+# (kind, matcher) tried in order at each position; the first that matches wins.
+RULES = (
+    (SPACE, _regex(r"\s+")),
+    (COMMENT, _regex(r";.*")),
+    (COMMENT, _paren_comment),
+    (STRING, _regex(r'"[^"]*"?')),
+    (PARAM, _regex(r"#(?:<[^>]*>?|\d+)")),
+    (LABEL, _regex(r"[Nn]\d+|[Oo](?:<[^>]*>?|\d+)|[A-Za-z_]\w*:(?!=)", _Context.at_block_start)),
+    (PARAM, _regex(r"[Rr]\d+(?=\s*=(?!=))")),
+    (PARAM, _regex(r"[Rr]\d+", _Context.in_expression)),
+    (NUMBER, _regex(r"[+-]" + _NUMBER, lambda context: context.spaced() or not context.after_value())),
+    (NUMBER, _regex(_NUMBER)),
+    (None, _word_or_name),
+    (SYMBOL, _regex(r"[=\[\](),+\-*/<>:%&|!^~?@{}]")),
+    (TEXT, _regex(r".", )),
+)
+
+
+def tokenise(line: str) -> list[Token]:
+    """The units of one NC line, in order; their texts concatenate to the line."""
+    context = _Context([])
+    position = 0
+    while position < len(line):
+        kind, end = _next(line, position, context)
+        token = Token(kind, line[position:end])
+        if kind == NUMBER:
+            token = replace(token, address=_address(context))
+        if kind == TEXT and context.tokens and context.tokens[-1].kind == TEXT:
+            token = Token(TEXT, context.tokens.pop().text + token.text)
+        context.tokens.append(token)
+        position = end
+    return context.tokens
+
+
+def _next(line: str, position: int, context: _Context) -> tuple[str, int]:
+    for kind, matcher in RULES:
+        found = matcher(line, position, context)
+        if found is None:
+            continue
+        if kind is None:
+            return found
+        return kind, found
+    return TEXT, position + 1   # unreachable: the TEXT rule matches any character but "\n"
+
+
+def _address(context: _Context) -> str | None:
+    """The word a number is the value of: `X-170`, `X #14`, `A=-1.763`, `M1=3`."""
+    significant = [t for t in context.tokens if t.kind != SPACE]
+    if significant and significant[-1].text == "=":
+        significant.pop()
+        if significant and significant[-1].kind == NUMBER and significant[-1].address:
+            return significant[-1].address        # `M1=3`: the value of M's extension
+    if significant and significant[-1].kind == WORD:
+        return significant[-1].text.upper()
+    return None
+
+
+def detokenise(tokens) -> str:
+    return "".join(token.text for token in tokens)
+
+
+@dataclass(frozen=True)
+class LineFacts:
+    """What a line says, for module assignment: codes `G1`/`M8`, words, axes, code or not."""
+    codes: frozenset
+    words: frozenset
+    axes: frozenset
+    has_code: bool
+    first: Token | None
+    labels: tuple
+
+
+def code_number(text: str) -> str:
+    """`01` → `1`, `91.10` → `91.1`: the number of a G or M code as it is meant."""
+    return format(Decimal(text).normalize(), "f")
+
+
+def facts(tokens) -> LineFacts:
+    significant = [t for t in tokens if t.kind not in (SPACE, COMMENT)]
+    words = frozenset(t.text.upper() for t in significant if t.kind in (WORD, NAME))
+    codes = frozenset(t.address + code_number(t.text) for t in significant
+                      if t.kind == NUMBER and t.address in ("G", "M"))
+    return LineFacts(codes, words, words & AXIS_LETTERS, bool(significant),
+                     significant[0] if significant else None,
+                     tuple(t.text.upper() for t in significant if t.kind == LABEL))
