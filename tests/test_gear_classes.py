@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import math
 
+import psycopg
 import pytest
 
 from engine.errors import EngineError
@@ -300,3 +301,19 @@ def test_suggest_for_the_papers_gear_proposes_its_published_data(run):
     text = json.dumps(proposal)
     assert '"hob_speed": 246' in text and "105.0" in text and "36.0" in text
     assert "8.11 mm per workpiece rev is above the typical" in text
+
+
+def test_a_confirmed_job_becomes_a_case_of_the_history(run):
+    import json
+
+    job_id = json.loads(run("instantiate", "--gear", 45, "--json").stdout)["job_id"]
+    before = json.loads(run("cases", "list", "--json").stdout)["cases"]
+    confirmed = run("cases", "confirm", "--job", job_id)
+    assert confirmed.exit_code == 0, confirmed.output
+    new = json.loads(run("cases", "list", "--json").stdout)["cases"][len(before):]
+    assert [(case["cut"], case["job_id"]) for case in new] == [("rough", job_id), ("finish", job_id)]
+    with psycopg.connect(run.url) as conn:
+        cutting = conn.execute("SELECT cutting FROM job WHERE id = %s", (job_id,)).fetchone()[0]
+    assert [case["axial_feed"] for case in new] == [cutting["rough"]["axial_feed"], cutting["finish"]["axial_feed"]]
+    again = run("cases", "confirm", "--job", job_id)
+    assert again.exit_code == 1 and "already confirmed" in again.stderr
