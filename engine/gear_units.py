@@ -7,7 +7,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from .errors import EngineError
-from .gears import (POSITIVE, Column, GearImportError, _parse_cell, _read_records, derived_diameters,
+from .gears import (POSITIVE, Column, GearImportError, _parse_cell, read_records, derived_diameters,
                     parse_number, parse_positive_whole)
 
 UNIT_COLUMNS: tuple[Column, ...] = (
@@ -30,7 +30,7 @@ def import_units(conn, path: str | Path, only_gears: set[int] | None = None) -> 
     """Store the units of the CSV at `path` (only those of `only_gears` if given); return
     how many. Raises GearImportError listing every problem."""
     path = Path(path)
-    records = _read_records(path)
+    records = read_records(path)
     if len(records) < 2:
         raise EngineError(f"{path} has no unit rows")
     names = [cell.lower() for cell in records[0][1]]

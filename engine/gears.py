@@ -154,7 +154,7 @@ def derived_diameters(module: Any, teeth: int, helix_angle: Any = 0,
 Record = tuple[int, list[str]]  # (physical line the record starts on, its cells)
 
 
-def _read_records(path: Path) -> list[Record]:
+def read_records(path: Path) -> list[Record]:
     """Every non-blank CSV record of the file with the line it starts on, cells stripped."""
     records: list[Record] = []
     try:
@@ -337,7 +337,7 @@ def read_gears(path: str | Path, classes: dict[str, bool]) -> list[dict[str, Any
     diameters), keyed by column name. `classes` maps each installed gear class to whether
     it has template rows (a class gears can be in). Raises GearImportError listing every problem, or EngineError."""
     path = Path(path)
-    records = _read_records(path)
+    records = read_records(path)
     if len(records) < 2:
         raise EngineError(f"{path} has no gear rows")
     names = _header_names(path, records[0][1])

@@ -7,7 +7,6 @@ physical line number in the file (header = line 1), and only a good file is stor
 """
 from __future__ import annotations
 
-import csv
 from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import Any
@@ -16,7 +15,7 @@ import psycopg
 from psycopg import sql
 
 from .errors import EngineError
-from .gears import (POSITIVE, TOOTH_DEPTH, CellError, Column, parse_hand, parse_number,
+from .gears import (POSITIVE, TOOTH_DEPTH, CellError, Column, parse_hand, parse_number, read_records,
                     parse_positive_whole, parse_text)
 from .hobs import ACCURACY_CLASSES, PURPOSES, HobChoice, choose_hob
 from .models import ancestry
@@ -149,28 +148,6 @@ def add_hob(conn: psycopg.Connection, hob: Hob) -> None:
 
 # --- a CSV file of hobs ------------------------------------------------------------------
 
-def _records(path: Path) -> list[tuple[int, list[str]]]:
-    """Every non-blank record of the file with the physical line it starts on."""
-    records = []
-    try:
-        with open(path, encoding="utf-8-sig", newline="") as handle:
-            reader = csv.reader(handle)
-            start = 1
-            for record in reader:
-                if any(cell.strip() for cell in record):
-                    records.append((start, [cell.strip() for cell in record]))
-                start = reader.line_num + 1
-    except FileNotFoundError:
-        raise EngineError(f"{path}: no such file") from None
-    except UnicodeDecodeError as error:
-        raise EngineError(f"{path}: not UTF-8 text (byte at offset {error.start})") from None
-    except OSError as error:
-        raise EngineError(f"{path}: cannot read it ({error.strerror or error})") from None
-    except csv.Error as error:
-        raise EngineError(f"{path}: line {reader.line_num}: not valid CSV ({error})") from None
-    return records
-
-
 def _header(path: Path, cells: list[str]) -> list[str]:
     names = [cell.lower() for cell in cells]
     unknown = [name for name in names if name not in COLUMN_NAMES]
@@ -196,7 +173,7 @@ def read_hobs(path: str | Path) -> list[dict[str, Any]]:
     """Every hob of the CSV file at `path`, checked, keyed by column name.
     Raises HobImportError listing every problem of every row, or EngineError."""
     path = Path(path)
-    records = _records(path)
+    records = read_records(path)
     if len(records) < 2:
         raise EngineError(f"{path} has no hob rows")
     names = _header(path, records[0][1])
