@@ -115,7 +115,7 @@ def is_relevant(layer: str) -> bool:
 
 def collect(modelspace, sagitta: float) -> Collected:
     """One pass over model space: segments, texts and points of layer 0 and layers 1 … n."""
-    collected = Collected()
+    collected, own = Collected(), Context(sagitta)
     for entity in modelspace:
         with named_on_failure(entity):
             layer = entity.dxf.layer
@@ -124,7 +124,7 @@ def collect(modelspace, sagitta: float) -> Collected:
                 for effective_layer, part in inserted_entities(entity, layer):
                     take(part, effective_layer, context, collected)
             else:
-                take(entity, layer, Context(sagitta), collected)
+                take(entity, layer, own, collected)
     return collected
 
 

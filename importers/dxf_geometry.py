@@ -61,13 +61,6 @@ Segment = Union[Line, Arc]
 
 
 @dataclass(frozen=True)
-class Placed:
-    """A segment with the layer it belongs to (after INSERT layer inheritance)."""
-    layer: str
-    segment: Segment
-
-
-@dataclass(frozen=True)
 class Context:
     sagitta: float  # FLATTEN_TOLERANCE_MM in drawing units
     handle: str = ""  # handle of the top-level entity (virtual block content has none)

@@ -35,10 +35,13 @@ END_MATCH_TOLERANCE_MM = 0.01
 # The profile must be at least this share of the length of everything drawn on layer 0.
 PROFILE_SHARE_MIN = 0.5
 TWO_PI = 2.0 * math.pi
+HALF_PI = math.pi / 2.0
 
 
 def scaled(segment: Segment, scale: float, mirror: bool = False) -> Segment:
     """Drawing (x, y) → machine (z, radius) in mm; mirror maps radius −r to r."""
+    if scale == 1.0 and not mirror:
+        return segment  # segments are immutable: a millimetre drawing needs no copy
     sign = -1.0 if mirror else 1.0
 
     def point(p: Point) -> Point:
@@ -66,17 +69,24 @@ def length(segment: Segment) -> float:
 def bounds(segment: Segment) -> tuple[float, float, float, float]:
     """(z_min, z_max, r_min, r_max) including the extreme points of an arc."""
     (z0, r0), (z1, r1) = segment.start, segment.end
+    z_min, z_max, r_min, r_max = min(z0, z1), max(z0, z1), min(r0, r1), max(r0, r1)
     if isinstance(segment, Line):
-        return min(z0, z1), max(z0, z1), min(r0, r1), max(r0, r1)
-    points = [segment.start, segment.end]
+        return z_min, z_max, r_min, r_max
     (cz, cr), radius = segment.centre, segment.radius
-    a0, turn = math.atan2(r0 - cr, z0 - cz), sweep(segment)
-    for quadrant in range(4):
-        angle = quadrant * math.pi / 2.0
-        if ((angle - a0) if segment.ccw else (a0 - angle)) % TWO_PI <= turn:
-            points.append((cz + radius * math.cos(angle), cr + radius * math.sin(angle)))
-    zs, rs = [p[0] for p in points], [p[1] for p in points]
-    return min(zs), max(zs), min(rs), max(rs)
+    a0, a1 = math.atan2(r0 - cr, z0 - cz), math.atan2(r1 - cr, z1 - cz)
+    if not segment.ccw:
+        a0, a1 = a1, a0  # the same points, swept counter-clockwise from a1 to a0
+    turn = (a1 - a0) % TWO_PI
+    # The circle's extreme points at 0°, 90°, 180°, 270° count where the sweep reaches them.
+    if -a0 % TWO_PI <= turn:
+        z_max = cz + radius
+    if (HALF_PI - a0) % TWO_PI <= turn:
+        r_max = cr + radius
+    if (math.pi - a0) % TWO_PI <= turn:
+        z_min = cz - radius
+    if (3 * HALF_PI - a0) % TWO_PI <= turn:
+        r_min = cr - radius
+    return z_min, z_max, r_min, r_max
 
 
 def merged_bounds(segments: Sequence[Segment]) -> tuple[float, float, float, float]:
