@@ -1,0 +1,219 @@
+"""read_drawing: a DXF turning drawing (design notes §8) → Drawing, or one DxfError line.
+
+Layer `0` holds the profile and at most one POINT (the tool-change position); layers named
+`1` … `n` hold the tool-centre path of operation n and its @-codes as TEXT/MTEXT. Only
+model space counts. Layers with other names (dimensions, hatch, centre lines) are left
+out and listed in `notes`; so are TEXTs on layer 0 (no @-codes there). Lengths come out
+in mm, in machine coordinates (z, radius), scaled by $INSUNITS (unitless: mm). @-code
+values are taken as written: r/min, mm/min or mm/rev, mm — the seed's units, whatever
+the drawing's length unit.
+"""
+from __future__ import annotations
+
+from collections import Counter, defaultdict
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import NamedTuple
+
+from .dxf_codes import CodeText, layer_codes
+from .dxf_geometry import (FLATTEN_TOLERANCE_MM, HANDLERS, Context, Segment, inserted_entities,
+                           named_on_failure, segments_of, unit_scale)
+from .dxf_profile import Profile, chain_segments, find_profile, scaled
+from .dxf_read import DxfError, ezdxf_warnings, load_drawing_file, summarised
+
+PROFILE_LAYER = "0"
+TEXT_TYPES = ("TEXT", "MTEXT")
+# Codes an operation kind cannot do without (a thread cannot be cut without its pitch).
+REQUIRED_CODES = {"THREAD": ("thread_pitch",)}
+
+
+class MachinePoint(NamedTuple):
+    """A point in machine coordinates: z and radius in mm (X in a program is the diameter)."""
+    z: float
+    radius: float
+
+    @property
+    def x_diameter(self) -> float:
+        return 2.0 * self.radius
+
+
+@dataclass
+class Operation:
+    """One operation layer: number n (= its order and tool by convention), kind (@G), the
+    other @-codes by name, and its tool-centre path chained into paths (mm, z/radius)."""
+    layer: str
+    number: int
+    kind: str
+    codes: dict[str, object]
+    paths: list[list[Segment]]
+
+    @property
+    def segments(self) -> list[Segment]:
+        return [segment for path in self.paths for segment in path]
+
+
+@dataclass
+class Drawing:
+    """A drawing that can become a job. repairs: what the tolerant reader and the auditor
+    fixed in the file; notes: what the reader assumed or left out (units, other layers,
+    entity types without geometry, chains on layer 0 besides the profile)."""
+    source: Path
+    units: str
+    scale_to_mm: float
+    profile: Profile
+    operations: list[Operation]
+    tool_change: MachinePoint | None
+    repairs: list[str] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+
+
+@dataclass
+class LayerContent:
+    segments: list[Segment] = field(default_factory=list)
+    texts: list[CodeText] = field(default_factory=list)
+    points: list[tuple[str, tuple[float, float]]] = field(default_factory=list)
+
+
+@dataclass
+class Collected:
+    layers: dict[str, LayerContent] = field(default_factory=lambda: defaultdict(LayerContent))
+    skipped: Counter = field(default_factory=Counter)
+    other_layers: Counter = field(default_factory=Counter)
+
+
+def read_drawing(path: str | Path) -> Drawing:
+    """Read a turning drawing; DxfError (one line naming the layer, handle or text) if it
+    cannot become a job."""
+    with ezdxf_warnings() as warnings:
+        drawing_file = load_drawing_file(path)
+        units, scale, assumed = unit_scale(drawing_file.doc.header.get("$INSUNITS"))
+        collected = collect(drawing_file.doc.modelspace(), FLATTEN_TOLERANCE_MM / scale)
+    layer0 = collected.layers.get(PROFILE_LAYER, LayerContent())
+    if not layer0.segments:
+        raise DxfError(no_geometry_message(collected))
+    chains = chain_segments([scaled(s, scale) for s in layer0.segments])
+    profile = find_profile(chains)
+    operations = [operation(name, number, collected.layers[name], scale, profile.mirrored)
+                  for number, name in operation_layers(collected.layers)]
+    tool_change = tool_change_point(layer0.points, scale, profile.mirrored)
+    notes = reading_notes(units, assumed, collected, profile) + summarised(warnings)
+    if len(chains) > 1:
+        notes.append(f"layer 0: {len(chains) - 1} other chain(s) are not part of the profile, left out")
+    return Drawing(drawing_file.path, units, scale, profile, [op for op in operations if op],
+                   tool_change, drawing_file.repairs, notes)
+
+
+def operation_number(layer: str) -> int | None:
+    """n for an operation layer named n (1, 2, …; '01' too), else None."""
+    name = layer.strip()
+    return int(name) if name.isdecimal() and int(name) > 0 else None
+
+
+def is_relevant(layer: str) -> bool:
+    return layer == PROFILE_LAYER or operation_number(layer) is not None
+
+
+def collect(modelspace, sagitta: float) -> Collected:
+    """One pass over model space: segments, texts and points of layer 0 and layers 1 … n."""
+    collected, own = Collected(), Context(sagitta)
+    for entity in modelspace:
+        with named_on_failure(entity):
+            layer = entity.dxf.layer
+            if entity.dxftype() == "INSERT":
+                context = Context(sagitta, entity.dxf.handle)
+                for effective_layer, part in inserted_entities(entity, layer):
+                    take(part, effective_layer, context, collected)
+            else:
+                take(entity, layer, own, collected)
+    return collected
+
+
+def take(entity, layer: str, context: Context, collected: Collected) -> None:
+    kind = entity.dxftype()
+    if not is_relevant(layer):
+        collected.other_layers[layer] += 1
+        return
+    content = collected.layers[layer]
+    handle = context.handle or entity.dxf.handle
+    if kind in HANDLERS:
+        content.segments.extend(segments_of(entity, context))
+    elif kind in TEXT_TYPES:
+        content.texts.append(CodeText(layer, handle, entity.plain_text()))
+    elif kind == "POINT":
+        location = entity.dxf.location
+        content.points.append((handle, (location.x, location.y)))
+    else:
+        collected.skipped[kind] += 1
+
+
+def operation_layers(layers: dict[str, LayerContent]) -> list[tuple[int, str]]:
+    """(operation number, layer name) in order; two names for one number is an error."""
+    numbered: dict[int, str] = {}
+    for name in layers:
+        number = operation_number(name)
+        if number is None:
+            continue
+        if number in numbered:
+            raise DxfError(f"layers {numbered[number]!r} and {name!r} both mean operation {number}; "
+                           "merge them into one layer")
+        numbered[number] = name
+    return sorted(numbered.items())
+
+
+def operation(name: str, number: int, content: LayerContent, scale: float,
+              mirror: bool) -> Operation | None:
+    """The operation on one numbered layer; None for a layer with neither path nor codes."""
+    codes = layer_codes(content.texts)
+    if not content.segments and not codes:
+        return None
+    if "kind" not in codes:
+        raise DxfError(f"layer {name!r} (operation {number}) has a tool path of {len(content.segments)} "
+                       f"segment(s) but no @G code; add a TEXT like '@GROUGH' on that layer "
+                       f"(types: ROUGH SLOT FINISH THREAD FACE PART)")
+    kind = codes.pop("kind")
+    if not content.segments:
+        raise DxfError(f"layer {name!r} (operation {number}, @G {kind}) has no tool path; "
+                       "draw the tool-centre path on that layer")
+    for required in REQUIRED_CODES.get(kind, ()):
+        if required not in codes:
+            raise DxfError(f"layer {name!r} (operation {number}, @G {kind}) needs its {required} "
+                           "(@P for the thread pitch)")
+    paths = chain_segments([scaled(s, scale, mirror) for s in content.segments])
+    return Operation(name, number, kind, codes, [chain.segments for chain in paths])
+
+
+def tool_change_point(points: list[tuple[str, tuple[float, float]]], scale: float,
+                      mirror: bool) -> MachinePoint | None:
+    if not points:
+        return None
+    if len(points) > 1:
+        handles = ", ".join(handle for handle, _ in points[:6])
+        raise DxfError(f"layer 0 has {len(points)} POINTs (handles {handles}); the convention allows "
+                       "one, the tool-change position: delete the others or move them to another layer")
+    _, (x, y) = points[0]
+    return MachinePoint(x * scale, (-y if mirror else y) * scale)
+
+
+def reading_notes(units: str, assumed: bool, collected: Collected, profile: Profile) -> list[str]:
+    notes = []
+    if assumed:
+        notes.append("no drawing units ($INSUNITS unset or unitless): lengths taken as millimetres")
+    if profile.mirrored:
+        notes.append("the profile lies below the axis: mirrored onto it (paths and tool-change point too)")
+    if collected.skipped:
+        listed = ", ".join(f"{count} {kind}" for kind, count in sorted(collected.skipped.items()))
+        notes.append(f"not geometry, left out on layer 0 / operation layers: {listed}")
+    if collected.other_layers:
+        listed = ", ".join(f"{name!r} ({count})" for name, count in sorted(collected.other_layers.items()))
+        notes.append(f"layers that are neither 0 nor an operation number, left out: {listed}")
+    return notes
+
+
+def no_geometry_message(collected: Collected) -> str:
+    elsewhere = {name: len(content.segments) for name, content in collected.layers.items() if content.segments}
+    found = ", ".join(f"layer {name!r}: {count} segment(s)" for name, count in sorted(elsewhere.items()))
+    found = found or ", ".join(f"layer {name!r}: {count} entities" for name, count in
+                               sorted(collected.other_layers.items())[:5])
+    return ("layer 0 has no profile: no LINE, ARC, CIRCLE, polyline, SPLINE or ELLIPSE on layer 0 of "
+            f"model space ({'found ' + found if found else 'model space has no geometry'}); "
+            "draw the part outline on layer 0")

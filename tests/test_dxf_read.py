@@ -1,0 +1,454 @@
+"""Reading turning drawings (design notes §8): real drawings made by other people, drawings
+generated here in the seed-000 convention, and the refusals a user must understand.
+
+Expectations come from the files themselves (counted with ezdxf here), from the
+reference (§E: positive bulge = counter-clockwise, extrusion (0,0,-1) flips an arc), from
+ezdxf's own bulge geometry, and from the NC programs another lathe tool made of the Emco
+drawings (data/nc/emco_from_dxf) — not from the reader's output."""
+from __future__ import annotations
+
+import math
+import random
+import re
+from pathlib import Path
+
+import ezdxf
+import ezdxf.path
+import pytest
+from ezdxf.math import bulge_center
+
+from importers.dxf_codes import CodeText, codes_in, layer_codes
+from importers.dxf_drawing import read_drawing
+from importers.dxf_geometry import FLATTEN_TOLERANCE_MM, Arc, Line
+from importers.dxf_profile import chain_segments
+from importers.dxf_read import DxfError, load_drawing_file
+
+
+def shared_data() -> Path:
+    for folder in Path(__file__).resolve().parents:
+        if (folder / "shared" / "data").is_dir():
+            return folder / "shared" / "data"
+    raise RuntimeError("no shared/data beside the project: the real drawings are missing")
+
+
+DATA = shared_data()
+DXF = DATA / "dxf"
+GEOMETRY = {"LINE", "ARC", "CIRCLE", "LWPOLYLINE", "POLYLINE", "SPLINE", "ELLIPSE"}
+EMCO = ["emco_lathe_testNegDXF_R14.dxf", "emco_lathe_testg02hemisphere_R14.dxf",
+        "emco_lathe_testg03hemisphere_R14.dxf"]
+
+# Per real drawing: what happens and why (the why is checked against the file in FACTS).
+NOTHING_ON_0 = "no geometry on layer 0"
+SCATTERED = "layer 0 is many pieces, none half of it"
+FULL_VIEW = "full side view symmetric about the axis, lines meet in T-junctions"
+CROSSES = "one polyline crossing the axis"
+BINARY = "binary DXF"
+HALF_PROFILE = "half-profile"
+CLOSED = "closed outline on the axis"
+REAL = {
+    "d2g_132_R14.dxf": (NOTHING_ON_0, "layer 0 has no profile"),
+    "d2g_132_R2000.dxf": (NOTHING_ON_0, "layer 0 has no profile"),
+    "d2g_132_R2004.dxf": (NOTHING_ON_0, "layer 0 has no profile"),
+    "d2g_Bogen_Ellipsen_Polylinien_Block_R2007.dxf": (SCATTERED, "no clear profile"),
+    "d2g_DEMO_R10.dxf": (SCATTERED, "no clear profile"),
+    "d2g_FLH-001_R12.dxf": (NOTHING_ON_0, "layer 0 has no profile"),
+    "d2g_Polylinie_R14.dxf": (CROSSES, "crosses the axis"),
+    "d2g_SchlittenBack_R10_polyline.dxf": (NOTHING_ON_0, "layer 0 has no profile"),
+    "d2g_Spirale_R14_spline.dxf": (NOTHING_ON_0, "layer 0 has no profile"),
+    "d2g_Stir_1_R12.dxf": (SCATTERED, "no clear profile"),
+    "d2g_Turbocad_12.5_R14.dxf": (CLOSED, None),
+    "d2gp_Drawing2_R2004_mtext.dxf": (NOTHING_ON_0, "layer 0 has no profile"),
+    "d2gp_fc_mounting_R12.dxf": (SCATTERED, "no clear profile"),
+    "d2gp_fc_mounting_R2013.dxf": (SCATTERED, "no clear profile"),
+    "d2gp_pumpenteile_R2000.dxf": (SCATTERED, "no clear profile"),
+    "emco_lathe_testNegDXF_R14.dxf": (HALF_PROFILE, None),
+    "emco_lathe_testg02hemisphere_R14.dxf": (HALF_PROFILE, None),
+    "emco_lathe_testg03hemisphere_R14.dxf": (HALF_PROFILE, None),
+    "ezdxf_AC1003_LINE_Example.dxf": (NOTHING_ON_0, "layer 0 has no profile"),
+    "ezdxf_Leica_Disto_S910_R12.dxf": (NOTHING_ON_0, "layer 0 has no profile"),
+    "ezdxf_POLI-ALL210_R12_polylines.dxf": (NOTHING_ON_0, "layer 0 has no profile"),
+    "ezdxf_binary_dxf_R2000.dxf": (BINARY, "binary DXF is not supported"),
+    "ezdxf_custom_blocks_R2010.dxf": (SCATTERED, "no clear profile"),
+    "ezdxf_edgeminer_1_polylines_R2018.dxf": (SCATTERED, "no clear profile"),
+    "ezdxf_uncommon_R2018.dxf": (SCATTERED, "no clear profile"),
+    "qcad_M4x25_DIN931_f_R2010.dxf": (NOTHING_ON_0, "layer 0 has no profile"),
+    "qcad_flange_R2013.dxf": (SCATTERED, "no clear profile"),
+    "qcad_screw_R2007.dxf": (FULL_VIEW, "no clear profile"),
+}
+
+
+def layer0_paths(name: str) -> list:
+    """ezdxf paths of the layer-0 geometry in model space, blocks exploded (DXF layer-0 rule)."""
+    try:
+        doc = ezdxf.readfile(DXF / name)
+    except Exception:  # the two damaged files: ezdxf's own tolerant reader
+        doc, _ = ezdxf.recover.readfile(DXF / name)
+    paths = []
+
+    def visit(entity, layer):
+        own = entity.dxf.layer if entity.dxf.layer != "0" else layer
+        if entity.dxftype() == "INSERT":
+            for part in entity.virtual_entities():
+                visit(part, own)
+        elif entity.dxftype() in GEOMETRY and own == "0" and not is_mesh(entity):
+            paths.append(ezdxf.path.make_path(entity))
+
+    for entity in doc.modelspace():
+        visit(entity, entity.dxf.layer)
+    return paths
+
+
+def is_mesh(entity) -> bool:
+    return entity.dxftype() == "POLYLINE" and (entity.is_polygon_mesh or entity.is_poly_face_mesh)
+
+
+def path_length(path) -> float:
+    points = list(path.flattening(0.05))  # shares only need about 1 %
+    return sum(math.dist(a, b) for a, b in zip(points, points[1:]))
+
+
+def largest_piece_share(paths) -> float:
+    """Length share of the largest set of paths connected end to end (union-find on end
+    points): an upper bound for any chain the reader could take as the profile."""
+    parent = list(range(len(paths)))
+
+    def root(i):
+        while parent[i] != i:
+            i = parent[i]
+        return i
+
+    for i, a in enumerate(paths):
+        for j in range(i):
+            b = paths[j]
+            if any(math.dist(p, q) <= 0.01 for p in (a.start, a.end) for q in (b.start, b.end)):
+                parent[root(i)] = root(j)
+    lengths = [path_length(p) for p in paths]
+    pieces: dict[int, float] = {}
+    for i, length in enumerate(lengths):
+        pieces[root(i)] = pieces.get(root(i), 0.0) + length
+    return max(pieces.values()) / sum(lengths)
+
+
+def check_fact(name: str, category: str) -> None:
+    if category == BINARY:
+        assert (DXF / name).read_bytes().startswith(b"AutoCAD Binary DXF")
+        return
+    paths = layer0_paths(name)
+    if category == NOTHING_ON_0:
+        assert paths == []
+    elif category == SCATTERED:
+        assert largest_piece_share(paths) < 0.5
+    elif category == CROSSES:
+        ys = [v.y for v in paths[0].flattening(0.01)]
+        assert len(paths) == 1 and min(ys) < 0 < max(ys)
+    elif category == FULL_VIEW:
+        crossing = [p for p in paths if min(p.start.y, p.end.y) < 0 < max(p.start.y, p.end.y)]
+        assert len(crossing) >= 2
+    else:
+        assert paths
+
+
+@pytest.mark.parametrize("name", sorted(REAL))
+def test_every_real_drawing_reads_or_is_refused_with_its_reason(name):
+    category, refusal = REAL[name]
+    check_fact(name, category)
+    if refusal is None:
+        drawing = read_drawing(DXF / name)
+        assert drawing.profile.closed_by_axis == (category == HALF_PROFILE)
+    else:
+        with pytest.raises(DxfError, match=re.escape(refusal)) as caught:
+            read_drawing(DXF / name)
+        assert "\n" not in str(caught.value)
+
+
+def test_the_list_covers_every_real_drawing():
+    assert sorted(p.name for p in DXF.glob("*.dxf")) == sorted(REAL)
+
+
+def test_a_damaged_file_is_read_tolerantly_and_the_repair_reported():
+    with pytest.raises(Exception):
+        ezdxf.readfile(DXF / "ezdxf_AC1003_LINE_Example.dxf")
+    loaded = load_drawing_file(DXF / "ezdxf_AC1003_LINE_Example.dxf")
+    assert len(loaded.doc.modelspace()) == 22  # 13 LINE + 9 ARC on layer 1, as ezdxf.recover counts
+    assert any("ezdxf.recover" in repair for repair in loaded.repairs)
+
+
+def test_turbocad_outline_is_the_rectangle_not_its_circles():
+    doc = ezdxf.readfile(DXF / "d2g_Turbocad_12.5_R14.dxf")
+    outline = next(e for e in doc.modelspace() if e.dxftype() == "LWPOLYLINE")
+    circles = [e for e in doc.modelspace() if e.dxftype() == "CIRCLE"]
+    corners = {(round(x, 6), round(y, 6)) for x, y in outline.get_points("xy")}
+    perimeter = 2 * (100 + 50)
+    assert outline.closed and perimeter > sum(2 * math.pi * c.dxf.radius for c in circles)
+    profile = read_drawing(DXF / "d2g_Turbocad_12.5_R14.dxf").profile
+    assert {(round(s.start[0], 6), round(s.start[1], 6)) for s in profile.segments} == corners
+    assert profile.bounds == pytest.approx((0, 100, 0, 50))
+
+
+def drawn_end_points(name: str) -> list[tuple[float, float]]:
+    doc = ezdxf.readfile(DXF / name)
+    points = []
+    for entity in doc.modelspace():
+        if entity.dxftype() == "LINE":
+            points += [entity.dxf.start, entity.dxf.end]
+        else:
+            points += [entity.start_point, entity.end_point]
+    return [(p.x, p.y) for p in points]
+
+
+def nc_arc_words(name: str) -> list[str]:
+    """The arc G words (02/03) another tool's Emco program made of this drawing."""
+    stem = name.removeprefix("emco_lathe_").removesuffix("_R14.dxf")
+    text = (DATA / "nc" / "emco_from_dxf" / f"{stem}.cnc").read_text()
+    return re.findall(r"^\s*\d+\s+(0[23])\s", text, flags=re.MULTILINE)
+
+
+@pytest.mark.parametrize("name", EMCO)
+def test_emco_half_profile_reproduces_the_drawn_entities(name):
+    drawn = drawn_end_points(name)
+    below = all(y <= 1e-9 for _, y in drawn)
+    expected = [(x, abs(y)) for x, y in drawn]  # drawn below the axis: mirrored onto it
+    profile = read_drawing(DXF / name).profile
+    vertices = [s.start for s in profile.segments] + [profile.end]
+    for point in expected:
+        assert min(math.dist(point, v) for v in vertices) <= 0.01, point
+    assert profile.closed_by_axis and profile.mirrored == below
+    z_values = [x for x, _ in drawn]
+    assert profile.start[0] == pytest.approx(max(z_values)) and profile.end[0] == pytest.approx(min(z_values))
+    closing = profile.closing_segments()
+    assert closing[0].start == profile.end and closing[-1].end == profile.start
+    assert closing[0].end[1] == 0.0 and closing[-1].start[1] == 0.0
+
+
+@pytest.mark.parametrize("name", EMCO)
+def test_emco_arc_directions_match_the_other_tools_program(name):
+    words = nc_arc_words(name)
+    assert len(words) == 4 and words[:2] == words[2:]  # the finish pass, then its subroutine copy
+    arcs = [s for s in read_drawing(DXF / name).profile.segments if isinstance(s, Arc)]
+    assert [arc.ccw for arc in arcs] == [word == "03" for word in words[:2]]
+
+
+INCH = 25.4
+
+
+def seed_drawing(path: Path, *, rough_codes="@GROUGH @S100 @F1300 @T01 @M8", layer2_codes="@GSLOT\\P@S80 @F20 @T02 @M9",
+                 fmt="asc") -> dict[str, str]:
+    """A drawing in the seed-000 convention, in inches; returns handles of interest."""
+    doc = ezdxf.new("R2010")
+    doc.header["$INSUNITS"] = 1
+    for name in ("1", "2", "3"):
+        doc.layers.add(name)
+    msp = doc.modelspace()
+    msp.add_line((0, 0), (0, 0.5))
+    msp.add_lwpolyline([(0, 0.5, 0), (-1, 0.5, 0.5), (-2, 0.5, 0)], format="xyb")
+    # OCS centre (2.5, 0.5), 180°→360° with extrusion −Z: in WCS from (−2, .5) down to (−3, .5).
+    msp.add_arc((2.5, 0.5), 0.5, 180, 360, dxfattribs={"extrusion": (0, 0, -1)})
+    block = doc.blocks.new("STEP")
+    block.add_line((1, 0.5), (0, 0.5))
+    msp.add_blockref("STEP", (-4, 0))
+    msp.add_line((-4, 0), (-4, 0.5))
+    msp.add_point((1, 1.5))
+    rough = msp.add_text(rough_codes, dxfattribs={"layer": "1", "insert": (1, 2)})
+    for y in (0.9, 0.8, 0.7):
+        msp.add_line((0.1, y), (-3.9, y), dxfattribs={"layer": "1"})
+    slot = msp.add_mtext(layer2_codes, dxfattribs={"layer": "2", "insert": (1, 3)})
+    for x in (-2.3, -2.7):
+        msp.add_line((x, 0.8), (x, 0.1), dxfattribs={"layer": "2"})
+    msp.add_text("@GTHREAD @S700 @T03 @P1.5 @D0.4 @A30", dxfattribs={"layer": "3", "insert": (1, 4)})
+    msp.add_line((-0.2, 0.5), (-0.9, 0.5), dxfattribs={"layer": "3"})
+    msp.add_line((-0.2, 0.45), (-0.9, 0.45), dxfattribs={"layer": "3"})
+    doc.saveas(path, fmt=fmt)
+    return {"rough": rough.dxf.handle, "slot": slot.dxf.handle}
+
+
+def scaled_point(x: float, y: float) -> tuple[float, float]:
+    return (x * INCH, y * INCH)
+
+
+def test_seed_convention_drawing_geometry_in_mm(tmp_path):
+    seed_drawing(tmp_path / "part.dxf")
+    drawing = read_drawing(tmp_path / "part.dxf")
+    assert (drawing.units, drawing.scale_to_mm) == ("in", pytest.approx(INCH))
+    corners = [(0, 0), (0, 0.5), (-1, 0.5), (-2, 0.5), (-3, 0.5), (-4, 0.5), (-4, 0)]
+    profile = drawing.profile
+    assert [s.start for s in profile.segments] + [profile.end] == [
+        pytest.approx(scaled_point(*c)) for c in corners]
+    assert [type(s) for s in profile.segments] == [Line, Line, Arc, Arc, Line, Line]
+    assert profile.closed_by_axis and not profile.mirrored
+    sagitta = 0.5 * 1 / 2  # bulge · chord / 2
+    assert profile.bounds == pytest.approx((-4 * INCH, 0, 0, (0.5 + sagitta) * INCH))
+    assert drawing.tool_change == pytest.approx(scaled_point(1, 1.5))
+
+
+def test_seed_convention_arc_directions_after_ocs(tmp_path):
+    seed_drawing(tmp_path / "part.dxf")
+    bulged, extruded = [s for s in read_drawing(tmp_path / "part.dxf").profile.segments if isinstance(s, Arc)]
+    # Positive bulge, followed in the order drawn: counter-clockwise (§E).
+    assert bulged.ccw is True
+    assert bulged.centre == pytest.approx(scaled_point(*bulge_center((-1, 0.5), (-2, 0.5), 0.5)))
+    # Counter-clockwise in an OCS with extrusion −Z is clockwise seen from +Z (§E).
+    assert extruded.ccw is False
+    assert extruded.centre == pytest.approx(scaled_point(-2.5, 0.5))
+
+
+def test_seed_convention_operations_and_codes(tmp_path):
+    seed_drawing(tmp_path / "part.dxf")
+    operations = read_drawing(tmp_path / "part.dxf").operations
+    assert [(op.layer, op.kind) for op in operations] == [("1", "ROUGH"), ("2", "SLOT"), ("3", "THREAD")]
+    assert operations[0].codes == {"spindle_rpm": 100, "feed": 1300, "tool": 1, "coolant": True}
+    assert operations[1].codes == {"spindle_rpm": 80, "feed": 20, "tool": 2, "coolant": False}
+    assert operations[2].codes == {"spindle_rpm": 700, "tool": 3, "thread_pitch": 1.5,
+                                   "depth_per_pass": 0.4, "infeed_angle": 30}
+    rough = operations[0]
+    assert len(rough.paths) == 3
+    assert rough.paths[0][0].start == pytest.approx(scaled_point(0.1, 0.9))
+    assert rough.paths[0][0].end == pytest.approx(scaled_point(-3.9, 0.9))
+
+
+def test_spline_and_ellipse_are_lines_within_the_tolerance(tmp_path):
+    doc = ezdxf.new("R2010")
+    doc.header["$INSUNITS"] = 4
+    msp = doc.modelspace()
+    msp.add_ellipse((-20, 0), major_axis=(20, 0), ratio=0.5, start_param=0, end_param=math.pi / 2)
+    spline = msp.add_spline([(-20, 10), (-25, 12), (-30, 9), (-35, 10)])
+    msp.add_line((-35, 10), (-40, 10))
+    msp.add_line((-40, 10), (-40, 0))
+    doc.saveas(tmp_path / "curves.dxf")
+    profile = read_drawing(tmp_path / "curves.dxf").profile
+    assert profile.closed_by_axis
+    on_ellipse = [s for s in profile.segments if s.start[0] >= -20 - 1e-9 and s.end[0] >= -20 - 1e-9]
+    assert len(on_ellipse) > 10
+    for s in on_ellipse:  # the true ellipse between two chord ends stays within tolerance
+        t0, t1 = (math.atan2(p[1] / 10, (p[0] + 20) / 20) for p in (s.start, s.end))
+        deviation = max(distance_to_chord(((-20 + 20 * math.cos(t), 10 * math.sin(t))), s)
+                        for t in (t0 + (t1 - t0) * k / 50 for k in range(51)))
+        assert deviation <= FLATTEN_TOLERANCE_MM * 1.01
+    exact = [(v.x, v.y) for v in spline.construction_tool().approximate(400)]
+    on_spline = [s for s in profile.segments if -35 - 1e-9 <= min(s.start[0], s.end[0]) and max(s.start[0], s.end[0]) <= -20 + 1e-9]
+    for point in exact:
+        assert min(distance_to_segment(point, s) for s in on_spline) <= FLATTEN_TOLERANCE_MM * 1.01
+
+
+def distance_to_chord(point, segment) -> float:
+    (x0, y0), (x1, y1) = segment.start, segment.end
+    return abs((x1 - x0) * (y0 - point[1]) - (x0 - point[0]) * (y1 - y0)) / math.dist(segment.start, segment.end)
+
+
+def distance_to_segment(point, segment) -> float:
+    (x0, y0), (x1, y1) = segment.start, segment.end
+    dx, dy = x1 - x0, y1 - y0
+    t = max(0.0, min(1.0, ((point[0] - x0) * dx + (point[1] - y0) * dy) / (dx * dx + dy * dy)))
+    return math.dist(point, (x0 + t * dx, y0 + t * dy))
+
+
+def test_no_profile_is_refused_naming_what_was_found(tmp_path):
+    doc = ezdxf.new("R2010")
+    doc.layers.add("1")
+    doc.modelspace().add_line((0, 1), (-10, 1), dxfattribs={"layer": "1"})
+    doc.saveas(tmp_path / "empty0.dxf")
+    with pytest.raises(DxfError, match=r"layer 0 has no profile.*layer '1': 1 segment"):
+        read_drawing(tmp_path / "empty0.dxf")
+
+
+def test_bad_code_value_names_layer_handle_and_text(tmp_path):
+    handles = seed_drawing(tmp_path / "bad.dxf", rough_codes="@GROUGH @Sfast @T01")
+    with pytest.raises(DxfError) as caught:
+        read_drawing(tmp_path / "bad.dxf")
+    message = str(caught.value)
+    assert "layer '1'" in message and f"handle {handles['rough']}" in message
+    assert "'@GROUGH @Sfast @T01'" in message and "@S" in message
+
+
+def test_operation_layer_without_type_is_refused(tmp_path):
+    seed_drawing(tmp_path / "untyped.dxf", layer2_codes="@S80 @F20 @T02")
+    with pytest.raises(DxfError, match=r"layer '2' .*no @G code"):
+        read_drawing(tmp_path / "untyped.dxf")
+
+
+def test_binary_dxf_is_refused_even_with_a_good_profile(tmp_path):
+    seed_drawing(tmp_path / "part.dxf", fmt="bin")
+    assert (tmp_path / "part.dxf").read_bytes().startswith(b"AutoCAD Binary DXF")
+    with pytest.raises(DxfError, match="binary DXF is not supported; save the drawing as ASCII DXF"):
+        read_drawing(tmp_path / "part.dxf")
+
+
+def test_truncated_file_is_refused(tmp_path):
+    whole = (DXF / EMCO[1]).read_bytes()
+    (tmp_path / "half.dxf").write_bytes(whole[: len(whole) // 2])
+    with pytest.raises(DxfError, match="truncated DXF"):
+        read_drawing(tmp_path / "half.dxf")
+
+
+@pytest.mark.parametrize("content, reason", [
+    (b"G0 X10 Z5\nM30\n", "not a DXF file"), (b"AC1032\x00\x00binary", "DWG file"), (b"", "not a DXF file")])
+def test_other_files_are_refused(tmp_path, content, reason):
+    (tmp_path / "thing.dxf").write_bytes(content)
+    with pytest.raises(DxfError, match=reason):
+        read_drawing(tmp_path / "thing.dxf")
+
+
+def test_damaged_files_are_refused_or_read_never_crash(tmp_path):
+    lines = (DXF / EMCO[2]).read_bytes().split(b"\n")
+    rng = random.Random(5)
+    for attempt in range(25):
+        damaged = list(lines)
+        for _ in range(2):
+            where = rng.randrange(4, len(damaged) - 4)
+            damaged[where:where + 1] = rng.choice([[b"abc"], [], [b"0", b"LINE"], [b"nan"]])
+        (tmp_path / f"{attempt}.dxf").write_bytes(b"\n".join(damaged))
+        try:
+            read_drawing(tmp_path / f"{attempt}.dxf")
+        except DxfError as refusal:
+            assert "\n" not in str(refusal)
+
+
+def test_open_chain_the_axis_cannot_close_is_refused_with_the_reason(tmp_path):
+    doc = ezdxf.new("R2010")
+    doc.modelspace().add_lwpolyline([(0, 5), (-10, 5), (-10, 8), (-2, 8)])  # ends inside its Z range
+    doc.saveas(tmp_path / "hook.dxf")
+    with pytest.raises(DxfError, match="not its smallest and largest Z"):
+        read_drawing(tmp_path / "hook.dxf")
+
+
+def test_second_point_on_layer_0_is_refused(tmp_path):
+    seed_drawing(tmp_path / "part.dxf")
+    doc = ezdxf.readfile(tmp_path / "part.dxf")
+    extra = doc.modelspace().add_point((2, 2))
+    doc.saveas(tmp_path / "part.dxf")
+    with pytest.raises(DxfError, match=f"2 POINTs .*{extra.dxf.handle}"):
+        read_drawing(tmp_path / "part.dxf")
+
+
+def test_chaining_joins_ends_within_tolerance_only():
+    touching = [Line((0, 1), (-5, 1)), Line((-10, 1), (-5.005, 1)), Line((-10.05, 1), (-15, 1))]
+    chains = chain_segments(touching)
+    assert [len(c.segments) for c in chains] == [2, 1]
+    assert chains[0].segments[1] == Line((-5.005, 1), (-10, 1))  # reversed to continue the first
+
+
+def text(value: str) -> CodeText:
+    return CodeText("4", "A1", value)
+
+
+@pytest.mark.parametrize("written, parsed", [
+    ("@GROUGH@S100", {"kind": "ROUGH", "spindle_rpm": 100}),
+    ("@g finish @s = 1200 @F:0,15", {"kind": "FINISH", "spindle_rpm": 1200, "feed": 0.15}),
+    ("see info@shop.example @T2", {"tool": 2}),
+    ("@GPART\n@M08", {"kind": "PART", "coolant": True}),
+])
+def test_code_spellings(written, parsed):
+    assert codes_in(text(written)) == parsed
+
+
+@pytest.mark.parametrize("written, fragment", [
+    ("@X5", "unknown code @X"), ("@M7", "8 (coolant on) or 9"), ("@A95", "angle"), ("@S-5", "greater than 0"),
+    ("@Sinf", "must be a number"), ("@GMILL", "ROUGH | SLOT"), ("@T0", "tool number"), ("@G", "bad value ''"),
+])
+def test_bad_codes_are_refused(written, fragment):
+    with pytest.raises(DxfError, match=re.escape(fragment)):
+        codes_in(text(written))
+
+
+def test_one_code_with_two_values_on_a_layer_is_refused():
+    with pytest.raises(DxfError, match="given twice"):
+        layer_codes([text("@GROUGH @S100"), CodeText("4", "A2", "@S200")])
