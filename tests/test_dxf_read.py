@@ -22,13 +22,7 @@ from importers.dxf_drawing import read_drawing
 from importers.dxf_geometry import FLATTEN_TOLERANCE_MM, Arc, Line
 from importers.dxf_profile import chain_segments
 from importers.dxf_read import DxfError, load_drawing_file
-
-
-def shared_data() -> Path:
-    for folder in Path(__file__).resolve().parents:
-        if (folder / "shared" / "data").is_dir():
-            return folder / "shared" / "data"
-    raise RuntimeError("no shared/data beside the project: the real drawings are missing")
+from shared_data import shared_data
 
 
 DATA = shared_data()

@@ -26,7 +26,9 @@ from engine.nc_import import import_nc, number_field
 from engine.nc_tokens import detokenise, tokenise
 from engine.templates import ensure_class, export_csv, load_template, parse_csv, replace_template
 
-DATA = Path(os.environ.get("NC_DATA_DIR", "/work/shared/data/nc"))
+from shared_data import shared_data
+
+DATA = Path(os.environ["NC_DATA_DIR"]) if os.environ.get("NC_DATA_DIR") else shared_data() / "nc"
 FAMILY = "linuxcnc/plasmac_family/"
 MACROS = "linuxcnc/lathe_macros/"
 
