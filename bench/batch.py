@@ -1,8 +1,9 @@
 """Batch throughput: `instantiate_gears` (the library path behind `engine instantiate --gears`)
 over 10,000 gears stored in PostgreSQL, against a plain Jinja2 pipeline that reads the same
-gear rows, computes the same jobs with the same model, hob and cutting-data code, renders the
-same lines from bench/jinja/*.j2 and stores jobs and programs with the same COPY statements.
-Repetitions alternate; stored jobs/programs are truncated before each one.
+gear rows, computes the same jobs with the same model, hob and cutting-data code (the Planner's
+own methods: case-based cutting data, cached per gear kind), renders the same lines from
+bench/jinja/*.j2 and stores jobs (cutting data included) and programs with the same COPY statements.
+Repetitions alternate; stored jobs/programs are deleted (and vacuumed) before each one.
 Targets: ours/Jinja2 >= 1 and ours >= 5,000 programs/s.
 
     python bench/batch.py [--reps 3] [--count 10000] [--profile] [--database-url URL]
@@ -27,7 +28,9 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
 from _common import add_database_argument, bench_database, median, verdict  # noqa: E402
-from engine.cutting_data import default_cutting_data  # noqa: E402
+from engine.cases import CUT_KINDS_BY_COUNT, job_cutting_record  # noqa: E402
+from engine.errors import EngineError  # noqa: E402
+from engine.hobbing.choices import Choices  # noqa: E402
 from engine.hobs import choose_hob  # noqa: E402
 from engine.instantiate import Planner, _check_machine_fits, _check_table_speed  # noqa: E402
 from engine.nc_check import check_program  # noqa: E402
@@ -36,9 +39,18 @@ FIRST_ID = 100_000
 TARGET_RATE = 5_000          # programs/s
 TARGET_RATIO = 1.0           # ours / Jinja2
 SAMPLE = 50                  # gears whose Jinja2 output is compared line by line before timing
+VARIANT_SAMPLE = 12          # of those, gears also compared under each process-choice variant
+# Process choices the batch itself does not use (it runs the defaults: climb, tailstock, no
+# shift, coolant): the equality check also covers the template rows they switch on.
+CHOICE_VARIANTS = (Choices(feed_mode="conventional-climb", cuts=2), Choices(feed_mode="conventional"),
+                   Choices(tailstock=False, coolant=False), Choices(shift_y=4.0),
+                   Choices(shift_per_part=1.3))
 RANDOM_SEED = 20261122
+WARMUP_GEARS = 300           # untimed run of each pipeline first (the Planner's caches live one run)
+PROFILE_GEARS = 1_000        # --profile: phases and cProfile over the batch's first gears
 
 MATERIALS = ("45", "C45", "20CrMnTi", "40Cr")   # the rows of engine.cutting_data.CUTTING_SPEED
+# (C45 has no case in seed_templates/cases.csv: its nearest cases differ in material)
 # Seeded hobs (seed_templates/hobs.csv): module -> (hands, best accuracy class). Grade <= 7
 # needs an AA hob (engine.hobs.REQUIRED_CLASS_BY_GRADE): only m 2, 2.5, 3 have one.
 MODULES_BY_GRADE = {6: ("2", "2.5", "3"), 7: ("2", "2.5", "3"), 8: ("1.5", "2", "2.5", "3", "4")}
@@ -51,12 +63,14 @@ GEAR_COLUMNS = ("id", "gear_class", "module", "teeth", "pressure_angle", "helix_
 # Which template row emits each line of the standard code (seed_templates/classes/*.csv, same
 # ids in both classes) and the p_emit condition that decides it: the Jinja2 pipeline stores
 # row_ids like the decision table does (program.row_ids is NOT NULL).
-ROW_IDS = ((10, None), (20, None), (30, None), (40, None), (50, None), (60, None), (70, None), (80, None),
-           (90, None), (100, None), (110, None), (120, None), (130, None), (140, None), (150, None),
-           (160, "shift"), (170, None), (180, "coolant"),
-           (190, "cut1"), (200, "cut1"), (210, "cut1"), (220, "cut1"), (230, "cut1"),
-           (240, "cut2"), (250, "cut2"), (260, "cut2"), (270, "cut2"), (280, "cut2"),
-           (290, "coolant"), (300, None), (310, None), (320, None))
+ROW_IDS = ((100, None), (200, None), (300, None), (400, None), (500, None), (600, None), (700, None),
+           (800, None), (900, None), (1000, None), (1100, None), (1200, "tailstock"), (1250, None),
+           (1300, None), (1400, None), (1500, None),
+           (1600, "shift_fixed"), (1610, "shift_per_part"), (1620, "shift_per_part"), (1630, "shift_per_part"),
+           (1640, "shift_per_part"), (1650, "shift_per_part"), (1700, None), (1800, "coolant"),
+           (1900, "cut1"), (2000, "cut1"), (2100, "cut1"), (2200, "cut1"), (2300, "cut1"),
+           (2400, "cut2"), (2500, "cut2"), (2600, "cut2"), (2700, "cut2"), (2800, "cut2"),
+           (2900, "coolant"), (3000, None), (3100, None), (3150, "tailstock"), (3200, None))
 
 # Same id allocation as engine.storage; the COPY statements are engine.storage's own.
 NEXT_IDS = "SELECT nextval(%s::regclass) FROM generate_series(1, %s)"
@@ -96,9 +110,17 @@ def insert_gears(conn, rows: list[tuple]) -> None:
     conn.commit()
 
 
-def truncate(conn) -> None:
-    conn.execute("TRUNCATE program, job")
+def clear_jobs(conn) -> None:
+    """Empty job and program before a run. DELETE and VACUUM, not TRUNCATE: cutting_case.job_id
+    references job, and TRUNCATE would have to empty the case base with it."""
+    conn.execute("DELETE FROM program")
+    conn.execute("DELETE FROM job")
     conn.commit()
+    conn.autocommit = True
+    try:
+        conn.execute("VACUUM job, program")
+    finally:
+        conn.autocommit = False
 
 
 # --- our path ------------------------------------------------------------------------------
@@ -133,7 +155,9 @@ class JinjaPipeline:
         self._row_ids: dict[tuple, list[int]] = {}
 
     def row_ids(self, params: dict, module_params: dict) -> list[int]:
-        flags = {"shift": bool(params["shift_on"] and params["shift_y"] != 0), "coolant": bool(params["coolant"]),
+        flags = {"tailstock": bool(params["tailstock"]),
+                 "shift_fixed": bool(params["shift_on"] and params["shift_per_part"] == 0),
+                 "shift_per_part": params["shift_per_part"] > 0, "coolant": bool(params["coolant"]),
                  "cut1": bool(module_params["cutmotion:1"]["cut_on"]),
                  "cut2": bool(module_params["cutmotion:2"]["cut_on"])}
         key = tuple(flags.values())
@@ -142,13 +166,15 @@ class JinjaPipeline:
             found = self._row_ids[key] = [row for row, condition in ROW_IDS if condition is None or flags[condition]]
         return found
 
-    def plan(self, planner, gear, templates: dict) -> tuple:
+    def plan(self, planner: Planner, gear, templates: dict) -> tuple:
+        """Planner.plan step for step (same calls, same order), rendering instead of run_template."""
         machine = planner.machine
         _check_machine_fits(gear, machine)
-        hob = choose_hob(gear, planner.hobs).hob
-        cutting = default_cutting_data(gear.module, gear.material, bool(hob.coating), hob.tip_diameter,
-                                       machine.spindle_max).with_overrides(**planner.overrides)
-        job = planner.model(gear.gear_class).job(gear, gear.gear_class, hob, machine, cutting, planner.choices)
+        model = planner.model(gear.gear_class)
+        hob = choose_hob(gear, planner.hobs, purpose=model.hob_purpose,
+                         shift_travel=model.shift_travel(planner.choices)).hob
+        cutting, case_ids = planner.cutting_data(gear, hob)
+        job = model.job(gear, gear.gear_class, hob, machine, cutting, planner.choices)
         _check_table_speed(gear, hob.starts, cutting.hob_speed, machine)
         jinja_template, version, template_hash = templates[gear.gear_class]
         params, module_params = job.params, job.module_params
@@ -157,8 +183,10 @@ class JinjaPipeline:
         name = str(params.get("program_name", f"JOB_{gear.id}"))
         if self.check:
             check_program(lines, machine, name)
+        kinds = CUT_KINDS_BY_COUNT[planner.choices.cut_count(gear.module)]
+        record = job_cutting_record(cutting, gear, hob, kinds, case_ids)
         return (gear.id, gear.gear_class, machine.name, hob.id, params, module_params, version, template_hash,
-                name, lines, self.row_ids(params, module_params))
+                name, lines, self.row_ids(params, module_params), record)
 
     def templates(self, conn) -> dict:
         from engine.templates import load_template
@@ -193,12 +221,13 @@ def store(conn, planned: list[tuple]) -> None:
                 copy.set_types(storage.JOB_TYPES)
             for job_id, item in zip(job_ids, planned):
                 gear_id, gear_class, machine, hob_id, params, module_params = item[:6]
-                copy.write_row((job_id, gear_id, gear_class, machine, hob_id, Jsonb(params), Jsonb(module_params)))
+                copy.write_row((job_id, gear_id, gear_class, machine, hob_id, Jsonb(params), Jsonb(module_params),
+                                Jsonb(item[11] or {})))
         with conn.cursor().copy(storage.COPY_PROGRAM) as copy:
             if getattr(storage, "PROGRAM_TYPES", None):
                 copy.set_types(storage.PROGRAM_TYPES)
             for program_id, job_id, item in zip(program_ids, job_ids, planned):
-                copy.write_row((program_id, job_id, item[1], *item[6:]))
+                copy.write_row((program_id, job_id, item[1], *item[6:11]))
 
 
 def run_jinja(conn, pipeline: JinjaPipeline, first: int, last: int) -> tuple[float, int]:
@@ -210,32 +239,61 @@ def run_jinja(conn, pipeline: JinjaPipeline, first: int, last: int) -> tuple[flo
 
 # --- checks, profile, CLI ------------------------------------------------------------------
 
-def same_programs(conn, pipeline: JinjaPipeline, gear_ids: list[int]) -> bool:
-    """Our program and the Jinja2 one, line for line and row id for row id."""
+def same_programs(conn, pipeline: JinjaPipeline, gear_ids: list[int]) -> tuple[int, int] | None:
+    """Our program and the Jinja2 one, line for line and row id for row id, and the same job
+    cutting record: the batch's default choices on every sampled gear, each CHOICE_VARIANTS
+    entry on a part of them. Returns (programs compared, variant plans refused by our engine
+    and so not comparable), or None after printing the first difference."""
     from engine.records import load_gear
 
-    planner = Planner(conn)
     templates = pipeline.templates(conn)
-    for gear_id in gear_ids:
-        gear = load_gear(conn, gear_id)
-        ours = planner.plan(gear).result
-        theirs = pipeline.plan(planner, gear, templates)
-        lines, row_ids = theirs[9], theirs[10]
-        if ours.lines != lines or ours.row_ids != row_ids:
-            print(f"MISMATCH gear {gear_id} ({gear.gear_class}): the Jinja2 template does not produce our program; "
-                  "the throughput comparison would be meaningless.")
-            for number in range(max(len(ours.lines), len(lines))):
-                a = ours.lines[number] if number < len(ours.lines) else "<none>"
-                b = lines[number] if number < len(lines) else "<none>"
-                if a != b:
-                    print(f"  line {number + 1}: ours   {a!r}\n  line {number + 1}: jinja2 {b!r}")
-                    break
-            else:
-                print(f"  lines equal; row ids differ: ours {ours.row_ids} jinja2 {row_ids}")
-            conn.rollback()
-            return False
+    gears = {gear_id: load_gear(conn, gear_id) for gear_id in gear_ids}
+    variant_ids = [gear_id for gear_class in ("spur", "helical")   # half of each class, spread
+                   for gear_id in _spread([i for i in gear_ids if gears[i].gear_class == gear_class],
+                                          VARIANT_SAMPLE // 2)]
+    compared = refused = 0
+    for choices, ids in [(Choices(), gear_ids)] + [(variant, variant_ids) for variant in CHOICE_VARIANTS]:
+        planner = Planner(conn, choices=choices)
+        for gear_id in ids:
+            try:
+                ours = planner.plan(gears[gear_id])
+            except EngineError:   # e.g. a shift step the chosen hob is too short for
+                if choices == Choices():
+                    raise
+                refused += 1
+                continue
+            theirs = pipeline.plan(planner, gears[gear_id], templates)
+            if not _same_program(ours, theirs, gears[gear_id], choices):
+                conn.rollback()
+                return None
+            compared += 1
     conn.rollback()
-    return True
+    return compared, refused
+
+
+def _spread(ids: list[int], count: int) -> list[int]:
+    return ids[::max(1, len(ids) // count)][:count]
+
+
+def _same_program(ours, theirs: tuple, gear, choices: Choices) -> bool:
+    lines, row_ids, cutting = theirs[9], theirs[10], theirs[11]
+    if ours.result.lines == lines and ours.result.row_ids == row_ids and ours.cutting == cutting:
+        return True
+    print(f"MISMATCH gear {gear.id} ({gear.gear_class}, {choices}): the Jinja2 pipeline does not produce our "
+          "program; the throughput comparison would be meaningless.")
+    ours_lines = ours.result.lines
+    for number in range(max(len(ours_lines), len(lines))):
+        a = ours_lines[number] if number < len(ours_lines) else "<none>"
+        b = lines[number] if number < len(lines) else "<none>"
+        if a != b:
+            print(f"  line {number + 1}: ours   {a!r}\n  line {number + 1}: jinja2 {b!r}")
+            break
+    else:
+        if ours.result.row_ids != row_ids:
+            print(f"  lines equal; row ids differ: ours {ours.result.row_ids} jinja2 {row_ids}")
+        else:
+            print(f"  programs equal; job.cutting differs: ours {ours.cutting} jinja2 {cutting}")
+    return False
 
 
 def sample_ids(rows: list[tuple]) -> list[int]:
@@ -257,7 +315,7 @@ def profile_ours(conn, first: int, last: int, top: int) -> None:
     from engine.records import load_gears
     from engine.storage import store_many
 
-    truncate(conn)
+    clear_jobs(conn)
     start = time.perf_counter()
     planner = Planner(conn)
     gears = load_gears(conn, first, last)
@@ -267,12 +325,19 @@ def profile_ours(conn, first: int, last: int, top: int) -> None:
     store_many(conn, planned)
     conn.commit()
     stored = time.perf_counter()
-    count = len(planned)
-    print(f"\nphases of our path (one run, {count} gears): load {(loaded - start) * 1000:.0f} ms, "
-          f"plan {(computed - loaded) * 1000:.0f} ms ({(computed - loaded) / count * 1e6:.0f} µs/gear), "
-          f"store {(stored - computed) * 1000:.0f} ms ({(stored - computed) / count * 1e6:.0f} µs/gear)")
+    for gear in gears:   # again, every gear's cutting data now in the Planner's cache
+        planner.plan(gear)
+    replanned = time.perf_counter()
+    count, kinds = len(planned), len(planner._cutting)
 
-    truncate(conn)
+    def spent(seconds: float) -> str:
+        return f"{seconds * 1000:.0f} ms ({seconds / count * 1e6:.0f} µs/gear)"
+    print(f"\nphases of our path (one run, {count} gears, {kinds} distinct cutting-data cache keys): "
+          f"load {spent(loaded - start)}, plan {spent(computed - loaded)}, store {spent(stored - computed)}; "
+          f"plan again with the cutting data cached {spent(replanned - stored)}, so the case-based cutting "
+          f"data cost about {spent(computed - loaded - (replanned - stored))}")
+
+    clear_jobs(conn)
     from engine.instantiate import instantiate_gears
 
     profiler = cProfile.Profile()
@@ -297,6 +362,34 @@ def run_cli_once(url: str, first: int, last: int) -> tuple[float, int]:
     return seconds, json.loads(completed.stdout)["programs"]
 
 
+def check_stored(conn, count: int) -> bool:
+    stored = conn.execute("SELECT count(*) FROM program WHERE job_id IN (SELECT id FROM job)").fetchone()[0]
+    conn.rollback()
+    if stored != count:
+        print(f"error: expected {count} stored programs, found {stored}")
+    return stored == count
+
+
+def print_summary(count: int, first: int, last: int, times: dict, cli) -> None:
+    rate = {name: count / median(values) for name, values in times.items()}
+    best = {name: count / min(values) for name, values in times.items()}
+    print()
+    labels = {"ours": "ours: instantiate_gears + commit",
+              "jinja2": "jinja2: same plan, render, limit check, COPY",
+              "jinja2-nocheck": "jinja2 without the limit check (information)"}
+    for name, label in labels.items():
+        print(f"{label:45s}: median {rate[name]:6.0f} programs/s (best {best[name]:.0f}; "
+              f"{', '.join(f'{s:.2f}' for s in times[name])} s)")
+    if cli is not None:
+        seconds, programs = cli
+        print(f"engine instantiate --gears {first}-{last} --json (CLI, once, with process start): "
+              f"{seconds:.2f} s = {programs / seconds:.0f} programs/s")
+    ratio = rate["ours"] / rate["jinja2"]
+    print(f"ratio ours/jinja2 = {ratio:.2f} (target >= {TARGET_RATIO:g}): {verdict(ratio >= TARGET_RATIO)}")
+    print(f"ratio ours/jinja2-nocheck = {rate['ours'] / rate['jinja2-nocheck']:.2f} (information)")
+    print(f"ours {rate['ours']:.0f} programs/s (target >= {TARGET_RATE}): {verdict(rate['ours'] >= TARGET_RATE)}")
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     add_database_argument(parser)
@@ -305,6 +398,8 @@ def main(argv=None) -> int:
     parser.add_argument("--no-cli", action="store_true", help="skip the one run through the `engine` CLI")
     parser.add_argument("--profile", action="store_true",
                         help="also time the phases of our path and print cProfile hotspots")
+    parser.add_argument("--profile-count", type=int, default=PROFILE_GEARS,
+                        help=f"gears (the batch's first) that --profile times and profiles (default {PROFILE_GEARS})")
     parser.add_argument("--top", type=int, default=25, help="rows of each cProfile listing (default 25)")
     args = parser.parse_args(argv)
 
@@ -321,56 +416,40 @@ def main(argv=None) -> int:
               f"{args.reps} alternated repetitions, interpreter {sys.executable}")
 
         sample = sample_ids(rows)
-        if not same_programs(conn, pipeline, sample):
+        checked = same_programs(conn, pipeline, sample)
+        if checked is None:
             return 1
-        print(f"check: the Jinja2 pipeline renders our programs exactly for {len(sample)} sampled gears "
-              "(lines and row ids)")
+        compared, refused = checked
+        print(f"check: the Jinja2 pipeline renders our programs exactly (lines, row ids, job.cutting): "
+              f"{len(sample)} sampled gears with the batch's choices, {compared - len(sample)} more plans under "
+              f"{len(CHOICE_VARIANTS)} other choice sets ({refused} refused by the shared model)")
 
         runs = {"ours": run_ours, "jinja2": lambda c, a, b: run_jinja(c, pipeline, a, b),
                 "jinja2-nocheck": lambda c, a, b: run_jinja(c, unchecked, a, b)}
-        for run in runs.values():   # warm-up, untimed: caches, compiled templates, table files
-            truncate(conn)
-            run(conn, first, last)
-        stored = conn.execute("SELECT count(*) FROM program WHERE job_id IN (SELECT id FROM job)").fetchone()[0]
-        conn.rollback()
-        if stored != args.count:
-            print(f"error: expected {args.count} stored programs, found {stored}")
-            return 1
+        for run in runs.values():   # warm-up, untimed: imports, compiled templates, table files
+            clear_jobs(conn)
+            run(conn, first, min(last, first + WARMUP_GEARS - 1))
 
         times = {name: [] for name in runs}
         for repetition in range(args.reps):
             order = list(runs) if repetition % 2 == 0 else list(reversed(runs))
             for name in order:
-                truncate(conn)
+                clear_jobs(conn)
                 seconds, count = runs[name](conn, first, last)
                 assert count == args.count, (name, count)
                 times[name].append(seconds)
+        if not check_stored(conn, args.count):
+            return 1
 
         cli = None
         if not args.no_cli:
-            truncate(conn)
+            clear_jobs(conn)
             cli = run_cli_once(url, first, last)
 
         if args.profile:
-            profile_ours(conn, first, last, args.top)
+            profile_ours(conn, first, min(last, first + args.profile_count - 1), args.top)
 
-    rate = {name: args.count / median(values) for name, values in times.items()}
-    best = {name: args.count / min(values) for name, values in times.items()}
-    print()
-    labels = {"ours": "ours: instantiate_gears + commit",
-              "jinja2": "jinja2: same plan, render, limit check, COPY",
-              "jinja2-nocheck": "jinja2 without the limit check (information)"}
-    for name, label in labels.items():
-        print(f"{label:45s}: median {rate[name]:6.0f} programs/s (best {best[name]:.0f}; "
-              f"{', '.join(f'{s:.2f}' for s in times[name])} s)")
-    if cli is not None:
-        seconds, count = cli
-        print(f"engine instantiate --gears {first}-{last} --json (CLI, once, with process start): "
-              f"{seconds:.2f} s = {count / seconds:.0f} programs/s")
-    ratio = rate["ours"] / rate["jinja2"]
-    print(f"ratio ours/jinja2 = {ratio:.2f} (target >= {TARGET_RATIO:g}): {verdict(ratio >= TARGET_RATIO)}")
-    print(f"ratio ours/jinja2-nocheck = {rate['ours'] / rate['jinja2-nocheck']:.2f} (information)")
-    print(f"ours {rate['ours']:.0f} programs/s (target >= {TARGET_RATE}): {verdict(rate['ours'] >= TARGET_RATE)}")
+    print_summary(args.count, first, last, times, cli)
     return 0
 
 
