@@ -132,3 +132,5 @@ main.add_command(suggest)
 main.add_command(cases)
 from .cli_nc import import_nc_command  # noqa: E402
 main.add_command(import_nc_command)
+from .cli_refactor import refactor_command  # noqa: E402  (also registers `template shared`)
+main.add_command(refactor_command)

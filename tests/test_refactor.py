@@ -1,0 +1,226 @@
+"""The nightly refactor (design notes §5): identical bodies merged, every class's assembled
+template byte-identical, no body stored twice, a second run changes nothing, and the
+near-duplicate lines reported with Sim = K / (M + N − K) computed here by a small LCS."""
+from __future__ import annotations
+
+import json
+
+import psycopg
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from engine.errors import EngineError
+from engine.refactor import assembled_templates, check_invariants, refactor
+from engine.templates import TemplateRow, ensure_class, export_csv, load_template, replace_template
+
+
+def exports(conn) -> dict[str, str]:
+    """Every class with rows, exported as the user would: `engine template export`."""
+    names = [name for (name,) in conn.execute(
+        "SELECT name FROM gear_class g WHERE EXISTS (SELECT 1 FROM class_template(g.name)) ORDER BY name")]
+    return {name: export_csv(load_template(conn, name)) for name in names}
+
+
+def component_count(conn) -> int:
+    return conn.execute("SELECT count(*) FROM component").fetchone()[0]
+
+
+def bodies_stored_twice(conn) -> int:
+    # GROUP BY puts NULLs together: equal groups are equal bodies, independent of the md5 key.
+    return conn.execute("SELECT count(*) FROM (SELECT 1 FROM component GROUP BY t, o, p_calc, s, p_emit "
+                        "HAVING count(*) > 1) d").fetchone()[0]
+
+
+def duplicate_row_body(conn, gear_class: str, row_id: int) -> tuple[int, int]:
+    """Store a copy of the row's component and point the row at it: (original id, copy id)."""
+    original = conn.execute("SELECT component_id FROM assembly WHERE gear_class = %s AND id = %s",
+                            (gear_class, row_id)).fetchone()[0]
+    copy = conn.execute("INSERT INTO component (t, o, p_calc, s, p_emit) SELECT t, o, p_calc, s, p_emit "
+                        "FROM component WHERE id = %s RETURNING id", (original,)).fetchone()[0]
+    conn.execute("UPDATE assembly SET component_id = %s WHERE gear_class = %s AND id = %s",
+                 (copy, gear_class, row_id))
+    return original, copy
+
+
+def lcs_sim(a: list[str], b: list[str]) -> float:
+    """Sim = K / (M + N − K), K the longest common subsequence of the token lists."""
+    table = [[0] * (len(b) + 1) for _ in range(len(a) + 1)]
+    for i, x in enumerate(a):
+        for j, y in enumerate(b):
+            table[i + 1][j + 1] = table[i][j] + 1 if x == y else max(table[i][j + 1], table[i + 1][j])
+    k = table[-1][-1]
+    return k / (len(a) + len(b) - k)
+
+
+def test_seeded_library_is_stored_once_and_a_run_changes_nothing(conn):
+    before = exports(conn)
+    report = refactor(conn)
+    assert report.changed is False
+    assert report.components_before == report.components_after == component_count(conn)
+    assert exports(conn) == before
+
+
+def test_duplicate_bodies_are_merged_and_every_export_stays_byte_identical(conn):
+    original, copy = duplicate_row_body(conn, "spur", 1400)
+    second_original, second_copy = duplicate_row_body(conn, "worm_wheel", 1410)
+    count = component_count(conn)
+    assert bodies_stored_twice(conn) == 2
+    before = exports(conn)
+
+    report = refactor(conn)
+
+    assert report.changed is True
+    assert (report.components_before, report.components_after) == (count, count - 2)
+    assert component_count(conn) == count - 2
+    assert bodies_stored_twice(conn) == 0
+    assert exports(conn) == before
+    pointed = conn.execute("SELECT component_id FROM assembly WHERE (gear_class, id) IN "
+                           "(('spur', 1400), ('worm_wheel', 1410)) ORDER BY gear_class").fetchall()
+    assert pointed == [(original,), (second_original,)]   # the lowest id of each body is kept
+    assert conn.execute("SELECT count(*) FROM component WHERE id IN (%s, %s)",
+                        (copy, second_copy)).fetchone()[0] == 0
+
+
+def test_a_second_run_reports_nothing_changed(conn):
+    duplicate_row_body(conn, "helical", 1400)
+    assert refactor(conn).changed is True
+    after_first = exports(conn)
+    again = refactor(conn)
+    assert again.changed is False
+    assert again.components_before == again.components_after
+    assert exports(conn) == after_first
+
+
+def test_unused_components_are_deleted(conn):
+    count = component_count(conn)
+    conn.execute("INSERT INTO component (t, o) VALUES ('main', '\"; NOBODY USES THIS\"')")
+    report = refactor(conn)
+    assert report.changed is True
+    assert report.components_after == count
+
+
+def test_near_duplicates_between_spur_and_helical_coupling_lines(conn):
+    report = refactor(conn, threshold=0.6)
+    spur, helical = ["EGDEF", "(", "C", ",", "B", ",", "1", ")"], \
+        ["EGDEF", "(", "C", ",", "B", ",", "1", ",", "Z", ",", "1", ")"]
+    expected = lcs_sim(spur, helical)
+    assert expected == pytest.approx(8 / 12)
+    found = [pair for pair in report.near_duplicates
+             if {pair["a"], pair["b"]} == {'"EGDEF(C,B,1)"', '"EGDEF(C,B,1,Z,1)"'}]
+    assert len(found) == 1
+    pair = found[0]
+    assert pair["t"] == "sync"
+    assert pair["sim"] == pytest.approx(expected, abs=1e-4)
+    uses = {pair["a"]: pair["rows_a"], pair["b"]: pair["rows_b"]}
+    assert ["spur", 1400] in uses['"EGDEF(C,B,1)"']
+    assert ["helical", 1400] in uses['"EGDEF(C,B,1,Z,1)"']
+    assert all(0.6 - 1e-4 <= p["sim"] < 1 and p["a"] != p["b"] for p in report.near_duplicates)
+
+
+def test_threshold_keeps_only_closer_pairs(conn):
+    # Y against Z axis in the coupling: 11 of 12 tokens in common, Sim = 11/13 ≥ 0.8.
+    axis_y = ["EGDEF", "(", "C", ",", "B", ",", "1", ",", "Y", ",", "1", ")"]
+    axis_z = ["EGDEF", "(", "C", ",", "B", ",", "1", ",", "Z", ",", "1", ")"]
+    report = refactor(conn, threshold=0.8)
+    by_texts = {frozenset((p["a"], p["b"])): p for p in report.near_duplicates}
+    close = by_texts[frozenset(('"EGDEF(C,B,1,Y,1)"', '"EGDEF(C,B,1,Z,1)"'))]
+    assert close["sim"] == pytest.approx(lcs_sim(axis_y, axis_z), abs=1e-4)
+    assert frozenset(('"EGDEF(C,B,1)"', '"EGDEF(C,B,1,Z,1)"')) not in by_texts   # Sim 2/3 < 0.8
+    assert all(p["sim"] >= 0.8 - 1e-4 for p in report.near_duplicates)
+
+
+def test_invariant_check_names_the_class_whose_template_would_change(conn):
+    snapshot = assembled_templates(conn)
+    _, copy = duplicate_row_body(conn, "worm_wheel", 1410)   # a leaf class: no class inherits it
+    conn.execute("UPDATE component SET o = '\"EGDEF(C,B,2)\"' WHERE id = %s", (copy,))
+    with pytest.raises(EngineError, match="class 'worm_wheel'"):
+        check_invariants(conn, snapshot)
+
+
+def test_invariant_check_refuses_a_body_stored_twice(conn):
+    duplicate_row_body(conn, "taper", 1410)
+    with pytest.raises(EngineError, match="stored 2 times"):
+        check_invariants(conn, assembled_templates(conn))
+
+
+# Bodies (t, o, condition) valid in any class; ids keep the module order (main < prep < sync < …).
+POOL = [("main", '"G90 G71 G94"', None), ("main", '"WALIMON"', None), ("prep", '"M20"', None),
+        ("prep", '"G0 A=0"', "beta == 0"), ("sync", '"EGDEF(C,B,1)"', None),
+        ("sync", '"EGDEF(C,B,1,Z,1)"', None), ("cutcond", '"M8"', None), ("cutcond", '"M8"', "cuts > 1")]
+MODULE_BASE = {"main": 100, "prep": 1200, "sync": 1400, "cutcond": 1700}
+
+library = st.lists(st.lists(st.tuples(st.sampled_from(range(len(POOL))), st.booleans()),
+                            min_size=1, max_size=6), min_size=2, max_size=4)
+
+
+@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(classes=library, derive=st.booleans())
+def test_random_libraries_refactor_losslessly_once_and_idempotently(conn, classes, derive):
+    with conn.transaction(force_rollback=True):
+        for number, picks in enumerate(classes):
+            name = f"prop_{number}"
+            ensure_class(conn, name, "prop_0" if derive and number else None)
+            rows = [TemplateRow(MODULE_BASE[POOL[p][0]] + 10 * i, POOL[p][0], 1, None, None,
+                                POOL[p][1], POOL[p][2]) for i, (p, _) in enumerate(picks)]
+            replace_template(conn, name, rows)
+            for row, (_, copy_it) in zip(rows, picks):
+                own = conn.execute("SELECT 1 FROM assembly WHERE gear_class = %s AND id = %s",
+                                   (name, row.id)).fetchone()
+                if copy_it and own:
+                    duplicate_row_body(conn, name, row.id)
+        before = exports(conn)
+        first = refactor(conn)
+        assert exports(conn) == before
+        assert bodies_stored_twice(conn) == 0
+        assert first.components_after == component_count(conn)
+        second = refactor(conn)
+        assert second.changed is False
+        assert second.components_before == second.components_after == first.components_after
+        assert exports(conn) == before
+
+
+def test_cli_json_reports_a_merge_then_nothing(run):
+    first = run("refactor", "--json")
+    assert first.exit_code == 0, first.output
+    keys = json.loads(first.stdout)
+    assert {"changed", "components_before", "components_after", "near_duplicates"} <= set(keys)
+    assert keys["changed"] is False
+    with psycopg.connect(run.url) as conn:
+        duplicate_row_body(conn, "spur", 1400)
+    merged = json.loads(run("refactor", "--json").stdout)
+    assert merged["changed"] is True
+    assert merged["components_after"] == merged["components_before"] - 1 == keys["components_after"]
+    again = run("refactor")
+    assert again.exit_code == 0
+    assert "nothing to merge" in again.stdout
+
+
+def test_cli_threshold_out_of_range_is_refused(run):
+    result = run("refactor", "--threshold", "1.5")
+    assert result.exit_code != 0
+    assert "--threshold" in result.output
+
+
+def test_cli_template_shared_names_the_other_classes(run):
+    with psycopg.connect(run.url) as conn:
+        for name, second in (("shared_a", '"M8"'), ("shared_b", '"M9"')):
+            ensure_class(conn, name)
+            replace_template(conn, name, [TemplateRow(100, "main", 1, None, None, '"G90 G71 G94 ; SHARED"', None),
+                                          TemplateRow(1700, "cutcond", 1, None, None, second, None)])
+    result = run("template", "shared", "--class", "shared_a")
+    assert result.exit_code == 0, result.output
+    first, second = result.stdout.splitlines()
+    assert "shared with 1 class(es): shared_b" in first
+    assert "used by this class only" in second
+    missing = run("template", "shared", "--class", "no_such_class")
+    assert missing.exit_code == 1
+    assert "no_such_class" in missing.stderr
+
+
+@pytest.mark.parametrize("args, words", [(("refactor",), ("--threshold", "--json", "Merge")),
+                                         (("template", "shared"), ("--class", "shared"))])
+def test_help_texts(run, args, words):
+    result = run(*args, "--help")
+    assert result.exit_code == 0
+    assert all(word in result.stdout for word in words)
