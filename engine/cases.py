@@ -15,37 +15,20 @@ import pandas as pd
 import psycopg
 from psycopg import sql
 
-from .cutting_data import RADIAL_TO_AXIAL, CuttingData, default_cutting_data, hob_speed, per_minute
+from .case_base import (CASE_COLUMNS, CUT_KINDS, CUT_KINDS_BY_COUNT, CaseBase, KindProposal,  # noqa: F401
+                        feeds_per_minute, feeds_per_rev, job_cutting_record)
+from .cutting_data import CuttingData
 from .errors import EngineError
 from .hobs import choose_hob
 from .paths import SEED_DIR
 from .records import Gear, Hob, Machine, load_gear, load_hobs, load_machine
 
-CUT_KINDS = ("rough", "finish")
-CUT_KINDS_BY_COUNT = {1: ("rough",), 2: ("rough", "finish")}   # a single cut is a rough cut, as in the paper
 FEATURE_COLUMNS = ("module", "teeth", "material", "hardness", "quality_grade", "hob_material",
                    "hob_coating", "hob_starts", "hob_tip_diameter")
 VALUE_COLUMNS = ("hob_speed", "axial_feed", "radial_feed")   # r/min, mm/min, mm/min
-CASE_COLUMNS = ("id", *FEATURE_COLUMNS, "cut", *VALUE_COLUMNS, "source", "job_id", "created_at")
 FLOAT_COLUMNS = ("module", "hardness", "hob_tip_diameter", *VALUE_COLUMNS)
 INTEGER_COLUMNS = ("teeth", "quality_grade", "hob_starts", "job_id")
 SEED_FILE = SEED_DIR / "cases.csv"
-EXACT = 1e-9   # a case this close is the same situation: taken as is
-
-# d = Σ weight·|case − query|/scale over numeric features + Σ weight·[case ≠ query] over
-# categorical ones; a value missing on either side counts as a full mismatch (1).
-DISTANCE_FEATURES = pd.DataFrame([
-    ("module", "numeric", 1.0, 3.0),            # chip size and tooth depth follow the module
-    ("material", "categorical", None, 2.0),     # each material has its own speed range (§C)
-    ("hardness", "numeric", 50.0, 1.0),         # HB; 50 HB spans a heat-treatment state
-    ("quality_grade", "numeric", 2.0, 0.5),
-    ("hob_material", "categorical", None, 2.0),  # HSS or carbide: a different speed range
-    ("hob_coating", "categorical", None, 1.5),   # coated HSS runs about twice as fast (§C)
-    ("hob_starts", "numeric", 1.0, 1.0),        # multi-start hobs: lower feed or speed (§C)
-    ("hob_tip_diameter", "numeric", 20.0, 0.5),  # mostly carried over by the transfer through v
-    ("teeth", "numeric", 20.0, 0.25),           # carried over by feeds per workpiece revolution
-    ("cut", "categorical", None, 3.0),          # candidates are of the same cut kind anyway
-], columns=["feature", "kind", "scale", "weight"]).set_index("feature")
 
 # Typical axial feed per workpiece revolution [mm/rev], single-start hob, steel, wet (§C):
 # the first row whose module is at least the gear's (the last row beyond).
@@ -61,16 +44,6 @@ SPEED_RANGE = {
     "40Cr": {"uncoated HSS": (20, 35), "coated HSS": (50, 90), "carbide": (120, 220)},
 }
 CUTTING = {"rough": "roughing", "finish": "finishing"}
-
-
-@dataclass(frozen=True)
-class KindProposal:
-    cut: str
-    cutting_speed: float     # m/min
-    axial_feed: float        # mm per workpiece revolution
-    radial_feed: float       # mm per workpiece revolution
-    source: str
-    case_ids: tuple = ()     # the cases it came from
 
 
 @dataclass(frozen=True)
@@ -103,83 +76,23 @@ def list_cases(conn) -> pd.DataFrame:
                          **{column: "Int64" for column in INTEGER_COLUMNS}})
 
 
-def with_transfer_columns(cases: pd.DataFrame) -> pd.DataFrame:
-    """What carries over to another hob and gear: v and the feeds per workpiece revolution."""
-    table_speed = cases.hob_speed * cases.hob_starts / cases.teeth
-    return cases.assign(cutting_speed=math.pi * cases.hob_tip_diameter * cases.hob_speed / 1000,
-                        axial_per_rev=cases.axial_feed / table_speed,
-                        radial_per_rev=cases.radial_feed / table_speed)
-
-
-def query_of(gear: Gear, hob: Hob, cut: str) -> dict:
-    return {"module": gear.module, "teeth": gear.teeth, "material": gear.material, "hardness": gear.hardness,
-            "quality_grade": gear.quality_grade, "hob_material": hob.material, "hob_coating": hob.coating,
-            "hob_starts": hob.starts, "hob_tip_diameter": hob.tip_diameter, "cut": cut}
-
-
-def distances(cases: pd.DataFrame, query: dict) -> pd.Series:
-    total = pd.Series(0.0, index=cases.index)
-    for feature, rule in DISTANCE_FEATURES.iterrows():
-        wanted = query[feature]
-        if wanted is None:
-            term = pd.Series(1.0, index=cases.index)
-        elif rule.kind == "numeric":
-            term = (cases[feature].astype(float) - float(wanted)).abs() / rule.scale
-        else:
-            term = (cases[feature].fillna("").astype(str).str.casefold() != str(wanted).casefold()).astype(float)
-        total += rule.weight * term.fillna(1.0)
-    return total
-
-
-def nearest(cases: pd.DataFrame, query: dict, top: int) -> pd.DataFrame:
-    of_kind = cases[cases.cut == query["cut"]]
-    ranked = of_kind.assign(distance=distances(of_kind, query))
-    return ranked.sort_values(["distance", "id"], kind="stable").head(top)
-
-
-def propose(ranked: pd.DataFrame, cut: str, defaults: CuttingData) -> KindProposal:
-    """Inverse-distance weighted mean of the transferred values; exact matches as they are."""
-    if ranked.empty:
-        axial = defaults.axial_feed_rough if cut == "rough" else defaults.axial_feed_finish
-        radial = defaults.radial_feed if cut == "rough" else RADIAL_TO_AXIAL * axial
-        return KindProposal(cut, defaults.cutting_speed, axial, radial, f"{cut}: no cases, {defaults.source}")
-    exact = ranked[ranked.distance <= EXACT]
-    chosen = exact if not exact.empty else ranked
-    weights = pd.Series(1.0, index=chosen.index) if not exact.empty else 1.0 / chosen.distance
-    ids = tuple(int(case_id) for case_id in chosen.id)
-
-    def mean(column):
-        return float((chosen[column] * weights).sum() / weights.sum())
-    how = "as is" if not exact.empty else "inverse-distance weighted"
-    source = f"{cut}: case{'s' if len(ids) > 1 else ''} {', '.join(f'#{i}' for i in ids)} {how}"
-    return KindProposal(cut, mean("cutting_speed"), mean("axial_per_rev"), mean("radial_per_rev"), source, ids)
-
-
 def suggest(conn, gear: Gear, hob: Hob, machine: Machine, *, top: int = 3) -> Suggestion:
     """Cutting data for this gear, hob and machine from the `top` nearest cases per cut kind."""
     return suggest_from(load_case_base(conn), gear, hob, machine, top=top)
 
 
-def load_case_base(conn) -> pd.DataFrame:
-    """The history with the transfer columns, read once for many suggestions (a batch)."""
-    return with_transfer_columns(list_cases(conn))
+def load_case_base(conn) -> CaseBase:
+    """The history read once for many suggestions (a batch)."""
+    return CaseBase.load(conn)
 
 
-def suggest_from(cases: pd.DataFrame, gear: Gear, hob: Hob, machine: Machine, *, top: int = 3) -> Suggestion:
-    """`suggest` over a case base already read (`load_case_base`)."""
-    if top < 1:
-        raise EngineError(f"top {top}: ask for at least 1 case per cut kind")
-    defaults = default_cutting_data(gear.module, gear.material, bool(hob.coating), hob.tip_diameter,
-                                    machine.spindle_max)
-    ranked = {cut: nearest(cases, query_of(gear, hob, cut), top) for cut in CUT_KINDS}
-    proposals = {cut: propose(ranked[cut], cut, defaults) for cut in CUT_KINDS}
-    rough, finish = proposals["rough"], proposals["finish"]
-    # The job runs one hob speed (the model's n0): the rough cut's, as a single cut is a rough cut.
-    cutting = CuttingData(rough.cutting_speed, hob_speed(rough.cutting_speed, hob.tip_diameter, machine.spindle_max),
-                          rough.axial_feed, finish.axial_feed, rough.radial_feed,
-                          "; ".join(p.source for p in proposals.values()), finish.radial_feed)
-    shown = [frame for frame in ranked.values() if not frame.empty]
-    table = pd.concat(shown, ignore_index=True) if shown else cases.assign(distance=0.0).head(0)
+def suggest_from(base: CaseBase, gear: Gear, hob: Hob, machine: Machine, *, top: int = 3) -> Suggestion:
+    """`suggest` over a case base already read (`load_case_base`), with the nearest cases as a
+    table and the plausibility notes."""
+    cutting, proposals, found = base.cutting_data(gear, hob, machine, top)
+    rows = [base.records[int(position)] | {"distance": float(distance)}
+            for positions, distances in found.values() for position, distance in zip(positions, distances)]
+    table = pd.DataFrame(rows, columns=[*CASE_COLUMNS, "distance"])
     notes = plausibility_notes(gear, hob, machine, cutting, proposals)
     return Suggestion(gear, hob, machine, cutting, table, proposals, notes)
 
@@ -199,21 +112,6 @@ def suggest_for_gear(conn, gear_id: int, machine_name: str | None = None, *, top
     choice = choose_hob(gear, load_hobs(conn), purpose=model.hob_purpose if model else "cylindrical")
     suggestion = suggest(conn, gear, choice.hob, machine, top=top)
     return replace(suggestion, hob_reason=choice.reason)
-
-
-def feeds_per_rev(cutting: CuttingData, cut: str) -> tuple[float, float]:
-    if cut == "rough":
-        return cutting.axial_feed_rough, cutting.radial_feed
-    if cut == "finish":
-        return cutting.axial_feed_finish, cutting.finish_radial_feed
-    raise EngineError(f"cut kind {cut!r} is not one of {', '.join(CUT_KINDS)}")
-
-
-def feeds_per_minute(cutting: CuttingData, gear: Gear, hob: Hob, cut: str) -> dict:
-    """v_f = f·n0·z0/z2 in mm/min, to 0.1 as the program writes it (§B5)."""
-    axial, radial = feeds_per_rev(cutting, cut)
-    return {name: round(per_minute(feed, cutting.hob_speed, hob.starts, gear.teeth), 1)
-            for name, feed in (("axial_feed", axial), ("radial_feed", radial))}
 
 
 def plausibility_notes(gear: Gear, hob: Hob, machine: Machine, cutting: CuttingData, proposals: dict) -> list[str]:
@@ -257,14 +155,6 @@ def _speed_notes(gear: Gear, hob: Hob, proposals: dict) -> list[str]:
         notes.append(f"finish: its cases suggest v = {finish.cutting_speed:.1f} m/min; the job runs one hob speed, "
                      f"the rough cut's ({rough.cutting_speed:.1f} m/min)")
     return notes
-
-
-def job_cutting_record(cutting: CuttingData, gear: Gear, hob: Hob, cut_kinds: list[str],
-                       case_ids: list[int]) -> dict:
-    """What job.cutting holds: the job's cuts only (a single-cut job is a rough cut), feeds in mm/min."""
-    record = {"source": cutting.source, "hob_speed": cutting.hob_speed,
-              "cutting_speed": round(cutting.cutting_speed, 1), "case_ids": [int(i) for i in case_ids]}
-    return record | {cut: feeds_per_minute(cutting, gear, hob, cut) for cut in cut_kinds}
 
 
 CONFIRM_QUERY = """

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 
-from .cases import CUT_KINDS_BY_COUNT, job_cutting_record, load_case_base, suggest_from
+from .case_base import CUT_KINDS_BY_COUNT, CaseBase, job_cutting_record
 from .decision_table import Result, compiled_template
 from .errors import EngineError
 from .hobbing.choices import Choices
@@ -69,7 +69,7 @@ class Planner:
             raise EngineError(f"machine {self.machine.name} is a {self.machine.kind}, not a hobbing machine; "
                               f"use --machine {DEFAULT_HOBBING_MACHINE}")
         self.hobs = load_hobs(conn)
-        self.case_base = load_case_base(conn)
+        self.case_base = CaseBase.load(conn)
         self._cutting: dict[tuple, tuple] = {}
         self.choices = choices
         self.overrides = overrides or {}
@@ -111,8 +111,9 @@ class Planner:
         and the ids of the cases they came from; gears alike share one suggestion."""
         key = (gear.module, gear.teeth, gear.material, gear.hardness, gear.quality_grade, hob.id)
         if key not in self._cutting:
-            suggestion = suggest_from(self.case_base, gear, hob, self.machine)
-            self._cutting[key] = (suggestion.cutting.with_overrides(**self.overrides), suggestion.case_ids())
+            cutting, proposals, _ = self.case_base.cutting_data(gear, hob, self.machine)
+            case_ids = [case_id for proposal in proposals.values() for case_id in proposal.case_ids]
+            self._cutting[key] = (cutting.with_overrides(**self.overrides), case_ids)
         return self._cutting[key]
 
 
