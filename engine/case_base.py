@@ -71,6 +71,16 @@ class CaseBase:
         self.radial_per_rev = np.array([r["radial_feed"] for r in records], dtype=float) / table_speed
         cuts = np.array([r["cut"] for r in records], dtype=object)
         self.of_kind = {cut: np.flatnonzero(cuts == cut) for cut in CUT_KINDS}
+        numeric = [f for f in DISTANCE_FEATURES if f[1] == "numeric"]
+        categorical = [f for f in DISTANCE_FEATURES if f[1] == "categorical"]
+        self.numeric_names = [name for name, _, _, _ in numeric]
+        self.categorical_names = [name for name, _, _, _ in categorical]
+        self.scales = np.array([scale for _, _, scale, _ in numeric])
+        self.numeric_weights = np.array([weight for _, _, _, weight in numeric])
+        self.categorical_weights = np.array([weight for _, _, _, weight in categorical])
+        self.matrices = {cut: (np.column_stack([self.columns[n][rows] for n in self.numeric_names]),
+                               np.column_stack([self.columns[n][rows] for n in self.categorical_names]))
+                         for cut, rows in self.of_kind.items()}
 
     @classmethod
     def load(cls, conn) -> "CaseBase":
@@ -85,21 +95,19 @@ class CaseBase:
 
     def nearest(self, query: dict, top: int) -> tuple[np.ndarray, np.ndarray]:
         """(positions, distances) of the `top` nearest cases of the query's cut kind, nearest first
-        (ties by case id)."""
+        (ties by case id). One matrix operation per kind of feature: a batch asks this per gear."""
         positions = self.of_kind.get(query["cut"], np.empty(0, dtype=np.int64))
-        total = np.zeros(len(positions))
-        for feature, kind, scale, weight in DISTANCE_FEATURES:
-            total += weight * self._term(self.columns[feature][positions], kind, scale, query[feature])
+        if not len(positions):
+            return positions, np.empty(0)
+        numbers, words = self.matrices[query["cut"]]
+        wanted = np.array([np.nan if query[n] is None else float(query[n]) for n in self.numeric_names])
+        terms = np.abs(numbers - wanted) / self.scales
+        terms = np.where(np.isnan(terms), 1.0, terms)          # missing on either side: full mismatch
+        labels = np.array([_MISSING if query[n] is None else str(query[n]).casefold()
+                           for n in self.categorical_names], dtype=object)
+        total = terms @ self.numeric_weights + (words != labels).astype(float) @ self.categorical_weights
         order = np.lexsort((self.ids[positions], total))[:top]
         return positions[order], total[order]
-
-    @staticmethod
-    def _term(values: np.ndarray, kind: str, scale, wanted) -> np.ndarray:
-        if wanted is None:
-            return np.ones(len(values))
-        if kind == "numeric":
-            return np.nan_to_num(np.abs(values - float(wanted)) / scale, nan=1.0)
-        return (values != str(wanted).casefold()).astype(float)
 
     def propose(self, query: dict, top: int, defaults: CuttingData) -> tuple[KindProposal, np.ndarray, np.ndarray]:
         """Inverse-distance weighted mean of the transferred values; exact matches as they are."""
@@ -138,6 +146,9 @@ class CaseBase:
                               rough.axial_feed, finish.axial_feed, rough.radial_feed,
                               "; ".join(p.source for p in proposals.values()), finish.radial_feed)
         return cutting, proposals, {cut: (positions, distance) for cut, (_, positions, distance) in found.items()}
+
+
+_MISSING = object()   # a query value not given: equal to no case's value
 
 
 def _plain(value):
