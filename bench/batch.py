@@ -28,7 +28,7 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
 from _common import add_database_argument, bench_database, median, verdict  # noqa: E402
-from engine.cases import CUT_KINDS_BY_COUNT, job_cutting_record  # noqa: E402
+from engine.case_base import CUT_KINDS_BY_COUNT, job_cutting_record  # noqa: E402
 from engine.errors import EngineError  # noqa: E402
 from engine.hobbing.choices import Choices  # noqa: E402
 from engine.hobs import choose_hob  # noqa: E402

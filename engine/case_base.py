@@ -1,7 +1,8 @@
-"""The machining history as arrays, for the nearest-case search of every instantiation.
+"""The machining history, for the nearest-case search of every instantiation.
 
-numpy only, no pandas: a batch asks once per gear kind (thousands of times) and a single
-`engine instantiate` must start fast; `engine.cases` builds the tables people read on top.
+Plain Python, no pandas or numpy: a single `engine instantiate` must start fast (numpy's
+import alone is 70 ms), a batch asks once per gear kind, and a shop's history is hundreds of
+cases, not millions; `engine.cases` builds the tables people read on top.
 Distance d = Σ weight·|case − query|/scale over numeric features + Σ weight·[case ≠ query]
 over categorical ones; a value missing on either side counts as a full mismatch (1).
 Cases transfer to this gear and hob through what carries over between hobs and gears: the
@@ -10,10 +11,10 @@ cutting speed v = π·d_a0·n0/1000 and the feeds per workpiece revolution f = v
 """
 from __future__ import annotations
 
+import heapq
 import math
 from dataclasses import dataclass
 
-import numpy as np
 
 from .cutting_data import RADIAL_TO_AXIAL, CuttingData, default_cutting_data, hob_speed, per_minute
 from .errors import EngineError
@@ -58,97 +59,96 @@ def query_of(gear, hob, cut: str) -> dict:
 
 
 class CaseBase:
-    """The history read once: one array per feature, and the transferred values."""
+    """The history read once, per cut kind: each case's features and transferred values."""
 
     def __init__(self, records: list[dict]):
         self.records = records
-        self.ids = np.array([r["id"] for r in records], dtype=np.int64)
-        self.columns = {feature: self._column(feature, kind) for feature, kind, _, _ in DISTANCE_FEATURES}
-        table_speed = np.array([r["hob_speed"] * r["hob_starts"] / r["teeth"] for r in records], dtype=float)
-        self.cutting_speed = np.array([math.pi * r["hob_tip_diameter"] * r["hob_speed"] / 1000 for r in records],
-                                      dtype=float)
-        self.axial_per_rev = np.array([r["axial_feed"] for r in records], dtype=float) / table_speed
-        self.radial_per_rev = np.array([r["radial_feed"] for r in records], dtype=float) / table_speed
-        cuts = np.array([r["cut"] for r in records], dtype=object)
-        self.of_kind = {cut: np.flatnonzero(cuts == cut) for cut in CUT_KINDS}
-        numeric = [f for f in DISTANCE_FEATURES if f[1] == "numeric"]
-        categorical = [f for f in DISTANCE_FEATURES if f[1] == "categorical"]
-        self.numeric_names = [name for name, _, _, _ in numeric]
-        self.categorical_names = [name for name, _, _, _ in categorical]
-        self.scales = np.array([scale for _, _, scale, _ in numeric])
-        self.numeric_weights = np.array([weight for _, _, _, weight in numeric])
-        self.categorical_weights = np.array([weight for _, _, _, weight in categorical])
-        self.matrices = {cut: (np.column_stack([self.columns[n][rows] for n in self.numeric_names]),
-                               np.column_stack([self.columns[n][rows] for n in self.categorical_names]))
-                         for cut, rows in self.of_kind.items()}
+        self.of_kind = {cut: [_Case.of(position, record) for position, record in enumerate(records)
+                              if record["cut"] == cut] for cut in CUT_KINDS}
 
     @classmethod
     def load(cls, conn) -> "CaseBase":
         rows = conn.execute(LOAD_CASES).fetchall()
         return cls([{name: _plain(value) for name, value in zip(CASE_COLUMNS, row)} for row in rows])
 
-    def _column(self, feature: str, kind: str) -> np.ndarray:
-        values = [r[feature] for r in self.records]
-        if kind == "numeric":
-            return np.array([np.nan if v is None else float(v) for v in values], dtype=float)
-        return np.array(["" if v is None else str(v).casefold() for v in values], dtype=object)
+    def nearest(self, query: dict, top: int) -> list[tuple[float, "_Case"]]:
+        """(distance, case) of the `top` nearest cases of the query's cut kind, nearest first
+        (ties by case id)."""
+        wanted = _features(query)
+        ranked = ((distance(case.features, wanted), case) for case in self.of_kind.get(query["cut"], []))
+        return heapq.nsmallest(top, ranked, key=lambda found: (found[0], found[1].id))
 
-    def nearest(self, query: dict, top: int) -> tuple[np.ndarray, np.ndarray]:
-        """(positions, distances) of the `top` nearest cases of the query's cut kind, nearest first
-        (ties by case id). One matrix operation per kind of feature: a batch asks this per gear."""
-        positions = self.of_kind.get(query["cut"], np.empty(0, dtype=np.int64))
-        if not len(positions):
-            return positions, np.empty(0)
-        numbers, words = self.matrices[query["cut"]]
-        wanted = np.array([np.nan if query[n] is None else float(query[n]) for n in self.numeric_names])
-        terms = np.abs(numbers - wanted) / self.scales
-        terms = np.where(np.isnan(terms), 1.0, terms)          # missing on either side: full mismatch
-        labels = np.array([_MISSING if query[n] is None else str(query[n]).casefold()
-                           for n in self.categorical_names], dtype=object)
-        total = terms @ self.numeric_weights + (words != labels).astype(float) @ self.categorical_weights
-        order = np.lexsort((self.ids[positions], total))[:top]
-        return positions[order], total[order]
-
-    def propose(self, query: dict, top: int, defaults: CuttingData) -> tuple[KindProposal, np.ndarray, np.ndarray]:
+    def propose(self, query: dict, top: int, defaults: CuttingData) -> tuple[KindProposal, list]:
         """Inverse-distance weighted mean of the transferred values; exact matches as they are."""
         cut = query["cut"]
-        positions, distance = self.nearest(query, top)
-        if not len(positions):
+        found = self.nearest(query, top)
+        if not found:
             axial = defaults.axial_feed_rough if cut == "rough" else defaults.axial_feed_finish
             radial = defaults.radial_feed if cut == "rough" else RADIAL_TO_AXIAL * axial
-            return KindProposal(cut, defaults.cutting_speed, axial, radial,
-                                f"{cut}: no cases, {defaults.source}"), positions, distance
-        exact = distance <= EXACT
-        chosen = positions[exact] if exact.any() else positions
-        weights = np.ones(len(chosen)) if exact.any() else 1.0 / distance
-        ids = tuple(int(i) for i in self.ids[chosen])
+            return KindProposal(cut, defaults.cutting_speed, axial, radial, f"{cut}: no cases, {defaults.source}"), found
+        exact = [(1.0, case) for d, case in found if d <= EXACT]
+        weighted = exact or [(1.0 / d, case) for d, case in found]
+        total = sum(weight for weight, _ in weighted)
+        ids = tuple(case.id for _, case in weighted)
 
-        def mean(values):
-            return float((values[chosen] * weights).sum() / weights.sum())
-        how = "as is" if exact.any() else "inverse-distance weighted"
+        def mean(name):
+            return sum(weight * getattr(case, name) for weight, case in weighted) / total
+        how = "as is" if exact else "inverse-distance weighted"
         source = f"{cut}: case{'s' if len(ids) > 1 else ''} {', '.join(f'#{i}' for i in ids)} {how}"
-        proposal = KindProposal(cut, mean(self.cutting_speed), mean(self.axial_per_rev),
-                                mean(self.radial_per_rev), source, ids)
-        return proposal, positions, distance
+        proposal = KindProposal(cut, mean("cutting_speed"), mean("axial_per_rev"), mean("radial_per_rev"), source, ids)
+        return proposal, found
 
     def cutting_data(self, gear, hob, machine, top: int = 3) -> tuple[CuttingData, dict, dict]:
-        """(cutting data, proposal per cut kind, (positions, distances) per cut kind). The job
+        """(cutting data, proposal per cut kind, the nearest (distance, case) per cut kind). The job
         runs one hob speed: the rough cut's, as a single cut is a rough cut."""
         if top < 1:
             raise EngineError(f"top {top}: ask for at least 1 case per cut kind")
         defaults = default_cutting_data(gear.module, gear.material, bool(hob.coating), hob.tip_diameter,
                                         machine.spindle_max)
         found = {cut: self.propose(query_of(gear, hob, cut), top, defaults) for cut in CUT_KINDS}
-        proposals = {cut: proposal for cut, (proposal, _, _) in found.items()}
+        proposals = {cut: proposal for cut, (proposal, _) in found.items()}
         rough, finish = proposals["rough"], proposals["finish"]
         cutting = CuttingData(rough.cutting_speed, hob_speed(rough.cutting_speed, hob.tip_diameter,
                                                              machine.spindle_max),
                               rough.axial_feed, finish.axial_feed, rough.radial_feed,
                               "; ".join(p.source for p in proposals.values()), finish.radial_feed)
-        return cutting, proposals, {cut: (positions, distance) for cut, (_, positions, distance) in found.items()}
+        return cutting, proposals, {cut: nearest for cut, (_, nearest) in found.items()}
 
 
-_MISSING = object()   # a query value not given: equal to no case's value
+@dataclass(frozen=True)
+class _Case:
+    position: int            # in CaseBase.records
+    id: int
+    features: tuple          # in DISTANCE_FEATURES order: floats, casefolded text, None when missing
+    cutting_speed: float     # m/min
+    axial_per_rev: float     # mm per workpiece revolution
+    radial_per_rev: float
+
+    @classmethod
+    def of(cls, position: int, r: dict) -> "_Case":
+        table_speed = r["hob_speed"] * r["hob_starts"] / r["teeth"]
+        return cls(position, r["id"], _features(r), math.pi * r["hob_tip_diameter"] * r["hob_speed"] / 1000,
+                   r["axial_feed"] / table_speed, r["radial_feed"] / table_speed)
+
+
+def _features(values: dict) -> tuple:
+    def plain(value, kind):
+        if value is None:
+            return None
+        return float(value) if kind == "numeric" else str(value).casefold()
+    return tuple(plain(values[name], kind) for name, kind, _, _ in DISTANCE_FEATURES)
+
+
+def distance(case: tuple, query: tuple) -> float:
+    total = 0.0
+    for (_, kind, scale, weight), have, want in zip(DISTANCE_FEATURES, case, query):
+        if have is None or want is None:
+            total += weight
+        elif kind == "numeric":
+            total += weight * abs(have - want) / scale
+        elif have != want:
+            total += weight
+    return total
 
 
 def _plain(value):

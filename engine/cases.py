@@ -15,8 +15,7 @@ import pandas as pd
 import psycopg
 from psycopg import sql
 
-from .case_base import (CASE_COLUMNS, CUT_KINDS, CUT_KINDS_BY_COUNT, CaseBase, KindProposal,  # noqa: F401
-                        feeds_per_minute, feeds_per_rev, job_cutting_record)
+from .case_base import CASE_COLUMNS, CUT_KINDS, CaseBase, KindProposal, feeds_per_minute, feeds_per_rev
 from .cutting_data import CuttingData
 from .errors import EngineError
 from .hobs import choose_hob
@@ -90,8 +89,8 @@ def suggest_from(base: CaseBase, gear: Gear, hob: Hob, machine: Machine, *, top:
     """`suggest` over a case base already read (`load_case_base`), with the nearest cases as a
     table and the plausibility notes."""
     cutting, proposals, found = base.cutting_data(gear, hob, machine, top)
-    rows = [base.records[int(position)] | {"distance": float(distance)}
-            for positions, distances in found.values() for position, distance in zip(positions, distances)]
+    rows = [base.records[case.position] | {"distance": distance}
+            for nearest in found.values() for distance, case in nearest]
     table = pd.DataFrame(rows, columns=[*CASE_COLUMNS, "distance"])
     notes = plausibility_notes(gear, hob, machine, cutting, proposals)
     return Suggestion(gear, hob, machine, cutting, table, proposals, notes)

@@ -10,7 +10,8 @@ import psycopg
 from psycopg import sql
 import pytest
 
-from engine.cases import confirm_job, job_cutting_record, list_cases, seed_cases, suggest
+from engine.case_base import job_cutting_record
+from engine.cases import confirm_job, list_cases, seed_cases, suggest
 from engine.cutting_data import per_minute
 from engine.errors import EngineError
 from engine.paths import SEED_DIR
