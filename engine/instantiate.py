@@ -17,7 +17,7 @@ from .errors import EngineError
 from .hobbing.choices import Choices
 from .hobs import choose_hob
 from .models import model_for_class
-from .nc_check import LimitError, check_program
+from .nc_check import LimitError, check_program, check_table_speed
 from .outputs import write_program_files
 from .records import Gear, Machine, load_gear, load_gears, load_hobs, load_machine
 from .templates import Template, load_template
@@ -136,10 +136,7 @@ def _check_table_speed(gear: Gear, starts: int, hob_speed: float, machine: Machi
     if hob_speed > machine.spindle_max:
         raise LimitError(f"gear {gear.id}: hob speed {hob_speed:g} r/min exceeds {machine.name}'s hob spindle "
                          f"maximum {machine.spindle_max:g} r/min; nothing stored")
-    table_speed = hob_speed * starts / gear.teeth
-    if machine.table_speed_max is not None and table_speed > machine.table_speed_max:
-        raise LimitError(f"gear {gear.id}: table speed {table_speed:.1f} r/min exceeds {machine.name}'s "
-                         f"{machine.table_speed_max:g} r/min; lower the hob speed; nothing stored")
+    check_table_speed(gear.id, gear.teeth, starts, hob_speed, machine)
 
 
 def instantiate_gear(conn, gear_id: int, *, machine: str | None = None, choices: Choices = Choices(),

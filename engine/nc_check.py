@@ -37,6 +37,14 @@ def check_program(lines: list[str], machine: Machine, program_name: str = "progr
             raise LimitError(f"{program_name} line {number} {line.strip()!r}: {problem}; nothing stored")
 
 
+def check_table_speed(gear_id, teeth: int, starts: int, hob_speed: float, machine: Machine) -> None:
+    """The table turns at n0·z0/z2 (§B4); a gear with few teeth turns it fastest."""
+    table_speed = hob_speed * starts / teeth
+    if machine.table_speed_max is not None and table_speed > machine.table_speed_max:
+        raise LimitError(f"gear {gear_id}: table speed {table_speed:.1f} r/min ({teeth} teeth) exceeds "
+                         f"{machine.name}'s {machine.table_speed_max:g} r/min; lower the hob speed; nothing stored")
+
+
 def words(line: str) -> list[tuple[str, float]]:
     """The address words of a block that the check reads: (letter, value) for X, Y, Z, S, G."""
     return _words(line)

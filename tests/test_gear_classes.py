@@ -317,3 +317,22 @@ def test_a_confirmed_job_becomes_a_case_of_the_history(run):
     assert [case["axial_feed"] for case in new] == [cutting["rough"]["axial_feed"], cutting["finish"]["axial_feed"]]
     again = run("cases", "confirm", "--job", job_id)
     assert again.exit_code == 1 and "already confirmed" in again.stderr
+
+
+def test_a_table_speed_over_the_machine_limit_is_refused_naming_it(conn):
+    program, nc = program_of(conn, 42)
+    n0, teeth = nc.block_with("M3").words["S"], gear(conn, 42)["z2"]
+    conn.execute("UPDATE machine SET table_speed_max = %s WHERE name = 'hobber-840d'", (n0 / teeth - 1,))
+    with pytest.raises(EngineError, match=rf"table speed {n0 / teeth:.1f} r/min \(19 teeth\) exceeds "
+                                          rf"hobber-840d's {n0 / teeth - 1:g} r/min"):
+        instantiate_gear(conn, 42)
+
+
+def test_the_table_speed_of_every_duplex_unit_is_checked(conn):
+    program, nc = program_of(conn, 54)
+    n0 = nc.block_with("M3").words["S"]
+    unit1, unit2 = gear(conn, 54)["z2"], 19
+    between = (n0 / unit1 + n0 / unit2) / 2       # unit 1 (30 teeth) turns slower, unit 2 faster
+    conn.execute("UPDATE machine SET table_speed_max = %s WHERE name = 'hobber-840d'", (between,))
+    with pytest.raises(EngineError, match=r"\(19 teeth\) exceeds"):
+        instantiate_gear(conn, 54)

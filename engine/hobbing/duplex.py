@@ -9,7 +9,7 @@ import math
 from dataclasses import dataclass
 
 from ..errors import EngineError
-from ..nc_check import LimitError
+from ..nc_check import check_table_speed
 from .cylindrical import CylindricalModel, JobParameters
 from .passes import plan_cuts, working_area
 from . import shifting
@@ -29,7 +29,7 @@ class DuplexModel(CylindricalModel):
         setups = [self.setup(unit, hob) for unit in units]
         module_params, passes = {}, []
         for number, (unit, setup) in enumerate(zip(units, setups), start=1):
-            check_table_speed(gear, unit, hob, cutting.hob_speed, machine)
+            check_table_speed(gear.id, unit.teeth, hob.starts, cutting.hob_speed, machine)
             unit_cuts = self._unit_cuts(number, unit, hob, cutting, choices, setup)
             module_params.update(unit_cuts)
             passes.append((unit, setup, [c for c in unit_cuts.values() if c["cut_on"]]))
@@ -91,14 +91,6 @@ def unit_gears(gear) -> list[UnitGear]:
         raise EngineError(f"gear {gear.id}: unit 2 starts at Z{unit2.z_top:g}, inside unit 1 "
                           f"(Z0…{-first.face_width:g}); correct z_top in gear_unit")
     return [first, unit2]
-
-
-def check_table_speed(gear, unit, hob, hob_speed, machine) -> None:
-    table_speed = hob_speed * hob.starts / unit.teeth
-    if machine.table_speed_max is not None and table_speed > machine.table_speed_max:
-        raise LimitError(f"gear {gear.id}: table speed {table_speed:.1f} r/min for a unit of {unit.teeth} teeth "
-                         f"exceeds {machine.name}'s {machine.table_speed_max:g} r/min; lower the hob speed; "
-                         f"nothing stored")
 
 
 def check_clearance(gear, hob, passes) -> None:
