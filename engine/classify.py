@@ -132,31 +132,23 @@ class GearClassReport:
         return said
 
 
-GEAR_FEATURES = """
-SELECT g.id, g.gear_class, g.cone_angle, g.crowning, g.helix_angle,
-       (SELECT count(*) FROM gear_unit u WHERE u.gear_id = g.id)
-FROM gear g WHERE g.id = %s"""
-
-
 def explain_gear(conn, gear_id: int) -> GearClassReport:
     """Classify a stored gear again and say how; also the model and hob it gets."""
     from .hobs import choose_hob
     from .models import MODELS, ancestry
     from .records import load_gear, load_hobs
 
-    row = conn.execute(GEAR_FEATURES, (gear_id,)).fetchone()
-    if row is None:
-        raise EngineError(f"gear {gear_id} does not exist; import it with `engine gears import FILE.csv`")
-    features = dict(zip(("gear_id", "gear_class", "cone_angle", "crowning", "helix_angle", "units"), row))
-    classification = classify(features)
-    lineage = ancestry(conn, row[1]) if row[1] else []
+    gear = load_gear(conn, gear_id)
+    classification = classify({"gear_id": gear.id, "cone_angle": gear.cone_angle, "crowning": gear.crowning,
+                               "helix_angle": gear.helix_angle, "units": len(gear.units)})
+    lineage = ancestry(conn, gear.gear_class) if gear.gear_class else []
     model_class = next((name for name in lineage if name in MODELS), None)
     hob = None
     if model_class:
         model = MODELS[model_class]
         try:
-            chosen = choose_hob(load_gear(conn, gear_id), load_hobs(conn), purpose=model.hob_purpose)
+            chosen = choose_hob(gear, load_hobs(conn), purpose=model.hob_purpose)
             hob = chosen.reason
         except EngineError as error:
             hob = f"none fits: {error}"
-    return GearClassReport(gear_id, row[1], classification, model_class, hob)
+    return GearClassReport(gear_id, gear.gear_class, classification, model_class, hob)

@@ -100,7 +100,7 @@ def load_gears(conn, first: int | None = None, last: int | None = None) -> list[
     if not gears:
         return gears
     units = _load_units(conn, gears[0].id, gears[-1].id)
-    return [_with_units(gear, units) if gear.id in units else gear for gear in gears]
+    return [_with_units(gear, units) for gear in gears]
 
 
 def _load_units(conn, first: int, last: int) -> dict[int, tuple]:

@@ -20,8 +20,9 @@ class TaperModel(CylindricalModel):
                               f"got {gear.cone_angle}; set cone_angle or choose another class")
         setup = super().setup(gear, hob)
         slope = math.tan(math.radians(gear.cone_angle))
-        # The infeed above the face happens at a larger X: retract beyond it.
-        highest = setup.full_depth + max(setup.reach.approach, gear.face_width + setup.reach.approach) * abs(slope)
+        # The pass reaches the approach distance beyond either face, where the cone line lies
+        # furthest out: retract beyond it.
+        highest = setup.full_depth + (gear.face_width + setup.reach.approach) * abs(slope)
         return Setup(setup.lead, setup.swivel, setup.full_depth, setup.reach,
                      max(setup.x_retract, highest + RETRACT_CLEARANCE))
 
