@@ -12,7 +12,6 @@ import pytest
 
 from engine.case_base import job_cutting_record
 from engine.cases import confirm_job, list_cases, seed_cases, suggest
-from engine.cutting_data import per_minute
 from engine.errors import EngineError
 from engine.paths import SEED_DIR
 from engine.records import load_gear, load_hobs, load_machine
@@ -46,7 +45,8 @@ def insert_case(conn, **values):
 
 
 def mm_per_min(feed_per_rev, cutting, starts=1, teeth=19):
-    return round(per_minute(feed_per_rev, cutting.hob_speed, starts, teeth), 1)
+    """§B5: v_f = f·n0·z0/z2."""
+    return round(feed_per_rev * cutting.hob_speed * starts / teeth, 1)
 
 
 @pytest.fixture
