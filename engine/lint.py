@@ -60,11 +60,29 @@ def lint_class(conn, gear_class: str) -> list[LintProblem]:
     problems = structural_problems(gear_class, list(template.rows))
     if problems:
         return problems
-    model = model_for_class(conn, gear_class)
-    if model is None:
-        return [LintProblem(gear_class, None, "model", "no hobbing model for this class or its ancestors; "
-                            "its parameter names cannot be checked")]
-    return list(_unknown_names(gear_class, template.rows, model))
+    # An imported class's rows name the parameters of its program, even under a parent with a model.
+    name_source = _imported_names(conn, gear_class) or model_for_class(conn, gear_class)
+    if name_source is None:
+        return [LintProblem(gear_class, None, "model", "no hobbing model for this class or its ancestors, "
+                            "so its parameter names cannot be checked; give the class a model, or import "
+                            "it with `engine import-nc FILE --class NAME --params P.json`")]
+    return list(_unknown_names(gear_class, template.rows, name_source))
+
+
+@dataclass(frozen=True)
+class _ImportedNames:
+    """The names of an imported class: the parameters of the program it came from, in every module."""
+    names: frozenset
+
+    def parameter_names(self, t: str, n: int) -> frozenset:
+        return self.names
+
+
+def _imported_names(conn, gear_class: str) -> _ImportedNames | None:
+    found = conn.execute("SELECT import_params FROM gear_class WHERE name = %s", (gear_class,)).fetchone()
+    if found is None or found[0] is None:
+        return None
+    return _ImportedNames(frozenset(found[0]))
 
 
 def _unknown_names(gear_class: str, rows, model):

@@ -48,6 +48,8 @@ from dataclasses import dataclass, field
 from decimal import Decimal, InvalidOperation
 from pathlib import Path
 
+from psycopg.types.json import Jsonb
+
 from .decision_table import MODULE_ORDER, CompiledTemplate
 from .errors import EngineError
 from .expressions import CONSTANTS, FUNCTIONS, MAX_EXPRESSION_LENGTH, compile_expression, evaluation_globals
@@ -88,12 +90,27 @@ def import_nc(conn, path, gear_class: str, params: dict | None = None, modules: 
     with conn.transaction():
         created = ensure_class(conn, gear_class, parent)
         changed = replace_template(conn, gear_class, rows)
+        _store_import_params(conn, gear_class, params)
         template = load_template(conn, gear_class)
         _verify(template, params, lines, path)
     counts = {t: sum(1 for row in rows if row.t == t) for t in MODULE_ORDER}
     return ImportReport(gear_class, str(path), len(rows), built.parameterised,
                         {t: c for t, c in counts.items() if c}, created, changed, template.version,
                         built.ambiguous)
+
+
+def _store_import_params(conn, gear_class: str, params: dict) -> None:
+    """Keep the parameters the class was imported with: lint checks its names against them."""
+    conn.execute("UPDATE gear_class SET import_params = %s WHERE name = %s",
+                 (Jsonb(params, dumps=_params_json), gear_class))
+
+
+def _params_json(params: dict) -> str:
+    try:
+        return json.dumps(params, default=str, allow_nan=False)
+    except ValueError:
+        raise EngineError("parameter values must be finite: NaN and infinity cannot be stored; "
+                          "give numbers or text") from None
 
 
 def _verify(template, params: dict, lines: list[str], path) -> None:

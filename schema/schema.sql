@@ -23,7 +23,10 @@ CREATE TABLE gear_class (
     name             text PRIMARY KEY CHECK (name ~ '^[a-z][a-z0-9_]*$'),
     parent           text REFERENCES gear_class (name),
     description      text NOT NULL DEFAULT '',
-    template_version integer NOT NULL DEFAULT 0 CHECK (template_version >= 0)
+    template_version integer NOT NULL DEFAULT 0 CHECK (template_version >= 0),
+    -- The parameter values of the proven program the class was imported from (engine
+    -- import-nc); lint checks the template's names against them. NULL: not imported.
+    import_params    jsonb CHECK (jsonb_typeof(import_params) = 'object')
 );
 
 -- A component is the body of a template row (T, O, P_calc, S, P_emit). A body used by
