@@ -15,7 +15,8 @@ from .cli_commands import template
               help="Report line pairs of one module type with this similarity or more (Sim < 1).")
 @click.option("--json", "as_json", is_flag=True,
               help="Print one JSON object: changed, components_before, components_after, shared, "
-                   "near_duplicates.")
+                   "near_duplicates (per pair: t, sim, texts a and b, uses_a/uses_b and the first "
+                   "10 class:row uses of each; template_view has them all).")
 @click.pass_context
 def refactor_command(ctx, threshold, as_json):
     """Merge identical component bodies and report near-duplicate lines to unify.
@@ -57,12 +58,13 @@ def _print_report(report) -> None:
                f"near-duplicate pair(s) with similarity >= {report.threshold:g} to unify by hand.")
     for pair in report.near_duplicates:
         click.echo(f"\n  {pair['t']}  Sim {pair['sim']:.3f}")
-        click.echo(f"    {pair['a']}   ({_uses(pair['rows_a'])})")
-        click.echo(f"    {pair['b']}   ({_uses(pair['rows_b'])})")
+        click.echo(f"    {pair['a']}   ({_uses(pair['rows_a'], pair['uses_a'])})")
+        click.echo(f"    {pair['b']}   ({_uses(pair['rows_b'], pair['uses_b'])})")
 
 
-def _uses(rows) -> str:
-    return ", ".join(f"{gear_class}:{row_id}" for gear_class, row_id in rows)
+def _uses(rows, count: int) -> str:
+    listed = ", ".join(f"{gear_class}:{row_id}" for gear_class, row_id in rows)
+    return listed + (f" and {count - len(rows)} more" if count > len(rows) else "")
 
 
 @template.command("shared")

@@ -7,12 +7,11 @@ assembled template unchanged), stored once (no two components with the same body
 """
 from __future__ import annotations
 
-import ast
 from collections import defaultdict
 from dataclasses import dataclass, field
 
 from .errors import EngineError
-from .nc_tokens import SPACE, tokenise
+from .similarity import Units, nc_units, similar_pairs
 from .templates import TemplateRow, load_template, rows_hash
 
 # Concurrent instantiations read either the old or the new library: writers wait for us,
@@ -137,82 +136,35 @@ def check_invariants(conn, snapshot: dict[str, tuple[TemplateRow, ...]]) -> None
                           "nothing was changed, report this as a bug")
 
 
-def nc_units(text: str) -> tuple[str, ...]:
-    """The tokens of the NC line a line expression produces: string literals and f-string
-    parts are tokenised as NC text, each `{…}` placeholder is one unit; anything else is
-    tokenised as it stands. Blanks are dropped."""
-    try:
-        node = ast.parse(text.strip(), mode="eval").body
-    except SyntaxError:
-        node = None
-    pieces = _literal_pieces(node) if node is not None else None
-    if pieces is None:
-        pieces = [(text, False)]
-    units: list[str] = []
-    for piece, is_placeholder in pieces:
-        if is_placeholder:
-            units.append(piece)
-        else:
-            units.extend(token.text for token in tokenise(piece) if token.kind != SPACE)
-    return tuple(units)
-
-
-def _literal_pieces(node) -> list[tuple[str, bool]] | None:
-    """(text, is_placeholder) pieces of a string, f-string or `+` of them; None otherwise."""
-    if isinstance(node, ast.Constant) and isinstance(node.value, str):
-        return [(node.value, False)]
-    if isinstance(node, ast.JoinedStr):
-        pieces = []
-        for part in node.values:
-            if isinstance(part, ast.Constant):
-                pieces.append((str(part.value), False))
-            else:
-                pieces.append(("{" + ast.unparse(part.value) + "}", True))
-        return pieces
-    if isinstance(node, ast.BinOp) and isinstance(node.op, ast.Add):
-        left, right = _literal_pieces(node.left), _literal_pieces(node.right)
-        if left is None or right is None:
-            return None
-        return left + right
-    return None
+# A text used by hundreds of classes would repeat all its uses in every pair it is in;
+# the report lists this many and counts the rest (template_view has them all).
+USES_LISTED = 10
 
 
 def near_duplicates(conn, threshold: float) -> list[dict]:
     """Pairs of distinct line texts of one module type with threshold ≤ Sim < 1, where
-    Sim = K / (M + N − K) on token lists (K the longest common subsequence)."""
+    Sim = K / (M + N − K) on NC unit lists (K the longest common subsequence); per text
+    its number of uses and the first USES_LISTED (class, row id)."""
     uses: dict[tuple[str, str], list[list]] = defaultdict(list)
     for t, o, gear_class, row_id in conn.execute(LINE_USES):
         uses[(t, o)].append([gear_class, row_id])
-    by_type: dict[str, dict[tuple[str, ...], list[str]]] = defaultdict(lambda: defaultdict(list))
+    by_type: dict[str, dict[Units, list[str]]] = defaultdict(lambda: defaultdict(list))
     for t, o in uses:
         by_type[t][nc_units(o)].append(o)
     pairs = []
     for t in sorted(by_type):
-        for (a, b), sim in _similar_pairs(list(by_type[t]), threshold):
-            for text_a in by_type[t][a]:
-                for text_b in by_type[t][b]:
-                    pairs.append({"t": t, "sim": round(sim, 4), "a": text_a, "b": text_b,
-                                  "rows_a": uses[(t, text_a)], "rows_b": uses[(t, text_b)]})
+        texts_of = list(by_type[t].values())
+        for i, j, sim in similar_pairs(list(by_type[t]), threshold):
+            pairs += [_pair(t, sim, text_a, text_b, uses) for text_a in texts_of[i] for text_b in texts_of[j]]
     return sorted(pairs, key=lambda pair: (-pair["sim"], pair["t"], pair["a"], pair["b"]))
 
 
-def _similar_pairs(units: list[tuple[str, ...]], threshold: float):
-    """((units a, units b), Sim) for every pair of distinct token lists with Sim ≥ threshold."""
-    if len(units) < 2:
-        return
-    from rapidfuzz import process
-    from rapidfuzz.distance import Indel
-
-    # Indel's normalized similarity ns = 2K / (M + N); Sim = ns / (2 − ns) grows with ns.
-    cutoff = 2 * threshold / (1 + threshold)
-    scores = process.cdist(units, units, scorer=Indel.normalized_similarity,
-                           score_cutoff=cutoff - 1e-9, workers=-1)
-    for i in range(len(units)):
-        for j in range(i + 1, len(units)):
-            ns = float(scores[i][j])
-            sim = ns / (2 - ns)
-            if threshold - 1e-9 <= sim < 1 - 1e-12:
-                yield (units[i], units[j]), sim
+def _pair(t: str, sim: float, text_a: str, text_b: str, uses) -> dict:
+    text_a, text_b = sorted((text_a, text_b))
+    rows_a, rows_b = uses[(t, text_a)], uses[(t, text_b)]
+    return {"t": t, "sim": round(sim, 4), "a": text_a, "b": text_b,
+            "uses_a": len(rows_a), "uses_b": len(rows_b),
+            "rows_a": rows_a[:USES_LISTED], "rows_b": rows_b[:USES_LISTED]}
 
 
 @dataclass(frozen=True)

@@ -224,3 +224,20 @@ def test_help_texts(run, args, words):
     result = run(*args, "--help")
     assert result.exit_code == 0
     assert all(word in result.stdout for word in words)
+
+
+def test_a_text_used_by_many_classes_lists_ten_uses_and_counts_them_all(conn):
+    for number in range(12):
+        ensure_class(conn, f"many_{number}")
+        replace_template(conn, f"many_{number}", [TemplateRow(100, "main", 1, None, None, '"G90 G71 G94 ; MANY"', None)])
+    ensure_class(conn, "few")
+    replace_template(conn, "few", [TemplateRow(100, "main", 1, None, None, '"G90 G71 G94 ; FEW"', None)])
+    report = refactor(conn, threshold=0.6)
+    pair = next(p for p in report.near_duplicates
+                if {p["a"], p["b"]} == {'"G90 G71 G94 ; MANY"', '"G90 G71 G94 ; FEW"'})
+    uses = {pair["a"]: (pair["uses_a"], pair["rows_a"]), pair["b"]: (pair["uses_b"], pair["rows_b"])}
+    many_count, many_rows = uses['"G90 G71 G94 ; MANY"']
+    assert many_count == 12
+    assert len(many_rows) == 10 and all(name.startswith("many_") and row == 100 for name, row in many_rows)
+    assert uses['"G90 G71 G94 ; FEW"'] == (1, [["few", 100]])
+    assert pair["sim"] == pytest.approx(lcs_sim(["G90", "G71", "G94", "; MANY"], ["G90", "G71", "G94", "; FEW"]))
