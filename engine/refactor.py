@@ -1,22 +1,39 @@
 """The nightly re-factoring of the module library (design notes §5).
 
 One transaction: identical component bodies are merged (found by hashing, linear), the
-near-duplicates a human should unify are reported (rapidfuzz on token lists, within one
-module type), and the invariants are checked before commit — lossless (every class's
-assembled template unchanged), stored once (no two components with the same body).
+near-duplicates a human should unify are reported (engine.similarity, within one module
+type), and the invariants are checked before commit — lossless (every class's assembled
+template unchanged, compared by a digest the server computes per class), stored once (no
+two components with the same body).
 """
 from __future__ import annotations
 
 from collections import defaultdict
 from dataclasses import dataclass, field
 
+import psycopg
+
 from .errors import EngineError
 from .similarity import Units, nc_units, similar_pairs
-from .templates import TemplateRow, load_template, rows_hash
+from .templates import TemplateRow, load_template
 
 # Concurrent instantiations read either the old or the new library: writers wait for us,
-# readers (plain SELECT) are not blocked and see the last committed state.
+# readers (plain SELECT) are not blocked and see the last committed state. The engine's
+# writers lock the two tables in this order too (templates.LOCK_FOR_WRITING); a hand-made
+# SQL edit may not, and a deadlock with it costs the refactor a retry, not the night.
 LOCK = "LOCK TABLE component, assembly IN SHARE ROW EXCLUSIVE MODE"
+DEADLOCK_RETRIES = 3
+
+# Per class: row count and a digest of every assembled row (id, n and the whole body).
+TEMPLATE_DIGESTS = """
+SELECT g.name, count(*)::int,
+       encode(sha256(convert_to(string_agg(
+           concat_ws(',', r.id, r.n, quote_literal(c.t), quote_nullable(c.p_calc), quote_nullable(c.s),
+                     quote_nullable(c.o), quote_nullable(c.p_emit)), E'\\n' ORDER BY r.id), 'UTF8')), 'hex')
+FROM gear_class g
+CROSS JOIN LATERAL class_template(g.name) r
+JOIN component c ON c.id = r.component_id
+GROUP BY g.name"""
 
 ASSEMBLED_ROWS = """
 SELECT g.name, r.id, c.t, r.n, c.p_calc, c.s, c.o, c.p_emit
@@ -49,12 +66,14 @@ SELECT count(*)::int FROM (
     SELECT component_id FROM assembly GROUP BY component_id
     HAVING count(DISTINCT gear_class) >= 2) shared"""
 
-# Line texts with the classes and row ids that store them, per module type.
+# Per line text of a module type: how many rows store it, and the first few (class, row id).
 LINE_USES = """
-SELECT c.t, c.o, a.gear_class, a.id
+SELECT c.t, c.o, count(*)::int,
+       (array_agg(a.gear_class ORDER BY a.gear_class, a.id))[1:%(listed)s],
+       (array_agg(a.id ORDER BY a.gear_class, a.id))[1:%(listed)s]
 FROM assembly a JOIN component c ON c.id = a.component_id
 WHERE c.o IS NOT NULL
-ORDER BY c.t, c.o, a.gear_class, a.id"""
+GROUP BY c.t, c.o"""
 
 STAGES = ("snapshot", "merge identical bodies", "find near-duplicates", "check invariants")
 
@@ -80,11 +99,20 @@ def refactor(conn, threshold: float = 0.8, progress=None) -> RefactorReport:
     `progress(stage, done, total)` is called before each stage."""
     if not 0 < threshold <= 1:
         raise EngineError(f"threshold {threshold} is outside (0, 1]; give e.g. --threshold 0.8")
-    step = _stepper(progress)
+    for attempt in range(1, DEADLOCK_RETRIES + 1):
+        try:
+            return _refactor_once(conn, threshold, _stepper(progress))
+        except psycopg.errors.DeadlockDetected:
+            if attempt == DEADLOCK_RETRIES:
+                raise EngineError(f"refactor deadlocked {attempt} times with other writers of the template "
+                                  "library; nothing was changed, run it again when they are done") from None
+
+
+def _refactor_once(conn, threshold: float, step) -> RefactorReport:
     with conn.transaction():
         conn.execute(LOCK)
         step()
-        snapshot = assembled_templates(conn)
+        snapshot = template_digests(conn)
         before = _count_components(conn)
         step()
         repointed = conn.execute(REPOINT_DUPLICATES).rowcount
@@ -121,19 +149,28 @@ def assembled_templates(conn) -> dict[str, tuple[TemplateRow, ...]]:
     return {name: tuple(found) for name, found in rows.items()}
 
 
-def check_invariants(conn, snapshot: dict[str, tuple[TemplateRow, ...]]) -> None:
+def template_digests(conn) -> dict[str, tuple[int, str]]:
+    """Per class with rows: (row count, digest of its assembled rows); computed by the server."""
+    return {name: (count, digest) for name, count, digest in conn.execute(TEMPLATE_DIGESTS)}
+
+
+def check_invariants(conn, snapshot: dict[str, tuple[int, str]]) -> None:
     """Lossless and stored once, or an EngineError naming the class that broke."""
-    now = assembled_templates(conn)
+    now = template_digests(conn)
     for name in sorted(set(snapshot) | set(now)):
-        if snapshot.get(name, ()) != now.get(name, ()):
+        if snapshot.get(name) != now.get(name):
             raise EngineError(
                 f"refactor would change the assembled template of class {name!r} "
-                f"(hash {rows_hash(snapshot.get(name, ()))} -> {rows_hash(now.get(name, ()))}); "
+                f"(rows, digest {_shown(snapshot.get(name))} -> {_shown(now.get(name))}); "
                 "nothing was changed, report this as a bug")
     twice = conn.execute(BODIES_STORED_TWICE).fetchone()
     if twice:
         raise EngineError(f"after refactor a body of class {twice[0]!r} is stored {twice[1]} times; "
                           "nothing was changed, report this as a bug")
+
+
+def _shown(digest: tuple[int, str] | None) -> str:
+    return "none" if digest is None else f"{digest[0]}, {digest[1][:16]}"
 
 
 # A text used by hundreds of classes would repeat all its uses in every pair it is in;
@@ -145,11 +182,10 @@ def near_duplicates(conn, threshold: float) -> list[dict]:
     """Pairs of distinct line texts of one module type with threshold ≤ Sim < 1, where
     Sim = K / (M + N − K) on NC unit lists (K the longest common subsequence); per text
     its number of uses and the first USES_LISTED (class, row id)."""
-    uses: dict[tuple[str, str], list[list]] = defaultdict(list)
-    for t, o, gear_class, row_id in conn.execute(LINE_USES):
-        uses[(t, o)].append([gear_class, row_id])
+    uses: dict[tuple[str, str], tuple[int, list]] = {}
     by_type: dict[str, dict[Units, list[str]]] = defaultdict(lambda: defaultdict(list))
-    for t, o in uses:
+    for t, o, count, classes, row_ids in conn.execute(LINE_USES, {"listed": USES_LISTED}):
+        uses[(t, o)] = (count, [[name, row_id] for name, row_id in zip(classes, row_ids)])
         by_type[t][nc_units(o)].append(o)
     pairs = []
     for t in sorted(by_type):
@@ -161,10 +197,9 @@ def near_duplicates(conn, threshold: float) -> list[dict]:
 
 def _pair(t: str, sim: float, text_a: str, text_b: str, uses) -> dict:
     text_a, text_b = sorted((text_a, text_b))
-    rows_a, rows_b = uses[(t, text_a)], uses[(t, text_b)]
+    (uses_a, rows_a), (uses_b, rows_b) = uses[(t, text_a)], uses[(t, text_b)]
     return {"t": t, "sim": round(sim, 4), "a": text_a, "b": text_b,
-            "uses_a": len(rows_a), "uses_b": len(rows_b),
-            "rows_a": rows_a[:USES_LISTED], "rows_b": rows_b[:USES_LISTED]}
+            "uses_a": uses_a, "uses_b": uses_b, "rows_a": rows_a, "rows_b": rows_b}
 
 
 @dataclass(frozen=True)

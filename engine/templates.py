@@ -105,6 +105,7 @@ def replace_template(conn, gear_class: str, rows: list[TemplateRow]) -> bool:
     from .lint import check_rows
 
     with conn.transaction():
+        conn.execute(LOCK_FOR_WRITING)
         conn.execute("SELECT 1 FROM gear_class WHERE name = %s FOR UPDATE", (gear_class,))
         inherited = {row.id: row for row in inherited_rows(conn, gear_class)}
         own = [row for row in rows if inherited.get(row.id) != row]
@@ -122,6 +123,11 @@ def replace_template(conn, gear_class: str, rows: list[TemplateRow]) -> bool:
         conn.execute(BUMP_VERSIONS, (gear_class,))
     return True
 
+
+# Writers take their locks on the library in the refactor's order (engine.refactor.LOCK), so
+# a writer that started first finishes and the refactor waits for it, never a deadlock.
+# ROW EXCLUSIVE: writers do not wait for each other.
+LOCK_FOR_WRITING = "LOCK TABLE component, assembly IN ROW EXCLUSIVE MODE"
 
 OWN_ROWS = """
 SELECT a.id, c.t, a.n, c.p_calc, c.s, c.o, c.p_emit

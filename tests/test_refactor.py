@@ -11,7 +11,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from engine.errors import EngineError
-from engine.refactor import assembled_templates, check_invariants, refactor
+from engine.refactor import check_invariants, refactor, template_digests
 from engine.templates import TemplateRow, ensure_class, export_csv, load_template, replace_template
 
 
@@ -131,7 +131,7 @@ def test_threshold_keeps_only_closer_pairs(conn):
 
 
 def test_invariant_check_names_the_class_whose_template_would_change(conn):
-    snapshot = assembled_templates(conn)
+    snapshot = template_digests(conn)
     _, copy = duplicate_row_body(conn, "worm_wheel", 1410)   # a leaf class: no class inherits it
     conn.execute("UPDATE component SET o = '\"EGDEF(C,B,2)\"' WHERE id = %s", (copy,))
     with pytest.raises(EngineError, match="class 'worm_wheel'"):
@@ -141,7 +141,7 @@ def test_invariant_check_names_the_class_whose_template_would_change(conn):
 def test_invariant_check_refuses_a_body_stored_twice(conn):
     duplicate_row_body(conn, "taper", 1410)
     with pytest.raises(EngineError, match="stored 2 times"):
-        check_invariants(conn, assembled_templates(conn))
+        check_invariants(conn, template_digests(conn))
 
 
 # Bodies (t, o, condition) valid in any class; ids keep the module order (main < prep < sync < …).
