@@ -26,21 +26,17 @@ DEADLOCK_RETRIES = 3
 
 # Per class: row count and a digest of every assembled row (id, n and the whole body).
 TEMPLATE_DIGESTS = """
-SELECT g.name, count(*)::int,
+SELECT r.gear_class, count(*)::int,
        encode(sha256(convert_to(string_agg(
            concat_ws(',', r.id, r.n, quote_literal(c.t), quote_nullable(c.p_calc), quote_nullable(c.s),
                      quote_nullable(c.o), quote_nullable(c.p_emit)), E'\\n' ORDER BY r.id), 'UTF8')), 'hex')
-FROM gear_class g
-CROSS JOIN LATERAL class_template(g.name) r
-JOIN component c ON c.id = r.component_id
-GROUP BY g.name"""
+FROM assembled_row r JOIN component c ON c.id = r.component_id
+GROUP BY r.gear_class"""
 
 ASSEMBLED_ROWS = """
-SELECT g.name, r.id, c.t, r.n, c.p_calc, c.s, c.o, c.p_emit
-FROM gear_class g
-CROSS JOIN LATERAL class_template(g.name) r
-JOIN component c ON c.id = r.component_id
-ORDER BY g.name, r.id"""
+SELECT r.gear_class, r.id, c.t, r.n, c.p_calc, c.s, c.o, c.p_emit
+FROM assembled_row r JOIN component c ON c.id = r.component_id
+ORDER BY r.gear_class, r.id"""
 
 # Every assembly row pointing at a later copy of a body is repointed to the body's lowest id.
 REPOINT_DUPLICATES = """
@@ -54,12 +50,11 @@ DELETE_UNUSED = """
 DELETE FROM component c
 WHERE NOT EXISTS (SELECT 1 FROM assembly a WHERE a.component_id = c.id)"""
 
+# A body stored more than once (as component ids), and a class that uses one of them.
 BODIES_STORED_TWICE = """
-SELECT min(a.gear_class), count(DISTINCT c.id)::int
-FROM component c LEFT JOIN assembly a ON a.component_id = c.id
-GROUP BY component_body_key(c.t, c.o, c.p_calc, c.s, c.p_emit)
-HAVING count(DISTINCT c.id) > 1
-LIMIT 1"""
+SELECT (SELECT min(a.gear_class) FROM assembly a WHERE a.component_id = ANY(twice.ids)), cardinality(twice.ids)
+FROM (SELECT array_agg(id) AS ids FROM component
+      GROUP BY component_body_key(t, o, p_calc, s, p_emit) HAVING count(*) > 1 LIMIT 1) twice"""
 
 COMPONENTS_SHARED = """
 SELECT count(*)::int FROM (

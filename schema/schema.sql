@@ -78,18 +78,27 @@ AS $$
     ORDER BY a.id, l.depth
 $$;
 
+-- Every class's assembled rows in one set-based statement (class_template suits one class).
+CREATE VIEW assembled_row AS
+WITH RECURSIVE lineage(gear_class, ancestor, depth) AS (
+    SELECT g.name, g.name, 0 FROM gear_class g
+    UNION ALL
+    SELECT l.gear_class, g.parent, l.depth + 1
+    FROM lineage l JOIN gear_class g ON g.name = l.ancestor
+    WHERE g.parent IS NOT NULL AND l.depth < 50)
+SELECT DISTINCT ON (l.gear_class, a.id) l.gear_class, a.id, a.n, a.component_id, a.gear_class AS owner
+FROM lineage l JOIN assembly a ON a.gear_class = l.ancestor
+ORDER BY l.gear_class, a.id, l.depth;
+
 CREATE VIEW template_view AS
-WITH assembled AS (
-    SELECT g.name AS gear_class, r.id, r.n, r.component_id, r.owner
-    FROM gear_class g CROSS JOIN LATERAL class_template(g.name) r),
-body_use AS (
+WITH body_use AS (
     SELECT component_body_key(c.t, c.o, c.p_calc, c.s, c.p_emit) AS body,
            count(DISTINCT a.gear_class)::integer AS classes
-    FROM assembled a JOIN component c ON c.id = a.component_id
+    FROM assembled_row a JOIN component c ON c.id = a.component_id
     GROUP BY 1)
 SELECT a.gear_class, a.id, c.t, a.n, c.p_calc, c.s, c.o, c.p_emit, u.classes AS shared_by,
        a.owner AS inherited_from
-FROM assembled a
+FROM assembled_row a
 JOIN component c ON c.id = a.component_id
 JOIN body_use u ON u.body = component_body_key(c.t, c.o, c.p_calc, c.s, c.p_emit);
 
