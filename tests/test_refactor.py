@@ -1,6 +1,6 @@
 """The nightly refactor (design notes §5): identical bodies merged, every class's assembled
 template byte-identical, no body stored twice, a second run changes nothing, and the
-near-duplicate lines reported with Sim = K / (M + N − K) computed here by a small LCS."""
+near-duplicate lines reported with Sim = K / (M + N − K) computed by a plain LCS table (test_similarity)."""
 from __future__ import annotations
 
 import json
@@ -12,7 +12,10 @@ from hypothesis import strategies as st
 
 from engine.errors import EngineError
 from engine.refactor import check_invariants, refactor, template_digests
+from engine.similarity import nc_units
 from engine.templates import TemplateRow, ensure_class, export_csv, load_template, replace_template
+
+from test_similarity import lcs_sim
 
 
 def exports(conn) -> dict[str, str]:
@@ -41,16 +44,6 @@ def duplicate_row_body(conn, gear_class: str, row_id: int) -> tuple[int, int]:
     conn.execute("UPDATE assembly SET component_id = %s WHERE gear_class = %s AND id = %s",
                  (copy, gear_class, row_id))
     return original, copy
-
-
-def lcs_sim(a: list[str], b: list[str]) -> float:
-    """Sim = K / (M + N − K), K the longest common subsequence of the token lists."""
-    table = [[0] * (len(b) + 1) for _ in range(len(a) + 1)]
-    for i, x in enumerate(a):
-        for j, y in enumerate(b):
-            table[i + 1][j + 1] = table[i][j] + 1 if x == y else max(table[i][j + 1], table[i + 1][j])
-    k = table[-1][-1]
-    return k / (len(a) + len(b) - k)
 
 
 def test_seeded_library_is_stored_once_and_a_run_changes_nothing(conn):
@@ -175,6 +168,72 @@ def test_random_libraries_refactor_losslessly_once_and_idempotently(conn, classe
         assert bodies_stored_twice(conn) == 0
         assert first.components_after == component_count(conn)
         second = refactor(conn)
+        assert second.changed is False
+        assert second.components_before == second.components_after == first.components_after
+        assert exports(conn) == before
+
+
+# Any library: bodies drawn from NC words (f-strings when they hold a field), with or
+# without conditions and computations, classes deriving from any earlier class, some rows
+# pointing at copies of their bodies as SQL edits leave them.
+NC_WORDS = ["G0", "G1", "X", "Z", "F", "M8", "{x:.3f}", "{feed}", "; CUT"]
+CONDITIONS = [None, "cuts > 1", "coolant", "shift_y <> 0"]
+COMPUTATIONS = [None, "k = 1", "x2 = x * 2"]
+
+
+@st.composite
+def random_body(draw):
+    words = " ".join(draw(st.lists(st.sampled_from(NC_WORDS), min_size=1, max_size=6)))
+    o = f'f"{words}"' if "{" in words else f'"{words}"'
+    s = draw(st.sampled_from(COMPUTATIONS))
+    return (draw(st.sampled_from(list(MODULE_BASE))), o, "cuts > 1" if s and draw(st.booleans()) else None,
+            s, draw(st.sampled_from(CONDITIONS)))
+
+
+random_library = st.lists(st.tuples(st.lists(st.tuples(random_body(), st.booleans()), min_size=1, max_size=8),
+                                    st.integers(min_value=-1, max_value=6)), min_size=1, max_size=5)
+
+
+def store_random_library(conn, classes) -> None:
+    for number, (bodies, parent) in enumerate(classes):
+        name = f"any_{number}"
+        ensure_class(conn, name, f"any_{parent}" if 0 <= parent < number else None)
+        rows = {MODULE_BASE[t] + 10 * i: TemplateRow(MODULE_BASE[t] + 10 * i, t, 1, p_calc, s, o, p_emit)
+                for i, ((t, o, p_calc, s, p_emit), _) in enumerate(bodies)}
+        replace_template(conn, name, sorted(rows.values(), key=lambda row: row.id))
+        for i, ((t, *_), copy_it) in enumerate(bodies):
+            own = conn.execute("SELECT 1 FROM assembly WHERE gear_class = %s AND id = %s",
+                               (name, MODULE_BASE[t] + 10 * i)).fetchone()
+            if copy_it and own:
+                duplicate_row_body(conn, name, MODULE_BASE[t] + 10 * i)
+
+
+def expected_near_duplicates(conn, threshold: float) -> set[frozenset]:
+    """Every pair of stored line texts of one module type whose NC units have threshold ≤ Sim < 1."""
+    texts = conn.execute("SELECT DISTINCT c.t, c.o FROM assembly a JOIN component c ON c.id = a.component_id "
+                         "WHERE c.o IS NOT NULL").fetchall()
+    found = set()
+    for index, (t, a) in enumerate(texts):
+        for u, b in texts[index + 1:]:
+            if t == u and threshold - 1e-9 <= lcs_sim(nc_units(a), nc_units(b)) < 1 - 1e-9:
+                found.add(frozenset((t, a, b)))
+    return found
+
+
+@settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(classes=random_library, threshold=st.sampled_from([0.5, 0.8]))
+def test_any_library_refactors_losslessly_stored_once_idempotently_with_every_near_duplicate(
+        conn, classes, threshold):
+    with conn.transaction(force_rollback=True):
+        store_random_library(conn, classes)
+        before = exports(conn)
+        first = refactor(conn, threshold)
+        assert exports(conn) == before
+        assert bodies_stored_twice(conn) == 0
+        assert first.components_after == component_count(conn)
+        reported = {frozenset((pair["t"], pair["a"], pair["b"])) for pair in first.near_duplicates}
+        assert reported == expected_near_duplicates(conn, threshold)
+        second = refactor(conn, threshold)
         assert second.changed is False
         assert second.components_before == second.components_after == first.components_after
         assert exports(conn) == before
