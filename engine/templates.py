@@ -78,7 +78,7 @@ def list_classes(conn) -> list[tuple]:
     """(name, parent, template_version, row count, description) of every class."""
     return conn.execute("""
         SELECT g.name, g.parent, g.template_version, count(r.id)::int, g.description
-        FROM gear_class g LEFT JOIN LATERAL class_template(g.name) r ON true
+        FROM gear_class g LEFT JOIN assembled_row r ON r.gear_class = g.name
         GROUP BY g.name ORDER BY g.name""").fetchall()
 
 

@@ -181,3 +181,15 @@ def test_an_unreachable_server_is_one_line_and_exit_1():
     assert result.exit_code == 1
     assert result.stderr.startswith("error: cannot connect to postgresql://nobody@127.0.0.1:1/none")
     assert len(result.stderr.strip().splitlines()) == 1
+
+
+def test_template_list_counts_each_class_s_own_and_inherited_rows(run):
+    result = run("template", "list")
+    assert result.exit_code == 0, result.output
+    with psycopg.connect(run.url) as conn:
+        expected = dict(conn.execute("SELECT g.name, (SELECT count(*) FROM class_template(g.name)) "
+                                     "FROM gear_class g").fetchall())
+    listed = {line.split()[0]: line for line in result.stdout.splitlines() if line.strip()}
+    assert expected["duplex"] > expected["spur"] > 0
+    for name in ("spur", "duplex", "helical", "worm_wheel"):
+        assert f"{expected[name]} rows" in listed[name], listed[name]
