@@ -127,7 +127,7 @@ def replace_template(conn, gear_class: str, rows: list[TemplateRow]) -> bool:
 # Writers take their locks on the library in the refactor's order (engine.refactor.LOCK), so
 # a writer that started first finishes and the refactor waits for it, never a deadlock.
 # ROW EXCLUSIVE: writers do not wait for each other.
-LOCK_FOR_WRITING = "LOCK TABLE component, assembly IN ROW EXCLUSIVE MODE"
+LOCK_FOR_WRITING = "LOCK TABLE gear_class, component, assembly IN ROW EXCLUSIVE MODE"
 
 OWN_ROWS = """
 SELECT a.id, c.t, a.n, c.p_calc, c.s, c.o, c.p_emit
