@@ -22,7 +22,9 @@ def refactor_command(ctx, threshold, as_json):
     """Merge identical component bodies and report near-duplicate lines to unify.
 
     One transaction: every class's assembled template stays exactly as it was (checked
-    before commit), and a second run changes nothing."""
+    before commit, else nothing is changed and the class is named), and a second run
+    changes nothing. Instantiations go on meanwhile; template writers wait. Meant to run
+    every night (README: cron or a systemd timer); exit code 0 also when nothing changed."""
     from .refactor import refactor
 
     with connection(ctx) as conn, _progress() as progress:
