@@ -62,6 +62,8 @@ class CompiledTemplate:
         uses_sql = any(c.is_sql for r in self.rows for c in _expressions_of(r))
         self.globals = {**evaluation_globals(uses_sql), "_text": _text, "_clock": time.perf_counter}
         self.code, self.places = build(self.rows, template.gear_class)
+        # Rows that print a whole tool path (nc_path) emit several lines at once.
+        self.prints_paths = any(row.o is not None and "nc_path" in row.o.text for row in self.rows)
         # Lines a row always emits the same, parsed for the limit check once per template.
         self.constant_words = {row.row.id: words(row.o.tree.value) for row in self.rows
                                if row.o is not None and isinstance(row.o.tree, ast.Constant)
@@ -85,7 +87,7 @@ class CompiledTemplate:
             raise
         except Exception as error:  # an expression's own failure, reported with its place
             raise self._error_at(error) from None
-        return result
+        return _one_line_each(result) if self.prints_paths else result
 
     def _error_at(self, error: Exception) -> TemplateError:
         place = self.places[_line_in_template(error.__traceback__, self.code.co_filename)]
@@ -102,9 +104,26 @@ class _NotText(Exception):
     pass
 
 
+def _one_line_each(result: Result) -> Result:
+    """The blocks of an nc_path row as lines of their own, each with the row's id."""
+    from .turning.nc_path import NcLines
+
+    flat = Result()
+    for line, row_id in zip(result.lines, result.row_ids):
+        if isinstance(line, NcLines):
+            flat.lines.extend(line)
+            flat.row_ids.extend([row_id] * len(line))
+        else:
+            flat.lines.append(line)
+            flat.row_ids.append(row_id)
+    return flat
+
+
 def _text(value):
     """`o` must give text (a bare number would print in whatever form Python chooses), of
-    bounded length."""
+    bounded length; or the blocks of nc_path."""
+    if type(value).__name__ == "NcLines":
+        return value
     if type(value) is not str:
         raise _NotText(f"gives {type(value).__name__} {value!r}, not text "
                        "(write an f-string with a format, e.g. f\"X{x:.3f}\")")

@@ -136,6 +136,14 @@ FUNCTIONS.update({
     "abs": abs, "min": min, "max": max, "round": safe_round, "int": int, "float": float,
     "str": safe_str, "bool": bool, "len": len, "format": safe_format,
 })
+
+def _nc_path(*args):
+    from .turning.nc_path import nc_path
+
+    return nc_path(*args)
+
+
+FUNCTIONS["nc_path"] = _nc_path   # a tool path, one NC block per move (engine.turning.nc_path)
 CONSTANTS = {"pi": math.pi, "e": math.e, "True": True, "False": False, "None": None}
 GUARDED_OPERATORS = {ast.Pow: "_safe_pow", ast.Mult: "_safe_mult", ast.Add: "_safe_add",
                      ast.LShift: "_safe_lshift", ast.Mod: "_safe_mod"}

@@ -1,0 +1,24 @@
+"""Tool moves of a turning job, in machine coordinates: Z along the axis (mm), X as a
+diameter (mm), as a program states them. The template rows decide how each kind is
+written (engine.turning.nc_path), so the dialects live in rows, not here."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+MOVE_KINDS = ("rapid", "feed", "cw", "ccw", "thread")
+
+
+@dataclass(frozen=True, slots=True)
+class Move:
+    """One block's motion to (z, x). Arcs: radius and the centre relative to the start
+    point (i radial, k axial, both mm, i as a radius). Thread: the lead per turn."""
+    kind: str
+    z: float
+    x: float
+    radius: float | None = None
+    i: float | None = None
+    k: float | None = None
+    pitch: float | None = None
+
+
+Pass = list[Move]   # one pass: its approach, its cut, its retract
