@@ -14,8 +14,6 @@ import math
 from dataclasses import dataclass
 from typing import Callable, Iterator, Union
 
-from ezdxf import units
-
 from .dxf_read import DxfError, one_line
 
 # Largest distance between a flattened SPLINE/ELLIPSE (or an arc outside the XY plane) and
@@ -71,6 +69,8 @@ def unit_scale(insunits: int | None) -> tuple[str, float, bool]:
     if not insunits:
         return "mm", 1.0, True
     try:
+        from ezdxf import units
+
         return units.decode(insunits), units.conversion_factor(insunits, units.MM), False
     except (KeyError, IndexError, ValueError):
         raise DxfError(f"$INSUNITS = {insunits} is not a known unit code; set the drawing units "

@@ -14,9 +14,10 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import ezdxf
-from ezdxf import recover
-from ezdxf.document import Drawing as EzdxfDocument
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:   # ezdxf takes a third of a second to import: only reading a drawing pays it
+    from ezdxf.document import Drawing as EzdxfDocument
 
 from engine.errors import EngineError
 
@@ -37,7 +38,7 @@ class DxfError(EngineError):
 class DrawingFile:
     """An opened drawing: the ezdxf document and what the reader repaired or assumed."""
     path: Path
-    doc: EzdxfDocument
+    doc: "EzdxfDocument"
     repairs: list[str] = field(default_factory=list)
 
 
@@ -47,6 +48,8 @@ def load_drawing_file(path: str | Path) -> DrawingFile:
     check_is_ascii_dxf(path)
     repairs: list[str] = []
     try:
+        import ezdxf
+
         doc = ezdxf.readfile(path)
     except Exception as strict_failure:  # any strict-reader failure: the tolerant reader decides
         doc = recover_document(path)
@@ -55,11 +58,13 @@ def load_drawing_file(path: str | Path) -> DrawingFile:
     return DrawingFile(path, doc, repairs)
 
 
-def recover_document(path: Path) -> EzdxfDocument:
+def recover_document(path: Path) -> "EzdxfDocument":
     """ezdxf.recover rebuilds sections, tables and links; a file whose group codes and values
     are out of step is refused (its explore mode would guess, and a guessed coordinate
     makes a wrong part)."""
     try:
+        from ezdxf import recover
+
         doc, _ = recover.readfile(path)
     except Exception as failure:  # ezdxf raises several types for unreadable structure
         raise DxfError(f"{path}: not a readable DXF ({one_line(failure)}); "
@@ -67,7 +72,7 @@ def recover_document(path: Path) -> EzdxfDocument:
     return doc
 
 
-def audit_messages(doc: EzdxfDocument) -> list[str]:
+def audit_messages(doc: "EzdxfDocument") -> list[str]:
     auditor = doc.audit()
     return ([f"fixed: {entry.message}" for entry in auditor.fixes]
             + [f"error: {entry.message}" for entry in auditor.errors])

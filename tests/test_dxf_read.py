@@ -13,6 +13,7 @@ import re
 from pathlib import Path
 
 import ezdxf
+import ezdxf.recover
 import ezdxf.path
 import pytest
 from ezdxf.math import bulge_center
