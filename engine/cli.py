@@ -134,3 +134,6 @@ from .cli_nc import import_nc_command  # noqa: E402
 main.add_command(import_nc_command)
 from .cli_refactor import refactor_command  # noqa: E402  (also registers `template shared`)
 main.add_command(refactor_command)
+from .cli_turning import import_dxf_command, plot_command  # noqa: E402  (turning jobs from DXF drawings)
+main.add_command(import_dxf_command)
+main.add_command(plot_command)

@@ -84,8 +84,9 @@ class Planner:
     def model(self, gear_class: str):
         if gear_class not in self._models:
             model = model_for_class(self.conn, gear_class)
-            if model is None:
-                raise EngineError(f"gear class {gear_class!r} has no hobbing model (nor has any ancestor)")
+            if model is None or not hasattr(model, "job"):
+                raise EngineError(f"gear class {gear_class!r} has no hobbing model (nor has any ancestor); "
+                                  "turning jobs come from drawings: engine import-dxf FILE.dxf")
             self._models[gear_class] = model
         return self._models[gear_class]
 
@@ -154,9 +155,15 @@ def instantiate_job(conn, job_id: int, out: str | Path | None = None) -> Program
     if row is None:
         raise EngineError(f"job {job_id} does not exist; see `SELECT id, gear_id FROM job`")
     gear_id, gear_class, machine_name, hob_id, params, module_params = row
-    template = load_template(conn, gear_class)
-    result = run_template(template, params, module_params, load_machine(conn, machine_name))
-    planned = Planned(gear_id, gear_class, machine_name, hob_id, params, module_params, template, result)
+    machine = load_machine(conn, machine_name)
+    if machine.kind == "lathe":   # a turning job: its passes are computed from its parameters
+        from .turning.planning import plan_turning_job
+
+        planned = plan_turning_job(conn, gear_class, machine, params, module_params)
+    else:
+        template = load_template(conn, gear_class)
+        result = run_template(template, params, module_params, machine)
+        planned = Planned(gear_id, gear_class, machine_name, hob_id, params, module_params, template, result)
     return _store_and_write(conn, [planned], out, existing_job=job_id)[0]
 
 

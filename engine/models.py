@@ -6,6 +6,7 @@ from .hobbing.cylindrical import CylindricalModel
 from .hobbing.duplex import DuplexModel
 from .hobbing.taper import TaperModel
 from .hobbing.worm_wheel import WormWheelModel
+from .turning.model import TurningModel
 
 # The hobbing model of a node of the group-technology tree serves it and every class below
 # it that has no model of its own.
@@ -15,6 +16,7 @@ MODELS = {
     "taper": TaperModel(),
     "crowned": CrownedModel(),
     "worm_wheel": WormWheelModel(),
+    "turning": TurningModel(),   # names only (for lint): turning jobs come from drawings
 }
 
 CLASS_ANCESTRY = """

@@ -1,0 +1,63 @@
+"""`engine import-dxf`: a lathe drawing becomes one turning job (design notes §8).
+
+The drawing is read, its numbers become job parameters, the program is computed and
+checked against the lathe (so a job that could never be instantiated is not stored), and
+the job is stored, all in one transaction: on any error nothing is stored. The program
+itself is stored by `engine instantiate --job ID`, like every instantiation.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from psycopg.types.json import Jsonb
+
+from importers.dxf_drawing import read_drawing
+
+from .job_params import ProfileOptions, turning_job
+from .model import job_passes, key, present_operations
+from .planning import lathe, plan_turning_job, turning_class
+
+# ISO lathe program numbers O0001 … O9999: the job id, wrapped into that range.
+ISO_PROGRAM_NUMBERS = 9999
+
+INSERT_TURNING_JOB = """
+INSERT INTO job (id, gear_id, gear_class, machine, hob_id, params, module_params)
+VALUES (%s, NULL, %s, %s, NULL, %s, %s)"""
+
+
+@dataclass
+class ImportReport:
+    job_id: int
+    drawing: str
+    machine: str
+    gear_class: str
+    program_lines: int
+    operations: list[dict] = field(default_factory=list)
+    repairs: list[str] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+
+
+def import_dxf(conn, path: str | Path, machine_name: str | None = None,
+               options: ProfileOptions = ProfileOptions(), alternate: list[int] | None = None) -> ImportReport:
+    """Read the drawing and store its job; EngineError (nothing stored) if it cannot become one."""
+    machine = lathe(conn, machine_name)
+    gear_class = turning_class(machine)
+    drawing = read_drawing(path)
+    with conn.transaction():
+        job_id = conn.execute("SELECT nextval('job_id_seq')").fetchone()[0]
+        job = turning_job(drawing, machine.name, gear_class, (job_id - 1) % ISO_PROGRAM_NUMBERS + 1,
+                          options, alternate)
+        planned = plan_turning_job(conn, gear_class, machine, job.params, job.module_params)
+        conn.execute(INSERT_TURNING_JOB, (job_id, gear_class, machine.name, Jsonb(job.params),
+                                          Jsonb(job.module_params)))
+    notes = job.notes + empty_operations(job) + drawing.notes
+    return ImportReport(job_id, str(drawing.source), machine.name, gear_class, len(planned.result.lines),
+                        job.operations, drawing.repairs, notes)
+
+
+def empty_operations(job) -> list[str]:
+    passes = job_passes(job.params, job.module_params)
+    return [f"operation {n} ({job.module_params[key('cutmotion', n)]['kind']}) has no pass: nothing to cut "
+            "(the blank lies within the allowance of the profile); the program leaves it out"
+            for n in present_operations(job.module_params) if n in passes and not passes[n]]

@@ -1,0 +1,113 @@
+"""The passes of each operation of a turning job, computed from its stored parameters at every
+instantiation (so a feed, a depth or a segment edited in SQL gives the new program).
+
+Operation kinds (@G): ROUGH with drawn paths is fed along each drawn path; ROUGH without
+paths roughs the blank down to the profile plus the allowance in horizontal passes (seed
+001); FINISH follows its drawn paths, or the profile when it has none (of a closed section
+its outer side); SLOT plunges along
+each drawn path and retracts; THREAD cuts the drawn thread in passes of @D at the @A
+infeed angle. FACE is fed along its drawn paths like ROUGH, PART plunges like SLOT: on
+the drawn tool-centre path the motion is the same.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from importers.dxf_geometry import Segment
+from importers.dxf_profile import END_MATCH_TOLERANCE_MM, Profile, merged_bounds
+
+from ..errors import EngineError
+from . import toolpaths
+from .moves import Pass
+from .segments import path_from_param
+
+DRAWN_FEED_KINDS = ("ROUGH", "FACE")
+PLUNGE_KINDS = ("SLOT", "PART")
+KINDS = ("ROUGH", "SLOT", "FINISH", "THREAD", "FACE", "PART")
+
+
+@dataclass(frozen=True)
+class JobGeometry:
+    """What every operation of a job shares: the profile, the closed outline, the blank."""
+    profile: list[Segment]
+    finish_path: list[Segment]     # the side of the profile a finishing tool follows
+    outline: list[Segment]
+    stock: tuple[float, float, float] | None    # (z_front, z_back, radius) of the blank
+    clearance: float
+
+
+def job_geometry(params: dict) -> JobGeometry:
+    profile = path_from_param(params.get("profile"), "params.profile")
+    if not profile:
+        raise EngineError("params.profile is empty; a turning job needs the part's profile segments")
+    closed_by_axis = bool(params.get("closed_by_axis"))
+    closing = Profile(profile, closed_by_axis, merged_bounds(profile)).closing_segments()
+    stock = None
+    if params.get("stock_diameter") is not None:
+        stock = (number_param(params, "stock_z_front", "params"), number_param(params, "stock_z_back", "params"),
+                 number_param(params, "stock_diameter", "params") / 2.0)
+    finish_path = profile if closed_by_axis else outer_side(profile)
+    clearance = number_param(params, "clearance", "params", 0, above=True)
+    return JobGeometry(profile, finish_path, profile + closing, stock, clearance)
+
+
+def outer_side(closed: list[Segment]) -> list[Segment]:
+    """The outer side of a closed section, as a half-profile would be drawn: from its start
+    (largest Z, then largest radius; the reader orients it counter-clockwise, so it runs
+    towards −Z along the top) to where it first reaches its smallest Z. The faces and the
+    bore or axis side are not part of it, as the axis closes a half-profile."""
+    z_min = merged_bounds(closed)[0]
+    for count, segment in enumerate(closed, start=1):
+        if segment.end[0] <= z_min + END_MATCH_TOLERANCE_MM:
+            return closed[:count]
+    return closed
+
+
+def operation_passes(geometry: JobGeometry, cutmotion: dict, where: str) -> list[Pass]:
+    """The passes of one operation (`where` names its module parameters in errors)."""
+    kind = cutmotion.get("kind")
+    if kind not in KINDS:
+        raise EngineError(f"{where}.kind = {kind!r} is not one of {' | '.join(KINDS)}")
+    paths = [path_from_param(path, f"{where}.paths[{i}]") for i, path in enumerate(cutmotion.get("paths") or [])]
+    if not paths and kind in ("ROUGH", "FINISH"):
+        return _along_profile(geometry, kind, cutmotion, where)
+    if not paths:
+        raise EngineError(f"{where}: a {kind} operation needs drawn paths (paths is empty)")
+    clearance = geometry.clearance
+    if kind in DRAWN_FEED_KINDS:
+        return toolpaths.drawn_rough_passes(paths, clearance)
+    if kind in PLUNGE_KINDS:
+        return toolpaths.slot_passes(paths, clearance)
+    if kind == "FINISH":
+        return [one for path in paths for one in toolpaths.finish_passes(path, clearance)]
+    return toolpaths.thread_passes(paths, number_param(cutmotion, "depth_per_pass", where, 0, above=True),
+                                   number_param(cutmotion, "infeed_angle", where, 0),
+                                   number_param(cutmotion, "thread_pitch", where, 0, above=True), clearance)
+
+
+def _along_profile(geometry: JobGeometry, kind: str, cutmotion: dict, where: str) -> list[Pass]:
+    if kind == "FINISH":
+        return toolpaths.finish_passes(geometry.finish_path, geometry.clearance)
+    if geometry.stock is None:
+        raise EngineError(f"{where}: roughing along the profile needs the blank; set params.stock_diameter, "
+                          "stock_z_front and stock_z_back")
+    z_front, z_back, radius = geometry.stock
+    depth = number_param(cutmotion, "depth_per_pass", where, 0, above=True)
+    allowance = number_param(cutmotion, "allowance", where, 0)
+    return toolpaths.profile_rough_passes(geometry.outline, radius, depth, allowance, z_front, z_back,
+                                          geometry.clearance)
+
+
+def number_param(values: dict, key: str, where: str, minimum: float | None = None,
+                 above: bool = False) -> float:
+    """A number from stored parameters (at least, or above, `minimum`), or an error naming it."""
+    value = values.get(key)
+    wrong = isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value)
+    if not wrong and minimum is not None:
+        wrong = value <= minimum if above else value < minimum
+    if wrong:
+        rule = "a number" if minimum is None else f"a number {'above' if above else 'of at least'} {minimum:g}"
+        raise EngineError(f"{where}.{key} = {value!r} must be {rule}; set it in SQL "
+                          "(job.params / job.module_params) and instantiate the job again")
+    return float(value)

@@ -1,0 +1,61 @@
+"""Profile and tool-path segments as job parameters: JSON lists a DBA can read and edit.
+
+    ["line", z0, r0, z1, r1]
+    ["arc",  z0, r0, z1, r1, zc, rc, ccw]
+
+mm, machine coordinates: z along the axis, r the radius (a program's X is the diameter);
+ccw: counter-clockwise seen with Z to the right and the radius up (G03 on a lathe).
+"""
+from __future__ import annotations
+
+import math
+
+from importers.dxf_geometry import Arc, Line, Segment
+
+from ..errors import EngineError
+
+DIGITS = 6             # mm to 1 nm: far below any drawing's accuracy, short in SQL
+ARC_RADIUS_TOLERANCE = 0.01   # mm: an arc's two ends must be this close to one radius
+
+
+def segment_param(segment: Segment) -> list:
+    (z0, r0), (z1, r1) = segment.start, segment.end
+    ends = [round(value, DIGITS) for value in (z0, r0, z1, r1)]
+    if isinstance(segment, Line):
+        return ["line", *ends]
+    zc, rc = segment.centre
+    return ["arc", *ends, round(zc, DIGITS), round(rc, DIGITS), bool(segment.ccw)]
+
+
+def path_param(segments: list[Segment]) -> list[list]:
+    return [segment_param(segment) for segment in segments]
+
+
+def path_from_param(items, where: str) -> list[Segment]:
+    """Segments from their JSON form; `where` names the parameter in an error."""
+    if not isinstance(items, list):
+        raise EngineError(f"{where} must be a list of segments, not {type(items).__name__}; "
+                          f"fix it in SQL (job.params / job.module_params)")
+    return [segment_from_param(item, f"{where}[{index}]") for index, item in enumerate(items)]
+
+
+def segment_from_param(item, where: str) -> Segment:
+    shape = '["line", z0, r0, z1, r1] or ["arc", z0, r0, z1, r1, zc, rc, ccw]'
+    if not isinstance(item, list) or not item or item[0] not in ("line", "arc"):
+        raise EngineError(f"{where} = {item!r} is not a segment; write {shape}")
+    kind, numbers = item[0], item[1:]
+    expected = 4 if kind == "line" else 7
+    if len(numbers) != expected or not all(_is_number(v) for v in numbers[:6]):
+        raise EngineError(f"{where} = {item!r}: a {kind} is {shape.split(' or ')[kind == 'arc']}")
+    start, end = (numbers[0], numbers[1]), (numbers[2], numbers[3])
+    if kind == "line":
+        return Line(start, end)
+    centre = (numbers[4], numbers[5])
+    if abs(math.dist(start, centre) - math.dist(end, centre)) > ARC_RADIUS_TOLERANCE:
+        raise EngineError(f"{where} = {item!r}: start and end are not on one circle about the centre "
+                          f"(radii differ by more than {ARC_RADIUS_TOLERANCE} mm)")
+    return Arc(start, end, centre, bool(numbers[6]))
+
+
+def _is_number(value) -> bool:
+    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)

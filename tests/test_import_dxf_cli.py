@@ -1,0 +1,121 @@
+"""`engine import-dxf` and `engine plot` as a user meets them: every real drawing becomes a job
+or is refused with the reader's reason, edits in SQL reach the program, pictures are written,
+bad input gets one line, exit 1 and no job."""
+from __future__ import annotations
+
+import json
+
+import psycopg
+import pytest
+
+from engine.cli import main
+from test_dxf_read import DXF, EMCO, REAL, seed_drawing
+
+PROFILE_ONLY = set(EMCO) | {"d2g_Turbocad_12.5_R14.dxf"}
+
+
+def job_count(url) -> int:
+    with psycopg.connect(url) as conn:
+        return conn.execute("SELECT count(*) FROM job").fetchone()[0]
+
+
+def one_line_refusal(result) -> str:
+    assert result.exit_code == 1, result.output
+    assert len(result.stderr.strip().splitlines()) == 1 and "Traceback" not in result.output
+    return result.stderr.strip()
+
+
+def test_every_real_drawing_becomes_a_job_or_is_refused_with_its_reason(run):
+    assert {name for name, (_, refusal) in REAL.items() if refusal is None} == PROFILE_ONLY
+    for name, (_, refusal) in sorted(REAL.items()):
+        before = job_count(run.url)
+        result = run("import-dxf", DXF / name)
+        message = one_line_refusal(result)
+        assert job_count(run.url) == before, name
+        if refusal is not None:
+            assert refusal in message, (name, message)
+            continue
+        assert "--rough-depth" in message, (name, message)
+        made = run("import-dxf", DXF / name, "--rough-depth", "1", "--json")
+        assert made.exit_code == 0, (name, made.output)
+        job_id = json.loads(made.stdout)["job_id"]
+        assert job_count(run.url) == before + 1
+        program = run("instantiate", "--job", job_id, "--json")
+        assert program.exit_code == 0, (name, program.output)
+        assert json.loads(program.stdout)["lines"] > 10
+
+
+def test_import_reports_the_job_operations_and_what_was_assumed(run, tmp_path):
+    seed_drawing(tmp_path / "part.dxf")
+    result = run("import-dxf", tmp_path / "part.dxf", "--json")
+    assert result.exit_code == 0, result.output
+    report = json.loads(result.stdout)
+    assert {"job_id", "operations", "repairs", "notes"} <= report.keys()
+    assert [(op["operation"], op["kind"]) for op in report["operations"]] == [(1, "ROUGH"), (2, "SLOT"), (3, "THREAD")]
+    with psycopg.connect(run.url) as conn:
+        stored = conn.execute("SELECT gear_id, gear_class, machine, params->>'drawing' FROM job WHERE id = %s",
+                              (report["job_id"],)).fetchone()
+    assert stored == (None, "turning_iso", "lathe-iso", "part.dxf")
+    emco = run("import-dxf", DXF / EMCO[0], "--speed", "600")
+    assert emco.exit_code == 0 and emco.stdout.startswith("job ")
+    assert "no tool-change POINT" in emco.stderr and "mirrored" in emco.stderr
+
+
+def feed_words(lines: list[str]) -> list[tuple[int, str]]:
+    return [(number, word) for number, line in enumerate(lines) for word in line.split() if word.startswith("F")]
+
+
+def test_a_feed_edited_in_sql_changes_exactly_that_operation_s_f_words(run, tmp_path):
+    seed_drawing(tmp_path / "part.dxf")
+    job_id = json.loads(run("import-dxf", tmp_path / "part.dxf", "--json").stdout)["job_id"]
+    before = run("instantiate", "--job", job_id).stdout.splitlines()
+    with psycopg.connect(run.url) as conn:
+        conn.execute("""UPDATE job SET module_params = jsonb_set(module_params, '{cutmotion:2,feed}', '35')
+                        WHERE id = %s""", (job_id,))
+    after = run("instantiate", "--job", job_id).stdout.splitlines()
+    assert len(after) == len(before)
+    changed = [(b, a) for b, a in zip(before, after) if b != a]
+    assert changed == [("G98 F20", "G98 F35")]
+    assert {word for _, word in feed_words(after)} - {word for _, word in feed_words(before)} == {"F35"}
+
+
+def test_plot_writes_a_picture_of_the_job(run, tmp_path):
+    job_id = json.loads(run("import-dxf", DXF / EMCO[1], "--rough-depth", "1", "--json").stdout)["job_id"]
+    result = run("plot", "--job", job_id, "-o", tmp_path / "job.png")
+    assert result.exit_code == 0, result.output
+    assert (tmp_path / "job.png").read_bytes().startswith(b"\x89PNG\r\n\x1a\n")
+    assert "ROUGH" in result.stdout and "FINISH" in result.stdout
+    refused = run("plot", "--job", job_id, "-o", tmp_path / "job.jpg")
+    assert "png" in one_line_refusal(refused)
+
+
+def test_bad_inputs_get_one_line_exit_1_and_no_job(run, tmp_path):
+    seed_drawing(tmp_path / "part.dxf")
+    seed_drawing(tmp_path / "bad_code.dxf", rough_codes="@GROUGH @Sfast @T01")
+    whole = (DXF / EMCO[1]).read_bytes()
+    (tmp_path / "half.dxf").write_bytes(whole[: len(whole) // 2])
+    before = job_count(run.url)
+    cases = [
+        ((tmp_path / "missing.dxf",), "no such file"),
+        ((tmp_path / "half.dxf",), "truncated DXF"),
+        ((tmp_path / "bad_code.dxf",), "bad value 'fast' for @S"),
+        ((tmp_path / "part.dxf", "--machine", "nope"), "machine 'nope' does not exist"),
+        ((tmp_path / "part.dxf", "--machine", "hobber-840d"), "not a lathe"),
+        ((tmp_path / "part.dxf", "--alternate", "1,2"), "operation 2 is not a present ROUGH operation"),
+        ((tmp_path / "part.dxf", "--rough-depth", "2"), "profile-only drawings"),
+    ]
+    for args, words in cases:
+        message = one_line_refusal(run("import-dxf", *args))
+        assert words in message, (args, message)
+    assert job_count(run.url) == before
+
+
+def test_help_explains_every_option(run):
+    for command in ("import-dxf", "plot"):
+        result = run(command, "--help")
+        assert result.exit_code == 0
+        options = [param for param in main.commands[command].params if param.param_type_name == "option"]
+        assert all(option.help for option in options), command
+    text = run("import-dxf", "--help").output
+    for words in ("--rough-depth", "default: 1", "--alternate", "--stock-diameter", "lathe-840d", "@-codes"):
+        assert words in text, words
