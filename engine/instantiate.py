@@ -5,8 +5,6 @@ table → machine-limit check → job and program stored in one transaction → 
 """
 from __future__ import annotations
 
-import contextlib
-import gc
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -16,6 +14,7 @@ from .decision_table import Result, compiled_template
 from .errors import EngineError
 from .hobbing.choices import Choices
 from .hobs import choose_hob
+from .memory import no_cycle_collection
 from .models import model_for_class
 from .nc_check import LimitError, check_program, check_table_speed
 from .outputs import write_program_files
@@ -177,7 +176,7 @@ def instantiate_gears(conn, first: int | None = None, last: int | None = None, *
         raise EngineError(f"no gears with ids in {first or 'the start'}…{last or 'the end'}")
     from .storage import store_many
 
-    with _no_cycle_collection():
+    with no_cycle_collection():
         planned = [_plan_in_batch(planner, gear, progress) for gear in gears]
         return store_many(conn, planned, out)
 
@@ -192,19 +191,6 @@ def _plan_in_batch(planner: Planner, gear: Gear, progress) -> Planned:
     if progress:
         progress(1)
     return planned
-
-
-@contextlib.contextmanager
-def _no_cycle_collection():
-    """A batch allocates many objects and keeps them all until they are stored, which makes
-    Python's cycle collector rescan them again and again; they form no cycles."""
-    was_enabled = gc.isenabled()
-    gc.disable()
-    try:
-        yield
-    finally:
-        if was_enabled:
-            gc.enable()
 
 
 def _store_and_write(conn, planned: list[Planned], out, existing_job: int | None = None) -> list[Program]:

@@ -15,6 +15,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import NamedTuple
 
+from engine.memory import no_cycle_collection
+
 from .dxf_codes import CodeText, layer_codes
 from .dxf_geometry import (FLATTEN_TOLERANCE_MM, HANDLERS, Context, Segment, inserted_entities,
                            named_on_failure, segments_of, unit_scale)
@@ -84,7 +86,7 @@ class Collected:
 def read_drawing(path: str | Path) -> Drawing:
     """Read a turning drawing; DxfError (one line naming the layer, handle or text) if it
     cannot become a job."""
-    with ezdxf_warnings() as warnings:
+    with ezdxf_warnings() as warnings, no_cycle_collection():
         drawing_file = load_drawing_file(path)
         units, scale, assumed = unit_scale(drawing_file.doc.header.get("$INSUNITS"))
         collected = collect(drawing_file.doc.modelspace(), FLATTEN_TOLERANCE_MM / scale)

@@ -196,6 +196,23 @@ def test_a_bad_edit_is_named(conn, seed_part):
         instantiate_job(conn, report.job_id)
 
 
+@pytest.mark.parametrize("segment, words", [
+    ('"line"', r"params\.profile\[1\] = 'line' is not a segment"),
+    ('["line", 0, 8, -10]', r"params\.profile\[1\] = \['line', 0, 8, -10\]: a line is \[\"line\", z0"),
+    ('["line", 0, "8", -10, 8]', r"a line is"),
+    ('["arc", 0, 8, -10, 8, -2, 8, true]', r"not on one circle about the centre"),
+])
+def test_a_broken_segment_edited_in_sql_is_named_and_nothing_stored(conn, tmp_path, segment, words):
+    profile_only_drawing(tmp_path / "shaft.dxf")
+    report = import_dxf(conn, tmp_path / "shaft.dxf", options=ProfileOptions(rough_depth=1.0))
+    count = conn.execute("SELECT count(*) FROM program").fetchone()[0]
+    conn.execute("UPDATE job SET params = jsonb_set(params, '{profile,1}', %s::jsonb) WHERE id = %s",
+                 (segment, report.job_id))
+    with pytest.raises(EngineError, match=words):
+        instantiate_job(conn, report.job_id)
+    assert conn.execute("SELECT count(*) FROM program").fetchone()[0] == count
+
+
 def test_operation_slots_are_stored_once_and_refactor_changes_nothing(conn):
     for gear_class in ("turning_iso", "turning_840d"):
         slot_rows, bodies = conn.execute(

@@ -14,6 +14,7 @@ from psycopg.types.json import Jsonb
 
 from importers.dxf_drawing import read_drawing
 
+from ..memory import no_cycle_collection
 from .job_params import ProfileOptions, turning_job
 from .model import job_passes, key, present_operations
 from .planning import lathe, plan_turning_job, turning_class
@@ -43,21 +44,26 @@ def import_dxf(conn, path: str | Path, machine_name: str | None = None,
     """Read the drawing and store its job; EngineError (nothing stored) if it cannot become one."""
     machine = lathe(conn, machine_name)
     gear_class = turning_class(machine)
+    with no_cycle_collection():   # a large drawing: the profile, its parameters and passes
+        return _import(conn, path, machine, gear_class, options, alternate)
+
+
+def _import(conn, path, machine, gear_class: str, options: ProfileOptions, alternate) -> ImportReport:
     drawing = read_drawing(path)
     with conn.transaction():
         job_id = conn.execute("SELECT nextval('job_id_seq')").fetchone()[0]
         job = turning_job(drawing, machine.name, gear_class, (job_id - 1) % ISO_PROGRAM_NUMBERS + 1,
                           options, alternate)
-        planned = plan_turning_job(conn, gear_class, machine, job.params, job.module_params)
+        passes = job_passes(job.params, job.module_params)
+        planned = plan_turning_job(conn, gear_class, machine, job.params, job.module_params, passes)
         conn.execute(INSERT_TURNING_JOB, (job_id, gear_class, machine.name, Jsonb(job.params),
                                           Jsonb(job.module_params)))
-    notes = job.notes + empty_operations(job) + drawing.notes
+    notes = job.notes + empty_operations(job, passes) + drawing.notes
     return ImportReport(job_id, str(drawing.source), machine.name, gear_class, len(planned.result.lines),
                         job.operations, drawing.repairs, notes)
 
 
-def empty_operations(job) -> list[str]:
-    passes = job_passes(job.params, job.module_params)
+def empty_operations(job, passes: dict) -> list[str]:
     return [f"operation {n} ({job.module_params[key('cutmotion', n)]['kind']}) has no pass: nothing to cut "
             "(the blank lies within the allowance of the profile); the program leaves it out"
             for n in present_operations(job.module_params) if n in passes and not passes[n]]

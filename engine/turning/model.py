@@ -93,12 +93,14 @@ def alternated_pair(params: dict, module_params: dict, passes: dict) -> tuple[in
     return pair[0], pair[1]
 
 
-def template_module_params(params: dict, module_params: dict) -> dict:
+def template_module_params(params: dict, module_params: dict, passes: dict[int, list[Pass]] | None = None) -> dict:
     """The stored module parameters extended for the template: each operation's moves (its passes
     flattened), its number, and its kind in prep (for the operator's comment). An operation
     without passes (cutmotion:n absent or not op_present, alternated into another, or nothing
-    to cut) emits nothing, its prep and cutcond rows included."""
-    passes = job_passes(params, module_params)
+    to cut) emits nothing, its prep and cutcond rows included. `passes`: job_passes(params,
+    module_params) if the caller has them already."""
+    if passes is None:
+        passes = job_passes(params, module_params)
     cutting = {n for n, found in passes.items() if found}
     extended = {name: dict(values) for name, values in module_params.items()}
     for name, values in extended.items():

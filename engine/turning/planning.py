@@ -31,12 +31,14 @@ def turning_class(machine: Machine) -> str:
     return TURNING_CLASS_OF_DIALECT[machine.dialect]
 
 
-def plan_turning_job(conn, gear_class: str, machine: Machine, params: dict, module_params: dict):
-    """→ Planned (engine.instantiate): the program computed and checked, not stored."""
+def plan_turning_job(conn, gear_class: str, machine: Machine, params: dict, module_params: dict,
+                     passes: dict | None = None):
+    """→ Planned (engine.instantiate): the program computed and checked, not stored.
+    `passes`: the job's passes (model.job_passes) if the caller has them already."""
     from ..instantiate import Planned
 
     template = load_template(conn, gear_class)
-    extended = template_module_params(params, module_params)
+    extended = template_module_params(params, module_params, passes)
     result = compiled_template(template).run(params, extended)
     check_lathe_program(result.lines, machine, str(params.get("program_name", "program")))
     return Planned(None, gear_class, machine.name, None, params, module_params, template, result)

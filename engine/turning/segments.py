@@ -36,26 +36,42 @@ def path_from_param(items, where: str) -> list[Segment]:
     if not isinstance(items, list):
         raise EngineError(f"{where} must be a list of segments, not {type(items).__name__}; "
                           f"fix it in SQL (job.params / job.module_params)")
-    return [segment_from_param(item, f"{where}[{index}]") for index, item in enumerate(items)]
+    segments = []
+    for index, item in enumerate(items):
+        segment = _segment(item)
+        if segment is None:
+            _refuse(item, f"{where}[{index}]")
+        segments.append(segment)
+    return segments
 
 
-def segment_from_param(item, where: str) -> Segment:
-    shape = '["line", z0, r0, z1, r1] or ["arc", z0, r0, z1, r1, zc, rc, ccw]'
-    if not isinstance(item, list) or not item or item[0] not in ("line", "arc"):
-        raise EngineError(f"{where} = {item!r} is not a segment; write {shape}")
+def _segment(item) -> Segment | None:
+    """The segment, or None when the item is not one (the caller names it)."""
+    if type(item) is not list or not item:
+        return None
     kind, numbers = item[0], item[1:]
-    expected = 4 if kind == "line" else 7
-    if len(numbers) != expected or not all(_is_number(v) for v in numbers[:6]):
+    if kind == "line" and len(numbers) == 4 and _numbers(numbers):
+        return Line((numbers[0], numbers[1]), (numbers[2], numbers[3]))
+    if kind == "arc" and len(numbers) == 7 and _numbers(numbers[:6]):
+        start, end, centre = (numbers[0], numbers[1]), (numbers[2], numbers[3]), (numbers[4], numbers[5])
+        if abs(math.dist(start, centre) - math.dist(end, centre)) <= ARC_RADIUS_TOLERANCE:
+            return Arc(start, end, centre, bool(numbers[6]))
+    return None
+
+
+def _refuse(item, where: str) -> None:
+    shape = '["line", z0, r0, z1, r1] or ["arc", z0, r0, z1, r1, zc, rc, ccw]'
+    if type(item) is not list or not item or item[0] not in ("line", "arc"):
+        raise EngineError(f"{where} = {item!r} is not a segment; write {shape}")
+    kind = item[0]
+    if len(item) != (5 if kind == "line" else 8) or not _numbers(item[1:7]):
         raise EngineError(f"{where} = {item!r}: a {kind} is {shape.split(' or ')[kind == 'arc']}")
-    start, end = (numbers[0], numbers[1]), (numbers[2], numbers[3])
-    if kind == "line":
-        return Line(start, end)
-    centre = (numbers[4], numbers[5])
-    if abs(math.dist(start, centre) - math.dist(end, centre)) > ARC_RADIUS_TOLERANCE:
-        raise EngineError(f"{where} = {item!r}: start and end are not on one circle about the centre "
-                          f"(radii differ by more than {ARC_RADIUS_TOLERANCE} mm)")
-    return Arc(start, end, centre, bool(numbers[6]))
+    raise EngineError(f"{where} = {item!r}: start and end are not on one circle about the centre "
+                      f"(radii differ by more than {ARC_RADIUS_TOLERANCE} mm)")
 
 
-def _is_number(value) -> bool:
-    return isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+def _numbers(values) -> bool:
+    for value in values:
+        if type(value) not in (int, float) or not math.isfinite(value):
+            return False
+    return True
