@@ -7,8 +7,7 @@ import click
 
 from .cli import connection, emit_json
 from .errors import EngineError
-from .turning.job_params import PROFILE_DEFAULTS, STOCK_MARGIN
-from .turning.planning import DEFAULT_LATHE
+from .turning.defaults import DEFAULT_LATHE, PROFILE_DEFAULTS, STOCK_MARGIN
 
 POSITIVE = click.FloatRange(min=0, min_open=True)
 

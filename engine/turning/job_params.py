@@ -1,7 +1,7 @@
 """A read drawing → the parameters of its turning job (design notes §8): every number taken
 from the drawing is a named parameter in job.params or job.module_params, so it can be
 edited in SQL and the job instantiated again. What the drawing does not say is assumed
-from the defaults below and said in `notes`."""
+from the defaults (engine.turning.defaults) and said in `notes`."""
 from __future__ import annotations
 
 import math
@@ -12,21 +12,10 @@ from importers.dxf_drawing import Drawing, Operation
 from importers.dxf_profile import merged_bounds
 
 from ..errors import EngineError
+from .defaults import (CLEARANCE, DEFAULT_FEED, DEFAULT_INFEED_ANGLE, DEFAULT_SPEED, DEFAULT_THREAD_DEPTH_PER_PASS,
+                       PROFILE_DEFAULTS, STOCK_MARGIN, TOOL_CHANGE_DISTANCE)
 from .model import MAX_OPERATIONS, SLOT_DEFAULTS, key
 from .segments import path_param
-
-CLEARANCE = 2.0              # mm: rapid moves stop this far from the material
-TOOL_CHANGE_DISTANCE = 50.0  # mm beyond everything drawn, radially and axially, without a POINT
-STOCK_MARGIN = 2.0           # mm on the diameter: default blank over the profile's largest diameter
-DEFAULT_SPEED = 800.0        # r/min for an operation layer without @S
-DEFAULT_FEED = 150.0         # mm/min for an operation layer without @F
-DEFAULT_THREAD_DEPTH_PER_PASS = 0.2   # mm, a thread layer without @D
-DEFAULT_INFEED_ANGLE = 0.0   # degrees, a thread layer without @A: radial infeed
-
-
-# Profile-only drawings: radial depth per rough pass (mm), allowance left by roughing (mm),
-# tool, spindle (r/min), feed (mm/min).
-PROFILE_DEFAULTS = {"rough_depth": 1.0, "allowance": 0.2, "tool": 1, "speed": DEFAULT_SPEED, "feed": DEFAULT_FEED}
 
 
 @dataclass(frozen=True)

@@ -7,9 +7,9 @@ from ..errors import EngineError
 from ..records import Machine, load_machine
 from ..templates import load_template
 from .check import check_lathe_program
+from .defaults import DEFAULT_LATHE
 from .model import template_module_params
 
-DEFAULT_LATHE = "lathe-iso"
 TURNING_CLASS_OF_DIALECT = {"iso": "turning_iso", "840d": "turning_840d"}
 
 
