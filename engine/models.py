@@ -6,7 +6,7 @@ from .hobbing.cylindrical import CylindricalModel
 from .hobbing.duplex import DuplexModel
 from .hobbing.taper import TaperModel
 from .hobbing.worm_wheel import WormWheelModel
-from .turning.model import TurningModel
+from .turning.names import TurningModel
 
 # The hobbing model of a node of the group-technology tree serves it and every class below
 # it that has no model of its own.

@@ -19,7 +19,7 @@ from engine.nc_check import LimitError
 from engine.refactor import refactor
 from engine.turning.dxf_import import import_dxf
 from engine.turning.job_params import ProfileOptions
-from engine.turning.model import MAX_OPERATIONS
+from engine.turning.names import MAX_OPERATIONS
 from lathe_programs import distance_to_drawn, drawn_polylines, motions, operation_lines, words
 from test_dxf_read import DXF, EMCO, INCH, nc_arc_words, seed_drawing
 

@@ -14,7 +14,8 @@ from importers.dxf_profile import merged_bounds
 from ..errors import EngineError
 from .defaults import (CLEARANCE, DEFAULT_FEED, DEFAULT_INFEED_ANGLE, DEFAULT_SPEED, DEFAULT_THREAD_DEPTH_PER_PASS,
                        PROFILE_DEFAULTS, STOCK_MARGIN, TOOL_CHANGE_DISTANCE)
-from .model import MAX_OPERATIONS, SLOT_DEFAULTS, key
+from .model import key
+from .names import MAX_OPERATIONS, SLOT_DEFAULTS
 from .segments import path_param
 
 
