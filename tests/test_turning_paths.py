@@ -142,10 +142,10 @@ def midpoint_of(start, move: Move) -> tuple[float, float]:
 def test_finish_pass_reproduces_the_profile_and_arc_directions():
     profile = finish_profile()
     (moves,) = finish_passes(profile, CLEARANCE)
-    approach, infeed, *cutting, retract = moves
-    assert (approach.kind, approach.z, approach.x) == ("rapid", 0.0, pytest.approx(2 * (4.0 + CLEARANCE)))
+    approach, infeed, *cutting = moves
+    # The front face runs outwards (+r): approached from in front of it (+Z) and below.
+    assert (approach.kind, approach.z, approach.x) == ("rapid", CLEARANCE, pytest.approx(2 * (4.0 - CLEARANCE)))
     assert (infeed.kind, infeed.z, infeed.x) == ("feed", 0.0, pytest.approx(8.0))
-    assert (retract.kind, retract.z, retract.x) == ("rapid", -40.0, pytest.approx(2 * (12.0 + CLEARANCE)))
     assert [m.kind for m in cutting] == ["feed", "feed", "ccw", "cw", "feed", "feed"]
     for move, segment in zip(cutting, profile):
         assert move.z == pytest.approx(segment.end[0], abs=1e-9)
@@ -172,16 +172,12 @@ def test_seed_rough_passes_follow_the_seed_motions(seed_operations):
     assert len(passes) == 3
     previous_end = None
     for moves, radius in zip(passes, (0.9 * INCH, 0.8 * INCH, 0.7 * INCH)):
-        assert [m.kind for m in moves] == ["rapid", "feed", "feed", "rapid", "rapid"]
-        expected = [(start_z, radius + CLEARANCE),   # 5: X re-approach (first: to start z)
+        assert [m.kind for m in moves] == ["rapid", "feed", "feed"]
+        expected = [(start_z, radius + CLEARANCE),   # 5: X re-approach
                     (start_z, radius),               # 1: G01 X infeed
-                    (end_z, radius),                 # 2: G01 Z along the drawn line
-                    (end_z, radius + CLEARANCE),     # 3: G00 X retract
-                    (start_z, radius + CLEARANCE)]   # 4: G00 Z return
+                    (end_z, radius)]                 # 2: G01 Z along the drawn line
         assert [(m.z, m.x / 2) for m in moves] == [pytest.approx(p) for p in expected]
-        if previous_end is not None:
-            assert moves[0].z == pytest.approx(previous_end.z)   # motion 5 moves X only
-        previous_end = moves[-1]
+    # 3, 4: the retract (X) and the Z return run at the travel radius, added by standalone().
 
 
 def test_seed_slot_plunges_one_per_drawn_line(seed_operations):
@@ -200,14 +196,22 @@ def test_seed_thread_passes_compound_infeed(seed_operations):
     crest, root, start_z, end_z = 0.5 * INCH, 0.45 * INCH, -0.2 * INCH, -0.9 * INCH
     depth = crest - root
     assert len(passes) == math.ceil(depth / d) == 4
+    final_start = passes[-1][0].z
+    # The run-in before the drawn start (towards +Z, the side the cut comes from) is whole
+    # pitches, so the last pass lies on the drawn thread.
+    run_in = (final_start - start_z) / pitch
+    assert run_in >= CLEARANCE / pitch - 1e-9 and run_in == pytest.approx(round(run_in), abs=1e-9)
+    shifts = []
     for number, moves in enumerate(passes, start=1):
         pass_depth = min(number * d, depth)
-        assert [m.kind for m in moves] == ["rapid", "rapid", "thread", "rapid", "rapid"]
+        assert [m.kind for m in moves] == ["rapid", "rapid", "thread"]
         cut = moves[2]
         assert (cut.z, cut.x / 2, cut.pitch) == (pytest.approx(end_z), pytest.approx(crest - pass_depth), pitch)
-        # The thread runs towards −Z, so its start moves back towards +Z along the flank.
-        assert moves[0].z - start_z == pytest.approx(pass_depth * math.tan(math.radians(30)))
-        assert moves[0].x / 2 == pytest.approx(crest + CLEARANCE)
+        assert moves[1].z == moves[0].z and moves[0].x / 2 == pytest.approx(crest + CLEARANCE)
+        # Compound infeed along the flank: (H − d)·tan A towards the start side.
+        shifts.append(moves[0].z - final_start)
+        assert shifts[-1] == pytest.approx((depth - pass_depth) * math.tan(math.radians(angle)))
+    assert shifts == sorted(shifts, reverse=True) and shifts[-1] == 0
     assert passes[-1][2].x / 2 == pytest.approx(root)
 
 
@@ -237,9 +241,8 @@ def test_thread_refusals_name_the_problem(paths, per_pass, words):
 def test_drawn_rough_path_followed_segment_by_segment():
     path = [Line((2.0, 8.0), (-5.0, 8.0)), Arc((-5.0, 8.0), (-9.0, 8.0), (-7.0, 8.0), ccw=True)]
     (moves,) = drawn_rough_passes([path], CLEARANCE)
-    assert [m.kind for m in moves] == ["rapid", "feed", "feed", "ccw", "rapid", "rapid"]
-    # Retract and return run clearance above the arc's top (radius 8 + 2), not its end.
-    assert [m.x / 2 for m in moves[-2:]] == [pytest.approx(10.0 + CLEARANCE)] * 2
+    assert [m.kind for m in moves] == ["rapid", "feed", "feed", "ccw"]
+    assert (moves[-1].z, moves[-1].x / 2) == pytest.approx((-9.0, 8.0))
 
 
 # --- roughing from the profile -----------------------------------------------------------
@@ -307,8 +310,9 @@ def test_profile_roughing_levels_from_the_outside_in():
     profile = [Line((0.0, 5.0), (-10.0, 5.0)), Line((-10.0, 5.0), (-10.0, 9.0)), Line((-10.0, 9.0), (-30.0, 9.0))]
     passes = profile_rough_passes(profile + closing(profile), 12.0, 2.0, 0.5, 0.0, -30.0, CLEARANCE)
     levels = [moves[[m.kind for m in moves].index("feed")].x / 2 for moves in passes]
-    # Levels 10, 8, 6 (12 − k·2); 4 would be inside 5 + 0.5.
-    assert levels == pytest.approx([10.0, 8.0, 6.0])
+    # Levels 10, 8, 6 (12 − k·2; 4 would be inside 5 + 0.5) and one on each flat grown by
+    # the allowance (+ 1 µm chords), so nothing beyond the allowance is left on them.
+    assert levels == pytest.approx([10.0, 9.501, 8.0, 6.0, 5.501], abs=1e-5)
     last = polyline(passes[-1:])[-1]
     assert last[1][0] == pytest.approx(-10.0 + 0.5 + 0.001, abs=1e-6)   # the shoulder + allowance (+ 1 µm chords)
     assert last[0][0] == pytest.approx(CLEARANCE)   # starts in the air in front of the blank

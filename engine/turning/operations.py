@@ -14,12 +14,13 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from importers.dxf_geometry import Segment
+from importers.dxf_geometry import Line, Segment
 from importers.dxf_profile import END_MATCH_TOLERANCE_MM, Profile, merged_bounds
 
 from ..errors import EngineError
 from . import toolpaths
 from .moves import Pass
+from .region import Surroundings, flattened_outline
 from .segments import path_from_param
 
 DRAWN_FEED_KINDS = ("ROUGH", "FACE")
@@ -35,6 +36,11 @@ class JobGeometry:
     outline: list[Segment]
     stock: tuple[float, float, float] | None    # (z_front, z_back, radius) of the blank
     clearance: float
+    tool_change_radius: float | None = None
+
+    @property
+    def surroundings(self) -> Surroundings:
+        return Surroundings(tuple(flattened_outline(self.outline)), self.stock, self.clearance)
 
 
 def job_geometry(params: dict) -> JobGeometry:
@@ -47,9 +53,28 @@ def job_geometry(params: dict) -> JobGeometry:
     if params.get("stock_diameter") is not None:
         stock = (number_param(params, "stock_z_front", "params"), number_param(params, "stock_z_back", "params"),
                  number_param(params, "stock_diameter", "params") / 2.0)
-    finish_path = profile if closed_by_axis else outer_side(profile)
+    finish_path = off_the_axis(profile) if closed_by_axis else outer_side(profile)
     clearance = number_param(params, "clearance", "params", 0, above=True)
-    return JobGeometry(profile, finish_path, profile + closing, stock, clearance)
+    tool_change = params.get("tool_change_x")
+    tool_change_radius = None if tool_change is None else number_param(params, "tool_change_x", "params") / 2.0
+    return JobGeometry(profile, finish_path, profile + closing, stock, clearance, tool_change_radius)
+
+
+def off_the_axis(profile: list[Segment]) -> list[Segment]:
+    """The profile without the faces at its ends that reach the axis: a turning tool coming
+    from the outside finishes the outside and leaves from it; those faces are FACE or PART work."""
+    kept = list(profile)
+    while kept and is_face_to_axis(kept[0]):
+        kept.pop(0)
+    while kept and is_face_to_axis(kept[-1]):
+        kept.pop()
+    return kept or profile
+
+
+def is_face_to_axis(segment: Segment) -> bool:
+    (z0, r0), (z1, r1) = segment.start, segment.end
+    return (isinstance(segment, Line) and abs(z0 - z1) <= END_MATCH_TOLERANCE_MM
+            and min(r0, r1) <= END_MATCH_TOLERANCE_MM)
 
 
 def outer_side(closed: list[Segment]) -> list[Segment]:
@@ -65,7 +90,27 @@ def outer_side(closed: list[Segment]) -> list[Segment]:
 
 
 def operation_passes(geometry: JobGeometry, cutmotion: dict, where: str) -> list[Pass]:
-    """The passes of one operation (`where` names its module parameters in errors)."""
+    """The passes of one operation (`where` names its module parameters in errors), each
+    entered and left at a travel radius clear of part and blank; the operation is entered
+    from the tool-change point by Z first and left by X up to it first."""
+    passes = toolpaths.standalone(_passes(geometry, cutmotion, where), geometry.surroundings)
+    return from_and_to_tool_change(passes, geometry.tool_change_radius)
+
+
+def from_and_to_tool_change(passes: list[Pass], tool_change_radius: float | None) -> list[Pass]:
+    """The template's tool-change block moves Z only: the operation starts with a Z move at
+    the tool-change X and ends lifted to it."""
+    if not passes or tool_change_radius is None:
+        return passes
+    first, last = passes[0][0], passes[-1][-1]
+    lift_in, lift_out = (max(tool_change_radius, move.x / 2.0) for move in (first, last))
+    passes = [list(one) for one in passes]
+    passes[0].insert(0, toolpaths.rapid(first.z, lift_in))
+    passes[-1].append(toolpaths.rapid(last.z, lift_out))
+    return passes
+
+
+def _passes(geometry: JobGeometry, cutmotion: dict, where: str) -> list[Pass]:
     kind = cutmotion.get("kind")
     if kind not in KINDS:
         raise EngineError(f"{where}.kind = {kind!r} is not one of {' | '.join(KINDS)}")
@@ -83,7 +128,8 @@ def operation_passes(geometry: JobGeometry, cutmotion: dict, where: str) -> list
         return [one for path in paths for one in toolpaths.finish_passes(path, clearance)]
     return toolpaths.thread_passes(paths, number_param(cutmotion, "depth_per_pass", where, 0, above=True),
                                    number_param(cutmotion, "infeed_angle", where, 0),
-                                   number_param(cutmotion, "thread_pitch", where, 0, above=True), clearance)
+                                   number_param(cutmotion, "thread_pitch", where, 0, above=True), clearance,
+                                   geometry.surroundings)
 
 
 def _along_profile(geometry: JobGeometry, kind: str, cutmotion: dict, where: str) -> list[Pass]:

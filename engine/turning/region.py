@@ -8,6 +8,7 @@ exact one; callers that must keep a distance add the tolerance to it.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from typing import Iterable, Sequence
 
 from importers.dxf_geometry import Arc, Point, Segment
@@ -161,3 +162,40 @@ def free_intervals(edges: Sequence[Edge], level: float, grow: float, z_low: floa
 def is_blocked(edges: Sequence[Edge], level: float, grow: float, z_low: float, z_high: float) -> bool:
     """Whether any Z of [z_low, z_high] at r = level (or above) is nearer than grow."""
     return free_intervals(edges, level, grow, z_low, z_high, 0.0) != [(z_low, z_high)]
+
+
+def top_over(edges: Sequence[Edge], z_low: float, z_high: float) -> float:
+    """The largest radius of the edges over the Z span [z_low, z_high] (0 when none reach it).
+    Edges are straight, so the largest radius of each lies at an end of its clipped part."""
+    top = 0.0
+    for (z0, r0), (z1, r1) in edges:
+        lo, hi = max(min(z0, z1), z_low), min(max(z0, z1), z_high)
+        if lo > hi:
+            continue
+        if abs(z1 - z0) < NUMERIC_ZERO:
+            top = max(top, r0, r1)
+            continue
+        top = max(top, *(r0 + (z - z0) * (r1 - r0) / (z1 - z0) for z in (lo, hi)))
+    return top
+
+
+@dataclass(frozen=True)
+class Surroundings:
+    """What a rapid move must stay clear of: the part (its flattened outline) and the blank
+    (z_front, z_back, radius), kept at `clearance`."""
+    edges: tuple[Edge, ...]
+    blank: tuple[float, float, float] | None
+    clearance: float
+
+    def safe_radius(self, z_a: float, z_b: float) -> float:
+        """A radius at which the tool may travel in Z between z_a and z_b: above the part and
+        the blank over that span, by the clearance."""
+        low, high = min(z_a, z_b), max(z_a, z_b)
+        top = top_over(self.edges, low, high) + CHORD_TOLERANCE_MM
+        if self.blank is not None and low <= self.blank[0] and high >= self.blank[1]:
+            top = max(top, self.blank[2])
+        return top + self.clearance
+
+    def z_span(self) -> tuple[float, float]:
+        zs = [z for edge in self.edges for z, _ in edge] + list(self.blank[:2] if self.blank else [])
+        return min(zs), max(zs)

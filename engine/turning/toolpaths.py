@@ -17,11 +17,11 @@ from importers.dxf_profile import merged_bounds
 
 from ..errors import EngineError
 from .moves import Move, Pass
-from .region import (CHORD_TOLERANCE_MM, Edge, distance_to_region, flattened_outline, free_intervals,
-                     is_blocked)
+from .region import (CHORD_TOLERANCE_MM, Edge, Surroundings, distance_to_region, flattened_outline,
+                     free_intervals, is_blocked, top_over)
 
 __all__ = ["finish_passes", "drawn_rough_passes", "slot_passes", "thread_passes",
-           "profile_rough_passes", "alternate", "distance_to_region"]
+           "profile_rough_passes", "alternate", "standalone", "distance_to_region"]
 
 # A drawn line counts as axial (radial) when its ends differ by at most this in radius (Z).
 STRAIGHT_TOLERANCE_MM = 0.001
@@ -33,6 +33,8 @@ MIN_CUT_LENGTH_MM = 0.001
 MAX_ROUGH_LEVELS = 10_000
 # Profile points nearer the axis than this (mm) do not count for its smallest radius.
 ON_AXIS_MM = 0.001
+# A rough level along a flat lies this much (mm) beyond the allowance, clear of rounding.
+LEVEL_NOISE_MM = 1e-6
 
 # Where a user changes a number: the import-dxf flags (stored as the job parameters named
 # after them, which SQL can change).
@@ -65,35 +67,48 @@ def require_clearance(clearance: float) -> None:
                           "to a positive distance")
 
 
+def start_direction(segment: Segment) -> tuple[float, float]:
+    """Unit tangent (z, r) of a segment at its start, in its direction of travel."""
+    (z0, r0) = segment.start
+    if isinstance(segment, Line):
+        dz, dr = segment.end[0] - z0, segment.end[1] - r0
+    else:
+        cz, cr = segment.centre
+        sense = 1.0 if segment.ccw else -1.0
+        dz, dr = -sense * (r0 - cr), sense * (z0 - cz)
+    length = math.hypot(dz, dr) or 1.0
+    return dz / length, dr / length
+
+
 def finish_passes(path: list[Segment], clearance: float) -> list[Pass]:
-    """One pass along the path: approach lifted radially by clearance, the path's own
-    segments, radial retract by clearance."""
+    """One pass along the path: rapid to clearance before its start — back along its first
+    direction and out along its outward normal (the part lies left of a path drawn from the
+    front backwards), so in the air in front of the material — feed in, the path's own
+    segments; the travel radius in and out is added by standalone()."""
     require_clearance(clearance)
     if not path:
         raise EngineError("the finish path is empty; draw the contour on the FINISH layer "
                           "or let the profile be finished")
-    (start_z, start_r), (end_z, end_r) = path[0].start, path[-1].end
-    moves = [rapid(start_z, start_r + clearance), feed(start_z, start_r)]
-    moves += [cutting_move(segment) for segment in path]
-    moves.append(rapid(end_z, end_r + clearance))
-    return [moves]
+    (start_z, start_r), (dz, dr) = path[0].start, start_direction(path[0])
+    outward_z, outward_r = dr, -dz
+    moves = [rapid(start_z + clearance * (outward_z - dz), start_r + clearance * (outward_r - dr)),
+             feed(start_z, start_r)]
+    return [moves + [cutting_move(segment) for segment in path]]
 
 
 def drawn_rough_passes(paths: list[list[Segment]], clearance: float) -> list[Pass]:
-    """Seed-000 roughing: each drawn path one pass, outermost first. Per pass: rapid
-    re-approach above the start (5), feed infeed (1), the drawn cut (2), rapid retract
-    (3), rapid Z return (4); retract and return run clearance above the path's top."""
+    """Seed-000 roughing: each drawn path one pass, outermost first: rapid down to clearance
+    above its start, feed in, the drawn cut; retract and return run at the travel radius
+    (standalone())."""
     require_clearance(clearance)
     ordered = sorted(paths, key=lambda path: -merged_bounds(path)[3])
     return [drawn_rough_pass(path, clearance) for path in ordered]
 
 
 def drawn_rough_pass(path: list[Segment], clearance: float) -> Pass:
-    (start_z, start_r), (end_z, _) = path[0].start, path[-1].end
-    above = merged_bounds(path)[3] + clearance
+    start_z, start_r = path[0].start
     return [rapid(start_z, start_r + clearance), feed(start_z, start_r),
-            *(cutting_move(segment) for segment in path),
-            rapid(end_z, above), rapid(start_z, above)]
+            *(cutting_move(segment) for segment in path)]
 
 
 def radial_line(path: list[Segment], what: str) -> tuple[float, float, float]:
@@ -108,8 +123,8 @@ def radial_line(path: list[Segment], what: str) -> tuple[float, float, float]:
 
 
 def slot_passes(paths: list[list[Segment]], clearance: float) -> list[Pass]:
-    """Each drawn radial line one plunge, from the largest Z to the smallest: rapid above
-    its outer end, feed to its inner end, rapid back out."""
+    """Each drawn radial line one plunge, from the largest Z to the smallest: rapid down to
+    clearance above its outer end, feed to its inner end, rapid back out."""
     require_clearance(clearance)
     plunges = sorted((radial_line(path, "SLOT") for path in paths), key=lambda p: -p[0])
     return [[rapid(z, outer + clearance), feed(z, inner), rapid(z, outer + clearance)]
@@ -158,23 +173,63 @@ def pass_depths(depth: float, depth_per_pass: float) -> list[float]:
     return [min(k * depth_per_pass, depth) for k in range(1, count)] + [depth]
 
 
+def thread_run_in(around: Surroundings | None, start_z: float, back: float, root: float,
+                  pitch: float, clearance: float) -> float:
+    """How far before the drawn start (towards the start side) every pass begins, so its
+    in-feed happens in the air: clearance when nothing at the root radius or above lies
+    there, else beyond the part and the blank on that side by clearance. A whole number of
+    pitches, so the run-in leaves the helix where the drawing has it."""
+    needed = clearance
+    if around is not None:
+        low, high = around.z_span()
+        outer_end = high if back > 0 else low
+        beyond = start_z + back * STRAIGHT_TOLERANCE_MM
+        if top_over(around.edges, *sorted((beyond, outer_end))) >= root:
+            needed = max(needed, back * (outer_end - start_z) + clearance)
+    return math.ceil(needed / pitch - PASS_COUNT_NOISE) * pitch
+
+
 def thread_passes(paths: list[list[Segment]], depth_per_pass: float, infeed_angle_deg: float,
-                  pitch: float, clearance: float) -> list[Pass]:
+                  pitch: float, clearance: float, around: Surroundings | None = None) -> list[Pass]:
     """Threading passes to the depth between the drawn crest and root lines, along the
-    drawn crest line's direction. Compound infeed: each pass starts depth·tan(@A) further
-    back (towards the start side), so the tool cuts on one flank."""
+    drawn crest line's direction, each begun a run-in before the drawn start. Compound
+    infeed: the tool cuts on the flank it advances along, so a pass at depth d starts
+    (H − d)·tan(@A) further towards the start side than the last one (depth H), which
+    lies on the drawn thread."""
     require_clearance(clearance)
     require_thread_numbers(depth_per_pass, infeed_angle_deg, pitch)
     (start_z, end_z, crest), root = crest_and_root(paths)
     back = 1.0 if start_z > end_z else -1.0   # +Z is "back" when the thread runs towards −Z
-    slope, outside = math.tan(math.radians(infeed_angle_deg)), crest + clearance
+    slope, full = math.tan(math.radians(infeed_angle_deg)), crest - root
+    first_z = start_z + back * thread_run_in(around, start_z, back, root, pitch, clearance)
     passes = []
-    for depth in pass_depths(crest - root, depth_per_pass):
-        z = start_z + back * depth * slope
-        passes.append([rapid(z, outside), rapid(z, crest - depth),
-                       Move("thread", end_z, 2.0 * (crest - depth), pitch=pitch),
-                       rapid(end_z, outside), rapid(z, outside)])
+    for depth in pass_depths(full, depth_per_pass):
+        z = first_z + back * (full - depth) * slope
+        passes.append([rapid(z, crest + clearance), rapid(z, crest - depth),
+                       Move("thread", end_z, 2.0 * (crest - depth), pitch=pitch)])
     return passes
+
+
+def standalone(passes: list[Pass], around: Surroundings) -> list[Pass]:
+    """Each pass entered at one travel radius — above the part, the blank and the passes
+    themselves over the whole job — by Z there first and then X down, and left by X up to
+    it: any pass may then follow any other (crossed work steps, tool changes)."""
+    if not passes:
+        return passes
+    low, high = around.z_span()
+    zs = [move.z for one in passes for move in one] + [low, high]
+    travel = max(around.safe_radius(min(zs), max(zs)),
+                 max(move.x / 2.0 for one in passes for move in one) + around.clearance)
+    return [without_standstills([rapid(one[0].z, travel), *one, rapid(one[-1].z, travel)]) for one in passes]
+
+
+def without_standstills(moves: Pass) -> Pass:
+    """The moves without rapids to where the tool already is."""
+    kept = moves[:1]
+    for move in moves[1:]:
+        if not (move.kind == "rapid" and (move.z, move.x) == (kept[-1].z, kept[-1].x)):
+            kept.append(move)
+    return kept
 
 
 def alternate(first: list[Pass], second: list[Pass]) -> list[Pass]:
@@ -233,7 +288,7 @@ def profile_rough_passes(outline: list[Segment], stock_radius: float, depth_per_
     # distance from the chords keeps the allowance from the true arcs.
     edges, keep = flattened_outline(outline), allowance + CHORD_TOLERANCE_MM
     passes, above = [], stock_radius
-    for level in rough_levels(stock_radius, depth_per_pass):
+    for level in rough_levels(stock_radius, depth_per_pass, grown_flats(edges, keep)):
         cuts = free_intervals(edges, level, keep, z_back, z_front, MIN_CUT_LENGTH_MM)
         if not cuts:
             break
@@ -244,11 +299,21 @@ def profile_rough_passes(outline: list[Segment], stock_radius: float, depth_per_
     return passes
 
 
-def rough_levels(stock_radius: float, depth_per_pass: float) -> list[float]:
-    """stock − k·D for k = 1, 2, … while above the axis."""
+def rough_levels(stock_radius: float, depth_per_pass: float, floors: list[float]) -> list[float]:
+    """stock − k·D for k = 1, 2, … while above the axis, and every floor below the blank
+    (the flats of the part grown by the allowance, so each is roughed exactly to it),
+    from the outside in. A depth beyond the whole blank still leaves the floors."""
     count = math.ceil(stock_radius / depth_per_pass - PASS_COUNT_NOISE)
     levels = [stock_radius - k * depth_per_pass for k in range(1, count + 1)]
-    return [level for level in levels if level > ON_AXIS_MM]
+    levels += [floor for floor in floors if floor < stock_radius]
+    return sorted({level for level in levels if level > ON_AXIS_MM}, reverse=True)
+
+
+def grown_flats(edges: Sequence[Edge], keep: float) -> list[float]:
+    """The radius of every axial edge of the outline above the axis, grown by `keep` (and a
+    hair more, so that level is judged free of the flat it runs along)."""
+    return [r0 + keep + LEVEL_NOISE_MM for (z0, r0), (z1, r1) in edges
+            if abs(r0 - r1) <= STRAIGHT_TOLERANCE_MM and abs(z0 - z1) > STRAIGHT_TOLERANCE_MM and r0 > ON_AXIS_MM]
 
 
 def entry_z(edges: Sequence[Edge], level: float, keep: float, high: float, z_front: float,
