@@ -1,6 +1,7 @@
 """`engine`: a thin command-line shell; each command calls one library function.
 
-Exit codes: 0 ok, 1 a handled error (one line on stderr), 2 unexpected (--traceback shows it).
+Exit codes: 0 ok, 1 a handled error or bad input, option values included (one line on stderr),
+2 unexpected (--traceback shows it).
 """
 from __future__ import annotations
 
@@ -12,12 +13,31 @@ import click
 from .errors import EngineError
 
 
+def usage_error_line(error: click.UsageError) -> None:
+    """A bad option or argument (of any command): one line naming it and the value, exit 1."""
+    where = f" (see {error.ctx.command_path} --help)" if error.ctx else ""
+    click.echo(f"error: {error.format_message()}{where}", err=True)
+    raise click.exceptions.Exit(1)
+
+
 class EngineGroup(click.Group):
     """Turns errors into one-line messages and exit codes."""
+
+    def parse_args(self, ctx, args):
+        try:
+            return super().parse_args(ctx, args)
+        except click.exceptions.NoArgsIsHelpError:
+            raise
+        except click.UsageError as error:
+            usage_error_line(error)
 
     def invoke(self, ctx):
         try:
             return super().invoke(ctx)
+        except click.exceptions.NoArgsIsHelpError:
+            raise
+        except click.UsageError as error:
+            usage_error_line(error)
         except (click.exceptions.Exit, click.ClickException, click.Abort):
             raise
         except EngineError as error:

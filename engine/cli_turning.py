@@ -1,6 +1,7 @@
 """`engine import-dxf` and `engine plot`: turning jobs from lathe drawings (design notes §8)."""
 from __future__ import annotations
 
+import math
 from dataclasses import asdict
 
 import click
@@ -9,7 +10,19 @@ from .cli import connection, emit_json
 from .errors import EngineError
 from .turning.defaults import DEFAULT_LATHE, PROFILE_DEFAULTS, STOCK_MARGIN
 
-POSITIVE = click.FloatRange(min=0, min_open=True)
+
+
+class FiniteFloatRange(click.FloatRange):
+    """click.FloatRange lets nan and inf through (no comparison fails for nan)."""
+
+    def convert(self, value, param, ctx):
+        number = super().convert(value, param, ctx)
+        if not math.isfinite(number):
+            self.fail(f"{value!r} is not a finite number.", param, ctx)
+        return number
+
+
+POSITIVE = FiniteFloatRange(min=0, min_open=True)
 
 
 @click.command("import-dxf")
@@ -18,7 +31,7 @@ POSITIVE = click.FloatRange(min=0, min_open=True)
               help="Lathe record (lathe-iso or lathe-840d); its dialect picks the template class.")
 @click.option("--rough-depth", type=POSITIVE,
               help=f"Profile-only drawings: radial depth per rough pass, mm [default: {PROFILE_DEFAULTS['rough_depth']:g}].")
-@click.option("--allowance", type=click.FloatRange(min=0),
+@click.option("--allowance", type=FiniteFloatRange(min=0),
               help=f"Profile-only drawings: material left on the profile by roughing, mm "
                    f"[default: {PROFILE_DEFAULTS['allowance']:g}].")
 @click.option("--tool", type=click.IntRange(min=1),

@@ -146,7 +146,7 @@ def test_alternate_machines_two_rough_operations_pass_by_pass(conn, tmp_path):
 
 def test_alternating_needs_one_tool(conn, tmp_path):
     two_rough_layers(tmp_path / "wheel.dxf", tool_two="02")
-    with pytest.raises(EngineError, match="tools 1 and 2"):
+    with pytest.raises(EngineError, match=r"prep:2.tool = 2 differs from prep:1.tool = 1"):
         import_dxf(conn, tmp_path / "wheel.dxf", alternate=[1, 2])
 
 

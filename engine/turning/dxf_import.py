@@ -16,11 +16,8 @@ from importers.dxf_drawing import read_drawing
 
 from ..memory import no_cycle_collection
 from .job_params import ProfileOptions, turning_job
-from .model import job_passes, key, present_operations
+from .model import ISO_PROGRAM_NUMBERS, job_passes, key, present_operations
 from .planning import lathe, plan_turning_job, turning_class
-
-# ISO lathe program numbers O0001 … O9999: the job id, wrapped into that range.
-ISO_PROGRAM_NUMBERS = 9999
 
 INSERT_TURNING_JOB = """
 INSERT INTO job (id, gear_id, gear_class, machine, hob_id, params, module_params)
@@ -52,8 +49,8 @@ def _import(conn, path, machine, gear_class: str, options: ProfileOptions, alter
     drawing = read_drawing(path)
     with conn.transaction():
         job_id = conn.execute("SELECT nextval('job_id_seq')").fetchone()[0]
-        job = turning_job(drawing, machine.name, gear_class, (job_id - 1) % ISO_PROGRAM_NUMBERS + 1,
-                          options, alternate)
+        program_number = (job_id - 1) % ISO_PROGRAM_NUMBERS + 1    # the job id, wrapped into O0001 … O9999
+        job = turning_job(drawing, machine.name, gear_class, program_number, options, alternate)
         passes = job_passes(job.params, job.module_params)
         planned = plan_turning_job(conn, gear_class, machine, job.params, job.module_params, passes)
         conn.execute(INSERT_TURNING_JOB, (job_id, gear_class, machine.name, Jsonb(job.params),

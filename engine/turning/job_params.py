@@ -13,7 +13,7 @@ from importers.dxf_profile import merged_bounds
 
 from ..errors import EngineError
 from .defaults import (CLEARANCE, DEFAULT_FEED, DEFAULT_INFEED_ANGLE, DEFAULT_SPEED, DEFAULT_THREAD_DEPTH_PER_PASS,
-                       PROFILE_DEFAULTS, STOCK_MARGIN, TOOL_CHANGE_DISTANCE)
+                       FEED_PER_REV_NOTE, PROFILE_DEFAULTS, STOCK_MARGIN, TOOL_CHANGE_DISTANCE)
 from .model import key
 from .names import MAX_OPERATIONS, SLOT_DEFAULTS
 from .segments import path_param
@@ -52,6 +52,9 @@ class TurningJob:
 def turning_job(drawing: Drawing, machine: str, gear_class: str, program_number: int,
                 options: ProfileOptions = ProfileOptions(), alternate: list[int] | None = None) -> TurningJob:
     job = TurningJob({}, {})
+    if drawing.scale_to_mm != 1.0:
+        job.notes.append(f"{drawing.units} drawing: lengths scaled ×{drawing.scale_to_mm:g} to mm; the @-codes "
+                         "are taken as written, @F in mm/min, @P and @D in mm, @S in r/min (not scaled)")
     if drawing.operations:
         if options.cutting_data_given():
             raise EngineError(f"{drawing.source.name} has operation layers ({_layers(drawing)}); --rough-depth, "
@@ -159,6 +162,10 @@ def add_operation(job: TurningJob, n: int, tool: int, speed: float, coolant: boo
     job.module_params[key("prep", n)] = {"tool": tool, "tool_offset": tool, "op_present": True}
     job.module_params[key("cutcond", n)] = {"spindle_rpm": speed, "coolant": coolant, "op_present": True}
     job.module_params[key("cutmotion", n)] = cutmotion
+    feed = cutmotion.get("feed")
+    if feed and speed and feed / speed > FEED_PER_REV_NOTE:
+        job.notes.append(f"operation {n} ({source}): F{feed:g} mm/min at S{speed:g} is {feed / speed:.3g} mm/rev, "
+                         f"more than {FEED_PER_REV_NOTE:g} mm/rev; check that @F is mm/min")
     job.operations.append({"operation": n, "kind": cutmotion["kind"], "source": source, "tool": tool,
                            "spindle_rpm": speed, "feed": cutmotion.get("feed"), "coolant": coolant,
                            "paths": len(cutmotion["paths"])})

@@ -10,12 +10,24 @@ from the stored parameters and handed to the template as `moves`.
 """
 from __future__ import annotations
 
+import re
+
 from ..errors import EngineError
 from . import toolpaths
 from .arc_split import with_short_arcs
 from .moves import Move, Pass
 from .names import MAX_OPERATIONS
-from .operations import job_geometry, operation_passes
+from .operations import KINDS, job_geometry, number_param, operation_passes
+
+FIX = "set it in SQL (job.params / job.module_params) and instantiate the job again"
+# Letters, digits and _ from a letter: safe inside an ISO comment "( )" and as an 840D name %_N_…_MPF.
+PROGRAM_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]*")
+ISO_PROGRAM_NUMBERS = 9999     # O0001 … O9999
+MAX_TOOL = 99                  # two digits: ISO T0101 is tool 01, offset 01; 840D T1 D1
+MAX_INFEED_ANGLE = 60.0        # degrees: half a 60° thread's flank angle is 30; beyond 60 the tool rubs
+# What each alternated operation must share with its partner: the passes of both run with A's rows.
+ALTERNATE_SHARED = (("prep", "tool"), ("prep", "tool_offset"), ("cutcond", "spindle_rpm"),
+                    ("cutmotion", "feed"), ("cutcond", "coolant"))
 
 def key(t: str, n: int) -> str:
     return f"{t}:{n}"
@@ -24,10 +36,14 @@ def key(t: str, n: int) -> str:
 def present_operations(module_params: dict) -> list[int]:
     """Numbers n whose cutmotion:n is present, in order; every n must have a template slot."""
     numbers = []
+    if not isinstance(module_params, dict):
+        raise EngineError(f"module_params = {module_params!r} must be an object of module parameters; fix it in SQL")
     for name, values in module_params.items():
         if not isinstance(values, dict):
             raise EngineError(f"module_params {name!r} = {values!r} must be an object of parameters; fix it in SQL")
         t, _, n = name.partition(":")
+        if t == "cutmotion" and "op_present" in values:
+            bool_param(values, "op_present", f"module_params.{name}")
         if t == "cutmotion" and values.get("op_present"):
             if not n.isdecimal() or not 1 <= int(n) <= MAX_OPERATIONS:
                 raise EngineError(f"module_params {name!r}: the turning templates have operation slots "
@@ -38,6 +54,9 @@ def present_operations(module_params: dict) -> list[int]:
 
 def job_passes(params: dict, module_params: dict) -> dict[int, list[Pass]]:
     """The passes of every present operation, by operation number, alternation applied."""
+    check_job_params(params)
+    for n in present_operations(module_params):
+        check_operation_params(module_params, n)
     geometry = job_geometry(params)
     passes = {n: operation_passes(geometry, module_params[key("cutmotion", n)], f"module_params.cutmotion:{n}")
               for n in present_operations(module_params)}
@@ -60,11 +79,89 @@ def alternated_pair(params: dict, module_params: dict, passes: dict) -> tuple[in
         if n not in passes or module_params[key("cutmotion", n)].get("kind") != "ROUGH":
             raise EngineError(f"params.alternate {pair}: operation {n} is not a present ROUGH operation; "
                               "only two ROUGH operations alternate")
-    tools = [module_params.get(key("prep", n), {}).get("tool") for n in pair]
-    if tools[0] != tools[1]:
-        raise EngineError(f"params.alternate {pair}: operations use tools {tools[0]} and {tools[1]}; passes "
-                          "alternate without a tool change, so give both the same tool")
-    return pair[0], pair[1]
+    first, second = pair
+    for t, name in ALTERNATE_SHARED:
+        mine, theirs = module_params[key(t, first)].get(name), module_params[key(t, second)].get(name)
+        if mine != theirs:
+            raise EngineError(f"params.alternate {pair}: module_params.{key(t, second)}.{name} = {theirs!r} differs "
+                              f"from {key(t, first)}.{name} = {mine!r}; the alternated passes run with operation "
+                              f"{first}'s tool, spindle, feed and coolant, so make them equal")
+    return first, second
+
+
+def check_job_params(params) -> None:
+    """The job parameters the template and the passes read, with their JSON types, or an error naming one."""
+    if not isinstance(params, dict):
+        raise EngineError(f"params = {params!r} must be an object of job parameters; fix it in SQL")
+    for name in ("tool_change_z", "tool_change_x"):
+        number_param(params, name, "params")
+    number_param(params, "clearance", "params", 0, above=True)
+    if params.get("stock_diameter") is not None:
+        number_param(params, "stock_diameter", "params", 0, above=True)
+        number_param(params, "stock_z_front", "params")
+        number_param(params, "stock_z_back", "params")
+    bool_param(params, "closed_by_axis", "params")
+    integer_param(params, "program_number", "params", 1, ISO_PROGRAM_NUMBERS)
+    name = params.get("program_name")
+    if not (isinstance(name, str) and PROGRAM_NAME.fullmatch(name)):
+        raise EngineError(f"params.program_name = {name!r} must be letters, digits and _ from a letter "
+                          f"(an ISO comment and an 840D program name); {FIX}")
+
+
+def check_operation_params(module_params: dict, n: int) -> None:
+    """A present operation's own parameters: none falls back to the job's defaults (a missing feed
+    would be written F0, a missing cutcond no spindle start)."""
+    prep, cutcond, cutmotion = (operation_module(module_params, t, n) for t in ("prep", "cutcond", "cutmotion"))
+    where = {t: f"module_params.{key(t, n)}" for t in ("prep", "cutcond", "cutmotion")}
+    integer_param(prep, "tool", where["prep"], 1, MAX_TOOL)
+    integer_param(prep, "tool_offset", where["prep"], 0, MAX_TOOL)
+    number_param(cutcond, "spindle_rpm", where["cutcond"], 0, above=True)
+    bool_param(cutcond, "coolant", where["cutcond"])
+    for t, values in (("prep", prep), ("cutcond", cutcond)):
+        if values.get("op_present") is not True:
+            raise EngineError(f"{where[t]}.op_present = {values.get('op_present')!r} must be true: operation {n} "
+                              f"is present (cutmotion:{n}.op_present); {FIX}")
+    check_cutmotion(cutmotion, where["cutmotion"])
+
+
+def operation_module(module_params: dict, t: str, n: int) -> dict:
+    values = module_params.get(key(t, n))
+    if values is None:
+        raise EngineError(f"module_params.{key(t, n)} is missing: operation {n} is present "
+                          f"(cutmotion:{n}.op_present) and needs its {t} parameters; {FIX}")
+    return values
+
+
+def check_cutmotion(cutmotion: dict, where: str) -> None:
+    kind = cutmotion.get("kind")
+    if kind not in KINDS:
+        raise EngineError(f"{where}.kind = {kind!r} is not one of {' | '.join(KINDS)}; {FIX}")
+    if kind != "THREAD":
+        number_param(cutmotion, "feed", where, 0, above=True)
+    if kind == "ROUGH" and not cutmotion.get("paths"):
+        number_param(cutmotion, "depth_per_pass", where, 0, above=True)
+        number_param(cutmotion, "allowance", where, 0)
+    if kind == "THREAD":
+        number_param(cutmotion, "thread_pitch", where, 0, above=True)
+        number_param(cutmotion, "depth_per_pass", where, 0, above=True)
+        if not 0 <= number_param(cutmotion, "infeed_angle", where, 0) <= MAX_INFEED_ANGLE:
+            raise EngineError(f"{where}.infeed_angle = {cutmotion['infeed_angle']!r} must be 0 … "
+                              f"{MAX_INFEED_ANGLE:g} degrees; {FIX}")
+
+
+def integer_param(values: dict, name: str, where: str, low: int, high: int) -> int:
+    value = values.get(name)
+    if type(value) is not int or not low <= value <= high:
+        raise EngineError(f"{where}.{name} = {value!r} must be a whole number {low} … {high}; {FIX}")
+    return value
+
+
+def bool_param(values: dict, name: str, where: str) -> bool:
+    """true or false as JSON: a string "false" would read as true."""
+    value = values.get(name)
+    if type(value) is not bool:
+        raise EngineError(f"{where}.{name} = {value!r} must be true or false (JSON, not a string); {FIX}")
+    return value
 
 
 def template_module_params(params: dict, module_params: dict, passes: dict[int, list[Pass]] | None = None) -> dict:
@@ -89,5 +186,5 @@ def template_module_params(params: dict, module_params: dict, passes: dict[int, 
 
 
 def flattened(passes: list[Pass]) -> list[Move]:
-    """The passes as one list of moves, arcs over 180° in two halves (engine.turning.arc_split)."""
+    """The passes as one list of moves, arcs over 120° split into equal pieces (engine.turning.arc_split)."""
     return with_short_arcs([move for one in passes for move in one])

@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 
 from importers.dxf_geometry import Arc, Line, Segment
+from importers.dxf_profile import END_MATCH_TOLERANCE_MM
 
 from ..errors import EngineError
 
@@ -41,8 +42,20 @@ def path_from_param(items, where: str) -> list[Segment]:
         segment = _segment(item)
         if segment is None:
             _refuse(item, f"{where}[{index}]")
+        if segments:
+            _require_continuity(segments[-1], segment, f"{where}[{index}]")
         segments.append(segment)
     return segments
+
+
+def _require_continuity(previous: Segment, segment: Segment, where: str) -> None:
+    """A profile and a drawn path are chains: each segment starts where the one before ends
+    (as the drawing's reader joined them)."""
+    gap = math.dist(previous.end, segment.start)
+    if gap > END_MATCH_TOLERANCE_MM:
+        raise EngineError(f"{where} starts at (z {segment.start[0]:g}, r {segment.start[1]:g}), {gap:.4g} mm from "
+                          f"where the segment before ends (z {previous.end[0]:g}, r {previous.end[1]:g}); consecutive "
+                          f"segments must meet within {END_MATCH_TOLERANCE_MM:g} mm: fix it in SQL")
 
 
 def _segment(item) -> Segment | None:
