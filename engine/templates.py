@@ -101,7 +101,8 @@ def replace_template(conn, gear_class: str, rows: list[TemplateRow]) -> bool:
 
     A derived class (one whose ancestors have rows) stores only the rows that differ from
     what it inherits; inherited rows the file leaves out stay inherited. Returns True if
-    anything changed; the class's version and its descendants' versions are then bumped."""
+    anything changed; the class's version and its descendants' versions are then bumped and
+    template_audit records each changed row of the class."""
     from .lint import check_rows
 
     with conn.transaction():
@@ -113,6 +114,7 @@ def replace_template(conn, gear_class: str, rows: list[TemplateRow]) -> bool:
         current = tuple(TemplateRow(*row) for row in conn.execute(OWN_ROWS, (gear_class,)))
         if current == tuple(own):
             return False
+        before = conn.execute("SELECT class_rows_json(%s)::text", (gear_class,)).fetchone()[0]
         old_components = [r[0] for r in conn.execute(
             "DELETE FROM assembly WHERE gear_class = %s RETURNING component_id", (gear_class,))]
         for row in own:
@@ -121,6 +123,8 @@ def replace_template(conn, gear_class: str, rows: list[TemplateRow]) -> bool:
                          (gear_class, row.id, row.n, component_id))
         _delete_orphans(conn, old_components)
         conn.execute(BUMP_VERSIONS, (gear_class,))
+        # template_audit: one row per row of the class's assembled template that changed.
+        conn.execute("SELECT audit_class_change(%s, %s::jsonb)", (gear_class, before))
     return True
 
 

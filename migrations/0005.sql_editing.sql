@@ -1,0 +1,374 @@
+-- Editing templates in SQL (issue 6, design notes §10): INSERT, UPDATE and DELETE on
+-- template_view, copy-on-write for shared and inherited rows, versions, the audit trail and
+-- the roles engine_reader, engine_runner, engine_editor.
+--
+-- The triggers block the obvious problems (unknown class or module type, empty row, p_calc
+-- without s, duplicate or negative id, negative n). Whether an expression parses and names
+-- only known parameters is checked in Python: `engine lint` (run in CI and after hand edits)
+-- and every `engine template import` / `engine import-nc`.
+
+-- One row per change of a template row: who, when, which class and row, old and new row as
+-- {"id", "t", "n", "p_calc", "s", "o", "p_emit"} (NULL for INSERT's old and DELETE's new).
+-- template_version: the class's version after the change. Written by the template_view
+-- triggers (one row per row changed through the view) and by the engine's imports (engine
+-- template import, import-nc: one row per assembled row that differs). Edits made directly
+-- on component / assembly and the nightly refactor (which changes no template) write none.
+CREATE TABLE template_audit (
+    id               bigserial PRIMARY KEY,
+    changed_at       timestamptz NOT NULL DEFAULT now(),
+    changed_by       text NOT NULL DEFAULT current_user,
+    gear_class       text NOT NULL,   -- no foreign key: history outlives a dropped class
+    template_version integer,
+    row_id           integer NOT NULL,
+    operation        text NOT NULL CHECK (operation IN ('INSERT', 'UPDATE', 'DELETE')),
+    old              jsonb,
+    new              jsonb,
+    CHECK ((operation = 'INSERT') = (old IS NULL) AND (operation = 'DELETE') = (new IS NULL))
+);
+CREATE INDEX template_audit_class ON template_audit (gear_class, id);
+
+-- A template row as the audit stores it.
+CREATE FUNCTION template_row_json(id integer, t text, n integer, p_calc text, s text, o text, p_emit text)
+RETURNS jsonb LANGUAGE sql IMMUTABLE PARALLEL SAFE
+RETURN jsonb_build_object('id', id, 't', t, 'n', n, 'p_calc', p_calc, 's', s, 'o', o, 'p_emit', p_emit);
+
+-- The class's assembled rows (own and inherited) as {"<id>": row}, only row_ids if given.
+CREATE FUNCTION class_rows_json(class_name text, row_ids integer[] DEFAULT NULL)
+RETURNS jsonb LANGUAGE sql STABLE
+RETURN (SELECT coalesce(jsonb_object_agg(r.id::text,
+                            template_row_json(r.id, c.t, r.n, c.p_calc, c.s, c.o, c.p_emit)), '{}')
+        FROM class_template(class_name) r JOIN component c ON c.id = r.component_id
+        WHERE row_ids IS NULL OR r.id = ANY (row_ids));
+
+-- Who made a change: the role the session acts as (SET ROLE), also inside the SECURITY
+-- DEFINER functions below, where current_user is their owner.
+CREATE FUNCTION template_editor() RETURNS text LANGUAGE sql STABLE
+RETURN CASE WHEN current_setting('role') = 'none' THEN session_user::text ELSE current_setting('role') END;
+
+-- Bump template_version of the class and of every class below it (their assembled
+-- templates change together), once per transaction and class however many rows change:
+-- one committed state, one version. Returns the class's version.
+CREATE FUNCTION bump_template_versions(class_name text) RETURNS integer
+LANGUAGE plpgsql
+AS $$
+DECLARE
+    xact text := pg_current_xact_id()::text;
+    bumped text;
+BEGIN
+    FOR bumped IN
+        WITH RECURSIVE below(name, depth) AS (
+            SELECT g.name, 0 FROM gear_class g WHERE g.name = class_name
+            UNION ALL
+            SELECT g.name, b.depth + 1 FROM gear_class g JOIN below b ON g.parent = b.name WHERE b.depth < 50)
+        UPDATE gear_class g SET template_version = g.template_version + 1
+        FROM below b
+        WHERE g.name = b.name AND coalesce(current_setting('engine_bumped.' || g.name, true), '') <> xact
+        RETURNING g.name
+    LOOP
+        PERFORM set_config('engine_bumped.' || bumped, xact, true);
+    END LOOP;
+    RETURN (SELECT template_version FROM gear_class WHERE name = class_name);
+END
+$$;
+
+-- Audit rows for everything that differs between `before` (class_rows_json of the class
+-- taken before the change) and the class's rows now; only row_ids if given. The engine's
+-- imports call it after replacing a class's rows and bumping its version.
+CREATE FUNCTION audit_class_change(class_name text, before jsonb, row_ids integer[] DEFAULT NULL)
+RETURNS integer LANGUAGE sql SECURITY DEFINER SET search_path = public, pg_temp
+BEGIN ATOMIC
+    WITH changes AS (
+        SELECT coalesce(b.key, a.key)::integer AS row_id, b.value AS old, a.value AS new
+        FROM jsonb_each(before) b
+        FULL JOIN jsonb_each(class_rows_json(class_name, row_ids)) a ON a.key = b.key
+        WHERE b.value IS DISTINCT FROM a.value),
+    written AS (
+        INSERT INTO template_audit (changed_by, gear_class, template_version, row_id, operation, old, new)
+        SELECT template_editor(), class_name,
+               (SELECT template_version FROM gear_class WHERE name = class_name), row_id,
+               CASE WHEN old IS NULL THEN 'INSERT' WHEN new IS NULL THEN 'DELETE' ELSE 'UPDATE' END, old, new
+        FROM changes ORDER BY row_id
+        RETURNING 1)
+    SELECT count(*)::integer FROM written;
+END;
+
+-- The component holding this body: an existing one (the library stores each body once; the
+-- row is locked so a concurrent cleanup cannot delete it under us) or a new one.
+CREATE FUNCTION component_for(b_t text, b_o text, b_p_calc text, b_s text, b_p_emit text)
+RETURNS bigint LANGUAGE plpgsql
+AS $$
+DECLARE
+    found bigint;
+BEGIN
+    SELECT c.id INTO found FROM component c
+    WHERE component_body_key(c.t, c.o, c.p_calc, c.s, c.p_emit) = component_body_key(b_t, b_o, b_p_calc, b_s, b_p_emit)
+      AND c.t = b_t AND c.o IS NOT DISTINCT FROM b_o AND c.p_calc IS NOT DISTINCT FROM b_p_calc
+      AND c.s IS NOT DISTINCT FROM b_s AND c.p_emit IS NOT DISTINCT FROM b_p_emit
+    ORDER BY c.id LIMIT 1
+    FOR KEY SHARE;
+    IF found IS NULL THEN
+        INSERT INTO component (t, o, p_calc, s, p_emit) VALUES (b_t, b_o, b_p_calc, b_s, b_p_emit)
+        RETURNING id INTO found;
+    END IF;
+    RETURN found;
+END
+$$;
+
+-- Delete the component if no assembly row uses it any more (one a concurrent writer has
+-- just started using stays).
+CREATE FUNCTION delete_component_if_unused(unused_id bigint) RETURNS void
+LANGUAGE plpgsql
+AS $$
+BEGIN
+    DELETE FROM component c
+    WHERE c.id = unused_id AND NOT EXISTS (SELECT 1 FROM assembly a WHERE a.component_id = c.id);
+EXCEPTION WHEN foreign_key_violation THEN
+    NULL;
+END
+$$;
+
+-- The obvious problems of a row written through template_view, as errors naming the class,
+-- the row and the column (the same words as engine lint).
+CREATE FUNCTION template_row_check(class_name text, row_id integer, t text, n integer,
+                                   p_calc text, s text, o text)
+RETURNS void LANGUAGE plpgsql STABLE
+AS $$
+BEGIN
+    IF row_id IS NULL THEN
+        RAISE EXCEPTION 'class % column id: every template row needs an id', class_name
+            USING ERRCODE = 'not_null_violation', COLUMN = 'id';
+    END IF;
+    IF row_id < 0 THEN
+        RAISE EXCEPTION 'class % row % column id: id must not be negative', class_name, row_id
+            USING ERRCODE = 'check_violation', COLUMN = 'id';
+    END IF;
+    IF n IS NULL OR n < 0 THEN
+        RAISE EXCEPTION 'class % row % column n: n must be a whole number >= 0, got %', class_name, row_id,
+                        coalesce(n::text, 'NULL')
+            USING ERRCODE = 'check_violation', COLUMN = 'n';
+    END IF;
+    IF t IS NULL OR NOT EXISTS (SELECT 1 FROM module_type m WHERE m.code = t) THEN
+        RAISE EXCEPTION 'class % row % column t: unknown module type %; use one of %', class_name, row_id,
+                        coalesce(quote_literal(t), 'NULL'),
+                        (SELECT string_agg(code, ', ' ORDER BY position) FROM module_type)
+            USING ERRCODE = 'check_violation', COLUMN = 't';
+    END IF;
+    IF o IS NULL AND s IS NULL THEN
+        RAISE EXCEPTION 'class % row % column o: row has neither o nor s: it does nothing', class_name, row_id
+            USING ERRCODE = 'check_violation', COLUMN = 'o';
+    END IF;
+    IF p_calc IS NOT NULL AND s IS NULL THEN
+        RAISE EXCEPTION 'class % row % column p_calc: p_calc has no effect without s (use p_emit to decide output)',
+                        class_name, row_id
+            USING ERRCODE = 'check_violation', COLUMN = 'p_calc';
+    END IF;
+END
+$$;
+
+-- A blank expression cell is an absent expression, as in template CSV files.
+CREATE FUNCTION blank_to_null(text) RETURNS text LANGUAGE sql IMMUTABLE PARALLEL SAFE
+RETURN CASE WHEN $1 ~ '^\s*$' THEN NULL ELSE $1 END;
+
+-- INSERT, UPDATE, DELETE on template_view change only the class named in the row:
+-- * UPDATE points the class's own assembly row at the component with the new body (an
+--   existing one when the body is already stored); a row inherited from an ancestor gets an
+--   own row for this class (copy-on-write); the ancestor and every other class keep theirs.
+--   An own row set back to exactly what the class inherits is deleted (inherited again).
+--   id and n may change on own rows; an inherited row's id may not.
+-- * INSERT adds an own row with an id the class's assembled template does not have yet.
+-- * DELETE removes an own row; an inherited row cannot be deleted from a derived class.
+-- Components no longer used are deleted. Every change locks the library in the refactor's
+-- order (engine/refactor.py LOCK, engine/templates.py LOCK_FOR_WRITING), bumps the versions
+-- of the class and the classes below it, and writes template_audit. To change a shared body
+-- for every class at once, UPDATE component directly (not audited, no version bump).
+-- SECURITY DEFINER: editors need no rights on template_audit; the view's own privileges
+-- (GRANT ... ON template_view) decide who may edit.
+CREATE FUNCTION template_view_edit() RETURNS trigger
+LANGUAGE plpgsql SECURITY DEFINER SET search_path = public, pg_temp
+AS $$
+DECLARE
+    class_name text;
+    row_id     integer;
+    own_id     bigint;   -- component of the class's own row at OLD.id; NULL: inherited
+    owner_name text;
+    same       boolean;
+    old_row    jsonb;
+    new_row    jsonb;
+    new_version integer;
+BEGIN
+    IF TG_OP = 'DELETE' THEN
+        class_name := OLD.gear_class;
+    ELSE
+        class_name := NEW.gear_class;
+    END IF;
+    IF TG_OP = 'UPDATE' AND NEW.gear_class IS DISTINCT FROM OLD.gear_class THEN
+        RAISE EXCEPTION 'class % row % column gear_class: a row cannot move to another class', OLD.gear_class, OLD.id
+            USING ERRCODE = 'check_violation', COLUMN = 'gear_class',
+                  HINT = format('INSERT it into %s and DELETE it from %s', NEW.gear_class, OLD.gear_class);
+    END IF;
+    LOCK TABLE gear_class, component, assembly IN ROW EXCLUSIVE MODE;
+    -- Serializes editors of one class; NO KEY: programs being stored (foreign keys) do not wait.
+    PERFORM 1 FROM gear_class WHERE name = class_name FOR NO KEY UPDATE;
+    IF NOT FOUND THEN
+        RAISE EXCEPTION 'class % row % column gear_class: gear class % does not exist', class_name,
+                        coalesce(NEW.id, OLD.id), quote_nullable(class_name)
+            USING ERRCODE = 'foreign_key_violation', COLUMN = 'gear_class',
+                  HINT = 'create it first (INSERT INTO gear_class (name, parent) ...), see `engine template list`';
+    END IF;
+
+    IF TG_OP <> 'DELETE' THEN
+        NEW.o := blank_to_null(NEW.o);
+        NEW.s := blank_to_null(NEW.s);
+        NEW.p_calc := blank_to_null(NEW.p_calc);
+        NEW.p_emit := blank_to_null(NEW.p_emit);
+        IF TG_OP = 'INSERT' THEN
+            NEW.n := coalesce(NEW.n, 1);
+        END IF;
+        PERFORM template_row_check(class_name, NEW.id, NEW.t, NEW.n, NEW.p_calc, NEW.s, NEW.o);
+        new_row := template_row_json(NEW.id, NEW.t, NEW.n, NEW.p_calc, NEW.s, NEW.o, NEW.p_emit);
+    END IF;
+
+    IF TG_OP = 'INSERT' THEN
+        row_id := NEW.id;
+        SELECT r.owner INTO owner_name FROM class_template(class_name) r WHERE r.id = NEW.id;
+        IF FOUND THEN
+            RAISE EXCEPTION 'class % row % column id: the class already has row % (%)', class_name, NEW.id, NEW.id,
+                            CASE WHEN owner_name = class_name THEN 'its own' ELSE 'inherited from ' || owner_name END
+                USING ERRCODE = 'unique_violation', COLUMN = 'id',
+                      HINT = 'choose a free id, or UPDATE the row (an UPDATE of an inherited row overrides it for this class only)';
+        END IF;
+        INSERT INTO assembly (gear_class, id, n, component_id)
+        VALUES (class_name, NEW.id, NEW.n, component_for(NEW.t, NEW.o, NEW.p_calc, NEW.s, NEW.p_emit));
+
+    ELSIF TG_OP = 'UPDATE' THEN
+        row_id := NEW.id;
+        IF NEW.shared_by IS DISTINCT FROM OLD.shared_by OR NEW.inherited_from IS DISTINCT FROM OLD.inherited_from THEN
+            RAISE EXCEPTION 'class % row % column %: shared_by and inherited_from are computed, they cannot be set',
+                            class_name, OLD.id,
+                            CASE WHEN NEW.shared_by IS DISTINCT FROM OLD.shared_by THEN 'shared_by' ELSE 'inherited_from' END
+                USING ERRCODE = 'check_violation',
+                      HINT = 'edit id, t, n, p_calc, s, o, p_emit; an UPDATE makes the row this class''s own';
+        END IF;
+        old_row := template_row_json(OLD.id, OLD.t, OLD.n, OLD.p_calc, OLD.s, OLD.o, OLD.p_emit);
+        IF old_row = new_row THEN
+            RETURN NEW;   -- nothing changes: no version, no audit
+        END IF;
+        SELECT a.component_id INTO own_id FROM assembly a
+        WHERE a.gear_class = class_name AND a.id = OLD.id FOR UPDATE;
+        IF own_id IS NULL THEN
+            SELECT r.owner INTO owner_name FROM class_template(class_name) r WHERE r.id = OLD.id;
+            IF NOT FOUND THEN
+                RETURN NULL;   -- deleted meanwhile by another transaction: nothing to update
+            END IF;
+            IF NEW.id <> OLD.id THEN
+                RAISE EXCEPTION 'class % row % column id: the row is inherited from %; its id cannot be changed in a derived class',
+                                class_name, OLD.id, owner_name
+                    USING ERRCODE = 'check_violation', COLUMN = 'id',
+                          HINT = format('INSERT a row with id %s into %s (row %s stays inherited), or change the id in %s',
+                                        NEW.id, class_name, OLD.id, owner_name);
+            END IF;
+            -- Copy-on-write: this class gets its own row; the ancestor keeps its own.
+            INSERT INTO assembly (gear_class, id, n, component_id)
+            VALUES (class_name, NEW.id, NEW.n, component_for(NEW.t, NEW.o, NEW.p_calc, NEW.s, NEW.p_emit));
+        ELSE
+            IF NEW.id <> OLD.id THEN
+                SELECT r.owner INTO owner_name FROM class_template(class_name) r WHERE r.id = NEW.id;
+                IF FOUND THEN
+                    RAISE EXCEPTION 'class % row % column id: the class already has row % (%)', class_name, OLD.id, NEW.id,
+                                    CASE WHEN owner_name = class_name THEN 'its own' ELSE 'inherited from ' || owner_name END
+                        USING ERRCODE = 'unique_violation', COLUMN = 'id', HINT = 'choose a free id';
+                END IF;
+            END IF;
+            -- Set back to exactly what the parent gives at this id: the row is inherited again.
+            SELECT template_row_json(r.id, c.t, r.n, c.p_calc, c.s, c.o, c.p_emit) = new_row INTO same
+            FROM gear_class g
+            CROSS JOIN LATERAL class_template(g.parent) r
+            JOIN component c ON c.id = r.component_id
+            WHERE g.name = class_name AND g.parent IS NOT NULL AND r.id = NEW.id;
+            IF same AND NEW.id = OLD.id THEN
+                DELETE FROM assembly WHERE gear_class = class_name AND id = OLD.id;
+            ELSE
+                UPDATE assembly
+                SET id = NEW.id, n = NEW.n,
+                    component_id = component_for(NEW.t, NEW.o, NEW.p_calc, NEW.s, NEW.p_emit)
+                WHERE gear_class = class_name AND id = OLD.id;
+            END IF;
+            PERFORM delete_component_if_unused(own_id);
+        END IF;
+        NEW.inherited_from := class_name;
+
+    ELSE   -- DELETE
+        row_id := OLD.id;
+        old_row := template_row_json(OLD.id, OLD.t, OLD.n, OLD.p_calc, OLD.s, OLD.o, OLD.p_emit);
+        DELETE FROM assembly WHERE gear_class = class_name AND id = OLD.id RETURNING component_id INTO own_id;
+        IF own_id IS NULL THEN
+            SELECT r.owner INTO owner_name FROM class_template(class_name) r WHERE r.id = OLD.id;
+            IF NOT FOUND THEN
+                RETURN NULL;   -- deleted meanwhile by another transaction
+            END IF;
+            RAISE EXCEPTION 'class % row %: the row is inherited from %; an inherited row cannot be deleted from a derived class',
+                            class_name, OLD.id, owner_name
+                USING ERRCODE = 'restrict_violation', COLUMN = 'id',
+                      HINT = format('delete it from %s (every class deriving from %s loses it), or override it in %s '
+                                    'with an UPDATE that makes it do nothing (e.g. SET p_emit = ''False'')',
+                                    owner_name, owner_name, class_name);
+        END IF;
+        PERFORM delete_component_if_unused(own_id);
+        SELECT r.owner INTO owner_name FROM class_template(class_name) r WHERE r.id = OLD.id;
+        IF FOUND THEN
+            RAISE NOTICE 'class % row %: the row inherited from % applies again', class_name, OLD.id, owner_name;
+        END IF;
+    END IF;
+
+    new_version := bump_template_versions(class_name);
+    INSERT INTO template_audit (changed_by, gear_class, template_version, row_id, operation, old, new)
+    VALUES (template_editor(), class_name, new_version, row_id, TG_OP, old_row, new_row);
+    IF TG_OP = 'DELETE' THEN
+        RETURN OLD;
+    END IF;
+    RETURN NEW;
+END
+$$;
+
+CREATE TRIGGER template_view_edit INSTEAD OF INSERT OR UPDATE OR DELETE ON template_view
+FOR EACH ROW EXECUTE FUNCTION template_view_edit();
+
+REVOKE EXECUTE ON FUNCTION audit_class_change(text, jsonb, integer[]) FROM PUBLIC;
+
+-- Roles (NOLOGIN groups; grant them to login roles). Roles belong to the cluster, not to this
+-- database: create them once, whichever database migrates first, even concurrently.
+DO $$
+DECLARE
+    role_name text;
+BEGIN
+    FOREACH role_name IN ARRAY ARRAY['engine_reader', 'engine_runner', 'engine_editor'] LOOP
+        IF NOT EXISTS (SELECT 1 FROM pg_roles WHERE rolname = role_name) THEN
+            BEGIN
+                EXECUTE format('CREATE ROLE %I NOLOGIN', role_name);
+            EXCEPTION WHEN duplicate_object OR unique_violation THEN
+                NULL;   -- created meanwhile by a migration of another database
+            END;
+        END IF;
+    END LOOP;
+END
+$$;
+
+-- Privileges on the tables this migration knows. A later migration that adds a table or
+-- sequence grants on it too (SELECT to all three; writes to whoever must write it); tables
+-- created later by the role running the migrations are readable by all three by default.
+GRANT USAGE ON SCHEMA public TO engine_reader, engine_runner, engine_editor;
+GRANT SELECT ON ALL TABLES IN SCHEMA public TO engine_reader, engine_runner, engine_editor;
+GRANT SELECT ON ALL SEQUENCES IN SCHEMA public TO engine_reader, engine_runner, engine_editor;
+ALTER DEFAULT PRIVILEGES IN SCHEMA public GRANT SELECT ON TABLES TO engine_reader, engine_runner, engine_editor;
+-- Runners instantiate: jobs and programs (results are program rows); confirming a job adds
+-- its cuts to the machining history.
+GRANT INSERT, UPDATE ON job, program TO engine_runner;
+GRANT INSERT ON cutting_case TO engine_runner;
+GRANT USAGE ON SEQUENCE job_id_seq, program_id_seq, cutting_case_id_seq TO engine_runner;
+-- Editors change templates: through template_view (audited, versioned), or the library
+-- tables themselves on purpose; and create or describe classes. Not programs, jobs, cases
+-- or the audit trail.
+GRANT INSERT, UPDATE, DELETE ON template_view, component, assembly TO engine_editor;
+GRANT INSERT, UPDATE ON gear_class TO engine_editor;
+GRANT USAGE ON SEQUENCE component_id_seq TO engine_editor;
+GRANT EXECUTE ON FUNCTION audit_class_change(text, jsonb, integer[]) TO engine_editor;
