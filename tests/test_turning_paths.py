@@ -17,6 +17,7 @@ from hypothesis import strategies as st
 
 from engine.errors import EngineError
 from engine.turning.moves import Move
+from engine.turning.region import CHORD_TOLERANCE_MM
 from engine.turning.plot import plot_job
 from engine.turning.toolpaths import (alternate, distance_to_region, drawn_rough_passes,
                                       finish_passes, profile_rough_passes, slot_passes,
@@ -289,7 +290,8 @@ def step(z, low, high, kind, size):
        allowance=st.floats(0.0, 1.0), front_stock=st.sampled_from([0.0, 0.5, 2.0]))
 def test_profile_roughing_keeps_the_allowance_and_removes_the_material(profile, extra, per_pass,
                                                                        allowance, front_stock):
-    z_back, top = profile[-1].end[0], max(s.end[1] for s in profile)
+    z_back = profile[-1].end[0]
+    top = float(top_radius(np.linspace(z_back, 0.0, 20001), profile).max())   # domes rise above their ends
     stock, z_front = top + extra, front_stock
     outline = profile + closing(profile)
     passes = profile_rough_passes(outline, stock, per_pass, allowance, z_front, z_back, CLEARANCE)
@@ -303,7 +305,9 @@ def test_profile_roughing_keeps_the_allowance_and_removes_the_material(profile, 
     if len(material):   # less than allowance + depth above the part needs no rough pass
         assert cuts
         reach = np.min([segment_distances(material, Line(a, b)) for a, b in cuts], axis=0)
-        assert reach.max() <= per_pass + 1e-9
+        # within the 1 µm the roughing keeps off flattened arcs and flats (a level 10 nm above
+        # a flat is moved onto the flat + 1 µm: the layer above it is 10 nm thicker than D)
+        assert reach.max() <= per_pass + CHORD_TOLERANCE_MM
 
 
 def test_profile_roughing_levels_from_the_outside_in():
@@ -321,6 +325,7 @@ def test_profile_roughing_levels_from_the_outside_in():
 @pytest.mark.parametrize("change, words", [
     ({"depth_per_pass": 0.0}, "--rough-depth"), ({"allowance": -0.1}, "--allowance"),
     ({"stock_radius": 5.0}, "--stock-diameter"), ({"clearance": 0.0}, "params.clearance"),
+    ({"stock_radius": 8.0}, "the part does not fit in the blank; give --stock-diameter"),
 ])
 def test_profile_roughing_refuses_bad_numbers(change, words):
     profile = [Line((0.0, 5.0), (-10.0, 5.0)), Line((-10.0, 5.0), (-10.0, 9.0)), Line((-10.0, 9.0), (-30.0, 9.0))]
@@ -381,3 +386,40 @@ def test_plot_failure_leaves_no_half_written_file(tmp_path, monkeypatch):
     with pytest.raises(OSError):
         plot_job(tmp_path / "part.png", *plot_inputs())
     assert os.listdir(tmp_path) == []
+
+
+def shaft_with_collar_surroundings():
+    """Shaft R10 from Z 0 to Z −70 with a collar R20 at Z −30 … −40, closed by the axis."""
+    from engine.turning.region import Surroundings, flattened_outline
+
+    corners = [(0, 0), (0, 10), (-30, 10), (-30, 20), (-40, 20), (-40, 10), (-70, 10), (-70, 0)]
+    outline = [Line(a, b) for a, b in zip(corners, corners[1:] + corners[:1])]
+    return Surroundings(tuple(flattened_outline(outline)), None, CLEARANCE)
+
+
+def test_a_thread_whose_run_in_would_cut_the_part_is_refused():
+    around = shaft_with_collar_surroundings()
+    # Drawn from −62 towards −45 on the R10 shaft: before its start the shaft goes on to −70
+    # (the chuck side), so no run-in in the air exists.
+    towards_the_face = [axial(-62, -45, 10.0), axial(-62, -45, 9.0)]
+    with pytest.raises(EngineError, match=r"THREAD starting at Z -62: the part continues before it"):
+        thread_passes(towards_the_face, 0.3, 30, 1.5, CLEARANCE, around)
+    # Drawn from −20 towards −28 at the free end: the run-in goes through the shaft (radius
+    # 10 = the crest) to the front face, in the air beyond it by at least the clearance.
+    at_the_free_end = [axial(-20, -28, 10.0), axial(-20, -28, 9.0)]
+    passes = thread_passes(at_the_free_end, 0.3, 0, 1.5, CLEARANCE, around)
+    starts = {one[0].z for one in passes}
+    assert len(starts) == 1 and starts.pop() >= 0 + CLEARANCE
+    # A collar larger than the crest before the start would be cut too.
+    behind_the_collar = [axial(-45, -60, 10.0), axial(-45, -60, 9.0)]
+    with pytest.raises(EngineError, match="run-in would cut it"):
+        thread_passes(behind_the_collar, 0.3, 0, 1.5, CLEARANCE, around)
+
+
+def test_a_facing_cut_leaves_its_face_along_z_before_any_x_retract():
+    face = [[Line((0.0, 30.0), (0.0, 0.0))]]
+    moves = drawn_rough_passes(face, CLEARANCE)[0]
+    last_cut = max(i for i, move in enumerate(moves) if move.kind == "feed")
+    assert (moves[last_cut].z, moves[last_cut].x) == (0.0, 0.0)
+    leave = moves[last_cut + 1]
+    assert leave.kind == "rapid" and leave.x == 0.0 and leave.z == pytest.approx(CLEARANCE)

@@ -107,8 +107,18 @@ def drawn_rough_passes(paths: list[list[Segment]], clearance: float) -> list[Pas
 
 def drawn_rough_pass(path: list[Segment], clearance: float) -> Pass:
     start_z, start_r = path[0].start
-    return [rapid(start_z, start_r + clearance), feed(start_z, start_r),
-            *(cutting_move(segment) for segment in path)]
+    moves = [rapid(start_z, start_r + clearance), feed(start_z, start_r),
+             *(cutting_move(segment) for segment in path)]
+    return moves + _off_a_face(path[-1], clearance)
+
+
+def _off_a_face(last: Segment, clearance: float) -> list[Move]:
+    """A cut that ends moving radially (facing) has just made a face: the tool leaves it
+    along +Z, towards the part's free end, before the X retract would drag across it."""
+    (z0, r0), (z1, r1) = last.start, last.end
+    if isinstance(last, Line) and abs(z1 - z0) <= STRAIGHT_TOLERANCE_MM < abs(r1 - r0):
+        return [rapid(z1 + clearance, r1)]
+    return []
 
 
 def radial_line(path: list[Segment], what: str) -> tuple[float, float, float]:
@@ -173,18 +183,26 @@ def pass_depths(depth: float, depth_per_pass: float) -> list[float]:
     return [min(k * depth_per_pass, depth) for k in range(1, count)] + [depth]
 
 
-def thread_run_in(around: Surroundings | None, start_z: float, back: float, root: float,
+def thread_run_in(around: Surroundings | None, start_z: float, back: float, crest: float, root: float,
                   pitch: float, clearance: float) -> float:
     """How far before the drawn start (towards the start side) every pass begins, so its
     in-feed happens in the air: clearance when nothing at the root radius or above lies
-    there, else beyond the part and the blank on that side by clearance. A whole number of
-    pitches, so the run-in leaves the helix where the drawing has it."""
+    there, else beyond the part's free end (+Z) by clearance, through material no larger
+    than the crest. A whole number of pitches, so the run-in leaves the helix where the
+    drawing has it. Material before a start on the chuck side (−Z), or larger than the
+    crest, would be cut by the run-in: refused."""
     needed = clearance
     if around is not None:
         low, high = around.z_span()
         outer_end = high if back > 0 else low
         beyond = start_z + back * STRAIGHT_TOLERANCE_MM
-        if top_over(around.edges, *sorted((beyond, outer_end))) >= root:
+        top = top_over(around.edges, *sorted((beyond, outer_end)))
+        if top >= root:
+            if back < 0 or top > crest + STRAIGHT_TOLERANCE_MM:
+                raise EngineError(
+                    f"THREAD starting at Z {start_z:g}: the part continues before it (radius {top:g} mm, "
+                    f"root {root:g} mm) up to Z {outer_end:g}, so the passes' run-in would cut it; draw the "
+                    "thread from the part's free end, or draw a thread relief groove before its start")
             needed = max(needed, back * (outer_end - start_z) + clearance)
     return math.ceil(needed / pitch - PASS_COUNT_NOISE) * pitch
 
@@ -201,7 +219,7 @@ def thread_passes(paths: list[list[Segment]], depth_per_pass: float, infeed_angl
     (start_z, end_z, crest), root = crest_and_root(paths)
     back = 1.0 if start_z > end_z else -1.0   # +Z is "back" when the thread runs towards −Z
     slope, full = math.tan(math.radians(infeed_angle_deg)), crest - root
-    first_z = start_z + back * thread_run_in(around, start_z, back, root, pitch, clearance)
+    first_z = start_z + back * thread_run_in(around, start_z, back, crest, root, pitch, clearance)
     passes = []
     for depth in pass_depths(full, depth_per_pass):
         z = first_z + back * (full - depth) * slope
@@ -264,6 +282,10 @@ def require_rough_numbers(outline: Sequence[Segment], stock_radius: float, depth
                           "check the blank's length")
     if not outline:
         raise EngineError("the profile is empty; draw the part outline on layer 0")
+    largest = max(r for edge in flattened_outline(outline) for _, r in edge)
+    if stock_radius < largest - CHORD_TOLERANCE_MM:
+        raise EngineError(f"blank radius {stock_radius:g} mm is below the part's largest radius {largest:g} mm: "
+                          f"the part does not fit in the blank; give {STOCK_FLAG} of at least {2 * largest:g}")
     smallest = smallest_radius(outline)
     if not stock_radius > smallest:
         raise EngineError(f"blank radius {stock_radius!r} mm is not above the profile's smallest "
