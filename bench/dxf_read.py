@@ -55,7 +55,8 @@ def add_operations(msp, paths: int) -> int:
                          ("3", "@GTHREAD @S600 @T03 @P1.5 @D0.2 @A29")):
         msp.add_text(codes, dxfattribs={"layer": layer, "insert": (5, 40 + int(layer) * 5)})
     for index in range(paths):
-        msp.add_line((1, 30 - index * 0.01), (-50, 30 - index * 0.01), dxfattribs={"layer": "1"})
+        # 0.025 mm apart: more than the 0.01 mm within which ends chain, above the R20.5 profile
+        msp.add_line((1, 30 - index * 0.025), (-50, 30 - index * 0.025), dxfattribs={"layer": "1"})
     msp.add_line((0, 21), (-20, 21), dxfattribs={"layer": "2"})
     msp.add_line((-20, 21), (-20, 25), dxfattribs={"layer": "2"})
     for radius in (21.0, 20.08):

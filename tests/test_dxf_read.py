@@ -244,7 +244,7 @@ def seed_drawing(path: Path, *, rough_codes="@GROUGH @S100 @F1300 @T01 @M8", lay
     msp.add_line((-4, 0), (-4, 0.5))
     msp.add_point((1, 1.5))
     rough = msp.add_text(rough_codes, dxfattribs={"layer": "1", "insert": (1, 2)})
-    for y in (0.9, 0.8, 0.7):
+    for y in (0.9, 0.85, 0.8):   # above the bulge (top 0.75): roughing passes stay off the part
         msp.add_line((0.1, y), (-3.9, y), dxfattribs={"layer": "1"})
     slot = msp.add_mtext(layer2_codes, dxfattribs={"layer": "2", "insert": (1, 3)})
     for x in (-2.3, -2.7):

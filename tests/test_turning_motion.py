@@ -30,14 +30,19 @@ ARC_CENTRE_TOLERANCE_MM = 0.01
 THREAD_G = (32, 33)
 
 
+COLLAR_OUTSIDE = [(0, 10), (-19, 10), (-19, 8), (-21, 8), (-21, 10), (-30, 10), (-30, 20), (-40, 20),
+                  (-40, 10), (-49, 10), (-49, 8), (-51, 8), (-51, 10), (-60, 10)]
+
+
 def collar_drawing(path: Path) -> None:
-    """Shaft ⌀20 with a ⌀40 collar at Z −30…−40; slots at Z −20 and −50; roughing from the profile."""
+    """Shaft ⌀20 with a ⌀40 collar at Z −30…−40 and ⌀16 grooves at Z −19…−21 and −49…−51,
+    slotted by one plunge each (the grooves are part of the profile, as the convention has it)."""
     doc = ezdxf.new("R2010")
     doc.header["$INSUNITS"] = 4
     for layer in ("1", "2", "3"):
         doc.layers.add(layer)
     msp = doc.modelspace()
-    msp.add_lwpolyline([(0, 0), (0, 10), (-30, 10), (-30, 20), (-40, 20), (-40, 10), (-60, 10), (-60, 0)])
+    msp.add_lwpolyline([(0, 0), *COLLAR_OUTSIDE, (-60, 0)])
     msp.add_point((20, 30))
     msp.add_text("@GROUGH @S500 @F200 @T01", dxfattribs={"layer": "1"})
     msp.add_line((1, 10.5), (-29.5, 10.5), dxfattribs={"layer": "1"})
@@ -45,8 +50,7 @@ def collar_drawing(path: Path) -> None:
     msp.add_line((-20, 10), (-20, 8), dxfattribs={"layer": "2"})
     msp.add_line((-50, 10), (-50, 8), dxfattribs={"layer": "2"})
     msp.add_text("@GFINISH @S800 @F100 @T03", dxfattribs={"layer": "3"})
-    msp.add_lwpolyline([(0, 10), (-30, 10), (-30, 20), (-40, 20), (-40, 10), (-60, 10)],
-                       dxfattribs={"layer": "3"})
+    msp.add_lwpolyline(COLLAR_OUTSIDE, dxfattribs={"layer": "3"})
     doc.saveas(path)
 
 

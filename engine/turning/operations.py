@@ -13,12 +13,14 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 
 from importers.dxf_geometry import Line, Segment
 from importers.dxf_profile import END_MATCH_TOLERANCE_MM, Profile, merged_bounds
 
 from ..errors import EngineError
 from . import toolpaths
+from .gouge import PartIndex, check_no_gouge
 from .moves import Pass
 from .region import Surroundings, flattened_outline
 from .segments import path_from_param
@@ -38,9 +40,17 @@ class JobGeometry:
     clearance: float
     tool_change_radius: float | None = None
 
-    @property
+    @cached_property
+    def edges(self) -> tuple:
+        return tuple(flattened_outline(self.outline))
+
+    @cached_property
     def surroundings(self) -> Surroundings:
-        return Surroundings(tuple(flattened_outline(self.outline)), self.stock, self.clearance)
+        return Surroundings(self.edges, self.stock, self.clearance)
+
+    @cached_property
+    def part_index(self) -> PartIndex:
+        return PartIndex(self.edges)
 
 
 def job_geometry(params: dict) -> JobGeometry:
@@ -94,7 +104,10 @@ def operation_passes(geometry: JobGeometry, cutmotion: dict, where: str) -> list
     entered and left at a travel radius clear of part and blank; the operation is entered
     from the tool-change point by Z first and left by X up to it first."""
     passes = toolpaths.standalone(_passes(geometry, cutmotion, where), geometry.surroundings)
-    return from_and_to_tool_change(passes, geometry.tool_change_radius)
+    passes = from_and_to_tool_change(passes, geometry.tool_change_radius)
+    if cutmotion.get("kind") != "THREAD":   # a thread cuts below the drawn profile by design
+        check_no_gouge(passes, geometry.part_index, where)
+    return passes
 
 
 def from_and_to_tool_change(passes: list[Pass], tool_change_radius: float | None) -> list[Pass]:

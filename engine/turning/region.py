@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Iterable, Sequence
 
 from importers.dxf_geometry import Arc, Point, Segment
@@ -191,11 +192,20 @@ class Surroundings:
         """A radius at which the tool may travel in Z between z_a and z_b: above the part and
         the blank over that span, by the clearance."""
         low, high = min(z_a, z_b), max(z_a, z_b)
-        top = top_over(self.edges, low, high) + CHORD_TOLERANCE_MM
+        z_min, z_max, r_max = self.extent
+        # Over the whole part (as a travel between passes is) the top is the largest radius.
+        top = (r_max if low <= z_min and high >= z_max else top_over(self.edges, low, high)) + CHORD_TOLERANCE_MM
         if self.blank is not None and low <= self.blank[0] and high >= self.blank[1]:
             top = max(top, self.blank[2])
         return top + self.clearance
 
+    @cached_property
+    def extent(self) -> tuple[float, float, float]:
+        """Smallest and largest Z and the largest radius of the part's edges."""
+        points = [point for edge in self.edges for point in edge]
+        return (min(z for z, _ in points), max(z for z, _ in points), max(max(r for _, r in points), 0.0))
+
     def z_span(self) -> tuple[float, float]:
-        zs = [z for edge in self.edges for z, _ in edge] + list(self.blank[:2] if self.blank else [])
+        z_min, z_max, _ = self.extent
+        zs = [z_min, z_max] + list(self.blank[:2] if self.blank else [])
         return min(zs), max(zs)
