@@ -144,7 +144,8 @@ def _report_batch(batch, out, as_json: bool) -> None:
 
 @main.group()
 def template():
-    """Templates of gear classes: list, export and import as CSV (id,t,n,p_calc,s,o,p_emit)."""
+    """Templates of gear classes: list, export and import as CSV (id,t,n,p_calc,s,o,p_emit);
+    history, diff and restore of their versions."""
 
 
 @template.command("list")
@@ -192,6 +193,84 @@ def template_import(ctx, gear_class, parent, csv_file):
         version = conn.execute("SELECT template_version FROM gear_class WHERE name = %s", (gear_class,)).fetchone()[0]
     state = "created" if created else ("replaced" if changed else "unchanged (identical rows)")
     click.echo(f"class {gear_class}: {state}, {len(rows)} rows, version {version}")
+
+
+@template.command("history")
+@click.option("--class", "gear_class", required=True, help="Gear class name.")
+@click.option("--json", "as_json", is_flag=True, help="Print one JSON object: {versions: [...]}.")
+@click.pass_context
+def template_history(ctx, gear_class, as_json):
+    """Every stored version of the class, oldest first: when, who, rows, which rows changed."""
+    from .template_history import history
+
+    with connection(ctx) as conn:
+        entries = history(conn, gear_class)
+    if as_json:
+        return emit_json({"gear_class": gear_class, "versions": [_version_json(entry) for entry in entries]})
+    for number, entry in enumerate(entries):
+        click.echo(f"v{entry.version:<4} {entry.created_at:%Y-%m-%d %H:%M:%S} by {entry.created_by:14} "
+                   f"{entry.rows:3} rows  {_changes_text(entry.changes, first=number == 0)}".rstrip())
+
+
+def _changes_text(changes, first: bool) -> str:
+    """Which rows a version changed: each row, or counts per operation when there are many."""
+    if not changes:
+        return "" if first else "(rows inherited from a parent class changed)"
+    if len(changes) <= 6:
+        return ", ".join(f"{operation} {row_id}" for row_id, operation in changes)
+    operations = [operation for _, operation in changes]
+    return ", ".join(f"{operation} x{operations.count(operation)}" for operation in dict.fromkeys(operations))
+
+
+def _version_json(entry) -> dict:
+    return {"version": entry.version, "created_at": entry.created_at.isoformat(), "created_by": entry.created_by,
+            "rows": entry.rows, "changes": [{"row_id": row_id, "operation": operation}
+                                            for row_id, operation in entry.changes]}
+
+
+@template.command("diff")
+@click.option("--class", "gear_class", required=True, help="Gear class name.")
+@click.option("--from", "from_version", type=int, required=True, help="Earlier version (see `template history`).")
+@click.option("--to", "to_version", type=int, required=True, help="Later version.")
+@click.option("--json", "as_json", is_flag=True, help="Print one JSON object: {changes: [{row_id, kind, old, new}]}.")
+@click.pass_context
+def template_diff(ctx, gear_class, from_version, to_version, as_json):
+    """Rows added (+), removed (-) and changed (~) between two versions of the class, with old and new values."""
+    from .template_history import diff
+
+    with connection(ctx) as conn:
+        changes = diff(conn, gear_class, from_version, to_version)
+    if as_json:
+        return emit_json({"gear_class": gear_class, "from": from_version, "to": to_version,
+                          "changes": [{"row_id": c.row_id, "kind": c.kind, "old": c.old, "new": c.new}
+                                      for c in changes]})
+    for change in changes:
+        click.echo("\n".join(_diff_lines(change)))
+    click.echo(f"{len(changes)} row(s) differ between v{from_version} and v{to_version}", err=True)
+
+
+def _diff_lines(change) -> list[str]:
+    if change.kind == "added":
+        return [f"+ {change.row_id}: {change.new}"]
+    if change.kind == "removed":
+        return [f"- {change.row_id}: {change.old}"]
+    return [f"~ {change.row_id} {column}: {change.old[column]!r} -> {change.new[column]!r}"
+            for column in change.columns]
+
+
+@template.command("restore")
+@click.option("--class", "gear_class", required=True, help="Gear class name.")
+@click.option("--version", type=int, required=True, help="The version to bring back (see `template history`).")
+@click.pass_context
+def template_restore(ctx, gear_class, version):
+    """Make the class's template what it was in an earlier version, as a new version (history is kept)."""
+    from .template_history import restore
+
+    with connection(ctx) as conn:
+        changed, current = restore(conn, gear_class, version)
+    state = f"restored version {version} as version {current}" if changed else \
+        f"unchanged: version {current} already has the rows of version {version}"
+    click.echo(f"class {gear_class}: {state}")
 
 
 @main.command()
