@@ -19,6 +19,7 @@ from .expressions import (MAX_SECONDS_PER_INSTANTIATION, MAX_STRING_LENGTH, Comp
                           compile_expression, compile_statements, evaluation_globals)
 from .nc_check import words
 from .templates import Template, TemplateRow
+from .turning.nc_path import NcLines
 
 MODULE_ORDER = ("main", "prep", "sync", "shift", "cutcond", "cutmotion")
 
@@ -63,7 +64,7 @@ class CompiledTemplate:
         self.globals = {**evaluation_globals(uses_sql), "_text": _text, "_clock": time.perf_counter}
         self.code, self.places = build(self.rows, template.gear_class)
         # Rows that print a whole tool path (nc_path) emit several lines at once.
-        self.prints_paths = any(row.o is not None and "nc_path" in row.o.text for row in self.rows)
+        self.prints_paths = any(row.o is not None and _calls_nc_path(row.o.tree) for row in self.rows)
         # Lines a row always emits the same, parsed for the limit check once per template.
         self.constant_words = {row.row.id: words(row.o.tree.value) for row in self.rows
                                if row.o is not None and isinstance(row.o.tree, ast.Constant)
@@ -104,10 +105,12 @@ class _NotText(Exception):
     pass
 
 
+def _calls_nc_path(tree) -> bool:
+    return any(isinstance(node, ast.Call) and getattr(node.func, "id", None) == "nc_path" for node in ast.walk(tree))
+
+
 def _one_line_each(result: Result) -> Result:
     """The blocks of an nc_path row as lines of their own, each with the row's id."""
-    from .turning.nc_path import NcLines
-
     flat = Result()
     for line, row_id in zip(result.lines, result.row_ids):
         if isinstance(line, NcLines):
@@ -122,7 +125,7 @@ def _one_line_each(result: Result) -> Result:
 def _text(value):
     """`o` must give text (a bare number would print in whatever form Python chooses), of
     bounded length; or the blocks of nc_path."""
-    if type(value).__name__ == "NcLines":
+    if isinstance(value, NcLines):
         return value
     if type(value) is not str:
         raise _NotText(f"gives {type(value).__name__} {value!r}, not text "

@@ -99,7 +99,7 @@ def safe_mod(left, right):
 _FORMAT_NUMBERS = re.compile(r"\d+")
 
 
-def _check_format_spec(spec: str) -> None:
+def check_format_spec(spec: str) -> None:
     if any(int(number) > MAX_FORMAT_WIDTH for number in _FORMAT_NUMBERS.findall(spec)):
         raise ValueError(f"format width or precision above {MAX_FORMAT_WIDTH} in {spec!r}")
 
@@ -113,7 +113,7 @@ def _constant_spec(spec: ast.JoinedStr) -> str | None:
 
 def safe_format(value, spec: str) -> str:
     """format() with the width and precision of the spec bounded."""
-    _check_format_spec(spec)
+    check_format_spec(spec)
     return format(value, spec)
 
 
@@ -304,7 +304,7 @@ class _GuardOperators(ast.NodeTransformer):
         if spec is None or _constant_spec(spec) is not None:
             if spec is not None:
                 try:
-                    _check_format_spec(_constant_spec(spec))  # fixed spec: checked once, here
+                    check_format_spec(_constant_spec(spec))  # fixed spec: checked once, here
                 except ValueError as error:
                     raise ExpressionError(str(error)) from None
             node.value = self.visit(node.value)

@@ -13,10 +13,10 @@ from __future__ import annotations
 
 import string
 
-from ..expressions import MAX_FORMAT_WIDTH, safe_format
+from ..expressions import check_format_spec
+from .moves import MOVE_KINDS
 
 FIELDS = ("x", "z", "r", "i", "k", "pitch")   # x a diameter; r, i, k arc radius and centre offsets
-KINDS = ("rapid", "feed", "cw", "ccw", "thread")
 MAX_PATH_BLOCKS = 200_000     # blocks one nc_path call may print
 MAX_BLOCK_LENGTH = 512        # characters of one printed block
 # A coordinate this close to 0 prints as 0, never as -0.000.
@@ -28,7 +28,7 @@ class NcLines(tuple):
 
 
 def nc_path(moves, rapid: str, feed: str, cw: str, ccw: str, thread: str) -> NcLines:
-    formats = dict(zip(KINDS, (rapid, feed, cw, ccw, thread)))
+    formats = dict(zip(MOVE_KINDS, (rapid, feed, cw, ccw, thread)))
     parsed = {kind: _parsed(kind, text) for kind, text in formats.items()}
     if len(moves) > MAX_PATH_BLOCKS:
         raise ValueError(f"nc_path: {len(moves)} moves, more than {MAX_PATH_BLOCKS}")
@@ -44,20 +44,15 @@ def _parsed(kind: str, text) -> list[tuple[str, str | None, str]]:
         if field is not None and (field not in FIELDS or conversion or "{" in (spec or "")):
             raise ValueError(f"nc_path: {kind} format {text!r} may use only "
                              f"{', '.join('{' + name + '}' for name in FIELDS)} with a plain format")
-        if any(int(number) > MAX_FORMAT_WIDTH for number in _numbers(spec or "")):
-            raise ValueError(f"nc_path: format width or precision above {MAX_FORMAT_WIDTH} in {text!r}")
+        check_format_spec(spec or "")   # checked once per format, not per printed block
         pieces.append((literal, field, spec or ""))
     return pieces
-
-
-def _numbers(spec: str) -> list[str]:
-    return [part for part in "".join(c if c.isdigit() else " " for c in spec).split()]
 
 
 def _block(parsed: dict, move) -> str:
     kind = move.kind
     if kind not in parsed:
-        raise ValueError(f"nc_path: move kind {kind!r} is not one of {', '.join(KINDS)}")
+        raise ValueError(f"nc_path: move kind {kind!r} is not one of {', '.join(MOVE_KINDS)}")
     values = {"x": move.x, "z": move.z, "r": move.radius, "i": move.i, "k": move.k, "pitch": move.pitch}
     text = []
     for literal, field, spec in parsed[kind]:
@@ -66,7 +61,7 @@ def _block(parsed: dict, move) -> str:
             value = values[field]
             if value is None:
                 raise ValueError(f"nc_path: a {kind} move has no {field}; leave {{{field}}} out of its format")
-            text.append(safe_format(0.0 if abs(value) < ZERO else value, spec))
+            text.append(format(0.0 if abs(value) < ZERO else value, spec))
     block = "".join(text)
     if len(block) > MAX_BLOCK_LENGTH:
         raise ValueError(f"nc_path: a block longer than {MAX_BLOCK_LENGTH} characters")
