@@ -164,6 +164,13 @@ def timed_refactor(conn) -> tuple[float, object, dict]:
     return seconds, report, stages
 
 
+def assembled_templates(conn) -> list[tuple]:
+    """Every class's assembled rows, in order: compared before and after, independently of the
+    refactor's own digest check."""
+    return conn.execute("SELECT gear_class, id, t, n, p_calc, s, o, p_emit FROM template_view "
+                        "ORDER BY gear_class, id").fetchall()
+
+
 # The stored library read once into Python, with JIT off as in the refactor: the least that
 # touching every row costs.
 STORED_ROWS = """
@@ -183,8 +190,6 @@ def measure(server_url: str, classes: int, rows: int, reps: int, seed: int) -> d
     """Fresh library per repetition (the first refactor has copies to merge); alternated
     with the baseline read."""
     import psycopg
-
-    from engine.refactor import assembled_templates
 
     refactors, reads, result = [], [], {}
     for rep in range(reps):

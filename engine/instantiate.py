@@ -20,6 +20,7 @@ from .nc_check import LimitError, check_program, check_table_speed
 from .outputs import write_program_files
 from .records import Gear, Machine, load_gear, load_gears, load_hobs, load_machine
 from .templates import Template, load_template
+from .turning.names import TurningModel
 
 DEFAULT_HOBBING_MACHINE = "hobber-840d"
 
@@ -83,9 +84,11 @@ class Planner:
     def model(self, gear_class: str):
         if gear_class not in self._models:
             model = model_for_class(self.conn, gear_class)
-            if model is None or not hasattr(model, "job"):
-                raise EngineError(f"gear class {gear_class!r} has no hobbing model (nor has any ancestor); "
-                                  "turning jobs come from drawings: engine import-dxf FILE.dxf")
+            if isinstance(model, TurningModel):
+                raise EngineError(f"class {gear_class!r} is a turning class: its jobs come from drawings "
+                                  "(engine import-dxf FILE.dxf), not from gears")
+            if model is None:
+                raise EngineError(f"gear class {gear_class!r} has no hobbing model (nor has any ancestor)")
             self._models[gear_class] = model
         return self._models[gear_class]
 

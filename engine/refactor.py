@@ -15,7 +15,7 @@ import psycopg
 
 from .errors import EngineError
 from .similarity import Units, nc_units, similar_pairs
-from .templates import TemplateRow, load_template
+from .templates import load_template
 
 # Concurrent instantiations read either the old or the new library: writers wait for us,
 # readers (plain SELECT, foreign-key checks) are not blocked and see the last committed
@@ -40,11 +40,6 @@ SELECT a.gear_class, count(*)::int,
                      quote_nullable(c.o), quote_nullable(c.p_emit)), E'\\n' ORDER BY a.id), 'UTF8')), 'hex')
 FROM assembly a JOIN component c ON c.id = a.component_id
 GROUP BY a.gear_class"""
-
-ASSEMBLED_ROWS = """
-SELECT r.gear_class, r.id, c.t, r.n, c.p_calc, c.s, c.o, c.p_emit
-FROM assembled_row r JOIN component c ON c.id = r.component_id
-ORDER BY r.gear_class, r.id"""
 
 # Every assembly row pointing at a later copy of a body is repointed to the body's lowest id.
 REPOINT_DUPLICATES = """
@@ -143,14 +138,6 @@ def _stepper(progress):
 
 def _count_components(conn) -> int:
     return conn.execute("SELECT count(*)::int FROM component").fetchone()[0]
-
-
-def assembled_templates(conn) -> dict[str, tuple[TemplateRow, ...]]:
-    """Every class's assembled rows (own and inherited), in id order; one statement."""
-    rows = defaultdict(list)
-    for name, *values in conn.execute(ASSEMBLED_ROWS):
-        rows[name].append(TemplateRow(*values))
-    return {name: tuple(found) for name, found in rows.items()}
 
 
 def template_digests(conn) -> dict[str, tuple[int, str]]:

@@ -80,13 +80,6 @@ def _text_units(text: str) -> list[str]:
     return units
 
 
-def similarity(a: Sequence[str], b: Sequence[str]) -> float:
-    """Sim = K / (M + N − K) of two unit lists (1.0 for two empty lists)."""
-    from rapidfuzz.distance import Indel
-
-    return _sim(Indel.similarity(a, b) // 2, len(a), len(b))
-
-
 def _sim(common: int, m: int, n: int) -> float:
     return common / (m + n - common) if m + n else 1.0
 

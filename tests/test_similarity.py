@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from engine.similarity import nc_units, similar_pairs, similarity
+from engine.similarity import nc_units, similar_pairs
 
 
 def lcs_sim(a, b) -> float:
@@ -67,8 +67,9 @@ def test_a_line_expression_is_compared_by_the_units_of_its_nc_line(text, units):
     assert nc_units(text) == units
 
 
-def test_similarity_is_k_over_m_plus_n_minus_k():
+def test_a_reported_pair_has_sim_k_over_m_plus_n_minus_k():
     a = ("EGDEF", "(", "C", ",", "B", ",", "1", ",", "Y", ",", "1", ")")
     b = ("EGDEF", "(", "C", ",", "B", ",", "1", ",", "Z", ",", "1", ")")
-    assert similarity(a, b) == pytest.approx(11 / 13)
-    assert similarity(a, a[:8] + (")",)) == pytest.approx(lcs_sim(a, a[:8] + (")",)))
+    assert list(similar_pairs([a, b], 0.8)) == [(0, 1, pytest.approx(11 / 13))]
+    shorter = a[:8] + (")",)
+    assert list(similar_pairs([a, shorter], 0.5)) == [(0, 1, pytest.approx(lcs_sim(a, shorter)))]
