@@ -84,7 +84,7 @@ def _check_line(line: str, words: list, machine: Machine, state: _State) -> str 
 
 def _set_limit(is_lower: bool, axes: dict, machine: Machine, state: _State) -> str | None:
     for axis, value in axes.items():
-        problem = _outside_travel(axis, value, machine)
+        problem = outside_travel(axis, value, machine)
         if problem:
             return "working-area limit " + problem
     if is_lower:
@@ -98,7 +98,7 @@ def _check_move(axes: dict, machine: Machine, state: _State) -> str | None:
     if not state.limits_on or state.lower is None or state.upper is None:
         return "motion before G25/G26 and WALIMON set the working area"
     for axis, value in axes.items():
-        problem = _outside_travel(axis, value, machine)
+        problem = outside_travel(axis, value, machine)
         if problem:
             return problem
         low, high = state.lower.get(axis), state.upper.get(axis)
@@ -107,7 +107,7 @@ def _check_move(axes: dict, machine: Machine, state: _State) -> str | None:
     return None
 
 
-def _outside_travel(axis: str, value: float, machine: Machine) -> str | None:
+def outside_travel(axis: str, value: float, machine: Machine) -> str | None:
     low, high = getattr(machine, f"{axis.lower()}_min"), getattr(machine, f"{axis.lower()}_max")
     if value < low or value > high:
         return f"{axis}{value:g} exceeds the travel of {machine.name} ({axis} {low:g}…{high:g})"

@@ -8,11 +8,11 @@ from __future__ import annotations
 import math
 import re
 
-from ..nc_check import LimitError
+from ..nc_check import LimitError, outside_travel
 from ..records import Machine
+from .names import MAX_TOOL
 
 MAX_FEED = 20000.0     # mm/min: about a lathe's rapid traverse; a larger F is a unit slip or a typo
-MAX_TOOL = 99          # ISO T0101: tool and offset two digits each; 840D T1 D1
 _COMMENTS = re.compile(r"\([^)]*\)|;.*$")
 _ADDRESS = re.compile(r"(?<![A-Z_$])([A-Z]{1,2})\s*=?\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:E[-+]?\d+)?|[-+]?(?:NAN|INF))")
 _PLAIN_DECIMAL = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)")
@@ -80,10 +80,8 @@ def tool_problem(text: str, dialect: str) -> str | None:
 
 
 def travel_problem(letter: str, value: float, machine: Machine, what: str = "") -> str | None:
-    low, high = getattr(machine, f"{letter.lower()}_min"), getattr(machine, f"{letter.lower()}_max")
-    if low <= value <= high:
-        return None
-    return f"{what}{letter}{value:g} exceeds the travel of {machine.name} ({letter} {low:g}…{high:g})"
+    problem = outside_travel(letter, value, machine)
+    return problem and what + problem
 
 
 def arc_problem(position: dict, values: dict, ccw: bool, machine: Machine) -> str | None:

@@ -5,8 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import EngineError
-from .model import job_passes, key
-from .operations import job_geometry
+from .model import key, planned_passes
 from .plot import plot_job
 
 
@@ -20,9 +19,9 @@ def plot_turning_job(conn, job_id: int, out: str | Path) -> list[tuple[str, int,
     if machine_kind != "lathe":
         raise EngineError(f"job {job_id} is a {machine_kind} job, not a turning job; only turning jobs "
                           "(engine import-dxf) can be plotted")
-    geometry = job_geometry(params)
+    geometry, planned = planned_passes(params, module_params)
     operations = []
-    for n, passes in job_passes(params, module_params).items():
+    for n, passes in planned.items():
         kind = module_params[key("cutmotion", n)]["kind"]
         tool = module_params.get(key("prep", n), {}).get("tool", n)
         operations.append((f"{n} {kind}", tool, passes))

@@ -16,14 +16,13 @@ from ..errors import EngineError
 from . import toolpaths
 from .arc_split import with_short_arcs
 from .moves import Move, Pass
-from .names import MAX_OPERATIONS
-from .operations import KINDS, job_geometry, number_param, operation_passes
+from .names import MAX_OPERATIONS, MAX_TOOL
+from .operations import KINDS, JobGeometry, job_geometry, operation_passes
+from .params import FIX, bool_param, integer_param, number_param
 
-FIX = "set it in SQL (job.params / job.module_params) and instantiate the job again"
 # Letters, digits and _ from a letter: safe inside an ISO comment "( )" and as an 840D name %_N_…_MPF.
 PROGRAM_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]*")
 ISO_PROGRAM_NUMBERS = 9999     # O0001 … O9999
-MAX_TOOL = 99                  # two digits: ISO T0101 is tool 01, offset 01; 840D T1 D1
 MAX_INFEED_ANGLE = 60.0        # degrees: half a 60° thread's flank angle is 30; beyond 60 the tool rubs
 # What each alternated operation must share with its partner: the passes of both run with A's rows.
 ALTERNATE_SHARED = (("prep", "tool"), ("prep", "tool_offset"), ("cutcond", "spindle_rpm"),
@@ -54,17 +53,23 @@ def present_operations(module_params: dict) -> list[int]:
 
 def job_passes(params: dict, module_params: dict) -> dict[int, list[Pass]]:
     """The passes of every present operation, by operation number, alternation applied."""
+    return planned_passes(params, module_params)[1]
+
+
+def planned_passes(params: dict, module_params: dict) -> tuple[JobGeometry, dict[int, list[Pass]]]:
+    """The job's geometry and passes; every parameter is checked here, once, before it is read."""
     check_job_params(params)
-    for n in present_operations(module_params):
+    present = present_operations(module_params)
+    for n in present:
         check_operation_params(module_params, n)
     geometry = job_geometry(params)
     passes = {n: operation_passes(geometry, module_params[key("cutmotion", n)], f"module_params.cutmotion:{n}")
-              for n in present_operations(module_params)}
+              for n in present}
     pair = alternated_pair(params, module_params, passes)
     if pair:
         first, second = pair
         passes[first] = toolpaths.alternate(passes[first], passes.pop(second))
-    return passes
+    return geometry, passes
 
 
 def alternated_pair(params: dict, module_params: dict, passes: dict) -> tuple[int, int] | None:
@@ -147,21 +152,6 @@ def check_cutmotion(cutmotion: dict, where: str) -> None:
         if not 0 <= number_param(cutmotion, "infeed_angle", where, 0) <= MAX_INFEED_ANGLE:
             raise EngineError(f"{where}.infeed_angle = {cutmotion['infeed_angle']!r} must be 0 … "
                               f"{MAX_INFEED_ANGLE:g} degrees; {FIX}")
-
-
-def integer_param(values: dict, name: str, where: str, low: int, high: int) -> int:
-    value = values.get(name)
-    if type(value) is not int or not low <= value <= high:
-        raise EngineError(f"{where}.{name} = {value!r} must be a whole number {low} … {high}; {FIX}")
-    return value
-
-
-def bool_param(values: dict, name: str, where: str) -> bool:
-    """true or false as JSON: a string "false" would read as true."""
-    value = values.get(name)
-    if type(value) is not bool:
-        raise EngineError(f"{where}.{name} = {value!r} must be true or false (JSON, not a string); {FIX}")
-    return value
 
 
 def template_module_params(params: dict, module_params: dict, passes: dict[int, list[Pass]] | None = None) -> dict:

@@ -6,6 +6,7 @@ from __future__ import annotations
 # operation layers is refused. Nine covers the seed's jobs (rough, slot, thread, finish …)
 # with room; more slots are more rows, not more code.
 MAX_OPERATIONS = 9
+MAX_TOOL = 99   # two digits: ISO T0101 is tool 01, offset 01; 840D T1 D1
 
 # Defaults in job.params, overridden per module by the operation's own parameters.
 SLOT_DEFAULTS = {"op_present": False, "operation": 0, "kind": "", "tool": 0, "tool_offset": 0,

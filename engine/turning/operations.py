@@ -11,7 +11,6 @@ the drawn tool-centre path the motion is the same.
 """
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -38,7 +37,7 @@ class JobGeometry:
     outline: list[Segment]
     stock: tuple[float, float, float] | None    # (z_front, z_back, radius) of the blank
     clearance: float
-    tool_change_radius: float | None = None
+    tool_change_radius: float
 
     @cached_property
     def edges(self) -> tuple:
@@ -54,6 +53,7 @@ class JobGeometry:
 
 
 def job_geometry(params: dict) -> JobGeometry:
+    """The geometry of a job whose parameters model.check_job_params has checked."""
     profile = path_from_param(params.get("profile"), "params.profile")
     if not profile:
         raise EngineError("params.profile is empty; a turning job needs the part's profile segments")
@@ -61,12 +61,9 @@ def job_geometry(params: dict) -> JobGeometry:
     closing = Profile(profile, closed_by_axis, merged_bounds(profile)).closing_segments()
     stock = None
     if params.get("stock_diameter") is not None:
-        stock = (number_param(params, "stock_z_front", "params"), number_param(params, "stock_z_back", "params"),
-                 number_param(params, "stock_diameter", "params") / 2.0)
+        stock = (float(params["stock_z_front"]), float(params["stock_z_back"]), params["stock_diameter"] / 2.0)
     finish_path = off_the_axis(profile) if closed_by_axis else outer_side(profile)
-    clearance = number_param(params, "clearance", "params", 0, above=True)
-    tool_change = params.get("tool_change_x")
-    tool_change_radius = None if tool_change is None else number_param(params, "tool_change_x", "params") / 2.0
+    clearance, tool_change_radius = float(params["clearance"]), params["tool_change_x"] / 2.0
     return JobGeometry(profile, finish_path, profile + closing, stock, clearance, tool_change_radius)
 
 
@@ -110,10 +107,10 @@ def operation_passes(geometry: JobGeometry, cutmotion: dict, where: str) -> list
     return passes
 
 
-def from_and_to_tool_change(passes: list[Pass], tool_change_radius: float | None) -> list[Pass]:
+def from_and_to_tool_change(passes: list[Pass], tool_change_radius: float) -> list[Pass]:
     """The template's tool-change block moves Z only: the operation starts with a Z move at
     the tool-change X and ends lifted to it."""
-    if not passes or tool_change_radius is None:
+    if not passes:
         return passes
     first, last = passes[0][0], passes[-1][-1]
     lift_in, lift_out = (max(tool_change_radius, move.x / 2.0) for move in (first, last))
@@ -124,9 +121,7 @@ def from_and_to_tool_change(passes: list[Pass], tool_change_radius: float | None
 
 
 def _passes(geometry: JobGeometry, cutmotion: dict, where: str) -> list[Pass]:
-    kind = cutmotion.get("kind")
-    if kind not in KINDS:
-        raise EngineError(f"{where}.kind = {kind!r} is not one of {' | '.join(KINDS)}")
+    kind = cutmotion["kind"]
     paths = [path_from_param(path, f"{where}.paths[{i}]") for i, path in enumerate(cutmotion.get("paths") or [])]
     if not paths and kind in ("ROUGH", "FINISH"):
         return _along_profile(geometry, kind, cutmotion, where)
@@ -139,10 +134,8 @@ def _passes(geometry: JobGeometry, cutmotion: dict, where: str) -> list[Pass]:
         return toolpaths.slot_passes(paths, clearance)
     if kind == "FINISH":
         return [one for path in paths for one in toolpaths.finish_passes(path, clearance)]
-    return toolpaths.thread_passes(paths, number_param(cutmotion, "depth_per_pass", where, 0, above=True),
-                                   number_param(cutmotion, "infeed_angle", where, 0),
-                                   number_param(cutmotion, "thread_pitch", where, 0, above=True), clearance,
-                                   geometry.surroundings)
+    return toolpaths.thread_passes(paths, cutmotion["depth_per_pass"], cutmotion["infeed_angle"],
+                                   cutmotion["thread_pitch"], clearance, geometry.surroundings)
 
 
 def _along_profile(geometry: JobGeometry, kind: str, cutmotion: dict, where: str) -> list[Pass]:
@@ -152,21 +145,5 @@ def _along_profile(geometry: JobGeometry, kind: str, cutmotion: dict, where: str
         raise EngineError(f"{where}: roughing along the profile needs the blank; set params.stock_diameter, "
                           "stock_z_front and stock_z_back")
     z_front, z_back, radius = geometry.stock
-    depth = number_param(cutmotion, "depth_per_pass", where, 0, above=True)
-    allowance = number_param(cutmotion, "allowance", where, 0)
-    return toolpaths.profile_rough_passes(geometry.outline, radius, depth, allowance, z_front, z_back,
-                                          geometry.clearance)
-
-
-def number_param(values: dict, key: str, where: str, minimum: float | None = None,
-                 above: bool = False) -> float:
-    """A number from stored parameters (at least, or above, `minimum`), or an error naming it."""
-    value = values.get(key)
-    wrong = isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value)
-    if not wrong and minimum is not None:
-        wrong = value <= minimum if above else value < minimum
-    if wrong:
-        rule = "a number" if minimum is None else f"a number {'above' if above else 'of at least'} {minimum:g}"
-        raise EngineError(f"{where}.{key} = {value!r} must be {rule}; set it in SQL "
-                          "(job.params / job.module_params) and instantiate the job again")
-    return float(value)
+    return toolpaths.profile_rough_passes(geometry.outline, radius, cutmotion["depth_per_pass"],
+                                          cutmotion["allowance"], z_front, z_back, geometry.clearance)
