@@ -200,9 +200,10 @@ def test_an_update_that_changes_nothing_is_no_change(conn):
 
 
 def test_a_program_records_the_version_the_edit_made(conn):
+    before = versions(conn)["spur"]
     conn.execute("UPDATE template_view SET o = '\"G90 G71 G94 ; V\"' WHERE gear_class = 'spur' AND id = 800")
     program = instantiate_gear(conn, 42)
-    assert program.template_version == versions(conn)["spur"]
+    assert program.template_version == before + 1 == versions(conn)["spur"]
     assert '"G90 G71 G94 ; V"'.strip('"') in program.lines
 
 
