@@ -39,8 +39,8 @@ def bench_database(server_url: str, prefix: str, *, seeded: bool = True):
     try:
         url = url_of(server_url, name)
         if seeded:
-            from engine.migrate import migrate
-            from engine.seed import seed
+            from engine.db.migrate import migrate
+            from engine.db.seed import seed
 
             with psycopg.connect(url) as conn:
                 migrate(conn)

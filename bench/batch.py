@@ -28,12 +28,12 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
 from _common import add_database_argument, bench_database, median, verdict  # noqa: E402
-from engine.case_base import CUT_KINDS_BY_COUNT, job_cutting_record  # noqa: E402
+from engine.gears.case_base import CUT_KINDS_BY_COUNT, job_cutting_record  # noqa: E402
 from engine.errors import EngineError  # noqa: E402
 from engine.hobbing.choices import Choices  # noqa: E402
-from engine.hobs import choose_hob  # noqa: E402
-from engine.instantiate import Planner, _check_machine_fits, _check_table_speed  # noqa: E402
-from engine.nc_check import check_program  # noqa: E402
+from engine.gears.hob_matching import choose_hob  # noqa: E402
+from engine.programs.instantiate import Planner, _check_machine_fits, _check_table_speed  # noqa: E402
+from engine.programs.nc_check import check_program  # noqa: E402
 
 FIRST_ID = 100_000
 TARGET_RATE = 5_000          # programs/s
@@ -49,10 +49,10 @@ RANDOM_SEED = 20261122
 WARMUP_GEARS = 300           # untimed run of each pipeline first (the Planner's caches live one run)
 PROFILE_GEARS = 1_000        # --profile: phases and cProfile over the batch's first gears
 
-MATERIALS = ("45", "C45", "20CrMnTi", "40Cr")   # the rows of engine.cutting_data.CUTTING_SPEED
+MATERIALS = ("45", "C45", "20CrMnTi", "40Cr")   # the rows of engine.gears.cutting_data.CUTTING_SPEED
 # (C45 has no case in seed_templates/cases.csv: its nearest cases differ in material)
 # Seeded hobs (seed_templates/hobs.csv): module -> (hands, best accuracy class). Grade <= 7
-# needs an AA hob (engine.hobs.REQUIRED_CLASS_BY_GRADE): only m 2, 2.5, 3 have one.
+# needs an AA hob (engine.gears.hob_matching.REQUIRED_CLASS_BY_GRADE): only m 2, 2.5, 3 have one.
 MODULES_BY_GRADE = {6: ("2", "2.5", "3"), 7: ("2", "2.5", "3"), 8: ("1.5", "2", "2.5", "3", "4")}
 LEFT_HAND_HOB_MODULES = {"2", "3"}               # A-class left-hand hobs (grade 8 only)
 
@@ -72,7 +72,7 @@ ROW_IDS = ((100, None), (200, None), (300, None), (400, None), (500, None), (600
            (2400, "cut2"), (2500, "cut2"), (2600, "cut2"), (2700, "cut2"), (2800, "cut2"),
            (2900, "coolant"), (3000, None), (3100, None), (3150, "tailstock"), (3200, None))
 
-# Same id allocation as engine.storage; the COPY statements are engine.storage's own.
+# Same id allocation as engine.programs.storage; the COPY statements are engine.programs.storage's own.
 NEXT_IDS = "SELECT nextval(%s::regclass) FROM generate_series(1, %s)"
 
 
@@ -80,7 +80,7 @@ NEXT_IDS = "SELECT nextval(%s::regclass) FROM generate_series(1, %s)"
 
 def generate_gears(first: int, count: int) -> list[tuple]:
     """Plausible spur and helical gears the seeded hob library and hobber-840d can cut."""
-    from engine.gears import derived_diameters
+    from engine.gears.gear_import import derived_diameters
 
     rng = random.Random(RANDOM_SEED)
     thousandth = Decimal("0.001")
@@ -126,7 +126,7 @@ def clear_jobs(conn) -> None:
 # --- our path ------------------------------------------------------------------------------
 
 def run_ours(conn, first: int, last: int) -> tuple[float, int]:
-    from engine.instantiate import instantiate_gears
+    from engine.programs.instantiate import instantiate_gears
 
     start = time.perf_counter()
     programs = instantiate_gears(conn, first, last)
@@ -189,7 +189,7 @@ class JinjaPipeline:
                 name, lines, self.row_ids(params, module_params), record)
 
     def templates(self, conn) -> dict:
-        from engine.templates import load_template
+        from engine.templates.rows import load_template
 
         found = {}
         for gear_class in ("spur", "helical"):
@@ -198,7 +198,7 @@ class JinjaPipeline:
         return found
 
     def run(self, conn, first: int, last: int) -> list[tuple]:
-        from engine.records import load_gears
+        from engine.gears.records import load_gears
 
         planner = Planner(conn)
         templates = self.templates(conn)
@@ -208,10 +208,10 @@ class JinjaPipeline:
 
 
 def store(conn, planned: list[tuple]) -> None:
-    """Stored the way engine.storage.store_many does: its COPY statements (and binary types, if any)."""
+    """Stored the way engine.programs.storage.store_many does: its COPY statements (and binary types, if any)."""
     from psycopg.types.json import Jsonb
 
-    from engine import storage
+    from engine.programs import storage
 
     with conn.transaction():
         job_ids = [row[0] for row in conn.execute(NEXT_IDS, ("job_id_seq", len(planned)))]
@@ -244,7 +244,7 @@ def same_programs(conn, pipeline: JinjaPipeline, gear_ids: list[int]) -> tuple[i
     cutting record: the batch's default choices on every sampled gear, each CHOICE_VARIANTS
     entry on a part of them. Returns (programs compared, variant plans refused by our engine
     and so not comparable), or None after printing the first difference."""
-    from engine.records import load_gear
+    from engine.gears.records import load_gear
 
     templates = pipeline.templates(conn)
     gears = {gear_id: load_gear(conn, gear_id) for gear_id in gear_ids}
@@ -312,8 +312,8 @@ def profile_ours(conn, first: int, last: int, top: int) -> None:
     import cProfile
     import pstats
 
-    from engine.records import load_gears
-    from engine.storage import store_many
+    from engine.gears.records import load_gears
+    from engine.programs.storage import store_many
 
     clear_jobs(conn)
     start = time.perf_counter()
@@ -338,7 +338,7 @@ def profile_ours(conn, first: int, last: int, top: int) -> None:
           f"data cost about {spent(computed - loaded - (replanned - stored))}")
 
     clear_jobs(conn)
-    from engine.instantiate import instantiate_gears
+    from engine.programs.instantiate import instantiate_gears
 
     profiler = cProfile.Profile()
     profiler.enable()

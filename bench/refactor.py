@@ -52,7 +52,7 @@ ROWS_PER_TYPE = {"main": 0.15, "prep": 0.10, "sync": 0.05, "shift": 0.07, "cutco
 
 def seed_bodies() -> dict[str, list[tuple]]:
     """Distinct bodies (t, o, p_calc, s, p_emit) of the seeded standard code, per module type."""
-    from engine.templates import read_csv
+    from engine.templates.rows import read_csv
 
     bodies: dict[str, set] = defaultdict(set)
     for path in sorted(SEED_CLASSES.glob("*.csv")):
@@ -119,7 +119,7 @@ def variant(body: tuple, number: int) -> tuple:
 
 def own_line(body: tuple, suffix: str) -> tuple:
     """The class's own line: the seed line's NC words with the class's own parameters."""
-    from engine.similarity import nc_units
+    from engine.library.similarity import nc_units
 
     t, o, *_ = body
     units = nc_units(o) if o is not None else ("G0",)
@@ -148,7 +148,7 @@ def load(conn, library: Library) -> None:
 
 def timed_refactor(conn) -> tuple[float, object, dict]:
     """Seconds of one committed refactor, its report and the seconds of each stage."""
-    from engine.refactor import refactor
+    from engine.library.refactor import refactor
 
     stages, marks = {}, []
 
@@ -195,7 +195,7 @@ def measure(server_url: str, classes: int, rows: int, reps: int, seed: int) -> d
     for rep in range(reps):
         library = Library(classes, rows, seed + rep)
         with bench_database(server_url, "bench_refactor", seeded=False) as url:
-            from engine.migrate import migrate
+            from engine.db.migrate import migrate
 
             with psycopg.connect(url) as conn:
                 migrate(conn)

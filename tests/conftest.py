@@ -57,8 +57,8 @@ def _drop(server_url: str, database: str) -> None:
 def database_url(server_url) -> str:
     """A database migrated and seeded once per session. Do not commit into it: use `conn`
     (rolled back) or `fresh_database_url`."""
-    from engine.migrate import migrate
-    from engine.seed import seed
+    from engine.db.migrate import migrate
+    from engine.db.seed import seed
 
     name = f"engine_test_{uuid.uuid4().hex[:10]}"
     url = _create(server_url, name)
@@ -103,7 +103,7 @@ def run(fresh_database_url):
     "--gear", 42) → click's Result (exit_code, stdout, stderr); run.url is the database."""
     from click.testing import CliRunner
 
-    from engine.cli import main
+    from engine.cli.app import main
 
     def invoke(*args):
         return CliRunner().invoke(main, ["--database-url", fresh_database_url, *map(str, args)])

@@ -10,7 +10,7 @@ import psycopg
 import pytest
 from click.testing import CliRunner
 
-from engine.cli import main
+from engine.cli.app import main
 
 
 

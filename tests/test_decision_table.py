@@ -1,11 +1,11 @@
 """The decision table of design notes §4, step by step, on templates stored in PostgreSQL."""
 import pytest
 
-from engine.decision_table import CompiledTemplate, TemplateError
+from engine.templates.decision_table import CompiledTemplate, TemplateError
 from engine.errors import EngineError
 from engine.hobbing.choices import Choices
-from engine.instantiate import instantiate_gear
-from engine.templates import TemplateRow, ensure_class, load_template, replace_template
+from engine.programs.instantiate import instantiate_gear
+from engine.templates.rows import TemplateRow, ensure_class, load_template, replace_template
 
 
 def make_template(conn, name, rows):
@@ -131,7 +131,7 @@ def test_a_template_version_is_recorded_with_each_program(conn):
 
 
 def test_stored_job_reinstantiates_with_parameters_edited_in_sql(conn):
-    from engine.instantiate import instantiate_job
+    from engine.programs.instantiate import instantiate_job
 
     program = instantiate_gear(conn, 42, choices=Choices(coolant=True))
     conn.execute("UPDATE job SET params = params || '{\"coolant\": false}' WHERE id = %s", (program.job_id,))

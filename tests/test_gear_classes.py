@@ -15,7 +15,7 @@ import pytest
 
 from engine.errors import EngineError
 from engine.hobbing.choices import Choices
-from engine.instantiate import instantiate_gear
+from engine.programs.instantiate import instantiate_gear
 
 from nc_reader import read_program
 

@@ -10,8 +10,8 @@ import psycopg
 import pytest
 
 from engine.errors import EngineError
-from engine.hobs import choose_hob
-from engine.records import Gear, Hob
+from engine.gears.hob_matching import choose_hob
+from engine.gears.records import Gear, Hob
 
 SEED_HOBS = Path(__file__).resolve().parent.parent / "seed_templates" / "hobs.csv"
 

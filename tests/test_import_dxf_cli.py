@@ -8,7 +8,7 @@ import json
 import psycopg
 import pytest
 
-from engine.cli import main
+from engine.cli.app import main
 from test_dxf_read import DXF, EMCO, REAL, seed_drawing
 
 PROFILE_ONLY = set(EMCO) | {"d2g_Turbocad_12.5_R14.dxf"}

@@ -9,9 +9,9 @@ from dataclasses import replace
 import pytest
 
 from engine.errors import EngineError
-from engine.lint import LintProblem, lint_class
-from engine.nc_import import import_nc
-from engine.templates import TemplateRow, ensure_class, load_template, replace_template
+from engine.templates.lint import LintProblem, lint_class
+from engine.library.nc_import import import_nc
+from engine.templates.rows import TemplateRow, ensure_class, load_template, replace_template
 
 from test_nc_import import DATA, PARAMS, class_name, real_files, write
 

@@ -7,7 +7,7 @@ import psycopg
 import pytest
 
 from engine.errors import EngineError
-from engine.migrate import discover, migrate, status
+from engine.db.migrate import discover, migrate, status
 from engine.paths import MIGRATIONS_DIR, SCHEMA_DIR
 
 CATALOG_QUERIES = {

@@ -4,7 +4,7 @@ back byte for byte after import → export → instantiate with the same paramet
 equal to a parameter become references (never G/M numbers); lines get modules.
 
 Newline convention: the instantiated lines are written joined by "\\n" with a final "\\n"
-(engine.instantiate.Program.text); every real file ends with a newline, so the comparison
+(engine.programs.records.Program.text); every real file ends with a newline, so the comparison
 is of the exact bytes."""
 from __future__ import annotations
 
@@ -18,13 +18,13 @@ import pytest
 from click.testing import CliRunner
 from hypothesis import given, settings, strategies as st
 
-from engine.cli import main
-from engine.decision_table import compiled_template
+from engine.cli.app import main
+from engine.templates.decision_table import compiled_template
 from engine.errors import EngineError
-from engine.expressions import compile_expression, evaluation_globals
-from engine.nc_import import import_nc, number_field
-from engine.nc_tokens import detokenise, tokenise
-from engine.templates import ensure_class, export_csv, load_template, parse_csv, replace_template
+from engine.templates.expressions import compile_expression, evaluation_globals
+from engine.library.nc_import import import_nc, number_field
+from engine.library.nc_tokens import detokenise, tokenise
+from engine.templates.rows import ensure_class, export_csv, load_template, parse_csv, replace_template
 
 from shared_data import shared_data
 

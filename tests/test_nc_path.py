@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import pytest
 
-from engine.decision_table import CompiledTemplate, TemplateError
-from engine.templates import Template, TemplateRow
+from engine.templates.decision_table import CompiledTemplate, TemplateError
+from engine.templates.rows import Template, TemplateRow
 from engine.turning.moves import Move
 
 ISO = ('nc_path(moves, "G00 X{x:.3f} Z{z:.3f}", "G01 X{x:.3f} Z{z:.3f}", "G02 X{x:.3f} Z{z:.3f} R{r:.3f}", '

@@ -11,9 +11,9 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from engine.errors import EngineError
-from engine.refactor import check_invariants, refactor, template_digests
-from engine.similarity import nc_units
-from engine.templates import TemplateRow, ensure_class, export_csv, load_template, replace_template
+from engine.library.refactor import check_invariants, refactor, template_digests
+from engine.library.similarity import nc_units
+from engine.templates.rows import TemplateRow, ensure_class, export_csv, load_template, replace_template
 
 from test_similarity import lcs_sim
 

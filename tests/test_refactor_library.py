@@ -14,11 +14,11 @@ from dataclasses import replace
 import psycopg
 import pytest
 
-from engine.expressions import compile_expression, evaluation_globals
-from engine.instantiate import instantiate_gear
-from engine.nc_import import import_nc
-from engine.refactor import STAGES, refactor
-from engine.templates import load_template, replace_template
+from engine.templates.expressions import compile_expression, evaluation_globals
+from engine.programs.instantiate import instantiate_gear
+from engine.library.nc_import import import_nc
+from engine.library.refactor import STAGES, refactor
+from engine.templates.rows import load_template, replace_template
 
 from test_nc_import import DATA, FAMILY, PARAMS, class_name, instantiate, real_files
 from test_refactor import bodies_stored_twice, component_count, duplicate_row_body, exports

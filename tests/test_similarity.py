@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from engine.similarity import nc_units, similar_pairs
+from engine.library.similarity import nc_units, similar_pairs
 
 
 def lcs_sim(a, b) -> float:

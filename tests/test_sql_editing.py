@@ -9,9 +9,9 @@ import pytest
 from psycopg import errors, sql
 from psycopg.pq import TransactionStatus
 
-from engine.instantiate import instantiate_gear
-from engine.refactor import refactor
-from engine.templates import TemplateRow, export_csv, load_template, replace_template
+from engine.programs.instantiate import instantiate_gear
+from engine.library.refactor import refactor
+from engine.templates.rows import TemplateRow, export_csv, load_template, replace_template
 
 ROW_COLUMNS = ("id", "t", "n", "p_calc", "s", "o", "p_emit")
 
@@ -431,7 +431,7 @@ def test_an_editor_may_run_the_template_import(conn):
 
 def test_roles_are_created_once_even_when_several_databases_migrate(empty_database_url):
     """Roles belong to the cluster: migrating another database finds them and carries on."""
-    from engine.migrate import migrate
+    from engine.db.migrate import migrate
 
     with psycopg.connect(empty_database_url) as conn:
         assert migrate(conn)

@@ -1,4 +1,4 @@
-"""engine.sqlcond: SQL conditions translated to Python AST, evaluated with SQL semantics.
+"""engine.templates.sqlcond: SQL conditions translated to Python AST, evaluated with SQL semantics.
 
 Expected values below follow PostgreSQL semantics as stated in each test (three-valued
 logic, NULL propagation, integer division truncating toward zero, no implicit casts);
@@ -13,7 +13,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from engine.errors import EngineError
-from engine.sqlcond import SQL_RUNTIME, translate
+from engine.templates.sqlcond import SQL_RUNTIME, translate
 
 GLOBALS = {"__builtins__": {}, **SQL_RUNTIME}
 

@@ -8,11 +8,11 @@ import pytest
 from psycopg import sql
 
 from engine.errors import EngineError
-from engine.migrate import migrate
+from engine.db.migrate import migrate
 from engine.paths import MIGRATIONS_DIR
-from engine.seed import seed
-from engine.template_history import diff, history, restore
-from engine.templates import export_csv, load_template
+from engine.db.seed import seed
+from engine.templates.history import diff, history, restore
+from engine.templates.rows import export_csv, load_template
 
 
 def exported(conn, gear_class):

@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..cutting_data import CuttingData
-from ..records import Gear, Hob, Machine
+from ..gears.cutting_data import CuttingData
+from ..gears.records import Gear, Hob, Machine
 from . import geometry, shifting
 from .choices import Choices
 from .passes import Cut, Reach, feeds, hob_reach, pass_ends, plan_cuts, working_area

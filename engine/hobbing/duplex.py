@@ -9,7 +9,7 @@ import math
 from dataclasses import dataclass
 
 from ..errors import EngineError
-from ..nc_check import check_table_speed
+from ..programs.nc_check import check_table_speed
 from .cylindrical import CylindricalModel, JobParameters
 from .passes import plan_cuts, working_area
 from . import shifting

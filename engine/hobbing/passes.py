@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..cutting_data import CuttingData, per_minute
+from ..gears.cutting_data import CuttingData, per_minute
 from . import geometry
 from .choices import Choices
 

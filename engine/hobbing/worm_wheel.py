@@ -8,7 +8,7 @@ from __future__ import annotations
 import math
 from dataclasses import replace
 
-from ..cutting_data import per_minute
+from ..gears.cutting_data import per_minute
 from . import geometry
 from .cylindrical import CylindricalModel, JobParameters, Setup
 from .passes import APPROACH_SAFETY, feeds, plan_cuts, working_area

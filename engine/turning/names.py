@@ -1,5 +1,5 @@
 """The names of a turning job and its templates: operation slots, the job and module
-parameters (for `engine lint`). Light on purpose: engine.models imports it on every start."""
+parameters (for `engine lint`). Light on purpose: engine.gears.models imports it on every start."""
 from __future__ import annotations
 
 # Operation slots in the turning templates (rows 1000·n + 10 … 80); a drawing with more

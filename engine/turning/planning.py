@@ -2,10 +2,10 @@
 passes computed from them, then checked against the lathe. Nothing is stored here."""
 from __future__ import annotations
 
-from ..decision_table import compiled_template
+from ..templates.decision_table import compiled_template
 from ..errors import EngineError
-from ..records import Machine, load_machine
-from ..templates import load_template
+from ..gears.records import Machine, load_machine
+from ..templates.rows import load_template
 from .check import check_lathe_program
 from .defaults import DEFAULT_LATHE
 from .model import template_module_params
@@ -35,7 +35,7 @@ def plan_turning_job(conn, gear_class: str, machine: Machine, params: dict, modu
                      passes: dict | None = None):
     """→ Planned (engine.instantiate): the program computed and checked, not stored.
     `passes`: the job's passes (model.job_passes) if the caller has them already."""
-    from ..instantiate import Planned
+    from ..programs.instantiate import Planned
 
     template = load_template(conn, gear_class)
     extended = template_module_params(params, module_params, passes)

@@ -1,0 +1,103 @@
+"""Commands for cutting data from the machining history: `engine suggest`, `engine cases`."""
+from __future__ import annotations
+
+import click
+
+from .app import connection, emit_json
+
+CASE_TABLE_COLUMNS = {   # column -> heading, for the small tables printed
+    "id": "case", "distance": "distance", "module": "m", "teeth": "z", "material": "material", "hardness": "HB",
+    "quality_grade": "grade", "hob_material": "hob", "hob_coating": "coating", "hob_starts": "z0",
+    "hob_tip_diameter": "da0", "cut": "cut", "hob_speed": "n0", "axial_feed": "axial", "radial_feed": "radial",
+    "source": "source",
+}
+
+
+@click.command()
+@click.option("--gear", "gear_id", type=int, required=True, help="Gear id to propose cutting data for.")
+@click.option("--top", type=click.IntRange(min=1), default=3, show_default=True,
+              help="Nearest cases per cut kind (rough, finish).")
+@click.option("--machine", help="Machine record (default hobber-840d): caps the hob speed.")
+@click.option("--json", "as_json", is_flag=True, help="Print one JSON object instead of prose.")
+@click.pass_context
+def suggest(ctx, gear_id, top, machine, as_json):
+    """Propose hob speed and feeds for a gear from the nearest cases of the machining history.
+
+    Prints the hob the library chooses, the nearest cases per cut kind with their distance,
+    the proposal (n0, v, feeds in mm/min and mm per workpiece revolution) and plausibility notes.
+    """
+    from ..gears.cases import suggest_for_gear
+
+    with connection(ctx) as conn:
+        suggestion = suggest_for_gear(conn, gear_id, machine, top=top)
+    emit_json(_suggestion_json(suggestion)) if as_json else click.echo(_suggestion_text(suggestion))
+
+
+def _suggestion_json(s) -> dict:
+    return {"gear_id": s.gear.id, "hob": {"id": s.hob.id, "reason": s.hob_reason}, "machine": s.machine.name,
+            "hob_speed": s.cutting.hob_speed, "cutting_speed": round(s.cutting.cutting_speed, 1),
+            "source": s.cutting.source, "notes": s.notes, "cases": _records(s.cases),
+            **{cut: {**s.feeds(cut), "source": p.source, "case_ids": list(p.case_ids)}
+               for cut, p in s.proposals.items()}}
+
+
+def _suggestion_text(s) -> str:
+    gear, cutting = s.gear, s.cutting
+    lines = [f"gear {gear.id}: m{gear.module:g} z{gear.teeth} {gear.material or '?'} "
+             f"{'' if gear.hardness is None else f'{gear.hardness:g} HB '}grade {gear.quality_grade or '?'}",
+             f"hob {s.hob.id}: {s.hob_reason}",
+             f"machine {s.machine.name} (hob spindle max {s.machine.spindle_max:g} r/min)"]
+    for cut, proposal in s.proposals.items():
+        cases = s.cases[s.cases.cut == cut]
+        lines += ["", f"{cut} cases (nearest {len(cases)}):" if len(cases) else f"{cut}: no cases in the history"]
+        if len(cases):
+            lines.append(_table(cases.drop(columns="cut")))
+    lines += ["", f"proposal: n0 {cutting.hob_speed} r/min, v {cutting.cutting_speed:.1f} m/min  ({cutting.source})"]
+    for cut in s.proposals:
+        f = s.feeds(cut)
+        lines.append(f"  {cut:6}  axial {f['axial_feed']:.1f} mm/min ({f['axial_feed_per_rev']:.2f} mm/rev)  "
+                     f"radial {f['radial_feed']:.1f} mm/min ({f['radial_feed_per_rev']:.2f} mm/rev)")
+    lines += ["", "notes:", *(f"  - {note}" for note in s.notes)] if s.notes else ["", "notes: none"]
+    return "\n".join(lines)
+
+
+def _table(frame) -> str:
+    shown = frame[[c for c in CASE_TABLE_COLUMNS if c in frame.columns]].rename(columns=CASE_TABLE_COLUMNS)
+    return shown.to_string(index=False, na_rep="-", float_format=lambda v: f"{v:g}")
+
+
+def _records(frame) -> list[dict]:
+    plain = frame.astype(object).where(frame.notna(), None)
+    return plain.to_dict("records")
+
+
+@click.group()
+def cases():
+    """The machining history (cutting cases) that `engine suggest` reasons over."""
+
+
+@cases.command("list")
+@click.option("--json", "as_json", is_flag=True, help="Print one JSON object: {cases: [...]}.")
+@click.pass_context
+def cases_list(ctx, as_json):
+    """List every cutting case: gear and hob features, cut, n0 r/min, feeds mm/min, source."""
+    from ..gears.cases import list_cases
+
+    with connection(ctx) as conn:
+        history = list_cases(conn)
+    if as_json:
+        emit_json({"cases": _records(history.drop(columns="created_at"))})
+    else:
+        click.echo(_table(history) if len(history) else "no cases in the history")
+
+
+@cases.command("confirm")
+@click.option("--job", "job_id", type=int, required=True, help="Job whose stored cutting data proved good.")
+@click.pass_context
+def cases_confirm(ctx, job_id):
+    """Confirm a job: its stored cutting data become new cases (one per cut kind)."""
+    from ..gears.cases import confirm_job
+
+    with connection(ctx) as conn:
+        ids = confirm_job(conn, job_id)
+    click.echo(f"job {job_id} confirmed: added case(s) {', '.join(f'#{i}' for i in ids)}")

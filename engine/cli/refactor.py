@@ -1,0 +1,85 @@
+"""`engine refactor` and `engine template shared`: thin shells over engine.refactor."""
+from __future__ import annotations
+
+import sys
+from contextlib import contextmanager
+
+import click
+
+from .app import connection, emit_json
+from .commands import template
+
+
+@click.command("refactor")
+@click.option("--threshold", default=0.8, show_default=True, type=click.FloatRange(0, 1, min_open=True),
+              help="Report line pairs of one module type with this similarity or more (Sim < 1).")
+@click.option("--json", "as_json", is_flag=True,
+              help="Print one JSON object: changed, components_before, components_after, shared, "
+                   "near_duplicates (per pair: t, sim, texts a and b, uses_a/uses_b and the first "
+                   "10 class:row uses of each; template_view has them all).")
+@click.pass_context
+def refactor_command(ctx, threshold, as_json):
+    """Merge identical component bodies and report near-duplicate lines to unify.
+
+    One transaction: every class's assembled template stays exactly as it was (checked
+    before commit, else nothing is changed and the class is named), and a second run
+    changes nothing. Instantiations go on meanwhile; template writers wait. Meant to run
+    every night (README: cron or a systemd timer); exit code 0 also when nothing changed."""
+    from ..library.refactor import refactor
+
+    with connection(ctx) as conn, _progress() as progress:
+        report = refactor(conn, threshold, progress)
+    if as_json:
+        emit_json(report.as_dict())
+    else:
+        _print_report(report)
+
+
+@contextmanager
+def _progress():
+    """A progress bar on stderr, only when stderr is a terminal."""
+    if not sys.stderr.isatty():
+        yield None
+        return
+    with click.progressbar(length=1, label="refactor", file=sys.stderr) as bar:
+        def update(stage, done, total):
+            bar.length = total
+            bar.label = stage
+            bar.update(done - bar.pos)
+        yield update
+        bar.update(bar.length - bar.pos)
+
+
+def _print_report(report) -> None:
+    merged = report.components_before - report.components_after
+    state = (f"merged or removed {merged} component(s)" if report.changed
+             else "nothing to merge (the library was already stored once)")
+    click.echo(f"refactor: {state}; components {report.components_before} -> "
+               f"{report.components_after}, {report.shared} used by two or more classes; "
+               f"every class's assembled template unchanged. {len(report.near_duplicates)} "
+               f"near-duplicate pair(s) with similarity >= {report.threshold:g} to unify by hand.")
+    for pair in report.near_duplicates:
+        click.echo(f"\n  {pair['t']}  Sim {pair['sim']:.3f}")
+        click.echo(f"    {pair['a']}   ({_uses(pair['rows_a'], pair['uses_a'])})")
+        click.echo(f"    {pair['b']}   ({_uses(pair['rows_b'], pair['uses_b'])})")
+
+
+def _uses(rows, count: int) -> str:
+    listed = ", ".join(f"{gear_class}:{row_id}" for gear_class, row_id in rows)
+    return listed + (f" and {count - len(rows)} more" if count > len(rows) else "")
+
+
+@template.command("shared")
+@click.option("--class", "gear_class", required=True, help="Gear class name.")
+@click.pass_context
+def template_shared(ctx, gear_class):
+    """Per row of the class's template: shared with other classes (which) or its own."""
+    from ..library.refactor import shared_rows
+
+    with connection(ctx) as conn:
+        rows = shared_rows(conn, gear_class)
+    for row in rows:
+        where = "own" if row.inherited_from == gear_class else f"inherited from {row.inherited_from}"
+        use = (f"shared with {len(row.shared_with)} class(es): {', '.join(row.shared_with)}"
+               if row.shared_with else "used by this class only")
+        click.echo(f"{row.id:6} {row.t:9} {where:24} {use}  {row.o or ''}")

@@ -1,0 +1,1 @@
+"""The database: where it is (connection), migrations, and seeding the standard code."""

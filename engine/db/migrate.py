@@ -1,0 +1,148 @@
+"""Plain-SQL migrations `NNNN.slug.sql`, applied in order, each in its own transaction,
+recorded with a checksum, serialized by an advisory lock (the yoyo/alembic way)."""
+from __future__ import annotations
+
+import hashlib
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+from psycopg import sql
+
+from ..errors import EngineError
+from ..paths import MIGRATIONS_DIR
+
+MIGRATION_FILE = re.compile(r"^(\d{4})\.([a-z0-9_-]+)\.sql$")
+# Any constant works: all engines on one database agree on it.
+MIGRATION_LOCK_KEY = 0x4E43_5445_4D50  # "NCTEMP"
+
+CREATE_LEDGER = """
+CREATE TABLE IF NOT EXISTS schema_migration (
+    version    text PRIMARY KEY,
+    name       text NOT NULL,
+    checksum   text NOT NULL,
+    applied_at timestamptz NOT NULL DEFAULT now()
+)"""
+
+
+@dataclass(frozen=True)
+class Migration:
+    version: str
+    name: str
+    path: Path
+
+    @property
+    def text(self) -> str:
+        return self.path.read_text(encoding="utf-8")
+
+    @property
+    def checksum(self) -> str:
+        return hashlib.sha256(self.path.read_bytes()).hexdigest()
+
+
+@dataclass(frozen=True)
+class MigrationState:
+    migration: Migration
+    applied_at: object | None  # datetime when applied
+    changed: bool              # applied, but the file differs from what was applied
+
+    @property
+    def state(self) -> str:
+        if self.applied_at is None:
+            return "pending"
+        return "CHANGED" if self.changed else "applied"
+
+
+def discover(directory: Path = MIGRATIONS_DIR) -> list[Migration]:
+    """The migration files in version order; a stray .sql file is an error, not a skip."""
+    migrations = []
+    for path in sorted(directory.glob("*.sql")):
+        match = MIGRATION_FILE.match(path.name)
+        if not match:
+            raise EngineError(f"migration file {path.name} is not named NNNN.slug.sql; rename it")
+        migrations.append(Migration(match.group(1), match.group(2), path))
+    versions = [m.version for m in migrations]
+    if len(versions) != len(set(versions)):
+        raise EngineError(f"two migration files in {directory} share a version number")
+    return migrations
+
+
+def status(conn, directory: Path = MIGRATIONS_DIR) -> list[MigrationState]:
+    applied = _applied(conn)
+    states = []
+    for migration in discover(directory):
+        record = applied.get(migration.version)
+        states.append(MigrationState(
+            migration,
+            record[1] if record else None,
+            bool(record) and record[0] != migration.checksum,
+        ))
+    return states
+
+
+def migrate(conn, directory: Path = MIGRATIONS_DIR) -> list[Migration]:
+    """Apply every pending migration; return those applied. Refuses if an applied file changed.
+    Each migration commits on its own, so the connection must not be inside a transaction."""
+    from psycopg.pq import TransactionStatus
+
+    if conn.info.transaction_status != TransactionStatus.IDLE:
+        conn.commit()  # our own reads so far (status queries); migrations need real transactions
+    autocommit, conn.autocommit = conn.autocommit, True
+    conn.execute("SELECT pg_advisory_lock(%s)", (MIGRATION_LOCK_KEY,))
+    try:
+        conn.execute(CREATE_LEDGER)  # under the lock: IF NOT EXISTS alone is not race-free
+        return _apply_pending(conn, directory)
+    finally:
+        conn.execute("SELECT pg_advisory_unlock(%s)", (MIGRATION_LOCK_KEY,))
+        conn.autocommit = autocommit
+
+
+def _apply_pending(conn, directory: Path) -> list[Migration]:
+    states = status(conn, directory)
+    changed = [s.migration.path.name for s in states if s.changed]
+    if changed:
+        raise EngineError(
+            f"applied migration {changed[0]} was edited since it ran (checksum differs); "
+            "restore the file and put the change in a new migration"
+        )
+    done = []
+    for state in states:
+        if state.applied_at is None:
+            _apply(conn, state.migration)
+            done.append(state.migration)
+    return done
+
+
+def _apply(conn, migration: Migration) -> None:
+    import psycopg
+
+    try:
+        with conn.transaction():
+            conn.execute(sql.SQL(migration.text))
+            conn.execute(
+                "INSERT INTO schema_migration (version, name, checksum) VALUES (%s, %s, %s)",
+                (migration.version, migration.name, migration.checksum),
+            )
+    except psycopg.Error as error:
+        raise EngineError(
+            f"migration {migration.path.name} failed and was rolled back: "
+            f"{str(error).strip().splitlines()[0]}"
+        ) from error
+
+
+def _applied(conn) -> dict[str, tuple[str, object]]:
+    exists = conn.execute("SELECT to_regclass('schema_migration') IS NOT NULL").fetchone()[0]
+    if not exists:
+        return {}
+    rows = conn.execute("SELECT version, checksum, applied_at FROM schema_migration").fetchall()
+    return {version: (checksum, applied_at) for version, checksum, applied_at in rows}
+
+
+def require_current(conn) -> None:
+    """Refuse to work on a database whose schema is behind the code."""
+    pending = [s.migration.path.name for s in status(conn) if s.state != "applied"]
+    if pending:
+        raise EngineError(
+            f"the database schema is not current ({len(pending)} migration(s) pending or changed, "
+            f"first {pending[0]}); run `engine db migrate`"
+        )

@@ -1,0 +1,121 @@
+"""`engine seed`: load seed_templates/ — what is missing is added, nothing is overwritten,
+so a second run changes nothing and a template an engineer edited stays edited."""
+from __future__ import annotations
+
+import csv
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from psycopg import sql
+
+from ..paths import SEED_DIR
+from ..templates.rows import ensure_class, read_csv, replace_template
+
+# table, CSV file, key column, columns (in file order); loaded in this order.
+SEED_TABLES = (
+    ("machine", "machines.csv", "name"),
+    ("hob", "hobs.csv", "id"),
+)
+
+
+@dataclass
+class SeedReport:
+    added: dict = field(default_factory=dict)
+
+    def count(self, what: str, number: int = 1) -> None:
+        self.added[what] = self.added.get(what, 0) + number
+
+    def __str__(self) -> str:
+        if not any(self.added.values()):
+            return "seed: everything was already there; nothing changed"
+        return "seed: added " + ", ".join(f"{n} {what}" for what, n in self.added.items() if n)
+
+
+def seed(conn, directory: Path = SEED_DIR) -> SeedReport:
+    report = SeedReport()
+    with conn.transaction():
+        _seed_classes(conn, directory, report)
+        for table, file_name, key in SEED_TABLES:
+            report.count(table + "s", _insert_missing(conn, table, key, _read(directory / file_name)))
+        _seed_templates(conn, directory, report)
+        _seed_gears(conn, directory, report)
+        _seed_units(conn, directory, report)
+        _seed_cases(conn, directory, report)
+    return report
+
+
+def _read(path: Path) -> list[dict]:
+    with path.open(encoding="utf-8", newline="") as file:
+        return [{key: (value if value != "" else None) for key, value in row.items()}
+                for row in csv.DictReader(file)]
+
+
+def _seed_classes(conn, directory: Path, report: SeedReport) -> None:
+    for row in _read(directory / "gear_classes.csv"):
+        if ensure_class(conn, row["name"], row["parent"], row["description"] or ""):
+            report.count("gear classes")
+
+
+def _insert_missing(conn, table: str, key: str, rows: list[dict]) -> int:
+    added = 0
+    for row in rows:
+        query = sql.SQL("INSERT INTO {} ({}) VALUES ({}) ON CONFLICT ({}) DO NOTHING RETURNING 1").format(
+            sql.Identifier(table), sql.SQL(", ").join(map(sql.Identifier, row)),
+            sql.SQL(", ").join(sql.Placeholder() * len(row)), sql.Identifier(key))
+        added += conn.execute(query, list(row.values())).fetchone() is not None
+    return added
+
+
+def _seed_templates(conn, directory: Path, report: SeedReport) -> None:
+    """Parents before the classes derived from them (the tree order of gear_classes.csv), so
+    a derived class stores only the rows that differ from what it inherits."""
+    order = [row["name"] for row in _read(directory / "gear_classes.csv")]
+    paths = sorted((directory / "classes").glob("*.csv"),
+                   key=lambda path: (order.index(path.stem) if path.stem in order else len(order), path.stem))
+    for path in paths:
+        has_rows = conn.execute("SELECT 1 FROM assembly WHERE gear_class = %s LIMIT 1", (path.stem,)).fetchone()
+        if not has_rows:
+            ensure_class(conn, path.stem)
+            replace_template(conn, path.stem, read_csv(path))
+            report.count("templates")
+
+
+def _seed_gears(conn, directory: Path, report: SeedReport) -> None:
+    """Sample gears not yet in the database, through the same checks as `engine gears import`."""
+    import tempfile
+
+    from ..gears.gear_import import import_gears
+
+    source = directory / "gears.csv"
+    known = {row[0] for row in conn.execute("SELECT id FROM gear")}
+    with source.open(encoding="utf-8", newline="") as file:
+        reader = csv.DictReader(file)
+        missing = [row for row in reader if int(row["gear_id"]) not in known]
+        header = reader.fieldnames
+    if not missing:
+        return
+    with tempfile.TemporaryDirectory() as folder:
+        subset = Path(folder) / source.name
+        with subset.open("w", encoding="utf-8", newline="") as file:
+            writer = csv.DictWriter(file, header)
+            writer.writeheader()
+            writer.writerows(missing)
+        report.count("gears", import_gears(conn, subset))
+
+
+def _seed_units(conn, directory: Path, report: SeedReport) -> None:
+    """Further units of the sample multi-unit gears, where the gear has none yet."""
+    from ..gears.units import import_units
+
+    source = directory / "gear_units.csv"
+    with_units = {row[0] for row in conn.execute("SELECT DISTINCT gear_id FROM gear_unit")}
+    rows = [row for row in _read(source) if int(row["gear_id"]) not in with_units]
+    if rows:
+        report.count("gear units", import_units(conn, source, only_gears={int(r["gear_id"]) for r in rows}))
+
+
+def _seed_cases(conn, directory: Path, report: SeedReport) -> None:
+    """The machining history's seed cases (the paper's example among them)."""
+    from ..gears.cases import seed_cases
+
+    report.count("cases", seed_cases(conn, directory / "cases.csv"))

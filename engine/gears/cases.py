@@ -1,0 +1,238 @@
+"""Cutting data by case-based reasoning over the machining history (design notes §6; paper §4).
+
+For each cut kind the nearest past cuts (weighted distance over gear and hob features) are
+transferred to this gear and hob through what carries over between hobs and gears: the
+cutting speed v = π·d_a0·n0/1000 and the feeds per workpiece revolution f = v_f/(n0·z0/z2)
+(reference/hobbing.md §B4, §B5). Proposals are checked against the typical ranges of §C.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+import pandas as pd
+import psycopg
+from psycopg import sql
+
+from .case_base import CASE_COLUMNS, CUT_KINDS, CaseBase, KindProposal, feeds_per_minute, feeds_per_rev
+from .cutting_data import CuttingData
+from ..errors import EngineError
+from .hob_matching import choose_hob
+from ..paths import SEED_DIR
+from .records import Gear, Hob, Machine, load_gear, load_hobs, load_machine
+
+FEATURE_COLUMNS = ("module", "teeth", "material", "hardness", "quality_grade", "hob_material",
+                   "hob_coating", "hob_starts", "hob_tip_diameter")
+VALUE_COLUMNS = ("hob_speed", "axial_feed", "radial_feed")   # r/min, mm/min, mm/min
+FLOAT_COLUMNS = ("module", "hardness", "hob_tip_diameter", *VALUE_COLUMNS)
+INTEGER_COLUMNS = ("teeth", "quality_grade", "hob_starts", "job_id")
+SEED_FILE = SEED_DIR / "cases.csv"
+
+# Typical axial feed per workpiece revolution [mm/rev], single-start hob, steel, wet (§C):
+# the first row whose module is at least the gear's (the last row beyond).
+AXIAL_FEED_RANGE = pd.DataFrame([
+    (1.0, 1.0, 2.0, 0.5, 1.0), (2.0, 1.5, 3.0, 0.8, 1.5), (3.0, 2.0, 3.5, 1.0, 2.0), (4.0, 2.0, 4.0, 1.0, 2.0),
+], columns=["module", "rough_low", "rough_high", "finish_low", "finish_high"])
+
+# Typical cutting speed v [m/min] by workpiece material and hob (§C).
+SPEED_RANGE = {
+    "45": {"uncoated HSS": (30, 45), "coated HSS": (60, 120), "carbide": (150, 300)},
+    "C45": {"uncoated HSS": (30, 45), "coated HSS": (60, 120), "carbide": (150, 300)},
+    "20CrMnTi": {"uncoated HSS": (30, 40), "coated HSS": (60, 110), "carbide": (150, 280)},
+    "40Cr": {"uncoated HSS": (20, 35), "coated HSS": (50, 90), "carbide": (120, 220)},
+}
+CUTTING = {"rough": "roughing", "finish": "finishing"}
+
+
+@dataclass(frozen=True)
+class Suggestion:
+    gear: Gear
+    hob: Hob
+    machine: Machine
+    cutting: CuttingData
+    cases: pd.DataFrame                  # the nearest cases per cut kind, with `distance`
+    proposals: dict                      # cut kind -> KindProposal
+    notes: list = field(default_factory=list)
+    hob_reason: str = ""
+
+    def feeds(self, cut: str) -> dict:
+        """Axial and radial feed of one cut kind, per workpiece revolution and per minute."""
+        axial, radial = feeds_per_rev(self.cutting, cut)
+        return {"axial_feed_per_rev": axial, "radial_feed_per_rev": radial,
+                **feeds_per_minute(self.cutting, self.gear, self.hob, cut)}
+
+    def case_ids(self, cut_kinds=CUT_KINDS) -> list[int]:
+        return [case_id for cut in cut_kinds for case_id in self.proposals[cut].case_ids]
+
+
+def list_cases(conn) -> pd.DataFrame:
+    """The machining history, one row per case, numbers as floats."""
+    query = sql.SQL("SELECT {} FROM cutting_case ORDER BY id").format(
+        sql.SQL(", ").join(map(sql.Identifier, CASE_COLUMNS)))
+    cases = pd.DataFrame(conn.execute(query).fetchall(), columns=list(CASE_COLUMNS))
+    return cases.astype({"id": "int64", **{column: float for column in FLOAT_COLUMNS},
+                         **{column: "Int64" for column in INTEGER_COLUMNS}})
+
+
+def suggest(conn, gear: Gear, hob: Hob, machine: Machine, *, top: int = 3) -> Suggestion:
+    """Cutting data for this gear, hob and machine from the `top` nearest cases per cut kind."""
+    return suggest_from(load_case_base(conn), gear, hob, machine, top=top)
+
+
+def load_case_base(conn) -> CaseBase:
+    """The history read once for many suggestions (a batch)."""
+    return CaseBase.load(conn)
+
+
+def suggest_from(base: CaseBase, gear: Gear, hob: Hob, machine: Machine, *, top: int = 3) -> Suggestion:
+    """`suggest` over a case base already read (`load_case_base`), with the nearest cases as a
+    table and the plausibility notes."""
+    cutting, proposals, found = base.cutting_data(gear, hob, machine, top)
+    rows = [base.records[case.position] | {"distance": distance}
+            for nearest in found.values() for distance, case in nearest]
+    table = pd.DataFrame(rows, columns=[*CASE_COLUMNS, "distance"])
+    notes = plausibility_notes(gear, hob, machine, cutting, proposals)
+    return Suggestion(gear, hob, machine, cutting, table, proposals, notes)
+
+
+def suggest_for_gear(conn, gear_id: int, machine_name: str | None = None, *, top: int = 3) -> Suggestion:
+    """`engine suggest`: the hob the library chooses for the gear, and its cutting data."""
+    from ..programs.instantiate import DEFAULT_HOBBING_MACHINE
+
+    gear = load_gear(conn, gear_id)
+    machine = load_machine(conn, machine_name or DEFAULT_HOBBING_MACHINE)
+    if machine.kind != "hobber":
+        raise EngineError(f"machine {machine.name} is a {machine.kind}, not a hobbing machine; "
+                          f"use --machine {DEFAULT_HOBBING_MACHINE}")
+    from .models import model_for_class
+
+    model = model_for_class(conn, gear.gear_class) if gear.gear_class else None
+    choice = choose_hob(gear, load_hobs(conn), purpose=model.hob_purpose if model else "cylindrical")
+    suggestion = suggest(conn, gear, choice.hob, machine, top=top)
+    return replace(suggestion, hob_reason=choice.reason)
+
+
+def plausibility_notes(gear: Gear, hob: Hob, machine: Machine, cutting: CuttingData, proposals: dict) -> list[str]:
+    notes = [note for proposal in proposals.values() for note in _feed_note(gear, proposal)]
+    notes += _speed_notes(gear, hob, proposals)
+    exact_speed = 1000 * cutting.cutting_speed / (math.pi * hob.tip_diameter)
+    if exact_speed > machine.spindle_max:
+        notes.append(f"hob speed {exact_speed:.0f} r/min capped at {machine.name}'s spindle maximum "
+                     f"{machine.spindle_max:g} r/min: v is {math.pi * hob.tip_diameter * cutting.hob_speed / 1000:.1f} m/min")
+    table_speed = cutting.hob_speed * hob.starts / gear.teeth
+    if machine.table_speed_max is not None and table_speed > machine.table_speed_max:
+        notes.append(f"table speed {table_speed:.1f} r/min exceeds {machine.name}'s {machine.table_speed_max:g} r/min; "
+                     "lower the hob speed")
+    return notes
+
+
+def _feed_note(gear: Gear, proposal: KindProposal) -> list[str]:
+    at_least = AXIAL_FEED_RANGE[AXIAL_FEED_RANGE.module >= gear.module]
+    row = (at_least if not at_least.empty else AXIAL_FEED_RANGE).iloc[0]
+    low, high = row[f"{proposal.cut}_low"], row[f"{proposal.cut}_high"]
+    if low <= proposal.axial_feed <= high:
+        return []
+    side = "above" if proposal.axial_feed > high else "below"
+    check = f"; check the feed definition of case(s) {', '.join(f'#{i}' for i in proposal.case_ids)}" \
+        if proposal.case_ids else ""
+    return [f"{proposal.cut}: axial feed {proposal.axial_feed:.2f} mm per workpiece rev is {side} the typical "
+            f"{low:.1f}–{high:.1f} for m{row.module:g} {CUTTING[proposal.cut]} (reference §C){check}"]
+
+
+def _speed_notes(gear: Gear, hob: Hob, proposals: dict) -> list[str]:
+    tool = "carbide" if "carbide" in hob.material.casefold() else "coated HSS" if hob.coating else "uncoated HSS"
+    ranges = SPEED_RANGE.get(gear.material or "")
+    if ranges is None:
+        return [f"no reference cutting speed range for material {gear.material or '(none)'}; check v by hand"]
+    low, high = ranges[tool]
+    notes = [f"{p.cut}: cutting speed {p.cutting_speed:.1f} m/min is {'above' if p.cutting_speed > high else 'below'} "
+             f"the typical {low}–{high} for {gear.material} with a {tool} hob (reference §C)"
+             for p in proposals.values() if not low <= p.cutting_speed <= high]
+    rough, finish = proposals["rough"], proposals["finish"]
+    if abs(finish.cutting_speed - rough.cutting_speed) > 0.05 * rough.cutting_speed:
+        notes.append(f"finish: its cases suggest v = {finish.cutting_speed:.1f} m/min; the job runs one hob speed, "
+                     f"the rough cut's ({rough.cutting_speed:.1f} m/min)")
+    return notes
+
+
+CONFIRM_QUERY = """
+SELECT j.cutting, j.confirmed_at, g.id, g.module, g.teeth, g.material, g.hardness, g.quality_grade,
+       h.material, h.coating, h.starts, h.tip_diameter
+FROM job j LEFT JOIN gear g ON g.id = j.gear_id LEFT JOIN hob h ON h.id = j.hob_id
+WHERE j.id = %s FOR UPDATE OF j"""
+INSERT_CASE = sql.SQL("INSERT INTO cutting_case ({}) VALUES ({}) RETURNING id").format(
+    sql.SQL(", ").join(map(sql.Identifier, (*FEATURE_COLUMNS, "cut", *VALUE_COLUMNS, "source", "job_id"))),
+    sql.SQL(", ").join(sql.Placeholder() for _ in range(len(FEATURE_COLUMNS) + 6)))
+
+
+def confirm_job(conn, job_id: int) -> list[int]:
+    """A proven job joins the history: one case per cut kind of its stored cutting data."""
+    with conn.transaction():
+        row = conn.execute(CONFIRM_QUERY, (job_id,)).fetchone()
+        cutting, features = _confirmable(job_id, row)
+        ids = [conn.execute(INSERT_CASE, (*features, cut, cutting["hob_speed"], cutting[cut]["axial_feed"],
+                                          cutting[cut]["radial_feed"], f"job {job_id}", job_id)).fetchone()[0]
+               for cut in CUT_KINDS if cut in cutting]
+        conn.execute("UPDATE job SET confirmed_at = now() WHERE id = %s", (job_id,))
+    return ids
+
+
+def _confirmable(job_id: int, row) -> tuple[dict, tuple]:
+    if row is None:
+        raise EngineError(f"job {job_id} does not exist; nothing confirmed")
+    cutting, confirmed_at, gear_id, *features = row
+    case = dict(zip(FEATURE_COLUMNS, features))
+    if confirmed_at is not None:
+        raise EngineError(f"job {job_id} was already confirmed at {confirmed_at:%Y-%m-%d %H:%M}; "
+                          "its cases are in the history (engine cases list)")
+    if not any(cut in cutting for cut in CUT_KINDS):
+        raise EngineError(f"job {job_id} has no cutting data stored (job.cutting is empty); "
+                          "store the chosen cutting data with the job before confirming it")
+    if gear_id is None or case["hob_tip_diameter"] is None:
+        raise EngineError(f"job {job_id} has no gear or no hob; only hobbing jobs become cutting cases")
+    if case["material"] is None:
+        raise EngineError(f"gear {gear_id} of job {job_id} has no material; set it before confirming the job")
+    for cut in (cut for cut in CUT_KINDS if cut in cutting):
+        values = [cutting.get("hob_speed"), *(cutting[cut].get(name) for name in ("axial_feed", "radial_feed"))]
+        if not all(isinstance(v, (int, float)) and v > 0 for v in values):
+            raise EngineError(f"job {job_id}: cutting data of the {cut} cut need a positive hob_speed, "
+                              "axial_feed and radial_feed (mm/min); fix job.cutting")
+    return cutting, tuple(features)
+
+
+def seed_cases(conn, path: Path = SEED_FILE) -> int:
+    """Add the cases of the seed file not yet in the history (same features, cut and source)."""
+    path = Path(path)
+    if not path.is_file():
+        raise EngineError(f"{path} does not exist; give the machining history seed file (columns of cutting_case)")
+    frame = pd.read_csv(path, dtype=str, keep_default_na=False)
+    missing = [c for c in (*FEATURE_COLUMNS, "cut", *VALUE_COLUMNS, "source") if c not in frame.columns]
+    if missing:
+        raise EngineError(f"{path}: missing column(s) {', '.join(missing)}")
+    added = 0
+    with conn.transaction():
+        for line, row in enumerate(frame.to_dict("records"), start=2):
+            values = {column: (value if value != "" or column in ("hob_coating", "source") else None)
+                      for column, value in row.items()}
+            try:
+                added += _insert_if_missing(conn, values)
+            except (psycopg.errors.DataError, psycopg.errors.IntegrityError) as error:
+                raise EngineError(f"{path.name} line {line}: {str(error).splitlines()[0]}; nothing seeded") from None
+    return added
+
+
+MATCH_COLUMNS = (*FEATURE_COLUMNS, "cut", "source")
+SEED_COLUMNS = (*MATCH_COLUMNS, *VALUE_COLUMNS)
+FIND_CASE = sql.SQL("SELECT 1 FROM cutting_case WHERE {}").format(sql.SQL(" AND ").join(
+    sql.SQL("{} IS NOT DISTINCT FROM {}").format(sql.Identifier(c), sql.Placeholder(c)) for c in MATCH_COLUMNS))
+SEED_CASE = sql.SQL("INSERT INTO cutting_case ({}) VALUES ({})").format(
+    sql.SQL(", ").join(map(sql.Identifier, SEED_COLUMNS)), sql.SQL(", ").join(map(sql.Placeholder, SEED_COLUMNS)))
+
+
+def _insert_if_missing(conn, values: dict) -> int:
+    # Values go as text: the server parses them into the column types (numeric exactly).
+    if conn.execute(FIND_CASE, values).fetchone():
+        return 0
+    conn.execute(SEED_CASE, values)
+    return 1

@@ -1,0 +1,154 @@
+"""Group-technology classification of a gear that names no class (design notes §6).
+
+The tree is walked as a tuple of rules asked in order — face-width variation first (cone,
+crowning), then the generating line (helix) —; the first rule answered "yes" names the
+leaf class, and a gear that answers "no" to all of them is `DEFAULT_CLASS`. Adding a rule
+is adding a row to `RULES`, not another branch. Features no class combines (`CONFLICTS`)
+are refused with the reason. Classes that the gear columns alone do not tell apart
+(worm_wheel: the tooth profile comes from the worm; duplex: further units are imported
+after the gear) are not classified: the gear CSV names them explicitly.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Callable, Collection, Mapping
+
+from ..errors import EngineError
+
+DEFAULT_CLASS = "spur"
+
+
+@dataclass(frozen=True)
+class Rule:
+    """If `field` of the gear is given and `holds` for its value, the gear is `gear_class`."""
+
+    question: str
+    field: str
+    holds: Callable[[float], bool]
+    gear_class: str
+
+
+RULES: tuple[Rule, ...] = (
+    Rule("has it further toothed units?", "units", lambda value: value > 0, "duplex"),
+    Rule("is a cone angle given and not 0?", "cone_angle", lambda value: value != 0, "taper"),
+    Rule("is a crowning given and greater than 0?", "crowning", lambda value: value > 0, "crowned"),
+    Rule("is the helix angle not 0?", "helix_angle", lambda value: value != 0, "helical"),
+)
+
+
+# (fields both given and not 0, why no class fits them together)
+CONFLICTS: tuple[tuple[tuple[str, str], str], ...] = (
+    (("cone_angle", "crowning"), "no class hobs a crowned taper gear (cone angle and crowning both given)"),
+)
+
+
+@dataclass(frozen=True)
+class Classification:
+    """The leaf class a gear falls in (None: no class fits, see `problem`), and the
+    questions and answers that led there."""
+
+    gear_class: str | None
+    path: list[tuple[str, str]] = field(default_factory=list)
+    problem: str | None = None
+
+    def explain(self) -> str:
+        """One line: `question? no → question? yes → helical`."""
+        steps = [f"{question} {answer}" for question, answer in self.path]
+        return " → ".join(steps + [self.gear_class or f"no class: {self.problem}"])
+
+
+def given_number(gear: Mapping[str, Any], name: str) -> float | None:
+    """The gear's value of `name` as a float, or None when it is absent or empty."""
+    value = gear.get(name)
+    if value is None or (isinstance(value, str) and not value.strip()):
+        return None
+    return float(value)
+
+
+def _answer(rule: Rule, gear: Mapping[str, Any]) -> str:
+    value = given_number(gear, rule.field)
+    if value is None:
+        return "no (not given)"
+    return f"{'yes' if rule.holds(value) else 'no'} ({rule.field} = {value:g})"
+
+
+def classify(gear: Mapping[str, Any]) -> Classification:
+    """The leaf class of `gear` (a mapping of gear CSV column names to values) by `RULES`.
+
+    Each step of `.path` is (question, answer); an answer starts with "yes" or "no" and
+    names the value it looked at."""
+    path: list[tuple[str, str]] = []
+    for (first, second), reason in CONFLICTS:
+        values = (given_number(gear, first), given_number(gear, second))
+        if all(values):
+            path.append((f"are {first} and {second} both given?", f"yes ({values[0]:g}, {values[1]:g})"))
+            return Classification(None, path, reason)
+    for rule in RULES:
+        answer = _answer(rule, gear)
+        path.append((rule.question, answer))
+        if answer.startswith("yes"):
+            return Classification(rule.gear_class, path)
+    return Classification(DEFAULT_CLASS, path)
+
+
+def not_installed_message(gear_id: Any, gear_class: str) -> str:
+    """What to say when a gear is classified into a class the database does not have."""
+    return (f"gear {gear_id}: classified as {gear_class}, but no gear class '{gear_class}' is "
+            f"installed; give gear_class explicitly or add the class "
+            f"(engine template import --class {gear_class} …)")
+
+
+def classify_installed(gear: Mapping[str, Any], installed: Collection[str]) -> Classification:
+    """`classify(gear)`, raising EngineError when the class found is not in `installed`."""
+    classification = classify(gear)
+    gear_id = gear.get("gear_id", gear.get("id", "?"))
+    if classification.gear_class is None:
+        raise EngineError(f"gear {gear_id}: {classification.problem}; give gear_class explicitly")
+    if classification.gear_class not in installed:
+        raise EngineError(not_installed_message(gear_id, classification.gear_class))
+    return classification
+
+
+@dataclass(frozen=True)
+class GearClassReport:
+    """What `engine classify --gear ID` says: the stored class, the automatic decision path,
+    and the hobbing model and hob the gear gets."""
+
+    gear_id: int
+    stored_class: str | None
+    classification: Classification
+    model_class: str | None
+    hob: str | None
+
+    def lines(self) -> list[str]:
+        automatic = self.classification.gear_class
+        said = [f"gear {self.gear_id}: class {self.stored_class}",
+                f"  decision path: {self.classification.explain()}"]
+        if self.stored_class != automatic:
+            said.append(f"  the gear file named class {self.stored_class} explicitly "
+                        f"(the tree alone gives {automatic or 'no class'})")
+        said.append(f"  hobbing model: {self.model_class or 'none: no class on the path up has a model'}")
+        said.append(f"  hob: {self.hob}")
+        return said
+
+
+def explain_gear(conn, gear_id: int) -> GearClassReport:
+    """Classify a stored gear again and say how; also the model and hob it gets."""
+    from .hob_matching import choose_hob
+    from .models import MODELS, ancestry
+    from .records import load_gear, load_hobs
+
+    gear = load_gear(conn, gear_id)
+    classification = classify({"gear_id": gear.id, "cone_angle": gear.cone_angle, "crowning": gear.crowning,
+                               "helix_angle": gear.helix_angle, "units": len(gear.units)})
+    lineage = ancestry(conn, gear.gear_class) if gear.gear_class else []
+    model_class = next((name for name in lineage if name in MODELS), None)
+    hob = None
+    if model_class:
+        model = MODELS[model_class]
+        try:
+            chosen = choose_hob(gear, load_hobs(conn), purpose=model.hob_purpose)
+            hob = chosen.reason
+        except EngineError as error:
+            hob = f"none fits: {error}"
+    return GearClassReport(gear_id, gear.gear_class, classification, model_class, hob)

@@ -1,0 +1,209 @@
+"""Choosing a hob from the library for a gear (paper §4: automatic tool matching).
+
+Each required property is a row of HOB_TESTS; the library is narrowed row by row, so a
+refusal names the first property that no remaining hob has, and what the remaining hobs
+offer instead. Among the hobs that pass, the same hand as the gear comes first, then the
+coarsest sufficient class (fine hobs are kept for fine gears), then the id.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+from ..errors import EngineError
+from ..hobbing.geometry import generating_length, lead_angle
+from .records import Gear, Hob
+
+# Hob accuracy classes from best to coarsest (DIN 3968 / GB/T 6084).
+ACCURACY_CLASSES = ("AAA", "AA", "A", "B", "C", "D")
+# Coarsest hob class that still cuts a gear of a quality grade (GB/T 10095), finest grade first.
+REQUIRED_CLASS_BY_GRADE = ((5, "AAA"), (7, "AA"), (8, "A"), (9, "B"), (10, "C"), (12, "D"))
+DEFAULT_GRADE = 8
+PURPOSES = ("cylindrical", "worm_wheel")
+ANGLE_TOLERANCE = 1e-6
+MODULE_TOLERANCE = 1e-6
+# A worm-wheel hob copies its worm: its lead angle must be the wheel's helix angle.
+LEAD_ANGLE_TOLERANCE = 0.5   # degrees
+SHIFT_MARGIN = 5.0           # mm kept unused at each end of the hob (§B15 "margins")
+ADD_A_HOB = "add one with `engine hobs add …` or `engine hobs import FILE.csv`"
+
+
+@dataclass(frozen=True)
+class HobChoice:
+    hob: Hob
+    reason: str
+
+
+class NoHobError(EngineError):
+    """No hob of the library fits; `property_name` is the first property none has."""
+
+    def __init__(self, message: str, property_name: str) -> None:
+        super().__init__(message)
+        self.property_name = property_name
+
+
+@dataclass(frozen=True)
+class Need:
+    """What a gear asks of its hob."""
+
+    purpose: str
+    grade: int
+    accuracy_class: str
+    hand: str
+    generating: float
+    shift_travel: float
+
+    @property
+    def length(self) -> float:
+        return self.generating + self.shift_travel + 2 * SHIFT_MARGIN
+
+
+def required_class(quality_grade: int | None) -> str:
+    grade = quality_grade if quality_grade is not None else DEFAULT_GRADE
+    for finest_grade, hob_class in REQUIRED_CLASS_BY_GRADE:
+        if grade <= finest_grade:
+            return hob_class
+    return ACCURACY_CLASSES[-1]
+
+
+def _class_rank(accuracy_class: str) -> int:
+    return ACCURACY_CLASSES.index(accuracy_class) if accuracy_class in ACCURACY_CLASSES else len(ACCURACY_CLASSES)
+
+
+def _lead(hob: Hob) -> float:
+    return lead_angle(hob.module, hob.starts, hob.tip_diameter)
+
+
+@dataclass(frozen=True)
+class HobTest:
+    """One property of a hob, for the gears of `purposes`. A required test narrows the
+    library (`fits`); a preference only orders it. `wanted` says what the gear needs,
+    `offered` what a hob has and `distance` how far that is from the need (refusals list
+    the closest first); `said` is the property in the reason of a choice."""
+
+    name: str
+    purposes: tuple[str, ...]
+    said: Callable[[Gear, Hob, Need], str]
+    fits: Callable[[Gear, Hob, Need], bool] | None = None
+    wanted: Callable[[Gear, Need], str] | None = None
+    offered: Callable[[Hob], str] | None = None
+    distance: Callable[[Gear, Hob, Need], float] | None = None
+
+    @property
+    def required(self) -> bool:
+        return self.fits is not None
+
+
+def _hand_preference(gear: Gear, hob: Hob, need: Need) -> str:
+    if gear.hand is None:
+        return f"hand {hob.hand} (the gear has no hand; {need.hand} preferred)"
+    if hob.hand == gear.hand:
+        return f"same hand ({hob.hand})"
+    return f"opposite hand ({hob.hand}; no {gear.hand}-hand hob fits)"
+
+
+def _length_said(gear: Gear, hob: Hob, need: Need) -> str:
+    return (f"length {hob.length:g} ≥ {need.length:.1f} needed (generating {need.generating:.1f} "
+            f"+ shift {need.shift_travel:g} + margins {2 * SHIFT_MARGIN:g})")
+
+
+BOTH = PURPOSES
+HOB_TESTS: tuple[HobTest, ...] = (
+    HobTest("purpose", BOTH,
+            said=lambda gear, hob, need: f"purpose {hob.purpose}",
+            fits=lambda gear, hob, need: hob.purpose == need.purpose,
+            wanted=lambda gear, need: f"purpose {need.purpose}",
+            offered=lambda hob: f"purpose {hob.purpose}",
+            distance=lambda gear, hob, need: 0.0),
+    HobTest("module", BOTH,
+            said=lambda gear, hob, need: f"module {hob.module:g}",
+            fits=lambda gear, hob, need: abs(hob.module - gear.module) < MODULE_TOLERANCE,
+            wanted=lambda gear, need: f"module {gear.module:g}",
+            offered=lambda hob: f"module {hob.module:g}",
+            distance=lambda gear, hob, need: abs(hob.module - gear.module)),
+    HobTest("pressure angle", BOTH,
+            said=lambda gear, hob, need: f"pressure angle {hob.pressure_angle:g}°",
+            fits=lambda gear, hob, need: abs(hob.pressure_angle - gear.pressure_angle) < ANGLE_TOLERANCE,
+            wanted=lambda gear, need: f"pressure angle {gear.pressure_angle:g}°",
+            offered=lambda hob: f"pressure angle {hob.pressure_angle:g}°",
+            distance=lambda gear, hob, need: abs(hob.pressure_angle - gear.pressure_angle)),
+    HobTest("accuracy class", BOTH,
+            said=lambda gear, hob, need: (f"class {hob.accuracy_class} (grade {need.grade} needs "
+                                          f"{need.accuracy_class} or better)"),
+            fits=lambda gear, hob, need: _class_rank(hob.accuracy_class) <= _class_rank(need.accuracy_class),
+            wanted=lambda gear, need: f"class {need.accuracy_class} or better (grade {need.grade})",
+            offered=lambda hob: f"class {hob.accuracy_class}",
+            distance=lambda gear, hob, need: _class_rank(hob.accuracy_class) - _class_rank(need.accuracy_class)),
+    HobTest("hand", ("cylindrical",), said=_hand_preference),
+    HobTest("hand", ("worm_wheel",),
+            said=lambda gear, hob, need: f"hand {hob.hand} (the wheel's, required)",
+            fits=lambda gear, hob, need: hob.hand == need.hand,
+            wanted=lambda gear, need: f"hand {need.hand}",
+            offered=lambda hob: f"hand {hob.hand}",
+            distance=lambda gear, hob, need: 0.0),
+    HobTest("lead angle", ("worm_wheel",),
+            said=lambda gear, hob, need: (f"lead angle {_lead(hob):.2f}° (helix {gear.helix_angle:g}° "
+                                          f"± {LEAD_ANGLE_TOLERANCE:g}°)"),
+            fits=lambda gear, hob, need: abs(_lead(hob) - gear.helix_angle) <= LEAD_ANGLE_TOLERANCE,
+            wanted=lambda gear, need: f"lead angle {gear.helix_angle:g}° ± {LEAD_ANGLE_TOLERANCE:g}°",
+            offered=lambda hob: f"lead angle {_lead(hob):.2f}°",
+            distance=lambda gear, hob, need: abs(_lead(hob) - gear.helix_angle)),
+    HobTest("length", BOTH,
+            said=_length_said,
+            fits=lambda gear, hob, need: hob.length >= need.length,
+            wanted=lambda gear, need: f"length ≥ {need.length:.1f} mm",
+            offered=lambda hob: f"length {hob.length:g}",
+            distance=lambda gear, hob, need: need.length - hob.length),
+)
+
+
+def need_of(gear: Gear, purpose: str = "cylindrical", shift_travel: float = 0.0) -> Need:
+    if purpose not in PURPOSES:
+        raise EngineError(f"hob purpose {purpose!r} is not one of {', '.join(PURPOSES)}")
+    if shift_travel < 0:
+        raise EngineError(f"shift travel {shift_travel:g} mm is negative; give 0 or more")
+    grade = gear.quality_grade if gear.quality_grade is not None else DEFAULT_GRADE
+    return Need(purpose, grade, required_class(gear.quality_grade), gear.hand or "R",
+                generating_length(gear.module, gear.pressure_angle), shift_travel)
+
+
+def choose_hob(gear: Gear, hobs: list[Hob], *, purpose: str = "cylindrical",
+               shift_travel: float = 0.0) -> HobChoice:
+    """The best fitting hob for `gear` (see the module notes), with the reason: every
+    property checked and its values. Raises NoHobError naming the first unmet property."""
+    need = need_of(gear, purpose, shift_travel)
+    tests = [test for test in HOB_TESTS if purpose in test.purposes]
+    candidates = list(hobs)
+    for position, test in enumerate(tests):
+        if not test.required:
+            continue
+        passing = [hob for hob in candidates if test.fits(gear, hob, need)]
+        if not passing:
+            raise NoHobError(_refusal(gear, need, test, tests[:position], candidates), test.name)
+        candidates = passing
+    candidates.sort(key=lambda hob: (hob.hand != need.hand, -_class_rank(hob.accuracy_class), hob.id))
+    best = candidates[0]
+    reason = f"{best.id}: " + ", ".join(test.said(gear, best, need) for test in tests)
+    return HobChoice(best, reason)
+
+
+def _closest(gear: Gear, need: Need, test: HobTest, hobs: list[Hob], groups: int = 3) -> str:
+    """What the hobs offer for the test's property, closest to the need first, with ids."""
+    by_value: dict[str, list[Hob]] = {}
+    for hob in hobs:
+        by_value.setdefault(test.offered(hob), []).append(hob)
+    ordered = sorted(by_value.items(),
+                     key=lambda item: min(abs(test.distance(gear, hob, need)) for hob in item[1]))
+    shown = [f"{value} ({', '.join(hob.id for hob in group[:3])}{', …' if len(group) > 3 else ''})"
+             for value, group in ordered[:groups]]
+    return ", ".join(shown) + (", …" if len(ordered) > groups else "")
+
+
+def _refusal(gear: Gear, need: Need, test: HobTest, earlier: list[HobTest], candidates: list[Hob]) -> str:
+    earlier_wanted = [t.wanted(gear, need) for t in earlier if t.required]
+    among = f" among those with {', '.join(earlier_wanted)}" if earlier_wanted else ""
+    if not candidates:
+        offered = "the hob library is empty"
+    else:
+        offered = ("they have " if earlier_wanted else "the library has ") + _closest(gear, need, test, candidates)
+    return f"gear {gear.id}: no hob has {test.wanted(gear, need)}{among}: {offered}; {ADD_A_HOB}"

@@ -1,0 +1,388 @@
+"""Importing a proven NC program as the standard code of a class (design notes §4, §5).
+
+Each line of the file becomes one template row, ids 10, 20, 30 … in line order. A number
+in the line whose value equals a job parameter (compared as Decimal: `F250.` matches 250)
+becomes a reference to that parameter; the numbers of G and M words (and of `$` and
+labels) never do, nor numbers inside comments and strings. A line with no reference is a
+constant row (`o` = a plain string literal); a line with references is an f-string.
+
+Exact spelling: the field that replaces a number is a format recipe read off the
+number as written, so that the original value prints exactly as the original wrote it:
+* digits after the point → precision:             `0.0500` → `{p:.4f}`, `4` → `{p:.0f}`
+* a point with no digits after it → a literal `.`: `250.`   → `{p:.0f}.`
+* leading zeros → zero-padded width (sign incl.):  `-00500` → `{p:06.0f}`
+* an explicit `+` → the `+` flag:                  `+5`     → `{p:+.0f}`
+* no digit before the point (`.4`, `-.4`): written from the rounded magnitude, the integer
+  part only when it is not 0: `{'-' if p < 0 else ''}{round(abs(p) * 10) // 10 or ''}.`
+  `{round(abs(p) * 10) % 10:01d}`
+Other values of the parameter print in the same style (same decimals, same padding).
+Every field is evaluated with the original value before it is used; a number whose recipe
+would not give its spelling back (a float that cannot hold all its digits), and a
+negative zero (`J-0`: the sign is not in the value), stay literal. When several
+parameters have the value of a number, the first one given is used (reported).
+
+Literal text is quoted exactly: backslashes and the quote character are escaped, braces
+doubled inside f-strings, and control characters (tabs) written as escapes.
+
+Modules: the rules of MODULE_RULES decide a line's module type from its tokens, in order;
+a line no rule decides keeps the module of the line before (the first line: main). The
+engineer's corrections (`modules`: line number → type) are decisions too, so the lines
+after a corrected line follow it until a rule decides otherwise. N counts, per type, the
+runs of that type: it increases each time the type recurs after another type.
+
+Lines: the file is split at "\\n" (a final newline ends the last line, it adds no empty
+line; a "\\r" stays part of its line). Instantiating the import with the same parameters
+and writing the lines joined by "\\n" plus a final "\\n" gives the file byte for byte
+when it ended with a newline (every file of data/nc does); otherwise only that final
+newline differs. The import checks this itself before it commits.
+"""
+from __future__ import annotations
+
+import csv
+import io
+import json
+import keyword
+import math
+import re
+from dataclasses import dataclass, field
+from decimal import Decimal, InvalidOperation
+from pathlib import Path
+
+from psycopg.types.json import Jsonb
+
+from ..templates.decision_table import MODULE_ORDER, CompiledTemplate
+from ..errors import EngineError
+from ..templates.expressions import CONSTANTS, FUNCTIONS, MAX_EXPRESSION_LENGTH, compile_expression, evaluation_globals
+from .nc_tokens import LABEL, NUMBER, SYMBOL, LineFacts, facts, tokenise
+from ..templates.rows import TemplateRow, ensure_class, load_template, replace_template
+
+CODE_ADDRESSES = frozenset({"G", "M", "$"})   # their numbers name a function, not a value
+CLASS_NAME = re.compile(r"^[a-z][a-z0-9_]*$")
+ROW_STEP = 10
+
+
+@dataclass
+class ImportReport:
+    gear_class: str
+    path: str
+    rows: int
+    parameterised: int                      # numbers turned into parameter references
+    modules: dict                           # module type → rows
+    created: bool
+    changed: bool
+    version: int
+    ambiguous: dict = field(default_factory=dict)   # value → parameters having it (first used)
+
+
+def import_nc(conn, path, gear_class: str, params: dict | None = None, modules: dict | None = None,
+              parent: str | None = None) -> ImportReport:
+    """Store the NC program at `path` as the template of `gear_class`: all or nothing."""
+    if not CLASS_NAME.match(gear_class or ""):
+        raise EngineError(f"class name {gear_class!r}: use lower-case letters, digits and _, "
+                          "starting with a letter")
+    params = dict(params or {})
+    check_param_names(params)
+    lines = read_nc_lines(path)
+    assigned = assign_modules([facts(tokenise(line)) for line in lines], _checked_modules(modules, len(lines)))
+    built = _Builder(_values_of(params), path)
+    rows = [built.row(ROW_STEP * (index + 1), t, n, line)
+            for index, (line, (t, n)) in enumerate(zip(lines, assigned))]
+    with conn.transaction():
+        created = ensure_class(conn, gear_class, parent)
+        changed = replace_template(conn, gear_class, rows)
+        _store_import_params(conn, gear_class, params)
+        template = load_template(conn, gear_class)
+        _verify(template, params, lines, path)
+    counts = {t: sum(1 for row in rows if row.t == t) for t in MODULE_ORDER}
+    return ImportReport(gear_class, str(path), len(rows), built.parameterised,
+                        {t: c for t, c in counts.items() if c}, created, changed, template.version,
+                        built.ambiguous)
+
+
+def _store_import_params(conn, gear_class: str, params: dict) -> None:
+    """Keep the parameters the class was imported with: lint checks its names against them."""
+    conn.execute("UPDATE gear_class SET import_params = %s WHERE name = %s",
+                 (Jsonb(params, dumps=_params_json), gear_class))
+
+
+def _params_json(params: dict) -> str:
+    try:
+        return json.dumps(params, default=str, allow_nan=False)
+    except ValueError:
+        raise EngineError("parameter values must be finite: NaN and infinity cannot be stored; "
+                          "give numbers or text") from None
+
+
+def _verify(template, params: dict, lines: list[str], path) -> None:
+    """The stored class, instantiated with the same parameters, gives the file back."""
+    inherited = [row.id for row in template.rows if row.id > ROW_STEP * len(lines) or row.id % ROW_STEP]
+    if inherited:
+        raise EngineError(f"class {template.gear_class} inherits rows {inherited[:5]} from its parent, so it "
+                          "would not give the program back; import it under a parent without rows")
+    produced = CompiledTemplate(template).run(params).lines
+    for number, (got, want) in enumerate(zip(produced, lines), start=1):
+        if got != want:
+            raise EngineError(f"{path} line {number}: the imported template gives {got!r}, not {want!r}; "
+                              "nothing stored (please report this line)")
+
+
+# --- reading -------------------------------------------------------------------------
+
+_CONTROL = re.compile(r"[\x00-\x08\x0b\x0e-\x1f\x7f]")
+
+
+def read_nc_lines(path) -> list[str]:
+    """The lines of a text NC file; a clear error for a missing, empty or binary file."""
+    try:
+        data = Path(path).read_bytes()
+    except OSError as error:
+        raise EngineError(f"cannot read {path}: {error.strerror}; give an NC program file") from None
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as error:
+        raise EngineError(f"{path} is not UTF-8 text (byte 0x{data[error.start]:02x} at offset "
+                          f"{error.start}); give a text NC program, converted to UTF-8") from None
+    control = _CONTROL.search(text)
+    if control:
+        line = text.count("\n", 0, control.start()) + 1
+        raise EngineError(f"{path} line {line} has control character 0x{ord(control.group()):02x}: "
+                          "it is binary, not a text NC program")
+    if not text.strip():
+        raise EngineError(f"{path} is empty; give an NC program with at least one line")
+    lines = text.split("\n")
+    if text.endswith("\n"):
+        lines.pop()
+    return lines
+
+
+RESERVED_NAMES = frozenset(FUNCTIONS) | frozenset(CONSTANTS) | {"template_version"}
+
+
+def check_param_names(params: dict) -> None:
+    for name in params:
+        if not (isinstance(name, str) and name.isidentifier()) or keyword.iskeyword(name) \
+                or name.startswith("_") or name in RESERVED_NAMES:
+            raise EngineError(f"parameter name {name!r} cannot be used in a template expression; "
+                              "use letters, digits and _ (not starting with _, not a function name)")
+
+
+def read_params(path) -> dict:
+    """Job parameter values: a JSON object {name: value} or a CSV with columns name,value."""
+    text = _read_text(path, "parameters file")
+    if str(path).lower().endswith(".json"):
+        try:
+            params = json.loads(text)
+        except json.JSONDecodeError as error:
+            raise EngineError(f"{path}: not JSON ({error.msg}, line {error.lineno}); "
+                              "give an object {\"name\": value, …}") from None
+        if not isinstance(params, dict):
+            raise EngineError(f"{path}: give a JSON object {{\"name\": value, …}}, not {type(params).__name__}")
+    else:
+        params = {}
+        for line, record in _csv_records(text, path, ("name", "value")):
+            if record["name"] in params:
+                raise EngineError(f"{path} line {line}: parameter {record['name']!r} appears twice")
+            params[record["name"]] = _csv_value(record["value"])
+    check_param_names(params)
+    return params
+
+
+def read_modules(path) -> dict[int, str]:
+    """The engineer's module types for some lines: a CSV with columns line_no,t."""
+    modules = {}
+    for line, record in _csv_records(_read_text(path, "modules file"), path, ("line_no", "t")):
+        if not re.fullmatch(r"[0-9]+", record["line_no"]):
+            raise EngineError(f"{path} line {line}: line_no must be a whole number, got {record['line_no']!r}")
+        if int(record["line_no"]) in modules:
+            raise EngineError(f"{path} line {line}: program line {record['line_no']} appears twice")
+        modules[int(record["line_no"])] = record["t"]
+    _checked_modules(modules, None)
+    return modules
+
+
+def _read_text(path, what: str) -> str:
+    try:
+        return Path(path).read_text(encoding="utf-8-sig")
+    except (OSError, UnicodeDecodeError) as error:
+        reason = getattr(error, "strerror", None) or "not UTF-8 text"
+        raise EngineError(f"cannot read {what} {path}: {reason}") from None
+
+
+def _csv_records(text: str, path, columns: tuple):
+    reader = csv.DictReader(io.StringIO(text))
+    if tuple(name.strip() for name in reader.fieldnames or ()) != columns:
+        raise EngineError(f"{path}: columns must be {','.join(columns)}; found {','.join(reader.fieldnames or ())}")
+    for record in reader:
+        if None in record or any(value is None for value in record.values()):
+            raise EngineError(f"{path} line {reader.line_num}: give exactly {len(columns)} cells")
+        yield reader.line_num, {key.strip(): value.strip() for key, value in record.items()}
+
+
+def _csv_value(text: str):
+    """A whole number as int, another number as float, anything else as text."""
+    if re.fullmatch(r"[+-]?\d+", text):
+        return int(text)
+    return float(text) if re.fullmatch(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?", text) else text
+
+
+def _checked_modules(modules: dict | None, line_count: int | None) -> dict:
+    for line_no, t in (modules or {}).items():
+        if t not in MODULE_ORDER:
+            raise EngineError(f"modules: line {line_no} has module type {t!r}; use one of {', '.join(MODULE_ORDER)}")
+        if line_no < 1 or (line_count is not None and line_no > line_count):
+            raise EngineError(f"modules: line {line_no} is not a line of the program (1…{line_count or 'N'})")
+    return dict(modules or {})
+
+
+# --- module assignment -----------------------------------------------------------------
+
+@dataclass
+class _State:
+    seen_code: bool = False
+    seen_cut: bool = False
+
+
+SYNC_WORDS = frozenset({"EGDEF", "EGON", "EGONSYN", "EGONSYNE", "EGOFS", "EGOFC", "EGDEL"})
+CUTCOND_CODES = frozenset({"M3", "M4", "M5", "M7", "M8", "M9"})
+END_CODES = frozenset({"M2", "M30", "M17"})
+PREP_CODES = frozenset({f"G{n}" for n in (7, 8, 17, 18, 19, 20, 21, 25, 26, 40, 41, 42, 43, 49,
+                                          53, 54, 55, 56, 57, 58, 59, 64, 90, 91, 500, 700, 710)} | {"M6"})
+PREP_WORDS = frozenset({"T", "WALIMON", "WALIMOF", "TRAFOOF", "TRAORI", "CYCLE800"})
+CUT_CODES = frozenset({"G1", "G2", "G3"})
+
+
+def _is_frame(f: LineFacts) -> bool:
+    """`%` header, `O<name> sub`/`endsub`, a lone program number, the end of the program."""
+    program_label = any(label.startswith("O") for label in f.labels) and (
+        f.words & {"SUB", "ENDSUB"} or (len(f.labels) == 1 and f.first.kind == LABEL and not f.words))
+    starts_with_percent = f.first is not None and f.first.kind == SYMBOL and f.first.text == "%"
+    return bool(starts_with_percent or program_label or f.codes & END_CODES or "PROC" in f.words)
+
+
+# (module type, what it recognises, predicate over the line's facts and the state so far);
+# the first rule that holds decides.
+MODULE_RULES = (
+    ("main", "program frame", lambda f, s: _is_frame(f)),
+    ("main", "comments before the first block", lambda f, s: not s.seen_code and not f.has_code),
+    ("sync", "electronic gearbox", lambda f, s: f.words & SYNC_WORDS),
+    ("cutcond", "spindle, coolant, speed, feed alone",
+     lambda f, s: f.codes & CUTCOND_CODES or "S" in f.words or ("F" in f.words and not f.axes)),
+    ("prep", "limits, offsets, units, tool call", lambda f, s: f.codes & PREP_CODES or f.words & PREP_WORDS),
+    ("shift", "G0 move of Y alone", lambda f, s: "G0" in f.codes and f.axes == {"Y"}),
+    ("prep", "G0 positioning before the first cut", lambda f, s: "G0" in f.codes and not s.seen_cut),
+    ("cutmotion", "G1/G2/G3 move", lambda f, s: f.codes & CUT_CODES),
+    ("cutmotion", "G0 move after a cut", lambda f, s: "G0" in f.codes),
+)
+
+
+def assign_modules(lines: list[LineFacts], corrections: dict | None = None) -> list[tuple[str, int]]:
+    """(t, n) of every line: by the engineer's correction, else by MODULE_RULES, else as before."""
+    corrections = corrections or {}
+    state, current, runs, assigned = _State(), "main", {t: 0 for t in MODULE_ORDER}, []
+    for number, line in enumerate(lines, start=1):
+        decided = corrections.get(number) or next(
+            (t for t, _, holds in MODULE_RULES if holds(line, state)), current)
+        state.seen_code |= line.has_code
+        state.seen_cut |= bool(line.codes & CUT_CODES)
+        if decided != current or not assigned:
+            runs[decided] += 1
+        current = decided
+        assigned.append((decided, runs[decided]))
+    return assigned
+
+
+# --- rows ------------------------------------------------------------------------------
+
+def _values_of(params: dict) -> dict:
+    """Decimal value → [(name, value)] of the numeric parameters, in the order given."""
+    values: dict = {}
+    for name, value in params.items():
+        if isinstance(value, bool) or not isinstance(value, (int, float, Decimal)):
+            continue
+        if isinstance(value, float) and not math.isfinite(value):
+            continue
+        values.setdefault(Decimal(str(value)), []).append((name, value))
+    return values
+
+
+_SPELLING = re.compile(r"([+-]?)([0-9]*)(\.?)([0-9]*)")
+
+
+def number_field(name: str, spelling: str) -> str:
+    """The f-string replacement field that prints `name` in the style of `spelling`."""
+    sign, integer, point, fraction = _SPELLING.fullmatch(spelling).groups()
+    digits = len(fraction)
+    if not integer:
+        scale = 10 ** digits
+        positive = "'+'" if sign == "+" else "''"
+        magnitude = f"round(abs({name}) * {scale})"
+        return (f"{{'-' if {name} < 0 else {positive}}}{{{magnitude} // {scale} or ''}}."
+                f"{{{magnitude} % {scale}:0{digits}d}}")
+    trailing_point = bool(point) and not fraction
+    width = len(spelling) - trailing_point
+    padding = f"0{width}" if len(integer) > 1 and integer.startswith("0") else ""
+    return f"{{{name}:{'+' if sign == '+' else ''}{padding}.{digits}f}}" + ("." if trailing_point else "")
+
+
+class _Builder:
+    def __init__(self, values: dict, path):
+        self.values, self.path = values, path
+        self.parameterised, self.ambiguous = 0, {}
+
+    def row(self, row_id: int, t: str, n: int, line: str) -> TemplateRow:
+        parts = [self._part(token) for token in tokenise(line)]
+        fields = "".join(text for is_field, text in parts if is_field)
+        literal = "".join(text for is_field, text in parts if not is_field)
+        quote = "'" if '"' in literal and "'" not in literal + fields else '"'
+        if fields:
+            body = "".join(text if is_field else _escaped(text, quote, braces=True) for is_field, text in parts)
+            o = f"f{quote}{body}{quote}"
+        else:
+            o = f"{quote}{_escaped(line, quote, braces=False)}{quote}"
+        if len(o) > MAX_EXPRESSION_LENGTH:
+            raise EngineError(f"{self.path} line {row_id // ROW_STEP}: {len(line)} characters, more than a "
+                              f"template row holds ({MAX_EXPRESSION_LENGTH}); split the line")
+        self.parameterised += sum(1 for is_field, _ in parts if is_field)
+        return TemplateRow(row_id, t, n, None, None, o, None)
+
+    def _part(self, token) -> tuple[bool, str]:
+        """(True, replacement field) for a number that becomes a reference, else (False, text)."""
+        if token.kind != NUMBER or token.address in CODE_ADDRESSES or _is_negative_zero(token.text):
+            return False, token.text
+        candidates = self.values.get(Decimal(token.text))
+        if not candidates:
+            return False, token.text
+        name, value = candidates[0]
+        source = number_field(name, token.text)
+        if _evaluate(source, name, value) != token.text:
+            return False, token.text
+        if len(candidates) > 1:
+            self.ambiguous[str(Decimal(token.text))] = [n for n, _ in candidates]
+        return True, source
+
+
+def _is_negative_zero(spelling: str) -> bool:
+    try:
+        return spelling.startswith("-") and Decimal(spelling) == 0
+    except InvalidOperation:
+        return False
+
+
+def _evaluate(source: str, name: str, value) -> str:
+    compiled = compile_expression(f'f"{source}"')
+    return eval(compiled.code, evaluation_globals(), {name: value})
+
+
+def _escaped(text: str, quote: str, braces: bool) -> str:
+    out = []
+    for character in text:
+        if character in ("\\", quote):
+            out.append("\\" + character)
+        elif braces and character in "{}":
+            out.append(character * 2)
+        elif character.isprintable():
+            out.append(character)
+        else:
+            out.append(repr(character)[1:-1])
+    return "".join(out)
+

@@ -1,0 +1,205 @@
+"""Instantiation: a workpiece (or a stored job) → its NC program, checked, stored, written.
+
+gear → class → model + hob + cutting data → job parameters → decision table → result
+table → machine-limit check → job and program stored in one transaction → .MPF file.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+
+from ..gears.case_base import CUT_KINDS_BY_COUNT, CaseBase, job_cutting_record
+from ..templates.decision_table import Result, compiled_template
+from ..errors import EngineError
+from ..hobbing.choices import Choices
+from ..gears.hob_matching import choose_hob
+from ..memory import no_cycle_collection
+from ..gears.models import model_for_class
+from .nc_check import LimitError, check_program, check_table_speed
+from .outputs import write_program_files
+from ..gears.records import Gear, Machine, load_gear, load_gears, load_hobs, load_machine
+from ..templates.rows import Template, load_template
+from ..turning.names import TurningModel
+
+DEFAULT_HOBBING_MACHINE = "hobber-840d"
+
+
+@dataclass(slots=True)
+class Planned:
+    """A job computed in memory, with its program, not yet stored."""
+    gear_id: int | None
+    gear_class: str
+    machine: str
+    hob_id: str | None
+    params: dict
+    module_params: dict
+    template: Template
+    result: Result
+    cutting: dict | None = None      # job.cutting: the cutting data chosen and their source
+
+    @property
+    def name(self) -> str:
+        return str(self.params.get("program_name", f"JOB_{self.gear_id}"))
+
+
+@dataclass(frozen=True)
+class Program:
+    program_id: int
+    job_id: int
+    name: str
+    lines: list[str]
+    gear_class: str
+    template_version: int
+    template_hash: str
+    path: str | None = None
+
+    @property
+    def text(self) -> str:
+        return "\n".join(self.lines) + "\n"
+
+
+class Planner:
+    """Everything shared by the gears of one run: machine, hob library, templates."""
+
+    def __init__(self, conn, machine: str | None = None, choices: Choices = Choices(), overrides=None):
+        self.conn = conn
+        self.machine = load_machine(conn, machine or DEFAULT_HOBBING_MACHINE)
+        if self.machine.kind != "hobber":
+            raise EngineError(f"machine {self.machine.name} is a {self.machine.kind}, not a hobbing machine; "
+                              f"use --machine {DEFAULT_HOBBING_MACHINE}")
+        self.hobs = load_hobs(conn)
+        self.case_base = CaseBase.load(conn)
+        self._cutting: dict[tuple, tuple] = {}
+        self.choices = choices
+        self.overrides = overrides or {}
+        self._templates: dict[str, Template] = {}
+        self._models: dict[str, object] = {}
+
+    def template(self, gear_class: str) -> Template:
+        if gear_class not in self._templates:
+            self._templates[gear_class] = load_template(self.conn, gear_class)
+        return self._templates[gear_class]
+
+    def model(self, gear_class: str):
+        if gear_class not in self._models:
+            model = model_for_class(self.conn, gear_class)
+            if isinstance(model, TurningModel):
+                raise EngineError(f"class {gear_class!r} is a turning class: its jobs come from drawings "
+                                  "(engine import-dxf FILE.dxf), not from gears")
+            if model is None:
+                raise EngineError(f"gear class {gear_class!r} has no hobbing model (nor has any ancestor)")
+            self._models[gear_class] = model
+        return self._models[gear_class]
+
+    def plan(self, gear: Gear) -> Planned:
+        if gear.gear_class is None:
+            raise EngineError(f"gear {gear.id} has no gear class; re-import it to classify it")
+        _check_machine_fits(gear, self.machine)
+        model = self.model(gear.gear_class)
+        hob = choose_hob(gear, self.hobs, purpose=model.hob_purpose,
+                         shift_travel=model.shift_travel(self.choices)).hob
+        cutting, case_ids = self.cutting_data(gear, hob)
+        job = model.job(gear, gear.gear_class, hob, self.machine, cutting, self.choices)
+        _check_table_speed(gear, hob.starts, cutting.hob_speed, self.machine)
+        template = self.template(gear.gear_class)
+        result = run_template(template, job.params, job.module_params, self.machine)
+        kinds = CUT_KINDS_BY_COUNT[self.choices.cut_count(gear.module)]
+        record = job_cutting_record(cutting, gear, hob, kinds, case_ids)
+        return Planned(gear.id, gear.gear_class, self.machine.name, hob.id, job.params,
+                       job.module_params, template, result, record)
+
+    def cutting_data(self, gear: Gear, hob) -> tuple:
+        """Cutting data from the nearest cases of the machining history (overrides applied),
+        and the ids of the cases they came from; gears alike share one suggestion."""
+        key = (gear.module, gear.teeth, gear.material, gear.hardness, gear.quality_grade, hob.id)
+        if key not in self._cutting:
+            cutting, proposals, _ = self.case_base.cutting_data(gear, hob, self.machine)
+            case_ids = [case_id for proposal in proposals.values() for case_id in proposal.case_ids]
+            self._cutting[key] = (cutting.with_overrides(**self.overrides), case_ids)
+        return self._cutting[key]
+
+
+def run_template(template: Template, params: dict, module_params: dict, machine: Machine) -> Result:
+    """Evaluate the decision table and check the program against the machine."""
+    compiled = compiled_template(template)
+    result = compiled.run(params, module_params)
+    check_program(result.lines, machine, str(params.get("program_name", "program")), result.row_ids,
+                  compiled.constant_words)
+    return result
+
+
+def _check_machine_fits(gear: Gear, machine: Machine) -> None:
+    if machine.module_max is not None and gear.module > machine.module_max:
+        raise LimitError(f"gear {gear.id}: module {gear.module:g} exceeds {machine.name}'s maximum "
+                         f"module {machine.module_max:g}; nothing stored")
+
+
+def _check_table_speed(gear: Gear, starts: int, hob_speed: float, machine: Machine) -> None:
+    if hob_speed > machine.spindle_max:
+        raise LimitError(f"gear {gear.id}: hob speed {hob_speed:g} r/min exceeds {machine.name}'s hob spindle "
+                         f"maximum {machine.spindle_max:g} r/min; nothing stored")
+    check_table_speed(gear.id, gear.teeth, starts, hob_speed, machine)
+
+
+def instantiate_gear(conn, gear_id: int, *, machine: str | None = None, choices: Choices = Choices(),
+                     overrides: dict | None = None, out: str | Path | None = None) -> Program:
+    """Compute, check and store the program of one gear; write it to `out` if given."""
+    planner = Planner(conn, machine, choices, overrides)
+    planned = planner.plan(load_gear(conn, gear_id))
+    return _store_and_write(conn, [planned], out)[0]
+
+
+def instantiate_job(conn, job_id: int, out: str | Path | None = None) -> Program:
+    """Instantiate a stored job again with its stored (possibly edited) parameters."""
+    row = conn.execute("SELECT gear_id, gear_class, machine, hob_id, params, module_params FROM job "
+                       "WHERE id = %s", (job_id,)).fetchone()
+    if row is None:
+        raise EngineError(f"job {job_id} does not exist; see `SELECT id, gear_id FROM job`")
+    gear_id, gear_class, machine_name, hob_id, params, module_params = row
+    machine = load_machine(conn, machine_name)
+    if machine.kind == "lathe":   # a turning job: its passes are computed from its parameters
+        from ..turning.planning import plan_turning_job
+
+        planned = plan_turning_job(conn, gear_class, machine, params, module_params)
+    else:
+        template = load_template(conn, gear_class)
+        result = run_template(template, params, module_params, machine)
+        planned = Planned(gear_id, gear_class, machine_name, hob_id, params, module_params, template, result)
+    return _store_and_write(conn, [planned], out, existing_job=job_id)[0]
+
+
+def instantiate_gears(conn, first: int | None = None, last: int | None = None, *,
+                      machine: str | None = None, choices: Choices = Choices(), overrides=None,
+                      out: str | Path | None = None, progress=None):
+    """All gears with first ≤ id ≤ last: all programs stored, or none (the first failure names its gear)."""
+    planner = Planner(conn, machine, choices, overrides)
+    gears = load_gears(conn, first, last)
+    if not gears:
+        raise EngineError(f"no gears with ids in {first or 'the start'}…{last or 'the end'}")
+    from .storage import store_many
+
+    with no_cycle_collection():
+        planned = [_plan_in_batch(planner, gear, progress) for gear in gears]
+        return store_many(conn, planned, out)
+
+
+def _plan_in_batch(planner: Planner, gear: Gear, progress) -> Planned:
+    try:
+        planned = planner.plan(gear)
+    except EngineError as error:
+        message = str(error)
+        prefix = "" if message.startswith(f"gear {gear.id}") else f"gear {gear.id}: "
+        raise type(error)(f"{prefix}{message} (batch stopped, nothing stored)") from None
+    if progress:
+        progress(1)
+    return planned
+
+
+def _store_and_write(conn, planned: list[Planned], out, existing_job: int | None = None) -> list[Program]:
+    from .storage import store_one
+
+    with write_program_files(planned, out) as paths:
+        with conn.transaction():
+            programs = [store_one(conn, item, existing_job, paths.get(item.name)) for item in planned]
+    return programs

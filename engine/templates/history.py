@@ -1,0 +1,109 @@
+"""Template versions of a class: history, diff between two versions, restore of one.
+
+Every committed version's assembled rows are in template_version_rows (written at commit by
+the trigger of migration 0006); template_audit says which rows each version changed.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from datetime import datetime
+
+from ..errors import EngineError
+from .rows import CSV_COLUMNS, TemplateRow, replace_template
+
+
+@dataclass(frozen=True)
+class VersionEntry:
+    version: int
+    created_at: datetime
+    created_by: str
+    rows: int
+    changes: tuple[tuple[int, str], ...]   # (row id, INSERT/UPDATE/DELETE) from template_audit
+
+
+@dataclass(frozen=True)
+class RowChange:
+    row_id: int
+    kind: str            # added, removed, changed
+    old: dict | None     # the row in the first version (None: added)
+    new: dict | None     # the row in the second version (None: removed)
+
+    @property
+    def columns(self) -> list[str]:
+        """The columns whose values differ (every column for an added or removed row)."""
+        return [column for column in CSV_COLUMNS if (self.old or {}).get(column) != (self.new or {}).get(column)]
+
+
+# Each stored version with the audit rows written since the version stored before it
+# (several bumps in one transaction store only the committed one).
+HISTORY = """
+WITH versions AS (
+    SELECT version, created_at, created_by, jsonb_array_length(rows) AS row_count,
+           lag(version, 1, -1) OVER (ORDER BY version) AS previous
+    FROM template_version_rows WHERE gear_class = %(class)s)
+SELECT v.version, v.created_at, v.created_by, v.row_count,
+       coalesce(array_agg(a.row_id ORDER BY a.id) FILTER (WHERE a.id IS NOT NULL), '{}'),
+       coalesce(array_agg(a.operation ORDER BY a.id) FILTER (WHERE a.id IS NOT NULL), '{}')
+FROM versions v
+LEFT JOIN template_audit a ON a.gear_class = %(class)s
+     AND a.template_version > v.previous AND a.template_version <= v.version
+GROUP BY v.version, v.created_at, v.created_by, v.row_count
+ORDER BY v.version"""
+
+
+def history(conn, gear_class: str) -> list[VersionEntry]:
+    """Every stored version of the class, oldest first, with who made it and which rows changed."""
+    _require_class(conn, gear_class)
+    return [VersionEntry(version, created_at, created_by, row_count, tuple(zip(row_ids, operations)))
+            for version, created_at, created_by, row_count, row_ids, operations
+            in conn.execute(HISTORY, {"class": gear_class})]
+
+
+def diff(conn, gear_class: str, from_version: int, to_version: int) -> list[RowChange]:
+    """Rows added, removed or changed from one version to the other, in row id order."""
+    old = {row["id"]: row for row in version_rows_json(conn, gear_class, from_version)}
+    new = {row["id"]: row for row in version_rows_json(conn, gear_class, to_version)}
+    return [_row_change(row_id, old.get(row_id), new.get(row_id))
+            for row_id in sorted(old.keys() | new.keys()) if old.get(row_id) != new.get(row_id)]
+
+
+def _row_change(row_id: int, old: dict | None, new: dict | None) -> RowChange:
+    kind = "added" if old is None else "removed" if new is None else "changed"
+    return RowChange(row_id, kind, old, new)
+
+
+def restore(conn, gear_class: str, version: int) -> tuple[bool, int]:
+    """Make the class's template what it was in `version`, as a new version (history stays
+    append-only). Returns (changed, the class's version now); unchanged if identical.
+
+    The stored rows are the assembled template; replace_template keeps as the class's own
+    rows only those that differ from what it inherits now."""
+    with conn.transaction():
+        rows = [TemplateRow(**row) for row in version_rows_json(conn, gear_class, version)]
+        if not rows:
+            raise EngineError(f"class {gear_class!r} version {version} has no template rows; nothing to restore")
+        changed = replace_template(conn, gear_class, rows)
+        current = conn.execute("SELECT template_version FROM gear_class WHERE name = %s", (gear_class,)).fetchone()[0]
+    return changed, current
+
+
+def version_rows_json(conn, gear_class: str, version: int) -> list[dict]:
+    """The class's assembled rows in `version`; an error naming the stored versions if absent."""
+    found = conn.execute("SELECT rows FROM template_version_rows WHERE gear_class = %s AND version = %s",
+                         (gear_class, version)).fetchone()
+    if found is None:
+        _require_class(conn, gear_class)
+        raise EngineError(f"class {gear_class!r} has no version {version}; "
+                          f"stored versions: {_version_list(conn, gear_class)}")
+    return found[0]
+
+
+def _version_list(conn, gear_class: str) -> str:
+    versions = [row[0] for row in conn.execute(
+        "SELECT version FROM template_version_rows WHERE gear_class = %s ORDER BY version", (gear_class,))]
+    return ", ".join(map(str, versions)) or "none"
+
+
+def _require_class(conn, gear_class: str) -> None:
+    if conn.execute("SELECT 1 FROM gear_class WHERE name = %s", (gear_class,)).fetchone() is None:
+        raise EngineError(f"gear class {gear_class!r} does not exist; see `engine template list`")

@@ -1,0 +1,118 @@
+"""Checks of template rows: structure, every expression parses and is allowed, and names
+only parameters the class's model provides or earlier rows compute."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from .decision_table import MODULE_ORDER, TemplateError, compile_row
+from ..errors import EngineError
+from .rows import TemplateRow, load_template
+
+
+@dataclass(frozen=True)
+class LintProblem:
+    gear_class: str
+    row_id: int | None
+    column: str
+    message: str
+
+    def __str__(self) -> str:
+        where = f"row {self.row_id} column {self.column}" if self.row_id is not None else self.column
+        return f"class {self.gear_class} {where}: {self.message}"
+
+
+def check_rows(gear_class: str, rows: list[TemplateRow]) -> None:
+    """Refuse rows that could never run: raise the first problem as an EngineError."""
+    problems = structural_problems(gear_class, rows)
+    if problems:
+        raise EngineError(str(problems[0]) + (f" (and {len(problems) - 1} more)" if len(problems) > 1 else ""))
+
+
+def structural_problems(gear_class: str, rows: list[TemplateRow]) -> list[LintProblem]:
+    problems = []
+    for row in rows:
+        problems += [LintProblem(gear_class, row.id, column, message)
+                     for column, message in _row_structure(row)]
+        if row.t in MODULE_ORDER and row.id >= 0:
+            try:
+                compile_row(gear_class, row)
+            except TemplateError as error:
+                problems.append(LintProblem(gear_class, row.id, error.column, str(error).split(": ", 1)[1]))
+    return problems
+
+
+def _row_structure(row: TemplateRow):
+    if row.t not in MODULE_ORDER:
+        yield "t", f"unknown module type {row.t!r}; use one of {', '.join(MODULE_ORDER)}"
+    if row.id < 0 or row.n < 0:
+        yield "id", "id and n must not be negative"
+    if row.o is None and row.s is None:
+        yield "o", "row has neither o nor s: it does nothing"
+    if row.p_calc is not None and row.s is None:
+        yield "p_calc", "p_calc has no effect without s (use p_emit to decide output)"
+
+
+def lint_class(conn, gear_class: str) -> list[LintProblem]:
+    """Every problem of one class's template, including unknown parameter names."""
+    from ..gears.models import model_for_class
+
+    template = load_template(conn, gear_class)
+    problems = structural_problems(gear_class, list(template.rows))
+    if problems:
+        return problems
+    # An imported class's rows name the parameters of its program, even under a parent with a model.
+    name_source = _imported_names(conn, gear_class) or model_for_class(conn, gear_class)
+    if name_source is None:
+        return [LintProblem(gear_class, None, "model", "no hobbing model for this class or its ancestors, "
+                            "so its parameter names cannot be checked; give the class a model, or import "
+                            "it with `engine import-nc FILE --class NAME --params P.json`")]
+    return list(_unknown_names(gear_class, template.rows, name_source))
+
+
+@dataclass(frozen=True)
+class _ImportedNames:
+    """The names of an imported class: the parameters of the program it came from, in every module."""
+    names: frozenset
+
+    def parameter_names(self, t: str, n: int) -> frozenset:
+        return self.names
+
+
+def _imported_names(conn, gear_class: str) -> _ImportedNames | None:
+    found = conn.execute("SELECT import_params FROM gear_class WHERE name = %s", (gear_class,)).fetchone()
+    if found is None or found[0] is None:
+        return None
+    return _ImportedNames(frozenset(found[0]))
+
+
+def _unknown_names(gear_class: str, rows, model):
+    assigned: set[str] = set()
+    for row in rows:
+        compiled = compile_row(gear_class, row)
+        known = model.parameter_names(row.t, row.n) | assigned
+        for column, expression in _in_evaluation_order(compiled):
+            for name in sorted(expression.names - known):
+                yield LintProblem(gear_class, row.id, column, f"unknown parameter {name!r}")
+            if column == "s":
+                known = known | {n for n, c in compiled.s if c is expression}
+        assigned |= {name for name, _ in compiled.s}
+
+
+def _in_evaluation_order(compiled):
+    if compiled.p_calc is not None:
+        yield "p_calc", compiled.p_calc
+    for _, statement in compiled.s:
+        yield "s", statement
+    for column in ("o", "p_emit"):
+        expression = getattr(compiled, column)
+        if expression is not None:
+            yield column, expression
+
+
+def lint_all(conn) -> list[LintProblem]:
+    names = [row[0] for row in conn.execute(
+        "SELECT DISTINCT gear_class FROM assembly ORDER BY gear_class")]
+    problems = []
+    for name in names:
+        problems += lint_class(conn, name)
+    return problems
