@@ -189,7 +189,7 @@ class JinjaPipeline:
                 name, lines, self.row_ids(params, module_params), record)
 
     def templates(self, conn) -> dict:
-        from engine.templates.rows import load_template
+        from engine.templates.store import load_template
 
         found = {}
         for gear_class in ("spur", "helical"):

@@ -5,7 +5,8 @@ from engine.templates.decision_table import CompiledTemplate, TemplateError
 from engine.errors import EngineError
 from engine.hobbing.choices import Choices
 from engine.programs.instantiate import instantiate_gear
-from engine.templates.rows import TemplateRow, ensure_class, load_template, replace_template
+from engine.templates.rows import TemplateRow
+from engine.templates.store import ensure_class, load_template, replace_template
 
 
 def make_template(conn, name, rows):

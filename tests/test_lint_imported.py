@@ -9,9 +9,11 @@ from dataclasses import replace
 import pytest
 
 from engine.errors import EngineError
-from engine.templates.lint import LintProblem, lint_class
+from engine.templates.checks import LintProblem
+from engine.templates.lint import lint_class
 from engine.library.nc_import import import_nc
-from engine.templates.rows import TemplateRow, ensure_class, load_template, replace_template
+from engine.templates.rows import TemplateRow
+from engine.templates.store import ensure_class, load_template, replace_template
 
 from test_nc_import import DATA, PARAMS, class_name, real_files, write
 

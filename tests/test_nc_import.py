@@ -24,7 +24,8 @@ from engine.errors import EngineError
 from engine.templates.expressions import compile_expression, evaluation_globals
 from engine.library.nc_import import import_nc, number_field
 from engine.library.nc_tokens import detokenise, tokenise
-from engine.templates.rows import ensure_class, export_csv, load_template, parse_csv, replace_template
+from engine.templates.rows import export_csv, parse_csv
+from engine.templates.store import ensure_class, load_template, replace_template
 
 from shared_data import shared_data
 

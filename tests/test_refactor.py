@@ -13,7 +13,8 @@ from hypothesis import strategies as st
 from engine.errors import EngineError
 from engine.library.refactor import check_invariants, refactor, template_digests
 from engine.library.similarity import nc_units
-from engine.templates.rows import TemplateRow, ensure_class, export_csv, load_template, replace_template
+from engine.templates.rows import TemplateRow, export_csv
+from engine.templates.store import ensure_class, load_template, replace_template
 
 from test_similarity import lcs_sim
 

@@ -18,7 +18,7 @@ from engine.templates.expressions import compile_expression, evaluation_globals
 from engine.programs.instantiate import instantiate_gear
 from engine.library.nc_import import import_nc
 from engine.library.refactor import STAGES, refactor
-from engine.templates.rows import load_template, replace_template
+from engine.templates.store import load_template, replace_template
 
 from test_nc_import import DATA, FAMILY, PARAMS, class_name, instantiate, real_files
 from test_refactor import bodies_stored_twice, component_count, duplicate_row_body, exports

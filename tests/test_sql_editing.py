@@ -11,7 +11,8 @@ from psycopg.pq import TransactionStatus
 
 from engine.programs.instantiate import instantiate_gear
 from engine.library.refactor import refactor
-from engine.templates.rows import TemplateRow, export_csv, load_template, replace_template
+from engine.templates.rows import TemplateRow, export_csv
+from engine.templates.store import load_template, replace_template
 
 ROW_COLUMNS = ("id", "t", "n", "p_calc", "s", "o", "p_emit")
 

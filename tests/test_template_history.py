@@ -12,7 +12,8 @@ from engine.db.migrate import migrate
 from engine.paths import MIGRATIONS_DIR
 from engine.db.seed import seed
 from engine.templates.history import diff, history, restore
-from engine.templates.rows import export_csv, load_template
+from engine.templates.rows import export_csv
+from engine.templates.store import load_template
 
 
 def exported(conn, gear_class):

@@ -152,7 +152,7 @@ def template():
 @click.pass_context
 def template_list(ctx):
     """Every gear class with its parent, template version and number of rows."""
-    from ..templates.rows import list_classes
+    from ..templates.store import list_classes
 
     with connection(ctx) as conn:
         for name, parent, version, rows, description in list_classes(conn):
@@ -165,7 +165,8 @@ def template_list(ctx):
 @click.pass_context
 def template_export(ctx, gear_class, out):
     """Print the class's assembled template as CSV."""
-    from ..templates.rows import export_csv, load_template
+    from ..templates.rows import export_csv
+    from ..templates.store import load_template
 
     with connection(ctx) as conn:
         text = export_csv(load_template(conn, gear_class))
@@ -183,7 +184,8 @@ def template_export(ctx, gear_class, out):
 @click.pass_context
 def template_import(ctx, gear_class, parent, csv_file):
     """Replace the class's rows with CSV_FILE; every expression is checked first (all or nothing)."""
-    from ..templates.rows import ensure_class, read_csv, replace_template
+    from ..templates.rows import read_csv
+    from ..templates.store import ensure_class, replace_template
 
     rows = read_csv(csv_file)
     with connection(ctx) as conn:

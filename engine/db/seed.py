@@ -9,7 +9,8 @@ from pathlib import Path
 from psycopg import sql
 
 from ..paths import SEED_DIR
-from ..templates.rows import ensure_class, read_csv, replace_template
+from ..templates.rows import read_csv
+from ..templates.store import ensure_class, replace_template
 
 # table, CSV file, key column, columns (in file order); loaded in this order.
 SEED_TABLES = (

@@ -54,7 +54,8 @@ from ..templates.decision_table import MODULE_ORDER, CompiledTemplate
 from ..errors import EngineError
 from ..templates.expressions import CONSTANTS, FUNCTIONS, MAX_EXPRESSION_LENGTH, compile_expression, evaluation_globals
 from .nc_tokens import LABEL, NUMBER, SYMBOL, LineFacts, facts, tokenise
-from ..templates.rows import TemplateRow, ensure_class, load_template, replace_template
+from ..templates.rows import TemplateRow
+from ..templates.store import ensure_class, load_template, replace_template
 
 CODE_ADDRESSES = frozenset({"G", "M", "$"})   # their numbers name a function, not a value
 CLASS_NAME = re.compile(r"^[a-z][a-z0-9_]*$")

@@ -15,12 +15,12 @@ import psycopg
 
 from ..errors import EngineError
 from .similarity import Units, nc_units, similar_pairs
-from ..templates.rows import load_template
+from ..templates.store import load_template
 
 # Concurrent instantiations read either the old or the new library: writers wait for us,
 # readers (plain SELECT, foreign-key checks) are not blocked and see the last committed
 # state. The engine's writers lock the three tables in this order too
-# (templates.LOCK_FOR_WRITING); a hand-made SQL edit may not, and a deadlock with it costs
+# (engine.templates.store.LOCK_FOR_WRITING); a hand-made SQL edit may not, and a deadlock with it costs
 # the refactor a retry, not the night.
 LOCK = "LOCK TABLE gear_class, component, assembly IN SHARE ROW EXCLUSIVE MODE"
 DEADLOCK_RETRIES = 3

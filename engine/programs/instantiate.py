@@ -19,7 +19,8 @@ from ..gears.models import model_for_class
 from .nc_check import LimitError, check_program, check_table_speed
 from .outputs import write_program_files
 from ..gears.records import Gear, Machine, load_gear, load_gears, load_hobs, load_machine
-from ..templates.rows import Template, load_template
+from ..templates.rows import Template
+from ..templates.store import load_template
 from ..turning.names import TurningModel
 
 DEFAULT_HOBBING_MACHINE = "hobber-840d"

@@ -9,7 +9,8 @@ from dataclasses import dataclass
 from datetime import datetime
 
 from ..errors import EngineError
-from .rows import CSV_COLUMNS, TemplateRow, replace_template
+from .rows import CSV_COLUMNS, TemplateRow
+from .store import replace_template
 
 
 @dataclass(frozen=True)

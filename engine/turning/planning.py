@@ -5,7 +5,7 @@ from __future__ import annotations
 from ..templates.decision_table import compiled_template
 from ..errors import EngineError
 from ..gears.records import Machine, load_machine
-from ..templates.rows import load_template
+from ..templates.store import load_template
 from .check import check_lathe_program
 from .defaults import DEFAULT_LATHE
 from .model import template_module_params

@@ -1,0 +1,53 @@
+"""Checks of a template's rows before they are stored or run: structure (module type, ids,
+rows that do nothing) and every expression parses and is allowed (design notes §4). Rows are
+checked here, where every writer of rows comes through, not where they are loaded."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ..errors import EngineError
+from .decision_table import MODULE_ORDER, TemplateError, compile_row
+from .rows import TemplateRow
+
+
+@dataclass(frozen=True)
+class LintProblem:
+    gear_class: str
+    row_id: int | None
+    column: str
+    message: str
+
+    def __str__(self) -> str:
+        where = f"row {self.row_id} column {self.column}" if self.row_id is not None else self.column
+        return f"class {self.gear_class} {where}: {self.message}"
+
+
+def check_rows(gear_class: str, rows: list[TemplateRow]) -> None:
+    """Refuse rows that could never run: raise the first problem as an EngineError."""
+    problems = structural_problems(gear_class, rows)
+    if problems:
+        raise EngineError(str(problems[0]) + (f" (and {len(problems) - 1} more)" if len(problems) > 1 else ""))
+
+
+def structural_problems(gear_class: str, rows: list[TemplateRow]) -> list[LintProblem]:
+    problems = []
+    for row in rows:
+        problems += [LintProblem(gear_class, row.id, column, message)
+                     for column, message in _row_structure(row)]
+        if row.t in MODULE_ORDER and row.id >= 0:
+            try:
+                compile_row(gear_class, row)
+            except TemplateError as error:
+                problems.append(LintProblem(gear_class, row.id, error.column, str(error).split(": ", 1)[1]))
+    return problems
+
+
+def _row_structure(row: TemplateRow):
+    if row.t not in MODULE_ORDER:
+        yield "t", f"unknown module type {row.t!r}; use one of {', '.join(MODULE_ORDER)}"
+    if row.id < 0 or row.n < 0:
+        yield "id", "id and n must not be negative"
+    if row.o is None and row.s is None:
+        yield "o", "row has neither o nor s: it does nothing"
+    if row.p_calc is not None and row.s is None:
+        yield "p_calc", "p_calc has no effect without s (use p_emit to decide output)"

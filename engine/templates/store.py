@@ -1,0 +1,146 @@
+"""A class's template in the database: loading it, listing classes, creating a class and
+replacing its rows.
+
+Rows are stored as components (bodies, shared between classes when identical) and each
+class's assembly (row id, module number N, component). See design notes §4, §5.
+"""
+from __future__ import annotations
+
+from ..errors import EngineError
+from .checks import check_rows
+from .rows import Template, TemplateRow
+
+# A class's rows: its own and those it inherits from its ancestors (nearest wins by id).
+LOAD_ROWS = """
+SELECT r.id, c.t, r.n, c.p_calc, c.s, c.o, c.p_emit
+FROM class_template(%s) r JOIN component c ON c.id = r.component_id
+ORDER BY r.id"""
+
+# One statement, so version and rows come from one snapshot even while an editor or the
+# nightly refactor commits.
+LOAD_TEMPLATE = """
+SELECT g.template_version, r.id, c.t, r.n, c.p_calc, c.s, c.o, c.p_emit
+FROM gear_class g
+LEFT JOIN LATERAL class_template(g.name) r ON true
+LEFT JOIN component c ON c.id = r.component_id
+WHERE g.name = %s ORDER BY r.id"""
+
+
+def load_template(conn, gear_class: str) -> Template:
+    """The class's assembled template; an error if the class does not exist or has no rows."""
+    found = conn.execute(LOAD_TEMPLATE, (gear_class,)).fetchall()
+    if not found:
+        raise EngineError(f"gear class {gear_class!r} does not exist; see `engine template list`")
+    if found[0][1] is None:
+        raise EngineError(f"gear class {gear_class!r} has no template rows; "
+                          f"import them with `engine template import --class {gear_class} FILE.csv`")
+    return Template(gear_class, found[0][0], tuple(TemplateRow(*row[1:]) for row in found))
+
+
+def list_classes(conn) -> list[tuple]:
+    """(name, parent, template_version, row count, description) of every class."""
+    return conn.execute("""
+        SELECT g.name, g.parent, g.template_version, count(r.id)::int, g.description
+        FROM gear_class g LEFT JOIN assembled_row r ON r.gear_class = g.name
+        GROUP BY g.name ORDER BY g.name""").fetchall()
+
+
+def ensure_class(conn, name: str, parent: str | None = None, description: str = "") -> bool:
+    """Create the class if it is new; return True if created."""
+    if parent is not None and not _class_exists(conn, parent):
+        raise EngineError(f"parent class {parent!r} does not exist; create it first")
+    created = conn.execute(
+        "INSERT INTO gear_class (name, parent, description) VALUES (%s, %s, %s) "
+        "ON CONFLICT (name) DO NOTHING RETURNING name", (name, parent, description)).fetchone()
+    return created is not None
+
+
+def _class_exists(conn, name: str) -> bool:
+    return conn.execute("SELECT 1 FROM gear_class WHERE name = %s", (name,)).fetchone() is not None
+
+
+def replace_template(conn, gear_class: str, rows: list[TemplateRow]) -> bool:
+    """Make `rows` the class's template, reusing identical component bodies.
+
+    A derived class (one whose ancestors have rows) stores only the rows that differ from
+    what it inherits; inherited rows the file leaves out stay inherited. Returns True if
+    anything changed; the class's version and its descendants' versions are then bumped and
+    template_audit records each changed row of the class."""
+    with conn.transaction():
+        conn.execute(LOCK_FOR_WRITING)
+        conn.execute("SELECT 1 FROM gear_class WHERE name = %s FOR UPDATE", (gear_class,))
+        inherited = {row.id: row for row in inherited_rows(conn, gear_class)}
+        own = [row for row in rows if inherited.get(row.id) != row]
+        check_rows(gear_class, merge_rows(inherited.values(), own))
+        current = tuple(TemplateRow(*row) for row in conn.execute(OWN_ROWS, (gear_class,)))
+        if current == tuple(own):
+            return False
+        before = conn.execute("SELECT class_rows_json(%s)::text", (gear_class,)).fetchone()[0]
+        old_components = [r[0] for r in conn.execute(
+            "DELETE FROM assembly WHERE gear_class = %s RETURNING component_id", (gear_class,))]
+        for row in own:
+            component_id = _component_for(conn, row)
+            conn.execute("INSERT INTO assembly (gear_class, id, n, component_id) VALUES (%s, %s, %s, %s)",
+                         (gear_class, row.id, row.n, component_id))
+        _delete_orphans(conn, old_components)
+        conn.execute(BUMP_VERSIONS, (gear_class,))
+        # template_audit: one row per row of the class's assembled template that changed.
+        conn.execute("SELECT audit_class_change(%s, %s::jsonb)", (gear_class, before))
+    return True
+
+
+# Writers take their locks on the library in the refactor's order (engine.library.refactor.LOCK), so
+# a writer that started first finishes and the refactor waits for it, never a deadlock.
+# ROW EXCLUSIVE: writers do not wait for each other.
+LOCK_FOR_WRITING = "LOCK TABLE gear_class, component, assembly IN ROW EXCLUSIVE MODE"
+
+OWN_ROWS = """
+SELECT a.id, c.t, a.n, c.p_calc, c.s, c.o, c.p_emit
+FROM assembly a JOIN component c ON c.id = a.component_id
+WHERE a.gear_class = %s ORDER BY a.id"""
+
+# The class and every class below it: their assembled templates change together.
+BUMP_VERSIONS = """
+WITH RECURSIVE below(name, depth) AS (
+    SELECT name, 0 FROM gear_class WHERE name = %s
+    UNION ALL
+    SELECT g.name, b.depth + 1 FROM gear_class g JOIN below b ON g.parent = b.name WHERE b.depth < 50)
+UPDATE gear_class SET template_version = template_version + 1
+WHERE name IN (SELECT name FROM below)"""
+
+
+def inherited_rows(conn, gear_class: str) -> list[TemplateRow]:
+    """The rows the class would have with no rows of its own: its parent's assembled template."""
+    parent = conn.execute("SELECT parent FROM gear_class WHERE name = %s", (gear_class,)).fetchone()
+    if parent is None or parent[0] is None:
+        return []
+    return [TemplateRow(*row) for row in conn.execute(LOAD_ROWS, (parent[0],))]
+
+
+def merge_rows(inherited, own) -> list[TemplateRow]:
+    """Own rows override inherited rows with the same id; the result in id order."""
+    merged = {row.id: row for row in inherited}
+    merged.update((row.id, row) for row in own)
+    return [merged[row_id] for row_id in sorted(merged)]
+
+
+FIND_COMPONENT = """
+SELECT id FROM component
+WHERE t = %s AND o IS NOT DISTINCT FROM %s AND p_calc IS NOT DISTINCT FROM %s
+  AND s IS NOT DISTINCT FROM %s AND p_emit IS NOT DISTINCT FROM %s
+ORDER BY id LIMIT 1"""
+
+
+def _component_for(conn, row: TemplateRow) -> int:
+    body = (row.t, row.o, row.p_calc, row.s, row.p_emit)
+    found = conn.execute(FIND_COMPONENT, body).fetchone()
+    if found:
+        return found[0]
+    return conn.execute("INSERT INTO component (t, o, p_calc, s, p_emit) VALUES (%s, %s, %s, %s, %s) "
+                        "RETURNING id", body).fetchone()[0]
+
+
+def _delete_orphans(conn, component_ids: list[int]) -> None:
+    if component_ids:
+        conn.execute("DELETE FROM component c WHERE c.id = ANY(%s) AND NOT EXISTS "
+                     "(SELECT 1 FROM assembly a WHERE a.component_id = c.id)", (component_ids,))
