@@ -3,8 +3,9 @@ before it runs, or stopped by a limit, with a message that names the problem."""
 import pytest
 
 from engine.errors import EngineError
-from engine.templates.expressions import (MAX_INT_BITS, MAX_STRING_LENGTH, compile_expression, compile_statements,
-                                evaluate_with_asteval, evaluation_globals)
+from engine.templates.expressions import (compile_expression, compile_statements, evaluate_with_asteval,
+                                          evaluation_globals)
+from engine.templates.guards import MAX_INT_BITS, MAX_STRING_LENGTH
 
 
 def evaluate(text, **scope):

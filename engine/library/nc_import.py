@@ -52,7 +52,8 @@ from psycopg.types.json import Jsonb
 
 from ..templates.decision_table import MODULE_ORDER, CompiledTemplate
 from ..errors import EngineError
-from ..templates.expressions import CONSTANTS, FUNCTIONS, MAX_EXPRESSION_LENGTH, compile_expression, evaluation_globals
+from ..templates.expressions import MAX_EXPRESSION_LENGTH, compile_expression, evaluation_globals
+from ..templates.functions import CONSTANTS, FUNCTIONS
 from .nc_tokens import LABEL, NUMBER, SYMBOL, LineFacts, facts, tokenise
 from ..templates.rows import TemplateRow
 from ..templates.store import ensure_class, load_template, replace_template

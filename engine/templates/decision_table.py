@@ -15,8 +15,9 @@ from functools import partial
 from dataclasses import dataclass, field
 
 from ..errors import EngineError
-from .expressions import (MAX_SECONDS_PER_INSTANTIATION, MAX_STRING_LENGTH, Compiled, ExpressionError,
-                          compile_expression, compile_statements, evaluation_globals)
+from .expressions import (MAX_SECONDS_PER_INSTANTIATION, Compiled, ExpressionError, compile_expression,
+                          compile_statements, evaluation_globals)
+from .guards import MAX_STRING_LENGTH
 from ..programs.nc_check import words
 from .rows import Template, TemplateRow
 from ..turning.nc_path import NcLines

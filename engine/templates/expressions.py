@@ -7,9 +7,9 @@ new lines.
 
 Safety comes from the shape of what is allowed, not from watching a running program:
 no statements other than plain assignments in `s`, no loops, comprehensions, lambdas,
-attribute access, imports or calls other than the named functions below; the operators
-that can blow up (`**`, `*`, `+`, `<<`, `%`) and format widths go through guards with the
-limits below (asteval's own guards and limits, applied to compiled code). Every
+attribute access, imports or calls other than the named functions (engine.templates.functions);
+the operators that can blow up (`**`, `*`, `+`, `<<`, `%`) and format widths go through the
+guards of engine.templates.guards (asteval's own guards and limits, applied to compiled code). Every
 expression therefore runs in time bounded by its size. A wall-clock budget per
 instantiation is kept as a second line of defence (engine.templates.decision_table).
 
@@ -21,18 +21,16 @@ asteval Interpreter; tests check both agree on every seeded template.
 from __future__ import annotations
 
 import ast
-import math
-import re
 from dataclasses import dataclass
-from typing import Any, Callable
+from typing import Any
 
 from ..errors import EngineError
+from .functions import CONSTANTS, FUNCTIONS
+from .guards import (check_format_spec, guard_length, safe_add, safe_format, safe_lshift, safe_mod,
+                     safe_mult, safe_pow)
 
 MAX_EXPRESSION_LENGTH = 4_000      # characters of one expression or statement block
 MAX_NODES = 400                    # AST nodes of one expression
-MAX_STRING_LENGTH = 1 << 16        # characters of any string an expression builds
-MAX_INT_BITS = 4_096               # bits of any integer an expression builds
-MAX_FORMAT_WIDTH = 200             # width/precision in a format spec
 MAX_SECONDS_PER_INSTANTIATION = 2.0
 
 ALLOWED_NODES = (
@@ -45,111 +43,11 @@ ALLOWED_NODES = (
 )
 
 
-def _bits(value) -> int:
-    return value.bit_length() if isinstance(value, int) else 0
-
-
-def _too_long(value) -> bool:
-    return isinstance(value, (str, bytes, tuple, list)) and len(value) > MAX_STRING_LENGTH
-
-
-def _guard(result):
-    if _too_long(result):
-        raise ValueError(f"result longer than {MAX_STRING_LENGTH} characters")
-    return result
-
-
-def safe_pow(base, exponent):
-    if isinstance(base, int) and isinstance(exponent, int) and exponent > 0 and abs(base) > 1:
-        if exponent * abs(base).bit_length() > MAX_INT_BITS:
-            raise ValueError(f"power too large (more than {MAX_INT_BITS} bits)")
-    return base ** exponent
-
-
-def safe_mult(left, right):
-    if isinstance(left, int) and isinstance(right, int):
-        if _bits(left) + _bits(right) > MAX_INT_BITS:
-            raise ValueError(f"product too large (more than {MAX_INT_BITS} bits)")
-    for sequence, count in ((left, right), (right, left)):
-        if isinstance(sequence, (str, tuple, list)) and isinstance(count, int):
-            if len(sequence) * count > MAX_STRING_LENGTH:
-                raise ValueError(f"repetition longer than {MAX_STRING_LENGTH} characters")
-    return left * right
-
-
-def safe_add(left, right):
-    if isinstance(left, (str, tuple, list)) and isinstance(right, type(left)):
-        if len(left) + len(right) > MAX_STRING_LENGTH:
-            raise ValueError(f"result longer than {MAX_STRING_LENGTH} characters")
-    return left + right
-
-
-def safe_lshift(left, right):
-    if isinstance(right, int) and right + _bits(left) > MAX_INT_BITS:
-        raise ValueError(f"shift too large (more than {MAX_INT_BITS} bits)")
-    return left << right
-
-
-def safe_mod(left, right):
-    if isinstance(left, str):
-        raise ValueError("'%' string formatting is not allowed; use an f-string")
-    return left % right
-
-
-_FORMAT_NUMBERS = re.compile(r"\d+")
-
-
-def check_format_spec(spec: str) -> None:
-    if any(int(number) > MAX_FORMAT_WIDTH for number in _FORMAT_NUMBERS.findall(spec)):
-        raise ValueError(f"format width or precision above {MAX_FORMAT_WIDTH} in {spec!r}")
-
-
-def _constant_spec(spec: ast.JoinedStr) -> str | None:
-    """The text of a format spec without replacement fields, else None."""
-    if all(isinstance(part, ast.Constant) for part in spec.values):
-        return "".join(part.value for part in spec.values)
-    return None
-
-
-def safe_format(value, spec: str) -> str:
-    """format() with the width and precision of the spec bounded."""
-    check_format_spec(spec)
-    return format(value, spec)
-
-
-def safe_str(value=""):
-    if isinstance(value, int) and _bits(value) > MAX_INT_BITS:
-        raise ValueError("integer too large to print")
-    return _guard(str(value))
-
-
-def safe_round(value, digits=None):
-    if digits is not None and abs(digits) > MAX_FORMAT_WIDTH:
-        raise ValueError(f"round() to more than {MAX_FORMAT_WIDTH} digits")
-    return round(value) if digits is None else round(value, digits)
-
-
-_MATH = ("sin", "cos", "tan", "asin", "acos", "atan", "atan2", "radians", "degrees", "sqrt",
-         "hypot", "ceil", "floor", "trunc", "fabs", "copysign", "exp", "log", "log10", "isclose")
-FUNCTIONS: dict[str, Callable[..., Any]] = {name: getattr(math, name) for name in _MATH}
-FUNCTIONS.update({
-    "abs": abs, "min": min, "max": max, "round": safe_round, "int": int, "float": float,
-    "str": safe_str, "bool": bool, "len": len, "format": safe_format,
-})
-
-def _nc_path(*args):
-    from ..turning.nc_path import nc_path
-
-    return nc_path(*args)
-
-
-FUNCTIONS["nc_path"] = _nc_path   # a tool path, one NC block per move (engine.turning.nc_path)
-CONSTANTS = {"pi": math.pi, "e": math.e, "True": True, "False": False, "None": None}
 GUARDED_OPERATORS = {ast.Pow: "_safe_pow", ast.Mult: "_safe_mult", ast.Add: "_safe_add",
                      ast.LShift: "_safe_lshift", ast.Mod: "_safe_mod"}
 RUNTIME = {"_safe_pow": safe_pow, "_safe_mult": safe_mult, "_safe_add": safe_add,
            "_safe_lshift": safe_lshift, "_safe_mod": safe_mod, "_safe_format": safe_format,
-           "_guard": _guard}
+           "_guard": guard_length}
 
 
 def _sql_runtime() -> dict:
@@ -280,6 +178,13 @@ def _read_names(tree: ast.AST):
         if isinstance(node, ast.Name) and node.id not in FUNCTIONS and node.id not in CONSTANTS \
                 and not node.id.startswith("_sql_"):
             yield node.id
+
+
+def _constant_spec(spec: ast.JoinedStr) -> str | None:
+    """The text of a format spec without replacement fields, else None."""
+    if all(isinstance(part, ast.Constant) for part in spec.values):
+        return "".join(part.value for part in spec.values)
+    return None
 
 
 class _GuardOperators(ast.NodeTransformer):

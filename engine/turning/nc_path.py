@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import string
 
-from ..templates.expressions import check_format_spec
+from ..templates.guards import check_format_spec
 from .moves import MOVE_KINDS
 
 FIELDS = ("x", "z", "r", "i", "k", "pitch")   # x a diameter; r, i, k arc radius and centre offsets
