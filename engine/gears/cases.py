@@ -20,7 +20,7 @@ from .cutting_data import CuttingData
 from ..errors import EngineError
 from .hob_matching import choose_hob
 from ..paths import SEED_DIR
-from .records import Gear, Hob, Machine, load_gear, load_hobs, load_machine
+from .records import Gear, Hob, Machine, hobbing_machine, load_gear, load_hobs
 
 FEATURE_COLUMNS = ("module", "teeth", "material", "hardness", "quality_grade", "hob_material",
                    "hob_coating", "hob_starts", "hob_tip_diameter")
@@ -98,13 +98,8 @@ def suggest_from(base: CaseBase, gear: Gear, hob: Hob, machine: Machine, *, top:
 
 def suggest_for_gear(conn, gear_id: int, machine_name: str | None = None, *, top: int = 3) -> Suggestion:
     """`engine suggest`: the hob the library chooses for the gear, and its cutting data."""
-    from ..programs.instantiate import DEFAULT_HOBBING_MACHINE
-
     gear = load_gear(conn, gear_id)
-    machine = load_machine(conn, machine_name or DEFAULT_HOBBING_MACHINE)
-    if machine.kind != "hobber":
-        raise EngineError(f"machine {machine.name} is a {machine.kind}, not a hobbing machine; "
-                          f"use --machine {DEFAULT_HOBBING_MACHINE}")
+    machine = hobbing_machine(conn, machine_name)
     from .models import model_for_class
 
     model = model_for_class(conn, gear.gear_class) if gear.gear_class else None

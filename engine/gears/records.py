@@ -121,6 +121,18 @@ def load_hobs(conn) -> list[Hob]:
     return [_as_float(Hob, row) for row in conn.execute(HOB_QUERY + " ORDER BY id")]
 
 
+DEFAULT_HOBBING_MACHINE = "hobber-840d"
+
+
+def hobbing_machine(conn, name: str | None) -> Machine:
+    """The machine record, which must be a hobbing machine (default: the seeded 840D hobber)."""
+    machine = load_machine(conn, name or DEFAULT_HOBBING_MACHINE)
+    if machine.kind != "hobber":
+        raise EngineError(f"machine {machine.name} is a {machine.kind}, not a hobbing machine; "
+                          f"use --machine {DEFAULT_HOBBING_MACHINE}")
+    return machine
+
+
 def load_machine(conn, name: str) -> Machine:
     row = conn.execute(MACHINE_QUERY + " WHERE name = %s", (name,)).fetchone()
     if row is None:

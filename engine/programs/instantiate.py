@@ -5,70 +5,30 @@ table → machine-limit check → job and program stored in one transaction → 
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
 from pathlib import Path
 
-
-from ..gears.case_base import CUT_KINDS_BY_COUNT, CaseBase, job_cutting_record
-from ..templates.decision_table import Result, compiled_template
 from ..errors import EngineError
-from ..hobbing.choices import Choices
+from ..gears.case_base import CUT_KINDS_BY_COUNT, CaseBase, job_cutting_record
 from ..gears.hob_matching import choose_hob
-from ..memory import no_cycle_collection
 from ..gears.models import model_for_class
-from .nc_check import LimitError, check_program, check_table_speed
-from .outputs import write_program_files
-from ..gears.records import Gear, Machine, load_gear, load_gears, load_hobs, load_machine
+from ..gears.records import Gear, Machine, hobbing_machine, load_gear, load_gears, load_hobs, load_machine
+from ..hobbing.choices import Choices
+from ..memory import no_cycle_collection
+from ..templates.decision_table import Result, compiled_template
 from ..templates.rows import Template
 from ..templates.store import load_template
 from ..turning.names import TurningModel
-
-DEFAULT_HOBBING_MACHINE = "hobber-840d"
-
-
-@dataclass(slots=True)
-class Planned:
-    """A job computed in memory, with its program, not yet stored."""
-    gear_id: int | None
-    gear_class: str
-    machine: str
-    hob_id: str | None
-    params: dict
-    module_params: dict
-    template: Template
-    result: Result
-    cutting: dict | None = None      # job.cutting: the cutting data chosen and their source
-
-    @property
-    def name(self) -> str:
-        return str(self.params.get("program_name", f"JOB_{self.gear_id}"))
-
-
-@dataclass(frozen=True)
-class Program:
-    program_id: int
-    job_id: int
-    name: str
-    lines: list[str]
-    gear_class: str
-    template_version: int
-    template_hash: str
-    path: str | None = None
-
-    @property
-    def text(self) -> str:
-        return "\n".join(self.lines) + "\n"
-
+from .nc_check import LimitError, check_program, check_table_speed
+from .outputs import write_program_files
+from .records import Planned, Program
+from .storage import store_many, store_one
 
 class Planner:
     """Everything shared by the gears of one run: machine, hob library, templates."""
 
     def __init__(self, conn, machine: str | None = None, choices: Choices = Choices(), overrides=None):
         self.conn = conn
-        self.machine = load_machine(conn, machine or DEFAULT_HOBBING_MACHINE)
-        if self.machine.kind != "hobber":
-            raise EngineError(f"machine {self.machine.name} is a {self.machine.kind}, not a hobbing machine; "
-                              f"use --machine {DEFAULT_HOBBING_MACHINE}")
+        self.machine = hobbing_machine(conn, machine)
         self.hobs = load_hobs(conn)
         self.case_base = CaseBase.load(conn)
         self._cutting: dict[tuple, tuple] = {}
@@ -178,8 +138,6 @@ def instantiate_gears(conn, first: int | None = None, last: int | None = None, *
     gears = load_gears(conn, first, last)
     if not gears:
         raise EngineError(f"no gears with ids in {first or 'the start'}…{last or 'the end'}")
-    from .storage import store_many
-
     with no_cycle_collection():
         planned = [_plan_in_batch(planner, gear, progress) for gear in gears]
         return store_many(conn, planned, out)
@@ -198,8 +156,6 @@ def _plan_in_batch(planner: Planner, gear: Gear, progress) -> Planned:
 
 
 def _store_and_write(conn, planned: list[Planned], out, existing_job: int | None = None) -> list[Program]:
-    from .storage import store_one
-
     with write_program_files(planned, out) as paths:
         with conn.transaction():
             programs = [store_one(conn, item, existing_job, paths.get(item.name)) for item in planned]

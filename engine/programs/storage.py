@@ -5,6 +5,9 @@ from dataclasses import dataclass
 
 from psycopg.types.json import Jsonb
 
+from .outputs import write_program_files
+from .records import Planned, Program
+
 INSERT_JOB = """
 INSERT INTO job (gear_id, gear_class, machine, hob_id, params, module_params, cutting)
 VALUES (%s, %s, %s, %s, %s, %s, %s) RETURNING id"""
@@ -17,7 +20,7 @@ COPY_PROGRAM = ("COPY program (id, job_id, gear_class, template_version, templat
 PROGRAM_TYPES = ("int8", "int8", "text", "int4", "text", "text", "text[]", "int4[]")
 
 
-def store_one(conn, planned, existing_job: int | None, path: str | None):
+def store_one(conn, planned: Planned, existing_job: int | None, path: str | None) -> Program:
     job_id = existing_job
     if job_id is None:
         job_id = conn.execute(INSERT_JOB, (planned.gear_id, planned.gear_class, planned.machine, planned.hob_id,
@@ -27,10 +30,8 @@ def store_one(conn, planned, existing_job: int | None, path: str | None):
     return _program(program_id, job_id, planned, path)
 
 
-def store_many(conn, planned: list, out=None) -> "Batch":
+def store_many(conn, planned: list[Planned], out=None) -> "Batch":
     """All jobs and programs in one transaction, through COPY (the batch path)."""
-    from .outputs import write_program_files
-
     with write_program_files(planned, out), conn.transaction():
         job_ids = _next_ids(conn, "job_id_seq", len(planned))
         program_ids = _next_ids(conn, "program_id_seq", len(planned))
@@ -71,8 +72,6 @@ def _program_values(job_id: int, planned) -> tuple:
             planned.result.lines, planned.result.row_ids)
 
 
-def _program(program_id: int, job_id: int, planned, path):
-    from .instantiate import Program
-
+def _program(program_id: int, job_id: int, planned: Planned, path) -> Program:
     return Program(program_id, job_id, planned.name, planned.result.lines, planned.gear_class,
                    planned.template.version, planned.template.hash, path)

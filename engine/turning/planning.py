@@ -2,9 +2,10 @@
 passes computed from them, then checked against the lathe. Nothing is stored here."""
 from __future__ import annotations
 
-from ..templates.decision_table import compiled_template
 from ..errors import EngineError
 from ..gears.records import Machine, load_machine
+from ..programs.records import Planned
+from ..templates.decision_table import compiled_template
 from ..templates.store import load_template
 from .check import check_lathe_program
 from .defaults import DEFAULT_LATHE
@@ -33,10 +34,8 @@ def turning_class(machine: Machine) -> str:
 
 def plan_turning_job(conn, gear_class: str, machine: Machine, params: dict, module_params: dict,
                      passes: dict | None = None):
-    """→ Planned (engine.instantiate): the program computed and checked, not stored.
+    """→ Planned (engine.programs.records): the program computed and checked, not stored.
     `passes`: the job's passes (model.job_passes) if the caller has them already."""
-    from ..programs.instantiate import Planned
-
     template = load_template(conn, gear_class)
     extended = template_module_params(params, module_params, passes)
     result = compiled_template(template).run(params, extended)
