@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import click
 
-from .app import connection, emit_json
+from .context import connection, emit_json
 
 CASE_TABLE_COLUMNS = {   # column -> heading, for the small tables printed
     "id": "case", "distance": "distance", "module": "m", "teeth": "z", "material": "material", "hardness": "HB",

@@ -1,11 +1,11 @@
-"""`engine hobs …`: the hob library (registered on engine.cli.main)."""
+"""`engine hobs …`: the hob library (list, add, import, match)."""
 from __future__ import annotations
 
 from dataclasses import asdict
 
 import click
 
-from .app import connection, emit_json
+from .context import connection, emit_json
 
 TABLE = (  # (heading, width, the cell of a hob)
     ("id", 14, lambda hob: hob.id),

@@ -5,7 +5,7 @@ from dataclasses import asdict
 
 import click
 
-from .app import connection, emit_json
+from .context import connection, emit_json
 
 
 @click.command("import-nc")

@@ -1,4 +1,4 @@
-"""`engine refactor` and `engine template shared`: thin shells over engine.refactor."""
+"""`engine refactor` and `engine template shared`: thin shells over engine.library.refactor."""
 from __future__ import annotations
 
 import sys
@@ -6,8 +6,7 @@ from contextlib import contextmanager
 
 import click
 
-from .app import connection, emit_json
-from .commands import template
+from .context import connection, emit_json
 
 
 @click.command("refactor")
@@ -69,7 +68,7 @@ def _uses(rows, count: int) -> str:
     return listed + (f" and {count - len(rows)} more" if count > len(rows) else "")
 
 
-@template.command("shared")
+@click.command("shared")
 @click.option("--class", "gear_class", required=True, help="Gear class name.")
 @click.pass_context
 def template_shared(ctx, gear_class):

@@ -6,7 +6,7 @@ from dataclasses import asdict
 
 import click
 
-from .app import connection, emit_json
+from .context import connection, emit_json
 from ..errors import EngineError
 from ..turning.defaults import DEFAULT_LATHE, PROFILE_DEFAULTS, STOCK_MARGIN
 

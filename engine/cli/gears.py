@@ -1,0 +1,53 @@
+"""`engine gears import|units` and `engine classify`: workpieces and their class."""
+from __future__ import annotations
+
+import click
+
+from .context import connection, emit_json
+
+
+@click.group()
+def gears():
+    """Workpieces: import them from CSV (columns of design notes §9)."""
+
+
+@gears.command("import")
+@click.argument("csv_file", type=click.Path(dir_okay=False))
+@click.option("--json", "as_json", is_flag=True, help="Print one JSON object: {imported: N}.")
+@click.pass_context
+def gears_import(ctx, csv_file, as_json):
+    """Import gears from CSV_FILE; any bad row stops the whole file (nothing stored)."""
+    from ..gears.gear_import import import_gears
+
+    with connection(ctx) as conn:
+        count = import_gears(conn, csv_file)
+    emit_json({"imported": count}) if as_json else click.echo(f"imported {count} gear(s) from {csv_file}")
+
+
+@gears.command("units")
+@click.argument("csv_file", type=click.Path(dir_okay=False))
+@click.pass_context
+def gears_units(ctx, csv_file):
+    """Import further toothed units of multi-unit (duplex) gears from CSV_FILE.
+
+    Columns: gear_id, unit (2, 3, ...), teeth, face_width, tip_diameter, root_diameter,
+    z_top (Z of the unit's upper face; the gear's top face is Z = 0). The units of each
+    gear in the file replace its units; any bad row stops the whole file."""
+    from ..gears.units import import_units
+
+    with connection(ctx) as conn:
+        count = import_units(conn, csv_file)
+    click.echo(f"imported {count} unit(s) from {csv_file}")
+
+
+@click.command()
+@click.option("--gear", "gear_id", type=int, required=True, help="Gear id.")
+@click.pass_context
+def classify(ctx, gear_id):
+    """Explain a gear's class: the group-technology decision path (face-width variation,
+    generating line, units), the class stored, its hobbing model and the hob it gets."""
+    from ..gears.classify import explain_gear
+
+    with connection(ctx) as conn:
+        report = explain_gear(conn, gear_id)
+    click.echo("\n".join(report.lines()))

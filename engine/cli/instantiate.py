@@ -1,0 +1,94 @@
+"""`engine instantiate`: the program of a gear, a stored job, or a batch of gears."""
+from __future__ import annotations
+
+import re
+
+import click
+
+from ..errors import EngineError
+from .context import connection, emit_json
+
+RANGE = re.compile(r"^\s*(\d+)\s*(?:-\s*(\d+))?\s*$")
+
+
+def parse_range(text: str) -> tuple[int, int]:
+    match = RANGE.match(text)
+    if not match:
+        raise EngineError(f"--gears {text!r} is not a range like 1-5000 or 42")
+    first = int(match.group(1))
+    last = int(match.group(2) or first)
+    if last < first:
+        raise EngineError(f"--gears {text!r}: the range ends before it starts")
+    return first, last
+
+
+@click.command()
+@click.option("--gear", "gear_id", type=int, help="Gear id: compute a new job and its program.")
+@click.option("--job", "job_id", type=int, help="Stored job id: instantiate again with its (edited) parameters.")
+@click.option("--gears", "gear_range", help="Batch: gear ids FIRST-LAST (all stored, or none).")
+@click.option("--all", "all_gears", is_flag=True, help="Batch: every gear.")
+@click.option("--out", type=click.Path(), help="Write the .MPF file here (a directory for batches).")
+@click.option("--machine", help="Machine record (default hobber-840d).")
+@click.option("--cuts", type=click.IntRange(1, 2), help="1 = single cut, 2 = rough then finish (default by module).")
+@click.option("--coolant/--no-coolant", default=True, show_default=True, help="Coolant M8/M9.")
+@click.option("--shift-y", type=float, default=0.0, help="Hob shift position Y for this part, mm.")
+@click.option("--shift-per-part", type=float, default=0.0,
+              help="Shift the hob by this many mm every part (R11 counts), wrapping within the hob's usable length.")
+@click.option("--feed-mode", type=click.Choice(["climb", "conventional", "conventional-climb"]), default="climb",
+              show_default=True, help="Axial pass direction; conventional-climb: rough conventional, finish climb.")
+@click.option("--tailstock/--no-tailstock", default=True, show_default=True, help="Tailstock clamp M20/M21.")
+@click.option("--worm-feed", type=click.Choice(["radial", "tangential"]), default="radial", show_default=True,
+              help="Worm wheels: radial plunge, or tangential feed along Y.")
+@click.option("--hob-speed", type=int, help="Override the hob speed n0, r/min.")
+@click.option("--json", "as_json", is_flag=True, help="Print one JSON object (program_id, path, lines, ...).")
+@click.pass_context
+def instantiate(ctx, gear_id, job_id, gear_range, all_gears, out, machine, cuts, coolant, shift_y,
+                shift_per_part, feed_mode, tailstock, worm_feed, hob_speed, as_json):
+    """Produce the NC program of a gear (or a stored job, or a batch of gears).
+
+    The program is checked against the machine's limits, stored with the template
+    version it came from, printed (single program) and written to --out.
+    """
+    from ..hobbing.choices import Choices
+    from ..programs.instantiate import instantiate_gear, instantiate_gears, instantiate_job
+
+    chosen = [name for name, value in (("--gear", gear_id), ("--job", job_id), ("--gears", gear_range),
+                                       ("--all", all_gears)) if value]
+    if len(chosen) != 1:
+        raise EngineError("give exactly one of --gear ID, --job ID, --gears FIRST-LAST, --all")
+    choices = Choices(cuts=cuts, coolant=coolant, shift_y=shift_y, shift_per_part=shift_per_part,
+                      feed_mode=feed_mode, tailstock=tailstock, worm_feed=worm_feed)
+    overrides = {"hob_speed": hob_speed}
+    with connection(ctx) as conn:
+        if gear_id is not None:
+            program = instantiate_gear(conn, gear_id, machine=machine, choices=choices, overrides=overrides, out=out)
+        elif job_id is not None:
+            program = instantiate_job(conn, job_id, out=out)
+        else:
+            first, last = parse_range(gear_range) if gear_range else (None, None)
+            programs = instantiate_gears(conn, first, last, machine=machine, choices=choices,
+                                         overrides=overrides, out=out)
+            return _report_batch(programs, out, as_json)
+    _report_program(program, as_json)
+
+
+def _report_program(program, as_json: bool) -> None:
+    if as_json:
+        emit_json({"program_id": program.program_id, "job_id": program.job_id, "name": program.name,
+                   "path": program.path, "lines": len(program.lines), "gear_class": program.gear_class,
+                   "template_version": program.template_version, "template_hash": program.template_hash})
+        return
+    if program.path is None:
+        click.echo(program.text, nl=False)
+    click.echo(f"program {program.program_id} (job {program.job_id}, {len(program.lines)} lines) "
+               f"from {program.gear_class} v{program.template_version}"
+               + (f" written to {program.path}" if program.path else ""), err=True)
+
+
+def _report_batch(batch, out, as_json: bool) -> None:
+    if as_json:
+        emit_json({"programs": batch.programs, "lines": batch.lines, "path": out,
+                   "program_ids": [batch.first_program_id, batch.last_program_id]})
+    else:
+        click.echo(f"stored {batch.programs} program(s) {batch.first_program_id}…{batch.last_program_id}, "
+                   f"{batch.lines} lines" + (f", written to {out}" if out else ""))

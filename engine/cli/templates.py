@@ -1,0 +1,165 @@
+"""`engine template list|export|import|history|diff|restore|shared` and `engine lint`: the
+templates of the gear classes and their versions."""
+from __future__ import annotations
+
+import sys
+
+import click
+
+from .context import connection, emit_json
+from .refactor import template_shared
+
+
+@click.group()
+def template():
+    """Templates of gear classes: list, export and import as CSV (id,t,n,p_calc,s,o,p_emit);
+    history, diff and restore of their versions."""
+
+
+@template.command("list")
+@click.pass_context
+def template_list(ctx):
+    """Every gear class with its parent, template version and number of rows."""
+    from ..templates.store import list_classes
+
+    with connection(ctx) as conn:
+        for name, parent, version, rows, description in list_classes(conn):
+            click.echo(f"{name:14} parent={parent or '-':12} v{version:<3} {rows:3} rows  {description}")
+
+
+@template.command("export")
+@click.option("--class", "gear_class", required=True, help="Gear class name.")
+@click.option("--out", type=click.Path(dir_okay=False), help="Write to this file instead of stdout.")
+@click.pass_context
+def template_export(ctx, gear_class, out):
+    """Print the class's assembled template as CSV."""
+    from ..templates.rows import export_csv
+    from ..templates.store import load_template
+
+    with connection(ctx) as conn:
+        text = export_csv(load_template(conn, gear_class))
+    if out:
+        with open(out, "w", encoding="utf-8", newline="") as file:
+            file.write(text)
+    else:
+        click.echo(text, nl=False)
+
+
+@template.command("import")
+@click.option("--class", "gear_class", required=True, help="Gear class name (created if new).")
+@click.option("--parent", help="Parent class in the tree, for a new class.")
+@click.argument("csv_file", type=click.Path(dir_okay=False))
+@click.pass_context
+def template_import(ctx, gear_class, parent, csv_file):
+    """Replace the class's rows with CSV_FILE; every expression is checked first (all or nothing)."""
+    from ..templates.rows import read_csv
+    from ..templates.store import ensure_class, replace_template
+
+    rows = read_csv(csv_file)
+    with connection(ctx) as conn:
+        with conn.transaction():
+            created = ensure_class(conn, gear_class, parent)
+            changed = replace_template(conn, gear_class, rows)
+        version = conn.execute("SELECT template_version FROM gear_class WHERE name = %s", (gear_class,)).fetchone()[0]
+    state = "created" if created else ("replaced" if changed else "unchanged (identical rows)")
+    click.echo(f"class {gear_class}: {state}, {len(rows)} rows, version {version}")
+
+
+@template.command("history")
+@click.option("--class", "gear_class", required=True, help="Gear class name.")
+@click.option("--json", "as_json", is_flag=True, help="Print one JSON object: {versions: [...]}.")
+@click.pass_context
+def template_history(ctx, gear_class, as_json):
+    """Every stored version of the class, oldest first: when, who, rows, which rows changed."""
+    from ..templates.history import history
+
+    with connection(ctx) as conn:
+        entries = history(conn, gear_class)
+    if as_json:
+        return emit_json({"gear_class": gear_class, "versions": [_version_json(entry) for entry in entries]})
+    for number, entry in enumerate(entries):
+        click.echo(f"v{entry.version:<4} {entry.created_at:%Y-%m-%d %H:%M:%S} by {entry.created_by:14} "
+                   f"{entry.rows:3} rows  {_changes_text(entry.changes, first=number == 0)}".rstrip())
+
+
+def _changes_text(changes, first: bool) -> str:
+    """Which rows a version changed: each row, or counts per operation when there are many."""
+    if not changes:
+        return "" if first else "(rows inherited from a parent class changed)"
+    if len(changes) <= 6:
+        return ", ".join(f"{operation} {row_id}" for row_id, operation in changes)
+    operations = [operation for _, operation in changes]
+    return ", ".join(f"{operation} x{operations.count(operation)}" for operation in dict.fromkeys(operations))
+
+
+def _version_json(entry) -> dict:
+    return {"version": entry.version, "created_at": entry.created_at.isoformat(), "created_by": entry.created_by,
+            "rows": entry.rows, "changes": [{"row_id": row_id, "operation": operation}
+                                            for row_id, operation in entry.changes]}
+
+
+@template.command("diff")
+@click.option("--class", "gear_class", required=True, help="Gear class name.")
+@click.option("--from", "from_version", type=int, required=True, help="Earlier version (see `template history`).")
+@click.option("--to", "to_version", type=int, required=True, help="Later version.")
+@click.option("--json", "as_json", is_flag=True, help="Print one JSON object: {changes: [{row_id, kind, old, new}]}.")
+@click.pass_context
+def template_diff(ctx, gear_class, from_version, to_version, as_json):
+    """Rows added (+), removed (-) and changed (~) between two versions of the class, with old and new values."""
+    from ..templates.history import diff
+
+    with connection(ctx) as conn:
+        changes = diff(conn, gear_class, from_version, to_version)
+    if as_json:
+        return emit_json({"gear_class": gear_class, "from": from_version, "to": to_version,
+                          "changes": [{"row_id": c.row_id, "kind": c.kind, "old": c.old, "new": c.new}
+                                      for c in changes]})
+    for change in changes:
+        click.echo("\n".join(_diff_lines(change)))
+    click.echo(f"{len(changes)} row(s) differ between v{from_version} and v{to_version}", err=True)
+
+
+def _diff_lines(change) -> list[str]:
+    if change.kind == "added":
+        return [f"+ {change.row_id}: {change.new}"]
+    if change.kind == "removed":
+        return [f"- {change.row_id}: {change.old}"]
+    return [f"~ {change.row_id} {column}: {change.old[column]!r} -> {change.new[column]!r}"
+            for column in change.columns]
+
+
+@template.command("restore")
+@click.option("--class", "gear_class", required=True, help="Gear class name.")
+@click.option("--version", type=int, required=True, help="The version to bring back (see `template history`).")
+@click.pass_context
+def template_restore(ctx, gear_class, version):
+    """Make the class's template what it was in an earlier version, as a new version (history is kept)."""
+    from ..templates.history import restore
+
+    with connection(ctx) as conn:
+        changed, current = restore(conn, gear_class, version)
+    state = f"restored version {version} as version {current}" if changed else \
+        f"unchanged: version {current} already has the rows of version {version}"
+    click.echo(f"class {gear_class}: {state}")
+
+
+@click.command()
+@click.option("--json", "as_json", is_flag=True, help="Print one JSON object: {errors: [...]}.")
+@click.pass_context
+def lint(ctx, as_json):
+    """Check every expression of every template: parses, is allowed, names known parameters."""
+    from ..templates.lint import lint_all
+
+    with connection(ctx) as conn:
+        problems = lint_all(conn)
+    if as_json:
+        emit_json({"errors": [str(problem) for problem in problems]})
+    else:
+        for problem in problems:
+            click.echo(str(problem))
+        click.echo(f"{len(problems)} problem(s)", err=True)
+    if problems:
+        sys.exit(1)
+
+
+template.add_command(template_shared)
