@@ -2,7 +2,13 @@
 `python -c` that connects to the same database and runs one query, same interpreter,
 alternated run by run. Target: CLI median within 2.5x of the baseline median.
 
-    python bench/latency.py [--runs 15] [--database-url postgresql://postgres@127.0.0.1:5432/postgres]
+CLI start-up: `engine --help` of this tree against `engine --help` of an earlier commit
+(`--help-against REV`, default the commit before the package was laid out in folders), both
+run as `python -c` from their own source tree with the same interpreter and packages,
+alternated. Target: within noise of the earlier commit (ratio <= 1.10).
+
+    python bench/latency.py [--runs 15] [--help-against REV] [--no-help-startup]
+                            [--database-url postgresql://postgres@127.0.0.1:5432/postgres]
 """
 from __future__ import annotations
 
@@ -11,6 +17,7 @@ import json
 import shutil
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -20,6 +27,9 @@ from _common import add_database_argument, bench_database, median, verdict  # no
 
 TARGET_RATIO = 2.5
 GEAR_ID = 42
+HELP_AGAINST = "30ac394"          # main before engine/ was laid out as the design's sections (issue 11)
+HELP_TARGET_RATIO = 1.10          # "as fast as before, within noise" on this 2-core machine
+REPO = Path(__file__).resolve().parent.parent
 
 
 def engine_command() -> str:
@@ -45,10 +55,51 @@ def check(completed: subprocess.CompletedProcess, what: str) -> None:
         raise RuntimeError(f"{what} exited {completed.returncode}: {completed.stderr.strip()[:500]}")
 
 
+def help_command(tree: Path) -> list[str]:
+    """`engine --help` of the source tree `tree`, imported from there ahead of any installed copy."""
+    code = ("import sys; sys.path.insert(0, sys.argv[1]); import engine.cli as cli; "
+            "assert cli.__file__.startswith(sys.argv[1]), cli.__file__; cli.main(['--help'])")
+    return [sys.executable, "-c", code, str(tree)]
+
+
+def source_tree_of(revision: str, into: Path) -> Path:
+    """The engine/ and importers/ folders of `revision`, unpacked into `into`."""
+    archive = subprocess.run(["git", "-C", str(REPO), "archive", revision, "engine", "importers"],
+                             capture_output=True)
+    if archive.returncode != 0:
+        sys.exit(f"bench/latency.py: cannot read commit {revision} of {REPO} ({archive.stderr.decode().strip()}); "
+                 "give --help-against REV of this checkout, or --no-help-startup")
+    archive = archive.stdout
+    subprocess.run(["tar", "-x", "-C", str(into)], input=archive, check=True)
+    return into
+
+
+def help_startup(revision: str, runs: int) -> None:
+    """Prints the median start-up of `engine --help` here and at `revision`, alternated, and their ratio."""
+    with tempfile.TemporaryDirectory(prefix="bench_help_") as folder:
+        commands = {"this tree": help_command(REPO), revision: help_command(source_tree_of(revision, Path(folder)))}
+        for what, command in commands.items():   # untimed: the first start reads files and writes bytecode
+            check(timed(command)[1], f"engine --help ({what})")
+        times = {what: [] for what in commands}
+        for _ in range(runs):
+            for what, command in commands.items():
+                seconds, completed = timed(command)
+                check(completed, f"engine --help ({what})")
+                times[what].append(seconds)
+    now, before = median(times["this tree"]), median(times[revision])
+    print(f"engine --help, this tree               : median {now * 1000:7.1f} ms (min {min(times['this tree']) * 1000:.1f})")
+    print(f"engine --help at {revision:<22}: median {before * 1000:7.1f} ms (min {min(times[revision]) * 1000:.1f})")
+    print(f"ratio this tree/{revision} = {now / before:.2f}x (target <= {HELP_TARGET_RATIO}x): "
+          f"{verdict(now / before <= HELP_TARGET_RATIO)}")
+
+
 def main(argv=None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     add_database_argument(parser)
     parser.add_argument("--runs", type=int, default=15, help="alternated runs of each command (default 15)")
+    parser.add_argument("--help-against", default=HELP_AGAINST, metavar="REV",
+                        help=f"commit whose `engine --help` start-up is the baseline (default {HELP_AGAINST})")
+    parser.add_argument("--no-help-startup", action="store_true", help="skip the `engine --help` comparison")
     args = parser.parse_args(argv)
 
     with bench_database(args.database_url, "bench_latency") as url:
@@ -76,6 +127,8 @@ def main(argv=None) -> int:
     print(f"bare python -c connect + select 1      : median {bare_median * 1000:7.1f} ms "
           f"(min {min(bare_times) * 1000:.1f}, max {max(bare_times) * 1000:.1f})")
     print(f"ratio CLI/baseline = {ratio:.2f}x (target <= {TARGET_RATIO}x): {verdict(ratio <= TARGET_RATIO)}")
+    if not args.no_help_startup:
+        help_startup(args.help_against, args.runs)
     return 0
 
 

@@ -1,0 +1,151 @@
+"""The house (issue 11): engine/ is laid out as the design's sections, no two modules import each
+other in a circle (imports inside functions count: a cycle is a cycle of the design, whenever it
+runs), and nothing below the command line imports it. The walker reads the source with `ast`;
+it is checked on a small package of its own that has each fault."""
+import ast
+from pathlib import Path
+
+import engine
+import importers
+
+DESIGN_FOLDERS = ("templates", "library", "gears", "hobbing", "turning", "programs", "db", "cli")
+CLI = "engine.cli"
+CLI_ENTRY_POINTS = {"engine.__main__"}     # `python -m engine` is the command line itself
+
+
+def modules_under(folder: Path, package: str) -> dict[str, Path]:
+    """Dotted module name -> file, for every .py file of the package folder."""
+    found = {}
+    for path in folder.rglob("*.py"):
+        parts = [package, *path.relative_to(folder).with_suffix("").parts]
+        if parts[-1] == "__init__":
+            parts.pop()
+        found[".".join(parts)] = path
+    return found
+
+
+def imported_modules(name: str, path: Path, modules: dict[str, Path]) -> set[str]:
+    """The modules of `modules` that `name` imports anywhere in its file."""
+    package = name if path.name == "__init__.py" else name.rpartition(".")[0]
+    targets = set()
+    for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+        if isinstance(node, ast.Import):
+            targets |= {alias.name for alias in node.names}
+        elif isinstance(node, ast.ImportFrom):
+            base = _absolute(package, node.module, node.level)
+            for alias in node.names:   # `from pkg import submodule` imports the submodule
+                targets.add(f"{base}.{alias.name}" if f"{base}.{alias.name}" in modules else base)
+    return {known for known in map(lambda target: _known(target, modules), targets) if known not in (None, name)}
+
+
+def _absolute(package: str, module: str | None, level: int) -> str:
+    if not level:
+        return module or ""
+    parts = package.split(".")[:len(package.split(".")) - level + 1]
+    return ".".join(parts + ([module] if module else []))
+
+
+def _known(target: str, modules) -> str | None:
+    """The deepest module of ours that `target` names (a name imported from a module is the module)."""
+    while target and target not in modules:
+        target = target.rpartition(".")[0]
+    return target or None
+
+
+def import_graph(*packages) -> dict[str, set[str]]:
+    modules = {}
+    for folder, name in packages:
+        modules.update(modules_under(folder, name))
+    return {name: imported_modules(name, path, modules) for name, path in modules.items()}
+
+
+def cycles(graph: dict[str, set[str]]) -> list[list[str]]:
+    """Every import cycle found by depth-first search, each as the path that closes it."""
+    found, state, path = [], {}, []
+
+    def visit(module):
+        state[module] = "open"
+        path.append(module)
+        for target in sorted(graph[module]):
+            if state.get(target) == "open":
+                found.append(path[path.index(target):] + [target])
+            elif target not in state:
+                visit(target)
+        path.pop()
+        state[module] = "done"
+
+    for module in sorted(graph):
+        if module not in state:
+            visit(module)
+    return found
+
+
+def cli_importers(graph: dict[str, set[str]]) -> list[str]:
+    """`module -> cli module` for every module outside the CLI that imports it."""
+    def in_cli(module):
+        return module == CLI or module.startswith(CLI + ".")
+    return sorted(f"{module} -> {target}" for module, targets in graph.items() for target in targets
+                  if in_cli(target) and not in_cli(module) and module not in CLI_ENTRY_POINTS)
+
+
+def engine_graph():
+    return import_graph((Path(engine.__file__).parent, "engine"), (Path(importers.__file__).parent, "importers"))
+
+
+def test_no_import_cycle_in_the_package():
+    graph = engine_graph()
+    assert len(graph) > 80          # the walk read the whole package
+    assert cycles(graph) == []
+
+
+def test_nothing_below_the_command_line_imports_it():
+    graph = engine_graph()
+    assert any(target.startswith(CLI + ".") for target in graph["engine.cli.app"])   # the walk sees CLI imports
+    assert cli_importers(graph) == []
+
+
+def test_engine_is_laid_out_as_the_design_s_sections():
+    folder = Path(engine.__file__).parent
+    assert [name for name in DESIGN_FOLDERS if not (folder / name / "__init__.py").is_file()] == []
+    loose = sorted(path.name for path in folder.glob("*.py") if path.name not in ("__init__.py", "__main__.py"))
+    assert loose == ["errors.py", "memory.py", "paths.py"]   # shared by every section, below all of them
+
+
+def test_every_module_says_what_it_is_in_its_first_line():
+    folder = Path(engine.__file__).parent
+    silent = [str(path.relative_to(folder)) for path in folder.rglob("*.py")
+              if path.name != "__main__.py" and not (ast.get_docstring(ast.parse(path.read_text("utf-8"))) or "").strip()]
+    assert silent == []
+
+
+def _package(tmp_path, files: dict[str, str]):
+    for relative, text in files.items():
+        path = tmp_path / "pkg" / relative
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(text)
+    return import_graph((tmp_path / "pkg", "pkg"))
+
+
+def test_the_walker_finds_a_cycle_through_an_import_inside_a_function(tmp_path):
+    graph = _package(tmp_path, {
+        "__init__.py": "",
+        "a.py": "def f():\n    from .sub import b\n    return b\n",
+        "sub/__init__.py": "",
+        "sub/b.py": "from ..a import f\n",
+        "c.py": "import pkg.a\n",
+    })
+    assert graph["pkg.a"] == {"pkg.sub.b"} and graph["pkg.c"] == {"pkg.a"}
+    assert cycles(graph) == [["pkg.a", "pkg.sub.b", "pkg.a"]]
+
+
+def test_the_walker_finds_a_module_outside_the_cli_that_imports_it(tmp_path):
+    graph = _package(tmp_path, {
+        "__init__.py": "",
+        "cli/__init__.py": "from .app import main\n",
+        "cli/app.py": "from ..lib import work\n",
+        "lib.py": "def work():\n    from pkg.cli.app import main\n",
+    })
+    renamed = {name.replace("pkg", "engine", 1): {t.replace("pkg", "engine", 1) for t in targets}
+               for name, targets in graph.items()}
+    assert cli_importers(renamed) == ["engine.lib -> engine.cli.app"]
+    assert cycles(renamed) == [["engine.cli.app", "engine.lib", "engine.cli.app"]]
