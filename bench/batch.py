@@ -28,10 +28,10 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
 from _common import add_database_argument, bench_database, median, verdict  # noqa: E402
-from engine.gears.case_base import CUT_KINDS_BY_COUNT, job_cutting_record  # noqa: E402
 from engine.errors import EngineError  # noqa: E402
-from engine.hobbing.choices import Choices  # noqa: E402
+from engine.gears.case_base import CUT_KINDS_BY_COUNT, job_cutting_record  # noqa: E402
 from engine.gears.hob_matching import choose_hob  # noqa: E402
+from engine.hobbing.choices import Choices  # noqa: E402
 from engine.programs.instantiate import Planner, _check_machine_fits, _check_table_speed  # noqa: E402
 from engine.programs.nc_check import check_program  # noqa: E402
 

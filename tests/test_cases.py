@@ -10,11 +10,11 @@ import psycopg
 from psycopg import sql
 import pytest
 
+from engine.errors import EngineError
 from engine.gears.case_base import job_cutting_record
 from engine.gears.cases import confirm_job, list_cases, seed_cases, suggest
-from engine.errors import EngineError
-from engine.paths import SEED_DIR
 from engine.gears.records import load_gear, load_hobs, load_machine
+from engine.paths import SEED_DIR
 
 PAPER_GEAR = 9019
 # The published example: m 2, α 20°, z 19, d_a 42.5, 40Cr, grade 7, cone 6.5°, 1-start AA hob, rough cut.

@@ -1,10 +1,10 @@
 """The decision table of design notes §4, step by step, on templates stored in PostgreSQL."""
 import pytest
 
-from engine.templates.decision_table import CompiledTemplate, TemplateError
 from engine.errors import EngineError
 from engine.hobbing.choices import Choices
 from engine.programs.instantiate import instantiate_gear
+from engine.templates.decision_table import CompiledTemplate, TemplateError
 from engine.templates.rows import TemplateRow
 from engine.templates.store import ensure_class, load_template, replace_template
 

@@ -9,9 +9,9 @@ from dataclasses import replace
 import pytest
 
 from engine.errors import EngineError
+from engine.library.nc_import import import_nc
 from engine.templates.checks import LintProblem
 from engine.templates.lint import lint_class
-from engine.library.nc_import import import_nc
 from engine.templates.rows import TemplateRow
 from engine.templates.store import ensure_class, load_template, replace_template
 

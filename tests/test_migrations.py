@@ -6,8 +6,8 @@ import threading
 import psycopg
 import pytest
 
-from engine.errors import EngineError
 from engine.db.migrate import discover, migrate, status
+from engine.errors import EngineError
 from engine.paths import MIGRATIONS_DIR, SCHEMA_DIR
 
 CATALOG_QUERIES = {

@@ -19,11 +19,11 @@ from click.testing import CliRunner
 from hypothesis import given, settings, strategies as st
 
 from engine.cli.app import main
-from engine.templates.decision_table import compiled_template
 from engine.errors import EngineError
-from engine.templates.expressions import compile_expression, evaluation_globals
 from engine.library.nc_import import import_nc, number_field
 from engine.library.nc_tokens import detokenise, tokenise
+from engine.templates.decision_table import compiled_template
+from engine.templates.expressions import compile_expression, evaluation_globals
 from engine.templates.rows import export_csv, parse_csv
 from engine.templates.store import ensure_class, load_template, replace_template
 

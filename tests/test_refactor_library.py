@@ -14,10 +14,10 @@ from dataclasses import replace
 import psycopg
 import pytest
 
-from engine.templates.expressions import compile_expression, evaluation_globals
-from engine.programs.instantiate import instantiate_gear
 from engine.library.nc_import import import_nc
 from engine.library.refactor import STAGES, refactor
+from engine.programs.instantiate import instantiate_gear
+from engine.templates.expressions import compile_expression, evaluation_globals
 from engine.templates.store import load_template, replace_template
 
 from test_nc_import import DATA, FAMILY, PARAMS, class_name, instantiate, real_files

@@ -9,8 +9,8 @@ import pytest
 from psycopg import errors, sql
 from psycopg.pq import TransactionStatus
 
-from engine.programs.instantiate import instantiate_gear
 from engine.library.refactor import refactor
+from engine.programs.instantiate import instantiate_gear
 from engine.templates.rows import TemplateRow, export_csv
 from engine.templates.store import load_template, replace_template
 

@@ -7,10 +7,10 @@ import psycopg
 import pytest
 from psycopg import sql
 
-from engine.errors import EngineError
 from engine.db.migrate import migrate
-from engine.paths import MIGRATIONS_DIR
 from engine.db.seed import seed
+from engine.errors import EngineError
+from engine.paths import MIGRATIONS_DIR
 from engine.templates.history import diff, history, restore
 from engine.templates.rows import export_csv
 from engine.templates.store import load_template

@@ -8,9 +8,9 @@ import pytest
 from psycopg.types.json import Jsonb
 
 from engine.errors import EngineError
+from engine.gears.records import load_machine
 from engine.programs.instantiate import instantiate_job
 from engine.programs.nc_check import LimitError
-from engine.gears.records import load_machine
 from engine.turning.check import check_lathe_program
 from engine.turning.dxf_import import import_dxf
 from test_dxf_read import seed_drawing

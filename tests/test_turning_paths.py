@@ -17,8 +17,8 @@ from hypothesis import strategies as st
 
 from engine.errors import EngineError
 from engine.turning.moves import Move
-from engine.turning.region import CHORD_TOLERANCE_MM
 from engine.turning.plot import plot_job
+from engine.turning.region import CHORD_TOLERANCE_MM
 from engine.turning.toolpaths import (alternate, distance_to_region, drawn_rough_passes,
                                       finish_passes, profile_rough_passes, slot_passes,
                                       thread_passes)

@@ -6,9 +6,9 @@ from dataclasses import asdict
 
 import click
 
-from .context import connection, emit_json
 from ..errors import EngineError
 from ..turning.defaults import DEFAULT_LATHE, PROFILE_DEFAULTS, STOCK_MARGIN
+from .context import connection, emit_json
 
 
 

@@ -16,8 +16,8 @@ import math
 from dataclasses import dataclass
 
 
-from .cutting_data import RADIAL_TO_AXIAL, CuttingData, default_cutting_data, hob_speed, per_minute
 from ..errors import EngineError
+from .cutting_data import RADIAL_TO_AXIAL, CuttingData, default_cutting_data, hob_speed, per_minute
 
 CUT_KINDS = ("rough", "finish")
 CUT_KINDS_BY_COUNT = {1: ("rough",), 2: ("rough", "finish")}   # a single cut is a rough cut, as in the paper

@@ -15,11 +15,11 @@ import pandas as pd
 import psycopg
 from psycopg import sql
 
+from ..errors import EngineError
+from ..paths import SEED_DIR
 from .case_base import CASE_COLUMNS, CUT_KINDS, CaseBase, KindProposal, feeds_per_minute, feeds_per_rev
 from .cutting_data import CuttingData
-from ..errors import EngineError
 from .hob_matching import choose_hob
-from ..paths import SEED_DIR
 from .records import Gear, Hob, Machine, hobbing_machine, load_gear, load_hobs
 
 FEATURE_COLUMNS = ("module", "teeth", "material", "hardness", "quality_grade", "hob_material",

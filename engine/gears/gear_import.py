@@ -18,8 +18,8 @@ from typing import Any, Callable, Iterable
 import psycopg
 from psycopg import sql
 
-from .classify import classify, not_installed_message
 from ..errors import EngineError
+from .classify import classify, not_installed_message
 
 NUMBER = re.compile(r"[+-]?(\d+(\.\d*)?|\.\d+)([eE][+-]?\d{1,3})?")
 INTEGER_MAX = 2_147_483_647  # PostgreSQL integer

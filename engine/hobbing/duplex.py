@@ -10,9 +10,9 @@ from dataclasses import dataclass
 
 from ..errors import EngineError
 from ..programs.nc_check import check_table_speed
+from . import shifting
 from .cylindrical import CylindricalModel, JobParameters
 from .passes import plan_cuts, working_area
-from . import shifting
 
 TOOTH_DEPTH_MODULES = 2.25
 UNIT_MODULES = {1: (1, 2), 2: (3, 4)}   # unit → its cutmotion module numbers (rough, finish)

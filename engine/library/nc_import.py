@@ -50,13 +50,13 @@ from pathlib import Path
 
 from psycopg.types.json import Jsonb
 
-from ..templates.decision_table import MODULE_ORDER, CompiledTemplate
 from ..errors import EngineError
+from ..templates.decision_table import MODULE_ORDER, CompiledTemplate
 from ..templates.expressions import MAX_EXPRESSION_LENGTH, compile_expression, evaluation_globals
 from ..templates.functions import CONSTANTS, FUNCTIONS
-from .nc_tokens import LABEL, NUMBER, SYMBOL, LineFacts, facts, tokenise
 from ..templates.rows import TemplateRow
 from ..templates.store import ensure_class, load_template, replace_template
+from .nc_tokens import LABEL, NUMBER, SYMBOL, LineFacts, facts, tokenise
 
 CODE_ADDRESSES = frozenset({"G", "M", "$"})   # their numbers name a function, not a value
 CLASS_NAME = re.compile(r"^[a-z][a-z0-9_]*$")

@@ -14,8 +14,8 @@ from dataclasses import dataclass, field
 import psycopg
 
 from ..errors import EngineError
-from .similarity import Units, nc_units, similar_pairs
 from ..templates.store import load_template
+from .similarity import Units, nc_units, similar_pairs
 
 # Concurrent instantiations read either the old or the new library: writers wait for us,
 # readers (plain SELECT, foreign-key checks) are not blocked and see the last committed

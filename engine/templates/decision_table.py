@@ -15,12 +15,12 @@ from functools import partial
 from dataclasses import dataclass, field
 
 from ..errors import EngineError
+from ..programs.nc_check import words
+from ..turning.nc_path import NcLines
 from .expressions import (MAX_SECONDS_PER_INSTANTIATION, Compiled, ExpressionError, compile_expression,
                           compile_statements, evaluation_globals)
 from .guards import MAX_STRING_LENGTH
-from ..programs.nc_check import words
 from .rows import Template, TemplateRow
-from ..turning.nc_path import NcLines
 
 MODULE_ORDER = ("main", "prep", "sync", "shift", "cutcond", "cutmotion")
 

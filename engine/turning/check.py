@@ -8,8 +8,8 @@ from __future__ import annotations
 import math
 import re
 
-from ..programs.nc_check import LimitError, outside_travel
 from ..gears.records import Machine
+from ..programs.nc_check import LimitError, outside_travel
 from .names import MAX_TOOL
 
 MAX_FEED = 20000.0     # mm/min: about a lathe's rapid traverse; a larger F is a unit slip or a typo
