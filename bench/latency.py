@@ -62,22 +62,26 @@ def help_command(tree: Path) -> list[str]:
     return [sys.executable, "-c", code, str(tree)]
 
 
-def source_tree_of(revision: str, into: Path) -> Path:
-    """The engine/ and importers/ folders of `revision`, unpacked into `into`."""
-    archive = subprocess.run(["git", "-C", str(REPO), "archive", revision, "engine", "importers"],
-                             capture_output=True)
-    if archive.returncode != 0:
-        sys.exit(f"bench/latency.py: cannot read commit {revision} of {REPO} ({archive.stderr.decode().strip()}); "
-                 "give --help-against REV of this checkout, or --no-help-startup")
-    archive = archive.stdout
-    subprocess.run(["tar", "-x", "-C", str(into)], input=archive, check=True)
+def source_tree_of(revision: str, into: Path) -> Path | None:
+    """The engine/ and importers/ folders of `revision`, unpacked into `into`; None when this
+    checkout does not have the commit (a shallow clone, an unpacked archive)."""
+    archived = subprocess.run(["git", "-C", str(REPO), "archive", revision, "engine", "importers"],
+                              capture_output=True)
+    if archived.returncode != 0:
+        return None
+    subprocess.run(["tar", "-x", "-C", str(into)], input=archived.stdout, check=True)
     return into
 
 
 def help_startup(revision: str, runs: int) -> None:
     """Prints the median start-up of `engine --help` here and at `revision`, alternated, and their ratio."""
     with tempfile.TemporaryDirectory(prefix="bench_help_") as folder:
-        commands = {"this tree": help_command(REPO), revision: help_command(source_tree_of(revision, Path(folder)))}
+        earlier = source_tree_of(revision, Path(folder))
+        if earlier is None:
+            print(f"engine --help start-up: not compared, this checkout has no commit {revision} "
+                  "(give --help-against REV)")
+            return
+        commands = {"this tree": help_command(REPO), revision: help_command(earlier)}
         for what, command in commands.items():   # untimed: the first start reads files and writes bytecode
             check(timed(command)[1], f"engine --help ({what})")
         times = {what: [] for what in commands}

@@ -411,7 +411,7 @@ RETURN CASE WHEN $1 ~ '^\s*$' THEN NULL ELSE $1 END;
 -- * INSERT adds an own row with an id the class's assembled template does not have yet.
 -- * DELETE removes an own row; an inherited row cannot be deleted from a derived class.
 -- Components no longer used are deleted. Every change locks the library in the refactor's
--- order (engine/refactor.py LOCK, engine/templates.py LOCK_FOR_WRITING), bumps the versions
+-- order (engine/library/refactor.py LOCK, engine/templates/store.py LOCK_FOR_WRITING), bumps the versions
 -- of the class and the classes below it, and writes template_audit. To change a shared body
 -- for every class at once, UPDATE component directly (not audited, no version bump).
 -- SECURITY DEFINER: editors need no rights on template_audit; the view's own privileges

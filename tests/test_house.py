@@ -1,7 +1,8 @@
 """The house (issue 11): engine/ is laid out as the design's sections, no two modules import each
 other in a circle (imports inside functions count: a cycle is a cycle of the design, whenever it
-runs), and nothing below the command line imports it. The walker reads the source with `ast`;
-it is checked on a small package of its own that has each fault."""
+runs; so does a package's __init__, which runs when any module below it is first imported), and
+nothing below the command line imports it. The walker reads the source with `ast`; each check is
+also run on a small package of its own that has the fault."""
 import ast
 from pathlib import Path
 
@@ -35,7 +36,17 @@ def imported_modules(name: str, path: Path, modules: dict[str, Path]) -> set[str
             base = _absolute(package, node.module, node.level)
             for alias in node.names:   # `from pkg import submodule` imports the submodule
                 targets.add(f"{base}.{alias.name}" if f"{base}.{alias.name}" in modules else base)
-    return {known for known in map(lambda target: _known(target, modules), targets) if known not in (None, name)}
+    known = {found for found in (_known(target, modules) for target in targets) if found not in (None, name)}
+    return known | {package for target in known for package in _outer_packages(target, name, modules)}
+
+
+def _outer_packages(target: str, importer: str, modules) -> set[str]:
+    """The packages whose __init__ importing `target` runs first: those above it that are not
+    also above the importer (those are running already)."""
+    parts = target.split(".")
+    above = {".".join(parts[:length]) for length in range(1, len(parts))}
+    return {package for package in above
+            if package in modules and importer != package and not importer.startswith(package + ".")}
 
 
 def _absolute(package: str, module: str | None, level: int) -> str:
@@ -104,18 +115,42 @@ def test_nothing_below_the_command_line_imports_it():
     assert cli_importers(graph) == []
 
 
+def missing_design_folders(folder: Path) -> list[str]:
+    return [name for name in DESIGN_FOLDERS if not (folder / name / "__init__.py").is_file()]
+
+
+def loose_modules(folder: Path) -> list[str]:
+    return sorted(path.name for path in folder.glob("*.py") if path.name not in ("__init__.py", "__main__.py"))
+
+
+def modules_not_saying_what_they_are(folder: Path) -> list[str]:
+    """Modules whose first line is not the start of a docstring that says something."""
+    def says(path):
+        text = path.read_text("utf-8")
+        return text.startswith('"' * 3) and bool((ast.get_docstring(ast.parse(text)) or "").strip())
+    return sorted(str(path.relative_to(folder)) for path in folder.rglob("*.py") if not says(path))
+
+
 def test_engine_is_laid_out_as_the_design_s_sections():
     folder = Path(engine.__file__).parent
-    assert [name for name in DESIGN_FOLDERS if not (folder / name / "__init__.py").is_file()] == []
-    loose = sorted(path.name for path in folder.glob("*.py") if path.name not in ("__init__.py", "__main__.py"))
-    assert loose == ["errors.py", "memory.py", "paths.py"]   # shared by every section, below all of them
+    assert missing_design_folders(folder) == []
+    assert loose_modules(folder) == ["errors.py", "memory.py", "paths.py"]   # below every section
 
 
 def test_every_module_says_what_it_is_in_its_first_line():
-    folder = Path(engine.__file__).parent
-    silent = [str(path.relative_to(folder)) for path in folder.rglob("*.py")
-              if path.name != "__main__.py" and not (ast.get_docstring(ast.parse(path.read_text("utf-8"))) or "").strip()]
-    assert silent == []
+    for package in (engine, importers):
+        assert modules_not_saying_what_they_are(Path(package.__file__).parent) == []
+
+
+def test_the_layout_checks_find_a_missing_folder_a_loose_module_and_a_silent_module(tmp_path):
+    for name in DESIGN_FOLDERS[1:]:
+        (tmp_path / name).mkdir()
+        (tmp_path / name / "__init__.py").write_text(f'"""The {name} section."""\n')
+    (tmp_path / "gear_import.py").write_text('# a comment first\n"""Gears from CSV."""\n')
+    (tmp_path / "db" / "seed.py").write_text("import csv\n")
+    assert missing_design_folders(tmp_path) == ["templates"]
+    assert loose_modules(tmp_path) == ["gear_import.py"]
+    assert modules_not_saying_what_they_are(tmp_path) == ["db/seed.py", "gear_import.py"]
 
 
 def _package(tmp_path, files: dict[str, str]):
@@ -134,8 +169,20 @@ def test_the_walker_finds_a_cycle_through_an_import_inside_a_function(tmp_path):
         "sub/b.py": "from ..a import f\n",
         "c.py": "import pkg.a\n",
     })
-    assert graph["pkg.a"] == {"pkg.sub.b"} and graph["pkg.c"] == {"pkg.a"}
+    assert graph["pkg.a"] == {"pkg.sub.b", "pkg.sub"} and graph["pkg.c"] == {"pkg.a"}
     assert cycles(graph) == [["pkg.a", "pkg.sub.b", "pkg.a"]]
+
+
+def test_the_walker_finds_a_cycle_through_a_package_s_init(tmp_path):
+    graph = _package(tmp_path, {
+        "__init__.py": "",
+        "a.py": "from .sub.c import x\n",
+        "sub/__init__.py": "from .b import y\n",
+        "sub/b.py": "from ..a import z\n",
+        "sub/c.py": "from .b import y\n",     # inside sub: importing b does not run sub's __init__ again
+    })
+    assert graph["pkg.a"] == {"pkg.sub.c", "pkg.sub"} and graph["pkg.sub.c"] == {"pkg.sub.b"}
+    assert cycles(graph) == [["pkg.a", "pkg.sub", "pkg.sub.b", "pkg.a"]]
 
 
 def test_the_walker_finds_a_module_outside_the_cli_that_imports_it(tmp_path):
@@ -147,5 +194,6 @@ def test_the_walker_finds_a_module_outside_the_cli_that_imports_it(tmp_path):
     })
     renamed = {name.replace("pkg", "engine", 1): {t.replace("pkg", "engine", 1) for t in targets}
                for name, targets in graph.items()}
-    assert cli_importers(renamed) == ["engine.lib -> engine.cli.app"]
-    assert cycles(renamed) == [["engine.cli.app", "engine.lib", "engine.cli.app"]]
+    assert cli_importers(renamed) == ["engine.lib -> engine.cli", "engine.lib -> engine.cli.app"]
+    assert cycles(renamed) == [["engine.cli", "engine.cli.app", "engine.lib", "engine.cli"],
+                               ["engine.cli.app", "engine.lib", "engine.cli.app"]]

@@ -81,5 +81,11 @@ def main(ctx, database_url, traceback):
 
 COMMANDS = (demo, db, seed_command, gears, classify, instantiate, template, lint, hobs, suggest, cases,
             import_nc_command, refactor_command, import_dxf_command, plot_command)
-for command in COMMANDS:
-    main.add_command(command)
+
+
+def _register(group: click.Group, commands) -> None:
+    for command in commands:
+        group.add_command(command)
+
+
+_register(main, COMMANDS)

@@ -16,6 +16,9 @@ def template():
     history, diff and restore of their versions."""
 
 
+template.add_command(template_shared)   # which classes share each row: reported with the refactor
+
+
 @template.command("list")
 @click.pass_context
 def template_list(ctx):
@@ -161,5 +164,3 @@ def lint(ctx, as_json):
     if problems:
         sys.exit(1)
 
-
-template.add_command(template_shared)

@@ -3,11 +3,14 @@ so a second run changes nothing and a template an engineer edited stays edited."
 from __future__ import annotations
 
 import csv
+import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from psycopg import sql
 
+from ..gears.gear_import import import_gears
+from ..gears.units import import_units
 from ..paths import SEED_DIR
 from ..templates.rows import read_csv
 from ..templates.store import ensure_class, replace_template
@@ -83,10 +86,6 @@ def _seed_templates(conn, directory: Path, report: SeedReport) -> None:
 
 def _seed_gears(conn, directory: Path, report: SeedReport) -> None:
     """Sample gears not yet in the database, through the same checks as `engine gears import`."""
-    import tempfile
-
-    from ..gears.gear_import import import_gears
-
     source = directory / "gears.csv"
     known = {row[0] for row in conn.execute("SELECT id FROM gear")}
     with source.open(encoding="utf-8", newline="") as file:
@@ -106,8 +105,6 @@ def _seed_gears(conn, directory: Path, report: SeedReport) -> None:
 
 def _seed_units(conn, directory: Path, report: SeedReport) -> None:
     """Further units of the sample multi-unit gears, where the gear has none yet."""
-    from ..gears.units import import_units
-
     source = directory / "gear_units.csv"
     with_units = {row[0] for row in conn.execute("SELECT DISTINCT gear_id FROM gear_unit")}
     rows = [row for row in _read(source) if int(row["gear_id"]) not in with_units]
@@ -117,6 +114,6 @@ def _seed_units(conn, directory: Path, report: SeedReport) -> None:
 
 def _seed_cases(conn, directory: Path, report: SeedReport) -> None:
     """The machining history's seed cases (the paper's example among them)."""
-    from ..gears.cases import seed_cases
+    from ..gears.cases import seed_cases   # pandas: loaded only when the history is seeded
 
     report.count("cases", seed_cases(conn, directory / "cases.csv"))

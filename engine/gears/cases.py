@@ -20,6 +20,7 @@ from ..paths import SEED_DIR
 from .case_base import CASE_COLUMNS, CUT_KINDS, CaseBase, KindProposal, feeds_per_minute, feeds_per_rev
 from .cutting_data import CuttingData
 from .hob_matching import choose_hob
+from .models import model_for_class
 from .records import Gear, Hob, Machine, hobbing_machine, load_gear, load_hobs
 
 FEATURE_COLUMNS = ("module", "teeth", "material", "hardness", "quality_grade", "hob_material",
@@ -100,8 +101,6 @@ def suggest_for_gear(conn, gear_id: int, machine_name: str | None = None, *, top
     """`engine suggest`: the hob the library chooses for the gear, and its cutting data."""
     gear = load_gear(conn, gear_id)
     machine = hobbing_machine(conn, machine_name)
-    from .models import model_for_class
-
     model = model_for_class(conn, gear.gear_class) if gear.gear_class else None
     choice = choose_hob(gear, load_hobs(conn), purpose=model.hob_purpose if model else "cylindrical")
     suggestion = suggest(conn, gear, choice.hob, machine, top=top)

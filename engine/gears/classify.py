@@ -14,6 +14,9 @@ from dataclasses import dataclass, field
 from typing import Any, Callable, Collection, Mapping
 
 from ..errors import EngineError
+from .hob_matching import choose_hob
+from .models import MODELS, ancestry
+from .records import load_gear, load_hobs
 
 DEFAULT_CLASS = "spur"
 
@@ -134,10 +137,6 @@ class GearClassReport:
 
 def explain_gear(conn, gear_id: int) -> GearClassReport:
     """Classify a stored gear again and say how; also the model and hob it gets."""
-    from .hob_matching import choose_hob
-    from .models import MODELS, ancestry
-    from .records import load_gear, load_hobs
-
     gear = load_gear(conn, gear_id)
     classification = classify({"gear_id": gear.id, "cone_angle": gear.cone_angle, "crowning": gear.crowning,
                                "helix_angle": gear.helix_angle, "units": len(gear.units)})

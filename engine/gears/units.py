@@ -7,8 +7,8 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import EngineError
-from .gear_import import (POSITIVE, Column, GearImportError, _parse_cell, read_records, derived_diameters,
-                    parse_number, parse_positive_whole)
+from .gear_import import (POSITIVE, Column, GearImportError, _parse_cell, derived_diameters, parse_number,
+                          parse_positive_whole, read_records)
 
 UNIT_COLUMNS: tuple[Column, ...] = (
     Column("gear_id", parse_positive_whole, required=True),

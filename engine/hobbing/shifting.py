@@ -6,6 +6,7 @@ import math
 
 from ..errors import EngineError
 from .choices import Choices
+from .geometry import generating_length, lead_angle
 
 SHIFT_MARGIN = 5.0          # mm kept free at each end of the hob
 PITCH_MULTIPLE_TOLERANCE = 0.05   # mm: a step this close to n axial pitches repeats the same teeth
@@ -34,8 +35,6 @@ def parameters(choices: Choices, hob, gear) -> dict:
 
 def usable_length(hob, gear) -> float:
     """L_s = L_hob − L_gen − margins (§B15)."""
-    from .geometry import generating_length
-
     return hob.length - generating_length(gear.module, gear.pressure_angle) - 2 * SHIFT_MARGIN
 
 
@@ -49,8 +48,6 @@ def _check_step(step: float, half: float, hob, gear) -> None:
         raise EngineError(f"gear {gear.id}: shift per part {step:g} mm exceeds the usable shift length "
                           f"{max(0.0, 2 * half):.1f} mm of hob {hob.id} (length {hob.length:g}); "
                           f"use a smaller step or a longer hob")
-    from .geometry import lead_angle
-
     pitch = axial_pitch(gear.module, lead_angle(hob.module, hob.starts, hob.tip_diameter))
     multiple = round(step / pitch)
     if multiple >= 1 and abs(step - multiple * pitch) < PITCH_MULTIPLE_TOLERANCE:

@@ -23,6 +23,7 @@ from .outputs import write_program_files
 from .records import Planned, Program
 from .storage import store_many, store_one
 
+
 class Planner:
     """Everything shared by the gears of one run: machine, hob library, templates."""
 
@@ -120,7 +121,7 @@ def instantiate_job(conn, job_id: int, out: str | Path | None = None) -> Program
     gear_id, gear_class, machine_name, hob_id, params, module_params = row
     machine = load_machine(conn, machine_name)
     if machine.kind == "lathe":   # a turning job: its passes are computed from its parameters
-        from ..turning.planning import plan_turning_job
+        from ..turning.planning import plan_turning_job   # the tool paths: only for turning jobs
 
         planned = plan_turning_job(conn, gear_class, machine, params, module_params)
     else:

@@ -21,6 +21,7 @@ from .expressions import (MAX_SECONDS_PER_INSTANTIATION, Compiled, ExpressionErr
                           compile_statements, evaluation_globals)
 from .guards import MAX_STRING_LENGTH
 from .rows import Template, TemplateRow
+from .template_code import build
 
 MODULE_ORDER = ("main", "prep", "sync", "shift", "cutcond", "cutmotion")
 
@@ -57,8 +58,6 @@ class CompiledTemplate:
     """A template parsed, checked and compiled once; `run` evaluates it for one job."""
 
     def __init__(self, template: Template):
-        from .template_code import build
-
         self.template = template
         self.rows = tuple(compile_row(template.gear_class, row) for row in template.rows)
         uses_sql = any(c.is_sql for r in self.rows for c in _expressions_of(r))

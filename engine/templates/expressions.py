@@ -51,7 +51,7 @@ RUNTIME = {"_safe_pow": safe_pow, "_safe_mult": safe_mult, "_safe_add": safe_add
 
 
 def _sql_runtime() -> dict:
-    from .sqlcond import SQL_RUNTIME
+    from .sqlcond import SQL_RUNTIME   # sqlglot: loaded only by templates with SQL conditions
 
     return SQL_RUNTIME
 
@@ -125,7 +125,7 @@ def _check_length(text: str) -> None:
 
 
 def _parse_sql(text: str, python_error: SyntaxError) -> ast.Expression:
-    from .sqlcond import translate
+    from .sqlcond import translate   # sqlglot, as above
 
     try:
         return ast.Expression(body=translate(text))

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from ..gears.models import model_for_class
 from .checks import LintProblem, structural_problems
 from .decision_table import compile_row
 from .store import load_template
@@ -12,8 +13,6 @@ from .store import load_template
 
 def lint_class(conn, gear_class: str) -> list[LintProblem]:
     """Every problem of one class's template, including unknown parameter names."""
-    from ..gears.models import model_for_class
-
     template = load_template(conn, gear_class)
     problems = structural_problems(gear_class, list(template.rows))
     if problems:
