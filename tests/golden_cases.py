@@ -1,0 +1,98 @@
+"""The cases of the golden programs in tests/golden/: every seeded gear under each set of job
+choices, and turning jobs from the real Emco drawings and from drawings made in the tests, in
+both lathe dialects.
+
+Golden files are a regression guard, not a proof of correctness (the physics and the 840D
+contract are tested from the reference formulas elsewhere): they were written by
+tests/golden/make_golden.py before the evaluator changes of issue 12, so that a change of
+evaluator that alters any emitted byte fails. A change that is meant to alter programs (a
+corrected model, issue 14) writes them again with that script, and the diff shows every line
+it changed."""
+from __future__ import annotations
+
+from pathlib import Path
+
+from engine.errors import EngineError
+from engine.hobbing.choices import Choices
+from engine.programs.instantiate import instantiate_gear, instantiate_job
+from engine.turning.dxf_import import import_dxf
+from engine.turning.job_params import ProfileOptions
+
+GOLDEN = Path(__file__).resolve().parent / "golden"
+
+HOBBING_GEARS = (42, 43, 44, 45, 46, 47, 50, 51, 53, 54)   # seed_templates/gears.csv: every class
+CHOICE_SETS = {   # name -> (process choices, overrides)
+    "default": ({}, {}),
+    "two-cuts": ({"cuts": 2}, {}),
+    "single-cut": ({"cuts": 1}, {}),
+    "dry-no-tailstock": ({"coolant": False, "tailstock": False}, {}),
+    "conventional": ({"feed_mode": "conventional"}, {}),
+    "conventional-climb": ({"cuts": 2, "feed_mode": "conventional-climb"}, {}),
+    "shift-y": ({"shift_y": 5.0}, {}),
+    "shift-per-part": ({"shift_per_part": 0.5}, {}),
+    "tangential": ({"worm_feed": "tangential"}, {}),
+    "hob-speed": ({}, {"hob_speed": 300}),
+}
+
+# (name, drawing: "emco:<file>" from the real files or a maker of test_dxf_read/test_turning_jobs,
+#  ProfileOptions fields, alternate)
+TURNING_CASES = (
+    ("emco-neg", "emco:emco_lathe_testNegDXF_R14.dxf", {"rough_depth": 1.0}, None),
+    ("emco-g02", "emco:emco_lathe_testg02hemisphere_R14.dxf", {"rough_depth": 1.0}, None),
+    ("emco-g03", "emco:emco_lathe_testg03hemisphere_R14.dxf", {"rough_depth": 1.0, "allowance": 0.2}, None),
+    ("seed-part", "seed_drawing", {}, None),
+    ("shaft-profile", "profile_only_drawing", {"rough_depth": 1.5, "allowance": 0.3}, None),
+    ("wheel-alternate", "two_rough_layers", {}, [1, 2]),
+)
+LATHES = ("lathe-iso", "lathe-840d")
+
+
+def hobbing_cases() -> list[tuple[int, str]]:
+    return [(gear_id, choice_set) for gear_id in HOBBING_GEARS for choice_set in CHOICE_SETS]
+
+
+def turning_cases() -> list[tuple[str, str]]:
+    return [(case[0], lathe) for case in TURNING_CASES for lathe in LATHES]
+
+
+def hobbing_file(gear_id: int, choice_set: str) -> Path:
+    return GOLDEN / "hobbing" / f"GEAR{gear_id}_{choice_set}.MPF"
+
+
+def turning_file(name: str, lathe: str) -> Path:
+    return GOLDEN / "turning" / f"{name}_{lathe}.NC"
+
+
+def hobbing_text(conn, gear_id: int, choice_set: str) -> str:
+    """The program of the gear under the choice set, or the one-line refusal."""
+    choices, overrides = CHOICE_SETS[choice_set]
+    try:
+        return instantiate_gear(conn, gear_id, choices=Choices(**choices), overrides=overrides).text
+    except EngineError as error:
+        return f"refused: {error}\n"
+
+
+def turning_text(conn, folder: Path, name: str, lathe: str) -> str:
+    """The program of the turning case on the lathe, or the one-line refusal."""
+    _, maker, options, alternate = next(case for case in TURNING_CASES if case[0] == name)
+    path = _drawing(folder, name, maker)
+    try:
+        report = import_dxf(conn, path, lathe, ProfileOptions(**options), alternate)
+        return instantiate_job(conn, report.job_id).text
+    except EngineError as error:
+        return f"refused: {error}\n"
+
+
+def _drawing(folder: Path, name: str, maker: str) -> Path:
+    """The drawing of a case: a real file as it is, or one made by the tests' own makers under
+    a fixed name (the name is printed in the program's header)."""
+    from test_dxf_read import DXF, seed_drawing
+    from test_turning_jobs import profile_only_drawing, two_rough_layers
+
+    if maker.startswith("emco:"):
+        return DXF / maker.removeprefix("emco:")
+    makers = {"seed_drawing": seed_drawing, "profile_only_drawing": profile_only_drawing,
+              "two_rough_layers": two_rough_layers}
+    path = folder / f"{name}.dxf"
+    makers[maker](path)
+    return path
