@@ -23,7 +23,8 @@ from engine.errors import EngineError
 from engine.library.nc_import import import_nc, number_field
 from engine.library.nc_tokens import detokenise, tokenise
 from engine.templates.decision_table import compiled_template
-from engine.templates.expressions import compile_expression, evaluation_globals
+from engine.templates.evaluator import evaluate
+from engine.templates.expressions import compile_expression
 from engine.templates.rows import export_csv, parse_csv
 from engine.templates.store import ensure_class, load_template, replace_template
 
@@ -155,7 +156,7 @@ def test_a_number_field_prints_the_original_value_as_written(spelling):
     if Decimal(str(value)) != Decimal(spelling) or (spelling.startswith("-") and value == 0):
         return   # a float that cannot hold the digits, or a negative zero: the import keeps these literal
     compiled = compile_expression('f"' + number_field("p", spelling) + '"')
-    assert eval(compiled.code, evaluation_globals(), {"p": value}) == spelling
+    assert evaluate(compiled, {"p": value}) == spelling
 
 
 @pytest.mark.parametrize("spelling, value, printed", [
@@ -164,7 +165,7 @@ def test_a_number_field_prints_the_original_value_as_written(spelling):
 ])
 def test_other_values_print_in_the_style_of_the_original(spelling, value, printed):
     compiled = compile_expression('f"' + number_field("p", spelling) + '"')
-    assert eval(compiled.code, evaluation_globals(), {"p": value}) == printed
+    assert evaluate(compiled, {"p": value}) == printed
 
 
 # --- the real programs ---------------------------------------------------------------------

@@ -17,7 +17,8 @@ import pytest
 from engine.library.nc_import import import_nc
 from engine.library.refactor import STAGES, refactor
 from engine.programs.instantiate import instantiate_gear
-from engine.templates.expressions import compile_expression, evaluation_globals
+from engine.templates.evaluator import evaluate
+from engine.templates.expressions import compile_expression
 from engine.templates.store import load_template, replace_template
 
 from test_nc_import import DATA, FAMILY, PARAMS, class_name, instantiate, real_files
@@ -122,7 +123,7 @@ def test_lines_the_wrench_pair_shares_are_stored_once(conn):
         HAVING count(DISTINCT a.gear_class) = 2""", (imperial, metric)).fetchall()
     assert bodies
     assert all(copies == 1 for _, copies, _ in bodies)
-    produced = {unit: {eval(compile_expression(o).code, evaluation_globals(), dict(PARAMS[relative]))
+    produced = {unit: {evaluate(compile_expression(o), dict(PARAMS[relative]))
                        for o, _, _ in bodies} for unit, relative in files.items()}
     for unit in files:
         assert real_shared <= produced[unit] <= set(lines[unit])

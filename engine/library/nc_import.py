@@ -52,7 +52,8 @@ from psycopg.types.json import Jsonb
 
 from ..errors import EngineError
 from ..templates.decision_table import MODULE_ORDER, CompiledTemplate
-from ..templates.expressions import MAX_EXPRESSION_LENGTH, compile_expression, evaluation_globals
+from ..templates.evaluator import evaluate
+from ..templates.expressions import MAX_EXPRESSION_LENGTH, compile_expression
 from ..templates.functions import CONSTANTS, FUNCTIONS
 from ..templates.rows import TemplateRow
 from ..templates.store import ensure_class, load_template, replace_template
@@ -371,8 +372,7 @@ def _is_negative_zero(spelling: str) -> bool:
 
 
 def _evaluate(source: str, name: str, value) -> str:
-    compiled = compile_expression(f'f"{source}"')
-    return eval(compiled.code, evaluation_globals(), {name: value})
+    return evaluate(compile_expression(f'f"{source}"'), {name: value})
 
 
 def _escaped(text: str, quote: str, braces: bool) -> str:

@@ -5,25 +5,30 @@ For each row in id order, with scope = job parameters ∪ parameters of module (
 1. if `s` is present: run it when `p_calc` is absent or true, else skip the whole row;
 2. evaluate `o` to a string (absent `o`: the row only computes);
 3. append it to the result when `p_emit` is absent or true.
-Any failure aborts the whole instantiation with an error naming class, row, column, text.
+asteval evaluates every expression (engine.templates.evaluator). Each row's outcome goes
+into the program's trace (engine.templates.trace). A row whose inputs have the same values
+and origins as for an earlier job of the template has the same outcome: it is taken from
+the template's memo instead of being evaluated again. Any failure aborts the whole
+instantiation with an error naming class, row, column, text.
 """
 from __future__ import annotations
 
 import ast
 import time
-from functools import partial
 from dataclasses import dataclass, field
 
 from ..errors import EngineError
 from ..programs.nc_check import words
 from ..turning.nc_path import NcLines
+from .evaluator import EvaluationError, Evaluator, base_symbols
 from .expressions import (MAX_SECONDS_PER_INSTANTIATION, Compiled, ExpressionError, compile_expression,
-                          compile_statements, evaluation_globals)
+                          compile_statements)
 from .guards import MAX_STRING_LENGTH
 from .rows import Template, TemplateRow
-from .template_code import build
+from .trace import Outcome, memo_key, row_trace
 
 MODULE_ORDER = ("main", "prep", "sync", "shift", "cutcond", "cutmotion")
+MAX_MEMO_ROWS = 200_000   # outcomes kept per template; the memo starts again when full
 
 
 class TemplateError(EngineError):
@@ -41,6 +46,7 @@ class CompiledRow:
     p_calc: Compiled | None
     s: tuple[tuple[str, Compiled], ...]
     p_emit: Compiled | None
+    inputs: tuple[str, ...] = ()   # names the row reads before assigning them: its memo key
 
     @property
     def module(self) -> tuple[str, int]:
@@ -49,20 +55,22 @@ class CompiledRow:
 
 @dataclass(slots=True)
 class Result:
-    """The result table of one instantiation: emitted lines and the row id of each."""
+    """The result table of one instantiation: emitted lines, the row id of each, and the trace
+    of every row (engine.templates.trace)."""
     lines: list[str] = field(default_factory=list)
     row_ids: list[int] = field(default_factory=list)
+    trace: list[dict] = field(default_factory=list)
 
 
 class CompiledTemplate:
-    """A template parsed, checked and compiled once; `run` evaluates it for one job."""
+    """A template parsed and checked once; `run` evaluates it for one job."""
 
     def __init__(self, template: Template):
         self.template = template
         self.rows = tuple(compile_row(template.gear_class, row) for row in template.rows)
-        uses_sql = any(c.is_sql for r in self.rows for c in _expressions_of(r))
-        self.globals = {**evaluation_globals(uses_sql), "_text": _text, "_clock": time.perf_counter}
-        self.code, self.places = build(self.rows, template.gear_class)
+        self.symbols = base_symbols(any(c.is_sql for r in self.rows for c in _expressions_of(r)))
+        self.evaluator = Evaluator()
+        self.memo: dict[tuple, Outcome] = {}
         # Rows that print a whole tool path (nc_path) emit several lines at once.
         self.prints_paths = any(row.o is not None and _calls_nc_path(row.o.tree) for row in self.rows)
         # Lines a row always emits the same, parsed for the limit check once per template.
@@ -72,37 +80,101 @@ class CompiledTemplate:
 
     def run(self, params: dict, module_params: dict | None = None,
             deadline_seconds: float = MAX_SECONDS_PER_INSTANTIATION) -> Result:
-        result = Result()
-        scope = dict(params)
-        scope["template_version"] = self.template.version
-        scope["_mp"] = module_params = module_params or {}
-        scope["_prev"] = False
-        scope["_i"] = intermediates = {}
-        scope["_enter"] = _module_switcher(scope, params, module_params, intermediates)
-        scope["_deadline"] = time.perf_counter() + deadline_seconds
-        scope["_timeout"] = partial(_timeout, deadline_seconds)
-        scope["_lines_append"], scope["_rows_append"] = result.lines.append, result.row_ids.append
+        job = _Job(self, params, module_params or {}, time.perf_counter() + deadline_seconds, deadline_seconds)
+        for row in self.rows:
+            job.run_row(row)
+        return _one_line_each(job.result) if self.prints_paths else job.result
+
+    def remembered(self, key) -> Outcome | None:
+        return self.memo.get(key) if key is not None else None
+
+    def remember(self, key, outcome: Outcome) -> None:
+        if key is not None:
+            if len(self.memo) >= MAX_MEMO_ROWS:
+                self.memo.clear()
+            self.memo[key] = outcome
+
+
+class _Job:
+    """The state of one run: scope, intermediates and where each came from, module switching."""
+
+    def __init__(self, compiled: CompiledTemplate, params: dict, module_params: dict, deadline: float, budget: float):
+        self.compiled, self.params, self.module_params = compiled, params, module_params
+        # The engine's names win over a job parameter of the same name (nothing rebinds them).
+        self.scope = {**params, **compiled.symbols, "template_version": compiled.template.version}
+        self.intermediates: dict[str, int] = {}      # name -> id of the row that computed it
+        self.module, self.module_names, self.module_key = None, (), None
+        self.deadline, self.budget = deadline, budget
+        self.result = Result()
+
+    def run_row(self, row: CompiledRow) -> None:
+        if time.perf_counter() > self.deadline:
+            raise TemplateError(self.compiled.template.gear_class, row.row.id, "o", row.row.o or "",
+                                f"instantiation exceeded {self.budget} s")
+        if row.module != self.module:
+            self._enter(row.module)
+        key = memo_key(row, self.scope, self.origin)
+        outcome = self.compiled.remembered(key)
+        if outcome is None:
+            outcome = self._evaluate(row)
+            self.compiled.remember(key, outcome)
+        self._apply(row, outcome)
+
+    def origin(self, name: str) -> str:
+        """Where a name's value comes from: the row that computed it, the module, the job."""
+        if name in self.intermediates:
+            return f"row {self.intermediates[name]}"
+        if name in self.module_names:
+            return f"module {self.module_key}"
+        return "template" if name == "template_version" else "job"
+
+    def _enter(self, module: tuple[str, int]) -> None:
+        """Module (T, N) parameters in, the previous module's out; intermediates stay."""
+        self.module, key = module, f"{module[0]}:{module[1]}"
+        if not self.module_names and key not in self.module_params:
+            return
+        for name in self.module_names:
+            if name not in self.intermediates:
+                if name in self.params:
+                    self.scope[name] = self.params[name]
+                else:
+                    self.scope.pop(name, None)
+        current = self.module_params.get(key) or {}
+        self.module_names, self.module_key = tuple(current), key
+        for name, value in current.items():
+            if name not in self.intermediates:
+                self.scope[name] = value
+
+    def _evaluate(self, row: CompiledRow) -> Outcome:
+        """Evaluate the row in the current scope (its statements' values enter it as they run)."""
+        trace = row_trace(row, self.scope, self.origin)
+        if row.s:
+            if row.p_calc is not None and not trace.condition("p_calc", self._value(row, "p_calc", row.p_calc, trace)):
+                return trace.outcome(calc=False)
+            for name, expression in row.s:
+                self.scope[name] = trace.computed(name, self._value(row, "s", expression, trace))
+        if row.o is None:
+            return trace.outcome(calc=bool(row.s) or None)
+        line = _text(self._value(row, "o", row.o, trace), row, self.compiled.template.gear_class)
+        emit = row.p_emit is None or trace.condition("p_emit", self._value(row, "p_emit", row.p_emit, trace))
+        return trace.outcome(calc=bool(row.s) or None, line=line, emit=emit)
+
+    def _value(self, row: CompiledRow, column: str, expression: Compiled, trace):
+        trace.read(column, expression)
         try:
-            exec(self.code, self.globals, scope)
-        except TemplateError:
-            raise
-        except Exception as error:  # an expression's own failure, reported with its place
-            raise self._error_at(error) from None
-        return _one_line_each(result) if self.prints_paths else result
+            return self.compiled.evaluator.evaluate(expression.tree, expression.text, self.scope)
+        except EvaluationError as error:
+            raise TemplateError(self.compiled.template.gear_class, row.row.id, column, expression.text,
+                                str(error)) from None
 
-    def _error_at(self, error: Exception) -> TemplateError:
-        place = self.places[_line_in_template(error.__traceback__, self.code.co_filename)]
-        if isinstance(error, NameError):
-            problem = f"unknown parameter {getattr(error, 'name', None) or error!r}"
-        elif isinstance(error, _NotText):
-            problem = str(error)
-        else:
-            problem = f"{type(error).__name__}: {error}"
-        return TemplateError(self.template.gear_class, place.row_id, place.column, place.text, problem)
-
-
-class _NotText(Exception):
-    pass
+    def _apply(self, row: CompiledRow, outcome: Outcome) -> None:
+        for name, value in outcome.assignments:
+            self.scope[name] = value
+            self.intermediates[name] = row.row.id
+        if outcome.emit:
+            self.result.lines.append(outcome.line)
+            self.result.row_ids.append(row.row.id)
+        self.result.trace.append(outcome.trace)
 
 
 def _calls_nc_path(tree) -> bool:
@@ -111,7 +183,7 @@ def _calls_nc_path(tree) -> bool:
 
 def _one_line_each(result: Result) -> Result:
     """The blocks of an nc_path row as lines of their own, each with the row's id."""
-    flat = Result()
+    flat = Result(trace=result.trace)
     for line, row_id in zip(result.lines, result.row_ids):
         if isinstance(line, NcLines):
             flat.lines.extend(line)
@@ -122,51 +194,19 @@ def _one_line_each(result: Result) -> Result:
     return flat
 
 
-def _text(value):
+def _text(value, row: CompiledRow, gear_class: str):
     """`o` must give text (a bare number would print in whatever form Python chooses), of
     bounded length; or the blocks of nc_path."""
     if isinstance(value, NcLines):
         return value
     if type(value) is not str:
-        raise _NotText(f"gives {type(value).__name__} {value!r}, not text "
-                       "(write an f-string with a format, e.g. f\"X{x:.3f}\")")
-    if len(value) > MAX_STRING_LENGTH:
-        raise _NotText(f"gives a line longer than {MAX_STRING_LENGTH} characters")
-    return value
-
-
-def _line_in_template(traceback, filename: str) -> int:
-    line = 0
-    while traceback is not None:
-        if traceback.tb_frame.f_code.co_filename == filename:
-            line = traceback.tb_lineno
-        traceback = traceback.tb_next
-    return line
-
-
-def _timeout(budget: float):
-    raise TimeoutError(f"instantiation exceeded {budget} s")
-
-
-def _module_switcher(scope: dict, params: dict, module_params: dict, intermediates: dict):
-    """`_enter(key)`: module (T, N) parameters in, the previous module's out; intermediates stay."""
-    previous: list = []
-
-    def enter(key: str) -> None:
-        for name in previous:
-            if name not in intermediates:
-                if name in params:
-                    scope[name] = params[name]
-                else:
-                    scope.pop(name, None)
-        current = module_params.get(key)
-        previous[:] = current or ()
-        scope["_prev"] = bool(current)
-        if current:
-            for name, value in current.items():
-                if name not in intermediates:
-                    scope[name] = value
-    return enter
+        problem = (f"gives {type(value).__name__} {value!r}, not text "
+                   "(write an f-string with a format, e.g. f\"X{x:.3f}\")")
+    elif len(value) > MAX_STRING_LENGTH:
+        problem = f"gives a line longer than {MAX_STRING_LENGTH} characters"
+    else:
+        return value
+    raise TemplateError(gear_class, row.row.id, "o", row.o.text, problem[:300])
 
 
 def compile_row(gear_class: str, row: TemplateRow) -> CompiledRow:
@@ -179,9 +219,22 @@ def compile_row(gear_class: str, row: TemplateRow) -> CompiledRow:
         except ExpressionError as error:
             raise TemplateError(gear_class, row.id, column, text, str(error)) from None
 
-    statements = compiled("s", compile_statements)
-    return CompiledRow(row, compiled("o", compile_expression), compiled("p_calc", compile_expression),
-                       tuple(statements or ()), compiled("p_emit", compile_expression))
+    statements = tuple(compiled("s", compile_statements) or ())
+    p_calc = compiled("p_calc", compile_expression)
+    o, p_emit = compiled("o", compile_expression), compiled("p_emit", compile_expression)
+    return CompiledRow(row, o, p_calc, statements, p_emit, _inputs(p_calc if statements else None, statements, o, p_emit))
+
+
+def _inputs(p_calc, statements, o, p_emit) -> tuple[str, ...]:
+    """Names the row reads before it assigns them itself, in evaluation order."""
+    seen, assigned = {}, set()
+    for expression, target in [(p_calc, None), *((value, name) for name, value in statements), (o, None),
+                               (p_emit, None)]:
+        if expression is not None:
+            seen.update((name, None) for name in sorted(expression.names) if name not in assigned)
+        if target is not None:
+            assigned.add(target)
+    return tuple(seen)
 
 
 def _expressions_of(row: CompiledRow):

@@ -1,37 +1,36 @@
-"""Template expressions: parsed once, checked against a whitelist, compiled, evaluated safely.
+"""Template expressions: parsed once, checked against a whitelist, guarded, then run by asteval
+(engine.templates.evaluator).
 
 An expression is a Python expression (f-strings are the natural way to write NC lines) or,
 when the text is not Python, a condition written the way a DBA writes SQL; sqlglot
-translates it (engine.templates.sqlcond). `s` holds assignments `name = expr`, separated by `;` or
-new lines.
+translates it once (engine.templates.sqlcond) into Python that calls the `_sql_*` helpers.
+`s` holds assignments `name = expr`, separated by `;` or new lines.
 
-Safety comes from the shape of what is allowed, not from watching a running program:
-no statements other than plain assignments in `s`, no loops, comprehensions, lambdas,
-attribute access, imports or calls other than the named functions (engine.templates.functions);
-the operators that can blow up (`**`, `*`, `+`, `<<`, `%`) and format widths go through the
-guards of engine.templates.guards (asteval's own guards and limits, applied to compiled code). Every
-expression therefore runs in time bounded by its size. A wall-clock budget per
-instantiation is kept as a second line of defence (engine.templates.decision_table).
-
-We compile to Python code objects instead of walking the tree with asteval at every
-evaluation: the batch target (5,000 programs/s) leaves about 2 µs per expression, and a
-tree walk costs ten times that. `evaluate_with_asteval` runs the same text through an
-asteval Interpreter; tests check both agree on every seeded template.
+Two layers. Ours, the gate, runs at import, at lint and whenever a template is compiled:
+no statements other than plain assignments in `s` (never to an engine name), no loops,
+comprehensions, lambdas, attribute access, bytes, imports or calls other than the named
+functions (engine.templates.functions); at most MAX_NODES nodes nested at most MAX_DEPTH
+deep. The operators that can allocate without bound (`**`, `*`, `+`, `<<`, `%`), f-strings,
+list and tuple displays and dynamic format specs are rewritten into calls of the guards of
+engine.templates.guards, which bound every value an expression builds. Behind the gate,
+asteval's interpreter runs the guarded tree with only our functions in its symbol table.
+Every expression therefore runs in time bounded by its size; the decision table keeps a
+wall-clock budget per instantiation as well.
 """
 from __future__ import annotations
 
 import ast
 from dataclasses import dataclass
-from typing import Any
 
 from ..errors import EngineError
 from .functions import CONSTANTS, FUNCTIONS
-from .guards import (check_format_spec, guard_length, safe_add, safe_format, safe_lshift, safe_mod,
-                     safe_mult, safe_pow)
+from .guards import check_format_spec
 
 MAX_EXPRESSION_LENGTH = 4_000      # characters of one expression or statement block
 MAX_NODES = 400                    # AST nodes of one expression
+MAX_DEPTH = 40                     # nesting of one expression (asteval walks the tree recursively)
 MAX_SECONDS_PER_INSTANTIATION = 2.0
+ENGINE_NAMES = frozenset(FUNCTIONS) | frozenset(CONSTANTS) | {"template_version"}
 
 ALLOWED_NODES = (
     ast.Expression, ast.BinOp, ast.UnaryOp, ast.BoolOp, ast.Compare, ast.IfExp, ast.Call,
@@ -41,37 +40,17 @@ ALLOWED_NODES = (
     ast.BitAnd, ast.BitOr, ast.BitXor, ast.USub, ast.UAdd, ast.Not, ast.Invert, ast.And, ast.Or,
     ast.Eq, ast.NotEq, ast.Lt, ast.LtE, ast.Gt, ast.GtE, ast.In, ast.NotIn, ast.Is, ast.IsNot,
 )
-
-
 GUARDED_OPERATORS = {ast.Pow: "_safe_pow", ast.Mult: "_safe_mult", ast.Add: "_safe_add",
                      ast.LShift: "_safe_lshift", ast.Mod: "_safe_mod"}
-RUNTIME = {"_safe_pow": safe_pow, "_safe_mult": safe_mult, "_safe_add": safe_add,
-           "_safe_lshift": safe_lshift, "_safe_mod": safe_mod, "_safe_format": safe_format,
-           "_guard": guard_length}
-
-
-def _sql_runtime() -> dict:
-    from .sqlcond import SQL_RUNTIME   # sqlglot: loaded only by templates with SQL conditions
-
-    return SQL_RUNTIME
-
-
-def evaluation_globals(uses_sql: bool = False) -> dict:
-    """The globals every compiled expression runs with: no builtins, only our functions."""
-    names = {"__builtins__": {}, **FUNCTIONS, **CONSTANTS, **RUNTIME}
-    if uses_sql:
-        names.update(_sql_runtime())
-    return names
 
 
 @dataclass(frozen=True)
 class Compiled:
-    """One checked and compiled expression."""
+    """One checked expression: its text, the guarded tree asteval runs, the names it reads."""
     text: str
-    code: Any                  # code object, eval()-able
+    tree: ast.expr
     names: frozenset[str]      # parameter/variable names it reads
     is_sql: bool = False
-    tree: Any = None           # the checked and guarded expression node (for whole-template code)
 
 
 class ExpressionError(EngineError):
@@ -79,27 +58,35 @@ class ExpressionError(EngineError):
 
 
 def compile_expression(text: str) -> Compiled:
-    """Parse `text` as Python, else as SQL; check it; compile it."""
+    """Parse `text` as Python, else as SQL; check it; guard it."""
     _check_length(text)
     try:
-        tree = ast.parse(text.strip(), mode="eval")
+        tree = _parsed(text.strip(), "eval")
         is_sql = False
     except SyntaxError as python_error:
         tree, is_sql = _parse_sql(text, python_error), True
-    _check_tree(tree)
+    _check_tree(tree, sql_helpers=is_sql)
     names = frozenset(_read_names(tree))
     tree = _GuardOperators().visit(tree)
     if is_sql:
         tree = ast.Expression(body=ast.Call(ast.Name("_sql_truth", ast.Load()), [tree.body], []))
     ast.fix_missing_locations(tree)
-    return Compiled(text, compile(tree, "<template>", "eval"), names, is_sql, tree.body)
+    return Compiled(text, tree.body, names, is_sql)
+
+
+def _parsed(text: str, mode: str) -> ast.AST:
+    """ast.parse, with a nesting too deep for the parser refused like any other bad text."""
+    try:
+        return ast.parse(text, mode=mode)
+    except (RecursionError, MemoryError):
+        raise ExpressionError(f"nested too deeply (at most {MAX_DEPTH} levels)") from None
 
 
 def compile_statements(text: str) -> list[tuple[str, Compiled]]:
     """`s`: assignments `name = expr` separated by `;` or new lines, in order."""
     _check_length(text)
     try:
-        module = ast.parse(text.strip(), mode="exec")
+        module = _parsed(text.strip(), "exec")
     except SyntaxError as error:
         raise ExpressionError(f"does not parse: {error.msg} (column {error.offset})") from None
     assignments = []
@@ -110,6 +97,9 @@ def compile_statements(text: str) -> list[tuple[str, Compiled]]:
             raise ExpressionError(f"only assignments `name = expression` are allowed, not {kind}")
         name = statement.targets[0].id
         _check_name(name)
+        if name in ENGINE_NAMES:
+            raise ExpressionError(f"{name!r} is a name of the engine (a function, constant or the "
+                                  "template version); assign to another name")
         source = ast.get_source_segment(text.strip(), statement.value)
         assignments.append((name, compile_expression(source)))
     if not assignments:
@@ -129,6 +119,8 @@ def _parse_sql(text: str, python_error: SyntaxError) -> ast.Expression:
 
     try:
         return ast.Expression(body=translate(text))
+    except RecursionError:
+        raise ExpressionError(f"nested too deeply (at most {MAX_DEPTH} levels)") from None
     except EngineError as sql_error:
         raise ExpressionError(
             f"not a Python expression ({python_error.msg}, column {python_error.offset}) "
@@ -136,33 +128,49 @@ def _parse_sql(text: str, python_error: SyntaxError) -> ast.Expression:
         ) from None
 
 
-def _check_tree(tree: ast.AST) -> None:
+def _check_tree(tree: ast.AST, sql_helpers: bool = False) -> None:
+    """The gate: only allowed nodes, named functions and names; bounded in size and depth.
+    `_sql_*` helpers only in the translation of a SQL condition, never in Python text."""
+    if _depth(tree) > MAX_DEPTH:
+        raise ExpressionError(f"nested too deeply (at most {MAX_DEPTH} levels)")
     count = 0
     for node in ast.walk(tree):
         count += 1
         if not isinstance(node, ALLOWED_NODES):
             raise ExpressionError(f"{_describe(node)} is not allowed in a template expression")
+        if isinstance(node, ast.Constant) and isinstance(node.value, bytes):
+            raise ExpressionError("bytes literals are not allowed (NC lines are text)")
         if isinstance(node, ast.Call):
-            _check_call(node)
+            _check_call(node, sql_helpers)
         if isinstance(node, ast.Name):
-            _check_name(node.id)
+            _check_name(node.id, sql_helpers)
     if count > MAX_NODES:
         raise ExpressionError(f"expression too large ({count} nodes, at most {MAX_NODES})")
 
 
-def _check_call(node: ast.Call) -> None:
+def _depth(tree: ast.AST) -> int:
+    deepest, pending = 0, [(tree, 1)]
+    while pending:
+        node, depth = pending.pop()
+        deepest = max(deepest, depth)
+        if depth <= MAX_DEPTH:
+            pending.extend((child, depth + 1) for child in ast.iter_child_nodes(node))
+    return deepest
+
+
+def _check_call(node: ast.Call, sql_helpers: bool) -> None:
     if not isinstance(node.func, ast.Name):
         raise ExpressionError("only calls of named functions are allowed")
     name = node.func.id
-    if name not in FUNCTIONS and not name.startswith("_sql_"):
+    if name not in FUNCTIONS and not (sql_helpers and name.startswith("_sql_")):
         known = ", ".join(sorted(FUNCTIONS))
         raise ExpressionError(f"function {name}() is not available; known: {known}")
     if node.keywords:
         raise ExpressionError(f"keyword arguments are not allowed in {name}()")
 
 
-def _check_name(name: str) -> None:
-    if name.startswith("_") and not name.startswith("_sql_"):
+def _check_name(name: str, sql_helpers: bool = False) -> None:
+    if name.startswith("_") and not (sql_helpers and name.startswith("_sql_")):
         raise ExpressionError(f"name {name!r} is not allowed (names starting with _ are reserved)")
 
 
@@ -202,6 +210,19 @@ class _GuardOperators(ast.NodeTransformer):
         self.generic_visit(node)
         return ast.copy_location(ast.Call(ast.Name("_guard", ast.Load()), [node], []), node)
 
+    def visit_List(self, node: ast.List):
+        return self._sized(node)
+
+    def visit_Tuple(self, node: ast.Tuple):
+        return self._sized(node)
+
+    def _sized(self, node):
+        """A display of constants is bounded by the text; one of computed values is checked."""
+        self.generic_visit(node)
+        if all(isinstance(element, ast.Constant) for element in node.elts):
+            return node
+        return ast.copy_location(ast.Call(ast.Name("_guard", ast.Load()), [node], []), node)
+
     def visit_FormattedValue(self, node: ast.FormattedValue):
         if node.conversion != -1:
             raise ExpressionError("conversions (!r, !s, !a) are not allowed in f-strings")
@@ -216,21 +237,3 @@ class _GuardOperators(ast.NodeTransformer):
             return node
         value = ast.Call(ast.Name("_safe_format", ast.Load()), [self.visit(node.value), spec], [])
         return ast.copy_location(ast.FormattedValue(value, -1, None), node)
-
-
-ASTEVAL_CONFIG = {"ifexp": True, "formattedvalue": True}
-
-
-def evaluate_with_asteval(text: str, scope: dict) -> Any:
-    """Reference evaluation of one expression by asteval's interpreter (tests, diagnostics)."""
-    import asteval
-
-    interpreter = asteval.Interpreter(minimal=True, use_numpy=False, config=ASTEVAL_CONFIG, user_symbols={
-        **FUNCTIONS, **{k: v for k, v in CONSTANTS.items() if k[0].islower()}, **scope})
-    try:
-        ast.parse(text.strip(), mode="eval")
-    except SyntaxError:
-        compiled = compile_expression(text)
-        return eval(compiled.code, evaluation_globals(True), dict(scope))
-    result = interpreter.eval(text.strip(), show_errors=False, raise_errors=True)
-    return result

@@ -1,34 +1,55 @@
-"""Bounds on what a template expression may build (asteval's own guards and limits, applied to
-compiled code): the operators that can allocate without bound, str() and round(), and the width
-and precision of a format spec. nc_path checks its formats with the same check_format_spec."""
+"""Bounds on what a template expression may build, as functions the evaluator (asteval) calls
+in place of the operators that can allocate without bound, and of str() and round(); asteval's
+own guards run behind ours. Every value an expression builds has a size of at most MAX_SIZE
+(characters of a string; elements of a list or tuple, nested ones counted, so a list of
+65,536 references to a list of 65,536 is 2^32, not 65,536): comparing, printing or formatting
+a value is then bounded too. nc_path checks its formats with the same check_format_spec."""
 from __future__ import annotations
 
 import re
 
-MAX_STRING_LENGTH = 1 << 16        # characters of any string an expression builds
+from .asteval_import import asteval_safe_pow
+
+MAX_SIZE = 1 << 16                 # characters or (nested) elements of any value an expression builds
+MAX_STRING_LENGTH = MAX_SIZE
 MAX_INT_BITS = 4_096               # bits of any integer an expression builds
 MAX_FORMAT_WIDTH = 200             # width/precision in a format spec
+SEQUENCES = (str, tuple, list)
 
 
 def _bits(value) -> int:
     return value.bit_length() if isinstance(value, int) else 0
 
 
-def _too_long(value) -> bool:
-    return isinstance(value, (str, bytes, tuple, list)) and len(value) > MAX_STRING_LENGTH
+def size(value, limit: int = MAX_SIZE) -> int:
+    """Characters of a string, elements of a list or tuple with nested ones counted (each time
+    they occur); 1 for anything else. Stops counting once past `limit`."""
+    total, pending = 0, [value]
+    while pending and total <= limit:
+        item = pending.pop()
+        if isinstance(item, str):
+            total += len(item)
+        elif isinstance(item, (tuple, list)):
+            total += len(item)
+            pending.extend(element for element in item if isinstance(element, SEQUENCES))
+        else:
+            total += 1
+    return total
 
 
-def guard_length(result):
-    if _too_long(result):
-        raise ValueError(f"result longer than {MAX_STRING_LENGTH} characters")
+def guard_size(result):
+    """A built value (f-string, list or tuple display) of at most MAX_SIZE."""
+    if isinstance(result, SEQUENCES) and size(result) > MAX_SIZE:
+        raise ValueError(f"result larger than {MAX_SIZE} characters or elements")
     return result
 
 
 def safe_pow(base, exponent):
+    """Integer powers bounded in bits; then asteval's own safe_pow (exponent at most 10,000)."""
     if isinstance(base, int) and isinstance(exponent, int) and exponent > 0 and abs(base) > 1:
         if exponent * abs(base).bit_length() > MAX_INT_BITS:
             raise ValueError(f"power too large (more than {MAX_INT_BITS} bits)")
-    return base ** exponent
+    return asteval_safe_pow(base, exponent)
 
 
 def safe_mult(left, right):
@@ -36,16 +57,16 @@ def safe_mult(left, right):
         if _bits(left) + _bits(right) > MAX_INT_BITS:
             raise ValueError(f"product too large (more than {MAX_INT_BITS} bits)")
     for sequence, count in ((left, right), (right, left)):
-        if isinstance(sequence, (str, tuple, list)) and isinstance(count, int):
-            if len(sequence) * count > MAX_STRING_LENGTH:
-                raise ValueError(f"repetition longer than {MAX_STRING_LENGTH} characters")
+        if isinstance(sequence, SEQUENCES) and isinstance(count, int) and count > 0:
+            if size(sequence, MAX_SIZE // count + 1) * count > MAX_SIZE:
+                raise ValueError(f"repetition larger than {MAX_SIZE} characters or elements")
     return left * right
 
 
 def safe_add(left, right):
-    if isinstance(left, (str, tuple, list)) and isinstance(right, type(left)):
-        if len(left) + len(right) > MAX_STRING_LENGTH:
-            raise ValueError(f"result longer than {MAX_STRING_LENGTH} characters")
+    if isinstance(left, SEQUENCES) and isinstance(right, type(left)):
+        if size(left) + size(right) > MAX_SIZE:
+            raise ValueError(f"result larger than {MAX_SIZE} characters or elements")
     return left + right
 
 
@@ -78,7 +99,9 @@ def safe_format(value, spec: str) -> str:
 def safe_str(value=""):
     if isinstance(value, int) and _bits(value) > MAX_INT_BITS:
         raise ValueError("integer too large to print")
-    return guard_length(str(value))
+    if isinstance(value, SEQUENCES) and size(value, MAX_SIZE // 4) > MAX_SIZE // 4:
+        raise ValueError(f"value too large to print (more than {MAX_SIZE // 4} characters or elements)")
+    return guard_size(str(value))
 
 
 def safe_round(value, digits=None):

@@ -1,0 +1,20 @@
+"""asteval, imported without numpy. asteval imports numpy when it can (57 ms of every command's
+start) though templates never use it (the interpreter runs with use_numpy=False): where numpy
+is not loaded yet, asteval is imported as if numpy were not installed."""
+from __future__ import annotations
+
+import sys
+
+if "asteval.asteval" not in sys.modules and "numpy" not in sys.modules:
+    sys.modules["numpy"] = None   # asteval's `import numpy` then fails: HAS_NUMPY is False
+    try:
+        import asteval
+    finally:
+        del sys.modules["numpy"]
+
+import asteval  # noqa: E402
+import asteval.astutils  # noqa: E402
+
+Interpreter = asteval.Interpreter
+ALL_NODES = tuple(asteval.asteval.ALL_NODES)
+asteval_safe_pow = asteval.astutils.safe_pow

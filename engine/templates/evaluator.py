@@ -1,0 +1,76 @@
+"""asteval, the run-time evaluator of every template expression (design notes §4).
+
+One locked-down asteval Interpreter per compiled template: `minimal`, no numpy, only the
+nodes a checked expression can contain, and a symbol table that holds our functions,
+constants and guards and the job's names, nothing of Python's builtins. It runs the guarded
+trees the gate produced (engine.templates.expressions), parsed once per template version.
+"""
+from __future__ import annotations
+
+import ast
+
+from ..errors import EngineError
+from .asteval_import import ALL_NODES, Interpreter
+from .functions import CONSTANTS, FUNCTIONS
+from .guards import guard_size, safe_add, safe_format, safe_lshift, safe_mod, safe_mult, safe_pow
+
+# The asteval node handlers a checked expression needs; every other node is switched off.
+NODES = ("expression", "binop", "unaryop", "boolop", "compare", "ifexp", "call", "name", "constant",
+         "joinedstr", "formattedvalue", "tuple", "list", "subscript", "slice", "index")
+GUARDS = {"_safe_pow": safe_pow, "_safe_mult": safe_mult, "_safe_add": safe_add, "_safe_lshift": safe_lshift,
+          "_safe_mod": safe_mod, "_safe_format": safe_format, "_guard": guard_size}
+MAX_MESSAGE = 300   # characters of a failure's message (asteval's own repeats the arguments)
+
+
+def base_symbols(uses_sql: bool) -> dict:
+    """What every expression may name besides the job's parameters and intermediates."""
+    symbols = {**FUNCTIONS, **CONSTANTS, **GUARDS}
+    if uses_sql:
+        from .sqlcond import SQL_RUNTIME   # sqlglot: loaded only by templates with SQL conditions
+
+        symbols.update(SQL_RUNTIME)
+    return symbols
+
+
+class EvaluationError(EngineError):
+    """An expression failed under asteval: the message says how, in one line."""
+
+
+class Evaluator:
+    """A locked-down asteval Interpreter that evaluates one checked tree at a time in a scope."""
+
+    def __init__(self):
+        config = {node: node in NODES for node in ALL_NODES}
+        self.interpreter = Interpreter(symtable={}, minimal=True, use_numpy=False, config=config)
+
+    def evaluate(self, tree: ast.expr, text: str, scope: dict):
+        """The value of `tree` (the checked form of `text`) with `scope` as asteval's symbol table."""
+        interpreter = self.interpreter
+        interpreter.symtable = scope
+        interpreter.error, interpreter.error_msg, interpreter.expr = [], None, text
+        interpreter.retval = interpreter._interrupt = None
+        try:
+            return interpreter.run(tree)
+        except Exception as error:   # asteval re-raises the expression's own failure
+            raise EvaluationError(_problem(interpreter.error, error)) from None
+
+
+def _problem(held: list, raised: Exception) -> str:
+    """One line from the first failure asteval held: an unknown name as such, else the
+    original exception (asteval's message around a call repeats its arguments)."""
+    first = held[0] if held else None
+    if first is not None and first.exc is NameError and isinstance(first.node, ast.Name):
+        return f"unknown parameter {first.node.id!r}"
+    original = first.exc_info[1] if first is not None and first.exc_info[1] is not None else raised
+    text = " ".join(f"{type(original).__name__}: {original}".split())
+    return text if len(text) <= MAX_MESSAGE else text[:MAX_MESSAGE - 1] + "…"
+
+
+_SHARED: list[Evaluator] = []
+
+
+def evaluate(compiled, scope: dict):
+    """One expression on its own (import, tests): `scope` holds its names."""
+    if not _SHARED:
+        _SHARED.append(Evaluator())
+    return _SHARED[0].evaluate(compiled.tree, compiled.text, {**scope, **base_symbols(compiled.is_sql)})

@@ -1,0 +1,106 @@
+"""The trace of a program: for every row of the template version, whether `s` ran or `p_calc`
+skipped the row, whether `o` was emitted or `p_emit` suppressed it, the value of each
+condition, the values computed, and the inputs each expression read (name → value and where
+the value came from: the job, a module's parameters, the row that computed it).
+
+A row's entry, as stored in `program.trace` (a JSON list, one entry per row, in id order):
+    {"row": 1800, "t": "cutcond", "n": 1, "emit": false, "p_emit": false,
+     "read": {"o": {}, "p_emit": {"coolant": [false, "job"]}}}
+Keys that do not apply are left out: "calc" only for rows with `s`, "emit" only for rows
+with `o`. Values that are not plain JSON (tool paths, long texts) are summarised.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+MAX_TEXT = 200        # characters of a text value kept in the trace
+MAX_LISTED = 8        # elements of a list or tuple kept in the trace; longer ones are summarised
+MISSING = object()
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """What a row did for one set of inputs: the values it computed, its line and whether it
+    was emitted, and its trace entry."""
+    assignments: tuple[tuple[str, object], ...]
+    line: object
+    emit: bool
+    trace: dict
+
+
+class RowTrace:
+    """Collects one row's entry while the row is evaluated."""
+
+    def __init__(self, row, scope: dict, origin):
+        self.row, self.scope, self.origin = row, scope, origin
+        self.entry = {"row": row.row.id, "t": row.row.t, "n": row.row.n}
+        self.assignments: list[tuple[str, object]] = []
+
+    def read(self, column: str, expression) -> None:
+        """The inputs `expression` reads, with their values and origins, as it is evaluated."""
+        reads = self.entry.setdefault("read", {}).setdefault(column, {})
+        for name in sorted(expression.names):
+            if name in self.scope:
+                reads[name] = [json_value(self.scope[name]), self._origin(name)]
+
+    def condition(self, column: str, value) -> bool:
+        self.entry[column] = json_value(value)
+        return bool(value)
+
+    def computed(self, name: str, value):
+        self.assignments.append((name, value))
+        self.entry.setdefault("computed", {})[name] = json_value(value)
+        return value
+
+    def outcome(self, calc: bool | None, line=None, emit: bool | None = None) -> Outcome:
+        if calc is not None:
+            self.entry["calc"] = calc
+        if line is not None:
+            self.entry["emit"] = bool(emit)
+        return Outcome(tuple(self.assignments), line, bool(emit), self.entry)
+
+    def _origin(self, name: str) -> str:
+        if any(name == assigned for assigned, _ in self.assignments):
+            return f"row {self.row.row.id}"
+        return self.origin(name)
+
+
+def row_trace(row, scope: dict, origin) -> RowTrace:
+    return RowTrace(row, scope, origin)
+
+
+def json_value(value):
+    """A value as the trace keeps it: plain JSON values as they are, others summarised."""
+    if value is None or isinstance(value, (bool, int)):
+        return value
+    if isinstance(value, float):
+        return value if math.isfinite(value) else str(value)
+    if isinstance(value, str):
+        return value if len(value) <= MAX_TEXT else value[:MAX_TEXT] + f"… ({len(value)} characters)"
+    if isinstance(value, (list, tuple)):
+        if len(value) <= MAX_LISTED and all(not isinstance(item, (list, tuple, dict)) for item in value):
+            return [json_value(item) for item in value]
+        return f"{type(value).__name__} of {len(value)}"
+    return f"{type(value).__name__}"
+
+
+def memo_key(row, scope: dict, origin) -> tuple | None:
+    """The row and the exact values and origins of its inputs, or None if a value cannot be a key
+    (a list): rows with equal keys have equal outcomes."""
+    try:
+        key = (row.row.id, *((_token(scope.get(name, MISSING)), origin(name)) for name in row.inputs))
+        hash(key)
+    except TypeError:
+        return None
+    return key
+
+
+def _token(value):
+    """Equal tokens only for values that print alike: the type is part of it (1, 1.0 and True
+    are equal in Python) and floats are compared by their bits (0.0 and -0.0 are not)."""
+    if type(value) is float:
+        return float, value.hex()
+    if type(value) is tuple:
+        return tuple, tuple(_token(item) for item in value)
+    return type(value), value
