@@ -188,6 +188,10 @@ CREATE TABLE program (
     lines            text[] NOT NULL,
     row_ids          integer[] NOT NULL,
     created_at       timestamptz NOT NULL DEFAULT now(),
+    -- Per row of the template version: ran or skipped, emitted or suppressed, the conditions'
+    -- values, the values computed and the inputs read with their origins (engine/templates/trace.py).
+    -- NULL for programs stored before traces were kept.
+    trace            jsonb,
     CHECK (cardinality(lines) = cardinality(row_ids))
 );
 CREATE INDEX program_job ON program (job_id);
@@ -198,6 +202,18 @@ SELECT p.id AS program_id, l.line_no::integer AS line_no, p.row_ids[l.line_no] A
        l.text
 FROM program p,
      unnest(p.lines) WITH ORDINALITY AS l (text, line_no);
+
+-- The trace as a table: one row per template row of each program, with the lines it emitted.
+CREATE VIEW program_trace AS
+SELECT p.id AS program_id, e.position::integer AS position, (e.entry->>'row')::integer AS row_id,
+       e.entry->>'t' AS t, (e.entry->>'n')::integer AS n,
+       (e.entry->>'calc')::boolean AS calc, (e.entry->>'emit')::boolean AS emit,
+       e.entry->'p_calc' AS p_calc, e.entry->'p_emit' AS p_emit,
+       e.entry->'computed' AS computed, e.entry->'read' AS read,
+       ARRAY(SELECT l.text FROM unnest(p.lines, p.row_ids) AS l (text, row_id)
+             WHERE l.row_id = (e.entry->>'row')::integer) AS lines
+FROM program p,
+     jsonb_array_elements(p.trace) WITH ORDINALITY AS e (entry, position);
 
 -- Further toothed units of a multi-unit (duplex) gear; unit 1 is the gear row itself.
 -- One hob cuts all units, so module and pressure angle are the gear's.
@@ -656,3 +672,4 @@ FROM gear_class g
 ON CONFLICT (gear_class, version) DO NOTHING;
 
 GRANT SELECT ON template_version_rows TO engine_reader, engine_runner, engine_editor;
+GRANT SELECT ON program_trace TO engine_reader, engine_runner, engine_editor;

@@ -11,6 +11,7 @@ import click
 from ..errors import EngineError
 from .cases import cases, suggest
 from .db import db, demo, seed_command
+from .explain import explain
 from .gears import classify, gears
 from .hobs import hobs
 from .instantiate import instantiate
@@ -79,7 +80,7 @@ def main(ctx, database_url, traceback):
     ctx.meta["traceback"] = traceback
 
 
-COMMANDS = (demo, db, seed_command, gears, classify, instantiate, template, lint, hobs, suggest, cases,
+COMMANDS = (demo, db, seed_command, gears, classify, instantiate, explain, template, lint, hobs, suggest, cases,
             import_nc_command, refactor_command, import_dxf_command, plot_command)
 
 

@@ -40,10 +40,12 @@ def parse_range(text: str) -> tuple[int, int]:
 @click.option("--worm-feed", type=click.Choice(["radial", "tangential"]), default="radial", show_default=True,
               help="Worm wheels: radial plunge, or tangential feed along Y.")
 @click.option("--hob-speed", type=int, help="Override the hob speed n0, r/min.")
+@click.option("--explain", is_flag=True,
+              help="Also say why each row emitted its line or not, with the values (on stderr; in --json: explain).")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object (program_id, path, lines, ...).")
 @click.pass_context
 def instantiate(ctx, gear_id, job_id, gear_range, all_gears, out, machine, cuts, coolant, shift_y,
-                shift_per_part, feed_mode, tailstock, worm_feed, hob_speed, as_json):
+                shift_per_part, feed_mode, tailstock, worm_feed, hob_speed, explain, as_json):
     """Produce the NC program of a gear (or a stored job, or a batch of gears).
 
     The program is checked against the machine's limits, stored with the template
@@ -56,6 +58,9 @@ def instantiate(ctx, gear_id, job_id, gear_range, all_gears, out, machine, cuts,
                                        ("--all", all_gears)) if value]
     if len(chosen) != 1:
         raise EngineError("give exactly one of --gear ID, --job ID, --gears FIRST-LAST, --all")
+    if explain and (gear_range or all_gears):
+        raise EngineError("--explain explains one program: use it with --gear or --job, and "
+                          "`engine explain --program ID` for the programs of a batch")
     choices = Choices(cuts=cuts, coolant=coolant, shift_y=shift_y, shift_per_part=shift_per_part,
                       feed_mode=feed_mode, tailstock=tailstock, worm_feed=worm_feed)
     overrides = {"hob_speed": hob_speed}
@@ -69,15 +74,21 @@ def instantiate(ctx, gear_id, job_id, gear_range, all_gears, out, machine, cuts,
             programs = instantiate_gears(conn, first, last, machine=machine, choices=choices,
                                          overrides=overrides, out=out)
             return _report_batch(programs, out, as_json)
-    _report_program(program, as_json)
+    _report_program(program, as_json, explain)
 
 
-def _report_program(program, as_json: bool) -> None:
+def _report_program(program, as_json: bool, explain: bool) -> None:
+    from ..programs.explain import explained_rows
+
+    rows = explained_rows(program.trace, program.lines, program.row_ids) if explain else []
     if as_json:
         emit_json({"program_id": program.program_id, "job_id": program.job_id, "name": program.name,
                    "path": program.path, "lines": len(program.lines), "gear_class": program.gear_class,
-                   "template_version": program.template_version, "template_hash": program.template_hash})
+                   "template_version": program.template_version, "template_hash": program.template_hash,
+                   **({"explain": [row.as_dict() for row in rows]} if explain else {})})
         return
+    for row in rows:
+        click.echo(row.sentence(), err=True)
     if program.path is None:
         click.echo(program.text, nl=False)
     click.echo(f"program {program.program_id} (job {program.job_id}, {len(program.lines)} lines) "

@@ -38,6 +38,8 @@ class Program:
     template_version: int
     template_hash: str
     path: str | None = None
+    trace: list | None = None        # engine.templates.trace: why each row emitted or not
+    row_ids: list[int] | None = None  # the template row of each line
 
     @property
     def text(self) -> str:

@@ -12,12 +12,12 @@ INSERT_JOB = """
 INSERT INTO job (gear_id, gear_class, machine, hob_id, params, module_params, cutting)
 VALUES (%s, %s, %s, %s, %s, %s, %s) RETURNING id"""
 INSERT_PROGRAM = """
-INSERT INTO program (job_id, gear_class, template_version, template_hash, name, lines, row_ids)
-VALUES (%s, %s, %s, %s, %s, %s, %s) RETURNING id"""
+INSERT INTO program (job_id, gear_class, template_version, template_hash, name, lines, row_ids, trace)
+VALUES (%s, %s, %s, %s, %s, %s, %s, %s) RETURNING id"""
 COPY_JOB = "COPY job (id, gear_id, gear_class, machine, hob_id, params, module_params, cutting) FROM STDIN"
-COPY_PROGRAM = ("COPY program (id, job_id, gear_class, template_version, template_hash, name, lines, row_ids) "
-                "FROM STDIN (FORMAT BINARY)")
-PROGRAM_TYPES = ("int8", "int8", "text", "int4", "text", "text", "text[]", "int4[]")
+COPY_PROGRAM = ("COPY program (id, job_id, gear_class, template_version, template_hash, name, lines, row_ids, "
+                "trace) FROM STDIN (FORMAT BINARY)")
+PROGRAM_TYPES = ("int8", "int8", "text", "int4", "text", "text", "text[]", "int4[]", "jsonb")
 
 
 def store_one(conn, planned: Planned, existing_job: int | None, path: str | None) -> Program:
@@ -69,9 +69,10 @@ def _next_ids(conn, sequence: str, count: int) -> list[int]:
 def _program_values(job_id: int, planned) -> tuple:
     template = planned.template
     return (job_id, planned.gear_class, template.version, template.hash, planned.name,
-            planned.result.lines, planned.result.row_ids)
+            planned.result.lines, planned.result.row_ids, Jsonb(planned.result.trace))
 
 
 def _program(program_id: int, job_id: int, planned: Planned, path) -> Program:
     return Program(program_id, job_id, planned.name, planned.result.lines, planned.gear_class,
-                   planned.template.version, planned.template.hash, path)
+                   planned.template.version, planned.template.hash, path, planned.result.trace,
+                   planned.result.row_ids)

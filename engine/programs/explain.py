@@ -1,0 +1,96 @@
+"""Why each line of a program appeared, or did not, and with which values: the program's trace
+(engine.templates.trace) read back, one sentence per template row.
+
+    1800 not emitted: p_emit coolant = False (job)
+    1400 EGON(C,"FINE",B,-1,19) emitted: z0 = 1 (job), z2 = 19 (job)
+    1200 skipped: p_calc shift_on = False (job)
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ..errors import EngineError
+
+MAX_LISTED_LINES = 1   # lines of a row quoted in its sentence (a tool path prints hundreds)
+
+
+@dataclass(frozen=True)
+class ExplainedRow:
+    row_id: int
+    state: str           # emitted | not emitted | skipped | computed
+    lines: tuple[str, ...]
+    entry: dict          # the row's trace entry as stored
+
+    def sentence(self) -> str:
+        return f"{self.row_id} {_what(self)}{_because(self)}"
+
+    def as_dict(self) -> dict:
+        return {"row": self.row_id, "state": self.state, "lines": list(self.lines), "trace": self.entry}
+
+
+def explained_rows(trace: list[dict], lines: list[str], row_ids: list[int], row: int | None = None) -> list[ExplainedRow]:
+    """Each row of the trace (or only `row`) with its state and the lines it emitted."""
+    emitted: dict[int, list[str]] = {}
+    for line, row_id in zip(lines, row_ids):
+        emitted.setdefault(row_id, []).append(line)
+    entries = [entry for entry in trace if row is None or entry["row"] == row]
+    if row is not None and not entries:
+        raise EngineError(f"row {row} is not in the program's template version; see `engine explain --program ID`")
+    return [ExplainedRow(entry["row"], _state(entry), tuple(emitted.get(entry["row"], ())), entry) for entry in entries]
+
+
+def explain_program(conn, program_id: int, row: int | None = None) -> list[ExplainedRow]:
+    """The stored program's rows, explained from its stored trace."""
+    found = conn.execute("SELECT lines, row_ids, trace FROM program WHERE id = %s", (program_id,)).fetchone()
+    if found is None:
+        raise EngineError(f"program {program_id} does not exist; see `SELECT id, name FROM program`")
+    lines, row_ids, trace = found
+    if trace is None:
+        raise EngineError(f"program {program_id} was stored before programs kept their trace; "
+                          "make it again with `engine instantiate --job ID` to explain it")
+    return explained_rows(trace, lines, row_ids, row)
+
+
+def _state(entry: dict) -> str:
+    if entry.get("calc") is False:
+        return "skipped"
+    if "emit" in entry:
+        return "emitted" if entry["emit"] else "not emitted"
+    return "computed"
+
+
+def _what(row: ExplainedRow) -> str:
+    if row.state != "emitted":
+        return f"{row.state}"
+    shown = " | ".join(row.lines[:MAX_LISTED_LINES])
+    more = f" (+{len(row.lines) - MAX_LISTED_LINES} lines)" if len(row.lines) > MAX_LISTED_LINES else ""
+    return f"{shown}{more} emitted"
+
+
+def _because(row: ExplainedRow) -> str:
+    """The decisive condition and the values that decided, or the inputs of the line."""
+    entry, read = row.entry, row.entry.get("read", {})
+    if row.state == "skipped":
+        return f": p_calc {_inputs(read.get('p_calc'))}"
+    if row.state == "not emitted":
+        return f": p_emit {_inputs(read.get('p_emit'))}"
+    parts = []
+    if entry.get("computed"):
+        parts.append("computed " + ", ".join(f"{name} = {_value(value)}" for name, value in entry["computed"].items()))
+    inputs = {**read.get("p_calc", {}), **read.get("s", {}), **read.get("o", {}), **read.get("p_emit", {})}
+    if inputs:
+        parts.append(("from " if entry.get("computed") else "") + _inputs(inputs))
+    return (": " + " ".join(parts)) if parts else ""
+
+
+def _inputs(reads: dict | None) -> str:
+    if not reads:
+        return "(no inputs)"
+    return ", ".join(f"{name} = {_value(value)} ({origin})" for name, (value, origin) in reads.items())
+
+
+def _value(value) -> str:
+    """JSON values written as a template engineer writes them in an expression."""
+    if value is True or value is False or value is None:
+        return {True: "True", False: "False", None: "None"}[value]
+    return repr(value) if isinstance(value, (str, list)) else f"{value}"

@@ -1,0 +1,164 @@
+"""Every program explains itself (issue 12): its trace says for every row of its template
+version whether it ran and emitted, and the values that decided it; checked here on every
+seeded class against the stored program, the stored job and the template rows, with the
+conditions evaluated again by plain Python from the recorded values."""
+import math
+import re
+
+import psycopg
+import pytest
+
+from engine.hobbing.choices import Choices
+from engine.programs.instantiate import instantiate_gear, instantiate_gears, instantiate_job
+from engine.templates.store import load_template
+from engine.turning.dxf_import import import_dxf
+from test_dxf_read import seed_drawing
+
+SEEDED_GEARS = {42: "spur", 43: "helical", 45: "spur", 50: "taper", 51: "crowned", 53: "worm_wheel", 54: "duplex"}
+CHOICES = (Choices(), Choices(cuts=2, coolant=False, tailstock=False, feed_mode="conventional-climb"),
+           Choices(shift_per_part=0.5), Choices(worm_feed="tangential"))
+SQL_WORDS = ((r"\bAND\b", " and "), (r"\bOR\b", " or "), (r"\bNOT\b", " not "), (r"<>", "!="), (r"(?<![<>!=])=(?!=)", "=="))
+FUNCTIONS = {name: getattr(math, name) for name in ("sqrt", "sin", "cos", "tan", "radians", "degrees", "ceil",
+                                                    "floor", "fabs", "atan", "atan2", "hypot")}
+FUNCTIONS.update({"abs": abs, "min": min, "max": max, "round": round, "int": int, "float": float, "len": len})
+
+
+def stored(conn, program_id):
+    return conn.execute("""SELECT p.lines, p.row_ids, p.trace, p.gear_class, j.params, j.module_params
+                           FROM program p JOIN job j ON j.id = p.job_id WHERE p.id = %s""", (program_id,)).fetchone()
+
+
+def python_of(condition: str) -> str:
+    """The seeded SQL-style conditions (AND, OR, NOT, =, <>) as Python, for the check only."""
+    if not re.search(r"\b(AND|OR|NOT)\b|<>|(?<![<>!=])=(?!=)", condition):
+        return condition
+    for pattern, python in SQL_WORDS:
+        condition = re.sub(pattern, python, condition)
+    return condition
+
+
+def check_trace(conn, program_id):
+    lines, row_ids, trace, gear_class, params, module_params = stored(conn, program_id)
+    template = {row.id: row for row in load_template(conn, gear_class).rows}
+    assert [entry["row"] for entry in trace] == sorted(template)          # every row, in id order
+    emitting = {entry["row"] for entry in trace if entry.get("emit")}
+    assert set(row_ids) <= emitting                                        # every line from an emitting row
+    assert {row for row in emitting if "nc_path" not in template[row].o} <= set(row_ids)
+    computed = {}
+    for entry in trace:
+        row = template[entry["row"]]
+        check_origins(entry, row, params, module_params, computed)
+        check_decision(entry, row)
+        computed.update((name, (entry["row"], value)) for name, value in entry.get("computed", {}).items())
+
+
+def check_origins(entry, row, params, module_params, computed):
+    """Each value read is the job's, its module's, or the value a named row computed."""
+    for column, reads in entry.get("read", {}).items():
+        for name, (value, origin) in reads.items():
+            if origin == "job":
+                assert value == json_scalar(params[name]), (entry["row"], name)
+            elif origin.startswith("module "):   # a turning model adds the passes it computes to the stored ones
+                stored_module = module_params.get(origin.split()[1], {})
+                assert name not in stored_module or value == json_scalar(stored_module[name]), (entry["row"], name)
+            elif origin.startswith("row "):
+                source = int(origin.split()[1])
+                own = source == entry["row"] and name in entry.get("computed", {})
+                assert own or computed[name] == (source, value), (entry["row"], name, origin)
+            else:
+                assert origin == "template" and name == "template_version"
+
+
+def json_scalar(value):
+    return value if isinstance(value, (bool, int, float, str, type(None))) else pytest.approx(value)
+
+
+def check_decision(entry, row):
+    """A row that did not emit names the condition that decided it, with values that decide it
+    the same way when Python evaluates the condition again."""
+    if row.s is not None and row.p_calc is not None:
+        assert entry["calc"] is decided(row.p_calc, entry["read"]["p_calc"])
+        if not entry["calc"]:
+            assert "emit" not in entry and "computed" not in entry
+            return
+    if row.o is None:
+        assert "emit" not in entry
+        return
+    expected = True if row.p_emit is None else decided(row.p_emit, entry["read"]["p_emit"])
+    assert entry["emit"] is expected, (entry["row"], row.p_emit, entry)
+
+
+def decided(condition: str, reads: dict) -> bool:
+    values = {name: value for name, (value, _) in reads.items()}
+    return bool(eval(python_of(condition), {"__builtins__": {}, **FUNCTIONS}, values))
+
+
+@pytest.mark.parametrize("gear_id", sorted(SEEDED_GEARS))
+@pytest.mark.parametrize("choices", CHOICES, ids=["default", "two-cuts-dry", "shift-per-part", "tangential"])
+def test_every_seeded_hobbing_class_s_trace_explains_each_row(conn, gear_id, choices):
+    program = instantiate_gear(conn, gear_id, choices=choices)
+    check_trace(conn, program.program_id)
+
+
+@pytest.mark.parametrize("machine", ["lathe-iso", "lathe-840d"])
+def test_turning_classes_trace_explains_each_row(conn, tmp_path, machine):
+    seed_drawing(tmp_path / "part.dxf")
+    job = import_dxf(conn, tmp_path / "part.dxf", machine).job_id
+    check_trace(conn, instantiate_job(conn, job).program_id)
+
+
+def test_a_trace_is_stored_with_single_batch_and_remade_programs(conn):
+    single = instantiate_gear(conn, 42)
+    batch = instantiate_gears(conn, 42, 47)
+    remade = instantiate_job(conn, single.job_id)
+    ids = [single.program_id, remade.program_id,
+           *range(batch.first_program_id, batch.last_program_id + 1)]
+    traces = conn.execute("SELECT id, jsonb_array_length(trace) FROM program WHERE id = ANY(%s)", (ids,)).fetchall()
+    assert len(traces) >= 2 + batch.programs and all(length and length > 10 for _, length in traces)
+    for program_id, _ in traces:
+        check_trace(conn, program_id)
+
+
+def test_the_program_trace_view_has_a_row_per_template_row_with_its_lines(conn):
+    program = instantiate_gear(conn, 42, choices=Choices(coolant=False))
+    rows = conn.execute("SELECT row_id, emit, p_emit, read, lines FROM program_trace WHERE program_id = %s "
+                        "ORDER BY position", (program.program_id,)).fetchall()
+    assert [row[0] for row in rows] == [row.id for row in load_template(conn, "spur").rows]
+    by_row = {row[0]: row for row in rows}
+    assert by_row[1800][1:4] == (False, False, {"p_emit": {"coolant": [False, "job"]}, "o": {}})
+    assert by_row[1700][4] == ["M3 S246"] and by_row[1700][1] is True
+
+
+def test_engine_explain_says_why_a_line_is_missing(run):
+    made = run("instantiate", "--gear", "42", "--no-coolant", "--json")
+    program_id = __import__("json").loads(made.stdout)["program_id"]
+    explained = run("explain", "--program", program_id, "--row", "1800")
+    assert explained.exit_code == 0
+    assert explained.stdout == "1800 not emitted: p_emit coolant = False (job)\n"
+    whole = run("explain", "--program", program_id).stdout.splitlines()
+    assert 'EGON(C,"FINE",B,-1,19) emitted' in whole[next(i for i, l in enumerate(whole) if l.startswith("1500 "))]
+    assert "z2 = 19 (job)" in next(line for line in whole if line.startswith("1500 "))
+
+
+def test_instantiate_explain_prints_the_same_for_a_new_program(run):
+    made = run("instantiate", "--gear", "42", "--no-coolant", "--explain")
+    assert made.exit_code == 0 and made.stdout.startswith("%_N_GEAR42_MPF")
+    assert "1800 not emitted: p_emit coolant = False (job)" in made.stderr.splitlines()
+
+
+@pytest.mark.parametrize("args, words", [
+    (("explain", "--program", "999999"), "program 999999 does not exist"),
+    (("instantiate", "--gears", "42-43", "--explain"), "--explain explains one program"),
+])
+def test_explain_errors_are_one_line(run, args, words):
+    refused = run(*args)
+    assert refused.exit_code == 1 and words in refused.stderr and refused.stderr.count("\n") == 1
+
+
+def test_a_program_stored_before_traces_says_so(run):
+    made = run("instantiate", "--gear", "42", "--json")
+    program_id = __import__("json").loads(made.stdout)["program_id"]
+    with psycopg.connect(run.url) as conn:
+        conn.execute("UPDATE program SET trace = NULL WHERE id = %s", (program_id,))
+    refused = run("explain", "--program", program_id)
+    assert refused.exit_code == 1 and "before programs kept their trace" in refused.stderr
