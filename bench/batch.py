@@ -227,7 +227,7 @@ def store(conn, planned: list[tuple]) -> None:
             if getattr(storage, "PROGRAM_TYPES", None):
                 copy.set_types(storage.PROGRAM_TYPES)
             for program_id, job_id, item in zip(program_ids, job_ids, planned):
-                copy.write_row((program_id, job_id, item[1], *item[6:11]))
+                copy.write_row((program_id, job_id, item[1], *item[6:11], None))   # a Jinja2 program has no trace
 
 
 def run_jinja(conn, pipeline: JinjaPipeline, first: int, last: int) -> tuple[float, int]:

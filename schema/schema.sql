@@ -215,6 +215,15 @@ SELECT p.id AS program_id, e.position::integer AS position, (e.entry->>'row')::i
 FROM program p,
      jsonb_array_elements(p.trace) WITH ORDINALITY AS e (entry, position);
 
+-- SQL-style conditions translated once and kept: the Python expression sqlglot made of a
+-- condition's text, keyed by a hash of the translator's version and the text (never changed).
+CREATE TABLE sql_translation (
+    text_hash  text PRIMARY KEY,
+    sql        text NOT NULL,
+    python     text NOT NULL,
+    created_at timestamptz NOT NULL DEFAULT now()
+);
+
 -- Further toothed units of a multi-unit (duplex) gear; unit 1 is the gear row itself.
 -- One hob cuts all units, so module and pressure angle are the gear's.
 CREATE TABLE gear_unit (
@@ -673,3 +682,5 @@ ON CONFLICT (gear_class, version) DO NOTHING;
 
 GRANT SELECT ON template_version_rows TO engine_reader, engine_runner, engine_editor;
 GRANT SELECT ON program_trace TO engine_reader, engine_runner, engine_editor;
+GRANT SELECT ON sql_translation TO engine_reader, engine_runner, engine_editor;
+GRANT INSERT ON sql_translation TO engine_editor;

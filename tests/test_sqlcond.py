@@ -13,7 +13,8 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from engine.errors import EngineError
-from engine.templates.sqlcond import SQL_RUNTIME, translate
+from engine.templates.sqlcond.runtime import SQL_RUNTIME
+from engine.templates.sqlcond.translate import translate
 
 GLOBALS = {"__builtins__": {}, **SQL_RUNTIME}
 

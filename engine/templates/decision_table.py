@@ -16,6 +16,7 @@ from __future__ import annotations
 import ast
 import time
 from dataclasses import dataclass, field
+from functools import partial
 
 from ..errors import EngineError
 from ..programs.nc_check import words
@@ -67,7 +68,7 @@ class CompiledTemplate:
 
     def __init__(self, template: Template):
         self.template = template
-        self.rows = tuple(compile_row(template.gear_class, row) for row in template.rows)
+        self.rows = tuple(compile_row(template.gear_class, row, template.translations) for row in template.rows)
         self.symbols = base_symbols(any(c.is_sql for r in self.rows for c in _expressions_of(r)))
         self.evaluator = Evaluator()
         self.memo: dict[tuple, Outcome] = {}
@@ -209,7 +210,11 @@ def _text(value, row: CompiledRow, gear_class: str):
     raise TemplateError(gear_class, row.row.id, "o", row.o.text, problem[:300])
 
 
-def compile_row(gear_class: str, row: TemplateRow) -> CompiledRow:
+def compile_row(gear_class: str, row: TemplateRow, translations=None) -> CompiledRow:
+    """The row's expressions checked and guarded (SQL conditions from their stored translations
+    where `translations` has them)."""
+    expression = partial(compile_expression, translations=translations)
+
     def compiled(column: str, compile_function):
         text = getattr(row, column)
         if text is None:
@@ -220,8 +225,8 @@ def compile_row(gear_class: str, row: TemplateRow) -> CompiledRow:
             raise TemplateError(gear_class, row.id, column, text, str(error)) from None
 
     statements = tuple(compiled("s", compile_statements) or ())
-    p_calc = compiled("p_calc", compile_expression)
-    o, p_emit = compiled("o", compile_expression), compiled("p_emit", compile_expression)
+    p_calc = compiled("p_calc", expression)
+    o, p_emit = compiled("o", expression), compiled("p_emit", expression)
     return CompiledRow(row, o, p_calc, statements, p_emit, _inputs(p_calc if statements else None, statements, o, p_emit))
 
 
@@ -245,12 +250,13 @@ def _expressions_of(row: CompiledRow):
         yield compiled
 
 
-_CACHE: dict[tuple[str, int, str], CompiledTemplate] = {}
+_CACHE: dict[tuple, CompiledTemplate] = {}
 
 
 def compiled_template(template: Template) -> CompiledTemplate:
-    """Parse every expression once per template (keyed by class, version and content)."""
-    key = (template.gear_class, template.version, template.hash)
+    """Parse every expression once per template (keyed by class, version, content and the stored
+    translations of its SQL conditions, which the gate checks again when they change)."""
+    key = (template.gear_class, template.version, template.hash, frozenset(template.translations.items()))
     found = _CACHE.get(key)
     if found is None:
         found = _CACHE[key] = CompiledTemplate(template)

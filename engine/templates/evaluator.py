@@ -26,7 +26,7 @@ def base_symbols(uses_sql: bool) -> dict:
     """What every expression may name besides the job's parameters and intermediates."""
     symbols = {**FUNCTIONS, **CONSTANTS, **GUARDS}
     if uses_sql:
-        from .sqlcond import SQL_RUNTIME   # sqlglot: loaded only by templates with SQL conditions
+        from .sqlcond.runtime import SQL_RUNTIME   # the helpers translated SQL conditions call
 
         symbols.update(SQL_RUNTIME)
     return symbols

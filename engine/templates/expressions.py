@@ -20,6 +20,7 @@ wall-clock budget per instantiation as well.
 from __future__ import annotations
 
 import ast
+from collections.abc import Mapping
 from dataclasses import dataclass
 
 from ..errors import EngineError
@@ -57,14 +58,15 @@ class ExpressionError(EngineError):
     """An expression that does not parse, is not allowed, or fails when evaluated."""
 
 
-def compile_expression(text: str) -> Compiled:
-    """Parse `text` as Python, else as SQL; check it; guard it."""
+def compile_expression(text: str, translations: Mapping[str, str] | None = None) -> Compiled:
+    """Parse `text` as Python, else as SQL (its stored translation if `translations` has one);
+    check it; guard it."""
     _check_length(text)
     try:
         tree = _parsed(text.strip(), "eval")
         is_sql = False
     except SyntaxError as python_error:
-        tree, is_sql = _parse_sql(text, python_error), True
+        tree, is_sql = _sql_tree(text, python_error, translations or {}), True
     _check_tree(tree, sql_helpers=is_sql)
     names = frozenset(_read_names(tree))
     tree = _GuardOperators().visit(tree)
@@ -114,8 +116,37 @@ def _check_length(text: str) -> None:
         raise ExpressionError("empty expression")
 
 
+def translated_python(text: str) -> str | None:
+    """The Python expression sqlglot makes of a SQL condition (None if it is not one), to keep."""
+    try:
+        python_error = _python_error(text)
+        return None if python_error is None else ast.unparse(_parse_sql(text, python_error).body)
+    except ExpressionError:
+        return None
+
+
+def _python_error(text: str) -> SyntaxError | None:
+    try:
+        _parsed(text.strip(), "eval")
+    except SyntaxError as error:
+        return error
+    return None
+
+
+def _sql_tree(text: str, python_error: SyntaxError, translations: Mapping[str, str]) -> ast.Expression:
+    """A stored translation (checked by the gate like any tree), else sqlglot's."""
+    stored = translations.get(text)
+    if stored is None:
+        return _parse_sql(text, python_error)
+    try:
+        return _parsed(stored, "eval")
+    except SyntaxError:
+        raise ExpressionError("its stored translation (table sql_translation) does not parse; "
+                              "delete that row and run `engine lint`") from None
+
+
 def _parse_sql(text: str, python_error: SyntaxError) -> ast.Expression:
-    from .sqlcond import translate   # sqlglot, as above
+    from .sqlcond.translate import translate   # sqlglot: only where a condition is translated
 
     try:
         return ast.Expression(body=translate(text))

@@ -9,6 +9,7 @@ from ..gears.models import model_for_class
 from .checks import LintProblem, structural_problems
 from .decision_table import compile_row
 from .store import load_template
+from .translations import store_translations
 
 
 def lint_class(conn, gear_class: str) -> list[LintProblem]:
@@ -72,4 +73,7 @@ def lint_all(conn) -> list[LintProblem]:
     problems = []
     for name in names:
         problems += lint_class(conn, name)
+    if not problems:   # SQL conditions edited in SQL get their translation kept (engine.templates.translations)
+        for name in names:
+            store_translations(conn, load_template(conn, name).rows)
     return problems

@@ -7,7 +7,8 @@ import csv
 import hashlib
 import io
 import json
-from dataclasses import astuple, dataclass
+from collections.abc import Mapping
+from dataclasses import astuple, dataclass, field
 from functools import cached_property
 from pathlib import Path
 
@@ -33,6 +34,8 @@ class Template:
     gear_class: str
     version: int
     rows: tuple[TemplateRow, ...]
+    # SQL condition text → its stored Python translation (engine.templates.translations)
+    translations: Mapping[str, str] = field(default_factory=dict, compare=False, repr=False)
 
     @cached_property
     def hash(self) -> str:

@@ -9,6 +9,7 @@ from __future__ import annotations
 from ..errors import EngineError
 from .checks import check_rows
 from .rows import Template, TemplateRow
+from .translations import load_translations, store_translations
 
 # A class's rows: its own and those it inherits from its ancestors (nearest wins by id).
 LOAD_ROWS = """
@@ -34,7 +35,8 @@ def load_template(conn, gear_class: str) -> Template:
     if found[0][1] is None:
         raise EngineError(f"gear class {gear_class!r} has no template rows; "
                           f"import them with `engine template import --class {gear_class} FILE.csv`")
-    return Template(gear_class, found[0][0], tuple(TemplateRow(*row[1:]) for row in found))
+    rows = tuple(TemplateRow(*row[1:]) for row in found)
+    return Template(gear_class, found[0][0], rows, load_translations(conn, rows))
 
 
 def list_classes(conn) -> list[tuple]:
@@ -86,6 +88,7 @@ def replace_template(conn, gear_class: str, rows: list[TemplateRow]) -> bool:
         conn.execute(BUMP_VERSIONS, (gear_class,))
         # template_audit: one row per row of the class's assembled template that changed.
         conn.execute("SELECT audit_class_change(%s, %s::jsonb)", (gear_class, before))
+        store_translations(conn, own)
     return True
 
 

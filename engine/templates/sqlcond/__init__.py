@@ -77,10 +77,9 @@ share the operand checks in ``operands``.
 from __future__ import annotations
 
 from . import operands
-from .runtime import SQL_RUNTIME
-from .translate import translate
 
-__all__ = ["SQL_RUNTIME", "translate"]
+# `translate` (engine.templates.sqlcond.translate) imports sqlglot, a tenth of a second: it is
+# imported only where a condition is translated, not where translated conditions run (runtime).
 
 # The limits named above, importable from here as before the package split.
 MAX_INT_BITS = operands.MAX_INT_BITS

@@ -1,0 +1,64 @@
+"""SQL-style conditions translated once and kept in the database (table sql_translation), so that
+instantiating a template whose conditions are all translated does not load sqlglot (a tenth of
+a second of every command). A translation is looked up by a hash of the translator's version and
+the condition's text; what is read back passes the expression gate like any expression."""
+from __future__ import annotations
+
+import ast
+import hashlib
+
+from psycopg.errors import InsufficientPrivilege
+
+TRANSLATOR = "sqlcond-1"   # a change of the translator's output changes this, and so every key
+
+FIND = "SELECT sql, python FROM sql_translation WHERE text_hash = ANY(%s)"
+STORE = "INSERT INTO sql_translation (text_hash, sql, python) VALUES (%s, %s, %s) ON CONFLICT DO NOTHING"
+
+
+def text_hash(text: str) -> str:
+    return hashlib.sha256(f"{TRANSLATOR}\n{text}".encode()).hexdigest()
+
+
+def expression_texts(rows) -> set[str]:
+    """Every expression text of the rows that may be a condition in SQL (not `s`, which assigns)."""
+    return {text for row in rows for text in (row.p_calc, row.o, row.p_emit) if text is not None}
+
+
+def sql_texts(rows) -> set[str]:
+    """The texts that are not Python: conditions written the way a DBA writes SQL."""
+    return {text for text in expression_texts(rows) if not _is_python(text)}
+
+
+def load_translations(conn, rows) -> dict[str, str]:
+    """Stored translations of the rows' SQL conditions: text → Python expression."""
+    texts = sql_texts(rows)
+    if not texts:
+        return {}
+    found = conn.execute(FIND, ([text_hash(text) for text in texts],)).fetchall()
+    return {sql: python for sql, python in found if sql in texts}
+
+
+def store_translations(conn, rows) -> int:
+    """Translate the rows' SQL conditions that have no stored translation and keep them; a role
+    that may not write them (runners) leaves them to be translated when used. The number stored."""
+    from .expressions import translated_python
+
+    missing = sql_texts(rows) - set(load_translations(conn, rows))
+    made = [(text_hash(text), text, translated_python(text)) for text in sorted(missing)]
+    made = [row for row in made if row[2] is not None]
+    if not made:
+        return 0
+    try:
+        with conn.transaction(), conn.cursor() as cursor:
+            cursor.executemany(STORE, made)
+    except InsufficientPrivilege:
+        return 0
+    return len(made)
+
+
+def _is_python(text: str) -> bool:
+    try:
+        ast.parse(text.strip(), mode="eval")
+    except (SyntaxError, RecursionError, MemoryError, ValueError):
+        return False
+    return True

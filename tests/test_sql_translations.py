@@ -1,0 +1,59 @@
+"""SQL-style conditions are translated once and kept (issue 12): a seeded gear is instantiated
+without loading sqlglot, a condition edited in SQL still runs (translated when used) and gets
+its translation kept by `engine lint`, and a stored translation is checked like any expression."""
+import json
+import subprocess
+import sys
+
+import psycopg
+
+from engine.templates.expressions import translated_python
+from engine.templates.translations import text_hash
+
+PROBE = """
+import sys, json
+from engine.cli import main
+try:
+    main(["--database-url", sys.argv[1], "instantiate", "--gear", sys.argv[2], "--json"])
+except SystemExit as done:
+    print(json.dumps({"exit": done.code, "sqlglot": "sqlglot" in sys.modules}), file=sys.stderr)
+"""
+
+
+def instantiated_in_a_new_process(url: str, gear: int) -> dict:
+    done = subprocess.run([sys.executable, "-c", PROBE, url, str(gear)], capture_output=True, text=True, timeout=120)
+    return json.loads(done.stderr.strip().splitlines()[-1])
+
+
+def test_seeded_classes_run_from_their_kept_translations_without_sqlglot(fresh_database_url):
+    for gear in (42, 53):     # spur: `shift_on AND shift_per_part = 0`; worm wheel: `NOT tangential` …
+        assert instantiated_in_a_new_process(fresh_database_url, gear) == {"exit": 0, "sqlglot": False}
+
+
+def test_kept_translations_are_sqlglot_s_own(conn):
+    kept = conn.execute("SELECT text_hash, sql, python FROM sql_translation").fetchall()
+    assert {sql for _, sql, _ in kept} >= {"shift_on AND shift_per_part = 0", "NOT tangential"}
+    for digest, sql, python in kept:
+        assert digest == text_hash(sql) and python == translated_python(sql)
+
+
+def test_a_condition_edited_in_sql_runs_and_lint_keeps_its_translation(run):
+    with psycopg.connect(run.url) as conn:
+        conn.execute("UPDATE template_view SET p_emit = 'coolant AND 1 = 1' WHERE gear_class = 'spur' AND id = 1800")
+    made = run("instantiate", "--gear", "42", "--no-coolant")
+    assert made.exit_code == 0 and "\nM8\n" not in made.stdout
+    assert instantiated_in_a_new_process(run.url, 42)["sqlglot"] is True      # translated when used
+    assert run("lint").exit_code == 0
+    with psycopg.connect(run.url) as conn:
+        assert conn.execute("SELECT python FROM sql_translation WHERE sql = 'coolant AND 1 = 1'").fetchone() \
+            == (translated_python("coolant AND 1 = 1"),)
+    assert instantiated_in_a_new_process(run.url, 42) == {"exit": 0, "sqlglot": False}
+
+
+def test_a_tampered_translation_is_refused_by_the_gate(run):
+    with psycopg.connect(run.url) as conn:
+        conn.execute("UPDATE sql_translation SET python = 'open(\"/etc/passwd\")' "
+                     "WHERE sql = 'shift_on AND shift_per_part = 0'")
+    refused = run("instantiate", "--gear", "42")
+    assert refused.exit_code == 1 and refused.stderr.count("\n") == 1
+    assert "open() is not available" in refused.stderr and "row 1600" in refused.stderr
