@@ -92,6 +92,7 @@ def main(argv=None) -> int:
     with bench_database(args.database_url, "bench_evaluator") as url, tempfile.TemporaryDirectory() as folder:
         data = Path(folder) / "jobs.pickle"
         data.write_bytes(pickle.dumps(planned_jobs(url, args.count)))
+        (Path(folder) / "before").mkdir()
         before = source_tree_of(args.against, Path(folder) / "before")
         if before is None:
             sys.exit(f"bench/evaluator.py: this checkout has no commit {args.against}; give --against REV")

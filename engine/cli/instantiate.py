@@ -40,12 +40,14 @@ def parse_range(text: str) -> tuple[int, int]:
 @click.option("--worm-feed", type=click.Choice(["radial", "tangential"]), default="radial", show_default=True,
               help="Worm wheels: radial plunge, or tangential feed along Y.")
 @click.option("--hob-speed", type=int, help="Override the hob speed n0, r/min.")
+@click.option("--workers", type=click.IntRange(1, 64), default=1, show_default=True,
+              help="Batch: plan the gears in this many processes (all stored in one transaction, or none).")
 @click.option("--explain", is_flag=True,
               help="Also say why each row emitted its line or not, with the values (on stderr; in --json: explain).")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object (program_id, path, lines, ...).")
 @click.pass_context
 def instantiate(ctx, gear_id, job_id, gear_range, all_gears, out, machine, cuts, coolant, shift_y,
-                shift_per_part, feed_mode, tailstock, worm_feed, hob_speed, explain, as_json):
+                shift_per_part, feed_mode, tailstock, worm_feed, hob_speed, workers, explain, as_json):
     """Produce the NC program of a gear (or a stored job, or a batch of gears).
 
     The program is checked against the machine's limits, stored with the template
@@ -58,6 +60,8 @@ def instantiate(ctx, gear_id, job_id, gear_range, all_gears, out, machine, cuts,
                                        ("--all", all_gears)) if value]
     if len(chosen) != 1:
         raise EngineError("give exactly one of --gear ID, --job ID, --gears FIRST-LAST, --all")
+    if workers > 1 and not (gear_range or all_gears):
+        raise EngineError("--workers plans a batch: use it with --gears FIRST-LAST or --all")
     if explain and (gear_range or all_gears):
         raise EngineError("--explain explains one program: use it with --gear or --job, and "
                           "`engine explain --program ID` for the programs of a batch")
@@ -72,7 +76,7 @@ def instantiate(ctx, gear_id, job_id, gear_range, all_gears, out, machine, cuts,
         else:
             first, last = parse_range(gear_range) if gear_range else (None, None)
             programs = instantiate_gears(conn, first, last, machine=machine, choices=choices,
-                                         overrides=overrides, out=out)
+                                         overrides=overrides, out=out, workers=workers)
             return _report_batch(programs, out, as_json)
     _report_program(program, as_json, explain)
 

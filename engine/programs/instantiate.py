@@ -22,6 +22,7 @@ from .nc_check import LimitError, check_program, check_table_speed
 from .outputs import write_program_files
 from .records import Planned, Program
 from .storage import store_many, store_one
+from .workers import plan_in_workers
 
 
 class Planner:
@@ -133,24 +134,31 @@ def instantiate_job(conn, job_id: int, out: str | Path | None = None) -> Program
 
 def instantiate_gears(conn, first: int | None = None, last: int | None = None, *,
                       machine: str | None = None, choices: Choices = Choices(), overrides=None,
-                      out: str | Path | None = None, progress=None):
-    """All gears with first ≤ id ≤ last: all programs stored, or none (the first failure names its gear)."""
+                      out: str | Path | None = None, progress=None, workers: int = 1):
+    """All gears with first ≤ id ≤ last: all programs stored, or none (the first failure names its gear).
+    With workers > 1 the gears are planned in that many processes (engine.programs.workers)."""
     planner = Planner(conn, machine, choices, overrides)
     gears = load_gears(conn, first, last)
     if not gears:
         raise EngineError(f"no gears with ids in {first or 'the start'}…{last or 'the end'}")
     with no_cycle_collection():
-        planned = [_plan_in_batch(planner, gear, progress) for gear in gears]
-        return store_many(conn, planned, out)
+        if workers > 1 and len(gears) > 1:
+            encoded = plan_in_workers(planner, gears, workers, _plan_in_batch, progress)
+        else:
+            encoded = [_counted(_plan_in_batch(planner, gear), progress).encoded() for gear in gears]
+        return store_many(conn, encoded, out)
 
 
-def _plan_in_batch(planner: Planner, gear: Gear, progress) -> Planned:
+def _plan_in_batch(planner: Planner, gear: Gear) -> Planned:
     try:
-        planned = planner.plan(gear)
+        return planner.plan(gear)
     except EngineError as error:
         message = str(error)
         prefix = "" if message.startswith(f"gear {gear.id}") else f"gear {gear.id}: "
-        raise type(error)(f"{prefix}{message} (batch stopped, nothing stored)") from None
+        raise EngineError(f"{prefix}{message} (batch stopped, nothing stored)") from None
+
+
+def _counted(planned: Planned, progress) -> Planned:
     if progress:
         progress(1)
     return planned

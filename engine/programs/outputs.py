@@ -30,7 +30,7 @@ def write_program_files(planned, out):
     temporary = {}
     try:
         for item in planned:
-            temporary[item.name] = _write_temporary(paths[item.name], item.result.lines)
+            temporary[item.name] = _write_temporary(paths[item.name], item.lines)
         yield {name: str(path) for name, path in paths.items()}
         for name, temp_path in temporary.items():
             os.replace(temp_path, paths[name])

@@ -2,6 +2,7 @@
 storage and what storage hands back."""
 from __future__ import annotations
 
+import json
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -26,6 +27,35 @@ class Planned:
     @property
     def name(self) -> str:
         return str(self.params.get("program_name", f"JOB_{self.gear_id}"))
+
+    @property
+    def lines(self) -> list[str]:
+        return self.result.lines
+
+    def encoded(self) -> Encoded:
+        return Encoded(self.gear_id, self.gear_class, self.machine, self.hob_id, json.dumps(self.params),
+                       json.dumps(self.module_params), json.dumps(self.cutting or {}), self.template.version,
+                       self.template.hash, self.name, self.result.lines, self.result.row_ids,
+                       json.dumps(self.result.trace))
+
+
+@dataclass(frozen=True, slots=True)
+class Encoded:
+    """A planned job as a batch stores it: its JSON already encoded and its template reduced to
+    version and hash. Batch workers send this across processes (a few strings, not the objects)."""
+    gear_id: int | None
+    gear_class: str
+    machine: str
+    hob_id: str | None
+    params: str
+    module_params: str
+    cutting: str
+    template_version: int
+    template_hash: str
+    name: str
+    lines: list[str]
+    row_ids: list[int]
+    trace: str
 
 
 @dataclass(frozen=True)

@@ -6,7 +6,7 @@ from dataclasses import dataclass
 from psycopg.types.json import Jsonb
 
 from .outputs import write_program_files
-from .records import Planned, Program
+from .records import Encoded, Planned, Program
 
 INSERT_JOB = """
 INSERT INTO job (gear_id, gear_class, machine, hob_id, params, module_params, cutting)
@@ -30,21 +30,31 @@ def store_one(conn, planned: Planned, existing_job: int | None, path: str | None
     return _program(program_id, job_id, planned, path)
 
 
-def store_many(conn, planned: list[Planned], out=None) -> "Batch":
+def store_many(conn, encoded: list[Encoded], out=None) -> "Batch":
     """All jobs and programs in one transaction, through COPY (the batch path)."""
-    with write_program_files(planned, out), conn.transaction():
-        job_ids = _next_ids(conn, "job_id_seq", len(planned))
-        program_ids = _next_ids(conn, "program_id_seq", len(planned))
+    with write_program_files(encoded, out), conn.transaction():
+        job_ids = _next_ids(conn, "job_id_seq", len(encoded))
+        program_ids = _next_ids(conn, "program_id_seq", len(encoded))
         with conn.cursor().copy(COPY_JOB) as copy:
-            for job_id, item in zip(job_ids, planned):
+            for job_id, item in zip(job_ids, encoded):
                 copy.write_row((job_id, item.gear_id, item.gear_class, item.machine, item.hob_id,
-                                Jsonb(item.params), Jsonb(item.module_params), Jsonb(item.cutting or {})))
+                                _json(item.params), _json(item.module_params), _json(item.cutting)))
         with conn.cursor().copy(COPY_PROGRAM) as copy:
             copy.set_types(PROGRAM_TYPES)
-            for program_id, job_id, item in zip(program_ids, job_ids, planned):
-                copy.write_row((program_id, *_program_values(job_id, item)))
-    return Batch(len(planned), sum(len(item.result.lines) for item in planned),
+            for program_id, job_id, item in zip(program_ids, job_ids, encoded):
+                copy.write_row((program_id, job_id, item.gear_class, item.template_version, item.template_hash,
+                                item.name, item.lines, item.row_ids, _json(item.trace)))
+    return Batch(len(encoded), sum(len(item.lines) for item in encoded),
                  min(program_ids), max(program_ids), out)
+
+
+def _json(text: str) -> Jsonb:
+    """JSON encoded already (by a batch worker): passed on as it is."""
+    return Jsonb(text, dumps=_as_is)
+
+
+def _as_is(text: str) -> str:
+    return text
 
 
 @dataclass(frozen=True)

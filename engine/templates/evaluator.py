@@ -42,6 +42,7 @@ class Evaluator:
     def __init__(self):
         config = {node: node in NODES for node in ALL_NODES}
         self.interpreter = Interpreter(symtable={}, minimal=True, use_numpy=False, config=config)
+        self.interpreter.set_nodehandler("formattedvalue", _formatted_value(self.interpreter))
 
     def evaluate(self, tree: ast.expr, text: str, scope: dict):
         """The value of `tree` (the checked form of `text`) with `scope` as asteval's symbol table."""
@@ -53,6 +54,17 @@ class Evaluator:
             return interpreter.run(tree)
         except Exception as error:   # asteval re-raises the expression's own failure
             raise EvaluationError(_problem(interpreter.error, error)) from None
+
+
+def _formatted_value(interpreter):
+    """The f-string field handler: `format(value, spec)`. asteval's own goes through
+    string.Formatter to stop `{0.attr}` lookups in a format string, which a checked expression
+    cannot contain (its specs are plain and bounded, conversions are refused by the gate), at
+    a third of the time an NC line takes."""
+    def on_formattedvalue(node):
+        spec = "" if node.format_spec is None else interpreter.run(node.format_spec)
+        return format(interpreter.run(node.value), spec)
+    return on_formattedvalue
 
 
 def _problem(held: list, raised: Exception) -> str:

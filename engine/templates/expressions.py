@@ -52,6 +52,7 @@ class Compiled:
     tree: ast.expr
     names: frozenset[str]      # parameter/variable names it reads
     is_sql: bool = False
+    ordered_names: tuple[str, ...] = ()   # the names, sorted (the trace lists them in this order)
 
 
 class ExpressionError(EngineError):
@@ -73,7 +74,7 @@ def compile_expression(text: str, translations: Mapping[str, str] | None = None)
     if is_sql:
         tree = ast.Expression(body=ast.Call(ast.Name("_sql_truth", ast.Load()), [tree.body], []))
     ast.fix_missing_locations(tree)
-    return Compiled(text, tree.body, names, is_sql)
+    return Compiled(text, tree.body, names, is_sql, tuple(sorted(names)))
 
 
 def _parsed(text: str, mode: str) -> ast.AST:

@@ -40,9 +40,10 @@ class RowTrace:
     def read(self, column: str, expression) -> None:
         """The inputs `expression` reads, with their values and origins, as it is evaluated."""
         reads = self.entry.setdefault("read", {}).setdefault(column, {})
-        for name in sorted(expression.names):
-            if name in self.scope:
-                reads[name] = [json_value(self.scope[name]), self._origin(name)]
+        scope = self.scope
+        for name in expression.ordered_names:
+            if name in scope:
+                reads[name] = [json_value(scope[name]), self._origin(name)]
 
     def condition(self, column: str, value) -> bool:
         self.entry[column] = json_value(value)
@@ -72,7 +73,12 @@ def row_trace(row, scope: dict, origin) -> RowTrace:
 
 def json_value(value):
     """A value as the trace keeps it: plain JSON values as they are, others summarised."""
-    if value is None or isinstance(value, (bool, int)):
+    kind = type(value)
+    if kind is int or kind is bool or value is None or (kind is str and len(value) <= MAX_TEXT):
+        return value
+    if kind is float and math.isfinite(value):
+        return value
+    if isinstance(value, (bool, int)):
         return value
     if isinstance(value, float):
         return value if math.isfinite(value) else str(value)
@@ -88,8 +94,12 @@ def json_value(value):
 def memo_key(row, scope: dict, origin) -> tuple | None:
     """The row and the exact values and origins of its inputs, or None if a value cannot be a key
     (a list): rows with equal keys have equal outcomes."""
+    key = [row.row.id]
+    for name in row.inputs:
+        key.append(_token(scope.get(name, MISSING)))
+        key.append(origin(name))
+    key = tuple(key)
     try:
-        key = (row.row.id, *((_token(scope.get(name, MISSING)), origin(name)) for name in row.inputs))
         hash(key)
     except TypeError:
         return None
@@ -103,4 +113,4 @@ def _token(value):
         return float, value.hex()
     if type(value) is tuple:
         return tuple, tuple(_token(item) for item in value)
-    return type(value), value
+    return value if type(value) is str else (type(value), value)

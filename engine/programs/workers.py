@@ -1,0 +1,54 @@
+"""Planning a batch across cores: `engine instantiate --gears A-B --workers N`.
+
+The Planner is made ready in this process (machine, hob library, case base, and the model and
+compiled template of every class in the batch), then N worker processes are forked from it and
+plan slices of the gears; they read nothing from the database (the connection they inherit is
+never touched). Their jobs come back here in gear order and are stored in one transaction by
+the caller, so a batch is still all or none: the first failure stops it and names its gear.
+"""
+from __future__ import annotations
+
+import multiprocessing
+
+from ..templates.decision_table import compiled_template
+from .records import Encoded
+
+SLICES_PER_WORKER = 8   # small enough to balance the workers, large enough to amortise sending jobs
+
+_BATCH: list = []   # (planner, gears, plan function) of the batch being planned, inherited by the forked workers
+
+
+def plan_in_workers(planner, gears: list, workers: int, plan_one, progress=None) -> list[Encoded]:
+    """`plan_one(planner, gear) -> Planned` for every gear, in `workers` forked processes; each
+    job comes back encoded for storage (engine.programs.records.Encoded)."""
+    for gear_class in {gear.gear_class for gear in gears if gear.gear_class is not None}:
+        _ready(planner, gear_class)
+    size = max(1, len(gears) // (workers * SLICES_PER_WORKER))
+    slices = [(start, min(start + size, len(gears))) for start in range(0, len(gears), size)]
+    _BATCH[:] = [planner, gears, plan_one]
+    try:
+        with multiprocessing.get_context("fork").Pool(workers) as pool:
+            encoded = []
+            for jobs in pool.imap(_plan_slice, slices):
+                encoded += jobs
+                if progress:
+                    progress(len(jobs))
+            return encoded
+    finally:
+        _BATCH.clear()
+
+
+def _ready(planner, gear_class: str) -> None:
+    """What planning a gear of the class reads from the database, read now (a refused class is
+    left for its first gear to name, in gear order)."""
+    try:
+        planner.model(gear_class)
+        compiled_template(planner.template(gear_class))
+    except Exception:   # noqa: BLE001 — reported by the worker for the gear, as a single run would
+        pass
+
+
+def _plan_slice(bounds: tuple[int, int]) -> list[Encoded]:
+    """In a worker: plan and encode a slice of the gears (the JSON encoding is done here, in parallel)."""
+    planner, gears, plan_one = _BATCH
+    return [plan_one(planner, gear).encoded() for gear in gears[bounds[0]:bounds[1]]]
