@@ -1,0 +1,35 @@
+"""Batch planning across cores (issue 12): --workers N stores exactly what one process stores,
+all programs in one transaction, and a failure in a worker stops the batch with nothing stored."""
+import json
+
+import psycopg
+
+
+def stored_programs(url):
+    with psycopg.connect(url) as conn:
+        return conn.execute("""SELECT p.name, p.lines, p.row_ids, p.trace, j.params, j.module_params, j.cutting
+                               FROM program p JOIN job j ON j.id = p.job_id ORDER BY p.id""").fetchall()
+
+
+def test_two_workers_store_what_one_process_stores(run):
+    one = run("instantiate", "--gears", "42-54", "--json")
+    first = stored_programs(run.url)
+    two = run("instantiate", "--gears", "42-54", "--workers", "2", "--json")
+    both = stored_programs(run.url)
+    assert one.exit_code == two.exit_code == 0
+    assert json.loads(two.stdout)["programs"] == json.loads(one.stdout)["programs"] == len(first) >= 9
+    assert both[len(first):] == first                  # the same programs, traces and jobs, in gear order
+
+
+def test_a_failing_gear_in_a_worker_stops_the_batch_and_stores_nothing(run):
+    with psycopg.connect(run.url) as conn:
+        conn.execute("UPDATE gear SET gear_class = NULL WHERE id = 46")
+    refused = run("instantiate", "--gears", "42-54", "--workers", "2")
+    assert refused.exit_code == 1 and refused.stderr.count("\n") == 1
+    assert "gear 46 has no gear class" in refused.stderr and "nothing stored" in refused.stderr
+    assert stored_programs(run.url) == []
+
+
+def test_workers_are_for_batches(run):
+    refused = run("instantiate", "--gear", "42", "--workers", "2")
+    assert refused.exit_code == 1 and "--workers plans a batch" in refused.stderr
