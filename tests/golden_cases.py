@@ -15,7 +15,8 @@ from pathlib import Path
 
 from engine.errors import EngineError
 from engine.hobbing.choices import Choices
-from engine.programs.instantiate import instantiate_gear, instantiate_job
+from engine.programs.instantiate import instantiate_gear
+from engine.programs.remake import instantiate_job
 from engine.turning.dxf_import import import_dxf
 from engine.turning.job_params import ProfileOptions
 

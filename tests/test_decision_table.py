@@ -132,7 +132,7 @@ def test_a_template_version_is_recorded_with_each_program(conn):
 
 
 def test_stored_job_reinstantiates_with_parameters_edited_in_sql(conn):
-    from engine.programs.instantiate import instantiate_job
+    from engine.programs.remake import instantiate_job
 
     program = instantiate_gear(conn, 42, choices=Choices(coolant=True))
     conn.execute("UPDATE job SET params = params || '{\"coolant\": false}' WHERE id = %s", (program.job_id,))

@@ -9,7 +9,8 @@ import psycopg
 import pytest
 
 from engine.hobbing.choices import Choices
-from engine.programs.instantiate import instantiate_gear, instantiate_gears, instantiate_job
+from engine.programs.instantiate import instantiate_gear, instantiate_gears
+from engine.programs.remake import instantiate_job
 from engine.templates.store import load_template
 from engine.turning.dxf_import import import_dxf
 from test_dxf_read import seed_drawing

@@ -15,7 +15,7 @@ import ezdxf
 import numpy as np
 import pytest
 
-from engine.programs.instantiate import instantiate_job
+from engine.programs.remake import instantiate_job
 from engine.turning.dxf_import import import_dxf
 from engine.turning.job_params import ProfileOptions
 from lathe_programs import drawn_polylines, motions, words

@@ -9,7 +9,7 @@ from psycopg.types.json import Jsonb
 
 from engine.errors import EngineError
 from engine.gears.records import load_machine
-from engine.programs.instantiate import instantiate_job
+from engine.programs.remake import instantiate_job
 from engine.programs.nc_check import LimitError
 from engine.turning.check import check_lathe_program
 from engine.turning.dxf_import import import_dxf

@@ -11,14 +11,14 @@ from .context import connection, emit_json
 RANGE = re.compile(r"^\s*(\d+)\s*(?:-\s*(\d+))?\s*$")
 
 
-def parse_range(text: str) -> tuple[int, int]:
+def parse_range(text: str, option: str = "--gears") -> tuple[int, int]:
     match = RANGE.match(text)
     if not match:
-        raise EngineError(f"--gears {text!r} is not a range like 1-5000 or 42")
+        raise EngineError(f"{option} {text!r} is not a range like 1-5000 or 42")
     first = int(match.group(1))
     last = int(match.group(2) or first)
     if last < first:
-        raise EngineError(f"--gears {text!r}: the range ends before it starts")
+        raise EngineError(f"{option} {text!r}: the range ends before it starts")
     return first, last
 
 
@@ -26,6 +26,7 @@ def parse_range(text: str) -> tuple[int, int]:
 @click.option("--gear", "gear_id", type=int, help="Gear id: compute a new job and its program.")
 @click.option("--job", "job_id", type=int, help="Stored job id: instantiate again with its (edited) parameters.")
 @click.option("--gears", "gear_range", help="Batch: gear ids FIRST-LAST (all stored, or none).")
+@click.option("--jobs", "job_range", help="Batch: stored job ids FIRST-LAST made again with their stored parameters.")
 @click.option("--all", "all_gears", is_flag=True, help="Batch: every gear.")
 @click.option("--out", type=click.Path(), help="Write the .MPF file here (a directory for batches).")
 @click.option("--machine", help="Machine record (default hobber-840d).")
@@ -46,7 +47,7 @@ def parse_range(text: str) -> tuple[int, int]:
               help="Also say why each row emitted its line or not, with the values (on stderr; in --json: explain).")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object (program_id, path, lines, ...).")
 @click.pass_context
-def instantiate(ctx, gear_id, job_id, gear_range, all_gears, out, machine, cuts, coolant, shift_y,
+def instantiate(ctx, gear_id, job_id, gear_range, job_range, all_gears, out, machine, cuts, coolant, shift_y,
                 shift_per_part, feed_mode, tailstock, worm_feed, hob_speed, workers, explain, as_json):
     """Produce the NC program of a gear (or a stored job, or a batch of gears).
 
@@ -54,15 +55,16 @@ def instantiate(ctx, gear_id, job_id, gear_range, all_gears, out, machine, cuts,
     version it came from, printed (single program) and written to --out.
     """
     from ..hobbing.choices import Choices
-    from ..programs.instantiate import instantiate_gear, instantiate_gears, instantiate_job
+    from ..programs.instantiate import instantiate_gear, instantiate_gears
+    from ..programs.remake import instantiate_job, instantiate_jobs
 
     chosen = [name for name, value in (("--gear", gear_id), ("--job", job_id), ("--gears", gear_range),
-                                       ("--all", all_gears)) if value]
+                                       ("--jobs", job_range), ("--all", all_gears)) if value]
     if len(chosen) != 1:
-        raise EngineError("give exactly one of --gear ID, --job ID, --gears FIRST-LAST, --all")
+        raise EngineError("give exactly one of --gear ID, --job ID, --gears FIRST-LAST, --jobs FIRST-LAST, --all")
     if workers > 1 and not (gear_range or all_gears):
-        raise EngineError("--workers plans a batch: use it with --gears FIRST-LAST or --all")
-    if explain and (gear_range or all_gears):
+        raise EngineError("--workers plans a batch of gears: use it with --gears FIRST-LAST or --all")
+    if explain and (gear_range or job_range or all_gears):
         raise EngineError("--explain explains one program: use it with --gear or --job, and "
                           "`engine explain --program ID` for the programs of a batch")
     choices = Choices(cuts=cuts, coolant=coolant, shift_y=shift_y, shift_per_part=shift_per_part,
@@ -73,6 +75,8 @@ def instantiate(ctx, gear_id, job_id, gear_range, all_gears, out, machine, cuts,
             program = instantiate_gear(conn, gear_id, machine=machine, choices=choices, overrides=overrides, out=out)
         elif job_id is not None:
             program = instantiate_job(conn, job_id, out=out)
+        elif job_range:
+            return _report_batch(instantiate_jobs(conn, *parse_range(job_range, "--jobs"), out=out), out, as_json)
         else:
             first, last = parse_range(gear_range) if gear_range else (None, None)
             programs = instantiate_gears(conn, first, last, machine=machine, choices=choices,

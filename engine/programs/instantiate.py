@@ -11,7 +11,7 @@ from ..errors import EngineError
 from ..gears.case_base import CUT_KINDS_BY_COUNT, CaseBase, job_cutting_record
 from ..gears.hob_matching import choose_hob
 from ..gears.models import model_for_class
-from ..gears.records import Gear, Machine, hobbing_machine, load_gear, load_gears, load_hobs, load_machine
+from ..gears.records import Gear, Machine, hobbing_machine, load_gear, load_gears, load_hobs
 from ..hobbing.choices import Choices
 from ..memory import no_cycle_collection
 from ..templates.decision_table import Result, compiled_template
@@ -110,26 +110,7 @@ def instantiate_gear(conn, gear_id: int, *, machine: str | None = None, choices:
     """Compute, check and store the program of one gear; write it to `out` if given."""
     planner = Planner(conn, machine, choices, overrides)
     planned = planner.plan(load_gear(conn, gear_id))
-    return _store_and_write(conn, [planned], out)[0]
-
-
-def instantiate_job(conn, job_id: int, out: str | Path | None = None) -> Program:
-    """Instantiate a stored job again with its stored (possibly edited) parameters."""
-    row = conn.execute("SELECT gear_id, gear_class, machine, hob_id, params, module_params FROM job "
-                       "WHERE id = %s", (job_id,)).fetchone()
-    if row is None:
-        raise EngineError(f"job {job_id} does not exist; see `SELECT id, gear_id FROM job`")
-    gear_id, gear_class, machine_name, hob_id, params, module_params = row
-    machine = load_machine(conn, machine_name)
-    if machine.kind == "lathe":   # a turning job: its passes are computed from its parameters
-        from ..turning.planning import plan_turning_job   # the tool paths: only for turning jobs
-
-        planned = plan_turning_job(conn, gear_class, machine, params, module_params)
-    else:
-        template = load_template(conn, gear_class)
-        result = run_template(template, params, module_params, machine)
-        planned = Planned(gear_id, gear_class, machine_name, hob_id, params, module_params, template, result)
-    return _store_and_write(conn, [planned], out, existing_job=job_id)[0]
+    return store_and_write(conn, [planned], out)[0]
 
 
 def instantiate_gears(conn, first: int | None = None, last: int | None = None, *,
@@ -164,7 +145,7 @@ def _counted(planned: Planned, progress) -> Planned:
     return planned
 
 
-def _store_and_write(conn, planned: list[Planned], out, existing_job: int | None = None) -> list[Program]:
+def store_and_write(conn, planned: list[Planned], out, existing_job: int | None = None) -> list[Program]:
     with write_program_files(planned, out) as paths:
         with conn.transaction():
             programs = [store_one(conn, item, existing_job, paths.get(item.name)) for item in planned]

@@ -39,13 +39,25 @@ def store_many(conn, encoded: list[Encoded], out=None) -> "Batch":
             for job_id, item in zip(job_ids, encoded):
                 copy.write_row((job_id, item.gear_id, item.gear_class, item.machine, item.hob_id,
                                 _json(item.params), _json(item.module_params), _json(item.cutting)))
-        with conn.cursor().copy(COPY_PROGRAM) as copy:
-            copy.set_types(PROGRAM_TYPES)
-            for program_id, job_id, item in zip(program_ids, job_ids, encoded):
-                copy.write_row((program_id, job_id, item.gear_class, item.template_version, item.template_hash,
-                                item.name, item.lines, item.row_ids, _json(item.trace)))
+        _copy_programs(conn, program_ids, job_ids, encoded)
     return Batch(len(encoded), sum(len(item.lines) for item in encoded),
                  min(program_ids), max(program_ids), out)
+
+
+def store_programs(conn, encoded: list[Encoded], job_ids: list[int], out=None) -> "Batch":
+    """Programs of stored jobs (made again), in one transaction through COPY."""
+    with write_program_files(encoded, out), conn.transaction():
+        program_ids = _next_ids(conn, "program_id_seq", len(encoded))
+        _copy_programs(conn, program_ids, job_ids, encoded)
+    return Batch(len(encoded), sum(len(item.lines) for item in encoded), min(program_ids), max(program_ids), out)
+
+
+def _copy_programs(conn, program_ids: list[int], job_ids: list[int], encoded: list[Encoded]) -> None:
+    with conn.cursor().copy(COPY_PROGRAM) as copy:
+        copy.set_types(PROGRAM_TYPES)
+        for program_id, job_id, item in zip(program_ids, job_ids, encoded):
+            copy.write_row((program_id, job_id, item.gear_class, item.template_version, item.template_hash,
+                            item.name, item.lines, item.row_ids, _json(item.trace)))
 
 
 def _json(text: str) -> Jsonb:

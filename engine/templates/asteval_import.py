@@ -8,11 +8,11 @@ import sys
 if "asteval.asteval" not in sys.modules and "numpy" not in sys.modules:
     sys.modules["numpy"] = None   # asteval's `import numpy` then fails: HAS_NUMPY is False
     try:
-        import asteval
+        import asteval.astutils
     finally:
         del sys.modules["numpy"]
 
-import asteval  # noqa: E402
+import asteval  # noqa: E402  (imported above, or already by someone who had numpy loaded)
 import asteval.astutils  # noqa: E402
 
 Interpreter = asteval.Interpreter

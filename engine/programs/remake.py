@@ -1,0 +1,80 @@
+"""Stored jobs made again with their stored, possibly edited, parameters: one job (`engine
+instantiate --job ID`) or a range of them (`--jobs FIRST-LAST`), template rows only: no
+model, no hob choice, no cutting data. The programs are checked against the job's machine,
+stored with the template version they came from, and written after the database commit."""
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..errors import EngineError
+from ..gears.records import Machine, load_machine
+from ..memory import no_cycle_collection
+from ..templates.rows import Template
+from ..templates.store import load_template
+from .instantiate import store_and_write, run_template
+from .records import Planned, Program
+from .storage import Batch, store_programs
+
+JOB_COLUMNS = "id, gear_id, gear_class, machine, hob_id, params, module_params"
+
+
+class Remaker:
+    """Machines and templates read once for all the jobs made again in one run."""
+
+    def __init__(self, conn):
+        self.conn = conn
+        self._machines: dict[str, Machine] = {}
+        self._templates: dict[str, Template] = {}
+
+    def remade(self, job: tuple) -> Planned:
+        _, gear_id, gear_class, machine_name, hob_id, params, module_params = job
+        machine = self.machine(machine_name)
+        if machine.kind == "lathe":   # a turning job: its passes are computed from its parameters
+            from ..turning.planning import plan_turning_job   # the tool paths: only for turning jobs
+
+            return plan_turning_job(self.conn, gear_class, machine, params, module_params)
+        template = self.template(gear_class)
+        result = run_template(template, params, module_params, machine)
+        return Planned(gear_id, gear_class, machine_name, hob_id, params, module_params, template, result)
+
+    def machine(self, name: str) -> Machine:
+        if name not in self._machines:
+            self._machines[name] = load_machine(self.conn, name)
+        return self._machines[name]
+
+    def template(self, gear_class: str) -> Template:
+        if gear_class not in self._templates:
+            self._templates[gear_class] = load_template(self.conn, gear_class)
+        return self._templates[gear_class]
+
+
+def instantiate_job(conn, job_id: int, out: str | Path | None = None) -> Program:
+    """Instantiate a stored job again with its stored (possibly edited) parameters."""
+    job = conn.execute(f"SELECT {JOB_COLUMNS} FROM job WHERE id = %s", (job_id,)).fetchone()
+    if job is None:
+        raise EngineError(f"job {job_id} does not exist; see `SELECT id, gear_id FROM job`")
+    return store_and_write(conn, [Remaker(conn).remade(job)], out, existing_job=job_id)[0]
+
+
+def instantiate_jobs(conn, first: int | None = None, last: int | None = None, *,
+                     out: str | Path | None = None, progress=None) -> Batch:
+    """Every stored job with first ≤ id ≤ last made again: all programs stored, or none (the first
+    failure names its job)."""
+    jobs = conn.execute(f"SELECT {JOB_COLUMNS} FROM job WHERE id BETWEEN %s AND %s ORDER BY id",
+                        (first if first is not None else 0, last if last is not None else 2**62)).fetchall()
+    if not jobs:
+        raise EngineError(f"no jobs with ids in {first or 'the start'}…{last or 'the end'}")
+    remaker = Remaker(conn)
+    with no_cycle_collection():
+        encoded = [_remade_in_batch(remaker, job, progress).encoded() for job in jobs]
+        return store_programs(conn, encoded, [job[0] for job in jobs], out)
+
+
+def _remade_in_batch(remaker: Remaker, job: tuple, progress) -> Planned:
+    try:
+        planned = remaker.remade(job)
+    except EngineError as error:
+        raise EngineError(f"job {job[0]}: {error} (batch stopped, nothing stored)") from None
+    if progress:
+        progress(1)
+    return planned

@@ -1,0 +1,39 @@
+"""Stored jobs made again in a batch (`engine instantiate --jobs FIRST-LAST`, issue 12): the
+programs of their stored parameters, all stored in one transaction or none."""
+import json
+
+import psycopg
+
+
+def programs(url, where=""):
+    with psycopg.connect(url) as conn:
+        return conn.execute(f"SELECT job_id, lines, row_ids, trace FROM program {where} ORDER BY id").fetchall()
+
+
+def test_jobs_made_again_give_their_programs_back(run):
+    assert run("instantiate", "--gears", "42-54").exit_code == 0
+    first = programs(run.url)
+    jobs = [job for job, *_ in first]
+    made = run("instantiate", "--jobs", f"{min(jobs)}-{max(jobs)}", "--json")
+    assert made.exit_code == 0 and json.loads(made.stdout)["programs"] == len(first)
+    assert programs(run.url)[len(first):] == first      # same job, lines, rows and trace, in job order
+
+
+def test_a_job_edited_in_sql_is_made_with_its_new_parameters(run):
+    assert run("instantiate", "--gears", "42-43").exit_code == 0
+    job = programs(run.url)[0][0]
+    with psycopg.connect(run.url) as conn:
+        conn.execute("UPDATE job SET params = jsonb_set(params, '{n0}', '250') WHERE id = %s", (job,))
+    assert run("instantiate", "--jobs", f"{job}-{job}").exit_code == 0
+    assert "M3 S250" in programs(run.url, f"WHERE job_id = {job}")[-1][1]
+
+
+def test_a_failing_job_stops_the_batch_and_stores_nothing(run):
+    assert run("instantiate", "--gears", "42-45").exit_code == 0
+    jobs = [job for job, *_ in programs(run.url)]
+    with psycopg.connect(run.url) as conn:
+        conn.execute("UPDATE job SET params = params - 'z2' WHERE id = %s", (jobs[1],))
+    refused = run("instantiate", "--jobs", f"{min(jobs)}-{max(jobs)}")
+    assert refused.exit_code == 1 and refused.stderr.count("\n") == 1
+    assert f"job {jobs[1]}: " in refused.stderr and "unknown parameter 'z2'" in refused.stderr
+    assert len(programs(run.url)) == len(jobs)
