@@ -203,17 +203,24 @@ SELECT p.id AS program_id, l.line_no::integer AS line_no, p.row_ids[l.line_no] A
 FROM program p,
      unnest(p.lines) WITH ORDINALITY AS l (text, line_no);
 
--- The trace as a table: one row per template row of each program, with the lines it emitted.
+-- The trace as a table: one row per template row of each program, with the lines it emitted;
+-- `read` names the origin of each input (its value: program_input, or the row's `computed`).
 CREATE VIEW program_trace AS
 SELECT p.id AS program_id, e.position::integer AS position, (e.entry->>'row')::integer AS row_id,
-       e.entry->>'t' AS t, (e.entry->>'n')::integer AS n,
        (e.entry->>'calc')::boolean AS calc, (e.entry->>'emit')::boolean AS emit,
        e.entry->'p_calc' AS p_calc, e.entry->'p_emit' AS p_emit,
        e.entry->'computed' AS computed, e.entry->'read' AS read,
        ARRAY(SELECT l.text FROM unnest(p.lines, p.row_ids) AS l (text, row_id)
              WHERE l.row_id = (e.entry->>'row')::integer) AS lines
 FROM program p,
-     jsonb_array_elements(p.trace) WITH ORDINALITY AS e (entry, position);
+     jsonb_array_elements(p.trace->'rows') WITH ORDINALITY AS e (entry, position);
+
+-- The values a program's rows read from the job and from module parameters, once each.
+CREATE VIEW program_input AS
+SELECT p.id AS program_id, o.key AS origin, v.key AS name, v.value
+FROM program p,
+     jsonb_each(p.trace->'inputs') AS o,
+     jsonb_each(o.value) AS v;
 
 -- SQL-style conditions translated once and kept: the Python expression sqlglot made of a
 -- condition's text, keyed by a hash of the translator's version and the text (never changed).
@@ -681,6 +688,6 @@ FROM gear_class g
 ON CONFLICT (gear_class, version) DO NOTHING;
 
 GRANT SELECT ON template_version_rows TO engine_reader, engine_runner, engine_editor;
-GRANT SELECT ON program_trace TO engine_reader, engine_runner, engine_editor;
+GRANT SELECT ON program_trace, program_input TO engine_reader, engine_runner, engine_editor;
 GRANT SELECT ON sql_translation TO engine_reader, engine_runner, engine_editor;
 GRANT INSERT ON sql_translation TO engine_editor;

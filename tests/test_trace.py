@@ -41,22 +41,36 @@ def python_of(condition: str) -> str:
 def check_trace(conn, program_id):
     lines, row_ids, trace, gear_class, params, module_params = stored(conn, program_id)
     template = {row.id: row for row in load_template(conn, gear_class).rows}
-    assert [entry["row"] for entry in trace] == sorted(template)          # every row, in id order
-    emitting = {entry["row"] for entry in trace if entry.get("emit")}
+    rows, inputs = trace["rows"], trace["inputs"]
+    assert [entry["row"] for entry in rows] == sorted(template)           # every row, in id order
+    emitting = {entry["row"] for entry in rows if entry.get("emit")}
     assert set(row_ids) <= emitting                                        # every line from an emitting row
     assert {row for row in emitting if "nc_path" not in template[row].o} <= set(row_ids)
+    assert set(inputs) <= {"job", "template"} | {f"module {key}" for key in module_params} | \
+        {origin for entry in rows for reads in entry.get("read", {}).values() for origin in reads.values()}
     computed = {}
-    for entry in trace:
+    for entry in rows:
         row = template[entry["row"]]
-        check_origins(entry, row, params, module_params, computed)
-        check_decision(entry, row)
+        check_origins(entry, inputs, params, module_params, computed)
+        check_decision(entry, row, values_read(entry, inputs, computed))
         computed.update((name, (entry["row"], value)) for name, value in entry.get("computed", {}).items())
 
 
-def check_origins(entry, row, params, module_params, computed):
+def values_read(entry, inputs, computed) -> dict:
+    """column -> {name: value}: from the program's inputs, or the value the named row computed."""
+    def value(name, origin):
+        if origin.startswith("row "):
+            return entry["computed"][name] if origin == f"row {entry['row']}" else computed[name][1]
+        return inputs[origin][name]
+    return {column: {name: value(name, origin) for name, origin in reads.items()}
+            for column, reads in entry.get("read", {}).items()}
+
+
+def check_origins(entry, inputs, params, module_params, computed):
     """Each value read is the job's, its module's, or the value a named row computed."""
     for column, reads in entry.get("read", {}).items():
-        for name, (value, origin) in reads.items():
+        for name, origin in reads.items():
+            value = None if origin.startswith("row ") else inputs[origin][name]
             if origin == "job":
                 assert value == json_scalar(params[name]), (entry["row"], name)
             elif origin.startswith("module "):   # a turning model adds the passes it computes to the stored ones
@@ -65,7 +79,7 @@ def check_origins(entry, row, params, module_params, computed):
             elif origin.startswith("row "):
                 source = int(origin.split()[1])
                 own = source == entry["row"] and name in entry.get("computed", {})
-                assert own or computed[name] == (source, value), (entry["row"], name, origin)
+                assert own or computed[name][0] == source, (entry["row"], name, origin)   # the latest to compute it
             else:
                 assert origin == "template" and name == "template_version"
 
@@ -74,24 +88,23 @@ def json_scalar(value):
     return value if isinstance(value, (bool, int, float, str, type(None))) else pytest.approx(value)
 
 
-def check_decision(entry, row):
+def check_decision(entry, row, values):
     """A row that did not emit names the condition that decided it, with values that decide it
     the same way when Python evaluates the condition again."""
     if row.s is not None and row.p_calc is not None:
-        assert entry["calc"] is decided(row.p_calc, entry["read"]["p_calc"])
+        assert entry["calc"] is decided(row.p_calc, values["p_calc"])
         if not entry["calc"]:
             assert "emit" not in entry and "computed" not in entry
             return
     if row.o is None:
         assert "emit" not in entry
         return
-    expected = True if row.p_emit is None else decided(row.p_emit, entry["read"]["p_emit"])
+    expected = True if row.p_emit is None else decided(row.p_emit, values["p_emit"])
     assert entry["emit"] is expected, (entry["row"], row.p_emit, entry)
 
 
-def decided(condition: str, reads: dict) -> bool:
-    values = {name: value for name, (value, _) in reads.items()}
-    return bool(eval(python_of(condition), {"__builtins__": {}, **FUNCTIONS}, values))
+def decided(condition: str, values: dict) -> bool:
+    return bool(eval(python_of(condition), {"__builtins__": {}, **FUNCTIONS}, dict(values)))
 
 
 @pytest.mark.parametrize("gear_id", sorted(SEEDED_GEARS))
@@ -114,7 +127,8 @@ def test_a_trace_is_stored_with_single_batch_and_remade_programs(conn):
     remade = instantiate_job(conn, single.job_id)
     ids = [single.program_id, remade.program_id,
            *range(batch.first_program_id, batch.last_program_id + 1)]
-    traces = conn.execute("SELECT id, jsonb_array_length(trace) FROM program WHERE id = ANY(%s)", (ids,)).fetchall()
+    traces = conn.execute("SELECT id, jsonb_array_length(trace->'rows') FROM program WHERE id = ANY(%s)",
+                          (ids,)).fetchall()
     assert len(traces) >= 2 + batch.programs and all(length and length > 10 for _, length in traces)
     for program_id, _ in traces:
         check_trace(conn, program_id)
@@ -126,8 +140,11 @@ def test_the_program_trace_view_has_a_row_per_template_row_with_its_lines(conn):
                         "ORDER BY position", (program.program_id,)).fetchall()
     assert [row[0] for row in rows] == [row.id for row in load_template(conn, "spur").rows]
     by_row = {row[0]: row for row in rows}
-    assert by_row[1800][1:4] == (False, False, {"p_emit": {"coolant": [False, "job"]}, "o": {}})
+    assert by_row[1800][1:4] == (False, False, {"p_emit": {"coolant": "job"}, "o": {}})
     assert by_row[1700][4] == ["M3 S246"] and by_row[1700][1] is True
+    inputs = dict(((origin, name), value) for origin, name, value in conn.execute(
+        "SELECT origin, name, value FROM program_input WHERE program_id = %s", (program.program_id,)))
+    assert inputs[("job", "coolant")] is False and inputs[("job", "z2")] == 19
 
 
 def test_engine_explain_says_why_a_line_is_missing(run):

@@ -20,23 +20,34 @@ class ExplainedRow:
     state: str           # emitted | not emitted | skipped | computed
     lines: tuple[str, ...]
     entry: dict          # the row's trace entry as stored
+    read: dict           # column -> {name: [value, origin]}, the values looked up
 
     def sentence(self) -> str:
         return f"{self.row_id} {_what(self)}{_because(self)}"
 
     def as_dict(self) -> dict:
-        return {"row": self.row_id, "state": self.state, "lines": list(self.lines), "trace": self.entry}
+        return {"row": self.row_id, "state": self.state, "lines": list(self.lines), "read": self.read,
+                **{key: value for key, value in self.entry.items() if key not in ("row", "read")}}
 
 
-def explained_rows(trace: list[dict], lines: list[str], row_ids: list[int], row: int | None = None) -> list[ExplainedRow]:
-    """Each row of the trace (or only `row`) with its state and the lines it emitted."""
+def explained_rows(trace: dict, lines: list[str], row_ids: list[int], row: int | None = None) -> list[ExplainedRow]:
+    """Each row of the trace (or only `row`) with its state, the lines it emitted and the values
+    it read."""
     emitted: dict[int, list[str]] = {}
     for line, row_id in zip(lines, row_ids):
         emitted.setdefault(row_id, []).append(line)
-    entries = [entry for entry in trace if row is None or entry["row"] == row]
+    computed = {f"row {entry['row']}": entry.get("computed", {}) for entry in trace["rows"]}
+    values = {**trace["inputs"], **computed}
+    entries = [entry for entry in trace["rows"] if row is None or entry["row"] == row]
     if row is not None and not entries:
         raise EngineError(f"row {row} is not in the program's template version; see `engine explain --program ID`")
-    return [ExplainedRow(entry["row"], _state(entry), tuple(emitted.get(entry["row"], ())), entry) for entry in entries]
+    return [ExplainedRow(entry["row"], _state(entry), tuple(emitted.get(entry["row"], ())), entry,
+                         _values_read(entry, values)) for entry in entries]
+
+
+def _values_read(entry: dict, values: dict) -> dict:
+    return {column: {name: [values.get(origin, {}).get(name), origin] for name, origin in reads.items()}
+            for column, reads in entry.get("read", {}).items()}
 
 
 def explain_program(conn, program_id: int, row: int | None = None) -> list[ExplainedRow]:
@@ -69,7 +80,7 @@ def _what(row: ExplainedRow) -> str:
 
 def _because(row: ExplainedRow) -> str:
     """The decisive condition and the values that decided, or the inputs of the line."""
-    entry, read = row.entry, row.entry.get("read", {})
+    entry, read = row.entry, row.read
     if row.state == "skipped":
         return f": p_calc {_inputs(read.get('p_calc'))}"
     if row.state == "not emitted":

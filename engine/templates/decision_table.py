@@ -57,10 +57,10 @@ class CompiledRow:
 @dataclass(slots=True)
 class Result:
     """The result table of one instantiation: emitted lines, the row id of each, and the trace
-    of every row (engine.templates.trace)."""
+    (engine.templates.trace): the input values by origin, and an entry for every row."""
     lines: list[str] = field(default_factory=list)
     row_ids: list[int] = field(default_factory=list)
-    trace: list[dict] = field(default_factory=list)
+    trace: dict = field(default_factory=lambda: {"inputs": {}, "rows": []})
 
 
 class CompiledTemplate:
@@ -175,7 +175,10 @@ class _Job:
         if outcome.emit:
             self.result.lines.append(outcome.line)
             self.result.row_ids.append(row.row.id)
-        self.result.trace.append(outcome.trace)
+        inputs = self.result.trace["inputs"]
+        for origin, name, value in outcome.inputs:
+            inputs.setdefault(origin, {})[name] = value
+        self.result.trace["rows"].append(outcome.trace)
 
 
 def _calls_nc_path(tree) -> bool:

@@ -1,13 +1,17 @@
 """The trace of a program: for every row of the template version, whether `s` ran or `p_calc`
 skipped the row, whether `o` was emitted or `p_emit` suppressed it, the value of each
-condition, the values computed, and the inputs each expression read (name → value and where
-the value came from: the job, a module's parameters, the row that computed it).
+condition, the values computed, and the inputs each expression read (name → where the value
+came from: the job, a module's parameters, the row that computed it; and so its value).
 
-A row's entry, as stored in `program.trace` (a JSON list, one entry per row, in id order):
-    {"row": 1800, "t": "cutcond", "n": 1, "emit": false, "p_emit": false,
-     "read": {"o": {}, "p_emit": {"coolant": [false, "job"]}}}
-Keys that do not apply are left out: "calc" only for rows with `s`, "emit" only for rows
-with `o`. Values that are not plain JSON (tool paths, long texts) are summarised.
+As stored in `program.trace`, compact: each input value once, under its origin, and one entry
+per row in id order that names the origin of what it read:
+    {"inputs": {"job": {"coolant": false, "z2": 19, ...}, "module cutmotion:2": {"cut_x": 51.5}},
+     "rows": [{"row": 1400, "computed": {"coupling_z0": -1}, "read": {"s": {"z0": "job"}}},
+              {"row": 1500, "emit": true, "read": {"o": {"coupling_z0": "row 1400", "z2": "job"}}},
+              {"row": 1800, "emit": false, "p_emit": false, "read": {"o": {}, "p_emit": {"coolant": "job"}}}]}
+A value read from "row K" is that row's `computed` value. Keys that do not apply are left out:
+"calc" only for rows with `s`, "emit" only for rows with `o`. Values that are not plain JSON
+(tool paths, long texts) are summarised.
 """
 from __future__ import annotations
 
@@ -22,11 +26,13 @@ MISSING = object()
 @dataclass(frozen=True)
 class Outcome:
     """What a row did for one set of inputs: the values it computed, its line and whether it
-    was emitted, and its trace entry."""
+    was emitted, its trace entry, and the (origin, name, value) of each input it read from the
+    job or a module (the program's trace keeps those values once)."""
     assignments: tuple[tuple[str, object], ...]
     line: object
     emit: bool
     trace: dict
+    inputs: tuple[tuple[str, str, object], ...] = ()
 
 
 class RowTrace:
@@ -34,16 +40,19 @@ class RowTrace:
 
     def __init__(self, row, scope: dict, origin):
         self.row, self.scope, self.origin = row, scope, origin
-        self.entry = {"row": row.row.id, "t": row.row.t, "n": row.row.n}
+        self.entry = {"row": row.row.id}
         self.assignments: list[tuple[str, object]] = []
+        self.inputs: list[tuple[str, str, object]] = []
 
     def read(self, column: str, expression) -> None:
-        """The inputs `expression` reads, with their values and origins, as it is evaluated."""
+        """Where each input `expression` reads comes from (and the value, when not from a row)."""
         reads = self.entry.setdefault("read", {}).setdefault(column, {})
         scope = self.scope
         for name in expression.ordered_names:
             if name in scope:
-                reads[name] = [json_value(scope[name]), self._origin(name)]
+                origin = reads[name] = self._origin(name)
+                if not origin.startswith("row "):
+                    self.inputs.append((origin, name, json_value(scope[name])))
 
     def condition(self, column: str, value) -> bool:
         self.entry[column] = json_value(value)
@@ -59,7 +68,7 @@ class RowTrace:
             self.entry["calc"] = calc
         if line is not None:
             self.entry["emit"] = bool(emit)
-        return Outcome(tuple(self.assignments), line, bool(emit), self.entry)
+        return Outcome(tuple(self.assignments), line, bool(emit), self.entry, tuple(self.inputs))
 
     def _origin(self, name: str) -> str:
         if any(name == assigned for assigned, _ in self.assignments):
