@@ -1,6 +1,6 @@
 """Single-gear latency: `engine instantiate --gear 42 --json` as a subprocess against a bare
 `python -c` that connects to the same database and runs one query, same interpreter,
-alternated run by run. Target: CLI median within 2.5x of the baseline median.
+alternated run by run. Target: CLI median within 2.0x of the baseline median (issue 12).
 
 CLI start-up: `engine --help` of this tree against `engine --help` of an earlier commit
 (`--help-against REV`, default the commit before the package was laid out in folders), both
@@ -25,7 +25,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from _common import add_database_argument, bench_database, median, verdict  # noqa: E402
 
-TARGET_RATIO = 2.5
+TARGET_RATIO = 2.0          # issue 12 (was 2.5)
 GEAR_ID = 42
 HELP_AGAINST = "30ac394"          # main before engine/ was laid out as the design's sections (issue 11)
 HELP_TARGET_RATIO = 1.10          # "as fast as before, within noise" on this 2-core machine

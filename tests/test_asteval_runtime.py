@@ -57,7 +57,9 @@ def test_the_interpreter_knows_only_our_functions():
     ("o", "f'{[[0] * 65536] * 65536 == [[0] * 65536] * 65536}'", "larger than 65536"),
     ("o", "f'{[[0] * 256] * 256 == [[0] * 256] * 256}'", "larger than 65536"),
     ("o", "f'{str([0] * 20000)}'", "too large to print"),
-    ("o", "f'{[0] * 60000}'", "result larger than 65536"),
+    ("o", "f'{[0] * 60000}'", "too large to print"),
+    ("o", "f'{[2 ** 2000] * 1500}'", "too large to print"),          # integers weigh by their digits
+    ("o", "f'{int(\"9\" * 4300)}'", "int\\(\\) of a text longer than 4096"),
     ("s", "a = [0] * 40000; b = [a, a]", "result larger than 65536"),
     ("o", "f'{2 ** 4000 * 2 ** 4000}'", "more than 4096 bits"),
     ("o", "'%2000000000d' % 0", "use an f-string"),
@@ -127,3 +129,61 @@ def test_lint_names_a_deeply_nested_row_instead_of_failing(run, tmp_path):
 def test_math_stays_python_s_math():
     rows = [(1, "main", 1, None, "r = sqrt(h * (da0 - h))", "f'{r:.4f}'", None)]
     assert template_of(*rows).run({"h": 4.5, "da0": 70.0}).lines == [f"{math.sqrt(4.5 * 65.5):.4f}"]
+
+
+# Found by an adversarial review (issue 12): each stops at a bound, in one short line.
+@pytest.mark.parametrize("text, words", [
+    ("f'{0:{(9 ** 9999) ** 9999 > 0}}'", "format spec may take only a name or a constant"),
+    ("f'{0:{x:199999999}}'", "format spec may take only a name or a constant"),
+    ("f'{sin}'", "sin is a function"),
+    ("0x" + "f" * 1100, "integer literal larger than 4096 bits"),
+    ("x " + "= 1 " * 3000, "longer than"),
+])
+def test_adversarial_expressions_are_refused_by_the_gate(text, words):
+    with pytest.raises(Exception, match=words) as refused:
+        compile_expression(text)
+    assert len(str(refused.value)) < 700
+
+
+def test_a_nested_simple_case_is_refused_before_it_grows():
+    text = "x"
+    for _ in range(30):
+        text = f"CASE {text} WHEN 1 THEN 1 WHEN 2 THEN 2 END"
+    with pytest.raises(Exception, match="subject of a simple CASE must be a name or a constant"):
+        compile_expression(text + " = 1")
+
+
+def test_a_long_like_pattern_is_refused():
+    rows = [(1, "main", 1, None, None, "'x'", "v LIKE p")]
+    with pytest.raises(TemplateError, match="pattern longer than 1000"):
+        template_of(*rows).run({"v": "a" * 60000, "p": "%" + "a" * 32000 + "b%"})
+
+
+def test_deeply_nested_tuples_in_intermediates_do_not_break_the_run():
+    rows = [(1, "main", 1, None, "a = 0", None, None),
+            *((k, "main", 1, None, "\n".join(["a = (a,)"] * 70), None, None) for k in range(2, 10)),
+            (10, "main", 1, None, None, "f'{len(a)}'", None)]
+    assert template_of(*rows).run({}).lines == ["1"]
+
+
+@pytest.mark.parametrize("params, module_params", [({"pi": 3}, {}), ({}, {"main:1": {"e": 0.5}}),
+                                                   ({"template_version": 9}, {})])
+def test_no_parameter_may_rebind_an_engine_name(params, module_params):
+    rows = [(1, "main", 1, None, None, "f'E{e:.3f} P{pi:.3f}'", None)]
+    with pytest.raises(Exception, match="has the name of a function or constant of the engine"):
+        template_of(*rows).run(params, module_params)
+    assert template_of(*rows).run({}).lines == ["E2.718 P3.142"]
+
+
+def test_what_a_run_builds_is_bounded_in_memory():
+    statements = "\n".join(f"a{k} = [0] * 60000" for k in range(100))
+    rows = [(k, "main", 1, None, statements, None, None) for k in range(1, 5)]
+    with pytest.raises(TemplateError, match="built more than"):
+        template_of(*rows).run({})
+
+
+def test_a_value_too_long_to_show_is_shown_short():
+    rows = [(1, "main", 1, None, "x = 2 ** 2000", "x", None)]
+    with pytest.raises(TemplateError, match="not text") as refused:
+        template_of(*rows).run({})
+    assert len(str(refused.value)) < 700 and "bits" in str(refused.value)

@@ -24,12 +24,14 @@ from ..turning.nc_path import NcLines
 from .evaluator import EvaluationError, Evaluator, base_symbols
 from .expressions import (MAX_SECONDS_PER_INSTANTIATION, Compiled, ExpressionError, compile_expression,
                           compile_statements)
-from .guards import MAX_STRING_LENGTH
+from .guards import MAX_STRING_LENGTH, short_repr, size
 from .rows import Template, TemplateRow
 from .trace import Outcome, memo_key, row_trace
 
 MODULE_ORDER = ("main", "prep", "sync", "shift", "cutcond", "cutmotion")
 MAX_MEMO_ROWS = 200_000   # outcomes kept per template; the memo starts again when full
+MAX_MEMO_VALUE = 256      # characters or elements of a value an outcome kept in the memo may hold
+MAX_RUN_SIZE = 1 << 24    # characters and elements one run may build (values computed, lines emitted)
 
 
 class TemplateError(EngineError):
@@ -37,7 +39,7 @@ class TemplateError(EngineError):
 
     def __init__(self, gear_class: str, row_id: int, column: str, text: str, problem: str):
         self.gear_class, self.row_id, self.column, self.text = gear_class, row_id, column, text
-        super().__init__(f"class {gear_class} row {row_id} column {column}: {problem} in {text!r}")
+        super().__init__(f"class {gear_class} row {row_id} column {column}: {problem} in {short_repr(text)}")
 
 
 @dataclass(frozen=True)
@@ -82,15 +84,20 @@ class CompiledTemplate:
     def run(self, params: dict, module_params: dict | None = None,
             deadline_seconds: float = MAX_SECONDS_PER_INSTANTIATION) -> Result:
         job = _Job(self, params, module_params or {}, time.perf_counter() + deadline_seconds, deadline_seconds)
-        for row in self.rows:
-            job.run_row(row)
+        try:
+            for row in self.rows:
+                job.run_row(row)
+        finally:
+            self.evaluator.forget()
         return _one_line_each(job.result) if self.prints_paths else job.result
 
     def remembered(self, key) -> Outcome | None:
         return self.memo.get(key) if key is not None else None
 
     def remember(self, key, outcome: Outcome) -> None:
-        if key is not None:
+        """Outcomes whose values are small: the memo keeps no large value alive."""
+        if key is not None and not any(isinstance(value, (str, tuple, list)) and size(value, MAX_MEMO_VALUE)
+                                       > MAX_MEMO_VALUE for _, value in outcome.assignments):
             if len(self.memo) >= MAX_MEMO_ROWS:
                 self.memo.clear()
             self.memo[key] = outcome
@@ -101,12 +108,21 @@ class _Job:
 
     def __init__(self, compiled: CompiledTemplate, params: dict, module_params: dict, deadline: float, budget: float):
         self.compiled, self.params, self.module_params = compiled, params, module_params
-        # The engine's names win over a job parameter of the same name (nothing rebinds them).
+        _refuse_engine_names(compiled, params, "job parameter")
         self.scope = {**params, **compiled.symbols, "template_version": compiled.template.version}
         self.intermediates: dict[str, int] = {}      # name -> id of the row that computed it
         self.module, self.module_names, self.module_key = None, (), None
         self.deadline, self.budget = deadline, budget
         self.result = Result()
+        self.built = 0   # characters and elements built so far (values computed, lines emitted)
+
+    def _count_built(self, row: CompiledRow, outcome: Outcome) -> None:
+        """Memory is bounded per run as time is: what a run builds, added up."""
+        self.built += _built_size(outcome)
+        if self.built > MAX_RUN_SIZE:
+            raise TemplateError(self.compiled.template.gear_class, row.row.id, "s" if row.s else "o",
+                                row.row.s or row.row.o or "", f"the rows so far built more than {MAX_RUN_SIZE} "
+                                "characters and elements")
 
     def run_row(self, row: CompiledRow) -> None:
         if time.perf_counter() > self.deadline:
@@ -141,6 +157,7 @@ class _Job:
                 else:
                     self.scope.pop(name, None)
         current = self.module_params.get(key) or {}
+        _refuse_engine_names(self.compiled, current, f"parameter of module {key}")
         self.module_names, self.module_key = tuple(current), key
         for name, value in current.items():
             if name not in self.intermediates:
@@ -162,6 +179,9 @@ class _Job:
 
     def _value(self, row: CompiledRow, column: str, expression: Compiled, trace):
         trace.read(column, expression)
+        if time.perf_counter() > self.deadline:   # between expressions too: a row may hold many
+            raise TemplateError(self.compiled.template.gear_class, row.row.id, column, expression.text,
+                                f"instantiation exceeded {self.budget} s")
         try:
             return self.compiled.evaluator.evaluate(expression.tree, expression.text, self.scope)
         except EvaluationError as error:
@@ -169,6 +189,7 @@ class _Job:
                                 str(error)) from None
 
     def _apply(self, row: CompiledRow, outcome: Outcome) -> None:
+        self._count_built(row, outcome)
         for name, value in outcome.assignments:
             self.scope[name] = value
             self.intermediates[name] = row.row.id
@@ -179,6 +200,22 @@ class _Job:
         for origin, name, value in outcome.inputs:
             inputs.setdefault(origin, {})[name] = value
         self.result.trace["rows"].append(outcome.trace)
+
+
+def _built_size(outcome: Outcome) -> int:
+    """Lines emitted and values computed, each counted by its length: what a value holds inside
+    was counted when it was built (the guards bound each value built)."""
+    line = outcome.line if outcome.emit else ""
+    lines = sum(map(len, line)) if isinstance(line, NcLines) else len(line or "")
+    return lines + sum(len(value) if isinstance(value, (str, tuple, list)) else 1 for _, value in outcome.assignments)
+
+
+def _refuse_engine_names(compiled: CompiledTemplate, names, what: str) -> None:
+    """No job or module parameter may rebind a function, constant or guard of the engine."""
+    clash = sorted(name for name in names if name in compiled.symbols or name == "template_version")
+    if clash:
+        raise EngineError(f"class {compiled.template.gear_class}: {what} {short_repr(clash[0])} has the name of a "
+                          "function or constant of the engine; rename it")
 
 
 def _calls_nc_path(tree) -> bool:
@@ -204,7 +241,7 @@ def _text(value, row: CompiledRow, gear_class: str):
     if isinstance(value, NcLines):
         return value
     if type(value) is not str:
-        problem = (f"gives {type(value).__name__} {value!r}, not text "
+        problem = (f"gives {type(value).__name__} {short_repr(value)}, not text "
                    "(write an f-string with a format, e.g. f\"X{x:.3f}\")")
     elif len(value) > MAX_STRING_LENGTH:
         problem = f"gives a line longer than {MAX_STRING_LENGTH} characters"

@@ -12,7 +12,8 @@ import ast
 from ..errors import EngineError
 from .asteval_import import ALL_NODES, Interpreter
 from .functions import CONSTANTS, FUNCTIONS
-from .guards import guard_size, safe_add, safe_format, safe_lshift, safe_mod, safe_mult, safe_pow
+from .guards import (check_printable, guard_size, safe_add, safe_format, safe_lshift, safe_mod, safe_mult,
+                     safe_pow)
 
 # The asteval node handlers a checked expression needs; every other node is switched off.
 NODES = ("expression", "binop", "unaryop", "boolop", "compare", "ifexp", "call", "name", "constant",
@@ -43,6 +44,7 @@ class Evaluator:
         config = {node: node in NODES for node in ALL_NODES}
         self.interpreter = Interpreter(symtable={}, minimal=True, use_numpy=False, config=config)
         self.interpreter.set_nodehandler("formattedvalue", _formatted_value(self.interpreter))
+        self.interpreter.set_nodehandler("call", _call(self.interpreter))
 
     def evaluate(self, tree: ast.expr, text: str, scope: dict):
         """The value of `tree` (the checked form of `text`) with `scope` as asteval's symbol table."""
@@ -55,6 +57,11 @@ class Evaluator:
         except Exception as error:   # asteval re-raises the expression's own failure
             raise EvaluationError(_problem(interpreter.error, error)) from None
 
+    def forget(self) -> None:
+        """Drop the last job's scope and failures (a finished run keeps nothing alive)."""
+        interpreter = self.interpreter
+        interpreter.symtable, interpreter.error, interpreter.error_msg, interpreter.expr = {}, [], None, None
+
 
 def _formatted_value(interpreter):
     """The f-string field handler: `format(value, spec)`. asteval's own goes through
@@ -63,8 +70,20 @@ def _formatted_value(interpreter):
     a third of the time an NC line takes."""
     def on_formattedvalue(node):
         spec = "" if node.format_spec is None else interpreter.run(node.format_spec)
-        return format(interpreter.run(node.value), spec)
+        value = interpreter.run(node.value)
+        check_printable(value)   # before printing it: a field of a huge value is refused, not rendered
+        return format(value, spec)
     return on_formattedvalue
+
+
+def _call(interpreter):
+    """The call handler: the named function (the gate allows no other) on its arguments.
+    asteval's own puts every argument into the message of a failure, and a message must never
+    render a large value."""
+    def on_call(node):
+        function = interpreter.run(node.func)
+        return function(*[interpreter.run(argument) for argument in node.args])
+    return on_call
 
 
 def _problem(held: list, raised: Exception) -> str:

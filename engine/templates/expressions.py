@@ -25,11 +25,12 @@ from dataclasses import dataclass
 
 from ..errors import EngineError
 from .functions import CONSTANTS, FUNCTIONS
-from .guards import check_format_spec
+from .guards import MAX_INT_BITS, check_format_spec
 
 MAX_EXPRESSION_LENGTH = 4_000      # characters of one expression or statement block
 MAX_NODES = 400                    # AST nodes of one expression
 MAX_DEPTH = 40                     # nesting of one expression (asteval walks the tree recursively)
+MAX_TRANSLATION_LENGTH = 4 * MAX_EXPRESSION_LENGTH   # the Python a SQL condition is translated into
 MAX_SECONDS_PER_INSTANTIATION = 2.0
 ENGINE_NAMES = frozenset(FUNCTIONS) | frozenset(CONSTANTS) | {"template_version"}
 
@@ -139,6 +140,9 @@ def _sql_tree(text: str, python_error: SyntaxError, translations: Mapping[str, s
     stored = translations.get(text)
     if stored is None:
         return _parse_sql(text, python_error)
+    if len(stored) > MAX_TRANSLATION_LENGTH:
+        raise ExpressionError(f"its stored translation (table sql_translation) is longer than "
+                              f"{MAX_TRANSLATION_LENGTH} characters; delete that row and run `engine lint`")
     try:
         return _parsed(stored, "eval")
     except SyntaxError:
@@ -170,14 +174,43 @@ def _check_tree(tree: ast.AST, sql_helpers: bool = False) -> None:
         count += 1
         if not isinstance(node, ALLOWED_NODES):
             raise ExpressionError(f"{_describe(node)} is not allowed in a template expression")
-        if isinstance(node, ast.Constant) and isinstance(node.value, bytes):
-            raise ExpressionError("bytes literals are not allowed (NC lines are text)")
+        if isinstance(node, ast.Constant):
+            _check_constant(node.value)
+        if isinstance(node, ast.FormattedValue) and node.format_spec is not None:
+            _check_spec_fields(node.format_spec)
         if isinstance(node, ast.Call):
             _check_call(node, sql_helpers)
         if isinstance(node, ast.Name):
             _check_name(node.id, sql_helpers)
     if count > MAX_NODES:
         raise ExpressionError(f"expression too large ({count} nodes, at most {MAX_NODES})")
+    for name in _function_names_as_values(tree):
+        raise ExpressionError(f"{name} is a function: call it, {name}(…)")
+
+
+def _check_constant(value) -> None:
+    if isinstance(value, bytes):
+        raise ExpressionError("bytes literals are not allowed (NC lines are text)")
+    if isinstance(value, int) and value.bit_length() > MAX_INT_BITS:
+        raise ExpressionError(f"integer literal larger than {MAX_INT_BITS} bits")
+
+
+def _check_spec_fields(spec: ast.JoinedStr) -> None:
+    """A format spec may take a field from a name or a constant (`{x:>{width}}`), nothing more:
+    no operators, calls or nested specs run inside it."""
+    for part in spec.values:
+        if isinstance(part, ast.FormattedValue) and (
+                not isinstance(part.value, (ast.Name, ast.Constant)) or part.conversion != -1
+                or part.format_spec is not None):
+            raise ExpressionError("a format spec may take only a name or a constant in its {field}")
+
+
+def _function_names_as_values(tree: ast.AST):
+    """Names of functions used other than as the called name: an NC line would print
+    `<function …>`."""
+    called = {id(node.func) for node in ast.walk(tree) if isinstance(node, ast.Call)}
+    return [node.id for node in ast.walk(tree)
+            if isinstance(node, ast.Name) and node.id in FUNCTIONS and id(node) not in called]
 
 
 def _depth(tree: ast.AST) -> int:

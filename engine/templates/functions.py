@@ -6,13 +6,13 @@ import math
 from typing import Any, Callable
 
 from ..turning.nc_path import nc_path
-from .guards import safe_format, safe_round, safe_str
+from .guards import safe_format, safe_int, safe_round, safe_str
 
 _MATH = ("sin", "cos", "tan", "asin", "acos", "atan", "atan2", "radians", "degrees", "sqrt",
          "hypot", "ceil", "floor", "trunc", "fabs", "copysign", "exp", "log", "log10", "isclose")
 FUNCTIONS: dict[str, Callable[..., Any]] = {name: getattr(math, name) for name in _MATH}
 FUNCTIONS.update({
-    "abs": abs, "min": min, "max": max, "round": safe_round, "int": int, "float": float,
+    "abs": abs, "min": min, "max": max, "round": safe_round, "int": safe_int, "float": float,
     "str": safe_str, "bool": bool, "len": len, "format": safe_format,
 })
 FUNCTIONS["nc_path"] = nc_path   # a tool path, one NC block per move (engine.turning.nc_path)

@@ -7,6 +7,7 @@ a value is then bounded too. nc_path checks its formats with the same check_form
 from __future__ import annotations
 
 import re
+import reprlib
 
 from .asteval_import import asteval_safe_pow
 
@@ -15,6 +16,18 @@ MAX_STRING_LENGTH = MAX_SIZE
 MAX_INT_BITS = 4_096               # bits of any integer an expression builds
 MAX_FORMAT_WIDTH = 200             # width/precision in a format spec
 SEQUENCES = (str, tuple, list)
+INT_DIGITS_PER_UNIT = 64           # an integer counts one unit of size per 64 bits (printing it costs that)
+_SHORT = reprlib.Repr()
+_SHORT.maxstring = _SHORT.maxother = _SHORT.maxlong = 60
+_SHORT.maxlist = _SHORT.maxtuple = 6
+_SHORT.maxlevel = 2
+
+
+def short_repr(value) -> str:
+    """A value as a message shows it: a few elements, a few dozen characters, never the whole."""
+    if isinstance(value, int) and not isinstance(value, bool) and value.bit_length() > 256:
+        return f"<integer of {value.bit_length()} bits>"
+    return _SHORT.repr(value)
 
 
 def _bits(value) -> int:
@@ -31,10 +44,18 @@ def size(value, limit: int = MAX_SIZE) -> int:
             total += len(item)
         elif isinstance(item, (tuple, list)):
             total += len(item)
-            pending.extend(element for element in item if isinstance(element, SEQUENCES))
+            if total > limit:
+                break
+            pending.extend(element for element in item if isinstance(element, SEQUENCES) or _big_int(element))
+        elif _big_int(item):
+            total += item.bit_length() // INT_DIGITS_PER_UNIT
         else:
             total += 1
     return total
+
+
+def _big_int(value) -> bool:
+    return type(value) is int and value.bit_length() > INT_DIGITS_PER_UNIT
 
 
 def guard_size(result):
@@ -93,15 +114,31 @@ def check_format_spec(spec: str) -> None:
 def safe_format(value, spec: str) -> str:
     """format() with the width and precision of the spec bounded."""
     check_format_spec(spec)
+    check_printable(value)
     return format(value, spec)
 
 
 def safe_str(value=""):
     if isinstance(value, int) and _bits(value) > MAX_INT_BITS:
         raise ValueError("integer too large to print")
-    if isinstance(value, SEQUENCES) and size(value, MAX_SIZE // 4) > MAX_SIZE // 4:
-        raise ValueError(f"value too large to print (more than {MAX_SIZE // 4} characters or elements)")
+    check_printable(value)
     return guard_size(str(value))
+
+
+def safe_int(value=0, *base):
+    """int(), its result bounded like any integer an expression builds."""
+    if isinstance(value, str) and len(value) > MAX_INT_BITS:
+        raise ValueError(f"int() of a text longer than {MAX_INT_BITS} characters")
+    result = int(value, *base)
+    if _bits(result) > MAX_INT_BITS:
+        raise ValueError(f"integer too large (more than {MAX_INT_BITS} bits)")
+    return result
+
+
+def check_printable(value) -> None:
+    """A value an f-string field or str() may print: at most a quarter of MAX_SIZE."""
+    if (isinstance(value, SEQUENCES) or _big_int(value)) and size(value, MAX_SIZE // 4) > MAX_SIZE // 4:
+        raise ValueError(f"value too large to print (more than {MAX_SIZE // 4} characters or elements)")
 
 
 def safe_round(value, digits=None):

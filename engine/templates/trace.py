@@ -42,6 +42,7 @@ class RowTrace:
         self.row, self.scope, self.origin = row, scope, origin
         self.entry = {"row": row.row.id}
         self.assignments: list[tuple[str, object]] = []
+        self.assigned: set[str] = set()
         self.inputs: list[tuple[str, str, object]] = []
 
     def read(self, column: str, expression) -> None:
@@ -60,6 +61,7 @@ class RowTrace:
 
     def computed(self, name: str, value):
         self.assignments.append((name, value))
+        self.assigned.add(name)
         self.entry.setdefault("computed", {})[name] = json_value(value)
         return value
 
@@ -71,7 +73,7 @@ class RowTrace:
         return Outcome(tuple(self.assignments), line, bool(emit), self.entry, tuple(self.inputs))
 
     def _origin(self, name: str) -> str:
-        if any(name == assigned for assigned, _ in self.assignments):
+        if name in self.assigned:
             return f"row {self.row.row.id}"
         return self.origin(name)
 
@@ -100,26 +102,25 @@ def json_value(value):
     return f"{type(value).__name__}"
 
 
+MEMO_TEXT = 256   # characters of a text input that may be part of a memo key
+
+
 def memo_key(row, scope: dict, origin) -> tuple | None:
-    """The row and the exact values and origins of its inputs, or None if a value cannot be a key
-    (a list): rows with equal keys have equal outcomes."""
+    """The row and the exact values and origins of its inputs, or None unless every input is a
+    plain scalar (a number, a short text, a truth value, None): rows with equal keys have equal
+    outcomes. Equal keys only for values that print alike: the type is part of the key (1, 1.0
+    and True are equal in Python) and floats are compared by their bits (0.0 and -0.0 are not)."""
     key = [row.row.id]
     for name in row.inputs:
-        key.append(_token(scope.get(name, MISSING)))
+        value = scope.get(name, MISSING)
+        kind = type(value)
+        if kind is float:
+            key.append(value.hex())
+        elif kind is str and len(value) <= MEMO_TEXT:
+            key.append(value)
+        elif kind is int and value.bit_length() <= 64 or kind is bool or value is None:
+            key.append((kind, value))
+        else:
+            return None
         key.append(origin(name))
-    key = tuple(key)
-    try:
-        hash(key)
-    except TypeError:
-        return None
-    return key
-
-
-def _token(value):
-    """Equal tokens only for values that print alike: the type is part of it (1, 1.0 and True
-    are equal in Python) and floats are compared by their bits (0.0 and -0.0 are not)."""
-    if type(value) is float:
-        return float, value.hex()
-    if type(value) is tuple:
-        return tuple, tuple(_token(item) for item in value)
-    return value if type(value) is str else (type(value), value)
+    return tuple(key)

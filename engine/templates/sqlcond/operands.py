@@ -5,6 +5,8 @@ from __future__ import annotations
 import numbers
 from decimal import Decimal
 
+from ..guards import short_repr
+
 MAX_TEXT_LENGTH = 1 << 16  # characters of a string built by ||
 MAX_INT_BITS = 4_096  # bits of an integer built by + - *
 
@@ -23,7 +25,8 @@ def _kind(value):
 
 
 def _describe(value):
-    return f"{_kind(value)} {value!r}"
+    """A value in a message: never the whole of a large one."""
+    return f"{_kind(value)} {short_repr(value)}"
 
 
 def _same_number_type(a, b):

@@ -4,8 +4,11 @@ from __future__ import annotations
 
 import functools
 import re
+from decimal import Decimal
 
 from .operands import MAX_TEXT_LENGTH, _describe
+
+MAX_PATTERN_LENGTH = 1_000   # characters of a LIKE pattern (a template's patterns are a few words)
 
 
 class _LikePattern:
@@ -67,6 +70,8 @@ def _like(value, pattern, escape, flags, op):
     for operand in (value, pattern, escape):
         if not isinstance(operand, str):
             raise TypeError(f"operator {op} needs text, got {_describe(operand)}")
+    if len(pattern) > MAX_PATTERN_LENGTH:   # matching costs the pattern's length times the text's
+        raise ValueError(f"{op} pattern longer than {MAX_PATTERN_LENGTH} characters")
     return _like_pattern(pattern, escape, flags).matches(value)
 
 
@@ -83,6 +88,8 @@ def _text(value):
         return value
     if isinstance(value, bool):
         return "true" if value else "false"
+    if not isinstance(value, (int, float, Decimal)):
+        raise TypeError(f"operator || joins text and numbers, not {_describe(value)}")
     return str(value)
 
 

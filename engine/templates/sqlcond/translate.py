@@ -197,6 +197,10 @@ def _case(node, lazy):
             raise EngineError(f"unsupported CASE branch in condition: {render(branch)}")
         test = branch.this
         if subject is not None:  # simple CASE: compare the subject with each WHEN value
+            if not isinstance(subject, (exp.Column, exp.Literal, exp.Boolean, exp.Null)):
+                # the subject is repeated in every WHEN: nested, it would grow exponentially
+                raise EngineError(f"CASE {render(subject)} WHEN …: the subject of a simple CASE must be "
+                                  "a name or a constant; write CASE WHEN … THEN … instead")
             test = exp.EQ(this=subject.copy(), expression=branch.this.copy())
         parts += [test, branch.args["true"]]
     if not parts:
