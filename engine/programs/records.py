@@ -32,9 +32,11 @@ class Planned:
     def lines(self) -> list[str]:
         return self.result.lines
 
-    def encoded(self) -> Encoded:
-        return Encoded(self.gear_id, self.gear_class, self.machine, self.hob_id, json.dumps(self.params),
-                       json.dumps(self.module_params), json.dumps(self.cutting or {}), self.template.version,
+    def encoded(self, with_job: bool = True) -> Encoded:
+        """For storage; without the job's JSON when only the program is stored (a job made again)."""
+        job = (json.dumps(self.params), json.dumps(self.module_params), json.dumps(self.cutting or {})) \
+            if with_job else ("", "", "")
+        return Encoded(self.gear_id, self.gear_class, self.machine, self.hob_id, *job, self.template.version,
                        self.template.hash, self.name, self.result.lines, self.result.row_ids,
                        json.dumps(self.result.trace))
 

@@ -66,7 +66,7 @@ def instantiate_jobs(conn, first: int | None = None, last: int | None = None, *,
         raise EngineError(f"no jobs with ids in {first or 'the start'}…{last or 'the end'}")
     remaker = Remaker(conn)
     with no_cycle_collection():
-        encoded = [_remade_in_batch(remaker, job, progress).encoded() for job in jobs]
+        encoded = [_remade_in_batch(remaker, job, progress).encoded(with_job=False) for job in jobs]
         return store_programs(conn, encoded, [job[0] for job in jobs], out)
 
 
