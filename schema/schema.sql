@@ -690,4 +690,3 @@ ON CONFLICT (gear_class, version) DO NOTHING;
 GRANT SELECT ON template_version_rows TO engine_reader, engine_runner, engine_editor;
 GRANT SELECT ON program_trace, program_input TO engine_reader, engine_runner, engine_editor;
 GRANT SELECT ON sql_translation TO engine_reader, engine_runner, engine_editor;
-GRANT INSERT ON sql_translation TO engine_editor;

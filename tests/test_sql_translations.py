@@ -6,6 +6,7 @@ import subprocess
 import sys
 
 import psycopg
+import pytest
 
 from engine.templates.expressions import translated_python
 from engine.templates.translations import text_hash
@@ -30,11 +31,30 @@ def test_seeded_classes_run_from_their_kept_translations_without_sqlglot(fresh_d
         assert instantiated_in_a_new_process(fresh_database_url, gear) == {"exit": 0, "sqlglot": False}
 
 
-def test_kept_translations_are_sqlglot_s_own(conn):
-    kept = conn.execute("SELECT text_hash, sql, python FROM sql_translation").fetchall()
-    assert {sql for _, sql, _ in kept} >= {"shift_on AND shift_per_part = 0", "NOT tangential"}
-    for digest, sql, python in kept:
-        assert digest == text_hash(sql) and python == translated_python(sql)
+def test_kept_translations_are_the_seeded_conditions_in_python(conn):
+    kept = {sql: (digest, python) for digest, sql, python in
+            conn.execute("SELECT text_hash, sql, python FROM sql_translation")}
+    assert kept["NOT tangential"][1] == "_sql_not(tangential)"
+    assert kept["shift_on AND shift_per_part = 0"][1] == "_sql_and(shift_on, _sql_eq(shift_per_part, 0))"
+    assert all(digest == text_hash(sql) for sql, (digest, _) in kept.items())
+
+
+def test_no_engine_role_may_write_a_translation(conn):
+    for role in ("engine_runner", "engine_editor"):
+        with pytest.raises(psycopg.errors.InsufficientPrivilege), conn.transaction():
+            conn.execute(f"SET LOCAL ROLE {role}")
+            conn.execute("INSERT INTO sql_translation (text_hash, sql, python) VALUES ('x', 'coolant AND 1 = 1', 'True')")
+
+
+def test_lint_names_a_translation_that_is_not_sqlglot_s(run):
+    with psycopg.connect(run.url) as conn:
+        conn.execute("INSERT INTO sql_translation (text_hash, sql, python) VALUES (%s, 'coolant AND 1 = 1', 'True')",
+                     (text_hash("coolant AND 1 = 1"),))
+        conn.execute("UPDATE template_view SET p_emit = 'coolant AND 1 = 1' WHERE gear_class = 'spur' AND id = 1800")
+    linted = run("lint")
+    assert linted.exit_code == 1
+    assert "class spur row 1800 column p_emit: its stored translation (table sql_translation) is not sqlglot's" \
+        in linted.stdout
 
 
 def test_a_condition_edited_in_sql_runs_and_lint_keeps_its_translation(run):

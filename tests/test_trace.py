@@ -180,3 +180,14 @@ def test_a_program_stored_before_traces_says_so(run):
         conn.execute("UPDATE program SET trace = NULL WHERE id = %s", (program_id,))
     refused = run("explain", "--program", program_id)
     assert refused.exit_code == 1 and "before programs kept their trace" in refused.stderr
+
+
+def test_a_computed_text_with_a_nul_is_traced_not_fatal(conn):
+    from engine.templates.decision_table import CompiledTemplate
+    from engine.templates.rows import Template, TemplateRow
+
+    rows = (TemplateRow(1, "main", 1, None, "marker = 'a' + chr0 + 'b'", None, None),
+            TemplateRow(2, "main", 1, None, None, "'G90'", None))
+    result = CompiledTemplate(Template("nul", 1, rows)).run({"chr0": "\x00"})
+    stored = conn.execute("SELECT %s::jsonb", (__import__("json").dumps(result.trace),)).fetchone()[0]
+    assert stored["rows"][0]["computed"]["marker"] == "a\\x00b" and result.lines == ["G90"]

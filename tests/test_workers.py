@@ -33,3 +33,24 @@ def test_a_failing_gear_in_a_worker_stops_the_batch_and_stores_nothing(run):
 def test_workers_are_for_batches(run):
     refused = run("instantiate", "--gear", "42", "--workers", "2")
     assert refused.exit_code == 1 and "--workers plans a batch" in refused.stderr
+
+
+def test_a_class_refused_in_a_worker_is_one_line_and_nothing_is_stored(run):
+    # the Planner remembers the refusal: a worker never reads the database it shares with the parent
+    with psycopg.connect(run.url) as conn:
+        conn.execute("UPDATE gear SET gear_class = 'turning_iso' WHERE id IN (45, 46, 47)")
+    refused = run("instantiate", "--gears", "42-54", "--workers", "2")
+    assert refused.exit_code == 1 and refused.stderr.count("\n") == 1
+    assert "gear 45: class 'turning_iso' is a turning class" in refused.stderr
+    assert stored_programs(run.url) == []
+
+
+def test_jobs_of_one_gear_are_not_written_over_each_other(run, tmp_path):
+    assert run("instantiate", "--gears", "42-43").exit_code == 0
+    assert run("instantiate", "--gear", "42").exit_code == 0
+    before = stored_programs(run.url)
+    with psycopg.connect(run.url) as conn:
+        jobs = [row[0] for row in conn.execute("SELECT id FROM job ORDER BY id")]
+    refused = run("instantiate", "--jobs", f"{jobs[0]}-{jobs[-1]}", "--out", tmp_path / "programs")
+    assert refused.exit_code == 1 and "programs of this batch are named GEAR42" in refused.stderr
+    assert stored_programs(run.url) == before and not (tmp_path / "programs").exists()

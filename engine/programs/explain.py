@@ -2,8 +2,8 @@
 (engine.templates.trace) read back, one sentence per template row.
 
     1800 not emitted: p_emit coolant = False (job)
-    1400 EGON(C,"FINE",B,-1,19) emitted: z0 = 1 (job), z2 = 19 (job)
-    1200 skipped: p_calc shift_on = False (job)
+    1500 EGON(C,"FINE",B,-1,19) emitted: coupling_z0 = -1 (row 1400), z2 = 19 (job)
+    1600 not emitted: p_emit shift_on = False (job), shift_per_part = 0.0 (job)
 """
 from __future__ import annotations
 
@@ -88,7 +88,9 @@ def _because(row: ExplainedRow) -> str:
     parts = []
     if entry.get("computed"):
         parts.append("computed " + ", ".join(f"{name} = {_value(value)}" for name, value in entry["computed"].items()))
-    inputs = {**read.get("p_calc", {}), **read.get("s", {}), **read.get("o", {}), **read.get("p_emit", {})}
+    own = f"row {row.row_id}"   # a value the row computed itself is shown as computed, not as an input
+    inputs = {name: value_origin for column in ("p_calc", "s", "o", "p_emit")
+              for name, value_origin in read.get(column, {}).items() if value_origin[1] != own}
     if inputs:
         parts.append(("from " if entry.get("computed") else "") + _inputs(inputs))
     return (": " + " ".join(parts)) if parts else ""

@@ -38,22 +38,37 @@ class Planner:
         self.overrides = overrides or {}
         self._templates: dict[str, Template] = {}
         self._models: dict[str, object] = {}
+        self._refused: dict[str, EngineError] = {}   # a class whose model or template failed, once
 
     def template(self, gear_class: str) -> Template:
         if gear_class not in self._templates:
-            self._templates[gear_class] = load_template(self.conn, gear_class)
+            self._templates[gear_class] = self._remembering_refusal(gear_class, load_template, self.conn,
+                                                                    gear_class)
         return self._templates[gear_class]
+
+    def _remembering_refusal(self, gear_class: str, read, *args):
+        """A class refused once is refused again without reading the database (batch workers read none)."""
+        if gear_class in self._refused:
+            raise self._refused[gear_class]
+        try:
+            return read(*args)
+        except EngineError as error:
+            self._refused[gear_class] = error
+            raise
 
     def model(self, gear_class: str):
         if gear_class not in self._models:
-            model = model_for_class(self.conn, gear_class)
-            if isinstance(model, TurningModel):
-                raise EngineError(f"class {gear_class!r} is a turning class: its jobs come from drawings "
-                                  "(engine import-dxf FILE.dxf), not from gears")
-            if model is None:
-                raise EngineError(f"gear class {gear_class!r} has no hobbing model (nor has any ancestor)")
-            self._models[gear_class] = model
+            self._models[gear_class] = self._remembering_refusal(gear_class, self._model, gear_class)
         return self._models[gear_class]
+
+    def _model(self, gear_class: str):
+        model = model_for_class(self.conn, gear_class)
+        if isinstance(model, TurningModel):
+            raise EngineError(f"class {gear_class!r} is a turning class: its jobs come from drawings "
+                              "(engine import-dxf FILE.dxf), not from gears")
+        if model is None:
+            raise EngineError(f"gear class {gear_class!r} has no hobbing model (nor has any ancestor)")
+        return model
 
     def plan(self, gear: Gear) -> Planned:
         if gear.gear_class is None:

@@ -17,6 +17,10 @@ def target_paths(names: list[str], out: str | Path) -> dict[str, Path]:
         return {names[0]: out}
     if out.exists() and not out.is_dir():
         raise EngineError(f"--out {out} is a file; give a directory for a batch of programs")
+    twice = sorted({name for name in names if names.count(name) > 1}) if len(set(names)) < len(names) else []
+    if twice:   # one file would silently replace the other (jobs of one gear made again, say)
+        raise EngineError(f"{len(names) - len(set(names)) + 1} programs of this batch are named {twice[0]}, so "
+                          f"their files would replace each other in {out}; make them without --out, or one at a time")
     return {name: out / f"{name}.MPF" for name in names}
 
 

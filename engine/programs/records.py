@@ -35,7 +35,7 @@ class Planned:
     def encoded(self, with_job: bool = True) -> Encoded:
         """For storage; without the job's JSON when only the program is stored (a job made again)."""
         job = (json.dumps(self.params), json.dumps(self.module_params), json.dumps(self.cutting or {})) \
-            if with_job else ("", "", "")
+            if with_job else (None, None, None)
         return Encoded(self.gear_id, self.gear_class, self.machine, self.hob_id, *job, self.template.version,
                        self.template.hash, self.name, self.result.lines, self.result.row_ids,
                        json.dumps(self.result.trace))
@@ -49,9 +49,9 @@ class Encoded:
     gear_class: str
     machine: str
     hob_id: str | None
-    params: str
-    module_params: str
-    cutting: str
+    params: str | None            # None: the job is stored already (made again)
+    module_params: str | None
+    cutting: str | None
     template_version: int
     template_hash: str
     name: str
@@ -70,7 +70,7 @@ class Program:
     template_version: int
     template_hash: str
     path: str | None = None
-    trace: list | None = None        # engine.templates.trace: why each row emitted or not
+    trace: dict | None = None        # engine.templates.trace: why each row emitted or not
     row_ids: list[int] | None = None  # the template row of each line
 
     @property

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import multiprocessing
 
+from ..errors import EngineError
 from ..templates.decision_table import compiled_template
 from .records import Encoded
 
@@ -27,7 +28,7 @@ def plan_in_workers(planner, gears: list, workers: int, plan_one, progress=None)
     slices = [(start, min(start + size, len(gears))) for start in range(0, len(gears), size)]
     _BATCH[:] = [planner, gears, plan_one]
     try:
-        with multiprocessing.get_context("fork").Pool(workers) as pool:
+        with multiprocessing.get_context("fork").Pool(workers, initializer=_in_worker) as pool:
             encoded = []
             for jobs in pool.imap(_plan_slice, slices):
                 encoded += jobs
@@ -39,13 +40,25 @@ def plan_in_workers(planner, gears: list, workers: int, plan_one, progress=None)
 
 
 def _ready(planner, gear_class: str) -> None:
-    """What planning a gear of the class reads from the database, read now (a refused class is
-    left for its first gear to name, in gear order)."""
+    """What planning a gear of the class reads from the database, read now. A refused class is
+    remembered by the Planner and named by its first gear, in gear order, as in one process."""
     try:
         planner.model(gear_class)
         compiled_template(planner.template(gear_class))
-    except Exception:   # noqa: BLE001 — reported by the worker for the gear, as a single run would
+    except EngineError:
         pass
+
+
+class _NoDatabase:
+    """A worker's connection: it shares the parent's socket, so reading anything is refused."""
+
+    def __getattr__(self, name):
+        raise EngineError("a batch worker tried to read the database (a bug: the Planner should have "
+                          "read everything before the workers started)")
+
+
+def _in_worker() -> None:
+    _BATCH[0].conn = _NoDatabase()
 
 
 def _plan_slice(bounds: tuple[int, int]) -> list[Encoded]:

@@ -29,7 +29,7 @@ from .rows import Template, TemplateRow
 from .trace import Outcome, memo_key, row_trace
 
 MODULE_ORDER = ("main", "prep", "sync", "shift", "cutcond", "cutmotion")
-MAX_MEMO_ROWS = 200_000   # outcomes kept per template; the memo starts again when full
+MAX_MEMO_ROWS = 50_000    # outcomes kept per template (about 1.5 KB each); the memo starts again when full
 MAX_MEMO_VALUE = 256      # characters or elements of a value an outcome kept in the memo may hold
 MAX_RUN_SIZE = 1 << 24    # characters and elements one run may build (values computed, lines emitted)
 
@@ -96,8 +96,9 @@ class CompiledTemplate:
 
     def remember(self, key, outcome: Outcome) -> None:
         """Outcomes whose values are small: the memo keeps no large value alive."""
+        values = [value for _, value in outcome.assignments] + [outcome.line]
         if key is not None and not any(isinstance(value, (str, tuple, list)) and size(value, MAX_MEMO_VALUE)
-                                       > MAX_MEMO_VALUE for _, value in outcome.assignments):
+                                       > MAX_MEMO_VALUE for value in values):
             if len(self.memo) >= MAX_MEMO_ROWS:
                 self.memo.clear()
             self.memo[key] = outcome
@@ -126,7 +127,8 @@ class _Job:
 
     def run_row(self, row: CompiledRow) -> None:
         if time.perf_counter() > self.deadline:
-            raise TemplateError(self.compiled.template.gear_class, row.row.id, "o", row.row.o or "",
+            column = "s" if row.row.s else "o"
+            raise TemplateError(self.compiled.template.gear_class, row.row.id, column, getattr(row.row, column) or "",
                                 f"instantiation exceeded {self.budget} s")
         if row.module != self.module:
             self._enter(row.module)

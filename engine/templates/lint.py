@@ -8,6 +8,7 @@ from dataclasses import dataclass
 from ..gears.models import model_for_class
 from .checks import LintProblem, structural_problems
 from .decision_table import compile_row
+from .expressions import translated_python
 from .store import load_template
 from .translations import store_translations
 
@@ -15,7 +16,7 @@ from .translations import store_translations
 def lint_class(conn, gear_class: str) -> list[LintProblem]:
     """Every problem of one class's template, including unknown parameter names."""
     template = load_template(conn, gear_class)
-    problems = structural_problems(gear_class, list(template.rows))
+    problems = structural_problems(gear_class, list(template.rows)) + _translation_problems(template)
     if problems:
         return problems
     # An imported class's rows name the parameters of its program, even under a parent with a model.
@@ -25,6 +26,15 @@ def lint_class(conn, gear_class: str) -> list[LintProblem]:
                             "so its parameter names cannot be checked; give the class a model, or import "
                             "it with `engine import-nc FILE --class NAME --params P.json`")]
     return list(_unknown_names(gear_class, template.rows, name_source))
+
+
+def _translation_problems(template) -> list[LintProblem]:
+    """A stored translation of a SQL condition must be what sqlglot makes of its text: one
+    written by hand would give the condition another meaning than the text shows."""
+    wrong = {text for text, python in template.translations.items() if translated_python(text) != python}
+    return [LintProblem(template.gear_class, row.id, column, "its stored translation (table sql_translation) is "
+                        "not sqlglot's; delete that row of sql_translation and run `engine lint` again")
+            for row in template.rows for column in ("p_calc", "o", "p_emit") if getattr(row, column) in wrong]
 
 
 @dataclass(frozen=True)

@@ -85,7 +85,7 @@ def row_trace(row, scope: dict, origin) -> RowTrace:
 def json_value(value):
     """A value as the trace keeps it: plain JSON values as they are, others summarised."""
     kind = type(value)
-    if kind is int or kind is bool or value is None or (kind is str and len(value) <= MAX_TEXT):
+    if kind is int or kind is bool or value is None or (kind is str and len(value) <= MAX_TEXT and "\x00" not in value):
         return value
     if kind is float and math.isfinite(value):
         return value
@@ -93,13 +93,14 @@ def json_value(value):
         return value
     if isinstance(value, float):
         return value if math.isfinite(value) else str(value)
-    if isinstance(value, str):
-        return value if len(value) <= MAX_TEXT else value[:MAX_TEXT] + f"… ({len(value)} characters)"
+    if isinstance(value, str):   # PostgreSQL's jsonb holds no NUL
+        text = value.replace("\x00", "\\x00")
+        return text if len(text) <= MAX_TEXT else text[:MAX_TEXT] + f"… ({len(value)} characters)"
     if isinstance(value, (list, tuple)):
         if len(value) <= MAX_LISTED and all(not isinstance(item, (list, tuple, dict)) for item in value):
             return [json_value(item) for item in value]
-        return f"{type(value).__name__} of {len(value)}"
-    return f"{type(value).__name__}"
+        return f"<{type(value).__name__} of {len(value)}>"
+    return f"<{type(value).__name__}>"
 
 
 MEMO_TEXT = 256   # characters of a text input that may be part of a memo key
@@ -115,7 +116,7 @@ def memo_key(row, scope: dict, origin) -> tuple | None:
         value = scope.get(name, MISSING)
         kind = type(value)
         if kind is float:
-            key.append(value.hex())
+            key.append((float, value.hex()))
         elif kind is str and len(value) <= MEMO_TEXT:
             key.append(value)
         elif kind is int and value.bit_length() <= 64 or kind is bool or value is None:

@@ -5,18 +5,27 @@ the condition's text; what is read back passes the expression gate like any expr
 from __future__ import annotations
 
 import ast
+import functools
 import hashlib
+from importlib.metadata import version
 
 from psycopg.errors import InsufficientPrivilege
 
-TRANSLATOR = "sqlcond-1"   # a change of the translator's output changes this, and so every key
+TRANSLATOR = "sqlcond-1"   # a change of our translator's output changes this, and so every key
 
 FIND = "SELECT sql, python FROM sql_translation WHERE text_hash = ANY(%s)"
 STORE = "INSERT INTO sql_translation (text_hash, sql, python) VALUES (%s, %s, %s) ON CONFLICT DO NOTHING"
 
 
 def text_hash(text: str) -> str:
-    return hashlib.sha256(f"{TRANSLATOR}\n{text}".encode()).hexdigest()
+    return hashlib.sha256(f"{translator()}\n{text}".encode()).hexdigest()
+
+
+@functools.lru_cache(maxsize=1)
+def translator() -> str:
+    """Our translator's version and sqlglot's: an upgrade of either gives new keys, so no
+    translation made by another version is used."""
+    return f"{TRANSLATOR}/sqlglot-{version('sqlglot')}"
 
 
 def expression_texts(rows) -> set[str]:
