@@ -21,4 +21,4 @@ def connection(ctx, migrated: bool = True):
 
 
 def emit_json(payload: dict) -> None:
-    click.echo(json.dumps(payload, indent=2, default=str))
+    click.echo(json.dumps(payload, default=str))   # design notes §9: one JSON object on one line

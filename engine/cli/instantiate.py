@@ -67,6 +67,7 @@ def instantiate(ctx, gear_id, job_id, gear_range, job_range, all_gears, out, mac
     if explain and (gear_range or job_range or all_gears):
         raise EngineError("--explain explains one program: use it with --gear or --job, and "
                           "`engine explain --program ID` for the programs of a batch")
+    _refuse_new_job_choices_for_stored_jobs(ctx, job_id is not None or bool(job_range))
     choices = Choices(cuts=cuts, coolant=coolant, shift_y=shift_y, shift_per_part=shift_per_part,
                       feed_mode=feed_mode, tailstock=tailstock, worm_feed=worm_feed)
     overrides = {"hob_speed": hob_speed}
@@ -83,6 +84,21 @@ def instantiate(ctx, gear_id, job_id, gear_range, job_range, all_gears, out, mac
                                          overrides=overrides, out=out, workers=workers)
             return _report_batch(programs, out, as_json)
     _report_program(program, as_json, explain)
+
+
+NEW_JOB_CHOICES = ("machine", "cuts", "coolant", "shift_y", "shift_per_part", "feed_mode", "tailstock",
+                   "worm_feed", "hob_speed")
+
+
+def _refuse_new_job_choices_for_stored_jobs(ctx, stored_jobs: bool) -> None:
+    """A stored job is made with its stored parameters: a choice given with --job/--jobs would
+    silently do nothing."""
+    given = [parameter for parameter in ctx.command.params if parameter.name in NEW_JOB_CHOICES
+             and ctx.get_parameter_source(parameter.name) is not click.core.ParameterSource.DEFAULT]
+    if stored_jobs and given:
+        option = "/".join(given[0].opts + given[0].secondary_opts)
+        raise EngineError(f"{option} applies to a new job (--gear, --gears, --all); a stored job is made with its "
+                          "stored parameters: edit job.params in SQL to change them")
 
 
 def _report_program(program, as_json: bool, explain: bool) -> None:
