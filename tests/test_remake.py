@@ -37,3 +37,17 @@ def test_a_failing_job_stops_the_batch_and_stores_nothing(run):
     assert refused.exit_code == 1 and refused.stderr.count("\n") == 1
     assert f"job {jobs[1]}: " in refused.stderr and "unknown parameter 'z2'" in refused.stderr
     assert len(programs(run.url)) == len(jobs)
+
+
+def test_a_choice_for_a_new_job_is_refused_for_stored_jobs(run):
+    made = run("instantiate", "--gear", "42", "--json")
+    job = json.loads(made.stdout)["job_id"]
+    for args in (("--job", job, "--no-coolant"), ("--jobs", f"{job}-{job}", "--hob-speed", "300")):
+        refused = run("instantiate", *args)
+        assert refused.exit_code == 1 and "applies to a new job" in refused.stderr and "job.params" in refused.stderr
+    assert run("instantiate", "--job", job).exit_code == 0
+
+
+def test_json_is_one_object_on_one_line(run):   # design notes §9
+    made = run("instantiate", "--gear", "42", "--json")
+    assert made.stdout.count("\n") == 1 and json.loads(made.stdout)["lines"] > 20
