@@ -46,8 +46,9 @@ def check_trace(conn, program_id):
     emitting = {entry["row"] for entry in rows if entry.get("emit")}
     assert set(row_ids) <= emitting                                        # every line from an emitting row
     assert {row for row in emitting if "nc_path" not in template[row].o} <= set(row_ids)
-    assert set(inputs) <= {"job", "template"} | {f"module {key}" for key in module_params} | \
-        {origin for entry in rows for reads in entry.get("read", {}).values() for origin in reads.values()}
+    read_from_outside = {(origin, name) for entry in rows for reads in entry.get("read", {}).values()
+                         for name, origin in reads.items() if not origin.startswith("row ")}
+    assert {(origin, name) for origin, names in inputs.items() for name in names} == read_from_outside
     computed = {}
     for entry in rows:
         row = template[entry["row"]]

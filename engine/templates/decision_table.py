@@ -26,7 +26,7 @@ from .expressions import (MAX_SECONDS_PER_INSTANTIATION, Compiled, ExpressionErr
                           compile_statements)
 from .guards import MAX_STRING_LENGTH, short_repr, size
 from .rows import Template, TemplateRow
-from .trace import Outcome, memo_key, row_trace
+from .trace import Outcome, RowTrace, memo_key
 
 MODULE_ORDER = ("main", "prep", "sync", "shift", "cutcond", "cutmotion")
 MAX_MEMO_ROWS = 50_000    # outcomes kept per template (about 1.5 KB each); the memo starts again when full
@@ -167,7 +167,7 @@ class _Job:
 
     def _evaluate(self, row: CompiledRow) -> Outcome:
         """Evaluate the row in the current scope (its statements' values enter it as they run)."""
-        trace = row_trace(row, self.scope, self.origin)
+        trace = RowTrace(row, self.scope, self.origin)
         if row.s:
             if row.p_calc is not None and not trace.condition("p_calc", self._value(row, "p_calc", row.p_calc, trace)):
                 return trace.outcome(calc=False)
@@ -298,7 +298,7 @@ _CACHE: dict[tuple, CompiledTemplate] = {}
 def compiled_template(template: Template) -> CompiledTemplate:
     """Parse every expression once per template (keyed by class, version, content and the stored
     translations of its SQL conditions, which the gate checks again when they change)."""
-    key = (template.gear_class, template.version, template.hash, frozenset(template.translations.items()))
+    key = template.cache_key
     found = _CACHE.get(key)
     if found is None:
         found = _CACHE[key] = CompiledTemplate(template)

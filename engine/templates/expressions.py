@@ -184,8 +184,9 @@ def _check_tree(tree: ast.AST, sql_helpers: bool = False) -> None:
             _check_name(node.id, sql_helpers)
     if count > MAX_NODES:
         raise ExpressionError(f"expression too large ({count} nodes, at most {MAX_NODES})")
-    for name in _function_names_as_values(tree):
-        raise ExpressionError(f"{name} is a function: call it, {name}(…)")
+    misused = _function_names_as_values(tree)
+    if misused:
+        raise ExpressionError(f"{misused[0]} is a function: call it, {misused[0]}(…)")
 
 
 def _check_constant(value) -> None:

@@ -38,6 +38,12 @@ class Template:
     translations: Mapping[str, str] = field(default_factory=dict, compare=False, repr=False)
 
     @cached_property
+    def cache_key(self) -> tuple:
+        """What a compiled template depends on: class, version, rows and the stored translations of
+        its SQL conditions (which the gate checks again when they change)."""
+        return self.gear_class, self.version, self.hash, frozenset(self.translations.items())
+
+    @cached_property
     def hash(self) -> str:
         """Content hash of the assembled rows: what a program records next to the version."""
         return rows_hash(self.rows)

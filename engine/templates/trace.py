@@ -78,10 +78,6 @@ class RowTrace:
         return self.origin(name)
 
 
-def row_trace(row, scope: dict, origin) -> RowTrace:
-    return RowTrace(row, scope, origin)
-
-
 def json_value(value):
     """A value as the trace keeps it: plain JSON values as they are, others summarised."""
     kind = type(value)
