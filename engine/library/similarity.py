@@ -18,6 +18,7 @@ import math
 from collections import Counter, defaultdict
 from collections.abc import Iterator, Sequence
 
+from ..templates.guards import parse_python
 from .nc_tokens import NUMBER, SPACE, WORD, tokenise
 
 CODE_ADDRESSES = ("G", "M")   # their numbers name a function, they are never parameterised
@@ -30,7 +31,7 @@ Units = tuple[str, ...]
 def nc_units(text: str) -> Units:
     """The units of the NC line a line expression produces; blanks are dropped."""
     try:
-        node = ast.parse(text.strip(), mode="eval").body
+        node = parse_python(text.strip()).body
     except SyntaxError:
         node = None
     pieces = _literal_pieces(node) if node is not None else None

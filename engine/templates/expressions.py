@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 from ..errors import EngineError
 from .functions import CONSTANTS, FUNCTIONS
-from .guards import MAX_INT_BITS, check_format_spec
+from .guards import MAX_INT_BITS, check_format_spec, parse_python
 
 MAX_EXPRESSION_LENGTH = 4_000      # characters of one expression or statement block
 MAX_NODES = 400                    # AST nodes of one expression
@@ -81,7 +81,7 @@ def compile_expression(text: str, translations: Mapping[str, str] | None = None)
 def _parsed(text: str, mode: str) -> ast.AST:
     """ast.parse, with a nesting too deep for the parser refused like any other bad text."""
     try:
-        return ast.parse(text, mode=mode)
+        return parse_python(text, mode)
     except (RecursionError, MemoryError):
         raise ExpressionError(f"nested too deeply (at most {MAX_DEPTH} levels)") from None
 

@@ -6,8 +6,10 @@ own guards run behind ours. Every value an expression builds has a size of at mo
 a value is then bounded too. nc_path checks its formats with the same check_format_spec."""
 from __future__ import annotations
 
+import ast
 import re
 import reprlib
+import threading
 
 from .asteval_import import asteval_safe_pow
 
@@ -21,6 +23,18 @@ _SHORT = reprlib.Repr()
 _SHORT.maxstring = _SHORT.maxother = _SHORT.maxlong = 60
 _SHORT.maxlist = _SHORT.maxtuple = 6
 _SHORT.maxlevel = 2
+
+
+# CPython 3.11 counts the AST converter's recursion depth in state that threads share: two
+# threads parsing at once may fail with "SystemError: AST constructor recursion depth mismatch"
+# (seen with editors, the refactor and runners in one process). Parsing is quick; one at a time.
+_PARSING = threading.Lock()
+
+
+def parse_python(text: str, mode: str = "eval") -> ast.AST:
+    """ast.parse, one thread at a time."""
+    with _PARSING:
+        return ast.parse(text, mode=mode)
 
 
 def short_repr(value) -> str:

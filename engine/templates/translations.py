@@ -4,12 +4,13 @@ a second of every command). A translation is looked up by a hash of the translat
 the condition's text; what is read back passes the expression gate like any expression."""
 from __future__ import annotations
 
-import ast
 import functools
 import hashlib
 from importlib.metadata import version
 
 from psycopg.errors import InsufficientPrivilege
+
+from .guards import parse_python
 
 TRANSLATOR = "sqlcond-1"   # a change of our translator's output changes this, and so every key
 
@@ -67,7 +68,7 @@ def store_translations(conn, rows) -> int:
 
 def _is_python(text: str) -> bool:
     try:
-        ast.parse(text.strip(), mode="eval")
+        parse_python(text.strip())
     except (SyntaxError, RecursionError, MemoryError, ValueError):
         return False
     return True
