@@ -13,7 +13,7 @@ from ..templates.rows import Template
 from ..templates.store import load_template
 from .instantiate import store_and_write, run_template
 from .records import Planned, Program
-from .storage import Batch, store_programs
+from .storage import Batch, refuse_unsafe, store_programs
 
 JOB_COLUMNS = "id, gear_id, gear_class, machine, hob_id, params, module_params"
 
@@ -73,6 +73,7 @@ def instantiate_jobs(conn, first: int | None = None, last: int | None = None, *,
 def _remade_in_batch(remaker: Remaker, job: tuple, progress) -> Planned:
     try:
         planned = remaker.remade(job)
+        refuse_unsafe(planned.name, planned.lines)
     except EngineError as error:
         raise EngineError(f"job {job[0]}: {error} (batch stopped, nothing stored)") from None
     if progress:
