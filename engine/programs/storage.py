@@ -1,4 +1,5 @@
-"""Storing jobs and programs: one at a time, or a batch through COPY.
+"""Storing jobs and programs: one at a time, or a batch through COPY. Files are not written
+here: engine.programs.outputs writes them after the COMMIT of the caller's files_after_commit.
 
 A program is stored only with a safe name (engine/names.py) and lines that are one NC line
 each: a line break inside a line (from a job parameter or a template row) would be a block
@@ -12,7 +13,6 @@ from psycopg.types.json import Jsonb
 
 from ..errors import EngineError
 from ..names import checked, line_breaking, shown
-from .outputs import write_program_files
 from .records import Encoded, Planned, Program
 
 INSERT_JOB = """
@@ -39,10 +39,11 @@ def store_one(conn, planned: Planned, existing_job: int | None, path: str | None
 
 
 def store_many(conn, encoded: list[Encoded], out=None) -> "Batch":
-    """All jobs and programs in one transaction, through COPY (the batch path)."""
+    """All jobs and programs in one transaction, through COPY (the batch path); `out` is where
+    the caller writes their files."""
     for item in encoded:
         refuse_unsafe(item.name, item.lines)
-    with write_program_files(encoded, out), conn.transaction():
+    with conn.transaction():
         job_ids = _next_ids(conn, "job_id_seq", len(encoded))
         program_ids = _next_ids(conn, "program_id_seq", len(encoded))
         with conn.cursor().copy(COPY_JOB) as copy:
@@ -58,7 +59,7 @@ def store_programs(conn, encoded: list[Encoded], job_ids: list[int], out=None) -
     """Programs of stored jobs (made again), in one transaction through COPY."""
     for item in encoded:
         refuse_unsafe(item.name, item.lines)
-    with write_program_files(encoded, out), conn.transaction():
+    with conn.transaction():
         program_ids = _next_ids(conn, "program_id_seq", len(encoded))
         _copy_programs(conn, program_ids, job_ids, encoded)
     return Batch(len(encoded), sum(len(item.lines) for item in encoded), min(program_ids), max(program_ids), out)
