@@ -44,16 +44,18 @@ LANGUAGE sql IMMUTABLE PARALLEL SAFE
 RETURN jsonb_path_exists(value,
     'lax $.** ? (@.type() == "string" && @ like_regex "[\\x01-\\x08\\x0a-\\x1f\\x7f-\\x9f\\u2028\\u2029]")');
 
--- A job's parameters that are names fit their rule when present, and no text of the job
--- breaks a line.
+-- A name inside JSON: absent (SQL NULL), or a string that fits its kind's rule.
+CREATE FUNCTION safe_json_name(kind text, value jsonb) RETURNS boolean
+LANGUAGE sql IMMUTABLE PARALLEL SAFE
+RETURN value IS NULL OR (jsonb_typeof(value) = 'string' AND safe_name(kind, value #>> '{}'));
+
+-- A job's parameters that are names (printed in the program, or its file name) fit their
+-- rule when present, and no text of the job breaks a line.
 CREATE FUNCTION job_params_safe(params jsonb, module_params jsonb) RETURNS boolean
 LANGUAGE sql IMMUTABLE PARALLEL SAFE
-RETURN NOT EXISTS (
-        SELECT 1
-        FROM (VALUES ('program_name', 'program'), ('drawing', 'drawing'), ('machine', 'machine'),
-                     ('gear_class', 'class'), ('hob_id', 'hob')) AS named (key, kind)
-        WHERE params ? named.key
-          AND NOT (jsonb_typeof(params -> named.key) = 'string' AND safe_name(named.kind, params ->> named.key)))
+RETURN safe_json_name('program', params -> 'program_name') AND safe_json_name('drawing', params -> 'drawing')
+    AND safe_json_name('machine', params -> 'machine') AND safe_json_name('class', params -> 'gear_class')
+    AND safe_json_name('hob', params -> 'hob_id')
     AND NOT json_text_breaks_lines(params) AND NOT json_text_breaks_lines(module_params);
 
 -- Group-technology tree of gear classes. Leaf classes carry templates.
