@@ -97,6 +97,7 @@ def test_an_existing_file_is_replaced_only_with_force(run, tmp_path):
     assert (tmp_path / "GEAR42.MPF").read_text() == "; the program the operator has\n"
     assert everything_under(tmp_path) == ["GEAR42.MPF", "GEAR43.MPF"]
 
+    assert "give --out too" in one_line_refusal(run("instantiate", "--gear", 42, "--force"))
     assert run("instantiate", "--gears", "42-44", "--out", tmp_path, "--force").exit_code == 0
     assert program_count(run.url) == before + 3
     for name in ("GEAR42", "GEAR43", "GEAR44"):
