@@ -18,6 +18,46 @@ INSERT INTO module_type (code, position, title) VALUES
     ('cutcond',   5, 'cutting conditions: spindle, coolant'),
     ('cutmotion', 6, 'cutting motion: infeed, axial pass, retract');
 
+-- Safe names (migration 0009, engine/names.py NAME_RULES): program, drawing, hob, class and
+-- machine names leave the database as text the machine reads (the 840D program name and its
+-- file name; the others inside the program's comments). A newline in one would start a new NC
+-- block; a / or .. in a program name, a file outside --out. Does `name` fit its kind's rule?
+CREATE FUNCTION safe_name(kind text, name text) RETURNS boolean
+LANGUAGE sql IMMUTABLE PARALLEL SAFE
+RETURN coalesce(name ~ CASE kind
+    WHEN 'program' THEN '^(?:[A-Za-z]{2}|_[A-Za-z])[A-Za-z0-9_]{0,22}$'
+    WHEN 'drawing' THEN '^[A-Za-z0-9_][A-Za-z0-9_. -]{0,79}$'
+    WHEN 'hob' THEN '^[A-Za-z0-9][A-Za-z0-9_.-]{0,31}$'
+    WHEN 'class' THEN '^[a-z][a-z0-9_]{0,62}$'
+    WHEN 'machine' THEN '^[A-Za-z][A-Za-z0-9_.-]{0,31}$'
+END, false);
+
+-- Does the text hold a character that ends or hides an NC line (C0 controls but tab, DEL,
+-- C1 controls, U+2028, U+2029)? engine/names.py LINE_BREAKING.
+CREATE FUNCTION breaks_lines(value text) RETURNS boolean
+LANGUAGE sql IMMUTABLE PARALLEL SAFE
+RETURN value ~ '[\x01-\x08\x0a-\x1f\x7f-\x9f\u2028\u2029]';
+
+-- Does any text inside the JSON value (at any depth) hold such a character?
+CREATE FUNCTION json_text_breaks_lines(value jsonb) RETURNS boolean
+LANGUAGE sql IMMUTABLE PARALLEL SAFE
+RETURN jsonb_path_exists(value,
+    'lax $.** ? (@.type() == "string" && @ like_regex "[\\x01-\\x08\\x0a-\\x1f\\x7f-\\x9f\\u2028\\u2029]")');
+
+-- A name inside JSON: absent (SQL NULL), or a string that fits its kind's rule.
+CREATE FUNCTION safe_json_name(kind text, value jsonb) RETURNS boolean
+LANGUAGE sql IMMUTABLE PARALLEL SAFE
+RETURN value IS NULL OR (jsonb_typeof(value) = 'string' AND safe_name(kind, value #>> '{}'));
+
+-- A job's parameters that are names (printed in the program, or its file name) fit their
+-- rule when present, and no text of the job breaks a line.
+CREATE FUNCTION job_params_safe(params jsonb, module_params jsonb) RETURNS boolean
+LANGUAGE sql IMMUTABLE PARALLEL SAFE
+RETURN safe_json_name('program', params -> 'program_name') AND safe_json_name('drawing', params -> 'drawing')
+    AND safe_json_name('machine', params -> 'machine') AND safe_json_name('class', params -> 'gear_class')
+    AND safe_json_name('hob', params -> 'hob_id')
+    AND NOT json_text_breaks_lines(params) AND NOT json_text_breaks_lines(module_params);
+
 -- Group-technology tree of gear classes. Leaf classes carry templates.
 CREATE TABLE gear_class (
     name             text PRIMARY KEY CHECK (name ~ '^[a-z][a-z0-9_]*$'),
@@ -26,7 +66,8 @@ CREATE TABLE gear_class (
     template_version integer NOT NULL DEFAULT 0 CHECK (template_version >= 0),
     -- The parameter values of the proven program the class was imported from (engine
     -- import-nc); lint checks the template's names against them. NULL: not imported.
-    import_params    jsonb CHECK (jsonb_typeof(import_params) = 'object')
+    import_params    jsonb CHECK (jsonb_typeof(import_params) = 'object'),
+    CONSTRAINT gear_class_safe_name CHECK (safe_name('class', name))
 );
 
 -- A component is the body of a template row (T, O, P_calc, S, P_emit). A body used by
@@ -116,7 +157,8 @@ CREATE TABLE machine (
     spindle_max     numeric NOT NULL CHECK (spindle_max > 0),  -- hob spindle (hobber) or main spindle, r/min
     table_speed_max numeric,                                   -- r/min of C, hobbers only
     module_max      numeric,                                   -- mm, hobbers only
-    CHECK (x_min < x_max AND y_min <= y_max AND z_min < z_max)
+    CHECK (x_min < x_max AND y_min <= y_max AND z_min < z_max),
+    CONSTRAINT machine_safe_name CHECK (safe_name('machine', name))
 );
 
 -- Hob library.
@@ -132,7 +174,8 @@ CREATE TABLE hob (
     material       text NOT NULL DEFAULT 'HSS',
     coating        text NOT NULL DEFAULT '',
     -- A worm-wheel hob is made for its worm; it never cuts cylindrical gears, nor the reverse.
-    purpose        text NOT NULL DEFAULT 'cylindrical' CHECK (purpose IN ('cylindrical', 'worm_wheel'))
+    purpose        text NOT NULL DEFAULT 'cylindrical' CHECK (purpose IN ('cylindrical', 'worm_wheel')),
+    CONSTRAINT hob_safe_id CHECK (safe_name('hob', id))
 );
 
 -- Workpieces (design notes §9 columns).
@@ -172,7 +215,8 @@ CREATE TABLE job (
     created_at    timestamptz NOT NULL DEFAULT now(),
     -- the cutting data chosen for the job and where they came from; confirmed jobs become cases
     cutting       jsonb NOT NULL DEFAULT '{}' CHECK (jsonb_typeof(cutting) = 'object'),
-    confirmed_at  timestamptz
+    confirmed_at  timestamptz,
+    CONSTRAINT job_safe_params CHECK (job_params_safe(params, module_params))
 );
 CREATE INDEX job_gear ON job (gear_id);
 
@@ -195,6 +239,10 @@ CREATE TABLE program (
     CHECK (cardinality(lines) = cardinality(row_ids))
 );
 CREATE INDEX program_job ON program (job_id);
+-- Programs stored before migration 0009 keep their names and lines (NOT VALID: records are
+-- not rewritten); every program stored since has a safe name and lines without line breaks.
+ALTER TABLE program ADD CONSTRAINT program_safe_name CHECK (safe_name('program', name)) NOT VALID;
+ALTER TABLE program ADD CONSTRAINT program_lines_unbroken CHECK (NOT breaks_lines(array_to_string(lines, ''))) NOT VALID;
 
 -- The paper's result table, one row per emitted NC line.
 CREATE VIEW result_line AS

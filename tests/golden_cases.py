@@ -37,11 +37,15 @@ CHOICE_SETS = {   # name -> (process choices, overrides)
 }
 
 # (name, drawing: "emco:<file>" from the real files or a maker of test_dxf_read/test_turning_jobs,
-#  ProfileOptions fields, alternate)
+#  ProfileOptions fields and the program name if given, alternate). The Emco file names make
+#  program names longer than 840D's 24 characters, so those cases name their programs.
 TURNING_CASES = (
-    ("emco-neg", "emco:emco_lathe_testNegDXF_R14.dxf", {"rough_depth": 1.0}, None),
-    ("emco-g02", "emco:emco_lathe_testg02hemisphere_R14.dxf", {"rough_depth": 1.0}, None),
-    ("emco-g03", "emco:emco_lathe_testg03hemisphere_R14.dxf", {"rough_depth": 1.0, "allowance": 0.2}, None),
+    ("emco-neg", "emco:emco_lathe_testNegDXF_R14.dxf", {"rough_depth": 1.0, "program_name": "EMCO_TESTNEGDXF_R14"},
+     None),
+    ("emco-g02", "emco:emco_lathe_testg02hemisphere_R14.dxf",
+     {"rough_depth": 1.0, "program_name": "EMCO_TESTG02HEMISPHERE"}, None),
+    ("emco-g03", "emco:emco_lathe_testg03hemisphere_R14.dxf",
+     {"rough_depth": 1.0, "allowance": 0.2, "program_name": "EMCO_TESTG03HEMISPHERE"}, None),
     ("seed-part", "seed_drawing", {}, None),
     ("shaft-profile", "profile_only_drawing", {"rough_depth": 1.5, "allowance": 0.3}, None),
     ("wheel-alternate", "two_rough_layers", {}, [1, 2]),
@@ -83,9 +87,11 @@ def hobbing_text(conn, gear_id: int, choice_set: str) -> str:
 def turning_text(conn, folder: Path, name: str, lathe: str) -> str:
     """The program of the turning case on the lathe, or the one-line refusal."""
     _, maker, options, alternate = next(case for case in TURNING_CASES if case[0] == name)
+    options = dict(options)
+    program_name = options.pop("program_name", None)
     path = _drawing(folder, name, maker)
     try:
-        report = import_dxf(conn, path, lathe, ProfileOptions(**options), alternate)
+        report = import_dxf(conn, path, lathe, ProfileOptions(**options), alternate, program_name)
         return instantiate_job(conn, report.job_id).text
     except EngineError as error:
         return f"refused: {error}\n"

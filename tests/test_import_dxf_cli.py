@@ -6,7 +6,6 @@ from __future__ import annotations
 import json
 
 import psycopg
-import pytest
 
 from engine.cli.app import main
 from test_dxf_read import DXF, EMCO, REAL, seed_drawing
@@ -36,7 +35,10 @@ def test_every_real_drawing_becomes_a_job_or_is_refused_with_its_reason(run):
             assert refusal in message, (name, message)
             continue
         assert "--rough-depth" in message, (name, message)
-        made = run("import-dxf", DXF / name, "--rough-depth", "1", "--json")
+        unnamed = one_line_refusal(run("import-dxf", DXF / name, "--rough-depth", "1"))
+        assert "not an 840D program name" in unnamed and "--program-name" in unnamed, (name, unnamed)
+        assert job_count(run.url) == before, name   # their file names make no 840D name: one must be given
+        made = run("import-dxf", DXF / name, "--rough-depth", "1", "--program-name", "DRAWN_PART", "--json")
         assert made.exit_code == 0, (name, made.output)
         job_id = json.loads(made.stdout)["job_id"]
         assert job_count(run.url) == before + 1
@@ -56,7 +58,7 @@ def test_import_reports_the_job_operations_and_what_was_assumed(run, tmp_path):
         stored = conn.execute("SELECT gear_id, gear_class, machine, params->>'drawing' FROM job WHERE id = %s",
                               (report["job_id"],)).fetchone()
     assert stored == (None, "turning_iso", "lathe-iso", "part.dxf")
-    emco = run("import-dxf", DXF / EMCO[0], "--speed", "600")
+    emco = run("import-dxf", DXF / EMCO[0], "--speed", "600", "--program-name", "EMCO_NEG")
     assert emco.exit_code == 0 and emco.stdout.startswith("job ")
     assert "no tool-change POINT" in emco.stderr and "mirrored" in emco.stderr
 
@@ -80,7 +82,8 @@ def test_a_feed_edited_in_sql_changes_exactly_that_operation_s_f_words(run, tmp_
 
 
 def test_plot_writes_a_picture_of_the_job(run, tmp_path):
-    job_id = json.loads(run("import-dxf", DXF / EMCO[1], "--rough-depth", "1", "--json").stdout)["job_id"]
+    job_id = json.loads(run("import-dxf", DXF / EMCO[1], "--rough-depth", "1", "--program-name", "EMCO_G02",
+                            "--json").stdout)["job_id"]
     result = run("plot", "--job", job_id, "-o", tmp_path / "job.png")
     assert result.exit_code == 0, result.output
     assert (tmp_path / "job.png").read_bytes().startswith(b"\x89PNG\r\n\x1a\n")

@@ -115,7 +115,7 @@ def blank_of(conn, job_id: int, polylines):
 
 
 def program_and_blank(conn, path: Path, machine: str, options: ProfileOptions):
-    report = import_dxf(conn, path, machine, options, None)
+    report = import_dxf(conn, path, machine, options, None, "DRAWN_PART")   # the Emco file names are too long
     polylines = drawn_polylines(path)
     return instantiate_job(conn, report.job_id).lines, polylines, blank_of(conn, report.job_id, polylines)
 

@@ -28,7 +28,9 @@ def parse_range(text: str, option: str = "--gears") -> tuple[int, int]:
 @click.option("--gears", "gear_range", help="Batch: gear ids FIRST-LAST (all stored, or none).")
 @click.option("--jobs", "job_range", help="Batch: stored job ids FIRST-LAST made again with their stored parameters.")
 @click.option("--all", "all_gears", is_flag=True, help="Batch: every gear.")
-@click.option("--out", type=click.Path(), help="Write the .MPF file here (a directory for batches).")
+@click.option("--out", type=click.Path(), help="Write the .MPF file here (a directory for batches), after the "
+              "programs are committed.")
+@click.option("--force", is_flag=True, help="Replace files that exist in --out (else nothing is stored).")
 @click.option("--machine", help="Machine record (default hobber-840d).")
 @click.option("--cuts", type=click.IntRange(1, 2), help="1 = single cut, 2 = rough then finish (default by module).")
 @click.option("--coolant/--no-coolant", default=True, show_default=True, help="Coolant M8/M9.")
@@ -47,7 +49,7 @@ def parse_range(text: str, option: str = "--gears") -> tuple[int, int]:
               help="Also say why each row emitted its line or not, with the values (on stderr; in --json: explain).")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object (program_id, path, lines, ...).")
 @click.pass_context
-def instantiate(ctx, gear_id, job_id, gear_range, job_range, all_gears, out, machine, cuts, coolant, shift_y,
+def instantiate(ctx, gear_id, job_id, gear_range, job_range, all_gears, out, force, machine, cuts, coolant, shift_y,
                 shift_per_part, feed_mode, tailstock, worm_feed, hob_speed, workers, explain, as_json):
     """Produce the NC program of a gear (or a stored job, or a batch of gears).
 
@@ -71,17 +73,21 @@ def instantiate(ctx, gear_id, job_id, gear_range, job_range, all_gears, out, mac
     choices = Choices(cuts=cuts, coolant=coolant, shift_y=shift_y, shift_per_part=shift_per_part,
                       feed_mode=feed_mode, tailstock=tailstock, worm_feed=worm_feed)
     overrides = {"hob_speed": hob_speed}
+    if force and not out:
+        raise EngineError("--force replaces files in --out: give --out too")
     with connection(ctx) as conn:
         if gear_id is not None:
-            program = instantiate_gear(conn, gear_id, machine=machine, choices=choices, overrides=overrides, out=out)
+            program = instantiate_gear(conn, gear_id, machine=machine, choices=choices, overrides=overrides, out=out,
+                                       force=force)
         elif job_id is not None:
-            program = instantiate_job(conn, job_id, out=out)
+            program = instantiate_job(conn, job_id, out=out, force=force)
         elif job_range:
-            return _report_batch(instantiate_jobs(conn, *parse_range(job_range, "--jobs"), out=out), out, as_json)
+            return _report_batch(instantiate_jobs(conn, *parse_range(job_range, "--jobs"), out=out, force=force),
+                                 out, as_json)
         else:
             first, last = parse_range(gear_range) if gear_range else (None, None)
             programs = instantiate_gears(conn, first, last, machine=machine, choices=choices,
-                                         overrides=overrides, out=out, workers=workers)
+                                         overrides=overrides, out=out, force=force, workers=workers)
             return _report_batch(programs, out, as_json)
     _report_program(program, as_json, explain)
 

@@ -19,6 +19,7 @@ import psycopg
 from psycopg import sql
 
 from ..errors import EngineError
+from ..names import NAME_RULES, is_safe, shown
 from .classify import classify, not_installed_message
 
 NUMBER = re.compile(r"[+-]?(\d+(\.\d*)?|\.\d+)([eE][+-]?\d{1,3})?")
@@ -77,7 +78,12 @@ def parse_hand(cell: str) -> str:
 
 
 def parse_class_name(cell: str) -> str:
-    return cell.lower()
+    """Class names are lower case (`Spur` is spur); one that is not a safe class name
+    (engine/names.py) is refused, as it would be printed in the program's comments."""
+    name = cell.lower()
+    if not is_safe("class", name):
+        raise CellError(f"is not a gear class name: use {NAME_RULES['class'].rule}")
+    return name
 
 
 # --- the columns of design notes §9 ------------------------------------------------------
@@ -214,7 +220,7 @@ def _parse_cell(column: Column, cell: str) -> tuple[Any, str | None]:
     try:
         value = column.parse(cell)
     except CellError as error:
-        return None, f"{column.name} '{cell}' {error}"
+        return None, f"{column.name} {shown(cell)} {error}"
     if column.check is not None and not column.check(value):
         return value, f"{column.name} {cell} {column.rule}"
     return value, None

@@ -15,6 +15,7 @@ import psycopg
 from psycopg import sql
 
 from ..errors import EngineError
+from ..names import NAME_RULES, is_safe, said, shown
 from .gear_import import (POSITIVE, TOOTH_DEPTH, CellError, Column, parse_hand, parse_number,
                           parse_positive_whole, parse_text, read_records)
 from .hob_matching import ACCURACY_CLASSES, PURPOSES, HobChoice, choose_hob
@@ -45,6 +46,13 @@ def parse_accuracy_class(cell: str) -> str:
     return cell.upper()
 
 
+def parse_hob_id(cell: str) -> str:
+    """The id is printed in the program's `; HOB …` comment: a safe hob name (engine/names.py)."""
+    if not is_safe("hob", cell):
+        raise CellError(f"is not a safe hob id: use {NAME_RULES['hob'].rule}")
+    return cell
+
+
 def parse_purpose(cell: str) -> str:
     if cell.lower() not in PURPOSES:
         raise CellError(f"is not one of {', '.join(PURPOSES)}")
@@ -53,7 +61,7 @@ def parse_purpose(cell: str) -> str:
 
 # In the order of the fields of records.Hob (and of seed_templates/hobs.csv).
 HOB_COLUMNS: tuple[Column, ...] = (
-    Column("id", parse_text, required=True),
+    Column("id", parse_hob_id, required=True),
     Column("module", parse_number, required=True, **POSITIVE),
     Column("pressure_angle", parse_number, required=True, check=lambda v: 0 < v < 45, rule="is outside (0, 45)"),
     Column("starts", parse_positive_whole, required=True),
@@ -79,7 +87,7 @@ def _parse_cell(column: Column, cell: str) -> tuple[Any, str | None]:
     try:
         value = column.parse(cell)
     except CellError as error:
-        return None, f"{column.name} '{cell}' {error}"
+        return None, f"{column.name} {shown(cell)} {error}"
     if column.check is not None and not column.check(value):
         return None, f"{column.name} {cell} {column.rule}"
     return value, None
@@ -132,7 +140,7 @@ def add_hob(conn: psycopg.Connection, hob: Hob) -> None:
     """Store one new hob; refuse a bad one (every problem named) or an id already there."""
     values, problems = parse_hob({name: _cell(getattr(hob, name)) for name in COLUMN_NAMES})
     if problems:
-        raise EngineError(f"hob {hob.id or '(no id)'}: {'; '.join(problems)}; nothing stored")
+        raise EngineError(f"hob {said('hob', hob.id) if hob.id else '(no id)'}: {'; '.join(problems)}; nothing stored")
     exists = f"hob {values['id']} already exists; choose another id, or change it with `engine hobs import FILE.csv`"
     if conn.execute("SELECT 1 FROM hob WHERE id = %s", (values["id"],)).fetchone():
         raise EngineError(exists)

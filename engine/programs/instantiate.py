@@ -1,7 +1,8 @@
 """Instantiation: a workpiece (or a stored job) → its NC program, checked, stored, written.
 
 gear → class → model + hob + cutting data → job parameters → decision table → result
-table → machine-limit check → job and program stored in one transaction → .MPF file.
+table → machine-limit check → job and program stored in one transaction, committed → .MPF file
+(engine.programs.outputs: written only after the COMMIT).
 """
 from __future__ import annotations
 
@@ -19,7 +20,7 @@ from ..templates.rows import Template
 from ..templates.store import load_template
 from ..turning.names import TurningModel
 from .nc_check import LimitError, check_program, check_table_speed
-from .outputs import write_program_files
+from .outputs import ProgramFiles, files_after_commit
 from .records import Planned, Program
 from .storage import store_many, store_one
 from .workers import plan_in_workers
@@ -121,28 +122,35 @@ def _check_table_speed(gear: Gear, starts: int, hob_speed: float, machine: Machi
 
 
 def instantiate_gear(conn, gear_id: int, *, machine: str | None = None, choices: Choices = Choices(),
-                     overrides: dict | None = None, out: str | Path | None = None) -> Program:
-    """Compute, check and store the program of one gear; write it to `out` if given."""
-    planner = Planner(conn, machine, choices, overrides)
-    planned = planner.plan(load_gear(conn, gear_id))
-    return store_and_write(conn, [planned], out)[0]
+                     overrides: dict | None = None, out: str | Path | None = None, force: bool = False) -> Program:
+    """Compute, check and store the program of one gear; write it to `out` if given (after the
+    COMMIT; an existing file only with `force`)."""
+    with files_after_commit(conn, out, force) as files:
+        planner = Planner(conn, machine, choices, overrides)
+        planned = planner.plan(load_gear(conn, gear_id))
+        program = store_planned(conn, [planned], files)[0]
+    return program
 
 
 def instantiate_gears(conn, first: int | None = None, last: int | None = None, *,
                       machine: str | None = None, choices: Choices = Choices(), overrides=None,
-                      out: str | Path | None = None, progress=None, workers: int = 1):
-    """All gears with first ≤ id ≤ last: all programs stored, or none (the first failure names its gear).
-    With workers > 1 the gears are planned in that many processes (engine.programs.workers)."""
-    planner = Planner(conn, machine, choices, overrides)
-    gears = load_gears(conn, first, last)
-    if not gears:
-        raise EngineError(f"no gears with ids in {first or 'the start'}…{last or 'the end'}")
-    with no_cycle_collection():
-        if workers > 1 and len(gears) > 1:
-            encoded = plan_in_workers(planner, gears, workers, _plan_in_batch, progress)
-        else:
-            encoded = [_counted(_plan_in_batch(planner, gear), progress).encoded() for gear in gears]
-        return store_many(conn, encoded, out)
+                      out: str | Path | None = None, force: bool = False, progress=None, workers: int = 1):
+    """All gears with first ≤ id ≤ last: all programs stored, or none (the first failure names its gear),
+    and their files written after the COMMIT. With workers > 1 the gears are planned in that many
+    processes (engine.programs.workers)."""
+    with files_after_commit(conn, out, force) as files:
+        planner = Planner(conn, machine, choices, overrides)
+        gears = load_gears(conn, first, last)
+        if not gears:
+            raise EngineError(f"no gears with ids in {first or 'the start'}…{last or 'the end'}")
+        with no_cycle_collection():
+            if workers > 1 and len(gears) > 1:
+                encoded = plan_in_workers(planner, gears, workers, _plan_in_batch, progress)
+            else:
+                encoded = [_counted(_plan_in_batch(planner, gear), progress).encoded() for gear in gears]
+            files.plan([(item.name, item.lines) for item in encoded])
+            batch = store_many(conn, encoded, out)
+    return batch
 
 
 def _plan_in_batch(planner: Planner, gear: Gear) -> Planned:
@@ -160,8 +168,9 @@ def _counted(planned: Planned, progress) -> Planned:
     return planned
 
 
-def store_and_write(conn, planned: list[Planned], out, existing_job: int | None = None) -> list[Program]:
-    with write_program_files(planned, out) as paths:
-        with conn.transaction():
-            programs = [store_one(conn, item, existing_job, paths.get(item.name)) for item in planned]
-    return programs
+def store_planned(conn, planned: list[Planned], files: ProgramFiles,
+                  existing_job: int | None = None) -> list[Program]:
+    """Store the programs (and their jobs, unless `existing_job`); their files are checked now
+    and written by `files` after the caller's COMMIT."""
+    paths = files.plan([(item.name, item.lines) for item in planned])
+    return [store_one(conn, item, existing_job, paths.get(item.name)) for item in planned]

@@ -1,57 +1,240 @@
-"""Writing .MPF files: nothing half-written. Files are written next to their target under a
-temporary name and renamed only when the database transaction has committed."""
+"""Program files in --out: written only after their programs are committed, each whole or absent.
+
+A file in --out is what an operator loads into the machine, so it must be a program the
+database holds, byte for byte. Storing runs in a transaction of its own that commits for
+real (files_after_commit); psycopg makes `conn.transaction()` inside an open transaction a
+mere savepoint, so a connection already inside its caller's transaction is refused when
+files are asked for, rather than writing them before the caller's COMMIT. After the COMMIT
+each file is written unnamed (Linux O_TMPFILE) and given its name in one step (linkat), so
+a kill at any moment leaves each file complete or absent and no temporary file; --force
+removes the old file just before the new one is linked (a kill in between leaves no file).
+Where O_TMPFILE is not supported the file is written under a hidden temporary name first,
+which a kill at that moment can leave behind.
+
+Files are refused before anything is stored: a name that is not an 840D program name, a
+name that would land outside --out, two programs of one run whose names differ only in case
+(the control does not tell case), and an existing file without --force.
+"""
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
-import tempfile
+import secrets
 from pathlib import Path
 
+import psycopg
+from psycopg.pq import TransactionStatus
+
 from ..errors import EngineError
+from ..names import checked
+
+SUFFIX = ".MPF"
+# errno of open(O_TMPFILE) where the kernel or the file system does not support it
+NO_TMPFILE = (errno.EOPNOTSUPP, errno.EISDIR, errno.EINVAL, errno.ENOENT)
+PROC_FD = Path("/proc/self/fd")
 
 
-def target_paths(names: list[str], out: str | Path) -> dict[str, Path]:
-    """One program: `out` is the file (or an existing directory); several: `out` is a directory."""
-    out = Path(out)
-    if len(names) == 1 and not out.is_dir():
-        return {names[0]: out}
-    if out.exists() and not out.is_dir():
-        raise EngineError(f"--out {out} is a file; give a directory for a batch of programs")
-    twice = sorted({name for name in names if names.count(name) > 1}) if len(set(names)) < len(names) else []
-    if twice:   # one file would silently replace the other (jobs of one gear made again, say)
-        raise EngineError(f"{len(names) - len(set(names)) + 1} programs of this batch are named {twice[0]}, so "
-                          f"their files would replace each other in {out}; make them without --out, or one at a time")
-    return {name: out / f"{name}.MPF" for name in names}
+class ProgramFiles:
+    """The files of one run: checked when planned (before storing), written after the COMMIT."""
+
+    def __init__(self, out, force: bool = False):
+        self.out = Path(out) if out is not None else None
+        self.force = force
+        self.texts: dict[Path, bytes] = {}
+
+    def plan(self, programs: list[tuple[str, list[str]]]) -> dict[str, str]:
+        """{program name: path} for (name, lines) of each program; EngineError if any file cannot be written."""
+        if self.out is None or not programs:
+            return {}
+        paths = self._targets([name for name, _ in programs])
+        self._refuse_existing(list(paths.values()))
+        _refuse_unwritable(paths[programs[0][0]].parent)
+        self.texts = {paths[name]: _ascii(name, lines) for name, lines in programs}
+        return {name: str(path) for name, path in paths.items()}
+
+    def _targets(self, names: list[str]) -> dict[str, Path]:
+        """One program: --out is the file (unless it is a folder); several: --out is their folder."""
+        if len(names) == 1 and not self.out.is_dir():
+            return {names[0]: self.out}
+        if self.out.exists() and not self.out.is_dir():
+            raise EngineError(f"--out {self.out} is a file; give a directory for a batch of programs")
+        _refuse_same_program_twice(names, self.out)
+        return {name: _inside(self.out, name) for name in names}
+
+    def _refuse_existing(self, targets: list[Path]) -> None:
+        """An existing file is replaced only with --force; a file naming the same program in
+        other case (the control does not tell case) is never replaced, nor kept beside it."""
+        in_folder = _entries_by_program(targets[0].parent)
+        for target in targets:
+            other = next((entry for entry in in_folder.get(target.name.upper(), ()) if entry != target.name), None)
+            if other is not None:
+                raise EngineError(f"{target.parent / other} is there already, and the control reads it as the same "
+                                  f"program as {target.name} (it does not tell upper from lower case): remove or "
+                                  "rename it; nothing stored")
+        existing = [target for target in targets if target.name in in_folder.get(target.name.upper(), ())]
+        if existing and not self.force:
+            more = f" (and {len(existing) - 1} more of this run's files)" if len(existing) > 1 else ""
+            raise EngineError(f"{existing[0]} exists{more}; nothing stored: give --force to replace it, "
+                              "or another --out")
+
+    def write(self) -> None:
+        """After the COMMIT: every planned file, or (on an error) none of this run's files."""
+        written: list[Path] = []
+        try:
+            for target, data in self.texts.items():
+                target.parent.mkdir(parents=True, exist_ok=True)
+                _place(target, data, self.force)
+                written.append(target)
+        except OSError as error:
+            for path in written:
+                with contextlib.suppress(OSError):
+                    os.unlink(path)
+            raise EngineError(f"the program(s) are stored, but writing {error.filename or target} failed: "
+                              f"{error.strerror}; no file of this run was kept") from None
 
 
 @contextlib.contextmanager
-def write_program_files(planned, out):
-    """Yield {program name: final path}; files appear only if the block succeeds."""
-    if out is None:
-        yield {}
-        return
-    paths = target_paths([item.name for item in planned], out)
-    temporary = {}
-    try:
-        for item in planned:
-            temporary[item.name] = _write_temporary(paths[item.name], item.lines)
-        yield {name: str(path) for name, path in paths.items()}
-        for name, temp_path in temporary.items():
-            os.replace(temp_path, paths[name])
-    finally:
-        for temp_path in temporary.values():
-            with contextlib.suppress(FileNotFoundError):
-                os.unlink(temp_path)
+def files_after_commit(conn, out, force: bool = False):
+    """Yield ProgramFiles for the block, which runs in a transaction that commits for real when
+    the block ends; only then are the planned files written. Without --out (out None) the block
+    may run inside the caller's transaction (a savepoint), as nothing is written."""
+    files = ProgramFiles(out, force)
+    if out is not None and conn.info.transaction_status != TransactionStatus.IDLE:
+        raise EngineError("program files are written only after their programs are committed, but this "
+                          "connection is inside a transaction its caller commits: commit first, or store without --out")
+    with _committed(conn):
+        yield files
+    files.write()
 
 
-def _write_temporary(path: Path, lines: list[str]) -> str:
+@contextlib.contextmanager
+def _committed(conn):
+    """conn.transaction(), with a failed COMMIT said in one line (no file is written then)."""
+    transaction = conn.transaction()
+    transaction.__enter__()
     try:
-        path.parent.mkdir(parents=True, exist_ok=True)
-        handle, temp_path = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
-        with os.fdopen(handle, "w", encoding="ascii", newline="\n") as file:
-            file.write("\n".join(lines) + "\n")
-    except OSError as error:
-        raise EngineError(f"cannot write {path}: {error.strerror}") from None
+        yield
+    except BaseException as error:
+        transaction.__exit__(type(error), error, error.__traceback__)
+        raise
+    try:
+        transaction.__exit__(None, None, None)
+    except psycopg.Error as error:
+        raise commit_failure(error) from error
+
+
+def _inside(folder: Path, name: str) -> Path:
+    """The file of program `name` in `folder`; refused unless it is an 840D name that stays there."""
+    checked("program", name, "program name", "set job.params.program_name in SQL")
+    target = folder / f"{name}{SUFFIX}"
+    if target.resolve().parent != folder.resolve():
+        raise EngineError(f"program name {name!r} would write {target.resolve()}, outside --out {folder}")
+    return target
+
+
+def _refuse_same_program_twice(names: list[str], out: Path) -> None:
+    """The control does not tell case: GEAR42 and gear42 are one program, so one file."""
+    folded = [name.upper() for name in names]
+    twice = sorted({name for name, key in zip(names, folded) if folded.count(key) > 1}) \
+        if len(set(folded)) < len(folded) else []
+    if twice:   # one file would silently replace the other (jobs of one gear made again, say)
+        raise EngineError(f"{len(folded) - len(set(folded)) + 1} programs of this batch are named {twice[0]}, so "
+                          f"their files would replace each other in {out}; make them without --out, or one at a time")
+
+
+def _entries_by_program(folder: Path) -> dict[str, list[str]]:
+    """The names in the folder (none if it does not exist yet), by the program they name: upper case."""
+    try:
+        entries = os.listdir(folder)
+    except (FileNotFoundError, NotADirectoryError):
+        return {}
+    by_program: dict[str, list[str]] = {}
+    for entry in entries:
+        by_program.setdefault(entry.upper(), []).append(entry)
+    return by_program
+
+
+def _refuse_unwritable(folder: Path) -> None:
+    """Checked before storing: the folder (or the nearest folder above it that exists) takes files."""
+    existing = next(path for path in (folder, *folder.parents) if path.exists())
+    if not existing.is_dir() or not os.access(existing, os.W_OK | os.X_OK):
+        raise EngineError(f"cannot write files in {folder}: {existing} is not a folder this user may write; "
+                          "nothing stored")
+
+
+def _ascii(name: str, lines: list[str]) -> bytes:
+    try:
+        return ("\n".join(lines) + "\n").encode("ascii")
     except UnicodeEncodeError:
-        raise EngineError(f"program for {path.name} has non-ASCII characters; the control reads ASCII") from None
-    return temp_path
+        raise EngineError(f"program {name} has non-ASCII characters; the control reads ASCII; nothing stored") from None
+
+
+def _place(target: Path, data: bytes, replace: bool) -> None:
+    """Write `data` unnamed, then name it `target` in one step (no half-written or temporary file)."""
+    folder = os.open(target.parent, os.O_RDONLY | os.O_DIRECTORY | os.O_CLOEXEC)
+    try:
+        unnamed = _unnamed_file(folder)
+        if unnamed is None:
+            return _place_through_temporary(target, data, replace)
+        try:
+            _write_all(unnamed, data)
+            _link(unnamed, folder, target.name, replace)
+        finally:
+            os.close(unnamed)
+    finally:
+        os.close(folder)
+
+
+def _unnamed_file(folder: int) -> int | None:
+    """A new file without a name in the folder (mode 0666 less the umask), or None where the
+    kernel, the file system or a missing /proc cannot give one."""
+    if not hasattr(os, "O_TMPFILE") or not PROC_FD.is_dir():
+        return None
+    try:
+        return os.open(".", os.O_TMPFILE | os.O_WRONLY | os.O_CLOEXEC, 0o666, dir_fd=folder)
+    except OSError as error:
+        if error.errno in NO_TMPFILE:
+            return None
+        raise
+
+
+def _link(unnamed: int, folder: int, name: str, replace: bool) -> None:
+    """Give the unnamed file its name; with `replace`, the old file goes just before."""
+    if replace:
+        with contextlib.suppress(FileNotFoundError):
+            os.unlink(name, dir_fd=folder)
+    # linkat(…, AT_SYMLINK_FOLLOW) through /proc: os.link uses linkat only with a dir_fd; link(2) does not follow
+    os.link(f"{PROC_FD}/{unnamed}", name, dst_dir_fd=folder, follow_symlinks=True)
+
+
+def _place_through_temporary(target: Path, data: bytes, replace: bool) -> None:
+    """Without O_TMPFILE: a hidden temporary file, renamed (--force) or linked (never over a file)."""
+    temporary = target.with_name(f".{target.name}.{secrets.token_hex(6)}.tmp")
+    descriptor = os.open(temporary, os.O_CREAT | os.O_EXCL | os.O_WRONLY | os.O_CLOEXEC, 0o666)
+    try:
+        try:
+            _write_all(descriptor, data)
+        finally:
+            os.close(descriptor)
+        if replace:
+            os.replace(temporary, target)
+        else:
+            os.link(temporary, target)
+    finally:
+        with contextlib.suppress(FileNotFoundError):
+            os.unlink(temporary)
+
+
+def _write_all(descriptor: int, data: bytes) -> None:
+    view = memoryview(data)
+    while view:
+        view = view[os.write(descriptor, view):]
+
+
+def commit_failure(error: psycopg.Error) -> EngineError:
+    first_line = (str(error).strip().splitlines() or [type(error).__name__])[0]
+    if isinstance(error, psycopg.OperationalError):
+        return EngineError(f"the connection was lost while committing ({first_line}); no file written: "
+                           "whether the program(s) were stored, `SELECT max(id) FROM program` tells")
+    return EngineError(f"the database refused the commit ({first_line}); nothing stored, no file written")

@@ -11,9 +11,10 @@ from ..gears.records import Machine, load_machine
 from ..memory import no_cycle_collection
 from ..templates.rows import Template
 from ..templates.store import load_template
-from .instantiate import store_and_write, run_template
+from .instantiate import run_template, store_planned
+from .outputs import files_after_commit
 from .records import Planned, Program
-from .storage import Batch, store_programs
+from .storage import Batch, refuse_unsafe, store_programs
 
 JOB_COLUMNS = "id, gear_id, gear_class, machine, hob_id, params, module_params"
 
@@ -48,31 +49,37 @@ class Remaker:
         return self._templates[gear_class]
 
 
-def instantiate_job(conn, job_id: int, out: str | Path | None = None) -> Program:
+def instantiate_job(conn, job_id: int, out: str | Path | None = None, force: bool = False) -> Program:
     """Instantiate a stored job again with its stored (possibly edited) parameters."""
-    job = conn.execute(f"SELECT {JOB_COLUMNS} FROM job WHERE id = %s", (job_id,)).fetchone()
-    if job is None:
-        raise EngineError(f"job {job_id} does not exist; see `SELECT id, gear_id FROM job`")
-    return store_and_write(conn, [Remaker(conn).remade(job)], out, existing_job=job_id)[0]
+    with files_after_commit(conn, out, force) as files:
+        job = conn.execute(f"SELECT {JOB_COLUMNS} FROM job WHERE id = %s", (job_id,)).fetchone()
+        if job is None:
+            raise EngineError(f"job {job_id} does not exist; see `SELECT id, gear_id FROM job`")
+        program = store_planned(conn, [Remaker(conn).remade(job)], files, existing_job=job_id)[0]
+    return program
 
 
 def instantiate_jobs(conn, first: int | None = None, last: int | None = None, *,
-                     out: str | Path | None = None, progress=None) -> Batch:
+                     out: str | Path | None = None, force: bool = False, progress=None) -> Batch:
     """Every stored job with first ≤ id ≤ last made again: all programs stored, or none (the first
-    failure names its job)."""
-    jobs = conn.execute(f"SELECT {JOB_COLUMNS} FROM job WHERE id BETWEEN %s AND %s ORDER BY id",
-                        (first if first is not None else 0, last if last is not None else 2**62)).fetchall()
-    if not jobs:
-        raise EngineError(f"no jobs with ids in {first or 'the start'}…{last or 'the end'}")
-    remaker = Remaker(conn)
-    with no_cycle_collection():
-        encoded = [_remade_in_batch(remaker, job, progress).encoded(with_job=False) for job in jobs]
-        return store_programs(conn, encoded, [job[0] for job in jobs], out)
+    failure names its job), and their files written after the COMMIT."""
+    with files_after_commit(conn, out, force) as files:
+        jobs = conn.execute(f"SELECT {JOB_COLUMNS} FROM job WHERE id BETWEEN %s AND %s ORDER BY id",
+                            (first if first is not None else 0, last if last is not None else 2**62)).fetchall()
+        if not jobs:
+            raise EngineError(f"no jobs with ids in {first or 'the start'}…{last or 'the end'}")
+        remaker = Remaker(conn)
+        with no_cycle_collection():
+            encoded = [_remade_in_batch(remaker, job, progress).encoded(with_job=False) for job in jobs]
+            files.plan([(item.name, item.lines) for item in encoded])
+            batch = store_programs(conn, encoded, [job[0] for job in jobs], out)
+    return batch
 
 
 def _remade_in_batch(remaker: Remaker, job: tuple, progress) -> Planned:
     try:
         planned = remaker.remade(job)
+        refuse_unsafe(planned.name, planned.lines)
     except EngineError as error:
         raise EngineError(f"job {job[0]}: {error} (batch stopped, nothing stored)") from None
     if progress:

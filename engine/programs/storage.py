@@ -1,11 +1,18 @@
-"""Storing jobs and programs: one at a time, or a batch through COPY."""
+"""Storing jobs and programs: one at a time, or a batch through COPY. Files are not written
+here: engine.programs.outputs writes them after the COMMIT of the caller's files_after_commit.
+
+A program is stored only with a safe name (engine/names.py) and lines that are one NC line
+each: a line break inside a line (from a job parameter or a template row) would be a block
+that no check read. The database refuses both too (migration 0009); here they are refused
+with a message that names the program."""
 from __future__ import annotations
 
 from dataclasses import dataclass
 
 from psycopg.types.json import Jsonb
 
-from .outputs import write_program_files
+from ..errors import EngineError
+from ..names import checked, line_breaking, shown
 from .records import Encoded, Planned, Program
 
 INSERT_JOB = """
@@ -21,6 +28,7 @@ PROGRAM_TYPES = ("int8", "int8", "text", "int4", "text", "text", "text[]", "int4
 
 
 def store_one(conn, planned: Planned, existing_job: int | None, path: str | None) -> Program:
+    refuse_unsafe(planned.name, planned.lines)
     job_id = existing_job
     if job_id is None:
         job_id = conn.execute(INSERT_JOB, (planned.gear_id, planned.gear_class, planned.machine, planned.hob_id,
@@ -31,8 +39,11 @@ def store_one(conn, planned: Planned, existing_job: int | None, path: str | None
 
 
 def store_many(conn, encoded: list[Encoded], out=None) -> "Batch":
-    """All jobs and programs in one transaction, through COPY (the batch path)."""
-    with write_program_files(encoded, out), conn.transaction():
+    """All jobs and programs in one transaction, through COPY (the batch path); `out` is where
+    the caller writes their files."""
+    for item in encoded:
+        refuse_unsafe(item.name, item.lines)
+    with conn.transaction():
         job_ids = _next_ids(conn, "job_id_seq", len(encoded))
         program_ids = _next_ids(conn, "program_id_seq", len(encoded))
         with conn.cursor().copy(COPY_JOB) as copy:
@@ -46,10 +57,25 @@ def store_many(conn, encoded: list[Encoded], out=None) -> "Batch":
 
 def store_programs(conn, encoded: list[Encoded], job_ids: list[int], out=None) -> "Batch":
     """Programs of stored jobs (made again), in one transaction through COPY."""
-    with write_program_files(encoded, out), conn.transaction():
+    for item in encoded:
+        refuse_unsafe(item.name, item.lines)
+    with conn.transaction():
         program_ids = _next_ids(conn, "program_id_seq", len(encoded))
         _copy_programs(conn, program_ids, job_ids, encoded)
     return Batch(len(encoded), sum(len(item.lines) for item in encoded), min(program_ids), max(program_ids), out)
+
+
+def refuse_unsafe(name: str, lines: list[str]) -> None:
+    """EngineError unless the program's name is an 840D program name and no line breaks."""
+    checked("program", name, "program name", "set job.params.program_name in SQL; nothing stored")
+    if line_breaking("".join(lines)) is None:
+        return
+    for number, line in enumerate(lines, 1):
+        found = line_breaking(line)
+        if found is not None:
+            raise EngineError(f"program {name} line {number} {shown(line)} holds {shown(found)}, which would start "
+                              "another NC block: nothing stored; the job parameter or template row that made it "
+                              "must not hold line breaks")
 
 
 def _copy_programs(conn, program_ids: list[int], job_ids: list[int], encoded: list[Encoded]) -> None:

@@ -7,6 +7,7 @@ class's assembly (row id, module number N, component). See design notes §4, §5
 from __future__ import annotations
 
 from ..errors import EngineError
+from ..names import checked
 from .checks import check_rows
 from .rows import Template, TemplateRow
 from .translations import load_translations, store_translations
@@ -48,7 +49,9 @@ def list_classes(conn) -> list[tuple]:
 
 
 def ensure_class(conn, name: str, parent: str | None = None, description: str = "") -> bool:
-    """Create the class if it is new; return True if created."""
+    """Create the class if it is new; return True if created. A class name is printed in its
+    programs' comments: one that is not a safe class name (engine/names.py) is refused."""
+    checked("class", name, "class name")
     if parent is not None and not _class_exists(conn, parent):
         raise EngineError(f"parent class {parent!r} does not exist; create it first")
     created = conn.execute(

@@ -15,6 +15,7 @@ from psycopg.types.json import Jsonb
 from importers.dxf_drawing import read_drawing
 
 from ..memory import no_cycle_collection
+from ..names import checked
 from .job_params import ProfileOptions, turning_job
 from .model import ISO_PROGRAM_NUMBERS, job_passes, key, present_operations
 from .planning import lathe, plan_turning_job, turning_class
@@ -37,20 +38,25 @@ class ImportReport:
 
 
 def import_dxf(conn, path: str | Path, machine_name: str | None = None,
-               options: ProfileOptions = ProfileOptions(), alternate: list[int] | None = None) -> ImportReport:
-    """Read the drawing and store its job; EngineError (nothing stored) if it cannot become one."""
+               options: ProfileOptions = ProfileOptions(), alternate: list[int] | None = None,
+               program_name: str | None = None) -> ImportReport:
+    """Read the drawing and store its job; EngineError (nothing stored) if it cannot become one.
+    The program is named `program_name`, else after the drawing's file name (job_params.drawing_names)."""
+    checked("drawing", Path(path).name, "drawing file name", "rename the file")   # said before the drawing's own problems
+    if program_name is not None:
+        checked("program", program_name, "--program-name")
     machine = lathe(conn, machine_name)
     gear_class = turning_class(machine)
     with no_cycle_collection():   # a large drawing: the profile, its parameters and passes
-        return _import(conn, path, machine, gear_class, options, alternate)
+        return _import(conn, path, machine, gear_class, options, alternate, program_name)
 
 
-def _import(conn, path, machine, gear_class: str, options: ProfileOptions, alternate) -> ImportReport:
+def _import(conn, path, machine, gear_class: str, options: ProfileOptions, alternate, program_name) -> ImportReport:
     drawing = read_drawing(path)
     with conn.transaction():
         job_id = conn.execute("SELECT nextval('job_id_seq')").fetchone()[0]
         program_number = (job_id - 1) % ISO_PROGRAM_NUMBERS + 1    # the job id, wrapped into O0001 … O9999
-        job = turning_job(drawing, machine.name, gear_class, program_number, options, alternate)
+        job = turning_job(drawing, machine.name, gear_class, program_number, options, alternate, program_name)
         passes = job_passes(job.params, job.module_params)
         planned = plan_turning_job(conn, gear_class, machine, job.params, job.module_params, passes)
         conn.execute(INSERT_TURNING_JOB, (job_id, gear_class, machine.name, Jsonb(job.params),

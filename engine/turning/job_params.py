@@ -5,13 +5,14 @@ from the defaults (engine.turning.defaults) and said in `notes`."""
 from __future__ import annotations
 
 import math
-import re
 from dataclasses import dataclass, field
+from pathlib import Path
 
 from importers.dxf_drawing import Drawing, Operation
 from importers.dxf_profile import merged_bounds
 
 from ..errors import EngineError
+from ..names import NAME_RULES, checked, is_safe, shown
 from .defaults import (CLEARANCE, DEFAULT_FEED, DEFAULT_INFEED_ANGLE, DEFAULT_SPEED, DEFAULT_THREAD_DEPTH_PER_PASS,
                        FEED_PER_REV_NOTE, PROFILE_DEFAULTS, STOCK_MARGIN, TOOL_CHANGE_DISTANCE)
 from .model import key
@@ -50,7 +51,8 @@ class TurningJob:
 
 
 def turning_job(drawing: Drawing, machine: str, gear_class: str, program_number: int,
-                options: ProfileOptions = ProfileOptions(), alternate: list[int] | None = None) -> TurningJob:
+                options: ProfileOptions = ProfileOptions(), alternate: list[int] | None = None,
+                program_name: str | None = None) -> TurningJob:
     job = TurningJob({}, {})
     if drawing.scale_to_mm != 1.0:
         job.notes.append(f"{drawing.units} drawing: lengths scaled ×{drawing.scale_to_mm:g} to mm; the @-codes "
@@ -70,7 +72,8 @@ def turning_job(drawing: Drawing, machine: str, gear_class: str, program_number:
     else:
         add_profile_operations(job, options)
         stock_diameter = blank_diameter(drawing, options)
-    job.params = job_params(drawing, machine, gear_class, program_number, stock_diameter, alternate, job.notes)
+    names = drawing_names(drawing.source.name, program_name)
+    job.params = job_params(drawing, names, machine, gear_class, program_number, stock_diameter, alternate, job.notes)
     return job
 
 
@@ -78,14 +81,13 @@ def _layers(drawing: Drawing) -> str:
     return ", ".join(op.layer for op in drawing.operations)
 
 
-def job_params(drawing: Drawing, machine: str, gear_class: str, program_number: int,
+def job_params(drawing: Drawing, names: tuple[str, str], machine: str, gear_class: str, program_number: int,
                stock_diameter: float | None, alternate, notes: list[str]) -> dict:
     z_min, z_max, _, _ = drawing.profile.bounds
     tool_change_z, tool_change_x = tool_change(drawing, stock_diameter, notes)
     return {
         **SLOT_DEFAULTS,
-        "program_name": program_name(drawing.source.stem), "program_number": program_number,
-        "drawing": re.sub(r"[();]", "_", drawing.source.name), "units": drawing.units,
+        "program_name": names[1], "program_number": program_number, "drawing": names[0], "units": drawing.units,
         "machine": machine, "gear_class": gear_class,
         "profile": path_param(drawing.profile.segments), "closed_by_axis": drawing.profile.closed_by_axis,
         "stock_diameter": stock_diameter, "stock_z_front": round(z_max, 6), "stock_z_back": round(z_min, 6),
@@ -94,10 +96,23 @@ def job_params(drawing: Drawing, machine: str, gear_class: str, program_number: 
     }
 
 
-def program_name(stem: str) -> str:
-    """A program name both controls accept: letters, digits and _, starting with a letter."""
-    name = re.sub(r"[^A-Z0-9_]", "_", stem.upper()).strip("_") or "PART"
-    return name if name[0].isalpha() else f"P{name}"
+# A program name made from a drawing's file name: upper case (the NC does not tell case), with
+# the separators file names use where 840D names have _; nothing cut, nothing else replaced.
+FILE_NAME_SEPARATORS = str.maketrans({"-": "_", ".": "_", " ": "_"})
+
+
+def drawing_names(file_name: str, program_name: str | None = None) -> tuple[str, str]:
+    """(drawing, program name) of the job: the file name as it is (printed in the program's
+    comments) and the program name given, else made from the file name. Either refused
+    (EngineError) when it does not fit engine/names.py: never cut or altered to fit."""
+    drawing = checked("drawing", file_name, "drawing file name", "rename the file")
+    if program_name is not None:
+        return drawing, checked("program", program_name, "--program-name")
+    made = Path(file_name).stem.upper().translate(FILE_NAME_SEPARATORS)
+    if not is_safe("program", made):
+        raise EngineError(f"drawing {file_name}: the program name {shown(made)} made from its file name is not "
+                          f"an 840D program name ({NAME_RULES['program'].rule}); give one with --program-name NAME")
+    return drawing, made
 
 
 def tool_change(drawing: Drawing, stock_diameter: float | None, notes: list[str]) -> tuple[float, float]:

@@ -10,9 +10,8 @@ from the stored parameters and handed to the template as `moves`.
 """
 from __future__ import annotations
 
-import re
-
 from ..errors import EngineError
+from ..names import NAME_RULES, is_safe, shown
 from . import toolpaths
 from .arc_split import with_short_arcs
 from .moves import Move, Pass
@@ -20,8 +19,6 @@ from .names import MAX_OPERATIONS, MAX_TOOL
 from .operations import KINDS, JobGeometry, job_geometry, operation_passes
 from .params import FIX, bool_param, integer_param, number_param
 
-# Letters, digits and _ from a letter: safe inside an ISO comment "( )" and as an 840D name %_N_…_MPF.
-PROGRAM_NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]*")
 ISO_PROGRAM_NUMBERS = 9999     # O0001 … O9999
 MAX_INFEED_ANGLE = 60.0        # degrees: half a 60° thread's flank angle is 30; beyond 60 the tool rubs
 # What each alternated operation must share with its partner: the passes of both run with A's rows.
@@ -107,10 +104,9 @@ def check_job_params(params) -> None:
         number_param(params, "stock_z_back", "params")
     bool_param(params, "closed_by_axis", "params")
     integer_param(params, "program_number", "params", 1, ISO_PROGRAM_NUMBERS)
-    name = params.get("program_name")
-    if not (isinstance(name, str) and PROGRAM_NAME.fullmatch(name)):
-        raise EngineError(f"params.program_name = {name!r} must be letters, digits and _ from a letter "
-                          f"(an ISO comment and an 840D program name); {FIX}")
+    for name, kind in (("program_name", "program"), ("drawing", "drawing")):   # printed in the program
+        if not is_safe(kind, params.get(name)):
+            raise EngineError(f"params.{name} = {shown(params.get(name))} must be {NAME_RULES[kind].rule}; {FIX}")
 
 
 def check_operation_params(module_params: dict, n: int) -> None:
