@@ -1,7 +1,8 @@
 """Instantiation: a workpiece (or a stored job) → its NC program, checked, stored, written.
 
 gear → class → model + hob + cutting data → job parameters → decision table → result
-table → machine-limit check → job and program stored in one transaction → .MPF file.
+table → verifier (every line read in the machine's dialect, checked against the machine) →
+job and program stored in one transaction → .MPF file.
 """
 from __future__ import annotations
 
@@ -18,7 +19,7 @@ from ..templates.decision_table import Result, compiled_template
 from ..templates.rows import Template
 from ..templates.store import load_template
 from ..turning.names import TurningModel
-from .nc_check import LimitError, check_program, check_table_speed
+from .verifier import LimitError, check_table_speed, verify_program
 from .outputs import write_program_files
 from .records import Planned, Program
 from .storage import store_many, store_one
@@ -99,11 +100,9 @@ class Planner:
 
 
 def run_template(template: Template, params: dict, module_params: dict, machine: Machine) -> Result:
-    """Evaluate the decision table and check the program against the machine."""
-    compiled = compiled_template(template)
-    result = compiled.run(params, module_params)
-    check_program(result.lines, machine, str(params.get("program_name", "program")), result.row_ids,
-                  compiled.constant_words)
+    """Evaluate the decision table and verify the program for the machine (engine.programs.verifier)."""
+    result = compiled_template(template).run(params, module_params)
+    verify_program(result.lines, machine, str(params.get("program_name", "program")))
     return result
 
 

@@ -1,0 +1,153 @@
+"""The verifier: every emitted line of a program read with the grammar of the machine's dialect
+(machine.kind and machine.dialect) and followed in order against the machine. It fails closed:
+a line it cannot read as plain blocks of that dialect is refused like a line that exceeds a
+limit, with the program, the line number, the block and the reason.
+
+Followed in order: headers only where they belong; motion only after what the dialect needs
+first (G25, G26 and WALIMON on a hobber, DIAMON on an 840D lathe); every X/Y/Z within the
+travel and, on a hobber, within the working area G25/G26, whose limits lie within the travel
+themselves; S at most the spindle's maximum and, with the EGON ratio, the table's; a lathe arc's
+extremes within the travel; the hob-shift clamp as engine.programs.verifier.shift_clamp says."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from ...gears.records import Machine
+from .arcs import arc_box
+from .grammar import Dialect, dialect_of
+from .limits import check_spindle, check_table, check_travel
+from .lines import read_line
+from .refusals import LimitError, Refused, line_refused
+from .shift_clamp import ShiftClamp
+
+
+def verify_program(lines: list[str], machine: Machine, program_name: str = "program") -> None:
+    """Raises LimitError for the first line refused; returns only for a program read whole."""
+    try:
+        dialect = dialect_of(machine.kind, machine.dialect)
+    except Refused as refusal:
+        raise LimitError(f"machine {machine.name}: {refusal}; nothing stored") from None
+    walk = Walk(dialect, machine, len(lines))
+    number = 0
+    try:
+        for number, line in enumerate(lines, start=1):
+            walk.take(number, read_line(dialect, line))
+        walk.finish()
+    except Refused as refusal:
+        raise line_refused(program_name, number, lines[number - 1] if number else "", str(refusal)) from None
+
+
+@dataclass
+class Walk:
+    """What the lines so far have set: facts (G25, G26, WALIMON, DIAMON), the working area, the
+    lathe's position, the spindle speed and the table's coupling ratio, the hob-shift clamp."""
+    dialect: Dialect
+    machine: Machine
+    count: int
+    facts: set = field(default_factory=set)
+    area: dict = field(default_factory=lambda: {"lower": {}, "upper": {}})
+    position: dict = field(default_factory=dict)
+    speed: float | None = None
+    coupled_axes: tuple | None = None
+    ratio: float | None = None
+    clamp: ShiftClamp = field(default_factory=ShiftClamp)
+
+    def take(self, number: int, line) -> None:
+        if line.kind != "shift":
+            self.clamp.interrupted()
+        TAKERS[line.kind](self, number, line)
+
+    def finish(self) -> None:
+        self.clamp.interrupted()
+
+    def _header(self, number: int, line) -> None:
+        places = {"first": number == 1, "second": number == 2, "last": number == self.count}
+        if not any(places[place] for place in line.places):
+            raise Refused(f"the {line.what} belongs only in the {' or '.join(sorted(line.places))} line")
+
+    def _comment(self, number: int, line) -> None:
+        return None
+
+    def _block(self, number: int, block) -> None:
+        if block.area:
+            self._set_area(block)
+        elif block.moves:
+            self._check_motion(block.positions)
+            self._check_arc(block)
+            self.position.update(block.positions)
+        if "S" in block.values:
+            self._set_speed(block.values["S"])
+        self.facts.update(f"G{code}" for code in block.g_codes)
+        self.facts.update(block.keywords)
+
+    def _set_area(self, block) -> None:
+        for axis, value in block.positions.items():
+            check_travel(axis, value, self.machine, "working-area limit ")
+        self.area[block.area] = dict(block.positions)
+
+    def _check_motion(self, positions: dict) -> None:
+        if not self.dialect.motion_needs <= self.facts:
+            raise Refused(self.dialect.motion_needs_reason)
+        for axis, value in positions.items():
+            check_travel(axis, value, self.machine)
+            if self.dialect.working_area:
+                self._check_area(axis, value)
+
+    def _check_area(self, axis: str, value: float) -> None:
+        low, high = self.area["lower"].get(axis), self.area["upper"].get(axis)
+        if low is None or high is None:
+            raise Refused(f"{axis} has no working-area limit: G25 and G26 give X, Y and Z")
+        if not low <= value <= high:
+            raise Refused(f"{axis}{value:g} lies outside the working area G25/G26 {axis} {low:g}…{high:g}")
+
+    def _check_arc(self, block) -> None:
+        if block.motion not in (2, 3):
+            return
+        if not {"X", "Z"} <= self.position.keys():
+            raise Refused("an arc from an unknown start point: program X and Z before it")
+        end = {**self.position, **block.positions}
+        box = arc_box(self.position["X"], self.position["Z"], end["X"], end["Z"],
+                      block.values[self.dialect.arc_radius], block.motion == 3)
+        for axis, extremes in box.items():
+            for extreme in extremes:
+                check_travel(axis, extreme, self.machine, "the arc reaches ")
+
+    def _set_speed(self, speed: float) -> None:
+        check_spindle(speed, self.machine)
+        self.speed = speed
+        self._check_table()
+
+    def _check_table(self) -> None:
+        if self.speed is not None and self.ratio is not None:
+            check_table(self.speed, self.ratio, self.machine)
+
+    def _statement(self, number: int, statement) -> None:
+        STATEMENT_TAKERS[statement.name](self, statement)
+
+    def _define_coupling(self, statement) -> None:
+        self.coupled_axes = statement.leading
+
+    def _couple(self, statement) -> None:
+        if statement.leading != self.coupled_axes:
+            raise Refused(f"EGON couples {','.join(statement.leading)} but EGDEF defined "
+                          f"{','.join(self.coupled_axes or ()) or 'nothing'}")
+        self.ratio = statement.ratio
+        self._check_table()
+
+    def _uncouple(self, statement) -> None:
+        self.ratio = None
+
+    def _delete_coupling(self, statement) -> None:
+        self.coupled_axes = self.ratio = None
+
+    def _shift(self, number: int, line) -> None:
+        ends = self.clamp.take(line)
+        if ends is not None:
+            for value in ends:
+                self._check_motion({"Y": value})
+
+
+TAKERS = {"header": Walk._header, "comment": Walk._comment, "block": Walk._block,
+          "statement": Walk._statement, "shift": Walk._shift}
+STATEMENT_TAKERS = {"EGDEF": Walk._define_coupling, "EGON": Walk._couple, "EGOFS": Walk._uncouple,
+                    "EGDEL": Walk._delete_coupling}
