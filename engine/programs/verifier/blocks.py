@@ -8,11 +8,10 @@ from __future__ import annotations
 import re
 from dataclasses import dataclass
 
-from .grammar import (ANGLE, AXES, BLOCK_SHAPES, CODE, MOTION, POSITION, WORD_NEEDS_CODE, WORKING_AREA,
-                      Dialect)
+from .grammar import ANGLE, AXES, BLOCK_SHAPES, CODE, MOTION, WORD_NEEDS_CODE, WORKING_AREA, Dialect
 from .numbers import why_not_plain
 from .refusals import Refused
-from .words import read_value
+from .words import READERS
 
 TOKEN = re.compile(r"([A-Z]+)(=?)(.*)")
 EQUALS_KINDS = frozenset({"position", "angle", "feed", "speed", "radius", "pitch"})
@@ -28,6 +27,8 @@ class Block:
     area: str | None           # "lower" (G25) or "upper" (G26)
     positions: dict            # X/Y/Z of the block
     moves: bool                # the block moves an axis (X, Y, Z or the swivel A)
+    facts: frozenset           # what the block sets for later blocks: its G codes (as "G25"), keywords
+    speed: float | None        # S
 
 
 def read_block(dialect: Dialect, code: str) -> Block:
@@ -36,14 +37,18 @@ def read_block(dialect: Dialect, code: str) -> Block:
     for token in code.split():
         _read_token(dialect, token, codes, values, keywords)
     groups = _groups(dialect, codes)
-    motion = next((c for c in codes["G"] if groups[c] == MOTION), None)
     _check_shape(dialect, codes, values, keywords)
-    positions = {axis: values[axis] for axis in AXES if axis in values}
-    moves = any(dialect.addresses[address] in (POSITION, ANGLE) for address in values)
-    area = next((WORKING_AREA[c] for c in codes["G"] if c in WORKING_AREA), None)
+    motion = area = None
+    for code in codes["G"]:
+        motion = code if groups[code] == MOTION else motion
+        area = WORKING_AREA.get(code, area)
+    positions = {axis: value for axis, value in values.items() if axis in AXES}
+    moves = bool(positions) or any(dialect.addresses[address] == ANGLE for address in values)
     if moves and motion is None and area is None:
         raise Refused("a move without its G0/G1 (or G2/G3) in the same block: each block is verified on its own")
-    return Block(tuple(codes["G"]), values, frozenset(keywords), motion, area, positions, moves)
+    facts = frozenset([*(f"G{code}" for code in codes["G"]), *keywords])
+    return Block(tuple(codes["G"]), values, frozenset(keywords), motion, area, positions, moves, facts,
+                 values.get("S"))
 
 
 def _read_token(dialect: Dialect, token: str, codes: dict, values: dict, keywords: set) -> None:
@@ -55,8 +60,9 @@ def _read_token(dialect: Dialect, token: str, codes: dict, values: dict, keyword
     kind = dialect.addresses.get(address)
     if kind is None:
         raise Refused(_unknown(dialect, token, address, text))
-    _check_equals(dialect, address, kind, equals)
-    value = read_value(kind, address + equals, text)
+    if equals or len(address) > 1:
+        _check_equals(dialect, address, kind, equals)
+    value = READERS[kind](address + equals, text)
     if kind == CODE:
         codes[address].append(value)
     elif address in values:

@@ -31,18 +31,20 @@ class CommentLine:
 
 
 COMMENT = CommentLine()
-_remembered: dict[tuple, object] = {}
+_remembered: dict[str, dict] = {}    # dialect name -> line -> what it reads as
 
 
 def read_line(dialect: Dialect, line: str):
     """What `line` reads as, or Refused with the reason (both remembered)."""
-    key = (dialect.name, line)
-    found = _remembered.get(key)
+    if type(line) is not str:
+        raise Refused(f"a line must be text, not {type(line).__name__}")
+    remembered = _remembered.setdefault(dialect.name, {})
+    found = remembered.get(line)
     if found is None:
         found = _read_fresh(dialect, line)
-        if len(_remembered) >= MAX_REMEMBERED:
-            _remembered.clear()
-        _remembered[key] = found
+        if len(remembered) >= MAX_REMEMBERED:
+            remembered.clear()
+        remembered[line] = found
     if isinstance(found, Refused):
         raise found
     return found

@@ -10,15 +10,17 @@ themselves; S at most the spindle's maximum and, with the EGON ratio, the table'
 extremes within the travel; the hob-shift clamp as engine.programs.verifier.shift_clamp says."""
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+import math
 
 from ...gears.records import Machine
 from .arcs import arc_box
-from .grammar import Dialect, dialect_of
+from .grammar import AXES, Dialect, dialect_of
 from .limits import check_spindle, check_table, check_travel
 from .lines import read_line
 from .refusals import LimitError, Refused, line_refused
 from .shift_clamp import ShiftClamp
+
+ARCS = (2, 3)
 
 
 def verify_program(lines: list[str], machine: Machine, program_name: str = "program") -> None:
@@ -37,23 +39,25 @@ def verify_program(lines: list[str], machine: Machine, program_name: str = "prog
         raise line_refused(program_name, number, lines[number - 1] if number else "", str(refusal)) from None
 
 
-@dataclass
 class Walk:
-    """What the lines so far have set: facts (G25, G26, WALIMON, DIAMON), the working area, the
-    lathe's position, the spindle speed and the table's coupling ratio, the hob-shift clamp."""
-    dialect: Dialect
-    machine: Machine
-    count: int
-    facts: set = field(default_factory=set)
-    area: dict = field(default_factory=lambda: {"lower": {}, "upper": {}})
-    position: dict = field(default_factory=dict)
-    speed: float | None = None
-    coupled_axes: tuple | None = None
-    ratio: float | None = None
-    clamp: ShiftClamp = field(default_factory=ShiftClamp)
+    """What the lines so far have set: facts (G25, G26, WALIMON, DIAMON), the working area and
+    the bounds it leaves each axis, the lathe's position, the spindle speed and the table's
+    coupling ratio, the hob-shift clamp."""
+
+    def __init__(self, dialect: Dialect, machine: Machine, count: int):
+        self.dialect, self.machine, self.count = dialect, machine, count
+        self.facts: set = set()
+        self.ready = not dialect.motion_needs        # what motion needs has been set
+        self.area = {"lower": {}, "upper": {}}
+        self.travel = {axis: (getattr(machine, f"{axis.lower()}_min"), getattr(machine, f"{axis.lower()}_max"))
+                       for axis in AXES}
+        self.bounds = self.travel                     # travel, narrowed by the working area once set
+        self.position: dict = {}
+        self.speed = self.ratio = self.coupled_axes = None
+        self.clamp = ShiftClamp()
 
     def take(self, number: int, line) -> None:
-        if line.kind != "shift":
+        if self.clamp.at and line.kind != "shift":
             self.clamp.interrupted()
         TAKERS[line.kind](self, number, line)
 
@@ -73,36 +77,38 @@ class Walk:
             self._set_area(block)
         elif block.moves:
             self._check_motion(block.positions)
-            self._check_arc(block)
+            if block.motion in ARCS:
+                self._check_arc(block)
             self.position.update(block.positions)
-        if "S" in block.values:
-            self._set_speed(block.values["S"])
-        self.facts.update(f"G{code}" for code in block.g_codes)
-        self.facts.update(block.keywords)
+        if block.speed is not None:
+            self._set_speed(block.speed)
+        if block.facts:
+            self.facts |= block.facts
+            self.ready = self.dialect.motion_needs <= self.facts
 
     def _set_area(self, block) -> None:
         for axis, value in block.positions.items():
             check_travel(axis, value, self.machine, "working-area limit ")
         self.area[block.area] = dict(block.positions)
+        lower, upper = self.area["lower"], self.area["upper"]
+        self.bounds = {axis: (max(low, lower.get(axis, -math.inf)), min(high, upper.get(axis, math.inf)))
+                       for axis, (low, high) in self.travel.items()}
 
     def _check_motion(self, positions: dict) -> None:
-        if not self.dialect.motion_needs <= self.facts:
+        if not self.ready:
             raise Refused(self.dialect.motion_needs_reason)
+        bounds = self.bounds
         for axis, value in positions.items():
-            check_travel(axis, value, self.machine)
-            if self.dialect.working_area:
-                self._check_area(axis, value)
+            low, high = bounds[axis]
+            if not low <= value <= high:
+                self._refuse_position(axis, value)
 
-    def _check_area(self, axis: str, value: float) -> None:
+    def _refuse_position(self, axis: str, value: float) -> None:
+        check_travel(axis, value, self.machine)
         low, high = self.area["lower"].get(axis), self.area["upper"].get(axis)
-        if low is None or high is None:
-            raise Refused(f"{axis} has no working-area limit: G25 and G26 give X, Y and Z")
-        if not low <= value <= high:
-            raise Refused(f"{axis}{value:g} lies outside the working area G25/G26 {axis} {low:g}…{high:g}")
+        raise Refused(f"{axis}{value:g} lies outside the working area G25/G26 {axis} {low:g}…{high:g}")
 
     def _check_arc(self, block) -> None:
-        if block.motion not in (2, 3):
-            return
         if not {"X", "Z"} <= self.position.keys():
             raise Refused("an arc from an unknown start point: program X and Z before it")
         end = {**self.position, **block.positions}

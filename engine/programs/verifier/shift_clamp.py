@@ -40,6 +40,8 @@ class ShiftLine:
 
 
 def read_shift_line(code: str) -> ShiftLine | None:
+    if PARAMETER not in code and "IF" not in code:
+        return None
     for step, pattern in FORMS:
         match = pattern.fullmatch(code)
         if match:

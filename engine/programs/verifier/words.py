@@ -70,7 +70,3 @@ def _offset(word: str, text: str) -> int:
 READERS = {CODE: _code, POSITION: _position, ANGLE: _angle, FEED: _feed, SPEED: _above_zero,
            PITCH: _above_zero, RADIUS: _radius, TOOL: _tool, TOOL_AND_OFFSET: _tool_and_offset,
            OFFSET: _offset}
-
-
-def read_value(kind: str, word: str, text: str):
-    return READERS[kind](word, text)
