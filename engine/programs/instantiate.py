@@ -15,11 +15,11 @@ from ..gears.models import model_for_class
 from ..gears.records import Gear, Machine, hobbing_machine, load_gear, load_gears, load_hobs
 from ..hobbing.choices import Choices
 from ..memory import no_cycle_collection
-from ..templates.decision_table import Result, compiled_template
 from ..templates.rows import Template
 from ..templates.store import load_template
 from ..turning.names import TurningModel
-from .verifier import LimitError, check_table_speed, verify_program
+from .verified_run import run_template
+from .verifier import LimitError, check_table_speed
 from .outputs import write_program_files
 from .records import Planned, Program
 from .storage import store_many, store_one
@@ -97,13 +97,6 @@ class Planner:
             case_ids = [case_id for proposal in proposals.values() for case_id in proposal.case_ids]
             self._cutting[key] = (cutting.with_overrides(**self.overrides), case_ids)
         return self._cutting[key]
-
-
-def run_template(template: Template, params: dict, module_params: dict, machine: Machine) -> Result:
-    """Evaluate the decision table and verify the program for the machine (engine.programs.verifier)."""
-    result = compiled_template(template).run(params, module_params)
-    verify_program(result.lines, machine, str(params.get("program_name", "program")))
-    return result
 
 
 def _check_machine_fits(gear: Gear, machine: Machine) -> None:

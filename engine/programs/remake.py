@@ -11,7 +11,8 @@ from ..gears.records import Machine, load_machine
 from ..memory import no_cycle_collection
 from ..templates.rows import Template
 from ..templates.store import load_template
-from .instantiate import store_and_write, run_template
+from .instantiate import store_and_write
+from .verified_run import run_template
 from .records import Planned, Program
 from .storage import Batch, store_programs
 
