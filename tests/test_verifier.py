@@ -278,14 +278,26 @@ def test_a_template_row_with_a_line_break_stores_and_writes_nothing(run, tmp_pat
         assert programs(run.url) == before and list(tmp_path.iterdir()) == []
 
 
+def runner_sets_program_name(url: str, job: int, name: str) -> bool:
+    """As engine_runner (runners may write jobs): False if the database refuses the name itself."""
+    with psycopg.connect(url) as conn:
+        conn.execute("SET ROLE engine_runner")
+        try:
+            conn.execute("UPDATE job SET params = jsonb_set(params, '{program_name}', to_jsonb(%s::text)) "
+                         "WHERE id = %s", (name, job))
+        except (psycopg.errors.IntegrityError, psycopg.errors.RaiseException):
+            return False
+    return True
+
+
 @pytest.mark.parametrize("name", ["X\nG0 X9999 Z-9999", "X\rG0 X9999 Z-9999", "X\\nG0 X9999 Z-9999"])
 def test_a_stored_job_whose_program_name_holds_a_line_break_is_not_made_again(run, tmp_path, name):
     made = run("instantiate", "--gear", 42, "--json")
     assert made.exit_code == 0, made.output
     with psycopg.connect(run.url) as conn:
         job = conn.execute("SELECT max(id) FROM job").fetchone()[0]
-        conn.execute("UPDATE job SET params = jsonb_set(params, '{program_name}', to_jsonb(%s::text)) "
-                     "WHERE id = %s", (name, job))
+    if not runner_sets_program_name(run.url, job, name):
+        return     # the database refused the name where it entered: nothing for the verifier to see
     before = programs(run.url)
     for args in (("--job", job), ("--jobs", f"{job}-{job}")):
         message = one_line_exit_1(run("instantiate", *args, "--out", tmp_path))

@@ -20,9 +20,7 @@ EQUALS_KINDS = frozenset({"position", "angle", "feed", "speed", "radius", "pitch
 @dataclass(frozen=True, slots=True)
 class Block:
     kind = "block"
-    g_codes: tuple
     values: dict               # address -> value (G and M codes apart)
-    keywords: frozenset
     motion: int | None         # the block's G0/G1/G2/G3/thread code
     area: str | None           # "lower" (G25) or "upper" (G26)
     positions: dict            # X/Y/Z of the block
@@ -38,17 +36,20 @@ def read_block(dialect: Dialect, code: str) -> Block:
         _read_token(dialect, token, codes, values, keywords)
     groups = _groups(dialect, codes)
     _check_shape(dialect, codes, values, keywords)
+    return _block(dialect, codes["G"], groups, values, keywords)
+
+
+def _block(dialect: Dialect, g_codes: list, groups: dict, values: dict, keywords: set) -> Block:
     motion = area = None
-    for code in codes["G"]:
+    for code in g_codes:
         motion = code if groups[code] == MOTION else motion
         area = WORKING_AREA.get(code, area)
     positions = {axis: value for axis, value in values.items() if axis in AXES}
     moves = bool(positions) or any(dialect.addresses[address] == ANGLE for address in values)
     if moves and motion is None and area is None:
         raise Refused("a move without its G0/G1 (or G2/G3) in the same block: each block is verified on its own")
-    facts = frozenset([*(f"G{code}" for code in codes["G"]), *keywords])
-    return Block(tuple(codes["G"]), values, frozenset(keywords), motion, area, positions, moves, facts,
-                 values.get("S"))
+    facts = frozenset([*(f"G{code}" for code in g_codes), *keywords])
+    return Block(values, motion, area, positions, moves, facts, values.get("S"))
 
 
 def _read_token(dialect: Dialect, token: str, codes: dict, values: dict, keywords: set) -> None:
