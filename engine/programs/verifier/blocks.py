@@ -25,7 +25,7 @@ class Block:
     area: str | None           # "lower" (G25) or "upper" (G26)
     positions: dict            # X/Y/Z of the block
     moves: bool                # the block moves an axis (X, Y, Z or the swivel A)
-    facts: frozenset           # what the block sets for later blocks: its G codes (as "G25"), keywords
+    facts: frozenset           # what of the dialect's motion_needs the block sets (its G codes as "G25", keywords)
     speed: float | None        # S
 
 
@@ -48,7 +48,7 @@ def _block(dialect: Dialect, g_codes: list, groups: dict, values: dict, keywords
     moves = bool(positions) or any(dialect.addresses[address] == ANGLE for address in values)
     if moves and motion is None and area is None:
         raise Refused("a move without its G0/G1 (or G2/G3) in the same block: each block is verified on its own")
-    facts = frozenset([*(f"G{code}" for code in g_codes), *keywords])
+    facts = frozenset([*(f"G{code}" for code in g_codes), *keywords]) & dialect.motion_needs
     return Block(values, motion, area, positions, moves, facts, values.get("S"))
 
 

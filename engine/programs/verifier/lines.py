@@ -34,11 +34,16 @@ COMMENT = CommentLine()
 _remembered: dict[str, dict] = {}    # dialect name -> line -> what it reads as
 
 
+def remembered_lines(dialect: Dialect) -> dict:
+    """line -> what it reads as (or why it is refused), for the lines of `dialect` read so far."""
+    return _remembered.setdefault(dialect.name, {})
+
+
 def read_line(dialect: Dialect, line: str):
     """What `line` reads as, or Refused with the reason (both remembered)."""
     if type(line) is not str:
         raise Refused(f"a line must be text, not {type(line).__name__}")
-    remembered = _remembered.setdefault(dialect.name, {})
+    remembered = remembered_lines(dialect)
     found = remembered.get(line)
     if found is None:
         found = _read_fresh(dialect, line)

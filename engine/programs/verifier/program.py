@@ -16,7 +16,7 @@ from ...gears.records import Machine
 from .arcs import arc_box
 from .grammar import AXES, Dialect, dialect_of
 from .limits import check_spindle, check_table, check_travel
-from .lines import read_line
+from .lines import read_line, remembered_lines
 from .refusals import LimitError, Refused, line_refused
 from .shift_clamp import ShiftClamp
 
@@ -30,10 +30,11 @@ def verify_program(lines: list[str], machine: Machine, program_name: str = "prog
     except Refused as refusal:
         raise LimitError(f"machine {machine.name}: {refusal}; nothing stored") from None
     walk = Walk(dialect, machine, len(lines))
-    number = 0
+    remembered, number = remembered_lines(dialect), 0
     try:
         for number, line in enumerate(lines, start=1):
-            walk.take(number, read_line(dialect, line))
+            found = remembered.get(line) if type(line) is str else None
+            walk.take(number, read_line(dialect, line) if found is None or found.__class__ is Refused else found)
         walk.finish()
     except Refused as refusal:
         raise line_refused(program_name, number, lines[number - 1] if number else "", str(refusal)) from None
@@ -88,7 +89,9 @@ class Walk:
 
     def _set_area(self, block) -> None:
         for axis, value in block.positions.items():
-            check_travel(axis, value, self.machine, "working-area limit ")
+            low, high = self.travel[axis]
+            if not low <= value <= high:
+                check_travel(axis, value, self.machine, "working-area limit ")
         self.area[block.area] = dict(block.positions)
         lower, upper = self.area["lower"], self.area["upper"]
         self.bounds = {axis: (max(low, lower.get(axis, -math.inf)), min(high, upper.get(axis, math.inf)))
