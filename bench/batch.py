@@ -33,7 +33,7 @@ from engine.gears.case_base import CUT_KINDS_BY_COUNT, job_cutting_record  # noq
 from engine.gears.hob_matching import choose_hob  # noqa: E402
 from engine.hobbing.choices import Choices  # noqa: E402
 from engine.programs.instantiate import Planner, _check_machine_fits, _check_table_speed  # noqa: E402
-from engine.programs.nc_check import check_program  # noqa: E402
+from engine.programs.verifier import verify_program  # noqa: E402
 
 FIRST_ID = 100_000
 TARGET_RATE = 5_000          # programs/s
@@ -187,7 +187,7 @@ class JinjaPipeline:
         lines = text.splitlines()
         name = str(params.get("program_name", f"JOB_{gear.id}"))
         if self.check:
-            check_program(lines, machine, name)
+            verify_program(lines, machine, name)
         kinds = CUT_KINDS_BY_COUNT[planner.choices.cut_count(gear.module)]
         record = job_cutting_record(cutting, gear, hob, kinds, case_ids)
         return (gear.id, gear.gear_class, machine.name, hob.id, params, module_params, version, template_hash,

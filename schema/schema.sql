@@ -147,7 +147,8 @@ JOIN body_use u ON u.body = component_body_key(c.t, c.o, c.p_calc, c.s, c.p_emit
 CREATE TABLE machine (
     name            text PRIMARY KEY,
     kind            text NOT NULL CHECK (kind IN ('hobber', 'lathe')),
-    dialect         text NOT NULL,
+    dialect         text NOT NULL,   -- with kind, the grammar the verifier reads programs with: hobber/840d,
+                                     -- lathe/840d, lathe/iso (engine/programs/verifier/grammar.py); others make no program
     x_min           numeric NOT NULL,
     x_max           numeric NOT NULL,
     y_min           numeric NOT NULL DEFAULT 0,

@@ -120,7 +120,7 @@ def test_a_failing_row_stores_nothing_of_the_instantiation(conn):
 def test_a_template_version_is_recorded_with_each_program(conn):
     first = instantiate_gear(conn, 42)
     rows = list(load_template(conn, "spur").rows)
-    rows.insert(1, TemplateRow(15, "main", 1, None, None, '"; EDITED"', None))
+    rows.insert(2, TemplateRow(250, "main", 1, None, None, '"; EDITED"', None))   # after the header lines
     replace_template(conn, "spur", rows)
     second = instantiate_gear(conn, 42)
     assert second.template_version == first.template_version + 1

@@ -9,8 +9,7 @@ import pytest
 from engine.errors import EngineError
 from engine.gears.records import load_machine
 from engine.programs.remake import instantiate_job
-from engine.programs.nc_check import LimitError
-from engine.turning.check import check_lathe_program
+from engine.programs.verifier import LimitError, verify_program
 from engine.turning.dxf_import import import_dxf
 from test_dxf_read import seed_drawing
 from test_turning_jobs import two_rough_layers
@@ -91,7 +90,7 @@ def test_a_broken_profile_chain_is_refused_by_index(conn, seed_job):
 
 @pytest.mark.parametrize("lines, message", [
     (["G00 X10.000 Z5.000", "G03 X10.000 Z-5.000 R5.000"], r"the arc reaches X20 exceeds the travel"),
-    (["G98 F1e-05"], r"F1E-05 is not a plain decimal"),
+    (["G98 F1e-05"], r"F1e-05: an exponent"),
     (["G97 S0 M03"], r"S0 must be above 0"),
     (["T12301"], r"T12301 is not T<tool><offset>"),
 ])
@@ -99,12 +98,12 @@ def test_the_lathe_check_refuses(conn, lines, message):
     machine = load_machine(conn, "lathe-iso")
     narrow = type(machine)(**{**vars(machine), "x_max": 15.0})
     with pytest.raises(LimitError, match=message):
-        check_lathe_program(lines, narrow)
+        verify_program(lines, narrow)
 
 
 def test_a_lathe_arc_within_the_travel_passes(conn):
     machine = load_machine(conn, "lathe-iso")
-    check_lathe_program(["G00 X10.000 Z5.000", "G02 X10.000 Z-5.000 R5.000", "G98 F150"], machine)
+    verify_program(["G00 X10.000 Z5.000", "G02 X10.000 Z-5.000 R5.000", "G98 F150"], machine)
 
 
 def test_an_inch_drawing_says_its_codes_are_not_scaled(conn, tmp_path):

@@ -42,7 +42,7 @@ def parse_range(text: str, option: str = "--gears") -> tuple[int, int]:
 @click.option("--tailstock/--no-tailstock", default=True, show_default=True, help="Tailstock clamp M20/M21.")
 @click.option("--worm-feed", type=click.Choice(["radial", "tangential"]), default="radial", show_default=True,
               help="Worm wheels: radial plunge, or tangential feed along Y.")
-@click.option("--hob-speed", type=int, help="Override the hob speed n0, r/min.")
+@click.option("--hob-speed", type=click.IntRange(min=1), help="Override the hob speed n0, r/min (above 0).")
 @click.option("--workers", type=click.IntRange(1, 64), default=1, show_default=True,
               help="Batch: plan the gears in this many processes (all stored in one transaction, or none).")
 @click.option("--explain", is_flag=True,

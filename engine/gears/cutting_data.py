@@ -8,6 +8,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 
+from ..errors import EngineError
+
 # Cutting speed v [m/min] by material, for uncoated and coated HSS hobs, wet (§C, mid-range).
 CUTTING_SPEED = {
     "45": (38.0, 90.0),
@@ -37,7 +39,11 @@ class CuttingData:
         return self.radial_feed if self.radial_feed_finish is None else self.radial_feed_finish
 
     def with_overrides(self, **overrides) -> "CuttingData":
+        """A speed or feed of 0 or below stops the hob or the feed: refused as it is given."""
         given = {name: value for name, value in overrides.items() if value is not None}
+        for name, value in given.items():
+            if not value > 0:
+                raise EngineError(f"{name.replace('_', ' ')} {value:g} must be above 0 (r/min or mm/min)")
         return replace(self, **given, source=self.source + " + overrides") if given else self
 
 

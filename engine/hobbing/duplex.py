@@ -9,7 +9,7 @@ import math
 from dataclasses import dataclass
 
 from ..errors import EngineError
-from ..programs.nc_check import check_table_speed
+from ..programs.verifier import check_table_speed
 from . import shifting
 from .cylindrical import CylindricalModel, JobParameters
 from .passes import plan_cuts, working_area

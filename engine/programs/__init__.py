@@ -1,1 +1,1 @@
-"""Programs (design notes §7): instantiation, the machine-limit check, storage and output files."""
+"""Programs (design notes §7): instantiation, the fail-closed program verifier, storage and output files."""

@@ -1,8 +1,9 @@
 """Instantiation: a workpiece (or a stored job) → its NC program, checked, stored, written.
 
 gear → class → model + hob + cutting data → job parameters → decision table → result
-table → machine-limit check → job and program stored in one transaction, committed → .MPF file
-(engine.programs.outputs: written only after the COMMIT).
+table → verifier (every line read in the machine's dialect, checked against the machine) →
+job and program stored in one transaction, committed → .MPF file (engine.programs.outputs:
+written only after the COMMIT).
 """
 from __future__ import annotations
 
@@ -15,12 +16,12 @@ from ..gears.models import model_for_class
 from ..gears.records import Gear, Machine, hobbing_machine, load_gear, load_gears, load_hobs
 from ..hobbing.choices import Choices
 from ..memory import no_cycle_collection
-from ..templates.decision_table import Result, compiled_template
 from ..templates.rows import Template
 from ..templates.store import load_template
 from ..turning.names import TurningModel
-from .nc_check import LimitError, check_program, check_table_speed
 from .outputs import ProgramFiles, files_after_commit
+from .verified_run import run_template
+from .verifier import LimitError, check_table_speed
 from .records import Planned, Program
 from .storage import store_many, store_one
 from .workers import plan_in_workers
@@ -97,15 +98,6 @@ class Planner:
             case_ids = [case_id for proposal in proposals.values() for case_id in proposal.case_ids]
             self._cutting[key] = (cutting.with_overrides(**self.overrides), case_ids)
         return self._cutting[key]
-
-
-def run_template(template: Template, params: dict, module_params: dict, machine: Machine) -> Result:
-    """Evaluate the decision table and check the program against the machine."""
-    compiled = compiled_template(template)
-    result = compiled.run(params, module_params)
-    check_program(result.lines, machine, str(params.get("program_name", "program")), result.row_ids,
-                  compiled.constant_words)
-    return result
 
 
 def _check_machine_fits(gear: Gear, machine: Machine) -> None:

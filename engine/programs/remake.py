@@ -11,8 +11,9 @@ from ..gears.records import Machine, load_machine
 from ..memory import no_cycle_collection
 from ..templates.rows import Template
 from ..templates.store import load_template
-from .instantiate import run_template, store_planned
+from .instantiate import store_planned
 from .outputs import files_after_commit
+from .verified_run import run_template
 from .records import Planned, Program
 from .storage import Batch, refuse_unsafe, store_programs
 

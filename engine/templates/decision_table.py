@@ -19,7 +19,6 @@ from dataclasses import dataclass, field
 from functools import partial
 
 from ..errors import EngineError
-from ..programs.nc_check import words
 from ..turning.nc_path import NcLines
 from .evaluator import EvaluationError, Evaluator, base_symbols
 from .expressions import (MAX_SECONDS_PER_INSTANTIATION, Compiled, ExpressionError, compile_expression,
@@ -76,10 +75,6 @@ class CompiledTemplate:
         self.memo: dict[tuple, Outcome] = {}
         # Rows that print a whole tool path (nc_path) emit several lines at once.
         self.prints_paths = any(row.o is not None and _calls_nc_path(row.o.tree) for row in self.rows)
-        # Lines a row always emits the same, parsed for the limit check once per template.
-        self.constant_words = {row.row.id: words(row.o.tree.value) for row in self.rows
-                               if row.o is not None and isinstance(row.o.tree, ast.Constant)
-                               and isinstance(row.o.tree.value, str)}
 
     def run(self, params: dict, module_params: dict | None = None,
             deadline_seconds: float = MAX_SECONDS_PER_INSTANTIATION) -> Result:

@@ -5,9 +5,8 @@ from __future__ import annotations
 from ..errors import EngineError
 from ..gears.records import Machine, load_machine
 from ..programs.records import Planned
-from ..templates.decision_table import compiled_template
+from ..programs.verified_run import run_template
 from ..templates.store import load_template
-from .check import check_lathe_program
 from .defaults import DEFAULT_LATHE
 from .model import template_module_params
 
@@ -38,6 +37,5 @@ def plan_turning_job(conn, gear_class: str, machine: Machine, params: dict, modu
     `passes`: the job's passes (model.job_passes) if the caller has them already."""
     template = load_template(conn, gear_class)
     extended = template_module_params(params, module_params, passes)
-    result = compiled_template(template).run(params, extended)
-    check_lathe_program(result.lines, machine, str(params.get("program_name", "program")))
+    result = run_template(template, params, extended, machine)
     return Planned(None, gear_class, machine.name, None, params, module_params, template, result)

@@ -1,0 +1,154 @@
+"""The dialects the verifier reads, declared as data: for each machine kind and controller
+dialect of the machine record (machine.kind, machine.dialect), the header lines, the comment
+form, the addresses and the kind of value each takes, the G codes (with their modal group) and
+M codes allowed, the keywords and statements, and what must hold before the first motion.
+
+Only what the seeded templates emit (and the controller reads the way the verifier assumes) is
+in a dialect. Anything else is refused: a code such as G54 or G91 changes what every later
+position means in a way a block-by-block reading cannot see, so it is not guessed at."""
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field
+
+from .refusals import Refused
+
+# Value kinds of addresses (engine.programs.verifier.words reads and checks each).
+POSITION, ANGLE, FEED, SPEED, CODE, TOOL, TOOL_AND_OFFSET, OFFSET, RADIUS, PITCH = (
+    "position", "angle", "feed", "speed", "code", "tool", "tool and offset", "offset", "radius", "pitch")
+MOTION = "motion"          # the modal group of G0, G1, G2, G3 and threading
+AXES = ("X", "Y", "Z")
+
+# 840D program names (reference §A1): letters, digits and _, read in through `%_N_<name>_MPF`.
+NAME = r"[A-Za-z0-9_]+"
+# ISO: a comment ends at the first ")", so no "(" or ")" inside (other characters are printable
+# ASCII anyway: engine.programs.verifier.characters reads every line first).
+ISO_COMMENT_TEXT = r"[ -'*-~]*"
+
+
+@dataclass(frozen=True)
+class Header:
+    """A whole line of fixed form that may stand only at the given places ("first", "second",
+    "last" line of the program): a second `%_N_…_MPF` would start another program."""
+    what: str
+    pattern: re.Pattern
+    places: frozenset
+
+
+@dataclass(frozen=True)
+class Dialect:
+    name: str
+    headers: tuple
+    comment: str                          # "semicolon": `; text` to the end; "parentheses": `(text)`
+    addresses: dict                       # address -> value kind
+    g_codes: dict                         # code -> modal group: two of one group in a block are refused
+    m_codes: frozenset
+    keywords: frozenset = frozenset()     # words without a value: WALIMON, DIAMON
+    statements: frozenset = frozenset()   # NAME(arguments) lines (engine.programs.verifier.statements)
+    motion_needs: frozenset = frozenset() # facts (G codes or keywords) that must precede the first motion
+    motion_needs_reason: str = ""
+    working_area: bool = False            # G25/G26 bound every later X/Y/Z (hobbing)
+    shift_clamp: bool = False             # the hob-shift-per-part R11 clamp (engine.programs.verifier.shift_clamp)
+    equals_allowed: bool = False          # 840D: `X=12.5` is `X12.5`; names of two letters need it (`CR=5`)
+    arc_radius: str | None = None         # the address of an arc's radius
+    needs_words: dict = field(default_factory=dict)   # G code -> the words its block must hold
+
+    def code_group(self, letter: str, code: int) -> str:
+        if letter == "M":
+            if code not in self.m_codes:
+                known = ", ".join(f"M{c}" for c in sorted(self.m_codes))
+                raise Refused(f"M{code} is not an M code of the {self.name} grammar (it has {known})")
+            return f"M{code}"
+        if code not in self.g_codes:
+            known = ", ".join(f"G{c}" for c in sorted(self.g_codes))
+            raise Refused(REFUSED_G_CODES.get(code, f"G{code} is not a G code of the {self.name} grammar")
+                          + f" (it has {known})")
+        return self.g_codes[code]
+
+
+# G codes that are refused with a reason: what they would do to the positions the verifier reads.
+REFUSED_G_CODES = {
+    91: "incremental G91 moves cannot be verified; program absolute positions (G90)",
+    70: "G70 programs inches (840D) or runs a finishing cycle (ISO); neither can be verified",
+    20: "G20 programs inches; every limit is in mm (G21)",
+    95: "G95 feeds per revolution; F is bounded in mm/min (G94)",
+    99: "G99 feeds per revolution; F is bounded in mm/min (G98)",
+    96: "G96 constant cutting speed leaves the spindle speed unbounded; program r/min (G97)",
+    **{code: f"G{code} shifts every position by a work offset the verifier cannot see"
+       for code in (54, 55, 56, 57, 58, 59, 92, 500)},
+    **{code: f"G{code} moves by way of a reference point the verifier cannot see" for code in (28, 74, 75)},
+}
+
+# A block that holds one of these G codes holds no other G code and only these words.
+BLOCK_SHAPES = {
+    4: ("dwell", frozenset({"F"})),
+    25: ("lower working-area limit", frozenset(AXES)),
+    26: ("upper working-area limit", frozenset(AXES)),
+}
+WORKING_AREA = {25: "lower", 26: "upper"}
+# Words that mean something only together with one of these G codes in the same block.
+WORD_NEEDS_CODE = {"R": frozenset({2, 3}), "CR": frozenset({2, 3}), "K": frozenset({33})}
+
+HOBBING_840D = Dialect(
+    name="840D hobbing",
+    headers=(Header("program header %_N_<NAME>_MPF", re.compile(rf"%_N_{NAME}_MPF"), frozenset({"first"})),
+             Header("path line ;$PATH=/_N_MPF_DIR", re.compile(r";\$PATH=/_N_MPF_DIR"), frozenset({"second"}))),
+    comment="semicolon",
+    addresses={"X": POSITION, "Y": POSITION, "Z": POSITION, "A": ANGLE, "F": FEED, "S": SPEED,
+               "G": CODE, "M": CODE},
+    g_codes={0: MOTION, 1: MOTION, 4: "dwell", 25: "working area", 26: "working area", 71: "units",
+             90: "distance", 94: "feed type"},
+    m_codes=frozenset({3, 5, 8, 9, 20, 21, 30}),
+    keywords=frozenset({"WALIMON"}),
+    statements=frozenset({"EGDEF", "EGON", "EGOFS", "EGDEL"}),
+    motion_needs=frozenset({"G25", "G26", "WALIMON"}),
+    motion_needs_reason="motion before G25/G26 and WALIMON set the working area",
+    working_area=True,
+    shift_clamp=True,
+    equals_allowed=True,
+)
+
+LATHE_840D = Dialect(
+    name="840D lathe",
+    headers=HOBBING_840D.headers,
+    comment="semicolon",
+    addresses={"X": POSITION, "Z": POSITION, "F": FEED, "S": SPEED, "T": TOOL, "D": OFFSET, "CR": RADIUS,
+               "K": PITCH, "G": CODE, "M": CODE},
+    g_codes={0: MOTION, 1: MOTION, 2: MOTION, 3: MOTION, 33: MOTION, 18: "plane", 40: "tool radius",
+             71: "units", 90: "distance", 94: "feed type", 97: "spindle speed"},
+    m_codes=frozenset({3, 5, 8, 9, 30}),
+    keywords=frozenset({"DIAMON"}),
+    motion_needs=frozenset({"DIAMON"}),
+    motion_needs_reason="motion before DIAMON: X would be a radius, and the travel is checked as a diameter",
+    equals_allowed=True,
+    arc_radius="CR",
+    needs_words={2: "CR", 3: "CR", 33: "K"},
+)
+
+LATHE_ISO = Dialect(
+    name="ISO lathe",
+    headers=(Header("tape mark %", re.compile(r"%"), frozenset({"first", "last"})),
+             Header("program number O<nnnn> (NAME)", re.compile(rf"O\d{{4}} \({ISO_COMMENT_TEXT}\)"),
+                    frozenset({"second"}))),
+    comment="parentheses",
+    addresses={"X": POSITION, "Z": POSITION, "F": FEED, "S": SPEED, "T": TOOL_AND_OFFSET, "R": RADIUS,
+               "G": CODE, "M": CODE},
+    g_codes={0: MOTION, 1: MOTION, 2: MOTION, 3: MOTION, 32: MOTION, 18: "plane", 21: "units",
+             40: "tool radius", 90: "distance", 97: "spindle speed", 98: "feed type"},
+    m_codes=frozenset({3, 5, 8, 9, 30}),
+    arc_radius="R",
+    needs_words={2: "R", 3: "R", 32: "F"},
+)
+
+# machine.kind, machine.dialect -> the grammar its programs are read with.
+DIALECTS = {("hobber", "840d"): HOBBING_840D, ("lathe", "840d"): LATHE_840D, ("lathe", "iso"): LATHE_ISO}
+
+
+def dialect_of(kind: str, dialect: str) -> Dialect:
+    """The grammar of a machine record; a record the verifier has no grammar for makes no program."""
+    found = DIALECTS.get((kind, dialect))
+    if found is None:
+        known = ", ".join(f"{k}/{d}" for k, d in DIALECTS)
+        raise Refused(f"no verifier grammar for a {kind} with dialect {dialect!r} (known: {known}); "
+                      "set machine.kind and machine.dialect")
+    return found
