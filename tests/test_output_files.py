@@ -70,10 +70,11 @@ def test_a_program_name_that_leaves_out_is_refused_and_nothing_is_stored(run, tm
     out.mkdir(parents=True)
     before = program_count(run.url)
     for extra in ((), ("--force",)):
+        # the verifier (its %_N_ header) or the file layer refuses it first; the file layer alone: below
         message = one_line_refusal(run("instantiate", "--jobs", f"{job_id}-{job_id}", "--out", out, *extra))
-        assert "not a safe program name" in message
+        assert "not a safe program name" in message or "%_N_" in message
         message = one_line_refusal(run("instantiate", "--job", job_id, "--out", out / "..", *extra))
-        assert "not a safe program name" in message
+        assert "not a safe program name" in message or "%_N_" in message
     assert program_count(run.url) == before
     assert everything_under(tmp_path) == ["deep", "deep/er", "deep/er/out"]
 
