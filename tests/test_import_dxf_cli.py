@@ -77,8 +77,8 @@ def test_a_feed_edited_in_sql_changes_exactly_that_operation_s_f_words(run, tmp_
     after = run("instantiate", "--job", job_id).stdout.splitlines()
     assert len(after) == len(before)
     changed = [(b, a) for b, a in zip(before, after) if b != a]
-    assert changed == [("G98 F20", "G98 F35")]
-    assert {word for _, word in feed_words(after)} - {word for _, word in feed_words(before)} == {"F35"}
+    assert changed == [("G98 F20.000", "G98 F35.000")]
+    assert {word for _, word in feed_words(after)} - {word for _, word in feed_words(before)} == {"F35.000"}
 
 
 def test_plot_writes_a_picture_of_the_job(run, tmp_path):

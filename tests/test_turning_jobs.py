@@ -23,8 +23,11 @@ from engine.turning.names import MAX_OPERATIONS
 from lathe_programs import distance_to_drawn, drawn_polylines, motions, operation_lines, words
 from test_dxf_read import DXF, EMCO, INCH, nc_arc_words, seed_drawing
 
-DIALECTS = {"lathe-iso": {"tools": ("T0101", "T0202"), "thread": "G32", "coolant": ("M08", "M09")},
-            "lathe-840d": {"tools": ("T1 D1", "T2 D2"), "thread": "G33", "coolant": ("M8", "M9")}}
+# ISO F words carry their decimal point (a Fanuc-type control reads F1300 by a parameter's unit).
+DIALECTS = {"lathe-iso": {"tools": ("T0101", "T0202"), "thread": "G32", "coolant": ("M08", "M09"),
+                          "feeds": ("F1300.000", "F20.000"), "pitch": "F1.5000"},
+            "lathe-840d": {"tools": ("T1 D1", "T2 D2"), "thread": "G33", "coolant": ("M8", "M9"),
+                           "feeds": ("F1300", "F20"), "pitch": "K1.5"}}
 
 
 def program_of(conn, path, machine="lathe-iso", **options) -> list[str]:
@@ -45,7 +48,7 @@ def test_seed_drawing_program_carries_every_code_of_the_drawing(conn, seed_part,
     lines = program_of(conn, seed_part, machine)
     dialect = DIALECTS[machine]
     text = "\n".join(lines)
-    for word in ("S100", "S80", "S700", "F1300", "F20"):
+    for word in ("S100", "S80", "S700", *dialect["feeds"]):
         assert word in words_of(lines), word
     assert all(tool in lines for tool in dialect["tools"])
     rough = operation_lines(lines, 1)
@@ -55,8 +58,7 @@ def test_seed_drawing_program_carries_every_code_of_the_drawing(conn, seed_part,
     depth = (0.5 - 0.45) * INCH                            # crest and root lines of layer 3
     passes = [line for line in operation_lines(lines, 3) if line.startswith(dialect["thread"] + " ")]
     assert len(passes) == math.ceil(depth / 0.4)
-    pitch = "F1.5" if machine == "lathe-iso" else "K1.5"
-    assert all(pitch in line.split() for line in passes)
+    assert all(dialect["pitch"] in line.split() for line in passes)
 
 
 def words_of(lines: list[str]) -> set[str]:
