@@ -49,7 +49,8 @@ JOB = "params = jsonb_set(params, '{%s}', '%s')"
     (MODULE % ("cutcond:1,spindle_rpm", "null"), r"cutcond:1\.spindle_rpm = None must be a number above 0"),
     (MODULE % ("prep:1,tool", "123"), r"prep:1\.tool = 123 must be a whole number 1 … 99"),
     (MODULE % ("prep:1,tool", "1.5"), r"prep:1\.tool = 1\.5 must be a whole number"),
-    (MODULE % ("prep:1,tool_offset", '"a"'), r"prep:1\.tool_offset = 'a' must be a whole number 0 … 99"),
+    (MODULE % ("prep:1,tool_offset", '"a"'), r"prep:1\.tool_offset = 'a' must be a whole number 1 … 99"),
+    (MODULE % ("prep:1,tool_offset", "0"), r"prep:1\.tool_offset = 0 must be a whole number 1 … 99"),   # T0100: no offset
     (MODULE % ("cutmotion:2,op_present", '"false"'), r"cutmotion:2\.op_present = 'false' must be true or false"),
     (MODULE % ("cutcond:2,coolant", '"no"'), r"cutcond:2\.coolant = 'no' must be true or false"),
     (MODULE % ("cutmotion:1,kind", '"rough"'), r"cutmotion:1\.kind = 'rough' is not one of"),
@@ -59,7 +60,8 @@ JOB = "params = jsonb_set(params, '{%s}', '%s')"
     (JOB % ("tool_change_x", "null"), r"params\.tool_change_x = None must be a number"),
     (JOB % ("stock_diameter", "-5"), r"params\.stock_diameter = -5 must be a number above 0"),
     (JOB % ("closed_by_axis", '"false"'), r"params\.closed_by_axis = 'false' must be true or false"),
-    (JOB % ("program_number", "123456"), r"params\.program_number = 123456 must be a whole number 1 … 9999"),
+    (JOB % ("program_number", "123456"), r"params\.program_number = 123456 must be a whole number 1 … 8999"),
+    (JOB % ("program_number", "9000"), r"params\.program_number = 9000 must be a whole number 1 … 8999"),   # macros
 ])
 def test_a_bad_or_missing_parameter_is_refused_by_name(conn, seed_job, set_sql, message):
     refused_after(conn, seed_job, set_sql, message)
@@ -88,6 +90,10 @@ def test_a_broken_profile_chain_is_refused_by_index(conn, seed_job):
                   r"params\.profile\[1\] starts at .* must meet within 0\.01 mm")
 
 
+ISO_START = ["%", "O0001 (PART)", "G21 G18 G40 G90", "T0101", "G97 S500 M03", "G98 F150."]
+ISO_END = ["M30", "%"]
+
+
 @pytest.mark.parametrize("lines, message", [
     (["G00 X10.000 Z5.000", "G03 X10.000 Z-5.000 R5.000"], r"the arc reaches X20 exceeds the travel"),
     (["G98 F1e-05"], r"F1e-05: an exponent"),
@@ -98,12 +104,12 @@ def test_the_lathe_check_refuses(conn, lines, message):
     machine = load_machine(conn, "lathe-iso")
     narrow = type(machine)(**{**vars(machine), "x_max": 15.0})
     with pytest.raises(LimitError, match=message):
-        verify_program(lines, narrow)
+        verify_program(ISO_START + lines + ISO_END, narrow, "PART")
 
 
 def test_a_lathe_arc_within_the_travel_passes(conn):
     machine = load_machine(conn, "lathe-iso")
-    verify_program(["G00 X10.000 Z5.000", "G02 X10.000 Z-5.000 R5.000", "G98 F150"], machine)
+    verify_program(ISO_START + ["G00 X10.000 Z5.000", "G02 X10.000 Z-5.000 R5.000"] + ISO_END, machine, "PART")
 
 
 def test_an_inch_drawing_says_its_codes_are_not_scaled(conn, tmp_path):

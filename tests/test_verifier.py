@@ -17,6 +17,7 @@ import pytest
 
 from engine.gears.records import load_machine
 from engine.programs.verifier import LimitError, verify_program
+from golden_cases import TURNING_CASES
 from test_dxf_read import seed_drawing
 
 GOLDEN = Path(__file__).resolve().parent / "golden"
@@ -24,11 +25,23 @@ GOLDEN = Path(__file__).resolve().parent / "golden"
 # A hobbing prelude: the working area X 50…62, Y −30…30, Z −25…20 (inside hobber-840d's travel
 # X 20…320, Y −80…80, Z −350…150, seed_templates/machines.csv).
 AREA = {"X": (50.0, 62.0), "Y": (-30.0, 30.0), "Z": (-25.0, 20.0)}
-HOBBING = ["%_N_GEAR42_MPF", ";$PATH=/_N_MPF_DIR", "; GEAR 42", "G90 G71 G94",
+HOBBING = ["%_N_TEST_MPF", ";$PATH=/_N_MPF_DIR", "; GEAR 42", "G90 G71 G94",
            "G25 X50.000 Y-30.000 Z-25.000", "G26 X62.000 Y30.000 Z20.000", "WALIMON"]
-LATHE_840D = ["%_N_PART_MPF", ";$PATH=/_N_MPF_DIR", "; DRAWING part.dxf", "G18 G71 G90 G40 DIAMON"]
-LATHE_ISO = ["%", "O0001 (PART)", "(DRAWING part.dxf)", "G21 G18 G40 G90"]
+LATHE_840D = ["%_N_TEST_MPF", ";$PATH=/_N_MPF_DIR", "; DRAWING part.dxf", "G18 G71 G90 G40 DIAMON"]
+LATHE_ISO = ["%", "O0001 (TEST)", "(DRAWING part.dxf)", "G21 G18 G40 G90"]
 PRELUDES = {"hobber-840d": HOBBING, "lathe-840d": LATHE_840D, "lathe-iso": LATHE_ISO}
+# What a cut needs (engine.programs.verifier.machine_state): the table coupled and the hob
+# turning (S246/19 = 12.9 r/min of C, below hobber-840d's 120); a tool with its offset, the
+# spindle turning, the feed mode stated.
+READY = {"hobber-840d": ["EGDEF(C,B,1)", 'EGON(C,"FINE",B,-1,19)', "M3 S246"],
+         "lathe-840d": ["T1 D1", "G97 S500 M3", "G94 F100"],
+         "lathe-iso": ["T0101", "G97 S500 M03", "G98 F100."]}
+ENDINGS = {"hobber-840d": ["M30"], "lathe-840d": ["M30"], "lathe-iso": ["M30", "%"]}
+
+
+def program(machine: str, body: list[str], ready: bool = True) -> list[str]:
+    """A whole program named TEST: the prelude, what a cut needs (if `ready`), the body, the end."""
+    return PRELUDES[machine] + (READY[machine] if ready else []) + body + ENDINGS[machine]
 
 
 def refusal(conn, machine: str, lines: list[str]) -> str:
@@ -52,11 +65,21 @@ def golden_programs() -> list:
                for path in sorted((GOLDEN / "turning").glob("*.NC"))])
 
 
+def program_name(path: Path) -> str:
+    """The name the job gives the golden program: GEAR<id> for a gear (the hobbing models), for
+    a drawing the name its case gives, else its file name in upper case with - as _."""
+    if path.suffix == ".MPF":
+        return path.stem.partition("_")[0]
+    case = path.stem.rpartition("_")[0]
+    options = next(options for name, _, options, _ in TURNING_CASES if name == case)
+    return options.get("program_name", case.upper().replace("-", "_"))
+
+
 @pytest.mark.parametrize("path, machine", golden_programs())
 def test_every_golden_program_is_accepted(conn, path, machine):
     lines = path.read_text().splitlines()
     assert len(lines) > 10
-    assert accepted(conn, machine, lines)
+    verify_program(lines, load_machine(conn, machine), program_name(path))
 
 
 def test_the_golden_programs_cover_every_dialect_and_the_shift_clamp():
@@ -68,8 +91,8 @@ def test_the_golden_programs_cover_every_dialect_and_the_shift_clamp():
 # ---------------------------------------------------------------- the 840D forms of issue 13
 
 def test_the_prelude_with_a_plain_move_inside_the_machine_is_accepted(conn):
-    assert accepted(conn, "hobber-840d", HOBBING + ["G0 X55.000 Z10.000", "G0 X=55 Y=0", "M3 S500",
-                                                    "G1 Z-20.000 F100.0", "M30"])
+    assert accepted(conn, "hobber-840d", program("hobber-840d", ["G0 X55.000 Z10.000", "G0 X=55 Y=0", "M3 S500",
+                                                                 "G1 Z-20.000 F100.0"]))
 
 
 @pytest.mark.parametrize("block, reason", [
@@ -114,22 +137,22 @@ def test_a_move_outside_the_working_area_is_refused(conn, block, axis, value):
     low, high = AREA[axis]
     assert not low <= value <= high
     assert f"{axis}{value:g} lies outside the working area G25/G26 {axis} {low:g}…{high:g}" in \
-        refusal(conn, "hobber-840d", HOBBING + [block])
+        refusal(conn, "hobber-840d", program("hobber-840d", [block]))
 
 
 @pytest.mark.parametrize("before", [["G25 X50 Y-30 Z-25", "G26 X62 Y30 Z20"], ["G25 X50 Y-30 Z-25", "WALIMON"],
                                     ["G26 X62 Y30 Z20", "WALIMON"], []])
 def test_motion_before_g25_g26_and_walimon_is_refused(conn, before):
-    lines = ["%_N_GEAR42_MPF", ";$PATH=/_N_MPF_DIR", *before, "G0 X55"]
+    lines = ["%_N_TEST_MPF", ";$PATH=/_N_MPF_DIR", *before, "G0 X55", "M30"]
     assert "motion before G25/G26 and WALIMON" in refusal(conn, "hobber-840d", lines)
 
 
 def test_a_working_area_must_bound_every_axis_and_lie_within_the_travel(conn):
     machine = load_machine(conn, "hobber-840d")
-    assert "must give each of X, Y, Z" in refusal(conn, "hobber-840d", ["G25 X50 Z-25"])
+    assert "must give each of X, Y, Z" in refusal(conn, "hobber-840d", HOBBING[:2] + ["G25 X50 Z-25"])
     widened = f"G26 X{machine.x_max + 1:g} Y30 Z20"
     assert f"working-area limit X{machine.x_max + 1:g} exceeds the travel" in \
-        refusal(conn, "hobber-840d", ["G25 X50 Y-30 Z-25", widened])
+        refusal(conn, "hobber-840d", HOBBING[:2] + ["G25 X50 Y-30 Z-25", widened])
 
 
 def test_a_later_g26_is_checked_against_the_travel_too(conn):
@@ -146,8 +169,8 @@ def clamp(low: float, high: float, reset: float, step: float = 0.5) -> list[str]
 
 def test_the_clamp_inside_the_working_area_is_accepted(conn):
     low, high = AREA["Y"]
-    assert accepted(conn, "hobber-840d", HOBBING + clamp(low + 1, high - 1, low + 1) + ["M3 S300"])
-    assert accepted(conn, "hobber-840d", HOBBING + clamp(low, high, high))
+    assert accepted(conn, "hobber-840d", program("hobber-840d", clamp(low + 1, high - 1, low + 1) + ["M3 S300"]))
+    assert accepted(conn, "hobber-840d", program("hobber-840d", clamp(low, high, high)))
 
 
 @pytest.mark.parametrize("low, high, reset, message", [
@@ -170,7 +193,8 @@ def test_the_clamp_is_checked_at_both_ends_of_its_interval(conn, low, high, rese
     ["R11=R11+0.5", "IF (R11<-5) AND (R11>5)", "R11=-5", "ENDIF", "G0 Y=R11"],
 ])
 def test_any_other_r_parameter_use_is_refused(conn, lines):
-    refusal(conn, "hobber-840d", HOBBING + lines)
+    message = refusal(conn, "hobber-840d", program("hobber-840d", lines))
+    assert any(reason in message for reason in ("clamp", "R-parameter", "IF: not a word")), message
 
 
 # ---------------------------------------------------------------- characters
@@ -219,7 +243,7 @@ def test_a_header_stands_only_where_it_belongs(conn):
     ("lathe-iso", "G98 F20000.1", "feed F20000.1 exceeds 20000"),
 ])
 def test_speeds_and_feeds_of_0_or_below_or_not_numbers_are_refused(conn, machine, block, reason):
-    assert reason in refusal(conn, machine, PRELUDES[machine] + [block])
+    assert reason in refusal(conn, machine, program(machine, [block]))
 
 
 def test_the_spindle_and_the_table_are_bounded_by_the_machine_record(conn):
@@ -227,29 +251,31 @@ def test_the_spindle_and_the_table_are_bounded_by_the_machine_record(conn):
     teeth = 5
     fastest = machine.table_speed_max * teeth      # S at which C turns at the table's maximum
     assert fastest < machine.spindle_max
-    coupled = HOBBING + ["EGDEF(C,B,1)", f'EGON(C,"FINE",B,-1,{teeth})']
-    assert accepted(conn, "hobber-840d", coupled + [f"M3 S{fastest:g}"])
-    assert "above hobber-840d's 120 r/min" in refusal(conn, "hobber-840d", coupled + [f"M3 S{fastest + 5:g}"])
+    coupled = ["EGDEF(C,B,1)", f'EGON(C,"FINE",B,-1,{teeth})']
+    assert accepted(conn, "hobber-840d", program("hobber-840d", coupled + [f"M3 S{fastest:g}"], ready=False))
+    assert "above hobber-840d's 120 r/min" in \
+        refusal(conn, "hobber-840d", program("hobber-840d", coupled + [f"M3 S{fastest + 5:g}"], ready=False))
     assert f"exceeds hobber-840d's {machine.spindle_max:g} r/min" in \
-        refusal(conn, "hobber-840d", HOBBING + [f"M3 S{machine.spindle_max + 1:g}"])
+        refusal(conn, "hobber-840d", program("hobber-840d", [f"M3 S{machine.spindle_max + 1:g}"], ready=False))
 
 
 def test_an_840d_lathe_moves_only_after_diamon(conn):
-    assert "motion before DIAMON" in refusal(conn, "lathe-840d", ["%_N_PART_MPF", "G0 X50 Z5"])
-    assert accepted(conn, "lathe-840d", LATHE_840D + ["G0 X50 Z5", "G3 X50 Z-5 CR=5", "T1 D1", "G33 Z-10 K1.5"])
+    assert "motion before DIAMON" in refusal(conn, "lathe-840d", ["%_N_TEST_MPF", "G0 X50 Z5", "M30"])
+    assert accepted(conn, "lathe-840d", program("lathe-840d", ["G0 X50 Z5", "G3 X50 Z-5 CR=5", "G33 Z-10 K1.5"]))
 
 
 def test_a_lathe_arc_needs_its_start_and_its_radius(conn):
-    assert "an arc from an unknown start point" in refusal(conn, "lathe-iso", LATHE_ISO + ["G02 X10 Z-5 R5"])
-    assert "G2 without its R" in refusal(conn, "lathe-iso", LATHE_ISO + ["G00 X10 Z5", "G02 X10 Z-5"])
-    assert "CR belongs to G2/G3" in refusal(conn, "lathe-840d", LATHE_840D + ["G1 X10 Z5 CR=5"])
+    assert "an arc from an unknown start point" in \
+        refusal(conn, "lathe-iso", program("lathe-iso", ["G02 X10. Z-5. R5."]))
+    assert "G2 without its R" in refusal(conn, "lathe-iso", program("lathe-iso", ["G00 X10. Z5.", "G02 X10. Z-5."]))
+    assert "CR belongs to G2/G3" in refusal(conn, "lathe-840d", program("lathe-840d", ["G1 X10 Z5 CR=5"]))
 
 
 def test_a_machine_without_a_grammar_makes_no_program(conn):
     machine = load_machine(conn, "hobber-840d")
     iso_hobber = type(machine)(**{**vars(machine), "dialect": "iso"})
     with pytest.raises(LimitError, match="no verifier grammar for a hobber with dialect 'iso'"):
-        verify_program(["%", "M30", "%"], iso_hobber)
+        verify_program(["%", "M30", "%"], iso_hobber, "TEST")
 
 
 # ---------------------------------------------------------------- end to end, on a real database

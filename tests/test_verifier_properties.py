@@ -2,19 +2,25 @@
 lathe, ISO lathe. The test chooses every value and renders it itself, plainly or as an address
 expression, an R-parameter, an exponent, inf/nan, IC/AC, an indirect axis, with or without a
 control character in the block or its comment; it knows what the block evaluates to. The
-oracle is the test's own: a block is accepted exactly when it is plain, holds printable ASCII
-only, and its evaluated position (and feed, and speed) lies within the machine. So no block
-whose position lies outside the machine is accepted, and a plain block inside it is not refused:
-the test fails both ways.
+oracle is the test's own: a block is accepted exactly when it is plain (on ISO with its decimal
+point), holds printable ASCII only, and its evaluated position (and feed, and speed) lies
+within the machine. So no block whose position lies outside the machine is accepted, and a
+plain block inside it is not refused: the test fails both ways.
+
+And, after the review of issue 13: a cut is accepted exactly when the spindle turns, the table
+is coupled, a tool offset is active, as the test's own reading of the events before it says;
+the table's speed with a Z differential is bounded by the reference's formula
+n_C = (z0/z2)·n_B + k·v/360 (§A5); an arc exactly when its radius reaches half its chord.
 
 The machines' limits come from seed_templates/machines.csv, the working area from the
 prelude written here."""
 from __future__ import annotations
 
 import csv
+import math
 from pathlib import Path
 
-from hypothesis import given, settings
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from engine.gears.records import Machine
@@ -22,7 +28,10 @@ from engine.programs.verifier import LimitError, verify_program
 
 SEED = Path(__file__).resolve().parent.parent / "seed_templates" / "machines.csv"
 MAX_FEED = 20000.0        # mm/min: the feed bound the lathe check has always had (about a rapid traverse)
+MAX_DIFFERENTIAL = 360.0  # °/mm: one table turn per mm of travel
+ARC_TOLERANCE = 0.002     # mm by which half an arc's chord may exceed its radius (three-decimal rounding)
 AREA = {"X": (50.0, 250.0), "Y": (-30.0, 30.0), "Z": (-200.0, 100.0)}   # the hobbing prelude's G25/G26
+NAME = "PROPERTY"
 
 
 def machines() -> dict[str, Machine]:
@@ -37,15 +46,20 @@ def machines() -> dict[str, Machine]:
 
 
 MACHINES = machines()
-DIALECTS = {   # name -> prelude, axes, motion codes, whether 840D (`=` forms, `;` comments), speed block
-    "hobber-840d": (["%_N_P_MPF", ";$PATH=/_N_MPF_DIR", "G90 G71 G94",
+DIALECTS = {   # name -> prelude (ready to cut: S·z0/z2 = 100/40 r/min of C), axes, motion codes, whether
+               # 840D (`=` forms, `;` comments, no decimal point needed), speed block
+    "hobber-840d": ([f"%_N_{NAME}_MPF", ";$PATH=/_N_MPF_DIR", "G90 G71 G94",
                      "G25 X{X[0]:.3f} Y{Y[0]:.3f} Z{Z[0]:.3f}".format(**AREA),
-                     "G26 X{X[1]:.3f} Y{Y[1]:.3f} Z{Z[1]:.3f}".format(**AREA), "WALIMON"],
+                     "G26 X{X[1]:.3f} Y{Y[1]:.3f} Z{Z[1]:.3f}".format(**AREA), "WALIMON",
+                     "EGDEF(C,B,1)", 'EGON(C,"FINE",B,-1,40)', "M3 S100"],
                     ("X", "Y", "Z"), ("G0", "G1"), True, "M3 S{}"),
-    "lathe-840d": (["%_N_P_MPF", ";$PATH=/_N_MPF_DIR", "G18 G71 G90 G40 DIAMON"],
+    "lathe-840d": ([f"%_N_{NAME}_MPF", ";$PATH=/_N_MPF_DIR", "G18 G71 G90 G40 DIAMON", "T1 D1", "G97 S100 M3",
+                    "G94 F100"],
                    ("X", "Z"), ("G0", "G1"), True, "G97 S{} M3"),
-    "lathe-iso": (["%", "O0001 (P)", "G21 G18 G40 G90"], ("X", "Z"), ("G00", "G01"), False, "G97 S{} M03"),
+    "lathe-iso": (["%", f"O0001 ({NAME})", "G21 G18 G40 G90", "T0101", "G97 S100 M03", "G98 F100."],
+                  ("X", "Z"), ("G00", "G01"), False, "G97 S{} M03"),
 }
+ENDINGS = {"hobber-840d": ["M30"], "lathe-840d": ["M30"], "lathe-iso": ["M30", "%"]}
 PLAIN = ("plain", "plain one decimal", "plain whole", "plain trailing point", "equals")
 NOT_PLAIN = ("expression", "r-parameter", "exponent", "inf/nan", "ic/ac", "indirect")
 CONTROL = ["\n", "\r", "\x00", "\x7f", "\t", "\x1b", "é", "\u2028", "\x85"]
@@ -126,16 +140,18 @@ def moves(draw):
     for axis in chosen:
         low, high = (getattr(machine, f"{axis.lower()}_min"), getattr(machine, f"{axis.lower()}_max"))
         lines, word, position, plain = draw(rendered(axis, draw(values_around(low, high)), is_840d))
+        plain = plain and (is_840d or "." in word)          # ISO: X114 is 0.114 mm without its point
         before, fine = before + lines, fine and plain and inside(machine, axis, position, hobbing)
         words.append(word)
     if words[0] in ("G1", "G01") and draw(st.booleans()):
         lines, word, feed, plain = draw(rendered("F", draw(values_around(0.0, MAX_FEED)), is_840d))
+        plain = plain and (is_840d or "." in word)
         before, fine = before + lines, fine and plain and 0 < feed <= MAX_FEED
         words.append(word)
     block, broken = draw(control_or_not(" ".join(words)))
     note, broken_note = draw(comment(is_840d))
     accepted = fine and not broken and not broken_note
-    return machine, prelude + before + [block + note], accepted
+    return machine, prelude + before + [block + note] + ENDINGS[name], accepted
 
 
 @st.composite
@@ -145,12 +161,13 @@ def speeds(draw):
     machine = MACHINES[name]
     lines, word, speed, plain = draw(rendered("S", draw(values_around(0.0, machine.spindle_max)), is_840d))
     block, broken = draw(control_or_not(form.format(word[1:])))
-    return machine, prelude + lines + [block], plain and not broken and 0 < speed <= machine.spindle_max
+    return (machine, prelude + lines + [block] + ENDINGS[name],
+            plain and not broken and 0 < speed <= machine.spindle_max)
 
 
 def verdict(machine: Machine, lines: list[str]) -> bool:
     try:
-        verify_program(lines, machine, "PROPERTY")
+        verify_program(lines, machine, NAME)
     except LimitError:
         return False
     return True
@@ -180,4 +197,80 @@ def test_the_hob_shift_clamp_is_accepted_exactly_when_its_whole_interval_lies_in
     lo, hi, back = (float(f"{value:.3f}") for value in (low, high, reset))
     accepted = (float(f"{step:.3f}") > 0 and lo <= back <= hi
                 and inside(machine, "Y", lo, True) and inside(machine, "Y", hi, True))
-    assert verdict(machine, prelude + clamp) == accepted, clamp
+    assert verdict(machine, prelude + clamp + ENDINGS["hobber-840d"]) == accepted, clamp
+
+
+# ---------------------------------------------------------------- the state a cut needs
+
+HOB_EVENTS = ("M3 S246", "M5", 'EGON(C,"FINE",B,-1,19)', "EGOFS(C)", "G0 X55.000", "M8", "M9")
+
+
+@settings(max_examples=300, deadline=None)
+@given(events=st.lists(st.sampled_from(HOB_EVENTS), max_size=8))
+def test_a_hob_cut_is_accepted_exactly_when_the_spindle_turns_and_the_table_is_coupled(events):
+    """The test's own reading: the spindle turns after an M3 S with no M5 since; the table is
+    coupled after an EGON with no EGOFS since."""
+    prelude = DIALECTS["hobber-840d"][0][:6] + ["EGDEF(C,B,1)"]
+    def last(*lines):
+        return next((event for event in reversed(events) if event in lines), None)
+    accepted = last("M3 S246", "M5") == "M3 S246" and last(HOB_EVENTS[2], "EGOFS(C)") == HOB_EVENTS[2]
+    lines = prelude + events + ["G1 Z10.000 F100.0"] + ENDINGS["hobber-840d"]
+    assert verdict(MACHINES["hobber-840d"], lines) == accepted, events
+
+
+TOOL_EVENTS = {   # block -> the offset it leaves: None if the block does not touch it
+    "lathe-840d": {"T1 D1": True, "T2": False, "D0": False, "D3": True, "T4 D0": False, "D1 T5": True,
+                   "M8": None, "G97 S300 M3": None},
+    "lathe-iso": {"T0101": True, "T0200": False, "T0305": True, "T1200": False, "M08": None,
+                  "G97 S300 M03": None},
+}
+
+
+@settings(max_examples=300, deadline=None)
+@given(data=st.data())
+def test_a_lathe_cut_is_accepted_exactly_when_a_tool_offset_is_active(data):
+    """840D: a T activates the edge the machine data says, so only a D (0: none) says the
+    offset; ISO T<tool><offset>: offset 00 cancels it (reference §E)."""
+    name = data.draw(st.sampled_from(sorted(TOOL_EVENTS)))
+    events = data.draw(st.lists(st.sampled_from(sorted(TOOL_EVENTS[name])), max_size=6))
+    prelude = [line for line in DIALECTS[name][0] if line not in ("T1 D1", "T0101")]
+    offsets = [TOOL_EVENTS[name][event] for event in events if TOOL_EVENTS[name][event] is not None]
+    cut = "G01 X20.000 Z-10.000" if name == "lathe-iso" else "G1 X20.000 Z-10.000"
+    lines = prelude + events + [cut] + ENDINGS[name]
+    assert verdict(MACHINES[name], lines) == bool(offsets and offsets[-1]), events
+
+
+# ---------------------------------------------------------------- the table with its Z differential
+
+@settings(max_examples=400, deadline=None)
+@given(teeth=st.integers(5, 120), speed=st.integers(1, 1000), factor=st.floats(0, 2 * MAX_DIFFERENTIAL),
+       feed=st.floats(0.1, MAX_FEED))
+def test_the_table_is_accepted_exactly_when_its_speed_with_the_z_term_is_within_the_machine(teeth, speed, factor,
+                                                                                          feed):
+    machine = MACHINES["hobber-840d"]
+    k, v = float(f"{factor:.6f}"), float(f"{feed:.1f}")
+    table = speed / teeth + k * v / 360.0                    # reference §A5, k in °/mm, v in mm/min
+    assume(abs(table - machine.table_speed_max) > 1e-6 and abs(speed / teeth - machine.table_speed_max) > 1e-6)
+    lines = (DIALECTS["hobber-840d"][0][:6] + ["EGDEF(C,B,1,Z,1)", f'EGON(C,"FINE",B,-1,{teeth},Z,{k:.6f},1)',
+                                                f"M3 S{speed}", f"G1 Z10.000 F{v:.1f}"] + ENDINGS["hobber-840d"])
+    accepted = 0 < v and k <= MAX_DIFFERENTIAL and table <= machine.table_speed_max
+    assert verdict(machine, lines) == accepted, lines
+
+
+# ---------------------------------------------------------------- arcs
+
+@settings(max_examples=400, deadline=None)
+@given(start_x=st.floats(150, 250), start_z=st.floats(-300, -100), end_x=st.floats(150, 250),
+       end_z=st.floats(-300, -100), radius=st.floats(0.01, 30), longer=st.booleans(), ccw=st.booleans())
+def test_an_arc_is_accepted_exactly_when_its_radius_reaches_half_its_chord(start_x, start_z, end_x, end_z, radius,
+                                                                          longer, ccw):
+    """X is a diameter: the chord runs over (ΔX/2, ΔZ). The arc stays inside lathe-iso's travel
+    (X 0…400, Z −600…200) for any radius up to 30 from these points: its centre lies within one
+    radius of its ends, its points within two (X as a radius 75 − 60 … 125 + 60)."""
+    values = [float(f"{value:.3f}") for value in (start_x, start_z, end_x, end_z, radius)]
+    sx, sz, ex, ez, r = values
+    half_chord = math.hypot((ex - sx) / 2.0, ez - sz) / 2.0
+    assume(abs(r + ARC_TOLERANCE - half_chord) > 1e-6)
+    arc = f"G0{3 if ccw else 2} X{ex:.3f} Z{ez:.3f} R{-r if longer else r:.3f}"
+    lines = DIALECTS["lathe-iso"][0] + [f"G00 X{sx:.3f} Z{sz:.3f}", arc] + ENDINGS["lathe-iso"]
+    assert verdict(MACHINES["lathe-iso"], lines) == (r + ARC_TOLERANCE >= half_chord), lines

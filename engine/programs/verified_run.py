@@ -12,5 +12,6 @@ from .verifier import verify_program
 def run_template(template: Template, params: dict, module_params: dict, machine: Machine) -> Result:
     """Evaluate the decision table and verify the program for the machine (engine.programs.verifier)."""
     result = compiled_template(template).run(params, module_params)
-    verify_program(result.lines, machine, str(params.get("program_name", "program")))
+    name = params.get("program_name") if isinstance(params, dict) else None
+    verify_program(result.lines, machine, name if isinstance(name, str) else None)
     return result

@@ -55,7 +55,7 @@ def _import(conn, path, machine, gear_class: str, options: ProfileOptions, alter
     drawing = read_drawing(path)
     with conn.transaction():
         job_id = conn.execute("SELECT nextval('job_id_seq')").fetchone()[0]
-        program_number = (job_id - 1) % ISO_PROGRAM_NUMBERS + 1    # the job id, wrapped into O0001 … O9999
+        program_number = (job_id - 1) % ISO_PROGRAM_NUMBERS + 1    # the job id, wrapped into O0001 … O8999
         job = turning_job(drawing, machine.name, gear_class, program_number, options, alternate, program_name)
         passes = job_passes(job.params, job.module_params)
         planned = plan_turning_job(conn, gear_class, machine, job.params, job.module_params, passes)

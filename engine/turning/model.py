@@ -19,7 +19,9 @@ from .names import MAX_OPERATIONS, MAX_TOOL
 from .operations import KINDS, JobGeometry, job_geometry, operation_passes
 from .params import FIX, bool_param, integer_param, number_param
 
-ISO_PROGRAM_NUMBERS = 9999     # O0001 … O9999
+# O0001 … O8999: O9000 … O9999 hold the machine builder's macros on Fanuc-type controls, so a
+# program stored there would replace one (the verifier refuses such a number too).
+ISO_PROGRAM_NUMBERS = 8999
 MAX_INFEED_ANGLE = 60.0        # degrees: half a 60° thread's flank angle is 30; beyond 60 the tool rubs
 # What each alternated operation must share with its partner: the passes of both run with A's rows.
 ALTERNATE_SHARED = (("prep", "tool"), ("prep", "tool_offset"), ("cutcond", "spindle_rpm"),
@@ -115,7 +117,9 @@ def check_operation_params(module_params: dict, n: int) -> None:
     prep, cutcond, cutmotion = (operation_module(module_params, t, n) for t in ("prep", "cutcond", "cutmotion"))
     where = {t: f"module_params.{key(t, n)}" for t in ("prep", "cutcond", "cutmotion")}
     integer_param(prep, "tool", where["prep"], 1, MAX_TOOL)
-    integer_param(prep, "tool_offset", where["prep"], 0, MAX_TOOL)
+    # offset 0 cancels the offset (reference §E: T0100, 840D D0): the tool would cut with the
+    # turret's position, not its tip's
+    integer_param(prep, "tool_offset", where["prep"], 1, MAX_TOOL)
     number_param(cutcond, "spindle_rpm", where["cutcond"], 0, above=True)
     bool_param(cutcond, "coolant", where["cutcond"])
     for t, values in (("prep", prep), ("cutcond", cutcond)):

@@ -1,8 +1,23 @@
-"""Lathe arcs (G2/G3 with a radius, X a diameter): the points of the arc farthest along Z and X
-must lie within the travel too, not only its end points."""
+"""Lathe arcs (G2/G3 with a radius, X a diameter): the radius must reach from one end to the
+other, and the points of the arc farthest along Z and X must lie within the travel too, not
+only its end points."""
 from __future__ import annotations
 
 import math
+
+from .refusals import Refused
+
+# mm by which half the chord may exceed the radius: the rounding of end points and radius to
+# three decimals moves them by less; a control alarms (or, worse, guesses a centre) beyond its own.
+ARC_TOLERANCE = 0.002
+
+
+def check_radius(start_x: float, start_z: float, end_x: float, end_z: float, radius: float) -> None:
+    """No circle of radius |R| passes through both ends if |R| is shorter than half the chord."""
+    half_chord = math.hypot((end_x - start_x) / 2.0, end_z - start_z) / 2.0
+    if abs(radius) + ARC_TOLERANCE < half_chord:
+        raise Refused(f"the arc's radius {abs(radius):g} is shorter than half its chord ({half_chord:.3f}): "
+                      "no circle of that radius passes through both ends")
 
 
 def arc_extremes(start, end, radius: float, ccw: bool) -> list[tuple[float, float]]:

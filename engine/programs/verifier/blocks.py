@@ -2,19 +2,36 @@
 word by word with the dialect's tables, and its shape checked: each address once, one G code of
 each modal group, G4/G25/G26 blocks with only their own words, an arc with its radius, a thread
 with its pitch, and every move with its motion G code in the same block (the verifier reads each
-block on its own, so it does not carry a modal G0/G1 over from earlier blocks)."""
+block on its own, so it does not carry a modal G0/G1 over from earlier blocks). What the block
+does to the machine state is kept as its events (engine.programs.verifier.machine_state): its G
+codes and keywords, which hold for its own motion, and its M codes and S, T, D words, which the
+motion must not wait for (when an M code is output, before or after the motion, is the machine
+builder's choice)."""
 from __future__ import annotations
 
 import re
 from dataclasses import dataclass
 
-from .grammar import ANGLE, AXES, BLOCK_SHAPES, CODE, MOTION, WORD_NEEDS_CODE, WORKING_AREA, Dialect
+from .grammar import (ANGLE, AXES, BLOCK_SHAPES, CODE, DWELL, MOTION, OFFSET, POINT_REASON, SPEED, TOOL,
+                      TOOL_AND_OFFSET, WORD_NEEDS_CODE, WORKING_AREA, Dialect)
+from .machine_state import OFFSET_OFF, OFFSET_ON, TOOL_CHANGE
 from .numbers import why_not_plain
 from .refusals import Refused
 from .words import READERS
 
 TOKEN = re.compile(r"([A-Z]+)(=?)(.*)")
 EQUALS_KINDS = frozenset({"position", "angle", "feed", "speed", "radius", "pitch"})
+
+
+def _offset(number: int) -> str:
+    return OFFSET_ON if number else OFFSET_OFF
+
+
+# The events of a word, by its kind: an S gives the spindle a speed; a T changes the tool; D (840D)
+# is the offset, D0 none; an ISO T<tool><offset> changes the tool and sets or cancels its offset.
+WORD_EVENTS = {SPEED: lambda value: ("S",), TOOL: lambda value: (TOOL_CHANGE,),
+               OFFSET: lambda number: (_offset(number),),
+               TOOL_AND_OFFSET: lambda number: (TOOL_CHANGE, _offset(number % 100))}
 
 
 @dataclass(frozen=True, slots=True)
@@ -25,34 +42,41 @@ class Block:
     area: str | None           # "lower" (G25) or "upper" (G26)
     positions: dict            # X/Y/Z of the block
     moves: bool                # the block moves an axis (X, Y, Z or the swivel A)
-    facts: frozenset           # what of the dialect's motion_needs the block sets (its G codes as "G25", keywords)
+    modal: frozenset           # its G codes ("G90") and keywords: they hold for the block's own motion
+    events: frozenset          # its M codes ("M3") and word events (S, tool change, offset on/off)
     speed: float | None        # S
+    feed: float | None         # F where it is a feed (not a G4 dwell's time)
+    needs: str | None          # the motion whose needs the block must meet ("G1"), if it moves
 
 
 def read_block(dialect: Dialect, code: str) -> Block:
     codes: dict[str, list] = {"G": [], "M": []}
-    values, keywords = {}, set()
+    values, keywords, events = {}, set(), []
     for token in code.split():
-        _read_token(dialect, token, codes, values, keywords)
+        _read_token(dialect, token, codes, values, keywords, events)
     groups = _groups(dialect, codes)
     _check_shape(dialect, codes, values, keywords)
-    return _block(dialect, codes["G"], groups, values, keywords)
+    return _block(dialect, codes, groups, values, keywords, events)
 
 
-def _block(dialect: Dialect, g_codes: list, groups: dict, values: dict, keywords: set) -> Block:
+def _block(dialect: Dialect, codes: dict, groups: dict, values: dict, keywords: set, events: list) -> Block:
     motion = area = None
-    for code in g_codes:
+    for code in codes["G"]:
         motion = code if groups[code] == MOTION else motion
         area = WORKING_AREA.get(code, area)
     positions = {axis: value for axis, value in values.items() if axis in AXES}
     moves = bool(positions) or any(dialect.addresses[address] == ANGLE for address in values)
     if moves and motion is None and area is None:
         raise Refused("a move without its G0/G1 (or G2/G3) in the same block: each block is verified on its own")
-    facts = frozenset([*(f"G{code}" for code in g_codes), *keywords]) & dialect.motion_needs
-    return Block(values, motion, area, positions, moves, facts, values.get("S"))
+    effects = dialect.state.effects.keys()     # only events that change the state are kept
+    modal = frozenset(effects & {*(f"G{code}" for code in codes["G"]), *keywords})
+    events = frozenset(effects & {*(f"M{code}" for code in codes["M"]), *events})
+    feed = None if DWELL in codes["G"] else values.get("F")
+    needs = f"G{motion}" if moves and area is None else None
+    return Block(values, motion, area, positions, moves, modal, events, values.get("S"), feed, needs)
 
 
-def _read_token(dialect: Dialect, token: str, codes: dict, values: dict, keywords: set) -> None:
+def _read_token(dialect: Dialect, token: str, codes: dict, values: dict, keywords: set, events: list) -> None:
     match = TOKEN.fullmatch(token)
     address, equals, text = match.groups() if match else ("", "", token)
     if address in dialect.keywords and not (equals or text):
@@ -64,6 +88,10 @@ def _read_token(dialect: Dialect, token: str, codes: dict, values: dict, keyword
     if equals or len(address) > 1:
         _check_equals(dialect, address, kind, equals)
     value = READERS[kind](address + equals, text)
+    if address in dialect.point_required and "." not in text:
+        raise Refused(f"{address}{text} {POINT_REASON}; write {address}{text}.")
+    if kind in WORD_EVENTS:
+        events.extend(WORD_EVENTS[kind](value))
     if kind == CODE:
         codes[address].append(value)
     elif address in values:

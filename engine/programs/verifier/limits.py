@@ -1,9 +1,11 @@
 """The machine's own limits (design notes §6): travel per axis, the spindle's maximum, the
-table's maximum speed. No program exceeding one is stored or written."""
+table's maximum speed, the feed a thread's lead and spindle speed make. No program exceeding
+one is stored or written."""
 from __future__ import annotations
 
 from ...gears.records import Machine
 from .refusals import LimitError, Refused
+from .words import MAX_FEED
 
 
 def outside_travel(axis: str, value: float, machine: Machine) -> str | None:
@@ -24,12 +26,23 @@ def check_spindle(speed: float, machine: Machine) -> None:
         raise Refused(f"spindle speed S{speed:g} exceeds {machine.name}'s {machine.spindle_max:g} r/min")
 
 
-def check_table(speed: float, ratio: float, machine: Machine) -> None:
-    """The table turns at n0·z0/z2 (reference §B4): the spindle speed times the EGON ratio."""
-    table_speed = speed * ratio
+def check_table(speed: float, ratio: float, machine: Machine, differential: tuple = ()) -> None:
+    """The table turns at n0·z0/z2 (reference §B4) plus, for each differential axis moving at v
+    mm/min with k degrees of C per mm, k·v/360 r/min (reference §A5: n_C = (z0/z2)·n_B ±
+    k_Y·v_Y ± k_Z·v_Z). `differential`: (axis, k, v) of each moving leading axis; the terms
+    are added as if their signs agreed, the most the table can turn."""
+    table_speed = speed * ratio + sum(factor * velocity / 360.0 for _, factor, velocity in differential)
     if machine.table_speed_max is not None and table_speed > machine.table_speed_max:
-        raise Refused(f"the table turns at {table_speed:.1f} r/min (S{speed:g} × {ratio:g}), above "
+        terms = "".join(f" + {axis} {factor:g}°/mm × {velocity:g} mm/min" for axis, factor, velocity in differential)
+        raise Refused(f"the table turns at {table_speed:.1f} r/min (S{speed:g} × {ratio:g}{terms}), above "
                       f"{machine.name}'s {machine.table_speed_max:g} r/min")
+
+
+def check_thread(lead: float, speed: float, word: str) -> None:
+    """A thread's tool travels lead × S mm/min along Z: at most the feed the verifier allows."""
+    if lead * speed > MAX_FEED:
+        raise Refused(f"the thread's lead {word}{lead:g} at S{speed:g} feeds {lead * speed:g} mm/min along Z, "
+                      f"above {MAX_FEED:g} (mm/min, about a rapid traverse)")
 
 
 def check_table_speed(gear_id, teeth: int, starts: int, hob_speed: float, machine: Machine) -> None:

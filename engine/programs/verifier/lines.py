@@ -23,6 +23,8 @@ class HeaderLine:
     kind = "header"
     what: str
     places: frozenset
+    name: str | None = None        # the program name it gives (%_N_<name>_MPF, ISO O<n> (<name>))
+    number: int | None = None      # the ISO program number
 
 
 @dataclass(frozen=True, slots=True)
@@ -65,8 +67,9 @@ def _read_fresh(dialect: Dialect, line: str):
 def _read(dialect: Dialect, line: str):
     check_characters(line)
     for header in dialect.headers:
-        if header.pattern.fullmatch(line):
-            return HeaderLine(header.what, header.places)
+        match = header.pattern.fullmatch(line)
+        if match:
+            return _header(header, match.groupdict())
     code = SPLIT_COMMENT[dialect.comment](line).strip()
     if not code:
         return COMMENT
@@ -78,6 +81,11 @@ def _read(dialect: Dialect, line: str):
     if statement and statement.group(1) in dialect.statements:
         return read_statement(*statement.groups())
     return read_block(dialect, code)
+
+
+def _header(header, groups: dict) -> HeaderLine:
+    number = groups.get("number")
+    return HeaderLine(header.what, header.places, groups.get("name"), int(number) if number else None)
 
 
 def _semicolon(line: str) -> str:

@@ -1,14 +1,15 @@
 """The electronic-gearbox statements of 840D hobbing (reference §A5), read argument by argument:
 `EGDEF(C,B,1[,Z,1][,Y,1])` defines the coupling of the table C to the hob spindle B (and the
 differential axes), `EGON(C,"FINE",B,z0,z2[,Z,num,den]…)` switches it on with the ratio z0/z2,
-`EGOFS(C)` switches it off, `EGDEL(C)` deletes it. The ratio is kept: with the spindle speed S it
-gives the table speed the machine record bounds."""
+`EGOFS(C)` switches it off, `EGDEL(C)` deletes it. The ratio and the differential factors are
+kept: with the spindle speed S and the feeds of Z and Y they give the table speed the machine
+record bounds (reference §A5: n_C = (z0/z2)·n_B ± k_Y·v_Y ± k_Z·v_Z)."""
 from __future__ import annotations
 
 import re
 from dataclasses import dataclass
 
-from .numbers import plain_decimal
+from .numbers import plain_decimal, whole_number
 from .refusals import Refused
 
 STATEMENT = re.compile(r"([A-Z]+)\((.*)\)")
@@ -17,7 +18,10 @@ HOB_SPINDLE = "B"                    # the hob spindle leads, always first
 LEADING_AXES = ("B", "Z", "Y")       # B; Z for the helical differential; Y for tangential feed
 COUPLING_TYPES = ("0", "1")          # 0 actual value, 1 setpoint
 EG_MODES = ('"NOC"', '"FINE"', '"COARSE"', '"IPOSTOP"')
-INTEGER = re.compile(r"[-+]?\d+")
+RATIO_DIGITS = 4                     # teeth and starts: no gear has 10,000 teeth
+# Degrees of C per mm of Z or Y: 360/lead (reference §B9, §B10), 0.494 °/mm for m 2, z 30,
+# β 15°. A full table turn per mm of travel is a lead of 1 mm, which no hobbed gear has.
+MAX_DIFFERENTIAL = 360.0
 
 
 @dataclass(frozen=True, slots=True)
@@ -26,6 +30,7 @@ class Statement:
     name: str
     leading: tuple = ()              # leading axes, in order
     ratio: float | None = None       # |z0/z2| of the hob spindle (EGON)
+    factors: tuple = ()              # (axis, |degrees of C per mm|) of Z and Y (EGON)
 
 
 def read_statement(name: str, arguments: str) -> Statement:
@@ -61,25 +66,34 @@ def _egon(name: str, arguments: list) -> Statement:
         raise Refused(f"{name}: after the mode come triples of a leading axis, numerator and denominator")
     leading = _leading(name, triples[0::3])
     ratio = _hob_ratio(name, triples[1], triples[2])
-    _differential_factors(name, triples[3:])
-    return Statement(name, leading, ratio)
+    return Statement(name, leading, ratio, _differential_factors(name, triples[3:]))
 
 
 def _hob_ratio(name: str, numerator: str, denominator: str) -> float:
     """z0/z2 of the hob spindle: whole numbers, the starts signed, the teeth above 0."""
-    if not (INTEGER.fullmatch(numerator) and denominator.isdecimal() and denominator.isascii()
-            and int(numerator) != 0 and int(denominator) > 0):
+    starts = whole_number(f"{name} hob starts ", numerator, RATIO_DIGITS)
+    teeth = whole_number(f"{name} teeth ", denominator, RATIO_DIGITS)
+    if starts == 0 or teeth <= 0 or denominator[0] in "+-":
         raise Refused(f"{name}: the hob ratio {numerator}/{denominator} must be whole numbers "
                       "±starts/teeth, neither 0")
-    return abs(int(numerator) / int(denominator))
+    return abs(starts / teeth)
 
 
-def _differential_factors(name: str, triples: list) -> None:
-    """Z and Y factors (degrees of C per mm): plain decimals over a denominator that is not 0."""
+def _differential_factors(name: str, triples: list) -> tuple:
+    """Z and Y factors (degrees of C per mm): plain decimals over a denominator that is not 0,
+    at most MAX_DIFFERENTIAL in size."""
+    factors = []
     for axis, numerator, denominator in zip(triples[0::3], triples[1::3], triples[2::3]):
-        plain_decimal(f"{name} {axis} factor ", numerator)
-        if plain_decimal(f"{name} {axis} denominator ", denominator) == 0:
+        top = plain_decimal(f"{name} {axis} factor ", numerator)
+        bottom = plain_decimal(f"{name} {axis} denominator ", denominator)
+        if bottom == 0:
             raise Refused(f"{name}: the {axis} factor's denominator is 0")
+        factor = abs(top / bottom)
+        if factor > MAX_DIFFERENTIAL:
+            raise Refused(f"{name}: the {axis} factor {numerator}/{denominator} is {factor:.6g}°/mm, above "
+                          f"{MAX_DIFFERENTIAL:g}°/mm (a lead shorter than 1 mm): no hobbed gear has it")
+        factors.append((axis, factor))
+    return tuple(factors)
 
 
 def _off(name: str, arguments: list) -> Statement:

@@ -1,0 +1,152 @@
+"""What the machine must be doing before it moves, per dialect, as data, and the state the walk
+keeps to know it.
+
+A position is right only in the state it is read in: a move in unstated units or positioning
+is read in whatever the last program left; a cut with the hob spindle stopped, or with the
+table not coupled to it, breaks the hob; a cut with no tool offset active moves the turret,
+not the tool tip, to the position (reference §E: T0100 cancels the offset); a feed in an
+unstated mode is whatever the last program left. So every event of a line (a G or
+M code, a keyword, a statement, an S, T or D word) sets or clears facts, and every motion and
+statement needs facts to hold (or not to hold) before it. M30 ends the program: nothing after
+it is read by the control, so nothing may follow (but the ISO closing %).
+
+EGDEL(C) at the end of a hobbing program (design notes §7) is not yet needed: the seeded
+hobbing templates do not emit it."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from .refusals import Refused
+
+SPINDLE_SPEED, SPINDLE_TURNING, TOOL_OFFSET = "spindle speed", "spindle turning", "tool offset"
+COUPLING_DEFINED, COUPLED, ENDED = "coupling defined", "coupled", "ended"
+TOOL_CHANGE, OFFSET_ON, OFFSET_OFF = "tool change", "offset on", "offset off"
+
+
+@dataclass(frozen=True)
+class Effect:
+    """What one event does: facts it sets and facts it clears (a block's clears come first)."""
+    sets: frozenset = frozenset()
+    clears: frozenset = frozenset()
+
+
+@dataclass(frozen=True)
+class Need:
+    """A fact that must hold before a motion or statement (or, not `present`, must not)."""
+    fact: str
+    reason: str
+    present: bool = True
+
+
+class Needs:
+    """The needs of one motion or statement, in the order they are said, and as sets to test."""
+
+    def __init__(self, *needs: Need):
+        self.needs = needs
+        self.required = frozenset(need.fact for need in needs if need.present)
+        self.forbidden = frozenset(need.fact for need in needs if not need.present)
+
+    def __add__(self, other: "Needs") -> "Needs":
+        return Needs(*self.needs, *other.needs)
+
+    def check(self, facts: set) -> None:
+        if self.required <= facts and not self.forbidden & facts:
+            return
+        raise Refused(next(need.reason for need in self.needs if (need.fact in facts) != need.present))
+
+
+@dataclass(frozen=True)
+class StateRules:
+    effects: dict        # event -> Effect
+    needs: dict          # "G1" (a block moving with G1), "EGDEF" … -> Needs
+
+
+def stated(*codes: int) -> dict:
+    """Modal G codes that, once a block gives them, hold for the rest of the program."""
+    return {f"G{code}": Effect(sets=frozenset({f"G{code}"})) for code in codes}
+
+
+def needs_stated(*codes: int) -> Needs:
+    return Needs(*(Need(f"G{code}", f"motion before G{code} ({STATED_CODES[code]}) is stated: the control would "
+                                    "keep whatever the last program left") for code in codes))
+
+
+STATED_CODES = {71: "mm", 21: "mm", 90: "absolute positions", 94: "feed in mm/min", 98: "feed in mm/min",
+                18: "the ZX plane of the arcs", 40: "no tool-nose radius compensation",
+                97: "spindle speed in r/min"}
+
+SPINDLE = {"S": Effect(sets=frozenset({SPINDLE_SPEED})), "M3": Effect(sets=frozenset({SPINDLE_TURNING})),
+           "M5": Effect(clears=frozenset({SPINDLE_TURNING}))}
+END = {"M30": Effect(sets=frozenset({ENDED}))}
+SPINDLE_NEEDS = Needs(
+    Need(SPINDLE_SPEED, "a cut before any spindle speed S: the spindle would turn at whatever S the control holds"),
+    Need(SPINDLE_TURNING, "a cut with the spindle stopped: M3 with S above 0 first, and no M5 since"))
+# 840D: a tool change T activates the edge the machine data chooses, so only a D in the same
+# block or after it says the offset; D0 deselects it. ISO T<tool><offset>: offset 00 cancels.
+OFFSETS = {TOOL_CHANGE: Effect(clears=frozenset({TOOL_OFFSET})), OFFSET_ON: Effect(sets=frozenset({TOOL_OFFSET})),
+           OFFSET_OFF: Effect(clears=frozenset({TOOL_OFFSET}))}
+OFFSET_NEEDS = Needs(Need(TOOL_OFFSET, "a cut with no tool offset active (T…D0, T0100, or a T without its D): "
+                                       "the position would be the turret's, not the tool tip's"))
+
+AREA_REASON = "motion before G25/G26 and WALIMON set the working area"
+AREA_NEEDS = Needs(*(Need(fact, AREA_REASON) for fact in ("G25", "G26", "WALIMON")))
+COUPLING = {"EGDEF": Effect(sets=frozenset({COUPLING_DEFINED})), "EGON": Effect(sets=frozenset({COUPLED})),
+            "EGOFS": Effect(clears=frozenset({COUPLED})), "EGDEL": Effect(clears=frozenset({COUPLED, COUPLING_DEFINED}))}
+HOB_MOVE_NEEDS = AREA_NEEDS + needs_stated(90, 71)
+HOB_CUT_NEEDS = HOB_MOVE_NEEDS + needs_stated(94) + SPINDLE_NEEDS + Needs(
+    Need(COUPLED, "a cut with the table not coupled to the hob: EGON(C,…) first, and no EGOFS(C) since"))
+
+HOBBING_STATE = StateRules(
+    effects={**stated(25, 26, 71, 90, 94), "WALIMON": Effect(sets=frozenset({"WALIMON"})), **SPINDLE, **END, **COUPLING},
+    needs={"G0": HOB_MOVE_NEEDS, "G1": HOB_CUT_NEEDS,
+           "EGDEF": Needs(Need(COUPLING_DEFINED, "EGDEF(C…) while C's coupling is defined: EGDEL(C) first (reference "
+                                                 "§A7: a second definition alarms)", present=False)),
+           "EGON": Needs(Need(COUPLING_DEFINED, "EGON before EGDEF defined the coupling")),
+           "EGOFS": Needs(),
+           "EGDEL": Needs(Need(COUPLED, "EGDEL(C) while the coupling is on: EGOFS(C) first", present=False))},
+)
+
+LATHE_840D_MOVE = Needs(Need("DIAMON", "motion before DIAMON: X would be a radius, and the travel is checked as a "
+                                      "diameter")) + needs_stated(71, 90)
+LATHE_840D_THREAD = LATHE_840D_MOVE + needs_stated(18, 40, 97) + SPINDLE_NEEDS + OFFSET_NEEDS
+LATHE_840D_CUT = LATHE_840D_THREAD + needs_stated(94)
+LATHE_840D_STATE = StateRules(
+    effects={**stated(18, 40, 71, 90, 94, 97), "DIAMON": Effect(sets=frozenset({"DIAMON"})), **SPINDLE, **END, **OFFSETS},
+    needs={"G0": LATHE_840D_MOVE, "G1": LATHE_840D_CUT, "G2": LATHE_840D_CUT, "G3": LATHE_840D_CUT,
+           "G33": LATHE_840D_THREAD},
+)
+
+LATHE_ISO_MOVE = needs_stated(21, 90)
+LATHE_ISO_THREAD = LATHE_ISO_MOVE + needs_stated(18, 40, 97) + SPINDLE_NEEDS + OFFSET_NEEDS
+LATHE_ISO_CUT = LATHE_ISO_THREAD + needs_stated(98)
+LATHE_ISO_STATE = StateRules(
+    effects={**stated(18, 21, 40, 90, 97, 98), **SPINDLE, **END, **OFFSETS},
+    needs={"G0": LATHE_ISO_MOVE, "G1": LATHE_ISO_CUT, "G2": LATHE_ISO_CUT, "G3": LATHE_ISO_CUT, "G32": LATHE_ISO_THREAD},
+)
+
+
+class State:
+    """The facts that hold after the lines so far."""
+
+    def __init__(self, rules: StateRules):
+        self.rules = rules
+        self.facts: set = set()
+
+    def apply(self, events: frozenset) -> None:
+        effects = [self.rules.effects[event] for event in events if event in self.rules.effects]
+        for effect in effects:
+            self.facts -= effect.clears
+        for effect in effects:
+            self.facts |= effect.sets
+
+    def check(self, what: str) -> None:
+        """Refused unless what `what` (a motion "G1", a statement "EGDEF") needs holds; a motion no
+        rule speaks of is refused too."""
+        needs = self.rules.needs.get(what)
+        if needs is None:
+            raise Refused(f"no rule of this dialect says what {what} needs; it is not verified")
+        needs.check(self.facts)
+
+    @property
+    def ended(self) -> bool:
+        return ENDED in self.facts
