@@ -70,6 +70,21 @@ def test_a_template_row_emitting_a_huge_hob_ratio_stores_nothing(run, tmp_path):
     assert programs(run.url) == before and list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.parametrize("digits", [4400, 400])
+def test_a_job_parameter_of_thousands_of_digits_is_refused_in_one_line(run, tmp_path, digits):
+    made = run("instantiate", "--gear", 42, "--json")
+    assert made.exit_code == 0, made.output
+    with psycopg.connect(run.url) as conn:
+        job = conn.execute("SELECT max(id) FROM job").fetchone()[0]
+        conn.execute("UPDATE job SET params = jsonb_set(params, '{z2}', ('1' || repeat('0', %s))::jsonb) "
+                     "WHERE id = %s", (digits, job))
+    before = programs(run.url)
+    for args in (("--job", job), ("--jobs", f"{job}-{job}")):
+        message = one_line_exit_1(run("instantiate", *args, "--out", tmp_path))
+        assert f"{digits + 1} digits" in message and "correct it in SQL" in message
+        assert programs(run.url) == before and list(tmp_path.iterdir()) == []
+
+
 # ---------------------------------------------------------------- 2. the machine state before a cut
 
 @pytest.mark.parametrize("body, reason", [

@@ -66,13 +66,18 @@ def _create_database(admin_url: str, database: str) -> None:
 
 
 def connect(database_url: str | None = None, **kwargs):
-    """A psycopg connection to the resolved database."""
+    """A psycopg connection to the resolved database; its JSON numbers are read bounded
+    (engine.db.json_numbers)."""
     import psycopg
+
+    from .json_numbers import read_bounded_json
 
     url = resolve_url(database_url)
     try:
-        return psycopg.connect(url, **kwargs)
+        conn = psycopg.connect(url, **kwargs)
     except psycopg.OperationalError as error:
         where = url or "the server named by the PG* variables"
         first_line = str(error).strip().splitlines()[0] if str(error).strip() else type(error).__name__
         raise EngineError(f"cannot connect to {where}: {first_line}") from error
+    read_bounded_json(conn)
+    return conn
