@@ -106,6 +106,25 @@ def test_an_existing_file_is_replaced_only_with_force(run, tmp_path):
     assert everything_under(tmp_path) == ["GEAR42.MPF", "GEAR43.MPF", "GEAR44.MPF"]
 
 
+@pytest.mark.parametrize("out", ["newdir/", "newdir"])
+def test_a_batch_of_one_program_writes_into_the_folder_out_made_if_missing(run, tmp_path, out):
+    made = run("instantiate", "--gears", "42-42", "--out", f"{tmp_path}/{out}")
+    assert made.exit_code == 0, made.output
+    assert (tmp_path / "newdir").is_dir() and everything_under(tmp_path / "newdir") == ["GEAR42.MPF"]
+    with psycopg.connect(run.url) as conn:
+        job = conn.execute("SELECT max(id) FROM job").fetchone()[0]
+    again = run("instantiate", "--jobs", f"{job}-{job}", "--out", f"{tmp_path}/again{out.removeprefix('newdir')}")
+    assert again.exit_code == 0, again.output
+    assert everything_under(tmp_path / "again") == ["GEAR42.MPF"]
+    assert (tmp_path / "again" / "GEAR42.MPF").read_bytes() == latest_text(run.url, "GEAR42")
+
+
+def test_one_program_goes_into_a_folder_out_ending_with_a_slash_else_into_the_file_out(run, tmp_path):
+    assert run("instantiate", "--gear", 42, "--out", f"{tmp_path}/folder/").exit_code == 0
+    assert run("instantiate", "--gear", 42, "--out", tmp_path / "GEAR42.MPF").exit_code == 0
+    assert everything_under(tmp_path) == ["GEAR42.MPF", "folder", "folder/GEAR42.MPF"]
+
+
 def test_a_file_naming_the_same_program_in_other_case_is_never_replaced(run, tmp_path):
     (tmp_path / "gear42.MPF").write_text("; written by hand\n")
     before = program_count(run.url)

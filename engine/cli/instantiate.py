@@ -28,8 +28,8 @@ def parse_range(text: str, option: str = "--gears") -> tuple[int, int]:
 @click.option("--gears", "gear_range", help="Batch: gear ids FIRST-LAST (all stored, or none).")
 @click.option("--jobs", "job_range", help="Batch: stored job ids FIRST-LAST made again with their stored parameters.")
 @click.option("--all", "all_gears", is_flag=True, help="Batch: every gear.")
-@click.option("--out", type=click.Path(), help="Write the .MPF file here (a directory for batches), after the "
-              "programs are committed.")
+@click.option("--out", type=click.Path(), help="Write the .MPF file here after the programs are committed: a "
+              "batch always into this folder (made if missing), one program into it if it is a folder or ends with /.")
 @click.option("--force", is_flag=True, help="Replace files that exist in --out (else nothing is stored).")
 @click.option("--machine", help="Machine record (default hobber-840d).")
 @click.option("--cuts", type=click.IntRange(1, 2), help="1 = single cut, 2 = rough then finish (default by module).")

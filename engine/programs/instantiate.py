@@ -130,7 +130,7 @@ def instantiate_gears(conn, first: int | None = None, last: int | None = None, *
     """All gears with first ≤ id ≤ last: all programs stored, or none (the first failure names its gear),
     and their files written after the COMMIT. With workers > 1 the gears are planned in that many
     processes (engine.programs.workers)."""
-    with files_after_commit(conn, out, force) as files:
+    with files_after_commit(conn, out, force, batch=True) as files:
         planner = Planner(conn, machine, choices, overrides)
         gears = load_gears(conn, first, last)
         if not gears:

@@ -36,11 +36,15 @@ PROC_FD = Path("/proc/self/fd")
 
 
 class ProgramFiles:
-    """The files of one run: checked when planned (before storing), written after the COMMIT."""
+    """The files of one run: checked when planned (before storing), written after the COMMIT.
+    A batch (--gears, --jobs, --all) always writes into the folder --out, made if missing, however
+    many programs it makes; one program is written to the file --out unless --out is a folder
+    or ends with /."""
 
-    def __init__(self, out, force: bool = False):
+    def __init__(self, out, force: bool = False, batch: bool = False):
         self.out = Path(out) if out is not None else None
         self.force = force
+        self.folder = batch or (out is not None and str(out).endswith(os.sep))
         self.texts: dict[Path, bytes] = {}
 
     def plan(self, programs: list[tuple[str, list[str]]]) -> dict[str, str]:
@@ -54,11 +58,11 @@ class ProgramFiles:
         return {name: str(path) for name, path in paths.items()}
 
     def _targets(self, names: list[str]) -> dict[str, Path]:
-        """One program: --out is the file (unless it is a folder); several: --out is their folder."""
-        if len(names) == 1 and not self.out.is_dir():
+        """One program: --out is the file (unless a folder is meant); a batch: --out is their folder."""
+        if len(names) == 1 and not self.folder and not self.out.is_dir():
             return {names[0]: self.out}
         if self.out.exists() and not self.out.is_dir():
-            raise EngineError(f"--out {self.out} is a file; give a directory for a batch of programs")
+            raise EngineError(f"--out {self.out} is a file; give a folder for a batch of programs")
         _refuse_same_program_twice(names, self.out)
         return {name: _inside(self.out, name) for name in names}
 
@@ -95,11 +99,11 @@ class ProgramFiles:
 
 
 @contextlib.contextmanager
-def files_after_commit(conn, out, force: bool = False):
+def files_after_commit(conn, out, force: bool = False, batch: bool = False):
     """Yield ProgramFiles for the block, which runs in a transaction that commits for real when
     the block ends; only then are the planned files written. Without --out (out None) the block
     may run inside the caller's transaction (a savepoint), as nothing is written."""
-    files = ProgramFiles(out, force)
+    files = ProgramFiles(out, force, batch)
     if out is not None and conn.info.transaction_status != TransactionStatus.IDLE:
         raise EngineError("program files are written only after their programs are committed, but this "
                           "connection is inside a transaction its caller commits: commit first, or store without --out")

@@ -64,7 +64,7 @@ def instantiate_jobs(conn, first: int | None = None, last: int | None = None, *,
                      out: str | Path | None = None, force: bool = False, progress=None) -> Batch:
     """Every stored job with first ≤ id ≤ last made again: all programs stored, or none (the first
     failure names its job), and their files written after the COMMIT."""
-    with files_after_commit(conn, out, force) as files:
+    with files_after_commit(conn, out, force, batch=True) as files:
         jobs = conn.execute(f"SELECT {JOB_COLUMNS} FROM job WHERE id BETWEEN %s AND %s ORDER BY id",
                             (first if first is not None else 0, last if last is not None else 2**62)).fetchall()
         if not jobs:
