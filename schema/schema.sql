@@ -178,6 +178,8 @@ CREATE TABLE hob (
     purpose        text NOT NULL DEFAULT 'cylindrical' CHECK (purpose IN ('cylindrical', 'worm_wheel')),
     CONSTRAINT hob_safe_id CHECK (safe_name('hob', id))
 );
+-- One hob per id whatever its case (migration 0011): H-M2-AA-R1 and h-m2-aa-r1 are one hob.
+CREATE UNIQUE INDEX hob_id_ignoring_case ON hob (upper(id));
 
 -- Workpieces (design notes §9 columns).
 CREATE TABLE gear (

@@ -285,6 +285,34 @@ def test_an_import_with_an_unknown_column_is_refused(run, tmp_path):
     assert "unknown column(s) 'diameter'" in result.stderr and "missing required column(s)" in result.stderr
 
 
+HEADER = "id,module,pressure_angle,starts,tip_diameter,length,hand,accuracy_class\n"
+
+
+@pytest.mark.parametrize("rows, words", [
+    ("h-m2-aa-r1,2,20,1,70,150,R,AA\n", "hob h-m2-aa-r1 is hob H-M2-AA-R1 of the library"),
+    ("H-M9-A-R1,9,20,1,170,200,R,A\nh-m9-a-r1,9,20,1,170,200,R,A\n", "id h-m9-a-r1 is already on line 2"),
+])
+def test_an_import_of_a_hob_id_differing_only_in_case_is_refused(run, tmp_path, rows, words):
+    path = tmp_path / "hobs.csv"
+    path.write_text(HEADER + rows, encoding="utf-8")
+    before = hob_rows(run.url)
+    result = run("hobs", "import", path)
+    assert result.exit_code == 1, result.output
+    assert words in result.stderr and "ids that differ only in case name one hob" in result.stderr
+    assert hob_rows(run.url) == before
+
+
+def test_an_added_hob_id_differing_only_in_case_is_refused_and_so_is_it_in_sql(run):
+    before = hob_rows(run.url)
+    result = run("hobs", "add", "--id", "h-m2-aa-r1", "--module", 2, "--tip-diameter", 70, "--length", 100,
+                 "--hand", "R", "--accuracy-class", "AA")
+    assert result.exit_code == 1 and "hob h-m2-aa-r1 is hob H-M2-AA-R1 of the library" in result.stderr
+    with pytest.raises(psycopg.errors.UniqueViolation, match="hob_id_ignoring_case"):
+        execute(run.url, "INSERT INTO hob (id, module, starts, tip_diameter, length, hand, accuracy_class) "
+                         "VALUES ('h-m2-aa-r1', 2, 1, 70, 100, 'R', 'AA')")
+    assert hob_rows(run.url) == before
+
+
 def test_match_names_the_hob_of_the_seeded_gear_42(run):
     # gear 42: m 2, α 20°, grade 7 (needs AA), spur → H-M2-AA-R1 (the paper's 1-start AA hob).
     result = run("hobs", "match", "--gear", 42)

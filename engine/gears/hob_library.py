@@ -142,8 +142,9 @@ def add_hob(conn: psycopg.Connection, hob: Hob) -> None:
     if problems:
         raise EngineError(f"hob {said('hob', hob.id) if hob.id else '(no id)'}: {'; '.join(problems)}; nothing stored")
     exists = f"hob {values['id']} already exists; choose another id, or change it with `engine hobs import FILE.csv`"
-    if conn.execute("SELECT 1 FROM hob WHERE id = %s", (values["id"],)).fetchone():
-        raise EngineError(exists)
+    found = conn.execute("SELECT id FROM hob WHERE upper(id) = upper(%s)", (values["id"],)).fetchone()
+    if found:
+        raise EngineError(exists if found[0] == values["id"] else _same_but_case(values["id"], found[0]))
     try:
         with conn.transaction():
             conn.execute(_INSERT, [values[name] for name in COLUMN_NAMES])
@@ -188,10 +189,13 @@ def read_hobs(path: str | Path) -> list[dict[str, Any]]:
     hobs, problems, bad_lines, first_line = [], [], set(), {}
     for line, cells in records[1:]:
         hob, row_problems = _row(names, cells)
-        if hob["id"] in first_line:
-            row_problems.append(f"id {hob['id']} is already on line {first_line[hob['id']]}")
-        elif hob["id"] is not None:
-            first_line[hob["id"]] = line
+        folded = hob["id"].upper() if hob["id"] is not None else None
+        if folded in first_line:
+            earlier, earlier_id = first_line[folded]
+            case = f" as {earlier_id} (ids that differ only in case name one hob)" if earlier_id != hob["id"] else ""
+            row_problems.append(f"id {hob['id']} is already on line {earlier}{case}")
+        elif folded is not None:
+            first_line[folded] = (line, hob["id"])
         problems += [f"line {line}: {problem}" for problem in row_problems]
         bad_lines |= {line} if row_problems else set()
         hobs.append(hob)
@@ -204,6 +208,10 @@ def import_hobs(conn: psycopg.Connection, path: str | Path) -> HobImport:
     """Insert or update (by id) every hob of the CSV file at `path`, all or nothing."""
     hobs = read_hobs(path)
     ids = [hob["id"] for hob in hobs]
+    twin = conn.execute("SELECT id, new FROM hob, unnest(%s::text[]) AS new WHERE upper(id) = upper(new) AND id <> new "
+                        "LIMIT 1", (ids,)).fetchone()
+    if twin:
+        raise EngineError(f"{path}: {_same_but_case(twin[1], twin[0])}; nothing imported")
     try:
         with conn.transaction():
             existing = conn.execute("SELECT count(*) FROM hob WHERE id = ANY(%s)", (ids,)).fetchone()[0]
@@ -213,6 +221,11 @@ def import_hobs(conn: psycopg.Connection, path: str | Path) -> HobImport:
         raise EngineError(f"{path}: the database refused the hobs "
                           f"({error.diag.message_primary or error}); nothing imported") from error
     return HobImport(added=len(ids) - existing, updated=existing)
+
+
+def _same_but_case(given: str, stored: str) -> str:
+    """A hob id is one hob whatever its case (an operator reading `; HOB …` cannot tell them apart)."""
+    return f"hob {given} is hob {stored} of the library (ids that differ only in case name one hob); use {stored}"
 
 
 # --- matching ----------------------------------------------------------------------------
