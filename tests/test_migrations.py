@@ -106,3 +106,23 @@ def test_concurrent_migrate_runs_apply_each_migration_once(empty_database_url):
         thread.join()
     assert errors == []
     assert sorted(applied) == sorted(m.version for m in discover())
+
+
+def test_hob_ids_differing_only_in_case_stop_migration_0011_with_their_names(empty_database_url, tmp_path):
+    folder = copy_migrations(tmp_path)
+    later = [path for path in folder.glob("*.sql") if path.name >= "0011"]
+    held = {path.name: path.read_text() for path in later}
+    for path in later:
+        path.unlink()
+    hob = ("INSERT INTO hob (id, module, starts, tip_diameter, length, hand, accuracy_class) "
+           "VALUES (%s, 2, 1, 70, 100, 'R', 'AA')")
+    with psycopg.connect(empty_database_url) as conn:
+        migrate(conn, folder)
+        for hob_id in ("H-M2-AA-R1", "h-m2-aa-r1", "H-OTHER"):
+            conn.execute(hob, (hob_id,))
+        conn.commit()
+        for name, text in held.items():
+            (folder / name).write_text(text)
+        with pytest.raises(EngineError, match=r'0011\.hob_ids_ignore_case\.sql failed.*"H-M2-AA-R1" and "h-m2-aa-r1"'):
+            migrate(conn, folder)
+        assert conn.execute("SELECT count(*) FROM hob").fetchone()[0] == 3

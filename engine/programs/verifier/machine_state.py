@@ -30,6 +30,14 @@ class Effect:
     clears: frozenset = frozenset()
 
 
+def sets(*facts: str) -> Effect:
+    return Effect(sets=frozenset(facts))
+
+
+def clears(*facts: str) -> Effect:
+    return Effect(clears=frozenset(facts))
+
+
 @dataclass(frozen=True)
 class Need:
     """A fact that must hold before a motion or statement (or, not `present`, must not)."""
@@ -63,7 +71,7 @@ class StateRules:
 
 def stated(*codes: int) -> dict:
     """Modal G codes that, once a block gives them, hold for the rest of the program."""
-    return {f"G{code}": Effect(sets=frozenset({f"G{code}"})) for code in codes}
+    return {f"G{code}": sets(f"G{code}") for code in codes}
 
 
 def needs_stated(*codes: int) -> Needs:
@@ -75,29 +83,27 @@ STATED_CODES = {71: "mm", 21: "mm", 90: "absolute positions", 94: "feed in mm/mi
                 18: "the ZX plane of the arcs", 40: "no tool-nose radius compensation",
                 97: "spindle speed in r/min"}
 
-SPINDLE = {"S": Effect(sets=frozenset({SPINDLE_SPEED})), "M3": Effect(sets=frozenset({SPINDLE_TURNING})),
-           "M5": Effect(clears=frozenset({SPINDLE_TURNING}))}
-END = {"M30": Effect(sets=frozenset({ENDED}))}
+SPINDLE = {"S": sets(SPINDLE_SPEED), "M3": sets(SPINDLE_TURNING), "M5": clears(SPINDLE_TURNING)}
+END = {"M30": sets(ENDED)}
 SPINDLE_NEEDS = Needs(
     Need(SPINDLE_SPEED, "a cut before any spindle speed S: the spindle would turn at whatever S the control holds"),
     Need(SPINDLE_TURNING, "a cut with the spindle stopped: M3 with S above 0 first, and no M5 since"))
 # 840D: a tool change T activates the edge the machine data chooses, so only a D in the same
 # block or after it says the offset; D0 deselects it. ISO T<tool><offset>: offset 00 cancels.
-OFFSETS = {TOOL_CHANGE: Effect(clears=frozenset({TOOL_OFFSET})), OFFSET_ON: Effect(sets=frozenset({TOOL_OFFSET})),
-           OFFSET_OFF: Effect(clears=frozenset({TOOL_OFFSET}))}
+OFFSETS = {TOOL_CHANGE: clears(TOOL_OFFSET), OFFSET_ON: sets(TOOL_OFFSET), OFFSET_OFF: clears(TOOL_OFFSET)}
 OFFSET_NEEDS = Needs(Need(TOOL_OFFSET, "a cut with no tool offset active (T…D0, T0100, or a T without its D): "
                                        "the position would be the turret's, not the tool tip's"))
 
 AREA_REASON = "motion before G25/G26 and WALIMON set the working area"
 AREA_NEEDS = Needs(*(Need(fact, AREA_REASON) for fact in ("G25", "G26", "WALIMON")))
-COUPLING = {"EGDEF": Effect(sets=frozenset({COUPLING_DEFINED})), "EGON": Effect(sets=frozenset({COUPLED})),
-            "EGOFS": Effect(clears=frozenset({COUPLED})), "EGDEL": Effect(clears=frozenset({COUPLED, COUPLING_DEFINED}))}
+COUPLING = {"EGDEF": sets(COUPLING_DEFINED), "EGON": sets(COUPLED),
+            "EGOFS": clears(COUPLED), "EGDEL": clears(COUPLED, COUPLING_DEFINED)}
 HOB_MOVE_NEEDS = AREA_NEEDS + needs_stated(90, 71)
 HOB_CUT_NEEDS = HOB_MOVE_NEEDS + needs_stated(94) + SPINDLE_NEEDS + Needs(
     Need(COUPLED, "a cut with the table not coupled to the hob: EGON(C,…) first, and no EGOFS(C) since"))
 
 HOBBING_STATE = StateRules(
-    effects={**stated(25, 26, 71, 90, 94), "WALIMON": Effect(sets=frozenset({"WALIMON"})), **SPINDLE, **END, **COUPLING},
+    effects={**stated(25, 26, 71, 90, 94), "WALIMON": sets("WALIMON"), **SPINDLE, **END, **COUPLING},
     needs={"G0": HOB_MOVE_NEEDS, "G1": HOB_CUT_NEEDS,
            "EGDEF": Needs(Need(COUPLING_DEFINED, "EGDEF(C…) while C's coupling is defined: EGDEL(C) first (reference "
                                                  "§A7: a second definition alarms)", present=False)),
@@ -111,7 +117,7 @@ LATHE_840D_MOVE = Needs(Need("DIAMON", "motion before DIAMON: X would be a radiu
 LATHE_840D_THREAD = LATHE_840D_MOVE + needs_stated(18, 40, 97) + SPINDLE_NEEDS + OFFSET_NEEDS
 LATHE_840D_CUT = LATHE_840D_THREAD + needs_stated(94)
 LATHE_840D_STATE = StateRules(
-    effects={**stated(18, 40, 71, 90, 94, 97), "DIAMON": Effect(sets=frozenset({"DIAMON"})), **SPINDLE, **END, **OFFSETS},
+    effects={**stated(18, 40, 71, 90, 94, 97), "DIAMON": sets("DIAMON"), **SPINDLE, **END, **OFFSETS},
     needs={"G0": LATHE_840D_MOVE, "G1": LATHE_840D_CUT, "G2": LATHE_840D_CUT, "G3": LATHE_840D_CUT,
            "G33": LATHE_840D_THREAD},
 )
@@ -121,7 +127,8 @@ LATHE_ISO_THREAD = LATHE_ISO_MOVE + needs_stated(18, 40, 97) + SPINDLE_NEEDS + O
 LATHE_ISO_CUT = LATHE_ISO_THREAD + needs_stated(98)
 LATHE_ISO_STATE = StateRules(
     effects={**stated(18, 21, 40, 90, 97, 98), **SPINDLE, **END, **OFFSETS},
-    needs={"G0": LATHE_ISO_MOVE, "G1": LATHE_ISO_CUT, "G2": LATHE_ISO_CUT, "G3": LATHE_ISO_CUT, "G32": LATHE_ISO_THREAD},
+    needs={"G0": LATHE_ISO_MOVE, "G1": LATHE_ISO_CUT, "G2": LATHE_ISO_CUT, "G3": LATHE_ISO_CUT,
+           "G32": LATHE_ISO_THREAD},
 )
 
 
