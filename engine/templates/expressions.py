@@ -75,7 +75,44 @@ def compile_expression(text: str, translations: Mapping[str, str] | None = None)
     if is_sql:
         tree = ast.Expression(body=ast.Call(ast.Name("_sql_truth", ast.Load()), [tree.body], []))
     ast.fix_missing_locations(tree)
+    _check_constant_parts(tree.body, text.strip() if not is_sql else None, is_sql)
     return Compiled(text, tree.body, names, is_sql, tuple(sorted(names)))
+
+
+# Nodes that compute: a part of an expression made of these and constants has one value for every job.
+_COMPUTING = (ast.BinOp, ast.UnaryOp, ast.BoolOp, ast.Compare, ast.IfExp, ast.Call, ast.JoinedStr, ast.Tuple,
+              ast.List, ast.Subscript)
+
+
+def _check_constant_parts(tree: ast.expr, source: str | None, is_sql: bool) -> None:
+    """Every part that reads no parameter (`[[0] * 65536] * 65536`, `10 ** 10 ** 6`) is evaluated
+    here, under the bounds of one instantiation: one that fails would fail for every job, so the
+    template is refused where it enters (import, lint, compile), not at its first job."""
+    from .evaluator import EvaluationError, evaluate_part   # asteval: only where a template is compiled
+
+    for part in _constant_parts(tree):
+        text = (ast.get_source_segment(source, part) if source else None) or "a part without parameters"
+        try:
+            evaluate_part(part, text, is_sql)
+        except EvaluationError as error:
+            what = "it" if part is tree or text == source else text
+            raise ExpressionError(f"{what} fails for every job: {error}") from None
+
+
+def _constant_parts(tree: ast.expr):
+    """The largest computing parts of `tree` that read no parameter."""
+    pending = [tree]
+    while pending:
+        node = pending.pop()
+        if isinstance(node, _COMPUTING) and not any(
+                isinstance(inner, ast.Name) and _is_parameter(inner.id) for inner in ast.walk(node)):
+            yield node
+        else:
+            pending.extend(ast.iter_child_nodes(node))
+
+
+def _is_parameter(name: str) -> bool:
+    return name not in FUNCTIONS and name not in CONSTANTS and not name.startswith("_")
 
 
 def _parsed(text: str, mode: str) -> ast.AST:
@@ -180,6 +217,8 @@ def _check_tree(tree: ast.AST, sql_helpers: bool = False) -> None:
             _check_spec_fields(node.format_spec)
         if isinstance(node, ast.Call):
             _check_call(node, sql_helpers)
+        if _formats_with_percent(node):
+            raise ExpressionError("'%' string formatting is not allowed; use an f-string")
         if isinstance(node, ast.Name):
             _check_name(node.id, sql_helpers)
     if count > MAX_NODES:
@@ -194,6 +233,13 @@ def _check_constant(value) -> None:
         raise ExpressionError("bytes literals are not allowed (NC lines are text)")
     if isinstance(value, int) and value.bit_length() > MAX_INT_BITS:
         raise ExpressionError(f"integer literal larger than {MAX_INT_BITS} bits")
+
+
+def _formats_with_percent(node: ast.AST) -> bool:
+    """`'…' % x` on a written text: refused here as the guard refuses it at run time (its width
+    is not bounded), so that lint names it without a job."""
+    return isinstance(node, ast.BinOp) and isinstance(node.op, ast.Mod) and (
+        isinstance(node.left, ast.JoinedStr) or isinstance(node.left, ast.Constant) and isinstance(node.left.value, str))
 
 
 def _check_spec_fields(spec: ast.JoinedStr) -> None:
@@ -278,6 +324,13 @@ class _GuardOperators(ast.NodeTransformer):
 
     def visit_List(self, node: ast.List):
         return self._sized(node)
+
+    def visit_Subscript(self, node: ast.Subscript):
+        """A slice copies what it cuts: the copy is paid for like any built value."""
+        self.generic_visit(node)
+        if not isinstance(node.slice, ast.Slice):
+            return node
+        return ast.copy_location(ast.Call(ast.Name("_built", ast.Load()), [node], []), node)
 
     def visit_Tuple(self, node: ast.Tuple):
         return self._sized(node)
