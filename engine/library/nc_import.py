@@ -51,11 +51,11 @@ from pathlib import Path
 from psycopg.types.json import Jsonb
 
 from ..errors import EngineError
-from ..templates.decision_table import MODULE_ORDER, CompiledTemplate
+from ..templates.decision_table import CompiledTemplate
 from ..templates.evaluator import evaluate
 from ..templates.expressions import MAX_EXPRESSION_LENGTH, compile_expression
 from ..templates.functions import CONSTANTS, FUNCTIONS
-from ..templates.rows import TemplateRow
+from ..templates.rows import MODULE_ORDER, TemplateRow
 from ..templates.store import ensure_class, load_template, replace_template
 from .nc_tokens import LABEL, NUMBER, SYMBOL, LineFacts, facts, tokenise
 

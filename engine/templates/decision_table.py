@@ -30,7 +30,6 @@ from .guards import MAX_STRING_LENGTH, short_repr, size
 from .rows import Template, TemplateRow
 from .trace import Outcome, RowTrace, memo_key
 
-MODULE_ORDER = ("main", "prep", "sync", "shift", "cutcond", "cutmotion")
 MAX_MEMO_ROWS = 50_000    # outcomes kept per template (about 1.5 KB each); the memo starts again when full
 MAX_MEMO_VALUE = 256      # characters or elements of a value an outcome kept in the memo may hold
 
