@@ -22,10 +22,9 @@ from functools import partial
 from ..errors import EngineError
 from ..programs.nc_check import words
 from ..turning.nc_path import NcLines
-from .budget import Budget, spending
+from .budget import Budget, seconds_for, spending
 from .evaluator import EvaluationError, Evaluator, base_symbols
-from .expressions import (MAX_SECONDS_PER_INSTANTIATION, Compiled, ExpressionError, compile_expression,
-                          compile_statements)
+from .expressions import Compiled, ExpressionError, compile_expression, compile_statements
 from .guards import MAX_STRING_LENGTH, short_repr, size
 from .rows import Template, TemplateRow
 from .trace import Outcome, RowTrace, memo_key
@@ -75,15 +74,15 @@ class CompiledTemplate:
         self._evaluators = threading.local()   # runners may share a process (and this compiled template)
         self.memo: dict[tuple, tuple[Outcome, int]] = {}   # key -> (outcome, bytes it cost to evaluate)
         # Rows that print a whole tool path (nc_path) emit several lines at once.
-        self.prints_paths = any(row.o is not None and _calls_nc_path(row.o.tree) for row in self.rows)
+        self.prints_paths = any(row.o is not None and "nc_path" in row.o.calls for row in self.rows)
         # Lines a row always emits the same, parsed for the limit check once per template.
         self.constant_words = {row.row.id: words(row.o.tree.value) for row in self.rows
                                if row.o is not None and isinstance(row.o.tree, ast.Constant)
                                and isinstance(row.o.tree.value, str)}
 
-    def run(self, params: dict, module_params: dict | None = None,
-            deadline_seconds: float = MAX_SECONDS_PER_INSTANTIATION) -> Result:
-        job = _Job(self, params, module_params or {}, Budget(deadline_seconds))
+    def run(self, params: dict, module_params: dict | None = None, deadline_seconds: float | None = None) -> Result:
+        seconds = seconds_for(len(self.rows)) if deadline_seconds is None else deadline_seconds
+        job = _Job(self, params, module_params or {}, Budget(seconds))
         try:
             with spending(job.budget):
                 for row in self.rows:
@@ -218,10 +217,6 @@ def _refuse_engine_names(compiled: CompiledTemplate, names, what: str) -> None:
                           "function or constant of the engine; rename it")
 
 
-def _calls_nc_path(tree) -> bool:
-    return any(isinstance(node, ast.Call) and getattr(node.func, "id", None) == "nc_path" for node in ast.walk(tree))
-
-
 def _one_line_each(result: Result) -> Result:
     """The blocks of an nc_path row as lines of their own, each with the row's id."""
     flat = Result(trace=result.trace)
@@ -250,9 +245,33 @@ def _text(value, row: CompiledRow, gear_class: str):
     raise TemplateError(gear_class, row.row.id, "o", row.o.text, problem[:300])
 
 
+_ONCE = threading.local()
+
+
+class rows_compiled_once:
+    """`with rows_compiled_once():` each row compiled in the block is compiled once, however often
+    it is checked and run (an import checks its rows before storing them, then instantiates them)."""
+
+    def __enter__(self):
+        self.outer, _ONCE.rows = getattr(_ONCE, "rows", None), {}
+
+    def __exit__(self, *exc) -> None:
+        _ONCE.rows = self.outer
+
+
 def compile_row(gear_class: str, row: TemplateRow, translations=None) -> CompiledRow:
     """The row's expressions checked and guarded (SQL conditions from their stored translations
     where `translations` has them)."""
+    remembered = getattr(_ONCE, "rows", None)
+    if remembered is None or translations:
+        return _compile_row(gear_class, row, translations)
+    key = gear_class, row
+    if key not in remembered:
+        remembered[key] = _compile_row(gear_class, row, translations)
+    return remembered[key]
+
+
+def _compile_row(gear_class: str, row: TemplateRow, translations=None) -> CompiledRow:
     expression = partial(compile_expression, translations=translations)
 
     def compiled(column: str, compile_function):

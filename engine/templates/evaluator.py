@@ -50,6 +50,8 @@ class Evaluator:
 
     def evaluate(self, tree: ast.expr, text: str, scope: dict):
         """The value of `tree` (the checked form of `text`) with `scope` as asteval's symbol table."""
+        if type(tree) is ast.Constant:   # a line written out (most rows of an imported program)
+            return tree.value
         interpreter = self.interpreter
         interpreter.symtable = scope
         interpreter.error, interpreter.error_msg, interpreter.expr = [], None, text
