@@ -34,7 +34,8 @@ Lines: the file is split at "\\n" (a final newline ends the last line, it adds n
 line; a "\\r" stays part of its line). Instantiating the import with the same parameters
 and writing the lines joined by "\\n" plus a final "\\n" gives the file byte for byte
 when it ended with a newline (every file of data/nc does); otherwise only that final
-newline differs. The import checks this itself before it commits.
+newline differs. The import checks this itself before it commits (engine.library.nc_verify), while
+the rows are being written.
 """
 from __future__ import annotations
 
@@ -51,13 +52,14 @@ from pathlib import Path
 from psycopg.types.json import Jsonb
 
 from ..errors import EngineError
-from ..templates.decision_table import CompiledTemplate
+from ..memory import no_cycle_collection
 from ..templates.evaluator import evaluate
 from ..templates.expressions import MAX_EXPRESSION_LENGTH, compile_expression
 from ..templates.functions import CONSTANTS, FUNCTIONS
 from ..templates.rows import MODULE_ORDER, TemplateRow
 from ..templates.store import ensure_class, load_template, replace_template
 from .nc_tokens import LABEL, NUMBER, SYMBOL, LineFacts, facts, tokenise
+from .nc_verify import Proof
 
 CODE_ADDRESSES = frozenset({"G", "M", "$"})   # their numbers name a function, not a value
 CLASS_NAME = re.compile(r"^[a-z][a-z0-9_]*$")
@@ -80,22 +82,31 @@ class ImportReport:
 def import_nc(conn, path, gear_class: str, params: dict | None = None, modules: dict | None = None,
               parent: str | None = None) -> ImportReport:
     """Store the NC program at `path` as the template of `gear_class`: all or nothing."""
+    with no_cycle_collection():   # tokens and checked trees of every line: millions of objects
+        return _import(conn, path, gear_class, params, modules, parent)
+
+
+def _import(conn, path, gear_class: str, params: dict | None, modules: dict | None, parent: str | None) -> ImportReport:
     if not CLASS_NAME.match(gear_class or ""):
         raise EngineError(f"class name {gear_class!r}: use lower-case letters, digits and _, "
                           "starting with a letter")
     params = dict(params or {})
     check_param_names(params)
     lines = read_nc_lines(path)
-    assigned = assign_modules([facts(tokenise(line)) for line in lines], _checked_modules(modules, len(lines)))
+    tokens = [tokenise(line) for line in lines]
+    assigned = assign_modules([facts(line) for line in tokens], _checked_modules(modules, len(lines)))
     built = _Builder(_values_of(params), path)
-    rows = [built.row(ROW_STEP * (index + 1), t, n, line)
-            for index, (line, (t, n)) in enumerate(zip(lines, assigned))]
+    rows = [built.row(ROW_STEP * (index + 1), t, n, line, line_tokens)
+            for index, (line, line_tokens, (t, n)) in enumerate(zip(lines, tokens, assigned))]
+    del tokens
+    proof = Proof(params, lines, path)
     with conn.transaction():
         created = ensure_class(conn, gear_class, parent)
-        changed = replace_template(conn, gear_class, rows)
+        changed = replace_template(conn, gear_class, rows, check=proof.start_on)   # proved while written
         _store_import_params(conn, gear_class, params)
         template = load_template(conn, gear_class)
-        _verify(template, params, lines, path)
+        _refuse_inherited(template, lines)
+        proof.verdict(template.rows)
     counts = {t: sum(1 for row in rows if row.t == t) for t in MODULE_ORDER}
     return ImportReport(gear_class, str(path), len(rows), built.parameterised,
                         {t: c for t, c in counts.items() if c}, created, changed, template.version,
@@ -116,17 +127,12 @@ def _params_json(params: dict) -> str:
                           "give numbers or text") from None
 
 
-def _verify(template, params: dict, lines: list[str], path) -> None:
-    """The stored class, instantiated with the same parameters, gives the file back."""
+def _refuse_inherited(template, lines: list[str]) -> None:
+    """The class must be made of the program's rows alone."""
     inherited = [row.id for row in template.rows if row.id > ROW_STEP * len(lines) or row.id % ROW_STEP]
     if inherited:
         raise EngineError(f"class {template.gear_class} inherits rows {inherited[:5]} from its parent, so it "
                           "would not give the program back; import it under a parent without rows")
-    produced = CompiledTemplate(template).run(params).lines
-    for number, (got, want) in enumerate(zip(produced, lines), start=1):
-        if got != want:
-            raise EngineError(f"{path} line {number}: the imported template gives {got!r}, not {want!r}; "
-                              "nothing stored (please report this line)")
 
 
 # --- reading -------------------------------------------------------------------------
@@ -331,9 +337,10 @@ class _Builder:
     def __init__(self, values: dict, path):
         self.values, self.path = values, path
         self.parameterised, self.ambiguous = 0, {}
+        self.spelled: dict[tuple, bool] = {}   # (field, name, number) -> the field gives the number back
 
-    def row(self, row_id: int, t: str, n: int, line: str) -> TemplateRow:
-        parts = [self._part(token) for token in tokenise(line)]
+    def row(self, row_id: int, t: str, n: int, line: str, tokens) -> TemplateRow:
+        parts = [self._part(token) for token in tokens]
         fields = "".join(text for is_field, text in parts if is_field)
         literal = "".join(text for is_field, text in parts if not is_field)
         quote = "'" if '"' in literal and "'" not in literal + fields else '"'
@@ -357,7 +364,10 @@ class _Builder:
             return False, token.text
         name, value = candidates[0]
         source = number_field(name, token.text)
-        if _evaluate(source, name, value) != token.text:
+        key = (source, name, token.text)   # the value is the parameter's, one per name
+        if key not in self.spelled:
+            self.spelled[key] = _evaluate(source, name, value) == token.text
+        if not self.spelled[key]:
             return False, token.text
         if len(candidates) > 1:
             self.ambiguous[str(Decimal(token.text))] = [n for n, _ in candidates]
