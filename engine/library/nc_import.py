@@ -43,25 +43,23 @@ import csv
 import io
 import json
 import keyword
-import math
 import re
 from dataclasses import dataclass, field
-from decimal import Decimal, InvalidOperation
+from functools import partial
 from pathlib import Path
 
 from psycopg.types.json import Jsonb
 
 from ..errors import EngineError
 from ..memory import no_cycle_collection
-from ..templates.evaluator import evaluate
-from ..templates.expressions import MAX_EXPRESSION_LENGTH, compile_expression
 from ..templates.functions import CONSTANTS, FUNCTIONS
 from ..templates.rows import MODULE_ORDER, TemplateRow
 from ..templates.store import ensure_class, load_template, replace_template
-from .nc_tokens import LABEL, NUMBER, SYMBOL, LineFacts, facts, tokenise
+from .nc_halves import in_halves
+from .nc_rows import Builder, values_of
+from .nc_tokens import LABEL, SYMBOL, LineFacts, facts, tokenise
 from .nc_verify import Proof
 
-CODE_ADDRESSES = frozenset({"G", "M", "$"})   # their numbers name a function, not a value
 CLASS_NAME = re.compile(r"^[a-z][a-z0-9_]*$")
 ROW_STEP = 10
 
@@ -93,12 +91,15 @@ def _import(conn, path, gear_class: str, params: dict | None, modules: dict | No
     params = dict(params or {})
     check_param_names(params)
     lines = read_nc_lines(path)
-    tokens = [tokenise(line) for line in lines]
-    assigned = assign_modules([facts(line) for line in tokens], _checked_modules(modules, len(lines)))
-    built = _Builder(_values_of(params), path)
-    rows = [built.row(ROW_STEP * (index + 1), t, n, line, line_tokens)
-            for index, (line, line_tokens, (t, n)) in enumerate(zip(lines, tokens, assigned))]
-    del tokens
+    built = Builder(values_of(params), path)
+    halves = in_halves(len(lines), partial(_read_lines, lines, built))
+    assigned = assign_modules([facts for half in halves for facts in half[0]], _checked_modules(modules, len(lines)))
+    texts = [o for half in halves for o in half[1]]
+    rows = [TemplateRow(ROW_STEP * (index + 1), t, n, None, None, o, None) for index, (o, (t, n)) in
+            enumerate(zip(texts, assigned))]
+    built.parameterised = sum(half[2] for half in halves)
+    for half in halves:
+        built.ambiguous.update((value, names) for value, names in half[3].items() if value not in built.ambiguous)
     proof = Proof(params, lines, path)
     with conn.transaction():
         created = ensure_class(conn, gear_class, parent)
@@ -111,6 +112,18 @@ def _import(conn, path, gear_class: str, params: dict | None, modules: dict | No
     return ImportReport(gear_class, str(path), len(rows), built.parameterised,
                         {t: c for t, c in counts.items() if c}, created, changed, template.version,
                         built.ambiguous)
+
+
+def _read_lines(lines: list[str], built: Builder, start: int, end: int) -> tuple:
+    """Lines start…end: the facts of each (for its module), its row's `o`, and the references
+    made and the ambiguous values found in them."""
+    built.parameterised, built.ambiguous = 0, {}
+    line_facts, texts = [], []
+    for number in range(start, end):
+        tokens = tokenise(lines[number])
+        line_facts.append(facts(tokens))
+        texts.append(built.o(number + 1, lines[number], tokens))
+    return line_facts, texts, built.parameterised, built.ambiguous
 
 
 def _store_import_params(conn, gear_class: str, params: dict) -> None:
@@ -298,103 +311,3 @@ def assign_modules(lines: list[LineFacts], corrections: dict | None = None) -> l
         current = decided
         assigned.append((decided, runs[decided]))
     return assigned
-
-
-# --- rows ------------------------------------------------------------------------------
-
-def _values_of(params: dict) -> dict:
-    """Decimal value → [(name, value)] of the numeric parameters, in the order given."""
-    values: dict = {}
-    for name, value in params.items():
-        if isinstance(value, bool) or not isinstance(value, (int, float, Decimal)):
-            continue
-        if isinstance(value, float) and not math.isfinite(value):
-            continue
-        values.setdefault(Decimal(str(value)), []).append((name, value))
-    return values
-
-
-_SPELLING = re.compile(r"([+-]?)([0-9]*)(\.?)([0-9]*)")
-
-
-def number_field(name: str, spelling: str) -> str:
-    """The f-string replacement field that prints `name` in the style of `spelling`."""
-    sign, integer, point, fraction = _SPELLING.fullmatch(spelling).groups()
-    digits = len(fraction)
-    if not integer:
-        scale = 10 ** digits
-        positive = "'+'" if sign == "+" else "''"
-        magnitude = f"round(abs({name}) * {scale})"
-        return (f"{{'-' if {name} < 0 else {positive}}}{{{magnitude} // {scale} or ''}}."
-                f"{{{magnitude} % {scale}:0{digits}d}}")
-    trailing_point = bool(point) and not fraction
-    width = len(spelling) - trailing_point
-    padding = f"0{width}" if len(integer) > 1 and integer.startswith("0") else ""
-    return f"{{{name}:{'+' if sign == '+' else ''}{padding}.{digits}f}}" + ("." if trailing_point else "")
-
-
-class _Builder:
-    def __init__(self, values: dict, path):
-        self.values, self.path = values, path
-        self.parameterised, self.ambiguous = 0, {}
-        self.spelled: dict[tuple, bool] = {}   # (field, name, number) -> the field gives the number back
-
-    def row(self, row_id: int, t: str, n: int, line: str, tokens) -> TemplateRow:
-        parts = [self._part(token) for token in tokens]
-        fields = "".join(text for is_field, text in parts if is_field)
-        literal = "".join(text for is_field, text in parts if not is_field)
-        quote = "'" if '"' in literal and "'" not in literal + fields else '"'
-        if fields:
-            body = "".join(text if is_field else _escaped(text, quote, braces=True) for is_field, text in parts)
-            o = f"f{quote}{body}{quote}"
-        else:
-            o = f"{quote}{_escaped(line, quote, braces=False)}{quote}"
-        if len(o) > MAX_EXPRESSION_LENGTH:
-            raise EngineError(f"{self.path} line {row_id // ROW_STEP}: {len(line)} characters, more than a "
-                              f"template row holds ({MAX_EXPRESSION_LENGTH}); split the line")
-        self.parameterised += sum(1 for is_field, _ in parts if is_field)
-        return TemplateRow(row_id, t, n, None, None, o, None)
-
-    def _part(self, token) -> tuple[bool, str]:
-        """(True, replacement field) for a number that becomes a reference, else (False, text)."""
-        if token.kind != NUMBER or token.address in CODE_ADDRESSES or _is_negative_zero(token.text):
-            return False, token.text
-        candidates = self.values.get(Decimal(token.text))
-        if not candidates:
-            return False, token.text
-        name, value = candidates[0]
-        source = number_field(name, token.text)
-        key = (source, name, token.text)   # the value is the parameter's, one per name
-        if key not in self.spelled:
-            self.spelled[key] = _evaluate(source, name, value) == token.text
-        if not self.spelled[key]:
-            return False, token.text
-        if len(candidates) > 1:
-            self.ambiguous[str(Decimal(token.text))] = [n for n, _ in candidates]
-        return True, source
-
-
-def _is_negative_zero(spelling: str) -> bool:
-    try:
-        return spelling.startswith("-") and Decimal(spelling) == 0
-    except InvalidOperation:
-        return False
-
-
-def _evaluate(source: str, name: str, value) -> str:
-    return evaluate(compile_expression(f'f"{source}"'), {name: value})
-
-
-def _escaped(text: str, quote: str, braces: bool) -> str:
-    out = []
-    for character in text:
-        if character in ("\\", quote):
-            out.append("\\" + character)
-        elif braces and character in "{}":
-            out.append(character * 2)
-        elif character.isprintable():
-            out.append(character)
-        else:
-            out.append(repr(character)[1:-1])
-    return "".join(out)
-

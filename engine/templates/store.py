@@ -126,15 +126,16 @@ def merge_rows(inherited, own) -> list[TemplateRow]:
     return [merged[row_id] for row_id in sorted(merged)]
 
 
-# The rows' bodies found or added a whole template at a time, in four statements whose plans see
+# The rows' bodies found or added a whole template at a time, in a few statements whose plans see
 # all the rows (a lookup per row, from Python or in component_for, was planned for the library as
 # it was before the import: a sequential scan per row once the library had grown by thousands of
 # bodies). Identity of bodies as in component_for: the component_body key, then the exact columns;
 # the oldest of identical bodies; each found body locked against a concurrent cleanup.
-BODIES = "unnest(%s::text[], %s::text[], %s::text[], %s::text[], %s::text[]) WITH ORDINALITY AS b(t, o, p_calc, s, p_emit, position)"
-FIND_BODIES = f"""
+BODY_TABLE = "CREATE TEMPORARY TABLE template_body (position integer, t text, o text, p_calc text, s text, p_emit text)"
+COPY_BODY_TABLE = "COPY template_body FROM STDIN"
+FIND_BODIES = """
 SELECT DISTINCT ON (b.position) b.position, c.id
-FROM {BODIES}
+FROM template_body b
 JOIN component c ON component_body_key(c.t, c.o, c.p_calc, c.s, c.p_emit)
                     = component_body_key(b.t, b.o, b.p_calc, b.s, b.p_emit)
  AND c.t = b.t AND c.o IS NOT DISTINCT FROM b.o AND c.p_calc IS NOT DISTINCT FROM b.p_calc
@@ -152,7 +153,7 @@ def _insert_assembly(conn, gear_class: str, rows: list[TemplateRow]) -> None:
     if not rows:
         return
     bodies = list(dict.fromkeys(_body(row) for row in rows))
-    found = dict(conn.execute(FIND_BODIES, _columns(bodies)).fetchall())
+    found = _found(conn, bodies)
     kept = {row[0] for row in conn.execute(LOCK_BODIES, (list(found.values()),))}
     ids = {bodies[position - 1]: component for position, component in found.items() if component in kept}
     missing = [body for body in bodies if body not in ids]
@@ -171,8 +172,16 @@ def _body(row: TemplateRow) -> tuple:
     return row.t, row.o, row.p_calc, row.s, row.p_emit
 
 
-def _columns(bodies: list[tuple]) -> list[list]:
-    return [list(column) for column in zip(*bodies)]
+def _found(conn, bodies: list[tuple]) -> dict[int, int]:
+    """Position (from 1) of each body already stored → the oldest component holding it. The bodies
+    go in by COPY (as arrays, psycopg quoted every text in Python: seconds for an import)."""
+    conn.execute(BODY_TABLE)
+    with conn.cursor().copy(COPY_BODY_TABLE) as copy:
+        for position, body in enumerate(bodies, start=1):
+            copy.write_row((position, *body))
+    found = dict(conn.execute(FIND_BODIES).fetchall())
+    conn.execute("DROP TABLE template_body")
+    return found
 
 
 def _delete_orphans(conn, component_ids: list[int]) -> None:
