@@ -17,7 +17,9 @@ seeded database made for it, so every run stores the same rows into the same lib
 from __future__ import annotations
 
 import argparse
+import os
 import random
+import resource
 import sys
 import tempfile
 import time
@@ -66,6 +68,24 @@ def program(lines: int, seed: int = 13) -> list[str]:
     return out[:lines]
 
 
+CPU: list[tuple[float, float]] = []   # (this process and its forks, the database backend) per import
+
+
+def cpu_seconds() -> float:
+    """CPU time of this process and of its children that have ended (the import's fork)."""
+    own, children = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
+    return own.ru_utime + own.ru_stime + children.ru_utime + children.ru_stime
+
+
+def backend_cpu_seconds(pid: int) -> float:
+    """CPU time of the server process of a connection (the server runs on this machine), else NaN."""
+    try:
+        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    except OSError:
+        return float("nan")
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
 def timed_import(server_url: str, seeded: str, path: Path, gear_class: str) -> float:
     """One import, committed, into a copy of the seeded database made for it and dropped after."""
     import uuid
@@ -80,9 +100,12 @@ def timed_import(server_url: str, seeded: str, path: Path, gear_class: str) -> f
         admin.execute(sql.SQL("CREATE DATABASE {} TEMPLATE {}").format(sql.Identifier(copy), sql.Identifier(seeded)))
     try:
         with psycopg.connect(url_of(server_url, copy)) as conn:
+            server, before = conn.info.backend_pid, cpu_seconds()
+            server_before = backend_cpu_seconds(server)
             start = time.perf_counter()
             report = import_nc(conn, path, gear_class, PARAMS)
             seconds = time.perf_counter() - start
+            CPU.append((cpu_seconds() - before, backend_cpu_seconds(server) - server_before))
     finally:
         with psycopg.connect(server_url, autocommit=True) as admin:
             admin.execute(sql.SQL("DROP DATABASE IF EXISTS {} WITH (FORCE)").format(sql.Identifier(copy)))
@@ -108,17 +131,21 @@ def main(argv=None) -> int:
             paths[name].write_text("\n".join(program(count)) + "\n")
         if args.keep:
             args.keep.write_bytes(paths["large"].read_bytes())
-        times = {name: [] for name in sizes}
+        times, cpu = {name: [] for name in sizes}, {name: [] for name in sizes}
         timed_import(args.database_url, seeded, paths["small"], "nc_warm_up")   # imports, caches: not timed
         for repetition in range(args.reps):
             for name in (sizes if repetition % 2 == 0 else reversed(list(sizes))):
                 times[name].append(timed_import(args.database_url, seeded, paths[name], f"nc_{name}"))
+                cpu[name].append(CPU[-1])
     small, large = median(times["small"]), median(times["large"])
+    client, server = (median(values) for values in zip(*cpu["large"]))
     print(f"import-nc: 840D programs of {sizes['small']} and {sizes['large']} numbered lines, {args.reps} alternated runs")
     for name in sizes:
         print(f"  {sizes[name]:7d} lines: median {median(times[name]):6.2f} s "
               f"({median(times[name]) / sizes[name] * 1e6:5.1f} us per line); runs "
               + ", ".join(f"{t:.2f}" for t in times[name]))
+    print(f"the large import (medians): {client:.2f} s of CPU in this process and its fork, {server:.2f} s in the database "
+          f"server; load average now {', '.join(f'{load:.2f}' for load in os.getloadavg())} on {os.cpu_count()} cores")
     growth = large / small
     print(f"growth: 10x the lines took {growth:.2f}x the time (linear <= {LINEAR}x): {verdict(growth <= LINEAR)}")
     print(f"{sizes['large']} lines in {large:.2f} s (target <= {TARGET_SECONDS} s for 100,000): "
