@@ -18,8 +18,8 @@ from typing import NamedTuple
 from engine.memory import no_cycle_collection
 
 from .dxf_codes import CodeText, layer_codes
-from .dxf_geometry import (FLATTEN_TOLERANCE_MM, HANDLERS, Context, Segment, inserted_entities,
-                           named_on_failure, segments_of, unit_scale)
+from .dxf_geometry import (FLATTEN_TOLERANCE_MM, HANDLERS, MAX_COORDINATE_MM, Context, Segment, check_finite,
+                           check_reach, inserted_entities, named_on_failure, segments_of, unit_scale)
 from .dxf_profile import Profile, chain_segments, find_profile, scaled
 from .dxf_read import DxfError, ezdxf_warnings, load_drawing_file, summarised
 
@@ -89,7 +89,7 @@ def read_drawing(path: str | Path) -> Drawing:
     with ezdxf_warnings() as warnings, no_cycle_collection():
         drawing_file = load_drawing_file(path)
         units, scale, assumed = unit_scale(drawing_file.doc.header.get("$INSUNITS"))
-        collected = collect(drawing_file.doc.modelspace(), FLATTEN_TOLERANCE_MM / scale)
+        collected = collect(drawing_file.doc.modelspace(), scale)
     layer0 = collected.layers.get(PROFILE_LAYER, LayerContent())
     if not layer0.segments:
         raise DxfError(no_geometry_message(collected))
@@ -115,14 +115,17 @@ def is_relevant(layer: str) -> bool:
     return layer == PROFILE_LAYER or operation_number(layer) is not None
 
 
-def collect(modelspace, sagitta: float) -> Collected:
-    """One pass over model space: segments, texts and points of layer 0 and layers 1 … n."""
-    collected, own = Collected(), Context(sagitta)
+def collect(modelspace, scale: float) -> Collected:
+    """One pass over model space: segments, texts and points of layer 0 and layers 1 … n
+    (scale: drawing units to mm)."""
+    sagitta, reach = FLATTEN_TOLERANCE_MM / scale, MAX_COORDINATE_MM / scale
+    collected, own = Collected(), Context(sagitta, reach=reach)
     for entity in modelspace:
         with named_on_failure(entity):
             layer = entity.dxf.layer
             if entity.dxftype() == "INSERT":
-                context = Context(sagitta, entity.dxf.handle)
+                check_finite(entity, own)
+                context = Context(sagitta, entity.dxf.handle, reach)
                 for effective_layer, part in inserted_entities(entity, layer):
                     take(part, effective_layer, context, collected)
             else:
@@ -137,12 +140,14 @@ def take(entity, layer: str, context: Context, collected: Collected) -> None:
         return
     content = collected.layers[layer]
     handle = context.handle or entity.dxf.handle
+    check_finite(entity, context)
     if kind in HANDLERS:
         content.segments.extend(segments_of(entity, context))
     elif kind in TEXT_TYPES:
         content.texts.append(CodeText(layer, handle, entity.plain_text()))
     elif kind == "POINT":
         location = entity.dxf.location
+        check_reach(entity, context, (location.x, location.y))
         content.points.append((handle, (location.x, location.y)))
     else:
         collected.skipped[kind] += 1

@@ -24,6 +24,10 @@ FLATTEN_TOLERANCE_MM = 0.002
 PLANAR_EPSILON = 1e-9
 # Shorter lines and smaller radii (drawing units) are drawing noise, not geometry.
 DEGENERATE_LENGTH = 1e-9
+# No turned part reaches a kilometre from its origin (mm): a coordinate beyond, or one that is no
+# number at all (NaN, inf, or 1e308 that overflows once scaled), is a broken entity. It is
+# refused where it is read, before chains, passes or a program are computed from it.
+MAX_COORDINATE_MM = 1_000_000.0
 
 Point = tuple[float, float]
 
@@ -62,6 +66,7 @@ Segment = Union[Line, Arc]
 class Context:
     sagitta: float  # FLATTEN_TOLERANCE_MM in drawing units
     handle: str = ""  # handle of the top-level entity (virtual block content has none)
+    reach: float = MAX_COORDINATE_MM  # MAX_COORDINATE_MM in drawing units
 
 
 def unit_scale(insunits: int | None) -> tuple[str, float, bool]:
@@ -83,7 +88,29 @@ def segments_of(entity, context: Context) -> list[Segment]:
     if handler is None:
         return []
     with named_on_failure(entity, context.handle):
-        return list(handler(entity, context))
+        segments = list(handler(entity, context))
+    for segment in segments:
+        check_reach(entity, context, segment.start, segment.end, *([segment.centre] if isinstance(segment, Arc) else []))
+    return segments
+
+
+def check_reach(entity, context: Context, *points: Point) -> None:
+    """Every point a number within MAX_COORDINATE_MM of the origin (NaN fails the comparison)."""
+    for x, y in points:
+        if not (abs(x) <= context.reach and abs(y) <= context.reach):
+            raise DxfError(f"{entity.dxftype()} {context.handle or entity.dxf.handle} on layer "
+                           f"{entity.dxf.get('layer', '?')!r} has the point ({x:g}, {y:g}), not a number within "
+                           f"{MAX_COORDINATE_MM:g} mm of the origin; redraw or delete it")
+
+
+def check_finite(entity, context: Context) -> None:
+    """No attribute of a read entity (a point, radius, angle, extrusion, scale) is NaN or infinite."""
+    for name, value in entity.dxf.all_existing_dxf_attribs().items():
+        numbers = value if isinstance(value, (tuple, list)) or hasattr(value, "isclose") else (value,)
+        if any(isinstance(number, float) and not math.isfinite(number) for number in numbers):
+            raise DxfError(f"{entity.dxftype()} {context.handle or entity.dxf.handle} on layer "
+                           f"{entity.dxf.get('layer', '?')!r}: its {name} holds {value}, not a number; "
+                           "redraw or delete it")
 
 
 @contextlib.contextmanager
@@ -243,7 +270,7 @@ def curve_segments(entity, context: Context) -> Iterator[Segment]:
 
 
 def context_for(context: Context, source) -> Context:
-    return Context(context.sagitta, context.handle or source.dxf.handle)
+    return Context(context.sagitta, context.handle or source.dxf.handle, context.reach)
 
 
 HANDLERS: dict[str, Callable[..., Iterator[Segment]]] = {

@@ -56,9 +56,9 @@ def test_the_interpreter_knows_only_our_functions():
 @pytest.mark.parametrize("column, text, words", [
     ("o", "f'{[[0] * 65536] * 65536 == [[0] * 65536] * 65536}'", "larger than 65536"),
     ("o", "f'{[[0] * 256] * 256 == [[0] * 256] * 256}'", "larger than 65536"),
-    ("o", "f'{str([0] * 20000)}'", "too large to print"),
-    ("o", "f'{[0] * 60000}'", "too large to print"),
-    ("o", "f'{[2 ** 2000] * 1500}'", "too large to print"),          # integers weigh by their digits
+    ("o", "f'{str([0] * 20000)}'", "a list cannot be printed"),      # an NC word is one value
+    ("o", "f'{[0] * 60000}'", "a list cannot be printed"),
+    ("o", "f'{str(\"9\" * 20000)}'", "too large to print"),
     ("o", "f'{int(\"9\" * 4300)}'", "int\\(\\) of a text longer than 4096"),
     ("s", "a = [0] * 40000; b = [a, a]", "result larger than 65536"),
     ("o", "f'{2 ** 4000 * 2 ** 4000}'", "more than 4096 bits"),
@@ -106,7 +106,7 @@ def with_output(exported: str, old: str, new: str) -> str:
 
 def test_a_hostile_row_through_the_cli_is_one_line_exit_1_and_stores_nothing(run, tmp_path):
     exported = run("template", "export", "--class", "spur").stdout
-    hostile = "f'{[[0] * 65536] * 65536 == [[0] * 65536] * 65536}'"
+    hostile = "f'{[[0] * z2] * 65536 == [[0] * z2] * 65536}'"   # data-dependent: the gate cannot evaluate it
     (tmp_path / "spur.csv").write_text(with_output(exported, '"G90 G71 G94"', hostile))
     assert run("template", "import", "--class", "spur", str(tmp_path / "spur.csv")).exit_code == 0
     with psycopg.connect(run.url) as conn:

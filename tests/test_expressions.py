@@ -1,6 +1,7 @@
 """Template expressions: what users write works; what an attacker writes is refused
 before it runs, or stopped by a limit, with a message that names the problem."""
 import pytest
+from hypothesis import given, settings, strategies as st
 
 from engine.errors import EngineError
 from engine.templates.evaluator import evaluate as evaluate_compiled
@@ -105,3 +106,52 @@ def test_asteval_evaluation_agrees_with_python_on_ordinary_expressions(text):
     scope = {"cut_x": 51.5, "feed": 41.8}
     python = eval(text, {"__builtins__": {}, **FUNCTIONS, "pi": math.pi}, dict(scope))   # the reference
     assert evaluate(text, **scope) == python
+
+
+# The gate reads the verdict on plain lines off their shape (engine.templates.plain_lines): it
+# must be the full gate's verdict, tree for tree, name for name, refusal for refusal.
+PLAIN_PIECES = st.one_of(
+    st.text(alphabet=st.characters(blacklist_categories=("Cs",), blacklist_characters='"\\{}\n\r'), max_size=8),
+    st.sampled_from(["{x}", "{x:.3f}", "{feed:+08.2f}", "{pi:.4f}", "{sin}", "{_x}", "{x!r}", "{x:9999}",
+                     "{x:>{w}}", "{x + 1}", "{x:{'5'}}", "{{", "}}", "{True}", "{min(x, 1)}"]),
+)
+
+
+def full_verdict(text):
+    import ast
+
+    from engine.templates.expressions import _fully_checked
+
+    try:
+        compiled = _fully_checked(text, ast.parse(text.strip(), mode="eval"), False)
+    except EngineError as error:
+        return str(error)
+    return ast.dump(compiled.tree, include_attributes=True), compiled.names, compiled.ordered_names, compiled.calls
+
+
+def verdict(text):
+    import ast
+
+    try:
+        compiled = compile_expression(text)
+    except EngineError as error:
+        return str(error)
+    return ast.dump(compiled.tree, include_attributes=True), compiled.names, compiled.ordered_names, compiled.calls
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.lists(PLAIN_PIECES, max_size=12).map("".join), st.booleans())
+def test_plain_lines_get_the_full_gate_s_verdict(body, f_string):
+    text = ('f"' if f_string else '"') + body + '"'
+    try:
+        compile(text, "<line>", "eval")
+    except SyntaxError:
+        return   # not Python: the SQL route, which the shape reading never takes
+    assert verdict(text) == full_verdict(text)
+
+
+@pytest.mark.parametrize("text", ['"G0 Z5."', "12", "1.5", "2 ** 5000", "b'x'", 'f"{x:.1f}" + "y"', "True",
+                                  'f"' + "{x}" * 150 + '"',   # more nodes than the gate allows
+                                  'f"' + "{x}a" * 98 + "{x}{x}" + '"', 'f"' + "{x}a" * 99 + "{x}" + '"'])   # 400, 401
+def test_written_constants_get_the_full_gate_s_verdict(text):
+    assert verdict(text) == full_verdict(text)

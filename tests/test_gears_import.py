@@ -181,7 +181,7 @@ def test_a_bad_row_is_reported_with_its_line_and_nothing_is_stored(conn, tmp_pat
 def test_all_problems_of_all_rows_are_collected_in_file_order(conn, tmp_path):
     text = (f"{HEADER}\n{SPUR}\n"
             "90010,,2,19,,75,X,20,,,,,,,,\n"
-            '90011,,2,19,,,,20,,,,,"40\nCr",,,\n'  # a quoted cell over two lines: lines 4-5
+            '90011,,2,19,,,,20,,,,,40Cr,,,\n\n'  # a blank line 5 still counts (a quoted line break is refused)
             "90012,bevelx,abc,19,,,,20,,,,,,,,\n")
     path = write(tmp_path, text)
     with pytest.raises(GearImportError) as caught:

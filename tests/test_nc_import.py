@@ -20,7 +20,8 @@ from hypothesis import given, settings, strategies as st
 
 from engine.cli.app import main
 from engine.errors import EngineError
-from engine.library.nc_import import import_nc, number_field
+from engine.library.nc_import import import_nc
+from engine.library.nc_rows import number_field
 from engine.library.nc_tokens import detokenise, tokenise
 from engine.templates.decision_table import compiled_template
 from engine.templates.evaluator import evaluate

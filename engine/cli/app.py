@@ -6,6 +6,10 @@ Exit codes: 0 ok, 1 a handled error or bad input, option values included (one li
 """
 from __future__ import annotations
 
+import logging
+import sys
+import traceback
+
 import click
 
 from ..errors import EngineError
@@ -59,9 +63,31 @@ class EngineGroup(click.Group):
             if ctx.meta.get("traceback"):
                 raise
             first_line = (str(error).strip().splitlines() or [""])[0]
+            if _database_failure(error):   # the server, not the engine: exit 1, and say what was kept
+                click.echo(f"error: {_database_failure_message(error, first_line)}", err=True)
+                ctx.exit(1)
             click.echo(f"unexpected error: {type(error).__name__}: {first_line} "
                        "(run with --traceback for details)", err=True)
             ctx.exit(2)
+
+
+def _database_failure(error: Exception) -> bool:
+    """The server ended the work: the connection lost or terminated (pg_terminate_backend, a
+    restart), a statement cancelled, a deadlock, the disk full. psycopg is only looked at if
+    the command loaded it (`engine --help` does not)."""
+    psycopg = sys.modules.get("psycopg")
+    return psycopg is not None and isinstance(error, psycopg.OperationalError)
+
+
+def _database_failure_message(error: Exception, first_line: str) -> str:
+    """What the user must know: whether anything was stored. A transaction the server ended
+    before COMMIT stored nothing; one lost during its COMMIT may or may not have been stored."""
+    committing = any(frame.f_code.co_name == "_commit_gen" for frame, _ in traceback.walk_tb(error.__traceback__))
+    if committing:
+        return (f"the database connection failed while committing ({first_line}); whether the work was stored "
+                "is unknown: check (e.g. engine template history, the program table) before running it again")
+    return (f"the database ended the command ({first_line}); its transaction was rolled back, nothing of it "
+            "was stored: run the command again when the server is back")
 
 
 @click.group(cls=EngineGroup)
@@ -78,6 +104,8 @@ def main(ctx, database_url, traceback):
     ctx.ensure_object(dict)
     ctx.obj["database_url"] = database_url
     ctx.meta["traceback"] = traceback
+    if not traceback:   # psycopg logs what it ignores while a lost connection unwinds; the error says it
+        logging.getLogger("psycopg").addHandler(logging.NullHandler())
 
 
 COMMANDS = (demo, db, seed_command, gears, classify, instantiate, explain, template, lint, hobs, suggest, cases,

@@ -8,7 +8,6 @@ Numbers are kept as Decimal, so they are stored exactly as written.
 from __future__ import annotations
 
 import csv
-import math
 import re
 from dataclasses import dataclass
 from decimal import Decimal
@@ -18,13 +17,13 @@ from typing import Any, Callable, Iterable
 import psycopg
 from psycopg import sql
 
-from ..errors import EngineError
+from ..errors import EngineError, csv_problem
 from ..names import NAME_RULES, is_safe, shown
 from .classify import classify, not_installed_message
+from .records import MAX_MAGNITUDE, derived_diameters
 
 NUMBER = re.compile(r"[+-]?(\d+(\.\d*)?|\.\d+)([eE][+-]?\d{1,3})?")
 INTEGER_MAX = 2_147_483_647  # PostgreSQL integer
-TOOTH_DEPTH = Decimal("2.25")  # full tooth depth in modules: root = tip − 2·2.25·m
 
 
 class GearImportError(EngineError):
@@ -49,7 +48,10 @@ def parse_text(cell: str) -> str:
 def parse_number(cell: str) -> Decimal:
     if not NUMBER.fullmatch(cell):
         raise CellError("is not a number")
-    return Decimal(cell)
+    value = Decimal(cell)
+    if abs(value) > MAX_MAGNITUDE:
+        raise CellError(f"is larger than {MAX_MAGNITUDE:g} in size (no quantity of a gear or hob is that large)")
+    return value
 
 
 def parse_whole(cell: str) -> int:
@@ -121,38 +123,12 @@ COLUMNS: tuple[Column, ...] = (
     Column("cone_angle", parse_number, check=lambda v: -45 < v < 45, rule="is outside (-45, 45)"),
     Column("crowning", parse_number, check=lambda v: 0 <= v < 1, rule="is outside [0, 1) mm"),
     Column("material", parse_text),
-    Column("hardness", parse_number, **POSITIVE),
+    Column("hardness", parse_number, check=lambda v: 0 < v <= 700, rule="is outside (0, 700] HB (Brinell ends at 650)"),
     Column("quality_grade", parse_whole, check=lambda v: 1 <= v <= 12, rule="is outside 1..12"),
     Column("quantity", parse_positive_whole),
 )
 COLUMN_BY_NAME = {column.name: column for column in COLUMNS}
 DEFAULTS = {"pressure_angle": Decimal(20), "helix_angle": Decimal(0)}
-
-
-# --- geometry ----------------------------------------------------------------------------
-
-def reference_diameter(module: Any, teeth: int, helix_angle: Any = 0) -> Any:
-    """d = m·z / cos β (β in degrees), exact for a spur gear; Decimal in, Decimal out."""
-    if helix_angle == 0:
-        return module * teeth
-    cos_beta = math.cos(math.radians(float(helix_angle)))
-    if isinstance(module, Decimal):
-        return module * teeth / Decimal(repr(cos_beta))
-    return module * teeth / cos_beta
-
-
-def derived_diameters(module: Any, teeth: int, helix_angle: Any = 0,
-                      tip_diameter: Any = None, root_diameter: Any = None) -> tuple[Any, Any]:
-    """(tip, root) diameters: the given ones, else tip = d + 2m and root = tip − 2·2.25·m
-    (so a given tip that includes profile shift keeps the full tooth depth 2.25 m)."""
-    tip = tip_diameter
-    if tip is None:
-        tip = reference_diameter(module, teeth, helix_angle) + 2 * module
-    root = root_diameter
-    if root is None:
-        depth = TOOTH_DEPTH if isinstance(module, Decimal) else float(TOOTH_DEPTH)
-        root = tip - 2 * depth * module
-    return tip, root
 
 
 # --- reading the file --------------------------------------------------------------------
@@ -161,13 +137,18 @@ Record = tuple[int, list[str]]  # (physical line the record starts on, its cells
 
 
 def read_records(path: Path) -> list[Record]:
-    """Every non-blank CSV record of the file with the line it starts on, cells stripped."""
+    """Every non-blank CSV record of the file with the line it starts on, cells stripped. No
+    cell of these files holds a line break, so a record over several lines is a quote left
+    open: refused at the line where it opens, before it swallows the rows after it."""
     records: list[Record] = []
+    start = 1
     try:
         with open(path, encoding="utf-8-sig", newline="") as handle:
-            reader = csv.reader(handle)
-            start = 1
+            reader = csv.reader(handle, strict=True)
             for record in reader:
+                if reader.line_num > start:
+                    raise EngineError(f"{path}: line {start}: a quote opened on this line is closed only on line "
+                                      f"{reader.line_num}; close it on line {start} (a cell holds no line break)")
                 cells = [cell.strip() for cell in record]
                 if any(cells):
                     records.append((start, cells))
@@ -179,7 +160,7 @@ def read_records(path: Path) -> list[Record]:
     except OSError as error:
         raise EngineError(f"{path}: cannot read it ({error.strerror or error})") from None
     except csv.Error as error:
-        raise EngineError(f"{path}: line {reader.line_num}: not valid CSV ({error})") from None
+        raise EngineError(f"{path}: line {start}: {csv_problem(error)}") from None
     return records
 
 

@@ -16,11 +16,11 @@ from psycopg import sql
 
 from ..errors import EngineError
 from ..names import NAME_RULES, is_safe, said, shown
-from .gear_import import (POSITIVE, TOOTH_DEPTH, CellError, Column, parse_hand, parse_number,
+from .gear_import import (POSITIVE, CellError, Column, parse_hand, parse_number,
                           parse_positive_whole, parse_text, read_records)
 from .hob_matching import ACCURACY_CLASSES, PURPOSES, HobChoice, choose_hob
 from .models import ancestry
-from .records import Hob, load_gear, load_hobs
+from .records import TOOTH_DEPTH, Hob, load_gear, load_hobs
 
 
 class HobImportError(EngineError):

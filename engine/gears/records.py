@@ -1,9 +1,14 @@
 """Workpieces, hobs and machines as read from the database."""
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+import math
+from dataclasses import dataclass, fields, replace
+from decimal import Decimal
+from typing import Any
 
 from ..errors import EngineError
+
+TOOTH_DEPTH = Decimal("2.25")  # full tooth depth in modules: root = tip − 2·2.25·m
 
 
 @dataclass(frozen=True)
@@ -69,17 +74,52 @@ class Machine:
     module_max: float | None
 
 
+def reference_diameter(module: Any, teeth: int, helix_angle: Any = 0) -> Any:
+    """d = m·z / cos β (β in degrees), exact for a spur gear; Decimal in, Decimal out."""
+    if helix_angle == 0:
+        return module * teeth
+    cos_beta = math.cos(math.radians(float(helix_angle)))
+    if isinstance(module, Decimal):
+        return module * teeth / Decimal(repr(cos_beta))
+    return module * teeth / cos_beta
+
+
+def derived_diameters(module: Any, teeth: int, helix_angle: Any = 0,
+                      tip_diameter: Any = None, root_diameter: Any = None) -> tuple[Any, Any]:
+    """(tip, root) diameters: the given ones, else tip = d + 2m and root = tip − 2·2.25·m
+    (so a given tip that includes profile shift keeps the full tooth depth 2.25 m)."""
+    tip = tip_diameter
+    if tip is None:
+        tip = reference_diameter(module, teeth, helix_angle) + 2 * module
+    root = root_diameter
+    if root is None:
+        depth = TOOTH_DEPTH if isinstance(module, Decimal) else float(TOOTH_DEPTH)
+        root = tip - 2 * depth * module
+    return tip, root
+
+
 def _columns(record_type, exclude=frozenset()) -> str:
     return ", ".join(field.name for field in fields(record_type) if field.name not in exclude)
 
 
+# No dimension of a gear, hob or machine reaches a kilometre (mm), no speed a million (r/min):
+# a larger number is a slip of the keyboard, and 1e999, a valid numeric in PostgreSQL, is no
+# float at all (the models would compute with infinities). The CSV readers refuse the same.
+MAX_MAGNITUDE = 1e6
+
+
 def _as_float(record_type, row) -> object:
-    """numeric columns arrive as Decimal; models compute in float."""
-    from decimal import Decimal
+    """numeric columns arrive as Decimal; models compute in float, so each must be a finite
+    float of a plausible size (a record edited in SQL is read as strictly as a file)."""
+    values = [float(v) if isinstance(v, Decimal) else v for v in row]
+    for field, value, stored in zip(fields(record_type), values, row):
+        if isinstance(value, float) and not abs(value) <= MAX_MAGNITUDE:   # NaN fails too
+            raise EngineError(f"{_KINDS.get(record_type, 'record')} {row[0]}: {field.name} {stored} is not a number "
+                              f"of at most {MAX_MAGNITUDE:g} in size; correct it (in the database or the CSV file)")
+    return record_type(*values)
 
-    return record_type(*(float(v) if isinstance(v, Decimal) else v for v in row))
 
-
+_KINDS = {Gear: "gear", GearUnit: "unit", Hob: "hob", Machine: "machine"}
 GEAR_QUERY = f"SELECT {_columns(Gear, exclude={'units'})} FROM gear"  # static, from the dataclass
 UNIT_QUERY = f"SELECT gear_id, {_columns(GearUnit)} FROM gear_unit"
 HOB_QUERY = f"SELECT {_columns(Hob)} FROM hob"
@@ -90,17 +130,28 @@ def load_gear(conn, gear_id: int) -> Gear:
     row = conn.execute(GEAR_QUERY + " WHERE id = %s", (gear_id,)).fetchone()
     if row is None:
         raise EngineError(f"gear {gear_id} does not exist; import it with `engine gears import FILE.csv`")
-    return _with_units(_as_float(Gear, row), _load_units(conn, gear_id, gear_id))
+    return _with_units(_completed(_as_float(Gear, row)), _load_units(conn, gear_id, gear_id))
 
 
 def load_gears(conn, first: int | None = None, last: int | None = None) -> list[Gear]:
     rows = conn.execute(GEAR_QUERY + " WHERE id BETWEEN %s AND %s ORDER BY id",
                         (first if first is not None else 0, last if last is not None else 2**31 - 1))
-    gears = [_as_float(Gear, row) for row in rows]
+    gears = [_completed(_as_float(Gear, row)) for row in rows]
     if not gears:
         return gears
     units = _load_units(conn, gears[0].id, gears[-1].id)
     return [_with_units(gear, units) for gear in gears]
+
+
+def _completed(gear: Gear) -> Gear:
+    """A gear written in SQL without its diameters gets them as a CSV import computes them."""
+    if gear.tip_diameter is not None and gear.root_diameter is not None:
+        return gear
+    tip, root = derived_diameters(gear.module, gear.teeth, gear.helix_angle, gear.tip_diameter, gear.root_diameter)
+    if not 0 < root < tip:
+        raise EngineError(f"gear {gear.id}: its computed root diameter {root:g} is not between 0 and the tip "
+                          f"diameter {tip:g}; give tip_diameter and root_diameter")
+    return replace(gear, tip_diameter=tip, root_diameter=root)
 
 
 def _load_units(conn, first: int, last: int) -> dict[int, tuple]:
@@ -112,8 +163,6 @@ def _load_units(conn, first: int, last: int) -> dict[int, tuple]:
 
 
 def _with_units(gear: Gear, units: dict) -> Gear:
-    from dataclasses import replace
-
     return replace(gear, units=units.get(gear.id, ())) if gear.id in units else gear
 
 

@@ -34,7 +34,8 @@ Lines: the file is split at "\\n" (a final newline ends the last line, it adds n
 line; a "\\r" stays part of its line). Instantiating the import with the same parameters
 and writing the lines joined by "\\n" plus a final "\\n" gives the file byte for byte
 when it ended with a newline (every file of data/nc does); otherwise only that final
-newline differs. The import checks this itself before it commits.
+newline differs. The import checks this itself before it commits (engine.library.nc_verify), while
+the rows are being written.
 """
 from __future__ import annotations
 
@@ -42,24 +43,23 @@ import csv
 import io
 import json
 import keyword
-import math
 import re
 from dataclasses import dataclass, field
-from decimal import Decimal, InvalidOperation
+from functools import partial
 from pathlib import Path
 
 from psycopg.types.json import Jsonb
 
 from ..errors import EngineError
-from ..templates.decision_table import MODULE_ORDER, CompiledTemplate
-from ..templates.evaluator import evaluate
-from ..templates.expressions import MAX_EXPRESSION_LENGTH, compile_expression
+from ..memory import no_cycle_collection
 from ..templates.functions import CONSTANTS, FUNCTIONS
-from ..templates.rows import TemplateRow
+from ..templates.rows import MODULE_ORDER, TemplateRow
 from ..templates.store import ensure_class, load_template, replace_template
-from .nc_tokens import LABEL, NUMBER, SYMBOL, LineFacts, facts, tokenise
+from .nc_halves import in_halves
+from .nc_rows import Builder, values_of
+from .nc_tokens import LABEL, SYMBOL, LineFacts, facts, tokenise
+from .nc_verify import Proof
 
-CODE_ADDRESSES = frozenset({"G", "M", "$"})   # their numbers name a function, not a value
 CLASS_NAME = re.compile(r"^[a-z][a-z0-9_]*$")
 ROW_STEP = 10
 
@@ -80,26 +80,50 @@ class ImportReport:
 def import_nc(conn, path, gear_class: str, params: dict | None = None, modules: dict | None = None,
               parent: str | None = None) -> ImportReport:
     """Store the NC program at `path` as the template of `gear_class`: all or nothing."""
+    with no_cycle_collection():   # tokens and checked trees of every line: millions of objects
+        return _import(conn, path, gear_class, params, modules, parent)
+
+
+def _import(conn, path, gear_class: str, params: dict | None, modules: dict | None, parent: str | None) -> ImportReport:
     if not CLASS_NAME.match(gear_class or ""):
         raise EngineError(f"class name {gear_class!r}: use lower-case letters, digits and _, "
                           "starting with a letter")
     params = dict(params or {})
     check_param_names(params)
     lines = read_nc_lines(path)
-    assigned = assign_modules([facts(tokenise(line)) for line in lines], _checked_modules(modules, len(lines)))
-    built = _Builder(_values_of(params), path)
-    rows = [built.row(ROW_STEP * (index + 1), t, n, line)
-            for index, (line, (t, n)) in enumerate(zip(lines, assigned))]
+    built = Builder(values_of(params), path)
+    halves = in_halves(len(lines), partial(_read_lines, lines, built))
+    assigned = assign_modules([facts for half in halves for facts in half[0]], _checked_modules(modules, len(lines)))
+    texts = [o for half in halves for o in half[1]]
+    rows = [TemplateRow(ROW_STEP * (index + 1), t, n, None, None, o, None) for index, (o, (t, n)) in
+            enumerate(zip(texts, assigned))]
+    built.parameterised = sum(half[2] for half in halves)
+    for half in halves:
+        built.ambiguous.update((value, names) for value, names in half[3].items() if value not in built.ambiguous)
+    proof = Proof(params, lines, path)
     with conn.transaction():
         created = ensure_class(conn, gear_class, parent)
-        changed = replace_template(conn, gear_class, rows)
+        changed = replace_template(conn, gear_class, rows, check=proof.start_on)   # proved while written
         _store_import_params(conn, gear_class, params)
         template = load_template(conn, gear_class)
-        _verify(template, params, lines, path)
+        _refuse_inherited(template, lines)
+        proof.verdict(template.rows)
     counts = {t: sum(1 for row in rows if row.t == t) for t in MODULE_ORDER}
     return ImportReport(gear_class, str(path), len(rows), built.parameterised,
                         {t: c for t, c in counts.items() if c}, created, changed, template.version,
                         built.ambiguous)
+
+
+def _read_lines(lines: list[str], built: Builder, start: int, end: int) -> tuple:
+    """Lines start…end: the facts of each (for its module), its row's `o`, and the references
+    made and the ambiguous values found in them."""
+    built.parameterised, built.ambiguous = 0, {}
+    line_facts, texts = [], []
+    for number in range(start, end):
+        tokens = tokenise(lines[number])
+        line_facts.append(facts(tokens))
+        texts.append(built.o(number + 1, lines[number], tokens))
+    return line_facts, texts, built.parameterised, built.ambiguous
 
 
 def _store_import_params(conn, gear_class: str, params: dict) -> None:
@@ -116,17 +140,12 @@ def _params_json(params: dict) -> str:
                           "give numbers or text") from None
 
 
-def _verify(template, params: dict, lines: list[str], path) -> None:
-    """The stored class, instantiated with the same parameters, gives the file back."""
+def _refuse_inherited(template, lines: list[str]) -> None:
+    """The class must be made of the program's rows alone."""
     inherited = [row.id for row in template.rows if row.id > ROW_STEP * len(lines) or row.id % ROW_STEP]
     if inherited:
         raise EngineError(f"class {template.gear_class} inherits rows {inherited[:5]} from its parent, so it "
                           "would not give the program back; import it under a parent without rows")
-    produced = CompiledTemplate(template).run(params).lines
-    for number, (got, want) in enumerate(zip(produced, lines), start=1):
-        if got != want:
-            raise EngineError(f"{path} line {number}: the imported template gives {got!r}, not {want!r}; "
-                              "nothing stored (please report this line)")
 
 
 # --- reading -------------------------------------------------------------------------
@@ -292,99 +311,3 @@ def assign_modules(lines: list[LineFacts], corrections: dict | None = None) -> l
         current = decided
         assigned.append((decided, runs[decided]))
     return assigned
-
-
-# --- rows ------------------------------------------------------------------------------
-
-def _values_of(params: dict) -> dict:
-    """Decimal value → [(name, value)] of the numeric parameters, in the order given."""
-    values: dict = {}
-    for name, value in params.items():
-        if isinstance(value, bool) or not isinstance(value, (int, float, Decimal)):
-            continue
-        if isinstance(value, float) and not math.isfinite(value):
-            continue
-        values.setdefault(Decimal(str(value)), []).append((name, value))
-    return values
-
-
-_SPELLING = re.compile(r"([+-]?)([0-9]*)(\.?)([0-9]*)")
-
-
-def number_field(name: str, spelling: str) -> str:
-    """The f-string replacement field that prints `name` in the style of `spelling`."""
-    sign, integer, point, fraction = _SPELLING.fullmatch(spelling).groups()
-    digits = len(fraction)
-    if not integer:
-        scale = 10 ** digits
-        positive = "'+'" if sign == "+" else "''"
-        magnitude = f"round(abs({name}) * {scale})"
-        return (f"{{'-' if {name} < 0 else {positive}}}{{{magnitude} // {scale} or ''}}."
-                f"{{{magnitude} % {scale}:0{digits}d}}")
-    trailing_point = bool(point) and not fraction
-    width = len(spelling) - trailing_point
-    padding = f"0{width}" if len(integer) > 1 and integer.startswith("0") else ""
-    return f"{{{name}:{'+' if sign == '+' else ''}{padding}.{digits}f}}" + ("." if trailing_point else "")
-
-
-class _Builder:
-    def __init__(self, values: dict, path):
-        self.values, self.path = values, path
-        self.parameterised, self.ambiguous = 0, {}
-
-    def row(self, row_id: int, t: str, n: int, line: str) -> TemplateRow:
-        parts = [self._part(token) for token in tokenise(line)]
-        fields = "".join(text for is_field, text in parts if is_field)
-        literal = "".join(text for is_field, text in parts if not is_field)
-        quote = "'" if '"' in literal and "'" not in literal + fields else '"'
-        if fields:
-            body = "".join(text if is_field else _escaped(text, quote, braces=True) for is_field, text in parts)
-            o = f"f{quote}{body}{quote}"
-        else:
-            o = f"{quote}{_escaped(line, quote, braces=False)}{quote}"
-        if len(o) > MAX_EXPRESSION_LENGTH:
-            raise EngineError(f"{self.path} line {row_id // ROW_STEP}: {len(line)} characters, more than a "
-                              f"template row holds ({MAX_EXPRESSION_LENGTH}); split the line")
-        self.parameterised += sum(1 for is_field, _ in parts if is_field)
-        return TemplateRow(row_id, t, n, None, None, o, None)
-
-    def _part(self, token) -> tuple[bool, str]:
-        """(True, replacement field) for a number that becomes a reference, else (False, text)."""
-        if token.kind != NUMBER or token.address in CODE_ADDRESSES or _is_negative_zero(token.text):
-            return False, token.text
-        candidates = self.values.get(Decimal(token.text))
-        if not candidates:
-            return False, token.text
-        name, value = candidates[0]
-        source = number_field(name, token.text)
-        if _evaluate(source, name, value) != token.text:
-            return False, token.text
-        if len(candidates) > 1:
-            self.ambiguous[str(Decimal(token.text))] = [n for n, _ in candidates]
-        return True, source
-
-
-def _is_negative_zero(spelling: str) -> bool:
-    try:
-        return spelling.startswith("-") and Decimal(spelling) == 0
-    except InvalidOperation:
-        return False
-
-
-def _evaluate(source: str, name: str, value) -> str:
-    return evaluate(compile_expression(f'f"{source}"'), {name: value})
-
-
-def _escaped(text: str, quote: str, braces: bool) -> str:
-    out = []
-    for character in text:
-        if character in ("\\", quote):
-            out.append("\\" + character)
-        elif braces and character in "{}":
-            out.append(character * 2)
-        elif character.isprintable():
-            out.append(character)
-        else:
-            out.append(repr(character)[1:-1])
-    return "".join(out)
-

@@ -6,8 +6,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ..errors import EngineError
-from .decision_table import MODULE_ORDER, TemplateError, compile_row
-from .rows import TemplateRow
+from .decision_table import TemplateError, compile_row
+from .rows import MODULE_ORDER, TemplateRow
 
 
 @dataclass(frozen=True)

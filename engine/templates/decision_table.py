@@ -8,29 +8,27 @@ For each row in id order, with scope = job parameters ∪ parameters of module (
 asteval evaluates every expression (engine.templates.evaluator). Each row's outcome goes
 into the program's trace (engine.templates.trace). A row whose inputs have the same values
 and origins as for an earlier job of the template has the same outcome: it is taken from
-the template's memo instead of being evaluated again. Any failure aborts the whole
+the template's memo instead of being evaluated again (and pays again what it cost). A run spends
+one budget of time and bytes (engine.templates.budget). Any failure aborts the whole
 instantiation with an error naming class, row, column, text.
 """
 from __future__ import annotations
 
-import ast
-import time
+import threading
 from dataclasses import dataclass, field
 from functools import partial
 
 from ..errors import EngineError
 from ..turning.nc_path import NcLines
+from .budget import Budget, seconds_for, spending
 from .evaluator import EvaluationError, Evaluator, base_symbols
-from .expressions import (MAX_SECONDS_PER_INSTANTIATION, Compiled, ExpressionError, compile_expression,
-                          compile_statements)
+from .expressions import Compiled, ExpressionError, compile_expression, compile_statements
 from .guards import MAX_STRING_LENGTH, short_repr, size
 from .rows import Template, TemplateRow
 from .trace import Outcome, RowTrace, memo_key
 
-MODULE_ORDER = ("main", "prep", "sync", "shift", "cutcond", "cutmotion")
 MAX_MEMO_ROWS = 50_000    # outcomes kept per template (about 1.5 KB each); the memo starts again when full
 MAX_MEMO_VALUE = 256      # characters or elements of a value an outcome kept in the memo may hold
-MAX_RUN_SIZE = 1 << 24    # characters and elements one run may build (values computed, lines emitted)
 
 
 class TemplateError(EngineError):
@@ -71,68 +69,77 @@ class CompiledTemplate:
         self.template = template
         self.rows = tuple(compile_row(template.gear_class, row, template.translations) for row in template.rows)
         self.symbols = base_symbols(any(c.is_sql for r in self.rows for c in _expressions_of(r)))
-        self.evaluator = Evaluator()
-        self.memo: dict[tuple, Outcome] = {}
+        self._evaluators = threading.local()   # runners may share a process (and this compiled template)
+        self.memo: dict[tuple, tuple[Outcome, int]] = {}   # key -> (outcome, bytes it cost to evaluate)
         # Rows that print a whole tool path (nc_path) emit several lines at once.
-        self.prints_paths = any(row.o is not None and _calls_nc_path(row.o.tree) for row in self.rows)
+        self.prints_paths = any(row.o is not None and "nc_path" in row.o.calls for row in self.rows)
 
-    def run(self, params: dict, module_params: dict | None = None,
-            deadline_seconds: float = MAX_SECONDS_PER_INSTANTIATION) -> Result:
-        job = _Job(self, params, module_params or {}, time.perf_counter() + deadline_seconds, deadline_seconds)
+    def run(self, params: dict, module_params: dict | None = None, deadline_seconds: float | None = None) -> Result:
+        seconds = seconds_for(len(self.rows)) if deadline_seconds is None else deadline_seconds
+        job = _Job(self, params, module_params or {}, Budget(seconds))
         try:
-            for row in self.rows:
-                job.run_row(row)
+            with spending(job.budget):
+                for row in self.rows:
+                    job.run_row(row)
         finally:
-            self.evaluator.forget()
+            job.evaluator.forget()
         return _one_line_each(job.result) if self.prints_paths else job.result
 
-    def remembered(self, key) -> Outcome | None:
+    @property
+    def evaluator(self) -> Evaluator:
+        """This thread's interpreter: one evaluation's scope and failures are its own."""
+        if not hasattr(self._evaluators, "evaluator"):
+            self._evaluators.evaluator = Evaluator()
+        return self._evaluators.evaluator
+
+    def remembered(self, key) -> tuple[Outcome, int] | None:
         return self.memo.get(key) if key is not None else None
 
-    def remember(self, key, outcome: Outcome) -> None:
+    def remember(self, key, outcome: Outcome, cost: int) -> None:
         """Outcomes whose values are small: the memo keeps no large value alive."""
         values = [value for _, value in outcome.assignments] + [outcome.line]
         if key is not None and not any(isinstance(value, (str, tuple, list)) and size(value, MAX_MEMO_VALUE)
                                        > MAX_MEMO_VALUE for value in values):
             if len(self.memo) >= MAX_MEMO_ROWS:
                 self.memo.clear()
-            self.memo[key] = outcome
+            self.memo[key] = outcome, cost
 
 
 class _Job:
     """The state of one run: scope, intermediates and where each came from, module switching."""
 
-    def __init__(self, compiled: CompiledTemplate, params: dict, module_params: dict, deadline: float, budget: float):
+    def __init__(self, compiled: CompiledTemplate, params: dict, module_params: dict, budget: Budget):
         self.compiled, self.params, self.module_params = compiled, params, module_params
         _refuse_engine_names(compiled, params, "job parameter")
         self.scope = {**params, **compiled.symbols, "template_version": compiled.template.version}
         self.intermediates: dict[str, int] = {}      # name -> id of the row that computed it
         self.module, self.module_names, self.module_key = None, (), None
-        self.deadline, self.budget = deadline, budget
+        self.budget, self.evaluator = budget, compiled.evaluator
         self.result = Result()
-        self.built = 0   # characters and elements built so far (values computed, lines emitted)
-
-    def _count_built(self, row: CompiledRow, outcome: Outcome) -> None:
-        """Memory is bounded per run as time is: what a run builds, added up."""
-        self.built += _built_size(outcome)
-        if self.built > MAX_RUN_SIZE:
-            raise TemplateError(self.compiled.template.gear_class, row.row.id, "s" if row.s else "o",
-                                row.row.s or row.row.o or "", f"the rows so far built more than {MAX_RUN_SIZE} "
-                                "characters and elements")
 
     def run_row(self, row: CompiledRow) -> None:
-        if time.perf_counter() > self.deadline:
-            column = "s" if row.row.s else "o"
-            raise TemplateError(self.compiled.template.gear_class, row.row.id, column, getattr(row.row, column) or "",
-                                f"instantiation exceeded {self.budget} s")
         if row.module != self.module:
             self._enter(row.module)
         key = memo_key(row, self.scope, self.origin)
-        outcome = self.compiled.remembered(key)
-        if outcome is None:
+        remembered = self.compiled.remembered(key)
+        if remembered is None:
+            self._pay(row, 0)
+            spent = self.budget.spent
             outcome = self._evaluate(row)
-            self.compiled.remember(key, outcome)
+            self.compiled.remember(key, outcome, self.budget.spent - spent)
+        else:
+            outcome, cost = remembered
+            self._pay(row, cost)
         self._apply(row, outcome)
+
+    def _pay(self, row: CompiledRow, cost: int) -> None:
+        """The row's turn: within the run's time, and what its outcome cost when it was evaluated."""
+        try:
+            self.budget.pay(cost)
+        except (TimeoutError, ValueError) as error:
+            column = "s" if row.row.s else "o"
+            raise TemplateError(self.compiled.template.gear_class, row.row.id, column, getattr(row.row, column) or "",
+                                str(error)) from None
 
     def origin(self, name: str) -> str:
         """Where a name's value comes from: the row that computed it, the module, the job."""
@@ -176,17 +183,14 @@ class _Job:
 
     def _value(self, row: CompiledRow, column: str, expression: Compiled, trace):
         trace.read(column, expression)
-        if time.perf_counter() > self.deadline:   # between expressions too: a row may hold many
-            raise TemplateError(self.compiled.template.gear_class, row.row.id, column, expression.text,
-                                f"instantiation exceeded {self.budget} s")
         try:
-            return self.compiled.evaluator.evaluate(expression.tree, expression.text, self.scope)
-        except EvaluationError as error:
+            self.budget.check_time()   # between expressions too: a row may hold many
+            return self.evaluator.evaluate(expression.tree, expression.text, self.scope)
+        except (TimeoutError, EvaluationError) as error:
             raise TemplateError(self.compiled.template.gear_class, row.row.id, column, expression.text,
                                 str(error)) from None
 
     def _apply(self, row: CompiledRow, outcome: Outcome) -> None:
-        self._count_built(row, outcome)
         for name, value in outcome.assignments:
             self.scope[name] = value
             self.intermediates[name] = row.row.id
@@ -199,24 +203,12 @@ class _Job:
         self.result.trace["rows"].append(outcome.trace)
 
 
-def _built_size(outcome: Outcome) -> int:
-    """Lines emitted and values computed, each counted by its length: what a value holds inside
-    was counted when it was built (the guards bound each value built)."""
-    line = outcome.line if outcome.emit else ""
-    lines = sum(map(len, line)) if isinstance(line, NcLines) else len(line or "")
-    return lines + sum(len(value) if isinstance(value, (str, tuple, list)) else 1 for _, value in outcome.assignments)
-
-
 def _refuse_engine_names(compiled: CompiledTemplate, names, what: str) -> None:
     """No job or module parameter may rebind a function, constant or guard of the engine."""
     clash = sorted(name for name in names if name in compiled.symbols or name == "template_version")
     if clash:
         raise EngineError(f"class {compiled.template.gear_class}: {what} {short_repr(clash[0])} has the name of a "
                           "function or constant of the engine; rename it")
-
-
-def _calls_nc_path(tree) -> bool:
-    return any(isinstance(node, ast.Call) and getattr(node.func, "id", None) == "nc_path" for node in ast.walk(tree))
 
 
 def _one_line_each(result: Result) -> Result:
@@ -247,9 +239,33 @@ def _text(value, row: CompiledRow, gear_class: str):
     raise TemplateError(gear_class, row.row.id, "o", row.o.text, problem[:300])
 
 
+_ONCE = threading.local()
+
+
+class rows_compiled_once:
+    """`with rows_compiled_once():` each row compiled in the block is compiled once, however often
+    it is checked and run (an import checks its rows before storing them, then instantiates them)."""
+
+    def __enter__(self):
+        self.outer, _ONCE.rows = getattr(_ONCE, "rows", None), {}
+
+    def __exit__(self, *exc) -> None:
+        _ONCE.rows = self.outer
+
+
 def compile_row(gear_class: str, row: TemplateRow, translations=None) -> CompiledRow:
     """The row's expressions checked and guarded (SQL conditions from their stored translations
     where `translations` has them)."""
+    remembered = getattr(_ONCE, "rows", None)
+    if remembered is None or translations:
+        return _compile_row(gear_class, row, translations)
+    key = gear_class, row
+    if key not in remembered:
+        remembered[key] = _compile_row(gear_class, row, translations)
+    return remembered[key]
+
+
+def _compile_row(gear_class: str, row: TemplateRow, translations=None) -> CompiledRow:
     expression = partial(compile_expression, translations=translations)
 
     def compiled(column: str, compile_function):

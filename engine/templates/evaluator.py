@@ -8,18 +8,20 @@ trees the gate produced (engine.templates.expressions), parsed once per template
 from __future__ import annotations
 
 import ast
+import threading
 
 from ..errors import EngineError
 from .asteval_import import ALL_NODES, Interpreter
+from .budget import Budget, paid, spending
 from .functions import CONSTANTS, FUNCTIONS
-from .guards import (check_printable, guard_size, safe_add, safe_format, safe_lshift, safe_mod, safe_mult,
+from .guards import (built, check_printable, guard_size, safe_add, safe_format, safe_lshift, safe_mod, safe_mult,
                      safe_pow)
 
 # The asteval node handlers a checked expression needs; every other node is switched off.
 NODES = ("expression", "binop", "unaryop", "boolop", "compare", "ifexp", "call", "name", "constant",
          "joinedstr", "formattedvalue", "tuple", "list", "subscript", "slice", "index")
 GUARDS = {"_safe_pow": safe_pow, "_safe_mult": safe_mult, "_safe_add": safe_add, "_safe_lshift": safe_lshift,
-          "_safe_mod": safe_mod, "_safe_format": safe_format, "_guard": guard_size}
+          "_safe_mod": safe_mod, "_safe_format": safe_format, "_guard": guard_size, "_built": built}
 MAX_MESSAGE = 300   # characters of a failure's message (asteval's own repeats the arguments)
 
 
@@ -48,6 +50,8 @@ class Evaluator:
 
     def evaluate(self, tree: ast.expr, text: str, scope: dict):
         """The value of `tree` (the checked form of `text`) with `scope` as asteval's symbol table."""
+        if type(tree) is ast.Constant:   # a line written out (most rows of an imported program)
+            return tree.value
         interpreter = self.interpreter
         interpreter.symtable = scope
         interpreter.error, interpreter.error_msg, interpreter.expr = [], None, text
@@ -72,7 +76,7 @@ def _formatted_value(interpreter):
         spec = "" if node.format_spec is None else interpreter.run(node.format_spec)
         value = interpreter.run(node.value)
         check_printable(value)   # before printing it: a field of a huge value is refused, not rendered
-        return format(value, spec)
+        return paid(format(value, spec))
     return on_formattedvalue
 
 
@@ -97,11 +101,23 @@ def _problem(held: list, raised: Exception) -> str:
     return text if len(text) <= MAX_MESSAGE else text[:MAX_MESSAGE - 1] + "…"
 
 
-_SHARED: list[Evaluator] = []
+_THREAD = threading.local()   # an Interpreter holds the state of one evaluation: one per thread
 
 
-def evaluate(compiled, scope: dict):
-    """One expression on its own (import, tests): `scope` holds its names."""
-    if not _SHARED:
-        _SHARED.append(Evaluator())
-    return _SHARED[0].evaluate(compiled.tree, compiled.text, {**scope, **base_symbols(compiled.is_sql)})
+def _own_evaluator() -> Evaluator:
+    if not hasattr(_THREAD, "evaluator"):
+        _THREAD.evaluator = Evaluator()
+    return _THREAD.evaluator
+
+
+def evaluate(compiled, scope: dict, budget: Budget | None = None):
+    """One expression on its own (import, tests): `scope` holds its names; it spends `budget`,
+    by default a whole instantiation's."""
+    with spending(budget or Budget()):
+        return _own_evaluator().evaluate(compiled.tree, compiled.text, {**scope, **base_symbols(compiled.is_sql)})
+
+
+def evaluate_part(tree: ast.expr, text: str, is_sql: bool):
+    """A part of an expression that reads no parameter, on its own budget (the gate's check)."""
+    with spending(Budget()):
+        return _own_evaluator().evaluate(tree, text, base_symbols(is_sql))

@@ -14,8 +14,8 @@ deep. The operators that can allocate without bound (`**`, `*`, `+`, `<<`, `%`),
 list and tuple displays and dynamic format specs are rewritten into calls of the guards of
 engine.templates.guards, which bound every value an expression builds. Behind the gate,
 asteval's interpreter runs the guarded tree with only our functions in its symbol table.
-Every expression therefore runs in time bounded by its size; the decision table keeps a
-wall-clock budget per instantiation as well.
+Every expression therefore runs in time bounded by its size; an instantiation spends one budget of
+time and bytes as well (engine.templates.budget).
 """
 from __future__ import annotations
 
@@ -26,12 +26,13 @@ from dataclasses import dataclass
 from ..errors import EngineError
 from .functions import CONSTANTS, FUNCTIONS
 from .guards import MAX_INT_BITS, check_format_spec, parse_python
+from .plain_lines import plain
+from .tree_walk import Walk
 
 MAX_EXPRESSION_LENGTH = 4_000      # characters of one expression or statement block
 MAX_NODES = 400                    # AST nodes of one expression
 MAX_DEPTH = 40                     # nesting of one expression (asteval walks the tree recursively)
 MAX_TRANSLATION_LENGTH = 4 * MAX_EXPRESSION_LENGTH   # the Python a SQL condition is translated into
-MAX_SECONDS_PER_INSTANTIATION = 2.0
 ENGINE_NAMES = frozenset(FUNCTIONS) | frozenset(CONSTANTS) | {"template_version"}
 
 ALLOWED_NODES = (
@@ -54,6 +55,7 @@ class Compiled:
     names: frozenset[str]      # parameter/variable names it reads
     is_sql: bool = False
     ordered_names: tuple[str, ...] = ()   # the names, sorted (the trace lists them in this order)
+    calls: frozenset[str] = frozenset()   # the functions it calls
 
 
 class ExpressionError(EngineError):
@@ -69,13 +71,44 @@ def compile_expression(text: str, translations: Mapping[str, str] | None = None)
         is_sql = False
     except SyntaxError as python_error:
         tree, is_sql = _sql_tree(text, python_error, translations or {}), True
-    _check_tree(tree, sql_helpers=is_sql)
-    names = frozenset(_read_names(tree))
-    tree = _GuardOperators().visit(tree)
-    if is_sql:
-        tree = ast.Expression(body=ast.Call(ast.Name("_sql_truth", ast.Load()), [tree.body], []))
-    ast.fix_missing_locations(tree)
-    return Compiled(text, tree.body, names, is_sql, tuple(sorted(names)))
+    found = None if is_sql else plain(tree.body, MAX_NODES)
+    if found is not None:
+        body, names = found
+        return Compiled(text, body, names, False, tuple(sorted(names)))
+    return _fully_checked(text, tree, is_sql)
+
+
+def _fully_checked(text: str, tree: ast.Expression, is_sql: bool) -> Compiled:
+    """The whole gate on a parsed expression: checked, its constant parts evaluated, guarded."""
+    walk = Walk(tree, MAX_DEPTH, ExpressionError(f"nested too deeply (at most {MAX_DEPTH} levels)"))
+    _check_tree(walk, sql_helpers=is_sql)
+    names = frozenset(_read_names(walk))
+    parts = walk.parts_without(_is_parameter)
+    replaced = _guarded(walk)
+    if parts:
+        _check_constant_parts([replaced.get(id(part), part) for part in parts], parts, text.strip(), is_sql)
+    body = ast.Call(ast.Name("_sql_truth", ast.Load()), [tree.body], []) if is_sql else tree.body
+    calls = frozenset(node.func.id for node in walk.of_type(ast.Call))
+    return Compiled(text, body, names, is_sql, tuple(sorted(names)), calls)
+
+
+def _check_constant_parts(guarded: list, parts: list, source: str, is_sql: bool) -> None:
+    """Every part that reads no parameter (`[[0] * 65536] * 65536`, `10 ** 10 ** 6`) is evaluated
+    here, under the bounds of one instantiation: one that fails would fail for every job, so the
+    template is refused where it enters (import, lint, compile), not at its first job."""
+    from .evaluator import EvaluationError, evaluate_part   # asteval: only where a template is compiled
+
+    for part, original in zip(guarded, parts):
+        try:
+            evaluate_part(part, source, is_sql)
+        except EvaluationError as error:
+            text = None if is_sql else ast.get_source_segment(source, original)
+            what = "it" if text is None or text == source else text
+            raise ExpressionError(f"{what} fails for every job: {error}") from None
+
+
+def _is_parameter(name: str) -> bool:
+    return name not in FUNCTIONS and name not in CONSTANTS and not name.startswith("_")
 
 
 def _parsed(text: str, mode: str) -> ast.AST:
@@ -164,14 +197,11 @@ def _parse_sql(text: str, python_error: SyntaxError) -> ast.Expression:
         ) from None
 
 
-def _check_tree(tree: ast.AST, sql_helpers: bool = False) -> None:
-    """The gate: only allowed nodes, named functions and names; bounded in size and depth.
-    `_sql_*` helpers only in the translation of a SQL condition, never in Python text."""
-    if _depth(tree) > MAX_DEPTH:
-        raise ExpressionError(f"nested too deeply (at most {MAX_DEPTH} levels)")
-    count = 0
-    for node in ast.walk(tree):
-        count += 1
+def _check_tree(walk: Walk, sql_helpers: bool = False) -> None:
+    """The gate: only allowed nodes, named functions and names; bounded in size and depth (the
+    walk refused a deeper tree). `_sql_*` helpers only in the translation of a SQL condition,
+    never in Python text."""
+    for node in walk.nodes:
         if not isinstance(node, ALLOWED_NODES):
             raise ExpressionError(f"{_describe(node)} is not allowed in a template expression")
         if isinstance(node, ast.Constant):
@@ -180,11 +210,13 @@ def _check_tree(tree: ast.AST, sql_helpers: bool = False) -> None:
             _check_spec_fields(node.format_spec)
         if isinstance(node, ast.Call):
             _check_call(node, sql_helpers)
+        if _formats_with_percent(node):
+            raise ExpressionError("'%' string formatting is not allowed; use an f-string")
         if isinstance(node, ast.Name):
             _check_name(node.id, sql_helpers)
-    if count > MAX_NODES:
-        raise ExpressionError(f"expression too large ({count} nodes, at most {MAX_NODES})")
-    misused = _function_names_as_values(tree)
+    if len(walk.nodes) > MAX_NODES:
+        raise ExpressionError(f"expression too large ({len(walk.nodes)} nodes, at most {MAX_NODES})")
+    misused = _function_names_as_values(walk)
     if misused:
         raise ExpressionError(f"{misused[0]} is a function: call it, {misused[0]}(…)")
 
@@ -194,6 +226,13 @@ def _check_constant(value) -> None:
         raise ExpressionError("bytes literals are not allowed (NC lines are text)")
     if isinstance(value, int) and value.bit_length() > MAX_INT_BITS:
         raise ExpressionError(f"integer literal larger than {MAX_INT_BITS} bits")
+
+
+def _formats_with_percent(node: ast.AST) -> bool:
+    """`'…' % x` on a written text: refused here as the guard refuses it at run time (its width
+    is not bounded), so that lint names it without a job."""
+    return isinstance(node, ast.BinOp) and isinstance(node.op, ast.Mod) and (
+        isinstance(node.left, ast.JoinedStr) or isinstance(node.left, ast.Constant) and isinstance(node.left.value, str))
 
 
 def _check_spec_fields(spec: ast.JoinedStr) -> None:
@@ -206,22 +245,11 @@ def _check_spec_fields(spec: ast.JoinedStr) -> None:
             raise ExpressionError("a format spec may take only a name or a constant in its {field}")
 
 
-def _function_names_as_values(tree: ast.AST):
+def _function_names_as_values(walk: Walk):
     """Names of functions used other than as the called name: an NC line would print
     `<function …>`."""
-    called = {id(node.func) for node in ast.walk(tree) if isinstance(node, ast.Call)}
-    return [node.id for node in ast.walk(tree)
-            if isinstance(node, ast.Name) and node.id in FUNCTIONS and id(node) not in called]
-
-
-def _depth(tree: ast.AST) -> int:
-    deepest, pending = 0, [(tree, 1)]
-    while pending:
-        node, depth = pending.pop()
-        deepest = max(deepest, depth)
-        if depth <= MAX_DEPTH:
-            pending.extend((child, depth + 1) for child in ast.iter_child_nodes(node))
-    return deepest
+    called = {id(node.func) for node in walk.of_type(ast.Call)}
+    return [node.id for node in walk.of_type(ast.Name) if node.id in FUNCTIONS and id(node) not in called]
 
 
 def _check_call(node: ast.Call, sql_helpers: bool) -> None:
@@ -247,10 +275,9 @@ def _describe(node: ast.AST) -> str:
     return descriptions.get(type(node), type(node).__name__)
 
 
-def _read_names(tree: ast.AST):
-    for node in ast.walk(tree):
-        if isinstance(node, ast.Name) and node.id not in FUNCTIONS and node.id not in CONSTANTS \
-                and not node.id.startswith("_sql_"):
+def _read_names(walk: Walk):
+    for node in walk.of_type(ast.Name):
+        if node.id not in FUNCTIONS and node.id not in CONSTANTS and not node.id.startswith("_sql_"):
             yield node.id
 
 
@@ -261,45 +288,49 @@ def _constant_spec(spec: ast.JoinedStr) -> str | None:
     return None
 
 
-class _GuardOperators(ast.NodeTransformer):
-    """Route the operators that can allocate without bound through the guards."""
+def _guarded(walk: Walk) -> dict[int, ast.AST]:
+    """Route the operators that can allocate without bound through the guards, in place, children
+    before their parents. Returns the node that took the place of each node replaced (a part's
+    guarded form). A format spec is checked, never wrapped."""
+    replaced = {}
+    for node in reversed(walk.nodes):
+        instead = _guard_of(node, walk)
+        if instead is not node:
+            walk.put(node, instead)
+            replaced[id(node)] = instead
+    return replaced
 
-    def visit_BinOp(self, node: ast.BinOp):
-        self.generic_visit(node)
+
+def _guard_of(node: ast.AST, walk: Walk) -> ast.AST:
+    kind = type(node)
+    if kind is ast.BinOp:
         guard = GUARDED_OPERATORS.get(type(node.op))
-        if guard is None:
-            return node
-        return ast.copy_location(
-            ast.Call(ast.Name(guard, ast.Load()), [node.left, node.right], []), node)
+        return node if guard is None else _call(guard, [node.left, node.right], node)
+    if kind is ast.JoinedStr:
+        return node if walk.slots[id(node)][1] == "format_spec" else _call("_guard", [node], node)
+    if kind is ast.List or kind is ast.Tuple:   # a display of constants is bounded by the text
+        return node if all(isinstance(element, ast.Constant) for element in node.elts) else _call("_guard", [node], node)
+    if kind is ast.Subscript:                   # a slice copies what it cuts: paid like any built value
+        return _call("_built", [node], node) if isinstance(node.slice, ast.Slice) else node
+    if kind is ast.FormattedValue:
+        return _field(node)
+    return node
 
-    def visit_JoinedStr(self, node: ast.JoinedStr):
-        self.generic_visit(node)
-        return ast.copy_location(ast.Call(ast.Name("_guard", ast.Load()), [node], []), node)
 
-    def visit_List(self, node: ast.List):
-        return self._sized(node)
+def _call(guard: str, arguments: list, node: ast.AST) -> ast.Call:
+    return ast.copy_location(ast.Call(ast.Name(guard, ast.Load()), arguments, []), node)
 
-    def visit_Tuple(self, node: ast.Tuple):
-        return self._sized(node)
 
-    def _sized(self, node):
-        """A display of constants is bounded by the text; one of computed values is checked."""
-        self.generic_visit(node)
-        if all(isinstance(element, ast.Constant) for element in node.elts):
-            return node
-        return ast.copy_location(ast.Call(ast.Name("_guard", ast.Load()), [node], []), node)
-
-    def visit_FormattedValue(self, node: ast.FormattedValue):
-        if node.conversion != -1:
-            raise ExpressionError("conversions (!r, !s, !a) are not allowed in f-strings")
-        spec = node.format_spec
-        if spec is None or _constant_spec(spec) is not None:
-            if spec is not None:
-                try:
-                    check_format_spec(_constant_spec(spec))  # fixed spec: checked once, here
-                except ValueError as error:
-                    raise ExpressionError(str(error)) from None
-            node.value = self.visit(node.value)
-            return node
-        value = ast.Call(ast.Name("_safe_format", ast.Load()), [self.visit(node.value), spec], [])
-        return ast.copy_location(ast.FormattedValue(value, -1, None), node)
+def _field(node: ast.FormattedValue) -> ast.FormattedValue:
+    """A fixed format spec is checked once, here; a computed one by _safe_format when it runs."""
+    if node.conversion != -1:
+        raise ExpressionError("conversions (!r, !s, !a) are not allowed in f-strings")
+    spec = node.format_spec
+    if spec is None or _constant_spec(spec) is not None:
+        if spec is not None:
+            try:
+                check_format_spec(_constant_spec(spec))
+            except ValueError as error:
+                raise ExpressionError(str(error)) from None
+        return node
+    return ast.copy_location(ast.FormattedValue(_call("_safe_format", [node.value, spec], node), -1, None), node)

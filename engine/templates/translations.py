@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import functools
 import hashlib
+import re
 from importlib.metadata import version
 
 from psycopg.errors import InsufficientPrivilege
@@ -66,7 +67,16 @@ def store_translations(conn, rows) -> int:
     return len(made)
 
 
+# A text in quotes with no quote or backslash inside, f-string or not: a written NC line (most
+# rows of an imported program). Python parses it first whatever it means in SQL, so it is never
+# a SQL condition, and needs no parse to say so (nor does one the f-string parser would refuse:
+# it is refused as Python and as SQL).
+_QUOTED = re.compile(r"""f?"[^"\\\n]*"|f?'[^'\\\n]*'""")
+
+
 def _is_python(text: str) -> bool:
+    if _QUOTED.fullmatch(text.strip()):
+        return True
     try:
         parse_python(text.strip())
     except (SyntaxError, RecursionError, MemoryError, ValueError):

@@ -7,12 +7,14 @@ words of each dialect stay in the template rows:
 
 A format may name only the fields of FIELDS, with a bounded format spec: no attribute or
 index access, no conversions, nothing nested (str.format would otherwise reach into any
-object). The result is one entry of the result table per block, all from the same row.
+object). The result is one entry of the result table per block, all from the same row. Every
+block is paid for from the instantiation's budget as it is printed (engine.templates.budget).
 """
 from __future__ import annotations
 
 import string
 
+from ..templates.budget import paid
 from ..templates.guards import check_format_spec
 from .moves import MOVE_KINDS
 
@@ -32,7 +34,7 @@ def nc_path(moves, rapid: str, feed: str, cw: str, ccw: str, thread: str) -> NcL
     parsed = {kind: _parsed(kind, text) for kind, text in formats.items()}
     if len(moves) > MAX_PATH_BLOCKS:
         raise ValueError(f"nc_path: {len(moves)} moves, more than {MAX_PATH_BLOCKS}")
-    return NcLines(_block(parsed, move) for move in moves)
+    return paid(NcLines(_block(parsed, move) for move in moves))
 
 
 def _parsed(kind: str, text) -> list[tuple[str, str | None, str]]:
@@ -65,4 +67,4 @@ def _block(parsed: dict, move) -> str:
     block = "".join(text)
     if len(block) > MAX_BLOCK_LENGTH:
         raise ValueError(f"nc_path: a block longer than {MAX_BLOCK_LENGTH} characters")
-    return block
+    return paid(block)   # block by block: a long path stops at the run's budget, not after it

@@ -6,9 +6,11 @@ import functools
 import re
 from decimal import Decimal
 
+from ..budget import paid
 from .operands import MAX_TEXT_LENGTH, _describe
 
 MAX_PATTERN_LENGTH = 1_000   # characters of a LIKE pattern (a template's patterns are a few words)
+MAX_LIKE_STEPS = 1 << 22     # text length times pattern length: what one match may cost (a few ms)
 
 
 class _LikePattern:
@@ -72,6 +74,9 @@ def _like(value, pattern, escape, flags, op):
             raise TypeError(f"operator {op} needs text, got {_describe(operand)}")
     if len(pattern) > MAX_PATTERN_LENGTH:   # matching costs the pattern's length times the text's
         raise ValueError(f"{op} pattern longer than {MAX_PATTERN_LENGTH} characters")
+    if len(value) * len(pattern) > MAX_LIKE_STEPS:   # one regex search cannot be stopped at the deadline
+        raise ValueError(f"{op} of a text of {len(value)} characters with a pattern of {len(pattern)}: "
+                         f"more than {MAX_LIKE_STEPS} steps")
     return _like_pattern(pattern, escape, flags).matches(value)
 
 
@@ -101,4 +106,4 @@ def _sql_concat(a, b):
     text = _text(a) + _text(b)
     if len(text) > MAX_TEXT_LENGTH:
         raise ValueError(f"string too long (more than {MAX_TEXT_LENGTH} characters)")
-    return text
+    return paid(text)

@@ -1,0 +1,86 @@
+"""What one instantiation may spend: wall-clock time and the bytes of the values its expressions
+build (design notes §4). A shop runs thousands of gears unattended, so no template row, however
+written, may hold a batch up or take the machine's memory.
+
+Each guard (engine.templates.guards), f-string field, slice and nc_path block pays for the value
+it builds, temporaries included, as it builds it: the run is refused once it has built more than
+MAX_BYTES, and at the first payment after its deadline. Nothing an expression does between two
+payments costs more than one value of the guards' MAX_SIZE, so neither bound can be overrun by
+more than that, whatever one expression holds. The running budget is the thread's own (runners
+may share a process), and there is none between runs.
+"""
+from __future__ import annotations
+
+import sys
+import threading
+import time
+
+MAX_SECONDS = 2.0            # wall-clock time of one instantiation
+SECONDS_PER_ROW = 50e-6      # and per row of its template: an imported program of 100,000 lines is
+                             # 100,000 rows, about 20 us each to evaluate (asteval, trace, memo)
+MAX_BYTES = 64 << 20         # bytes of the values one instantiation's expressions build
+
+
+def seconds_for(rows: int) -> float:
+    """The time of an instantiation of a template of `rows` rows (2.002 s for 40 rows, 7 s for 100,000)."""
+    return MAX_SECONDS + SECONDS_PER_ROW * rows
+
+
+class Budget:
+    """The time and bytes left to one instantiation."""
+    __slots__ = ("seconds", "deadline", "max_bytes", "bytes_left")
+
+    def __init__(self, seconds: float = MAX_SECONDS, max_bytes: int = MAX_BYTES):
+        self.seconds, self.deadline = seconds, time.perf_counter() + seconds
+        self.max_bytes = self.bytes_left = max_bytes
+
+    def pay(self, nbytes: int) -> None:
+        self.bytes_left -= nbytes
+        if self.bytes_left < 0:
+            raise ValueError(f"the expressions built more than {self.max_bytes >> 20} MiB in one instantiation")
+        self.check_time()
+
+    def check_time(self) -> None:
+        if time.perf_counter() > self.deadline:
+            raise TimeoutError(f"instantiation exceeded {self.seconds:.3g} s")
+
+    @property
+    def spent(self) -> int:
+        """Bytes paid so far (a remembered row outcome pays again what it cost the first time)."""
+        return self.max_bytes - self.bytes_left
+
+
+_THREAD = threading.local()
+
+
+def running() -> Budget | None:
+    return getattr(_THREAD, "budget", None)
+
+
+class spending:
+    """`with spending(budget):` makes `budget` the one that built values pay from."""
+
+    def __init__(self, budget: Budget):
+        self.budget = budget
+
+    def __enter__(self) -> Budget:
+        self.outer, _THREAD.budget = running(), self.budget
+        return self.budget
+
+    def __exit__(self, *exc) -> None:
+        _THREAD.budget = self.outer
+
+
+def paid(value):
+    """`value`, its size in bytes paid from the running budget (none between runs)."""
+    budget = getattr(_THREAD, "budget", None)
+    if budget is not None:
+        budget.pay(sys.getsizeof(value))
+    return value
+
+
+def pay_time() -> None:
+    """The deadline, checked where work happens without building (nc_path between blocks)."""
+    budget = getattr(_THREAD, "budget", None)
+    if budget is not None:
+        budget.check_time()

@@ -1,0 +1,164 @@
+"""Hostile template rows (issue 13): every one is refused in one line with exit code 1 and stores
+nothing, within the instantiation's budget of bytes. Each enters the way a careless or hostile
+editor would, through the template view in SQL, and `engine instantiate` runs in a process whose
+address space is limited (RLIMIT_AS) to a few times what an instantiation needs: a row that
+allocated its gigabyte would die there of MemoryError (exit 2), not be refused. `engine lint`
+names every row the gate can judge without a job, and goes on to the next class."""
+import os
+import resource
+import subprocess
+import sys
+import tracemalloc
+from pathlib import Path
+
+import psycopg
+import pytest
+
+from engine.templates.budget import MAX_BYTES
+from engine.templates.decision_table import CompiledTemplate, TemplateError
+from engine.templates.rows import Template, TemplateRow
+from engine.turning.moves import Move
+
+ROOT = Path(__file__).resolve().parents[1]
+ADDRESS_SPACE = 384 << 20     # an instantiation of gear 42 needs about 60 MiB of address space
+ROW = 750                     # a new row of spur's main module, between 700 and 800
+RUNTIME = "z2 > 0"            # true for every gear, but only a job can say so: the gate cannot evaluate it
+WIDE = f"(({RUNTIME}) * 65536)"
+DEEP = 45                     # nesting levels (the gate allows 40)
+
+# (s, o, p_emit), words of the refusal, and whether the gate sees it without a job (then lint names it)
+HOSTILE = [
+    ((None, "f'{[[0] * 65536] * 65536 == [[0] * 65536] * 65536}'", None), "larger than 65536", True),
+    ((None, f"f'{{[[0] * {WIDE}] * {WIDE} == [[0] * {WIDE}] * {WIDE}}}'", None), "larger than 65536", False),
+    ((None, "[[0] * 65536] * 65536", None), "larger than 65536", True),
+    ((f"o = [[0] * {WIDE}] * {WIDE}", "'x'", None), "larger than 65536", False),
+    ((None, "b'a' * 10 ** 9", None), "bytes literals are not allowed", True),
+    ((None, "b'%2000000000d' % 0", None), "bytes literals are not allowed", True),
+    ((None, "'%2000000000d' % z2", None), "use an f-string", True),
+    ((None, "-" * 3000 + "z2", None), "nested too deeply", True),
+    ((None, "[" * DEEP + "z2" + "]" * DEEP, None), "nested too deeply", True),
+    ((None, "abs(" * DEEP + "z2" + ")" * DEEP, None), "nested too deeply", True),
+    ((None, "'x'", "NOT " * DEEP + "z2 = 1"), "nested too deeply", True),
+    (("_sql_truth = 1", "'x'", None), "reserved", True),
+    (("template_version = 1", "'x'", None), "name of the engine", True),
+    ((None, "f'{10 ** 10 ** 6}'", None), "power too large", True),
+    (("a = z2 ** 10 ** 6", "'x'", None), "power too large", False),
+    ((None, f"'x' * ({RUNTIME}) * 10 ** 9", None), "repetition larger", False),
+    ((f"a = 'x' * {WIDE}; b = a + a", "'x'", None), "larger than 65536", False),
+    ((f"w = ({RUNTIME}) * 10 ** 9", "f'{z2:>{w}}'", None), "format width", False),
+    ((None, f"f'{{[z2] * {WIDE}}}'", None), "a list cannot be printed", False),
+    ((None, f"str([z2] * {WIDE})", None), "a list cannot be printed", False),
+    ((None, "f'{int(\"9\" * 4300)}'", None), "longer than 4096", True),
+    ((f"a = 'a' * {WIDE}", "'x'", "a LIKE '%" + "_" * 990 + "b%'"), "steps", False),
+    # cheap one statement at a time, a copy of 256 KiB each (4-byte characters): the run's bytes run out
+    ((f"c = '\U0001F600' * {WIDE};" + ";".join(f"a{k}=c[1:]" for k in range(300)), "'x'", None),
+     "MiB in one instantiation", False),
+]
+
+
+def counts(conn):
+    return conn.execute("SELECT (SELECT count(*) FROM job), (SELECT count(*) FROM program)").fetchone()
+
+
+def limited_address_space():
+    resource.setrlimit(resource.RLIMIT_AS, (ADDRESS_SPACE, ADDRESS_SPACE))
+
+
+def engine(url, *args):
+    environment = {**os.environ, "PYTHONPATH": str(ROOT)}
+    return subprocess.run([sys.executable, "-m", "engine", "--database-url", url, *args], capture_output=True,
+                          text=True, env=environment, preexec_fn=limited_address_space, timeout=120)
+
+
+def put_row(conn, gear_class, row_id, columns):
+    s, o, p_emit = columns
+    conn.execute("DELETE FROM template_view WHERE gear_class = %s AND id = %s", (gear_class, row_id))
+    conn.execute("INSERT INTO template_view (gear_class, id, t, n, s, o, p_emit) VALUES (%s, %s, 'main', 1, %s, %s, %s)",
+                 (gear_class, row_id, s, o, p_emit))
+
+
+def test_an_ordinary_instantiation_fits_the_address_space_the_hostile_rows_get(fresh_database_url):
+    done = engine(fresh_database_url, "instantiate", "--gear", "42")
+    assert done.returncode == 0, done.stderr
+
+
+@pytest.mark.parametrize("columns, words, seen", HOSTILE, ids=lambda value: str(value)[:50] if isinstance(value, tuple)
+                         else None)
+def test_a_hostile_row_in_the_template_view_is_refused_in_one_line(fresh_database_url, columns, words, seen):
+    with psycopg.connect(fresh_database_url) as conn:
+        put_row(conn, "spur", ROW, columns)
+        conn.commit()
+        before = counts(conn)
+    refused = engine(fresh_database_url, "instantiate", "--gear", "42")
+    assert refused.returncode == 1, refused.stderr
+    assert refused.stderr.count("\n") == 1 and len(refused.stderr) < 700
+    assert refused.stderr.startswith(f"error: class spur row {ROW} column ") and words in refused.stderr
+    with psycopg.connect(fresh_database_url) as conn:
+        assert counts(conn) == before
+
+
+def test_lint_names_every_row_the_gate_refuses_and_goes_on(fresh_database_url):
+    seen = [columns for columns, _, gate_sees in HOSTILE if gate_sees]
+    with psycopg.connect(fresh_database_url) as conn:
+        for number, columns in enumerate(seen):
+            put_row(conn, "spur" if number % 2 else "helical", ROW + number, columns)
+        conn.commit()
+    linted = engine(fresh_database_url, "lint")
+    assert linted.returncode == 1, linted.stderr
+    named = {line.split(" column ")[0] for line in linted.stdout.splitlines()}
+    expected = {f"class {'spur' if number % 2 else 'helical'} row {ROW + number}" for number in range(len(seen))}
+    assert expected <= named
+    assert "class duplex" in linted.stdout   # duplex inherits spur's rows: lint went on past spur
+
+
+def test_rows_cheap_alone_stop_at_the_budget_of_the_whole_run(fresh_database_url):
+    """Each row prints one line of 256 KiB; 300 of them are more than one run may build."""
+    line = f"'\U0001F600' * {WIDE}"
+    with psycopg.connect(fresh_database_url) as conn:
+        for row_id in [*range(701, 800), *range(801, 900), *range(901, 1000), *range(1001, 1004)]:
+            put_row(conn, "spur", row_id, (None, line, None))
+        conn.commit()
+        before = counts(conn)
+    refused = engine(fresh_database_url, "instantiate", "--gear", "42")
+    assert refused.returncode == 1 and refused.stderr.count("\n") == 1, refused.stderr
+    assert f"more than {MAX_BYTES >> 20} MiB in one instantiation" in refused.stderr
+    with psycopg.connect(fresh_database_url) as conn:
+        assert counts(conn) == before
+
+
+def run_traced(rows, params, seconds=2.0):
+    """The refusal of a template, and the most memory Python held while it ran."""
+    template = CompiledTemplate(Template("hostile", 1, tuple(TemplateRow(10 * k + 10, "main", 1, None, s, o, p_emit)
+                                                             for k, (s, o, p_emit) in enumerate(rows))))
+    tracemalloc.start()
+    try:
+        with pytest.raises(TemplateError) as refused:
+            template.run(params, deadline_seconds=seconds)
+        return str(refused.value), tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+
+
+def test_tool_paths_are_paid_block_by_block():
+    """nc_path prints up to 200,000 blocks of 512 characters: two calls on a path of 65,000
+    copies of one move would build 70 MB; the second stops when the run's bytes run out."""
+    wide = "'X{x}" + "0" * 500 + "'"
+    rows = [(f"f = {wide}; m = [moves[0]] * 65000", "(nc_path(m, f, f, f, f, f), nc_path(m, f, f, f, f, f))", None)]
+    message, peak = run_traced(rows, {"moves": [Move("feed", 1.0, 2.0)]}, seconds=600)   # tracemalloc is slow
+    assert f"more than {MAX_BYTES >> 20} MiB in one instantiation" in message
+    assert peak < MAX_BYTES + (16 << 20)
+
+
+def test_a_long_tool_path_stops_at_the_deadline_between_blocks():
+    rows = [("f = 'X{x:200.190f}'; m = [moves[0]] * 65000", "nc_path(m, f, f, f, f, f)", None)]
+    template = CompiledTemplate(Template("hostile", 1, tuple(TemplateRow(10, "main", 1, None, *row) for row in rows)))
+    with pytest.raises(TemplateError, match="exceeded 0.01 s"):   # the path takes far longer than that
+        template.run({"moves": [Move("feed", 1.0, 2.0)]}, deadline_seconds=0.01)
+
+
+@pytest.mark.parametrize("columns, words, seen", [case for case in HOSTILE if not case[2]],
+                         ids=lambda value: str(value)[:50] if isinstance(value, tuple) else None)
+def test_what_a_refused_row_built_stays_within_the_budget(columns, words, seen):
+    message, peak = run_traced([columns], {"z2": 19})
+    assert words in message
+    assert peak < MAX_BYTES + (16 << 20)
