@@ -23,6 +23,8 @@ NEWLINE = f"\n{INJECTED}"
 
 # Per kind: names its rule refuses (a line break, a path, one character too many, bad first
 # characters, NUL) and names it takes, at the edges of the rule.
+LINE_BREAK_IN_CELL = "a cell holds no line break"
+
 UNSAFE = {
     "program": ["GEAR42" + NEWLINE, "../../x", "A" * 25, "1AB", "A1B", "_1AB", "AB\x00C", "AB\rC", "", "AB-1"],
     "class": ["spur" + NEWLINE, "../../x", "a" * 64, "1abc", "_abc", "Spur", "sp\x00ur", "sp ur", ""],
@@ -94,7 +96,8 @@ def test_a_gear_csv_with_an_unsafe_class_is_refused(run, tmp_path, name):
     write_csv(tmp_path / "gears.csv", GEAR_HEADER, ["900", name, "2", "19", "20", "0", "", "20", "42", "", "", "",
                                                    "40Cr", "250", "7", "50"])
     before = counts(run.url)
-    assert "gear_class" in refused(run("gears", "import", tmp_path / "gears.csv"))
+    message = refused(run("gears", "import", tmp_path / "gears.csv"))
+    assert "gear_class" in message or LINE_BREAK_IN_CELL in message   # the CSV reader refuses a broken line first
     assert counts(run.url) == before
 
 
@@ -103,7 +106,8 @@ def test_hobs_import_and_add_refuse_an_unsafe_id(run, tmp_path, name):
     write_csv(tmp_path / "hobs.csv", HOB_HEADER, [name, "2", "20", "1", "70", "100", "R", "AA", "HSS", "TiN",
                                                  "cylindrical"])
     before = counts(run.url)
-    assert "not a safe hob id" in refused(run("hobs", "import", tmp_path / "hobs.csv"))
+    message = refused(run("hobs", "import", tmp_path / "hobs.csv"))
+    assert "not a safe hob id" in message or LINE_BREAK_IN_CELL in message   # the CSV reader refuses a broken line first
     assert "not a safe hob id" in refused(run("hobs", "add", "--id", name, "--module", 2, "--tip-diameter", 70,
                                               "--length", 100, "--hand", "R", "--accuracy-class", "AA"))
     assert counts(run.url) == before
