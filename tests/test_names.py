@@ -21,10 +21,10 @@ from test_dxf_read import seed_drawing
 INJECTED = "G0 X9999 Z-9999"    # the block that reached stored programs through each route
 NEWLINE = f"\n{INJECTED}"
 
+LINE_BREAK_IN_CELL = "a cell holds no line break"   # the CSV reader's refusal
+
 # Per kind: names its rule refuses (a line break, a path, one character too many, bad first
 # characters, NUL) and names it takes, at the edges of the rule.
-LINE_BREAK_IN_CELL = "a cell holds no line break"
-
 UNSAFE = {
     "program": ["GEAR42" + NEWLINE, "../../x", "A" * 25, "1AB", "A1B", "_1AB", "AB\x00C", "AB\rC", "", "AB-1"],
     "class": ["spur" + NEWLINE, "../../x", "a" * 64, "1abc", "_abc", "Spur", "sp\x00ur", "sp ur", ""],
