@@ -6,6 +6,10 @@ class's assembly (row id, module number N, component). See design notes §4, §5
 """
 from __future__ import annotations
 
+from dataclasses import asdict
+
+from psycopg.types.json import Jsonb
+
 from ..errors import EngineError
 from .checks import check_rows
 from .rows import Template, TemplateRow
@@ -67,49 +71,19 @@ def replace_template(conn, gear_class: str, rows: list[TemplateRow]) -> bool:
     A derived class (one whose ancestors have rows) stores only the rows that differ from
     what it inherits; inherited rows the file leaves out stay inherited. Returns True if
     anything changed; the class's version and its descendants' versions are then bumped and
-    template_audit records each changed row of the class."""
+    template_audit records each changed row of the class. The database does the writing
+    (replace_class_template, SECURITY DEFINER), so an editor needs no rights on the library tables."""
     with conn.transaction():
-        conn.execute(LOCK_FOR_WRITING)
-        conn.execute("SELECT 1 FROM gear_class WHERE name = %s FOR UPDATE", (gear_class,))
-        inherited = {row.id: row for row in inherited_rows(conn, gear_class)}
-        own = [row for row in rows if inherited.get(row.id) != row]
-        check_rows(gear_class, merge_rows(inherited.values(), own))
-        current = tuple(TemplateRow(*row) for row in conn.execute(OWN_ROWS, (gear_class,)))
-        if current == tuple(own):
-            return False
-        before = conn.execute("SELECT class_rows_json(%s)::text", (gear_class,)).fetchone()[0]
-        old_components = [r[0] for r in conn.execute(
-            "DELETE FROM assembly WHERE gear_class = %s RETURNING component_id", (gear_class,))]
-        for row in own:
-            component_id = _component_for(conn, row)
-            conn.execute("INSERT INTO assembly (gear_class, id, n, component_id) VALUES (%s, %s, %s, %s)",
-                         (gear_class, row.id, row.n, component_id))
-        _delete_orphans(conn, old_components)
-        conn.execute(BUMP_VERSIONS, (gear_class,))
-        # template_audit: one row per row of the class's assembled template that changed.
-        conn.execute("SELECT audit_class_change(%s, %s::jsonb)", (gear_class, before))
-        store_translations(conn, own)
-    return True
+        inherited = inherited_rows(conn, gear_class)
+        check_rows(gear_class, merge_rows(inherited, rows))
+        changed = conn.execute(REPLACE, (gear_class, Jsonb([asdict(row) for row in rows]))).fetchone()[0]
+        if changed:
+            store_translations(conn, rows)
+    return changed
 
 
-# Writers take their locks on the library in the refactor's order (engine.library.refactor.LOCK), so
-# a writer that started first finishes and the refactor waits for it, never a deadlock.
-# ROW EXCLUSIVE: writers do not wait for each other.
-LOCK_FOR_WRITING = "LOCK TABLE gear_class, component, assembly IN ROW EXCLUSIVE MODE"
-
-OWN_ROWS = """
-SELECT a.id, c.t, a.n, c.p_calc, c.s, c.o, c.p_emit
-FROM assembly a JOIN component c ON c.id = a.component_id
-WHERE a.gear_class = %s ORDER BY a.id"""
-
-# The class and every class below it: their assembled templates change together.
-BUMP_VERSIONS = """
-WITH RECURSIVE below(name, depth) AS (
-    SELECT name, 0 FROM gear_class WHERE name = %s
-    UNION ALL
-    SELECT g.name, b.depth + 1 FROM gear_class g JOIN below b ON g.parent = b.name WHERE b.depth < 50)
-UPDATE gear_class SET template_version = template_version + 1
-WHERE name IN (SELECT name FROM below)"""
+# Locks the library in the refactor's order (engine.library.refactor.LOCK) in the database.
+REPLACE = "SELECT replace_class_template(%s, %s)"
 
 
 def inherited_rows(conn, gear_class: str) -> list[TemplateRow]:
@@ -125,25 +99,3 @@ def merge_rows(inherited, own) -> list[TemplateRow]:
     merged = {row.id: row for row in inherited}
     merged.update((row.id, row) for row in own)
     return [merged[row_id] for row_id in sorted(merged)]
-
-
-FIND_COMPONENT = """
-SELECT id FROM component
-WHERE t = %s AND o IS NOT DISTINCT FROM %s AND p_calc IS NOT DISTINCT FROM %s
-  AND s IS NOT DISTINCT FROM %s AND p_emit IS NOT DISTINCT FROM %s
-ORDER BY id LIMIT 1"""
-
-
-def _component_for(conn, row: TemplateRow) -> int:
-    body = (row.t, row.o, row.p_calc, row.s, row.p_emit)
-    found = conn.execute(FIND_COMPONENT, body).fetchone()
-    if found:
-        return found[0]
-    return conn.execute("INSERT INTO component (t, o, p_calc, s, p_emit) VALUES (%s, %s, %s, %s, %s) "
-                        "RETURNING id", body).fetchone()[0]
-
-
-def _delete_orphans(conn, component_ids: list[int]) -> None:
-    if component_ids:
-        conn.execute("DELETE FROM component c WHERE c.id = ANY(%s) AND NOT EXISTS "
-                     "(SELECT 1 FROM assembly a WHERE a.component_id = c.id)", (component_ids,))
