@@ -102,8 +102,11 @@ ALTER TABLE template_version_rows
     ADD COLUMN row_ids integer[] GENERATED ALWAYS AS (template_row_ids(rows)) STORED,
     ADD CONSTRAINT template_version_rows_hash UNIQUE (gear_class, version, hash);
 
-CREATE TRIGGER template_version_rows_is_a_record BEFORE UPDATE ON template_version_rows
-FOR EACH ROW EXECUTE FUNCTION refuse_changing_a_record();
+-- Never changed; deleted only with its class (a cascade, run by a trigger).
+CREATE TRIGGER template_version_rows_is_a_record BEFORE UPDATE OR DELETE ON template_version_rows
+FOR EACH ROW WHEN (pg_trigger_depth() < 1) EXECUTE FUNCTION refuse_changing_a_record();
+CREATE TRIGGER template_version_rows_is_not_truncated BEFORE TRUNCATE ON template_version_rows
+FOR EACH STATEMENT EXECUTE FUNCTION refuse_changing_a_record();
 
 -- --- changes noted, versions bumped, checked at commit ------------------------------------------
 
@@ -257,6 +260,25 @@ AS $$
     SELECT g.name, coalesce(r.rows, '[]') FROM gear_class g LEFT JOIN grouped r ON r.gear_class = g.name
     WHERE g.name = ANY (classes)
 $$;
+
+-- A stored version is the class's state when it is stored, whoever inserts it (the owner
+-- included): its current version and its assembled rows then.
+CREATE FUNCTION check_version_rows() RETURNS trigger
+LANGUAGE plpgsql SECURITY DEFINER SET search_path = public, pg_temp
+AS $$
+BEGIN
+    IF NEW.version IS DISTINCT FROM (SELECT template_version FROM gear_class WHERE name = NEW.gear_class)
+       OR NEW.rows IS DISTINCT FROM (SELECT r.rows FROM assembled_rows_of(ARRAY[NEW.gear_class]) r) THEN
+        RAISE EXCEPTION 'class % version %: a stored version holds the class''s current version and its rows '
+                        'as they are; the engine stores them', NEW.gear_class, NEW.version
+            USING ERRCODE = 'integrity_constraint_violation';
+    END IF;
+    RETURN NEW;
+END
+$$;
+
+CREATE TRIGGER template_version_rows_are_the_class BEFORE INSERT ON template_version_rows
+FOR EACH ROW EXECUTE FUNCTION check_version_rows();
 
 -- Store the class's current version with its rows now (a program is about to record it); a
 -- later change in this transaction then makes a new version.

@@ -154,6 +154,29 @@ def test_a_refactor_that_changed_a_class_would_be_refused_at_commit(fresh_databa
         assert export_csv(load_template(conn, "spur")) == before
 
 
+def test_a_stored_version_is_the_class_as_it_was_and_stays_so(conn):
+    """Not even the owner stores other rows under a version, or changes or drops one; a class
+    without programs still goes with its history."""
+    version = versions(conn, "spur")[0]
+    refusals = [("INSERT INTO template_version_rows (gear_class, version, rows) VALUES ('spur', %s, '[]')"
+                 % (version + 1), errors.IntegrityConstraintViolation),
+                ("UPDATE template_version_rows SET rows = '[]' WHERE gear_class = 'spur'", errors.InsufficientPrivilege),
+                ("DELETE FROM template_version_rows WHERE gear_class = 'spur'", errors.InsufficientPrivilege),
+                ("TRUNCATE template_version_rows CASCADE", errors.InsufficientPrivilege)]
+    for statement, error in refusals:
+        with pytest.raises(error), conn.transaction():
+            conn.execute(statement)
+    def stored_versions():
+        return dict(conn.execute("SELECT gear_class, count(*) FROM template_version_rows "
+                                 "WHERE gear_class IN ('spur', 'records_gone') GROUP BY 1").fetchall())
+    before = stored_versions()
+    conn.execute("INSERT INTO gear_class (name) VALUES ('records_gone')")
+    conn.execute("SET CONSTRAINTS template_rows_match_version IMMEDIATE")   # stores its version 0 now
+    assert stored_versions() == {**before, "records_gone": 1}
+    conn.execute("DELETE FROM gear_class WHERE name = 'records_gone'")
+    assert stored_versions() == before
+
+
 # --- the audit --------------------------------------------------------------------------------------
 
 def test_the_audit_names_the_login_person_and_the_role_on_every_route(database_url, login_in):
