@@ -991,8 +991,9 @@ FOR EACH ROW WHEN (OLD.parent IS DISTINCT FROM NEW.parent) EXECUTE FUNCTION gear
 -- Replace a class's rows (engine template import, template restore, import-nc into a class):
 -- `new_rows` is its whole assembled template as a JSON array of template rows; only the rows
 -- that differ from what the class inherits are stored as its own. Locks the library in the
--- refactor's order, bumps the versions of the class and the classes below it, audits every row
--- that changed. False (and nothing written) when the class's own rows are already these.
+-- refactor's order, bumps the versions of the class and the classes below it (each import is a
+-- version of its own, also several in one transaction, as `engine seed` makes them), audits
+-- every row that changed. False (and nothing written) when the class's own rows are already these.
 CREATE FUNCTION replace_class_template(class_name text, new_rows jsonb) RETURNS boolean
 LANGUAGE plpgsql SECURITY DEFINER SET search_path = public, pg_temp
 AS $$
@@ -1040,6 +1041,8 @@ BEGIN
     END LOOP;
     DELETE FROM component c
     WHERE c.id = ANY (old_components) AND NOT EXISTS (SELECT 1 FROM assembly a WHERE a.component_id = c.id);
+    UPDATE template_change SET bumped = false
+    WHERE xact = pg_current_xact_id() AND gear_class IN (SELECT name FROM classes_and_below(ARRAY[class_name]));
     PERFORM bump_template_versions(class_name);
     PERFORM audit_class_change(class_name, before);
     RETURN true;
