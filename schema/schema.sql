@@ -646,32 +646,29 @@ GRANT INSERT (name, parent, description), UPDATE (parent, description, import_pa
 -- version commits (or when a program of it is stored), and never changed (check_template_changes,
 -- at the end of this file).
 
--- A text as Python's json.dumps writes it (ensure_ascii): to_json escapes what both escape
--- (", \, control characters), and every character from DEL (0x7F) up becomes \uXXXX, outside
--- the BMP a surrogate pair. NULL is null.
-CREATE FUNCTION json_text_ascii(value text) RETURNS text
+-- JSON text as Python's json.dumps writes it (ensure_ascii): PostgreSQL's JSON output escapes
+-- what Python's does (", \, control characters); every character from DEL (0x7F) up becomes
+-- \uXXXX, outside the BMP a surrogate pair.
+CREATE FUNCTION json_ascii(json_text text) RETURNS text
 LANGUAGE sql IMMUTABLE PARALLEL SAFE
 RETURN CASE
-    WHEN value IS NULL THEN 'null'
-    WHEN to_json(value)::text ~ '^[ -~]*$' THEN to_json(value)::text
+    WHEN json_text ~ '^[ -~]*$' THEN json_text
     ELSE (SELECT string_agg(CASE
-                     WHEN ascii(ch) < 127 THEN ch
-                     WHEN ascii(ch) < 65536 THEN '\u' || lpad(to_hex(ascii(ch)), 4, '0')
-                     ELSE '\u' || to_hex(55296 + ((ascii(ch) - 65536) >> 10))
-                          || '\u' || to_hex(56320 + ((ascii(ch) - 65536) & 1023)) END, '' ORDER BY position)
-          FROM regexp_split_to_table(to_json(value)::text, '') WITH ORDINALITY AS c (ch, position))
+                     WHEN m.part[1] ~ '^[ -~]' THEN m.part[1]
+                     WHEN ascii(m.part[1]) < 65536 THEN '\u' || lpad(to_hex(ascii(m.part[1])), 4, '0')
+                     ELSE '\u' || to_hex(55296 + ((ascii(m.part[1]) - 65536) >> 10))
+                          || '\u' || to_hex(56320 + ((ascii(m.part[1]) - 65536) & 1023)) END, '' ORDER BY m.position)
+          FROM regexp_matches(json_text, '[ -~]+|[^ -~]', 'g') WITH ORDINALITY AS m (part, position))
 END;
 
 -- The content hash of an assembled template (rows as template_version_rows stores them):
--- sha256 of the JSON list of [id, t, n, p_calc, s, o, p_emit] in id order, 16 hex digits;
--- exactly engine.templates.rows.rows_hash, so a program's recorded hash is checked here.
+-- sha256 of the JSON list of [id, t, n, p_calc, s, o, p_emit] in id order, without spaces, 16
+-- hex digits; exactly engine.templates.rows.rows_hash, so a program's recorded hash is checked here.
 CREATE FUNCTION template_rows_hash(rows jsonb) RETURNS text
 LANGUAGE sql IMMUTABLE PARALLEL SAFE
-RETURN (SELECT left(encode(sha256(convert_to('[' || coalesce(string_agg(
-                   '[' || (r->>'id') || ',' || json_text_ascii(r->>'t') || ',' || (r->>'n') || ','
-                   || json_text_ascii(r->>'p_calc') || ',' || json_text_ascii(r->>'s') || ','
-                   || json_text_ascii(r->>'o') || ',' || json_text_ascii(r->>'p_emit') || ']',
-                   ',' ORDER BY e.position), '') || ']', 'UTF8')), 'hex'), 16)
+RETURN (SELECT left(encode(sha256(convert_to(json_ascii('[' || coalesce(string_agg(
+                   '[' || concat_ws(',', r->'id', r->'t', r->'n', r->'p_calc', r->'s', r->'o', r->'p_emit') || ']',
+                   ',' ORDER BY e.position), '') || ']'), 'UTF8')), 'hex'), 16)
         FROM jsonb_array_elements(rows) WITH ORDINALITY AS e (r, position));
 
 -- The row ids of an assembled template.
@@ -1002,7 +999,7 @@ DECLARE
     own jsonb;
     before jsonb;
     old_components bigint[];
-    item record;
+    duplicate record;
 BEGIN
     LOCK TABLE gear_class, component, assembly IN ROW EXCLUSIVE MODE;
     SELECT class_rows_json(g.parent) INTO inherited FROM gear_class g WHERE g.name = class_name FOR NO KEY UPDATE;
@@ -1014,9 +1011,9 @@ BEGIN
         RAISE EXCEPTION 'class %: the rows must be a JSON array of template rows', class_name
             USING ERRCODE = 'invalid_parameter_value';
     END IF;
-    FOR item IN SELECT x.id, count(*) AS times FROM jsonb_to_recordset(new_rows) AS x (id integer)
-               GROUP BY x.id HAVING count(*) > 1 LOOP
-        RAISE EXCEPTION 'class % row %: the row id appears % times', class_name, item.id, item.times
+    FOR duplicate IN SELECT x.id, count(*) AS times FROM jsonb_to_recordset(new_rows) AS x (id integer)
+                    GROUP BY x.id HAVING count(*) > 1 LOOP
+        RAISE EXCEPTION 'class % row %: the row id appears % times', class_name, duplicate.id, duplicate.times
             USING ERRCODE = 'unique_violation', COLUMN = 'id';
     END LOOP;
     SELECT coalesce(jsonb_agg(r.json ORDER BY r.id), '[]') INTO own
@@ -1030,15 +1027,30 @@ BEGIN
               FROM assembly a JOIN component c ON c.id = a.component_id WHERE a.gear_class = class_name) THEN
         RETURN false;
     END IF;
+    PERFORM template_row_check(class_name, x.id, x.t, x.n, x.p_calc, x.s, x.o)
+    FROM jsonb_to_recordset(own) AS x (id integer, t text, n integer, p_calc text, s text, o text);
     before := class_rows_json(class_name);
     WITH gone AS (DELETE FROM assembly WHERE gear_class = class_name RETURNING component_id)
     SELECT array_agg(component_id) INTO old_components FROM gone;
-    FOR item IN SELECT * FROM jsonb_to_recordset(own) AS x (id integer, t text, n integer, p_calc text, s text,
-                                                            o text, p_emit text) LOOP
-        PERFORM template_row_check(class_name, item.id, item.t, item.n, item.p_calc, item.s, item.o);
-        INSERT INTO assembly (gear_class, id, n, component_id)
-        VALUES (class_name, item.id, item.n, component_for(item.t, item.o, item.p_calc, item.s, item.p_emit));
-    END LOOP;
+    -- Each body stored once: a new component for a body not stored yet; those stored already are
+    -- locked, so a concurrent cleanup cannot delete them under us (as component_for does).
+    INSERT INTO component (t, o, p_calc, s, p_emit)
+    SELECT DISTINCT x.t, x.o, x.p_calc, x.s, x.p_emit
+    FROM jsonb_to_recordset(own) AS x (t text, o text, p_calc text, s text, p_emit text)
+    WHERE NOT EXISTS (SELECT 1 FROM component c
+                      WHERE component_body_key(c.t, c.o, c.p_calc, c.s, c.p_emit)
+                            = component_body_key(x.t, x.o, x.p_calc, x.s, x.p_emit)
+                        AND (c.t, c.o, c.p_calc, c.s, c.p_emit)
+                            IS NOT DISTINCT FROM (x.t, x.o, x.p_calc, x.s, x.p_emit));
+    INSERT INTO assembly (gear_class, id, n, component_id)
+    SELECT class_name, x.id, x.n, found.id
+    FROM jsonb_to_recordset(own) AS x (id integer, t text, n integer, p_calc text, s text, o text, p_emit text)
+    CROSS JOIN LATERAL (
+        SELECT c.id FROM component c
+        WHERE component_body_key(c.t, c.o, c.p_calc, c.s, c.p_emit)
+              = component_body_key(x.t, x.o, x.p_calc, x.s, x.p_emit)
+          AND (c.t, c.o, c.p_calc, c.s, c.p_emit) IS NOT DISTINCT FROM (x.t, x.o, x.p_calc, x.s, x.p_emit)
+        ORDER BY c.id LIMIT 1 FOR KEY SHARE) found;
     DELETE FROM component c
     WHERE c.id = ANY (old_components) AND NOT EXISTS (SELECT 1 FROM assembly a WHERE a.component_id = c.id);
     UPDATE template_change SET bumped = false
