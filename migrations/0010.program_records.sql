@@ -115,7 +115,13 @@ CREATE TABLE template_change (
     bumped     boolean NOT NULL DEFAULT false,
     PRIMARY KEY (xact, gear_class)
 );
-REVOKE ALL ON template_change FROM engine_reader, engine_runner, engine_editor;
+
+-- One row per transaction that noted a change: its insert queues the commit check, once however
+-- many classes the transaction touched.
+CREATE TABLE template_check_due (
+    xact xid8 PRIMARY KEY
+);
+REVOKE ALL ON template_change, template_check_due FROM engine_reader, engine_runner, engine_editor;
 
 -- The classes and every class below them (their assembled templates change together).
 CREATE FUNCTION classes_and_below(classes text[]) RETURNS TABLE (name text)
@@ -134,6 +140,8 @@ BEGIN ATOMIC
     INSERT INTO template_change (xact, gear_class)
     SELECT pg_current_xact_id(), b.name FROM classes_and_below(classes) b
     ON CONFLICT (xact, gear_class) DO NOTHING;
+    INSERT INTO template_check_due (xact) SELECT pg_current_xact_id() WHERE cardinality(classes) > 0
+    ON CONFLICT (xact) DO NOTHING;
 END;
 
 -- Statement triggers: which classes a change of assembly, component or gear_class touches.
@@ -300,10 +308,11 @@ DECLARE
     classes text[];
     touched record;
 BEGIN
+    DELETE FROM template_check_due WHERE xact = pg_current_xact_id();
     WITH done AS (DELETE FROM template_change WHERE xact = pg_current_xact_id() RETURNING gear_class)
     SELECT array_agg(gear_class) INTO classes FROM done;
     IF classes IS NULL THEN
-        RETURN NULL;   -- checked already, by the first of this transaction's notes
+        RETURN NULL;
     END IF;
     FOR touched IN
         SELECT r.gear_class, g.template_version AS version, r.rows, v.rows AS stored,
@@ -334,7 +343,7 @@ BEGIN
 END
 $$;
 
-CREATE CONSTRAINT TRIGGER template_rows_match_version AFTER INSERT ON template_change
+CREATE CONSTRAINT TRIGGER template_rows_match_version AFTER INSERT ON template_check_due
 DEFERRABLE INITIALLY DEFERRED
 FOR EACH ROW EXECUTE FUNCTION check_template_changes();
 

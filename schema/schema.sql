@@ -760,6 +760,12 @@ CREATE TABLE template_change (
     PRIMARY KEY (xact, gear_class)
 );
 
+-- One row per transaction that noted a change: its insert queues the commit check, once however
+-- many classes the transaction touched.
+CREATE TABLE template_check_due (
+    xact xid8 PRIMARY KEY
+);
+
 -- The classes and every class below them (their assembled templates change together).
 CREATE FUNCTION classes_and_below(classes text[]) RETURNS TABLE (name text)
 LANGUAGE sql STABLE
@@ -777,6 +783,8 @@ BEGIN ATOMIC
     INSERT INTO template_change (xact, gear_class)
     SELECT pg_current_xact_id(), b.name FROM classes_and_below(classes) b
     ON CONFLICT (xact, gear_class) DO NOTHING;
+    INSERT INTO template_check_due (xact) SELECT pg_current_xact_id() WHERE cardinality(classes) > 0
+    ON CONFLICT (xact) DO NOTHING;
 END;
 
 -- Statement triggers: which classes a change of assembly, component or gear_class touches.
@@ -919,10 +927,11 @@ DECLARE
     classes text[];
     touched record;
 BEGIN
+    DELETE FROM template_check_due WHERE xact = pg_current_xact_id();
     WITH done AS (DELETE FROM template_change WHERE xact = pg_current_xact_id() RETURNING gear_class)
     SELECT array_agg(gear_class) INTO classes FROM done;
     IF classes IS NULL THEN
-        RETURN NULL;   -- checked already, by the first of this transaction's notes
+        RETURN NULL;
     END IF;
     FOR touched IN
         SELECT r.gear_class, g.template_version AS version, r.rows, v.rows AS stored,
@@ -953,7 +962,7 @@ BEGIN
 END
 $$;
 
-CREATE CONSTRAINT TRIGGER template_rows_match_version AFTER INSERT ON template_change
+CREATE CONSTRAINT TRIGGER template_rows_match_version AFTER INSERT ON template_check_due
 DEFERRABLE INITIALLY DEFERRED
 FOR EACH ROW EXECUTE FUNCTION check_template_changes();
 
@@ -1288,7 +1297,7 @@ REVOKE EXECUTE ON FUNCTION audit_class_change(text, jsonb, integer[]), bump_temp
     store_current_version(text), replace_class_template(text, jsonb),
     store_program(bigint, text, integer, text, text, text[], integer[], jsonb), confirm_job_cases(bigint)
     FROM PUBLIC;
-REVOKE ALL ON template_change FROM engine_reader, engine_runner, engine_editor;
+REVOKE ALL ON template_change, template_check_due FROM engine_reader, engine_runner, engine_editor;
 GRANT EXECUTE ON FUNCTION store_program(bigint, text, integer, text, text, text[], integer[], jsonb),
     confirm_job_cases(bigint) TO engine_runner;
 GRANT INSERT ON program_submission TO engine_runner;
