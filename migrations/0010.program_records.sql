@@ -11,8 +11,9 @@
 -- * The version and hash a program records always equal the rows it was made from: every
 --   change of component, assembly or gear_class notes the classes it touches (and those below
 --   them), and at commit each touched class's assembled rows must equal the rows stored for its
---   version, or a new version is stored; anything else is refused. Versions are bumped once per
---   transaction by a marker only the engine's functions write (no user-settable setting).
+--   version, or a new version is stored; anything else is refused. Edits through the view bump
+--   a class's version once per transaction (each engine import makes a version of its own); what
+--   was bumped is marked in a table only the engine's functions write (no user-settable setting).
 -- * Editors change templates through template_view, re-parenting (versioned and audited here)
 --   and replace_class_template (engine template import, restore, import-nc); they lose direct
 --   writes to component, assembly and gear_class.template_version.
