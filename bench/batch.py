@@ -27,7 +27,7 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
-from _common import add_database_argument, bench_database, median, verdict  # noqa: E402
+from _common import add_database_argument, bench_database, delete_programs, median, verdict  # noqa: E402
 from engine.errors import EngineError  # noqa: E402
 from engine.gears.case_base import CUT_KINDS_BY_COUNT, job_cutting_record  # noqa: E402
 from engine.gears.hob_matching import choose_hob  # noqa: E402
@@ -114,7 +114,7 @@ def insert_gears(conn, rows: list[tuple]) -> None:
 def clear_jobs(conn) -> None:
     """Empty job and program before a run. DELETE and VACUUM, not TRUNCATE: cutting_case.job_id
     references job, and TRUNCATE would have to empty the case base with it."""
-    conn.execute("DELETE FROM program")
+    delete_programs(conn)
     conn.execute("DELETE FROM job")
     conn.commit()
     conn.autocommit = True

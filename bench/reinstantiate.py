@@ -17,7 +17,7 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
-from _common import add_database_argument, bench_database, median, verdict  # noqa: E402
+from _common import add_database_argument, bench_database, delete_programs, median, verdict  # noqa: E402
 
 TARGET_RATIO = 1.5
 FIRST_ID = 100_000
@@ -25,7 +25,7 @@ JOBS = "SELECT id, gear_id, gear_class, machine, hob_id, params, module_params F
 
 
 def clear_programs(conn) -> None:
-    conn.execute("DELETE FROM program")
+    delete_programs(conn)
     conn.commit()
 
 

@@ -6,7 +6,6 @@ import json
 import math
 from dataclasses import replace
 
-import psycopg
 from psycopg import sql
 import pytest
 
@@ -14,7 +13,9 @@ from engine.errors import EngineError
 from engine.gears.case_base import job_cutting_record
 from engine.gears.cases import confirm_job, list_cases, seed_cases, suggest
 from engine.gears.records import load_gear, load_hobs, load_machine
+from engine.hobbing.choices import Choices
 from engine.paths import SEED_DIR
+from engine.programs.instantiate import instantiate_gear
 
 PAPER_GEAR = 9019
 # The published example: m 2, α 20°, z 19, d_a 42.5, 40Cr, grade 7, cone 6.5°, 1-start AA hob, rough cut.
@@ -25,9 +26,10 @@ CASE_COLUMNS = ("module", "teeth", "material", "hardness", "quality_grade", "hob
 
 def insert_paper_gear(conn, gear_id=PAPER_GEAR, teeth=19):
     # class spur: the taper class is not seeded in every checkout, and the class does not enter the distance
+    # d_f 33.5: d_a 42.5 read as a profile shift x = +0.125 (reference §D)
     conn.execute("INSERT INTO gear (id, gear_class, module, teeth, pressure_angle, face_width, tip_diameter, "
-                 "cone_angle, material, hardness, quality_grade) "
-                 "VALUES (%s, 'spur', 2, %s, 20, 20, 42.5, 6.5, '40Cr', 250, 7)", (gear_id, teeth))
+                 "root_diameter, cone_angle, material, hardness, quality_grade) "
+                 "VALUES (%s, 'spur', 2, %s, 20, 20, 42.5, 33.5, 6.5, '40Cr', 250, 7)", (gear_id, teeth))
     return load_gear(conn, gear_id)
 
 
@@ -152,7 +154,9 @@ def test_a_confirmed_job_becomes_one_case_per_cut_and_only_once(conn, machine):
     suggestion = suggest(conn, gear, paper_hob, machine)
     record = job_cutting_record(suggestion.cutting, gear, paper_hob, ["rough"], suggestion.case_ids(["rough"]))
     assert record["rough"] == {"axial_feed": PAPER_AXIAL, "radial_feed": PAPER_RADIAL} and "finish" not in record
-    job_id = insert_job(conn, gear, paper_hob, record)
+    job_id = instantiate_gear(conn, gear.id).job_id   # a job becomes a case only once the engine made its program
+    stored = stored_cutting(conn, job_id)
+    assert (stored["hob_speed"], stored["rough"], "finish" in stored) == (PAPER_N0, record["rough"], False)
     before = len(list_cases(conn))
     (case_id,) = confirm_job(conn, job_id)
     case = list_cases(conn).set_index("id").loc[case_id]
@@ -167,11 +171,15 @@ def test_a_confirmed_job_becomes_one_case_per_cut_and_only_once(conn, machine):
 def test_a_two_cut_job_gives_a_rough_and_a_finish_case(conn, machine):
     gear, paper_hob = insert_paper_gear(conn), hob(conn)
     cutting = suggest(conn, gear, paper_hob, machine).cutting
-    job_id = insert_job(conn, gear, paper_hob, job_cutting_record(cutting, gear, paper_hob, ["rough", "finish"], []))
+    job_id = instantiate_gear(conn, gear.id, choices=Choices(cuts=2)).job_id
     ids = confirm_job(conn, job_id)
     cases = list_cases(conn).set_index("id").loc[ids]
     assert list(cases.cut) == ["rough", "finish"]
     assert cases.axial_feed.iloc[1] == mm_per_min(cutting.axial_feed_finish, cutting)
+
+
+def stored_cutting(conn, job_id):
+    return conn.execute("SELECT cutting FROM job WHERE id = %s", (job_id,)).fetchone()[0]
 
 
 def test_confirm_refuses_what_cannot_become_a_case(conn):
@@ -234,10 +242,7 @@ def test_cli_errors_are_one_line(run, args, words):
 
 
 def test_cli_confirm_adds_cases_once_and_list_shows_them(run):
-    with psycopg.connect(run.url) as conn:
-        gear, paper_hob = load_gear(conn, 42), hob(conn)
-        job_id = insert_job(conn, gear, paper_hob, {"hob_speed": 246, "cutting_speed": 54.1, "source": "test",
-                                                    "case_ids": [], "rough": {"axial_feed": 105.0, "radial_feed": 36.0}})
+    job_id = json.loads(run("instantiate", "--gear", 42, "--json").stdout)["job_id"]
     listed = json.loads(run("cases", "list", "--json").stdout)["cases"]
     assert len(listed) == len(seed_file_rows())
     result = run("cases", "confirm", "--job", job_id)

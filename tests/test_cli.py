@@ -131,8 +131,8 @@ def test_lint_passes_on_the_seed_and_names_an_unknown_parameter(run):
     result = run("lint", "--json")
     assert result.exit_code == 0 and json.loads(result.stdout) == {"errors": []}
     with psycopg.connect(run.url) as conn:
-        conn.execute("""UPDATE component SET o = 'f"G0 X{x_retrakt:.3f}"' WHERE id =
-                        (SELECT component_id FROM assembly WHERE gear_class = 'spur' AND id = 1250)""")
+        conn.execute("""UPDATE template_view SET o = 'f"G0 X{x_retrakt:.3f}"'
+                        WHERE gear_class = 'spur' AND id = 1250""")
         conn.commit()
     result = run("lint")
     assert result.exit_code == 1

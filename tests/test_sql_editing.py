@@ -436,10 +436,12 @@ def test_roles_are_created_once_even_when_several_databases_migrate(empty_databa
 
     with psycopg.connect(empty_database_url) as conn:
         assert migrate(conn)
-        granted = conn.execute("SELECT has_table_privilege('engine_runner', 'program', 'INSERT'), "
+        granted = conn.execute("SELECT has_function_privilege('engine_runner', 'store_program(bigint, text, "
+                               "integer, text, text, text[], integer[], jsonb)', 'EXECUTE'), "
+                               "has_table_privilege('engine_runner', 'program', 'INSERT'), "
                                "has_table_privilege('engine_editor', 'program', 'INSERT'), "
                                "has_table_privilege('engine_editor', 'template_view', 'UPDATE')").fetchone()
-    assert granted == (True, False, True)
+    assert granted == (True, False, False, True)   # programs are records: stored only through store_program
 
 
 # --- concurrency --------------------------------------------------------------------------------

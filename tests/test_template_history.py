@@ -8,7 +8,6 @@ import pytest
 from psycopg import sql
 
 from engine.db.migrate import migrate
-from engine.db.seed import seed
 from engine.errors import EngineError
 from engine.paths import MIGRATIONS_DIR
 from engine.templates.history import diff, history, restore
@@ -63,19 +62,29 @@ def test_every_seeded_class_has_its_current_version_stored(conn):
 
 
 def test_the_migration_stores_the_current_version_of_classes_loaded_before_it(empty_database_url, tmp_path):
+    """Templates written by an engine of migration 0005 (plain rows, a version the old engine
+    counted): migrating stores each class's current version, with the hash programs record."""
     folder = tmp_path / "migrations"
-    shutil.copytree(MIGRATIONS_DIR, folder)
-    (folder / "0006.template_versions.sql").unlink()
+    folder.mkdir()
+    for path in sorted(MIGRATIONS_DIR.glob("*.sql"))[:5]:
+        shutil.copy(path, folder)
     with psycopg.connect(empty_database_url) as conn:
         migrate(conn, folder)
-        seed(conn)
+        conn.execute("INSERT INTO gear_class (name, template_version) VALUES ('old_unit', 3)")
+        conn.execute("INSERT INTO gear_class (name, parent, template_version) VALUES ('old_pair', 'old_unit', 2)")
+        for gear_class, row_id, o in (("old_unit", 10, '"G90"'), ("old_unit", 20, '"M30"'),
+                                      ("old_pair", 15, '"; PAIR ÄÖ \\t"')):
+            conn.execute("WITH c AS (INSERT INTO component (t, o) VALUES ('main', %s) RETURNING id) "
+                         "INSERT INTO assembly (gear_class, id, component_id) SELECT %s, %s, id FROM c",
+                         (o, gear_class, row_id))
         conn.commit()
         migrate(conn)
         conn.commit()
-        stored = conn.execute("SELECT count(*) FROM template_version_rows v JOIN gear_class g "
-                              "ON g.name = v.gear_class AND g.template_version = v.version").fetchone()[0]
-        classes = conn.execute("SELECT count(*) FROM gear_class").fetchone()[0]
-    assert stored == classes > 0
+        stored = dict(conn.execute("SELECT v.gear_class, v.hash FROM template_version_rows v JOIN gear_class g "
+                                   "ON g.name = v.gear_class AND g.template_version = v.version").fetchall())
+        loaded = {name: load_template(conn, name) for name in ("old_unit", "old_pair")}
+    assert stored == {name: template.hash for name, template in loaded.items()}
+    assert [template.version for template in loaded.values()] == [3, 2]
 
 
 def test_history_lists_each_version_with_who_and_the_row_changed(edited):

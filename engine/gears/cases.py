@@ -150,49 +150,15 @@ def _speed_notes(gear: Gear, hob: Hob, proposals: dict) -> list[str]:
     return notes
 
 
-CONFIRM_QUERY = """
-SELECT j.cutting, j.confirmed_at, g.id, g.module, g.teeth, g.material, g.hardness, g.quality_grade,
-       h.material, h.coating, h.starts, h.tip_diameter
-FROM job j LEFT JOIN gear g ON g.id = j.gear_id LEFT JOIN hob h ON h.id = j.hob_id
-WHERE j.id = %s FOR UPDATE OF j"""
-INSERT_CASE = sql.SQL("INSERT INTO cutting_case ({}) VALUES ({}) RETURNING id").format(
-    sql.SQL(", ").join(map(sql.Identifier, (*FEATURE_COLUMNS, "cut", *VALUE_COLUMNS, "source", "job_id"))),
-    sql.SQL(", ").join(sql.Placeholder() for _ in range(len(FEATURE_COLUMNS) + 6)))
-
-
 def confirm_job(conn, job_id: int) -> list[int]:
-    """A proven job joins the history: one case per cut kind of its stored cutting data."""
-    with conn.transaction():
-        row = conn.execute(CONFIRM_QUERY, (job_id,)).fetchone()
-        cutting, features = _confirmable(job_id, row)
-        ids = [conn.execute(INSERT_CASE, (*features, cut, cutting["hob_speed"], cutting[cut]["axial_feed"],
-                                          cutting[cut]["radial_feed"], f"job {job_id}", job_id)).fetchone()[0]
-               for cut in CUT_KINDS if cut in cutting]
-        conn.execute("UPDATE job SET confirmed_at = now() WHERE id = %s", (job_id,))
-    return ids
-
-
-def _confirmable(job_id: int, row) -> tuple[dict, tuple]:
-    if row is None:
-        raise EngineError(f"job {job_id} does not exist; nothing confirmed")
-    cutting, confirmed_at, gear_id, *features = row
-    case = dict(zip(FEATURE_COLUMNS, features))
-    if confirmed_at is not None:
-        raise EngineError(f"job {job_id} was already confirmed at {confirmed_at:%Y-%m-%d %H:%M}; "
-                          "its cases are in the history (engine cases list)")
-    if not any(cut in cutting for cut in CUT_KINDS):
-        raise EngineError(f"job {job_id} has no cutting data stored (job.cutting is empty); "
-                          "store the chosen cutting data with the job before confirming it")
-    if gear_id is None or case["hob_tip_diameter"] is None:
-        raise EngineError(f"job {job_id} has no gear or no hob; only hobbing jobs become cutting cases")
-    if case["material"] is None:
-        raise EngineError(f"gear {gear_id} of job {job_id} has no material; set it before confirming the job")
-    for cut in (cut for cut in CUT_KINDS if cut in cutting):
-        values = [cutting.get("hob_speed"), *(cutting[cut].get(name) for name in ("axial_feed", "radial_feed"))]
-        if not all(isinstance(v, (int, float)) and v > 0 for v in values):
-            raise EngineError(f"job {job_id}: cutting data of the {cut} cut need a positive hob_speed, "
-                              "axial_feed and radial_feed (mm/min); fix job.cutting")
-    return cutting, tuple(features)
+    """A proven job joins the history: one case per cut kind of its stored cutting data. The database
+    decides (confirm_job_cases): only a job the engine made a program for, with cutting data its
+    machine can run, becomes a case; runners cannot add cases any other way."""
+    try:
+        with conn.transaction():
+            return conn.execute("SELECT confirm_job_cases(%s)", (job_id,)).fetchone()[0]
+    except (psycopg.errors.CheckViolation, psycopg.errors.NoDataFound) as error:
+        raise EngineError(error.diag.message_primary) from None
 
 
 def seed_cases(conn, path: Path = SEED_FILE) -> int:

@@ -19,9 +19,9 @@ from .similarity import Units, nc_units, similar_pairs
 
 # Concurrent instantiations read either the old or the new library: writers wait for us,
 # readers (plain SELECT, foreign-key checks) are not blocked and see the last committed
-# state. The engine's writers lock the three tables in this order too
-# (engine.templates.store.LOCK_FOR_WRITING); a hand-made SQL edit may not, and a deadlock with it costs
-# the refactor a retry, not the night.
+# state. The engine's writers lock the three tables in this order too (replace_class_template and
+# the template_view triggers, in the database); a hand-made SQL edit may not, and a deadlock with it
+# costs the refactor a retry, not the night.
 LOCK = "LOCK TABLE gear_class, component, assembly IN SHARE ROW EXCLUSIVE MODE"
 DEADLOCK_RETRIES = 3
 # JIT compiling these one-pass statements costs more than it saves, and only on large

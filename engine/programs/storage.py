@@ -1,10 +1,13 @@
 """Storing jobs and programs: one at a time, or a batch through COPY. Files are not written
 here: engine.programs.outputs writes them after the COMMIT of the caller's files_after_commit.
 
-A program is stored only with a safe name (engine/names.py) and lines that are one NC line
-each: a line break inside a line (from a job parameter or a template row) would be a block
-that no check read. The database refuses both too (migration 0009); here they are refused
-with a message that names the program."""
+Programs are records (design notes §10): no role may write the program table. The engine stores
+them through the database's own path, which checks each program against its job and the stored
+template version and records who stored it: store_program for one, COPY into the view
+program_submission for a batch (migration 0010). A program is stored only with a safe name
+(engine/names.py) and lines that are one NC line each: a line break inside a line would be a
+block that no check read. The database refuses both too (migrations 0009, 0010); here they are
+refused with a message that names the program."""
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -18,12 +21,10 @@ from .records import Encoded, Planned, Program
 INSERT_JOB = """
 INSERT INTO job (gear_id, gear_class, machine, hob_id, params, module_params, cutting)
 VALUES (%s, %s, %s, %s, %s, %s, %s) RETURNING id"""
-INSERT_PROGRAM = """
-INSERT INTO program (job_id, gear_class, template_version, template_hash, name, lines, row_ids, trace)
-VALUES (%s, %s, %s, %s, %s, %s, %s, %s) RETURNING id"""
+INSERT_PROGRAM = "SELECT store_program(%s, %s, %s, %s, %s, %s, %s, %s)"
 COPY_JOB = "COPY job (id, gear_id, gear_class, machine, hob_id, params, module_params, cutting) FROM STDIN"
-COPY_PROGRAM = ("COPY program (id, job_id, gear_class, template_version, template_hash, name, lines, row_ids, "
-                "trace) FROM STDIN (FORMAT BINARY)")
+COPY_PROGRAM = ("COPY program_submission (id, job_id, gear_class, template_version, template_hash, name, lines, "
+                "row_ids, trace) FROM STDIN (FORMAT BINARY)")
 PROGRAM_TYPES = ("int8", "int8", "text", "int4", "text", "text", "text[]", "int4[]", "jsonb")
 
 
