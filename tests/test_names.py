@@ -203,12 +203,13 @@ def test_names_written_in_sql_are_refused(conn):
 def test_a_program_with_an_unsafe_name_or_a_broken_line_is_refused_in_sql(conn):
     program = instantiate_gear(conn, 42)
     insert = ("INSERT INTO program (job_id, gear_class, template_version, template_hash, name, lines, row_ids) "
-              "VALUES (%s, 'spur', 1, 'x', %s, %s, %s)")
+              "VALUES (%s, 'spur', %s, %s, %s, %s, %s)")   # the version and hash it was made from: only the name or line is wrong
+    made_from = (program.template_version, program.template_hash)
     for name in UNSAFE["program"]:
         if "\x00" not in name:
-            refused_in_sql(conn, insert, (program.job_id, name, ["M30"], [1]))
+            refused_in_sql(conn, insert, (program.job_id, *made_from, name, ["M30"], [program.row_ids[-1]]))
     for line in ("; A" + NEWLINE, "; A\rG0 X9999", "; A\u2028G0", "; A\x0bB", "; A\x85B"):
-        refused_in_sql(conn, insert, (program.job_id, "GEAR42", [line, "M30"], [1, 2]))
+        refused_in_sql(conn, insert, (program.job_id, *made_from, "GEAR42", [line, "M30"], program.row_ids[-2:]))
 
 
 def test_the_migration_names_rows_written_before_it_and_stops(empty_database_url, tmp_path):

@@ -221,11 +221,11 @@ def test_who_stored_a_program_is_the_login_person_and_the_role(database_url, log
 
 
 def test_a_program_made_inside_an_edit_fixes_its_version_and_the_next_edit_makes_another(conn):
-    conn.execute("UPDATE template_view SET o = '\"G90 ; ONE\"' WHERE gear_class = 'spur' AND id = 800")
+    conn.execute("UPDATE template_view SET o = '\"G90 G71 G94 ; ONE\"' WHERE gear_class = 'spur' AND id = 800")
     made = instantiate_gear(conn, 42)
-    conn.execute("UPDATE template_view SET o = '\"G90 ; TWO\"' WHERE gear_class = 'spur' AND id = 800")
+    conn.execute("UPDATE template_view SET o = '\"G90 G71 G94 ; TWO\"' WHERE gear_class = 'spur' AND id = 800")
     later = instantiate_gear(conn, 42)
-    assert "G90 ; ONE" in made.lines and "G90 ; TWO" in later.lines
+    assert "G90 G71 G94 ; ONE" in made.lines and "G90 G71 G94 ; TWO" in later.lines
     assert later.template_version == made.template_version + 1
     for program in (made, later):   # each records the rows it was made from, stored for its version
         assert stored_version_hash(conn, "spur", program.template_version) == program.template_hash

@@ -83,7 +83,7 @@ def test_a_preset_bump_marker_does_not_skip_the_version(conn):
     with as_role(conn, "engine_editor"):
         for name in ("engine_bumped.spur", "engine_bumped.duplex"):
             conn.execute("SELECT set_config(%s, pg_current_xact_id()::text, true)", (name,))
-        conn.execute("UPDATE template_view SET o = '\"G90 ; PRESET\"' WHERE gear_class = 'spur' AND id = 800")
+        conn.execute("UPDATE template_view SET o = '\"G90 G71 G94 ; PRESET\"' WHERE gear_class = 'spur' AND id = 800")
     assert versions(conn, "spur", "duplex") == [before[0] + 1, before[1] + 1]
 
 
@@ -91,11 +91,11 @@ def test_reparenting_is_versioned_and_audited_for_the_class_and_below(conn):
     before = versions(conn, "spur", "duplex", "helical")
     with as_role(conn, "engine_editor"):
         conn.execute("INSERT INTO gear_class (name, parent) VALUES ('records_base', 'cylindrical')")
-        conn.execute("INSERT INTO template_view (gear_class, id, t, o) VALUES ('records_base', 50, 'main', "
+        conn.execute("INSERT INTO template_view (gear_class, id, t, o) VALUES ('records_base', 750, 'main', "
                      "'\"; SHOP STANDARD\"')")
         conn.execute("UPDATE gear_class SET parent = 'records_base' WHERE name = 'spur'")
     assert versions(conn, "spur", "duplex", "helical") == [before[0] + 1, before[1] + 1, before[2]]
-    assert audit_rows(conn, "spur")[-1] == ("engine_editor", conn.info.user, 50, "INSERT")
+    assert audit_rows(conn, "spur")[-1] == ("engine_editor", conn.info.user, 750, "INSERT")
     assert "; SHOP STANDARD" in instantiate_gear(conn, 42).lines
 
 
@@ -130,7 +130,7 @@ def test_a_direct_write_that_changes_rows_without_a_version_is_refused_at_commit
 
 def test_a_version_set_back_is_refused_at_commit(fresh_database_url):
     with psycopg.connect(fresh_database_url) as conn:
-        conn.execute("UPDATE template_view SET o = '\"G90 ; V2\"' WHERE gear_class = 'spur' AND id = 800")
+        conn.execute("UPDATE template_view SET o = '\"G90 G71 G94 ; V2\"' WHERE gear_class = 'spur' AND id = 800")
         conn.commit()
     message = commit_refused(fresh_database_url,
                              "UPDATE gear_class SET template_version = template_version - 1 WHERE name = 'spur'")
@@ -183,17 +183,17 @@ def test_the_audit_names_the_login_person_and_the_role_on_every_route(database_u
     login = login_in("engine_editor")
     with psycopg.connect(login.url(database_url)) as conn:
         conn.execute("SET ROLE engine_editor")
-        conn.execute("UPDATE template_view SET o = '\"G90 ; VIEW\"' WHERE gear_class = 'spur' AND id = 800")
+        conn.execute("UPDATE template_view SET o = '\"G90 G71 G94 ; VIEW\"' WHERE gear_class = 'spur' AND id = 800")
         rows = [r if r.id != 900 else TemplateRow(r.id, r.t, r.n, r.p_calc, r.s, '"; IMPORT"', r.p_emit)
                 for r in load_template(conn, "spur").rows]
         replace_template(conn, "spur", rows)
         conn.execute("INSERT INTO gear_class (name, parent) VALUES ('records_base', 'cylindrical')")
-        conn.execute("INSERT INTO template_view (gear_class, id, t, o) VALUES ('records_base', 50, 'main', '\"; B\"')")
+        conn.execute("INSERT INTO template_view (gear_class, id, t, o) VALUES ('records_base', 750, 'main', '\"; B\"')")
         conn.execute("UPDATE gear_class SET parent = 'records_base' WHERE name = 'spur'")   # re-parented
         audited = audit_rows(conn, "spur")[-3:]
         conn.rollback()
     assert audited == [("engine_editor", login.name, 800, "UPDATE"), ("engine_editor", login.name, 900, "UPDATE"),
-                       ("engine_editor", login.name, 50, "INSERT")]
+                       ("engine_editor", login.name, 750, "INSERT")]
 
 
 def test_who_and_when_of_an_audit_row_are_stamped_and_it_is_never_changed(conn):
@@ -252,14 +252,14 @@ def test_every_route_of_an_edit_keeps_each_programs_version_equal_to_its_rows(fr
         made.append(store_nc_program(conn, "records_part"))
 
     step(lambda conn: None)
-    step(lambda conn: conn.execute("UPDATE template_view SET o = '\"G90 ; VIEW\"' WHERE gear_class = 'spur' "
+    step(lambda conn: conn.execute("UPDATE template_view SET o = '\"G90 G71 G94 ; VIEW\"' WHERE gear_class = 'spur' "
                                    "AND id = 800"))
     step(lambda conn: replace_template(conn, "spur", [
         r if r.id != 500 else TemplateRow(r.id, r.t, r.n, r.p_calc, r.s, '"; IMPORTED"', r.p_emit)
         for r in load_template(conn, "spur").rows]))
     step(lambda conn: restore(conn, "spur", 1))
     step(lambda conn: (conn.execute("INSERT INTO gear_class (name, parent) VALUES ('records_base', 'cylindrical')"),
-                       conn.execute("INSERT INTO template_view (gear_class, id, t, o) VALUES ('records_base', 50, "
+                       conn.execute("INSERT INTO template_view (gear_class, id, t, o) VALUES ('records_base', 750, "
                                     "'main', '\"; BASE\"')"),
                        conn.execute("UPDATE gear_class SET parent = 'records_base' WHERE name = 'spur'")))
     step(lambda conn: (conn.execute("WITH copy AS (INSERT INTO component (t, o, p_calc, s, p_emit) SELECT t, o, "
