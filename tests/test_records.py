@@ -15,25 +15,16 @@ import psycopg
 import pytest
 from psycopg import errors, sql
 from psycopg.conninfo import conninfo_to_dict, make_conninfo
-from psycopg.pq import TransactionStatus
 from psycopg.types.json import Jsonb
 
 from engine.errors import EngineError
 from engine.gears.cases import confirm_job
 from engine.programs.instantiate import instantiate_gear, instantiate_gears
+from roles import as_role
 
 STORE = "SELECT store_program(%s, %s, %s, %s, %s, %s, %s, %s)"
 
 
-@contextmanager
-def as_role(conn, role):
-    """Act as `role` inside the test's transaction (the test user may SET ROLE to any role)."""
-    conn.execute(sql.SQL("SET ROLE {}").format(sql.Identifier(role)))
-    try:
-        yield
-    finally:
-        if conn.info.transaction_status != TransactionStatus.INERROR:
-            conn.execute("RESET ROLE")
 
 
 @dataclass(frozen=True)

@@ -2,30 +2,20 @@
 template_view with copy-on-write for shared and inherited rows, the obvious problems refused
 by the database, versions, template_audit, and the roles engine_reader, engine_runner,
 engine_editor."""
-from contextlib import contextmanager
 
 import psycopg
 import pytest
 from psycopg import errors, sql
-from psycopg.pq import TransactionStatus
 
 from engine.library.refactor import refactor
 from engine.programs.instantiate import instantiate_gear
 from engine.templates.rows import TemplateRow, export_csv
 from engine.templates.store import load_template, replace_template
+from roles import as_role
 
 ROW_COLUMNS = ("id", "t", "n", "p_calc", "s", "o", "p_emit")
 
 
-@contextmanager
-def as_role(conn, role):
-    """Act as `role` (the test user is a superuser; SET ROLE drops to the role's privileges)."""
-    conn.execute(sql.SQL("SET ROLE {}").format(sql.Identifier(role)))
-    try:
-        yield
-    finally:
-        if conn.info.transaction_status != TransactionStatus.INERROR:
-            conn.execute("RESET ROLE")
 
 
 def exported(conn, gear_class):
