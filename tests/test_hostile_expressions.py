@@ -4,6 +4,7 @@ editor would, through the template view in SQL, and `engine instantiate` runs in
 address space is limited (RLIMIT_AS) to a few times what an instantiation needs: a row that
 allocated its gigabyte would die there of MemoryError (exit 2), not be refused. `engine lint`
 names every row the gate can judge without a job, and goes on to the next class."""
+import json
 import os
 import resource
 import subprocess
@@ -16,7 +17,9 @@ import pytest
 
 from engine.templates.budget import MAX_BYTES
 from engine.templates.decision_table import CompiledTemplate, TemplateError
+from engine.templates.expressions import MAX_EXPRESSION_LENGTH
 from engine.templates.rows import Template, TemplateRow
+from engine.templates.trace import MAX_TRACE_BYTES
 from engine.turning.moves import Move
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -162,3 +165,68 @@ def test_what_a_refused_row_built_stays_within_the_budget(columns, words, seen):
     message, peak = run_traced([columns], {"z2": 19})
     assert words in message
     assert peak < MAX_BYTES + (16 << 20)
+
+
+def hundreds_of_large_integers(rows):
+    """Rows of the budget escape (issue 13): each `s` assigns one integer of 4,001 bits to a few
+    hundred names, cheap to compute and to hold (one object), 1,205 digits each as JSON."""
+    assignments, k = ["a0 = 1 << 4000"], 1
+    while len("; ".join([*assignments, f"a{k} = a0"])) < MAX_EXPRESSION_LENGTH:
+        assignments.append(f"a{k} = a0")
+        k += 1
+    return "; ".join(assignments), rows
+
+
+def test_hundreds_of_large_integers_keep_a_bounded_trace_or_are_refused(fresh_database_url, tmp_path):
+    """Either the program is stored with a trace within its bound (the integers summarised, the
+    rows past the bound counted), or the compile runs out of time and is refused in one line."""
+    s, rows = hundreds_of_large_integers(100)
+    with psycopg.connect(fresh_database_url) as conn:
+        conn.execute("INSERT INTO template_view (gear_class, id, t, n, s) "
+                     "SELECT 'spur', 90000 + g, 'main', 1, %s FROM generate_series(1, %s) g", (s, rows))
+        conn.commit()
+        before = counts(conn)
+    done = engine(fresh_database_url, "instantiate", "--gear", "42", "--out", str(tmp_path))
+    with psycopg.connect(fresh_database_url) as conn:
+        if done.returncode == 1:
+            assert done.stderr.count("\n") == 1 and done.stderr.startswith("error: class spur row 900"), done.stderr
+            assert "compiling the template exceeded" in done.stderr
+            assert counts(conn) == before
+            return
+        assert done.returncode == 0, done.stderr
+        trace, size = conn.execute("SELECT trace, octet_length(trace::text) FROM program ORDER BY id DESC LIMIT 1").fetchone()
+    assert size <= MAX_TRACE_BYTES + 64 * 1024   # the row entries, and the job's inputs once
+    assert trace["omitted"]["rows"] > 0 and trace["omitted"]["from_row"] > 90001
+    kept = [entry for entry in trace["rows"] if entry["row"] > 90000]
+    assert kept and kept[0]["computed"]["a7"] == f"<integer of {(1 << 4000).bit_length()} bits>"
+
+
+def test_lint_of_hundreds_of_large_integers_finishes(fresh_database_url):
+    """Every name the rows read they assign first: lint passes them, or names the row at which
+    the compile ran out of time, and goes on to the next class."""
+    s, rows = hundreds_of_large_integers(100)
+    with psycopg.connect(fresh_database_url) as conn:
+        conn.execute("INSERT INTO template_view (gear_class, id, t, n, s) "
+                     "SELECT 'spur', 90000 + g, 'main', 1, %s FROM generate_series(1, %s) g", (s, rows))
+        conn.commit()
+    linted = engine(fresh_database_url, "lint")
+    assert linted.returncode in (0, 1), linted.stderr
+    problems = linted.stdout.splitlines() if linted.returncode else []
+    assert all(" row 900" in line and "compiling the template exceeded" in line for line in problems), problems
+
+
+def test_a_trace_keeps_its_bound_and_counts_the_rows_past_it():
+    """400 rows of 20 texts of 150 characters each: about 2.6 MB as JSON, more than a trace keeps."""
+    statements = "; ".join(["a = 'x' * 150", *(f"b{k} = a" for k in range(19))])
+    rows = tuple(TemplateRow(10 * k + 10, "main", 1, None, statements, None, None) for k in range(400))
+    trace = CompiledTemplate(Template("many", 1, rows)).run({}).trace
+    kept = sum(len(json.dumps(entry)) for entry in trace["rows"])
+    assert kept <= MAX_TRACE_BYTES < kept + len(json.dumps(rows[0].s)) * 400
+    assert trace["rows"][0]["computed"]["b3"] == "x" * 150
+    assert trace["omitted"] == {"from_row": trace["rows"][-1]["row"] + 10, "rows": 400 - len(trace["rows"])}
+
+
+def test_the_trace_keeps_integers_up_to_64_bits_and_summarises_longer_ones():
+    rows = (TemplateRow(10, "main", 1, None, "small = (1 << 64) - 1; large = 1 << 64; truth = z2 > 0", "'x'", None),)
+    computed = CompiledTemplate(Template("ints", 1, rows)).run({"z2": 1}).trace["rows"][0]["computed"]
+    assert computed == {"small": 2 ** 64 - 1, "large": "<integer of 65 bits>", "truth": True}

@@ -39,6 +39,10 @@ def explained_rows(trace: dict, lines: list[str], row_ids: list[int], row: int |
     computed = {f"row {entry['row']}": entry.get("computed", {}) for entry in trace["rows"]}
     values = {**trace["inputs"], **computed}
     entries = [entry for entry in trace["rows"] if row is None or entry["row"] == row]
+    omitted = trace.get("omitted")
+    if row is not None and not entries and omitted is not None and row >= omitted["from_row"]:
+        raise EngineError(f"row {row} is beyond what the program's trace keeps (it keeps the rows before "
+                          f"row {omitted['from_row']}); see `engine explain --program ID`")
     if row is not None and not entries:
         raise EngineError(f"row {row} is not in the program's template version; see `engine explain --program ID`")
     return [ExplainedRow(entry["row"], _state(entry), tuple(emitted.get(entry["row"], ())), entry,

@@ -21,6 +21,13 @@ SECONDS_PER_ROW = 50e-6      # and per row of its template: an imported program 
 MAX_BYTES = 64 << 20         # bytes of the values one instantiation's expressions build
 
 
+def compiling(rows: int) -> spending:
+    """`with compiling(rows):` the compile of a template of `rows` rows (the gate's evaluation of
+    constant parts included) within the time its run has: no template, however written, holds
+    an import, lint or a batch up before it runs."""
+    return spending(Budget(seconds_for(rows), what="compiling the template"))
+
+
 def seconds_for(rows: int) -> float:
     """The time of an instantiation of a template of `rows` rows (2.002 s for 40 rows, 7 s for 100,000)."""
     return MAX_SECONDS + SECONDS_PER_ROW * rows
@@ -28,11 +35,20 @@ def seconds_for(rows: int) -> float:
 
 class Budget:
     """The time and bytes left to one instantiation."""
-    __slots__ = ("seconds", "deadline", "max_bytes", "bytes_left")
+    __slots__ = ("seconds", "deadline", "max_bytes", "bytes_left", "what")
 
-    def __init__(self, seconds: float = MAX_SECONDS, max_bytes: int = MAX_BYTES):
-        self.seconds, self.deadline = seconds, time.perf_counter() + seconds
+    def __init__(self, seconds: float = MAX_SECONDS, max_bytes: int = MAX_BYTES, what: str = "instantiation"):
+        self.seconds, self.deadline, self.what = seconds, time.perf_counter() + seconds, what
         self.max_bytes = self.bytes_left = max_bytes
+
+    @classmethod
+    def within(cls, outer: Budget | None) -> Budget:
+        """Bytes of its own, and a deadline no later than `outer`'s (the gate's evaluation of a
+        constant part, while a whole template is compiled)."""
+        budget = cls()
+        if outer is not None and outer.deadline < budget.deadline:
+            budget.seconds, budget.deadline, budget.what = outer.seconds, outer.deadline, outer.what
+        return budget
 
     def pay(self, nbytes: int) -> None:
         self.bytes_left -= nbytes
@@ -42,7 +58,7 @@ class Budget:
 
     def check_time(self) -> None:
         if time.perf_counter() > self.deadline:
-            raise TimeoutError(f"instantiation exceeded {self.seconds:.3g} s")
+            raise TimeoutError(f"{self.what} exceeded {self.seconds:.3g} s")
 
     @property
     def spent(self) -> int:

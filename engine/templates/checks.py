@@ -6,6 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ..errors import EngineError
+from .budget import compiling, pay_time
 from .decision_table import TemplateError, compile_row
 from .rows import MODULE_ORDER, TemplateRow
 
@@ -30,16 +31,28 @@ def check_rows(gear_class: str, rows: list[TemplateRow]) -> None:
 
 
 def structural_problems(gear_class: str, rows: list[TemplateRow]) -> list[LintProblem]:
-    problems = []
-    for row in rows:
-        problems += [LintProblem(gear_class, row.id, column, message)
-                     for column, message in _row_structure(row)]
-        if row.t in MODULE_ORDER and row.id >= 0:
-            try:
-                compile_row(gear_class, row)
-            except TemplateError as error:
-                problems.append(LintProblem(gear_class, row.id, error.column, str(error).split(": ", 1)[1]))
+    """Every row's structure, and its expressions compiled within the time of one compile: the
+    row at which that time ran out is a problem, and the rows after it are not compiled."""
+    problems, out_of_time = [], False
+    with compiling(len(rows)):
+        for row in rows:
+            problems += [LintProblem(gear_class, row.id, column, message)
+                         for column, message in _row_structure(row)]
+            if row.t in MODULE_ORDER and row.id >= 0 and not out_of_time:
+                try:
+                    compile_row(gear_class, row)
+                except TemplateError as error:
+                    problems.append(LintProblem(gear_class, row.id, error.column, str(error).split(": ", 1)[1]))
+                    out_of_time = _out_of_time()
     return problems
+
+
+def _out_of_time() -> bool:
+    try:
+        pay_time()
+    except TimeoutError:
+        return True
+    return False
 
 
 def _row_structure(row: TemplateRow):

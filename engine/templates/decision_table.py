@@ -20,12 +20,12 @@ from functools import partial
 
 from ..errors import EngineError
 from ..turning.nc_path import NcLines
-from .budget import Budget, seconds_for, spending
+from .budget import Budget, compiling, pay_time, seconds_for, spending
 from .evaluator import EvaluationError, Evaluator, base_symbols
 from .expressions import Compiled, ExpressionError, compile_expression, compile_statements
 from .guards import MAX_STRING_LENGTH, short_repr, size
 from .rows import Template, TemplateRow
-from .trace import Outcome, RowTrace, memo_key
+from .trace import Outcome, RowTrace, keep_entry, memo_key
 
 MAX_MEMO_ROWS = 50_000    # outcomes kept per template (about 1.5 KB each); the memo starts again when full
 MAX_MEMO_VALUE = 256      # characters or elements of a value an outcome kept in the memo may hold
@@ -67,7 +67,8 @@ class CompiledTemplate:
 
     def __init__(self, template: Template):
         self.template = template
-        self.rows = tuple(compile_row(template.gear_class, row, template.translations) for row in template.rows)
+        with compiling(len(template.rows)):
+            self.rows = tuple(compile_row(template.gear_class, row, template.translations) for row in template.rows)
         self.symbols = base_symbols(any(c.is_sql for r in self.rows for c in _expressions_of(r)))
         self._evaluators = threading.local()   # runners may share a process (and this compiled template)
         self.memo: dict[tuple, tuple[Outcome, int]] = {}   # key -> (outcome, bytes it cost to evaluate)
@@ -115,7 +116,7 @@ class _Job:
         self.intermediates: dict[str, int] = {}      # name -> id of the row that computed it
         self.module, self.module_names, self.module_key = None, (), None
         self.budget, self.evaluator = budget, compiled.evaluator
-        self.result = Result()
+        self.result, self.trace_bytes = Result(), 0
 
     def run_row(self, row: CompiledRow) -> None:
         if row.module != self.module:
@@ -200,7 +201,7 @@ class _Job:
         inputs = self.result.trace["inputs"]
         for origin, name, value in outcome.inputs:
             inputs.setdefault(origin, {})[name] = value
-        self.result.trace["rows"].append(outcome.trace)
+        self.trace_bytes = keep_entry(self.result.trace, outcome, self.trace_bytes)
 
 
 def _refuse_engine_names(compiled: CompiledTemplate, names, what: str) -> None:
@@ -255,7 +256,12 @@ class rows_compiled_once:
 
 def compile_row(gear_class: str, row: TemplateRow, translations=None) -> CompiledRow:
     """The row's expressions checked and guarded (SQL conditions from their stored translations
-    where `translations` has them)."""
+    where `translations` has them), within the time of the compile running (engine.templates.budget)."""
+    try:
+        pay_time()
+    except TimeoutError as error:
+        column = "s" if row.s else "o"
+        raise TemplateError(gear_class, row.id, column, getattr(row, column) or "", str(error)) from None
     remembered = getattr(_ONCE, "rows", None)
     if remembered is None or translations:
         return _compile_row(gear_class, row, translations)
@@ -274,7 +280,7 @@ def _compile_row(gear_class: str, row: TemplateRow, translations=None) -> Compil
             return None
         try:
             return compile_function(text)
-        except ExpressionError as error:
+        except (ExpressionError, TimeoutError) as error:
             raise TemplateError(gear_class, row.id, column, text, str(error)) from None
 
     statements = tuple(compiled("s", compile_statements) or ())

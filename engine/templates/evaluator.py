@@ -12,7 +12,7 @@ import threading
 
 from ..errors import EngineError
 from .asteval_import import ALL_NODES, Interpreter
-from .budget import Budget, paid, spending
+from .budget import Budget, paid, running, spending
 from .functions import CONSTANTS, FUNCTIONS
 from .guards import (built, check_printable, guard_size, safe_add, safe_format, safe_lshift, safe_mod, safe_mult,
                      safe_pow)
@@ -118,6 +118,13 @@ def evaluate(compiled, scope: dict, budget: Budget | None = None):
 
 
 def evaluate_part(tree: ast.expr, text: str, is_sql: bool):
-    """A part of an expression that reads no parameter, on its own budget (the gate's check)."""
-    with spending(Budget()):
-        return _own_evaluator().evaluate(tree, text, base_symbols(is_sql))
+    """A part of an expression that reads no parameter, on its own budget (the gate's check),
+    ending no later than the compile of its template (then that is the failure)."""
+    outer = running()
+    with spending(Budget.within(outer)):
+        try:
+            return _own_evaluator().evaluate(tree, text, base_symbols(is_sql))
+        except EvaluationError:
+            if outer is not None:
+                outer.check_time()
+            raise

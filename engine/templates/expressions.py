@@ -20,6 +20,7 @@ time and bytes as well (engine.templates.budget).
 from __future__ import annotations
 
 import ast
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass
 
@@ -126,7 +127,7 @@ def compile_statements(text: str) -> list[tuple[str, Compiled]]:
         module = _parsed(text.strip(), "exec")
     except SyntaxError as error:
         raise ExpressionError(f"does not parse: {error.msg} (column {error.offset})") from None
-    assignments = []
+    assignments, lines = [], _LINES.findall(text.strip())
     for statement in module.body:
         if not (isinstance(statement, ast.Assign) and len(statement.targets) == 1
                 and isinstance(statement.targets[0], ast.Name)):
@@ -137,11 +138,23 @@ def compile_statements(text: str) -> list[tuple[str, Compiled]]:
         if name in ENGINE_NAMES:
             raise ExpressionError(f"{name!r} is a name of the engine (a function, constant or the "
                                   "template version); assign to another name")
-        source = ast.get_source_segment(text.strip(), statement.value)
-        assignments.append((name, compile_expression(source)))
+        assignments.append((name, compile_expression(_source_of(lines, statement.value))))
     if not assignments:
         raise ExpressionError("no assignment found")
     return assignments
+
+
+_LINES = re.compile(r"[^\r\n]*(?:\r\n|\r|\n|$)")   # the lines as Python's parser counts them (not str.splitlines)
+
+
+def _source_of(lines: list[str], node: ast.expr) -> str:
+    """The text of `node` (ast.get_source_segment splits the whole text again for each node:
+    quadratic in a block of a few hundred statements). Offsets count UTF-8 bytes."""
+    first, last = node.lineno - 1, node.end_lineno - 1
+    if first == last:
+        return lines[first].encode()[node.col_offset:node.end_col_offset].decode()
+    head = lines[first].encode()[node.col_offset:].decode()
+    return head + "".join(lines[first + 1:last]) + lines[last].encode()[:node.end_col_offset].decode()
 
 
 def _check_length(text: str) -> None:

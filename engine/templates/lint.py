@@ -7,14 +7,20 @@ from dataclasses import dataclass
 
 from ..gears.models import model_for_class
 from .checks import LintProblem, structural_problems
-from .decision_table import compile_row
+from .decision_table import compile_row, rows_compiled_once
 from .expressions import translated_python
 from .store import load_template
 from .translations import store_translations
 
 
 def lint_class(conn, gear_class: str) -> list[LintProblem]:
-    """Every problem of one class's template, including unknown parameter names."""
+    """Every problem of one class's template, including unknown parameter names (its rows
+    compiled once, within the time of one compile)."""
+    with rows_compiled_once():
+        return _class_problems(conn, gear_class)
+
+
+def _class_problems(conn, gear_class: str) -> list[LintProblem]:
     template = load_template(conn, gear_class)
     problems = structural_problems(gear_class, list(template.rows)) + _translation_problems(template)
     if problems:

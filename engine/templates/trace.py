@@ -11,15 +11,22 @@ per row in id order that names the origin of what it read:
               {"row": 1800, "emit": false, "p_emit": false, "read": {"o": {}, "p_emit": {"coolant": "job"}}}]}
 A value read from "row K" is that row's `computed` value. Keys that do not apply are left out:
 "calc" only for rows with `s`, "emit" only for rows with `o`. Values that are not plain JSON
-(tool paths, long texts) are summarised.
+(tool paths, long texts, integers beyond 64 bits) are summarised. The trace of one program keeps
+at most MAX_TRACE_BYTES of row entries (a program is stored with its trace, and a template of a
+few hundred rows each computing hundreds of values would otherwise store hundreds of MB); the
+rows after the first that no longer fits are counted, not kept:
+    "omitted": {"from_row": 90123, "rows": 178}
 """
 from __future__ import annotations
 
+import json
 import math
 from dataclasses import dataclass
 
 MAX_TEXT = 200        # characters of a text value kept in the trace
 MAX_LISTED = 8        # elements of a list or tuple kept in the trace; longer ones are summarised
+MAX_INT_BITS = 64     # bits of an integer kept in the trace; longer ones are summarised
+MAX_TRACE_BYTES = 1 << 20   # bytes of JSON of the row entries one program's trace keeps
 MISSING = object()
 
 
@@ -33,6 +40,7 @@ class Outcome:
     emit: bool
     trace: dict
     inputs: tuple[tuple[str, str, object], ...] = ()
+    trace_bytes: int = 0   # the length of `trace` as JSON
 
 
 class RowTrace:
@@ -70,7 +78,8 @@ class RowTrace:
             self.entry["calc"] = calc
         if line is not None:
             self.entry["emit"] = bool(emit)
-        return Outcome(tuple(self.assignments), line, bool(emit), self.entry, tuple(self.inputs))
+        return Outcome(tuple(self.assignments), line, bool(emit), self.entry, tuple(self.inputs),
+                       len(json.dumps(self.entry)))
 
     def _origin(self, name: str) -> str:
         if name in self.assigned:
@@ -81,12 +90,16 @@ class RowTrace:
 def json_value(value):
     """A value as the trace keeps it: plain JSON values as they are, others summarised."""
     kind = type(value)
+    if kind is int and value.bit_length() > MAX_INT_BITS:
+        return f"<integer of {value.bit_length()} bits>"
     if kind is int or kind is bool or value is None or (kind is str and len(value) <= MAX_TEXT and "\x00" not in value):
         return value
     if kind is float and math.isfinite(value):
         return value
-    if isinstance(value, (bool, int)):
+    if isinstance(value, bool):
         return value
+    if isinstance(value, int):
+        return json_value(int(value))
     if isinstance(value, float):
         return value if math.isfinite(value) else str(value)
     if isinstance(value, str):   # PostgreSQL's jsonb holds no NUL
@@ -97,6 +110,21 @@ def json_value(value):
             return [json_value(item) for item in value]
         return f"<{type(value).__name__} of {len(value)}>"
     return f"<{type(value).__name__}>"
+
+
+def keep_entry(trace: dict, outcome: Outcome, kept: int) -> int:
+    """The row's entry appended to the program's trace (which holds `kept` bytes of entries)
+    while the trace stays within MAX_TRACE_BYTES; from the first entry that does not fit on,
+    the rows are only counted. The bytes the trace then holds."""
+    omitted = trace.get("omitted")
+    if omitted is None and kept + outcome.trace_bytes <= MAX_TRACE_BYTES:
+        trace["rows"].append(outcome.trace)
+        return kept + outcome.trace_bytes
+    if omitted is None:
+        trace["omitted"] = {"from_row": outcome.trace["row"], "rows": 1}
+    else:
+        omitted["rows"] += 1
+    return kept
 
 
 MEMO_TEXT = 256   # characters of a text input that may be part of a memo key
