@@ -135,13 +135,15 @@ def test_no_class_lies_deeper_than_the_lineage_the_templates_follow(conn):
     assert ancestors(conn, chain[-1]) == 50 and ancestors(conn, "duplex") == ancestors(conn, "spur") + 1
 
 
-def blocked(url, pid):
-    """Whether backend `pid` waits for a lock (polled until it does; a bug hangs, it does not pass)."""
+def blocked(url, pid, worker):
+    """Whether backend `pid` waits for a lock, polled while its worker runs (False once it ended)."""
     with psycopg.connect(url, autocommit=True) as watcher:
-        while not watcher.execute("SELECT wait_event_type = 'Lock' FROM pg_stat_activity WHERE pid = %s",
-                                  (pid,)).fetchone()[0]:
+        while worker.is_alive():
+            if watcher.execute("SELECT wait_event_type = 'Lock' FROM pg_stat_activity WHERE pid = %s",
+                               (pid,)).fetchone()[0]:
+                return True
             watcher.execute("SELECT pg_sleep(0.05)")
-    return True
+    return False
 
 
 def test_two_reparents_in_parallel_never_commit_a_cycle(fresh_database_url):
@@ -159,7 +161,7 @@ def test_two_reparents_in_parallel_never_commit_a_cycle(fresh_database_url):
                 refused.append(error)
         worker = threading.Thread(target=reparent_the_other)
         worker.start()
-        assert blocked(fresh_database_url, second.info.backend_pid)
+        assert blocked(fresh_database_url, second.info.backend_pid, worker)
         first.commit()
         worker.join()
     assert isinstance(refused[0], errors.CheckViolation) and "derive from records_ra" in str(refused[0])
