@@ -1017,6 +1017,60 @@ CREATE CONSTRAINT TRIGGER template_rows_match_version AFTER INSERT ON template_c
 DEFERRABLE INITIALLY DEFERRED
 FOR EACH ROW EXECUTE FUNCTION check_template_changes();
 
+-- A lineage is at most class_depth_limit() classes above a class and never a cycle, also when two
+-- re-parents run in parallel (migration 0012).
+-- The deepest lineage the recursions over gear_class follow: ancestors above a class.
+CREATE FUNCTION class_depth_limit() RETURNS integer LANGUAGE sql IMMUTABLE PARALLEL SAFE RETURN 50;
+
+-- How many classes lie below class_name on its longest branch (0 for a leaf), up to limit + 1.
+CREATE FUNCTION class_height(class_name text) RETURNS integer
+LANGUAGE sql STABLE
+AS $$
+    WITH RECURSIVE below(name, depth) AS (
+        SELECT class_name, 0
+        UNION ALL
+        SELECT g.name, b.depth + 1 FROM gear_class g JOIN below b ON g.parent = b.name
+        WHERE b.depth <= class_depth_limit())
+    SELECT max(depth) FROM below
+$$;
+
+-- A class created under a parent, or moved under one: the parent's ancestors, each locked FOR
+-- SHARE as it is read (so no one re-parents them until this transaction ends, and a re-parent
+-- that got there first is read as committed), must not include the class, and the deepest class
+-- below it must stay within class_depth_limit() ancestors.
+CREATE FUNCTION check_class_lineage() RETURNS trigger
+LANGUAGE plpgsql SECURITY DEFINER SET search_path = public, pg_temp
+AS $$
+DECLARE
+    ancestor text := NEW.parent;
+    above integer := 0;
+BEGIN
+    WHILE ancestor IS NOT NULL LOOP
+        IF ancestor = NEW.name THEN
+            RAISE EXCEPTION 'class % cannot derive from %: % is % or derives from it', NEW.name, NEW.parent,
+                            NEW.parent, NEW.name
+                USING ERRCODE = 'check_violation', COLUMN = 'parent';
+        END IF;
+        above := above + 1;
+        EXIT WHEN above > class_depth_limit();
+        SELECT g.parent INTO ancestor FROM gear_class g WHERE g.name = ancestor FOR SHARE;
+    END LOOP;
+    IF above + class_height(NEW.name) > class_depth_limit() THEN
+        RAISE EXCEPTION 'class % under % would be % or more levels deep (or classes below it would); a lineage '
+                        'holds at most % classes above a class; choose a parent higher in the tree', NEW.name,
+                        NEW.parent, above + class_height(NEW.name), class_depth_limit()
+            USING ERRCODE = 'check_violation', COLUMN = 'parent';
+    END IF;
+    RETURN NULL;
+END
+$$;
+
+CREATE TRIGGER gear_class_lineage_inserted AFTER INSERT ON gear_class
+FOR EACH ROW WHEN (NEW.parent IS NOT NULL) EXECUTE FUNCTION check_class_lineage();
+CREATE TRIGGER gear_class_lineage_reparented AFTER UPDATE OF parent ON gear_class
+FOR EACH ROW WHEN (NEW.parent IS NOT NULL AND OLD.parent IS DISTINCT FROM NEW.parent)
+EXECUTE FUNCTION check_class_lineage();
+
 -- Re-parenting changes the class's assembled template and those below it: versioned and
 -- audited like any edit; a class cannot derive from itself or from a class below it.
 CREATE FUNCTION gear_class_reparented() RETURNS trigger
@@ -1308,7 +1362,12 @@ BEGIN
                             '(mm/min); fix job.cutting', confirmed_job, cut USING ERRCODE = 'check_violation';
         END IF;
     END LOOP;
-    IF ran IS DISTINCT FROM speed AND ran IS NOT NULL THEN
+    IF ran IS NULL THEN
+        RAISE EXCEPTION 'job %: its last program does not record the hob speed it ran (no n0 in its trace), so '
+                        'nothing vouches for job.cutting; make the program again (engine instantiate --job %)',
+                        confirmed_job, confirmed_job USING ERRCODE = 'check_violation';
+    END IF;
+    IF ran IS DISTINCT FROM speed THEN
         RAISE EXCEPTION 'job %: job.cutting says hob speed % r/min, but its last program ran n0 = % r/min; make the '
                         'program again from the job or fix job.cutting', confirmed_job, speed, ran
             USING ERRCODE = 'check_violation';

@@ -307,3 +307,12 @@ def test_every_case_is_physically_plausible_whoever_adds_it(conn, speed, axial, 
         return
     with pytest.raises(errors.CheckViolation, match="violates check constraint"), conn.transaction():
         conn.execute(insert, (speed, axial, radial))
+
+
+def test_a_job_whose_program_does_not_record_its_hob_speed_is_not_a_case(conn, program):
+    """The case's speed must be one a program ran: without n0 in the trace nothing vouches for it."""
+    values = stored(conn, program.program_id)
+    conn.execute(STORE, as_params((*values[:7], {})))
+    with pytest.raises(EngineError, match="does not record the hob speed it ran"), as_role(conn, "engine_runner"):
+        confirm_job(conn, program.job_id)
+    assert conn.execute("SELECT count(*) FROM cutting_case WHERE job_id = %s", (program.job_id,)).fetchone()[0] == 0

@@ -6,6 +6,7 @@ nobody's hand."""
 from __future__ import annotations
 
 import re
+import threading
 
 import psycopg
 import pytest
@@ -103,6 +104,69 @@ def test_a_class_cannot_derive_from_itself_or_below_itself(conn):
     with pytest.raises(errors.CheckViolation, match="spur cannot derive from duplex"), conn.transaction(), \
             as_role(conn, "engine_editor"):
         conn.execute("UPDATE gear_class SET parent = 'duplex' WHERE name = 'spur'")
+
+
+
+def ancestors(conn, name):
+    """How many classes lie above `name`, walked in Python (not the database's capped recursion)."""
+    count, parent = 0, conn.execute("SELECT parent FROM gear_class WHERE name = %s", (name,)).fetchone()[0]
+    while parent is not None:
+        count, parent = count + 1, conn.execute("SELECT parent FROM gear_class WHERE name = %s",
+                                                (parent,)).fetchone()[0]
+    return count
+
+
+def test_no_class_lies_deeper_than_the_lineage_the_templates_follow(conn):
+    """Assembling stops 50 classes up: a class deeper would lose its far ancestors' rows, and a
+    re-parent past that depth could close a cycle."""
+    with as_role(conn, "engine_editor"):
+        conn.execute("INSERT INTO template_view (gear_class, id, t, o) VALUES ('spur', 750, 'main', '\"; TOP\"')")
+        chain = ["spur"]
+        while ancestors(conn, chain[-1]) < 50:
+            chain.append(f"records_zc{len(chain)}")
+            conn.execute("INSERT INTO gear_class (name, parent) VALUES (%s, %s)", chain[-2:][::-1])
+        assembled = dict(conn.execute("SELECT * FROM assembled_rows_of(%s)", (["spur", chain[-1]],)).fetchall())
+        assert '"; TOP"' in [row["o"] for row in assembled[chain[-1]]] and assembled[chain[-1]] == assembled["spur"]
+        for statement, params in [("INSERT INTO gear_class (name, parent) VALUES ('records_deeper', %s)", (chain[-1],)),
+                                  ("UPDATE gear_class SET parent = %s WHERE name = %s", (chain[-1], chain[1])),
+                                  ("UPDATE gear_class SET parent = %s WHERE name = 'duplex'", (chain[-1],))]:
+            with pytest.raises(errors.CheckViolation, match="cannot derive|at most 50 classes above"), conn.transaction():
+                conn.execute(statement, params)
+    assert ancestors(conn, chain[-1]) == 50 and ancestors(conn, "duplex") == ancestors(conn, "spur") + 1
+
+
+def blocked(url, pid, worker):
+    """Whether backend `pid` waits for a lock, polled while its worker runs (False once it ended)."""
+    with psycopg.connect(url, autocommit=True) as watcher:
+        while worker.is_alive():
+            if watcher.execute("SELECT wait_event_type = 'Lock' FROM pg_stat_activity WHERE pid = %s",
+                               (pid,)).fetchone()[0]:
+                return True
+            watcher.execute("SELECT pg_sleep(0.05)")
+    return False
+
+
+def test_two_reparents_in_parallel_never_commit_a_cycle(fresh_database_url):
+    with psycopg.connect(fresh_database_url, autocommit=True) as setup:
+        setup.execute("INSERT INTO gear_class (name, parent) VALUES ('records_ra', 'spur'), ('records_rb', 'spur')")
+    refused = []
+    with psycopg.connect(fresh_database_url) as first, psycopg.connect(fresh_database_url) as second:
+        first.execute("UPDATE gear_class SET parent = 'records_rb' WHERE name = 'records_ra'")
+
+        def reparent_the_other():
+            try:
+                second.execute("UPDATE gear_class SET parent = 'records_ra' WHERE name = 'records_rb'")
+                second.commit()
+            except psycopg.Error as error:
+                refused.append(error)
+        worker = threading.Thread(target=reparent_the_other)
+        worker.start()
+        assert blocked(fresh_database_url, second.info.backend_pid, worker)
+        first.commit()
+        worker.join()
+    assert isinstance(refused[0], errors.CheckViolation) and "derive from records_ra" in str(refused[0])
+    with psycopg.connect(fresh_database_url) as check:
+        assert ancestors(check, "records_ra") == ancestors(check, "spur") + 2
 
 
 # --- at commit: rows equal the rows stored for the version -----------------------------------------
