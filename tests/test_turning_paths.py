@@ -171,7 +171,6 @@ def test_seed_rough_passes_follow_the_seed_motions(seed_operations):
     passes = drawn_rough_passes(seed_operations["ROUGH"].paths, CLEARANCE)
     start_z, end_z = 0.1 * INCH, -3.9 * INCH
     assert len(passes) == 3
-    previous_end = None
     for moves, radius in zip(passes, (0.9 * INCH, 0.85 * INCH, 0.8 * INCH)):
         assert [m.kind for m in moves] == ["rapid", "feed", "feed"]
         expected = [(start_z, radius + CLEARANCE),   # 5: X re-approach
