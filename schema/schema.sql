@@ -158,8 +158,27 @@ CREATE TABLE machine (
     spindle_max     numeric NOT NULL CHECK (spindle_max > 0),  -- hob spindle (hobber) or main spindle, r/min
     table_speed_max numeric,                                   -- r/min of C, hobbers only
     module_max      numeric,                                   -- mm, hobbers only
+    -- Conventions and setup (migration 0013, reference §A7): each axis's sense relative to
+    -- DIN 66217 (+1 agrees, -1 opposite); the signs of A and of the coupling terms follow them.
+    a_direction     smallint NOT NULL DEFAULT 1 CHECK (a_direction IN (-1, 1)),
+    b_direction     smallint NOT NULL DEFAULT 1 CHECK (b_direction IN (-1, 1)),
+    c_direction     smallint NOT NULL DEFAULT 1 CHECK (c_direction IN (-1, 1)),
+    y_direction     smallint NOT NULL DEFAULT 1 CHECK (y_direction IN (-1, 1)),
+    z_direction     smallint NOT NULL DEFAULT 1 CHECK (z_direction IN (-1, 1)),
+    work_offset     text NOT NULL DEFAULT 'G54' CHECK (work_offset IN ('G54', 'G55', 'G56', 'G57')),
+    fixture_diameter numeric NOT NULL DEFAULT 0 CHECK (fixture_diameter >= 0),  -- below the blank; 0 = none
+    fixture_gap     numeric NOT NULL DEFAULT 0 CHECK (fixture_gap >= 0),        -- its top below the bottom face
+    tailstock_diameter numeric NOT NULL DEFAULT 0 CHECK (tailstock_diameter >= 0),  -- above the blank; 0 = none
+    tailstock_gap   numeric NOT NULL DEFAULT 0 CHECK (tailstock_gap >= 0),      -- its lowest point above the top face
+    load_x          numeric,                                   -- the load position at the end; NULL = stay
+    load_z          numeric,
+    rapid_rate      numeric NOT NULL DEFAULT 5000 CHECK (rapid_rate > 0),       -- G0, mm/min
+    orient_before_coupling boolean NOT NULL DEFAULT false,                      -- SPOS before EGON
+    door_close_m    smallint CHECK (door_close_m BETWEEN 0 AND 999),            -- guard door M functions
+    door_open_m     smallint CHECK (door_open_m BETWEEN 0 AND 999),
     CHECK (x_min < x_max AND y_min <= y_max AND z_min < z_max),
-    CONSTRAINT machine_safe_name CHECK (safe_name('machine', name))
+    CONSTRAINT machine_safe_name CHECK (safe_name('machine', name)),
+    CONSTRAINT machine_load_position CHECK ((load_x IS NULL) = (load_z IS NULL))
 );
 
 -- Hob library.
@@ -176,6 +195,7 @@ CREATE TABLE hob (
     coating        text NOT NULL DEFAULT '',
     -- A worm-wheel hob is made for its worm; it never cuts cylindrical gears, nor the reverse.
     purpose        text NOT NULL DEFAULT 'cylindrical' CHECK (purpose IN ('cylindrical', 'worm_wheel')),
+    tool_number    integer NOT NULL DEFAULT 1 CHECK (tool_number BETWEEN 1 AND 32000),  -- T<n> D1 (migration 0013)
     CONSTRAINT hob_safe_id CHECK (safe_name('hob', id))
 );
 -- One hob per id whatever its case (migration 0011): H-M2-AA-R1 and h-m2-aa-r1 are one hob.

@@ -63,6 +63,7 @@ def _seed_classes(conn, directory: Path, report: SeedReport) -> None:
 def _insert_missing(conn, table: str, key: str, rows: list[dict]) -> int:
     added = 0
     for row in rows:
+        row = {column: value for column, value in row.items() if value is not None}   # empty: the default
         query = sql.SQL("INSERT INTO {} ({}) VALUES ({}) ON CONFLICT ({}) DO NOTHING RETURNING 1").format(
             sql.Identifier(table), sql.SQL(", ").join(map(sql.Identifier, row)),
             sql.SQL(", ").join(sql.Placeholder() * len(row)), sql.Identifier(key))

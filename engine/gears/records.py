@@ -56,6 +56,7 @@ class Hob:
     material: str
     coating: str
     purpose: str
+    tool_number: int = 1
 
 
 @dataclass(frozen=True)
@@ -72,6 +73,23 @@ class Machine:
     spindle_max: float
     table_speed_max: float | None
     module_max: float | None
+    # Conventions and setup (migration 0013): each axis's sense relative to DIN 66217.
+    a_direction: int = 1
+    b_direction: int = 1
+    c_direction: int = 1
+    y_direction: int = 1
+    z_direction: int = 1
+    work_offset: str = "G54"
+    fixture_diameter: float = 0.0
+    fixture_gap: float = 0.0
+    tailstock_diameter: float = 0.0
+    tailstock_gap: float = 0.0
+    load_x: float | None = None
+    load_z: float | None = None
+    rapid_rate: float = 5000.0
+    orient_before_coupling: bool = False
+    door_close_m: int | None = None
+    door_open_m: int | None = None
 
 
 def reference_diameter(module: Any, teeth: int, helix_angle: Any = 0) -> Any:
