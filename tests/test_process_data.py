@@ -200,3 +200,19 @@ def test_cli_allowance_is_a_choice_of_a_new_job(run):
     assert made.exit_code == 0, made.output
     again = run("instantiate", "--job", json.loads(made.stdout)["job_id"], "--allowance", "1")
     assert again.exit_code == 1 and "--allowance applies to a new job" in again.stderr
+
+
+# --- feeds edited into a stored job ---------------------------------------------------------
+
+def test_a_stored_job_whose_feed_was_edited_beyond_the_table_is_made_with_a_warning(conn):
+    from engine.programs.remake import instantiate_job
+
+    job_id = instantiate_gear(conn, 42).job_id     # m2, 1-start hob, z 19, single cut
+    params = conn.execute("SELECT params FROM job WHERE id = %s", (job_id,)).fetchone()[0]
+    table_speed = params["n0"] * 1 / 19             # §B5: n2 = n0·z0/z2
+    assert not instantiate_job(conn, job_id).notes  # as the engine made it: within the table
+    conn.execute("UPDATE job SET module_params = jsonb_set(module_params, '{cutmotion:2,feed_axial}', '105') "
+                 "WHERE id = %s", (job_id,))
+    notes = instantiate_job(conn, job_id).notes
+    assert len(notes) == 1 and f"{105 / table_speed:.2f} mm per workpiece rev is above the 3.00" in notes[0]
+    assert notes[0].startswith(f"job {job_id}: rough:")

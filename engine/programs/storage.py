@@ -64,7 +64,8 @@ def store_programs(conn, encoded: list[Encoded], job_ids: list[int], out=None) -
     with conn.transaction():
         program_ids = _next_ids(conn, "program_id_seq", len(encoded))
         _copy_programs(conn, program_ids, job_ids, encoded)
-    return Batch(len(encoded), sum(len(item.lines) for item in encoded), min(program_ids), max(program_ids), out)
+    return Batch(len(encoded), sum(len(item.lines) for item in encoded), min(program_ids), max(program_ids), out,
+                 tuple(f"{item.name}: {note}" for item in encoded for note in item.notes))
 
 
 def refuse_unsafe(name: str, lines: list[str]) -> None:
