@@ -187,7 +187,8 @@ def load_gears(conn, first: int | None = None, last: int | None = None) -> list[
 def _completed(gear: Gear) -> Gear:
     """The module as the normal module; a gear written in SQL without its diameters gets them as
     a CSV import computes them."""
-    gear = replace(gear, module=normal_module(gear.module, gear.module_kind, gear.helix_angle))
+    if gear.module_kind == "axial":
+        gear = replace(gear, module=normal_module(gear.module, gear.module_kind, gear.helix_angle))
     if gear.tip_diameter is not None and gear.root_diameter is not None:
         return gear
     tip, root = derived_diameters(gear.module, gear.teeth, gear.helix_angle, gear.tip_diameter, gear.root_diameter)
