@@ -72,9 +72,10 @@ HOB_COLUMNS: tuple[Column, ...] = (
     Column("material", parse_text),
     Column("coating", parse_text),
     Column("purpose", parse_purpose),
+    Column("tool_number", parse_positive_whole),   # the program's T<tool_number> D1 (migration 0013)
 )
 COLUMN_NAMES = tuple(column.name for column in HOB_COLUMNS)
-DEFAULTS = {"material": "HSS", "coating": "", "purpose": "cylindrical"}
+DEFAULTS = {"material": "HSS", "coating": "", "purpose": "cylindrical", "tool_number": 1}
 assert COLUMN_NAMES == tuple(field.name for field in fields(Hob)), "HOB_COLUMNS must follow records.Hob"
 
 
