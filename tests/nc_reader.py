@@ -6,7 +6,8 @@ the engine they check. It understands the subset the hobbing templates write:
 * blocks with an optional `N…` number and a `;` comment;
 * G codes (G0/G1 are the modal motion group; G25/G26 with axis words set working-area
   limits and are no motion);
-* axis words X/Y/Z/A/B/C as `X12.5` or `A=-1.763`, S, F (modal), M codes (`M3`, also `M1=3`);
+* axis words X/Y/Z/A/B/C as `X12.5` or `A=-1.763`, S, F (modal), the tool call T and its edge D,
+  the spindle orientation `SPOS=0`, M codes (`M3`, also `M1=3`);
 * calls `NAME(arg, …)` such as `EGDEF(C,B,1,Z,1)`, `EGON(C,"FINE",B,-1,19)`, `EGOFS(C)`,
   whose arguments are kept as written (quotes removed from strings);
 * bare keywords (`WALIMON`, `WALIMOF`, …);
@@ -167,7 +168,7 @@ def _parse_block(index: int, line_no: int, line: str) -> Block | None:
             block.calls.append(Call(match["call"], _split_args(code[start:end])))
         elif match["eq"]:
             name, value = match["eq"], match["eqval"]
-            if name in AXES or name in ("S", "F"):
+            if name in AXES or name in ("S", "F", "SPOS"):
                 block.words[name] = float(value)
                 block.raw[name] = value
             elif re.fullmatch(r"M\d+", name):      # M1=3: M code 3 for spindle 1
@@ -185,7 +186,7 @@ def _parse_block(index: int, line_no: int, line: str) -> Block | None:
                 block.m.append(int(float(value)))
             elif address == "N":
                 block.number = int(float(value))
-            elif address in AXES or address in ("S", "F"):
+            elif address in AXES or address in ("S", "F", "T", "D"):
                 block.words[address] = float(value)
                 block.raw[address] = value
             else:

@@ -95,7 +95,7 @@ def test_the_papers_example_reproduced(conn):
     infeed = next(m for m in cutting_moves(nc) if m.changed == {"X"})
     assert infeed.feed == PAPER_RADIAL_BOUNDED
     assert nc.index("M8") is not None and nc.index("M20") is not None   # coolant on, tailstock clamp
-    assert not any("Y" in m.changed for m in nc.moves)                    # no shift
+    assert all(m.end["Y"] == 0 for m in nc.moves if "Y" in m.changed)   # no shift: Y at the hob centre
     job = conn.execute("SELECT cutting FROM job WHERE id = %s", (program.job_id,)).fetchone()[0]
     assert job["hob_speed"] == 246 and job["rough"] == {"axial_feed": PAPER_AXIAL_BOUNDED,
                                                         "radial_feed": PAPER_RADIAL_BOUNDED}
@@ -136,9 +136,10 @@ def test_crowning_is_a_symmetric_parabola_deepest_at_the_faces(conn):
 def test_worm_wheel_plunges_radially_without_z(conn):
     program, nc = program_of(conn, 53)
     g, hob = gear(conn, 53), hob_of(conn, program)
-    z_values = {m.end["Z"] for m in nc.moves}
+    coupled = [m for m in nc.moves if m.block < nc.index("EGOFS")]   # then it leaves for the load position
+    z_values = {m.end["Z"] for m in coupled}
     assert z_values == {-g["b"] / 2}, "the hob stays in the wheel's mid-plane"
-    assert all("Z" not in m.changed for m in nc.moves if m.start["Z"] is not None)
+    assert all("Z" not in m.changed for m in coupled if m.start["Z"] is not None)
     plunge = [m for m in cutting_moves(nc) if m.changed == {"X"}]
     assert abs(plunge[-1].end["X"] - (g["df2"] + hob["da0"]) / 2) < 0.01
     assert nc.block_with("A").words["A"] == 0                          # shaft angle 90°
@@ -152,7 +153,7 @@ def test_worm_wheel_tangential_feed_along_y_with_the_table_coupled(conn):
     program, nc = program_of(conn, 53, worm_feed="tangential")
     g, hob = gear(conn, 53), hob_of(conn, program)
     full_depth = (g["df2"] + hob["da0"]) / 2
-    assert all("Z" not in m.changed for m in nc.moves if m.start["Z"] is not None)
+    assert all("Z" not in m.changed for m in nc.moves if m.start["Z"] is not None and m.block < nc.index("EGOFS"))
     tangential = [m for m in cutting_moves(nc) if m.changed == {"Y"}]
     assert len(tangential) == 1
     move = tangential[0]
@@ -218,7 +219,8 @@ def test_helical_differential_has_the_hands_sign_in_either_feed_mode(conn, gear_
     g = gear(conn, gear_id)
     size = 360 * math.sin(math.radians(g["beta"])) / (math.pi * g["mn"] * g["z2"])   # §B9
     egon = nc.block_with("EGON").call("EGON").args
-    assert egon[5] == "Z" and abs(float(egon[6]) - (size if g["hand"] == "R" else -size)) < 1e-6
+    # §A7 on the DIN 66217 hobber: k_Z = −h_gear·size, whatever the feed direction
+    assert egon[5] == "Z" and abs(float(egon[6]) - (-size if g["hand"] == "R" else size)) < 1e-6
 
 
 def test_conventional_enters_below_the_blank_and_feeds_up(conn):

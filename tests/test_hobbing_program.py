@@ -99,12 +99,11 @@ class Case:
         return self.gear["beta"] + gamma
 
     def differential(self) -> float:
-        """§A5/§B9: 360·sin β/(π·mn·z2) degrees of C per mm of Z. Sign: the seeded helical
-        template's convention is + for a right-hand gear and − for a left-hand gear (climb
-        hobbing, the default choice)."""
+        """§A7/§B9: k_Z = −h_gear·360·sin β/(π·mn·z2) degrees of C per mm of Z on a DIN 66217
+        machine (the seeded hobber): negative for a right-hand gear, positive for a left-hand one."""
         beta = math.radians(self.gear["beta"])
         size = 360 * math.sin(beta) / (math.pi * self.gear["mn"] * self.gear["z2"])
-        return size if self.gear["hand"] == "R" else -size
+        return -size if self.gear["hand"] == "R" else size
 
     def tip_contact_distance(self) -> float:
         """Centre distance at which the hob tip touches the gear tip: (d_a2 + d_a0)/2."""
@@ -139,7 +138,8 @@ class Case:
         return self.nc.moves_in("G1")
 
     def cuts(self) -> list[dict]:
-        """Each cut as its four moves: G0 Z approach → G1 X infeed → G1 Z pass → G0 X retract."""
+        """Each cut as its five moves: G0 Z approach → G0 X to just outside the cut (the infeed
+        is in air) → G1 X infeed → G1 Z pass → G0 X retract."""
         moves = self.nc.moves
         found = []
         covered = set()
@@ -149,11 +149,13 @@ class Case:
             text = self.block(move.block).text
             assert set(self.block(move.block).axes) == {"X"}, \
                 f"gear {self.gear['id']}: first G1 of a cut must be the X infeed alone, got {text!r}"
-            assert 1 <= k and k + 2 < len(moves), f"gear {self.gear['id']}: incomplete cut around {text!r}"
-            approach, infeed, cross, retract = moves[k - 1], move, moves[k + 1], moves[k + 2]
-            a_block, p_block, r_block = (self.block(m.block) for m in (approach, cross, retract))
+            assert 2 <= k and k + 2 < len(moves), f"gear {self.gear['id']}: incomplete cut around {text!r}"
+            approach, air, infeed, cross, retract = moves[k - 2], moves[k - 1], move, moves[k + 1], moves[k + 2]
+            a_block, air_block, p_block, r_block = (self.block(m.block) for m in (approach, air, cross, retract))
             assert approach.mode == "G0" and set(a_block.axes) == {"Z"}, \
                 f"gear {self.gear['id']}: infeed {text!r} not preceded by a G0 Z approach but {a_block.text!r}"
+            assert air.mode == "G0" and set(air_block.axes) == {"X"} and air.end["X"] > move.end["X"], \
+                f"gear {self.gear['id']}: infeed {text!r} not preceded by a G0 X outside the cut but {air_block.text!r}"
             assert cross.mode == "G1" and "Z" in p_block.axes and set(p_block.axes) <= {"X", "Z"}, \
                 f"gear {self.gear['id']}: infeed {text!r} not followed by a G1 Z pass but {p_block.text!r}"
             assert retract.mode == "G0" and set(r_block.axes) == {"X"}, \
@@ -341,10 +343,10 @@ def test_spindle_and_coolant_around_the_cuts(case, gear_id):
     assert m3.index < first_g1
     assert c.first("M8") < first_g1
 
-    m9, egofs, m5 = c.first("M9"), c.first("EGOFS"), c.first("M5")
-    assert last_g1 < m9 < egofs < m5, (last_g1, m9, egofs, m5)
+    m9, egofs, egdel, m5 = c.first("M9"), c.first("EGOFS"), c.first("EGDEL"), c.first("M5")
+    assert last_g1 < m9 < egofs < egdel < m5, (last_g1, m9, egofs, egdel, m5)
     assert last_retract < m9, "stop only after the hob is retracted from the last cut"
-    assert c.block(egofs).call("EGOFS").args == ("C",)
+    assert c.block(egofs).call("EGOFS").args == ("C",) and c.block(egdel).call("EGDEL").args == ("C",)
 
 
 @pytest.mark.parametrize("gear_id", GEARS)
@@ -444,7 +446,7 @@ def test_programs_of_different_gears_differ_where_they_must(case):
     assert len(set(last_x.values())) == len(GEARS), last_x
     assert len({c.lines[0] for c in cases.values()}) == len(GEARS)
     factors = {g: c.block(c.first("EGON")).call("EGON").args[6] for g, c in cases.items() if g in HELICAL}
-    assert float(factors[43]) > 0 > float(factors[44])
+    assert float(factors[43]) < 0 < float(factors[44])   # gear 43 right hand, 44 left hand (§A7)
     assert abs(float(factors[43])) != pytest.approx(abs(float(factors[44])))
 
 

@@ -25,7 +25,7 @@ GOLDEN = Path(__file__).resolve().parent / "golden"
 # A hobbing prelude: the working area X 50…62, Y −30…30, Z −25…20 (inside hobber-840d's travel
 # X 20…320, Y −80…80, Z −350…150, seed_templates/machines.csv).
 AREA = {"X": (50.0, 62.0), "Y": (-30.0, 30.0), "Z": (-25.0, 20.0)}
-HOBBING = ["%_N_TEST_MPF", ";$PATH=/_N_MPF_DIR", "; GEAR 42", "G90 G71 G94",
+HOBBING = ["%_N_TEST_MPF", ";$PATH=/_N_MPF_DIR", "; GEAR 42", "G90 G71 G94 G54",
            "G25 X50.000 Y-30.000 Z-25.000", "G26 X62.000 Y30.000 Z20.000", "WALIMON"]
 LATHE_840D = ["%_N_TEST_MPF", ";$PATH=/_N_MPF_DIR", "; DRAWING part.dxf", "G18 G71 G90 G40 DIAMON"]
 LATHE_ISO = ["%", "O0001 (TEST)", "(DRAWING part.dxf)", "G21 G18 G40 G90"]
@@ -33,10 +33,11 @@ PRELUDES = {"hobber-840d": HOBBING, "lathe-840d": LATHE_840D, "lathe-iso": LATHE
 # What a cut needs (engine.programs.verifier.machine_state): the table coupled and the hob
 # turning (S246/19 = 12.9 r/min of C, below hobber-840d's 120); a tool with its offset, the
 # spindle turning, the feed mode stated.
-READY = {"hobber-840d": ["EGDEF(C,B,1)", 'EGON(C,"FINE",B,-1,19)', "M3 S246"],
+READY = {"hobber-840d": ["G0 Y0.000", "EGDEF(C,B,1)", 'EGON(C,"FINE",B,-1,19)', "M3 S246"],
          "lathe-840d": ["T1 D1", "G97 S500 M3", "G94 F100"],
          "lathe-iso": ["T0101", "G97 S500 M03", "G98 F100."]}
-ENDINGS = {"hobber-840d": ["M30"], "lathe-840d": ["M30"], "lathe-iso": ["M30", "%"]}
+# A hobbing program ends with the coupling off and deleted (reference §A7).
+ENDINGS = {"hobber-840d": ["EGOFS(C)", "EGDEL(C)", "M30"], "lathe-840d": ["M30"], "lathe-iso": ["M30", "%"]}
 
 
 def program(machine: str, body: list[str], ready: bool = True) -> list[str]:
@@ -112,7 +113,7 @@ def test_the_prelude_with_a_plain_move_inside_the_machine_is_accepted(conn):
     ("G1 Z-inf F100", r"Z-inf: inf/nan"),
     ("G0 X=$AA_IM[X]", r"an indirect address|an R-parameter or system variable"),
     ("G91 G0 X1", r"incremental G91"),
-    ("G54", r"G54 shifts every position by a work offset"),
+    ("G58", r"G58 shifts every position by a work offset"),
     ("WALIMOF", r"WALIMOF: not a word of the 840D hobbing grammar"),
     ("GOTOF END", r"GOTOF: not a word"),
     ("X55.000", r"a move without its G0/G1"),
@@ -251,7 +252,7 @@ def test_the_spindle_and_the_table_are_bounded_by_the_machine_record(conn):
     teeth = 5
     fastest = machine.table_speed_max * teeth      # S at which C turns at the table's maximum
     assert fastest < machine.spindle_max
-    coupled = ["EGDEF(C,B,1)", f'EGON(C,"FINE",B,-1,{teeth})']
+    coupled = ["G0 Y0.000", "EGDEF(C,B,1)", f'EGON(C,"FINE",B,-1,{teeth})']
     assert accepted(conn, "hobber-840d", program("hobber-840d", coupled + [f"M3 S{fastest:g}"], ready=False))
     assert "above hobber-840d's 120 r/min" in \
         refusal(conn, "hobber-840d", program("hobber-840d", coupled + [f"M3 S{fastest + 5:g}"], ready=False))

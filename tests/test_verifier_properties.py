@@ -48,9 +48,9 @@ def machines() -> dict[str, Machine]:
 MACHINES = machines()
 DIALECTS = {   # name -> prelude (ready to cut: S·z0/z2 = 100/40 r/min of C), axes, motion codes, whether
                # 840D (`=` forms, `;` comments, no decimal point needed), speed block
-    "hobber-840d": ([f"%_N_{NAME}_MPF", ";$PATH=/_N_MPF_DIR", "G90 G71 G94",
+    "hobber-840d": ([f"%_N_{NAME}_MPF", ";$PATH=/_N_MPF_DIR", "G90 G71 G94 G54",
                      "G25 X{X[0]:.3f} Y{Y[0]:.3f} Z{Z[0]:.3f}".format(**AREA),
-                     "G26 X{X[1]:.3f} Y{Y[1]:.3f} Z{Z[1]:.3f}".format(**AREA), "WALIMON",
+                     "G26 X{X[1]:.3f} Y{Y[1]:.3f} Z{Z[1]:.3f}".format(**AREA), "WALIMON", "G0 Y0.000",
                      "EGDEF(C,B,1)", 'EGON(C,"FINE",B,-1,40)', "M3 S100"],
                     ("X", "Y", "Z"), ("G0", "G1"), True, "M3 S{}"),
     "lathe-840d": ([f"%_N_{NAME}_MPF", ";$PATH=/_N_MPF_DIR", "G18 G71 G90 G40 DIAMON", "T1 D1", "G97 S100 M3",
@@ -59,7 +59,7 @@ DIALECTS = {   # name -> prelude (ready to cut: S·z0/z2 = 100/40 r/min of C), a
     "lathe-iso": (["%", f"O0001 ({NAME})", "G21 G18 G40 G90", "T0101", "G97 S100 M03", "G98 F100."],
                   ("X", "Z"), ("G00", "G01"), False, "G97 S{} M03"),
 }
-ENDINGS = {"hobber-840d": ["M30"], "lathe-840d": ["M30"], "lathe-iso": ["M30", "%"]}
+ENDINGS = {"hobber-840d": ["EGOFS(C)", "EGDEL(C)", "M30"], "lathe-840d": ["M30"], "lathe-iso": ["M30", "%"]}
 PLAIN = ("plain", "plain one decimal", "plain whole", "plain trailing point", "equals")
 NOT_PLAIN = ("expression", "r-parameter", "exponent", "inf/nan", "ic/ac", "indirect")
 CONTROL = ["\n", "\r", "\x00", "\x7f", "\t", "\x1b", "é", "\u2028", "\x85"]
@@ -210,7 +210,7 @@ HOB_EVENTS = ("M3 S246", "M5", 'EGON(C,"FINE",B,-1,19)', "EGOFS(C)", "G0 X55.000
 def test_a_hob_cut_is_accepted_exactly_when_the_spindle_turns_and_the_table_is_coupled(events):
     """The test's own reading: the spindle turns after an M3 S with no M5 since; the table is
     coupled after an EGON with no EGOFS since."""
-    prelude = DIALECTS["hobber-840d"][0][:6] + ["EGDEF(C,B,1)"]
+    prelude = DIALECTS["hobber-840d"][0][:7] + ["EGDEF(C,B,1)"]
     def last(*lines):
         return next((event for event in reversed(events) if event in lines), None)
     accepted = last("M3 S246", "M5") == "M3 S246" and last(HOB_EVENTS[2], "EGOFS(C)") == HOB_EVENTS[2]
@@ -251,7 +251,7 @@ def test_the_table_is_accepted_exactly_when_its_speed_with_the_z_term_is_within_
     k, v = float(f"{factor:.6f}"), float(f"{feed:.1f}")
     table = speed / teeth + k * v / 360.0                    # reference §A5, k in °/mm, v in mm/min
     assume(abs(table - machine.table_speed_max) > 1e-6 and abs(speed / teeth - machine.table_speed_max) > 1e-6)
-    lines = (DIALECTS["hobber-840d"][0][:6] + ["EGDEF(C,B,1,Z,1)", f'EGON(C,"FINE",B,-1,{teeth},Z,{k:.6f},1)',
+    lines = (DIALECTS["hobber-840d"][0][:7] + ["EGDEF(C,B,1,Z,1)", f'EGON(C,"FINE",B,-1,{teeth},Z,{k:.6f},1)',
                                                 f"M3 S{speed}", f"G1 Z10.000 F{v:.1f}"] + ENDINGS["hobber-840d"])
     accepted = 0 < v and k <= MAX_DIFFERENTIAL and table <= machine.table_speed_max
     assert verdict(machine, lines) == accepted, lines

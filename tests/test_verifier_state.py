@@ -30,7 +30,8 @@ CUT = "G1 Z10.000 F100.0"
 
 
 def hobbing(body: list[str]) -> list[str]:
-    return program("hobber-840d", body, ready=False)
+    """A hobbing program of `body`, with Y positioned first (EGON needs it, reference §A7)."""
+    return program("hobber-840d", ["G0 Y0.000", *body], ready=False)
 
 
 # ---------------------------------------------------------------- 1. numbers of any size

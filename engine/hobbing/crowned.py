@@ -15,6 +15,7 @@ MAX_CROWNING = 0.2   # mm of flank crowning C_β; more is not crowning but a dif
 class CrownedModel(CylindricalModel):
     class_parameters = frozenset({"crowning", "crown_depth", "z_mid"})
     cut_parameters = CylindricalModel.cut_parameters | {"face_from", "face_to"}
+    cut_shape = "crowned"
 
     def class_params(self, gear, hob, setup, choices) -> dict:
         if not gear.crowning or not 0 < gear.crowning <= MAX_CROWNING:
@@ -27,6 +28,7 @@ class CrownedModel(CylindricalModel):
         params = super().cut_params(cut, gear, hob, cutting, setup)
         top, bottom = 0.0, -gear.face_width
         params["face_from"], params["face_to"] = (top, bottom) if cut.climb else (bottom, top)
+        params["x_air"] = round(params["x_air"] - crown_depth(gear), 3)   # the infeed goes to the face depth
         return params
 
     def extents(self, gear, setup, cuts):

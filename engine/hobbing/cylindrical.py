@@ -6,11 +6,16 @@ from dataclasses import dataclass
 
 from ..gears.cutting_data import CuttingData
 from ..gears.records import Gear, Hob, Machine
-from . import geometry, shifting
+from . import conventions, geometry, shifting
 from .choices import Choices
+from .machine_job import SETUP_PARAMETERS, machine_job
 from .passes import Cut, Reach, feeds, hob_reach, pass_ends, plan_cuts, working_area
 
 RETRACT_CLEARANCE = 5.0   # mm between hob tip and gear tip when retracted
+# The infeed at the approach Z is in air: rapid to this far outside the cut's centre distance,
+# then feed. The run-in clears the blank at the cut's own X, so any X beyond it is clear too;
+# the millimetre absorbs the rapid's following error before the feed takes over.
+RAPID_SHORT_OF_CUT = 1.0
 
 
 @dataclass(frozen=True)
@@ -24,11 +29,10 @@ JOB_PARAMETERS = frozenset({
     "hob_id", "z0", "da0", "hob_hand", "machine", "n0", "cuts", "coolant", "tailstock", "feed_mode",
     "swivel", "lead_angle", "x_retract", "z_start", "z_end", "x_lower", "x_upper", "y_lower", "y_upper",
     "z_lower", "z_upper", "shift_on", "shift_y", "shift_per_part", "shift_min", "shift_max",
-    "template_version",
-    "allowance",
-})
+    "template_version", "coupling_b", "differential", "allowance",
+}) | SETUP_PARAMETERS
 CUT_PARAMETERS = frozenset({"cut_name", "cut_x", "feed_radial", "feed_axial", "cut_on", "climb",
-                            "z_from", "z_to"})
+                            "z_from", "z_to", "x_air"})
 
 
 @dataclass(frozen=True)
@@ -45,6 +49,7 @@ class CylindricalModel:
     """Spur and helical gears: radial infeed in air, axial pass with overrun, per cut."""
 
     hob_purpose = "cylindrical"
+    cut_shape = "axial"       # the pass its template emits (engine.hobbing.cycle_time.PASSES)
     class_parameters: frozenset = frozenset()
     cut_parameters: frozenset = CUT_PARAMETERS
 
@@ -58,7 +63,7 @@ class CylindricalModel:
 
     def setup(self, gear: Gear, hob: Hob) -> Setup:
         lead = geometry.lead_angle(hob.module, hob.starts, hob.tip_diameter)
-        swivel = geometry.swivel_angle(gear.helix_angle, gear.hand, lead, hob.hand)
+        swivel = conventions.swivel(gear.helix_angle, gear.hand, lead, hob.hand)
         full_depth = geometry.full_depth_centre_distance(gear.root_diameter, hob.tip_diameter)
         reach = hob_reach(gear, hob.tip_diameter, swivel, full_depth)
         x_retract = (gear.tip_diameter + hob.tip_diameter) / 2 + RETRACT_CLEARANCE
@@ -75,7 +80,11 @@ class CylindricalModel:
                   **shift, **self.class_params(gear, hob, setup, choices)}
         xs, zs = self.extents(gear, setup, [module_params[f"cutmotion:{cut.number}"] for cut in cuts if cut.on])
         params.update(working_area(xs, shifting.y_positions(shift), zs + [params["z_start"]]))
-        return JobParameters(params, module_params)
+        return self.for_machine(params, module_params, machine, hob)
+
+    def for_machine(self, params: dict, module_params: dict, machine: Machine, hob: Hob) -> JobParameters:
+        """The DIN-frame job in the machine's senses, with its setup and cycle time."""
+        return JobParameters(*machine_job(params, module_params, machine, hob, self.cut_shape))
 
     @staticmethod
     def base_params(gear, gear_class, hob, machine, cutting, choices, setup) -> dict:
@@ -86,7 +95,9 @@ class CylindricalModel:
             "hob_id": hob.id, "z0": hob.starts, "da0": hob.tip_diameter, "hob_hand": hob.hand,
             "machine": machine.name, "n0": cutting.hob_speed, "cuts": choices.cut_count(gear.module),
             "coolant": choices.coolant, "tailstock": choices.tailstock, "feed_mode": choices.feed_mode,
-            "swivel": round(setup.swivel, 4), "lead_angle": round(setup.lead, 4),
+            "swivel": round(setup.swivel, 6), "lead_angle": round(setup.lead, 4),
+            "coupling_b": conventions.coupling_numerator(hob.starts, hob.hand),
+            "differential": round(conventions.differential(gear.module, gear.teeth, gear.helix_angle, gear.hand), 6),
             "x_retract": round(setup.x_retract, 3),
             "z_start": round(setup.reach.approach, 3),
             "z_end": round(-gear.face_width - setup.reach.overrun, 3),
@@ -99,6 +110,7 @@ class CylindricalModel:
     def cut_params(self, cut: Cut, gear: Gear, hob: Hob, cutting: CuttingData, setup: Setup) -> dict:
         z_from, z_to = pass_ends(setup.reach, 0.0, -gear.face_width, cut.climb)
         return {"cut_name": cut.name, "cut_x": round(cut.centre_distance, 3), "cut_on": cut.on,
+                "x_air": round(cut.centre_distance + RAPID_SHORT_OF_CUT, 3),
                 "climb": cut.climb, "z_from": round(z_from, 3), "z_to": round(z_to, 3),
                 **feeds(cut, cutting, hob.starts, gear.teeth)}
 

@@ -42,7 +42,7 @@ class DuplexModel(CylindricalModel):
         xs = [x_retract] + [cut["cut_x"] for _, _, cuts in passes for cut in cuts]
         zs = [z for _, _, cuts in passes for cut in cuts for z in (cut["z_from"], cut["z_to"])]
         params.update(working_area(xs, shifting.y_positions(params), zs + [params["z_start"]]))
-        return JobParameters(params, module_params)
+        return self.for_machine(params, module_params, machine, hob)
 
     def _unit_cuts(self, number, unit, hob, cutting, choices, setup) -> dict:
         cuts = {}

@@ -1,4 +1,5 @@
-"""Hobbing geometry (reference/hobbing.md §B). Lengths in mm, angles in degrees."""
+"""Hobbing geometry (reference/hobbing.md §B). Lengths in mm, angles in degrees. The signed
+quantities (swivel, coupling factors) are engine.hobbing.conventions."""
 from __future__ import annotations
 
 import math
@@ -29,17 +30,6 @@ def generating_length(module: float, pressure_angle: float) -> float:
     return 2 * depth / math.tan(math.radians(pressure_angle)) + math.pi * module
 
 
-def signed(angle: float, hand: str | None) -> float:
-    """Right hand positive, left hand negative."""
-    return -angle if hand == "L" else angle
-
-
-def swivel_angle(helix_angle: float, gear_hand: str | None, lead: float, hob_hand: str) -> float:
-    """η = β − γ for the same hand, β + γ for opposite hands, γ for spur gears (§B2);
-    signed: right-hand helix positive. The sign on the A axis is the machine's."""
-    return signed(helix_angle, gear_hand) - signed(lead, hob_hand)
-
-
 def full_depth_centre_distance(root_diameter: float, hob_tip_diameter: float) -> float:
     """a = (d_f2 + d_a0)/2 (§B3)."""
     return (root_diameter + hob_tip_diameter) / 2
@@ -67,10 +57,3 @@ def overrun_length(module: float, depth: float, pressure_angle: float, swivel: f
     base = max(2.0, 1.5 * module)
     extra = depth / math.tan(math.radians(pressure_angle)) * math.sin(math.radians(abs(swivel)))
     return base + extra
-
-
-def differential_factor(module: float, teeth: int, helix_angle: float, gear_hand: str | None) -> float:
-    """Extra table rotation in degrees of C per mm of Z: ±360·sin β/(π·m_n·z2) (§B9),
-    positive for a right-hand helix."""
-    magnitude = 360 * math.sin(math.radians(helix_angle)) / (math.pi * module * teeth)
-    return signed(magnitude, gear_hand)

@@ -12,7 +12,8 @@ MAX_CONE_ANGLE = 15.0   # degrees: beyond a small taper the hob's generating geo
 
 
 class TaperModel(CylindricalModel):
-    class_parameters = frozenset({"cone_angle"})
+    class_parameters = frozenset({"cone_angle", "taper_slope"})
+    cut_shape = "taper"
 
     def setup(self, gear, hob) -> Setup:
         if not gear.cone_angle or abs(gear.cone_angle) > MAX_CONE_ANGLE:
@@ -27,7 +28,14 @@ class TaperModel(CylindricalModel):
                      max(setup.x_retract, highest + RETRACT_CLEARANCE))
 
     def class_params(self, gear, hob, setup, choices) -> dict:
-        return {"cone_angle": gear.cone_angle}
+        """taper_slope = dX/dZ = tan δ, turned with Z on the machine (engine.hobbing.conventions)."""
+        return {"cone_angle": gear.cone_angle, "taper_slope": round(math.tan(math.radians(gear.cone_angle)), 9)}
+
+    def cut_params(self, cut, gear, hob, cutting, setup) -> dict:
+        """The infeed stops short of the cone line at the approach Z, not of X(0)."""
+        params = super().cut_params(cut, gear, hob, cutting, setup)
+        params["x_air"] = round(params["x_air"] + params["z_from"] * math.tan(math.radians(gear.cone_angle)), 3)
+        return params
 
     def extents(self, gear, setup, cuts):
         xs, zs = super().extents(gear, setup, cuts)

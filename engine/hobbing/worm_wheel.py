@@ -10,8 +10,8 @@ from dataclasses import replace
 
 from ..errors import EngineError
 from ..gears.cutting_data import per_minute
-from . import geometry
-from .cylindrical import CylindricalModel, JobParameters, Setup
+from . import conventions
+from .cylindrical import RAPID_SHORT_OF_CUT, CylindricalModel, JobParameters, Setup
 from .passes import APPROACH_SAFETY, feeds, plan_cuts, working_area
 
 DWELL_TABLE_TURNS = 2.0   # table revolutions at full depth after a radial plunge (enveloping cuts)
@@ -20,7 +20,9 @@ DWELL_TABLE_TURNS = 2.0   # table revolutions at full depth after a radial plung
 class WormWheelModel(CylindricalModel):
     hob_purpose = "worm_wheel"
     class_parameters = frozenset({"z_mid", "tangential", "y_start", "y_end", "tangential_factor"})
-    cut_parameters = frozenset({"cut_name", "cut_x", "cut_on", "feed_radial", "dwell", "feed_tangential"})
+    cut_parameters = frozenset({"cut_name", "cut_x", "cut_on", "feed_radial", "dwell", "feed_tangential",
+                                "x_air"})
+    cut_shape = "worm"
 
     def shift_travel(self, choices) -> float:
         return 0.0   # a worm-wheel hob is not shifted; the tangential pass uses its whole length
@@ -37,6 +39,7 @@ class WormWheelModel(CylindricalModel):
         table_speed = cutting.hob_speed * hob.starts / gear.teeth
         module_params = {f"cutmotion:{cut.number}": {
             "cut_name": cut.name, "cut_x": round(cut.centre_distance, 3), "cut_on": cut.on,
+            "x_air": round(air_position(gear, hob, tangential, cut.centre_distance), 3),
             "dwell": round(DWELL_TABLE_TURNS * 60 / table_speed, 1),
             "feed_radial": feeds(cut, cutting, hob.starts, gear.teeth)["feed_radial"],
             "feed_tangential": round(per_minute(cutting.axial_feed_rough, cutting.hob_speed, hob.starts,
@@ -46,10 +49,10 @@ class WormWheelModel(CylindricalModel):
                   "shift_on": False, "shift_y": 0.0, "shift_per_part": 0.0, "shift_min": 0.0, "shift_max": 0.0,
                   "z_mid": round(-gear.face_width / 2, 3), "tangential": tangential,
                   "y_start": y_clear, "y_end": -y_clear,
-                  "tangential_factor": round(tangential_factor(gear, hob, setup.lead), 6)}
+                  "tangential_factor": round(conventions.tangential_factor(gear.module, gear.teeth, setup.lead), 6)}
         xs = [setup.x_retract] + [cut["cut_x"] for cut in module_params.values() if cut["cut_on"]]
         params.update(working_area(xs, [0.0, y_clear, -y_clear], [params["z_mid"]]))
-        return JobParameters(params, module_params)
+        return self.for_machine(params, module_params, machine, hob)
 
 
 def check_module_stated(gear) -> None:
@@ -69,8 +72,10 @@ def tangential_clearance(gear, hob, centre_distance: float) -> float:
     return reach + hob.length / 2 + APPROACH_SAFETY
 
 
-def tangential_factor(gear, hob, lead: float) -> float:
-    """Extra table rotation per mm of Y, degrees: 360·cos γ/(π·m_n·z2) (§A5); positive for
-    a right-hand hob (check the sign on the machine with a dry run)."""
-    size = 360 * math.cos(math.radians(lead)) / (math.pi * gear.module * gear.teeth)
-    return geometry.signed(size, hob.hand)
+def air_position(gear, hob, tangential: bool, centre_distance: float) -> float:
+    """Where the rapid approach ends. Radial: the hob tip just outside the wheel's tip in the
+    mid-plane, (d_a2 + d_a0)/2 plus the rapid's margin; the plunge from there is all cut.
+    Tangential: the hob stands beside the wheel in Y, so the whole infeed is in air."""
+    if tangential:
+        return centre_distance + RAPID_SHORT_OF_CUT
+    return (gear.tip_diameter + hob.tip_diameter) / 2 + RAPID_SHORT_OF_CUT

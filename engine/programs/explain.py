@@ -2,8 +2,8 @@
 (engine.templates.trace) read back, one sentence per template row.
 
     1800 not emitted: p_emit coolant = False (job)
-    1500 EGON(C,"FINE",B,-1,19) emitted: coupling_z0 = -1 (row 1400), z2 = 19 (job)
-    1600 not emitted: p_emit shift_on = False (job), shift_per_part = 0.0 (job)
+    1500 EGON(C,"FINE",B,-1,19) emitted: coupling_b = -1 (job), z2 = 19 (job)
+    1320 not emitted: p_emit shift_per_part = 0.0 (job)
 """
 from __future__ import annotations
 

@@ -20,7 +20,7 @@ from .refusals import Refused
 from .words import READERS
 
 TOKEN = re.compile(r"([A-Z]+)(=?)(.*)")
-EQUALS_KINDS = frozenset({"position", "angle", "feed", "speed", "radius", "pitch"})
+EQUALS_KINDS = frozenset({"position", "angle", "feed", "speed", "radius", "pitch", "spindle position"})
 
 
 def _offset(number: int) -> str:

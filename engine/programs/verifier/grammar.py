@@ -6,12 +6,15 @@ groups, the keywords and statements, the word that gives a thread's lead, and th
 state each motion needs (engine.programs.verifier.machine_state).
 
 Only what the seeded templates emit (and the controller reads the way the verifier assumes) is
-in a dialect. Anything else is refused: a code such as G54 or G91 changes what every later
-position means in a way a block-by-block reading cannot see, so it is not guessed at."""
+in a dialect. Anything else is refused: a code such as G91 changes what every later position
+means in a way a block-by-block reading cannot see, so it is not guessed at. The hobber selects
+its work offset G54…G57 from the machine record (design notes §7); the positions are read in
+that frame, the frame the working area and travel of the record are stated in. The door M
+functions are the machine record's own (dialect_for)."""
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from .machine_state import HOBBING_STATE, LATHE_840D_STATE, LATHE_ISO_STATE, StateRules
 from .refusals import Refused
@@ -19,6 +22,7 @@ from .refusals import Refused
 # Value kinds of addresses (engine.programs.verifier.words reads and checks each).
 POSITION, ANGLE, FEED, SPEED, CODE, TOOL, TOOL_AND_OFFSET, OFFSET, RADIUS, PITCH = (
     "position", "angle", "feed", "speed", "code", "tool", "tool and offset", "offset", "radius", "pitch")
+SPINDLE_POSITION = "spindle position"   # SPOS=<degrees>: orients the stopped spindle, moves no axis
 MOTION = "motion"          # the modal group of G0, G1, G2, G3 and threading
 AXES = ("X", "Y", "Z")
 
@@ -104,6 +108,8 @@ WORD_NEEDS_CODE = {"R": frozenset({2, 3}), "CR": frozenset({2, 3}), "K": frozens
 # M codes by what they switch: two of one group in a block contradict each other (M3 M5).
 M_GROUPS = {3: "spindle", 5: "spindle", 8: "coolant", 9: "coolant", 20: "tailstock", 21: "tailstock",
             30: "program end"}
+WORK_OFFSETS = (54, 55, 56, 57)   # the settable work offsets a hobber's record may name (machine.work_offset)
+DOOR_GROUP = "door"
 PROGRAM_HEADER_840D = Header("program header %_N_<NAME>_MPF", re.compile(rf"%_N_{NAME}_MPF"),
                              frozenset({"first"}), frozenset({"first"}))
 PATH_LINE_840D = Header("path line ;$PATH=/_N_MPF_DIR", re.compile(r";\$PATH=/_N_MPF_DIR"), frozenset({"second"}))
@@ -113,9 +119,10 @@ HOBBING_840D = Dialect(
     headers=(PROGRAM_HEADER_840D, PATH_LINE_840D),
     comment="semicolon",
     addresses={"X": POSITION, "Y": POSITION, "Z": POSITION, "A": ANGLE, "F": FEED, "S": SPEED,
-               "G": CODE, "M": CODE},
+               "T": TOOL, "D": OFFSET, "SPOS": SPINDLE_POSITION, "G": CODE, "M": CODE},
     g_codes={0: MOTION, 1: MOTION, 4: "dwell", 25: "working area", 26: "working area", 71: "units",
-             90: "distance", 94: "feed type"},
+             90: "distance", 94: "feed type", **{code: "work offset" for code in WORK_OFFSETS},
+             60: "path mode", 64: "path mode"},
     m_codes={code: M_GROUPS[code] for code in (3, 5, 8, 9, 20, 21, 30)},
     state=HOBBING_STATE,
     keywords=frozenset({"WALIMON"}),
@@ -164,6 +171,18 @@ LATHE_ISO = Dialect(
 
 # machine.kind, machine.dialect -> the grammar its programs are read with.
 DIALECTS = {("hobber", "840d"): HOBBING_840D, ("lathe", "840d"): LATHE_840D, ("lathe", "iso"): LATHE_ISO}
+
+
+def dialect_for(machine) -> Dialect:
+    """The grammar of a machine's programs: its dialect, and on a hobber the door M functions
+    its record names (they are the machine builder's, so no dialect holds them)."""
+    found = dialect_of(machine.kind, machine.dialect)
+    doors = tuple(code for code in (machine.door_close_m, machine.door_open_m) if code is not None)
+    if machine.kind != "hobber" or not doors:
+        return found
+    codes = {**found.m_codes, **{int(code): DOOR_GROUP for code in doors}}
+    name = f"{found.name} with doors {'/'.join(f'M{int(code)}' for code in doors)}"
+    return replace(found, name=name, m_codes=codes)
 
 
 def dialect_of(kind: str, dialect: str) -> Dialect:

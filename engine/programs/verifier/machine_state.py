@@ -10,8 +10,10 @@ M code, a keyword, a statement, an S, T or D word) sets or clears facts, and eve
 statement needs facts to hold (or not to hold) before it. M30 ends the program: nothing after
 it is read by the control, so nothing may follow (but the ISO closing %).
 
-EGDEL(C) at the end of a hobbing program (design notes §7) is not yet needed: the seeded
-hobbing templates do not emit it."""
+A hobbing program (design notes §7, reference §A7) moves the hob only in the work offset its
+machine record names (G54…G57), couples the table only with Y (the shift axis) positioned, so
+the generating zone lies where the program says, and ends with the coupling switched off and
+deleted (EGOFS(C), EGDEL(C)): the next program's EGDEF alarms while a definition exists."""
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -21,6 +23,8 @@ from .refusals import Refused
 SPINDLE_SPEED, SPINDLE_TURNING, TOOL_OFFSET = "spindle speed", "spindle turning", "tool offset"
 COUPLING_DEFINED, COUPLED, ENDED = "coupling defined", "coupled", "ended"
 TOOL_CHANGE, OFFSET_ON, OFFSET_OFF = "tool change", "offset on", "offset off"
+WORK_OFFSET, Y_POSITIONED = "work offset", "Y positioned"
+Y_POSITION = "Y position"     # the event of a block (or the shift clamp) that positions Y
 
 
 @dataclass(frozen=True)
@@ -98,18 +102,27 @@ AREA_REASON = "motion before G25/G26 and WALIMON set the working area"
 AREA_NEEDS = Needs(*(Need(fact, AREA_REASON) for fact in ("G25", "G26", "WALIMON")))
 COUPLING = {"EGDEF": sets(COUPLING_DEFINED), "EGON": sets(COUPLED),
             "EGOFS": clears(COUPLED), "EGDEL": clears(COUPLED, COUPLING_DEFINED)}
-HOB_MOVE_NEEDS = AREA_NEEDS + needs_stated(90, 71)
+WORK_OFFSETS = {f"G{code}": sets(WORK_OFFSET) for code in (54, 55, 56, 57)}
+HOB_MOVE_NEEDS = AREA_NEEDS + needs_stated(90, 71) + Needs(
+    Need(WORK_OFFSET, "a hob move before a work offset (G54…G57) is selected: the position would be read in "
+                      "whatever frame the last program left"))
 HOB_CUT_NEEDS = HOB_MOVE_NEEDS + needs_stated(94) + SPINDLE_NEEDS + Needs(
     Need(COUPLED, "a cut with the table not coupled to the hob: EGON(C,…) first, and no EGOFS(C) since"))
 
 HOBBING_STATE = StateRules(
-    effects={**stated(25, 26, 71, 90, 94), "WALIMON": sets("WALIMON"), **SPINDLE, **END, **COUPLING},
+    effects={**stated(25, 26, 71, 90, 94), "WALIMON": sets("WALIMON"), **SPINDLE, **END, **COUPLING,
+             **WORK_OFFSETS, **OFFSETS, Y_POSITION: sets(Y_POSITIONED)},
     needs={"G0": HOB_MOVE_NEEDS, "G1": HOB_CUT_NEEDS,
            "EGDEF": Needs(Need(COUPLING_DEFINED, "EGDEF(C…) while C's coupling is defined: EGDEL(C) first (reference "
                                                  "§A7: a second definition alarms)", present=False)),
-           "EGON": Needs(Need(COUPLING_DEFINED, "EGON before EGDEF defined the coupling")),
+           "EGON": Needs(Need(COUPLING_DEFINED, "EGON before EGDEF defined the coupling"),
+                         Need(Y_POSITIONED, "EGON before Y (the hob shift) is positioned: the generating zone "
+                                            "would lie wherever the last program left the hob (reference §A7)")),
            "EGOFS": Needs(),
-           "EGDEL": Needs(Need(COUPLED, "EGDEL(C) while the coupling is on: EGOFS(C) first", present=False))},
+           "EGDEL": Needs(Need(COUPLED, "EGDEL(C) while the coupling is on: EGOFS(C) first", present=False)),
+           "M30": Needs(Need(COUPLING_DEFINED, "M30 with C's coupling still defined: EGOFS(C) then EGDEL(C) first "
+                                               "(the next program's EGDEF would alarm, reference §A7)",
+                             present=False))},
 )
 
 LATHE_840D_MOVE = Needs(Need("DIAMON", "motion before DIAMON: X would be a radius, and the travel is checked as a "
@@ -153,6 +166,12 @@ class State:
         if needs is None:
             raise Refused(f"no rule of this dialect says what {what} needs; it is not verified")
         needs.check(self.facts)
+
+    def check_event(self, event: str) -> None:
+        """Refused unless what an event (M30) needs holds, where the dialect has a rule for it."""
+        needs = self.rules.needs.get(event)
+        if needs is not None:
+            needs.check(self.facts)
 
     @property
     def ended(self) -> bool:

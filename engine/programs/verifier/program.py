@@ -19,10 +19,10 @@ import math
 from ...gears.records import Machine
 from ...names import NAME_RULES, is_safe
 from .arcs import arc_box, check_radius
-from .grammar import AXES, Dialect, dialect_of
+from .grammar import AXES, Dialect, dialect_for
 from .limits import check_spindle, check_table, check_thread, check_travel
 from .lines import read_line, remembered_lines
-from .machine_state import State
+from .machine_state import Y_POSITION, State
 from .refusals import LimitError, Refused, line_refused, shown_name
 from .shift_clamp import ShiftClamp
 from .words import MAX_FEED
@@ -35,7 +35,7 @@ def verify_program(lines: list[str], machine: Machine, program_name: str | None)
     """Raises LimitError for the first line refused; returns only for a program read whole, whose
     header names `program_name` (the job's program_name)."""
     try:
-        dialect = dialect_of(machine.kind, machine.dialect)
+        dialect = dialect_for(machine)
     except Refused as refusal:
         raise LimitError(f"machine {machine.name}: {refusal}; nothing stored") from None
     walk = Walk(dialect, machine, len(lines), program_name)
@@ -127,6 +127,8 @@ class Walk:
         elif block.moves:
             self._move(block)
         if block.events:
+            for event in block.events:
+                self.state.check_event(event)
             self.state.apply(block.events)
         if block.speed is not None:
             self._set_speed(block.speed)
@@ -142,6 +144,8 @@ class Walk:
         if self.differential and self.ratio is not None:
             self._check_differential(block.motion, block.positions)
         self.position.update(block.positions)
+        if "Y" in block.positions:
+            self.state.apply(frozenset({Y_POSITION}))
 
     def _set_area(self, block) -> None:
         for axis, value in block.positions.items():
@@ -224,6 +228,7 @@ class Walk:
                 self._check_motion({"Y": value})
             if self.differential and self.ratio is not None:
                 self._check_differential(RAPID, {"Y": ends[0]})
+            self.state.apply(frozenset({Y_POSITION}))
 
 
 TAKERS = {"header": Walk._header, "comment": Walk._comment, "block": Walk._block,

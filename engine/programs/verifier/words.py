@@ -5,7 +5,8 @@ The machine's own limits (travel, spindle maximum) are engine.programs.verifier.
 from __future__ import annotations
 
 from ...turning.names import MAX_TOOL
-from .grammar import ANGLE, CODE, FEED, OFFSET, PITCH, POSITION, RADIUS, SPEED, TOOL, TOOL_AND_OFFSET
+from .grammar import (ANGLE, CODE, FEED, OFFSET, PITCH, POSITION, RADIUS, SPEED, SPINDLE_POSITION, TOOL,
+                      TOOL_AND_OFFSET)
 from .numbers import digits, plain_decimal
 from .refusals import Refused
 
@@ -69,4 +70,4 @@ def _offset(word: str, text: str) -> int:
 
 READERS = {CODE: _code, POSITION: _position, ANGLE: _angle, FEED: _feed, SPEED: _above_zero,
            PITCH: _above_zero, RADIUS: _radius, TOOL: _tool, TOOL_AND_OFFSET: _tool_and_offset,
-           OFFSET: _offset}
+           OFFSET: _offset, SPINDLE_POSITION: _angle}

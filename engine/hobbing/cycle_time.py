@@ -1,0 +1,100 @@
+"""Cycle time of a hobbing program, the header line `; CYCLE TIME <min> MIN` (issue 14).
+
+The definition the simulation checks the header against, from the program text alone: over
+the blocks in order, a G1 takes its path length √(ΔX²+ΔY²+ΔZ²)/F (G94, mm/min), a G0 takes
+max(|ΔX|,|ΔY|,|ΔZ|)/rapid_rate (each axis at the rapid rate), `G4 F<s>` takes s seconds, and
+rotary-only or non-motion blocks take nothing. The program starts at the machine's load
+position where it has one; an axis whose start is unknown (no load position, or Y) moves
+from wherever its first block puts it, which counts as no travel.
+
+The models replay here every motion their templates emit, in the same order, so the time is
+known before the program is written."""
+from __future__ import annotations
+
+import math
+
+CROWN_SEGMENTS = 24   # the crowned template's polyline: 24 G1 X Z segments per cut
+
+
+class Clock:
+    """Minutes of motion so far and the position the last block left."""
+
+    def __init__(self, rapid_rate: float, start: dict):
+        self.rapid_rate, self.position, self.minutes = rapid_rate, dict(start), 0.0
+
+    def rapid(self, **axes: float) -> None:
+        self.minutes += max(abs(v - self.position.get(a, v)) for a, v in axes.items()) / self.rapid_rate
+        self.position.update(axes)
+
+    def feed(self, rate: float, **axes: float) -> None:
+        length = math.sqrt(sum((v - self.position.get(a, v)) ** 2 for a, v in axes.items()))
+        self.minutes += length / rate
+        self.position.update(axes)
+
+    def dwell(self, seconds: float) -> None:
+        self.minutes += seconds / 60
+
+
+def axial_pass(clock: Clock, job: dict, cut: dict) -> None:
+    """Rapid to the approach Z and to just outside the cut's X, infeed, axial pass, retract."""
+    clock.rapid(Z=cut["z_from"])
+    clock.rapid(X=cut["x_air"])
+    clock.feed(cut["feed_radial"], X=cut["cut_x"])
+    clock.feed(cut["feed_axial"], Z=cut["z_to"])
+    clock.rapid(X=job["x_retract"])
+
+
+def taper_pass(clock: Clock, job: dict, cut: dict) -> None:
+    """The axial pass along the cone X(Z) = X(0) + Z·slope, its feed along the slant."""
+    slope = job["taper_slope"]
+    clock.rapid(Z=cut["z_from"])
+    clock.rapid(X=cut["x_air"])
+    clock.feed(cut["feed_radial"], X=cut["cut_x"] + cut["z_from"] * slope)
+    clock.feed(cut["feed_axial"] / math.cos(math.atan(slope)), X=cut["cut_x"] + cut["z_to"] * slope,
+               Z=cut["z_to"])
+    clock.rapid(X=job["x_retract"])
+
+
+def crowned_pass(clock: Clock, job: dict, cut: dict) -> None:
+    """Infeed at the face depth, to the first face, the parabola a(Z) as a polyline, overrun."""
+    top, depth = cut["cut_x"] - job["crown_depth"], job["crown_depth"]
+    clock.rapid(Z=cut["z_from"])
+    clock.rapid(X=cut["x_air"])
+    clock.feed(cut["feed_radial"], X=top)
+    clock.feed(cut["feed_axial"], Z=cut["face_from"])
+    for step in range(1, CROWN_SEGMENTS + 1):
+        z = cut["face_from"] + (cut["face_to"] - cut["face_from"]) * step / CROWN_SEGMENTS
+        clock.feed(cut["feed_axial"], X=cut["cut_x"] - depth * (2 * (z - job["z_mid"]) / job["b"]) ** 2, Z=z)
+    clock.feed(cut["feed_axial"], Z=cut["z_to"])
+    clock.rapid(X=job["x_retract"])
+
+
+def worm_pass(clock: Clock, job: dict, cut: dict) -> None:
+    """Radial: rapid to just outside the wheel, plunge, dwell. Tangential: infeed in air beside
+    the wheel, feed along Y through it, retract and return to the Y start."""
+    clock.rapid(X=cut["x_air"])
+    clock.feed(cut["feed_radial"], X=cut["cut_x"])
+    if job["tangential"]:
+        clock.feed(cut["feed_tangential"], Y=job["y_end"])
+    else:
+        clock.dwell(cut["dwell"])
+    clock.rapid(X=job["x_retract"])
+    if job["tangential"]:
+        clock.rapid(Y=job["y_start"])
+
+
+PASSES = {"axial": axial_pass, "taper": taper_pass, "crowned": crowned_pass, "worm": worm_pass}
+
+
+def cycle_time(job: dict, cuts: list[dict], shape: str, rapid_rate: float) -> float:
+    """Minutes of the whole program: to the start position, Y, every cut in order, the load
+    position. `job` and `cuts` in program values (engine.hobbing.conventions)."""
+    load = {"X": job["load_x"], "Z": job["load_z"]} if job["load_position"] else {}
+    clock = Clock(rapid_rate, load)
+    clock.rapid(X=job["x_retract"], Z=job["z_mid"] if shape == "worm" else job["z_start"])
+    clock.rapid(Y=job["y_start"] if shape == "worm" else job["shift_y"])
+    for cut in cuts:
+        PASSES[shape](clock, job, cut)
+    if load:
+        clock.rapid(**load)
+    return clock.minutes

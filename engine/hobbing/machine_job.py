@@ -1,0 +1,48 @@
+"""A job's parameters made ready for its machine: the signed values in the machine's senses
+(engine.hobbing.conventions), the machine's setup (work offset, tool call, door and load
+blocks, spindle orientation), the working area widened to the load position, and the cycle
+time of the program the template will write (engine.hobbing.cycle_time)."""
+from __future__ import annotations
+
+from ..gears.records import Hob, Machine
+from . import conventions
+from .cycle_time import cycle_time
+from .passes import LIMIT_MARGIN
+
+SETUP_PARAMETERS = frozenset({"work_offset", "tool_number", "door_close_m", "door_open_m", "load_position",
+                              "load_x", "load_z", "orient_before_coupling", "cycle_time"})
+
+
+def machine_setup(machine: Machine, hob: Hob) -> dict:
+    """What the machine record says every program does; a door M of 0 and load_position False
+    mean the machine has none (the template rows are switched off)."""
+    has_load = machine.load_x is not None and machine.load_z is not None
+    return {"work_offset": machine.work_offset, "tool_number": hob.tool_number,
+            "door_close_m": machine.door_close_m or 0, "door_open_m": machine.door_open_m or 0,
+            "load_position": has_load, "load_x": float(machine.load_x) if has_load else 0.0,
+            "load_z": float(machine.load_z) if has_load else 0.0,
+            "orient_before_coupling": bool(machine.orient_before_coupling)}
+
+
+def machine_job(params: dict, module_params: dict, machine: Machine, hob: Hob, shape: str) -> tuple[dict, dict]:
+    """(job parameters, module parameters) in program values, with the setup and cycle time.
+    `shape` names the cut of engine.hobbing.cycle_time.PASSES the class's template emits."""
+    job = {**conventions.on_machine(params, machine), **machine_setup(machine, hob)}
+    modules = {key: conventions.on_machine(values, machine) for key, values in module_params.items()}
+    if job["load_position"]:
+        _widen(job, "x", job["load_x"])
+        _widen(job, "z", job["load_z"])
+    cuts = [modules[key] for key in sorted(modules, key=_module_order)
+            if key.startswith("cutmotion:") and modules[key]["cut_on"]]
+    job["cycle_time"] = round(cycle_time(job, cuts, shape, machine.rapid_rate), 2)
+    return job, modules
+
+
+def _module_order(key: str) -> tuple:
+    kind, _, number = key.partition(":")
+    return kind, int(number)
+
+
+def _widen(job: dict, axis: str, value: float) -> None:
+    job[f"{axis}_lower"] = round(min(job[f"{axis}_lower"], value - LIMIT_MARGIN), 3)
+    job[f"{axis}_upper"] = round(max(job[f"{axis}_upper"], value + LIMIT_MARGIN), 3)
