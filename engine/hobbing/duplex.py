@@ -136,7 +136,7 @@ def _keep_cut_clear(gear, hob_extent, setup, numbered_unit, numbered_other, cut)
         f"{hob.id} (da0 {hob.tip_diameter:g}, swivel {setup.swivel:.2f}°) reaches {reach:.1f} mm along Z "
         f"into unit {other_number} (tip Ø{other.tip_diameter:g}); the units need "
         f"{least + CLEARANCE + reach:.1f} mm between their faces, they have {abs(other_face - face):.1f}; "
-        f"use a smaller hob, a larger gap between the units or another class; nothing stored")
+        f"use a smaller hob, a wider gap between the units or another class; nothing stored")
 
 
 def _rounded_inward(z: float, toward: int) -> float:
