@@ -13,6 +13,7 @@ from ..programs.verifier import check_table_speed
 from . import shifting
 from .cylindrical import CylindricalModel, JobParameters
 from .envelope import half_length, reach_into_cylinder
+from .geometry import cut_depth
 from .passes import plan_cuts, working_area
 
 TOOTH_DEPTH_MODULES = 2.25
@@ -102,7 +103,7 @@ def keep_clear(gear, hob, extent, units, setups, module_params) -> None:
     other unit by CLEARANCE: at the infeed (approach Z), along the axial pass and at the G0 X
     retract at the end Z, all at the cut's centre distance or further out, so the hull of the
     pass at cut_x covers them. Where the run-out faces the other unit it is shortened, as long as
-    the pass still carries the hob centre MIN_OVERRUN beyond the face (design notes §7); the
+    the pass still carries the hob centre beyond the face (design notes §7, shortest_overrun); the
     run-in is never shortened (the infeed must stay clear of the unit being cut)."""
     for number, (unit, setup) in enumerate(zip(units, setups), start=1):
         other_number = 3 - number
@@ -126,9 +127,9 @@ def _keep_cut_clear(gear, hob_extent, setup, numbered_unit, numbered_other, cut)
     end = "z_from" if (toward < 0) != cut["climb"] else "z_to"
     if toward * (cut[end] - limit) <= 0:
         return
-    least = MIN_OVERRUN if end == "z_to" else toward * (cut[end] - face)
+    least = shortest_overrun(unit, hob, setup.swivel, cut["cut_x"]) if end == "z_to" else toward * (cut[end] - face)
     shortened = _rounded_inward(limit, toward)
-    if end == "z_to" and toward * (shortened - face) >= MIN_OVERRUN:
+    if end == "z_to" and toward * (shortened - face) >= least:
         cut["z_to"] = shortened
         return
     raise EngineError(
@@ -137,6 +138,15 @@ def _keep_cut_clear(gear, hob_extent, setup, numbered_unit, numbered_other, cut)
         f"into unit {other_number} (tip Ø{other.tip_diameter:g}); the units need "
         f"{least + CLEARANCE + reach:.1f} mm between their faces, they have {abs(other_face - face):.1f}; "
         f"use a smaller hob, a wider gap between the units or another class; nothing stored")
+
+
+def shortest_overrun(unit, hob, swivel: float, cut_x: float) -> float:
+    """The least run-out that still finishes the face it leaves: the hob centre MIN_OVERRUN
+    beyond it, plus the axial projection of the generating zone (h/tan α_n)·sin η of a
+    swivelled hob (reference §B8)."""
+    depth = cut_depth(unit.tip_diameter, hob.tip_diameter, cut_x)
+    zone = depth / math.tan(math.radians(unit.pressure_angle)) * math.sin(math.radians(abs(swivel)))
+    return MIN_OVERRUN + zone
 
 
 def _rounded_inward(z: float, toward: int) -> float:
