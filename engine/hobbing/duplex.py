@@ -21,6 +21,9 @@ UNIT_MODULES = {1: (1, 2), 2: (3, 4)}   # unit → its cutmotion module numbers 
 SYNC_PARAMETERS = frozenset({"unit", "z2", "b", "z_top"})
 CLEARANCE = 1.0     # mm kept between the hob envelope and the unit not being cut
 MIN_OVERRUN = 1.0   # mm the pass carries the hob centre beyond the face it leaves, at the least
+# (other unit below, climb) → the pass end nearest the other unit: climb enters above the top
+# face (z_from) and leaves below the bottom one (z_to); conventional the reverse.
+FACING_END = {(True, True): "z_to", (True, False): "z_from", (False, True): "z_from", (False, False): "z_to"}
 
 
 class DuplexModel(CylindricalModel):
@@ -120,11 +123,11 @@ def _keep_cut_clear(gear, hob_extent, setup, numbered_unit, numbered_other, cut)
                                 other.tip_diameter / 2 + CLEARANCE)
     if reach is None:
         return
-    toward = -1 if other.z_top < unit.z_top else 1          # Z direction from this unit to the other
-    face = unit.z_top - unit.face_width if toward < 0 else unit.z_top
-    other_face = other.z_top if toward < 0 else other.z_top - other.face_width
+    below = other.z_top < unit.z_top
+    toward = -1 if below else 1                             # Z direction from this unit to the other
+    face, other_face = facing_faces(unit, other, below)
     limit = other_face - toward * (CLEARANCE + reach)       # furthest hob centre Z toward the other
-    end = "z_from" if (toward < 0) != cut["climb"] else "z_to"
+    end = FACING_END[below, cut["climb"]]
     if toward * (cut[end] - limit) <= 0:
         return
     least = shortest_overrun(unit, hob, setup.swivel, cut["cut_x"]) if end == "z_to" else toward * (cut[end] - face)
@@ -138,6 +141,13 @@ def _keep_cut_clear(gear, hob_extent, setup, numbered_unit, numbered_other, cut)
         f"into unit {other_number} (tip Ø{other.tip_diameter:g}); the units need "
         f"{least + CLEARANCE + reach:.1f} mm between their faces, they have {abs(other_face - face):.1f}; "
         f"use a smaller hob, a wider gap between the units or another class; nothing stored")
+
+
+def facing_faces(unit, other, other_below: bool) -> tuple[float, float]:
+    """(Z of this unit's face toward the other, Z of the other's face toward this one)."""
+    if other_below:
+        return unit.z_top - unit.face_width, other.z_top
+    return unit.z_top, other.z_top - other.face_width
 
 
 def shortest_overrun(unit, hob, swivel: float, cut_x: float) -> float:
