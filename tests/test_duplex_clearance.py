@@ -106,7 +106,8 @@ def layouts(draw):
     gear = Gear(9001, "duplex", module, teeth[0], 20.0, 0.0, None, widths[0], tips[0],
                 round(tips[0] - 4.5 * module, 3), None, None, None, None, None, None,
                 units=(GearUnit(2, teeth[1], widths[1], tips[1], None, -widths[0] - gap),))
-    choices = Choices(cuts=draw(st.sampled_from([None, 1, 2])), feed_mode=draw(st.sampled_from(sorted(FEED_MODES))))
+    choices = Choices(cuts=draw(st.sampled_from([None, 1, 2])), feed_mode=draw(st.sampled_from(sorted(FEED_MODES))),
+                      shift_y=draw(st.sampled_from([0.0, 0.0, 6.0, -10.0])))
     return gear, hob, choices
 
 
@@ -119,7 +120,8 @@ def units_of(gear: Gear) -> list[dict]:
 def check_program_cuts(gear: Gear, hob: Hob, params: dict, module_params: dict) -> float:
     """The least clearance of any cut to the other unit; asserts each pass still crosses its
     own unit's faces with the hob centre and keeps clear of the other unit."""
-    surface = hob_surface(hob.tip_diameter / 2, hob.length / 2, swivel(hob.module, hob.starts, hob.tip_diameter))
+    reach = hob.length / 2 + abs(params["shift_y"])          # the hob shifted either way along its axis
+    surface = hob_surface(hob.tip_diameter / 2, reach, swivel(hob.module, hob.starts, hob.tip_diameter))
     units, least = units_of(gear), math.inf
     for number, modules in ((1, (1, 2)), (2, (3, 4))):
         own, other = units[number - 1], units[2 - number]
