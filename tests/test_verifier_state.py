@@ -295,9 +295,11 @@ def test_the_table_speed_adds_the_z_term_at_the_feed_of_the_cut(conn):
 
 
 def test_the_z_term_counts_only_where_z_moves_and_at_rapid_for_g0(conn):
-    table_max = load_machine(conn, "hobber-840d").table_speed_max
-    factor = 2.0
-    assert table_speed(246, 1, 19, factor, 100) <= table_max < table_speed(246, 1, 19, factor, MAX_FEED)
+    """A G0 Z moves at the machine record's rapid rate (issue 14: rapid Z while coupled)."""
+    machine = load_machine(conn, "hobber-840d")
+    table_max, rapid = machine.table_speed_max, float(machine.rapid_rate)
+    factor = math.ceil((table_max - 246 / 19) * 360 / rapid * 10 + 1) / 10   # C past its maximum at rapid
+    assert table_speed(246, 1, 19, factor, 100) <= table_max < table_speed(246, 1, 19, factor, rapid)
     assert accepted(conn, "hobber-840d", coupled_z(f"{factor}", "G0 X55.000", "G1 Z10.000 F100.0"))
     assert "above hobber-840d's" in refusal(conn, "hobber-840d", coupled_z(f"{factor}", "G0 Z10.000"))
 

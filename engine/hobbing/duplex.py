@@ -12,11 +12,18 @@ from ..errors import EngineError
 from ..programs.verifier import check_table_speed
 from . import shifting
 from .cylindrical import CylindricalModel, JobParameters
+from .envelope import half_length, reach_into_cylinder
+from .geometry import cut_depth
 from .passes import plan_cuts, working_area
 
 TOOTH_DEPTH_MODULES = 2.25
 UNIT_MODULES = {1: (1, 2), 2: (3, 4)}   # unit → its cutmotion module numbers (rough, finish)
 SYNC_PARAMETERS = frozenset({"unit", "z2", "b", "z_top"})
+CLEARANCE = 1.0     # mm kept between the hob envelope and the unit not being cut
+MIN_OVERRUN = 1.0   # mm the pass carries the hob centre beyond the face it leaves, at the least
+# (other unit below, climb) → the pass end nearest the other unit: climb enters above the top
+# face (z_from) and leaves below the bottom one (z_to); conventional the reverse.
+FACING_END = {(True, True): "z_to", (True, False): "z_from", (False, True): "z_from", (False, False): "z_to"}
 
 
 class DuplexModel(CylindricalModel):
@@ -27,20 +34,21 @@ class DuplexModel(CylindricalModel):
     def job(self, gear, gear_class, hob, machine, cutting, choices) -> JobParameters:
         units = unit_gears(gear)
         setups = [self.setup(unit, hob) for unit in units]
-        module_params, passes = {}, []
+        module_params = {}
         for number, (unit, setup) in enumerate(zip(units, setups), start=1):
             check_table_speed(gear.id, unit.teeth, hob.starts, cutting.hob_speed, machine)
             unit_cuts = self._unit_cuts(number, unit, hob, cutting, choices, setup)
             module_params.update(unit_cuts)
-            passes.append((unit, setup, [c for c in unit_cuts.values() if c["cut_on"]]))
         module_params["sync:3"] = {"unit": 2, "z2": units[1].teeth, "b": units[1].face_width,
                                    "z_top": units[1].z_top}
-        check_clearance(gear, hob, passes)
+        shift = shifting.parameters(choices, hob, gear)
+        keep_clear(gear, hob, half_length(hob.length, shift), units, setups, module_params)
         x_retract = max(setup.x_retract for setup in setups)
         params = {**self.base_params(gear, gear_class, hob, machine, cutting, choices, setups[0]),
-                  **shifting.parameters(choices, hob, gear), "x_retract": round(x_retract, 3)}
-        xs = [x_retract] + [cut["cut_x"] for _, _, cuts in passes for cut in cuts]
-        zs = [z for _, _, cuts in passes for cut in cuts for z in (cut["z_from"], cut["z_to"])]
+                  **shift, "x_retract": round(x_retract, 3)}
+        cuts = [cut for cut in module_params.values() if cut.get("cut_on")]
+        xs = [x_retract] + [cut["cut_x"] for cut in cuts]
+        zs = [z for cut in cuts for z in (cut["z_from"], cut["z_to"])]
         params.update(working_area(xs, shifting.y_positions(params), zs + [params["z_start"]]))
         return self.for_machine(params, module_params, machine, hob)
 
@@ -93,25 +101,64 @@ def unit_gears(gear) -> list[UnitGear]:
     return [first, unit2]
 
 
-def check_clearance(gear, hob, passes) -> None:
-    """The hob, while cutting one unit, must not reach the other: where the other unit's tip
-    cylinder lies within the hob's tip radius, the hob touches it over a half-chord along Z
-    around its centre; every hob centre Z of the pass keeps that far from the other unit's faces."""
-    hob_radius = hob.tip_diameter / 2
-    for unit, setup, cuts in passes:
-        for other, _, _ in passes:
-            if other is unit or not cuts:
-                continue
-            gap = min(cut["cut_x"] for cut in cuts) - other.tip_diameter / 2
-            if gap >= hob_radius:
-                continue
-            half_chord = math.sqrt(hob_radius ** 2 - gap ** 2)
-            low = min(min(c["z_from"], c["z_to"]) for c in cuts) - half_chord
-            high = max(max(c["z_from"], c["z_to"]) for c in cuts) + half_chord
-            other_top, other_bottom = other.z_top, other.z_top - other.face_width
-            if low < other_top and high > other_bottom:
-                raise EngineError(
-                    f"gear {gear.id}: cutting the unit at Z{unit.z_top:g} the hob (da0 {hob.tip_diameter:g}) "
-                    f"reaches Z{low:.1f}…{high:.1f}, into the unit at Z{other_top:g}…{other_bottom:g}; "
-                    f"the units need a wider gap (or a smaller hob); nothing stored")
+def keep_clear(gear, hob, extent, units, setups, module_params) -> None:
+    """Every cut of one unit keeps the hob envelope (tip cylinder, length, swivel) clear of the
+    other unit by CLEARANCE: at the infeed (approach Z), along the axial pass and at the G0 X
+    retract at the end Z, all at the cut's centre distance or further out, so the hull of the
+    pass at cut_x covers them. Where the run-out faces the other unit it is shortened, as long as
+    the pass still carries the hob centre beyond the face (design notes §7, shortest_overrun); the
+    run-in is never shortened (the infeed must stay clear of the unit being cut)."""
+    for number, (unit, setup) in enumerate(zip(units, setups), start=1):
+        other_number = 3 - number
+        for module_number in UNIT_MODULES[number]:
+            cut = module_params[f"cutmotion:{module_number}"]
+            if cut["cut_on"]:
+                _keep_cut_clear(gear, (hob, extent), setup, (number, unit),
+                                (other_number, units[other_number - 1]), cut)
 
+
+def _keep_cut_clear(gear, hob_extent, setup, numbered_unit, numbered_other, cut) -> None:
+    (hob, extent), (number, unit), (other_number, other) = hob_extent, numbered_unit, numbered_other
+    reach = reach_into_cylinder(hob.tip_diameter / 2, extent, setup.swivel, cut["cut_x"],
+                                other.tip_diameter / 2 + CLEARANCE)
+    if reach is None:
+        return
+    below = other.z_top < unit.z_top
+    toward = -1 if below else 1                             # Z direction from this unit to the other
+    face, other_face = facing_faces(unit, other, below)
+    limit = other_face - toward * (CLEARANCE + reach)       # furthest hob centre Z toward the other
+    end = FACING_END[below, cut["climb"]]
+    if toward * (cut[end] - limit) <= 0:
+        return
+    least = shortest_overrun(unit, hob, setup.swivel, cut["cut_x"]) if end == "z_to" else toward * (cut[end] - face)
+    shortened = _rounded_inward(limit, toward)
+    if end == "z_to" and toward * (shortened - face) >= least:
+        cut["z_to"] = shortened
+        return
+    raise EngineError(
+        f"gear {gear.id}: cutting unit {number} ({cut['cut_name']} at X{cut['cut_x']:g}) the hob "
+        f"{hob.id} (da0 {hob.tip_diameter:g}, swivel {setup.swivel:.2f}°) reaches {reach:.1f} mm along Z "
+        f"into unit {other_number} (tip Ø{other.tip_diameter:g}); the units need "
+        f"{least + CLEARANCE + reach:.1f} mm between their faces, they have {abs(other_face - face):.1f}; "
+        f"use a smaller hob, a wider gap between the units or another class; nothing stored")
+
+
+def facing_faces(unit, other, other_below: bool) -> tuple[float, float]:
+    """(Z of this unit's face toward the other, Z of the other's face toward this one)."""
+    if other_below:
+        return unit.z_top - unit.face_width, other.z_top
+    return unit.z_top, other.z_top - other.face_width
+
+
+def shortest_overrun(unit, hob, swivel: float, cut_x: float) -> float:
+    """The least run-out that still finishes the face it leaves: the hob centre MIN_OVERRUN
+    beyond it, plus the axial projection of the generating zone (h/tan α_n)·sin η of a
+    swivelled hob (reference §B8)."""
+    depth = cut_depth(unit.tip_diameter, hob.tip_diameter, cut_x)
+    zone = depth / math.tan(math.radians(unit.pressure_angle)) * math.sin(math.radians(abs(swivel)))
+    return MIN_OVERRUN + zone
+
+
+def _rounded_inward(z: float, toward: int) -> float:
+    """z rounded to the program's 0.001 mm away from the other unit."""
+    return (math.floor if toward > 0 else math.ceil)(z * 1000) / 1000

@@ -7,8 +7,13 @@ import math
 
 from ..errors import EngineError
 from .cylindrical import RETRACT_CLEARANCE, CylindricalModel, Setup
+from .envelope import clearance_to_cone
+from .passes import Reach, pass_ends
 
 MAX_CONE_ANGLE = 15.0   # degrees: beyond a small taper the hob's generating geometry no longer holds
+INFEED_CLEARANCE = 0.5  # mm between the hob envelope and the conical blank at the infeed
+RUN_IN_STEP = 0.5       # mm: the run-in grows by this until the infeed clears, then is bisected
+RUN_IN_TOLERANCE = 0.005
 
 
 class TaperModel(CylindricalModel):
@@ -22,7 +27,8 @@ class TaperModel(CylindricalModel):
         setup = super().setup(gear, hob)
         slope = math.tan(math.radians(gear.cone_angle))
         # The pass reaches the approach distance beyond either face, where the cone line lies
-        # furthest out: retract beyond it.
+        # furthest out: retract beyond it. (A run-in lengthened for the cone (run_in) lies where
+        # the cone line runs inward, so it never reaches further out.)
         highest = setup.full_depth + (gear.face_width + setup.reach.approach) * abs(slope)
         return Setup(setup.lead, setup.swivel, setup.full_depth, setup.reach,
                      max(setup.x_retract, highest + RETRACT_CLEARANCE))
@@ -31,14 +37,45 @@ class TaperModel(CylindricalModel):
         """taper_slope = dX/dZ = tan δ, turned with Z on the machine (engine.hobbing.conventions)."""
         return {"cone_angle": gear.cone_angle, "taper_slope": round(math.tan(math.radians(gear.cone_angle)), 9)}
 
-    def cut_params(self, cut, gear, hob, cutting, setup) -> dict:
-        """The infeed stops short of the cone line at the approach Z, not of X(0)."""
-        params = super().cut_params(cut, gear, hob, cutting, setup)
-        params["x_air"] = round(params["x_air"] + params["z_from"] * math.tan(math.radians(gear.cone_angle)), 3)
-        return params
-
     def extents(self, gear, setup, cuts):
         xs, zs = super().extents(gear, setup, cuts)
         slope = math.tan(math.radians(gear.cone_angle))
         xs += [cut["cut_x"] + z * slope for cut in cuts for z in (cut["z_from"], cut["z_to"])]
         return xs, zs
+
+    def cut_params(self, cut, gear, hob, cutting, setup) -> dict:
+        """The infeed runs at the approach Z to X(z_from) on the cone line: where the cone
+        line runs inward beyond the face entered (a positive cone entered from below, a
+        negative one from above) the hob there sits deeper than the cut, so the run-in grows
+        until the hob at that X clears the conical blank."""
+        params = super().cut_params(cut, gear, hob, cutting, setup)
+        run_in = self.run_in(gear, hob, setup, params["cut_x"], params["climb"])
+        z_from, _ = pass_ends(Reach(run_in, setup.reach.overrun), 0.0, -gear.face_width, params["climb"])
+        params["z_from"] = round(z_from, 3)
+        # The rapid stops short of the cone line at the approach Z, not of X(0).
+        params["x_air"] = round(params["x_air"] + params["z_from"] * math.tan(math.radians(gear.cone_angle)), 3)
+        return params
+
+    def run_in(self, gear, hob, setup, cut_x: float, climb: bool) -> float:
+        """The least run-in, at least the cylindrical one (§B7), at which the hob centred on
+        the cone line at the approach Z clears the blank by INFEED_CLEARANCE."""
+        slope = math.tan(math.radians(gear.cone_angle))
+        blank = (gear.tip_diameter / 2, slope, gear.face_width)
+        extent = hob.length      # half the hob plus the most it may be shifted, half its length
+        face, outward = (0.0, 1) if climb else (-gear.face_width, -1)
+
+        def clear(run_in: float) -> bool:
+            z = face + outward * run_in
+            centre = (cut_x + z * slope, z)
+            return clearance_to_cone(hob.tip_diameter / 2, extent, setup.swivel, centre, blank) >= INFEED_CLEARANCE
+
+        short = long = setup.reach.approach
+        while not clear(long):
+            short, long = long, long + RUN_IN_STEP
+            if long > setup.reach.approach + hob.tip_diameter + gear.face_width:
+                raise EngineError(f"gear {gear.id}: no run-in clears the cone of {gear.cone_angle:g}° for hob "
+                                  f"{hob.id} (da0 {hob.tip_diameter:g}); use a smaller hob or another class")
+        while long - short > RUN_IN_TOLERANCE:
+            middle = (short + long) / 2
+            short, long = (short, middle) if clear(middle) else (middle, long)
+        return long

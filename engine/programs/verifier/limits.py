@@ -26,16 +26,42 @@ def check_spindle(speed: float, machine: Machine) -> None:
         raise Refused(f"spindle speed S{speed:g} exceeds {machine.name}'s {machine.spindle_max:g} r/min")
 
 
-def check_table(speed: float, ratio: float, machine: Machine, differential: tuple = ()) -> None:
+def check_table(speed: float, ratio: float, machine: Machine, differential: tuple = (), motion: str = "") -> None:
     """The table turns at n0·z0/z2 (reference §B4) plus, for each differential axis moving at v
     mm/min with k degrees of C per mm, k·v/360 r/min (reference §A5: n_C = (z0/z2)·n_B ±
     k_Y·v_Y ± k_Z·v_Z). `differential`: (axis, k, v) of each moving leading axis; the terms
-    are added as if their signs agreed, the most the table can turn."""
-    table_speed = speed * ratio + sum(factor * velocity / 360.0 for _, factor, velocity in differential)
+    are added as if their signs agreed, the most the table can turn. `motion`: "G0 " for a rapid
+    move, so the message says which traverse drives the table."""
+    table_speed = abs(speed * ratio) + sum(abs(factor * velocity) / 360.0 for _, factor, velocity in differential)
     if machine.table_speed_max is not None and table_speed > machine.table_speed_max:
-        terms = "".join(f" + {axis} {factor:g}°/mm × {velocity:g} mm/min" for axis, factor, velocity in differential)
+        terms = "".join(f" + {motion}{axis} {abs(factor):g}°/mm × {velocity:g} mm/min"
+                        for axis, factor, velocity in differential)
         raise Refused(f"the table turns at {table_speed:.1f} r/min (S{speed:g} × {ratio:g}{terms}), above "
-                      f"{machine.name}'s {machine.table_speed_max:g} r/min")
+                      f"{machine.name}'s {machine.table_speed_max:g} r/min{_slower(motion)}")
+
+
+def _slower(motion: str) -> str:
+    return "; move Z with G1 at a bounded feed while coupled" if motion else ""
+
+
+def leading_velocity(rapid: bool, feed: float | None, machine: Machine) -> float:
+    """How fast a leading axis moves in a block: G0 at the machine's rapid rate (each axis of
+    a G0 block traverses at it), G1 at the modal feed (G94 mm/min; MAX_FEED when none is set,
+    the most a feed word may say)."""
+    if rapid:
+        return float(machine.rapid_rate)
+    return feed or MAX_FEED
+
+
+def check_coupled_move(rapid: bool, feed: float | None, positions: dict, coupling: tuple, machine: Machine) -> None:
+    """A leading axis of the EG coupling that moves turns the table by its factor k (degrees of
+    C per mm) on top of the generating ratio (reference §A5): a G0 Z on a helical coupling adds
+    k_Z·rapid_rate/360 r/min. `coupling`: (hob speed, B→C ratio, {axis: factor})."""
+    speed, ratio, factors = coupling
+    velocity = leading_velocity(rapid, feed, machine)
+    moving = tuple((axis, factor, velocity) for axis, factor in factors.items() if axis in positions)
+    if moving:
+        check_table(speed or 0.0, ratio, machine, moving, "G0 " if rapid else "")
 
 
 def check_thread(lead: float, speed: float, word: str) -> None:

@@ -20,12 +20,11 @@ from ...gears.records import Machine
 from ...names import NAME_RULES, is_safe
 from .arcs import arc_box, check_radius
 from .grammar import AXES, Dialect, dialect_for
-from .limits import check_spindle, check_table, check_thread, check_travel
+from .limits import check_coupled_move, check_spindle, check_table, check_thread, check_travel
 from .lines import read_line, remembered_lines
 from .machine_state import Y_POSITION, State
 from .refusals import LimitError, Refused, line_refused, shown_name
 from .shift_clamp import ShiftClamp
-from .words import MAX_FEED
 
 ARCS = (2, 3)
 RAPID = 0
@@ -182,12 +181,9 @@ class Walk:
 
     def _check_differential(self, motion: int, positions: dict) -> None:
         """A leading axis moving while coupled turns the table by its factor: at the block's
-        feed, or for G0 at MAX_FEED (the machine record holds no rapid rate; the verifier's
-        feed bound is about one)."""
-        velocity = MAX_FEED if motion == RAPID else self.feed or MAX_FEED
-        moving = tuple((axis, factor, velocity) for axis, factor in self.differential.items() if axis in positions)
-        if moving:
-            check_table(self.speed or 0.0, self.ratio, self.machine, moving)
+        feed, or for G0 at the machine's rapid rate (engine.programs.verifier.limits)."""
+        check_coupled_move(motion == RAPID, self.feed, positions, (self.speed, self.ratio, self.differential),
+                           self.machine)
 
     def _set_speed(self, speed: float) -> None:
         check_spindle(speed, self.machine)

@@ -1,0 +1,160 @@
+"""Taper gears (issue 14 item 5): the infeed `G1 X{cut_x + z_from·tan δ}` at the approach Z
+leaves the hob clear of the conical blank, for both cone signs, climb and conventional, one
+cut and two, swivel included; the pass still carries the hob centre beyond both faces.
+
+Computed here from the geometry, independently of the engine: the blank is the solid of
+revolution of the trapezoid r ≤ d_a2/2 + Z·tan δ over Z −b…0 (tip diameter d_a2 at the top
+face, shrinking by 2·tan δ per mm downward for δ > 0); the distance of a point from it is the
+distance, in the meridian plane through the point, from (r, Z) to that trapezoid. Points on
+the hob's tip cylinder and end discs (radius d_a0/2, length L, axis in the Y–Z plane at the
+swivel η: spur η = γ, helical β ∓ γ by hands, reference §B1, §B2) are tested at the infeed.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from engine.errors import EngineError
+from engine.gears.records import Gear, Hob
+from engine.hobbing.choices import FEED_MODES, Choices
+from engine.hobbing.taper import TaperModel
+from engine.programs.instantiate import instantiate_gear
+
+from nc_reader import read_program
+from test_duplex_clearance import CUTTING, MACHINE, hob_surface, seeded_hobs
+
+MARGIN = 0.25           # mm: the least clearance an infeed may leave (the engine keeps more)
+
+
+# ------------------------------------------------------------------ geometry, test side
+
+def swivel(gear_beta: float, gear_hand: str | None, hob: Hob) -> float:
+    """|η| in radians: γ for spur, β − γ for the same hands, β + γ for opposite (§B1, §B2)."""
+    gamma = math.asin(hob.starts * hob.module / (hob.tip_diameter - 2.5 * hob.module))
+    beta = math.radians(gear_beta)
+    if not gear_beta:
+        return gamma
+    return abs(beta - gamma) if gear_hand == hob.hand else beta + gamma
+
+
+def distance_to_trapezoid(r: np.ndarray, z: np.ndarray, corners: list) -> np.ndarray:
+    """Signed distance of meridian points (r, z) from a convex polygon (negative inside)."""
+    distances, inside = [], np.ones_like(r, dtype=bool)
+    for (ar, az), (br, bz) in zip(corners, corners[1:] + corners[:1]):
+        dr, dz = br - ar, bz - az
+        t = np.clip(((r - ar) * dr + (z - az) * dz) / (dr * dr + dz * dz), 0, 1)
+        distances.append(np.hypot(r - ar - t * dr, z - az - t * dz))
+        inside &= (dr * (z - az) - dz * (r - ar)) >= 0      # corners run counterclockwise in (r, z)
+    least = np.min(distances, axis=0)
+    return np.where(inside, -least, least)
+
+
+def blank_corners(tip_diameter: float, cone_angle: float, face_width: float) -> list:
+    bottom = tip_diameter / 2 - face_width * math.tan(math.radians(cone_angle))
+    return [(0.0, 0.0), (0.0, -face_width), (bottom, -face_width), (tip_diameter / 2, 0.0)]
+
+
+def hob_clearance(surface: np.ndarray, centre: tuple, corners: list) -> float:
+    points = surface + [centre[0], 0.0, centre[1]]
+    return float(np.min(distance_to_trapezoid(np.hypot(points[:, 0], points[:, 1]), points[:, 2], corners)))
+
+
+def infeed_clearance(gear: Gear, hob: Hob, cut: dict, x_retract: float) -> float:
+    """The hob along the infeed at the approach Z: X from the retract position to the cone line."""
+    slope = math.tan(math.radians(gear.cone_angle))
+    surface = hob_surface(hob.tip_diameter / 2, hob.length / 2, swivel(gear.helix_angle, gear.hand, hob))
+    corners = blank_corners(gear.tip_diameter, gear.cone_angle, gear.face_width)
+    x_in = cut["cut_x"] + cut["z_from"] * slope
+    return min(hob_clearance(surface, (x, cut["z_from"]), corners) for x in np.linspace(x_in, x_retract, 4))
+
+
+def check_cuts(gear: Gear, hob: Hob, params: dict, module_params: dict) -> float:
+    least = math.inf
+    for cut in module_params.values():
+        if not cut.get("cut_on"):
+            continue
+        low, high = sorted((cut["z_from"], cut["z_to"]))
+        assert low < -gear.face_width and high > 0, f"the pass {low}…{high} does not cross both faces"
+        found = infeed_clearance(gear, hob, cut, params["x_retract"])
+        assert found >= MARGIN, f"{cut['cut_name']}: the infeed at Z{cut['z_from']} is {found:.2f} mm from the blank"
+        least = min(least, found)
+    return least
+
+
+# ------------------------------------------------------------------ every combination, on the model
+
+COMBINATIONS = [(cone, mode, cuts) for cone in (6.5, -6.5) for mode in sorted(FEED_MODES) for cuts in (1, 2)]
+
+
+def paper_gear(cone: float, helix: float = 0.0, hand: str | None = None) -> Gear:
+    """Reference §D: m2, z19, d_a 42.5 (d_f 33.5), b 20, cone 6.5°."""
+    return Gear(50, "taper", 2.0, 19, 20.0, helix, hand, 20.0, 42.5, 33.5, cone, None, None, None, None, None)
+
+
+@pytest.mark.parametrize("cone, feed_mode, cuts", COMBINATIONS)
+def test_every_infeed_clears_the_cone(cone, feed_mode, cuts):
+    hob = next(h for h in seeded_hobs() if h.id == "H-M2-AA-R1")
+    gear = paper_gear(cone)
+    job = TaperModel().job(gear, "taper", hob, MACHINE, CUTTING, Choices(feed_mode=feed_mode, cuts=cuts))
+    check_cuts(gear, hob, job.params, job.module_params)
+
+
+@pytest.mark.parametrize("cone, feed_mode, cuts", COMBINATIONS)
+def test_every_infeed_clears_the_cone_with_a_helical_swivel(cone, feed_mode, cuts):
+    hob = next(h for h in seeded_hobs() if h.id == "H-M2-A-L1")
+    gear = paper_gear(cone, 20.0, "R")
+    job = TaperModel().job(gear, "taper", hob, MACHINE, CUTTING, Choices(feed_mode=feed_mode, cuts=cuts))
+    check_cuts(gear, hob, job.params, job.module_params)
+
+
+@st.composite
+def taper_gears(draw):
+    hob = draw(st.sampled_from(seeded_hobs()))
+    teeth = draw(st.integers(8, 120))
+    helix = draw(st.sampled_from([0.0, 0.0, 10.0, 20.0, 30.0]))
+    hand = draw(st.sampled_from("RL")) if helix else None
+    reference = hob.module * teeth / math.cos(math.radians(helix))
+    tip = round(reference + 2 * hob.module * (1 + draw(st.floats(-0.3, 0.5))), 2)
+    cone = draw(st.floats(0.5, 15.0)) * draw(st.sampled_from([1, -1]))
+    width = round(draw(st.floats(4.0, 60.0)), 1)
+    gear = Gear(9201, "taper", hob.module, teeth, 20.0, helix, hand, width, tip, round(tip - 4.5 * hob.module, 3),
+                round(cone, 2), None, None, None, None, None)
+    choices = Choices(cuts=draw(st.sampled_from([None, 1, 2])), feed_mode=draw(st.sampled_from(sorted(FEED_MODES))))
+    return gear, hob, choices
+
+
+@settings(max_examples=120, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(taper_gears())
+def test_random_taper_gears_infeed_clear_of_the_blank(layout):
+    gear, hob, choices = layout
+    try:
+        job = TaperModel().job(gear, "taper", hob, MACHINE, CUTTING, choices)
+    except EngineError as refusal:
+        assert "\n" not in str(refusal)
+        return
+    check_cuts(gear, hob, job.params, job.module_params)
+
+
+# ------------------------------------------------------------------ the paper's gear 50, end to end
+
+@pytest.mark.parametrize("cone, feed_mode", [(6.5, "conventional-climb"), (6.5, "conventional"), (-6.5, "climb")])
+def test_the_papers_gear_infeeds_clear_of_its_cone_in_the_program(conn, cone, feed_mode):
+    """Seeded gear 50 (the paper's: cone 6.5°, conventional-climb was 0.62 mm inside)."""
+    conn.execute("UPDATE gear SET cone_angle = %s WHERE id = 50", (cone,))
+    row = conn.execute("SELECT module, teeth, face_width, tip_diameter, root_diameter FROM gear WHERE id = 50").fetchone()
+    gear = Gear(50, "taper", float(row[0]), row[1], 20.0, 0.0, None, float(row[2]), float(row[3]), float(row[4]),
+                cone, None, None, None, None, None)
+    program = instantiate_gear(conn, 50, choices=Choices(feed_mode=feed_mode, cuts=2))
+    hob = next(h for h in seeded_hobs() if h.id == program.lines[3].split()[2])
+    surface = hob_surface(hob.tip_diameter / 2, hob.length / 2, swivel(0.0, None, hob))
+    corners = blank_corners(gear.tip_diameter, cone, gear.face_width)
+    nc = read_program("\n".join(program.lines))
+    infeeds = [m for m in nc.moves_in("G1") if m.changed == {"X"}]
+    assert len(infeeds) == 2
+    for move in infeeds:
+        found = hob_clearance(surface, (move.end["X"], move.end["Z"]), corners)
+        assert found >= MARGIN, f"{nc.blocks[move.block].text}: {found:.2f} mm from the blank"
