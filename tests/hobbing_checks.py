@@ -24,6 +24,7 @@ class Job:
     coolant: bool = True
     shift: float | str = 0.0          # fixed shift position (DIN), or 'per part'
     worm_feed: str = "radial"
+    tailstock: bool = True
 
 
 @dataclass(frozen=True)
@@ -387,12 +388,3 @@ def _deepest(move: Move, eta: float, case: Case, unit: Unit, step: float) -> flo
     count = max(1, math.ceil(max(abs(dx), abs(dz)) / step))
     return max(hob_intrusion(move.start["X"] + dx * k / count, move.start["Z"] + dz * k / count, eta,
                              case.hob, case.gear, unit) for k in range(count + 1))
-
-
-ALL_CHECKS = (contract_problems, coupling_problems, depth_problems, approach_problems, feed_problems,
-              envelope_problems)
-
-
-def all_problems(nc: Nc, case: Case) -> list[str]:
-    return [f"{check.__name__}: {p}" for check in ALL_CHECKS for p in check(nc, case)]
-

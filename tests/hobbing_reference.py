@@ -209,6 +209,10 @@ class Machine:
     y: int = 1
     z: int = 1
     work_offset: str = "G54"
+    table_speed_max: float = 120.0      # r/min of C
+    rapid_rate: float = 8000.0          # mm/min, G0
+    fixture: tuple = (25.0, 0.0)        # diameter, gap below the lowest unit's bottom face (0 Ø = none)
+    tailstock: tuple = (25.0, 0.0)      # diameter, gap above the top face, when clamped (M20)
 
     def din(self, axis: str, value):
         """A programmed coordinate in the DIN 66217 frame (§A7: program = DIN × sense)."""

@@ -18,10 +18,12 @@ from __future__ import annotations
 
 from hobbing_checks import (Case, Job, approach_problems, contract_problems, coupling_problems, depth_problems,
                             envelope_problems, feed_problems)
+from hobbing_machine_checks import cycle_time_problems, obstacle_problems, table_speed_problems
 from hobbing_reference import Gear, Hob, Machine, Unit
 
 SPUR = """%_N_REFSPUR_MPF
 ;$PATH=/_N_MPF_DIR
+; CYCLE TIME 2.3 MIN
 ; GEAR hand-written
 G90 G71 G94
 G25 X20.000 Y-1.000 Z-30.000
@@ -48,6 +50,7 @@ M30"""
 
 HELICAL_MIRROR = """%_N_REFHEL_MPF
 ;$PATH=/_N_MPF_DIR
+; CYCLE TIME 4.2 MIN
 G90 G71 G94
 G25 X20.000 Y-1.000 Z-120.000
 G26 X300.000 Y1.000 Z40.000
@@ -73,6 +76,7 @@ M30"""
 
 WORM_TANGENTIAL_LEFT = """%_N_REFWORM_MPF
 ;$PATH=/_N_MPF_DIR
+; CYCLE TIME 5.8 MIN
 G90 G71 G94
 G25 X20.000 Y-80.000 Z-100.000
 G26 X300.000 Y80.000 Z120.000
@@ -98,6 +102,7 @@ M30"""
 
 DUPLEX = """%_N_REFDUPLEX_MPF
 ;$PATH=/_N_MPF_DIR
+; CYCLE TIME 3.8 MIN
 G90 G71 G94
 G25 X20.000 Y-1.000 Z-100.000
 G26 X300.000 Y1.000 Z120.000
@@ -154,6 +159,10 @@ HAND_WRITTEN = {
         "rough feed too high": ("F25", "F31", feed_problems),
         "rapid through the blank": ("G0 X300.000 Z100.000", "G0 X300.000 Z100.000\nG0 X40.000 Z-10.000",
                                     envelope_problems),
+        "hob into the fixture": ("G0 X300.000 Z100.000", "G0 X300.000 Z-60.000\nG0 X40.000", obstacle_problems),
+        "hob into the tailstock": ("G0 X300.000 Z100.000", "G0 X300.000 Z100.000\nG0 X40.000", obstacle_problems),
+        "cycle time off": ("CYCLE TIME 2.3", "CYCLE TIME 2.6", cycle_time_problems),
+        "no cycle time": ("; CYCLE TIME 2.3 MIN\n", "", cycle_time_problems),
     }),
     "helical on the mirrored machine": (HELICAL_MIRROR, HELICAL_CASE, {
         "Z factor with the DIN sign reversed": ("Z,-0.241126", "Z,0.241126", coupling_problems),
@@ -161,6 +170,7 @@ HAND_WRITTEN = {
         "B not transformed": ("B,1,41", "B,-1,41", coupling_problems),
         "A not transformed": ("A=12.628", "A=-12.628", coupling_problems),
         "approach short of §B7": ("Z-31.000", "Z-28.000", approach_problems),
+        "table over its speed": ("M3 S338", "M3 S5000", table_speed_problems),
     }),
     "left-hand tangential worm wheel": (WORM_TANGENTIAL_LEFT, WORM_CASE, {
         "Y factor sign follows the hob hand": ("Y,0.952548", "Y,-0.952548", coupling_problems),
@@ -168,6 +178,7 @@ HAND_WRITTEN = {
         "no Y leading axis": ("EGDEF(C,B,1,Y,1)", "EGDEF(C,B,1)", coupling_problems),
         "hob starts inside the wheel": ("G0 Y76.000", "G0 Y60.000", approach_problems),
         "plunge shallow": ("X81.400", "X81.500", depth_problems),
+        "table over its speed": ("S1=460", "S1=5000", table_speed_problems),
     }),
     "duplex large over small": (DUPLEX, DUPLEX_CASE, {
         "unit 2 infeed too close to unit 1": ("G0 Z-57.000", "G0 Z-45.000", envelope_problems),

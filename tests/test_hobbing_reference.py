@@ -31,8 +31,9 @@ from engine.errors import EngineError
 from engine.hobbing.choices import Choices
 from engine.programs.instantiate import instantiate_gear
 
-from hobbing_checks import (Case, Job, all_problems, approach_problems, contract_problems, coupling_problems,
-                            depth_problems, envelope_problems, feed_problems)
+from hobbing_checks import (Case, Job, approach_problems, contract_problems, coupling_problems, depth_problems,
+                            envelope_problems, feed_problems)
+from hobbing_machine_checks import all_problems, cycle_time_problems, obstacle_problems, table_speed_problems
 from hobbing_reference import Gear, Hob, Machine, Unit, layout_cuttable, lead_angle, read
 from hobbing_reference_programs import HAND_WRITTEN
 
@@ -214,7 +215,8 @@ class Bench:
         gear = make_gear(cls, gear_hand, hob, cone, large_below)
         choices = dict(JOB_CHOICES[choice], **({"worm_feed": worm} if worm_wheel else {}))
         shift = {"shift-fixed": 5.0, "shift-per-part": "per part"}.get(choice, 0.0)
-        case = Case(gear, hob, MACHINES[machine_key], Job(choices.get("coolant", True), shift, worm))
+        case = Case(gear, hob, MACHINES[machine_key],
+                    Job(choices.get("coolant", True), shift, worm, choices.get("tailstock", True)))
         gear_id = self.gear_ids[case_id] = 9000 + len(self.made)
         with self.conn.transaction(force_rollback=True):
             only_hob(self.conn, insert_hob(self.conn, hob, mn, "worm_wheel" if worm_wheel else "cylindrical"))
@@ -305,6 +307,24 @@ def test_rough_feed_within_reference_maximum_for_module(bench, case_id):
 def test_hob_envelope_never_enters_a_unit_outside_its_cut(bench, case_id):
     case, nc = program_of(bench, case_id)
     assert_none([] if nc is None else envelope_problems(nc, case), case_id)
+
+
+@pytest.mark.parametrize("case_id", CASE_IDS)
+def test_hob_never_touches_fixture_or_tailstock(bench, case_id):
+    case, nc = program_of(bench, case_id)
+    assert_none([] if nc is None else obstacle_problems(nc, case), case_id)
+
+
+@pytest.mark.parametrize("case_id", CASE_IDS)
+def test_table_speed_within_machine_limit_on_every_coupled_move(bench, case_id):
+    case, nc = program_of(bench, case_id)
+    assert_none([] if nc is None else table_speed_problems(nc, case), case_id)
+
+
+@pytest.mark.parametrize("case_id", CASE_IDS)
+def test_cycle_time_header_agrees_with_the_moves(bench, case_id):
+    case, nc = program_of(bench, case_id)
+    assert_none([] if nc is None else cycle_time_problems(nc, case), case_id)
 
 
 @pytest.mark.parametrize("case_id", [c for c in CASE_IDS if c.endswith("default@din")])
@@ -398,6 +418,7 @@ def test_random_valid_gears_make_a_correct_program_or_a_one_line_refusal(conn, k
                 assert f"gear {gear_id}" in message, f"a duplex refusal must name the gear: {message!r}"
             return
     shift = {5.0: 5.0}.get(choice.get("shift_y"), "per part" if choice.get("shift_per_part") else 0.0)
-    case = Case(gear, hob, DIN, Job(choice.get("coolant", True), shift, choice.get("worm_feed", "radial")))
+    case = Case(gear, hob, DIN, Job(choice.get("coolant", True), shift, choice.get("worm_feed", "radial"),
+                                    choice.get("tailstock", True)))
     problems = all_problems(read(program.text), case)
     assert not problems, f"{gear} {hob} {choice}:\n  " + "\n  ".join(problems) + "\n" + program.text
