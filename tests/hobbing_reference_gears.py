@@ -35,8 +35,8 @@ PAPER_STOCK = ("40Cr", 250, 7)  # the paper's: its seeded case feeds 8.11 mm per
 def insert_gear(conn, gear_id: int, gear: Gear, crowning: float = 0.0, stock: tuple = STOCK) -> None:
     first = gear.first
     conn.execute("INSERT INTO gear (id, gear_class, module, teeth, pressure_angle, helix_angle, hand, face_width, "
-                 "tip_diameter, root_diameter, cone_angle, crowning, material, hardness, quality_grade, quantity) "
-                 "VALUES (%s, %s, %s, %s, %s, %s, %s, %s, %s, %s, %s, %s, %s, %s, %s, 50)",
+                 "tip_diameter, root_diameter, cone_angle, crowning, material, hardness, quality_grade, quantity, "
+                 "module_kind) VALUES (%s, %s, %s, %s, %s, %s, %s, %s, %s, %s, %s, %s, %s, %s, %s, 50, 'normal')",
                  (gear_id, gear.gear_class, gear.mn, first.z2, gear.alpha, gear.beta, gear.hand, first.b,
                   first.da, first.df, gear.cone or None, crowning or None, *stock))
     for number, unit in enumerate(gear.units[1:], start=2):

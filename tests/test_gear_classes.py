@@ -65,10 +65,15 @@ def test_taper_x_follows_z_along_the_cone(conn):
         assert abs((move.end["X"] - move.start["X"]) / dz - slope) < 2 * ROUND / abs(dz)
         # the pass crosses both faces: from above Z = 0 to below Z = -b (climb)
         assert move.start["Z"] > 0 and move.end["Z"] < -g["b"]
-    # at the top face (Z = 0) the last cut is at full depth (d_f2 + d_a0)/2 (§B3, §7)
+    # at the top face (Z = 0) the last cut reaches the root cone: the hob's tip section (an
+    # ellipse r0 × r0/cos η for the swivel η = γ of a spur gear, §B2) touches the root line
+    # x = d_f2/2 + z·tan δ, so its centre lies the ellipse's support distance off that line
+    # (for δ = 0 this is (d_f2 + d_a0)/2, §B3)
     last = slanted[-1]
     x_at_top = last.start["X"] + (0 - last.start["Z"]) * slope
-    assert abs(x_at_top - (g["df2"] + hob["da0"]) / 2) < 0.01
+    delta, eta, r0 = math.radians(g["cone"]), math.radians(lead_angle(hob)), hob["da0"] / 2
+    support = r0 * math.sqrt(math.cos(delta) ** 2 + (math.sin(delta) / math.cos(eta)) ** 2)
+    assert abs(x_at_top - (g["df2"] / 2 + support / math.cos(delta))) < 0.01
 
 
 def test_taper_feed_along_the_slant_keeps_the_axial_feed(conn):
