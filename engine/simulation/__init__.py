@@ -6,5 +6,6 @@ swivel against the gear; the depth per cut, the run-out, the table speed, the fe
 revolution and the cycle time."""
 from .report import Finding, Report, SimulationError
 from .run import prove_program, simulate_program
+from .stored import simulate_stored_program
 
-__all__ = ["Finding", "Report", "SimulationError", "prove_program", "simulate_program"]
+__all__ = ["Finding", "Report", "SimulationError", "prove_program", "simulate_program", "simulate_stored_program"]

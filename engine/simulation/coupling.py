@@ -111,7 +111,7 @@ def coupling_problems(coupling: Coupling, gear: Gear, hob: Hob, teeth: int, worm
     problems = []
     wanted_b = expected_k_b(hob, teeth)
     if coupling.k_b * wanted_b < 0:
-        problems.append(f"the table turns the wrong way for a {_hand(hob.hand)} hob: k_B is {coupling.k_b:+.6g} in "
+        problems.append(f"the table turns the wrong way for a {hand_name(hob.hand)} hob: k_B is {coupling.k_b:+.6g} in "
                         f"the DIN frame, the reference needs {wanted_b:+.6g} (−h_hob·z0/z2)")
     for axis, wanted in _wanted_factors(gear, hob, teeth, worm_wheel, moving).items():
         found = coupling.factors.get(axis, 0.0)
@@ -132,9 +132,9 @@ def _wanted_factors(gear, hob, teeth, worm_wheel, moving) -> dict:
 def _factor_problem(axis: str, found: float, wanted: float, gear: Gear, teeth: int) -> str:
     if axis == "Z":
         beta, hand, lead = helix_of(found, gear, teeth)
-        made = "no helix (spur)" if hand is None else f"a {_hand(hand)} helix of β {beta:.3f}°, lead {lead:.1f} mm"
+        made = "no helix (spur)" if hand is None else f"a {hand_name(hand)} helix of β {beta:.3f}°, lead {lead:.1f} mm"
         return (f"the Z term {found:+.6f}°/mm (DIN) generates {made}; the gear needs {wanted:+.6f}°/mm "
-                f"(−h_gear·360·sinβ/(π·m_n·z2), {_hand(gear.hand) if gear.helix_angle else 'spur'})")
+                f"(−h_gear·360·sinβ/(π·m_n·z2), {hand_name(gear.hand) if gear.helix_angle else 'spur'})")
     return (f"the Y term {found:+.6f}°/mm (DIN) is not the {wanted:+.6f}°/mm the hob's feed along Y needs "
             "(+360·cosγ/(π·m_n·z2), 0 where Y does not feed while coupled)")
 
@@ -147,5 +147,5 @@ def swivel_problem(swivel_din: float, gear: Gear, hob: Hob) -> str | None:
             f"(h_hob·γ − h_gear·β, γ {lead_angle(hob):.3f}°): the hob's thread would not lie along the teeth")
 
 
-def _hand(hand: str | None) -> str:
+def hand_name(hand: str | None) -> str:
     return {"R": "right-hand", "L": "left-hand"}.get(hand, "spur")

@@ -13,7 +13,8 @@ import numpy as np
 
 from ..gears.records import Gear, Hob, Machine
 from ..programs.verifier.shift_clamp import ShiftClamp
-from . import coupling as couplings
+from .coupling import (Coupling, coupling_problems, generated_teeth_problem, hand_name, hand_sign, helix_of,
+                       lead_angle, read_coupling, swivel_problem)
 from .contact import Motion, follow
 from .cuts import Cut, summary
 from .envelope import HobBody
@@ -41,7 +42,7 @@ class Walk:
         self.swivel_known = False
         self.feed = self.speed = None
         self.spindle = self.tailstock = False
-        self.coupling: couplings.Coupling | None = None
+        self.coupling: Coupling | None = None
         self.session = 0
         self.cut: Cut | None = None
         self.last_cut_of: dict[int, Cut] = {}
@@ -71,10 +72,10 @@ class Walk:
 
     def _couple(self, step) -> None:
         code = step.line.partition(";")[0].strip()
-        self.coupling = couplings.read_coupling(code, self.senses)
+        self.coupling = read_coupling(code, self.senses)
         self.session += 1
         teeth = [unit.teeth for unit in self.units]
-        problem = couplings.generated_teeth_problem(self.coupling, self.hob, teeth)
+        problem = generated_teeth_problem(self.coupling, self.hob, teeth)
         if problem:
             self.report.add(step.number, step.line, problem)
         self._describe_coupling()
@@ -83,12 +84,12 @@ class Walk:
         teeth = self.coupling.teeth(self.hob.starts)
         self.report.teeth.append(f"{teeth:g}")
         if self.worm_wheel:
-            beta = couplings.lead_angle(self.hob) * couplings.hand_sign(self.hob.hand) - self.swivel
+            beta = lead_angle(self.hob) * hand_sign(self.hob.hand) - self.swivel
             hand = "R" if beta >= 0 else "L"
-            self.report.helix.append(f"{couplings._hand(hand)} β {abs(beta):.3f}° (hob lead and swivel)")
+            self.report.helix.append(f"{hand_name(hand)} β {abs(beta):.3f}° (hob lead and swivel)")
             return
-        beta, hand, lead = couplings.helix_of(self.coupling.factors.get("Z", 0.0), self.gear, round(teeth) or 1)
-        self.report.helix.append("spur" if hand is None else f"{couplings._hand(hand)} β {beta:.3f}° lead {lead:.1f} mm")
+        beta, hand, lead = helix_of(self.coupling.factors.get("Z", 0.0), self.gear, round(teeth) or 1)
+        self.report.helix.append("spur" if hand is None else f"{hand_name(hand)} β {beta:.3f}° lead {lead:.1f} mm")
 
     def _shift(self, step) -> None:
         ends = self.clamp.take(step.item)
@@ -177,9 +178,9 @@ class Walk:
         if not self.swivel_known:
             problems.append("the swivel A is not positioned before the cut")
         else:
-            problems.append(couplings.swivel_problem(self.swivel, self.gear, self.hob))
+            problems.append(swivel_problem(self.swivel, self.gear, self.hob))
         if teeth is not None:
-            problems += couplings.coupling_problems(self.coupling, self.gear, self.hob, teeth, self.worm_wheel, moving)
+            problems += coupling_problems(self.coupling, self.gear, self.hob, teeth, self.worm_wheel, moving)
         for problem in filter(None, problems):
             if (self.session, problem) not in self.said:
                 self.said.add((self.session, problem))
