@@ -20,6 +20,7 @@ class Cut:
     line: str
     teeth: int
     table_speed: float                  # workpiece revolutions per minute (S·|k_B|)
+    reach_before: dict = field(default_factory=dict)   # id(unit) -> its reach when the cut began
     moves: list = field(default_factory=list)   # (start DIN, end DIN, velocities {axis: mm/min})
 
     def add(self, start: dict, end: dict, velocities: dict) -> None:
@@ -53,7 +54,7 @@ def feed_per_revolution(cut: Cut, axes: tuple) -> float | None:
 
 def radial_feed(cut: Cut) -> float | None:
     radial = [move for move in cut.moves if set(move[2]) == {"X"}]
-    return feed_per_revolution(Cut(cut.number, cut.line, cut.teeth, cut.table_speed, radial), ("X",))
+    return feed_per_revolution(Cut(cut.number, cut.line, cut.teeth, cut.table_speed, moves=radial), ("X",))
 
 
 def summary(cut: Cut, unit: Solid, half_length: float) -> CutSummary:

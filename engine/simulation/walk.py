@@ -129,12 +129,11 @@ class Walk:
         self._table_speed(step, velocities)
         if cutting:
             self._check_cut(step, start, end)
+            self._extend_cut(step, start, end, velocities)
         else:
             self._end_cut()
         if {"X", "Z"} <= end.keys():
             self._contacts(step, motion, cutting, start, end)
-        if cutting and {"X", "Z"} <= end.keys():
-            self._extend_cut(step, start, end, velocities)
         self.position = end
 
     def _time(self, motion: int, program: dict) -> None:
@@ -230,7 +229,8 @@ class Walk:
         if self.cut is None or self.cut.teeth != teeth:
             self._end_cut()
             table = abs(self.coupling.k_b) * self.speed
-            self.cut = Cut(step.number, step.line, teeth, table)
+            before = {id(unit): unit.reach.copy() for unit in self.units if unit.teeth == teeth}
+            self.cut = Cut(step.number, step.line, teeth, table, before)
         self.cut.add(start, end, velocities)
 
     def _end_cut(self) -> None:
@@ -238,7 +238,7 @@ class Walk:
             return
         cut, self.cut = self.cut, None
         for unit in self.units:
-            if unit.teeth == cut.teeth and np.isfinite(unit.reach).any():
+            if id(unit) in cut.reach_before and (unit.reach < cut.reach_before[id(unit)]).any():
                 self.last_cut_of[id(unit)] = cut
                 self.report.cuts.append(summary(cut, unit, self.body.half_length))
                 self._check_run_out(cut, self.report.cuts[-1])
