@@ -219,6 +219,9 @@ CREATE TABLE gear (
     hardness       numeric,
     quality_grade  integer CHECK (quality_grade BETWEEN 1 AND 12),
     quantity       integer CHECK (quantity > 0),
+    -- The module stated is normal, or the worm's axial module m_x (worm wheels; migration 0014):
+    -- m_n = m_x·cos γ. NULL = not stated: normal for cylindrical gears, refused for worm wheels.
+    module_kind    text CHECK (module_kind IN ('normal', 'axial')),
     CHECK (helix_angle = 0 OR hand IS NOT NULL),
     CONSTRAINT gear_cone_angle CHECK (cone_angle > -45 AND cone_angle < 45),
     CONSTRAINT gear_crowning CHECK (crowning >= 0 AND crowning < 1)

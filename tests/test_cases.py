@@ -20,6 +20,13 @@ from engine.programs.instantiate import instantiate_gear
 PAPER_GEAR = 9019
 # The published example: m 2, α 20°, z 19, d_a 42.5, 40Cr, grade 7, cone 6.5°, 1-start AA hob, rough cut.
 PAPER_N0, PAPER_AXIAL, PAPER_RADIAL = 246, 105.0, 36.0
+# Reference §C: roughing f_a for m2 is 1.5–3.0 mm per workpiece rev; the paper's is 105/(246/19) = 8.11.
+M2_ROUGH_MAX = 3.0
+PAPER_FEED_PER_REV = PAPER_AXIAL / (PAPER_N0 / 19)
+BOUNDED_AXIAL = round(M2_ROUGH_MAX * PAPER_N0 / 19, 1)                                     # 38.8 mm/min
+BOUNDED_RADIAL = round(PAPER_RADIAL * M2_ROUGH_MAX / PAPER_FEED_PER_REV, 1)                # scaled alike
+# A case within the §C range even for a 2-start hob (3.0/√2 = 2.12): 25 mm/min is 1.93 mm/rev.
+USUAL_AXIAL, USUAL_RADIAL = 25.0, 8.0
 CASE_COLUMNS = ("module", "teeth", "material", "hardness", "quality_grade", "hob_material", "hob_coating",
                 "hob_starts", "hob_tip_diameter", "cut", "hob_speed", "axial_feed", "radial_feed", "source")
 
@@ -62,20 +69,58 @@ def empty_history(conn):
     return conn
 
 
-def test_the_papers_example_comes_back_as_published(conn, machine):
+def test_the_papers_example_comes_back_with_its_feed_bounded_to_the_m2_roughing_maximum(conn, machine):
     seed_cases(conn)
     gear = insert_paper_gear(conn)
     suggestion = suggest(conn, gear, hob(conn), machine)
     cutting = suggestion.cutting
     assert cutting.hob_speed == PAPER_N0
-    assert mm_per_min(cutting.axial_feed_rough, cutting) == PAPER_AXIAL
-    assert mm_per_min(cutting.radial_feed, cutting) == PAPER_RADIAL
     assert math.isclose(cutting.cutting_speed, math.pi * 70 * 246 / 1000)
     nearest = suggestion.cases[suggestion.cases.cut == "rough"].iloc[0]
     assert nearest.source.startswith("CAO/YAN/GUO 2015") and nearest.distance == 0
-    # Reference §D: 105 mm/min at n2 = 246/19 r/min is 8.11 mm per workpiece rev, above 1.5–3.0 for m2.
-    feed_note = [note for note in suggestion.notes if f"{105 / (246 / 19):.2f}" in note]
-    assert feed_note and "1.5–3.0" in feed_note[0] and "m2" in feed_note[0]
+    # Reference §D: 105 mm/min at n2 = 246/19 r/min is 8.11 mm per workpiece rev, 2.7× the 3.0 for m2 (§C):
+    # bounded to 3.0, the radial feed scaled by the same factor, and said in one note.
+    assert mm_per_min(cutting.axial_feed_rough, cutting) == BOUNDED_AXIAL
+    assert mm_per_min(cutting.radial_feed, cutting) == BOUNDED_RADIAL
+    feed_note = [note for note in suggestion.notes if f"{PAPER_FEED_PER_REV:.2f}" in note]
+    assert len(feed_note) == 1 and "bounded to 3.00" in feed_note[0] and "m2" in feed_note[0]
+
+
+@pytest.mark.parametrize("module, teeth, starts, cut, maximum", [
+    (1.0, 20, 1, "rough", 2.0), (1.5, 20, 1, "rough", 2.5), (2.5, 30, 1, "rough", 3.25), (4.0, 25, 1, "rough", 4.0),
+    (3.0, 41, 1, "finish", 2.0), (1.5, 20, 1, "finish", 1.25), (0.8, 20, 1, "rough", 2.0),
+    (2.0, 30, 2, "rough", 3.0 / math.sqrt(2)), (2.0, 30, 4, "finish", 1.5 / 2)])
+def test_a_case_feed_above_the_table_is_bounded_per_module_and_starts(empty_history, machine, module, teeth,
+                                                                      starts, cut, maximum):
+    """§C table interpolated between modules (m1 2.0/1.0, m2 3.0/1.5, m3 3.5/2.0, m4 4.0/2.0), the end rows
+    beyond; a z0-start hob takes the single-start maximum / √z0. A case of 6 mm/rev is above all of them."""
+    conn = empty_history
+    insert_case(conn, module=module, teeth=teeth, hob_starts=starts, cut=cut,
+                axial_feed=6.0 * PAPER_N0 * starts / teeth, radial_feed=2.0 * PAPER_N0 * starts / teeth)
+    conn.execute("INSERT INTO gear (id, gear_class, module, teeth, face_width, material, hardness, quality_grade) "
+                 "VALUES (9020, 'spur', %s, %s, 20, '40Cr', 250, 7)", (module, teeth))
+    suggestion = suggest(conn, load_gear(conn, 9020), hob(conn, module=module, starts=starts), machine)
+    feed = suggestion.feeds(cut)
+    assert feed["axial_feed_per_rev"] == pytest.approx(maximum)
+    assert feed["radial_feed_per_rev"] == pytest.approx(2.0 * maximum / 6.0)
+    assert sum(f"bounded to {maximum:.2f}" in note and note.startswith(cut) for note in suggestion.notes) == 1
+
+
+def test_a_case_feed_within_the_table_is_taken_as_is_without_a_note(empty_history, machine):
+    conn = empty_history
+    insert_case(conn, axial_feed=USUAL_AXIAL, radial_feed=USUAL_RADIAL)
+    suggestion = suggest(conn, insert_paper_gear(conn), hob(conn), machine)
+    assert mm_per_min(suggestion.cutting.axial_feed_rough, suggestion.cutting) == USUAL_AXIAL
+    assert not [note for note in suggestion.notes if "bounded" in note]
+
+
+def test_an_override_of_the_feed_beyond_the_table_is_refused(empty_history, machine):
+    from engine.gears.cutting_data import default_cutting_data
+
+    cutting = default_cutting_data(2.0, "40Cr", True, 70, 1000)
+    assert cutting.with_overrides(2.0, 1, axial_feed_rough=M2_ROUGH_MAX).axial_feed_rough == M2_ROUGH_MAX
+    with pytest.raises(EngineError, match="axial feed rough 3.1 mm per workpiece rev exceeds the 3.00 maximum for m2"):
+        cutting.with_overrides(2.0, 1, axial_feed_rough=3.1)
 
 
 def test_the_nearest_case_ranks_first_and_weighs_most(empty_history, machine):
@@ -95,24 +140,24 @@ def test_the_nearest_case_ranks_first_and_weighs_most(empty_history, machine):
 @pytest.mark.parametrize("tip_diameter", [50.0, 80.0, 90.0])
 def test_a_case_transfers_to_another_hob_through_the_cutting_speed(empty_history, machine, tip_diameter):
     conn = empty_history
-    insert_case(conn)   # the paper's cut, made with a d_a0 70 hob
+    insert_case(conn, axial_feed=USUAL_AXIAL, radial_feed=USUAL_RADIAL)   # a cut made with a d_a0 70 hob
     gear = insert_paper_gear(conn)
     cutting = suggest(conn, gear, hob(conn, tip_diameter=tip_diameter), machine).cutting
     # Same v = π·70·246/1000 on the other hob: n0 = 246·70/d_a0; same feed per workpiece rev.
     expected_n0 = round(PAPER_N0 * 70 / tip_diameter)
     assert cutting.hob_speed == expected_n0
-    assert mm_per_min(cutting.axial_feed_rough, cutting) == round(PAPER_AXIAL * expected_n0 / PAPER_N0, 1)
-    assert mm_per_min(cutting.radial_feed, cutting) == round(PAPER_RADIAL * expected_n0 / PAPER_N0, 1)
+    assert mm_per_min(cutting.axial_feed_rough, cutting) == round(USUAL_AXIAL * expected_n0 / PAPER_N0, 1)
+    assert mm_per_min(cutting.radial_feed, cutting) == round(USUAL_RADIAL * expected_n0 / PAPER_N0, 1)
 
 
 def test_feeds_per_workpiece_rev_carry_over_to_other_teeth_and_starts(empty_history, machine):
     conn = empty_history
-    insert_case(conn)
+    insert_case(conn, axial_feed=USUAL_AXIAL, radial_feed=USUAL_RADIAL)
     gear = insert_paper_gear(conn, teeth=38)
     cutting = suggest(conn, gear, hob(conn, starts=2), machine).cutting
-    # f = 105/(246·1/19) mm/rev; on z 38 with 2 starts: v_f = f·246·2/38 = 105 mm/min again.
+    # f = 25/(246·1/19) mm/rev; on z 38 with 2 starts: v_f = f·246·2/38 = 25 mm/min again.
     assert cutting.hob_speed == PAPER_N0
-    assert mm_per_min(cutting.axial_feed_rough, cutting, starts=2, teeth=38) == PAPER_AXIAL
+    assert mm_per_min(cutting.axial_feed_rough, cutting, starts=2, teeth=38) == USUAL_AXIAL
 
 
 def test_the_hob_speed_stops_at_the_spindle_maximum(empty_history, machine):
@@ -153,7 +198,7 @@ def test_a_confirmed_job_becomes_one_case_per_cut_and_only_once(conn, machine):
     gear, paper_hob = insert_paper_gear(conn), hob(conn)
     suggestion = suggest(conn, gear, paper_hob, machine)
     record = job_cutting_record(suggestion.cutting, gear, paper_hob, ["rough"], suggestion.case_ids(["rough"]))
-    assert record["rough"] == {"axial_feed": PAPER_AXIAL, "radial_feed": PAPER_RADIAL} and "finish" not in record
+    assert record["rough"] == {"axial_feed": BOUNDED_AXIAL, "radial_feed": BOUNDED_RADIAL} and "finish" not in record
     job_id = instantiate_gear(conn, gear.id).job_id   # a job becomes a case only once the engine made its program
     stored = stored_cutting(conn, job_id)
     assert (stored["hob_speed"], stored["rough"], "finish" in stored) == (PAPER_N0, record["rough"], False)
@@ -161,7 +206,7 @@ def test_a_confirmed_job_becomes_one_case_per_cut_and_only_once(conn, machine):
     (case_id,) = confirm_job(conn, job_id)
     case = list_cases(conn).set_index("id").loc[case_id]
     assert (case.module, case.teeth, case.material, case.cut, case.hob_tip_diameter) == (2, 19, "40Cr", "rough", 70)
-    assert (case.hob_speed, case.axial_feed, case.radial_feed) == (PAPER_N0, PAPER_AXIAL, PAPER_RADIAL)
+    assert (case.hob_speed, case.axial_feed, case.radial_feed) == (PAPER_N0, BOUNDED_AXIAL, BOUNDED_RADIAL)
     assert case.source == f"job {job_id}" and case.job_id == job_id
     with pytest.raises(EngineError, match=f"job {job_id} was already confirmed at"):
         confirm_job(conn, job_id)
@@ -221,11 +266,13 @@ def test_cli_suggest_prints_the_hob_cases_and_proposal(run):
     assert result.exit_code == 0, result.output
     out = result.stdout
     assert "H-M2-AA-R1" in out and "CAO/YAN/GUO 2015" in out
-    assert "n0 246 r/min" in out and "axial 105.0 mm/min (8.11 mm/rev)" in out and "radial 36.0 mm/min" in out
-    assert "1.5–3.0" in out
+    assert "n0 246 r/min" in out and f"axial {BOUNDED_AXIAL} mm/min (3.00 mm/rev)" in out
+    assert f"radial {BOUNDED_RADIAL} mm/min" in out
+    bounded = [line for line in out.splitlines() if "bounded to" in line]
+    assert len(bounded) == 1 and "8.11" in bounded[0] and "3.00" in bounded[0] and "m2" in bounded[0]
     report = json.loads(run("suggest", "--gear", 42, "--json", "--top", 1).stdout)
     assert report["hob"]["id"] == "H-M2-AA-R1" and report["hob_speed"] == PAPER_N0
-    assert (report["rough"]["axial_feed"], report["rough"]["radial_feed"]) == (PAPER_AXIAL, PAPER_RADIAL)
+    assert (report["rough"]["axial_feed"], report["rough"]["radial_feed"]) == (BOUNDED_AXIAL, BOUNDED_RADIAL)
     assert len(report["cases"]) == 2
 
 

@@ -75,22 +75,31 @@ def test_taper_feed_along_the_slant_keeps_the_axial_feed(conn):
     program, nc = program_of(conn, 50)
     slanted = [m for m in cutting_moves(nc) if {"X", "Z"} <= m.changed][-1]
     axial = slanted.feed * math.cos(math.radians(gear(conn, 50)["cone"]))
-    assert abs(axial - 105.0) < 0.1   # the paper's 105 mm/min axial, from the seeded case
+    assert abs(axial - PAPER_AXIAL_BOUNDED) < 0.1   # the paper's case, bounded to m2's roughing maximum
+
+
+# The paper's case (§D): 246 r/min, 105 axial and 36 radial mm/min, i.e. 105/(246/19) = 8.11 mm per
+# workpiece rev, 2.7× the roughing maximum 3.0 for m2 (§C): bounded to 3.0 mm/rev, radial scaled alike.
+PAPER_FEED_PER_REV = 105.0 / (246 / 19)
+PAPER_AXIAL_BOUNDED = round(3.0 * 246 / 19, 1)
+PAPER_RADIAL_BOUNDED = round(36.0 * 3.0 / PAPER_FEED_PER_REV, 1)
 
 
 def test_the_papers_example_reproduced(conn):
     """m2 z19 40Cr grade 7, 1-start AA hob, rough, no shift, coolant, tailstock (§D): the
-    seeded case gives 246 r/min, 105 axial and 36 radial mm/min."""
+    seeded case gives 246 r/min; its feeds are bounded to the §C roughing maximum for m2."""
     program, nc = program_of(conn, 50)
     hob = hob_of(conn, program)
     assert hob["z0"] == 1 and "AA" in next(line for line in program.lines if line.startswith("; HOB "))
     assert nc.block_with("M3").words["S"] == 246
     infeed = next(m for m in cutting_moves(nc) if m.changed == {"X"})
-    assert infeed.feed == 36.0
+    assert infeed.feed == PAPER_RADIAL_BOUNDED
     assert nc.index("M8") is not None and nc.index("M20") is not None   # coolant on, tailstock clamp
     assert not any("Y" in m.changed for m in nc.moves)                    # no shift
     job = conn.execute("SELECT cutting FROM job WHERE id = %s", (program.job_id,)).fetchone()[0]
-    assert job["hob_speed"] == 246 and job["rough"] == {"axial_feed": 105.0, "radial_feed": 36.0}
+    assert job["hob_speed"] == 246 and job["rough"] == {"axial_feed": PAPER_AXIAL_BOUNDED,
+                                                        "radial_feed": PAPER_RADIAL_BOUNDED}
+    assert any(f"{PAPER_FEED_PER_REV:.2f}" in note and "bounded to 3.00" in note for note in job["notes"])
     assert job["case_ids"], "the job records which cases its cutting data came from"
 
 
@@ -299,8 +308,11 @@ def test_suggest_for_the_papers_gear_proposes_its_published_data(run):
     assert out.exit_code == 0, out.output
     proposal = json.loads(out.stdout)
     text = json.dumps(proposal)
-    assert '"hob_speed": 246' in text and "105.0" in text and "36.0" in text
-    assert "8.11 mm per workpiece rev is above the typical" in text
+    assert '"hob_speed": 246' in text
+    assert (proposal["rough"]["axial_feed"], proposal["rough"]["radial_feed"]) == (PAPER_AXIAL_BOUNDED,
+                                                                                   PAPER_RADIAL_BOUNDED)
+    assert any(f"axial feed {PAPER_FEED_PER_REV:.2f} mm per workpiece rev" in note and "bounded to 3.00" in note
+               for note in proposal["notes"])
 
 
 def test_a_confirmed_job_becomes_a_case_of_the_history(run):

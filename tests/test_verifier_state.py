@@ -170,7 +170,9 @@ def test_a_spur_program_without_its_egon_and_m3_rows_stores_nothing(run, tmp_pat
         conn.execute("UPDATE template_view SET p_emit = 'False' WHERE gear_class = 'spur' AND id IN (1500, 1700)")
     before = programs(run.url)
     message = one_line_exit_1(run("instantiate", "--gear", 42, "--out", tmp_path))
-    assert "G1 X51.500 F36.0" in message and "spindle" in message
+    # gear 42's radial infeed: the paper's 36 mm/min scaled with its axial feed, 8.11 → 3.0 mm/rev (§C, §D)
+    radial = round(36.0 * 3.0 / (105.0 / (246 / 19)), 1)
+    assert f"G1 X51.500 F{radial}" in message and "spindle" in message
     assert programs(run.url) == before and list(tmp_path.iterdir()) == []
 
 

@@ -57,15 +57,17 @@ def hobs_list(ctx, as_json):
 @click.option("--material", default="HSS", show_default=True, help="Hob material.")
 @click.option("--coating", default="", help="Coating, e.g. TiN (empty: uncoated).")
 @click.option("--purpose", default="cylindrical", show_default=True, help="cylindrical or worm_wheel.")
+@click.option("--tool-number", type=int, default=1, show_default=True,
+              help="The hob's place in the machine's tool list: the program calls T<n> D1.")
 @click.pass_context
 def hobs_add(ctx, hob_id, module, pressure_angle, starts, tip_diameter, length, hand, accuracy_class,
-             material, coating, purpose):
+             material, coating, purpose, tool_number):
     """Add one hob to the library; a bad value or an existing id stores nothing."""
     from ..gears.hob_library import add_hob
     from ..gears.records import Hob
 
     hob = Hob(hob_id, module, pressure_angle, starts, tip_diameter, length, hand, accuracy_class,
-              material, coating, purpose)
+              material, coating, purpose, tool_number)
     with connection(ctx) as conn:
         add_hob(conn, hob)
     click.echo(f"added hob {hob_id}")

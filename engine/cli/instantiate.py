@@ -42,6 +42,9 @@ def parse_range(text: str, option: str = "--gears") -> tuple[int, int]:
 @click.option("--tailstock/--no-tailstock", default=True, show_default=True, help="Tailstock clamp M20/M21.")
 @click.option("--worm-feed", type=click.Choice(["radial", "tangential"]), default="radial", show_default=True,
               help="Worm wheels: radial plunge, or tangential feed along Y.")
+@click.option("--allowance", type=float, default=0.0, show_default=True,
+              help="Radial process allowance left at the final cut for shaving or grinding, mm (the final centre "
+                   "distance is raised by it; the paper's 2.5).")
 @click.option("--hob-speed", type=click.IntRange(min=1), help="Override the hob speed n0, r/min (above 0).")
 @click.option("--workers", type=click.IntRange(1, 64), default=1, show_default=True,
               help="Batch: plan the gears in this many processes (all stored in one transaction, or none).")
@@ -50,7 +53,7 @@ def parse_range(text: str, option: str = "--gears") -> tuple[int, int]:
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object (program_id, path, lines, ...).")
 @click.pass_context
 def instantiate(ctx, gear_id, job_id, gear_range, job_range, all_gears, out, force, machine, cuts, coolant, shift_y,
-                shift_per_part, feed_mode, tailstock, worm_feed, hob_speed, workers, explain, as_json):
+                shift_per_part, feed_mode, tailstock, worm_feed, allowance, hob_speed, workers, explain, as_json):
     """Produce the NC program of a gear (or a stored job, or a batch of gears).
 
     The program is checked against the machine's limits, stored with the template
@@ -71,7 +74,8 @@ def instantiate(ctx, gear_id, job_id, gear_range, job_range, all_gears, out, for
                           "`engine explain --program ID` for the programs of a batch")
     _refuse_new_job_choices_for_stored_jobs(ctx, job_id is not None or bool(job_range))
     choices = Choices(cuts=cuts, coolant=coolant, shift_y=shift_y, shift_per_part=shift_per_part,
-                      feed_mode=feed_mode, tailstock=tailstock, worm_feed=worm_feed)
+                      feed_mode=feed_mode, tailstock=tailstock, worm_feed=worm_feed,
+                      allowance=allowance)
     overrides = {"hob_speed": hob_speed}
     if force and not out:
         raise EngineError("--force replaces files in --out: give --out too")
@@ -93,7 +97,7 @@ def instantiate(ctx, gear_id, job_id, gear_range, job_range, all_gears, out, for
 
 
 NEW_JOB_CHOICES = ("machine", "cuts", "coolant", "shift_y", "shift_per_part", "feed_mode", "tailstock",
-                   "worm_feed", "hob_speed")
+                   "worm_feed", "allowance", "hob_speed")
 
 
 def _refuse_new_job_choices_for_stored_jobs(ctx, stored_jobs: bool) -> None:
@@ -115,10 +119,13 @@ def _report_program(program, as_json: bool, explain: bool) -> None:
         emit_json({"program_id": program.program_id, "job_id": program.job_id, "name": program.name,
                    "path": program.path, "lines": len(program.lines), "gear_class": program.gear_class,
                    "template_version": program.template_version, "template_hash": program.template_hash,
+                   "notes": list(program.notes),
                    **({"explain": [row.as_dict() for row in rows]} if explain else {})})
         return
     for row in rows:
         click.echo(row.sentence(), err=True)
+    for note in program.notes:
+        click.echo(f"note: {note}", err=True)
     if program.path is None:
         click.echo(program.text, nl=False)
     click.echo(f"program {program.program_id} (job {program.job_id}, {len(program.lines)} lines) "
@@ -129,7 +136,9 @@ def _report_program(program, as_json: bool, explain: bool) -> None:
 def _report_batch(batch, out, as_json: bool) -> None:
     if as_json:
         emit_json({"programs": batch.programs, "lines": batch.lines, "path": out,
-                   "program_ids": [batch.first_program_id, batch.last_program_id]})
+                   "program_ids": [batch.first_program_id, batch.last_program_id], "notes": list(batch.notes)})
     else:
+        for note in batch.notes:
+            click.echo(f"note: {note}", err=True)
         click.echo(f"stored {batch.programs} program(s) {batch.first_program_id}…{batch.last_program_id}, "
                    f"{batch.lines} lines" + (f", written to {out}" if out else ""))

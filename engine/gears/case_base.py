@@ -17,7 +17,8 @@ from dataclasses import dataclass
 
 
 from ..errors import EngineError
-from .cutting_data import RADIAL_TO_AXIAL, CuttingData, default_cutting_data, hob_speed, per_minute
+from .cutting_data import (FEED_EPSILON, RADIAL_TO_AXIAL, CuttingData, default_cutting_data, feed_maximum,
+                           hob_speed, per_minute)
 
 CUT_KINDS = ("rough", "finish")
 CUT_KINDS_BY_COUNT = {1: ("rough",), 2: ("rough", "finish")}   # a single cut is a rough cut, as in the paper
@@ -106,13 +107,31 @@ class CaseBase:
         defaults = default_cutting_data(gear.module, gear.material, bool(hob.coating), hob.tip_diameter,
                                         machine.spindle_max)
         found = {cut: self.propose(query_of(gear, hob, cut), top, defaults) for cut in CUT_KINDS}
-        proposals = {cut: proposal for cut, (proposal, _) in found.items()}
+        bounded = {cut: bounded_proposal(proposal, gear.module, hob.starts) for cut, (proposal, _) in found.items()}
+        proposals = {cut: proposal for cut, (proposal, _) in bounded.items()}
         rough, finish = proposals["rough"], proposals["finish"]
         cutting = CuttingData(rough.cutting_speed, hob_speed(rough.cutting_speed, hob.tip_diameter,
                                                              machine.spindle_max),
                               rough.axial_feed, finish.axial_feed, rough.radial_feed,
-                              "; ".join(p.source for p in proposals.values()), finish.radial_feed)
+                              "; ".join(p.source for p in proposals.values()), finish.radial_feed,
+                              tuple(note for _, note in bounded.values() if note))
         return cutting, proposals, {cut: nearest for cut, (_, nearest) in found.items()}
+
+
+def bounded_proposal(proposal: KindProposal, module: float, starts: int) -> tuple[KindProposal, str | None]:
+    """The proposal with its axial feed at most the maximum for the module and hob starts
+    (cutting_data.FEED_MAXIMUM, reference §C), and the one-line note when it was lowered. The
+    radial feed is scaled by the same factor: it came from the same cases, and a feed whose
+    definition is suspect (the paper's, §D) is suspect on both axes."""
+    limit = feed_maximum(module, proposal.cut, starts)
+    if proposal.axial_feed <= limit + FEED_EPSILON:
+        return proposal, None
+    factor = limit / proposal.axial_feed
+    lowered = KindProposal(proposal.cut, proposal.cutting_speed, limit, proposal.radial_feed * factor,
+                           f"{proposal.source}, feed bounded", proposal.case_ids)
+    return lowered, (f"{proposal.cut}: axial feed {proposal.axial_feed:.2f} mm per workpiece rev ({proposal.source}) "
+                     f"bounded to {limit:.2f}, the {proposal.cut}ing maximum for m{module:g} with a {starts}-start "
+                     f"hob (reference §C); radial feed scaled alike to {lowered.radial_feed:.2f}")
 
 
 @dataclass(frozen=True)
@@ -177,4 +196,6 @@ def job_cutting_record(cutting: CuttingData, gear, hob, cut_kinds, case_ids) -> 
     """What job.cutting holds: the job's cuts only (a single-cut job is a rough cut), feeds in mm/min."""
     record = {"source": cutting.source, "hob_speed": cutting.hob_speed,
               "cutting_speed": round(cutting.cutting_speed, 1), "case_ids": [int(i) for i in case_ids]}
+    if cutting.notes:
+        record["notes"] = list(cutting.notes)
     return record | {cut: feeds_per_minute(cutting, gear, hob, cut) for cut in cut_kinds}

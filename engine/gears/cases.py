@@ -108,7 +108,7 @@ def suggest_for_gear(conn, gear_id: int, machine_name: str | None = None, *, top
 
 
 def plausibility_notes(gear: Gear, hob: Hob, machine: Machine, cutting: CuttingData, proposals: dict) -> list[str]:
-    notes = [note for proposal in proposals.values() for note in _feed_note(gear, proposal)]
+    notes = list(cutting.notes) + [note for proposal in proposals.values() for note in _feed_note(gear, proposal)]
     notes += _speed_notes(gear, hob, proposals)
     exact_speed = 1000 * cutting.cutting_speed / (math.pi * hob.tip_diameter)
     if exact_speed > machine.spindle_max:

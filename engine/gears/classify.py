@@ -7,9 +7,15 @@ is adding a row to `RULES`, not another branch. Features no class combines (`CON
 are refused with the reason. Classes that the gear columns alone do not tell apart
 (worm_wheel: the tooth profile comes from the worm; duplex: further units are imported
 after the gear) are not classified: the gear CSV names them explicitly.
+
+Worm wheels are not guessed either way (`looks_like_worm_wheel`): a gear without a class
+whose data look like a worm wheel is refused with a request for its class, because a worm
+wheel classified as helical is cut with a cylindrical hob and an axial pass: the wrong flank
+on a bronze blank, scrapped.
 """
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 from typing import Any, Callable, Collection, Mapping
 
@@ -45,6 +51,33 @@ CONFLICTS: tuple[tuple[tuple[str, str], str], ...] = (
 )
 
 
+# A worm wheel's helix angle is its worm's lead angle tan γ = z1·m_x/d1: 3.6°–7.1° for the usual
+# single-start worms (diameter quotient q = d1/m_x of 8 to 16, DIN 3976), while helical gears are
+# cut at 8°–45°. Worm wheels are bronze (CuSn12, CuAl10Ni: a copper alloy runs against a hardened
+# steel worm); helical gears almost never are. What the drawing has: helix angle and material.
+WORM_LEAD_ANGLE_MAX = 8.0          # degrees: a helix below this is a worm's lead angle, not a helix
+COPPER_ALLOY = re.compile(r"^(g-?|gz-?|gc-?)?cu|bronze|brass", re.IGNORECASE)
+
+
+def looks_like_worm_wheel(gear: Mapping[str, Any]) -> str | None:
+    """Why a gear with a helix looks like a worm wheel (its helix angle is below a helical gear's
+    and would be a worm's lead angle, or its material is a copper alloy), or None. Either sign
+    is enough: refusing a genuine small-helix or bronze helical gear costs the engineer one
+    explicit class; guessing a worm wheel as helical costs the blank."""
+    helix = given_number(gear, "helix_angle")
+    if not helix:
+        return None
+    material = str(gear.get("material") or "")
+    signs = [f"helix angle {helix:g}° below {WORM_LEAD_ANGLE_MAX:g}°, a worm's lead angle"] \
+        if helix < WORM_LEAD_ANGLE_MAX else []
+    signs += [f"material {material}, a copper alloy"] if COPPER_ALLOY.search(material) else []
+    return " and ".join(signs) or None
+
+
+# class a rule found -> (question, the signs that the gear is another class instead, that class)
+ASK_INSTEAD = {"helical": ("does it look like a worm wheel?", looks_like_worm_wheel, "worm_wheel")}
+
+
 @dataclass(frozen=True)
 class Classification:
     """The leaf class a gear falls in (None: no class fits, see `problem`), and the
@@ -53,6 +86,7 @@ class Classification:
     gear_class: str | None
     path: list[tuple[str, str]] = field(default_factory=list)
     problem: str | None = None
+    remedy: str = "give gear_class explicitly"
 
     def explain(self) -> str:
         """One line: `question? no → question? yes → helical`."""
@@ -90,8 +124,21 @@ def classify(gear: Mapping[str, Any]) -> Classification:
         answer = _answer(rule, gear)
         path.append((rule.question, answer))
         if answer.startswith("yes"):
-            return Classification(rule.gear_class, path)
+            return _asked_first(rule.gear_class, gear, path)
     return Classification(DEFAULT_CLASS, path)
+
+
+def _asked_first(gear_class: str, gear: Mapping[str, Any], path: list) -> Classification:
+    """The class found, unless the gear also looks like a class the tree must not guess
+    (ASK_INSTEAD): then no class, and the request to name it."""
+    for found, (question, signs_of, other) in ASK_INSTEAD.items():
+        signs = signs_of(gear) if found == gear_class else None
+        if signs:
+            path.append((question, f"yes ({signs})"))
+            said = other.replace("_", " ")
+            return Classification(None, path, f"looks like a {said} ({signs}); the tree does not guess {said}s",
+                                  f"give gear_class {other} (or {found}) explicitly")
+    return Classification(gear_class, path)
 
 
 def not_installed_message(gear_id: Any, gear_class: str) -> str:
@@ -106,7 +153,7 @@ def classify_installed(gear: Mapping[str, Any], installed: Collection[str]) -> C
     classification = classify(gear)
     gear_id = gear.get("gear_id", gear.get("id", "?"))
     if classification.gear_class is None:
-        raise EngineError(f"gear {gear_id}: {classification.problem}; give gear_class explicitly")
+        raise EngineError(f"gear {gear_id}: {classification.problem}; {classification.remedy}")
     if classification.gear_class not in installed:
         raise EngineError(not_installed_message(gear_id, classification.gear_class))
     return classification
@@ -139,7 +186,7 @@ def explain_gear(conn, gear_id: int) -> GearClassReport:
     """Classify a stored gear again and say how; also the model and hob it gets."""
     gear = load_gear(conn, gear_id)
     classification = classify({"gear_id": gear.id, "cone_angle": gear.cone_angle, "crowning": gear.crowning,
-                               "helix_angle": gear.helix_angle, "units": len(gear.units)})
+                               "helix_angle": gear.helix_angle, "units": len(gear.units), "material": gear.material})
     lineage = ancestry(conn, gear.gear_class) if gear.gear_class else []
     model_class = next((name for name in lineage if name in MODELS), None)
     hob = None

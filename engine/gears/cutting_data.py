@@ -23,6 +23,19 @@ UNKNOWN_MATERIAL_SPEED = (25.0, 50.0)   # conservative when the material is not 
 AXIAL_FEED = ((1.0, 1.5, 0.8), (2.0, 2.5, 1.2), (3.0, 3.0, 1.5), (float("inf"), 3.0, 1.5))
 RADIAL_TO_AXIAL = 0.35   # radial infeed (in air) per workpiece revolution, relative to f_a
 
+# The most axial feed f_a [mm per workpiece revolution] a cut may take, by module: the upper end
+# of the typical ranges of reference/hobbing.md §C (single-start hob, steel, wet; typical practice
+# [K], calibrate with the shop's history). (module, roughing maximum, finishing maximum), modules
+# ascending; between two rows interpolated linearly, below the first and above the last row the
+# end row holds. A single cut is a rough cut. Cases carry feeds from other modules (the paper's
+# 8.11 mm/rev at m2, §D), so every transferred feed is bounded by this table.
+FEED_MAXIMUM = ((1.0, 2.0, 1.0), (2.0, 3.0, 1.5), (3.0, 3.5, 2.0), (4.0, 4.0, 2.0))
+FEED_MAXIMUM_COLUMN = {"rough": 1, "finish": 2}
+# Multi-start hobs: "lower f_a to keep chip thickness in range" (§C). At the same f_a each gash of a
+# z0-start hob takes z0 times the generating increment; the bound is the single-start one / √z0
+# (half at z0 = 4). The exponent is our choice [K][?], not from a source: calibrate it.
+MULTI_START_EXPONENT = 0.5
+
 
 @dataclass(frozen=True)
 class CuttingData:
@@ -33,18 +46,52 @@ class CuttingData:
     radial_feed: float            # mm per workpiece revolution (rough cut, and finish unless given)
     source: str
     radial_feed_finish: float | None = None   # mm per workpiece revolution; None = radial_feed
+    notes: tuple = ()             # what was bounded, one line each (engine suggest and instantiate say them)
 
     @property
     def finish_radial_feed(self) -> float:
         return self.radial_feed if self.radial_feed_finish is None else self.radial_feed_finish
 
-    def with_overrides(self, **overrides) -> "CuttingData":
-        """A speed or feed of 0 or below stops the hob or the feed: refused as it is given."""
+    def of_cuts(self, cut_kinds) -> "CuttingData":
+        """The same data with only the notes of these cut kinds (a single-cut job has no finish)."""
+        return replace(self, notes=tuple(note for note in self.notes if note.split(":")[0] in cut_kinds))
+
+    def with_overrides(self, module: float = 0.0, starts: int = 1, **overrides) -> "CuttingData":
+        """A speed or feed of 0 or below stops the hob or the feed: refused as it is given. An
+        axial feed (mm per workpiece revolution) above the maximum for the module is refused too:
+        the table's maximum is already the upper end of practice; a shop that proved more
+        calibrates FEED_MAXIMUM, it does not pass one job beyond it unnoticed."""
         given = {name: value for name, value in overrides.items() if value is not None}
         for name, value in given.items():
             if not value > 0:
                 raise EngineError(f"{name.replace('_', ' ')} {value:g} must be above 0 (r/min or mm/min)")
+        for name, cut in (("axial_feed_rough", "rough"), ("axial_feed_finish", "finish")):
+            if name in given and given[name] > feed_maximum(module, cut, starts) + FEED_EPSILON:
+                raise EngineError(f"{name.replace('_', ' ')} {given[name]:g} mm per workpiece rev exceeds the "
+                                  f"{feed_maximum(module, cut, starts):.2f} maximum for m{module:g} with a "
+                                  f"{starts}-start hob (reference §C); give a feed within it")
         return replace(self, **given, source=self.source + " + overrides") if given else self
+
+
+FEED_EPSILON = 1e-9
+
+
+def feed_maximum(module: float, cut: str, starts: int = 1) -> float:
+    """The most f_a [mm per workpiece revolution] for the module and cut kind (FEED_MAXIMUM,
+    interpolated), lowered for multi-start hobs by √z0."""
+    column = FEED_MAXIMUM_COLUMN[cut]
+    rows = [(row[0], row[column]) for row in FEED_MAXIMUM]
+    single_start = _interpolated(rows, module)
+    return single_start / max(1, starts) ** MULTI_START_EXPONENT
+
+
+def _interpolated(rows: list[tuple[float, float]], x: float) -> float:
+    if x <= rows[0][0]:
+        return rows[0][1]
+    for (x0, y0), (x1, y1) in zip(rows, rows[1:]):
+        if x <= x1:
+            return y0 + (y1 - y0) * (x - x0) / (x1 - x0)
+    return rows[-1][1]
 
 
 def hob_speed(cutting_speed: float, hob_tip_diameter: float, spindle_max: float) -> int:

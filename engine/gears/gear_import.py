@@ -19,8 +19,9 @@ from psycopg import sql
 
 from ..errors import EngineError, csv_problem
 from ..names import NAME_RULES, is_safe, shown
-from .classify import classify, not_installed_message
-from .records import MAX_MAGNITUDE, derived_diameters
+from .classify import Classification, classify, not_installed_message
+from .module_kind import MODULE_KINDS, check_module_kind as _check_module_kind
+from .records import MAX_MAGNITUDE, derived_diameters, normal_module
 
 NUMBER = re.compile(r"[+-]?(\d+(\.\d*)?|\.\d+)([eE][+-]?\d{1,3})?")
 INTEGER_MAX = 2_147_483_647  # PostgreSQL integer
@@ -79,6 +80,12 @@ def parse_hand(cell: str) -> str:
     return cell.upper()
 
 
+def parse_module_kind(cell: str) -> str:
+    if cell.lower() not in MODULE_KINDS:
+        raise CellError("must be normal or axial (a worm wheel's module as the worm's axial module)")
+    return cell.lower()
+
+
 def parse_class_name(cell: str) -> str:
     """Class names are lower case (`Spur` is spur); one that is not a safe class name
     (engine/names.py) is refused, as it would be printed in the program's comments."""
@@ -126,6 +133,7 @@ COLUMNS: tuple[Column, ...] = (
     Column("hardness", parse_number, check=lambda v: 0 < v <= 700, rule="is outside (0, 700] HB (Brinell ends at 650)"),
     Column("quality_grade", parse_whole, check=lambda v: 1 <= v <= 12, rule="is outside 1..12"),
     Column("quantity", parse_positive_whole),
+    Column("module_kind", parse_module_kind),
 )
 COLUMN_BY_NAME = {column.name: column for column in COLUMNS}
 DEFAULTS = {"pressure_angle": Decimal(20), "helix_angle": Decimal(0)}
@@ -254,7 +262,8 @@ def _classify(gear: dict[str, Any], classes: dict[str, bool]) -> str | None:
         return None
     classification = classify(gear)
     if classification.gear_class is None:
-        return f"{classification.problem}; give gear_class explicitly"
+        named = f"gear {gear['gear_id']} " if classification.remedy != Classification.remedy else ""
+        return f"{named}{classification.problem}; {classification.remedy}"
     found = classification.gear_class
     gear["gear_class"] = found
     return None if classes.get(found) else not_installed_message(gear["gear_id"], found)
@@ -267,8 +276,10 @@ def _check_hand(gear: dict[str, Any], classes: dict[str, bool]) -> str | None:
 
 
 def _fill_diameters(gear: dict[str, Any], classes: dict[str, bool]) -> str | None:
-    """Compute tip and root diameters not given; root must stay positive and below tip."""
-    tip, root = derived_diameters(gear["module"], gear["teeth"], gear["helix_angle"],
+    """Compute tip and root diameters not given, from the normal module; root must stay positive
+    and below tip."""
+    module = normal_module(gear["module"], gear["module_kind"], gear["helix_angle"])
+    tip, root = derived_diameters(module, gear["teeth"], gear["helix_angle"],
                                   gear["tip_diameter"], gear["root_diameter"])
     tip_said = "tip_diameter" if gear["tip_diameter"] is not None else "computed tip_diameter"
     root_said = "root_diameter" if gear["root_diameter"] is not None else "computed root_diameter"
@@ -285,9 +296,10 @@ def _fill_diameters(gear: dict[str, Any], classes: dict[str, bool]) -> str | Non
 COMPLETION_STEPS: tuple[tuple[tuple[str, ...], Callable[..., str | None]], ...] = (
     ((), _apply_defaults),
     (("gear_class",), _check_given_class),
-    (("gear_id", "gear_class", "cone_angle", "crowning", "helix_angle"), _classify),
+    (("gear_id", "gear_class", "cone_angle", "crowning", "helix_angle", "material"), _classify),
     (("helix_angle", "hand"), _check_hand),
-    (("module", "teeth", "helix_angle", "tip_diameter", "root_diameter"), _fill_diameters),
+    (("gear_class", "module_kind"), _check_module_kind),
+    (("module", "teeth", "helix_angle", "tip_diameter", "root_diameter", "module_kind"), _fill_diameters),
 )
 
 

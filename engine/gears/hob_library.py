@@ -72,9 +72,10 @@ HOB_COLUMNS: tuple[Column, ...] = (
     Column("material", parse_text),
     Column("coating", parse_text),
     Column("purpose", parse_purpose),
+    Column("tool_number", parse_positive_whole, check=lambda v: v <= 32000, rule="is above 32000"),
 )
 COLUMN_NAMES = tuple(column.name for column in HOB_COLUMNS)
-DEFAULTS = {"material": "HSS", "coating": "", "purpose": "cylindrical"}
+DEFAULTS = {"material": "HSS", "coating": "", "purpose": "cylindrical", "tool_number": 1}
 assert COLUMN_NAMES == tuple(field.name for field in fields(Hob)), "HOB_COLUMNS must follow records.Hob"
 
 

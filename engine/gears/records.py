@@ -29,7 +29,16 @@ class Gear:
     hardness: float | None
     quality_grade: int | None
     quantity: int | None
+    # How the drawing stated the module: 'normal', 'axial' (a worm wheel's: the worm's axial module,
+    # converted on load, so `module` is always the normal module the models compute with), or None
+    # (not stated: normal for cylindrical gears; the worm-wheel model refuses it).
+    module_kind: str | None = None
     units: tuple = ()          # further toothed units of a multi-unit gear (GearUnit), unit 2 first
+
+    @property
+    def stated_module(self) -> float:
+        """The module as the drawing gives it (the axial module of an axial-stated worm wheel)."""
+        return axial_module(self.module, self.helix_angle) if self.module_kind == "axial" else self.module
 
 
 @dataclass(frozen=True)
@@ -90,6 +99,20 @@ class Machine:
     orient_before_coupling: bool = False
     door_close_m: int | None = None
     door_open_m: int | None = None
+
+
+def normal_module(module: Any, module_kind: str | None, helix_angle: Any) -> Any:
+    """m_n = m_x·cos γ for a module stated as the worm's axial module (γ, the worm's lead angle,
+    is the wheel's helix angle: reference §B10, ΔC = 360·ΔY/(π·m_x·z2) = 360·cos γ·ΔY/(π·m_n·z2));
+    a normal or unstated module as it is. Decimal in, Decimal out."""
+    if module_kind != "axial":
+        return module
+    cos_gamma = math.cos(math.radians(float(helix_angle)))
+    return module * Decimal(repr(cos_gamma)) if isinstance(module, Decimal) else module * cos_gamma
+
+
+def axial_module(normal: float, helix_angle: float) -> float:
+    return normal / math.cos(math.radians(helix_angle))
 
 
 def reference_diameter(module: Any, teeth: int, helix_angle: Any = 0) -> Any:
@@ -162,7 +185,10 @@ def load_gears(conn, first: int | None = None, last: int | None = None) -> list[
 
 
 def _completed(gear: Gear) -> Gear:
-    """A gear written in SQL without its diameters gets them as a CSV import computes them."""
+    """The module as the normal module; a gear written in SQL without its diameters gets them as
+    a CSV import computes them."""
+    if gear.module_kind == "axial":
+        gear = replace(gear, module=normal_module(gear.module, gear.module_kind, gear.helix_angle))
     if gear.tip_diameter is not None and gear.root_diameter is not None:
         return gear
     tip, root = derived_diameters(gear.module, gear.teeth, gear.helix_angle, gear.tip_diameter, gear.root_diameter)

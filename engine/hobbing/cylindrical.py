@@ -25,6 +25,7 @@ JOB_PARAMETERS = frozenset({
     "swivel", "lead_angle", "x_retract", "z_start", "z_end", "x_lower", "x_upper", "y_lower", "y_upper",
     "z_lower", "z_upper", "shift_on", "shift_y", "shift_per_part", "shift_min", "shift_max",
     "template_version",
+    "allowance",
 })
 CUT_PARAMETERS = frozenset({"cut_name", "cut_x", "feed_radial", "feed_axial", "cut_on", "climb",
                             "z_from", "z_to"})
@@ -89,6 +90,7 @@ class CylindricalModel:
             "x_retract": round(setup.x_retract, 3),
             "z_start": round(setup.reach.approach, 3),
             "z_end": round(-gear.face_width - setup.reach.overrun, 3),
+            "allowance": choices.allowance,   # mm radial, left at the final cut (passes.plan_cuts)
         }
 
     def class_params(self, gear: Gear, hob: Hob, setup: Setup, choices: Choices) -> dict:

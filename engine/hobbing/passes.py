@@ -38,11 +38,14 @@ def hob_reach(gear, hob_tip_diameter: float, swivel: float, full_depth: float) -
 
 
 def plan_cuts(module: float, full_depth: float, choices: Choices) -> list[Cut]:
-    """Rough (off for a single cut) and finish; the rough cut leaves the finishing stock."""
+    """Rough (off for a single cut) and finish; the rough cut leaves the finishing stock. The final
+    cut stops short of full depth by the job's process allowance, left for shaving or grinding
+    (§B14: "before shaving or grinding, add the process allowance at the final pass")."""
     count = choices.cut_count(module)
-    rough = full_depth + choices.stock(module)
+    final = full_depth + choices.allowance
+    rough = final + choices.stock(module)
     return [Cut(1, CUT_NAMES[1], rough, count == 2, choices.climb(1, count)),
-            Cut(2, CUT_NAMES[2] if count == 2 else "SINGLE", full_depth, True, choices.climb(2, count))]
+            Cut(2, CUT_NAMES[2] if count == 2 else "SINGLE", final, True, choices.climb(2, count))]
 
 
 def pass_ends(reach: Reach, face_top: float, face_bottom: float, climb: bool) -> tuple[float, float]:

@@ -8,6 +8,7 @@ from __future__ import annotations
 import math
 from dataclasses import replace
 
+from ..errors import EngineError
 from ..gears.cutting_data import per_minute
 from . import geometry
 from .cylindrical import CylindricalModel, JobParameters, Setup
@@ -29,6 +30,7 @@ class WormWheelModel(CylindricalModel):
         return Setup(setup.lead, 0.0, setup.full_depth, setup.reach, setup.x_retract)
 
     def job(self, gear, gear_class, hob, machine, cutting, choices) -> JobParameters:
+        check_module_stated(gear)
         setup = self.setup(gear, hob)
         tangential = choices.worm_feed == "tangential"
         cuts = plan_cuts(gear.module, setup.full_depth, replace(choices, cuts=1) if tangential else choices)
@@ -48,6 +50,15 @@ class WormWheelModel(CylindricalModel):
         xs = [setup.x_retract] + [cut["cut_x"] for cut in module_params.values() if cut["cut_on"]]
         params.update(working_area(xs, [0.0, y_clear, -y_clear], [params["z_mid"]]))
         return JobParameters(params, module_params)
+
+
+def check_module_stated(gear) -> None:
+    """A worm wheel's module must be stated as axial or normal (gear.module_kind): worm drawings
+    usually give the worm's axial module m_x, and m_n = m_x·cos γ; a guess cuts the wrong depth."""
+    if gear.module_kind is None:
+        raise EngineError(f"gear {gear.id}: worm wheel module {gear.module:g} is not stated as axial or normal; set "
+                          "module_kind (axial: the worm's axial module, as worm drawings give it) in the gear file "
+                          "and import it again, or UPDATE gear SET module_kind")
 
 
 def tangential_clearance(gear, hob, centre_distance: float) -> float:

@@ -13,6 +13,7 @@ from ..errors import EngineError
 from ..gears.case_base import CUT_KINDS_BY_COUNT, CaseBase, job_cutting_record
 from ..gears.hob_matching import choose_hob
 from ..gears.models import model_for_class
+from ..gears.process_notes import hunting_tooth_notes
 from ..gears.records import Gear, Machine, hobbing_machine, load_gear, load_gears, load_hobs
 from ..hobbing.choices import Choices
 from ..memory import no_cycle_collection
@@ -85,9 +86,11 @@ class Planner:
         template = self.template(gear.gear_class)
         result = run_template(template, job.params, job.module_params, self.machine, Workpiece(gear, hob))
         kinds = CUT_KINDS_BY_COUNT[self.choices.cut_count(gear.module)]
+        cutting = cutting.of_cuts(kinds)
         record = job_cutting_record(cutting, gear, hob, kinds, case_ids)
+        notes = [f"gear {gear.id}: {note}" for note in cutting.notes] + hunting_tooth_notes(gear, hob)
         return Planned(gear.id, gear.gear_class, self.machine.name, hob.id, job.params,
-                       job.module_params, template, result, record)
+                       job.module_params, template, result, record, notes)
 
     def cutting_data(self, gear: Gear, hob) -> tuple:
         """Cutting data from the nearest cases of the machining history (overrides applied),
@@ -96,7 +99,7 @@ class Planner:
         if key not in self._cutting:
             cutting, proposals, _ = self.case_base.cutting_data(gear, hob, self.machine)
             case_ids = [case_id for proposal in proposals.values() for case_id in proposal.case_ids]
-            self._cutting[key] = (cutting.with_overrides(**self.overrides), case_ids)
+            self._cutting[key] = (cutting.with_overrides(gear.module, hob.starts, **self.overrides), case_ids)
         return self._cutting[key]
 
 

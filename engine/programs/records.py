@@ -3,7 +3,7 @@ storage and what storage hands back."""
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
@@ -23,6 +23,7 @@ class Planned:
     template: Template
     result: Result
     cutting: dict | None = None      # job.cutting: the cutting data chosen and their source
+    notes: list = field(default_factory=list)   # what the operator should know, one line each (bounded feeds, …)
 
     @property
     def name(self) -> str:
@@ -38,7 +39,7 @@ class Planned:
             if with_job else (None, None, None)
         return Encoded(self.gear_id, self.gear_class, self.machine, self.hob_id, *job, self.template.version,
                        self.template.hash, self.name, self.result.lines, self.result.row_ids,
-                       json.dumps(self.result.trace))
+                       json.dumps(self.result.trace), tuple(self.notes))
 
 
 @dataclass(frozen=True, slots=True)
@@ -58,6 +59,7 @@ class Encoded:
     lines: list[str]
     row_ids: list[int]
     trace: str
+    notes: tuple = ()
 
 
 @dataclass(frozen=True)
@@ -72,6 +74,7 @@ class Program:
     path: str | None = None
     trace: dict | None = None        # engine.templates.trace: why each row emitted or not
     row_ids: list[int] | None = None  # the template row of each line
+    notes: tuple = ()                 # what the operator should know, one line each (bounded feeds, …)
 
     @property
     def text(self) -> str:

@@ -7,6 +7,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import EngineError
+from ..gears.process_notes import stored_feed_notes
 from ..gears.records import Hob, Machine, load_gear, load_hobs, load_machine
 from ..memory import no_cycle_collection
 from ..templates.rows import Template
@@ -30,7 +31,7 @@ class Remaker:
         self._hobs: dict[str, Hob] | None = None
 
     def remade(self, job: tuple) -> Planned:
-        _, gear_id, gear_class, machine_name, hob_id, params, module_params = job
+        job_id, gear_id, gear_class, machine_name, hob_id, params, module_params = job
         machine = self.machine(machine_name)
         if machine.kind == "lathe":   # a turning job: its passes are computed from its parameters
             from ..turning.planning import plan_turning_job   # the tool paths: only for turning jobs
@@ -38,7 +39,8 @@ class Remaker:
             return plan_turning_job(self.conn, gear_class, machine, params, module_params)
         template = self.template(gear_class)
         result = run_template(template, params, module_params, machine, self.workpiece(gear_id, hob_id))
-        return Planned(gear_id, gear_class, machine_name, hob_id, params, module_params, template, result)
+        return Planned(gear_id, gear_class, machine_name, hob_id, params, module_params, template, result,
+                       notes=stored_feed_notes(job_id, params, module_params))
 
     def workpiece(self, gear_id: int | None, hob_id: str | None) -> Workpiece | None:
         """The job's gear and hob as stored now (the simulation proves against the records, not

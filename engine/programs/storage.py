@@ -53,7 +53,8 @@ def store_many(conn, encoded: list[Encoded], out=None) -> "Batch":
                                 _json(item.params), _json(item.module_params), _json(item.cutting)))
         _copy_programs(conn, program_ids, job_ids, encoded)
     return Batch(len(encoded), sum(len(item.lines) for item in encoded),
-                 min(program_ids), max(program_ids), out)
+                 min(program_ids), max(program_ids), out,
+                 tuple(f"{item.name}: {note}" for item in encoded for note in item.notes))
 
 
 def store_programs(conn, encoded: list[Encoded], job_ids: list[int], out=None) -> "Batch":
@@ -63,7 +64,8 @@ def store_programs(conn, encoded: list[Encoded], job_ids: list[int], out=None) -
     with conn.transaction():
         program_ids = _next_ids(conn, "program_id_seq", len(encoded))
         _copy_programs(conn, program_ids, job_ids, encoded)
-    return Batch(len(encoded), sum(len(item.lines) for item in encoded), min(program_ids), max(program_ids), out)
+    return Batch(len(encoded), sum(len(item.lines) for item in encoded), min(program_ids), max(program_ids), out,
+                 tuple(f"{item.name}: {note}" for item in encoded for note in item.notes))
 
 
 def refuse_unsafe(name: str, lines: list[str]) -> None:
@@ -105,6 +107,7 @@ class Batch:
     first_program_id: int
     last_program_id: int
     path: str | None
+    notes: tuple = ()   # "<program name>: <note>", one line each
 
     def __len__(self) -> int:
         return self.programs
@@ -124,4 +127,4 @@ def _program_values(job_id: int, planned) -> tuple:
 def _program(program_id: int, job_id: int, planned: Planned, path) -> Program:
     return Program(program_id, job_id, planned.name, planned.result.lines, planned.gear_class,
                    planned.template.version, planned.template.hash, path, planned.result.trace,
-                   planned.result.row_ids)
+                   planned.result.row_ids, tuple(planned.notes))
