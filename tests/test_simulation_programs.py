@@ -237,3 +237,16 @@ def test_the_report_is_one_json_line(records, spur):
     report = simulate_program(spur.lines(), spur.gear, spur.hob, records["machine"], "TEST")
     payload = json.loads(json.dumps(report.as_dict()))
     assert payload["refused"] is False and payload["teeth"] == ["19"]
+
+
+def test_a_rapid_is_also_followed_along_its_dog_leg_where_each_axis_runs_at_its_own_rate(records, spur):
+    """From X100 Z−40 to X51.5 Z40: the straight line keeps clear of the blank, but with both
+    axes at the rapid rate X arrives at Z8.5, where the hob (r 35) reaches 17.5 mm from the
+    axis at the top face: into the Ø42 blank."""
+    lines = spur.lines()
+    at = lines.index("G0 Y0.000")
+    lines = lines[:at] + ["G0 X100.000 Z-40.000", "G0 X51.500 Z40.000"] + lines[at:]
+    report = simulate_program(lines, spur.gear, spur.hob, records["machine"], "TEST")
+    messages = refusal(report, number_of(lines, "G0 X51.500 Z40.000"))
+    assert any("into unit 1" in m and "rapid" in m for m in messages)
+    assert not refusal(report, number_of(lines, "G0 X100.000 Z-40.000"))

@@ -1,5 +1,5 @@
 """The block-by-block walk: every axis (X, Y, Z, A; C through the coupling) followed in the DIN
-frame, each move's hob poses at most POSE_STEP apart checked against the solids, the coupling
+frame, each move's hob poses (engine.simulation.paths) checked against the solids, the coupling
 and swivel checked where the hob cuts, cuts collected, the table speed and cycle time summed.
 
 M codes whose timing against the block's motion is the machine builder's choice are taken the
@@ -19,11 +19,11 @@ from .contact import Motion, follow
 from .cuts import Cut, summary
 from .envelope import HobBody
 from .frame import Senses
+from .paths import move_poses
 from .report import Report
 from .solids import Solid
 from .timing import feed_minutes, header_minutes, header_problem, rapid_minutes
 
-POSE_STEP = 0.5          # mm between the hob poses followed along a move
 AXES = ("X", "Y", "Z")
 DWELL = 4
 
@@ -190,22 +190,13 @@ class Walk:
         return int(round(teeth)) if abs(teeth - round(teeth)) < 1e-9 else None
 
     def _contacts(self, step, motion: int, cutting: bool, start: dict, end: dict) -> None:
-        x, y, z = self._poses(start, end)
+        x, y, z = move_poses(start, end, motion == 0)
         teeth = self._cut_teeth() if cutting else None
         reason = self._reason(motion)
         running = self.coupling is not None and self.spindle
         for contact in follow(self.solids, self.body, self.swivel, x, y, z,
                               Motion(teeth, running, self.session, self.tailstock, reason)):
             self.report.add(step.number, step.line, self._contact_message(contact, reason, teeth))
-
-    def _poses(self, start: dict, end: dict):
-        known = all(axis in start for axis in ("X", "Z"))
-        ends = [{axis: start.get(axis, end[axis]) if known else end[axis] for axis in end}, end]
-        y0, y1 = (e.get("Y", 0.0) for e in ends)
-        length = math.dist([ends[0][a] for a in ("X", "Z")] + [y0], [end[a] for a in ("X", "Z")] + [y1])
-        count = max(2, int(math.ceil(length / POSE_STEP)) + 1)
-        share = np.linspace(0.0, 1.0, count)
-        return tuple(ends[0].get(a, 0.0) + share * (ends[1].get(a, 0.0) - ends[0].get(a, 0.0)) for a in AXES)
 
     def _reason(self, motion: int) -> str:
         if motion == 0:
