@@ -250,3 +250,14 @@ def test_a_rapid_is_also_followed_along_its_dog_leg_where_each_axis_runs_at_its_
     messages = refusal(report, number_of(lines, "G0 X51.500 Z40.000"))
     assert any("into unit 1" in m and "rapid" in m for m in messages)
     assert not refusal(report, number_of(lines, "G0 X100.000 Z-40.000"))
+
+
+def test_a_shift_clamp_out_of_order_and_a_swivel_upright_are_refused_in_one_line(records, spur):
+    lines = shift_lines(spur, -10.0, 10.0)
+    at = lines.index("R11=R11+1.0")
+    swapped = lines[:at] + [lines[at + 1], lines[at]] + lines[at + 2:]
+    with pytest.raises(SimulationError, match="hob-shift clamp"):
+        simulate_program(swapped, spur.gear, spur.hob, records["machine"], "TEST")
+    spur.a_value = 90.0
+    report = simulate_program(spur.lines(), spur.gear, spur.hob, records["machine"], "TEST")
+    assert any("not a hobbing set-up" in f.message for f in report.refusals)

@@ -12,6 +12,7 @@ import math
 import numpy as np
 
 from ..gears.records import Gear, Hob, Machine
+from ..programs.verifier.refusals import Refused
 from ..programs.verifier.shift_clamp import ShiftClamp
 from .coupling import (Coupling, coupling_problems, generated_teeth_problem, hand_name, hand_sign, helix_of,
                        lead_angle, read_coupling, swivel_problem)
@@ -20,12 +21,13 @@ from .cuts import Cut, summary
 from .envelope import HobBody
 from .frame import Senses
 from .paths import move_poses
-from .report import Report
+from .report import Report, SimulationError, where
 from .solids import Solid
 from .timing import feed_minutes, header_minutes, header_problem, rapid_minutes
 
 AXES = ("X", "Y", "Z")
 DWELL = 4
+MAX_SWIVEL = 80.0        # degrees from horizontal the hob axis may stand (helix angles stay well below)
 
 
 class Walk:
@@ -92,7 +94,10 @@ class Walk:
         self.report.helix.append("spur" if hand is None else f"{hand_name(hand)} β {beta:.3f}° lead {lead:.1f} mm")
 
     def _shift(self, step) -> None:
-        ends = self.clamp.take(step.item)
+        try:
+            ends = self.clamp.take(step.item)
+        except Refused as refusal:
+            raise SimulationError(f"{where(self.report.name, step.number, step.line)}: {refusal}") from None
         if ends is not None:
             self._move(step, 0, {"Y": ends[self.shift_end]})
 
@@ -190,11 +195,16 @@ class Walk:
         return int(round(teeth)) if abs(teeth - round(teeth)) < 1e-9 else None
 
     def _contacts(self, step, motion: int, cutting: bool, start: dict, end: dict) -> None:
+        swivel = (self.swivel + 90.0) % 180.0 - 90.0       # a cylinder turned by 180° is the same cylinder
+        if abs(swivel) > MAX_SWIVEL:
+            self.report.add(step.number, step.line, f"the swivel A {self.swivel:g}° sets the hob axis within "
+                                                    f"{90 - MAX_SWIVEL:g}° of the work axis: not a hobbing set-up")
+            return
         x, y, z = move_poses(start, end, motion == 0)
         teeth = self._cut_teeth() if cutting else None
         reason = self._reason(motion)
         running = self.coupling is not None and self.spindle
-        for contact in follow(self.solids, self.body, self.swivel, x, y, z,
+        for contact in follow(self.solids, self.body, swivel, x, y, z,
                               Motion(teeth, running, self.session, self.tailstock, reason)):
             self.report.add(step.number, step.line, self._contact_message(contact, reason, teeth))
 
@@ -261,8 +271,11 @@ class Walk:
             return
         stock = unit.stock()
         worst = int(np.argmax(stock))
-        if stock[worst] > 0.01:
-            z = unit.heights[worst] * self.senses.z
+        z = unit.heights[worst] * self.senses.z
+        if np.isinf(stock[worst]):
+            self.report.add(cut.number, cut.line, f"the cuts of {unit.name} never reach Z{z:.3f}: part of its face "
+                                                  "is not cut")
+        elif stock[worst] > 0.01:
             self.report.add(cut.number, cut.line, f"the last cut of {unit.name} leaves {stock[worst]:.3f} mm above the "
                                                   f"intended root at Z{z:.3f} (full depth (d_f2 + d_a0)/2 not reached)")
 
