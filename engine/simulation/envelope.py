@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0
-SEARCH_STEPS = 22          # the free coordinate's interval (≤ the hob length) shrinks to ~1e-3 mm
+SEARCH_STEPS = 24          # the free coordinate's interval (≤ the hob length) shrinks by 1e-5
 
 
 @dataclass(frozen=True, slots=True)
@@ -66,13 +66,15 @@ def nearest_radius(hob: HobBody, swivel: float, cx, cy, cz, heights):
 
 
 def _golden_minimum(function, low, high):
-    """min of a convex function on [low, high], elementwise (also checks both ends)."""
+    """min of a convex function on [low, high], elementwise: one new evaluation per step, and
+    both ends checked."""
     left, right = high - GOLDEN * (high - low), low + GOLDEN * (high - low)
     f_left, f_right = function(left), function(right)
     for _ in range(SEARCH_STEPS):
         keep_left = f_left < f_right
-        high = np.where(keep_left, right, high)
-        low = np.where(keep_left, low, left)
-        left, right = high - GOLDEN * (high - low), low + GOLDEN * (high - low)
-        f_left, f_right = function(left), function(right)
+        low, high = np.where(keep_left, low, left), np.where(keep_left, right, high)
+        probe = np.where(keep_left, high - GOLDEN * (high - low), low + GOLDEN * (high - low))
+        f_probe = function(probe)
+        left, right, f_left, f_right = (np.where(keep_left, probe, right), np.where(keep_left, left, probe),
+                                        np.where(keep_left, f_probe, f_right), np.where(keep_left, f_left, f_probe))
     return np.minimum(np.minimum(f_left, f_right), np.minimum(function(low), function(high)))

@@ -15,7 +15,8 @@ import numpy as np
 
 from ..gears.records import Gear, Hob, Machine
 
-HEIGHT_STEP = 0.25      # mm between the heights a solid is followed at (its faces included)
+HEIGHT_STEP = 0.5       # mm between the heights a solid is followed at (its faces included; the
+                        # clearance is convex in height, so between two it errs by < step²/(8·r0))
 BEYOND_TRAVEL = 50.0    # mm: a fixture or tailstock is followed this far past the Z travel and the hob
 
 
