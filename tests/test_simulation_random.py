@@ -119,4 +119,6 @@ def test_the_envelope_is_the_nearest_point_of_the_hob_at_each_height(radius, len
     extent = body.extent(swivel)
     grid = np.linspace(-extent, extent, 2001)[None, :]
     nearest = nearest_radius(body, swivel, cx[:, None], cy[:, None], cz[:, None], grid).min()
-    assert nearest >= distance.min() - 0.05               # and as near as the hob comes, to the sampling
+    step_along, step_round = length / 199, 2 * math.pi / 199          # the sampling grid of hob_points
+    resolution = step_along / 2 + radius * step_round ** 2 / 8 + 0.01
+    assert nearest >= distance.min() - resolution          # and as near as the hob comes, to the sampling
