@@ -32,11 +32,12 @@ CASE_COLUMNS = ("module", "teeth", "material", "hardness", "quality_grade", "hob
 
 
 def insert_paper_gear(conn, gear_id=PAPER_GEAR, teeth=19):
-    # class spur: the taper class is not seeded in every checkout, and the class does not enter the distance
+    # class spur, so no cone: the class and the cone do not enter the distance, and the simulation holds a
+    # program to the gear's cone (a spur program for a conical record leaves the cone's root uncut)
     # d_f 33.5: d_a 42.5 read as a profile shift x = +0.125 (reference §D)
     conn.execute("INSERT INTO gear (id, gear_class, module, teeth, pressure_angle, face_width, tip_diameter, "
-                 "root_diameter, cone_angle, material, hardness, quality_grade) "
-                 "VALUES (%s, 'spur', 2, %s, 20, 20, 42.5, 33.5, 6.5, '40Cr', 250, 7)", (gear_id, teeth))
+                 "root_diameter, material, hardness, quality_grade) "
+                 "VALUES (%s, 'spur', 2, %s, 20, 20, 42.5, 33.5, '40Cr', 250, 7)", (gear_id, teeth))
     return load_gear(conn, gear_id)
 
 

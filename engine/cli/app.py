@@ -21,6 +21,7 @@ from .hobs import hobs
 from .instantiate import instantiate
 from .nc_import import import_nc_command
 from .refactor import refactor_command
+from .simulate import simulate
 from .templates import lint, template
 from .turning import import_dxf_command, plot_command
 
@@ -109,7 +110,7 @@ def main(ctx, database_url, traceback):
 
 
 COMMANDS = (demo, db, seed_command, gears, classify, instantiate, explain, template, lint, hobs, suggest, cases,
-            import_nc_command, refactor_command, import_dxf_command, plot_command)
+            import_nc_command, refactor_command, import_dxf_command, plot_command, simulate)
 
 
 def _register(group: click.Group, commands) -> None:

@@ -21,7 +21,7 @@ from ..templates.rows import Template
 from ..templates.store import load_template
 from ..turning.names import TurningModel
 from .outputs import ProgramFiles, files_after_commit
-from .verified_run import run_template
+from .verified_run import Workpiece, run_template
 from .verifier import LimitError, check_table_speed
 from .records import Planned, Program
 from .storage import store_many, store_one
@@ -84,7 +84,7 @@ class Planner:
         job = model.job(gear, gear.gear_class, hob, self.machine, cutting, self.choices)
         _check_table_speed(gear, hob.starts, cutting.hob_speed, self.machine)
         template = self.template(gear.gear_class)
-        result = run_template(template, job.params, job.module_params, self.machine)
+        result = run_template(template, job.params, job.module_params, self.machine, Workpiece(gear, hob))
         kinds = CUT_KINDS_BY_COUNT[self.choices.cut_count(gear.module)]
         cutting = cutting.of_cuts(kinds)
         record = job_cutting_record(cutting, gear, hob, kinds, case_ids)

@@ -8,13 +8,13 @@ from pathlib import Path
 
 from ..errors import EngineError
 from ..gears.process_notes import stored_feed_notes
-from ..gears.records import Machine, load_machine
+from ..gears.records import Hob, Machine, load_gear, load_hobs, load_machine
 from ..memory import no_cycle_collection
 from ..templates.rows import Template
 from ..templates.store import load_template
 from .instantiate import store_planned
 from .outputs import files_after_commit
-from .verified_run import run_template
+from .verified_run import Workpiece, run_template
 from .records import Planned, Program
 from .storage import Batch, refuse_unsafe, store_programs
 
@@ -28,6 +28,7 @@ class Remaker:
         self.conn = conn
         self._machines: dict[str, Machine] = {}
         self._templates: dict[str, Template] = {}
+        self._hobs: dict[str, Hob] | None = None
 
     def remade(self, job: tuple) -> Planned:
         job_id, gear_id, gear_class, machine_name, hob_id, params, module_params = job
@@ -37,9 +38,21 @@ class Remaker:
 
             return plan_turning_job(self.conn, gear_class, machine, params, module_params)
         template = self.template(gear_class)
-        result = run_template(template, params, module_params, machine)
+        result = run_template(template, params, module_params, machine, self.workpiece(gear_id, hob_id))
         return Planned(gear_id, gear_class, machine_name, hob_id, params, module_params, template, result,
                        notes=stored_feed_notes(job_id, params, module_params))
+
+    def workpiece(self, gear_id: int | None, hob_id: str | None) -> Workpiece | None:
+        """The job's gear and hob as stored now (the simulation proves against the records, not
+        against job.params, which may have been edited)."""
+        if gear_id is None or hob_id is None:
+            return None
+        if self._hobs is None:
+            self._hobs = {hob.id: hob for hob in load_hobs(self.conn)}
+        hob = self._hobs.get(hob_id)
+        if hob is None:
+            raise EngineError(f"hob {hob_id!r} of the job does not exist; see `engine hobs list`")
+        return Workpiece(load_gear(self.conn, gear_id), hob)
 
     def machine(self, name: str) -> Machine:
         if name not in self._machines:

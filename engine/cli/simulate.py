@@ -1,0 +1,34 @@
+"""`engine simulate --program ID`: follow a stored hobbing program against its gear, hob and
+machine and say what it proves (engine.simulation)."""
+from __future__ import annotations
+
+import click
+
+from .context import connection, emit_json
+
+
+@click.command()
+@click.option("--program", "program_id", type=int, required=True, help="Stored program id.")
+@click.option("--json", "as_json", is_flag=True, help="Print one JSON object on one line.")
+@click.pass_context
+def simulate(ctx, program_id, as_json):
+    """Simulate a stored hobbing program: collisions of the hob (tip cylinder, length, swivel)
+    with the blank, its units, the fixture and the tailstock; the teeth, hand and lead the
+    coupling generates and the swivel, against the gear; depth, stock and run-out per cut; the
+    table speed; the feed per workpiece revolution; the cycle time against the header.
+
+    One line per finding, then the summary. Exit 1 when the simulation refuses the program.
+
+    Example: engine simulate --program 7 --json
+    """
+    from ..simulation import simulate_stored_program
+
+    with connection(ctx) as conn:
+        report = simulate_stored_program(conn, program_id)
+    if as_json:
+        emit_json(report.as_dict())
+    else:
+        for line in report.lines():
+            click.echo(line)
+    if report.refused:
+        raise report.error()

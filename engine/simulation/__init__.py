@@ -1,0 +1,11 @@
+"""The simulation that proves each hobbing program (design notes §7, issue 14): it reads only
+the program text, the gear, the hob and the machine (never the model code that made the
+program) and follows every axis block by block in the DIN 66217 frame: the hob envelope against
+the blank, its units, the fixture and the tailstock; the coupling's teeth, hand and lead and the
+swivel against the gear; the depth per cut, the run-out, the table speed, the feed per workpiece
+revolution and the cycle time."""
+from .report import Finding, Report, SimulationError
+from .run import prove_program, simulate_program
+from .stored import simulate_stored_program
+
+__all__ = ["Finding", "Report", "SimulationError", "prove_program", "simulate_program", "simulate_stored_program"]

@@ -1,0 +1,39 @@
+"""The hob positions along a move, at most POSE_STEP apart. A G1 runs on the straight line. A G0
+runs on it too where the control interpolates rapids (840D RTLION), but each axis at its own
+rapid rate where it does not (RTLIOF, the cycle time's model): all axes at the same speed until
+the shortest arrives, a dog-leg. Which one a machine does is its setting, so both are followed."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+POSE_STEP = 0.5          # mm
+AXES = ("X", "Y", "Z")
+
+
+def move_poses(start: dict, end: dict, rapid: bool) -> tuple:
+    """(x, y, z) arrays of DIN positions from start to end (an axis whose start is unknown
+    jumps: only the end is followed)."""
+    begin = {axis: start.get(axis, end[axis]) for axis in end} if {"X", "Z"} <= start.keys() else dict(end)
+    pieces = [_line(begin, end)]
+    if rapid:
+        leg = _dog_leg(begin, end)
+        pieces += [_line(a, b) for a, b in zip(leg[:-1], leg[1:])]
+    return tuple(np.concatenate([piece[i] for piece in pieces]) for i in range(3))
+
+
+def _dog_leg(begin: dict, end: dict) -> list[dict]:
+    """begin, the points where each axis arrives (all moving at one speed), end."""
+    travel = {axis: end[axis] - begin[axis] for axis in end}
+    arrivals = sorted({abs(d) for d in travel.values() if d})
+    points = [dict(begin)]
+    for reached in arrivals:
+        points.append({axis: begin[axis] + math.copysign(min(abs(d), reached), d) for axis, d in travel.items()})
+    return points
+
+
+def _line(a: dict, b: dict) -> tuple:
+    length = math.dist([a.get(axis, 0.0) for axis in AXES], [b.get(axis, 0.0) for axis in AXES])
+    share = np.linspace(0.0, 1.0, max(2, int(math.ceil(length / POSE_STEP)) + 1))
+    return tuple(a.get(axis, 0.0) + share * (b.get(axis, 0.0) - a.get(axis, 0.0)) for axis in AXES)

@@ -1,0 +1,57 @@
+"""A program read for the simulation with the verifier's own reader (engine.programs.verifier:
+the machine's dialect, line by line), plus the two things the verifier reads but does not keep:
+the signed EGON terms (engine.simulation.coupling) and a block's G and M codes (M20/M21 clamp
+and release the tailstock, G4 dwells). A line the verifier refuses the simulation refuses too:
+it cannot follow what it cannot read (fail closed)."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ..gears.records import Machine
+from ..programs.verifier import grammar
+from ..programs.verifier.blocks import TOKEN
+from ..programs.verifier.lines import read_line
+from ..programs.verifier.refusals import Refused
+from .report import SimulationError, where
+
+
+@dataclass(frozen=True, slots=True)
+class Step:
+    number: int        # line number, from 1
+    line: str          # as emitted
+    item: object       # what the verifier read it as (kind: header, comment, block, statement, shift)
+    g_codes: frozenset = frozenset()
+    m_codes: frozenset = frozenset()
+
+    @property
+    def kind(self) -> str:
+        return self.item.kind
+
+
+def machine_dialect(machine: Machine):
+    """The grammar the verifier reads this machine's programs with, the record's door M codes included."""
+    return grammar.dialect_for(machine)
+
+
+def read_program(lines: list[str], machine: Machine, name: str) -> list[Step]:
+    try:
+        dialect = machine_dialect(machine)
+    except Refused as refusal:
+        raise SimulationError(f"machine {machine.name}: {refusal}; the simulation cannot read its programs") from None
+    return [_step(dialect, number, line, name) for number, line in enumerate(lines, start=1)]
+
+
+def _step(dialect, number: int, line: str, name: str) -> Step:
+    try:
+        item = read_line(dialect, line)
+    except Refused as refusal:
+        raise SimulationError(f"{where(name, number, line)}: the simulation cannot read it ({refusal}); "
+                              "a program it cannot follow is refused") from None
+    if item.kind != "block":
+        return Step(number, line, item)
+    codes = {"G": set(), "M": set()}
+    for token in line.partition(";")[0].split():
+        address, equals, text = TOKEN.fullmatch(token).groups()
+        if address in codes and not equals:
+            codes[address].add(int(text))
+    return Step(number, line, item, frozenset(codes["G"]), frozenset(codes["M"]))

@@ -1,0 +1,48 @@
+"""The simulation of one hobbing program against its gear, hob and machine (design notes §7,
+issue 14): read with the verifier's reader, followed block by block (engine.simulation.walk).
+A program with the hob-shift-per-part clamp (R11 lies in an interval) is followed once with
+the shift at each end of it."""
+from __future__ import annotations
+
+from ..gears.records import Gear, Hob, Machine
+from .reading import read_program
+from .report import Report, SimulationError
+from .solids import setup_solids, unit_solids
+from .walk import Walk
+
+SHIFT_ENDS = (0, 1)     # the low and the high end of the R11 interval
+
+
+def simulate_program(lines: list[str], gear: Gear, hob: Hob, machine: Machine, name: str = "the program") -> Report:
+    """The report of the program `lines` for `gear` cut with `hob` on `machine` (a hobber).
+    Raises SimulationError only for a program (or machine) it cannot read."""
+    if machine.kind != "hobber":
+        raise SimulationError(f"machine {machine.name} is a {machine.kind}: the simulation follows hobbing programs")
+    steps = read_program(lines, machine, name)
+    ends = SHIFT_ENDS if any(step.kind == "shift" for step in steps) else SHIFT_ENDS[:1]
+    reports = [_follow(steps, lines, gear, hob, machine, name, end) for end in ends]
+    report = reports[0]
+    for other in reports[1:]:
+        for finding in other.findings:
+            report.add(finding.number, finding.line, finding.message, finding.refuses)
+        report.table_speed = max(report.table_speed, other.table_speed)
+    return report
+
+
+def prove_program(lines: list[str], gear: Gear, hob: Hob, machine: Machine, name: str = "the program") -> Report:
+    """The report, or SimulationError naming the first finding that refuses the program."""
+    report = simulate_program(lines, gear, hob, machine, name)
+    if report.refused:
+        raise report.error()
+    return report
+
+
+def _follow(steps, lines, gear: Gear, hob: Hob, machine: Machine, name: str, shift_end: int) -> Report:
+    worm_wheel = hob.purpose == "worm_wheel"
+    units = unit_solids(gear, hob, worm_wheel)
+    report = Report(name)
+    walk = Walk(report, gear, hob, machine, units, setup_solids(machine, units, hob), worm_wheel, shift_end)
+    for step in steps:
+        walk.take(step)
+    walk.finish(lines)
+    return report

@@ -1,0 +1,123 @@
+"""What the hob may meet, as solids of revolution about the work axis in the DIN frame: each
+toothed unit of the gear (its blank: the tip radius over its face width; a taper's cone), the
+fixture below the lowest unit and the tailstock above the top face (machine record, design
+notes §7). A unit also knows its intended root (reference §B3, §B11, §B12; a worm wheel's
+throat is the hob's own tip circle about the mid-plane, §B10) and keeps, per height, how close
+to the axis the hob has cut so far (`reach`), over the whole program and within the present
+coupling (`session_reach`): the gaps a coupled hob has cut are free to it while the coupling
+lasts, not after a new EGON, whose phase is not the old one."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..gears.records import Gear, Hob, Machine
+
+HEIGHT_STEP = 0.5       # mm between the heights a solid is followed at (its faces included; the
+                        # clearance is convex in height, so between two it errs by < step²/(8·r0))
+BEYOND_TRAVEL = 50.0    # mm: a fixture or tailstock is followed this far past the Z travel and the hob
+
+
+@dataclass(eq=False)
+class Solid:
+    name: str
+    z_low: float
+    z_high: float
+    radius_at_top: float          # radius at z_high … (for a cone: at Z = 0, see slope)
+    slope: float = 0.0            # dR/dz (a taper's tan δ)
+    teeth: int | None = None      # a toothed unit: the teeth the coupling must generate to cut it
+    clamped_only: bool = False    # the tailstock: there only between M20 and M21
+    root: object = None           # heights -> intended root radius (units)
+    heights: np.ndarray = field(init=False)
+    radius: np.ndarray = field(init=False)
+    reach: np.ndarray = field(init=False)
+    session_reach: np.ndarray = field(init=False)
+    session: int = -1
+
+    def __post_init__(self):
+        count = max(2, int(math.ceil((self.z_high - self.z_low) / HEIGHT_STEP)) + 1)
+        self.heights = np.linspace(self.z_low, self.z_high, count)
+        self.radius = self.radius_at(self.heights)
+        self.reach = np.full(count, np.inf)
+        self.session_reach = np.full(count, np.inf)
+        self.intended_root = self.root(self.heights) if self.root is not None else None
+
+    def radius_at(self, heights):
+        return self.radius_at_top + self.slope * heights
+
+    @property
+    def largest_radius(self) -> float:
+        return float(self.radius.max())
+
+    def start_session(self, session: int) -> None:
+        if self.session != session:
+            self.session = session
+            self.session_reach = np.full(len(self.heights), np.inf)
+
+    def stock(self) -> np.ndarray:
+        """How far above its intended root the hob has left each height of the unit."""
+        return self.reach - self.intended_root
+
+
+def unit_solids(gear: Gear, hob: Hob, worm_wheel: bool) -> list[Solid]:
+    """Unit 1 (the gear row, top face Z = 0) and the further units of a duplex gear."""
+    units = [(1, gear.teeth, gear.face_width, gear.tip_diameter, gear.root_diameter, 0.0)]
+    units += [(unit.unit, unit.teeth, unit.face_width, unit.tip_diameter, unit.root_diameter, unit.z_top)
+              for unit in gear.units]
+    return [_unit(gear, hob, worm_wheel, *unit) for unit in units]
+
+
+def _unit(gear: Gear, hob: Hob, worm_wheel: bool, number, teeth, width, tip, root, top) -> Solid:
+    slope = math.tan(math.radians(gear.cone_angle or 0.0)) if number == 1 else 0.0
+    root_of = ROOTS[_shape(gear, worm_wheel, number)](gear, hob, root / 2, top, width, slope)
+    return Solid(f"unit {number} ({teeth} teeth)", top - width, top, tip / 2 + 0.0, slope, teeth, root=root_of)
+
+
+def _shape(gear: Gear, worm_wheel: bool, number: int) -> str:
+    if worm_wheel:
+        return "throat"
+    if number == 1 and gear.crowning:
+        return "crowned"
+    return "cone"
+
+
+def _cone(gear, hob, root_radius, top, width, slope):
+    """Cylindrical and taper gears: d_f2/2 + z·tan δ (Z = 0 at the top face)."""
+    return lambda z: root_radius + slope * z
+
+
+def _crowned(gear, hob, root_radius, top, width, slope):
+    """Crowning (§B11): d_f2/2 − Δa·(2(z − z_m)/b)², Δa = C_β/sin α_n, deepest at the faces."""
+    depth = gear.crowning / math.sin(math.radians(gear.pressure_angle))
+    middle = top - width / 2
+    return lambda z: root_radius - depth * (2 * (z - middle) / width) ** 2
+
+
+def _throat(gear, hob, root_radius, top, width, slope):
+    """A worm wheel's root is the throat the hob's tip circle leaves about the mid-plane (§B10):
+    (d_f2 + d_a0)/2 − √(r0² − (z − z_m)²)."""
+    r0, middle = hob.tip_diameter / 2, top - width / 2
+    centre = root_radius + r0
+    return lambda z: centre - np.sqrt(np.maximum(r0 ** 2 - (z - middle) ** 2, 0.0))
+
+
+ROOTS = {"cone": _cone, "crowned": _crowned, "throat": _throat}
+
+
+def setup_solids(machine: Machine, units: list[Solid], hob: Hob) -> list[Solid]:
+    """The fixture below the lowest unit's bottom face and the tailstock above the top face,
+    each followed from its face to past the travel (a diameter of 0: none)."""
+    reach = hob.tip_diameter / 2 + hob.length
+    bottom = min(unit.z_low for unit in units) - machine.fixture_gap
+    top = max(unit.z_high for unit in units) + machine.tailstock_gap
+    z_far_low = min(machine.z_min, -machine.z_max) - reach - BEYOND_TRAVEL
+    z_far_high = max(machine.z_max, -machine.z_min) + reach + BEYOND_TRAVEL
+    solids = []
+    if machine.fixture_diameter > 0:
+        solids.append(Solid("the fixture", min(z_far_low, bottom - 1.0), bottom, machine.fixture_diameter / 2))
+    if machine.tailstock_diameter > 0:
+        solids.append(Solid("the tailstock", top, max(z_far_high, top + 1.0), machine.tailstock_diameter / 2,
+                            clamped_only=True))
+    return solids

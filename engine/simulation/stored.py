@@ -1,0 +1,33 @@
+"""A stored program simulated against the records of its job (`engine simulate --program ID`):
+its lines, the job's gear (with its units), hob and machine as the database holds them now."""
+from __future__ import annotations
+
+from ..errors import EngineError
+from ..gears.records import Hob, load_gear, load_hobs, load_machine
+from .report import Report
+from .run import simulate_program
+
+PROGRAM_QUERY = """
+SELECT p.name, p.lines, j.gear_id, j.hob_id, j.machine
+FROM program p JOIN job j ON j.id = p.job_id
+WHERE p.id = %s"""
+
+
+def simulate_stored_program(conn, program_id: int) -> Report:
+    row = conn.execute(PROGRAM_QUERY, (program_id,)).fetchone()
+    if row is None:
+        raise EngineError(f"program {program_id} does not exist; see `SELECT id, name FROM program`")
+    name, lines, gear_id, hob_id, machine_name = row
+    machine = load_machine(conn, machine_name)
+    if machine.kind != "hobber" or gear_id is None or hob_id is None:
+        raise EngineError(f"program {program_id} is not a hobbing program (machine {machine_name}, "
+                          f"gear {gear_id}, hob {hob_id}): the simulation follows hobbing programs only")
+    return simulate_program(list(lines), load_gear(conn, gear_id), load_hob(conn, hob_id), machine, name)
+
+
+def load_hob(conn, hob_id: str) -> Hob:
+    """The hob record (the library is small: read whole, as instantiation reads it)."""
+    found = next((hob for hob in load_hobs(conn) if hob.id == hob_id), None)
+    if found is None:
+        raise EngineError(f"hob {hob_id!r} does not exist; see `engine hobs list`")
+    return found

@@ -1,0 +1,284 @@
+"""The block-by-block walk: every axis (X, Y, Z, A; C through the coupling) followed in the DIN
+frame, each move's hob poses (engine.simulation.paths) checked against the solids, the coupling
+and swivel checked where the hob cuts, cuts collected, the table speed and cycle time summed.
+
+M codes whose timing against the block's motion is the machine builder's choice are taken the
+unsafe way round: the spindle counts as turning (M3) and the tailstock as released (M21) only
+after the block's motion, as stopped (M5) and clamped (M20) already during it."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from ..gears.records import Gear, Hob, Machine
+from ..programs.verifier.refusals import Refused
+from ..programs.verifier.shift_clamp import ShiftClamp
+from .coupling import (Coupling, coupling_problems, generated_teeth_problem, hand_name, hand_sign, helix_of,
+                       lead_angle, read_coupling, swivel_problem)
+from .contact import Motion, follow
+from .cuts import Cut, summary
+from .envelope import HobBody
+from .frame import Senses
+from .paths import move_poses
+from .report import Report, SimulationError, where
+from .solids import Solid
+from .timing import feed_minutes, header_minutes, header_problem, rapid_minutes
+
+AXES = ("X", "Y", "Z")
+DWELL = 4
+MAX_SWIVEL = 80.0        # degrees from horizontal the hob axis may stand (helix angles stay well below)
+
+
+class Walk:
+    def __init__(self, report: Report, gear: Gear, hob: Hob, machine: Machine, units: list[Solid],
+                 setup: list[Solid], worm_wheel: bool, shift_end: int):
+        self.report, self.gear, self.hob, self.machine = report, gear, hob, machine
+        self.units, self.solids, self.worm_wheel, self.shift_end = units, units + setup, worm_wheel, shift_end
+        self.senses = Senses.of(machine)
+        self.body = HobBody(hob.tip_diameter / 2, hob.length / 2)
+        load = (machine.load_x, machine.load_z)
+        self.program = {"X": load[0], "Z": load[1]} if None not in load else {}   # program values, for time
+        self.position = {axis: self.senses.position(axis, value) for axis, value in self.program.items()}
+        self.swivel = 0.0
+        self.swivel_known = False
+        self.feed = self.speed = None
+        self.spindle = self.tailstock = False
+        self.coupling: Coupling | None = None
+        self.session = 0
+        self.cut: Cut | None = None
+        self.last_cut_of: dict[int, Cut] = {}
+        self.clamp = ShiftClamp()
+        self.said: set = set()
+
+    # ---------------------------------------------------------------- lines
+
+    def take(self, step) -> None:
+        TAKERS[step.kind](self, step)
+
+    def _comment(self, step) -> None:
+        minutes = header_minutes(step.line)
+        if minutes is not None:
+            self.report.header_time = minutes
+            self.header_step = step
+
+    def _header(self, step) -> None:
+        return None
+
+    def _statement(self, step) -> None:
+        self._end_cut()
+        if step.item.name == "EGON":
+            self._couple(step)
+        elif step.item.name in ("EGOFS", "EGDEL"):
+            self.coupling = None
+
+    def _couple(self, step) -> None:
+        code = step.line.partition(";")[0].strip()
+        self.coupling = read_coupling(code, self.senses)
+        self.session += 1
+        teeth = [unit.teeth for unit in self.units]
+        problem = generated_teeth_problem(self.coupling, self.hob, teeth)
+        if problem:
+            self.report.add(step.number, step.line, problem)
+        self._describe_coupling()
+
+    def _describe_coupling(self) -> None:
+        teeth = self.coupling.teeth(self.hob.starts)
+        self.report.teeth.append(f"{teeth:g}")
+        if self.worm_wheel:
+            beta = lead_angle(self.hob) * hand_sign(self.hob.hand) - self.swivel
+            hand = "R" if beta >= 0 else "L"
+            self.report.helix.append(f"{hand_name(hand)} β {abs(beta):.3f}° (hob lead and swivel)")
+            return
+        beta, hand, lead = helix_of(self.coupling.factors.get("Z", 0.0), self.gear, round(teeth) or 1)
+        self.report.helix.append("spur" if hand is None else f"{hand_name(hand)} β {beta:.3f}° lead {lead:.1f} mm")
+
+    def _shift(self, step) -> None:
+        try:
+            ends = self.clamp.take(step.item)
+        except Refused as refusal:
+            raise SimulationError(f"{where(self.report.name, step.number, step.line)}: {refusal}") from None
+        if ends is not None:
+            self._move(step, 0, {"Y": ends[self.shift_end]})
+
+    def _block(self, step) -> None:
+        block = step.item
+        if 5 in step.m_codes:
+            self.spindle = False
+        if 20 in step.m_codes:
+            self.tailstock = True
+        if block.feed is not None:
+            self.feed = block.feed
+        if block.speed is not None:
+            self.speed = block.speed
+        if DWELL in step.g_codes:
+            self.report.cycle_time += block.values.get("F", 0.0) / 60.0
+        elif block.moves and block.area is None:
+            self._move(step, block.motion, dict(block.positions), block.values.get("A"))
+        if 3 in step.m_codes:
+            self.spindle = True
+        if 21 in step.m_codes:
+            self.tailstock = False
+
+    # ---------------------------------------------------------------- moves
+
+    def _move(self, step, motion: int, program: dict, swivel: float | None = None) -> None:
+        if swivel is not None:
+            self.swivel, self.swivel_known = self.senses.swivel(swivel), True
+        target = {axis: self.senses.position(axis, value) for axis, value in program.items()}
+        start = dict(self.position)
+        end = {**start, **target}
+        self._time(motion, program)
+        cutting = motion == 1 and self.coupling is not None and self.spindle and (self.speed or 0) > 0
+        velocities = self._velocities(motion, start, end)
+        self._table_speed(step, velocities)
+        if cutting:
+            self._check_cut(step, start, end)
+            self._extend_cut(step, start, end, velocities)
+        else:
+            self._end_cut()
+        if {"X", "Z"} <= end.keys():
+            self._contacts(step, motion, cutting, start, end)
+        self.position = end
+
+    def _time(self, motion: int, program: dict) -> None:
+        if motion == 0:
+            self.report.cycle_time += rapid_minutes(self.program, program, self.machine.rapid_rate)
+        elif self.feed:
+            self.report.cycle_time += feed_minutes(self.program, program, self.feed)
+        self.program.update(program)
+
+    def _velocities(self, motion: int, start: dict, end: dict) -> dict:
+        delta = {axis: end[axis] - start[axis] for axis in AXES if axis in end and axis in start
+                 and abs(end[axis] - start[axis]) > 1e-9}
+        if motion == 0:
+            return {axis: math.copysign(self.machine.rapid_rate, value) for axis, value in delta.items()}
+        length = math.sqrt(sum(value * value for value in delta.values()))
+        rate = self.feed or 0.0
+        return {axis: rate * value / length for axis, value in delta.items()} if length else {}
+
+    def _table_speed(self, step, velocities: dict) -> None:
+        """n_C = k_B·n_B + (k_Z·v_Z + k_Y·v_Y)/360 (reference §A5), program values and senses."""
+        if self.coupling is None:
+            return
+        factors = self.coupling.program_factors
+        turning = self.speed if self.spindle and self.speed else 0.0
+        program_v = {axis: v * {"X": 1, "Y": self.senses.y, "Z": self.senses.z}[axis] for axis, v in velocities.items()}
+        speed = abs(factors["B"] * turning + sum(factors.get(axis, 0.0) * program_v.get(axis, 0.0)
+                                                 for axis in ("Z", "Y")) / 360.0)
+        self.report.table_speed = max(self.report.table_speed, speed)
+        limit = self.machine.table_speed_max
+        if limit is not None and speed > limit + 1e-9:
+            self.report.add(step.number, step.line, f"the table turns at {speed:.1f} r/min, above {self.machine.name}'s "
+                                                    f"{limit:g} r/min (hob, Z and Y terms at this move's speeds)")
+
+    def _check_cut(self, step, start: dict, end: dict) -> None:
+        moving = frozenset(axis for axis in AXES if axis in start and abs(end[axis] - start[axis]) > 1e-9)
+        teeth = self._cut_teeth()
+        problems = []
+        if "Y" not in self.position:
+            problems.append("Y (the hob shift) is not positioned before the cut: the generating zone lies "
+                            "wherever the last program left the hob")
+        if not self.swivel_known:
+            problems.append("the swivel A is not positioned before the cut")
+        else:
+            problems.append(swivel_problem(self.swivel, self.gear, self.hob))
+        if teeth is not None:
+            problems += coupling_problems(self.coupling, self.gear, self.hob, teeth, self.worm_wheel, moving)
+        for problem in filter(None, problems):
+            if (self.session, problem) not in self.said:
+                self.said.add((self.session, problem))
+                self.report.add(step.number, step.line, problem)
+
+    def _cut_teeth(self) -> int | None:
+        teeth = self.coupling.teeth(self.hob.starts)
+        return int(round(teeth)) if abs(teeth - round(teeth)) < 1e-9 else None
+
+    def _contacts(self, step, motion: int, cutting: bool, start: dict, end: dict) -> None:
+        swivel = (self.swivel + 90.0) % 180.0 - 90.0       # a cylinder turned by 180° is the same cylinder
+        if abs(swivel) > MAX_SWIVEL:
+            self.report.add(step.number, step.line, f"the swivel A {self.swivel:g}° sets the hob axis within "
+                                                    f"{90 - MAX_SWIVEL:g}° of the work axis: not a hobbing set-up")
+            return
+        x, y, z = move_poses(start, end, motion == 0)
+        teeth = self._cut_teeth() if cutting else None
+        reason = self._reason(motion)
+        running = self.coupling is not None and self.spindle
+        for contact in follow(self.solids, self.body, swivel, x, y, z,
+                              Motion(teeth, running, self.session, self.tailstock, reason)):
+            self.report.add(step.number, step.line, self._contact_message(contact, reason, teeth))
+
+    def _reason(self, motion: int) -> str:
+        if motion == 0:
+            return "on a rapid move (G0)"
+        if self.coupling is None:
+            return "feeding with the table not coupled to the hob"
+        if not (self.spindle and self.speed):
+            return "feeding with the hob spindle stopped"
+        return f"feeding with a coupling that generates {self.coupling.teeth(self.hob.starts):g} teeth"
+
+    def _contact_message(self, contact, reason: str, teeth) -> str:
+        z = contact.height * self.senses.z
+        if contact.below_root:
+            return (f"the hob cuts {contact.depth:.3f} mm below the intended root of {contact.solid.name} at Z{z:.3f}")
+        return f"the hob runs {contact.depth:.3f} mm into {contact.solid.name} at Z{z:.3f} {reason}"
+
+    def _extend_cut(self, step, start: dict, end: dict, velocities: dict) -> None:
+        teeth = self._cut_teeth()
+        if teeth is None:
+            return
+        if self.cut is None or self.cut.teeth != teeth:
+            self._end_cut()
+            table = abs(self.coupling.k_b) * self.speed
+            before = {id(unit): unit.reach.copy() for unit in self.units if unit.teeth == teeth}
+            self.cut = Cut(step.number, step.line, teeth, table, before)
+        self.cut.add(start, end, velocities)
+
+    def _end_cut(self) -> None:
+        if self.cut is None:
+            return
+        cut, self.cut = self.cut, None
+        for unit in self.units:
+            if id(unit) in cut.reach_before and (unit.reach < cut.reach_before[id(unit)]).any():
+                self.last_cut_of[id(unit)] = cut
+                self.report.cuts.append(summary(cut, unit, self.body.half_length))
+                self._check_run_out(cut, self.report.cuts[-1])
+
+    def _check_run_out(self, cut: Cut, done) -> None:
+        if done.run_out is not None and done.run_out <= 0:
+            self.report.add(cut.number, cut.line, f"the pass ends {-done.run_out:.3f} mm short of carrying the hob "
+                                                  f"centre beyond the face of {done.unit} it leaves (no run-out)")
+
+    # ---------------------------------------------------------------- the end
+
+    def finish(self, lines: list[str]) -> None:
+        self._end_cut()
+        last = (len(lines), lines[-1] if lines else "")
+        for unit in self.units:
+            self._check_depth(unit, last)
+        if self.report.header_time is not None:
+            problem = header_problem(self.report.header_time, self.report.cycle_time)
+            if problem:
+                self.report.add(self.header_step.number, self.header_step.line, problem)
+        else:
+            self.report.add(*last, "no `; CYCLE TIME <m> MIN` header line: the cycle time is only reported",
+                            refuses=False)
+
+    def _check_depth(self, unit: Solid, last: tuple) -> None:
+        cut = self.last_cut_of.get(id(unit))
+        if cut is None:
+            self.report.add(*last, f"{unit.name} is never cut")
+            return
+        stock = unit.stock()
+        worst = int(np.argmax(stock))
+        z = unit.heights[worst] * self.senses.z
+        if np.isinf(stock[worst]):
+            self.report.add(cut.number, cut.line, f"the cuts of {unit.name} never reach Z{z:.3f}: part of its face "
+                                                  "is not cut")
+        elif stock[worst] > 0.01:
+            self.report.add(cut.number, cut.line, f"the last cut of {unit.name} leaves {stock[worst]:.3f} mm above the "
+                                                  f"intended root at Z{z:.3f} (full depth (d_f2 + d_a0)/2 not reached)")
+
+
+TAKERS = {"header": Walk._header, "comment": Walk._comment, "block": Walk._block,
+          "statement": Walk._statement, "shift": Walk._shift}
