@@ -147,7 +147,9 @@ def test_worm_wheel_plunges_radially_without_z(conn):
     assert all("Z" not in m.changed for m in coupled if m.start["Z"] is not None)
     plunge = [m for m in cutting_moves(nc) if m.changed == {"X"}]
     assert abs(plunge[-1].end["X"] - (g["df2"] + hob["da0"]) / 2) < 0.01
-    assert nc.block_with("A").words["A"] == 0                          # shaft angle 90°
+    # shaft angle 90°: A = h_hob·γ − h_gear·β (§A7), 0 but for the hob's lead differing from the helix (§B10)
+    assert hob["hand"] == g["hand"] == "R"
+    assert abs(nc.block_with("A").words["A"] - (lead_angle(hob) - g["beta"])) < 0.002
     assert nc.index("G4") is not None and nc.index("G4") > nc.index("move G1")   # dwell at depth
     egon = nc.block_with("EGON").call("EGON")
     assert egon.args[:5] == ("C", "FINE", "B", str(-hob["z0"] if hob["hand"] == "R" else hob["z0"]), "40")

@@ -72,7 +72,8 @@ def din_values(conn, gear_id, text) -> dict:
     z0, da0, hob_hand, _ = hob_row(conn, text)
     gamma = math.degrees(math.asin(z0 * mn / (da0 - 2.5 * mn)))
     worm = gear_id == CLASS_GEARS["worm_wheel"]
-    return {"A": 0.0 if worm else hand(hob_hand) * gamma - hand(gear_hand) * beta,
+    # A worm wheel's A is the same formula (§A7); it is 0 when the hob's lead is the wheel's helix (§B10)
+    return {"A": hand(hob_hand) * gamma - hand(gear_hand) * beta,
             "B": -hand(hob_hand) * z0,
             "Z": 0.0 if worm else -hand(gear_hand) * 360 * math.sin(math.radians(beta)) / (math.pi * mn * z2),
             "Y": 360 * math.cos(math.radians(gamma)) / (math.pi * mn * z2)}

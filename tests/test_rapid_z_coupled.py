@@ -17,7 +17,7 @@ from engine.gears.records import Machine
 from engine.programs.verifier import LimitError, verify_program
 
 TABLE_MAX = 120.0
-PRELUDE = ["%_N_RAPID_MPF", ";$PATH=/_N_MPF_DIR", "G90 G71 G94", "G25 X50.000 Y-30.000 Z-200.000",
+PRELUDE = ["%_N_RAPID_MPF", ";$PATH=/_N_MPF_DIR", "G90 G71 G94", "G54", "G25 X50.000 Y-30.000 Z-200.000",
            "G26 X250.000 Y30.000 Z100.000", "WALIMON"]
 
 
@@ -31,7 +31,7 @@ def table_speed(speed: float, teeth: int, factor: float, velocity: float) -> flo
 
 
 def coupled(teeth: int, factor: float, speed: int, *blocks: str) -> list[str]:
-    return PRELUDE + ["G0 X200.000 Z50.000", "EGDEF(C,B,1,Z,1)", f'EGON(C,"FINE",B,-1,{teeth},Z,{factor:.6f},1)',
+    return PRELUDE + ["G0 X200.000 Z50.000", "G0 Y0.000", "EGDEF(C,B,1,Z,1)", f'EGON(C,"FINE",B,-1,{teeth},Z,{factor:.6f},1)',
                       f"M3 S{speed}", *blocks, "M5", "EGOFS(C)", "EGDEL(C)", "M30"]
 
 

@@ -32,10 +32,16 @@ def machine_job(params: dict, module_params: dict, machine: Machine, hob: Hob, s
     if job["load_position"]:
         _widen(job, "x", job["load_x"])
         _widen(job, "z", job["load_z"])
+    return with_cycle_time(job, modules, shape, machine), modules
+
+
+def with_cycle_time(job: dict, modules: dict, shape: str, machine: Machine) -> dict:
+    """The job with the cycle time of its program (program values in, as stored): a stored job
+    whose feeds were edited is made again with the time its program now takes, so the header
+    never tells the operator a time the simulation does not find."""
     cuts = [modules[key] for key in sorted(modules, key=_module_order)
             if key.startswith("cutmotion:") and modules[key]["cut_on"]]
-    job["cycle_time"] = round(cycle_time(job, cuts, shape, machine.rapid_rate), 2)
-    return job, modules
+    return {**job, "cycle_time": round(cycle_time(job, cuts, shape, machine.rapid_rate), 2)}
 
 
 def _module_order(key: str) -> tuple:

@@ -1,6 +1,8 @@
 """Hobbing model of worm wheels (reference §A5, §B10). The hob copies the mating worm, its
-axis lies in the wheel's mid-plane at a shaft angle of 90° (A = 0), and there is no axial
-pass. Radial: X plunges to the full-depth centre distance and dwells while the table turns.
+axis lies in the wheel's mid-plane at a shaft angle of 90°, and there is no axial pass. Its
+swivel is the general A = h_hob·γ − h_gear·β (§A7): 0 when the hob's lead angle is the wheel's
+helix, and the small difference otherwise (an oversize or resharpened hob, within the hob
+match's tolerance), so the hob's thread lies along the teeth. Radial: X plunges to the full-depth centre distance and dwells while the table turns.
 Tangential: the centre distance is set in air, the hob feeds along its own axis (Y) through
 the wheel, and the table gets the extra rotation 360·cos γ/(π·m_n·z2) degrees per mm of Y."""
 from __future__ import annotations
@@ -11,7 +13,7 @@ from dataclasses import replace
 from ..errors import EngineError
 from ..gears.cutting_data import per_minute
 from . import conventions
-from .cylindrical import RAPID_SHORT_OF_CUT, CylindricalModel, JobParameters, Setup
+from .cylindrical import RAPID_SHORT_OF_CUT, CylindricalModel, JobParameters
 from .passes import APPROACH_SAFETY, feeds, plan_cuts, working_area
 
 DWELL_TABLE_TURNS = 2.0   # table revolutions at full depth after a radial plunge (enveloping cuts)
@@ -26,10 +28,6 @@ class WormWheelModel(CylindricalModel):
 
     def shift_travel(self, choices) -> float:
         return 0.0   # a worm-wheel hob is not shifted; the tangential pass uses its whole length
-
-    def setup(self, gear, hob) -> Setup:
-        setup = super().setup(gear, hob)
-        return Setup(setup.lead, 0.0, setup.full_depth, setup.reach, setup.x_retract)
 
     def job(self, gear, gear_class, hob, machine, cutting, choices) -> JobParameters:
         check_module_stated(gear)

@@ -7,8 +7,10 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..errors import EngineError
+from ..gears.models import model_for_class
 from ..gears.process_notes import stored_feed_notes
 from ..gears.records import Hob, Machine, load_gear, load_hobs, load_machine
+from ..hobbing.machine_job import with_cycle_time
 from ..memory import no_cycle_collection
 from ..templates.rows import Template
 from ..templates.store import load_template
@@ -38,6 +40,8 @@ class Remaker:
 
             return plan_turning_job(self.conn, gear_class, machine, params, module_params)
         template = self.template(gear_class)
+        if "cycle_time" in params:   # a hobbing job: the time follows feeds edited since
+            params = with_cycle_time(params, module_params, model_for_class(self.conn, gear_class).cut_shape, machine)
         result = run_template(template, params, module_params, machine, self.workpiece(gear_id, hob_id))
         return Planned(gear_id, gear_class, machine_name, hob_id, params, module_params, template, result,
                        notes=stored_feed_notes(job_id, params, module_params))

@@ -23,6 +23,7 @@ from .frame import Senses
 from .paths import move_poses
 from .report import Report, SimulationError, where
 from .solids import Solid
+from .allowance import depth_problem, header_allowance
 from .timing import feed_minutes, header_minutes, header_problem, rapid_minutes
 
 AXES = ("X", "Y", "Z")
@@ -50,6 +51,7 @@ class Walk:
         self.last_cut_of: dict[int, Cut] = {}
         self.clamp = ShiftClamp()
         self.said: set = set()
+        self.allowance = 0.0
 
     # ---------------------------------------------------------------- lines
 
@@ -61,6 +63,9 @@ class Walk:
         if minutes is not None:
             self.report.header_time = minutes
             self.header_step = step
+        allowance = header_allowance(step.line)
+        if allowance is not None:
+            self.allowance = allowance
 
     def _header(self, step) -> None:
         return None
@@ -275,9 +280,13 @@ class Walk:
         if np.isinf(stock[worst]):
             self.report.add(cut.number, cut.line, f"the cuts of {unit.name} never reach Z{z:.3f}: part of its face "
                                                   "is not cut")
-        elif stock[worst] > 0.01:
-            self.report.add(cut.number, cut.line, f"the last cut of {unit.name} leaves {stock[worst]:.3f} mm above the "
-                                                  f"intended root at Z{z:.3f} (full depth (d_f2 + d_a0)/2 not reached)")
+        else:
+            for at in (worst, int(np.argmin(stock))):
+                problem = depth_problem(float(stock[at]), self.allowance)
+                if problem:
+                    z = unit.heights[at] * self.senses.z
+                    self.report.add(cut.number, cut.line, f"the last cut of {unit.name} {problem} at Z{z:.3f}")
+                    return
 
 
 TAKERS = {"header": Walk._header, "comment": Walk._comment, "block": Walk._block,
