@@ -17,8 +17,10 @@ Case ids name class, hands (gear/hob), hob starts and the job choice, and the ma
 """
 from __future__ import annotations
 
+import math
 import uuid
 
+import numpy as np
 import psycopg
 import pytest
 from psycopg import sql
@@ -32,10 +34,11 @@ from engine.programs.instantiate import instantiate_gear
 
 from hobbing_checks import (Case, Job, approach_problems, contract_problems, coupling_problems, depth_problems,
                             envelope_problems, feed_problems)
+from hobbing_envelope import Solid, Sweep, intrusion
 from hobbing_machine_checks import all_problems, cycle_time_problems, obstacle_problems, table_speed_problems
 from hobbing_reference import Gear, Hob, Unit, layout_cuttable, lead_angle, read
 from hobbing_reference_gears import (DIN, MIRROR, PAPER_STOCK, REVERSED, STOCK, cylindrical, insert_gear, insert_hob,
-                                     insert_machine, make_gear, make_hob, only_hob, TOOL_NUMBER)
+                                     insert_machine, make_gear, make_hob, only_hob, read_machine, TOOL_NUMBER)
 from hobbing_reference_programs import HAND_WRITTEN
 
 
@@ -68,6 +71,52 @@ def test_reader_follows_axes_and_reads_calls():
     assert nc.after[nc.first("EGON")]["A"] == 1.763 and nc.first("WALIMON") < nc.first("motion")
     assert read("G0 Y=R11\nM1=3 S1=300\nG4 F2").blocks[0].words["Y"] == "R11"
     assert 3 in read("M1=3 S1=300").blocks[0].m and read("G4 F2").moves == []
+
+
+# ---------------------------------------------------------------- the 3-D hob envelope
+
+def sampled_depth(sweep: Sweep, solid: Solid, r0: float, length: float) -> float:
+    """Dense samples of the hob's tip cylinder (t ≤ 1 mm, φ 1°) along the move (≤ 0.5 mm): the
+    deepest point's depth in the solid, for comparison with the exact search."""
+    eta = np.radians(sweep.eta)
+    count = max(2, math.ceil(math.hypot(sweep.x1 - sweep.x0, sweep.z1 - sweep.z0) / 0.5) + 1)
+    fraction = np.linspace(0, 1, count)[:, None, None]
+    t = np.linspace(sweep.y_start[0] - length / 2, sweep.y_start[1] + length / 2, int(length) + 2)[None, :, None]
+    phi = np.radians(np.arange(360))[None, None, :]
+    x = sweep.x0 + fraction * (sweep.x1 - sweep.x0) + r0 * np.cos(phi)
+    y = t * np.cos(eta) - r0 * np.sin(phi) * np.sin(eta)
+    z = sweep.z0 + fraction * (sweep.z1 - sweep.z0) + t * np.sin(eta) + r0 * np.sin(phi) * np.cos(eta)
+    wall = (solid.radius + solid.slope * (z - solid.z_ref) - np.hypot(x, y)) / math.hypot(1, solid.slope)
+    return float(np.minimum(wall, np.minimum(z - solid.bottom, solid.top - z)).max())
+
+
+def test_envelope_of_the_swivelled_hob_is_three_dimensional():
+    """Gear 43's infeed (helical m3 z41, d_a 133.339, hob r0 40 L120, η −12.628°) at X100.919 Z31.336:
+    the hob's XZ shadow (tip circle stretched by ±60·sin η along Z) overlaps the blank by 1.58 mm, the
+    hob itself does not: where its tip cylinder lies within the tip radius it is well above the face."""
+    sweep, blank = Sweep(100.919, 31.336, 100.919, 31.336, -12.628), Solid(133.339 / 2, -30.0, 0.0)
+    assert intrusion(sweep, blank, 40.0, 120.0) < -3.0
+    assert sampled_depth(sweep, blank, 40.0, 120.0) <= intrusion(sweep, blank, 40.0, 120.0) + 1e-9
+
+
+@pytest.mark.parametrize("eta, slope, shift", [(0.0, 0.0, 0.0), (-12.628, 0.0, 0.0), (17.5, 0.0, 20.0),
+                                               (1.763, math.tan(math.radians(6.5)), 0.0),
+                                               (-8.0, -math.tan(math.radians(6.5)), -15.0)])
+def test_envelope_finds_a_small_intrusion_that_samples_would_miss_and_agrees_with_them(eta, slope, shift):
+    """The exact search is never shallower than dense samples, and finds a 0.05 mm intrusion: the hob
+    pushed 0.05 mm past the depth at which it first touches (found by bisection on X)."""
+    blank, r0, length = Solid(40.0, -25.0, 0.0, slope, 0.0), 35.0, 100.0
+    at = lambda x: Sweep(x, 30.0, x, -50.0, eta, (shift, shift), (shift, shift))    # noqa: E731
+    low, high = 0.0, 200.0
+    for _ in range(60):
+        low, high = ((low + high) / 2, high) if intrusion(at((low + high) / 2), blank, r0, length) > 0 else \
+            (low, (low + high) / 2)
+    touching = high
+    for x in (touching + 5, touching, touching - 0.05, touching - 3):
+        exact, sampled = intrusion(at(x), blank, r0, length), sampled_depth(at(x), blank, r0, length)
+        assert (exact <= 0) == (sampled <= 0) or exact < 0.01, (x, exact, sampled)
+        assert sampled <= 0 or sampled - 1e-6 <= exact < sampled + 0.05, (x, exact, sampled)
+    assert 0.04 < intrusion(at(touching - 0.05), blank, r0, length) < 0.06
 
 
 # ---------------------------------------------------------------- the matrix of cases
@@ -127,6 +176,7 @@ class Bench:
         self.conn, self.made, self.gear_ids = conn, {}, {}
         insert_machine(conn, MIRROR)
         insert_machine(conn, REVERSED)
+        self.machines = {key: read_machine(conn, machine.name) for key, machine in MACHINES.items()}
 
     def case(self, case_id: str) -> tuple[Case, object, object]:
         if case_id not in self.made:
@@ -142,7 +192,7 @@ class Bench:
         gear = make_gear(cls, gear_hand, hob, cone, large_below)
         choices = dict(JOB_CHOICES[choice], **({"worm_feed": worm} if worm_wheel else {}))
         shift = {"shift-fixed": 5.0, "shift-per-part": "per part"}.get(choice, 0.0)
-        case = Case(gear, hob, MACHINES[machine_key],
+        case = Case(gear, hob, self.machines[machine_key],
                     Job(choices.get("coolant", True), shift, worm, choices.get("tailstock", True)))
         gear_id = self.gear_ids[case_id] = 9000 + len(self.made)
         with self.conn.transaction(force_rollback=True):
@@ -179,11 +229,19 @@ def program_of(bench, case_id):
     case, nc, error = bench.case(case_id)
     if error is None:
         return case, nc
-    refusal_due = isinstance(error, EngineError) and not layout_cuttable(case.gear, case.hob)
+    refusal_due = isinstance(error, EngineError) and not layout_cuttable(case.gear, case.hob, shift=shift_range(case))
     message = str(error)
     if not refusal_due or len(message.splitlines()) != 1 or f"gear {bench.gear_ids[case_id]}" not in message:
         pytest.fail(f"{case_id}: no program, {type(error).__name__}: {error}")
     return case, None
+
+
+def shift_range(case: Case) -> tuple:
+    """Where the job puts the hob's shift (DIN): a fixed position, or for a shift per part anywhere the
+    hob's length allows around the centre (the program's own limits are unknown without a program)."""
+    if isinstance(case.job.shift, float):
+        return case.job.shift, case.job.shift
+    return -case.hob.length / 2, case.hob.length / 2
 
 
 def test_the_issue_duplex_layout_cannot_be_cut_but_the_other_can():
@@ -256,16 +314,16 @@ def test_cycle_time_header_agrees_with_the_moves(bench, case_id):
 
 @pytest.mark.parametrize("case_id", [c for c in CASE_IDS if c.endswith("default@din")])
 def test_tool_call_before_cutting_and_final_load_position(bench, case_id):
-    """Issue 14: T<tool_number> D1 before the first cut; the program ends at the machine's load
-    position (hobber-840d: X300 Z100)."""
+    """Issue 14: T<tool_number> D1 before the first cut; the program ends at the load position the
+    machine row declares."""
     case, nc = program_of(bench, case_id)
     if nc is None:
         return
     tool = [b for b in nc.blocks if b.words.get("T") == TOOL_NUMBER and b.words.get("D") == 1]
     assert tool and tool[0].index < nc.first("G1 move"), f"{case_id}: no T{TOOL_NUMBER} D1 before the first G1"
-    last = nc.moves[-1]
-    assert (last.end["X"], last.end["Z"]) == (300.0, 100.0), \
-        f"{case_id}: ends at X{last.end['X']} Z{last.end['Z']}, not the load position X300 Z100"
+    last, load = nc.moves[-1], case.machine.load
+    assert (last.end["X"], last.end["Z"]) == load, \
+        f"{case_id}: ends at X{last.end['X']} Z{last.end['Z']}, not the machine's load position X{load[0]} Z{load[1]}"
 
 
 # ---------------------------------------------------------------- the issue's duplex layout through the CLI
@@ -285,8 +343,9 @@ def test_issue_duplex_layout_through_the_cli_programs_safely_or_refuses_in_one_l
     fields = dict(part.split("=") for part in hob_line.split()[3:])
     with psycopg.connect(run.url) as conn:
         length, hand = conn.execute("SELECT length, hand FROM hob WHERE id = %s", (hob_line.split()[2],)).fetchone()
-    hob = Hob(int(fields["z0"]), float(fields["da0"]), hand, float(length))
-    assert_none(envelope_problems(nc, Case(gear, hob)) + approach_problems(nc, Case(gear, hob)), "issue duplex")
+        case = Case(gear, Hob(int(fields["z0"]), float(fields["da0"]), hand, float(length)),
+                    read_machine(conn, "hobber-840d"))
+    assert_none(envelope_problems(nc, case) + approach_problems(nc, case) + obstacle_problems(nc, case), "issue duplex")
 
 
 # ---------------------------------------------------------------- random valid gears of every class
@@ -345,7 +404,7 @@ def test_random_valid_gears_make_a_correct_program_or_a_one_line_refusal(conn, k
                 assert f"gear {gear_id}" in message, f"a duplex refusal must name the gear: {message!r}"
             return
     shift = {5.0: 5.0}.get(choice.get("shift_y"), "per part" if choice.get("shift_per_part") else 0.0)
-    case = Case(gear, hob, DIN, Job(choice.get("coolant", True), shift, choice.get("worm_feed", "radial"),
-                                    choice.get("tailstock", True)))
+    case = Case(gear, hob, read_machine(conn, DIN.name), Job(choice.get("coolant", True), shift,
+                                                             choice.get("worm_feed", "radial"), choice.get("tailstock", True)))
     problems = all_problems(read(program.text), case)
     assert not problems, f"{gear} {hob} {choice}:\n  " + "\n  ".join(problems) + "\n" + program.text
