@@ -10,14 +10,13 @@ import math
 import re
 from dataclasses import dataclass
 
-from hobbing_envelope import Sweep, intrusions
+from hobbing_envelope import hob_depths, known_xz, shift_limits
 from hobbing_reference import (Gear, Hob, Machine, Move, Nc, Unit, approach_needed, b_ratio, full_depth, lead_angle,
                                root_solid, roughing_feed_max, swivel, taper_depth, tip_radius_at, unit_solid,
                                y_factor, z_factor)
 
 ROUND = 0.002        # mm or degrees: coordinates and angles are written with 3 decimals
 DEPTH = 0.01         # mm, last cut against (d_f2 + d_a0)/2 (Contract), and below the root at most
-SWIVEL_STEP = 0.25   # degrees of A between the hob envelopes checked on a move that swivels
 AXIAL_CLASSES = ("spur", "helical", "taper", "crowned", "duplex")
 
 
@@ -83,45 +82,6 @@ def _unit_of(nc: Nc, case: Case, run: list[Move]) -> Unit:
 
 def passes(cut: Cut) -> list[Move]:
     return [m for m in cut.moves if m.delta("Z") != 0]
-
-
-def shift_limits(nc: Nc, machine: Machine) -> tuple:
-    """The Y range the program's own G25/G26 allow (DIN): where a shift set from a parameter can be."""
-    values = [machine.din("Y", b.words["Y"]) for b in nc.blocks if {25, 26} & set(b.g) and "Y" in b.words]
-    values = [v for v in values if isinstance(v, float)]
-    return (min(values), max(values)) if values else (0.0, 0.0)
-
-
-def sweeps(move: Move, case: Case, limits: tuple) -> list[Sweep]:
-    """The hob envelopes of a DIN move: its centre X/Z from start to end, its shift Y (a parameter:
-    anywhere within `limits`; never programmed: 0) and its swivel (a move that turns A: every
-    SWIVEL_STEP between; A not yet programmed: the gear's swivel)."""
-    ys = [(v, v) if isinstance(v, float) else (0.0, 0.0) if v is None else limits
-          for v in (move.start["Y"], move.end["Y"])]
-    a0, a1 = (move.start["A"], move.end["A"])
-    etas = [a1 if isinstance(a1, float) else swivel(case.gear, case.hob)]
-    if isinstance(a0, float) and isinstance(a1, float) and a0 != a1:
-        count = math.ceil(abs(a1 - a0) / SWIVEL_STEP)
-        etas = [a0 + (a1 - a0) * k / count for k in range(count + 1)]
-    return [Sweep(move.start["X"], move.start["Z"], move.end["X"], move.end["Z"], eta, *ys) for eta in etas]
-
-
-def deepest(pairs: list[tuple[Move, object]], case: Case, limits: tuple) -> list[float]:
-    """For each (DIN move, Solid): how deep the hob reaches into the solid during the move."""
-    flat, owner = [], []
-    for index, (move, solid) in enumerate(pairs):
-        for sweep in sweeps(move, case, limits):
-            flat.append((sweep, solid))
-            owner.append(index)
-    depth = intrusions([s for s, _ in flat], [b for _, b in flat], case.hob.r0, case.hob.length) if flat else []
-    found = [-math.inf] * len(pairs)
-    for index, value in zip(owner, depth):
-        found[index] = max(found[index], float(value))
-    return found
-
-
-def known_xz(move: Move) -> bool:
-    return all(isinstance(move.start[a], float) for a in "XZ")
 
 
 # ---------------------------------------------------------------- §7 program contract
@@ -300,7 +260,7 @@ def depth_problems(nc: Nc, case: Case) -> list[str]:
 
 def _root_problems(nc: Nc, all_cuts: list[Cut], case: Case) -> list[str]:
     pairs = [(move, cut.unit) for cut in all_cuts for move in passes(cut)]
-    depths = deepest([(move, root_solid(case.gear, unit)) for move, unit in pairs], case, shift_limits(nc, case.machine))
+    depths = _deepest([(move, root_solid(case.gear, unit)) for move, unit in pairs], case, shift_limits(nc, case.machine))
     return [f"pass block {move.block}: the hob (3-D) reaches {depth:.3f} mm below unit z{unit.z2}'s root cone"
             for (move, unit), depth in zip(pairs, depths) if depth > DEPTH]
 
@@ -352,7 +312,7 @@ def _infeed_problems(cut: Cut, infeed: Move, over: list[Move], case: Case, eta: 
     h = tip_radius_at(gear, unit, face) + hob.r0 - x
     problems = []
     if gear.beta == 0:
-        depth = deepest([(Move(infeed.block, "G0", infeed.end, infeed.end, None, None), unit_solid(gear, unit))],
+        depth = _deepest([(Move(infeed.block, "G0", infeed.end, infeed.end, None, None), unit_solid(gear, unit))],
                         case, limits)[0]
         if depth > ROUND:
             problems.append(f"infeed block {infeed.block} to X{x} at Z{z} (h = {h:.3f}): the hob is "
@@ -423,8 +383,12 @@ def envelope_problems(nc: Nc, case: Case) -> list[str]:
             during[move.block] = cut.unit
     pairs = [(move, unit) for move in (din_move(m, case.machine) for m in nc.moves) if known_xz(move)
              for unit in case.gear.units if during.get(move.block) != unit]
-    depths = deepest([(move, unit_solid(case.gear, unit)) for move, unit in pairs], case,
+    depths = _deepest([(move, unit_solid(case.gear, unit)) for move, unit in pairs], case,
                      shift_limits(nc, case.machine))
     return [f"{move.mode} block {move.block} {nc.blocks[move.block].text!r}: hob {depth:.3f} mm "
             f"into unit z{unit.z2} (d_a {unit.da}, Z{unit.bottom:g}…{unit.z_top:g})"
             for (move, unit), depth in zip(pairs, depths) if depth > ROUND]
+
+
+def _deepest(pairs: list, case: Case, limits: tuple) -> list[float]:
+    return hob_depths(pairs, swivel(case.gear, case.hob), case.hob.r0, case.hob.length, limits)

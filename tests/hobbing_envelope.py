@@ -23,7 +23,8 @@ from dataclasses import dataclass
 import numpy as np
 
 GOLDEN = (math.sqrt(5) - 1) / 2
-RESOLUTION = 1e-4       # mm of bracket left by the golden-section searches
+RESOLUTION = 5e-4       # mm of bracket left by the golden-section searches (depth is 1-Lipschitz)
+_FOUND: dict = {}       # (sweep, solid, r0, length) → intrusion: the same DIN moves recur across machines
 
 
 @dataclass(frozen=True)
@@ -55,7 +56,23 @@ def intrusion(sweep: Sweep, solid: Solid, r0: float, length: float) -> float:
 
 
 def intrusions(sweeps: list[Sweep], solids: list[Solid], r0: float, length: float) -> np.ndarray:
-    """`intrusion` for many (sweep, solid) pairs at once; pairs clear by their bounding box skip the search."""
+    """`intrusion` for many (sweep, solid) pairs at once (remembered: the same DIN moves recur)."""
+    keys = [(sweep, solid, r0, length) for sweep, solid in zip(sweeps, solids)]
+    missing = list(dict.fromkeys(k for k in keys if k not in _FOUND))
+    for still in (True, False):
+        group = [k for k in missing if _still(k[0]) == still]
+        if group:
+            found = _intrusions([k[0] for k in group], [k[1] for k in group], r0, length, still)
+            _FOUND.update(zip(group, found.tolist()))
+    return np.array([_FOUND[k] for k in keys], float)
+
+
+def _still(sweep: Sweep) -> bool:
+    return (sweep.x0, sweep.z0, sweep.y_start) == (sweep.x1, sweep.z1, sweep.y_end)
+
+
+def _intrusions(sweeps: list[Sweep], solids: list[Solid], r0: float, length: float, still: bool) -> np.ndarray:
+    """Pairs clear by their bounding box skip the search; a hob standing still needs no search along the move."""
     p = {name: np.array([getattr(s, name) for s in sweeps], float) for name in ("x0", "z0", "x1", "z1", "eta")}
     for name, index in (("ylo0", 0), ("yhi0", 1)):
         p[name] = np.array([s.y_start[index] for s in sweeps], float)
@@ -66,7 +83,7 @@ def intrusions(sweeps: list[Sweep], solids: list[Solid], r0: float, length: floa
     result = np.full(len(sweeps), -math.inf)
     near = _near(p, r0, length)
     if near.any():
-        result[near] = _search({k: v[near] for k, v in p.items()}, r0, length)
+        result[near] = _search({k: v[near] for k, v in p.items()}, r0, length, still)
     return result
 
 
@@ -100,7 +117,7 @@ def _golden_max(f, low: np.ndarray, high: np.ndarray, scale: float = 1.0) -> np.
     return np.maximum.reduce([f1, f2, f(low), f(high)])
 
 
-def _search(p: dict, r0: float, length: float) -> np.ndarray:
+def _search(p: dict, r0: float, length: float, still: bool) -> np.ndarray:
     eta = np.radians(p["eta"])
     ce, se = np.cos(eta), np.sin(eta)
 
@@ -116,6 +133,8 @@ def _search(p: dict, r0: float, length: float) -> np.ndarray:
         return _golden_max(at_w, np.full(x.shape, -r0), np.full(x.shape, r0))
 
     count = p["x0"].shape
+    if still:
+        return over_w(np.zeros(count))
     travel = np.hypot(p["x1"] - p["x0"], p["z1"] - p["z0"]) + np.maximum(np.abs(p["ylo1"] - p["ylo0"]),
                                                                          np.abs(p["yhi1"] - p["yhi0"]))
     return _golden_max(over_w, np.zeros(count), np.ones(count), max(float(np.max(travel)), 1.0))
@@ -150,6 +169,48 @@ def _best_along_t(x, z_a, y_a, t_low, t_high, ce, se, p: dict) -> np.ndarray:
         t = np.clip(np.where(np.isfinite(t), t, t_low), t_low, t_high)
         best = np.maximum(best, _depth(x, y_a + t * ce, z_a + t * se, p))
     return best
+
+
+SWIVEL_STEP = 0.25   # degrees of A between the hob envelopes checked on a move that swivels
+
+
+def shift_limits(nc, machine) -> tuple:
+    """The Y range the program's own G25/G26 allow (DIN): where a shift set from a parameter can be."""
+    values = [machine.din("Y", b.words["Y"]) for b in nc.blocks if {25, 26} & set(b.g) and "Y" in b.words]
+    values = [v for v in values if isinstance(v, float)]
+    return (min(values), max(values)) if values else (0.0, 0.0)
+
+
+def known_xz(move) -> bool:
+    return all(isinstance(move.start[a], float) for a in "XZ")
+
+
+def move_sweeps(move, swivel: float, limits: tuple) -> list[Sweep]:
+    """The hob envelopes of a move read in the DIN frame: its centre X/Z from start to end, its shift
+    Y (a parameter: anywhere within `limits`; never programmed: 0) and its swivel (a move that turns
+    A: every SWIVEL_STEP between; A not yet programmed: `swivel`, the gear's)."""
+    ys = [(v, v) if isinstance(v, float) else (0.0, 0.0) if v is None else limits
+          for v in (move.start["Y"], move.end["Y"])]
+    a0, a1 = (move.start["A"], move.end["A"])
+    etas = [a1 if isinstance(a1, float) else swivel]
+    if isinstance(a0, float) and isinstance(a1, float) and a0 != a1:
+        count = math.ceil(abs(a1 - a0) / SWIVEL_STEP)
+        etas = [a0 + (a1 - a0) * k / count for k in range(count + 1)]
+    return [Sweep(move.start["X"], move.start["Z"], move.end["X"], move.end["Z"], eta, *ys) for eta in etas]
+
+
+def hob_depths(pairs: list, swivel: float, r0: float, length: float, limits: tuple) -> list[float]:
+    """For each (DIN move, Solid): how deep the hob reaches into the solid during the move."""
+    flat, owner = [], []
+    for index, (move, solid) in enumerate(pairs):
+        for sweep in move_sweeps(move, swivel, limits):
+            flat.append((sweep, solid))
+            owner.append(index)
+    depth = intrusions([s for s, _ in flat], [b for _, b in flat], r0, length) if flat else []
+    found = [-math.inf] * len(pairs)
+    for index, value in zip(owner, depth):
+        found[index] = max(found[index], float(value))
+    return found
 
 
 def root_section_centre(root_radius: float, r0: float, cone: float, eta: float) -> float:

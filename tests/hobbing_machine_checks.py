@@ -7,10 +7,10 @@ from __future__ import annotations
 import math
 import re
 
-from hobbing_checks import (Case, approach_problems, contract_problems, coupling_problems, deepest, depth_problems,
-                            din_move, envelope_problems, feed_problems, known_xz, shift_limits)
-from hobbing_envelope import Solid
-from hobbing_reference import Nc
+from hobbing_checks import (Case, approach_problems, contract_problems, coupling_problems, depth_problems, din_move,
+                            envelope_problems, feed_problems)
+from hobbing_envelope import Solid, hob_depths, known_xz, shift_limits
+from hobbing_reference import Nc, swivel
 
 ROUND = 0.002
 REACH = 1000.0      # mm: the fixture and tailstock are long cylinders along the work axis
@@ -35,7 +35,8 @@ def obstacle_problems(nc: Nc, case: Case) -> list[str]:
     """No move brings the hob (3-D: tip cylinder, length, swivel, shift) into the fixture or the tailstock."""
     pairs = [(move, body) for move in (din_move(m, case.machine) for m in nc.moves) if known_xz(move)
              for body in obstacles(case)]
-    depths = deepest([(move, solid) for move, (_, _, solid) in pairs], case, shift_limits(nc, case.machine))
+    depths = hob_depths([(move, solid) for move, (_, _, solid) in pairs], swivel(case.gear, case.hob), case.hob.r0,
+                        case.hob.length, shift_limits(nc, case.machine))
     return [f"{move.mode} block {move.block} {nc.blocks[move.block].text!r}: hob {depth:.3f} mm "
             f"into the {name} (Ø{diameter:g})" for (move, (name, diameter, _)), depth in zip(pairs, depths)
             if depth > ROUND]
