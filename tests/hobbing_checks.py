@@ -10,12 +10,13 @@ import math
 import re
 from dataclasses import dataclass
 
-from hobbing_reference import (Gear, Hob, Machine, Move, Nc, Unit, approach_needed, b_ratio, full_depth,
-                               distance_to_section, hob_intrusion, lead_angle, roughing_feed_max, swivel,
-                               tip_radius_at, y_factor, z_factor)
+from hobbing_envelope import hob_depths, known_xz, shift_limits
+from hobbing_reference import (Gear, Hob, Machine, Move, Nc, Unit, approach_needed, b_ratio, full_depth, lead_angle,
+                               root_solid, roughing_feed_max, swivel, taper_depth, tip_radius_at, unit_solid,
+                               y_factor, z_factor)
 
 ROUND = 0.002        # mm or degrees: coordinates and angles are written with 3 decimals
-DEPTH = 0.01         # mm, last cut against (d_f2 + d_a0)/2 (Contract)
+DEPTH = 0.01         # mm, last cut against (d_f2 + d_a0)/2 (Contract), and below the root at most
 AXIAL_CLASSES = ("spur", "helical", "taper", "crowned", "duplex")
 
 
@@ -235,22 +236,33 @@ def _x_at(moves: list[Move], z: float) -> float | None:
 
 
 def depth_problems(nc: Nc, case: Case) -> list[str]:
-    """The last cut of each unit reaches (d_f2 + d_a0)/2: taper along the cone line at the top
-    face (where the stated diameters hold), crowned at mid-face, worm wheels at the plunge/Y pass."""
+    """The last cut of each unit reaches full depth: (d_f2 + d_a0)/2 (§B3) at mid-face, crowned at
+    mid-face, worm wheels at the plunge/Y pass; a taper at the top face (where the stated diameters
+    hold) where the hob's tip section touches the root line (`taper_depth`), and no taper pass takes
+    the hob (3-D) more than DEPTH below the root cone."""
     problems, all_cuts = [], cuts(nc, case)
+    taper = case.gear.gear_class == "taper"
     for unit in case.gear.units:
         mine = [c for c in all_cuts if c.unit == unit]
         if not mine:
             problems.append(f"unit z{unit.z2}: no cut")
             continue
         reached = _depth_of(mine[-1], case)
-        expected = full_depth(unit, case.hob)
+        expected = taper_depth(case.gear, unit, case.hob) if taper else full_depth(unit, case.hob)
+        rule = "the tip section touching the root line" if taper else "full depth (d_f2 + d_a0)/2"
         if reached is None:
             problems.append(f"unit z{unit.z2}: the last cut's pass does not cross Z{_depth_z(unit, case):g} (DIN) "
                             f"where its depth is measured")
         elif abs(reached - expected) > DEPTH:
-            problems.append(f"unit z{unit.z2}: last cut at X{reached:.3f}, full depth (d_f2 + d_a0)/2 = {expected:.3f}")
-    return problems + _cone_problems(all_cuts, case)
+            problems.append(f"unit z{unit.z2}: last cut at X{reached:.3f}, {rule} = {expected:.3f}")
+    return problems + _cone_problems(all_cuts, case) + (_root_problems(nc, all_cuts, case) if taper else [])
+
+
+def _root_problems(nc: Nc, all_cuts: list[Cut], case: Case) -> list[str]:
+    pairs = [(move, cut.unit) for cut in all_cuts for move in passes(cut)]
+    depths = _deepest([(move, root_solid(case.gear, unit)) for move, unit in pairs], case, shift_limits(nc, case.machine))
+    return [f"pass block {move.block}: the hob (3-D) reaches {depth:.3f} mm below unit z{unit.z2}'s root cone"
+            for (move, unit), depth in zip(pairs, depths) if depth > DEPTH]
 
 
 def _depth_of(cut: Cut, case: Case) -> float | None:
@@ -288,11 +300,11 @@ def approach_problems(nc: Nc, case: Case) -> list[str]:
         if infeed.delta("Z") != 0 or not over:
             problems.append(f"block {infeed.block}: a cut must start with a radial infeed, then an axial pass")
             continue
-        problems += _infeed_problems(cut, infeed, over, case, eta)
+        problems += _infeed_problems(cut, infeed, over, case, eta, shift_limits(nc, case.machine))
     return problems
 
 
-def _infeed_problems(cut: Cut, infeed: Move, over: list[Move], case: Case, eta: float) -> list[str]:
+def _infeed_problems(cut: Cut, infeed: Move, over: list[Move], case: Case, eta: float, limits: tuple) -> list[str]:
     unit, hob, gear = cut.unit, case.hob, case.gear
     down = over[-1].end["Z"] < infeed.end["Z"]
     face, far = (unit.z_top, unit.bottom) if down else (unit.bottom, unit.z_top)
@@ -300,10 +312,11 @@ def _infeed_problems(cut: Cut, infeed: Move, over: list[Move], case: Case, eta: 
     h = tip_radius_at(gear, unit, face) + hob.r0 - x
     problems = []
     if gear.beta == 0:
-        gap = distance_to_section(x, z, gear, unit)
-        if gap < hob.r0 - ROUND:
-            problems.append(f"infeed block {infeed.block} to X{x} at Z{z} (h = {h:.3f}): the hob tip is "
-                            f"{hob.r0 - gap:.3f} mm inside the blank (unit z{unit.z2})")
+        depth = _deepest([(Move(infeed.block, "G0", infeed.end, infeed.end, None, None), unit_solid(gear, unit))],
+                        case, limits)[0]
+        if depth > ROUND:
+            problems.append(f"infeed block {infeed.block} to X{x} at Z{z} (h = {h:.3f}): the hob is "
+                            f"{depth:.3f} mm inside the blank (unit z{unit.z2})")
     else:
         needed = approach_needed(h, hob, eta, unit.da)
         distance = (z - face) if down else (face - z)
@@ -359,8 +372,8 @@ def _axial_per_rev(move: Move, hob: Hob, unit: Unit) -> float:
     return move.feed * abs(move.delta("Z")) / length / table if table else math.inf
 
 
-def envelope_problems(nc: Nc, case: Case, step: float = 0.5) -> list[str]:
-    """No move brings the hob (tip radius, length, swivel: conservative) into a unit other than the
+def envelope_problems(nc: Nc, case: Case) -> list[str]:
+    """No move brings the hob (3-D: tip cylinder, length, swivel, shift) into a unit other than the
     one being cut during its cut; outside the cuts into none."""
     if case.gear.gear_class == "worm_wheel":
         return []
@@ -368,23 +381,14 @@ def envelope_problems(nc: Nc, case: Case, step: float = 0.5) -> list[str]:
     for cut in cuts(nc, case):
         for move in cut.moves + ([cut.retract] if cut.retract else []):
             during[move.block] = cut.unit
-    problems = []
-    for raw in nc.moves:
-        move = din_move(raw, case.machine)
-        a = move.end["A"] if isinstance(move.end["A"], float) else swivel(case.gear, case.hob)
-        for unit in case.gear.units:
-            if during.get(move.block) == unit or not isinstance(move.start["X"], float) \
-                    or not isinstance(move.start["Z"], float):
-                continue
-            deepest = _deepest(move, a, case, unit, step)
-            if deepest > ROUND:
-                problems.append(f"{move.mode} block {move.block} {nc.blocks[move.block].text!r}: hob {deepest:.3f} mm "
-                                f"into unit z{unit.z2} (d_a {unit.da}, Z{unit.bottom:g}…{unit.z_top:g})")
-    return problems
+    pairs = [(move, unit) for move in (din_move(m, case.machine) for m in nc.moves) if known_xz(move)
+             for unit in case.gear.units if during.get(move.block) != unit]
+    depths = _deepest([(move, unit_solid(case.gear, unit)) for move, unit in pairs], case,
+                     shift_limits(nc, case.machine))
+    return [f"{move.mode} block {move.block} {nc.blocks[move.block].text!r}: hob {depth:.3f} mm "
+            f"into unit z{unit.z2} (d_a {unit.da}, Z{unit.bottom:g}…{unit.z_top:g})"
+            for (move, unit), depth in zip(pairs, depths) if depth > ROUND]
 
 
-def _deepest(move: Move, eta: float, case: Case, unit: Unit, step: float) -> float:
-    dx, dz = move.delta("X"), move.delta("Z")
-    count = max(1, math.ceil(max(abs(dx), abs(dz)) / step))
-    return max(hob_intrusion(move.start["X"] + dx * k / count, move.start["Z"] + dz * k / count, eta,
-                             case.hob, case.gear, unit) for k in range(count + 1))
+def _deepest(pairs: list, case: Case, limits: tuple) -> list[float]:
+    return hob_depths(pairs, swivel(case.gear, case.hob), case.hob.r0, case.hob.length, limits)

@@ -9,45 +9,37 @@ import re
 
 from hobbing_checks import (Case, approach_problems, contract_problems, coupling_problems, depth_problems, din_move,
                             envelope_problems, feed_problems)
-from hobbing_reference import Gear, Nc, Unit, hob_intrusion, swivel
+from hobbing_envelope import Solid, hob_depths, known_xz, shift_limits
+from hobbing_reference import Nc, swivel
 
 ROUND = 0.002
 REACH = 1000.0      # mm: the fixture and tailstock are long cylinders along the work axis
 
 
-def obstacles(case: Case) -> list[tuple[str, Unit]]:
+def obstacles(case: Case) -> list[tuple[str, float, Solid]]:
     """Fixture below the lowest unit, tailstock above the top face (when the job clamps with it),
-    as cylinders in the DIN frame."""
+    as (name, diameter, cylinder) in the DIN frame, from the machine record."""
     found = []
     bottom = min(u.bottom for u in case.gear.units)
     top = max(u.z_top for u in case.gear.units)
     diameter, gap = case.machine.fixture
     if diameter > 0:
-        found.append(("fixture", Unit(0, REACH, diameter, 0.0, bottom - gap)))
+        found.append(("fixture", diameter, Solid(diameter / 2, bottom - gap - REACH, bottom - gap)))
     diameter, gap = case.machine.tailstock
     if diameter > 0 and case.job.tailstock:
-        found.append(("tailstock", Unit(0, REACH, diameter, 0.0, top + gap + REACH)))
+        found.append(("tailstock", diameter, Solid(diameter / 2, top + gap, top + gap + REACH)))
     return found
 
 
-def obstacle_problems(nc: Nc, case: Case, step: float = 0.5) -> list[str]:
-    """No move brings the hob (conservative for swivel) into the fixture or the tailstock."""
-    plain = Gear("obstacle", case.gear.mn, 0.0, None, ())
-    problems = []
-    for raw in nc.moves:
-        move = din_move(raw, case.machine)
-        if not isinstance(move.start["X"], float) or not isinstance(move.start["Z"], float):
-            continue
-        eta = move.end["A"] if isinstance(move.end["A"], float) else swivel(case.gear, case.hob)
-        dx, dz = move.delta("X"), move.delta("Z")
-        count = max(1, math.ceil(max(abs(dx), abs(dz)) / step))
-        for name, body in obstacles(case):
-            deepest = max(hob_intrusion(move.start["X"] + dx * k / count, move.start["Z"] + dz * k / count, eta,
-                                        case.hob, plain, body) for k in range(count + 1))
-            if deepest > ROUND:
-                problems.append(f"{move.mode} block {move.block} {nc.blocks[move.block].text!r}: hob {deepest:.3f} mm "
-                                f"into the {name} (Ø{body.da:g})")
-    return problems
+def obstacle_problems(nc: Nc, case: Case) -> list[str]:
+    """No move brings the hob (3-D: tip cylinder, length, swivel, shift) into the fixture or the tailstock."""
+    pairs = [(move, body) for move in (din_move(m, case.machine) for m in nc.moves) if known_xz(move)
+             for body in obstacles(case)]
+    depths = hob_depths([(move, solid) for move, (_, _, solid) in pairs], swivel(case.gear, case.hob), case.hob.r0,
+                        case.hob.length, shift_limits(nc, case.machine))
+    return [f"{move.mode} block {move.block} {nc.blocks[move.block].text!r}: hob {depth:.3f} mm "
+            f"into the {name} (Ø{diameter:g})" for (move, (name, diameter, _)), depth in zip(pairs, depths)
+            if depth > ROUND]
 
 
 def _coupling_at(nc: Nc) -> dict[int, tuple | None]:

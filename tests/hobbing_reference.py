@@ -20,6 +20,8 @@ import math
 import re
 from dataclasses import dataclass, field
 
+from hobbing_envelope import Solid, Sweep, intrusions, root_section_centre
+
 AXES = "XYZABC"
 NUMBER = r"[+-]?(?:\d+\.?\d*|\.\d+)"
 TOKEN = re.compile(r"""\s*(?:
@@ -213,6 +215,9 @@ class Machine:
     rapid_rate: float = 8000.0          # mm/min, G0
     fixture: tuple = (25.0, 0.0)        # diameter, gap below the lowest unit's bottom face (0 Ø = none)
     tailstock: tuple = (25.0, 0.0)      # diameter, gap above the top face, when clamped (M20)
+    load: tuple = (300.0, 100.0)        # programmed X, Z of the final position
+    # The defaults describe the hand-written programs' machine; engine programs are checked against
+    # the machine row the shop declared (tests/hobbing_reference_gears.read_machine).
 
     def din(self, axis: str, value):
         """A programmed coordinate in the DIN 66217 frame (§A7: program = DIN × sense)."""
@@ -329,53 +334,35 @@ def roughing_feed_max(module: float) -> float:
     return points[-1][1]
 
 
-def distance_to_section(x: float, z: float, gear: Gear, unit: Unit) -> float:
-    """Distance in the XZ plane from (x, z) to the unit's axial section (0 ≤ X ≤ tip radius,
-    with the cone); 0 inside."""
-    top = (tip_radius_at(gear, unit, unit.z_top), unit.z_top)
-    bottom = (tip_radius_at(gear, unit, unit.bottom), unit.bottom)
-    if unit.bottom <= z <= unit.z_top:
-        edge = top[0] + (z - top[1]) * (top[0] - bottom[0]) / unit.b
-        if x <= edge:
-            return 0.0
-    candidates = [_to_segment(x, z, top, bottom), _to_segment(x, z, (0.0, top[1]), top),
-                  _to_segment(x, z, (0.0, bottom[1]), bottom)]
-    return min(candidates)
+def unit_solid(gear: Gear, unit: Unit) -> Solid:
+    """The unit's tip body: d_a/2 at the top face, changing by tanδ per mm of Z (§B12)."""
+    return Solid(unit.da / 2, unit.bottom, unit.z_top, math.tan(math.radians(gear.cone)), unit.z_top)
 
 
-def _to_segment(x: float, z: float, p: tuple, q: tuple) -> float:
-    dx, dz = q[0] - p[0], q[1] - p[1]
-    length2 = dx * dx + dz * dz
-    t = 0.0 if length2 == 0 else max(0.0, min(1.0, ((x - p[0]) * dx + (z - p[1]) * dz) / length2))
-    return math.hypot(x - (p[0] + t * dx), z - (p[1] + t * dz))
+def root_solid(gear: Gear, unit: Unit) -> Solid:
+    """The body under the unit's root (d_f/2 at the top face, the same cone): no cut may enter it."""
+    return Solid(unit.df / 2, unit.bottom, unit.z_top, math.tan(math.radians(gear.cone)), unit.z_top)
 
 
-def hob_intrusion(x: float, z: float, eta: float, hob: Hob, gear: Gear, unit: Unit) -> float:
-    """How far (mm) the hob at centre (x, z) reaches into the unit's tip cylinder. Conservative
-    for swivel: the hob's projection onto the XZ plane lies within r0 of its axis, whose Z extent
-    is ±(L/2)·|sin η|."""
-    half = hob.length / 2 * abs(math.sin(math.radians(eta)))
-    steps = max(1, int(half / 0.5))
-    nearest = min(distance_to_section(x, z + half * (2 * k / steps - 1), gear, unit) for k in range(steps + 1))
-    return hob.r0 - nearest
+def taper_depth(gear: Gear, unit: Unit, hob: Hob) -> float:
+    """§B3 for a taper (§B12) at the top face: the hob's tip section in the plane Y = 0 is an ellipse
+    r0 × r0/cos η; the last cut makes it touch the root line, so the centre lies its support distance
+    off that line. (d_f2 + d_a0)/2 would cut the root r0·(1/cos δ − 1) too deep, measured along X."""
+    return root_section_centre(unit.df / 2, hob.r0, gear.cone, swivel(gear, hob))
 
 
-def layout_cuttable(gear: Gear, hob: Hob, tolerance: float = 0.002) -> bool:
+def layout_cuttable(gear: Gear, hob: Hob, tolerance: float = 0.002, shift: tuple = (0.0, 0.0)) -> bool:
     """Whether every unit can be cut at full depth from a clear approach (§B7) to a run-out beyond
-    its other face, climb or conventional, without the hob (conservative for swivel) entering
+    its other face, climb or conventional, without the hob (3-D, shifted within `shift`) entering
     another unit. When not, the correct answer is a refusal."""
     eta = swivel(gear, hob)
     for unit in gear.units:
-        others = [u for u in gear.units if u != unit]
+        others = [unit_solid(gear, u) for u in gear.units if u != unit]
         x = full_depth(unit, hob)
         reach = approach_needed(tip_radius_at(gear, unit, unit.z_top) + hob.r0 - x, hob, eta, unit.da)
         paths = ((unit.z_top + reach, unit.bottom - 0.01), (unit.bottom - reach, unit.z_top + 0.01))
-        if not any(_path_clear(x, path, eta, gear, hob, others, tolerance) for path in paths):
+        sweeps = [Sweep(x, start, x, end, eta, shift, shift) for start, end in paths]
+        if others and not any((intrusions([s] * len(others), others, hob.r0, hob.length) <= tolerance).all()
+                              for s in sweeps):
             return False
     return True
-
-
-def _path_clear(x: float, path: tuple, eta: float, gear: Gear, hob: Hob, others: list, tolerance: float) -> bool:
-    count = max(1, math.ceil(abs(path[1] - path[0]) / 0.5))
-    zs = [path[0] + (path[1] - path[0]) * k / count for k in range(count + 1)]
-    return all(hob_intrusion(x, z, eta, hob, gear, u) <= tolerance for u in others for z in zs)

@@ -85,3 +85,16 @@ def make_gear(gear_class: str, hand: str | None, hob: Hob, cone: float = 0.0, la
     if gear_class == "duplex":
         return Gear("duplex", 2, 0.0, None, (Unit(30, 20, 64.0, 55.0), Unit(19, 15, 42.0, 33.0, -75.0)))
     return Gear("spur", 2, 0.0, None, (Unit(30, 20, 64.0, 55.0),))
+
+
+def read_machine(conn, name: str) -> Machine:
+    """The test's Machine as the shop declared it in the machine row: senses, work offset, table speed,
+    rapid rate, fixture and tailstock (diameter, gap; NULL = none) and load position (program frame)."""
+    row = conn.execute("SELECT a_direction, b_direction, c_direction, y_direction, z_direction, work_offset, "
+                       "table_speed_max, rapid_rate, fixture_diameter, fixture_gap, tailstock_diameter, "
+                       "tailstock_gap, load_x, load_z FROM machine WHERE name = %s", (name,)).fetchone()
+    a, b, c, y, z, offset, table, rapid, fix_d, fix_gap, tail_d, tail_gap, load_x, load_z = row
+    number = lambda value: float(value or 0.0)      # noqa: E731
+    return Machine(name, a, b, c, y, z, offset, float(table) if table else math.inf, float(rapid),
+                   (number(fix_d), number(fix_gap)), (number(tail_d), number(tail_gap)),
+                   (None if load_x is None else float(load_x), None if load_z is None else float(load_z)))

@@ -1,0 +1,79 @@
+"""The 3-D hob envelope of the reference tests (tests/hobbing_envelope.py) against dense samples of
+the hob's tip cylinder, on gear 43's infeed where the old XZ shadow saw a collision, and the taper's
+root-cone check on the paper's gear (reference §B3, §B12, §D)."""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from hobbing_checks import Case, depth_problems
+from hobbing_envelope import Solid, Sweep, intrusion
+from hobbing_reference import Gear, Hob, Unit, read
+
+
+def sampled_depth(sweep: Sweep, solid: Solid, r0: float, length: float) -> float:
+    """Dense samples of the hob's tip cylinder (t ≤ 1 mm, φ 1°) along the move (≤ 0.5 mm): the
+    deepest point's depth in the solid, for comparison with the exact search."""
+    eta = np.radians(sweep.eta)
+    count = max(2, math.ceil(math.hypot(sweep.x1 - sweep.x0, sweep.z1 - sweep.z0) / 0.5) + 1)
+    fraction = np.linspace(0, 1, count)[:, None, None]
+    t = np.linspace(sweep.y_start[0] - length / 2, sweep.y_start[1] + length / 2, int(length) + 2)[None, :, None]
+    phi = np.radians(np.arange(360))[None, None, :]
+    x = sweep.x0 + fraction * (sweep.x1 - sweep.x0) + r0 * np.cos(phi)
+    y = t * np.cos(eta) - r0 * np.sin(phi) * np.sin(eta)
+    z = sweep.z0 + fraction * (sweep.z1 - sweep.z0) + t * np.sin(eta) + r0 * np.sin(phi) * np.cos(eta)
+    wall = (solid.radius + solid.slope * (z - solid.z_ref) - np.hypot(x, y)) / math.hypot(1, solid.slope)
+    return float(np.minimum(wall, np.minimum(z - solid.bottom, solid.top - z)).max())
+
+
+def test_envelope_of_the_swivelled_hob_is_three_dimensional():
+    """Gear 43's infeed (helical m3 z41, d_a 133.339, hob r0 40 L120, η −12.628°) at X100.919 Z31.336:
+    the hob's XZ shadow (tip circle stretched by ±60·sin η along Z) overlaps the blank by 1.58 mm, the
+    hob itself does not: where its tip cylinder lies within the tip radius it is well above the face."""
+    sweep, blank = Sweep(100.919, 31.336, 100.919, 31.336, -12.628), Solid(133.339 / 2, -30.0, 0.0)
+    assert intrusion(sweep, blank, 40.0, 120.0) < -3.0
+    assert sampled_depth(sweep, blank, 40.0, 120.0) <= intrusion(sweep, blank, 40.0, 120.0) + 1e-9
+
+
+@pytest.mark.parametrize("eta, slope, shift", [(0.0, 0.0, 0.0), (-12.628, 0.0, 0.0), (17.5, 0.0, 20.0),
+                                               (1.763, math.tan(math.radians(6.5)), 0.0),
+                                               (-8.0, -math.tan(math.radians(6.5)), -15.0)])
+def test_envelope_finds_a_small_intrusion_that_samples_would_miss_and_agrees_with_them(eta, slope, shift):
+    """The exact search is never shallower than dense samples, and finds a 0.05 mm intrusion: the hob
+    pushed 0.05 mm past the depth at which it first touches (found by bisection on X)."""
+    blank, r0, length = Solid(40.0, -25.0, 0.0, slope, 0.0), 35.0, 100.0
+    at = lambda x: Sweep(x, 10.0, x, -30.0, eta, (shift, shift), (shift, shift))    # noqa: E731
+    low, high = 0.0, 200.0
+    for _ in range(25):
+        low, high = ((low + high) / 2, high) if intrusion(at((low + high) / 2), blank, r0, length) > 0 else \
+            (low, (low + high) / 2)
+    touching = high
+    for x in (touching + 5, touching, touching - 0.05, touching - 3):
+        exact, sampled = intrusion(at(x), blank, r0, length), sampled_depth(at(x), blank, r0, length)
+        assert (exact <= 0) == (sampled <= 0) or exact < 0.01, (x, exact, sampled)
+        assert sampled <= 0 or sampled - 1e-6 <= exact < sampled + 0.05, (x, exact, sampled)
+    assert 0.04 < intrusion(at(touching - 0.05), blank, r0, length) < 0.06
+
+
+TAPER_PASS = """G90 G71 G94
+G54
+G0 X61.486 Z19.579
+G0 A=1.763
+G0 Y0.000
+G1 X54.208 F13.3
+G1 X49.313 Z-23.380 F39.1
+G0 X61.486
+"""
+
+
+@pytest.mark.parametrize("deeper, found", [(0.0, False), (0.05, True)])
+def test_taper_pass_touching_the_root_cone_passes_and_one_deeper_is_found(deeper, found):
+    """The paper's taper (m2 z19 d_f 33.5, δ 6.5°, hob R d_a0 70, η 1.763°): tangency puts the centre at
+    X(0) = 16.75 + 35·√(cos²6.5° + sin²6.5°/cos²1.763°)/cos 6.5° = 51.977, so X54.208 at Z19.579 and
+    X49.313 at Z−23.380; a pass 0.05 mm deeper is 0.05 mm below the root cone in 3-D."""
+    case = Case(Gear("taper", 2, 0.0, None, (Unit(19, 20, 42.5, 33.5),), cone=6.5), Hob(1, 70.0, "R", 115.0))
+    text = TAPER_PASS.replace("X54.208", f"X{54.208 - deeper:.3f}").replace("X49.313", f"X{49.313 - deeper:.3f}")
+    problems = [p for p in depth_problems(read(text), case) if "root cone" in p]
+    assert bool(problems) == found, problems
