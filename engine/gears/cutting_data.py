@@ -109,6 +109,12 @@ def default_cutting_data(module: float, material: str | None, coated: bool,
                        RADIAL_TO_AXIAL * rough, f"defaults ({known})")
 
 
+def programmed_feed(mm_per_minute: float) -> float:
+    """The F word written, 0.1 mm/min below or at the feed: rounding half up could carry a feed
+    bounded to the §C maximum just past it (5.275 → 5.3 mm/min is 2.51 mm/rev against 2.50)."""
+    return math.floor(mm_per_minute * 10 + 1e-9) / 10
+
+
 def per_minute(feed_per_workpiece_rev: float, hob_speed_rpm: float, starts: int, teeth: int) -> float:
     """v_f = f_a·n2 with table speed n2 = n0·z0/z2 (§B5)."""
     return feed_per_workpiece_rev * hob_speed_rpm * starts / teeth

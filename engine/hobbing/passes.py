@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..gears.cutting_data import CuttingData, per_minute
+from ..gears.cutting_data import CuttingData, per_minute, programmed_feed
 from . import geometry
 from .choices import Choices
 
@@ -61,8 +61,8 @@ def feeds(cut: Cut, cutting: CuttingData, starts: int, teeth: int) -> dict:
     """Feeds of one cut in mm/min (G94): rough cuts at the roughing feed, finishing at the
     finishing feed, a single cut at the roughing feed."""
     axial = cutting.axial_feed_finish if cut.name == "FINISH" else cutting.axial_feed_rough
-    return {"feed_axial": round(per_minute(axial, cutting.hob_speed, starts, teeth), 1),
-            "feed_radial": round(per_minute(cutting.radial_feed, cutting.hob_speed, starts, teeth), 1)}
+    return {"feed_axial": programmed_feed(per_minute(axial, cutting.hob_speed, starts, teeth)),
+            "feed_radial": programmed_feed(per_minute(cutting.radial_feed, cutting.hob_speed, starts, teeth))}
 
 
 def working_area(xs, ys, zs) -> dict:

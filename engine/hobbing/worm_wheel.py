@@ -11,7 +11,7 @@ import math
 from dataclasses import replace
 
 from ..errors import EngineError
-from ..gears.cutting_data import per_minute
+from ..gears.cutting_data import per_minute, programmed_feed
 from . import conventions
 from .cylindrical import RAPID_SHORT_OF_CUT, CylindricalModel, JobParameters
 from .passes import APPROACH_SAFETY, feeds, plan_cuts, working_area
@@ -40,8 +40,8 @@ class WormWheelModel(CylindricalModel):
             "x_air": round(air_position(gear, hob, tangential, cut.centre_distance), 3),
             "dwell": round(DWELL_TABLE_TURNS * 60 / table_speed, 1),
             "feed_radial": feeds(cut, cutting, hob.starts, gear.teeth)["feed_radial"],
-            "feed_tangential": round(per_minute(cutting.axial_feed_rough, cutting.hob_speed, hob.starts,
-                                                gear.teeth), 1)} for cut in cuts}
+            "feed_tangential": programmed_feed(per_minute(cutting.axial_feed_rough, cutting.hob_speed, hob.starts,
+                                                          gear.teeth))} for cut in cuts}
         y_clear = round(tangential_clearance(gear, hob, setup.full_depth), 3) if tangential else 0.0
         params = {**self.base_params(gear, gear_class, hob, machine, cutting, choices, setup),
                   "shift_on": False, "shift_y": 0.0, "shift_per_part": 0.0, "shift_min": 0.0, "shift_max": 0.0,
