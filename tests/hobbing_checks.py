@@ -247,8 +247,11 @@ def depth_problems(nc: Nc, case: Case) -> list[str]:
         if not mine:
             problems.append(f"unit z{unit.z2}: no cut")
             continue
+        if taper:
+            problems += _taper_depth_problems(nc, mine[-1], case)
+            continue
         reached = _depth_of(mine[-1], case)
-        expected = taper_depth(case.gear, unit, case.hob) if taper else full_depth(unit, case.hob)
+        expected = full_depth(unit, case.hob)
         rule = "the tip section touching the root line" if taper else "full depth (d_f2 + d_a0)/2"
         if reached is None:
             problems.append(f"unit z{unit.z2}: the last cut's pass does not cross Z{_depth_z(unit, case):g} (DIN) "
@@ -256,6 +259,21 @@ def depth_problems(nc: Nc, case: Case) -> list[str]:
         elif abs(reached - expected) > DEPTH:
             problems.append(f"unit z{unit.z2}: last cut at X{reached:.3f}, {rule} = {expected:.3f}")
     return problems + _cone_problems(all_cuts, case) + (_root_problems(nc, all_cuts, case) if taper else [])
+
+
+def _taper_depth_problems(nc: Nc, last: Cut, case: Case) -> list[str]:
+    """A taper's last cut touches the root cone (3-D): the deepest point of the hob over its pass
+    lies within DEPTH of the cone (deeper is `_root_problems`). The tip section in the plane
+    Y = 0 (`taper_depth`) is the first guess; a swivelled hob's points off that plane reach
+    further along Z (§B7), so the section alone can leave the hob a little short of the cone."""
+    pairs = [(move, root_solid(case.gear, last.unit)) for move in passes(last)]
+    depths = _deepest(pairs, case, shift_limits(nc, case.machine))
+    deepest = max(depths, default=None)
+    if deepest is None or deepest >= -DEPTH:
+        return []
+    section = taper_depth(case.gear, last.unit, case.hob)
+    return [f"unit z{last.unit.z2}: the last cut stays {-deepest:.3f} mm above the root cone (3-D); "
+            f"the tip section touching the root line would be at X{section:.3f}"]
 
 
 def _root_problems(nc: Nc, all_cuts: list[Cut], case: Case) -> list[str]:

@@ -50,7 +50,7 @@ def taper_pass(clock: Clock, job: dict, cut: dict) -> None:
     clock.rapid(Z=cut["z_from"])
     clock.rapid(X=cut["x_air"])
     clock.feed(cut["feed_radial"], X=cut["cut_x"] + cut["z_from"] * slope)
-    clock.feed(cut["feed_axial"] / math.cos(math.atan(slope)), X=cut["cut_x"] + cut["z_to"] * slope,
+    clock.feed(cut["feed_slant"], X=cut["cut_x"] + cut["z_to"] * slope,
                Z=cut["z_to"])
     clock.rapid(X=job["x_retract"])
 

@@ -6,6 +6,8 @@ from __future__ import annotations
 import math
 
 from ..errors import EngineError
+from ..gears.cutting_data import programmed_feed
+from .cone_contact import centre_on_root_cone
 from .cylindrical import RETRACT_CLEARANCE, CylindricalModel, Setup
 from .envelope import clearance_to_cone
 from .passes import Reach, pass_ends
@@ -16,19 +18,9 @@ RUN_IN_STEP = 0.5       # mm: the run-in grows by this until the infeed clears, 
 RUN_IN_TOLERANCE = 0.005
 
 
-def cone_depth_offset(hob_radius: float, cone_angle: float, swivel: float) -> float:
-    """How much further out than (d_f2 + d_a0)/2 the hob centre lies at Z = 0 when its tip
-    touches the root cone: the tip section (an ellipse of semi-axes r0 along X and r0/cos η
-    along Z for a swivel η) is tangent to the root line x = d_f2/2 + z·tan δ, so the centre
-    lies its support distance h off that line, h/cos δ along X. Placing it at d_f2/2 + r0
-    would cut the root r0·(1/cos δ − 1) too deep (0.23 mm on the paper's 6.5° gear)."""
-    delta, eta = math.radians(cone_angle), math.radians(swivel)
-    support = hob_radius * math.hypot(math.cos(delta), math.sin(delta) / math.cos(eta))
-    return support / math.cos(delta) - hob_radius
-
-
 class TaperModel(CylindricalModel):
     class_parameters = frozenset({"cone_angle", "taper_slope"})
+    cut_parameters = CylindricalModel.cut_parameters | {"feed_slant"}
     cut_shape = "taper"
 
     def setup(self, gear, hob) -> Setup:
@@ -36,7 +28,10 @@ class TaperModel(CylindricalModel):
             raise EngineError(f"gear {gear.id}: class taper needs a cone angle 0 < |δ| ≤ {MAX_CONE_ANGLE:g}°, "
                               f"got {gear.cone_angle}; set cone_angle or choose another class")
         setup = super().setup(gear, hob)
-        full_depth = setup.full_depth + cone_depth_offset(hob.tip_diameter / 2, gear.cone_angle, setup.swivel)
+        # The tip cylinder touches the root cone: (d_f2 + d_a0)/2 would cut it r0·(1/cos δ − 1)
+        # too deep (0.23 mm on the paper's 6.5° gear), more off the Y = 0 plane when swivelled.
+        full_depth = centre_on_root_cone(gear.root_diameter / 2, gear.cone_angle, hob.tip_diameter / 2,
+                                         hob.length, setup.swivel)
         setup = Setup(setup.lead, setup.swivel, full_depth, setup.reach, setup.x_retract)
         slope = math.tan(math.radians(gear.cone_angle))
         # The pass reaches the approach distance beyond either face, where the cone line lies
@@ -65,6 +60,9 @@ class TaperModel(CylindricalModel):
         run_in = self.run_in(gear, hob, setup, params["cut_x"], params["climb"])
         z_from, _ = pass_ends(Reach(run_in, setup.reach.overrun), 0.0, -gear.face_width, params["climb"])
         params["z_from"] = round(z_from, 3)
+        # §B12: F of a G1 X Z is along the slant, so v_Z = F·cos δ keeps the axial feed; written at
+        # or below it, and the cycle time counts the F written.
+        params["feed_slant"] = programmed_feed(params["feed_axial"] / math.cos(math.radians(gear.cone_angle)))
         # The rapid stops short of the cone line at the approach Z, not of X(0).
         params["x_air"] = round(params["x_air"] + params["z_from"] * math.tan(math.radians(gear.cone_angle)), 3)
         return params

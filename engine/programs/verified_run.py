@@ -42,5 +42,5 @@ def prove(lines: list[str], machine: Machine, workpiece: Workpiece | None, name:
         raise EngineError(f"{name}: a hobbing program needs its gear and hob to be proved by the simulation; "
                           "nothing stored")
     report = simulate_program(lines, workpiece.gear, workpiece.hob, machine, name)
-    if report.refused:
-        raise SimulationError(f"{report.error()}; nothing stored")
+    if report.refused:   # named by the gear: the id the user gave (a batch names each bad gear)
+        raise SimulationError(f"gear {workpiece.gear.id}: {report.error()}; nothing stored")
