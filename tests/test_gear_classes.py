@@ -110,29 +110,42 @@ def test_the_papers_example_reproduced(conn):
 
 # ---------------------------------------------------------------- crowned
 
-def crown_points(nc, face_width):
-    """(Z, X) of the G1 points on the face, in pass order."""
-    return [(m.end["Z"], m.end["X"]) for m in cutting_moves(nc)
-            if m.end["Z"] is not None and -face_width - 1e-9 <= m.end["Z"] <= 1e-9 and "Z" in m.changed]
+def crown_points(nc):
+    """(Z, X) of the polyline's vertices: per cut (a run of G1 moves between rapids: infeed,
+    the approach to the first vertex, the polyline, the run-out), the approach's end and the
+    polyline's vertices."""
+    runs, run = [], []
+    for move in nc.moves:
+        if move.mode == "G1":
+            run.append(move)
+        elif run:
+            runs, run = runs + [run], []
+    return [(m.end["Z"], m.end["X"]) for run in runs[-1:] for m in run[1:-1]]
 
 
 def test_crowning_is_a_symmetric_parabola_deepest_at_the_faces(conn):
+    """§B11: the root a(Z) = a_mid − Δa·(2(Z − Z_m)/b)², Δa = C_β/sin α_n. The hob's tip circle
+    is tangent to it, so its centre lies r0 along the root's normal: a(Z) + r0·(√(1 + a'²) − 1)
+    (a swivel of a few degrees moves it by less than 0.01 mm); the polyline runs beyond each
+    face until the contact point, r0·sin(atan a') inside the centre, has passed the face."""
     program, nc = program_of(conn, 51)
     g, hob = gear(conn, 51), hob_of(conn, program)
-    points = crown_points(nc, g["b"])
+    points = crown_points(nc)
     assert len(points) - 1 >= 20, "at least 20 segments across the face"
-    full_depth = (g["df2"] + hob["da0"]) / 2
-    crown = g["crowning"] / math.sin(math.radians(g["alpha"]))      # Δa = C_β / sin α_n
-    by_z = {round(z, 3): x for z, x in points}
+    full_depth, r0 = (g["df2"] + hob["da0"]) / 2, hob["da0"] / 2
+    crown = g["crowning"] / math.sin(math.radians(g["alpha"]))
     mid = -g["b"] / 2
-    assert abs(by_z[round(mid, 3)] - full_depth) < 0.01             # right depth at mid-face
-    assert abs(by_z[0.0] - (full_depth - crown)) < ROUND
-    assert abs(by_z[round(-g["b"], 3)] - (full_depth - crown)) < ROUND
+    face_slope = 4 * crown / g["b"]
+    beyond = r0 * face_slope / math.sqrt(1 + face_slope ** 2)
+    assert max(z for z, _ in points) >= beyond - ROUND and min(z for z, _ in points) <= -g["b"] - beyond + ROUND
+    by_z = {round(z, 3): x for z, x in points}
     for z, x in points:                                              # symmetric about mid-face
         mirror = round(2 * mid - z, 3)
         assert mirror in by_z and abs(by_z[mirror] - x) < ROUND
-        expected = full_depth - crown * (2 * (z - mid) / g["b"]) ** 2   # §B11
-        assert abs(x - expected) < ROUND
+        slope = 8 * crown * (z - mid) / g["b"] ** 2
+        expected = full_depth - crown * (2 * (z - mid) / g["b"]) ** 2 + r0 * (math.sqrt(1 + slope ** 2) - 1)
+        assert abs(x - expected) < 0.01, (z, x, expected)
+    assert max(x for _, x in points) == pytest.approx(full_depth, abs=0.01)   # full depth at mid-face
     assert max(x for _, x in points) == by_z[round(mid, 3)]         # largest centre distance mid-face
 
 

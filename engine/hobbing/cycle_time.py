@@ -57,14 +57,13 @@ def taper_pass(clock: Clock, job: dict, cut: dict) -> None:
 
 def crowned_pass(clock: Clock, job: dict, cut: dict) -> None:
     """Infeed at the face depth, to the first face, the parabola a(Z) as a polyline, overrun."""
-    top, depth = cut["cut_x"] - job["crown_depth"], job["crown_depth"]
     clock.rapid(Z=cut["z_from"])
     clock.rapid(X=cut["x_air"])
-    clock.feed(cut["feed_radial"], X=top)
+    clock.feed(cut["feed_radial"], X=cut["crown_x_0"])
     clock.feed(cut["feed_axial"], Z=cut["face_from"])
     for step in range(1, CROWN_SEGMENTS + 1):
         z = cut["face_from"] + (cut["face_to"] - cut["face_from"]) * step / CROWN_SEGMENTS
-        clock.feed(cut["feed_axial"], X=cut["cut_x"] - depth * (2 * (z - job["z_mid"]) / job["b"]) ** 2, Z=z)
+        clock.feed(cut["feed_axial"], X=cut[f"crown_x_{step}"], Z=z)
     clock.feed(cut["feed_axial"], Z=cut["z_to"])
     clock.rapid(X=job["x_retract"])
 
