@@ -28,6 +28,21 @@ def test_a_job_edited_in_sql_is_made_with_its_new_parameters(run):
     assert "M3 S250" in programs(run.url, f"WHERE job_id = {job}")[-1][1]
 
 
+def test_a_hobbing_job_renamed_to_another_gears_program_is_refused(run):
+    """GEAR43's job renamed GEAR44 in SQL would write GEAR44.MPF, replacing gear 44's program on
+    the control: refused in one line, nothing stored."""
+    assert run("instantiate", "--gears", "43-44").exit_code == 0
+    job = programs(run.url)[0][0]
+    with psycopg.connect(run.url) as conn:
+        conn.execute("""UPDATE job SET params = jsonb_set(params, '{program_name}', '"GEAR44"') WHERE id = %s""",
+                     (job,))
+    before = len(programs(run.url))
+    refused = run("instantiate", "--job", job)
+    assert refused.exit_code == 1 and refused.stderr.count("\n") == 1
+    assert f"job {job}: its program name 'GEAR44' is not GEAR43" in refused.stderr
+    assert len(programs(run.url)) == before
+
+
 def test_a_failing_job_stops_the_batch_and_stores_nothing(run):
     assert run("instantiate", "--gears", "42-45").exit_code == 0
     jobs = [job for job, *_ in programs(run.url)]

@@ -45,6 +45,11 @@ class Setup:
     x_retract: float
 
 
+def program_name(gear_id: int) -> str:
+    """A hobbing program is named after its gear: GEAR<id> (the file GEAR<id>.MPF on the control)."""
+    return f"GEAR{gear_id}"
+
+
 class CylindricalModel:
     """Spur and helical gears: radial infeed in air, axial pass with overrun, per cut."""
 
@@ -89,7 +94,7 @@ class CylindricalModel:
     @staticmethod
     def base_params(gear, gear_class, hob, machine, cutting, choices, setup) -> dict:
         return {
-            "program_name": f"GEAR{gear.id}", "gear_id": gear.id, "gear_class": gear_class,
+            "program_name": program_name(gear.id), "gear_id": gear.id, "gear_class": gear_class,
             "mn": gear.module, "z2": gear.teeth, "alpha_n": gear.pressure_angle, "beta": gear.helix_angle,
             "hand": gear.hand or "", "b": gear.face_width, "da2": gear.tip_diameter, "df2": gear.root_diameter,
             "hob_id": hob.id, "z0": hob.starts, "da0": hob.tip_diameter, "hob_hand": hob.hand,

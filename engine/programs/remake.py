@@ -10,6 +10,7 @@ from ..errors import EngineError
 from ..gears.models import model_for_class
 from ..gears.process_notes import stored_feed_notes
 from ..gears.records import Hob, Machine, load_gear, load_hobs, load_machine
+from ..hobbing.cylindrical import program_name
 from ..hobbing.machine_job import with_cycle_time
 from ..memory import no_cycle_collection
 from ..templates.rows import Template
@@ -41,6 +42,7 @@ class Remaker:
             return plan_turning_job(self.conn, gear_class, machine, params, module_params)
         template = self.template(gear_class)
         if "cycle_time" in params:   # a hobbing job: the time follows feeds edited since
+            check_program_name(job_id, gear_id, params)
             params = with_cycle_time(params, module_params, model_for_class(self.conn, gear_class).cut_shape, machine)
         result = run_template(template, params, module_params, machine, self.workpiece(gear_id, hob_id))
         return Planned(gear_id, gear_class, machine_name, hob_id, params, module_params, template, result,
@@ -67,6 +69,15 @@ class Remaker:
         if gear_class not in self._templates:
             self._templates[gear_class] = load_template(self.conn, gear_class)
         return self._templates[gear_class]
+
+
+def check_program_name(job_id: int, gear_id: int, params: dict) -> None:
+    """A hobbing job's program keeps its gear's name: under another gear's name (a runner's edit
+    of job.params) its file would replace that gear's program on the control."""
+    if params.get("program_name") != program_name(gear_id):
+        raise EngineError(f"job {job_id}: its program name {params.get('program_name')!r} is not "
+                          f"{program_name(gear_id)}, the name of gear {gear_id}'s program; correct job.params "
+                          f"or make a new job with `engine instantiate --gear {gear_id}`; nothing stored")
 
 
 def instantiate_job(conn, job_id: int, out: str | Path | None = None, force: bool = False) -> Program:
