@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import random
 import subprocess
 import sys
@@ -64,14 +63,16 @@ GEAR_COLUMNS = ("id", "gear_class", "module", "teeth", "pressure_angle", "helix_
 # Which template row emits each line of the standard code (seed_templates/classes/*.csv, same
 # ids in both classes) and the p_emit condition that decides it: the Jinja2 pipeline stores
 # row_ids like the decision table does (program.row_ids is NOT NULL).
-ROW_IDS = ((100, None), (200, None), (300, None), (400, None), (500, None), (600, None), (700, None),
-           (800, None), (900, None), (1000, None), (1100, None), (1200, "tailstock"), (1250, None),
-           (1300, None), (1400, None), (1500, None),
-           (1600, "shift_fixed"), (1610, "shift_per_part"), (1620, "shift_per_part"), (1630, "shift_per_part"),
-           (1640, "shift_per_part"), (1650, "shift_per_part"), (1700, None), (1800, "coolant"),
-           (1900, "cut1"), (2000, "cut1"), (2100, "cut1"), (2200, "cut1"), (2300, "cut1"),
-           (2400, "cut2"), (2500, "cut2"), (2600, "cut2"), (2700, "cut2"), (2800, "cut2"),
-           (2900, "coolant"), (3000, None), (3100, None), (3150, "tailstock"), (3200, None))
+ROW_IDS = ((100, None), (200, None), (300, None), (400, None), (500, None), (600, None), (650, None), (700, None),
+           (705, "allowance"), (800, None), (810, None), (900, None), (1000, None), (1100, None),
+           (1120, "door_close"), (1150, None), (1200, "tailstock"), (1250, None), (1300, None),
+           (1310, "shift_fixed"), (1320, "shift_per_part"), (1330, "shift_per_part"), (1340, "shift_per_part"),
+           (1350, "shift_per_part"), (1360, "shift_per_part"), (1370, "orient"), (1400, None), (1500, None),
+           (1700, None), (1800, "coolant"),
+           (1900, "cut1"), (2000, "cut1"), (2050, "cut1"), (2100, "cut1"), (2200, "cut1"), (2300, "cut1"),
+           (2400, "cut2"), (2500, "cut2"), (2550, "cut2"), (2600, "cut2"), (2700, "cut2"), (2800, "cut2"),
+           (2900, "coolant"), (3000, None), (3050, None), (3100, None), (3140, "load_position"),
+           (3150, "tailstock"), (3170, "door_open"), (3200, None))
 
 # Same id allocation as engine.programs.storage; the COPY statements are engine.programs.storage's own.
 NEXT_IDS = "SELECT nextval(%s::regclass) FROM generate_series(1, %s)"
@@ -147,7 +148,6 @@ def jinja_environment():
     environment = jinja2.Environment(loader=jinja2.FileSystemLoader(HERE / "jinja"), autoescape=False,
                                      trim_blocks=True, lstrip_blocks=True, keep_trailing_newline=True,
                                      undefined=jinja2.StrictUndefined, auto_reload=False)
-    environment.globals.update(sin=math.sin, radians=math.radians, pi=math.pi)
     return environment
 
 
@@ -160,9 +160,11 @@ class JinjaPipeline:
         self._row_ids: dict[tuple, list[int]] = {}
 
     def row_ids(self, params: dict, module_params: dict) -> list[int]:
-        flags = {"tailstock": bool(params["tailstock"]),
-                 "shift_fixed": bool(params["shift_on"] and params["shift_per_part"] == 0),
-                 "shift_per_part": params["shift_per_part"] > 0, "coolant": bool(params["coolant"]),
+        flags = {"tailstock": bool(params["tailstock"]), "allowance": params["allowance"] > 0,
+                 "shift_fixed": params["shift_per_part"] == 0, "shift_per_part": params["shift_per_part"] > 0,
+                 "coolant": bool(params["coolant"]), "orient": bool(params["orient_before_coupling"]),
+                 "door_close": params["door_close_m"] > 0, "door_open": params["door_open_m"] > 0,
+                 "load_position": bool(params["load_position"]),
                  "cut1": bool(module_params["cutmotion:1"]["cut_on"]),
                  "cut2": bool(module_params["cutmotion:2"]["cut_on"])}
         key = tuple(flags.values())
@@ -189,7 +191,7 @@ class JinjaPipeline:
         if self.check:
             verify_program(lines, machine, name)
         kinds = CUT_KINDS_BY_COUNT[planner.choices.cut_count(gear.module)]
-        record = job_cutting_record(cutting, gear, hob, kinds, case_ids)
+        record = job_cutting_record(cutting.of_cuts(kinds), gear, hob, kinds, case_ids)
         return (gear.id, gear.gear_class, machine.name, hob.id, params, module_params, version, template_hash,
                 name, lines, self.row_ids(params, module_params), record)
 

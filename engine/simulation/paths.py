@@ -17,14 +17,17 @@ def move_poses(start: dict, end: dict, rapid: bool) -> tuple:
     jumps: only the end is followed)."""
     begin = {axis: start.get(axis, end[axis]) for axis in end} if {"X", "Z"} <= start.keys() else dict(end)
     pieces = [_line(begin, end)]
-    if rapid:
-        leg = _dog_leg(begin, end)
+    leg = _dog_leg(begin, end) if rapid else []
+    if len(leg) > 2:   # with one arrival (one axis moving, or all by the same) the leg is the line itself
         pieces += [_line(a, b) for a, b in zip(leg[:-1], leg[1:])]
     return tuple(np.concatenate([piece[i] for piece in pieces]) for i in range(3))
 
 
 def _dog_leg(begin: dict, end: dict) -> list[dict]:
-    """begin, the points where each axis arrives (all moving at one speed), end."""
+    """begin, the points where each axis arrives (all moving at one speed), end. With a single
+    arrival (one axis moving, or every moving axis travelling the same distance) that is
+    [begin, end]: the straight line, whose poses move_poses already has, so it is not followed
+    twice (the same poses give the same contacts)."""
     travel = {axis: end[axis] - begin[axis] for axis in end}
     arrivals = sorted({abs(d) for d in travel.values() if d})
     points = [dict(begin)]
