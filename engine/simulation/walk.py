@@ -263,6 +263,8 @@ class Walk:
             before = {id(unit): unit.reach.copy() for unit in self.units if unit.teeth == teeth}
             self.cut = Cut(step.number, step.line, teeth, table, before)
         self.cut.add(start, end, velocities)
+        if not self.worm_wheel and self.cut.table_speed > 0 and velocities.get("Z"):
+            self._refuse(step, feed_problem(abs(velocities["Z"]) / self.cut.table_speed, self.gear, self.hob))
 
     def _end_cut(self) -> None:
         if self.cut is None:
@@ -275,13 +277,10 @@ class Walk:
                 self._check_run_out(cut, self.report.cuts[-1])
 
     def _check_run_out(self, cut: Cut, done) -> None:
-        """An axial pass carries the generating zone past the face (§B8) at a feed within §C; a
-        tangential worm-wheel pass carries the hob's trailing end past the centre plane."""
+        """An axial pass carries the generating zone past the face (§B8); a tangential worm-wheel pass carries the hob's trailing end past the centre plane."""
         least = 0.0 if self.worm_wheel else least_run_out(self.gear, self.swivel)
-        problems = [run_out_problem(done.run_out, least, done.unit)]
-        if not self.worm_wheel:
-            problems.append(feed_problem(done.pass_feed, self.gear, self.hob))
-        for problem in filter(None, problems):
+        problem = run_out_problem(done.run_out, least, done.unit)
+        if problem:
             self.report.add(cut.number, cut.line, problem)
 
     # ---------------------------------------------------------------- the end
