@@ -161,7 +161,9 @@ class Walk:
         """Y (unless a leading axis) and A may not move while the table is coupled (§B15)."""
         if "Y" in program and moves(self.position, "Y", self.senses.position("Y", program["Y"])):
             self._refuse(step, coupled_shift_problem(self.coupling))
-        if swivel is not None and (not self.swivel_known or moves({"A": self.swivel}, "A", self.senses.swivel(swivel))):
+        swivels = swivel is not None and (not self.swivel_known or
+                                          moves({"A": self.swivel}, "A", self.senses.swivel(swivel)))
+        if swivels:
             self._refuse(step, coupled_swivel_problem())
 
     def _time(self, motion: int, program: dict) -> None:
@@ -277,7 +279,8 @@ class Walk:
                 self._check_run_out(cut, self.report.cuts[-1])
 
     def _check_run_out(self, cut: Cut, done) -> None:
-        """An axial pass carries the generating zone past the face (§B8); a tangential worm-wheel pass carries the hob's trailing end past the centre plane."""
+        """An axial pass carries the generating zone past the face it leaves (§B8); a tangential
+        worm-wheel pass carries the hob's trailing end past the centre plane."""
         least = 0.0 if self.worm_wheel else least_run_out(self.gear, self.swivel)
         problem = run_out_problem(done.run_out, least, done.unit)
         if problem:
