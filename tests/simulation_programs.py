@@ -29,6 +29,12 @@ def k_y(gear, hob, teeth: int) -> float:
     return 360 * math.cos(math.radians(lead_angle(hob))) / (math.pi * gear.module * teeth)
 
 
+def least_run_out(gear, hob) -> float:
+    """§B8: the generating zone reaches (h/tan α_n)·sin|η| past the hob centre, h = 2.25·m_n."""
+    depth = 2.25 * gear.module
+    return depth / math.tan(math.radians(gear.pressure_angle)) * math.sin(math.radians(abs(swivel(gear, hob))))
+
+
 def full_depth(root_diameter: float, hob) -> float:
     """a = (d_f2 + d_a0)/2 (§B3)."""
     return (root_diameter + hob.tip_diameter) / 2
@@ -50,8 +56,8 @@ class Hand:
     hob: object
     speed: float = 246.0
     radial_feed: float = 36.0
-    axial_feed: float = 105.0
-    run_out: float = 3.0
+    axial_feed: float = 38.0         # §C: at most 3.0 mm/rev at m2, table 246/19 r/min: 38.8 mm/min
+    run_out: float | None = None       # default: 3 mm, or 1 mm past the §B8 least where that is more
     stock: float = 0.0                 # radial: the cut stops this far above full depth
     senses: dict = field(default_factory=lambda: {"a": 1, "b": 1, "c": 1, "y": 1, "z": 1})
     header: str | None = None          # a `; CYCLE TIME … MIN` line
@@ -74,7 +80,8 @@ class Hand:
 
     @property
     def z_end(self) -> float:
-        return -self.gear.face_width - self.run_out
+        run_out = max(3.0, least_run_out(self.gear, self.hob) + 1.0) if self.run_out is None else self.run_out
+        return -self.gear.face_width - run_out
 
     def lines(self, cut: list[str] | None = None) -> list[str]:
         s = self.senses

@@ -204,7 +204,11 @@ def test_cli_allowance_is_a_choice_of_a_new_job(run):
 
 # --- feeds edited into a stored job ---------------------------------------------------------
 
-def test_a_stored_job_whose_feed_was_edited_beyond_the_table_is_made_with_a_warning(conn):
+def test_a_stored_job_whose_feed_was_edited_beyond_the_table_is_refused_by_the_simulation(conn):
+    """A feed per workpiece revolution above the §C roughing maximum overloads the hob's teeth
+    whatever the pass (rough or finish): the program is wrong, not merely unusual, so the
+    simulation every hobbing program passes refuses it in one line naming the cut and the
+    maximum, and nothing is stored (it used to be made with only a note)."""
     from engine.programs.remake import instantiate_job
 
     job_id = instantiate_gear(conn, 42).job_id     # m2, 1-start hob, z 19, single cut
@@ -213,6 +217,8 @@ def test_a_stored_job_whose_feed_was_edited_beyond_the_table_is_made_with_a_warn
     assert not instantiate_job(conn, job_id).notes  # as the engine made it: within the table
     conn.execute("UPDATE job SET module_params = jsonb_set(module_params, '{cutmotion:2,feed_axial}', '105') "
                  "WHERE id = %s", (job_id,))
-    notes = instantiate_job(conn, job_id).notes
-    assert len(notes) == 1 and f"{105 / table_speed:.2f} mm per workpiece rev is above the 3.00" in notes[0]
-    assert notes[0].startswith(f"job {job_id}: rough:")
+    refusal = (rf"line \d+ 'G1 Z[-.0-9]+ F105.0': the pass feeds {105 / table_speed:.3f} mm per workpiece "
+               r"revolution, above the 3 mm/rev roughing maximum for m2")
+    with pytest.raises(EngineError, match=refusal) as refused:
+        instantiate_job(conn, job_id)
+    assert "\n" not in str(refused.value) and str(refused.value).endswith("nothing stored")

@@ -89,3 +89,12 @@ def test_a_slower_rapid_rate_lets_the_same_program_pass():
     lines = coupled(19, k, 246, "G0 Z-20.000")
     assert verdict(hobber(float(slow)), lines)
     assert not verdict(hobber(float(slow + 100)), lines)
+
+
+def test_a_rapid_z_to_where_z_already_stands_adds_no_table_term():
+    """`G0 Z50.000` with Z at 50 moves nothing, so it cannot turn the table by k_Z·v_Z; a
+    Z that does move at the same rapid would pass the maximum (§A5)."""
+    rapid, k = 8000.0, 5.0
+    assert table_speed(246, 19, k, rapid) > TABLE_MAX
+    assert verdict(hobber(rapid), coupled(19, k, 246, "G0 Z50.000"))
+    assert not verdict(hobber(rapid), coupled(19, k, 246, "G0 Z49.000"))

@@ -49,7 +49,7 @@ def test_the_reference_program_is_clean_and_its_summary_is_the_references(record
     assert cut.run_out == pytest.approx(3.0)
     table = 246 * 1 / 19                                  # n0·z0/z2 (§B4)
     assert cut.radial_feed == pytest.approx(36 / table)
-    assert cut.pass_feed == pytest.approx(105 / table)     # §B5: v_f = f_a·n2
+    assert cut.pass_feed == pytest.approx(38 / table)     # §B5: v_f = f_a·n2
     assert report.table_speed == pytest.approx(table)
     assert report.cycle_time == pytest.approx(spur.cycle_time(8000.0, (300.0, 100.0)), abs=1e-4)   # 3 decimals
 
@@ -82,7 +82,7 @@ def test_the_run_out_into_a_fixture_larger_than_the_root_is_refused(records, spu
     machine = replace(records["machine"], fixture_diameter=40.0, fixture_gap=0.0)   # root Ø33 < 40
     lines = spur.lines()
     report = simulate_program(lines, spur.gear, spur.hob, machine, "TEST")
-    assert any("into the fixture" in m for m in refusal(report, number_of(lines, f"G1 Z{spur.z_end:.3f} F105.0")))
+    assert any("into the fixture" in m for m in refusal(report, number_of(lines, f"G1 Z{spur.z_end:.3f} F38.0")))
     assert not simulate_program(lines, spur.gear, spur.hob, replace(machine, fixture_gap=20.0)).refused
 
 
@@ -100,7 +100,7 @@ def test_the_run_out_into_a_neighbour_unit_is_refused(records, spur):
     gear = replace(spur.gear, units=(unit,))
     lines = spur.lines()
     report = simulate_program(lines, gear, spur.hob, records["machine"], "TEST")
-    messages = refusal(report, number_of(lines, f"G1 Z{spur.z_end:.3f} F105.0"))
+    messages = refusal(report, number_of(lines, f"G1 Z{spur.z_end:.3f} F38.0"))
     assert any("into unit 2 (30 teeth)" in m and "generates 19 teeth" in m for m in messages)
     assert any("unit 2 (30 teeth) is never cut" in f.message for f in report.refusals)
 
@@ -122,13 +122,13 @@ def test_a_swivel_of_the_wrong_sign_is_refused_where_the_hob_cuts(records, spur)
 
 @pytest.mark.parametrize("gear_id, hob_id", [(43, "H-M3-AA-R1"), (44, "H-M2-A-L1")])
 def test_helical_programs_of_both_hands_are_clean_and_a_wrong_z_sign_is_refused(records, gear_id, hob_id):
-    program = Hand(records["gear"](gear_id), records["hobs"][hob_id], speed=300.0, axial_feed=30.0, radial_feed=10.0)
+    program = Hand(records["gear"](gear_id), records["hobs"][hob_id], speed=300.0, axial_feed=25.0, radial_feed=10.0)
     report = prove_program(program.lines(), program.gear, program.hob, records["machine"], "TEST")
     gear = program.gear
     lead = math.pi * gear.module * gear.teeth / math.sin(math.radians(gear.helix_angle))   # §B9
     hand_name = {"R": "right-hand", "L": "left-hand"}[gear.hand]
     assert report.helix == [f"{hand_name} β {gear.helix_angle:.3f}° lead {lead:.1f} mm"]
-    wrong = Hand(gear, program.hob, speed=300.0, axial_feed=30.0, radial_feed=10.0,
+    wrong = Hand(gear, program.hob, speed=300.0, axial_feed=25.0, radial_feed=10.0,
                  z_term=-k_z(gear, gear.teeth))     # the other sign: the other hand of helix
     lines = wrong.lines()
     messages = refusal(simulate_program(lines, gear, wrong.hob, records["machine"]), number_of(lines, wrong.cut()[1]))

@@ -74,6 +74,8 @@ def _meet(solid: Solid, hob: HobBody, swivel: float, cx, cy, cz, motion: Motion)
 def _cut(solid: Solid, motion: Motion, index, radius) -> Contact | None:
     solid.start_session(motion.session)
     finite = np.isfinite(radius)
+    if (radius[finite] < solid.radius[index[finite]] - TOLERANCE).any():
+        solid.cut_sessions.add(motion.session)
     np.minimum.at(solid.reach, index[finite], radius[finite])
     np.minimum.at(solid.session_reach, index[finite], radius[finite])
     below = solid.intended_root[index] - radius

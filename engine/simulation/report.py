@@ -11,7 +11,9 @@ from ..programs.verifier.refusals import shown, shown_name
 
 class SimulationError(EngineError):
     """A program the simulation refuses: a collision, a wrong coupling or swivel, a depth not
-    reached, no run-out, a table too fast, a wrong cycle time, or a line it cannot read."""
+    reached, a run-out short of the generating zone, a table too fast, a feed above §C, a shift
+    or swivel while coupled, a unit re-cut by a new coupling, a generating zone off the hob,
+    records other than the ones proved against, a wrong cycle time, or a line it cannot read."""
 
 
 def where(name: str, number: int, line: str) -> str:

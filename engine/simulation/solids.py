@@ -35,6 +35,7 @@ class Solid:
     reach: np.ndarray = field(init=False)
     session_reach: np.ndarray = field(init=False)
     session: int = -1
+    cut_sessions: set = field(default_factory=set)   # the couplings whose cuts entered its material
 
     def __post_init__(self):
         count = max(2, int(math.ceil((self.z_high - self.z_low) / HEIGHT_STEP)) + 1)

@@ -24,6 +24,9 @@ from .paths import move_poses
 from .report import Report, SimulationError, where
 from .solids import Solid
 from .allowance import depth_problem, header_allowance
+from .rules import (block_record_problem, coupled_shift_problem, coupled_swivel_problem, feed_problem,
+                    record_header_problem, least_run_out, moves, recut_problem, run_out_problem, setup_advice,
+                    zone_problem)
 from .timing import feed_minutes, header_minutes, header_problem, rapid_minutes
 
 AXES = ("X", "Y", "Z")
@@ -66,6 +69,11 @@ class Walk:
         allowance = header_allowance(step.line)
         if allowance is not None:
             self.allowance = allowance
+        self._refuse(step, record_header_problem(step.line, self.gear, self.hob, self.machine))
+
+    def _refuse(self, step, problem: str | None) -> None:
+        if problem:
+            self.report.add(step.number, step.line, problem)
 
     def _header(self, step) -> None:
         return None
@@ -108,6 +116,7 @@ class Walk:
 
     def _block(self, step) -> None:
         block = step.item
+        self._refuse(step, block_record_problem(step, self.hob, self.machine))
         if 5 in step.m_codes:
             self.spindle = False
         if 20 in step.m_codes:
@@ -128,6 +137,8 @@ class Walk:
     # ---------------------------------------------------------------- moves
 
     def _move(self, step, motion: int, program: dict, swivel: float | None = None) -> None:
+        if self.coupling is not None:
+            self._check_coupled_axes(step, program, swivel)
         if swivel is not None:
             self.swivel, self.swivel_known = self.senses.swivel(swivel), True
         target = {axis: self.senses.position(axis, value) for axis, value in program.items()}
@@ -145,6 +156,15 @@ class Walk:
         if {"X", "Z"} <= end.keys():
             self._contacts(step, motion, cutting, start, end)
         self.position = end
+
+    def _check_coupled_axes(self, step, program: dict, swivel: float | None) -> None:
+        """Y (unless a leading axis) and A may not move while the table is coupled (§B15)."""
+        if "Y" in program and moves(self.position, "Y", self.senses.position("Y", program["Y"])):
+            self._refuse(step, coupled_shift_problem(self.coupling))
+        swivels = swivel is not None and (not self.swivel_known or
+                                          moves({"A": self.swivel}, "A", self.senses.swivel(swivel)))
+        if swivels:
+            self._refuse(step, coupled_swivel_problem())
 
     def _time(self, motion: int, program: dict) -> None:
         if motion == 0:
@@ -188,6 +208,8 @@ class Walk:
             problems.append("the swivel A is not positioned before the cut")
         else:
             problems.append(swivel_problem(self.swivel, self.gear, self.hob))
+        if "Y" in self.position and not self.worm_wheel:
+            problems.append(zone_problem(self.position["Y"], self.gear, self.hob))
         if teeth is not None:
             problems += coupling_problems(self.coupling, self.gear, self.hob, teeth, self.worm_wheel, moving)
         for problem in filter(None, problems):
@@ -212,6 +234,10 @@ class Walk:
         for contact in follow(self.solids, self.body, swivel, x, y, z,
                               Motion(teeth, running, self.session, self.tailstock, reason)):
             self.report.add(step.number, step.line, self._contact_message(contact, reason, teeth))
+        for unit in self.units:
+            if len(unit.cut_sessions) > 1 and ("recut", unit.name) not in self.said:
+                self.said.add(("recut", unit.name))
+                self._refuse(step, recut_problem(unit.name))
 
     def _reason(self, motion: int) -> str:
         if motion == 0:
@@ -226,7 +252,8 @@ class Walk:
         z = contact.height * self.senses.z
         if contact.below_root:
             return (f"the hob cuts {contact.depth:.3f} mm below the intended root of {contact.solid.name} at Z{z:.3f}")
-        return f"the hob runs {contact.depth:.3f} mm into {contact.solid.name} at Z{z:.3f} {reason}"
+        return (f"the hob runs {contact.depth:.3f} mm into {contact.solid.name} at Z{z:.3f} {reason}"
+                f"{setup_advice(contact.solid.name)}")
 
     def _extend_cut(self, step, start: dict, end: dict, velocities: dict) -> None:
         teeth = self._cut_teeth()
@@ -238,6 +265,8 @@ class Walk:
             before = {id(unit): unit.reach.copy() for unit in self.units if unit.teeth == teeth}
             self.cut = Cut(step.number, step.line, teeth, table, before)
         self.cut.add(start, end, velocities)
+        if not self.worm_wheel and self.cut.table_speed > 0 and velocities.get("Z"):
+            self._refuse(step, feed_problem(abs(velocities["Z"]) / self.cut.table_speed, self.gear, self.hob))
 
     def _end_cut(self) -> None:
         if self.cut is None:
@@ -250,9 +279,12 @@ class Walk:
                 self._check_run_out(cut, self.report.cuts[-1])
 
     def _check_run_out(self, cut: Cut, done) -> None:
-        if done.run_out is not None and done.run_out <= 0:
-            self.report.add(cut.number, cut.line, f"the pass ends {-done.run_out:.3f} mm short of carrying the hob "
-                                                  f"centre beyond the face of {done.unit} it leaves (no run-out)")
+        """An axial pass carries the generating zone past the face it leaves (§B8); a tangential
+        worm-wheel pass carries the hob's trailing end past the centre plane."""
+        least = 0.0 if self.worm_wheel else least_run_out(self.gear, self.swivel)
+        problem = run_out_problem(done.run_out, least, done.unit)
+        if problem:
+            self.report.add(cut.number, cut.line, problem)
 
     # ---------------------------------------------------------------- the end
 

@@ -53,15 +53,23 @@ def leading_velocity(rapid: bool, feed: float | None, machine: Machine) -> float
     return feed or MAX_FEED
 
 
-def check_coupled_move(rapid: bool, feed: float | None, positions: dict, coupling: tuple, machine: Machine) -> None:
+def check_coupled_move(rapid: bool, feed: float | None, positions: dict, coupling: tuple, machine: Machine,
+                       held: dict | None = None) -> None:
     """A leading axis of the EG coupling that moves turns the table by its factor k (degrees of
     C per mm) on top of the generating ratio (reference §A5): a G0 Z on a helical coupling adds
-    k_Z·rapid_rate/360 r/min. `coupling`: (hob speed, B→C ratio, {axis: factor})."""
+    k_Z·rapid_rate/360 r/min. `coupling`: (hob speed, B→C ratio, {axis: factor}). `held`: the
+    positions the axes hold before the block; an axis written at the position it holds does not
+    move and adds no term."""
     speed, ratio, factors = coupling
     velocity = leading_velocity(rapid, feed, machine)
-    moving = tuple((axis, factor, velocity) for axis, factor in factors.items() if axis in positions)
+    moving = tuple((axis, factor, velocity) for axis, factor in factors.items()
+                   if axis in positions and not _holds(axis, positions[axis], held or {}))
     if moving:
         check_table(speed or 0.0, ratio, machine, moving, "G0 " if rapid else "")
+
+
+def _holds(axis: str, value: float, held: dict) -> bool:
+    return axis in held and abs(held[axis] - value) <= 1e-9
 
 
 def check_thread(lead: float, speed: float, word: str) -> None:

@@ -183,7 +183,7 @@ class Walk:
         """A leading axis moving while coupled turns the table by its factor: at the block's
         feed, or for G0 at the machine's rapid rate (engine.programs.verifier.limits)."""
         check_coupled_move(motion == RAPID, self.feed, positions, (self.speed, self.ratio, self.differential),
-                           self.machine)
+                           self.machine, self.position)
 
     def _set_speed(self, speed: float) -> None:
         check_spindle(speed, self.machine)
