@@ -4,6 +4,7 @@ kill -9 in the middle of a batch's files leaves every file equal to a committed 
 temporary file."""
 from __future__ import annotations
 
+import json
 import os
 import signal
 import stat
@@ -138,8 +139,9 @@ def test_two_programs_of_one_batch_differing_only_in_case_are_refused(run, tmp_p
     assert run("instantiate", "--gears", "42-43").exit_code == 0
     with psycopg.connect(run.url) as conn:
         jobs = [row[0] for row in conn.execute("SELECT id FROM job ORDER BY id")]
-        conn.execute("UPDATE job SET params = jsonb_set(params, '{program_name}', '\"gear42\"') WHERE id = %s",
-                     (jobs[1],))
+        for job, name in zip(jobs, ("PART7", "part7")):   # a part number each, differing only in case
+            conn.execute("UPDATE job SET params = jsonb_set(params, '{program_name}', %s) WHERE id = %s",
+                         (json.dumps(name), job))
     before = program_count(run.url)
     message = one_line_refusal(run("instantiate", "--jobs", f"{jobs[0]}-{jobs[1]}", "--out", tmp_path / "out"))
     assert "would replace each other" in message

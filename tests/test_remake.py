@@ -39,7 +39,7 @@ def test_a_hobbing_job_renamed_to_another_gears_program_is_refused(run):
     before = len(programs(run.url))
     refused = run("instantiate", "--job", job)
     assert refused.exit_code == 1 and refused.stderr.count("\n") == 1
-    assert f"job {job}: its program name 'GEAR44' is not GEAR43" in refused.stderr
+    assert f"program name 'GEAR44' of job {job} (gear 43) is the name of gear 44's program" in refused.stderr
     assert len(programs(run.url)) == before
 
 

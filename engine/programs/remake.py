@@ -4,6 +4,7 @@ model, no hob choice, no cutting data. The programs are checked against the job'
 stored with the template version they came from, and written after the database commit."""
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 from ..errors import EngineError
@@ -72,11 +73,14 @@ class Remaker:
 
 
 def check_program_name(job_id: int, gear_id: int, params: dict) -> None:
-    """A hobbing job's program keeps its gear's name: under another gear's name (a runner's edit
-    of job.params) its file would replace that gear's program on the control."""
-    if params.get("program_name") != program_name(gear_id):
-        raise EngineError(f"job {job_id}: its program name {params.get('program_name')!r} is not "
-                          f"{program_name(gear_id)}, the name of gear {gear_id}'s program; correct job.params "
+    """A hobbing job's program may be renamed (a part number), but never to another gear's
+    program name GEAR<id>: its file would replace that gear's program on the control (names
+    are compared as the control does, ignoring case)."""
+    name = params.get("program_name")
+    other = re.fullmatch(r"GEAR(\d+)", name, re.IGNORECASE) if isinstance(name, str) else None
+    if other and int(other.group(1)) != gear_id:
+        raise EngineError(f"program name {name!r} of job {job_id} (gear {gear_id}) is the name of gear "
+                          f"{int(other.group(1))}'s program; correct job.params (e.g. {program_name(gear_id)}) "
                           f"or make a new job with `engine instantiate --gear {gear_id}`; nothing stored")
 
 
