@@ -370,3 +370,24 @@ def test_the_table_speed_of_every_duplex_unit_is_checked(conn):
     conn.execute("UPDATE machine SET table_speed_max = %s WHERE name = 'hobber-840d'", (between,))
     with pytest.raises(EngineError, match=r"\(19 teeth\) exceeds"):
         instantiate_gear(conn, 54)
+
+
+@pytest.mark.parametrize("face_width", [30, 12, 6])
+@pytest.mark.parametrize("feed_mode", ["climb", "conventional-climb"])
+def test_the_largest_crowning_is_cut_to_its_root_on_narrow_faces(conn, face_width, feed_mode):
+    """C_β 0.2 (the class's maximum) on faces down to 6 mm: instantiate stores only what the
+    simulation proves (3-D hob against the crowned root, §B11), so storing is the assertion;
+    the polyline runs beyond both faces by r0·sin(atan a') (the contact point passes them)."""
+    conn.execute("UPDATE gear SET crowning = 0.2, face_width = %s WHERE id = 51", (face_width,))
+    program, nc = program_of(conn, 51, cuts=2, feed_mode=feed_mode)
+    hob = hob_of(conn, program)
+    slope = 4 * (0.2 / math.sin(math.radians(20))) / face_width
+    beyond = hob["da0"] / 2 * slope / math.sqrt(1 + slope ** 2)
+    zs = [z for z, _ in crown_points(nc)]
+    assert max(zs) >= beyond - ROUND and min(zs) <= -face_width - beyond + ROUND
+
+
+def test_a_crowning_too_steep_for_its_face_is_refused_in_one_line(conn):
+    conn.execute("UPDATE gear SET crowning = 0.2, face_width = 4 WHERE id = 51")
+    with pytest.raises(EngineError, match=r"^gear 51: crowning 0.2 mm on a face of 4 mm slopes the root by 30°"):
+        program_of(conn, 51)

@@ -135,7 +135,15 @@ def test_a_file_naming_the_same_program_in_other_case_is_never_replaced(run, tmp
     assert program_count(run.url) == before and everything_under(tmp_path) == ["gear42.MPF"]
 
 
+def test_the_file_layer_refuses_two_programs_of_one_batch_differing_only_in_case(tmp_path):
+    with pytest.raises(EngineError, match="would replace each other"):
+        outputs.ProgramFiles(tmp_path).plan([("PART7", ["M30"]), ("part7", ["M30"])])
+    assert everything_under(tmp_path) == []
+
+
 def test_two_programs_of_one_batch_differing_only_in_case_are_refused(run, tmp_path):
+    """Two gears' jobs renamed PART7 and part7: refused before any file (by the job's name check,
+    or by the file layer's), nothing stored."""
     assert run("instantiate", "--gears", "42-43").exit_code == 0
     with psycopg.connect(run.url) as conn:
         jobs = [row[0] for row in conn.execute("SELECT id FROM job ORDER BY id")]
@@ -144,7 +152,7 @@ def test_two_programs_of_one_batch_differing_only_in_case_are_refused(run, tmp_p
                          (json.dumps(name), job))
     before = program_count(run.url)
     message = one_line_refusal(run("instantiate", "--jobs", f"{jobs[0]}-{jobs[1]}", "--out", tmp_path / "out"))
-    assert "would replace each other" in message
+    assert "would replace each other" in message or "is the name of gear 43's program" in message
     assert program_count(run.url) == before and everything_under(tmp_path) == []
 
 

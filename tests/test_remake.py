@@ -43,6 +43,21 @@ def test_a_hobbing_job_renamed_to_another_gears_program_is_refused(run):
     assert len(programs(run.url)) == before
 
 
+def test_two_gears_jobs_renamed_to_one_part_number_are_refused(run):
+    """A part number may replace GEAR<id>, but two gears' programs under one name (PARTX) would
+    overwrite each other on the control: the second is refused, nothing stored."""
+    assert run("instantiate", "--gears", "43-44").exit_code == 0
+    first, second = [job for job, *_ in programs(run.url)][:2]
+    with psycopg.connect(run.url) as conn:
+        for job in (first, second):
+            conn.execute("""UPDATE job SET params = jsonb_set(params, '{program_name}', '"PARTX"') WHERE id = %s""",
+                         (job,))
+    before = len(programs(run.url))
+    refused = run("instantiate", "--job", second)
+    assert refused.exit_code == 1 and "program name 'PARTX'" in refused.stderr and "gear 43's program" in refused.stderr
+    assert len(programs(run.url)) == before
+
+
 def test_a_failing_job_stops_the_batch_and_stores_nothing(run):
     assert run("instantiate", "--gears", "42-45").exit_code == 0
     jobs = [job for job, *_ in programs(run.url)]

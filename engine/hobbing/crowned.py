@@ -12,11 +12,14 @@ import math
 from functools import lru_cache
 
 from ..errors import EngineError
+from . import geometry
 from .cylindrical import RAPID_SHORT_OF_CUT, CylindricalModel
+from .passes import APPROACH_SAFETY
 from .root_contact import centre_on_root
 
 MAX_CROWNING = 0.2   # mm of flank crowning C_β; more is not crowning but a different tooth form
 CROWN_SEGMENTS = 24  # the template's polyline: G1 X Z segments per cut
+MAX_FACE_SLOPE = 0.5  # dX/dZ of the crowned root at the faces (26.6°); crowning is far flatter
 VERTICES = tuple(f"crown_x_{k}" for k in range(CROWN_SEGMENTS + 1))
 
 
@@ -29,6 +32,12 @@ class CrownedModel(CylindricalModel):
         if not gear.crowning or not 0 < gear.crowning <= MAX_CROWNING:
             raise EngineError(f"gear {gear.id}: class crowned needs a crowning 0 < C_β ≤ {MAX_CROWNING:g} mm, "
                               f"got {gear.crowning}; set crowning or choose another class")
+        face_slope = 4 * crown_depth(gear) / gear.face_width   # a'(Z) at the faces
+        if face_slope > MAX_FACE_SLOPE:
+            raise EngineError(f"gear {gear.id}: crowning {gear.crowning:g} mm on a face of {gear.face_width:g} mm slopes "
+                              f"the root by {math.degrees(math.atan(face_slope)):.0f}° at the faces (at most "
+                              f"{math.degrees(math.atan(MAX_FACE_SLOPE)):.0f}°: beyond it a 24-segment polyline no "
+                              f"longer follows it); reduce the crowning or check the face width")
         return {"crowning": gear.crowning, "crown_depth": round(crown_depth(gear), 4),
                 "z_mid": round(-gear.face_width / 2, 4)}
 
@@ -43,6 +52,10 @@ class CrownedModel(CylindricalModel):
         stock = params["cut_x"] - setup.full_depth     # the rough cut's finishing stock, 0 on the last
         for name, z in zip(VERTICES, vertex_heights(params["face_from"], params["face_to"])):
             params[name] = round(tangent_centre(gear, hob, setup.swivel, z) + stock, 3)
+        # the infeed to the first vertex, deeper than the cut's X, happens clear of the blank (§B7)
+        entered = top if cut.climb else bottom
+        clear = entered + down * infeed_approach(gear, hob, setup.swivel, params[VERTICES[0]])
+        params["z_from"] = round(down * max(down * params["z_from"], down * clear), 3)
         params["x_air"] = round(params[VERTICES[0]] + RAPID_SHORT_OF_CUT, 3)   # the infeed goes to the face
         return params
 
@@ -62,6 +75,12 @@ def beyond_faces(gear, hob, face_from: float, face_to: float) -> tuple[float, fl
     reach = hob.tip_diameter / 2 * slope / math.sqrt(1 + slope ** 2) + 1.0
     outward = 1 if face_from > face_to else -1
     return face_from + outward * reach, face_to - outward * reach
+
+
+def infeed_approach(gear, hob, swivel: float, infeed_x: float) -> float:
+    """Run-in E (§B7) for the depth the hob has at the infeed X, plus the safety."""
+    depth = min(geometry.cut_depth(gear.tip_diameter, hob.tip_diameter, infeed_x), hob.tip_diameter / 2)
+    return geometry.approach_length(max(depth, 0.0), hob.tip_diameter, gear.tip_diameter, swivel) + APPROACH_SAFETY
 
 
 def vertex_heights(face_from: float, face_to: float) -> list[float]:

@@ -19,30 +19,43 @@ RootRadius = Callable[[np.ndarray], np.ndarray]   # intended root radius at heig
 
 
 def centre_on_root_cone(root_radius: float, cone_angle: float, hob_radius: float, hob_length: float,
-                        swivel: float) -> float:
-    """X of the hob centre at Z = 0 (the top face) with the tip cylinder tangent to the root cone."""
+                        swivel: float) -> tuple[float, float]:
+    """(X of the hob centre at Z = 0 (the top face) with the tip cylinder tangent to the root
+    cone, how far along Z from the centre it touches)."""
     slope = math.tan(math.radians(cone_angle))
-    return centre_on_root(lambda z: root_radius + z * slope, 0.0, hob_radius, hob_length, swivel)
+    return contact_on_root(lambda z: root_radius + z * slope, 0.0, hob_radius, hob_length, swivel)
 
 
 def centre_on_root(root: RootRadius, z_centre: float, hob_radius: float, hob_length: float,
                    swivel: float) -> float:
     """X of the hob centre at height z_centre with the tip cylinder tangent to the root r(z)."""
+    return contact_on_root(root, z_centre, hob_radius, hob_length, swivel)[0]
+
+
+def contact_on_root(root: RootRadius, z_centre: float, hob_radius: float, hob_length: float,
+                    swivel: float) -> tuple[float, float]:
+    """(X of the centre, Z of the contact point less z_centre): a swivelled hob touches the root
+    off its centre's height, so a pass must carry the centre that much beyond a face."""
     eta, half = math.radians(swivel), hob_length / 2
     along, around = np.linspace(-half, half, COARSE[0]), np.linspace(0, 2 * math.pi, COARSE[1])
-    needed, (i, j) = _needed(root, z_centre, hob_radius, eta, along, around)
+    coarse = _needed(root, z_centre, hob_radius, eta, along, around)
+    (i, j) = coarse[2]
     d_along, d_around = along[1] - along[0], around[1] - around[0]
     fine_along = np.linspace(max(-half, along[i] - REFINE_SPAN * d_along),
                              min(half, along[i] + REFINE_SPAN * d_along), COARSE[0])
     fine_around = np.linspace(around[j] - REFINE_SPAN * d_around, around[j] + REFINE_SPAN * d_around, COARSE[1])
-    return max(needed, _needed(root, z_centre, hob_radius, eta, fine_along, fine_around)[0])
+    fine = _needed(root, z_centre, hob_radius, eta, fine_along, fine_around)
+    best = max(coarse, fine, key=lambda found: found[0])
+    return best[0], best[1]
 
 
-def _needed(root, z_centre, hob_radius, eta, along, around) -> tuple[float, tuple[int, int]]:
+def _needed(root, z_centre, hob_radius, eta, along, around) -> tuple[float, float, tuple[int, int]]:
     t, phi = np.meshgrid(along, around, indexing="ij")
     x = hob_radius * np.cos(phi)
     y = t * math.cos(eta) - hob_radius * np.sin(phi) * math.sin(eta)
-    z = z_centre + t * math.sin(eta) + hob_radius * np.sin(phi) * math.cos(eta)
-    bound = np.sqrt(np.maximum(root(z) ** 2 - y ** 2, 0.0)) - x
+    dz = t * math.sin(eta) + hob_radius * np.sin(phi) * math.cos(eta)
+    # a root continued past the work axis (a steep parabola far beyond a face) is the axis itself
+    radius = np.maximum(root(z_centre + dz), 0.0)
+    bound = np.sqrt(np.maximum(radius ** 2 - y ** 2, 0.0)) - x
     worst = np.unravel_index(int(np.argmax(bound)), bound.shape)
-    return float(bound[worst]), (int(worst[0]), int(worst[1]))
+    return float(bound[worst]), float(dz[worst]), (int(worst[0]), int(worst[1]))

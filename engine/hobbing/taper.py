@@ -16,6 +16,7 @@ MAX_CONE_ANGLE = 15.0   # degrees: beyond a small taper the hob's generating geo
 INFEED_CLEARANCE = 0.5  # mm between the hob envelope and the conical blank at the infeed
 RUN_IN_STEP = 0.5       # mm: the run-in grows by this until the infeed clears, then is bisected
 RUN_IN_TOLERANCE = 0.005
+CONTACT_MARGIN = 0.5    # mm the contact point passes the face it leaves
 
 
 class TaperModel(CylindricalModel):
@@ -30,12 +31,12 @@ class TaperModel(CylindricalModel):
         setup = super().setup(gear, hob)
         # The tip cylinder touches the root cone: (d_f2 + d_a0)/2 would cut it r0·(1/cos δ − 1)
         # too deep (0.23 mm on the paper's 6.5° gear), more off the Y = 0 plane when swivelled.
-        full_depth = centre_on_root_cone(gear.root_diameter / 2, gear.cone_angle, hob.tip_diameter / 2,
-                                         hob.length, setup.swivel)
-        # Tangent to the cone, the hob touches the root r0·sin|δ| along Z from its centre: the
-        # run-out carries the centre that much further, or the face it leaves keeps stock
-        # (0.1 mm at 10°, 0.5 mm at 15° on a climb cut).
-        overrun = setup.reach.overrun + hob.tip_diameter / 2 * math.sin(math.radians(abs(gear.cone_angle)))
+        full_depth, contact_dz = centre_on_root_cone(gear.root_diameter / 2, gear.cone_angle,
+                                                     hob.tip_diameter / 2, hob.length, setup.swivel)
+        # Tangent to the cone, the hob touches the root about r0·sin|δ| along Z from its centre
+        # (further off for a swivelled hob): the run-out carries the centre that much further,
+        # or the face it leaves keeps stock (0.1 mm at 10°, 0.5 mm at 15° on a climb cut).
+        overrun = setup.reach.overrun + abs(contact_dz) + CONTACT_MARGIN
         setup = Setup(setup.lead, setup.swivel, full_depth, Reach(setup.reach.approach, overrun), setup.x_retract)
         slope = math.tan(math.radians(gear.cone_angle))
         # The pass reaches the approach or run-out distance beyond a face, where the cone line

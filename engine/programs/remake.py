@@ -43,7 +43,7 @@ class Remaker:
             return plan_turning_job(self.conn, gear_class, machine, params, module_params)
         template = self.template(gear_class)
         if "cycle_time" in params:   # a hobbing job: the time follows feeds edited since
-            check_program_name(job_id, gear_id, params)
+            check_program_name(self.conn, job_id, gear_id, params)
             params = with_cycle_time(params, module_params, model_for_class(self.conn, gear_class).cut_shape, machine)
         result = run_template(template, params, module_params, machine, self.workpiece(gear_id, hob_id))
         return Planned(gear_id, gear_class, machine_name, hob_id, params, module_params, template, result,
@@ -72,16 +72,23 @@ class Remaker:
         return self._templates[gear_class]
 
 
-def check_program_name(job_id: int, gear_id: int, params: dict) -> None:
+def check_program_name(conn, job_id: int, gear_id: int, params: dict) -> None:
     """A hobbing job's program may be renamed (a part number), but never to another gear's
-    program name GEAR<id>: its file would replace that gear's program on the control (names
-    are compared as the control does, ignoring case)."""
+    program name, GEAR<id> or the name another gear's job carries: its file would replace that
+    gear's program on the control (names compared as the control does, ignoring case)."""
     name = params.get("program_name")
     other = re.fullmatch(r"GEAR(\d+)", name, re.IGNORECASE) if isinstance(name, str) else None
-    if other and int(other.group(1)) != gear_id:
+    owner = int(other.group(1)) if other else _other_gear_named(conn, name, gear_id)
+    if owner is not None and owner != gear_id:
         raise EngineError(f"program name {name!r} of job {job_id} (gear {gear_id}) is the name of gear "
-                          f"{int(other.group(1))}'s program; correct job.params (e.g. {program_name(gear_id)}) "
+                          f"{owner}'s program; correct job.params (e.g. {program_name(gear_id)}) "
                           f"or make a new job with `engine instantiate --gear {gear_id}`; nothing stored")
+
+
+def _other_gear_named(conn, name, gear_id: int) -> int | None:
+    row = conn.execute("SELECT gear_id FROM job WHERE upper(params ->> 'program_name') = upper(%s) "
+                       "AND gear_id <> %s ORDER BY id LIMIT 1", (name, gear_id)).fetchone()
+    return row[0] if row else None
 
 
 def instantiate_job(conn, job_id: int, out: str | Path | None = None, force: bool = False) -> Program:
