@@ -200,3 +200,44 @@ def test_a_machine_part_too_big_for_the_gear_says_what_to_do(records, helical):
     found = refusals(helical.lines(), helical, fixture)
     messages = [m for ms in found.values() for m in ms if "into the fixture" in m]
     assert messages and all("smaller fixture" in m for m in messages)
+
+
+# second review ---------------------------------------------------------------------------------
+
+def split_pass(helical, *between: str) -> list[str]:
+    """The axial pass cut in two at Z-15 with `between` written in the cut."""
+    x_cut, z_cut, retract = helical.cut()
+    return helical.lines([x_cut, "G1 Z-15.000 F24.7", *between, z_cut, retract])
+
+
+@pytest.mark.parametrize("change", ["S100", "M3 S100"])
+def test_a_spindle_speed_change_in_the_cut_counts_for_the_feed(records, helical, change):
+    """§C: at S100 the table turns 100·1/41 r/min, so 24.7 mm/min is 10.1 mm per workpiece revolution."""
+    feed = 24.7 / (100 * helical.hob.starts / helical.gear.teeth)
+    assert feed > ROUGH_MAX_M3
+    lines = split_pass(helical, change)
+    found = refusals(lines, helical, records["machine"])
+    assert any(f"{feed:.3f} mm per workpiece revolution" in m for m in found[number_of(lines, change) + 1])
+    assert not refusals(split_pass(helical, f"S{SPEED:g}"), helical, records["machine"])
+
+
+def test_spos_in_the_cut_stops_the_spindle(records, helical):
+    lines = split_pass(helical, "SPOS=0")
+    found = refusals(lines, helical, records["machine"])
+    assert any("spindle stopped" in m for m in found[number_of(lines, "SPOS=0") + 1])
+
+
+@pytest.mark.parametrize("word", ["D0", "D1", "T1 D1"])
+def test_a_tool_or_offset_word_in_the_coupling_is_refused(records, helical, word):
+    lines = split_pass(helical, word)
+    found = refusals(lines, helical, records["machine"])
+    assert any("while the table is coupled" in m for m in found[number_of(lines, word)])
+
+
+def test_an_offset_other_than_d1_is_refused(records, helical):
+    lines = helical.lines()
+    lines.insert(number_of(lines, "WALIMON"), "T1 D2")
+    found = refusals(lines, helical, records["machine"])
+    assert any("tool offset D2" in m for m in found[number_of(lines, "T1 D2")])
+    lines[number_of(lines, "T1 D2") - 1] = "T1 D1"
+    assert not refusals(lines, helical, records["machine"])

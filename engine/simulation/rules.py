@@ -113,7 +113,19 @@ def block_record_problem(step, hob: Hob, machine: Machine) -> str | None:
     tool = step.item.values.get("T")
     if tool is not None and tool != hob.tool_number:
         return f"the program calls tool T{tool:g}; hob {hob.id} is tool T{hob.tool_number} (hob record)"
+    offset = step.item.values.get("D")
+    if offset is not None and offset != 1:
+        return f"the program selects tool offset D{offset:g}; the hob has one edge, D1"
     return None
+
+
+def coupled_tool_problem(values: dict) -> str | None:
+    """The tool and its offset are set before the coupling: changed in it, the hob's position jumps."""
+    words = [address for address in ("T", "D") if address in values]
+    if not words:
+        return None
+    return (f"{'/'.join(words)} written while the table is coupled: the tool and its offset (T<n> D1) are "
+            "selected before EGON")
 
 
 def setup_advice(solid_name: str) -> str:

@@ -24,9 +24,9 @@ from .paths import move_poses
 from .report import Report, SimulationError, where
 from .solids import Solid
 from .allowance import depth_problem, header_allowance
-from .rules import (block_record_problem, coupled_shift_problem, coupled_swivel_problem, feed_problem,
-                    record_header_problem, least_run_out, moves, recut_problem, run_out_problem, setup_advice,
-                    zone_problem)
+from .rules import (block_record_problem, coupled_shift_problem, coupled_tool_problem, coupled_swivel_problem,
+                    feed_problem, record_header_problem, least_run_out, moves, recut_problem, run_out_problem,
+                    setup_advice, zone_problem)
 from .timing import feed_minutes, header_minutes, header_problem, rapid_minutes
 
 AXES = ("X", "Y", "Z")
@@ -117,7 +117,9 @@ class Walk:
     def _block(self, step) -> None:
         block = step.item
         self._refuse(step, block_record_problem(step, self.hob, self.machine))
-        if 5 in step.m_codes:
+        if self.coupling is not None:
+            self._refuse(step, coupled_tool_problem(block.values))
+        if 5 in step.m_codes or "SPOS" in block.values:    # SPOS stops the spindle to position it
             self.spindle = False
         if 20 in step.m_codes:
             self.tailstock = True
@@ -265,8 +267,9 @@ class Walk:
             before = {id(unit): unit.reach.copy() for unit in self.units if unit.teeth == teeth}
             self.cut = Cut(step.number, step.line, teeth, table, before)
         self.cut.add(start, end, velocities)
-        if not self.worm_wheel and self.cut.table_speed > 0 and velocities.get("Z"):
-            self._refuse(step, feed_problem(abs(velocities["Z"]) / self.cut.table_speed, self.gear, self.hob))
+        table = abs(self.coupling.k_b) * self.speed        # the spindle speed now, not the cut's first
+        if not self.worm_wheel and table > 0 and velocities.get("Z"):
+            self._refuse(step, feed_problem(abs(velocities["Z"]) / table, self.gear, self.hob))
 
     def _end_cut(self) -> None:
         if self.cut is None:
