@@ -241,3 +241,50 @@ def test_an_offset_other_than_d1_is_refused(records, helical):
     assert any("tool offset D2" in m for m in found[number_of(lines, "T1 D2")])
     lines[number_of(lines, "T1 D2") - 1] = "T1 D1"
     assert not refusals(lines, helical, records["machine"])
+
+
+def with_comment(helical, comment: str, at: str = "G90 G71 G94") -> list[str]:
+    lines = helical.lines()
+    lines.insert(number_of(lines, at) - 1, comment)
+    return lines
+
+
+@pytest.mark.parametrize("comment", ["; gear 44 CLASS helical", "; GEAR44 CLASS helical", "; GEAR=44",
+                                     "; hob H-M3-A-L1", "; machine lathe-840d", "; cycle time 0.5 min",
+                                     "; CYCLE TIME 30 S", "; Allowance 0.3 mm"])
+def test_a_header_fact_not_in_its_canonical_form_is_refused(records, helical, comment):
+    lines = with_comment(helical, comment)
+    found = refusals(lines, helical, records["machine"])
+    assert any("canonical" in m for m in found[number_of(lines, comment)])
+
+
+def test_a_header_fact_in_a_trailing_comment_is_refused(records, helical):
+    lines = helical.lines()
+    at = number_of(lines, "G0 Y0.000")
+    lines[at - 1] = "G0 Y0.000 ; GEAR 44"
+    assert any("canonical" in m for m in refusals(lines, helical, records["machine"])[at])
+
+
+@pytest.mark.parametrize("comment", ["; TEMPLATE helical v1", "; CUT SINGLE X=99.919 CLIMB", "; TAILSTOCK CLAMP",
+                                     "; n0=338 r/min table=8.244 r/min cuts=1 climb", "; GEAR 43 CLASS helical",
+                                     "; HOB H-M3-AA-R1 z0=1 da0=80 hand=R", "; MACHINE hobber-840d"])
+def test_the_templates_other_comments_and_right_headers_are_accepted(records, helical, comment):
+    assert not refusals(with_comment(helical, comment), helical, records["machine"])
+
+
+def test_the_allowance_is_stated_once_before_the_first_motion(records, helical):
+    stated = "; ALLOWANCE 0.000 MM LEFT FOR FINISHING"
+    assert not refusals(with_comment(helical, stated), helical, records["machine"])
+    twice = with_comment(helical, stated)
+    twice.insert(number_of(twice, "G90 G71 G94") - 1, "; ALLOWANCE 0.000 MM")
+    found = refusals(twice, helical, records["machine"])
+    assert any("second" in m for m in found[number_of(twice, "; ALLOWANCE 0.000 MM")])
+    late = with_comment(helical, stated, at="G0 Y0.000")
+    found = refusals(late, helical, records["machine"])
+    assert any("after the first motion" in m for m in found[number_of(late, stated)])
+
+
+def test_a_program_without_its_cycle_time_header_is_refused(records, helical):
+    helical.header = None
+    lines = helical.lines()
+    assert any("no `; CYCLE TIME" in m for m in refusals(lines, helical, records["machine"])[len(lines)])

@@ -20,6 +20,7 @@ from .contact import Motion, follow
 from .cuts import Cut, summary
 from .envelope import HobBody
 from .frame import Senses
+from .headers import comment_problem, header_place_problem
 from .paths import move_poses
 from .report import Report, SimulationError, where
 from .solids import Solid
@@ -55,20 +56,24 @@ class Walk:
         self.clamp = ShiftClamp()
         self.said: set = set()
         self.allowance = 0.0
+        self.allowance_stated = self.moved = False
 
     # ---------------------------------------------------------------- lines
 
     def take(self, step) -> None:
+        self._refuse(step, comment_problem(step))
         TAKERS[step.kind](self, step)
 
     def _comment(self, step) -> None:
         minutes = header_minutes(step.line)
         if minutes is not None:
+            self._refuse(step, header_place_problem("CYCLE TIME", self.report.header_time is not None, self.moved))
             self.report.header_time = minutes
             self.header_step = step
         allowance = header_allowance(step.line)
         if allowance is not None:
-            self.allowance = allowance
+            self._refuse(step, header_place_problem("ALLOWANCE", self.allowance_stated, self.moved))
+            self.allowance, self.allowance_stated = allowance, True
         self._refuse(step, record_header_problem(step.line, self.gear, self.hob, self.machine))
 
     def _refuse(self, step, problem: str | None) -> None:
@@ -130,6 +135,7 @@ class Walk:
         if DWELL in step.g_codes:
             self.report.cycle_time += block.values.get("F", 0.0) / 60.0
         elif block.moves and block.area is None:
+            self.moved = True
             self._move(step, block.motion, dict(block.positions), block.values.get("A"))
         if 3 in step.m_codes:
             self.spindle = True
@@ -301,8 +307,8 @@ class Walk:
             if problem:
                 self.report.add(self.header_step.number, self.header_step.line, problem)
         else:
-            self.report.add(*last, "no `; CYCLE TIME <m> MIN` header line: the cycle time is only reported",
-                            refuses=False)
+            self.report.add(*last, "no `; CYCLE TIME <m> MIN` header line: a hobbing program states its cycle "
+                                   f"time (the simulation takes {self.report.cycle_time:.2f} min)")
 
     def _check_depth(self, unit: Solid, last: tuple) -> None:
         cut = self.last_cut_of.get(id(unit))
