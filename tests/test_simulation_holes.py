@@ -288,3 +288,16 @@ def test_a_program_without_its_cycle_time_header_is_refused(records, helical):
     helical.header = None
     lines = helical.lines()
     assert any("no `; CYCLE TIME" in m for m in refusals(lines, helical, records["machine"])[len(lines)])
+
+
+def test_a_radial_infeed_above_the_roughing_maximum_is_refused(records, helical):
+    """§C bounds the infeed too: 40 mm/min at a table of 338·1/41 r/min is 4.852 mm/rev > 3.5."""
+    table = SPEED * helical.hob.starts / helical.gear.teeth
+    feed = 40.0 / table
+    assert feed > ROUGH_MAX_M3
+    helical.radial_feed = 40.0
+    lines = helical.lines()
+    infeed = number_of(lines, f"G1 X{helical.x_cut:.3f} F40.0")
+    assert any(f"radial infeed feeds {feed:.3f} mm" in m for m in refusals(lines, helical, records["machine"])[infeed])
+    helical.radial_feed = 0.999 * ROUGH_MAX_M3 * table
+    assert not refusals(helical.lines(), helical, records["machine"])

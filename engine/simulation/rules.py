@@ -73,14 +73,14 @@ def run_out_problem(run_out: float | None, least: float, unit: str) -> str | Non
             f"generating zone reaches {least:.3f} mm past the centre at this swivel ((h/tan α_n)·sin|η|, §B8)")
 
 
-def feed_problem(feed: float | None, gear: Gear, hob: Hob) -> str | None:
+def feed_problem(feed: float | None, gear: Gear, hob: Hob, motion: str = "pass") -> str | None:
     """§C: the roughing maximum f_a for the module bounds every pass, rough or finish."""
     if feed is None:
         return None
     most = feed_maximum(gear.module, "rough", hob.starts)
     if feed <= most * (1 + FEED_TOLERANCE):
         return None
-    return (f"the pass feeds {feed:.3f} mm per workpiece revolution, above the {most:g} mm/rev roughing maximum "
+    return (f"the {motion} feeds {feed:.3f} mm per workpiece revolution, above the {most:g} mm/rev roughing maximum "
             f"for m{gear.module:g} with a {hob.starts}-start hob (§C)")
 
 

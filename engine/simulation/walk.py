@@ -276,6 +276,8 @@ class Walk:
         table = abs(self.coupling.k_b) * self.speed        # the spindle speed now, not the cut's first
         if not self.worm_wheel and table > 0 and velocities.get("Z"):
             self._refuse(step, feed_problem(abs(velocities["Z"]) / table, self.gear, self.hob))
+        if table > 0 and velocities.keys() == {"X"}:          # the radial infeed is bounded by §C too
+            self._refuse(step, feed_problem(abs(velocities["X"]) / table, self.gear, self.hob, "radial infeed"))
 
     def _end_cut(self) -> None:
         if self.cut is None:
