@@ -60,7 +60,7 @@ class Hand:
     run_out: float | None = None       # default: 3 mm, or 1 mm past the §B8 least where that is more
     stock: float = 0.0                 # radial: the cut stops this far above full depth
     senses: dict = field(default_factory=lambda: {"a": 1, "b": 1, "c": 1, "y": 1, "z": 1})
-    header: str | None = None          # a `; CYCLE TIME … MIN` line
+    header: str | None = "auto"        # a `; CYCLE TIME … MIN` line; "auto": the program's own time, None: none
     tailstock: bool = True
     teeth: int | None = None           # the EGON denominator (default: the gear's)
     a_value: float | None = None       # the swivel written (DIN), default the reference
@@ -84,6 +84,12 @@ class Hand:
         return -self.gear.face_width - run_out
 
     def lines(self, cut: list[str] | None = None) -> list[str]:
+        body = self._body(cut)
+        if self.header == "auto":
+            return body[:2] + [f"; CYCLE TIME {program_minutes(body, RAPID_RATE, LOAD):.1f} MIN"] + body[2:]
+        return body[:2] + ([self.header] if self.header else []) + body[2:]
+
+    def _body(self, cut: list[str] | None) -> list[str]:
         s = self.senses
         teeth = self.teeth or self.gear.teeth
         a_value = swivel(self.gear, self.hob) if self.a_value is None else self.a_value
@@ -92,7 +98,7 @@ class Hand:
         helical = self.gear.helix_angle != 0
         egon += f",Z,{factor * s['c'] * s['z']:.6f},1)" if helical else ")"
         z = s["z"]
-        return ["%_N_TEST_MPF", ";$PATH=/_N_MPF_DIR", *([self.header] if self.header else []),
+        return ["%_N_TEST_MPF", ";$PATH=/_N_MPF_DIR",
                 "G90 G71 G94", "G25 X20.000 Y-80.000 Z-350.000", "G26 X320.000 Y80.000 Z150.000", "WALIMON",
                 *(["M20"] if self.tailstock else []),
                 f"G0 X{self.x_retract:.3f} Z{self.z_start * z:.3f}", f"G0 A={a_value * s['a']:.3f}", "G0 Y0.000",
@@ -112,6 +118,36 @@ class Hand:
         minutes += (self.x_retract - self.x_cut) / self.radial_feed
         minutes += (self.z_start - self.z_end) / self.axial_feed
         return minutes + (self.x_retract - self.x_cut) / rapid_rate
+
+
+RAPID_RATE, LOAD = 8000.0, (300.0, 100.0)      # the seeded hobber-840d's G0 rate and load position
+
+
+def program_minutes(lines: list[str], rapid_rate: float, load: tuple) -> float:
+    """The BRIEF's cycle time of a program's blocks: G1 path length / F, G0 the longest axis travel
+    / rapid rate, G4 F<s> s seconds, from the load position."""
+    at, feed, motion, minutes = {"X": load[0], "Z": load[1]}, None, None, 0.0
+    for line in lines:
+        tokens = [w for w in line.partition(";")[0].split() if w[:1] in "GXYZF" and "=" not in w and "(" not in w]
+        words = {w[0]: w[1:] for w in tokens if w[0] != "G"}
+        codes = {w[1:] for w in tokens if w[0] == "G"}
+        motion = 0 if "0" in codes else 1 if "1" in codes else motion
+        if "4" in codes:
+            minutes += float(words["F"]) / 60
+            continue
+        feed = float(words["F"]) if "F" in words else feed
+        delta = [float(words[a]) - at.get(a, float(words[a])) for a in "XYZ" if a in words]
+        at.update({a: float(words[a]) for a in "XYZ" if a in words})
+        if delta and motion == 0:
+            minutes += max(abs(d) for d in delta) / rapid_rate
+        elif delta and motion == 1:
+            minutes += math.sqrt(sum(d * d for d in delta)) / feed
+    return minutes
+
+
+def with_cycle_time(lines: list[str]) -> list[str]:
+    """The program with its `; CYCLE TIME` header after the program name (on the seeded machine)."""
+    return lines[:1] + [f"; CYCLE TIME {program_minutes(lines, RAPID_RATE, LOAD):.1f} MIN"] + lines[1:]
 
 
 def number_of(lines: list[str], text: str) -> int:

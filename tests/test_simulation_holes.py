@@ -200,3 +200,104 @@ def test_a_machine_part_too_big_for_the_gear_says_what_to_do(records, helical):
     found = refusals(helical.lines(), helical, fixture)
     messages = [m for ms in found.values() for m in ms if "into the fixture" in m]
     assert messages and all("smaller fixture" in m for m in messages)
+
+
+# second review ---------------------------------------------------------------------------------
+
+def split_pass(helical, *between: str) -> list[str]:
+    """The axial pass cut in two at Z-15 with `between` written in the cut."""
+    x_cut, z_cut, retract = helical.cut()
+    return helical.lines([x_cut, "G1 Z-15.000 F24.7", *between, z_cut, retract])
+
+
+@pytest.mark.parametrize("change", ["S100", "M3 S100"])
+def test_a_spindle_speed_change_in_the_cut_counts_for_the_feed(records, helical, change):
+    """§C: at S100 the table turns 100·1/41 r/min, so 24.7 mm/min is 10.1 mm per workpiece revolution."""
+    feed = 24.7 / (100 * helical.hob.starts / helical.gear.teeth)
+    assert feed > ROUGH_MAX_M3
+    lines = split_pass(helical, change)
+    found = refusals(lines, helical, records["machine"])
+    assert any(f"{feed:.3f} mm per workpiece revolution" in m for m in found[number_of(lines, change) + 1])
+    assert not refusals(split_pass(helical, f"S{SPEED:g}"), helical, records["machine"])
+
+
+def test_spos_in_the_cut_stops_the_spindle(records, helical):
+    lines = split_pass(helical, "SPOS=0")
+    found = refusals(lines, helical, records["machine"])
+    assert any("spindle stopped" in m for m in found[number_of(lines, "SPOS=0") + 1])
+
+
+@pytest.mark.parametrize("word", ["D0", "D1", "T1 D1"])
+def test_a_tool_or_offset_word_in_the_coupling_is_refused(records, helical, word):
+    lines = split_pass(helical, word)
+    found = refusals(lines, helical, records["machine"])
+    assert any("while the table is coupled" in m for m in found[number_of(lines, word)])
+
+
+def test_an_offset_other_than_d1_is_refused(records, helical):
+    lines = helical.lines()
+    lines.insert(number_of(lines, "WALIMON"), "T1 D2")
+    found = refusals(lines, helical, records["machine"])
+    assert any("tool offset D2" in m for m in found[number_of(lines, "T1 D2")])
+    lines[number_of(lines, "T1 D2") - 1] = "T1 D1"
+    assert not refusals(lines, helical, records["machine"])
+
+
+def with_comment(helical, comment: str, at: str = "G90 G71 G94") -> list[str]:
+    lines = helical.lines()
+    lines.insert(number_of(lines, at) - 1, comment)
+    return lines
+
+
+@pytest.mark.parametrize("comment", ["; gear 44 CLASS helical", "; GEAR44 CLASS helical", "; GEAR=44",
+                                     "; hob H-M3-A-L1", "; machine lathe-840d", "; cycle time 0.5 min",
+                                     "; CYCLE TIME 30 S", "; Allowance 0.3 mm"])
+def test_a_header_fact_not_in_its_canonical_form_is_refused(records, helical, comment):
+    lines = with_comment(helical, comment)
+    found = refusals(lines, helical, records["machine"])
+    assert any("canonical" in m for m in found[number_of(lines, comment)])
+
+
+def test_a_header_fact_in_a_trailing_comment_is_refused(records, helical):
+    lines = helical.lines()
+    at = number_of(lines, "G0 Y0.000")
+    lines[at - 1] = "G0 Y0.000 ; GEAR 44"
+    assert any("canonical" in m for m in refusals(lines, helical, records["machine"])[at])
+
+
+@pytest.mark.parametrize("comment", ["; TEMPLATE helical v1", "; CUT SINGLE X=99.919 CLIMB", "; TAILSTOCK CLAMP",
+                                     "; n0=338 r/min table=8.244 r/min cuts=1 climb", "; GEAR 43 CLASS helical",
+                                     "; HOB H-M3-AA-R1 z0=1 da0=80 hand=R", "; MACHINE hobber-840d"])
+def test_the_templates_other_comments_and_right_headers_are_accepted(records, helical, comment):
+    assert not refusals(with_comment(helical, comment), helical, records["machine"])
+
+
+def test_the_allowance_is_stated_once_before_the_first_motion(records, helical):
+    stated = "; ALLOWANCE 0.000 MM LEFT FOR FINISHING"
+    assert not refusals(with_comment(helical, stated), helical, records["machine"])
+    twice = with_comment(helical, stated)
+    twice.insert(number_of(twice, "G90 G71 G94") - 1, "; ALLOWANCE 0.000 MM")
+    found = refusals(twice, helical, records["machine"])
+    assert any("second" in m for m in found[number_of(twice, "; ALLOWANCE 0.000 MM")])
+    late = with_comment(helical, stated, at="G0 Y0.000")
+    found = refusals(late, helical, records["machine"])
+    assert any("after the first motion" in m for m in found[number_of(late, stated)])
+
+
+def test_a_program_without_its_cycle_time_header_is_refused(records, helical):
+    helical.header = None
+    lines = helical.lines()
+    assert any("no `; CYCLE TIME" in m for m in refusals(lines, helical, records["machine"])[len(lines)])
+
+
+def test_a_radial_infeed_above_the_roughing_maximum_is_refused(records, helical):
+    """§C bounds the infeed too: 40 mm/min at a table of 338·1/41 r/min is 4.852 mm/rev > 3.5."""
+    table = SPEED * helical.hob.starts / helical.gear.teeth
+    feed = 40.0 / table
+    assert feed > ROUGH_MAX_M3
+    helical.radial_feed = 40.0
+    lines = helical.lines()
+    infeed = number_of(lines, f"G1 X{helical.x_cut:.3f} F40.0")
+    assert any(f"radial infeed feeds {feed:.3f} mm" in m for m in refusals(lines, helical, records["machine"])[infeed])
+    helical.radial_feed = 0.999 * ROUGH_MAX_M3 * table
+    assert not refusals(helical.lines(), helical, records["machine"])

@@ -13,7 +13,7 @@ from engine.errors import EngineError
 from engine.gears.records import GearUnit, load_gear, load_hobs, load_machine
 from engine.simulation import SimulationError, prove_program, simulate_program
 
-from simulation_programs import Hand, k_y, k_z, lead_angle, number_of, swivel
+from simulation_programs import Hand, k_y, k_z, lead_angle, number_of, swivel, with_cycle_time
 
 MACHINE = "hobber-840d"
 
@@ -138,15 +138,15 @@ def test_helical_programs_of_both_hands_are_clean_and_a_wrong_z_sign_is_refused(
 def test_todays_gear_43_program_with_the_signs_of_before_issue_14_is_refused_for_a_and_z(records):
     """The program the seeded templates made before issue 14 (A=12.629, Z,0.241126 where the
     reference gives −12.628 and −0.241126), with Y positioned so only the signs are at stake."""
-    lines = ["%_N_GEAR43_MPF", ";$PATH=/_N_MPF_DIR", "G90 G71 G94", "G25 X98.919 Y-1.000 Z-39.555",
+    lines = with_cycle_time(["%_N_GEAR43_MPF", ";$PATH=/_N_MPF_DIR", "G90 G71 G94", "G25 X98.919 Y-1.000 Z-39.555",
              "G26 X112.669 Y1.000 Z32.336", "WALIMON", "M20 ; TAILSTOCK CLAMP", "G0 X111.669 Z31.336",
              "G0 A=12.629", "G0 Y0.000", "EGDEF(C,B,1,Z,1)", 'EGON(C,"FINE",B,-1,41,Z,0.241126,1)', "M3 S338", "M8",
              "G0 Z31.336", "G1 X99.919 F8.2", "G1 Z-38.555 F24.7", "G0 X111.669", "M9", "EGOFS(C)", "EGDEL(C)",
-             "M5", "M21 ; TAILSTOCK RELEASE", "M30"]
+             "M5", "M21 ; TAILSTOCK RELEASE", "M30"])
     gear, hob = records["gear"](43), records["hobs"]["H-M3-AA-R1"]
     report = simulate_program(lines, gear, hob, records["machine"], "GEAR43")
-    assert any("-12.628" in m for m in refusal(report, 16))
-    assert any("Z term +0.241126" in m and "left-hand" in m for m in refusal(report, 17))
+    assert any("-12.628" in m for m in refusal(report, 17))
+    assert any("Z term +0.241126" in m and "left-hand" in m for m in refusal(report, 18))
     fixed = [line.replace("A=12.629", "A=-12.628").replace("Z,0.241126", "Z,-0.241126") for line in lines]
     assert not simulate_program(fixed, gear, hob, records["machine"]).refused
 
@@ -213,18 +213,19 @@ def test_tangential_worm_wheels_of_both_hands_need_the_same_positive_y_term(reco
         x_cut = (gear.root_diameter + hob.tip_diameter) / 2
         y_clear = gear.tip_diameter / 2 + hob.length / 2 + 5.0
         numerator = -(1 if hand_of == "R" else -1) * hob.starts
-        return ["%_N_TEST_MPF", "G90 G71 G94", "G25 X20.000 Y-80.000 Z-350.000", "G26 X320.000 Y80.000 Z150.000",
+        return with_cycle_time(["%_N_TEST_MPF", "G90 G71 G94", "G25 X20.000 Y-80.000 Z-350.000",
+                                "G26 X320.000 Y80.000 Z150.000",
                 "WALIMON", f"G0 X{x_cut + 20:.3f} Z{-gear.face_width / 2:.3f}", f"G0 A={swivel(gear, hob):.3f}",
                 f"G0 Y{y_clear:.3f}", "EGDEF(C,B,1,Y,1)", f'EGON(C,"FINE",B,{numerator},{gear.teeth},Y,{y_term:.6f},1)',
                 "M3 S460", f"G1 X{x_cut:.3f} F20.0", f"G1 Y{-y_clear:.3f} F30.0", f"G0 X{x_cut + 20:.3f}",
-                "EGOFS(C)", "EGDEL(C)", "M5", "M30"]
+                "EGOFS(C)", "EGDEL(C)", "M5", "M30"])
 
     term = k_y(gear, hob, gear.teeth)
     assert abs(swivel(gear, hob)) < 0.01 + abs(lead_angle(hob) - gear.helix_angle)
     report = prove_program(program(term), gear, hob, machine)
     assert report.cuts[0].run_out > 0
     wrong = program(-term)
-    messages = refusal(simulate_program(wrong, gear, hob, machine), 13)
+    messages = refusal(simulate_program(wrong, gear, hob, machine), 14)
     assert any("Y term" in m for m in messages)
 
 

@@ -73,14 +73,14 @@ def run_out_problem(run_out: float | None, least: float, unit: str) -> str | Non
             f"generating zone reaches {least:.3f} mm past the centre at this swivel ((h/tan α_n)·sin|η|, §B8)")
 
 
-def feed_problem(feed: float | None, gear: Gear, hob: Hob) -> str | None:
+def feed_problem(feed: float | None, gear: Gear, hob: Hob, motion: str = "pass") -> str | None:
     """§C: the roughing maximum f_a for the module bounds every pass, rough or finish."""
     if feed is None:
         return None
     most = feed_maximum(gear.module, "rough", hob.starts)
     if feed <= most * (1 + FEED_TOLERANCE):
         return None
-    return (f"the pass feeds {feed:.3f} mm per workpiece revolution, above the {most:g} mm/rev roughing maximum "
+    return (f"the {motion} feeds {feed:.3f} mm per workpiece revolution, above the {most:g} mm/rev roughing maximum "
             f"for m{gear.module:g} with a {hob.starts}-start hob (§C)")
 
 
@@ -113,7 +113,19 @@ def block_record_problem(step, hob: Hob, machine: Machine) -> str | None:
     tool = step.item.values.get("T")
     if tool is not None and tool != hob.tool_number:
         return f"the program calls tool T{tool:g}; hob {hob.id} is tool T{hob.tool_number} (hob record)"
+    offset = step.item.values.get("D")
+    if offset is not None and offset != 1:
+        return f"the program selects tool offset D{offset:g}; the hob has one edge, D1"
     return None
+
+
+def coupled_tool_problem(values: dict) -> str | None:
+    """The tool and its offset are set before the coupling: changed in it, the hob's position jumps."""
+    words = [address for address in ("T", "D") if address in values]
+    if not words:
+        return None
+    return (f"{'/'.join(words)} written while the table is coupled: the tool and its offset (T<n> D1) are "
+            "selected before EGON")
 
 
 def setup_advice(solid_name: str) -> str:

@@ -20,13 +20,14 @@ from .contact import Motion, follow
 from .cuts import Cut, summary
 from .envelope import HobBody
 from .frame import Senses
+from .headers import comment_problem, header_place_problem
 from .paths import move_poses
 from .report import Report, SimulationError, where
 from .solids import Solid
 from .allowance import depth_problem, header_allowance
-from .rules import (block_record_problem, coupled_shift_problem, coupled_swivel_problem, feed_problem,
-                    record_header_problem, least_run_out, moves, recut_problem, run_out_problem, setup_advice,
-                    zone_problem)
+from .rules import (block_record_problem, coupled_shift_problem, coupled_tool_problem, coupled_swivel_problem,
+                    feed_problem, record_header_problem, least_run_out, moves, recut_problem, run_out_problem,
+                    setup_advice, zone_problem)
 from .timing import feed_minutes, header_minutes, header_problem, rapid_minutes
 
 AXES = ("X", "Y", "Z")
@@ -55,20 +56,24 @@ class Walk:
         self.clamp = ShiftClamp()
         self.said: set = set()
         self.allowance = 0.0
+        self.allowance_stated = self.moved = False
 
     # ---------------------------------------------------------------- lines
 
     def take(self, step) -> None:
+        self._refuse(step, comment_problem(step))
         TAKERS[step.kind](self, step)
 
     def _comment(self, step) -> None:
         minutes = header_minutes(step.line)
         if minutes is not None:
+            self._refuse(step, header_place_problem("CYCLE TIME", self.report.header_time is not None, self.moved))
             self.report.header_time = minutes
             self.header_step = step
         allowance = header_allowance(step.line)
         if allowance is not None:
-            self.allowance = allowance
+            self._refuse(step, header_place_problem("ALLOWANCE", self.allowance_stated, self.moved))
+            self.allowance, self.allowance_stated = allowance, True
         self._refuse(step, record_header_problem(step.line, self.gear, self.hob, self.machine))
 
     def _refuse(self, step, problem: str | None) -> None:
@@ -117,7 +122,9 @@ class Walk:
     def _block(self, step) -> None:
         block = step.item
         self._refuse(step, block_record_problem(step, self.hob, self.machine))
-        if 5 in step.m_codes:
+        if self.coupling is not None:
+            self._refuse(step, coupled_tool_problem(block.values))
+        if 5 in step.m_codes or "SPOS" in block.values:    # SPOS stops the spindle to position it
             self.spindle = False
         if 20 in step.m_codes:
             self.tailstock = True
@@ -128,6 +135,7 @@ class Walk:
         if DWELL in step.g_codes:
             self.report.cycle_time += block.values.get("F", 0.0) / 60.0
         elif block.moves and block.area is None:
+            self.moved = True
             self._move(step, block.motion, dict(block.positions), block.values.get("A"))
         if 3 in step.m_codes:
             self.spindle = True
@@ -265,8 +273,11 @@ class Walk:
             before = {id(unit): unit.reach.copy() for unit in self.units if unit.teeth == teeth}
             self.cut = Cut(step.number, step.line, teeth, table, before)
         self.cut.add(start, end, velocities)
-        if not self.worm_wheel and self.cut.table_speed > 0 and velocities.get("Z"):
-            self._refuse(step, feed_problem(abs(velocities["Z"]) / self.cut.table_speed, self.gear, self.hob))
+        table = abs(self.coupling.k_b) * self.speed        # the spindle speed now, not the cut's first
+        if not self.worm_wheel and table > 0 and velocities.get("Z"):
+            self._refuse(step, feed_problem(abs(velocities["Z"]) / table, self.gear, self.hob))
+        if table > 0 and velocities.keys() == {"X"}:          # the radial infeed is bounded by §C too
+            self._refuse(step, feed_problem(abs(velocities["X"]) / table, self.gear, self.hob, "radial infeed"))
 
     def _end_cut(self) -> None:
         if self.cut is None:
@@ -298,8 +309,8 @@ class Walk:
             if problem:
                 self.report.add(self.header_step.number, self.header_step.line, problem)
         else:
-            self.report.add(*last, "no `; CYCLE TIME <m> MIN` header line: the cycle time is only reported",
-                            refuses=False)
+            self.report.add(*last, "no `; CYCLE TIME <m> MIN` header line: a hobbing program states its cycle "
+                                   f"time (the simulation takes {self.report.cycle_time:.2f} min)")
 
     def _check_depth(self, unit: Solid, last: tuple) -> None:
         cut = self.last_cut_of.get(id(unit))

@@ -1,0 +1,35 @@
+"""The header comments a hobbing program states facts in (`; GEAR n`, `; HOB id`, `; MACHINE
+name`, `; CYCLE TIME m MIN`, `; ALLOWANCE a MM`): the simulation holds each to the records, the
+simulated time and the last cut's depth. A comment that looks like one of them but is written
+another way (other case, `GEAR=44`, a trailing comment on a block) would go unchecked while a
+reader takes it as the program's claim, so it fails closed: refused unless it is the canonical form."""
+from __future__ import annotations
+
+import re
+
+CLAIM = re.compile(r"\b(GEAR|HOB|MACHINE|CYCLE|ALLOWANCE)", re.IGNORECASE)
+CANONICAL = (re.compile(r"; GEAR \S+( .*)?"), re.compile(r"; HOB \S+( .*)?"), re.compile(r"; MACHINE \S+"),
+             re.compile(r"; CYCLE TIME [0-9]+(\.[0-9]+)? MIN"), re.compile(r"; ALLOWANCE [0-9]+(\.[0-9]+)? MM( .*)?"))
+REMARKS = ("HOB SHIFT PER PART",)     # the templates' note on the shift parameter's line
+
+
+def comment_problem(step) -> str | None:
+    """A comment naming a header fact must be that header's canonical whole line."""
+    code, semicolon, comment = step.line.partition(";")
+    if not semicolon or comment.strip() in REMARKS or not CLAIM.search(comment):
+        return None
+    if step.kind == "comment" and not code.strip() and any(form.fullmatch(step.line) for form in CANONICAL):
+        return None
+    return ("a comment that names a header fact (gear, hob, machine, cycle time, allowance) is not its canonical "
+            "whole-line form `; GEAR <id>`, `; HOB <id>`, `; MACHINE <name>`, `; CYCLE TIME <m> MIN`, "
+            "`; ALLOWANCE <mm> MM`: it would go unchecked")
+
+
+def header_place_problem(fact: str, stated_before: bool, moved: bool) -> str | None:
+    """A header fact is stated once, in the header block before the first motion: a second or a
+    late one leaves the reader two claims or one the machine has already passed."""
+    if stated_before:
+        return f"a second `; {fact}` line: the header states it once"
+    if moved:
+        return f"`; {fact}` after the first motion block: it belongs to the header, before any motion"
+    return None
