@@ -11,9 +11,11 @@ from ..programs.verifier.refusals import shown, shown_name
 
 class SimulationError(EngineError):
     """A program the simulation refuses: a collision, a wrong coupling or swivel, a depth not
-    reached, a run-out short of the generating zone, a table too fast, a feed above §C, a shift
-    or swivel while coupled, a unit re-cut by a new coupling, a generating zone off the hob,
-    records other than the ones proved against, a wrong cycle time, or a line it cannot read."""
+    reached, a run-out short of the generating zone, a table too fast, a feed (axial or radial, at
+    the current spindle speed) above §C, a shift, swivel or T/D word while coupled, an offset other
+    than D1, a unit re-cut by a new coupling, a generating zone off the hob, records other than the
+    ones proved against, a header fact not in its canonical form, stated twice or after the first
+    motion, a wrong or missing cycle time, or a line it cannot read."""
 
 
 def where(name: str, number: int, line: str) -> str:
