@@ -1,7 +1,6 @@
 """Random valid gears of every class, instantiated through the library on the test database:
-every program is stored proved by the simulation or refused with an EngineError (one line);
-the programs the templates make, set to the reference (tests/simulation_reference.py), are
-simulated clean or refused, never anything else. The hob envelope agrees with the hob's
+every program is stored proved by the simulation or refused with an EngineError (one line),
+never anything else. The hob envelope agrees with the hob's
 points sampled densely."""
 from __future__ import annotations
 
@@ -12,14 +11,11 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from engine.errors import EngineError
-from engine.gears.records import load_gear, load_hobs, load_machine
 from engine.hobbing.choices import Choices
-from engine.programs import verified_run
 from engine.programs.instantiate import instantiate_gear
-from engine.simulation import simulate_program, simulate_stored_program
+from engine.simulation import simulate_stored_program
 from engine.simulation.envelope import HobBody, centres, nearest_radius
 
-from simulation_reference import to_reference
 
 GEAR_ID = 900001
 INSERT_GEAR = """
@@ -65,7 +61,7 @@ def _insert(conn, gear, unit) -> None:
 
 @settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(case=gears())
-def test_random_gears_are_proved_or_refused_in_one_line(conn, monkeypatch, case):
+def test_random_gears_are_proved_or_refused_in_one_line(conn, case):
     gear_row, unit, choices = case
     with conn.transaction(force_rollback=True):
         _insert(conn, gear_row, unit)
@@ -75,21 +71,6 @@ def test_random_gears_are_proved_or_refused_in_one_line(conn, monkeypatch, case)
             assert "\n" not in str(error)
         else:
             assert not simulate_stored_program(conn, program.program_id).refused
-    with conn.transaction(force_rollback=True):
-        _insert(conn, gear_row, unit)
-        with monkeypatch.context() as patch:
-            patch.setattr(verified_run, "prove", lambda *args, **kwargs: None)
-            try:
-                program = instantiate_gear(conn, GEAR_ID, choices=choices)
-            except EngineError:
-                return
-        hob_id = conn.execute("SELECT hob_id FROM job WHERE id = %s", (program.job_id,)).fetchone()[0]
-        gear, machine = load_gear(conn, GEAR_ID), load_machine(conn, "hobber-840d")
-        hob = next(h for h in load_hobs(conn) if h.id == hob_id)
-        try:
-            simulate_program(to_reference(program.lines, gear, hob, machine), gear, hob, machine, program.name)
-        except EngineError as error:
-            assert "\n" not in str(error)
 
 
 def hob_points(body: HobBody, swivel: float, centre, count: int = 200) -> np.ndarray:

@@ -1,7 +1,6 @@
 """The simulation on the programs the seeded templates make for the seeded gears, per class and
-job choice, set to the reference where the templates before issue 14 were wrong
-(tests/simulation_reference.py); `instantiate` stores only what the simulation proves, and
-`engine simulate --program ID` says what the library says."""
+job choice, exactly as the templates write them; `instantiate` stores only what the
+simulation proves, and `engine simulate --program ID` says what the library says."""
 from __future__ import annotations
 
 import json
@@ -14,8 +13,6 @@ from engine.hobbing.choices import Choices
 from engine.programs import verified_run
 from engine.programs.instantiate import instantiate_gear
 from engine.simulation import simulate_program, simulate_stored_program
-
-from simulation_reference import to_reference
 
 MACHINE = "hobber-840d"
 CASES = [   # gear, class, job choices
@@ -41,8 +38,7 @@ def simulated(conn, monkeypatch, gear_id: int, choices: Choices):
     hob_id = conn.execute("SELECT hob_id FROM job WHERE id = %s", (program.job_id,)).fetchone()[0]
     gear, machine = load_gear(conn, gear_id), load_machine(conn, MACHINE)
     hob = next(h for h in load_hobs(conn) if h.id == hob_id)
-    lines = to_reference(program.lines, gear, hob, machine)
-    return simulate_program(lines, gear, hob, machine, program.name)
+    return simulate_program(program.lines, gear, hob, machine, program.name)
 
 
 @pytest.mark.parametrize("gear_id, what, choices", CASES, ids=[case[1] for case in CASES])

@@ -13,8 +13,6 @@ from __future__ import annotations
 
 import math
 
-CROWN_SEGMENTS = 24   # the crowned template's polyline: 24 G1 X Z segments per cut
-
 
 class Clock:
     """Minutes of motion so far and the position the last block left."""
@@ -61,8 +59,9 @@ def crowned_pass(clock: Clock, job: dict, cut: dict) -> None:
     clock.rapid(X=cut["x_air"])
     clock.feed(cut["feed_radial"], X=cut["crown_x_0"])
     clock.feed(cut["feed_axial"], Z=cut["face_from"])
-    for step in range(1, CROWN_SEGMENTS + 1):
-        z = cut["face_from"] + (cut["face_to"] - cut["face_from"]) * step / CROWN_SEGMENTS
+    segments = sum(name.startswith("crown_x_") for name in cut) - 1   # the polyline's vertices, 0…n
+    for step in range(1, segments + 1):
+        z = cut["face_from"] + (cut["face_to"] - cut["face_from"]) * step / segments
         clock.feed(cut["feed_axial"], X=cut[f"crown_x_{step}"], Z=z)
     clock.feed(cut["feed_axial"], Z=cut["z_to"])
     clock.rapid(X=job["x_retract"])
