@@ -50,10 +50,13 @@ def parse_range(text: str, option: str = "--gears") -> tuple[int, int]:
               help="Batch: plan the gears in this many processes (all stored in one transaction, or none).")
 @click.option("--explain", is_flag=True,
               help="Also say why each row emitted its line or not, with the values (on stderr; in --json: explain).")
+@click.option("--draft", is_flag=True, help="Use the class's draft (an editor trying a change), not its released "
+              "template; the program is recorded as a draft.")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object (program_id, path, lines, ...).")
 @click.pass_context
 def instantiate(ctx, gear_id, job_id, gear_range, job_range, all_gears, out, force, machine, cuts, coolant, shift_y,
-                shift_per_part, feed_mode, tailstock, worm_feed, allowance, hob_speed, workers, explain, as_json):
+                shift_per_part, feed_mode, tailstock, worm_feed, allowance, hob_speed, workers, explain, draft,
+                as_json):
     """Produce the NC program of a gear (or a stored job, or a batch of gears).
 
     The program is checked against the machine's limits, stored with the template
@@ -82,16 +85,16 @@ def instantiate(ctx, gear_id, job_id, gear_range, job_range, all_gears, out, for
     with connection(ctx) as conn:
         if gear_id is not None:
             program = instantiate_gear(conn, gear_id, machine=machine, choices=choices, overrides=overrides, out=out,
-                                       force=force)
+                                       force=force, draft=draft)
         elif job_id is not None:
-            program = instantiate_job(conn, job_id, out=out, force=force)
+            program = instantiate_job(conn, job_id, out=out, force=force, draft=draft)
         elif job_range:
-            return _report_batch(instantiate_jobs(conn, *parse_range(job_range, "--jobs"), out=out, force=force),
-                                 out, as_json)
+            return _report_batch(instantiate_jobs(conn, *parse_range(job_range, "--jobs"), out=out, force=force,
+                                                  draft=draft), out, as_json)
         else:
             first, last = parse_range(gear_range) if gear_range else (None, None)
             programs = instantiate_gears(conn, first, last, machine=machine, choices=choices,
-                                         overrides=overrides, out=out, force=force, workers=workers)
+                                         overrides=overrides, out=out, force=force, workers=workers, draft=draft)
             return _report_batch(programs, out, as_json)
     _report_program(program, as_json, explain)
 

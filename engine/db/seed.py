@@ -25,6 +25,7 @@ SEED_TABLES = (
 @dataclass
 class SeedReport:
     added: dict = field(default_factory=dict)
+    created: list = field(default_factory=list)   # the classes this seed created
 
     def count(self, what: str, number: int = 1) -> None:
         self.added[what] = self.added.get(what, 0) + number
@@ -41,11 +42,27 @@ def seed(conn, directory: Path = SEED_DIR) -> SeedReport:
         _seed_classes(conn, directory, report)
         for table, file_name, key in SEED_TABLES:
             report.count(table + "s", _insert_missing(conn, table, key, _read(directory / file_name)))
-        _seed_templates(conn, directory, report)
+        seeded = _seed_templates(conn, directory, report)
         _seed_gears(conn, directory, report)
         _seed_units(conn, directory, report)
         _seed_cases(conn, directory, report)
+        _release_seeded(conn, seeded, report)
     return report
+
+
+RELEASE_SEEDED = ("SELECT release_template(g.name, g.template_version, v.hash, note => %s) FROM gear_class g "
+                  "JOIN template_version_rows v ON v.gear_class = g.name AND v.version = g.template_version "
+                  "WHERE g.name = %s AND released_version(g.name) IS DISTINCT FROM g.template_version")
+
+
+def _release_seeded(conn, classes: list[str], report: SeedReport) -> None:
+    """The templates the seed loaded are released: they are the shipped, tested templates."""
+    for gear_class in classes:
+        conn.execute("SELECT store_current_version(%s) WHERE NOT EXISTS (SELECT 1 FROM template_version_rows v "
+                     "JOIN gear_class g ON g.name = v.gear_class AND g.template_version = v.version "
+                     "WHERE g.name = %s)", (gear_class, gear_class))
+        released = conn.execute(RELEASE_SEEDED, ("released by engine seed: the shipped template", gear_class))
+        report.count("template releases", len(released.fetchall()))
 
 
 def _read(path: Path) -> list[dict]:
@@ -58,6 +75,7 @@ def _seed_classes(conn, directory: Path, report: SeedReport) -> None:
     for row in _read(directory / "gear_classes.csv"):
         if ensure_class(conn, row["name"], row["parent"], row["description"] or ""):
             report.count("gear classes")
+            report.created.append(row["name"])
 
 
 def _insert_missing(conn, table: str, key: str, rows: list[dict]) -> int:
@@ -71,18 +89,21 @@ def _insert_missing(conn, table: str, key: str, rows: list[dict]) -> int:
     return added
 
 
-def _seed_templates(conn, directory: Path, report: SeedReport) -> None:
+def _seed_templates(conn, directory: Path, report: SeedReport) -> list[str]:
     """Parents before the classes derived from them (the tree order of gear_classes.csv), so
     a derived class stores only the rows that differ from what it inherits."""
     order = [row["name"] for row in _read(directory / "gear_classes.csv")]
     paths = sorted((directory / "classes").glob("*.csv"),
                    key=lambda path: (order.index(path.stem) if path.stem in order else len(order), path.stem))
+    templated = []
     for path in paths:
         has_rows = conn.execute("SELECT 1 FROM assembly WHERE gear_class = %s LIMIT 1", (path.stem,)).fetchone()
         if not has_rows:
             ensure_class(conn, path.stem)
             replace_template(conn, path.stem, read_csv(path))
             report.count("templates")
+            templated.append(path.stem)
+    return report.created + [name for name in templated if name not in report.created]
 
 
 def _seed_gears(conn, directory: Path, report: SeedReport) -> None:

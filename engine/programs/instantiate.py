@@ -18,7 +18,7 @@ from ..gears.records import Gear, Machine, hobbing_machine, load_gear, load_gear
 from ..hobbing.choices import Choices
 from ..memory import no_cycle_collection
 from ..templates.rows import Template
-from ..templates.store import load_template
+from ..templates.versions import runnable_template
 from ..turning.names import TurningModel
 from .outputs import ProgramFiles, files_after_commit
 from .verified_run import Workpiece, run_template
@@ -31,8 +31,10 @@ from .workers import plan_in_workers
 class Planner:
     """Everything shared by the gears of one run: machine, hob library, templates."""
 
-    def __init__(self, conn, machine: str | None = None, choices: Choices = Choices(), overrides=None):
+    def __init__(self, conn, machine: str | None = None, choices: Choices = Choices(), overrides=None,
+                 draft: bool = False):
         self.conn = conn
+        self.draft = draft   # the classes' drafts (an editor trying them), not their released versions
         self.machine = hobbing_machine(conn, machine)
         self.hobs = load_hobs(conn)
         self.case_base = CaseBase.load(conn)
@@ -45,8 +47,8 @@ class Planner:
 
     def template(self, gear_class: str) -> Template:
         if gear_class not in self._templates:
-            self._templates[gear_class] = self._remembering_refusal(gear_class, load_template, self.conn,
-                                                                    gear_class)
+            self._templates[gear_class] = self._remembering_refusal(gear_class, runnable_template, self.conn,
+                                                                    gear_class, self.draft)
         return self._templates[gear_class]
 
     def _remembering_refusal(self, gear_class: str, read, *args):
@@ -117,11 +119,12 @@ def _check_table_speed(gear: Gear, starts: int, hob_speed: float, machine: Machi
 
 
 def instantiate_gear(conn, gear_id: int, *, machine: str | None = None, choices: Choices = Choices(),
-                     overrides: dict | None = None, out: str | Path | None = None, force: bool = False) -> Program:
+                     overrides: dict | None = None, out: str | Path | None = None, force: bool = False,
+                     draft: bool = False) -> Program:
     """Compute, check and store the program of one gear; write it to `out` if given (after the
-    COMMIT; an existing file only with `force`)."""
+    COMMIT; an existing file only with `force`). With `draft`, from the class's draft."""
     with files_after_commit(conn, out, force) as files:
-        planner = Planner(conn, machine, choices, overrides)
+        planner = Planner(conn, machine, choices, overrides, draft)
         planned = planner.plan(load_gear(conn, gear_id))
         program = store_planned(conn, [planned], files)[0]
     return program
@@ -129,12 +132,13 @@ def instantiate_gear(conn, gear_id: int, *, machine: str | None = None, choices:
 
 def instantiate_gears(conn, first: int | None = None, last: int | None = None, *,
                       machine: str | None = None, choices: Choices = Choices(), overrides=None,
-                      out: str | Path | None = None, force: bool = False, progress=None, workers: int = 1):
+                      out: str | Path | None = None, force: bool = False, progress=None, workers: int = 1,
+                      draft: bool = False):
     """All gears with first ≤ id ≤ last: all programs stored, or none (the first failure names its gear),
     and their files written after the COMMIT. With workers > 1 the gears are planned in that many
     processes (engine.programs.workers)."""
     with files_after_commit(conn, out, force, batch=True) as files:
-        planner = Planner(conn, machine, choices, overrides)
+        planner = Planner(conn, machine, choices, overrides, draft)
         gears = load_gears(conn, first, last)
         if not gears:
             raise EngineError(f"no gears with ids in {first or 'the start'}…{last or 'the end'}")
@@ -144,7 +148,7 @@ def instantiate_gears(conn, first: int | None = None, last: int | None = None, *
             else:
                 encoded = [_counted(_plan_in_batch(planner, gear), progress).encoded() for gear in gears]
             files.plan([(item.name, item.lines) for item in encoded])
-            batch = store_many(conn, encoded, out)
+            batch = store_many(conn, encoded, out, files)
     return batch
 
 
@@ -168,4 +172,6 @@ def store_planned(conn, planned: list[Planned], files: ProgramFiles,
     """Store the programs (and their jobs, unless `existing_job`); their files are checked now
     and written by `files` after the caller's COMMIT."""
     paths = files.plan([(item.name, item.lines) for item in planned])
-    return [store_one(conn, item, existing_job, paths.get(item.name)) for item in planned]
+    programs = [store_one(conn, item, existing_job, paths.get(item.name)) for item in planned]
+    files.replace_texts({program.name: program.lines for program in programs})
+    return programs

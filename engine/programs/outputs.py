@@ -46,6 +46,7 @@ class ProgramFiles:
         self.force = force
         self.folder = batch or (out is not None and str(out).endswith(os.sep))
         self.texts: dict[Path, bytes] = {}
+        self.paths: dict[str, Path] = {}
 
     def plan(self, programs: list[tuple[str, list[str]]]) -> dict[str, str]:
         """{program name: path} for (name, lines) of each program; EngineError if any file cannot be written."""
@@ -55,7 +56,14 @@ class ProgramFiles:
         self._refuse_existing(list(paths.values()))
         _refuse_unwritable(paths[programs[0][0]].parent)
         self.texts = {paths[name]: _ascii(name, lines) for name, lines in programs}
+        self.paths = paths
         return {name: str(path) for name, path in paths.items()}
+
+    def replace_texts(self, stored: dict[str, list[str]]) -> None:
+        """The planned files hold the programs as stored (with their lineage line), by program name."""
+        for name, lines in stored.items():
+            if name in self.paths:
+                self.texts[self.paths[name]] = _ascii(name, lines)
 
     def _targets(self, names: list[str]) -> dict[str, Path]:
         """One program: --out is the file (unless a folder is meant); a batch: --out is their folder."""

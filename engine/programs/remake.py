@@ -15,7 +15,7 @@ from ..hobbing.cylindrical import program_name
 from ..hobbing.machine_job import with_cycle_time
 from ..memory import no_cycle_collection
 from ..templates.rows import Template
-from ..templates.store import load_template
+from ..templates.versions import runnable_template
 from .instantiate import store_planned
 from .outputs import files_after_commit
 from .verified_run import Workpiece, run_template
@@ -28,8 +28,9 @@ JOB_COLUMNS = "id, gear_id, gear_class, machine, hob_id, params, module_params"
 class Remaker:
     """Machines and templates read once for all the jobs made again in one run."""
 
-    def __init__(self, conn):
+    def __init__(self, conn, draft: bool = False):
         self.conn = conn
+        self.draft = draft   # the classes' drafts (an editor trying them), not their released versions
         self._machines: dict[str, Machine] = {}
         self._templates: dict[str, Template] = {}
         self._hobs: dict[str, Hob] | None = None
@@ -40,7 +41,7 @@ class Remaker:
         if machine.kind == "lathe":   # a turning job: its passes are computed from its parameters
             from ..turning.planning import plan_turning_job   # the tool paths: only for turning jobs
 
-            return plan_turning_job(self.conn, gear_class, machine, params, module_params)
+            return plan_turning_job(self.conn, gear_class, machine, params, module_params, draft=self.draft)
         template = self.template(gear_class)
         if "cycle_time" in params:   # a hobbing job: the time follows feeds edited since
             check_program_name(self.conn, job_id, gear_id, params)
@@ -68,7 +69,7 @@ class Remaker:
 
     def template(self, gear_class: str) -> Template:
         if gear_class not in self._templates:
-            self._templates[gear_class] = load_template(self.conn, gear_class)
+            self._templates[gear_class] = runnable_template(self.conn, gear_class, self.draft)
         return self._templates[gear_class]
 
 
@@ -91,18 +92,19 @@ def _other_gear_named(conn, name, gear_id: int) -> int | None:
     return row[0] if row else None
 
 
-def instantiate_job(conn, job_id: int, out: str | Path | None = None, force: bool = False) -> Program:
+def instantiate_job(conn, job_id: int, out: str | Path | None = None, force: bool = False,
+                    draft: bool = False) -> Program:
     """Instantiate a stored job again with its stored (possibly edited) parameters."""
     with files_after_commit(conn, out, force) as files:
         job = conn.execute(f"SELECT {JOB_COLUMNS} FROM job WHERE id = %s", (job_id,)).fetchone()
         if job is None:
             raise EngineError(f"job {job_id} does not exist; see `SELECT id, gear_id FROM job`")
-        program = store_planned(conn, [Remaker(conn).remade(job)], files, existing_job=job_id)[0]
+        program = store_planned(conn, [Remaker(conn, draft).remade(job)], files, existing_job=job_id)[0]
     return program
 
 
 def instantiate_jobs(conn, first: int | None = None, last: int | None = None, *,
-                     out: str | Path | None = None, force: bool = False, progress=None) -> Batch:
+                     out: str | Path | None = None, force: bool = False, progress=None, draft: bool = False) -> Batch:
     """Every stored job with first ≤ id ≤ last made again: all programs stored, or none (the first
     failure names its job), and their files written after the COMMIT."""
     with files_after_commit(conn, out, force, batch=True) as files:
@@ -110,11 +112,11 @@ def instantiate_jobs(conn, first: int | None = None, last: int | None = None, *,
                             (first if first is not None else 0, last if last is not None else 2**62)).fetchall()
         if not jobs:
             raise EngineError(f"no jobs with ids in {first or 'the start'}…{last or 'the end'}")
-        remaker = Remaker(conn)
+        remaker = Remaker(conn, draft)
         with no_cycle_collection():
             encoded = [_remade_in_batch(remaker, job, progress).encoded(with_job=False) for job in jobs]
             files.plan([(item.name, item.lines) for item in encoded])
-            batch = store_programs(conn, encoded, [job[0] for job in jobs], out)
+            batch = store_programs(conn, encoded, [job[0] for job in jobs], out, files)
     return batch
 
 

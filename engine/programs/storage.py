@@ -3,8 +3,9 @@ here: engine.programs.outputs writes them after the COMMIT of the caller's files
 
 Programs are records (design notes §10): no role may write the program table. The engine stores
 them through the database's own path, which checks each program against its job and the stored
-template version and records who stored it: store_program for one, COPY into the view
-program_submission for a batch (migration 0010). A program is stored only with a safe name
+template version and records who stored it: the view program_submission, one INSERT or a
+batch through COPY (migration 0010). Each program gets its lineage line here (engine.programs.
+lineage), checked by the database too (migration 0015). A program is stored only with a safe name
 (engine/names.py) and lines that are one NC line each: a line break inside a line would be a
 block that no check read. The database refuses both too (migrations 0009, 0010); here they are
 refused with a message that names the program."""
@@ -16,12 +17,21 @@ from psycopg.types.json import Jsonb
 
 from ..errors import EngineError
 from ..names import checked, line_breaking, shown
+from .lineage import lineage_line, lineage_words, with_lineage
 from .records import Encoded, Planned, Program
+
+# What a lineage line needs from the database: the hash of each job's stored parameters, each
+# machine's dialect (its comment form), whether each template version is a draft (not released).
+INPUT_HASHES = "SELECT id, job_input_hash(params, module_params) FROM job WHERE id = ANY(%s)"
+DIALECTS = "SELECT name, dialect FROM machine WHERE name = ANY(%s)"
+DRAFTS = ("SELECT c, v, NOT EXISTS (SELECT 1 FROM template_release r WHERE r.gear_class = c AND r.version = v) "
+          "FROM unnest(%s::text[], %s::int[]) AS x (c, v)")
 
 INSERT_JOB = """
 INSERT INTO job (gear_id, gear_class, machine, hob_id, params, module_params, cutting)
 VALUES (%s, %s, %s, %s, %s, %s, %s) RETURNING id"""
-INSERT_PROGRAM = "SELECT store_program(%s, %s, %s, %s, %s, %s, %s, %s)"
+INSERT_PROGRAM = ("INSERT INTO program_submission (id, job_id, gear_class, template_version, template_hash, name, "
+                  "lines, row_ids, trace) VALUES (%s, %s, %s, %s, %s, %s, %s, %s, %s) RETURNING id")
 COPY_JOB = "COPY job (id, gear_id, gear_class, machine, hob_id, params, module_params, cutting) FROM STDIN"
 COPY_PROGRAM = ("COPY program_submission (id, job_id, gear_class, template_version, template_hash, name, lines, "
                 "row_ids, trace) FROM STDIN (FORMAT BINARY)")
@@ -29,17 +39,39 @@ PROGRAM_TYPES = ("int8", "int8", "text", "int4", "text", "text", "text[]", "int4
 
 
 def store_one(conn, planned: Planned, existing_job: int | None, path: str | None) -> Program:
+    """The program (and its job, unless `existing_job`), its lineage line added."""
     refuse_unsafe(planned.name, planned.lines)
     job_id = existing_job
     if job_id is None:
         job_id = conn.execute(INSERT_JOB, (planned.gear_id, planned.gear_class, planned.machine, planned.hob_id,
                                            Jsonb(planned.params), Jsonb(planned.module_params),
                                            Jsonb(planned.cutting or {}))).fetchone()[0]
-    program_id = conn.execute(INSERT_PROGRAM, _program_values(job_id, planned)).fetchone()[0]
-    return _program(program_id, job_id, planned, path)
+    program_id = _next_ids(conn, "program_id_seq", 1)[0]
+    template = planned.template
+    lines, row_ids = Lineage(conn, [planned.machine], [(template.gear_class, template.version)], [job_id]).added(
+        program_id, job_id, planned.machine, template.gear_class, template.version, template.hash,
+        planned.result.lines, planned.result.row_ids)
+    conn.execute(INSERT_PROGRAM, (program_id, job_id, planned.gear_class, template.version, template.hash,
+                                  planned.name, lines, row_ids, Jsonb(planned.result.trace)))
+    return _program(program_id, job_id, planned, path, lines, row_ids)
 
 
-def store_many(conn, encoded: list[Encoded], out=None) -> "Batch":
+class Lineage:
+    """Lineage lines for the programs of one store: what they need read in three queries."""
+
+    def __init__(self, conn, machines, versions, job_ids):
+        self.input_hashes = dict(conn.execute(INPUT_HASHES, (list(job_ids),)).fetchall())
+        self.dialects = dict(conn.execute(DIALECTS, (list(set(machines)),)).fetchall())
+        classes, numbers = zip(*set(versions)) if versions else ((), ())
+        self.drafts = {(c, v): draft for c, v, draft in conn.execute(DRAFTS, (list(classes), list(numbers)))}
+
+    def added(self, program_id, job_id, machine, gear_class, version, template_hash, lines, row_ids):
+        words = lineage_words(program_id, gear_class, version, template_hash, self.input_hashes[job_id],
+                              self.drafts[(gear_class, version)])
+        return with_lineage(list(lines), list(row_ids), lineage_line(words, self.dialects.get(machine, "")))
+
+
+def store_many(conn, encoded: list[Encoded], out=None, files=None) -> "Batch":
     """All jobs and programs in one transaction, through COPY (the batch path); `out` is where
     the caller writes their files."""
     for item in encoded:
@@ -51,20 +83,20 @@ def store_many(conn, encoded: list[Encoded], out=None) -> "Batch":
             for job_id, item in zip(job_ids, encoded):
                 copy.write_row((job_id, item.gear_id, item.gear_class, item.machine, item.hob_id,
                                 _json(item.params), _json(item.module_params), _json(item.cutting)))
-        _copy_programs(conn, program_ids, job_ids, encoded)
-    return Batch(len(encoded), sum(len(item.lines) for item in encoded),
+        _stored_texts(files, _copy_programs(conn, program_ids, job_ids, encoded))
+    return Batch(len(encoded), sum(len(item.lines) + 1 for item in encoded),
                  min(program_ids), max(program_ids), out,
                  tuple(f"{item.name}: {note}" for item in encoded for note in item.notes))
 
 
-def store_programs(conn, encoded: list[Encoded], job_ids: list[int], out=None) -> "Batch":
+def store_programs(conn, encoded: list[Encoded], job_ids: list[int], out=None, files=None) -> "Batch":
     """Programs of stored jobs (made again), in one transaction through COPY."""
     for item in encoded:
         refuse_unsafe(item.name, item.lines)
     with conn.transaction():
         program_ids = _next_ids(conn, "program_id_seq", len(encoded))
-        _copy_programs(conn, program_ids, job_ids, encoded)
-    return Batch(len(encoded), sum(len(item.lines) for item in encoded), min(program_ids), max(program_ids), out,
+        _stored_texts(files, _copy_programs(conn, program_ids, job_ids, encoded))
+    return Batch(len(encoded), sum(len(item.lines) + 1 for item in encoded), min(program_ids), max(program_ids), out,
                  tuple(f"{item.name}: {note}" for item in encoded for note in item.notes))
 
 
@@ -81,12 +113,20 @@ def refuse_unsafe(name: str, lines: list[str]) -> None:
                               "must not hold line breaks")
 
 
-def _copy_programs(conn, program_ids: list[int], job_ids: list[int], encoded: list[Encoded]) -> None:
+def _copy_programs(conn, program_ids: list[int], job_ids: list[int], encoded: list[Encoded]) -> dict:
+    """COPY the programs with their lineage lines; {program name: lines as stored}."""
+    lineage = Lineage(conn, [item.machine for item in encoded],
+                      [(item.gear_class, item.template_version) for item in encoded], job_ids)
+    stored = {}
     with conn.cursor().copy(COPY_PROGRAM) as copy:
         copy.set_types(PROGRAM_TYPES)
         for program_id, job_id, item in zip(program_ids, job_ids, encoded):
+            lines, row_ids = lineage.added(program_id, job_id, item.machine, item.gear_class, item.template_version,
+                                           item.template_hash, item.lines, item.row_ids)
             copy.write_row((program_id, job_id, item.gear_class, item.template_version, item.template_hash,
-                            item.name, item.lines, item.row_ids, _json(item.trace)))
+                            item.name, lines, row_ids, _json(item.trace)))
+            stored[item.name] = lines
+    return stored
 
 
 def _json(text: str) -> Jsonb:
@@ -118,13 +158,13 @@ def _next_ids(conn, sequence: str, count: int) -> list[int]:
     return [row[0] for row in rows]
 
 
-def _program_values(job_id: int, planned) -> tuple:
-    template = planned.template
-    return (job_id, planned.gear_class, template.version, template.hash, planned.name,
-            planned.result.lines, planned.result.row_ids, Jsonb(planned.result.trace))
+def _stored_texts(files, stored: dict) -> None:
+    """The files of the batch hold the programs as stored, lineage line and all."""
+    if files is not None:
+        files.replace_texts(stored)
 
 
-def _program(program_id: int, job_id: int, planned: Planned, path) -> Program:
-    return Program(program_id, job_id, planned.name, planned.result.lines, planned.gear_class,
+def _program(program_id: int, job_id: int, planned: Planned, path, lines, row_ids) -> Program:
+    return Program(program_id, job_id, planned.name, lines, planned.gear_class,
                    planned.template.version, planned.template.hash, path, planned.result.trace,
-                   planned.result.row_ids, tuple(planned.notes))
+                   row_ids, tuple(planned.notes))

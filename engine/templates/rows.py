@@ -38,6 +38,7 @@ class Template:
     rows: tuple[TemplateRow, ...]
     # SQL condition text → its stored Python translation (engine.templates.translations)
     translations: Mapping[str, str] = field(default_factory=dict, compare=False, repr=False)
+    draft: bool = field(default=False, compare=False)   # not a released version (engine.templates.versions)
 
     @cached_property
     def cache_key(self) -> tuple:

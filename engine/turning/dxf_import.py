@@ -39,7 +39,7 @@ class ImportReport:
 
 def import_dxf(conn, path: str | Path, machine_name: str | None = None,
                options: ProfileOptions = ProfileOptions(), alternate: list[int] | None = None,
-               program_name: str | None = None) -> ImportReport:
+               program_name: str | None = None, draft: bool = False) -> ImportReport:
     """Read the drawing and store its job; EngineError (nothing stored) if it cannot become one.
     The program is named `program_name`, else after the drawing's file name (job_params.drawing_names)."""
     checked("drawing", Path(path).name, "drawing file name", "rename the file")   # said before the drawing's own problems
@@ -48,17 +48,18 @@ def import_dxf(conn, path: str | Path, machine_name: str | None = None,
     machine = lathe(conn, machine_name)
     gear_class = turning_class(machine)
     with no_cycle_collection():   # a large drawing: the profile, its parameters and passes
-        return _import(conn, path, machine, gear_class, options, alternate, program_name)
+        return _import(conn, path, machine, gear_class, options, alternate, program_name, draft)
 
 
-def _import(conn, path, machine, gear_class: str, options: ProfileOptions, alternate, program_name) -> ImportReport:
+def _import(conn, path, machine, gear_class: str, options: ProfileOptions, alternate, program_name,
+            draft: bool) -> ImportReport:
     drawing = read_drawing(path)
     with conn.transaction():
         job_id = conn.execute("SELECT nextval('job_id_seq')").fetchone()[0]
         program_number = (job_id - 1) % ISO_PROGRAM_NUMBERS + 1    # the job id, wrapped into O0001 … O8999
         job = turning_job(drawing, machine.name, gear_class, program_number, options, alternate, program_name)
         passes = job_passes(job.params, job.module_params)
-        planned = plan_turning_job(conn, gear_class, machine, job.params, job.module_params, passes)
+        planned = plan_turning_job(conn, gear_class, machine, job.params, job.module_params, passes, draft)
         conn.execute(INSERT_TURNING_JOB, (job_id, gear_class, machine.name, Jsonb(job.params),
                                           Jsonb(job.module_params)))
     notes = job.notes + empty_operations(job, passes) + drawing.notes

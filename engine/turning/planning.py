@@ -6,7 +6,7 @@ from ..errors import EngineError
 from ..gears.records import Machine, load_machine
 from ..programs.records import Planned
 from ..programs.verified_run import run_template
-from ..templates.store import load_template
+from ..templates.versions import runnable_template
 from .defaults import DEFAULT_LATHE
 from .model import template_module_params
 
@@ -32,10 +32,11 @@ def turning_class(machine: Machine) -> str:
 
 
 def plan_turning_job(conn, gear_class: str, machine: Machine, params: dict, module_params: dict,
-                     passes: dict | None = None):
+                     passes: dict | None = None, draft: bool = False):
     """→ Planned (engine.programs.records): the program computed and checked, not stored.
-    `passes`: the job's passes (model.job_passes) if the caller has them already."""
-    template = load_template(conn, gear_class)
+    `passes`: the job's passes (model.job_passes) if the caller has them already; `draft`: the class's
+    draft, not its released template."""
+    template = runnable_template(conn, gear_class, draft)
     extended = template_module_params(params, module_params, passes)
     result = run_template(template, params, extended, machine)
     return Planned(None, gear_class, machine.name, None, params, module_params, template, result)

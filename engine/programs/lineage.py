@@ -1,0 +1,54 @@
+"""The lineage line every stored program carries (design notes §7, issue 15):
+`; PROGRAM <id> TEMPLATE <class> v<version> <hash8> INPUT <hash8>` (` DRAFT` appended for a
+program made from a draft), so an operator can match a file on the control to its record.
+
+The engine writes it, not a template row: every program has it, whatever its template says.
+Its row id is -1 (no template row). The database checks it against the program, its template
+version and the hash of its job's stored parameters (migration 0015, job_input_hash)."""
+from __future__ import annotations
+
+import re
+
+LINEAGE_ROW_ID = -1
+# Comment forms by dialect: ISO/Fanuc comments are in parentheses, 840D ones follow `;`.
+COMMENT_FORMS = {"iso": "({})"}
+DEFAULT_COMMENT_FORM = "; {}"
+# The line a template writes its version on (the lineage follows it), and the program header
+# lines it must not come before when a template writes none.
+TEMPLATE_LINE = re.compile(r"^\s*[;(]\s*TEMPLATE\s", re.IGNORECASE)
+HEADER_LINE = re.compile(r"^\s*(%|;\$PATH|O\d)")
+SEARCHED_LINES = 40
+
+
+def lineage_words(program_id: int, gear_class: str, version: int, template_hash: str, input_hash: str,
+                  draft: bool) -> str:
+    """The words of the line, as the database's program_lineage() writes them."""
+    words = f"PROGRAM {program_id} TEMPLATE {gear_class} v{version} {template_hash[:8]} INPUT {input_hash[:8]}"
+    return words + (" DRAFT" if draft else "")
+
+
+def lineage_line(words: str, dialect: str) -> str:
+    return COMMENT_FORMS.get(dialect, DEFAULT_COMMENT_FORM).format(words)
+
+
+def with_lineage(lines: list[str], row_ids: list[int], line: str) -> tuple[list[str], list[int]]:
+    """The program's lines and row ids with the lineage line after the template-version line (or,
+    without one, after the program header lines)."""
+    at = _position(lines)
+    return lines[:at] + [line] + lines[at:], row_ids[:at] + [LINEAGE_ROW_ID] + row_ids[at:]
+
+
+def _position(lines: list[str]) -> int:
+    head = lines[:SEARCHED_LINES]
+    found = next((number for number, text in enumerate(head) if TEMPLATE_LINE.match(text)), None)
+    if found is not None:
+        return found + 1
+    headers = 0
+    while headers < len(head) and HEADER_LINE.match(head[headers]):
+        headers += 1
+    return headers
+
+
+def without_lineage(lines: list[str], row_ids: list[int]) -> list[str]:
+    """The lines a template made (the lineage line left out): what two versions' programs compare on."""
+    return [text for text, row_id in zip(lines, row_ids) if row_id != LINEAGE_ROW_ID]

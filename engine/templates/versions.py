@@ -1,0 +1,50 @@
+"""Which version of a class's template runs (design notes §10, issue 15): runners and
+`engine instantiate` get the class's latest released version; an editor trying a change gets
+the draft (`--draft`), the class's current rows, and its programs are recorded as drafts.
+
+Every committed change of a template is a stored version (template_version_rows); the class's
+current version is its draft until `engine template release` records it in template_release."""
+from __future__ import annotations
+
+from dataclasses import replace
+
+from ..errors import EngineError
+from .rows import Template, TemplateRow
+from .store import load_template
+from .translations import load_translations
+
+RELEASED = """
+SELECT v.version, v.rows FROM template_release r
+JOIN template_version_rows v ON v.gear_class = r.gear_class AND v.version = r.version
+WHERE r.gear_class = %s ORDER BY r.id DESC LIMIT 1"""
+RELEASED_VERSION = "SELECT released_version(%s)"
+
+
+def released_template(conn, gear_class: str) -> Template:
+    """The class's latest released template: what the shop floor runs."""
+    found = conn.execute(RELEASED, (gear_class,)).fetchone()
+    if found is None:
+        load_template(conn, gear_class)   # an unknown or empty class is refused as such
+        raise EngineError(f"class {gear_class!r} has no released template version; an editor tries the draft with "
+                          f"--draft, and `engine template release --class {gear_class}` releases it")
+    rows = tuple(TemplateRow(**row) for row in found[1])
+    if not rows:
+        raise EngineError(f"class {gear_class!r} version {found[0]} (released) has no template rows")
+    return Template(gear_class, found[0], rows, load_translations(conn, rows))
+
+
+def draft_template(conn, gear_class: str) -> Template:
+    """The class's current rows (its draft, or its released version if it has no draft), marked
+    whether they are a draft."""
+    template = load_template(conn, gear_class)
+    released = conn.execute(RELEASED_VERSION, (gear_class,)).fetchone()[0]
+    return replace(template, draft=released != template.version)
+
+
+def runnable_template(conn, gear_class: str, draft: bool = False) -> Template:
+    """The template a job of the class is made with: the draft if asked for, else the released one."""
+    return draft_template(conn, gear_class) if draft else released_template(conn, gear_class)
+
+
+def released_version(conn, gear_class: str) -> int | None:
+    return conn.execute(RELEASED_VERSION, (gear_class,)).fetchone()[0]
