@@ -20,6 +20,7 @@ from .gears import classify, gears
 from .hobs import hobs
 from .instantiate import instantiate
 from .nc_import import import_nc_command
+from .programs import programs
 from .refactor import refactor_command
 from .simulate import simulate
 from .templates import lint, template
@@ -110,7 +111,7 @@ def main(ctx, database_url, traceback):
 
 
 COMMANDS = (demo, db, seed_command, gears, classify, instantiate, explain, template, lint, hobs, suggest, cases,
-            import_nc_command, refactor_command, import_dxf_command, plot_command, simulate)
+            import_nc_command, refactor_command, import_dxf_command, plot_command, simulate, programs)
 
 
 def _register(group: click.Group, commands) -> None:
