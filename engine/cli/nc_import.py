@@ -37,5 +37,15 @@ def import_nc_command(ctx, nc_file, gear_class, params_file, modules_file, paren
     state = "created" if report.created else ("replaced" if report.changed else "unchanged (identical rows)")
     click.echo(f"class {report.gear_class}: {state}, {report.rows} rows ({modules_text}), "
                f"{report.parameterised} parameter reference(s), version {report.version}")
+    if report.released_version != report.version:
+        click.echo(_draft_note(report), err=True)
     for value, names in report.ambiguous.items():
         click.echo(f"  value {value} belongs to {', '.join(names)}: used {names[0]}", err=True)
+
+
+def _draft_note(report) -> str:
+    """Runners keep the released version: say what they get and how to try and release the import."""
+    released = f"v{report.released_version}" if report.released_version is not None else "none"
+    return (f"  version {report.version} is a draft (runners get the released version: {released}); try it with "
+            f"`engine instantiate --gear ID --draft`, release it with `engine template release --class "
+            f"{report.gear_class}`")

@@ -55,6 +55,7 @@ from ..memory import no_cycle_collection
 from ..templates.functions import CONSTANTS, FUNCTIONS
 from ..templates.rows import MODULE_ORDER, TemplateRow
 from ..templates.store import ensure_class, load_template, replace_template
+from ..templates.versions import released_version
 from .nc_halves import in_halves
 from .nc_rows import Builder, values_of
 from .nc_tokens import LABEL, SYMBOL, LineFacts, facts, tokenise
@@ -75,6 +76,7 @@ class ImportReport:
     changed: bool
     version: int
     ambiguous: dict = field(default_factory=dict)   # value → parameters having it (first used)
+    released_version: int | None = None     # what runners get: the import is a draft until released
 
 
 def import_nc(conn, path, gear_class: str, params: dict | None = None, modules: dict | None = None,
@@ -111,7 +113,7 @@ def _import(conn, path, gear_class: str, params: dict | None, modules: dict | No
     counts = {t: sum(1 for row in rows if row.t == t) for t in MODULE_ORDER}
     return ImportReport(gear_class, str(path), len(rows), built.parameterised,
                         {t: c for t, c in counts.items() if c}, created, changed, template.version,
-                        built.ambiguous)
+                        built.ambiguous, released_version(conn, gear_class))
 
 
 def _read_lines(lines: list[str], built: Builder, start: int, end: int) -> tuple:
