@@ -1,6 +1,6 @@
 """Hostile template rows (issue 13): every one is refused in one line with exit code 1 and stores
 nothing, within the instantiation's budget of bytes. Each enters the way a careless or hostile
-editor would, through the template view in SQL, and `engine instantiate` runs in a process whose
+editor would, through the template view in SQL (the draft), and `engine instantiate --draft` runs in a process whose
 address space is limited (RLIMIT_AS) to a few times what an instantiation needs: a row that
 allocated its gigabyte would die there of MemoryError (exit 2), not be refused. `engine lint`
 names every row the gate can judge without a job, and goes on to the next class."""
@@ -92,7 +92,7 @@ def test_a_hostile_row_in_the_template_view_is_refused_in_one_line(fresh_databas
         put_row(conn, "spur", ROW, columns)
         conn.commit()
         before = counts(conn)
-    refused = engine(fresh_database_url, "instantiate", "--gear", "42")
+    refused = engine(fresh_database_url, "instantiate", "--gear", "42", "--draft")   # the editor tries the draft
     assert refused.returncode == 1, refused.stderr
     assert refused.stderr.count("\n") == 1 and len(refused.stderr) < 700
     assert refused.stderr.startswith(f"error: class spur row {ROW} column ") and words in refused.stderr
@@ -122,7 +122,7 @@ def test_rows_cheap_alone_stop_at_the_budget_of_the_whole_run(fresh_database_url
             put_row(conn, "spur", row_id, (None, line, None))
         conn.commit()
         before = counts(conn)
-    refused = engine(fresh_database_url, "instantiate", "--gear", "42")
+    refused = engine(fresh_database_url, "instantiate", "--gear", "42", "--draft")   # the editor tries the draft
     assert refused.returncode == 1 and refused.stderr.count("\n") == 1, refused.stderr
     assert f"more than {MAX_BYTES >> 20} MiB in one instantiation" in refused.stderr
     with psycopg.connect(fresh_database_url) as conn:
@@ -186,7 +186,7 @@ def test_hundreds_of_large_integers_keep_a_bounded_trace_or_are_refused(fresh_da
                      "SELECT 'spur', 90000 + g, 'main', 1, %s FROM generate_series(1, %s) g", (s, rows))
         conn.commit()
         before = counts(conn)
-    done = engine(fresh_database_url, "instantiate", "--gear", "42", "--out", str(tmp_path))
+    done = engine(fresh_database_url, "instantiate", "--gear", "42", "--draft", "--out", str(tmp_path))
     with psycopg.connect(fresh_database_url) as conn:
         if done.returncode == 1:
             assert done.stderr.count("\n") == 1 and done.stderr.startswith("error: class spur row 900"), done.stderr

@@ -10,6 +10,7 @@ import pytest
 
 from engine.hobbing.choices import Choices
 from engine.programs.instantiate import instantiate_gear, instantiate_gears
+from engine.programs.lineage import LINEAGE_ROW_ID
 from engine.programs.remake import instantiate_job
 from engine.templates.store import load_template
 from engine.turning.dxf_import import import_dxf
@@ -44,8 +45,10 @@ def check_trace(conn, program_id):
     rows, inputs = trace["rows"], trace["inputs"]
     assert [entry["row"] for entry in rows] == sorted(template)           # every row, in id order
     emitting = {entry["row"] for entry in rows if entry.get("emit")}
-    assert set(row_ids) <= emitting                                        # every line from an emitting row
-    assert {row for row in emitting if "nc_path" not in template[row].o} <= set(row_ids)
+    assert row_ids.count(LINEAGE_ROW_ID) == 1                              # the engine's lineage line, no row's
+    template_rows = set(row_ids) - {LINEAGE_ROW_ID}
+    assert template_rows <= emitting                                       # every other line from an emitting row
+    assert {row for row in emitting if "nc_path" not in template[row].o} <= template_rows
     read_from_outside = {(origin, name) for entry in rows for reads in entry.get("read", {}).values()
                          for name, origin in reads.items() if not origin.startswith("row ")}
     assert {(origin, name) for origin, names in inputs.items() for name in names} == read_from_outside
@@ -174,12 +177,21 @@ def test_explain_errors_are_one_line(run, args, words):
     assert refused.exit_code == 1 and words in refused.stderr and refused.stderr.count("\n") == 1
 
 
+# A copy of a program under a new id, its lineage line naming that id (the database checks it).
+COPY_WITHOUT_TRACE = """
+INSERT INTO program_submission (id, job_id, gear_class, template_version, template_hash, name, lines, row_ids, trace)
+SELECT n.id, p.job_id, p.gear_class, p.template_version, p.template_hash, p.name,
+       ARRAY(SELECT CASE WHEN l.row_id = -1 THEN regexp_replace(l.text, 'PROGRAM \\d+', 'PROGRAM ' || n.id) ELSE l.text END
+             FROM unnest(p.lines, p.row_ids) WITH ORDINALITY AS l (text, row_id, number) ORDER BY l.number),
+       p.row_ids, NULL
+FROM program p, (SELECT nextval('program_id_seq') AS id) n WHERE p.id = %s RETURNING id"""
+
+
 def test_a_program_stored_before_traces_says_so(run):
     made = run("instantiate", "--gear", "42", "--json")
     program_id = __import__("json").loads(made.stdout)["program_id"]
     with psycopg.connect(run.url) as conn:   # programs are records: a copy stored without its trace
-        program_id = conn.execute("SELECT store_program(job_id, gear_class, template_version, template_hash, name, "
-                                  "lines, row_ids, NULL) FROM program WHERE id = %s", (program_id,)).fetchone()[0]
+        program_id = conn.execute(COPY_WITHOUT_TRACE, (program_id,)).fetchone()[0]
     refused = run("explain", "--program", program_id)
     assert refused.exit_code == 1 and "before programs kept their trace" in refused.stderr
 
