@@ -1,7 +1,8 @@
 """Hostile template rows (issue 13): every one is refused in one line with exit code 1 and stores
 nothing, within the instantiation's budget of bytes. Each enters the way a careless or hostile
-editor would, through the template view in SQL (the draft), and `engine instantiate --draft` runs in a process whose
-address space is limited (RLIMIT_AS) to a few times what an instantiation needs: a row that
+editor would, through the template view in SQL (into the draft), and the editor's `engine instantiate
+--draft` runs in a process whose address space is limited (RLIMIT_AS) to a few times what an
+instantiation needs: a row that
 allocated its gigabyte would die there of MemoryError (exit 2), not be refused. `engine lint`
 names every row the gate can judge without a job, and goes on to the next class."""
 import json

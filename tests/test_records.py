@@ -22,7 +22,10 @@ from engine.gears.cases import confirm_job
 from engine.programs.instantiate import instantiate_gear, instantiate_gears
 from roles import as_role
 
-STORE = "SELECT store_program(%s, %s, %s, %s, %s, %s, %s, %s)"
+# The engine's path for one program (engine.programs.storage): an id drawn from the sequence first,
+# so that the program's lineage line can name it.
+SUBMIT = ("INSERT INTO program_submission (id, job_id, gear_class, template_version, template_hash, name, lines, "
+          "row_ids, trace) VALUES (%s, %s, %s, %s, %s, %s, %s, %s, %s) RETURNING id")
 
 
 
@@ -68,9 +71,18 @@ def stored(conn, program_id):
                         "FROM program WHERE id = %s", (program_id,)).fetchone()
 
 
-def as_params(values):
-    """A program's values as parameters of store_program (the trace as JSON)."""
-    return (*values[:7], Jsonb(values[7]))
+def submitted(conn, values) -> int:
+    """Store a program's values (job_id, …, lines, row_ids, trace) as a new program through the engine's
+    path, its lineage line (row id -1) naming the new id as the engine writes it; → its id."""
+    program_id = conn.execute("SELECT nextval('program_id_seq')").fetchone()[0]
+    return conn.execute(SUBMIT, (program_id, *values[:5], renamed(values[5], values[6], program_id), values[6],
+                                 Jsonb(values[7]))).fetchone()[0]
+
+
+def renamed(lines, row_ids, program_id):
+    """The lines with the lineage line's program id replaced by `program_id`."""
+    return [re.sub(r"PROGRAM \d+", f"PROGRAM {program_id}", line, count=1) if row_id == -1 else line
+            for line, row_id in zip(lines, row_ids)]
 
 
 def program_count(conn):
@@ -169,14 +181,16 @@ def test_a_forged_program_is_refused_by_the_engines_own_path(conn, program, chan
     values = dict(zip(("job_id", "gear_class", "template_version", "template_hash", "name", "lines", "row_ids",
                        "trace"), real))
     with pytest.raises(error, match=re.escape(words)), conn.transaction(), as_role(conn, "engine_runner"):
-        conn.execute(STORE, as_params(forged(real, **changes(values))))
+        submitted(conn, forged(real, **changes(values)))
     assert program_count(conn) == 1
 
 
 def test_the_real_program_passes_the_same_checks(conn, program):
     with as_role(conn, "engine_runner"):
-        again = conn.execute(STORE, as_params(stored(conn, program.program_id))).fetchone()[0]
-    assert stored(conn, again) == stored(conn, program.program_id)
+        again = submitted(conn, stored(conn, program.program_id))
+    job_id, gear_class, version, template_hash, name, lines, row_ids, trace = stored(conn, program.program_id)
+    assert stored(conn, again) == (job_id, gear_class, version, template_hash, name, renamed(lines, row_ids, again),
+                                   row_ids, trace)
 
 
 def test_a_batch_id_not_drawn_from_the_sequence_is_refused(conn, program):
@@ -184,9 +198,7 @@ def test_a_batch_id_not_drawn_from_the_sequence_is_refused(conn, program):
     ahead = conn.execute("SELECT last_value + 1000 FROM program_id_seq").fetchone()[0]
     with pytest.raises(errors.CheckViolation, match="not drawn from program_id_seq"), conn.transaction(), \
             as_role(conn, "engine_runner"):
-        conn.execute("INSERT INTO program_submission (id, job_id, gear_class, template_version, template_hash, "
-                     "name, lines, row_ids, trace) VALUES (%s, %s, %s, %s, %s, %s, %s, %s, %s)",
-                     (ahead, *as_params(values)))
+        conn.execute(SUBMIT, (ahead, *values[:5], renamed(values[5], values[6], ahead), values[6], Jsonb(values[7])))
 
 
 def test_runners_store_single_programs_and_batches_recording_a_stored_version(conn):
@@ -213,9 +225,9 @@ def test_who_stored_a_program_is_the_login_person_and_the_role(database_url, log
 
 def test_a_program_made_inside_an_edit_fixes_its_version_and_the_next_edit_makes_another(conn):
     conn.execute("UPDATE template_view SET o = '\"G90 G71 G94 ; ONE\"' WHERE gear_class = 'spur' AND id = 800")
-    made = instantiate_gear(conn, 42)
+    made = instantiate_gear(conn, 42, draft=True)   # the editor tries each draft
     conn.execute("UPDATE template_view SET o = '\"G90 G71 G94 ; TWO\"' WHERE gear_class = 'spur' AND id = 800")
-    later = instantiate_gear(conn, 42)
+    later = instantiate_gear(conn, 42, draft=True)
     assert "G90 G71 G94 ; ONE" in made.lines and "G90 G71 G94 ; TWO" in later.lines
     assert later.template_version == made.template_version + 1
     for program in (made, later):   # each records the rows it was made from, stored for its version
@@ -312,7 +324,7 @@ def test_every_case_is_physically_plausible_whoever_adds_it(conn, speed, axial, 
 def test_a_job_whose_program_does_not_record_its_hob_speed_is_not_a_case(conn, program):
     """The case's speed must be one a program ran: without n0 in the trace nothing vouches for it."""
     values = stored(conn, program.program_id)
-    conn.execute(STORE, as_params((*values[:7], {})))
+    submitted(conn, (*values[:7], {}))
     with pytest.raises(EngineError, match="does not record the hob speed it ran"), as_role(conn, "engine_runner"):
         confirm_job(conn, program.job_id)
     assert conn.execute("SELECT count(*) FROM cutting_case WHERE job_id = %s", (program.job_id,)).fetchone()[0] == 0

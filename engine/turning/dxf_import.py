@@ -31,7 +31,7 @@ class ImportReport:
     drawing: str
     machine: str
     gear_class: str
-    program_lines: int
+    program_lines: int   # as `engine instantiate --job` stores the program: the engine's lineage line counted
     operations: list[dict] = field(default_factory=list)
     repairs: list[str] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
@@ -63,7 +63,7 @@ def _import(conn, path, machine, gear_class: str, options: ProfileOptions, alter
         conn.execute(INSERT_TURNING_JOB, (job_id, gear_class, machine.name, Jsonb(job.params),
                                           Jsonb(job.module_params)))
     notes = job.notes + empty_operations(job, passes) + drawing.notes
-    return ImportReport(job_id, str(drawing.source), machine.name, gear_class, len(planned.result.lines),
+    return ImportReport(job_id, str(drawing.source), machine.name, gear_class, len(planned.result.lines) + 1,
                         job.operations, drawing.repairs, notes)
 
 
