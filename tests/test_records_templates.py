@@ -19,10 +19,14 @@ from engine.cli.app import main
 from engine.library import refactor as refactoring
 from engine.library.nc_import import import_nc
 from engine.programs.instantiate import instantiate_gear
+from engine.programs.lineage import without_lineage
+from engine.programs.records import Planned
+from engine.programs.storage import store_one
 from engine.templates.decision_table import CompiledTemplate
 from engine.templates.history import restore
 from engine.templates.rows import Template, TemplateRow, export_csv, rows_hash
 from engine.templates.store import load_template, replace_template
+from engine.templates.versions import draft_template
 
 from test_records import as_role, logins
 
@@ -97,7 +101,7 @@ def test_reparenting_is_versioned_and_audited_for_the_class_and_below(conn):
         conn.execute("UPDATE gear_class SET parent = 'records_base' WHERE name = 'spur'")
     assert versions(conn, "spur", "duplex", "helical") == [before[0] + 1, before[1] + 1, before[2]]
     assert audit_rows(conn, "spur")[-1] == ("engine_editor", conn.info.user, 750, "INSERT")
-    assert "; SHOP STANDARD" in instantiate_gear(conn, 42).lines
+    assert "; SHOP STANDARD" in instantiate_gear(conn, 42, draft=True).lines   # spur's draft, tried by the editor
 
 
 def test_a_class_cannot_derive_from_itself_or_below_itself(conn):
@@ -276,12 +280,12 @@ def test_who_and_when_of_an_audit_row_are_stamped_and_it_is_never_changed(conn):
 def program_matches_its_version(conn, program_id):
     """The program's lines are what its stored version's rows make of its job, and its hash is
     the hash of those rows (computed by the engine, not by the SQL that stored it)."""
-    gear_class, version, digest, lines, params, module_params = conn.execute(
-        "SELECT p.gear_class, p.template_version, p.template_hash, p.lines, j.params, j.module_params "
+    gear_class, version, digest, lines, row_ids, params, module_params = conn.execute(
+        "SELECT p.gear_class, p.template_version, p.template_hash, p.lines, p.row_ids, j.params, j.module_params "
         "FROM program p JOIN job j ON j.id = p.job_id WHERE p.id = %s", (program_id,)).fetchone()
     rows = version_rows(conn, gear_class, version)
     made = CompiledTemplate(Template(gear_class, version, rows)).run(params, module_params).lines
-    return rows_hash(rows) == digest and made == lines
+    return rows_hash(rows) == digest and made == without_lineage(lines, row_ids)
 
 
 NC_PROGRAM = "%\nO1000\nG0 X{x} Z2\nG1 Z-10 F0.2\nM30\n%\n"
@@ -289,14 +293,14 @@ NC_PROGRAM = "%\nO1000\nG0 X{x} Z2\nG1 Z-10 F0.2\nM30\n%\n"
 
 def store_nc_program(conn, gear_class):
     """An imported class has no model: its job is written by hand and its program made the way
-    the engine makes one (decision table, then store_program)."""
-    template = load_template(conn, gear_class)
+    the engine makes one (decision table, then storage with its lineage line), from the draft the
+    import made (the editor trying it)."""
+    template = draft_template(conn, gear_class)
     result = CompiledTemplate(template).run({})
-    job = conn.execute("INSERT INTO job (gear_class, machine, params) VALUES (%s, 'lathe-iso', '{}') RETURNING id",
-                       (gear_class,)).fetchone()[0]
-    return conn.execute("SELECT store_program(%s, %s, %s, %s, 'NC', %s, %s, %s)",
-                        (job, gear_class, template.version, template.hash, result.lines, result.row_ids,
-                         Jsonb(result.trace))).fetchone()[0]
+    job = conn.execute("INSERT INTO job (gear_class, machine, params) VALUES (%s, 'lathe-iso', '{\"program_name\": "
+                       "\"NC\"}') RETURNING id", (gear_class,)).fetchone()[0]
+    planned = Planned(None, gear_class, "lathe-iso", None, {"program_name": "NC"}, {}, template, result)
+    return store_one(conn, planned, job, None).program_id
 
 
 def test_every_route_of_an_edit_keeps_each_programs_version_equal_to_its_rows(fresh_database_url, tmp_path):
@@ -307,7 +311,7 @@ def test_every_route_of_an_edit_keeps_each_programs_version_equal_to_its_rows(fr
         with psycopg.connect(url) as conn:
             edit(conn)
             conn.commit()
-            made.append(instantiate_gear(conn, 42).program_id)
+            made.append(instantiate_gear(conn, 42, draft=True).program_id)   # the editor tries each edit
             conn.commit()
 
     def import_part(conn, x):
