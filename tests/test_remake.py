@@ -4,10 +4,13 @@ import json
 
 import psycopg
 
+from lineage_text import LINES_ID_MASKED
+
 
 def programs(url, where=""):
     with psycopg.connect(url) as conn:
-        return conn.execute(f"SELECT job_id, lines, row_ids, trace FROM program {where} ORDER BY id").fetchall()
+        return conn.execute(f"SELECT job_id, {LINES_ID_MASKED}, row_ids, trace FROM program p {where} "
+                            "ORDER BY id").fetchall()
 
 
 def test_jobs_made_again_give_their_programs_back(run):

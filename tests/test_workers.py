@@ -4,11 +4,13 @@ import json
 
 import psycopg
 
+from lineage_text import LINES_ID_MASKED
+
 
 def stored_programs(url):
     with psycopg.connect(url) as conn:
-        return conn.execute("""SELECT p.name, p.lines, p.row_ids, p.trace, j.params, j.module_params, j.cutting
-                               FROM program p JOIN job j ON j.id = p.job_id ORDER BY p.id""").fetchall()
+        return conn.execute("SELECT p.name, " + LINES_ID_MASKED + ", p.row_ids, p.trace, j.params, j.module_params, "
+                            "j.cutting FROM program p JOIN job j ON j.id = p.job_id ORDER BY p.id").fetchall()
 
 
 def test_two_workers_store_what_one_process_stores(run):
