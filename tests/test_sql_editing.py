@@ -11,6 +11,7 @@ from engine.library.refactor import refactor
 from engine.programs.instantiate import instantiate_gear
 from engine.templates.rows import TemplateRow, export_csv
 from engine.templates.store import load_template, replace_template
+from releases import release_draft
 from roles import as_role
 
 ROW_COLUMNS = ("id", "t", "n", "p_calc", "s", "o", "p_emit")
@@ -193,7 +194,7 @@ def test_an_update_that_changes_nothing_is_no_change(conn):
 def test_a_program_records_the_version_the_edit_made(conn):
     before = versions(conn)["spur"]
     conn.execute("UPDATE template_view SET o = '\"G90 G71 G94 ; V\"' WHERE gear_class = 'spur' AND id = 800")
-    program = instantiate_gear(conn, 42)
+    program = instantiate_gear(conn, 42, draft=True)   # the editor tries the edit
     assert program.template_version == before + 1 == versions(conn)["spur"]
     assert '"G90 G71 G94 ; V"'.strip('"') in program.lines
 
@@ -402,10 +403,12 @@ def test_a_reader_reads_everything(conn):
         assert load_template(conn, "spur").rows
 
 
-def test_an_editor_edits_templates_and_a_runner_instantiates_them(conn):
+def test_an_editor_edits_templates_a_releaser_releases_and_a_runner_instantiates_them(conn):
     with as_role(conn, "engine_editor"):
         conn.execute("UPDATE template_view SET o = '\"G90 G71 G94 ; BY EDITOR\"' WHERE gear_class = 'spur' AND id = 800")
         conn.execute("UPDATE gear_class SET description = description || '.' WHERE name = 'spur'")
+    with as_role(conn, "engine_releaser"):
+        release_draft(conn, "spur")
     with as_role(conn, "engine_runner"):
         program = instantiate_gear(conn, 42)
     assert "G90 G71 G94 ; BY EDITOR" in program.lines
