@@ -15,14 +15,15 @@ PROBE = """
 import sys, json
 from engine.cli import main
 try:
-    main(["--database-url", sys.argv[1], "instantiate", "--gear", sys.argv[2], "--json"])
+    main(["--database-url", sys.argv[1], "instantiate", "--gear", sys.argv[2], "--json", *sys.argv[3:]])
 except SystemExit as done:
     print(json.dumps({"exit": done.code, "sqlglot": "sqlglot" in sys.modules}), file=sys.stderr)
 """
 
 
-def instantiated_in_a_new_process(url: str, gear: int) -> dict:
-    done = subprocess.run([sys.executable, "-c", PROBE, url, str(gear)], capture_output=True, text=True, timeout=120)
+def instantiated_in_a_new_process(url: str, gear: int, *options: str) -> dict:
+    done = subprocess.run([sys.executable, "-c", PROBE, url, str(gear), *options], capture_output=True, text=True,
+                          timeout=120)
     return json.loads(done.stderr.strip().splitlines()[-1])
 
 
@@ -61,14 +62,14 @@ def test_lint_names_a_translation_that_is_not_sqlglot_s(run):
 def test_a_condition_edited_in_sql_runs_and_lint_keeps_its_translation(run):
     with psycopg.connect(run.url) as conn:
         conn.execute("UPDATE template_view SET p_emit = 'coolant AND 1 = 1' WHERE gear_class = 'spur' AND id = 1800")
-    made = run("instantiate", "--gear", "42", "--no-coolant")
+    made = run("instantiate", "--gear", "42", "--no-coolant", "--draft")   # the editor tries the edited draft
     assert made.exit_code == 0 and "\nM8\n" not in made.stdout
-    assert instantiated_in_a_new_process(run.url, 42)["sqlglot"] is True      # translated when used
+    assert instantiated_in_a_new_process(run.url, 42, "--draft")["sqlglot"] is True      # translated when used
     assert run("lint").exit_code == 0
     with psycopg.connect(run.url) as conn:
         assert conn.execute("SELECT python FROM sql_translation WHERE sql = 'coolant AND 1 = 1'").fetchone() \
             == (translated_python("coolant AND 1 = 1"),)
-    assert instantiated_in_a_new_process(run.url, 42) == {"exit": 0, "sqlglot": False}
+    assert instantiated_in_a_new_process(run.url, 42, "--draft") == {"exit": 0, "sqlglot": False}
 
 
 def test_a_tampered_translation_is_refused_by_the_gate(run):
