@@ -46,6 +46,5 @@ def import_nc_command(ctx, nc_file, gear_class, params_file, modules_file, paren
 def _draft_note(report) -> str:
     """Runners keep the released version: say what they get and how to try and release the import."""
     released = f"v{report.released_version}" if report.released_version is not None else "none"
-    return (f"  version {report.version} is a draft (runners get the released version: {released}); try it with "
-            f"`engine instantiate --gear ID --draft`, release it with `engine template release --class "
-            f"{report.gear_class}`")
+    return (f"  version {report.version} is a draft (runners get the released version: {released}); an editor tries it "
+            f"with `engine instantiate --draft`, `engine template release --class {report.gear_class}` releases it")

@@ -10,6 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ..errors import EngineError
+from .lineage import LINEAGE_ROW_ID
 
 MAX_LISTED_LINES = 1   # lines of a row quoted in its sentence (a tool path prints hundreds)
 
@@ -32,7 +33,7 @@ class ExplainedRow:
 
 def explained_rows(trace: dict, lines: list[str], row_ids: list[int], row: int | None = None) -> list[ExplainedRow]:
     """Each row of the trace (or only `row`) with its state, the lines it emitted and the values
-    it read."""
+    it read. The lineage line (row id -1) is the engine's, no row's: it is in no trace."""
     emitted: dict[int, list[str]] = {}
     for line, row_id in zip(lines, row_ids):
         emitted.setdefault(row_id, []).append(line)
@@ -43,6 +44,9 @@ def explained_rows(trace: dict, lines: list[str], row_ids: list[int], row: int |
     if row is not None and not entries and omitted is not None and row >= omitted["from_row"]:
         raise EngineError(f"row {row} is beyond what the program's trace keeps (it keeps the rows before "
                           f"row {omitted['from_row']}); see `engine explain --program ID`")
+    if row == LINEAGE_ROW_ID:
+        raise EngineError(f"row {row} is the program's lineage line, written by the engine, not by a template row "
+                          "(`; PROGRAM <id> TEMPLATE …`); see `engine programs show ID`")
     if row is not None and not entries:
         raise EngineError(f"row {row} is not in the program's template version; see `engine explain --program ID`")
     return [ExplainedRow(entry["row"], _state(entry), tuple(emitted.get(entry["row"], ())), entry,

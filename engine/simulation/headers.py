@@ -11,12 +11,15 @@ CLAIM = re.compile(r"\b(GEAR|HOB|MACHINE|CYCLE|ALLOWANCE)", re.IGNORECASE)
 CANONICAL = (re.compile(r"; GEAR \S+( .*)?"), re.compile(r"; HOB \S+( .*)?"), re.compile(r"; MACHINE \S+"),
              re.compile(r"; CYCLE TIME [0-9]+(\.[0-9]+)? MIN"), re.compile(r"; ALLOWANCE [0-9]+(\.[0-9]+)? MM( .*)?"))
 REMARKS = ("HOB SHIFT PER PART",)     # the templates' note on the shift parameter's line
+# The engine's lineage line (engine.programs.lineage): its class name may hold a header word (a class
+# `gear_x`, `hobbed`), but it states no header fact; the database checked it when the program was stored.
+LINEAGE = re.compile(r"; PROGRAM [0-9]+ TEMPLATE \S+ v[0-9]+ [0-9a-f]{8} INPUT [0-9a-f]{8}( DRAFT)?")
 
 
 def comment_problem(step) -> str | None:
     """A comment naming a header fact must be that header's canonical whole line."""
     code, semicolon, comment = step.line.partition(";")
-    if not semicolon or comment.strip() in REMARKS or not CLAIM.search(comment):
+    if not semicolon or comment.strip() in REMARKS or not CLAIM.search(comment) or LINEAGE.fullmatch(step.line):
         return None
     if step.kind == "comment" and not code.strip() and any(form.fullmatch(step.line) for form in CANONICAL):
         return None
