@@ -17,6 +17,7 @@ from psycopg.types.json import Jsonb
 from engine.errors import EngineError
 from engine.programs.instantiate import instantiate_gear
 from engine.programs.lineage import LINEAGE_ROW_ID
+from engine.simulation import simulate_stored_program
 from lineage_text import id_masked
 from releases import release_draft
 from roles import as_role
@@ -225,6 +226,18 @@ def test_batches_and_remade_jobs_carry_their_lineage(run, tmp_path):
     one = run("instantiate", "--job", jobs[0], "--out", tmp_path / "ONE.MPF", "--json")
     assert one.exit_code == 0, one.output
     check_lineage(run, json.loads(one.stdout)["program_id"], tmp_path / "ONE.MPF")
+
+
+def test_a_stored_program_whose_class_name_holds_a_header_word_simulates(conn):
+    """`gear_hobbed` holds GEAR and HOB: its lineage line is still no header claim."""
+    conn.execute("INSERT INTO gear_class (name, parent) VALUES ('gear_hobbed', 'spur')")
+    conn.execute("""INSERT INTO gear SELECT (jsonb_populate_record(NULL::gear, to_jsonb(g) ||
+                    '{"id": 9042, "gear_class": "gear_hobbed"}')).* FROM gear g WHERE g.id = 42""")
+    release_draft(conn, "gear_hobbed")
+    program = instantiate_gear(conn, 9042)
+    assert any(" TEMPLATE gear_hobbed v" in line for line in program.lines)
+    report = simulate_stored_program(conn, program.program_id)
+    assert not report.refused, "\n".join(report.lines())
 
 
 # --- the database refuses a lineage line it did not expect -----------------------------------------------

@@ -11,21 +11,27 @@ CLAIM = re.compile(r"\b(GEAR|HOB|MACHINE|CYCLE|ALLOWANCE)", re.IGNORECASE)
 CANONICAL = (re.compile(r"; GEAR \S+( .*)?"), re.compile(r"; HOB \S+( .*)?"), re.compile(r"; MACHINE \S+"),
              re.compile(r"; CYCLE TIME [0-9]+(\.[0-9]+)? MIN"), re.compile(r"; ALLOWANCE [0-9]+(\.[0-9]+)? MM( .*)?"))
 REMARKS = ("HOB SHIFT PER PART",)     # the templates' note on the shift parameter's line
-# The engine's lineage line (engine.programs.lineage): its class name may hold a header word (a class
-# `gear_x`, `hobbed`), but it states no header fact; the database checked it when the program was stored.
-LINEAGE = re.compile(r"; PROGRAM [0-9]+ TEMPLATE \S+ v[0-9]+ [0-9a-f]{8} INPUT [0-9a-f]{8}( DRAFT)?")
+# The template's version line and the engine's lineage line (engine.programs.lineage): a class name
+# may hold a header word (`gear_x`, `hobbed`), but they state no header fact; the database checked the
+# lineage line when the program was stored.
+CLASS_LINES = (re.compile(r"; TEMPLATE \S+ v[0-9]+"),
+               re.compile(r"; PROGRAM [0-9]+ TEMPLATE \S+ v[0-9]+ [0-9a-f]{8} INPUT [0-9a-f]{8}( DRAFT)?"))
 
 
 def comment_problem(step) -> str | None:
     """A comment naming a header fact must be that header's canonical whole line."""
     code, semicolon, comment = step.line.partition(";")
-    if not semicolon or comment.strip() in REMARKS or not CLAIM.search(comment) or LINEAGE.fullmatch(step.line):
+    if not semicolon or comment.strip() in REMARKS or not CLAIM.search(comment) or _names_a_class(step.line):
         return None
     if step.kind == "comment" and not code.strip() and any(form.fullmatch(step.line) for form in CANONICAL):
         return None
     return ("a comment that names a header fact (gear, hob, machine, cycle time, allowance) is not its canonical "
             "whole-line form `; GEAR <id>`, `; HOB <id>`, `; MACHINE <name>`, `; CYCLE TIME <m> MIN`, "
             "`; ALLOWANCE <mm> MM`: it would go unchecked")
+
+
+def _names_a_class(line: str) -> bool:
+    return any(form.fullmatch(line) for form in CLASS_LINES)
 
 
 def header_place_problem(fact: str, stated_before: bool, moved: bool) -> str | None:
