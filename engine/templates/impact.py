@@ -6,9 +6,8 @@ without the verifier and the simulation, which the gate does not need to see a l
 The released program is the job's latest stored one (its lineage line left out) when it was made
 from the released version from the job's current parameters; otherwise the released template is
 evaluated too. The draft is evaluated as if it had the released version number, so the
-`; TEMPLATE class vN` line does not count as a change. Jobs with identical parameters and the same
-released program are grouped by the database and evaluated once: 10,000 stored jobs of a class
-take seconds (bench/impact.py)."""
+`; TEMPLATE class vN` line does not count as a change. Jobs with identical parameters are
+evaluated once: 10,000 stored jobs of a class take seconds (bench/impact.py)."""
 from __future__ import annotations
 
 import difflib
@@ -18,6 +17,7 @@ from dataclasses import dataclass, field, replace
 from ..errors import EngineError
 from ..gears.models import model_for_class
 from ..gears.records import load_machine
+from ..programs.lineage import without_lineage
 from .decision_table import compiled_template
 from .rows import Template
 from .versions import draft_template, released_template
@@ -32,23 +32,19 @@ WITH RECURSIVE tree(name, depth) AS (
     SELECT g.name, t.depth + 1 FROM gear_class g JOIN tree t ON g.parent = t.name WHERE t.depth < 50)
 SELECT name FROM tree ORDER BY depth, name"""
 
-# The jobs of the classes, grouped by what their programs are made from, each group with the
-# released program its jobs share (NULL: evaluate the released template): the job's latest program
-# if it came from the released version (class, version, hash) and the job's current parameters.
-JOB_GROUPS = """
+# Every job of the classes with its latest program, and whether that program came from the
+# released version (class, version, hash) and the job's current parameters.
+JOBS = """
 WITH released(gear_class, version, hash) AS (SELECT * FROM unnest(%s::text[], %s::int[], %s::text[]))
-SELECT j.gear_class, j.machine, j.params::text, j.module_params::text,
-       CASE WHEN p.template_version = r.version AND p.template_hash = r.hash
-                 AND p.input_hash = job_input_hash(j.params, j.module_params)
-            THEN ARRAY(SELECT l.text FROM unnest(p.lines, p.row_ids) AS l (text, row_id) WHERE l.row_id <> -1)
-       END AS released_lines,
-       array_agg(j.id ORDER BY j.id)
+SELECT j.id, j.gear_class, j.machine, j.params::text, j.module_params::text,
+       coalesce(p.template_version = r.version AND p.template_hash = r.hash
+                AND p.input_hash = job_input_hash(j.params, j.module_params), false),
+       p.lines, p.row_ids
 FROM job j
 JOIN released r ON r.gear_class = j.gear_class
-LEFT JOIN LATERAL (SELECT p.template_version, p.template_hash, p.input_hash, p.lines, p.row_ids
-                   FROM program p WHERE p.job_id = j.id ORDER BY p.id DESC LIMIT 1) p ON true
-GROUP BY 1, 2, 3, 4, 5
-ORDER BY min(j.id)"""
+LEFT JOIN (SELECT DISTINCT ON (job_id) job_id, template_version, template_hash, input_hash, lines, row_ids
+           FROM program ORDER BY job_id, id DESC) p ON p.job_id = j.id
+ORDER BY j.id"""
 
 
 @dataclass(frozen=True)
@@ -91,14 +87,15 @@ def impact(conn, gear_class: str) -> Impact:
     """Every stored job of the class and its descendants made with the draft, compared with the
     released program."""
     pairs = _template_pairs(conn, class_tree(conn, gear_class))
-    report, inputs = Impact(gear_class), _JobInputs(conn)
+    report = Impact(gear_class)
     if not pairs:
         return report
     classes = list(pairs)
     versions = [pairs[name][0].version for name in classes]
     hashes = [pairs[name][0].hash for name in classes]
-    for group in conn.execute(JOB_GROUPS, (classes, versions, hashes)):
-        _compare_group(report, pairs[group[0]], inputs, group)
+    made = _Made(conn, pairs)
+    for job in conn.cursor(binary=True).execute(JOBS, (classes, versions, hashes)):
+        _compare(report, made, job)
     return report
 
 
@@ -116,31 +113,54 @@ def _template_pairs(conn, classes: list[str]) -> dict[str, tuple[Template, Templ
     return pairs
 
 
-def _compare_group(report: Impact, pair: tuple[Template, Template], inputs: "_JobInputs", group) -> None:
-    gear_class, machine, params_text, modules_text, stored_lines, job_ids = group
-    report.jobs += len(job_ids)
-    released, draft = pair
-    if released.hash == draft.hash:
+def _compare(report: Impact, made: "_Made", job) -> None:
+    job_id, gear_class, machine, params_text, modules_text, from_released, lines, row_ids = job
+    report.jobs += 1
+    if not made.has_draft(gear_class):
         return   # no draft: nothing changes
-    try:
-        params, modules = inputs.of(gear_class, machine, params_text, modules_text)
-        new_lines = compiled_template(draft).run(params, modules).lines
-    except EngineError as error:
-        report.failures += [JobFailure(job_id, gear_class, str(error)) for job_id in job_ids]
+    key = gear_class, machine, params_text, modules_text
+    new_lines = made.draft_lines(key)
+    if isinstance(new_lines, EngineError):
+        report.failures.append(JobFailure(job_id, gear_class, str(new_lines)))
         return
-    old_lines = stored_lines if stored_lines is not None else _released_lines(released, params, modules)
+    old_lines = without_lineage(lines, row_ids) if from_released else made.released_lines(key)
     if old_lines != new_lines:
-        report.changed += len(job_ids)
-        text = unified_diff(old_lines, new_lines, released)
-        report.diffs += [JobDiff(job_id, gear_class, text) for job_id in job_ids]
+        report.changed += 1
+        report.diffs.append(JobDiff(job_id, gear_class, unified_diff(old_lines, new_lines, made.released(gear_class))))
 
 
-def _released_lines(released: Template, params: dict, modules: dict) -> list[str] | None:
-    """The released template's lines for the job (None if it fails: every draft line is a change)."""
-    try:
-        return compiled_template(released).run(params, modules).lines
-    except EngineError:
-        return []
+class _Made:
+    """The programs of distinct job inputs, made once: with the draft (or its failure) and, where the
+    stored program is not the released one, with the released template."""
+
+    def __init__(self, conn, pairs: dict[str, tuple[Template, Template]]):
+        self.pairs, self.inputs = pairs, _JobInputs(conn)
+        self.drafts: dict[tuple, list[str] | EngineError] = {}
+        self.releases: dict[tuple, list[str]] = {}
+
+    def has_draft(self, gear_class: str) -> bool:
+        released, draft = self.pairs[gear_class]
+        return released.hash != draft.hash
+
+    def released(self, gear_class: str) -> Template:
+        return self.pairs[gear_class][0]
+
+    def draft_lines(self, key: tuple) -> list[str] | EngineError:
+        if key not in self.drafts:
+            try:
+                self.drafts[key] = compiled_template(self.pairs[key[0]][1]).run(*self.inputs.of(*key)).lines
+            except EngineError as error:
+                self.drafts[key] = error
+        return self.drafts[key]
+
+    def released_lines(self, key: tuple) -> list[str]:
+        """The released template's lines for the job (none if it fails: every draft line is a change)."""
+        if key not in self.releases:
+            try:
+                self.releases[key] = compiled_template(self.released(key[0])).run(*self.inputs.of(*key)).lines
+            except EngineError:
+                self.releases[key] = []
+        return self.releases[key]
 
 
 def unified_diff(old: list[str], new: list[str], released: Template) -> str:
