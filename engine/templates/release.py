@@ -81,7 +81,7 @@ def gate(conn, gear_class: str, draft) -> tuple[list[dict], dict]:
     """The three checks; GateRefusal naming every failure. Returns the tests run and the checks."""
     lint_problems = [str(problem) for problem in lint_class(conn, gear_class)]
     results = _golden_results(conn, gear_class)
-    problems = lint_problems + [f"golden test {result.gear_class}/{result.name} fails: {result.failure}"
+    problems = lint_problems + [f"golden {result.failure}"
                                 for result in results if not result.passed]
     if not lint_problems:   # rows that do not compile cannot be analysed: lint named them
         problems += [str(finding) for finding in class_findings(conn, gear_class, draft)]
