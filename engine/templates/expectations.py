@@ -133,7 +133,8 @@ def check_numeric(name: str, expression: str, tolerance: str | None, context: Co
     expected = expected_value(expression, context.names)
     reading = read_property(name, context.lines)
     allowed = _tolerance(tolerance, reading)
-    shown = f"{name.strip()} = {expression.strip()} = {_shown(expected, reading)} ± {allowed:g}"
+    value = _shown(expected, reading)
+    shown = f"{name.strip()} = {expression.strip()}{'' if value == expression.strip() else ' = ' + value} ± {allowed:.3g}"
     if reading is None:
         return f"expected {shown}, program has no {name.strip()}"
     if abs(reading.value - expected) <= allowed:

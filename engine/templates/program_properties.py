@@ -49,11 +49,16 @@ class AddressValue:
         found, motion = [], None
         for number, line in enumerate(lines, 1):
             block = words(line)
-            motion = next((MOTIONS[int(float(v))] for a, v in block if a == "G" and float(v) in MOTIONS), motion)
+            motion = _motion(block, motion)
             if self.motion is not None and motion != self.motion:
                 continue
             found += [Reading(float(v), number, line, decimals_step(v)) for a, v in block if a == self.address]
         return found
+
+
+def _motion(block: list[tuple[str, str]], before: str | None) -> str | None:
+    """The modal motion (G0…G3) after the block."""
+    return next((MOTIONS[int(float(v))] for a, v in reversed(block) if a == "G" and float(v) in MOTIONS), before)
 
 
 @dataclass(frozen=True)
@@ -88,14 +93,16 @@ def _egon_factor(call: str, axis: str, number: int, line: str) -> Reading | None
 
 @dataclass(frozen=True)
 class SlopeXZ:
-    """dX/dZ of the last block that moves X and Z together (a taper's cone): absolute positions
-    followed block by block."""
+    """dX/dZ of the last feed block (G1) that moves X and Z together (a taper's cone): absolute
+    positions followed block by block."""
 
     def readings(self, lines: list[str]) -> list[Reading]:
-        found, position = [], {}
+        found, position, motion = [], {}, None
         for number, line in enumerate(lines, 1):
-            moved = {a: (float(v), decimals_step(v)) for a, v in words(line) if a in "XZ"}
-            if len(moved) == 2 and {"X", "Z"} <= position.keys() and moved["Z"][0] != position["Z"]:
+            block = words(line)
+            motion = _motion(block, motion)
+            moved = {a: (float(v), decimals_step(v)) for a, v in block if a in "XZ"}
+            if motion == "G1" and len(moved) == 2 and {"X", "Z"} <= position.keys() and moved["Z"][0] != position["Z"]:
                 slope = (moved["X"][0] - position["X"]) / (moved["Z"][0] - position["Z"])
                 step = 2 * max(moved["X"][1], moved["Z"][1]) / abs(moved["Z"][0] - position["Z"])
                 found.append(Reading(slope, number, line, step))
