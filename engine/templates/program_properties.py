@@ -16,6 +16,7 @@ COMMENT = re.compile(r";.*$|(?<![A-Za-z0-9_])\([^()]*\)")   # 840D `; …` and I
 WORD = re.compile(r"(?<![A-Za-z_$0-9.])([A-Z])=?(-?(?:\d+\.?\d*|\.\d+))(?![A-Za-z_(])")
 EGON_CALL = re.compile(r"\bEGON\s*\(([^)]*)\)")
 MOTIONS = {0: "G0", 1: "G1", 2: "G2", 3: "G3"}   # the modal motion group an address value is filtered by
+LIMIT_CODES = {25.0, 26.0}   # G25/G26 X… Y… Z… S…: working-area and speed limits, not positions (hobbing.md §A4)
 
 
 @dataclass(frozen=True)
@@ -42,6 +43,7 @@ def words(line: str) -> list[tuple[str, str]]:
 
 @dataclass(frozen=True)
 class AddressValue:
+    """The values of one address over the blocks that position (G25/G26 limits left out)."""
     address: str
     motion: str | None       # only blocks in this modal motion (G0, G1, …); None: any block
 
@@ -49,11 +51,20 @@ class AddressValue:
         found, motion = [], None
         for number, line in enumerate(lines, 1):
             block = words(line)
-            motion = next((MOTIONS[int(float(v))] for a, v in block if a == "G" and float(v) in MOTIONS), motion)
-            if self.motion is not None and motion != self.motion:
+            motion = _motion(block, motion)
+            if self.motion is not None and motion != self.motion or _sets_limits(block):
                 continue
             found += [Reading(float(v), number, line, decimals_step(v)) for a, v in block if a == self.address]
         return found
+
+
+def _motion(block: list[tuple[str, str]], before: str | None) -> str | None:
+    """The modal motion (G0…G3) after the block."""
+    return next((MOTIONS[int(float(v))] for a, v in reversed(block) if a == "G" and float(v) in MOTIONS), before)
+
+
+def _sets_limits(block: list[tuple[str, str]]) -> bool:
+    return any(a == "G" and float(v) in LIMIT_CODES for a, v in block)
 
 
 @dataclass(frozen=True)
@@ -88,14 +99,16 @@ def _egon_factor(call: str, axis: str, number: int, line: str) -> Reading | None
 
 @dataclass(frozen=True)
 class SlopeXZ:
-    """dX/dZ of the last block that moves X and Z together (a taper's cone): absolute positions
-    followed block by block."""
+    """dX/dZ of the last feed block (G1) that moves X and Z together (a taper's cone): absolute
+    positions followed block by block."""
 
     def readings(self, lines: list[str]) -> list[Reading]:
-        found, position = [], {}
+        found, position, motion = [], {}, None
         for number, line in enumerate(lines, 1):
-            moved = {a: (float(v), decimals_step(v)) for a, v in words(line) if a in "XZ"}
-            if len(moved) == 2 and {"X", "Z"} <= position.keys() and moved["Z"][0] != position["Z"]:
+            block = words(line)
+            motion = _motion(block, motion)
+            moved = {a: (float(v), decimals_step(v)) for a, v in block if a in "XZ"}
+            if motion == "G1" and len(moved) == 2 and {"X", "Z"} <= position.keys() and moved["Z"][0] != position["Z"]:
                 slope = (moved["X"][0] - position["X"]) / (moved["Z"][0] - position["Z"])
                 step = 2 * max(moved["X"][1], moved["Z"][1]) / abs(moved["Z"][0] - position["Z"])
                 found.append(Reading(slope, number, line, step))
