@@ -23,7 +23,8 @@ from roles import as_role
 
 SEEDED_CLASSES = ("spur", "helical", "duplex", "taper", "crowned", "worm_wheel", "turning_iso", "turning_840d")
 COOLANT_ROW = 1800   # seed_templates/classes/spur.csv: cutcond 1, `"M8"` when coolant
-COMMENTED_COOLANT = '"M8 ; COOLANT ON"'
+COOLANT_OFF_ROW = 2900   # cutcond 2, `"M9"` when coolant: no seeded golden test reads it
+COMMENTED = '"M9 ; COOLANT OFF"'
 
 
 EDIT = sql.SQL("UPDATE template_view SET {} = %s WHERE gear_class = %s AND id = %s")
@@ -65,9 +66,10 @@ def test_a_draft_failing_a_golden_test_cannot_be_released_and_the_refusal_names_
     conn.execute("INSERT INTO template_test (gear_class, name, gear_id, expect) "
                  "VALUES ('spur', 'coolant_on_before_cutting', 42, ARRAY['line: M8'])")
     assert all(result.passed for result in run_golden_tests(conn, ["spur"], draft=False))
-    edit(conn, "spur", COOLANT_ROW, o='"M7"')
+    edit(conn, "spur", COOLANT_ROW, o='"M9"')
     error = refusal(conn, "spur")
-    assert "spur/coolant_on_before_cutting" in str(error)
+    assert any("spur/coolant_on_before_cutting" in problem for problem in error.problems)
+    assert "golden test" in str(error)
     assert released_version(conn, "spur") == released_template(conn, "spur").version
 
 
@@ -75,8 +77,8 @@ def test_a_golden_test_of_a_descendant_is_run_against_its_draft_too(conn):
     """duplex inherits spur's coolant row: a spur edit that breaks a duplex test is refused."""
     conn.execute("INSERT INTO template_test (gear_class, name, gear_id, expect) "
                  "VALUES ('duplex', 'duplex_coolant_on', 54, ARRAY['line: M8'])")
-    edit(conn, "spur", COOLANT_ROW, o='"M7"')
-    assert "duplex/duplex_coolant_on" in str(refusal(conn, "spur"))
+    edit(conn, "spur", COOLANT_ROW, o='"M9"')
+    assert any("duplex/duplex_coolant_on" in problem for problem in refusal(conn, "spur").problems)
 
 
 def test_a_static_analysis_finding_refuses_the_release_naming_the_row(conn):
@@ -205,25 +207,25 @@ def test_impact_names_the_jobs_the_draft_fails_for(conn):
 # --- release, runners, roles ----------------------------------------------------------------------
 
 def test_after_release_runners_get_the_new_version(conn):
-    edit(conn, "spur", COOLANT_ROW, o=COMMENTED_COOLANT)
+    edit(conn, "spur", COOLANT_OFF_ROW, o=COMMENTED)
     draft_version = load_template(conn, "spur").version
     with as_role(conn, "engine_runner"):
         before = instantiate_gear(conn, 45)
-    assert "M8 ; COOLANT ON" not in before.lines
+    assert "M9 ; COOLANT OFF" not in before.lines
     report = release(conn, "spur")
     assert report.release_id is not None and released_version(conn, "spur") == draft_version
     with as_role(conn, "engine_runner"):
         after = instantiate_gear(conn, 45)
-    assert after.template_version == draft_version and "M8 ; COOLANT ON" in after.lines
+    assert after.template_version == draft_version and "M9 ; COOLANT OFF" in after.lines
     assert report.drafts_below == ["duplex"]   # spur's change gave duplex a draft of its own
     assert released_version(conn, "duplex") < load_template(conn, "duplex").version
 
 
 def test_the_release_records_tests_and_impact(conn):
     conn.execute("INSERT INTO template_test (gear_class, name, gear_id, expect) "
-                 "VALUES ('spur', 'coolant_comment', 42, ARRAY['match: ^M8'])")
+                 "VALUES ('spur', 'coolant_comment', 42, ARRAY['match: ^M9'])")
     instantiate_gear(conn, 42)
-    edit(conn, "spur", COOLANT_ROW, o=COMMENTED_COOLANT)
+    edit(conn, "spur", COOLANT_OFF_ROW, o=COMMENTED)
     release(conn, "spur")
     tests, recorded = conn.execute("SELECT tests, impact FROM template_release WHERE gear_class = 'spur' "
                                    "ORDER BY id DESC LIMIT 1").fetchone()
@@ -233,7 +235,7 @@ def test_the_release_records_tests_and_impact(conn):
 
 @pytest.mark.parametrize("role", ["engine_runner", "engine_editor"])
 def test_a_runner_or_an_editor_cannot_release(conn, role):
-    edit(conn, "spur", COOLANT_ROW, o=COMMENTED_COOLANT)
+    edit(conn, "spur", COOLANT_OFF_ROW, o=COMMENTED)
     before = released_version(conn, "spur")
     with as_role(conn, role):
         error = refusal(conn, "spur")
@@ -242,7 +244,7 @@ def test_a_runner_or_an_editor_cannot_release(conn, role):
 
 
 def test_a_releaser_releases(conn):
-    edit(conn, "spur", COOLANT_ROW, o=COMMENTED_COOLANT)
+    edit(conn, "spur", COOLANT_OFF_ROW, o=COMMENTED)
     with as_role(conn, "engine_releaser"):
         report = release(conn, "spur")
         assert report.release_id is not None
@@ -252,9 +254,9 @@ def test_a_releaser_releases(conn):
 
 # --- the command line ------------------------------------------------------------------------------
 
-def committed_edit(url, **columns):
+def committed_edit(url, row_id=COOLANT_ROW, **columns):
     with psycopg.connect(url) as conn:
-        edit(conn, "spur", COOLANT_ROW, **columns)
+        edit(conn, "spur", row_id, **columns)
 
 
 def test_release_on_the_command_line_and_history(run):
@@ -262,19 +264,20 @@ def test_release_on_the_command_line_and_history(run):
     committed_edit(run.url, o="M8 ; COOLANT ON")
     refused = run("template", "release", "--class", "spur", "--yes")
     assert refused.exit_code == 1 and f"row {COOLANT_ROW} column o" in refused.stderr
-    committed_edit(run.url, o=COMMENTED_COOLANT)
+    committed_edit(run.url, o='"M8"')
+    committed_edit(run.url, COOLANT_OFF_ROW, o=COMMENTED)
     dry = run("template", "release", "--class", "spur", "--dry-run", "--json")
     payload = json.loads(dry.stdout)
     assert dry.stdout.count("\n") == 1 and payload["impact"]["changed"] == 1 and not payload["released"]
-    assert "+M8 ; COOLANT ON" in payload["impact"]["diffs"][0]["diff"]
+    assert "+M9 ; COOLANT OFF" in payload["impact"]["diffs"][0]["diff"]
     declined = CliInput(run, "n\n")("template", "release", "--class", "spur")
     assert "1 program(s) change" in declined.stdout and "nothing released" in declined.stdout
     released = run("template", "release", "--class", "spur", "--yes")
     assert released.exit_code == 0 and "released class spur" in released.stdout
-    committed_edit(run.url, o='"M8 ; COOLANT ON, FLOOD"')
+    committed_edit(run.url, COOLANT_OFF_ROW, o='"M9 ; COOLANT OFF, FLOOD"')
     history = run("template", "history", "--class", "spur").stdout
     states = [line.split()[1] for line in history.splitlines() if line.startswith("v")]
-    assert states == ["retired", "superseded", "released", "draft"]   # v2 was the broken draft
+    assert states == ["retired", "superseded", "superseded", "released", "draft"]   # v2 broken, v3 mended
     assert "1 of 1 stored program(s) changed" in history
 
 
