@@ -97,8 +97,9 @@ def template_history(ctx, gear_class, as_json):
 
 def _release_text(release) -> str:
     impact = "" if release.jobs is None else f", {release.changed} of {release.jobs} stored program(s) changed"
+    note = f" ({release.note})" if release.note else ""
     return (f"released {release.released_at:%Y-%m-%d %H:%M:%S} by {release.released_by} as {release.role}: "
-            f"{release.tests} golden test(s){impact}")
+            f"{release.tests} golden test(s){impact}{note}")
 
 
 def _changes_text(changes, first: bool) -> str:

@@ -99,9 +99,9 @@ def impact(conn, gear_class: str) -> Impact:
     return report
 
 
-def _template_pairs(conn, classes: list[str]) -> dict[str, tuple[Template, Template]]:
-    """(released, draft evaluated as the released version) of each class that has a released
-    template; the draft is the released one for a class without a draft."""
+def _template_pairs(conn, classes: list[str]) -> dict[str, tuple[Template, Template, int]]:
+    """(released, draft evaluated as the released version, the draft's own version) of each class
+    that has a released template; the draft is the released one for a class without a draft."""
     pairs = {}
     for name in classes:
         try:
@@ -109,7 +109,7 @@ def _template_pairs(conn, classes: list[str]) -> dict[str, tuple[Template, Templ
         except EngineError:
             continue   # a class without rows (an inner node of the tree) has no jobs of its own
         draft = draft_template(conn, name)
-        pairs[name] = released, replace(draft, version=released.version, draft=False)
+        pairs[name] = released, replace(draft, version=released.version, draft=False), draft.version
     return pairs
 
 
@@ -126,24 +126,29 @@ def _compare(report: Impact, made: "_Made", job) -> None:
     old_lines = without_lineage(lines, row_ids) if from_released else made.released_lines(key)
     if old_lines != new_lines:
         report.changed += 1
-        report.diffs.append(JobDiff(job_id, gear_class, unified_diff(old_lines, new_lines, made.released(gear_class))))
+        report.diffs.append(JobDiff(job_id, gear_class, made.diff(gear_class, old_lines, new_lines)))
 
 
 class _Made:
     """The programs of distinct job inputs, made once: with the draft (or its failure) and, where the
     stored program is not the released one, with the released template."""
 
-    def __init__(self, conn, pairs: dict[str, tuple[Template, Template]]):
+    def __init__(self, conn, pairs: dict[str, tuple[Template, Template, int]]):
         self.pairs, self.inputs = pairs, _JobInputs(conn)
         self.drafts: dict[tuple, list[str] | EngineError] = {}
         self.releases: dict[tuple, list[str]] = {}
 
     def has_draft(self, gear_class: str) -> bool:
-        released, draft = self.pairs[gear_class]
+        released, draft, _ = self.pairs[gear_class]
         return released.hash != draft.hash
 
     def released(self, gear_class: str) -> Template:
         return self.pairs[gear_class][0]
+
+    def diff(self, gear_class: str, old: list[str], new: list[str]) -> str:
+        released, _, draft_version = self.pairs[gear_class]
+        return unified_diff(old, new, f"{gear_class} v{released.version} (released)",
+                            f"{gear_class} v{draft_version} (draft)")
 
     def draft_lines(self, key: tuple) -> list[str] | EngineError:
         if key not in self.drafts:
@@ -163,9 +168,8 @@ class _Made:
         return self.releases[key]
 
 
-def unified_diff(old: list[str], new: list[str], released: Template) -> str:
-    label = f"{released.gear_class} v{released.version}"
-    return "\n".join(difflib.unified_diff(old, new, f"{label} (released)", f"{label} + draft", lineterm=""))
+def unified_diff(old: list[str], new: list[str], old_label: str, new_label: str) -> str:
+    return "\n".join(difflib.unified_diff(old, new, old_label, new_label, lineterm=""))
 
 
 class _JobInputs:
