@@ -219,6 +219,9 @@ def test_after_release_runners_get_the_new_version(conn):
     assert after.template_version == draft_version and "M9 ; COOLANT OFF" in after.lines
     assert report.drafts_below == ["duplex"]   # spur's change gave duplex a draft of its own
     assert released_version(conn, "duplex") < load_template(conn, "duplex").version
+    with as_role(conn, "engine_runner"):
+        duplex = instantiate_gear(conn, 54)   # duplex's runners keep its released rows
+    assert "M9" in duplex.lines and "M9 ; COOLANT OFF" not in duplex.lines
 
 
 def test_the_release_records_tests_and_impact(conn):
