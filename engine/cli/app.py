@@ -17,6 +17,7 @@ from .cases import cases, suggest
 from .db import db, demo, seed_command
 from .explain import explain
 from .gears import classify, gears
+from .golden import test_command
 from .hobs import hobs
 from .instantiate import instantiate
 from .nc_import import import_nc_command
@@ -111,7 +112,8 @@ def main(ctx, database_url, traceback):
 
 
 COMMANDS = (demo, db, seed_command, gears, classify, instantiate, explain, template, lint, hobs, suggest, cases,
-            import_nc_command, refactor_command, import_dxf_command, plot_command, simulate, programs)
+            import_nc_command, refactor_command, import_dxf_command, plot_command, simulate, programs,
+            test_command)
 
 
 def _register(group: click.Group, commands) -> None:

@@ -8,6 +8,7 @@ import click
 
 from .context import connection, emit_json
 from .refactor import template_shared
+from .release import template_release
 
 
 @click.group()
@@ -17,6 +18,7 @@ def template():
 
 
 template.add_command(template_shared)   # which classes share each row: reported with the refactor
+template.add_command(template_release)  # the gate between a draft and the shop floor
 
 
 @template.command("list")
@@ -73,7 +75,12 @@ def template_import(ctx, gear_class, parent, csv_file):
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object: {versions: [...]}.")
 @click.pass_context
 def template_history(ctx, gear_class, as_json):
-    """Every stored version of the class, oldest first: when, who, rows, which rows changed."""
+    """Every stored version of the class, oldest first: when, who, rows, its state (released, retired,
+    draft, superseded), its release (who, when, golden tests run, programs changed of stored jobs)
+    and which rows changed.
+
+    Example: engine template history --class spur
+    """
     from ..templates.history import history
 
     with connection(ctx) as conn:
@@ -81,8 +88,18 @@ def template_history(ctx, gear_class, as_json):
     if as_json:
         return emit_json({"gear_class": gear_class, "versions": [_version_json(entry) for entry in entries]})
     for number, entry in enumerate(entries):
-        click.echo(f"v{entry.version:<4} {entry.created_at:%Y-%m-%d %H:%M:%S} by {entry.created_by:14} "
-                   f"{entry.rows:3} rows  {_changes_text(entry.changes, first=number == 0)}".rstrip())
+        click.echo(f"v{entry.version:<4} {entry.state:10} {entry.created_at:%Y-%m-%d %H:%M:%S} by "
+                   f"{entry.created_by:14} {entry.rows:3} rows  "
+                   f"{_changes_text(entry.changes, first=number == 0)}".rstrip())
+        if entry.release is not None:
+            click.echo(f"      {_release_text(entry.release)}")
+
+
+def _release_text(release) -> str:
+    impact = "" if release.jobs is None else f", {release.changed} of {release.jobs} stored program(s) changed"
+    note = f" ({release.note})" if release.note else ""
+    return (f"released {release.released_at:%Y-%m-%d %H:%M:%S} by {release.released_by} as {release.role}: "
+            f"{release.tests} golden test(s){impact}{note}")
 
 
 def _changes_text(changes, first: bool) -> str:
@@ -97,8 +114,16 @@ def _changes_text(changes, first: bool) -> str:
 
 def _version_json(entry) -> dict:
     return {"version": entry.version, "created_at": entry.created_at.isoformat(), "created_by": entry.created_by,
-            "rows": entry.rows, "changes": [{"row_id": row_id, "operation": operation}
-                                            for row_id, operation in entry.changes]}
+            "rows": entry.rows, "state": entry.state, "release": _release_json(entry.release),
+            "changes": [{"row_id": row_id, "operation": operation} for row_id, operation in entry.changes]}
+
+
+def _release_json(release) -> dict | None:
+    if release is None:
+        return None
+    return {"released_at": release.released_at.isoformat(), "released_by": release.released_by,
+            "role": release.role, "tests": release.tests, "changed": release.changed, "jobs": release.jobs,
+            "note": release.note}
 
 
 @template.command("diff")

@@ -3,11 +3,13 @@ so a second run changes nothing and a template an engineer edited stays edited."
 from __future__ import annotations
 
 import csv
+import json
 import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from psycopg import sql
+from psycopg.types.json import Jsonb
 
 from ..gears.gear_import import import_gears
 from ..gears.units import import_units
@@ -46,6 +48,7 @@ def seed(conn, directory: Path = SEED_DIR) -> SeedReport:
         _seed_gears(conn, directory, report)
         _seed_units(conn, directory, report)
         _seed_cases(conn, directory, report)
+        _seed_template_tests(conn, directory, report)
         _release_seeded(conn, seeded, report)
     return report
 
@@ -53,6 +56,27 @@ def seed(conn, directory: Path = SEED_DIR) -> SeedReport:
 RELEASE_SEEDED = ("SELECT release_template(g.name, g.template_version, v.hash, note => %s) FROM gear_class g "
                   "JOIN template_version_rows v ON v.gear_class = g.name AND v.version = g.template_version "
                   "WHERE g.name = %s AND released_version(g.name) IS DISTINCT FROM g.template_version")
+
+
+INSERT_TEST = ("INSERT INTO template_test (gear_class, name, gear_id, params, choices, expect, description) "
+               "SELECT %s, %s, %s, %s, %s, %s, %s WHERE EXISTS (SELECT 1 FROM gear_class WHERE name = %s) "
+               "ON CONFLICT (gear_class, name) DO NOTHING RETURNING 1")
+
+
+def _seed_template_tests(conn, directory: Path, report: SeedReport) -> None:
+    """The golden tests of the shipped templates (engine test), by class and name: a test a DBA
+    edited stays edited; a missing one is added, like every seeded row."""
+    path = directory / "template_tests.json"
+    if not path.exists():
+        return
+    added = 0
+    for test in json.loads(path.read_text(encoding="utf-8")):
+        params = test.get("params")
+        added += conn.execute(INSERT_TEST, (test["class"], test["name"], test.get("gear_id"),
+                                            Jsonb(params) if params is not None else None,
+                                            Jsonb(test.get("choices", {})), test["expect"],
+                                            test.get("description", ""), test["class"])).fetchone() is not None
+    report.count("template tests", added)
 
 
 def _release_seeded(conn, classes: list[str], report: SeedReport) -> None:

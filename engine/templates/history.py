@@ -20,6 +20,20 @@ class VersionEntry:
     created_by: str
     rows: int
     changes: tuple[tuple[int, str], ...]   # (row id, INSERT/UPDATE/DELETE) from template_audit
+    state: str = ""                        # released, retired, draft, superseded (template_version_state)
+    release: "ReleaseEntry | None" = None  # the release of this version, if it was released
+
+
+@dataclass(frozen=True)
+class ReleaseEntry:
+    """Who released a version, when, and what the gate saw: tests run, programs changed of jobs."""
+    released_at: datetime
+    released_by: str
+    role: str
+    tests: int
+    changed: int | None
+    jobs: int | None
+    note: str | None
 
 
 @dataclass(frozen=True)
@@ -52,10 +66,21 @@ GROUP BY v.version, v.created_at, v.created_by, v.row_count
 ORDER BY v.version"""
 
 
+STATES = "SELECT version, state FROM template_version_state WHERE gear_class = %s"
+RELEASES = """
+SELECT version, released_at, released_by, role, jsonb_array_length(tests), (impact ->> 'changed')::int,
+       (impact ->> 'jobs')::int, note
+FROM template_release WHERE gear_class = %s"""
+
+
 def history(conn, gear_class: str) -> list[VersionEntry]:
-    """Every stored version of the class, oldest first, with who made it and which rows changed."""
+    """Every stored version of the class, oldest first, with who made it, which rows changed, its
+    state (released, retired, draft, superseded) and its release."""
     _require_class(conn, gear_class)
-    return [VersionEntry(version, created_at, created_by, row_count, tuple(zip(row_ids, operations)))
+    states = dict(conn.execute(STATES, (gear_class,)).fetchall())
+    releases = {row[0]: ReleaseEntry(*row[1:]) for row in conn.execute(RELEASES, (gear_class,))}
+    return [VersionEntry(version, created_at, created_by, row_count, tuple(zip(row_ids, operations)),
+                         states.get(version, ""), releases.get(version))
             for version, created_at, created_by, row_count, row_ids, operations
             in conn.execute(HISTORY, {"class": gear_class})]
 

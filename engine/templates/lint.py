@@ -25,13 +25,25 @@ def _class_problems(conn, gear_class: str) -> list[LintProblem]:
     problems = structural_problems(gear_class, list(template.rows)) + _translation_problems(template)
     if problems:
         return problems
-    # An imported class's rows name the parameters of its program, even under a parent with a model.
-    name_source = _imported_names(conn, gear_class) or model_for_class(conn, gear_class)
+    name_source = _name_source(conn, gear_class)
     if name_source is None:
         return [LintProblem(gear_class, None, "model", "no hobbing model for this class or its ancestors, "
                             "so its parameter names cannot be checked; give the class a model, or import "
                             "it with `engine import-nc FILE --class NAME --params P.json`")]
     return list(_unknown_names(gear_class, template.rows, name_source))
+
+
+def _name_source(conn, gear_class: str):
+    """What tells the parameters a class's rows may read: an imported class's rows name the
+    parameters of its program, even under a parent with a model; else the class's model."""
+    return _imported_names(conn, gear_class) or model_for_class(conn, gear_class)
+
+
+def known_names_of(conn, gear_class: str):
+    """`(t, n) -> frozenset` of the parameter names a module's rows may read, or None when the
+    class has no model nor import to say (engine lint reports that)."""
+    source = _name_source(conn, gear_class)
+    return None if source is None else source.parameter_names
 
 
 def _translation_problems(template) -> list[LintProblem]:

@@ -1,0 +1,114 @@
+"""The impact step of `engine template release` (issue 15) over N stored jobs of one seeded class
+(spur), against a baseline in the same run: the same jobs read and made again with the draft (its
+compiled template evaluated for each job), without the released programs read and without diffing.
+A few hundred spur jobs are made by the engine (verifier and simulation); N jobs are copied from
+them with their own program names (so no two jobs share their parameters) and stored with their
+released programs through the batch COPY path; then a row is edited through template_view.
+Target (issue 15): impact of 10,000 jobs <= 10 s on the 2-core machine.
+
+    python bench/impact.py [--count 10000] [--reps 3] [--database-url URL]
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+
+from _common import add_database_argument, bench_database, median, verdict  # noqa: E402
+
+TARGET_SECONDS = 10.0
+FIRST_GEAR = 100_000
+MADE_GEARS = 300
+GEAR_CLASS = "spur"
+JOBS = "SELECT id, gear_class, params, module_params FROM job WHERE gear_class = %s ORDER BY id"
+EDIT = "UPDATE template_view SET o = %s WHERE gear_class = %s AND id = 1800"   # the coolant-on line
+
+
+def stored_jobs(conn, count: int) -> None:
+    """`count` spur jobs with their released programs, copied from jobs the engine made."""
+    from batch import generate_gears, insert_gears
+    from engine.programs.instantiate import instantiate_gears
+    from engine.programs.records import Encoded
+    from engine.programs.storage import store_many
+    from engine.templates.decision_table import compiled_template
+    from engine.templates.versions import released_template
+
+    insert_gears(conn, generate_gears(FIRST_GEAR, MADE_GEARS))
+    instantiate_gears(conn, FIRST_GEAR, FIRST_GEAR + MADE_GEARS - 1)
+    conn.commit()
+    made = conn.execute("SELECT gear_id, machine, hob_id, params, module_params FROM job WHERE gear_class = %s",
+                        (GEAR_CLASS,)).fetchall()
+    released = compiled_template(released_template(conn, GEAR_CLASS))
+    encoded = []
+    for number in range(count - len(made)):
+        gear_id, machine, hob_id, params, modules = made[number % len(made)]
+        params = {**params, "program_name": f"BENCH{number:05d}"}
+        result = released.run(params, modules)
+        encoded.append(Encoded(gear_id, GEAR_CLASS, machine, hob_id, json.dumps(params), json.dumps(modules), "{}",
+                               released.template.version, released.template.hash, params["program_name"],
+                               result.lines, result.row_ids, "{}"))
+    store_many(conn, encoded)
+    conn.commit()
+
+
+def run_impact(conn) -> tuple[float, int]:
+    from engine.templates import decision_table
+    from engine.templates.impact import impact
+
+    decision_table._CACHE.clear()   # as a new process: nothing compiled, nothing remembered
+    start = time.perf_counter()
+    report = impact(conn, GEAR_CLASS)
+    conn.rollback()
+    return time.perf_counter() - start, report.changed
+
+
+def run_bare(conn) -> tuple[float, int]:
+    """The same jobs read and made again with the draft: no released program, no diff."""
+    from engine.templates import decision_table
+    from engine.templates.decision_table import compiled_template
+    from engine.templates.versions import draft_template
+
+    decision_table._CACHE.clear()
+    start = time.perf_counter()
+    draft = compiled_template(draft_template(conn, GEAR_CLASS))
+    lines = sum(len(draft.run(params, modules).lines) for _, _, params, modules in conn.execute(JOBS, (GEAR_CLASS,)))
+    conn.rollback()
+    return time.perf_counter() - start, lines
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    add_database_argument(parser)
+    parser.add_argument("--count", type=int, default=10_000, help="stored jobs of the class (default 10000)")
+    parser.add_argument("--reps", type=int, default=3, help="alternated runs of each (default 3)")
+    args = parser.parse_args(argv)
+
+    import psycopg
+
+    with bench_database(args.database_url, "bench_impact") as url, psycopg.connect(url) as conn:
+        stored_jobs(conn, args.count)
+        conn.execute(EDIT, ('"M8 ; COOLANT ON"', GEAR_CLASS))
+        conn.commit()
+        jobs = conn.execute("SELECT count(*) FROM job WHERE gear_class = %s", (GEAR_CLASS,)).fetchone()[0]
+        runs = {"impact": run_impact, "bare": run_bare}
+        times, counts = {name: [] for name in runs}, {}
+        for repetition in range(args.reps):
+            for name in (runs if repetition % 2 == 0 else reversed(list(runs))):
+                seconds, counts[name] = runs[name](conn)
+                times[name].append(seconds)
+    ours, bare = median(times["impact"]), median(times["bare"])
+    print(f"impact: {jobs} stored {GEAR_CLASS} jobs, {counts['impact']} programs change, {args.reps} alternated runs")
+    print(f"impact (read, evaluate the draft, compare, diff): median {ours:6.2f} s = {jobs / ours:6.0f} jobs/s")
+    print(f"bare (read, evaluate the draft)                 : median {bare:6.2f} s = {jobs / bare:6.0f} jobs/s")
+    print(f"ratio impact/bare = {ours / bare:.2f}x; impact {ours:.2f} s (target <= {TARGET_SECONDS:g} s): "
+          f"{verdict(ours <= TARGET_SECONDS)}")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,76 @@
+"""`engine template release`: the gate, the impact and the release of a class's draft."""
+from __future__ import annotations
+
+import click
+
+from .context import connection, emit_json
+
+SHOWN_FAILURES = 5   # jobs the draft fails for, listed by the text output (all with --json)
+
+
+@click.command("release")
+@click.option("--class", "gear_class", required=True, help="Gear class whose draft is released.")
+@click.option("--dry-run", is_flag=True, help="Run the gate and show the impact; release nothing.")
+@click.option("--yes", is_flag=True, help="Release without asking (after the gate and the impact).")
+@click.option("--json", "as_json", is_flag=True, help="Print one JSON object, every diff included.")
+@click.pass_context
+def template_release(ctx, gear_class, dry_run, yes, as_json):
+    """Release the class's draft to the shop floor: refused, naming every row, column and test that
+    failed, unless engine lint, the golden tests of the class and its descendants and the static
+    analysis pass. Shows how many stored programs the release changes and the first diffs, then
+    asks (unless --yes). Needs the role engine_releaser.
+
+    Example: engine template release --class spur --dry-run
+    """
+    from ..templates.impact import DIFFS_SHOWN
+    from ..templates.release import release
+
+    def confirm(report) -> bool:
+        if yes:
+            return True
+        if not as_json:
+            _show(report, DIFFS_SHOWN)
+        return click.confirm(f"release class {report.gear_class} v{report.version}?", err=True)
+
+    with connection(ctx) as conn:
+        report = release(conn, gear_class, dry_run=dry_run, confirm=confirm)
+    if as_json:
+        return emit_json(_as_json(report))
+    if dry_run or yes:
+        _show(report, DIFFS_SHOWN)
+    click.echo(_outcome(report))
+
+
+def _show(report, diffs_shown: int) -> None:
+    impact = report.impact
+    click.echo(f"class {report.gear_class} v{report.version} ({report.hash[:8]}): gate passed: lint, "
+               f"{len(report.tests)} golden test(s), static analysis")
+    click.echo(f"impact: {impact.jobs} stored job(s) of {report.gear_class} and its descendants, "
+               f"{impact.changed} program(s) change, {len(impact.failures)} fail with the draft")
+    for failure in impact.failures[:SHOWN_FAILURES]:
+        click.echo(f"  job {failure.job_id} ({failure.gear_class}): {failure.error}")
+    for diff in impact.diffs[:diffs_shown]:
+        click.echo(f"job {diff.job_id} ({diff.gear_class}):\n{diff.diff}")
+    if len(impact.diffs) > diffs_shown:
+        click.echo(f"… {len(impact.diffs) - diffs_shown} more changed program(s) (all with --json)")
+
+
+def _outcome(report) -> str:
+    below = (f"; descendants with drafts that need their own release: {', '.join(report.drafts_below)}"
+             if report.drafts_below else "")
+    if report.release_id is not None:
+        return f"released class {report.gear_class} v{report.version} (release {report.release_id}){below}"
+    what = "dry run" if report.dry_run else "not confirmed"
+    return f"{what}: nothing released{below}"
+
+
+def _as_json(report) -> dict:
+    impact = report.impact
+    return {"gear_class": report.gear_class, "version": report.version, "hash": report.hash,
+            "dry_run": report.dry_run, "released": report.release_id is not None, "release_id": report.release_id,
+            "tests": report.tests, "checks": report.checks, "drafts_below": report.drafts_below,
+            "impact": {"jobs": impact.jobs, "changed": impact.changed,
+                       "failures": [{"job_id": f.job_id, "gear_class": f.gear_class, "error": f.error}
+                                    for f in impact.failures],
+                       "diffs": [{"job_id": d.job_id, "gear_class": d.gear_class, "diff": d.diff}
+                                 for d in impact.diffs]}}

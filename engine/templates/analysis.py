@@ -1,0 +1,146 @@
+"""Static analysis of a class's assembled template, the third check of the release gate (issue 15):
+rows that parse and name known parameters (engine lint) can still be wrong in ways no single
+expression shows. Each rule below looks at the rows together, in evaluation order:
+
+* a condition (`p_calc`, `p_emit`) that reads no name and is false: the row never computes or
+  never prints, for every job — an edit that switched a line off by accident;
+* two rows writing the same intermediate with nothing between them reading it, the second
+  unconditionally: the first write is dead (a copied row whose name was not changed);
+* a row identical to an earlier one (t, n, p_calc, s, o, p_emit): the NC line or computation
+  doubled by a paste. No seeded template has one (a second `ENDIF` or retract sits in another
+  module, or under another condition), so any duplicate is refused, not only adjacent ones;
+* a name read before any row or parameter gives it: a row reads a name that its module's
+  parameters do not hold and only a later row (or none) assigns.
+
+Every expression is compiled and evaluated through the expression gate
+(engine.templates.expressions, engine.templates.evaluator), never Python's eval."""
+from __future__ import annotations
+
+from dataclasses import astuple, dataclass
+
+from .decision_table import CompiledRow, compile_row
+from .evaluator import EvaluationError, evaluate
+from .lint import known_names_of
+from .rows import Template
+
+CONDITION_COLUMNS = ("p_calc", "p_emit")
+
+
+@dataclass(frozen=True)
+class Finding:
+    """One problem the analysis found: where (row, column) and what, in one line."""
+    gear_class: str
+    row_id: int
+    column: str
+    rule: str
+    message: str
+
+    def __str__(self) -> str:
+        return f"class {self.gear_class} row {self.row_id} column {self.column}: {self.message} ({self.rule})"
+
+
+def analyse(template: Template, known_names=None) -> list[Finding]:
+    """Every finding of every rule (RULES) on the template's rows, in row order. `known_names(t, n)`
+    gives the parameters a module's rows may read (a model's parameter_names); without it the
+    read-before-given rule is not run (lint reports a class without a model)."""
+    compiled = [compile_row(template.gear_class, row, template.translations) for row in template.rows]
+    findings = []
+    for rule, check in RULES:
+        if rule != "read-before-given" or known_names is not None:
+            findings += [Finding(template.gear_class, row_id, column, rule, message)
+                         for row_id, column, message in check(compiled, known_names)]
+    return sorted(findings, key=lambda finding: (finding.row_id, finding.column, finding.rule))
+
+
+def constant_false(rows: list[CompiledRow], known_names):
+    """A condition that reads no name and evaluates false: the row is off for every job."""
+    for row in rows:
+        for column in CONDITION_COLUMNS:
+            condition = getattr(row, column)
+            if condition is not None and not condition.names and _is_false(condition):
+                yield row.row.id, column, f"{condition.text!r} is false for every job: the row never " + (
+                    "computes" if column == "p_calc" else "prints")
+
+
+def _is_false(condition) -> bool:
+    try:
+        return not evaluate(condition, {})
+    except EvaluationError:
+        return False   # a condition failing for every job is lint's to report
+
+
+def dead_writes(rows: list[CompiledRow], known_names):
+    """An intermediate assigned again, unconditionally, before any row reads it."""
+    pending: dict[str, list[int]] = {}   # name -> rows whose write no row has read yet
+    for row in rows:
+        for name in _names_read(row):
+            pending.pop(name, None)
+        for name in dict.fromkeys(name for name, _ in row.s):
+            if row.p_calc is None:
+                for earlier in pending.pop(name, ()):
+                    yield earlier, "s", (f"assigns {name!r}, which row {row.row.id} assigns again "
+                                         "unconditionally before any row reads it")
+            pending.setdefault(name, []).append(row.row.id)
+
+
+def _names_read(row: CompiledRow) -> set[str]:
+    expressions = [row.p_calc, row.o, row.p_emit, *(value for _, value in row.s)]
+    return {name for expression in expressions if expression is not None for name in expression.names}
+
+
+def duplicates(rows: list[CompiledRow], known_names):
+    """A row identical (t, n, p_calc, s, o, p_emit) to an earlier row."""
+    first: dict[tuple, int] = {}
+    for row in rows:
+        body = astuple(row.row)[1:]
+        if body in first:
+            yield row.row.id, "o", f"repeats row {first[body]} exactly (t, n, p_calc, s, o, p_emit)"
+        first.setdefault(body, row.row.id)
+
+
+def read_before_given(rows: list[CompiledRow], known_names):
+    """A name a row reads that its module's parameters do not hold and no earlier row assigns."""
+    assigned_at = {}
+    for row in rows:
+        for name, _ in row.s:
+            assigned_at.setdefault(name, row.row.id)
+    given: set[str] = set()
+    for row in rows:
+        known = known_names(row.row.t, row.row.n) | given
+        for column, name in _reads_in_order(row):
+            if name not in known:
+                yield row.row.id, column, _not_given(name, assigned_at.get(name))
+                known = known | {name}
+        given |= {name for name, _ in row.s}
+
+
+def _reads_in_order(row: CompiledRow):
+    """(column, name) the row reads before assigning the name itself, in evaluation order."""
+    assigned: set[str] = set()
+    steps = [("p_calc", row.p_calc, None), *(("s", value, name) for name, value in row.s),
+             ("o", row.o, None), ("p_emit", row.p_emit, None)]
+    for column, expression, target in steps:
+        if expression is not None:
+            yield from ((column, name) for name in sorted(expression.names - assigned))
+        if target is not None:
+            assigned.add(target)
+
+
+def _not_given(name: str, later_row: int | None) -> str:
+    if later_row is not None:
+        return f"reads {name!r} before row {later_row} assigns it"
+    return f"reads {name!r}, which no parameter of the class and no row gives"
+
+
+# The rules, in the order their findings are explained: (name, check(compiled rows, known_names)).
+RULES = (
+    ("constant-false", constant_false),
+    ("dead-write", dead_writes),
+    ("duplicate-row", duplicates),
+    ("read-before-given", read_before_given),
+)
+
+
+def class_findings(conn, gear_class: str, template: Template) -> list[Finding]:
+    """The analysis of a stored class's template, with the names its model (or import) provides."""
+    return analyse(template, known_names_of(conn, gear_class))

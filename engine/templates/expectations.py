@@ -1,0 +1,186 @@
+"""The expectation language of golden tests (template_test.expect, one text per element), for
+DBAs editing tests in SQL. A program is a list of lines (without the lineage line, which the
+engine adds when it stores a program):
+
+    line: M30                   this exact line is in the program (spaces at the ends ignored)
+    no line: M8                 no line is exactly this
+    line 3: G90 G71 G94         line 3 (1-based) is exactly this
+    last line: M30              the last line is exactly this
+    match: ^EGON\\(C,"FINE",B   at least one line matches the regular expression (re.search)
+    no match: ^G1 .*F0\\b       no line matches it
+    <property> = <expression> [± <tolerance>]     (`+-` for ±)
+        the property read from the program (engine.templates.program_properties) equals the
+        expression, evaluated over the job's parameters (mn, z2, z0, da0, df2, beta, hand, …,
+        see `engine explain`) with the engine's own checked evaluator (never Python's eval).
+        Besides the job's parameters the expression may name h_hob and h_gear (+1 right hand,
+        -1 left, 0 none: hobbing.md §A7), and for a gear test gear_<field> (gear_teeth, …) and
+        unit<N>_<field> (unit2_teeth, …) of the gear record.
+        Properties: `EGON ratio` (Z1/N1 of the B axis in the first EGON; `last EGON ratio`),
+        `EGON Z factor` (any leading axis: `EGON Y factor`), `first|last|min|max [G0|G1] <address>`
+        (e.g. `last X`, `max G1 X`: the values of that address over the blocks, optionally only
+        blocks in that modal motion; G25/G26 limit blocks are not positions and are left out), `XZ slope` (dX/dZ of the last block moving X and Z),
+        `count of G1` (blocks holding the word), `line count`.
+        Default tolerance: 1e-6 plus half a unit in the last digit the program printed (0.0005
+        for `X51.500`).
+
+An expectation that cannot be read, a property no rule reads, or an expression that does not
+evaluate (an unknown name) fails the test with that reason: it never passes.
+"""
+from __future__ import annotations
+
+import math
+import re
+from dataclasses import dataclass
+
+from ..errors import EngineError
+from .evaluator import evaluate
+from .program_properties import Reading, UnknownProperty, property_reader, read_property
+
+ABSOLUTE_TOLERANCE = 1e-6
+TEXT_KINDS = (   # (pattern, kind); the first that matches the expectation's text wins
+    (r"no line:\s?(.*)", "no line"),
+    (r"last line:\s?(.*)", "last line"),
+    (r"line (\d+):\s?(.*)", "line n"),
+    (r"line:\s?(.*)", "line"),
+    (r"no match:\s?(.*)", "no match"),
+    (r"match:\s?(.*)", "match"),
+)
+NUMERIC = re.compile(r"(?P<property>[^=]+?)\s*=\s*(?P<expression>.+?)(?:\s*(?:±|\+-)\s*(?P<tolerance>\S+))?\s*")
+
+
+class ExpectationError(EngineError):
+    """An expectation that cannot be read or evaluated: the test fails with this reason."""
+
+
+@dataclass(frozen=True)
+class Context:
+    """What an expectation is checked against: the program's lines and the names its
+    expressions may read."""
+    lines: list[str]
+    names: dict
+
+
+def check(expectation: str, context: Context) -> str | None:
+    """None if the program meets the expectation, else the first difference in one line."""
+    text = expectation.strip()
+    for pattern, kind in TEXT_KINDS:
+        match = re.fullmatch(pattern, text, re.DOTALL)
+        if match:
+            return TEXT_CHECKS[kind](*match.groups(), lines=context.lines)
+    numeric = NUMERIC.fullmatch(text)
+    if numeric is None:
+        raise ExpectationError(f"cannot read expectation {text!r}: write `line: …`, `no line: …`, `match: …`, "
+                               "`no match: …` or `<property> = <expression> [± tolerance]`")
+    return check_numeric(numeric.group("property"), numeric.group("expression"), numeric.group("tolerance"),
+                         context)
+
+
+def _line_present(wanted: str, lines: list[str]) -> str | None:
+    return None if wanted.strip() in _stripped(lines) else "program has no such line"
+
+
+def _line_absent(unwanted: str, lines: list[str]) -> str | None:
+    stripped = _stripped(lines)
+    if unwanted.strip() not in stripped:
+        return None
+    number = stripped.index(unwanted.strip()) + 1
+    return f"program has it (line {number}: {lines[number - 1]})"
+
+
+def _line_at(number: str, wanted: str, lines: list[str]) -> str | None:
+    index = int(number) - 1
+    if not 0 <= index < len(lines):
+        return f"program has only {len(lines)} lines"
+    return None if lines[index].strip() == wanted.strip() else f"program has line {number}: {lines[index]}"
+
+
+def _last_line(wanted: str, lines: list[str]) -> str | None:
+    return _line_at(str(len(lines)), wanted, lines) if lines else "program has no lines"
+
+
+def _pattern(text: str):
+    try:
+        return re.compile(text)
+    except re.error as error:
+        raise ExpectationError(f"pattern {text!r} is not a regular expression: {error}") from None
+
+
+def _matches(pattern: str, lines: list[str]) -> str | None:
+    compiled = _pattern(pattern)
+    return None if any(compiled.search(line) for line in lines) else "no line matches"
+
+
+def _no_match(pattern: str, lines: list[str]) -> str | None:
+    compiled = _pattern(pattern)
+    number = next((n for n, line in enumerate(lines, 1) if compiled.search(line)), None)
+    return None if number is None else f"line {number} matches: {lines[number - 1]}"
+
+
+def _stripped(lines: list[str]) -> list[str]:
+    return [line.strip() for line in lines]
+
+
+TEXT_CHECKS = {"line": _line_present, "no line": _line_absent, "line n": _line_at, "last line": _last_line,
+               "match": _matches, "no match": _no_match}
+
+
+def check_numeric(name: str, expression: str, tolerance: str | None, context: Context) -> str | None:
+    """The property against the expression's value, within the tolerance."""
+    try:
+        property_reader(name)
+    except UnknownProperty as error:
+        raise ExpectationError(str(error)) from None
+    expected = expected_value(expression, context.names)
+    reading = read_property(name, context.lines)
+    allowed = _tolerance(tolerance, reading)
+    value = _shown(expected, reading)
+    shown = f"{name.strip()} = {expression.strip()}{'' if value == expression.strip() else ' = ' + value} ± {allowed:.3g}"
+    if reading is None:
+        return f"expected {shown}, program has no {name.strip()}"
+    if abs(reading.value - expected) <= allowed:
+        return None
+    return f"expected {shown}, program has {_shown(reading.value, reading)}{reading.where()}"
+
+
+def expected_value(expression: str, names: dict) -> float:
+    """The expression over the test's names, by the templates' own checked evaluator."""
+    from .expressions import compile_expression   # the gate: only what a template expression may be
+
+    try:
+        value = evaluate(compile_expression(expression.strip()), names)
+    except EngineError as error:
+        raise ExpectationError(f"expression {expression.strip()!r}: {error}") from None
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise ExpectationError(f"expression {expression.strip()!r} gives {value!r}, not a finite number")
+    return float(value)
+
+
+def _tolerance(text: str | None, reading: Reading | None) -> float:
+    if text is None:
+        return ABSOLUTE_TOLERANCE + (reading.printed_step / 2 if reading is not None else 0.0)
+    try:
+        value = float(text)
+    except ValueError:
+        raise ExpectationError(f"tolerance {text!r} is not a number") from None
+    if not value >= 0:
+        raise ExpectationError(f"tolerance {text!r} must not be negative")
+    return value
+
+
+def _shown(value: float, reading: Reading | None) -> str:
+    """A value with the decimals the program printed (6 significant digits if it printed none)."""
+    if reading is not None and 0 < reading.printed_step < 1:
+        return f"{value:.{round(-math.log10(reading.printed_step))}f}"
+    return f"{value:.6g}"
+
+
+def first_difference(expectations, context: Context) -> str | None:
+    """The first expectation the program does not meet, as `expected …`, naming it; None if all hold."""
+    for expectation in expectations:
+        try:
+            problem = check(expectation, context)
+        except ExpectationError as error:
+            return f"expectation {expectation.strip()!r} fails: {error}"
+        if problem is not None:
+            return problem if problem.startswith("expected") else f"expected {expectation.strip()!r}: {problem}"
+    return None

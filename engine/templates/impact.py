@@ -1,0 +1,203 @@
+"""What a release would change on the shop floor (issue 15): every stored job of a class and of
+its descendants made again with the draft template and compared with its program from the
+released version. Template rows only (as engine.programs.remake makes a stored job again,
+without the verifier and the simulation, which the gate does not need to see a line change).
+
+The released program is the job's latest stored one (its lineage line left out) when it was made
+from the released version from the job's current parameters; otherwise the released template is
+evaluated too. The draft is evaluated as if it had the released version number, so the
+`; TEMPLATE class vN` line does not count as a change. Jobs with identical parameters are
+evaluated once: 10,000 stored jobs of a class take seconds (bench/impact.py)."""
+from __future__ import annotations
+
+import difflib
+import json
+from dataclasses import dataclass, field, replace
+
+from ..errors import EngineError
+from ..gears.models import model_for_class
+from ..gears.records import load_machine
+from ..programs.lineage import without_lineage
+from .decision_table import compiled_template
+from .rows import Template
+from .versions import draft_template, released_template
+
+DIFFS_SHOWN = 5   # unified diffs the CLI prints (all of them with --json)
+
+# The class and its descendants.
+TREE = """
+WITH RECURSIVE tree(name, depth) AS (
+    SELECT name, 0 FROM gear_class WHERE name = %s
+    UNION ALL
+    SELECT g.name, t.depth + 1 FROM gear_class g JOIN tree t ON g.parent = t.name WHERE t.depth < 50)
+SELECT name FROM tree ORDER BY depth, name"""
+
+# Every job of the classes with its latest program, and whether that program came from the
+# released version (class, version, hash) and the job's current parameters.
+JOBS = """
+WITH released(gear_class, version, hash) AS (SELECT * FROM unnest(%s::text[], %s::int[], %s::text[]))
+SELECT j.id, j.gear_class, j.machine, j.params::text, j.module_params::text,
+       coalesce(p.template_version = r.version AND p.template_hash = r.hash
+                AND p.input_hash = job_input_hash(j.params, j.module_params), false),
+       p.lines, p.row_ids
+FROM job j
+JOIN released r ON r.gear_class = j.gear_class
+LEFT JOIN (SELECT DISTINCT ON (job_id) job_id, template_version, template_hash, input_hash, lines, row_ids
+           FROM program ORDER BY job_id, id DESC) p ON p.job_id = j.id
+ORDER BY j.id"""
+
+
+@dataclass(frozen=True)
+class JobDiff:
+    job_id: int
+    gear_class: str
+    diff: str   # unified diff, released → draft
+
+
+@dataclass(frozen=True)
+class JobFailure:
+    job_id: int
+    gear_class: str
+    error: str
+
+
+@dataclass
+class Impact:
+    """The impact of releasing a class's draft: jobs examined, programs that change, jobs the
+    draft fails for, and the diffs of the changed programs (in job id order)."""
+    gear_class: str
+    jobs: int = 0
+    changed: int = 0
+    failures: list[JobFailure] = field(default_factory=list)
+    diffs: list[JobDiff] = field(default_factory=list)
+
+    def summary(self) -> dict:
+        """What a release records: the counts, the changed and failing job ids."""
+        return {"jobs": self.jobs, "changed": self.changed, "failed": len(self.failures),
+                "changed_jobs": [diff.job_id for diff in self.diffs][:1000],
+                "failed_jobs": [failure.job_id for failure in self.failures][:1000]}
+
+
+def class_tree(conn, gear_class: str) -> list[str]:
+    """The class and its descendants, nearest first."""
+    return [row[0] for row in conn.execute(TREE, (gear_class,))]
+
+
+def impact(conn, gear_class: str) -> Impact:
+    """Every stored job of the class and its descendants made with the draft, compared with the
+    released program."""
+    pairs = _template_pairs(conn, class_tree(conn, gear_class))
+    report = Impact(gear_class)
+    if not pairs:
+        return report
+    classes = list(pairs)
+    versions = [pairs[name][0].version for name in classes]
+    hashes = [pairs[name][0].hash for name in classes]
+    made = _Made(conn, pairs)
+    for job in conn.cursor(binary=True).execute(JOBS, (classes, versions, hashes)):
+        _compare(report, made, job)
+    return report
+
+
+def _template_pairs(conn, classes: list[str]) -> dict[str, tuple[Template, Template, int]]:
+    """(released, draft evaluated as the released version, the draft's own version) of each class
+    that has a released template; the draft is the released one for a class without a draft."""
+    pairs = {}
+    for name in classes:
+        try:
+            released = released_template(conn, name)
+        except EngineError:
+            continue   # a class without rows (an inner node of the tree) has no jobs of its own
+        draft = draft_template(conn, name)
+        pairs[name] = released, replace(draft, version=released.version, draft=False), draft.version
+    return pairs
+
+
+def _compare(report: Impact, made: "_Made", job) -> None:
+    job_id, gear_class, machine, params_text, modules_text, from_released, lines, row_ids = job
+    report.jobs += 1
+    if not made.has_draft(gear_class):
+        return   # no draft: nothing changes
+    key = gear_class, machine, params_text, modules_text
+    new_lines = made.draft_lines(key)
+    if isinstance(new_lines, EngineError):
+        report.failures.append(JobFailure(job_id, gear_class, str(new_lines)))
+        return
+    old_lines = without_lineage(lines, row_ids) if from_released else made.released_lines(key)
+    if old_lines != new_lines:
+        report.changed += 1
+        report.diffs.append(JobDiff(job_id, gear_class, made.diff(gear_class, old_lines, new_lines)))
+
+
+class _Made:
+    """The programs of distinct job inputs, made once: with the draft (or its failure) and, where the
+    stored program is not the released one, with the released template."""
+
+    def __init__(self, conn, pairs: dict[str, tuple[Template, Template, int]]):
+        self.pairs, self.inputs = pairs, _JobInputs(conn)
+        self.drafts: dict[tuple, list[str] | EngineError] = {}
+        self.releases: dict[tuple, list[str]] = {}
+
+    def has_draft(self, gear_class: str) -> bool:
+        released, draft, _ = self.pairs[gear_class]
+        return released.hash != draft.hash
+
+    def released(self, gear_class: str) -> Template:
+        return self.pairs[gear_class][0]
+
+    def diff(self, gear_class: str, old: list[str], new: list[str]) -> str:
+        released, _, draft_version = self.pairs[gear_class]
+        return unified_diff(old, new, f"{gear_class} v{released.version} (released)",
+                            f"{gear_class} v{draft_version} (draft)")
+
+    def draft_lines(self, key: tuple) -> list[str] | EngineError:
+        if key not in self.drafts:
+            try:
+                self.drafts[key] = compiled_template(self.pairs[key[0]][1]).run(*self.inputs.of(*key)).lines
+            except EngineError as error:
+                self.drafts[key] = error
+        return self.drafts[key]
+
+    def released_lines(self, key: tuple) -> list[str]:
+        """The released template's lines for the job (none if it fails: every draft line is a change)."""
+        if key not in self.releases:
+            try:
+                self.releases[key] = compiled_template(self.released(key[0])).run(*self.inputs.of(*key)).lines
+            except EngineError:
+                self.releases[key] = []
+        return self.releases[key]
+
+
+def unified_diff(old: list[str], new: list[str], old_label: str, new_label: str) -> str:
+    return "\n".join(difflib.unified_diff(old, new, old_label, new_label, lineterm=""))
+
+
+class _JobInputs:
+    """A stored job's parameters as its template reads them, as engine.programs.remake makes them:
+    a hobbing job's cycle time from its stored feeds, a turning job's moves from its passes."""
+
+    def __init__(self, conn):
+        self.conn, self.machines, self.shapes = conn, {}, {}
+
+    def of(self, gear_class: str, machine_name: str, params_text: str, modules_text: str) -> tuple[dict, dict]:
+        params, modules = json.loads(params_text), json.loads(modules_text or "{}")
+        machine = self.machine(machine_name)
+        if machine.kind == "lathe":
+            from ..turning.model import template_module_params   # the tool paths: only for turning jobs
+
+            return params, template_module_params(params, modules)
+        if "cycle_time" in params:
+            from ..hobbing.machine_job import with_cycle_time
+
+            params = with_cycle_time(params, modules, self.cut_shape(gear_class), machine)
+        return params, modules
+
+    def cut_shape(self, gear_class: str) -> str:
+        if gear_class not in self.shapes:
+            self.shapes[gear_class] = model_for_class(self.conn, gear_class).cut_shape
+        return self.shapes[gear_class]
+
+    def machine(self, name: str):
+        if name not in self.machines:
+            self.machines[name] = load_machine(self.conn, name)
+        return self.machines[name]
