@@ -308,3 +308,22 @@ def test_programs_show_gives_the_record_and_refuses_in_one_line(run):
                         (("--hash", "ffffffffffff"), "no program has"), ((), "one of the two")):
         refused = run("programs", "show", *args)
         assert refused.exit_code == 1 and refused.stderr.count("\n") == 1 and words in refused.stderr, refused.stderr
+
+
+def test_a_role_without_the_right_gets_one_line_and_exit_1(fresh_database_url):
+    """An editor alone (no engine_runner) trying a draft, or a reader instantiating: the database
+    refuses; the user reads which roles may do it, exit 1, and nothing is stored."""
+    import os
+    import subprocess
+    import sys
+
+    import psycopg
+
+    for role, args in (("engine_editor", ["--draft"]), ("engine_reader", [])):
+        environment = dict(os.environ, DATABASE_URL=fresh_database_url, PGOPTIONS=f"-c role={role}")
+        done = subprocess.run([sys.executable, "-m", "engine", "instantiate", "--gear", "42", *args],
+                              capture_output=True, text=True, env=environment)
+        assert done.returncode == 1, done.stderr
+        assert done.stderr.count("\n") == 1 and "engine_runner makes programs" in done.stderr
+    with psycopg.connect(fresh_database_url) as conn:
+        assert conn.execute("SELECT count(*) FROM job").fetchone()[0] == 0

@@ -66,12 +66,23 @@ class EngineGroup(click.Group):
             if ctx.meta.get("traceback"):
                 raise
             first_line = (str(error).strip().splitlines() or [""])[0]
+            if _refused_by_role(error):   # a role without the right: a handled refusal, nothing was stored
+                click.echo(f"error: the database refused this for your role ({first_line}); its transaction was "
+                           "rolled back, nothing stored: ask for the role that may do it (engine_runner makes "
+                           "programs, engine_editor edits templates, engine_releaser releases them)", err=True)
+                ctx.exit(1)
             if _database_failure(error):   # the server, not the engine: exit 1, and say what was kept
                 click.echo(f"error: {_database_failure_message(error, first_line)}", err=True)
                 ctx.exit(1)
             click.echo(f"unexpected error: {type(error).__name__}: {first_line} "
                        "(run with --traceback for details)", err=True)
             ctx.exit(2)
+
+
+def _refused_by_role(error: Exception) -> bool:
+    """The server refused a statement for the session's role (SQLSTATE 42501)."""
+    psycopg = sys.modules.get("psycopg")
+    return psycopg is not None and isinstance(error, psycopg.errors.InsufficientPrivilege)
 
 
 def _database_failure(error: Exception) -> bool:
