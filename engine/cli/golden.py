@@ -27,7 +27,7 @@ def test_command(ctx, gear_class, released, show_coverage, days, as_json):
 
     Example: engine test --class spur --json
     """
-    from ..templates.golden import class_and_descendants
+    from ..templates.store import class_and_descendants
 
     with connection(ctx) as conn:
         classes = class_and_descendants(conn, gear_class) if gear_class else None

@@ -18,10 +18,6 @@ from .versions import runnable_template
 
 TESTS = ("SELECT id, gear_class, name, gear_id, params, choices, expect, description FROM template_test "
          "WHERE %(all)s OR gear_class = ANY(%(classes)s) ORDER BY gear_class, name")
-DESCENDANTS = """
-WITH RECURSIVE tree AS (SELECT name FROM gear_class WHERE name = %s
-                        UNION SELECT g.name FROM gear_class g JOIN tree t ON g.parent = t.name)
-SELECT name FROM tree ORDER BY name"""
 
 
 @dataclass(frozen=True)
@@ -47,14 +43,6 @@ class GoldenResult:
 def load_tests(conn, classes: list[str] | None = None) -> list[GoldenTest]:
     rows = conn.execute(TESTS, {"all": classes is None, "classes": list(classes or [])}).fetchall()
     return [GoldenTest(*row[:6], tuple(row[6]), row[7]) for row in rows]
-
-
-def class_and_descendants(conn, gear_class: str) -> list[str]:
-    """The class and every class derived from it (their templates inherit its rows)."""
-    found = [row[0] for row in conn.execute(DESCENDANTS, (gear_class,))]
-    if not found:
-        raise EngineError(f"gear class {gear_class!r} does not exist; see `engine template list`")
-    return found
 
 
 def run_golden_tests(conn, classes: list[str] | None = None, draft: bool = True) -> list[GoldenResult]:

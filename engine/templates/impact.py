@@ -20,17 +20,10 @@ from ..gears.records import load_machine
 from ..programs.lineage import without_lineage
 from .decision_table import compiled_template
 from .rows import Template
+from .store import class_and_descendants
 from .versions import draft_template, released_template
 
 DIFFS_SHOWN = 5   # unified diffs the CLI prints (all of them with --json)
-
-# The class and its descendants.
-TREE = """
-WITH RECURSIVE tree(name, depth) AS (
-    SELECT name, 0 FROM gear_class WHERE name = %s
-    UNION ALL
-    SELECT g.name, t.depth + 1 FROM gear_class g JOIN tree t ON g.parent = t.name WHERE t.depth < 50)
-SELECT name FROM tree ORDER BY depth, name"""
 
 # Every job of the classes with its latest program, and whether that program came from the
 # released version (class, version, hash) and the job's current parameters.
@@ -78,15 +71,10 @@ class Impact:
                 "failed_jobs": [failure.job_id for failure in self.failures][:1000]}
 
 
-def class_tree(conn, gear_class: str) -> list[str]:
-    """The class and its descendants, nearest first."""
-    return [row[0] for row in conn.execute(TREE, (gear_class,))]
-
-
 def impact(conn, gear_class: str) -> Impact:
     """Every stored job of the class and its descendants made with the draft, compared with the
     released program."""
-    pairs = _template_pairs(conn, class_tree(conn, gear_class))
+    pairs = _template_pairs(conn, class_and_descendants(conn, gear_class))
     report = Impact(gear_class)
     if not pairs:
         return report

@@ -16,8 +16,9 @@ from psycopg.types.json import Jsonb
 
 from ..errors import EngineError
 from .analysis import class_findings
-from .impact import Impact, class_tree, impact
+from .impact import Impact, impact
 from .lint import lint_class
+from .store import class_and_descendants
 from .versions import draft_template
 
 RELEASER_ROLE = "engine_releaser"
@@ -94,14 +95,14 @@ def gate(conn, gear_class: str, draft) -> tuple[list[dict], dict]:
 def _golden_results(conn, gear_class: str) -> list:
     from .golden import run_golden_tests   # the golden tests' language (engine test)
 
-    return run_golden_tests(conn, class_tree(conn, gear_class), draft=True)
+    return run_golden_tests(conn, class_and_descendants(conn, gear_class), draft=True)
 
 
 def drafts_below(conn, gear_class: str) -> list[str]:
     """The descendants whose current rows are not released: the class's change gave them drafts
     (or they had their own), which need their own release."""
     found = []
-    for name in class_tree(conn, gear_class)[1:]:
+    for name in class_and_descendants(conn, gear_class)[1:]:
         try:
             if draft_template(conn, name).draft:
                 found.append(name)

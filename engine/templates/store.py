@@ -64,6 +64,18 @@ def ensure_class(conn, name: str, parent: str | None = None, description: str = 
     return created is not None
 
 
+# The database's own walk down the class tree (migration 0010): the class first, then those below it.
+CLASS_AND_BELOW = "SELECT name FROM classes_and_below(ARRAY[%(class)s]) ORDER BY name <> %(class)s, name"
+
+
+def class_and_descendants(conn, gear_class: str) -> list[str]:
+    """The class, then every class derived from it (their templates inherit its rows)."""
+    found = [row[0] for row in conn.execute(CLASS_AND_BELOW, {"class": gear_class})]
+    if not found:
+        raise EngineError(f"gear class {gear_class!r} does not exist; see `engine template list`")
+    return found
+
+
 def _class_exists(conn, name: str) -> bool:
     return conn.execute("SELECT 1 FROM gear_class WHERE name = %s", (name,)).fetchone() is not None
 
