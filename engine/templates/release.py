@@ -98,17 +98,19 @@ def _golden_results(conn, gear_class: str) -> list:
     return run_golden_tests(conn, class_and_descendants(conn, gear_class), draft=True)
 
 
+# Classes below (not the class itself) with rows whose current version is not the released one.
+DRAFTS_BELOW = """
+SELECT g.name FROM classes_and_below(ARRAY[%(class)s]) b JOIN gear_class g ON g.name = b.name
+WHERE g.name <> %(class)s AND g.template_version IS DISTINCT FROM released_version(g.name)
+  AND EXISTS (SELECT 1 FROM assembled_row r WHERE r.gear_class = g.name)
+ORDER BY g.name"""
+
+
 def drafts_below(conn, gear_class: str) -> list[str]:
     """The descendants whose current rows are not released: the class's change gave them drafts
-    (or they had their own), which need their own release."""
-    found = []
-    for name in class_and_descendants(conn, gear_class)[1:]:
-        try:
-            if draft_template(conn, name).draft:
-                found.append(name)
-        except EngineError:
-            continue   # an inner node without rows has nothing to release
-    return found
+    (or they had their own), which need their own release. An inner node without rows has nothing
+    to release."""
+    return [row[0] for row in conn.execute(DRAFTS_BELOW, {"class": gear_class})]
 
 
 def _record(conn, report: ReleaseReport) -> int:
