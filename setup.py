@@ -1,0 +1,13 @@
+"""The top-level data folders (design notes §3: migrations/, schema/, seed_templates/) ship
+inside the wheel as the package engine_data, which engine.paths finds with importlib.
+Everything else about the project is in pyproject.toml."""
+from setuptools import find_packages, setup
+
+DATA_FOLDERS = {"engine_data.migrations": "migrations", "engine_data.schema": "schema",
+                "engine_data.seed_templates": "seed_templates",
+                "engine_data.seed_templates.classes": "seed_templates/classes"}
+
+setup(packages=find_packages(include=["engine", "engine.*", "importers", "importers.*"]) + list(DATA_FOLDERS),
+      package_dir=DATA_FOLDERS,
+      package_data={"engine": ["py.typed"], **{package: ["*.sql", "*.csv", "*.json", "*.md"]
+                                               for package in DATA_FOLDERS}})
