@@ -1,4 +1,5 @@
-"""`engine refactor` and `engine template shared`: thin shells over engine.library.refactor."""
+"""`engine refactor` (and its intend / intents / unintend) and `engine template shared`: thin
+shells over engine.library.refactor and engine.library.intended."""
 from __future__ import annotations
 
 import sys
@@ -7,15 +8,16 @@ from contextlib import contextmanager
 import click
 
 from .context import connection, emit_json
+from .intended import intend_command, intents_command, unintend_command
 
 
-@click.command("refactor")
+@click.group("refactor", invoke_without_command=True)
 @click.option("--threshold", default=0.8, show_default=True, type=click.FloatRange(0, 1, min_open=True),
               help="Report line pairs of one module type with this similarity or more (Sim < 1).")
 @click.option("--json", "as_json", is_flag=True,
-              help="Print one JSON object: changed, components_before, components_after, shared, "
-                   "near_duplicates (per pair: t, sim, texts a and b, uses_a/uses_b and the first "
-                   "10 class:row uses of each; template_view has them all).")
+              help="Print one JSON object: changed, components_before, components_after, shared, new, "
+                   "known, intended (counts) and near_duplicates (per pair: key, new, t, sim, texts a and "
+                   "b, uses_a/uses_b and the first 10 class:row uses of each; template_view has them all).")
 @click.pass_context
 def refactor_command(ctx, threshold, as_json):
     """Merge identical component bodies and report near-duplicate lines to unify.
@@ -23,7 +25,15 @@ def refactor_command(ctx, threshold, as_json):
     One transaction: every class's assembled template stays exactly as it was (checked
     before commit, else nothing is changed and the class is named), and a second run
     changes nothing. Instantiations go on meanwhile; template writers wait. Meant to run
-    every night (README: cron or a systemd timer); exit code 0 also when nothing changed."""
+    every night (README: cron or a systemd timer); exit code 0 also when nothing changed.
+
+    Pairs no earlier run listed come first, marked new; pairs marked intended (the
+    subcommands) are not listed, only counted. Each pair has a key for `intend`.
+
+    Example: engine refactor --threshold 0.85 --json >> refactor.jsonl
+    """
+    if ctx.invoked_subcommand is not None:
+        return
     from ..library.refactor import refactor
 
     with connection(ctx) as conn, _progress() as progress:
@@ -32,6 +42,10 @@ def refactor_command(ctx, threshold, as_json):
         emit_json(report.as_dict())
     else:
         _print_report(report)
+
+
+for _command in (intend_command, intents_command, unintend_command):
+    refactor_command.add_command(_command)
 
 
 @contextmanager
@@ -56,9 +70,10 @@ def _print_report(report) -> None:
     click.echo(f"refactor: {state}; components {report.components_before} -> "
                f"{report.components_after}, {report.shared} used by two or more classes; "
                f"every class's assembled template unchanged. {len(report.near_duplicates)} "
-               f"near-duplicate pair(s) with similarity >= {report.threshold:g} to unify by hand.")
+               f"near-duplicate pair(s) with similarity >= {report.threshold:g} to unify by hand "
+               f"({report.new} new, {report.known} known; {report.intended} marked intended, not listed).")
     for pair in report.near_duplicates:
-        click.echo(f"\n  {pair['t']}  Sim {pair['sim']:.3f}")
+        click.echo(f"\n  {'NEW ' if pair['new'] else ''}{pair['key']}  {pair['t']}  Sim {pair['sim']:.3f}")
         click.echo(f"    {pair['a']}   ({_uses(pair['rows_a'], pair['uses_a'])})")
         click.echo(f"    {pair['b']}   ({_uses(pair['rows_b'], pair['uses_b'])})")
 

@@ -2,7 +2,8 @@
 
 One transaction: identical component bodies are merged (found by hashing, linear), the
 near-duplicates a human should unify are reported (engine.library.similarity, within one module
-type), and the invariants are checked before commit — lossless (every class's assembled
+type; those not listed by an earlier run first, those marked intended only counted:
+engine.library.intended), and the invariants are checked before commit — lossless (every class's assembled
 template unchanged, compared by a digest the server computes per class), stored once (no
 two components with the same body).
 """
@@ -15,6 +16,7 @@ import psycopg
 
 from ..errors import EngineError
 from ..templates.store import load_template
+from .intended import list_and_remember
 from .similarity import Units, nc_units, similar_pairs
 
 # Concurrent instantiations read either the old or the new library: writers wait for us,
@@ -82,13 +84,17 @@ class RefactorReport:
     components_before: int
     components_after: int
     shared: int
-    near_duplicates: list[dict] = field(default_factory=list)
+    near_duplicates: list[dict] = field(default_factory=list)   # listed: new ones first
     threshold: float = 0.8
+    new: int = 0         # listed pairs no earlier run listed
+    known: int = 0       # listed pairs an earlier run listed
+    intended: int = 0    # pairs found but not listed: marked intended (engine refactor intents)
 
     def as_dict(self) -> dict:
         return {"changed": self.changed, "components_before": self.components_before,
                 "components_after": self.components_after, "shared": self.shared,
-                "threshold": self.threshold, "near_duplicates": self.near_duplicates}
+                "threshold": self.threshold, "new": self.new, "known": self.known, "intended": self.intended,
+                "near_duplicates": self.near_duplicates}
 
 
 def refactor(conn, threshold: float = 0.8, progress=None) -> RefactorReport:
@@ -117,13 +123,14 @@ def _refactor_once(conn, threshold: float, step) -> RefactorReport:
         repointed = conn.execute(REPOINT_DUPLICATES).rowcount
         deleted = conn.execute(DELETE_UNUSED).rowcount
         step()
-        pairs = near_duplicates(conn, threshold)
+        listed = list_and_remember(conn, near_duplicates(conn, threshold))
         step()
         check_invariants(conn, snapshot)
         return RefactorReport(changed=bool(repointed or deleted), components_before=before,
                               components_after=_count_components(conn),
                               shared=conn.execute(COMPONENTS_SHARED).fetchone()[0],
-                              near_duplicates=pairs, threshold=threshold)
+                              near_duplicates=listed.pairs, threshold=threshold,
+                              new=listed.new, known=listed.known, intended=listed.intended)
 
 
 def _stepper(progress):
