@@ -118,6 +118,24 @@ def test_roles_editors_mark_readers_do_not_runners_remember(conn):
         conn.execute("UPDATE near_duplicate_intended SET why = 'rewritten'")
 
 
+def test_texts_that_are_lines_of_two_module_types_need_the_type(conn):
+    ensure_class(conn, "two_types")
+    replace_template(conn, "two_types", [TemplateRow(row_id, t, 1, None, None, text, None)
+                                         for row_id, t, text in ((100, "main", '"G0 X1 Z5"'),
+                                                                 (110, "main", '"G0 X1 Z6"'),
+                                                                 (1200, "prep", '"G0 X1 Z5"'),
+                                                                 (1210, "prep", '"G0 X1 Z6"'))])
+    with pytest.raises(EngineError, match="module types main, prep; choose one with --type"):
+        intend(conn, "notes", texts=('"G0 X1 Z5"', '"G0 X1 Z6"'))
+    mark = intend(conn, "notes", texts=('"G0 X1 Z5"', '"G0 X1 Z6"'), t="prep")
+    assert mark.t == "prep"
+    with pytest.raises(EngineError, match="module type 'sync'"):
+        intend(conn, "notes", texts=('"G0 X1 Z5"', '"G0 X1 Z6"'), t="sync")
+    listed = refactor(conn, threshold=0.5)
+    assert [pair["t"] for pair in listed.near_duplicates if texts(pair) == {'"G0 X1 Z5"', '"G0 X1 Z6"'}] == ["main"]
+    assert listed.intended == 1
+
+
 @pytest.mark.parametrize("why, key, pair_texts, words", [
     ("   ", None, (Y_COUPLING, Z_COUPLING), "--why is empty"),
     ("ok", "0123456789ab", None, "not among the pairs a refactor run reported"),

@@ -191,7 +191,7 @@ def _pair_of_texts(conn, texts: tuple[str, str] | None, t: str | None) -> tuple[
 
 def _module_type(conn, a: str, b: str, t: str | None) -> str:
     types = [found for (found,) in conn.execute(TYPES_OF_BOTH, (a, b))]
-    if t is not None and t not in types or not types:
+    if not types or (t is not None and t not in types):
         where = f"module type {t!r}" if t is not None else "one module type"
         raise EngineError(f"the texts {a!r} and {b!r} are not both lines of {where} in the library; "
                           "copy them from the refactor report (the o column of template_view)")
