@@ -6,7 +6,7 @@ linear growth means a ratio of 10. Also printed: the time per line, and the larg
 the 10 s of issue 13.
 
 The programs are what a CAM system writes for a hob: every block numbered (so no two lines are
-alike, as in data/nc/sinumerik/cam_840dsl), plunges, axial passes and shifts of Y with
+alike, as in tests/data/nc/sinumerik/cam_840dsl), plunges, axial passes and shifts of Y with
 coordinates to three decimals, comments, R parameters and the electronic gearbox; the job's
 feed, speeds, depth and shift are parameters, so about one number in five becomes a reference.
 Each import is committed (the version snapshot and audit are written at COMMIT) into a copy of the

@@ -26,7 +26,7 @@ class NameRule:
         return isinstance(name, str) and re.fullmatch(self.pattern, name, re.ASCII) is not None
 
 
-# 840D program names (reference/hobbing.md §A1): letters, digits and _; the first two
+# 840D program names (docs/reference/hobbing.md §A1): letters, digits and _; the first two
 # characters letters, or _ and a letter; at most 24 characters. The NC does not tell upper
 # from lower case, so two names differing only in case are one program (engine.programs.outputs).
 # Comments: `;` ends an 840D block's code and `(` `)` delimit an ISO comment, so neither may

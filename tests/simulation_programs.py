@@ -1,5 +1,5 @@
 """Hand-written hobbing programs for the simulation tests, every value computed here from the
-reference (shared/reference/hobbing.md §A5, §A7, §B) and the gear, hob and machine records,
+reference (docs/reference/hobbing.md §A5, §A7, §B) and the gear, hob and machine records,
 never from the engine: the program a careful programmer would write, and its mistakes."""
 from __future__ import annotations
 

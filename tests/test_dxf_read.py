@@ -4,7 +4,7 @@ generated here in the seed-000 convention, and the refusals a user must understa
 Expectations come from the files themselves (counted with ezdxf here), from the
 reference (§E: positive bulge = counter-clockwise, extrusion (0,0,-1) flips an arc), from
 ezdxf's own bulge geometry, and from the NC programs another lathe tool made of the Emco
-drawings (data/nc/emco_from_dxf) — not from the reader's output."""
+drawings (tests/data/nc/emco_from_dxf) — not from the reader's output."""
 from __future__ import annotations
 
 import math

@@ -1,5 +1,5 @@
 """The geometry of the programs of every gear class (issue 3), checked against formulas of
-reference/hobbing.md computed here from the gear, hob and machine rows read with SQL, and
+docs/reference/hobbing.md computed here from the gear, hob and machine rows read with SQL, and
 read with tests/nc_reader.py (no engine code reads the programs).
 
 Seeded gears: 50 the paper's taper gear (m2 z19 d_a 42.5 δ 6.5° 40Cr grade 7), 51 crowned

@@ -1,7 +1,7 @@
 """The hobbing program conventions of design notes §7 (Contract) on the seeded gears.
 
 Every expected number is computed here, independently of the engine, from the formulas
-of the reference (shared/reference/hobbing.md §A5, §B) and the data in the gear, hob and
+of the reference (docs/reference/hobbing.md §A5, §B) and the data in the gear, hob and
 machine tables (read with SQL). The programs are read with tests/nc_reader.py, which
 shares no code with engine.programs.verifier.
 

@@ -2,7 +2,7 @@
 
 Programs are made through the public library function (engine.programs.instantiate.instantiate_gear)
 and the CLI, for gears, hobs and a machine inserted here, and read with tests/hobbing_reference.py;
-the checks (tests/hobbing_checks.py) compute every expected number from shared/reference/hobbing.md
+the checks (tests/hobbing_checks.py) compute every expected number from docs/reference/hobbing.md
 §A5, §A7, §B, §C and design notes §7:
 
 * EGON B ratio −h_hob·z0 : z2, helical Z factor −h_gear·360 sinβ/(π mn z2), swivel A = h_hob·γ − h_gear·β,

@@ -1,4 +1,4 @@
-"""Importing proven NC programs as standard code: the real files of data/nc (LinuxCNC
+"""Importing proven NC programs as standard code: the real files of tests/data/nc (LinuxCNC
 plasmac imperial/metric pairs, lathe macros, a Sinumerik CAM program, EMCO tapes) come
 back byte for byte after import → export → instantiate with the same parameters; numbers
 equal to a parameter become references (never G/M numbers); lines get modules.
@@ -9,7 +9,6 @@ is of the exact bytes."""
 from __future__ import annotations
 
 import json
-import os
 from decimal import Decimal
 from pathlib import Path
 
@@ -31,7 +30,7 @@ from engine.templates.store import ensure_class, load_template, replace_template
 
 from shared_data import shared_data
 
-DATA = Path(os.environ["NC_DATA_DIR"]) if os.environ.get("NC_DATA_DIR") else shared_data() / "nc"
+DATA = shared_data() / "nc"
 FAMILY = "linuxcnc/plasmac_family/"
 MACROS = "linuxcnc/lathe_macros/"
 
@@ -63,8 +62,7 @@ PARAMS = {
 
 
 def real_files():
-    if not DATA.is_dir():
-        pytest.skip(f"real NC files not found in {DATA} (set NC_DATA_DIR)")
+    assert DATA.is_dir(), f"the real NC files are missing: {DATA} (tests/data/README.md)"
     found = sorted(str(p.relative_to(DATA)) for p in DATA.rglob("*") if p.is_file() and p.suffix != ".tsv")
     assert set(found) == set(PARAMS), "a real file without parameters in PARAMS (or one gone)"
     return found

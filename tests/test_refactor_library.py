@@ -1,5 +1,5 @@
 """The nightly refactor (design notes §5) on a library a gear shop really has: every real NC
-program of the shared data (plasmac imperial/metric pairs, lathe macros, CAM and EMCO
+program of tests/data (plasmac imperial/metric pairs, lathe macros, CAM and EMCO
 programs) imported next to the seeded gear classes. Checked: the refactor is lossless
 (every class's export byte-identical, every imported class still instantiates to its
 file's bytes), merges the copies a DBA's SQL edits leave (each body stored once

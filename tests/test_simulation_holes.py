@@ -1,7 +1,7 @@
 """Wrong hobbing programs the simulation used to let through (issue 14's adversary), each
 hand-written for gear 43 (helical m3 z41 β15 R) and hob H-M3-AA-R1 (R, Ø80, L120) in the style
 of tests/simulation_programs.py, with every expected number from the reference
-(shared/reference/hobbing.md §B8, §B15, §C): each is refused on the line that makes it."""
+(docs/reference/hobbing.md §B8, §B15, §C): each is refused on the line that makes it."""
 from __future__ import annotations
 
 import math

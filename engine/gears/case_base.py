@@ -7,7 +7,7 @@ Distance d = Σ weight·|case − query|/scale over numeric features + Σ weight
 over categorical ones; a value missing on either side counts as a full mismatch (1).
 Cases transfer to this gear and hob through what carries over between hobs and gears: the
 cutting speed v = π·d_a0·n0/1000 and the feeds per workpiece revolution f = v_f/(n0·z0/z2)
-(reference/hobbing.md §B4, §B5).
+(docs/reference/hobbing.md §B4, §B5).
 """
 from __future__ import annotations
 

@@ -3,7 +3,7 @@
 For each cut kind the nearest past cuts (weighted distance over gear and hob features) are
 transferred to this gear and hob through what carries over between hobs and gears: the
 cutting speed v = π·d_a0·n0/1000 and the feeds per workpiece revolution f = v_f/(n0·z0/z2)
-(reference/hobbing.md §B4, §B5). Proposals are checked against the typical ranges of §C.
+(docs/reference/hobbing.md §B4, §B5). Proposals are checked against the typical ranges of §C.
 """
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Cutting data for a hobbing job: hob speed and feeds (reference/hobbing.md §B4–B5, §C).
+"""Cutting data for a hobbing job: hob speed and feeds (docs/reference/hobbing.md §B4–B5, §C).
 
 Defaults come from the typical-practice table of the reference (to be calibrated with the
 shop's own history); any value can be overridden per job.
@@ -24,7 +24,7 @@ AXIAL_FEED = ((1.0, 1.5, 0.8), (2.0, 2.5, 1.2), (3.0, 3.0, 1.5), (float("inf"), 
 RADIAL_TO_AXIAL = 0.35   # radial infeed (in air) per workpiece revolution, relative to f_a
 
 # The most axial feed f_a [mm per workpiece revolution] a cut may take, by module: the upper end
-# of the typical ranges of reference/hobbing.md §C (single-start hob, steel, wet; typical practice
+# of the typical ranges of docs/reference/hobbing.md §C (single-start hob, steel, wet; typical practice
 # [K], calibrate with the shop's history). (module, roughing maximum, finishing maximum), modules
 # ascending; between two rows interpolated linearly, below the first and above the last row the
 # end row holds. A single cut is a rough cut. Cases carry feeds from other modules (the paper's

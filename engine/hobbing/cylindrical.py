@@ -1,5 +1,5 @@
 """Hobbing model of cylindrical gears (spur and helical): the parameters their standard
-code needs. Formulas: reference/hobbing.md §B. The other classes' models derive from it."""
+code needs. Formulas: docs/reference/hobbing.md §B. The other classes' models derive from it."""
 from __future__ import annotations
 
 from dataclasses import dataclass

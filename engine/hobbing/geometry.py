@@ -1,4 +1,4 @@
-"""Hobbing geometry (reference/hobbing.md §B). Lengths in mm, angles in degrees. The signed
+"""Hobbing geometry (docs/reference/hobbing.md §B). Lengths in mm, angles in degrees. The signed
 quantities (swivel, coupling factors) are engine.hobbing.conventions."""
 from __future__ import annotations
 

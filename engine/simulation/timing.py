@@ -1,4 +1,4 @@
-"""The cycle time (the definition the models print in the header, shared brief): over the
+"""The cycle time (the definition the models print in the header, docs/design.md §7): over the
 blocks in order, a G1 takes √(ΔX²+ΔY²+ΔZ²)/F (G94, mm/min), a G0 max(|ΔX|,|ΔY|,|ΔZ|)/rapid
 rate (each axis at the rapid rate), `G4 F<s>` s seconds; rotary-only and non-motion blocks
 nothing. Program values: the program starts at the machine's load position where the record
