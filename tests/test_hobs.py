@@ -320,7 +320,7 @@ def test_match_names_the_hob_of_the_seeded_gear_42(run):
     assert result.stdout.splitlines()[0] == "gear 42: hob H-M2-AA-R1"
     assert "class AA (grade 7 needs AA or better)" in result.stdout
     shifted = json.loads(run("hobs", "match", "--gear", 42, "--shift-travel", 20, "--json").stdout)
-    assert shifted["hob"] == "H-M2-AA-R1" and f"{GENERATING_M2 + 30:.1f} needed" in shifted["reason"]
+    assert shifted["hob_id"] == "H-M2-AA-R1" and f"{GENERATING_M2 + 30:.1f} needed" in shifted["reason"]
 
 
 def test_match_says_which_property_no_hob_has(run):
