@@ -1795,3 +1795,10 @@ GRANT SELECT ON near_duplicate_seen, near_duplicate_intended
 GRANT INSERT (pair_key, t, a, b, why), UPDATE (withdrawn_at) ON near_duplicate_intended TO engine_editor;
 GRANT USAGE ON SEQUENCE near_duplicate_intended_id_seq TO engine_editor;
 GRANT INSERT, UPDATE (last_seen) ON near_duplicate_seen TO engine_runner;
+-- --- gears: when each was stored (migration 0017) ----------------------------------------------
+
+-- When a gear was stored (issue 16: `engine gears list --since/--until`): set by the database
+-- on insert; an import that updates a gear keeps the first date. NULL for gears stored before
+-- this migration (their date is unknown, and no date is invented for them).
+ALTER TABLE gear ADD COLUMN created_at timestamptz;
+ALTER TABLE gear ALTER COLUMN created_at SET DEFAULT now();

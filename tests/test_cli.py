@@ -189,7 +189,11 @@ def test_template_list_counts_each_class_s_own_and_inherited_rows(run):
     with psycopg.connect(run.url) as conn:
         expected = dict(conn.execute("SELECT g.name, (SELECT count(*) FROM class_template(g.name)) "
                                      "FROM gear_class g").fetchall())
-    listed = {line.split()[0]: line for line in result.stdout.splitlines() if line.strip()}
+    lines = result.stdout.splitlines()
+    assert lines[0].split() == ["class", "parent", "version", "rows", "description"]
+    listed = {line.split()[0]: line.split() for line in lines[1:]}
     assert expected["duplex"] > expected["spur"] > 0
     for name in ("spur", "duplex", "helical", "worm_wheel"):
-        assert f"{expected[name]} rows" in listed[name], listed[name]
+        assert listed[name][3] == str(expected[name]), listed[name]
+    as_json = json.loads(run("template", "list", "--json").stdout)["classes"]
+    assert {record["class"]: record["rows"] for record in as_json} == expected

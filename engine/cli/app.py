@@ -20,6 +20,7 @@ from .gears import classify, gears
 from .golden import test_command
 from .hobs import hobs
 from .instantiate import instantiate
+from .jobs import jobs
 from .nc_import import import_nc_command
 from .programs import programs
 from .refactor import refactor_command
@@ -124,7 +125,7 @@ def main(ctx, database_url, traceback):
 
 COMMANDS = (demo, db, seed_command, gears, classify, instantiate, explain, template, lint, hobs, suggest, cases,
             import_nc_command, refactor_command, import_dxf_command, plot_command, simulate, programs,
-            test_command)
+            test_command, jobs)
 
 
 def _register(group: click.Group, commands) -> None:

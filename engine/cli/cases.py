@@ -4,6 +4,7 @@ from __future__ import annotations
 import click
 
 from .context import connection, emit_json
+from .output import Column, emit_list, list_options
 
 CASE_TABLE_COLUMNS = {   # column -> heading, for the small tables printed
     "id": "case", "distance": "distance", "module": "m", "teeth": "z", "material": "material", "hardness": "HB",
@@ -11,6 +12,8 @@ CASE_TABLE_COLUMNS = {   # column -> heading, for the small tables printed
     "hob_tip_diameter": "da0", "cut": "cut", "hob_speed": "n0", "axial_feed": "axial", "radial_feed": "radial",
     "source": "source",
 }
+CASE_LIST_COLUMNS = tuple(Column(heading, "case_id" if key == "id" else key)
+                          for key, heading in CASE_TABLE_COLUMNS.items() if key != "distance")
 
 
 @click.command()
@@ -77,18 +80,18 @@ def cases():
 
 
 @cases.command("list")
-@click.option("--json", "as_json", is_flag=True, help="Print one JSON object: {cases: [...]}.")
+@list_options("cases")
 @click.pass_context
-def cases_list(ctx, as_json):
-    """List every cutting case: gear and hob features, cut, n0 r/min, feeds mm/min, source."""
-    from ..gears.cases import list_cases
+def cases_list(ctx, output):
+    """List every cutting case: gear and hob features, cut, n0 r/min, feeds mm/min, source.
+
+    Example: engine cases list --csv
+    """
+    from ..gears.cases import case_records
 
     with connection(ctx) as conn:
-        history = list_cases(conn)
-    if as_json:
-        emit_json({"cases": _records(history.drop(columns="created_at"))})
-    else:
-        click.echo(_table(history) if len(history) else "no cases in the history")
+        history = case_records(conn)
+    emit_list(output, "cases", CASE_LIST_COLUMNS, history)
 
 
 @cases.command("confirm")

@@ -4,11 +4,16 @@ from __future__ import annotations
 import click
 
 from .context import connection, emit_json
+from .gear_records import GEAR_RECORD_COMMANDS
 
 
 @click.group()
 def gears():
     """Workpieces: import them from CSV (columns of design notes §9)."""
+
+
+for _command in GEAR_RECORD_COMMANDS:   # list, show, delete: engine.cli.gear_records
+    gears.add_command(_command)
 
 
 @gears.command("import")

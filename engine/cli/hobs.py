@@ -1,4 +1,4 @@
-"""`engine hobs …`: the hob library (list, add, import, match)."""
+"""`engine hobs …`: the hob library (list, show, add, import, delete, match)."""
 from __future__ import annotations
 
 from dataclasses import asdict
@@ -6,43 +6,78 @@ from dataclasses import asdict
 import click
 
 from .context import connection, emit_json
+from .output import Column, emit_list, fields_text, list_options, section_text
 
-TABLE = (  # (heading, width, the cell of a hob)
-    ("id", 14, lambda hob: hob.id),
-    ("module", 6, lambda hob: f"{hob.module:g}"),
-    ("α", 4, lambda hob: f"{hob.pressure_angle:g}"),
-    ("starts", 6, lambda hob: str(hob.starts)),
-    ("da0", 6, lambda hob: f"{hob.tip_diameter:g}"),
-    ("length", 6, lambda hob: f"{hob.length:g}"),
-    ("hand", 4, lambda hob: hob.hand),
-    ("class", 5, lambda hob: hob.accuracy_class),
-    ("material", 8, lambda hob: hob.material),
-    ("coating", 7, lambda hob: hob.coating),
-    ("purpose", 0, lambda hob: hob.purpose),
+HOB_COLUMNS = (
+    Column("id", "hob_id"), Column("module", "module"), Column("α", "pressure_angle"), Column("starts", "starts"),
+    Column("da0", "tip_diameter"), Column("length", "length"), Column("hand", "hand"),
+    Column("class", "accuracy_class"), Column("material", "material"), Column("coating", "coating"),
+    Column("purpose", "purpose"), Column("T", "tool_number"),
 )
+HOB_FIELDS = (
+    Column("hob", "hob_id"), Column("module", "module"), Column("pressure angle", "pressure_angle"),
+    Column("starts", "starts"), Column("tip diameter", "tip_diameter"), Column("length", "length"),
+    Column("hand", "hand"), Column("accuracy class", "accuracy_class"), Column("material", "material"),
+    Column("coating", "coating"), Column("purpose", "purpose"), Column("tool number", "tool_number"),
+)
+JOB_COLUMNS = (Column("job", "job_id"), Column("gear", "gear_id"), Column("class", "class"),
+               Column("machine", "machine"), Column("made", "created_at"))
 
 
 @click.group("hobs")
 def hobs():
-    """Hob library: list, add, import from CSV, and match a hob to a gear."""
+    """Hob library: list, show, add, import from CSV, delete, and match a hob to a gear."""
 
 
 @hobs.command("list")
-@click.option("--json", "as_json", is_flag=True, help="Print one JSON object: {hobs: [...]}.")
+@list_options("hobs")
 @click.pass_context
-def hobs_list(ctx, as_json):
-    """Every hob of the library, one line each (module, α, starts, da0, length, hand, class, ...)."""
-    from ..gears.hob_library import list_hobs
+def hobs_list(ctx, output):
+    """Every hob of the library, one line each (module, α, starts, da0, length, hand, class, ...).
+
+    Example: engine hobs list --csv
+    """
+    from ..gears.hob_records import hob_records
 
     with connection(ctx) as conn:
-        library = list_hobs(conn)
+        library = hob_records(conn)
+    emit_list(output, "hobs", HOB_COLUMNS, library)
+
+
+@hobs.command("show")
+@click.argument("hob_id")
+@click.option("--json", "as_json", is_flag=True, help="Print one JSON line: {\"hob\": {..., jobs}}.")
+@click.pass_context
+def hobs_show(ctx, hob_id, as_json):
+    """One hob as stored (its id in any case) and the jobs that use it.
+
+    Example: engine hobs show H-M2-AA-R1
+    """
+    from ..gears.hob_records import hob_details
+
+    with connection(ctx) as conn:
+        hob = hob_details(conn, hob_id)
     if as_json:
-        emit_json({"hobs": [asdict(hob) for hob in library]})
+        emit_json({"hob": hob})
         return
-    click.echo(" ".join(f"{heading:{width}}" for heading, width, _ in TABLE).rstrip())
-    for hob in library:
-        click.echo(" ".join(f"{cell(hob):{width}}" for _, width, cell in TABLE).rstrip())
-    click.echo(f"{len(library)} hob(s)", err=True)
+    click.echo(fields_text(HOB_FIELDS, hob))
+    click.echo(section_text("jobs", JOB_COLUMNS, hob["jobs"]))
+
+
+@hobs.command("delete")
+@click.argument("hob_id")
+@click.option("--yes", is_flag=True, help="Delete it (without: say what would be deleted, exit 1).")
+@click.pass_context
+def hobs_delete(ctx, hob_id, yes):
+    """Delete a hob no job refers to.
+
+    Example: engine hobs delete H-M5-B-L1 --yes
+    """
+    from ..gears.hob_records import delete_hob
+
+    with connection(ctx) as conn:
+        deleted = delete_hob(conn, hob_id, yes)
+    click.echo(f"deleted {deleted}")
 
 
 @hobs.command("add")
@@ -96,7 +131,7 @@ def hobs_import(ctx, csv_file, as_json):
               help="Hob shift the job will use, mm (the hob must be this much longer).")
 @click.option("--purpose", type=click.Choice(["cylindrical", "worm_wheel"]),
               help="Hob purpose (default: worm_wheel for worm-wheel classes, else cylindrical).")
-@click.option("--json", "as_json", is_flag=True, help="Print one JSON object: {gear, hob, reason}.")
+@click.option("--json", "as_json", is_flag=True, help="Print one JSON line: {gear_id, hob_id, reason}.")
 @click.pass_context
 def hobs_match(ctx, gear_id, shift_travel, purpose, as_json):
     """The hob the engine would choose for a gear, and why (or which property no hob has)."""
@@ -105,7 +140,7 @@ def hobs_match(ctx, gear_id, shift_travel, purpose, as_json):
     with connection(ctx) as conn:
         choice = match_hob(conn, gear_id, purpose=purpose, shift_travel=shift_travel)
     if as_json:
-        emit_json({"gear": gear_id, "hob": choice.hob.id, "reason": choice.reason})
+        emit_json({"gear_id": gear_id, "hob_id": choice.hob.id, "reason": choice.reason})
     else:
         click.echo(f"gear {gear_id}: hob {choice.hob.id}")
         click.echo(f"  {choice.reason}")

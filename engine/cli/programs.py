@@ -1,9 +1,19 @@
-"""`engine programs …`: stored programs, found by id or by the hash on their lineage line."""
+"""`engine programs …`: stored programs, listed by filters, or found by id or by the hash on their
+lineage line."""
 from __future__ import annotations
 
 import click
 
 from .context import connection, emit_json
+from .output import Column, day, day_options, emit_list, list_options
+
+PROGRAM_COLUMNS = (
+    Column("program", "program_id"), Column("name", "name"), Column("job", "job_id"), Column("gear", "gear_id"),
+    Column("class", "class"), Column("version", "template_version"), Column("draft", "draft"),
+    Column("template", "template_hash", lambda digest: digest[:8]),
+    Column("input", "input_hash", lambda digest: (digest or "-")[:8]),
+    Column("lines", "line_count"), Column("stored", "created_at"),
+)
 
 RECORD_FIELDS = (  # (label, the value of a ProgramRecord)
     ("program", lambda record: record.id),
@@ -21,14 +31,37 @@ RECORD_FIELDS = (  # (label, the value of a ProgramRecord)
 
 @click.group("programs")
 def programs():
-    """Stored programs: show one by id, or find it from the hash on its lineage line."""
+    """Stored programs: list them, show one by id, or find it from the hash on its lineage line."""
+
+
+@programs.command("list")
+@click.option("--class", "gear_class", help="Only programs of this class.")
+@click.option("--gear", "gear_id", type=int, help="Only programs made for this gear.")
+@click.option("--job", "job_id", type=int, help="Only programs made from this job.")
+@click.option("--draft/--released", default=None,
+              help="Only programs made from a draft version (for trying), or only from released ones.")
+@day_options("programs stored")
+@list_options("programs")
+@click.pass_context
+def programs_list(ctx, gear_class, gear_id, job_id, draft, since, until, output):
+    """The programs stored, one line each: name, job, gear, class, template version and hash,
+    draft or released, number of lines, when stored (the text: `engine programs show ID`).
+
+    Example: engine programs list --gear 42 --released --since 2026-11-01
+    """
+    from ..programs.lookup import list_programs
+
+    with connection(ctx) as conn:
+        found = list_programs(conn, gear_class, gear_id, job_id, draft, day(since), day(until))
+    emit_list(output, "programs", PROGRAM_COLUMNS, found)
 
 
 @programs.command("show")
 @click.argument("program_id", type=int, required=False)
 @click.option("--hash", "prefix", metavar="H",
               help="8 or more hex digits of the INPUT or TEMPLATE hash on a program's lineage line; lists every match.")
-@click.option("--json", "as_json", is_flag=True, help="Print one JSON object: {programs: [{id, job_id, ..., lines}]}.")
+@click.option("--json", "as_json", is_flag=True,
+              help="Print one JSON line: {programs: [{program_id, job_id, gear_id, class, ..., lines}]}.")
 @click.pass_context
 def programs_show(ctx, program_id, prefix, as_json):
     """Show a stored program's record and its lines, by PROGRAM_ID or by --hash.

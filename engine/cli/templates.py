@@ -7,8 +7,12 @@ import sys
 import click
 
 from .context import connection, emit_json
+from .output import Column, emit_list, list_options
 from .refactor import template_shared
 from .release import template_release
+
+CLASS_COLUMNS = (Column("class", "class"), Column("parent", "parent"), Column("version", "template_version"),
+                 Column("rows", "rows"), Column("description", "description"))
 
 
 @click.group()
@@ -22,14 +26,18 @@ template.add_command(template_release)  # the gate between a draft and the shop 
 
 
 @template.command("list")
+@list_options("classes")
 @click.pass_context
-def template_list(ctx):
-    """Every gear class with its parent, template version and number of rows."""
-    from ..templates.store import list_classes
+def template_list(ctx, output):
+    """Every gear class with its parent, template version and number of rows (its own and inherited).
+
+    Example: engine template list --json
+    """
+    from ..templates.store import class_records
 
     with connection(ctx) as conn:
-        for name, parent, version, rows, description in list_classes(conn):
-            click.echo(f"{name:14} parent={parent or '-':12} v{version:<3} {rows:3} rows  {description}")
+        classes = class_records(conn)
+    emit_list(output, "classes", CLASS_COLUMNS, classes)
 
 
 @template.command("export")

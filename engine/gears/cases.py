@@ -15,6 +15,7 @@ import pandas as pd
 import psycopg
 from psycopg import sql
 
+from ..db.listing import records
 from ..errors import EngineError
 from ..paths import SEED_DIR
 from .case_base import CASE_COLUMNS, CUT_KINDS, CaseBase, KindProposal, feeds_per_minute, feeds_per_rev
@@ -65,6 +66,18 @@ class Suggestion:
 
     def case_ids(self, cut_kinds=CUT_KINDS) -> list[int]:
         return [case_id for cut in cut_kinds for case_id in self.proposals[cut].case_ids]
+
+
+CASE_RECORDS = """
+SELECT id AS case_id, module, teeth, material, hardness, quality_grade, hob_material, hob_coating, hob_starts,
+       hob_tip_diameter, cut, hob_speed, axial_feed, radial_feed, source, job_id, created_at
+FROM cutting_case ORDER BY id"""
+
+
+def case_records(conn) -> list[dict]:
+    """The machining history as a person looks into it (`engine cases list`): one record per case,
+    its id under case_id, numbers as floats."""
+    return records(conn.execute(CASE_RECORDS))
 
 
 def list_cases(conn) -> pd.DataFrame:

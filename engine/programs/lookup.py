@@ -1,12 +1,14 @@
 """A stored program found from what an operator has in hand (`engine programs show`): its id, or
 the hash on its lineage line (engine.programs.lineage) read off a file on the control, the INPUT
-hash of the job's parameters or the TEMPLATE hash of the version it was made from."""
+hash of the job's parameters or the TEMPLATE hash of the version it was made from; and the
+programs stored, filtered (`engine programs list`)."""
 from __future__ import annotations
 
 import re
 from dataclasses import asdict, dataclass
-from datetime import datetime
+from datetime import date, datetime
 
+from ..db.listing import day_range, records, require_class
 from ..errors import EngineError
 
 MIN_HASH_DIGITS = 8   # what the lineage line shows
@@ -40,7 +42,10 @@ class ProgramRecord:
     lines: list[str]
 
     def as_dict(self) -> dict:
-        return {**asdict(self), "created_at": self.created_at.isoformat()}
+        """The record with the common key names (program_id, class) and its lines."""
+        fields = asdict(self)
+        return {"program_id": fields.pop("id"), "class": fields.pop("gear_class"), **fields,
+                "created_at": self.created_at.isoformat()}
 
 
 def find_programs(conn, program_id: int | None = None, prefix: str | None = None) -> list[ProgramRecord]:
@@ -76,3 +81,25 @@ def checked_prefix(text: str) -> str:
         raise EngineError(f"--hash {text!r}: give {MIN_HASH_DIGITS} or more hex digits, as on the program's "
                           "lineage line (`; PROGRAM <id> TEMPLATE <class> v<n> <hash8> INPUT <hash8>`)")
     return prefix
+
+
+LIST_PROGRAMS = """
+SELECT p.id AS program_id, p.name, p.job_id, j.gear_id, p.gear_class AS class, p.template_version, p.draft,
+       p.template_hash, p.input_hash, cardinality(p.lines) AS line_count, p.stored_by, p.created_at
+FROM program p JOIN job j ON j.id = p.job_id
+WHERE (%(class)s::text IS NULL OR p.gear_class = %(class)s)
+  AND (%(gear)s::int IS NULL OR j.gear_id = %(gear)s)
+  AND (%(job)s::bigint IS NULL OR p.job_id = %(job)s)
+  AND (%(draft)s::boolean IS NULL OR p.draft = %(draft)s)
+  AND (%(since)s::date IS NULL OR p.created_at >= %(since)s::date)
+  AND (%(until)s::date IS NULL OR p.created_at < %(until)s::date + 1)
+ORDER BY p.id"""
+
+
+def list_programs(conn, gear_class: str | None = None, gear_id: int | None = None, job_id: int | None = None,
+                  draft: bool | None = None, since: date | None = None, until: date | None = None) -> list[dict]:
+    """Every program matching all filters given (None: any), by id: its record without its lines.
+    draft True: made from a draft version (for trying only); False: from a released one."""
+    require_class(conn, gear_class)
+    filters = {"class": gear_class, "gear": gear_id, "job": job_id, "draft": draft, **day_range(since, until)}
+    return records(conn.execute(LIST_PROGRAMS, filters))

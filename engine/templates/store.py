@@ -10,6 +10,7 @@ from dataclasses import asdict
 
 from psycopg.types.json import Jsonb
 
+from ..db.listing import records
 from ..errors import EngineError
 from ..names import checked
 from .checks import check_rows
@@ -44,12 +45,12 @@ def load_template(conn, gear_class: str) -> Template:
     return Template(gear_class, found[0][0], rows, load_translations(conn, rows))
 
 
-def list_classes(conn) -> list[tuple]:
-    """(name, parent, template_version, row count, description) of every class."""
-    return conn.execute("""
-        SELECT g.name, g.parent, g.template_version, count(r.id)::int, g.description
+def class_records(conn) -> list[dict]:
+    """Every class by name: its parent, template version, row count (own and inherited), description."""
+    return records(conn.execute("""
+        SELECT g.name AS class, g.parent, g.template_version, count(r.id)::int AS rows, g.description
         FROM gear_class g LEFT JOIN assembled_row r ON r.gear_class = g.name
-        GROUP BY g.name ORDER BY g.name""").fetchall()
+        GROUP BY g.name ORDER BY g.name"""))
 
 
 def ensure_class(conn, name: str, parent: str | None = None, description: str = "") -> bool:

@@ -1,0 +1,87 @@
+"""`engine gears list|show|delete`: the workpieces stored, their units and jobs (registered on the
+`gears` group of engine.cli.gears)."""
+from __future__ import annotations
+
+import click
+
+from .context import connection, emit_json
+from .output import Column, day, day_options, emit_list, fields_text, list_options, section_text
+
+GEAR_COLUMNS = (
+    Column("gear", "gear_id"), Column("class", "class"), Column("m", "module"), Column("z", "teeth"),
+    Column("β", "helix_angle"), Column("hand", "hand"), Column("b", "face_width"), Column("material", "material"),
+    Column("HB", "hardness"), Column("grade", "quality_grade"), Column("qty", "quantity"),
+    Column("units", "unit_count"), Column("jobs", "job_count"), Column("stored", "created_at"),
+)
+GEAR_FIELDS = (
+    Column("gear", "gear_id"), Column("class", "class"), Column("module", "module"),
+    Column("module kind", "module_kind"), Column("teeth", "teeth"), Column("pressure angle", "pressure_angle"),
+    Column("helix angle", "helix_angle"), Column("hand", "hand"), Column("face width", "face_width"),
+    Column("tip diameter", "tip_diameter"), Column("root diameter", "root_diameter"),
+    Column("cone angle", "cone_angle"), Column("crowning", "crowning"), Column("material", "material"),
+    Column("hardness", "hardness"), Column("quality grade", "quality_grade"), Column("quantity", "quantity"),
+    Column("stored", "created_at"),
+)
+UNIT_COLUMNS = (Column("unit", "unit"), Column("z", "teeth"), Column("b", "face_width"),
+                Column("da", "tip_diameter"), Column("df", "root_diameter"), Column("z_top", "z_top"))
+JOB_COLUMNS = (Column("job", "job_id"), Column("class", "class"), Column("machine", "machine"),
+               Column("hob", "hob_id"), Column("programs", "program_count"), Column("made", "created_at"),
+               Column("confirmed", "confirmed_at"))
+
+
+@click.command("list")
+@click.option("--class", "gear_class", help="Only gears of this class.")
+@day_options("gears stored")
+@list_options("gears")
+@click.pass_context
+def gears_list(ctx, gear_class, since, until, output):
+    """The gears stored, one line each: class, module, teeth, helix angle, face width, material,
+    units, jobs, when stored.
+
+    Example: engine gears list --class spur --since 2026-01-01 --csv
+    """
+    from ..gears.gear_records import list_gears
+
+    with connection(ctx) as conn:
+        found = list_gears(conn, gear_class, day(since), day(until))
+    emit_list(output, "gears", GEAR_COLUMNS, found)
+
+
+@click.command("show")
+@click.argument("gear_id", type=int)
+@click.option("--json", "as_json", is_flag=True, help="Print one JSON line: {\"gear\": {..., units, jobs}}.")
+@click.pass_context
+def gears_show(ctx, gear_id, as_json):
+    """One gear as stored: its class and dimensions, its further toothed units, its jobs.
+
+    Example: engine gears show 42
+    """
+    from ..gears.gear_records import gear_details
+
+    with connection(ctx) as conn:
+        gear = gear_details(conn, gear_id)
+    if as_json:
+        emit_json({"gear": gear})
+        return
+    click.echo(fields_text(GEAR_FIELDS, gear))
+    click.echo(section_text("further units", UNIT_COLUMNS, gear["units"]))
+    click.echo(section_text("jobs", JOB_COLUMNS, gear["jobs"]))
+
+
+@click.command("delete")
+@click.argument("gear_id", type=int)
+@click.option("--yes", is_flag=True, help="Delete it (without: say what would be deleted, exit 1).")
+@click.pass_context
+def gears_delete(ctx, gear_id, yes):
+    """Delete a gear (and its further units) that no job and no golden test refers to.
+
+    Example: engine gears delete 90001 --yes
+    """
+    from ..gears.gear_records import delete_gear
+
+    with connection(ctx) as conn:
+        deleted = delete_gear(conn, gear_id, yes)
+    click.echo(f"deleted {deleted}")
+
+
+GEAR_RECORD_COMMANDS = (gears_list, gears_show, gears_delete)

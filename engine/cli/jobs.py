@@ -1,0 +1,84 @@
+"""`engine jobs list|show|delete`: the jobs stored (a gear on a machine with its parameters) and
+the programs made from each."""
+from __future__ import annotations
+
+import json
+
+import click
+
+from .context import connection, emit_json
+from .output import Column, day, day_options, emit_list, fields_text, list_options, section_text
+
+JOB_COLUMNS = (
+    Column("job", "job_id"), Column("gear", "gear_id"), Column("class", "class"), Column("machine", "machine"),
+    Column("hob", "hob_id"), Column("programs", "program_count"), Column("made", "created_at"),
+    Column("confirmed", "confirmed_at"),
+)
+JOB_FIELDS = JOB_COLUMNS[:5] + (
+    Column("made", "created_at"), Column("confirmed", "confirmed_at"),
+    Column("parameters", "params", lambda params: json.dumps(params, sort_keys=True)),
+    Column("module parameters", "module_params", lambda params: json.dumps(params, sort_keys=True)),
+    Column("cutting data", "cutting", lambda cutting: json.dumps(cutting, sort_keys=True)),
+)
+PROGRAM_COLUMNS = (Column("program", "program_id"), Column("name", "name"), Column("version", "template_version"),
+                   Column("draft", "draft"), Column("stored", "created_at"))
+
+
+@click.group("jobs")
+def jobs():
+    """Jobs: a gear on a machine with every parameter its template needs; list, show, delete."""
+
+
+@jobs.command("list")
+@click.option("--class", "gear_class", help="Only jobs of this class.")
+@click.option("--gear", "gear_id", type=int, help="Only jobs of this gear.")
+@day_options("jobs made")
+@list_options("jobs")
+@click.pass_context
+def jobs_list(ctx, gear_class, gear_id, since, until, output):
+    """The jobs stored, one line each: gear, class, machine, hob, programs made, when.
+
+    Example: engine jobs list --gear 42 --json
+    """
+    from ..programs.job_records import list_jobs
+
+    with connection(ctx) as conn:
+        found = list_jobs(conn, gear_class, gear_id, day(since), day(until))
+    emit_list(output, "jobs", JOB_COLUMNS, found)
+
+
+@jobs.command("show")
+@click.argument("job_id", type=int)
+@click.option("--json", "as_json", is_flag=True, help="Print one JSON line: {\"job\": {..., params, programs}}.")
+@click.pass_context
+def jobs_show(ctx, job_id, as_json):
+    """One job as stored: gear, class, machine, hob, its parameters and cutting data, its programs.
+
+    Example: engine jobs show 7
+    """
+    from ..programs.job_records import job_details
+
+    with connection(ctx) as conn:
+        job = job_details(conn, job_id)
+    if as_json:
+        emit_json({"job": job})
+        return
+    click.echo(fields_text(JOB_FIELDS, job))
+    click.echo(section_text("programs", PROGRAM_COLUMNS, job["programs"]))
+
+
+@jobs.command("delete")
+@click.argument("job_id", type=int)
+@click.option("--yes", is_flag=True, help="Delete it (without: say what would be deleted, exit 1).")
+@click.pass_context
+def jobs_delete(ctx, job_id, yes):
+    """Delete a job no program and no cutting case refers to (a job with programs is kept:
+    programs are records nobody rewrites).
+
+    Example: engine jobs delete 7 --yes
+    """
+    from ..programs.job_records import delete_job
+
+    with connection(ctx) as conn:
+        deleted = delete_job(conn, job_id, yes)
+    click.echo(f"deleted {deleted}")

@@ -1,0 +1,61 @@
+"""The workpieces stored, as a person looks into them (`engine gears list|show|delete`): each gear
+with its class, its toothed units and the jobs made for it. A gear a job or a golden test refers
+to is kept: the job's programs were cut from it."""
+from __future__ import annotations
+
+from datetime import date
+
+from ..db.listing import Deletion, Reference, day_range, delete_row, one_record, records, require_class
+
+GEAR_COLUMNS = """
+SELECT g.id AS gear_id, g.gear_class AS class, g.module, g.module_kind, g.teeth, g.pressure_angle,
+       g.helix_angle, g.hand, g.face_width, g.tip_diameter, g.root_diameter, g.cone_angle, g.crowning,
+       g.material, g.hardness, g.quality_grade, g.quantity,
+       1 + (SELECT count(*) FROM gear_unit u WHERE u.gear_id = g.id)::int AS unit_count,
+       (SELECT count(*) FROM job j WHERE j.gear_id = g.id)::int AS job_count, g.created_at
+FROM gear g"""
+LIST_GEARS = GEAR_COLUMNS + """
+WHERE (%(class)s::text IS NULL OR g.gear_class = %(class)s)
+  AND (%(since)s::date IS NULL OR g.created_at >= %(since)s::date)
+  AND (%(until)s::date IS NULL OR g.created_at < %(until)s::date + 1)
+ORDER BY g.id"""
+ONE_GEAR = GEAR_COLUMNS + " WHERE g.id = %s"
+GEAR_UNITS = """
+SELECT unit, teeth, face_width, tip_diameter, root_diameter, z_top FROM gear_unit WHERE gear_id = %s ORDER BY unit"""
+GEAR_JOBS = """
+SELECT j.id AS job_id, j.gear_class AS class, j.machine, j.hob_id, j.created_at, j.confirmed_at,
+       (SELECT count(*) FROM program p WHERE p.job_id = j.id)::int AS program_count
+FROM job j WHERE j.gear_id = %s ORDER BY j.id"""
+
+GEAR_DELETION = Deletion(
+    kind="gear",
+    lock_sql="""SELECT format('gear %%s (class %%s, m%%s z%%s)', id, coalesce(gear_class, '-'),
+                              trim_scale(module), teeth)
+                || CASE WHEN EXISTS (SELECT 1 FROM gear_unit u WHERE u.gear_id = gear.id)
+                        THEN ' and its further toothed units' ELSE '' END
+                FROM gear WHERE id = %s FOR UPDATE""",
+    references=(Reference("job", "SELECT count(*) FROM job WHERE gear_id = %s"),
+                Reference("golden test", "SELECT count(*) FROM template_test WHERE gear_id = %s")),
+    delete_sql="DELETE FROM gear WHERE id = %s",   # its units go with it (ON DELETE CASCADE)
+    listing="engine gears list",
+)
+
+
+def list_gears(conn, gear_class: str | None = None, since: date | None = None,
+               until: date | None = None) -> list[dict]:
+    """Every gear of the class (any class if None) stored from `since` to `until` (whole days,
+    both included), by id."""
+    require_class(conn, gear_class)
+    return records(conn.execute(LIST_GEARS, {"class": gear_class, **day_range(since, until)}))
+
+
+def gear_details(conn, gear_id: int) -> dict:
+    """The gear as stored, its further toothed units (unit 1 is the gear itself) and its jobs."""
+    gear = one_record(conn.execute(ONE_GEAR, (gear_id,)), "gear", gear_id, "engine gears list")
+    return {**gear, "units": records(conn.execute(GEAR_UNITS, (gear_id,))),
+            "jobs": records(conn.execute(GEAR_JOBS, (gear_id,)))}
+
+
+def delete_gear(conn, gear_id: int, yes: bool) -> str:
+    """Delete the gear (and its units) if no job or golden test refers to it; what was deleted."""
+    return delete_row(conn, GEAR_DELETION, gear_id, yes)

@@ -1,0 +1,55 @@
+"""The jobs stored, as a person looks into them (`engine jobs list|show|delete`): each job's gear,
+class, machine and hob, its parameters, and the programs made from it. Programs are records
+nobody rewrites, so a job with a program is never deleted; nor one whose cutting data became
+cases of the machining history."""
+from __future__ import annotations
+
+from datetime import date
+
+from ..db.listing import Deletion, Reference, day_range, delete_row, one_record, records, require_class
+
+JOB_COLUMNS = """
+SELECT j.id AS job_id, j.gear_id, j.gear_class AS class, j.machine, j.hob_id,
+       (SELECT count(*) FROM program p WHERE p.job_id = j.id)::int AS program_count,
+       j.created_at, j.confirmed_at"""
+LIST_JOBS = JOB_COLUMNS + """
+FROM job j
+WHERE (%(class)s::text IS NULL OR j.gear_class = %(class)s)
+  AND (%(gear)s::int IS NULL OR j.gear_id = %(gear)s)
+  AND (%(since)s::date IS NULL OR j.created_at >= %(since)s::date)
+  AND (%(until)s::date IS NULL OR j.created_at < %(until)s::date + 1)
+ORDER BY j.id"""
+ONE_JOB = JOB_COLUMNS + ", j.params, j.module_params, j.cutting FROM job j WHERE j.id = %s"
+JOB_PROGRAMS = """
+SELECT id AS program_id, name, template_version, draft, created_at FROM program WHERE job_id = %s ORDER BY id"""
+
+JOB_DELETION = Deletion(
+    kind="job",
+    lock_sql="""SELECT format('job %%s (gear %%s, class %%s, machine %%s)', id, coalesce(gear_id::text, '-'),
+                              gear_class, machine)
+                FROM job WHERE id = %s FOR UPDATE""",
+    references=(Reference("program", "SELECT count(*) FROM program WHERE job_id = %s"),
+                Reference("cutting case", "SELECT count(*) FROM cutting_case WHERE job_id = %s")),
+    delete_sql="DELETE FROM job WHERE id = %s",
+    listing="engine jobs list",
+)
+
+
+def list_jobs(conn, gear_class: str | None = None, gear_id: int | None = None, since: date | None = None,
+              until: date | None = None) -> list[dict]:
+    """Every job of the class and gear (any if None) made from `since` to `until` (whole days,
+    both included), by id."""
+    require_class(conn, gear_class)
+    filters = {"class": gear_class, "gear": gear_id, **day_range(since, until)}
+    return records(conn.execute(LIST_JOBS, filters))
+
+
+def job_details(conn, job_id: int) -> dict:
+    """The job as stored (its parameters and cutting data included) and its programs."""
+    job = one_record(conn.execute(ONE_JOB, (job_id,)), "job", job_id, "engine jobs list")
+    return {**job, "programs": records(conn.execute(JOB_PROGRAMS, (job_id,)))}
+
+
+def delete_job(conn, job_id: int, yes: bool) -> str:
+    """Delete the job if no program and no cutting case refers to it; what was deleted."""
+    return delete_row(conn, JOB_DELETION, job_id, yes)
