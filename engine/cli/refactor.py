@@ -1,12 +1,10 @@
 """`engine refactor` and `engine template shared`: thin shells over engine.library.refactor."""
 from __future__ import annotations
 
-import sys
-from contextlib import contextmanager
-
 import click
 
 from .context import connection, emit_json
+from .progress import progress_bar
 
 
 @click.command("refactor")
@@ -26,27 +24,12 @@ def refactor_command(ctx, threshold, as_json):
     every night (README: cron or a systemd timer); exit code 0 also when nothing changed."""
     from ..library.refactor import refactor
 
-    with connection(ctx) as conn, _progress() as progress:
+    with connection(ctx) as conn, progress_bar("refactor") as progress:
         report = refactor(conn, threshold, progress)
     if as_json:
         emit_json(report.as_dict())
     else:
         _print_report(report)
-
-
-@contextmanager
-def _progress():
-    """A progress bar on stderr, only when stderr is a terminal."""
-    if not sys.stderr.isatty():
-        yield None
-        return
-    with click.progressbar(length=1, label="refactor", file=sys.stderr) as bar:
-        def update(stage, done, total):
-            bar.length = total
-            bar.label = stage
-            bar.update(done - bar.pos)
-        yield update
-        bar.update(bar.length - bar.pos)
 
 
 def _print_report(report) -> None:
