@@ -21,7 +21,8 @@ from ..memory import no_cycle_collection
 from ..templates.rows import Template
 from ..templates.versions import runnable_template
 from ..turning.names import TurningModel
-from .batches import checked, dry_batch, dry_program, good_ones, planned_or_bad, read_only, refuse_out_in_dry_run
+from .batches import Bad, checked, dry_batch, dry_program, good_ones, planned_or_bad, read_only, reason_of, \
+    refuse_out_in_dry_run
 from .outputs import ProgramFiles, files_after_commit
 from .verified_run import Workpiece, run_template
 from .verifier import LimitError, check_table_speed
@@ -160,15 +161,21 @@ def instantiate_gears(conn, first: int | None = None, last: int | None = None, *
 
 
 def _planned_gears(planner: Planner, first, last, workers: int, progress) -> list:
-    """Each gear's program encoded for storage, or Bad with its reason, in gear order."""
-    gears = load_gears(planner.conn, first, last)
-    if not gears:
+    """Each gear's program encoded for storage, or Bad with its reason, in gear order (a gear
+    whose record cannot even be completed among them)."""
+    refused: dict[int, str] = {}
+    gears = load_gears(planner.conn, first, last, refused)
+    if not gears and not refused:
         raise EngineError(f"no gears with ids in {first or 'the start'}…{last or 'the end'}")
     with no_cycle_collection():
         if workers > 1 and len(gears) > 1:
-            return plan_in_workers(planner, gears, workers, _plan_in_batch, progress)
-        return [_counted(_plan_in_batch(planner, gear), done, len(gears), progress)
-                for done, gear in enumerate(gears, 1)]
+            planned = plan_in_workers(planner, gears, workers, _plan_in_batch, progress)
+        else:
+            planned = [_counted(_plan_in_batch(planner, gear), done, len(gears), progress)
+                       for done, gear in enumerate(gears, 1)]
+    by_gear = dict(zip([gear.id for gear in gears], planned)) | {gear_id: Bad(reason_of(f"gear {gear_id}", message))
+                                                                  for gear_id, message in refused.items()}
+    return [by_gear[gear_id] for gear_id in sorted(by_gear)]
 
 
 def _plan_in_batch(planner: Planner, gear: Gear):
