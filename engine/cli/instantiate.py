@@ -26,7 +26,7 @@ def parse_range(text: str, option: str = "--gears") -> tuple[int, int]:
 @click.command()
 @click.option("--gear", "gear_id", type=int, help="Gear id: compute a new job and its program.")
 @click.option("--job", "job_id", type=int, help="Stored job id: instantiate again with its (edited) parameters.")
-@click.option("--gears", "gear_range", help="Batch: gear ids FIRST-LAST (all stored, or none).")
+@click.option("--gears", "gear_range", help="Batch: gear ids FIRST-LAST (all stored, or none unless --skip-bad).")
 @click.option("--jobs", "job_range", help="Batch: stored job ids FIRST-LAST made again with their stored parameters.")
 @click.option("--all", "all_gears", is_flag=True, help="Batch: every gear.")
 @click.option("--out", type=click.Path(), help="Write the .MPF file here after the programs are committed: a "

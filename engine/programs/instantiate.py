@@ -150,7 +150,7 @@ def instantiate_gears(conn, first: int | None = None, last: int | None = None, *
     nothing stored. `progress(stage, done, total)` as the gears are planned."""
     refuse_out_in_dry_run(dry_run, out)
     stage = read_only(conn) if dry_run else files_after_commit(conn, out, force, batch=True)
-    with stage as files:
+    with stage as files, no_cycle_collection():   # planning and storing build the batch
         outcomes = _planned_gears(Planner(conn, machine, choices, overrides, draft), first, last, workers, progress)
         encoded, skipped = good_ones(outcomes, "gear", skip_bad)
         if dry_run:
@@ -167,12 +167,11 @@ def _planned_gears(planner: Planner, first, last, workers: int, progress) -> lis
     gears = load_gears(planner.conn, first, last, refused)
     if not gears and not refused:
         raise EngineError(f"no gears with ids in {first or 'the start'}…{last or 'the end'}")
-    with no_cycle_collection():
-        if workers > 1 and len(gears) > 1:
-            planned = plan_in_workers(planner, gears, workers, _plan_in_batch, progress)
-        else:
-            planned = [_counted(_plan_in_batch(planner, gear), done, len(gears), progress)
-                       for done, gear in enumerate(gears, 1)]
+    if workers > 1 and len(gears) > 1:
+        planned = plan_in_workers(planner, gears, workers, _plan_in_batch, progress)
+    else:
+        planned = [_counted(_plan_in_batch(planner, gear), done, len(gears), progress)
+                   for done, gear in enumerate(gears, 1)]
     by_gear = dict(zip([gear.id for gear in gears], planned)) | {gear_id: Bad(reason_of(f"gear {gear_id}", message))
                                                                   for gear_id, message in refused.items()}
     return [by_gear[gear_id] for gear_id in sorted(by_gear)]

@@ -126,14 +126,13 @@ def instantiate_jobs(conn, first: int | None = None, last: int | None = None, *,
     would be stored, nothing stored. `progress(stage, done, total)` as the jobs are made."""
     refuse_out_in_dry_run(dry_run, out)
     stage = read_only(conn) if dry_run else files_after_commit(conn, out, force, batch=True)
-    with stage as files:
+    with stage as files, no_cycle_collection():   # making and storing build the batch
         jobs = conn.execute(f"SELECT {JOB_COLUMNS} FROM job WHERE id BETWEEN %s AND %s ORDER BY id",
                             (first if first is not None else 0, last if last is not None else 2**62)).fetchall()
         if not jobs:
             raise EngineError(f"no jobs with ids in {first or 'the start'}…{last or 'the end'}")
         remaker = Remaker(conn, draft)
-        with no_cycle_collection():
-            outcomes = [_remade_in_batch(remaker, job, done, len(jobs), progress) for done, job in enumerate(jobs, 1)]
+        outcomes = [_remade_in_batch(remaker, job, done, len(jobs), progress) for done, job in enumerate(jobs, 1)]
         good, skipped = good_ones(outcomes, "job", skip_bad)
         if dry_run:
             return dry_batch([item for _, item in good], skipped)
