@@ -12,6 +12,9 @@ from pathlib import Path
 import psycopg
 import pytest
 from psycopg import sql
+from roles import as_role
+
+from engine.programs.instantiate import instantiate_gear, instantiate_gears
 
 CHECKOUT = Path(__file__).resolve().parent.parent
 
@@ -229,6 +232,19 @@ def test_the_database_refuses_a_dry_run_lineage_line(run):
             conn.execute("INSERT INTO program_submission (id, job_id, gear_class, template_version, template_hash, "
                          "name, lines, row_ids, trace) VALUES (nextval('program_id_seq'), %s, %s, %s, %s, %s, %s, "
                          "%s, '{}')", (job, gear_class, version, template_hash, name, dry, row_ids))
+
+
+def test_a_reader_may_look_at_a_program_that_only_a_runner_may_store(conn):
+    """A dry run writes nothing, so the role that only reads (engine_reader) may make one; the
+    stored run is the database's to refuse it. Inside the caller's transaction it is a savepoint."""
+    with as_role(conn, "engine_reader"):
+        program = instantiate_gear(conn, 42, dry_run=True)
+        batch = instantiate_gears(conn, 42, 47, dry_run=True)
+    assert program.program_id is None and program.name == "GEAR42"
+    assert sum(line.startswith("; PROGRAM DRY-RUN TEMPLATE spur v") for line in program.lines) == 1
+    assert batch.dry_run and batch.programs == 6 and batch.first_program_id is None
+    with as_role(conn, "engine_reader"), pytest.raises(psycopg.errors.InsufficientPrivilege):
+        instantiate_gear(conn, 42)
 
 
 # the progress bar --------------------------------------------------------------------------
