@@ -151,7 +151,9 @@ def test_two_programs_of_one_batch_differing_only_in_case_are_refused(run, tmp_p
             conn.execute("UPDATE job SET params = jsonb_set(params, '{program_name}', %s) WHERE id = %s",
                          (json.dumps(name), job))
     before = program_count(run.url)
-    message = one_line_refusal(run("instantiate", "--jobs", f"{jobs[0]}-{jobs[1]}", "--out", tmp_path / "out"))
+    refused = run("instantiate", "--jobs", f"{jobs[0]}-{jobs[1]}", "--out", tmp_path / "out")
+    assert refused.exit_code == 1 and "Traceback" not in refused.output   # each bad job named (issue 16)
+    message = refused.stderr
     assert "would replace each other" in message or "is the name of gear 43's program" in message
     assert program_count(run.url) == before and everything_under(tmp_path) == []
 

@@ -7,6 +7,7 @@ import click
 
 from ..errors import EngineError
 from .context import connection, emit_json
+from .progress import progress_bar
 
 RANGE = re.compile(r"^\s*(\d+)\s*(?:-\s*(\d+))?\s*$")
 
@@ -25,7 +26,7 @@ def parse_range(text: str, option: str = "--gears") -> tuple[int, int]:
 @click.command()
 @click.option("--gear", "gear_id", type=int, help="Gear id: compute a new job and its program.")
 @click.option("--job", "job_id", type=int, help="Stored job id: instantiate again with its (edited) parameters.")
-@click.option("--gears", "gear_range", help="Batch: gear ids FIRST-LAST (all stored, or none).")
+@click.option("--gears", "gear_range", help="Batch: gear ids FIRST-LAST (all stored, or none unless --skip-bad).")
 @click.option("--jobs", "job_range", help="Batch: stored job ids FIRST-LAST made again with their stored parameters.")
 @click.option("--all", "all_gears", is_flag=True, help="Batch: every gear.")
 @click.option("--out", type=click.Path(), help="Write the .MPF file here after the programs are committed: a "
@@ -52,19 +53,34 @@ def parse_range(text: str, option: str = "--gears") -> tuple[int, int]:
               help="Also say why each row emitted its line or not, with the values (on stderr; in --json: explain).")
 @click.option("--draft", is_flag=True, help="Use the class's draft (an editor trying a change), not its released "
               "template; the program is recorded as a draft.")
+@click.option("--dry-run", is_flag=True, help="Compute and check as a stored run does, store nothing: print the "
+              "program (its lineage line says PROGRAM DRY-RUN), or a batch's count of what it would store. "
+              "Not with --out.")
+@click.option("--skip-bad", is_flag=True, help="Batch: store the good programs and list the bad gears or jobs "
+              "skipped (else any bad one stores nothing).")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object (program_id, path, lines, ...).")
 @click.pass_context
 def instantiate(ctx, gear_id, job_id, gear_range, job_range, all_gears, out, force, machine, cuts, coolant, shift_y,
                 shift_per_part, feed_mode, tailstock, worm_feed, allowance, hob_speed, workers, explain, draft,
-                as_json):
+                dry_run, skip_bad, as_json):
     """Produce the NC program of a gear (or a stored job, or a batch of gears).
 
-    The program is checked against the machine's limits, stored with the template
-    version it came from, printed (single program) and written to --out.
+    The program is checked against the machine's limits and proved by the
+    simulation, stored with the template version it came from, printed (single
+    program) and written to --out. --dry-run makes the same checks and stores
+    nothing (no job, no program, no file).
+
+    A batch (--gears, --all, --jobs) tries every gear or job and names each bad
+    one with its reason, with a progress bar on a terminal. Exit code 0: stored
+    (with --skip-bad: the good ones, the bad ones listed on stderr); 1: bad
+    input, or any bad gear or job without --skip-bad, or none good: nothing
+    stored; 2: a bug.
+
+    Example: engine instantiate --gear 42 --out /srv/nc/
     """
     from ..hobbing.choices import Choices
-    from ..programs.instantiate import instantiate_gear, instantiate_gears
-    from ..programs.remake import instantiate_job, instantiate_jobs
+    from ..programs.instantiate import instantiate_gear
+    from ..programs.remake import instantiate_job
 
     chosen = [name for name, value in (("--gear", gear_id), ("--job", job_id), ("--gears", gear_range),
                                        ("--jobs", job_range), ("--all", all_gears)) if value]
@@ -82,21 +98,33 @@ def instantiate(ctx, gear_id, job_id, gear_range, job_range, all_gears, out, for
     overrides = {"hob_speed": hob_speed}
     if force and not out:
         raise EngineError("--force replaces files in --out: give --out too")
+    if skip_bad and not (gear_range or job_range or all_gears):
+        raise EngineError("--skip-bad skips the bad gears of a batch: use it with --gears, --jobs or --all")
     with connection(ctx) as conn:
         if gear_id is not None:
             program = instantiate_gear(conn, gear_id, machine=machine, choices=choices, overrides=overrides, out=out,
-                                       force=force, draft=draft)
+                                       force=force, draft=draft, dry_run=dry_run)
         elif job_id is not None:
-            program = instantiate_job(conn, job_id, out=out, force=force, draft=draft)
-        elif job_range:
-            return _report_batch(instantiate_jobs(conn, *parse_range(job_range, "--jobs"), out=out, force=force,
-                                                  draft=draft), out, as_json)
+            program = instantiate_job(conn, job_id, out=out, force=force, draft=draft, dry_run=dry_run)
         else:
-            first, last = parse_range(gear_range) if gear_range else (None, None)
-            programs = instantiate_gears(conn, first, last, machine=machine, choices=choices,
-                                         overrides=overrides, out=out, force=force, workers=workers, draft=draft)
-            return _report_batch(programs, out, as_json)
+            with progress_bar("instantiate") as progress:
+                batch = _batch(conn, job_range, gear_range, progress, out=out, force=force, draft=draft,
+                               skip_bad=skip_bad, dry_run=dry_run, machine=machine, choices=choices,
+                               overrides=overrides, workers=workers)
+            return _report_batch(batch, out, as_json)
     _report_program(program, as_json, explain)
+
+
+def _batch(conn, job_range, gear_range, progress, machine, choices, overrides, workers, **common):
+    """A batch of stored jobs made again (--jobs), or of gears (--gears, --all)."""
+    from ..programs.instantiate import instantiate_gears
+    from ..programs.remake import instantiate_jobs
+
+    if job_range:
+        return instantiate_jobs(conn, *parse_range(job_range, "--jobs"), progress=progress, **common)
+    first, last = parse_range(gear_range) if gear_range else (None, None)
+    return instantiate_gears(conn, first, last, machine=machine, choices=choices, overrides=overrides,
+                             workers=workers, progress=progress, **common)
 
 
 NEW_JOB_CHOICES = ("machine", "cuts", "coolant", "shift_y", "shift_per_part", "feed_mode", "tailstock",
@@ -118,12 +146,14 @@ def _report_program(program, as_json: bool, explain: bool) -> None:
     from ..programs.explain import explained_rows
 
     rows = explained_rows(program.trace, program.lines, program.row_ids) if explain else []
+    dry_run = program.program_id is None
     if as_json:
         emit_json({"program_id": program.program_id, "job_id": program.job_id, "name": program.name,
                    "path": program.path, "lines": len(program.lines), "gear_class": program.gear_class,
                    "template_version": program.template_version, "template_hash": program.template_hash,
                    "notes": list(program.notes),
-                   **({"explain": [row.as_dict() for row in rows]} if explain else {})})
+                   **({"explain": [row.as_dict() for row in rows]} if explain else {}),
+                   **({"dry_run": True, "text": program.text} if dry_run else {})})
         return
     for row in rows:
         click.echo(row.sentence(), err=True)
@@ -131,17 +161,33 @@ def _report_program(program, as_json: bool, explain: bool) -> None:
         click.echo(f"note: {note}", err=True)
     if program.path is None:
         click.echo(program.text, nl=False)
-    click.echo(f"program {program.program_id} (job {program.job_id}, {len(program.lines)} lines) "
-               f"from {program.gear_class} v{program.template_version}"
-               + (f" written to {program.path}" if program.path else ""), err=True)
+    click.echo(_program_summary(program) + (f" written to {program.path}" if program.path else ""), err=True)
+
+
+def _program_summary(program) -> str:
+    if program.program_id is None:
+        job = f"job {program.job_id}, " if program.job_id is not None else ""
+        return (f"dry run: program {program.name} ({job}{len(program.lines)} lines) from {program.gear_class} "
+                f"v{program.template_version} checked; nothing stored")
+    return (f"program {program.program_id} (job {program.job_id}, {len(program.lines)} lines) "
+            f"from {program.gear_class} v{program.template_version}")
 
 
 def _report_batch(batch, out, as_json: bool) -> None:
     if as_json:
         emit_json({"programs": batch.programs, "lines": batch.lines, "path": out,
-                   "program_ids": [batch.first_program_id, batch.last_program_id], "notes": list(batch.notes)})
-    else:
-        for note in batch.notes:
-            click.echo(f"note: {note}", err=True)
-        click.echo(f"stored {batch.programs} program(s) {batch.first_program_id}…{batch.last_program_id}, "
-                   f"{batch.lines} lines" + (f", written to {out}" if out else ""))
+                   "program_ids": [batch.first_program_id, batch.last_program_id], "notes": list(batch.notes),
+                   "skipped": list(batch.skipped), "dry_run": batch.dry_run})
+        return
+    for note in batch.notes:
+        click.echo(f"note: {note}", err=True)
+    for reason in batch.skipped:
+        click.echo(f"skipped: {reason}", err=True)
+    if batch.skipped:
+        click.echo(f"skipped {len(batch.skipped)} bad of {len(batch.skipped) + batch.programs} (--skip-bad): "
+                   "their programs are not stored", err=True)
+    if batch.dry_run:
+        click.echo(f"dry run: would store {batch.programs} program(s), {batch.lines} lines; nothing stored")
+        return
+    click.echo(f"stored {batch.programs} program(s) {batch.first_program_id}…{batch.last_program_id}, "
+               f"{batch.lines} lines" + (f", written to {out}" if out else ""))

@@ -2,13 +2,11 @@
 shells over engine.library.refactor and engine.library.intended."""
 from __future__ import annotations
 
-import sys
-from contextlib import contextmanager
-
 import click
 
 from .context import connection, emit_json
 from .intended import intend_command, intents_command, unintend_command
+from .progress import progress_bar
 
 
 @click.group("refactor", invoke_without_command=True)
@@ -36,7 +34,7 @@ def refactor_command(ctx, threshold, as_json):
         return
     from ..library.refactor import refactor
 
-    with connection(ctx) as conn, _progress() as progress:
+    with connection(ctx) as conn, progress_bar("refactor") as progress:
         report = refactor(conn, threshold, progress)
     if as_json:
         emit_json(report.as_dict())
@@ -46,21 +44,6 @@ def refactor_command(ctx, threshold, as_json):
 
 for _command in (intend_command, intents_command, unintend_command):
     refactor_command.add_command(_command)
-
-
-@contextmanager
-def _progress():
-    """A progress bar on stderr, only when stderr is a terminal."""
-    if not sys.stderr.isatty():
-        yield None
-        return
-    with click.progressbar(length=1, label="refactor", file=sys.stderr) as bar:
-        def update(stage, done, total):
-            bar.length = total
-            bar.label = stage
-            bar.update(done - bar.pos)
-        yield update
-        bar.update(bar.length - bar.pos)
 
 
 def _print_report(report) -> None:

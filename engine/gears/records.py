@@ -174,14 +174,26 @@ def load_gear(conn, gear_id: int) -> Gear:
     return _with_units(_completed(_as_float(Gear, row)), _load_units(conn, gear_id, gear_id))
 
 
-def load_gears(conn, first: int | None = None, last: int | None = None) -> list[Gear]:
+def load_gears(conn, first: int | None = None, last: int | None = None, refused: dict | None = None) -> list[Gear]:
+    """The gears first…last; with `refused`, a gear that cannot be completed is left out and its
+    message kept there by id (a batch names every bad gear), else it stops the load."""
     rows = conn.execute(GEAR_QUERY + " WHERE id BETWEEN %s AND %s ORDER BY id",
                         (first if first is not None else 0, last if last is not None else 2**31 - 1))
-    gears = [_completed(_as_float(Gear, row)) for row in rows]
+    gears = [gear for gear in (_completed_or_refused(_as_float(Gear, row), refused) for row in rows) if gear]
     if not gears:
         return gears
     units = _load_units(conn, gears[0].id, gears[-1].id)
     return [_with_units(gear, units) for gear in gears]
+
+
+def _completed_or_refused(gear: Gear, refused: dict | None) -> Gear | None:
+    if refused is None:
+        return _completed(gear)
+    try:
+        return _completed(gear)
+    except EngineError as error:
+        refused[gear.id] = str(error)
+        return None
 
 
 def _completed(gear: Gear) -> Gear:

@@ -7,6 +7,7 @@ written only after the COMMIT).
 """
 from __future__ import annotations
 
+from dataclasses import replace
 from pathlib import Path
 
 from ..errors import EngineError
@@ -20,12 +21,14 @@ from ..memory import no_cycle_collection
 from ..templates.rows import Template
 from ..templates.versions import runnable_template
 from ..turning.names import TurningModel
+from .batches import Bad, checked, dry_batch, dry_program, good_ones, planned_or_bad, read_only, reason_of, \
+    refuse_out_in_dry_run
 from .outputs import ProgramFiles, files_after_commit
 from .verified_run import Workpiece, run_template
 from .verifier import LimitError, check_table_speed
 from .records import Planned, Program
-from .storage import store_many, store_one
-from .workers import plan_in_workers
+from .storage import Batch, store_many, store_one
+from .workers import PLANNING, plan_in_workers
 
 
 class Planner:
@@ -120,9 +123,15 @@ def _check_table_speed(gear: Gear, starts: int, hob_speed: float, machine: Machi
 
 def instantiate_gear(conn, gear_id: int, *, machine: str | None = None, choices: Choices = Choices(),
                      overrides: dict | None = None, out: str | Path | None = None, force: bool = False,
-                     draft: bool = False) -> Program:
+                     draft: bool = False, dry_run: bool = False) -> Program:
     """Compute, check and store the program of one gear; write it to `out` if given (after the
-    COMMIT; an existing file only with `force`). With `draft`, from the class's draft."""
+    COMMIT; an existing file only with `force`). With `draft`, from the class's draft. With
+    `dry_run`, the same checks, nothing stored (engine.programs.batches): the program returned."""
+    refuse_out_in_dry_run(dry_run, out)
+    if dry_run:
+        with read_only(conn):
+            return dry_program(conn, Planner(conn, machine, choices, overrides, draft).plan(load_gear(conn, gear_id)),
+                               None)
     with files_after_commit(conn, out, force) as files:
         planner = Planner(conn, machine, choices, overrides, draft)
         planned = planner.plan(load_gear(conn, gear_id))
@@ -133,38 +142,50 @@ def instantiate_gear(conn, gear_id: int, *, machine: str | None = None, choices:
 def instantiate_gears(conn, first: int | None = None, last: int | None = None, *,
                       machine: str | None = None, choices: Choices = Choices(), overrides=None,
                       out: str | Path | None = None, force: bool = False, progress=None, workers: int = 1,
-                      draft: bool = False):
-    """All gears with first ≤ id ≤ last: all programs stored, or none (the first failure names its gear),
-    and their files written after the COMMIT. With workers > 1 the gears are planned in that many
-    processes (engine.programs.workers)."""
-    with files_after_commit(conn, out, force, batch=True) as files:
-        planner = Planner(conn, machine, choices, overrides, draft)
-        gears = load_gears(conn, first, last)
-        if not gears:
-            raise EngineError(f"no gears with ids in {first or 'the start'}…{last or 'the end'}")
-        with no_cycle_collection():
-            if workers > 1 and len(gears) > 1:
-                encoded = plan_in_workers(planner, gears, workers, _plan_in_batch, progress)
-            else:
-                encoded = [_counted(_plan_in_batch(planner, gear), progress).encoded() for gear in gears]
-            files.plan([(item.name, item.lines) for item in encoded])
-            batch = store_many(conn, encoded, out, files)
-    return batch
+                      draft: bool = False, skip_bad: bool = False, dry_run: bool = False) -> Batch:
+    """All gears with first ≤ id ≤ last, every one planned: all programs stored, or none if any
+    gear is bad (BadBatch names each); with `skip_bad` the good ones are stored and the bad ones
+    listed in Batch.skipped. Files are written after the COMMIT. With workers > 1 the gears are
+    planned in that many processes (engine.programs.workers). `dry_run`: what would be stored,
+    nothing stored. `progress(stage, done, total)` as the gears are planned."""
+    refuse_out_in_dry_run(dry_run, out)
+    stage = read_only(conn) if dry_run else files_after_commit(conn, out, force, batch=True)
+    with stage as files, no_cycle_collection():   # planning and storing build the batch
+        outcomes = _planned_gears(Planner(conn, machine, choices, overrides, draft), first, last, workers, progress)
+        encoded, skipped = good_ones(outcomes, "gear", skip_bad)
+        if dry_run:
+            return dry_batch(encoded, skipped)
+        files.plan([(item.name, item.lines) for item in encoded])
+        batch = store_many(conn, encoded, out, files)
+    return replace(batch, skipped=skipped)
 
 
-def _plan_in_batch(planner: Planner, gear: Gear) -> Planned:
-    try:
-        return planner.plan(gear)
-    except EngineError as error:
-        message = str(error)
-        prefix = "" if message.startswith(f"gear {gear.id}") else f"gear {gear.id}: "
-        raise EngineError(f"{prefix}{message} (batch stopped, nothing stored)") from None
+def _planned_gears(planner: Planner, first, last, workers: int, progress) -> list:
+    """Each gear's program encoded for storage, or Bad with its reason, in gear order (a gear
+    whose record cannot even be completed among them)."""
+    refused: dict[int, str] = {}
+    gears = load_gears(planner.conn, first, last, refused)
+    if not gears and not refused:
+        raise EngineError(f"no gears with ids in {first or 'the start'}…{last or 'the end'}")
+    if workers > 1 and len(gears) > 1:
+        planned = plan_in_workers(planner, gears, workers, _plan_in_batch, progress)
+    else:
+        planned = [_counted(_plan_in_batch(planner, gear), done, len(gears), progress)
+                   for done, gear in enumerate(gears, 1)]
+    by_gear = dict(zip([gear.id for gear in gears], planned)) | {gear_id: Bad(reason_of(f"gear {gear_id}", message))
+                                                                  for gear_id, message in refused.items()}
+    return [by_gear[gear_id] for gear_id in sorted(by_gear)]
 
 
-def _counted(planned: Planned, progress) -> Planned:
+def _plan_in_batch(planner: Planner, gear: Gear):
+    """The gear's program encoded for storage, or Bad: the batch goes on to name every bad gear."""
+    return planned_or_bad("gear", gear.id, lambda: checked(planner.plan(gear)).encoded())
+
+
+def _counted(outcome, done: int, total: int, progress):
     if progress:
-        progress(1)
-    return planned
+        progress(PLANNING, done, total)
+    return outcome
 
 
 def store_planned(conn, planned: list[Planned], files: ProgramFiles,

@@ -64,8 +64,8 @@ class Encoded:
 
 @dataclass(frozen=True)
 class Program:
-    program_id: int
-    job_id: int
+    program_id: int | None   # None: a dry run (engine.programs.batches), nothing stored
+    job_id: int | None       # None: a dry run of a new job
     name: str
     lines: list[str]
     gear_class: str

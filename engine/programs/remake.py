@@ -1,10 +1,12 @@
 """Stored jobs made again with their stored, possibly edited, parameters: one job (`engine
 instantiate --job ID`) or a range of them (`--jobs FIRST-LAST`), template rows only: no
 model, no hob choice, no cutting data. The programs are checked against the job's machine,
-stored with the template version they came from, and written after the database commit."""
+stored with the template version they came from, and written after the database commit. A
+batch tries every job and names each bad one (engine.programs.batches)."""
 from __future__ import annotations
 
 import re
+from dataclasses import replace
 from pathlib import Path
 
 from ..errors import EngineError
@@ -16,11 +18,13 @@ from ..hobbing.machine_job import with_cycle_time
 from ..memory import no_cycle_collection
 from ..templates.rows import Template
 from ..templates.versions import runnable_template
+from .batches import checked, dry_batch, dry_program, good_ones, planned_or_bad, read_only, refuse_out_in_dry_run
 from .instantiate import store_planned
 from .outputs import files_after_commit
 from .verified_run import Workpiece, run_template
 from .records import Planned, Program
-from .storage import Batch, refuse_unsafe, store_programs
+from .storage import Batch, store_programs
+from .workers import PLANNING
 
 JOB_COLUMNS = "id, gear_id, gear_class, machine, hob_id, params, module_params"
 
@@ -93,39 +97,53 @@ def _other_gear_named(conn, name, gear_id: int) -> int | None:
 
 
 def instantiate_job(conn, job_id: int, out: str | Path | None = None, force: bool = False,
-                    draft: bool = False) -> Program:
-    """Instantiate a stored job again with its stored (possibly edited) parameters."""
+                    draft: bool = False, dry_run: bool = False) -> Program:
+    """Instantiate a stored job again with its stored (possibly edited) parameters. With `dry_run`,
+    the same checks, nothing stored (engine.programs.batches): the program returned."""
+    refuse_out_in_dry_run(dry_run, out)
+    if dry_run:
+        with read_only(conn):
+            return dry_program(conn, Remaker(conn, draft).remade(_stored_job(conn, job_id)), job_id)
     with files_after_commit(conn, out, force) as files:
-        job = conn.execute(f"SELECT {JOB_COLUMNS} FROM job WHERE id = %s", (job_id,)).fetchone()
-        if job is None:
-            raise EngineError(f"job {job_id} does not exist; see `SELECT id, gear_id FROM job`")
+        job = _stored_job(conn, job_id)
         program = store_planned(conn, [Remaker(conn, draft).remade(job)], files, existing_job=job_id)[0]
     return program
 
 
+def _stored_job(conn, job_id: int) -> tuple:
+    job = conn.execute(f"SELECT {JOB_COLUMNS} FROM job WHERE id = %s", (job_id,)).fetchone()
+    if job is None:
+        raise EngineError(f"job {job_id} does not exist; see `SELECT id, gear_id FROM job`")
+    return job
+
+
 def instantiate_jobs(conn, first: int | None = None, last: int | None = None, *,
-                     out: str | Path | None = None, force: bool = False, progress=None, draft: bool = False) -> Batch:
-    """Every stored job with first ≤ id ≤ last made again: all programs stored, or none (the first
-    failure names its job), and their files written after the COMMIT."""
-    with files_after_commit(conn, out, force, batch=True) as files:
+                     out: str | Path | None = None, force: bool = False, progress=None, draft: bool = False,
+                     skip_bad: bool = False, dry_run: bool = False) -> Batch:
+    """Every stored job with first ≤ id ≤ last made again, every one tried: all programs stored,
+    or none if any job is bad (BadBatch names each); with `skip_bad` the good ones are stored and
+    the bad ones listed in Batch.skipped. Files are written after the COMMIT. `dry_run`: what
+    would be stored, nothing stored. `progress(stage, done, total)` as the jobs are made."""
+    refuse_out_in_dry_run(dry_run, out)
+    stage = read_only(conn) if dry_run else files_after_commit(conn, out, force, batch=True)
+    with stage as files, no_cycle_collection():   # making and storing build the batch
         jobs = conn.execute(f"SELECT {JOB_COLUMNS} FROM job WHERE id BETWEEN %s AND %s ORDER BY id",
                             (first if first is not None else 0, last if last is not None else 2**62)).fetchall()
         if not jobs:
             raise EngineError(f"no jobs with ids in {first or 'the start'}…{last or 'the end'}")
         remaker = Remaker(conn, draft)
-        with no_cycle_collection():
-            encoded = [_remade_in_batch(remaker, job, progress).encoded(with_job=False) for job in jobs]
-            files.plan([(item.name, item.lines) for item in encoded])
-            batch = store_programs(conn, encoded, [job[0] for job in jobs], out, files)
-    return batch
+        outcomes = [_remade_in_batch(remaker, job, done, len(jobs), progress) for done, job in enumerate(jobs, 1)]
+        good, skipped = good_ones(outcomes, "job", skip_bad)
+        if dry_run:
+            return dry_batch([item for _, item in good], skipped)
+        files.plan([(item.name, item.lines) for _, item in good])
+        batch = store_programs(conn, [item for _, item in good], [job_id for job_id, _ in good], out, files)
+    return replace(batch, skipped=skipped)
 
 
-def _remade_in_batch(remaker: Remaker, job: tuple, progress) -> Planned:
-    try:
-        planned = remaker.remade(job)
-        refuse_unsafe(planned.name, planned.lines)
-    except EngineError as error:
-        raise EngineError(f"job {job[0]}: {error} (batch stopped, nothing stored)") from None
+def _remade_in_batch(remaker: Remaker, job: tuple, done: int, total: int, progress):
+    """(job id, its program encoded for storage), or Bad with its reason: the batch goes on."""
+    outcome = planned_or_bad("job", job[0], lambda: (job[0], checked(remaker.remade(job)).encoded(with_job=False)))
     if progress:
-        progress(1)
-    return planned
+        progress(PLANNING, done, total)
+    return outcome

@@ -59,8 +59,8 @@ def store_one(conn, planned: Planned, existing_job: int | None, path: str | None
 class Lineage:
     """Lineage lines for the programs of one store: what they need read in three queries."""
 
-    def __init__(self, conn, machines, versions, job_ids):
-        self.input_hashes = dict(conn.execute(INPUT_HASHES, (list(job_ids),)).fetchall())
+    def __init__(self, conn, machines, versions, job_ids, input_hashes: dict | None = None):
+        self.input_hashes = dict(conn.execute(INPUT_HASHES, (list(job_ids),)).fetchall()) | (input_hashes or {})
         self.dialects = dict(conn.execute(DIALECTS, (list(set(machines)),)).fetchall())
         classes, numbers = zip(*set(versions)) if versions else ((), ())
         self.drafts = {(c, v): draft for c, v, draft in conn.execute(DRAFTS, (list(classes), list(numbers)))}
@@ -140,14 +140,17 @@ def _as_is(text: str) -> str:
 
 @dataclass(frozen=True)
 class Batch:
-    """What a batch stored: how many programs and lines, the lowest and highest program id
-    (other sessions may draw ids in between), and where files went."""
+    """What a batch stored (or, a dry run, would store): how many programs and lines, the lowest
+    and highest program id (other sessions may draw ids in between; None in a dry run), where
+    files went, and the gears or jobs skipped as bad (--skip-bad), each with its reason."""
     programs: int
     lines: int
-    first_program_id: int
-    last_program_id: int
+    first_program_id: int | None
+    last_program_id: int | None
     path: str | None
-    notes: tuple = ()   # "<program name>: <note>", one line each
+    notes: tuple = ()     # "<program name>: <note>", one line each
+    skipped: tuple = ()   # "gear 7: <reason>" (or "job 7: …"), one line each
+    dry_run: bool = False
 
     def __len__(self) -> int:
         return self.programs

@@ -4,7 +4,8 @@ The Planner is made ready in this process (machine, hob library, case base, and 
 compiled template of every class in the batch), then N worker processes are forked from it and
 plan slices of the gears; they read nothing from the database (the connection they inherit is
 never touched). Their jobs come back here in gear order and are stored in one transaction by
-the caller, so a batch is still all or none: the first failure stops it and names its gear.
+the caller, so a batch is still all or none. A bad gear does not stop the workers: it comes back
+as its reason (engine.programs.batches.Bad), so the batch names every bad gear in one run.
 """
 from __future__ import annotations
 
@@ -12,16 +13,16 @@ import multiprocessing
 
 from ..errors import EngineError
 from ..templates.decision_table import compiled_template
-from .records import Encoded
-
 SLICES_PER_WORKER = 8   # small enough to balance the workers, large enough to amortise sending jobs
 
+PLANNING = "planning"   # the stage a batch's progress callback is told while its gears are planned
 _BATCH: list = []   # (planner, gears, plan function) of the batch being planned, inherited by the forked workers
 
 
-def plan_in_workers(planner, gears: list, workers: int, plan_one, progress=None) -> list[Encoded]:
-    """`plan_one(planner, gear) -> Planned` for every gear, in `workers` forked processes; each
-    job comes back encoded for storage (engine.programs.records.Encoded)."""
+def plan_in_workers(planner, gears: list, workers: int, plan_one, progress=None) -> list:
+    """`plan_one(planner, gear)` for every gear, in `workers` forked processes, in gear order: what
+    it returns comes back pickled (a job encoded for storage, engine.programs.records.Encoded, or
+    the reason a gear is bad); `progress(stage, done, total)` as slices come back."""
     for gear_class in {gear.gear_class for gear in gears if gear.gear_class is not None}:
         _ready(planner, gear_class)
     size = max(1, len(gears) // (workers * SLICES_PER_WORKER))
@@ -29,12 +30,12 @@ def plan_in_workers(planner, gears: list, workers: int, plan_one, progress=None)
     _BATCH[:] = [planner, gears, plan_one]
     try:
         with multiprocessing.get_context("fork").Pool(workers, initializer=_in_worker) as pool:
-            encoded = []
-            for jobs in pool.imap(_plan_slice, slices):
-                encoded += jobs
+            outcomes = []
+            for planned in pool.imap(_plan_slice, slices):
+                outcomes += planned
                 if progress:
-                    progress(len(jobs))
-            return encoded
+                    progress(PLANNING, len(outcomes), len(gears))
+            return outcomes
     finally:
         _BATCH.clear()
 
@@ -61,7 +62,7 @@ def _in_worker() -> None:
     _BATCH[0].conn = _NoDatabase()
 
 
-def _plan_slice(bounds: tuple[int, int]) -> list[Encoded]:
-    """In a worker: plan and encode a slice of the gears (the JSON encoding is done here, in parallel)."""
+def _plan_slice(bounds: tuple[int, int]) -> list:
+    """In a worker: plan a slice of the gears (plan_one encodes them, here, in parallel)."""
     planner, gears, plan_one = _BATCH
-    return [plan_one(planner, gear).encoded() for gear in gears[bounds[0]:bounds[1]]]
+    return [plan_one(planner, gear) for gear in gears[bounds[0]:bounds[1]]]
