@@ -18,7 +18,7 @@ def demo(ctx, gear_id):
 
     Example: engine demo --gear 43
     """
-    from ..demo import run_demo
+    from ..programs.demo import run_demo
 
     if ctx.obj["database_url"]:
         click.echo("demo: --database-url/DATABASE_URL ignored: the demo writes sample data and runs only on the "

@@ -8,8 +8,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from .db.embedded import embedded_data_dir, embedded_url
-from .db.seed import SeedReport
+from ..db.embedded import embedded_data_dir, embedded_url
+from ..db.seed import SeedReport
 
 
 @dataclass(frozen=True)
@@ -22,10 +22,10 @@ class DemoResult:
 
 def run_demo(gear_id: int = 42) -> DemoResult:
     """Migrate and seed (samples included) the embedded server's database, instantiate one gear."""
-    from .db.connection import connect
-    from .db.migrate import migrate
-    from .db.seed import seed
-    from .programs.instantiate import instantiate_gear
+    from ..db.connection import connect
+    from ..db.migrate import migrate
+    from ..db.seed import seed
+    from .instantiate import instantiate_gear
 
     with connect(embedded_url()) as conn:
         applied = migrate(conn)
