@@ -139,6 +139,8 @@ def test_db_url_prints_the_url_given_or_the_libpq_variables():
                                                               "PGDATABASE": "shop", "PGPORT": "5433"})
     assert from_libpq.exit_code == 0
     assert sorted(from_libpq.stdout.split()) == ["dbname=shop", "host=/run/pg", "port=5433"]
+    from_variable = CliRunner().invoke(main, ["db", "url"], env={"DATABASE_URL": given})
+    assert (from_variable.stdout, from_variable.stderr) == (given + "\n", "from DATABASE_URL\n")
 
 
 def test_psql_missing_everywhere_says_the_command_to_run(tmp_path, monkeypatch):

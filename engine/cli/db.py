@@ -1,5 +1,6 @@
-"""Setting up the database: `engine db migrate|status`, `engine seed`, and `engine demo`, which
-does both on the embedded server and instantiates one gear."""
+"""Setting up and operating the database: `engine db migrate|status`, `engine db url|psql|stop`
+(the embedded server), `engine seed [--samples]`, and `engine demo`, which migrates and seeds the
+embedded server's database and instantiates one gear."""
 from __future__ import annotations
 
 import os

@@ -27,7 +27,7 @@ def url_in_use(database_url: str | None = None) -> tuple[str, str]:
     server is started if it is the one). For libpq's PG* variables, the conninfo they make."""
     url = resolve_url(database_url)
     if url and (database_url or os.environ.get("DATABASE_URL")):
-        return url, "--database-url" if database_url else "DATABASE_URL"
+        return url, "DATABASE_URL" if url == os.environ.get("DATABASE_URL") else "--database-url"
     if not url:
         return _libpq_conninfo(), "the PG* variables"
     return url, f"the embedded PostgreSQL, data in {embedded_data_dir()}"
