@@ -104,7 +104,8 @@ def test_the_embedded_server_is_started_shown_opened_and_stopped(engine):
     running = server_state(engine.data_dir)
     stopped = engine("db", "stop")
     assert stopped.returncode == 0, stopped.stderr
-    assert stopped.stdout.startswith(f"stopped the embedded PostgreSQL (pid {running.pid}, data in {engine.data_dir})")
+    assert stopped.stdout.startswith(
+        f"stopped the embedded PostgreSQL (pid {running.pid}, data in {engine.data_dir})")
     assert not server_state(engine.data_dir).running
     with pytest.raises(psycopg.OperationalError):
         psycopg.connect(url, connect_timeout=5)

@@ -22,8 +22,9 @@ def demo(ctx, gear_id):
     from ..programs.demo import run_demo
 
     if ctx.obj["database_url"]:
-        click.echo("demo: --database-url/DATABASE_URL ignored: the demo writes sample data and runs only on the "
-                   "embedded PostgreSQL; to load the samples into that database run `engine seed --samples`", err=True)
+        click.echo("demo: --database-url/DATABASE_URL ignored: the demo writes sample data and runs only on "
+                   "the embedded PostgreSQL; to load the samples into that database run `engine seed --samples`",
+                   err=True)
     result = run_demo(gear_id)
     program = result.program
     click.echo(f"demo: on the embedded PostgreSQL (data in {result.data_dir}); "

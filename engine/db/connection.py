@@ -4,7 +4,7 @@ from __future__ import annotations
 import os
 
 from ..errors import EngineError
-from .embedded import EMBEDDED_DATABASE, embedded_data_dir, embedded_url  # noqa: F401 (their old home)
+from .embedded import embedded_data_dir, embedded_url
 
 LIBPQ_KEYWORDS = {"PGHOST": "host", "PGPORT": "port", "PGDATABASE": "dbname", "PGUSER": "user",
                   "PGSERVICE": "service"}

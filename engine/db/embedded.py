@@ -66,7 +66,8 @@ def embedded_url(database: str = EMBEDDED_DATABASE) -> str:
 
 def _url_of(info, database: str = "postgres") -> str:
     """The server's URL with its port: libpq would otherwise take PGPORT for the socket's name."""
-    return f"{info.get_uri(database=database)}&port={info.port}" if info.socket_dir else info.get_uri(database=database)
+    url = info.get_uri(database=database)
+    return f"{url}&port={info.port}" if info.socket_dir and info.port else url
 
 
 def _create_database(admin_url: str, database: str) -> None:
