@@ -96,7 +96,11 @@ class ServerState:
 def server_state(data_dir: Path | None = None) -> ServerState:
     """Whether the embedded server on `data_dir` runs, from its postmaster.pid; starts nothing."""
     data_dir = data_dir or embedded_data_dir()
-    info = _package().postgres_server.PostmasterInfo.read_from_pgdata(data_dir) if data_dir.is_dir() else None
+    try:
+        info = _package().postgres_server.PostmasterInfo.read_from_pgdata(data_dir) if data_dir.is_dir() else None
+    except PermissionError as error:   # another user's server (root's belongs to embedded_postgres)
+        raise EngineError(f"cannot read the embedded server's data in {data_dir} ({error.strerror}); "
+                          "run the command as the user who owns it, or as root") from error
     return ServerState(data_dir, info.pid if info is not None and info.is_running() else None)
 
 
