@@ -109,6 +109,7 @@ def _database_failure_message(error: Exception, first_line: str) -> str:
 @click.option("--database-url", envvar="DATABASE_URL", default=None,
               help="PostgreSQL URL. Default: DATABASE_URL, else libpq PG* variables, else the embedded server.")
 @click.option("--traceback", is_flag=True, help="Show the full stack trace of an error.")
+@click.version_option(package_name="nc-template-engine", message="%(package)s %(version)s")
 @click.pass_context
 def main(ctx, database_url, traceback):
     """NC program template engine for gear hobbing (Siemens 840D).

@@ -1,6 +1,9 @@
-"""Setting up the database: `engine db migrate|status`, `engine seed`, and `engine demo`, which
-does both on the embedded server and instantiates one gear."""
+"""Setting up and operating the database: `engine db migrate|status`, `engine db url|psql|stop`
+(the embedded server), `engine seed [--samples]`, and `engine demo`, which migrates and seeds the
+embedded server's database and instantiates one gear."""
 from __future__ import annotations
+
+import os
 
 import click
 
@@ -11,16 +14,21 @@ from .context import connection
 @click.option("--gear", "gear_id", default=42, show_default=True, help="Gear to instantiate.")
 @click.pass_context
 def demo(ctx, gear_id):
-    """Migrate, seed and instantiate one gear on the embedded PostgreSQL; print the program."""
-    from ..programs.instantiate import instantiate_gear
-    from ..db.migrate import migrate
-    from ..db.seed import seed
+    """Migrate, seed (with the samples) and instantiate one gear on the embedded PostgreSQL;
+    print the program. Never on another database: --database-url and DATABASE_URL are ignored.
 
-    with connection(ctx, migrated=False) as conn:
-        applied = migrate(conn)
-        report = seed(conn)
-        program = instantiate_gear(conn, gear_id)
-    click.echo(f"migrations applied: {len(applied)}; {report}", err=True)
+    Example: engine demo --gear 43
+    """
+    from ..programs.demo import run_demo
+
+    if ctx.obj["database_url"]:
+        click.echo("demo: --database-url/DATABASE_URL ignored: the demo writes sample data and runs only on "
+                   "the embedded PostgreSQL; to load the samples into that database run `engine seed --samples`",
+                   err=True)
+    result = run_demo(gear_id)
+    program = result.program
+    click.echo(f"demo: on the embedded PostgreSQL (data in {result.data_dir}); "
+               f"migrations applied: {result.applied}; {result.report}", err=True)
     click.echo(program.text, nl=False)
     click.echo(f"program {program.program_id} ({len(program.lines)} lines) from template "
                f"{program.gear_class} v{program.template_version} ({program.template_hash})", err=True)
@@ -28,13 +36,17 @@ def demo(ctx, gear_id):
 
 @click.group()
 def db():
-    """Database schema: apply or list the numbered SQL migrations."""
+    """The database: apply or list the numbered SQL migrations; the URL in use, psql on it, and
+    stopping the embedded PostgreSQL."""
 
 
 @db.command("migrate")
 @click.pass_context
 def db_migrate(ctx):
-    """Apply pending migrations in order, each in its own transaction."""
+    """Apply pending migrations in order, each in its own transaction.
+
+    Example: engine db migrate
+    """
     from ..db.migrate import migrate
 
     with connection(ctx, migrated=False) as conn:
@@ -45,7 +57,10 @@ def db_migrate(ctx):
 @db.command("status")
 @click.pass_context
 def db_status(ctx):
-    """Show every migration: applied (when), pending, or CHANGED since applied."""
+    """Show every migration: applied (when), pending, or CHANGED since applied.
+
+    Example: engine db status
+    """
     from ..db.migrate import status
 
     with connection(ctx, migrated=False) as conn:
@@ -54,11 +69,64 @@ def db_status(ctx):
             click.echo(f"{state.state:8} {state.migration.path.name}{when}")
 
 
-@click.command("seed")
+@db.command("url")
 @click.pass_context
-def seed_command(ctx):
-    """Load seed_templates/: classes, standard code, machines, hobs, sample gears (adds only what is missing)."""
+def db_url(ctx):
+    """Print the URL of the database in use (--database-url, DATABASE_URL, the PG* variables, else
+    the embedded PostgreSQL, which is started if it is not running); where it came from on stderr.
+
+    Example: psql "$(engine db url)"
+    """
+    from ..db.connection import url_in_use
+
+    url, source = url_in_use(ctx.obj["database_url"])
+    click.echo(url)
+    click.echo(f"from {source}", err=True)
+
+
+@db.command("psql", context_settings={"ignore_unknown_options": True})
+@click.argument("psql_args", nargs=-1, type=click.UNPROCESSED)
+@click.pass_context
+def db_psql(ctx, psql_args):
+    """Open psql on the database in use: the embedded package's own psql, else the one on PATH;
+    further arguments go to psql. Without any psql, says which command to run.
+
+    Example: engine db psql -c 'SELECT name, parent FROM gear_class'
+    """
+    from ..db.connection import psql_command
+
+    command = psql_command(ctx.obj["database_url"], psql_args)
+    os.execvp(command[0], command)
+
+
+@db.command("stop")
+def db_stop():
+    """Stop the embedded PostgreSQL cleanly (committed work is kept), also when run as root;
+    the next command that needs it starts it again.
+
+    Example: engine db stop
+    """
+    from ..db.embedded import stop_embedded
+
+    state = stop_embedded()
+    if state.running:
+        click.echo(f"stopped the embedded PostgreSQL (pid {state.pid}, data in {state.data_dir})")
+    else:
+        click.echo(f"the embedded PostgreSQL is not running (data in {state.data_dir}); nothing to stop")
+
+
+@click.command("seed")
+@click.option("--samples", is_flag=True,
+              help="Also the sample gears, hobs, machining-history cases and the golden tests on sample gears.")
+@click.pass_context
+def seed_command(ctx, samples):
+    """Load seed_templates/ (adds only what is missing, overwrites nothing): the class tree, the
+    standard code of every class (released), the machine records and the golden tests that need
+    no sample gear. A shop's gears, hobs and history are its own: the samples only with --samples.
+
+    Example: engine seed --samples
+    """
     from ..db.seed import seed
 
     with connection(ctx) as conn:
-        click.echo(str(seed(conn)))
+        click.echo(str(seed(conn, samples=samples)))

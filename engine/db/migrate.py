@@ -53,8 +53,11 @@ class MigrationState:
         return "CHANGED" if self.changed else "applied"
 
 
-def discover(directory: Path = MIGRATIONS_DIR) -> list[Migration]:
-    """The migration files in version order; a stray .sql file is an error, not a skip."""
+def discover(directory: Path | None = None) -> list[Migration]:
+    """The migration files in version order (of this installation's migrations/ by default); a
+    stray .sql file is an error, not a skip. None at all is an installation without its data
+    (a wheel built without them): refused, or `db migrate` would report success on nothing."""
+    directory = directory or MIGRATIONS_DIR
     migrations = []
     for path in sorted(directory.glob("*.sql")):
         match = MIGRATION_FILE.match(path.name)
@@ -64,10 +67,13 @@ def discover(directory: Path = MIGRATIONS_DIR) -> list[Migration]:
     versions = [m.version for m in migrations]
     if len(versions) != len(set(versions)):
         raise EngineError(f"two migration files in {directory} share a version number")
+    if not migrations:
+        raise EngineError(f"no migrations found in {directory}: this installation is incomplete; "
+                          "reinstall the engine (pip install .) or run it from a checkout")
     return migrations
 
 
-def status(conn, directory: Path = MIGRATIONS_DIR) -> list[MigrationState]:
+def status(conn, directory: Path | None = None) -> list[MigrationState]:
     applied = _applied(conn)
     states = []
     for migration in discover(directory):
@@ -80,11 +86,12 @@ def status(conn, directory: Path = MIGRATIONS_DIR) -> list[MigrationState]:
     return states
 
 
-def migrate(conn, directory: Path = MIGRATIONS_DIR) -> list[Migration]:
+def migrate(conn, directory: Path | None = None) -> list[Migration]:
     """Apply every pending migration; return those applied. Refuses if an applied file changed.
     Each migration commits on its own, so the connection must not be inside a transaction."""
     from psycopg.pq import TransactionStatus
 
+    discover(directory)   # an installation without migrations is refused before anything is written
     if conn.info.transaction_status != TransactionStatus.IDLE:
         conn.commit()  # our own reads so far (status queries); migrations need real transactions
     autocommit, conn.autocommit = conn.autocommit, True
@@ -97,7 +104,7 @@ def migrate(conn, directory: Path = MIGRATIONS_DIR) -> list[Migration]:
         conn.autocommit = autocommit
 
 
-def _apply_pending(conn, directory: Path) -> list[Migration]:
+def _apply_pending(conn, directory: Path | None) -> list[Migration]:
     states = status(conn, directory)
     changed = [s.migration.path.name for s in states if s.changed]
     if changed:

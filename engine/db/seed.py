@@ -22,6 +22,7 @@ SEED_TABLES = (
     ("machine", "machines.csv", "name"),
     ("hob", "hobs.csv", "id"),
 )
+SHOP_TABLES = SEED_TABLES[:1]   # the machines; the hobs are samples
 
 
 @dataclass
@@ -38,19 +39,38 @@ class SeedReport:
         return "seed: added " + ", ".join(f"{n} {what}" for what, n in self.added.items() if n)
 
 
-def seed(conn, directory: Path = SEED_DIR) -> SeedReport:
+def seed(conn, directory: Path = SEED_DIR, *, samples: bool = True) -> SeedReport:
+    """Load what is missing, in one transaction.
+
+    What every shop needs (`engine seed`): the class tree and the standard code of each class,
+    released (the shipped templates, tested here); the machine records (every program is checked
+    against its machine's limits, the default machines are the ones the standard code's dialects
+    are written for, and a shop edits its records rather than typing them from nothing); the
+    golden tests that state their job's parameters (the release gate runs them).
+
+    The samples (`samples`: `engine seed --samples`, `engine demo`, the tests; the library's
+    default, for them): the sample gears and their further units, the sample hob library, the
+    machining-history cases, and the golden tests that name a sample gear. Gears, hobs and the
+    history are a shop's own data; a sample gear 42 next to the shop's gears would be
+    instantiated by mistake, a sample hob chosen for a real job, sample cases would move its
+    cutting data; a test naming gear 42 would test whatever the shop's gear 42 is."""
     report = SeedReport()
     with conn.transaction():
         _seed_classes(conn, directory, report)
-        for table, file_name, key in SEED_TABLES:
+        for table, file_name, key in SEED_TABLES if samples else SHOP_TABLES:
             report.count(table + "s", _insert_missing(conn, table, key, _read(directory / file_name)))
         seeded = _seed_templates(conn, directory, report)
-        _seed_gears(conn, directory, report)
-        _seed_units(conn, directory, report)
-        _seed_cases(conn, directory, report)
-        _seed_template_tests(conn, directory, report)
+        if samples:
+            _seed_samples(conn, directory, report)
+        _seed_template_tests(conn, directory, report, samples)
         _release_seeded(conn, seeded, report)
     return report
+
+
+def _seed_samples(conn, directory: Path, report: SeedReport) -> None:
+    _seed_gears(conn, directory, report)
+    _seed_units(conn, directory, report)
+    _seed_cases(conn, directory, report)
 
 
 RELEASE_SEEDED = ("SELECT release_template(g.name, g.template_version, v.hash, note => %s) FROM gear_class g "
@@ -63,14 +83,17 @@ INSERT_TEST = ("INSERT INTO template_test (gear_class, name, gear_id, params, ch
                "ON CONFLICT (gear_class, name) DO NOTHING RETURNING 1")
 
 
-def _seed_template_tests(conn, directory: Path, report: SeedReport) -> None:
+def _seed_template_tests(conn, directory: Path, report: SeedReport, samples: bool = True) -> None:
     """The golden tests of the shipped templates (engine test), by class and name: a test a DBA
-    edited stays edited; a missing one is added, like every seeded row."""
+    edited stays edited; a missing one is added, like every seeded row. Those naming a sample
+    gear only with the samples."""
     path = directory / "template_tests.json"
     if not path.exists():
         return
     added = 0
     for test in json.loads(path.read_text(encoding="utf-8")):
+        if test.get("gear_id") is not None and not samples:
+            continue
         params = test.get("params")
         added += conn.execute(INSERT_TEST, (test["class"], test["name"], test.get("gear_id"),
                                             Jsonb(params) if params is not None else None,
