@@ -16,9 +16,9 @@ PROVENANCES = ("dxf", "nc")   # each folder of tests/data with its PROVENANCE.ts
 
 # Pointers out of the clone: the sibling folder of the old design notes, reference and data,
 # and absolute paths into somebody's machine (system paths such as /etc or /proc are the
-# machine's, not a checkout's, and stay allowed).
+# machine's, not a checkout's, and stay allowed; so does /srv, where a shop keeps its NC files).
 OUTSIDE = re.compile(rb"\.\./shared|\bshared/(DESIGN|reference|data|seeds|tools)\b"
-                     rb"|(?<![\w.~-])/(work|home|root|Users|mnt|srv)/")
+                     rb"|(?<![\w.~-])/(work|home|root|Users|mnt)/")
 
 
 def tracked_files() -> list[Path]:
