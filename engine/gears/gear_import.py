@@ -171,7 +171,7 @@ def _check_hand(gear: dict[str, Any], classes: Classes) -> Said:
 
 def _check_kind(gear: dict[str, Any], classes: Classes) -> Said:
     problem = _check_module_kind(gear, classes.templated)
-    return ("module_kind", problem) if problem else None
+    return ("module_kind", problem.removeprefix("module_kind ")) if problem else None
 
 
 def _fill_diameters(gear: dict[str, Any], classes: Classes) -> Said:
