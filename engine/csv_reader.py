@@ -303,13 +303,16 @@ def _records(text: str, source: str, separator: str, kind: CsvKind) -> list[tupl
                 records.append((start, [cell.strip() for cell in record] if kind.strip else record))
             start = reader.line_num + 1
     except csv.Error as error:
-        raise refuse(source, *_csv_problem(error), line=start) from None
+        spans = not kind.multiline and reader.line_num > start   # a quote ran on into the next lines
+        raise refuse(source, *_csv_problem(error, spans), line=start) from None
     return records
 
 
-def _csv_problem(error: csv.Error) -> tuple[str, str]:
+def _csv_problem(error: csv.Error, spans: bool = False) -> tuple[str, str]:
     if "unexpected end of data" in str(error):
         return "a quote opened here is never closed", "close it (a quote inside a cell is written \"\")"
+    if spans:
+        return "a quote opened on this line is not closed on it", "close it (a quote inside a cell is written \"\")"
     return f"not valid CSV ({error})", "save it again as CSV"
 
 
