@@ -273,9 +273,11 @@ def read_csv_text(text: str, source: str, kind: CsvKind) -> CsvFile:
     records = _records(text, source, separator, kind)
     if not records:
         raise refuse(source, "is empty", f"give a header line ({','.join(kind.names)}) and {kind.name} rows")
-    header = _header(source, records[0][1], kind)
+    header = _header(source, records[0], kind)
     body = records[1:]
-    problems = [problem for line, cells in body for problem in _count_problem(text, separator, header, line, cells)]
+    miscounted = [(line, cells) for line, cells in body if len(cells) != len(header)]
+    lines = re.split(r"\r\n|\r|\n", text) if miscounted else []   # the lines as the csv reader counts them
+    problems = [_count_problem(lines[line - 1], separator, header, line, cells) for line, cells in miscounted]
     if problems:
         raise CsvError(source, problems)
     return CsvFile(source, separator, header, body)
@@ -316,31 +318,28 @@ def _csv_problem(error: csv.Error, spans: bool = False) -> tuple[str, str]:
     return f"not valid CSV ({error})", "save it again as CSV"
 
 
-def _header(source: str, cells: list[str], kind: CsvKind) -> list[str]:
+def _header(source: str, record: tuple[int, list[str]], kind: CsvKind) -> list[str]:
     """The column names of the header (lower case), checked against the kind's declared columns."""
-    names = [cell.lower() for cell in cells]
+    line, names = record[0], [cell.strip().lower() for cell in record[1]]
     unknown = [name for name in names if name and name not in kind.names]
     twice = sorted({name for name in names if name and names.count(name) > 1})
     missing = [column.name for column in kind.columns
                if (column.required or kind.every_column) and column.name not in names]
-    problems = [Problem(1, None, f"unknown column(s) {', '.join(unknown)}",
+    problems = [Problem(line, None, f"unknown column(s) {', '.join(unknown)}",
                         f"use the columns {', '.join(kind.names)}")] if unknown else []
-    problems += [Problem(1, None, f"column(s) named twice: {', '.join(twice)}", "name each column once")] if twice else []
-    problems += [Problem(1, None, f"missing required column(s) {', '.join(missing)}",
+    problems += [Problem(line, None, f"column(s) named twice: {', '.join(twice)}", "name each column once")] if twice else []
+    problems += [Problem(line, None, f"missing required column(s) {', '.join(missing)}",
                          f"add them to the header ({', '.join(kind.names)})")] if missing else []
     if problems:
         raise CsvFileError("; ".join(problem.said(source) for problem in problems))
     return names
 
 
-def _count_problem(text: str, separator: str, header: list[str], line: int, cells: list[str]) -> list[Problem]:
+def _count_problem(raw: str, separator: str, header: list[str], line: int, cells: list[str]) -> Problem:
     """A record with another cell count than the header's: its values would land in the wrong columns."""
-    if len(cells) == len(header):
-        return []
     todo = "give one cell per column (an empty cell for a value not given); quote a cell that holds " \
            f"'{separator}'"
-    raw = text.splitlines()[line - 1] if line <= len(text.splitlines()) else ""
     if separator == "," and len(cells) > len(header) and SPLIT_DECIMAL.search(raw):
         todo = ("a value like 2,5 looks like a decimal comma that split into two cells: write 2.5, or save "
                 "the file with ';' between the columns")
-    return [Problem(line, None, f"{len(cells)} cells, but the header names {len(header)} columns", todo)]
+    return Problem(line, None, f"{len(cells)} cells, but the header names {len(header)} columns", todo)

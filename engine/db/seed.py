@@ -5,7 +5,7 @@ from __future__ import annotations
 import csv
 import json
 import tempfile
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from pathlib import Path
 
 from psycopg import sql
@@ -14,6 +14,7 @@ from psycopg.types.json import Jsonb
 from ..csv_reader import Column, CsvKind, parse_text, read_csv_file
 from ..gears.gear_import import GEAR_KIND, import_gears
 from ..gears.hob_library import HOB_COLUMNS
+from ..gears.records import Machine
 from ..gears.units import UNIT_KIND, import_units
 from ..paths import SEED_DIR
 from ..templates.rows import read_csv
@@ -22,11 +23,8 @@ from ..templates.store import ensure_class, replace_template
 # The seed tables' CSV kinds: every cell goes as text, and the database parses it into its column's type.
 CLASS_KIND = CsvKind("gear class", (Column("name", parse_text, required=True), Column("parent", parse_text),
                                     Column("description", parse_text)))
-MACHINE_KIND = CsvKind("machine", tuple(Column(name, parse_text, required=name in ("name", "kind", "dialect")) for name in (
-    "name", "kind", "dialect", "x_min", "x_max", "y_min", "y_max", "z_min", "z_max", "spindle_max", "table_speed_max",
-    "module_max", "a_direction", "b_direction", "c_direction", "y_direction", "z_direction", "work_offset",
-    "fixture_diameter", "fixture_gap", "tailstock_diameter", "tailstock_gap", "load_x", "load_z", "rapid_rate",
-    "orient_before_coupling", "door_close_m", "door_open_m")))
+MACHINE_KIND = CsvKind("machine", tuple(Column(spec.name, parse_text, required=spec.name in ("name", "kind", "dialect"))
+                                        for spec in fields(Machine)))   # the columns of the machine table
 SEED_HOB_KIND = CsvKind("hob", tuple(Column(column.name, parse_text, column.required) for column in HOB_COLUMNS))
 
 # table, CSV file, key column, its kind; loaded in this order.
