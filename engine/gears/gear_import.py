@@ -1,9 +1,11 @@
 """Workpieces from a gear CSV (design notes §9 columns).
 
-Every row is read and checked first; only when the whole file is good are all its gears
-upserted, in one transaction. A file with any bad row stores nothing and reports every
-problem, one line each, with the physical line number in the file (header = line 1).
-Numbers are kept as Decimal, so they are stored exactly as written.
+The file is read by the one CSV reader (engine.csv_reader: `,` or `;` with decimal commas). Every
+row is read and checked first (cells, class, module kind, the diameters of cylindrical gears against
+m_n, z, β and x); only when the whole file is good are all its gears stored, in one transaction. A
+file with any bad row stores nothing and reports every problem, one line each, as
+`<file>, line N, column C: what; what to do`. A gear_id already stored is refused unless `replace`,
+which reports every changed field. Numbers are kept as Decimal, so they are stored exactly as written.
 """
 from __future__ import annotations
 
