@@ -269,3 +269,11 @@ def test_worm_wheels_and_taper_gears_are_not_held_to_the_cylindrical_formulas(co
     assert conn.execute("SELECT count(*) FROM gear WHERE id IN (90217, 90218)").fetchone()[0] == 2
     helical = write(tmp_path, f"{HEADER}\n90219,helical,3,40,4.05,R,25,{far:.2f},,,\n", "h.csv")
     assert "column tip_diameter" in refusal(lambda: import_gears(conn, helical))
+
+
+def test_a_further_unit_of_a_duplex_gear_is_held_to_the_formulas_of_its_module(conn, tmp_path):
+    # gear 54 (seeded): duplex, m = 2; a spur unit of z = 19 has d_a = 2·19 + 2·2 = 42 at x = 0
+    good = write(tmp_path, f"gear_id,unit,teeth,face_width,tip_diameter,z_top\n54,2,19,15,{tip(2, 19):g},-75\n", "u.csv")
+    assert import_units(conn, good) == 1
+    wrong = write(tmp_path, f"gear_id,unit,teeth,face_width,tip_diameter,z_top\n54,2,19,15,{tip(3, 19):g},-75\n", "w.csv")
+    assert f"line 2, column tip_diameter: {tip(3, 19):g} contradicts d_a" in refusal(lambda: import_units(conn, wrong))

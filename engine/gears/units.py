@@ -8,6 +8,7 @@ from pathlib import Path
 
 from ..csv_reader import Column, CsvKind, Problem, parse_number, parse_positive_whole, read_csv_file
 from ..errors import EngineError
+from .gear_geometry import diameter_problems
 from .gear_import import POSITIVE, GearImportError, derived_diameters
 
 UNIT_COLUMNS: tuple[Column, ...] = (
@@ -56,15 +57,25 @@ def _parse_unit(file, line: int, cells: dict) -> tuple[dict, list[Problem]]:
     return unit, problems
 
 
+UNIT_GEAR = ("SELECT module, face_width, gear_class IN (SELECT name FROM classes_and_below(ARRAY['cylindrical'])) "
+             "FROM gear WHERE id = %s")
+
+
 def _database_problems(conn, units: list) -> list[Problem]:
-    """Each unit's gear must exist; diameters are completed from the gear's module."""
+    """Each unit's gear must exist; given diameters of a cylindrical gear's unit (a spur unit of the
+    gear's module) must fit the formulas (engine.gears.gear_geometry); the others are completed."""
     problems = []
     for line, unit in units:
-        gear = conn.execute("SELECT module, face_width FROM gear WHERE id = %s", (unit["gear_id"],)).fetchone()
+        gear = conn.execute(UNIT_GEAR, (unit["gear_id"],)).fetchone()
         if gear is None:
             problems.append(Problem(line, "gear_id", f"gear {unit['gear_id']} does not exist", "import the gear first"))
             continue
-        module, face_width = gear
+        module, face_width, cylindrical = gear
+        spur = {**unit, "module": module, "helix_angle": 0, "module_kind": None, "profile_shift": None}
+        geometry = [Problem(line, p.column, p.what, p.todo) for p in diameter_problems(spur)] if cylindrical else []
+        problems += geometry
+        if geometry:
+            continue
         if unit["z_top"] > -face_width:
             problems.append(Problem(line, "z_top", f"{unit['z_top']} lies inside unit 1 (Z0…{-face_width})",
                                     "give a Z below the gear's first unit"))
