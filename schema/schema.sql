@@ -1795,6 +1795,7 @@ GRANT SELECT ON near_duplicate_seen, near_duplicate_intended
 GRANT INSERT (pair_key, t, a, b, why), UPDATE (withdrawn_at) ON near_duplicate_intended TO engine_editor;
 GRANT USAGE ON SEQUENCE near_duplicate_intended_id_seq TO engine_editor;
 GRANT INSERT, UPDATE (last_seen) ON near_duplicate_seen TO engine_runner;
+
 -- --- gears: when each was stored (migration 0017) ----------------------------------------------
 
 -- When a gear was stored (issue 16: `engine gears list --since/--until`): set by the database
@@ -1802,3 +1803,9 @@ GRANT INSERT, UPDATE (last_seen) ON near_duplicate_seen TO engine_runner;
 -- this migration (their date is unknown, and no date is invented for them).
 ALTER TABLE gear ADD COLUMN created_at timestamptz;
 ALTER TABLE gear ALTER COLUMN created_at SET DEFAULT now();
+
+-- --- gears: the profile shift (migration 0020) ----------------------------------------------
+-- Issue 16: a gear's profile shift x (in modules), as the drawing gives it. The gear import checks the
+-- tip and root diameters of cylindrical gears against d = m_n·z/cos β, d_a = d + 2·m_n·(1 + x) and
+-- d_f = d − 2·m_n·(1.25 − x); NULL = not given (the diameters must then fit some plausible x).
+ALTER TABLE gear ADD COLUMN profile_shift numeric CONSTRAINT gear_profile_shift CHECK (profile_shift > -2 AND profile_shift < 2);

@@ -48,9 +48,9 @@ def refusal(result) -> str:
     # closed again by a later quote: the record runs over lines 3 to 5
     (lambda rows: (rows.__setitem__(1, rows[1].replace("40Cr", '"40Cr')),
                    rows.__setitem__(3, rows[3].replace("40Cr", '40Cr"'))), "line 3: a quote opened on this line"),
-    (lambda rows: rows.__setitem__(3, rows[3].replace(",220,", ",1e999,")), "line 5: hardness '1e999'"),
-    (lambda rows: rows.__setitem__(3, rows[3].replace(",220,", ",900,")), "line 5: hardness 900 is outside"),
-    (lambda rows: rows.__setitem__(3, rows[3].replace(",,20,,,,,40Cr", ",,1e999,,,,,40Cr")), "line 5: face_width '1e999'"),
+    (lambda rows: rows.__setitem__(3, rows[3].replace(",220,", ",1e999,")), "line 5, column hardness: '1e999'"),
+    (lambda rows: rows.__setitem__(3, rows[3].replace(",220,", ",900,")), "line 5, column hardness: 900 is outside"),
+    (lambda rows: rows.__setitem__(3, rows[3].replace(",,20,,,,,40Cr", ",,1e999,,,,,40Cr")), "line 5, column face_width: '1e999'"),
 ])
 def test_a_bad_gear_file_imports_nothing_and_names_the_line(run, tmp_path, edit, words):
     rows = gear_rows()

@@ -105,7 +105,7 @@ def test_gears_import_reports_every_bad_row_and_stores_nothing(run, tmp_path):
     assert stored_counts(run.url) == before
     csv_file.write_text("gear_id,module,teeth,face_width,material\n100,2,20,15,45\n")
     result = run("gears", "import", csv_file, "--json")
-    assert result.exit_code == 0 and json.loads(result.stdout) == {"imported": 1}
+    assert result.exit_code == 0 and json.loads(result.stdout) == {"imported": 1, "replaced": [], "changes": []}
 
 
 def test_template_export_import_round_trip_is_byte_identical(run, tmp_path):

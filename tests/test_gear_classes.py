@@ -310,7 +310,7 @@ def test_a_gear_no_class_fits_is_refused_with_the_reason(run, tmp_path):
     path.write_text("gear_id,module,teeth,face_width,cone_angle,crowning\n900,2,19,20,6.5,0.02\n")
     result = run("gears", "import", path)
     assert result.exit_code == 1
-    assert "line 2: no class hobs a crowned taper gear" in result.stderr + result.stdout
+    assert "line 2, column gear_class: no class hobs a crowned taper gear" in result.stderr + result.stdout
 
 
 def test_a_gear_no_hob_fits_is_refused_with_the_property(run, tmp_path):

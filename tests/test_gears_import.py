@@ -38,7 +38,7 @@ def stored(conn, gear_id: int) -> dict:
 
 def test_good_file_imports_every_row_with_its_values(conn, tmp_path):
     before = gear_count(conn)
-    assert import_gears(conn, write(tmp_path, GOOD)) == 2
+    assert import_gears(conn, write(tmp_path, GOOD)).imported == 2
     assert gear_count(conn) == before + 2
 
     spur = stored(conn, 90001)
@@ -68,11 +68,11 @@ def test_given_tip_keeps_full_tooth_depth_and_numbers_stay_as_written(conn, tmp_
     assert stored(conn, 90004)["root_diameter"] == Decimal("32.95")
 
 
-def test_reimport_updates_the_gears(conn, tmp_path):
+def test_reimport_with_replace_updates_the_gears(conn, tmp_path):
     import_gears(conn, write(tmp_path, GOOD))
     before = gear_count(conn)
     corrected = GOOD.replace("90001,,2,19,", "90001,,2,21,")
-    assert import_gears(conn, write(tmp_path, corrected, "corrected.csv")) == 2
+    assert import_gears(conn, write(tmp_path, corrected, "corrected.csv"), replace=True).imported == 2
     assert gear_count(conn) == before
     spur = stored(conn, 90001)
     # z=21: d = 42, tip = 46, root = 46 − 9 = 37.
@@ -81,13 +81,13 @@ def test_reimport_updates_the_gears(conn, tmp_path):
 
 def test_any_column_order_whitespace_and_optional_columns_left_out(conn, tmp_path):
     text = " teeth , face_width ,gear_id, module \n 19 , 20 , 90005 , 2 \n"
-    assert import_gears(conn, write(tmp_path, text)) == 1
+    assert import_gears(conn, write(tmp_path, text)).imported == 1
     gear = stored(conn, 90005)
     assert (gear["teeth"], gear["module"], gear["gear_class"]) == (19, 2, "spur")
 
 
 def test_file_with_byte_order_mark_imports(conn, tmp_path):
-    assert import_gears(conn, write(tmp_path, GOOD, encoding="utf-8-sig")) == 2
+    assert import_gears(conn, write(tmp_path, GOOD, encoding="utf-8-sig")).imported == 2
     assert stored(conn, 90001)["gear_class"] == "spur"
 
 
@@ -95,7 +95,7 @@ def test_ten_thousand_rows_import(conn, tmp_path):
     rows = [f"{100000 + n},,2,{17 + n % 80},,{15 if n % 2 else ''},{'L' if n % 2 else ''},20,,,,,,,,"
             for n in range(10_000)]
     before = gear_count(conn)
-    assert import_gears(conn, write(tmp_path, "\n".join([HEADER] + rows) + "\n")) == 10_000
+    assert import_gears(conn, write(tmp_path, "\n".join([HEADER] + rows) + "\n")).imported == 10_000
     assert gear_count(conn) == before + 10_000
     assert conn.execute("SELECT count(*) FROM gear WHERE id >= 100000 AND gear_class = 'helical'"
                         ).fetchone()[0] == 5_000
@@ -138,32 +138,32 @@ def test_classified_class_not_installed_is_an_error(tmp_path):
     with pytest.raises(GearImportError) as caught:
         read_gears(path, {"spur": True, "helical": True})
     assert caught.value.problems == [
-        "line 2: gear 7: classified as taper, but no gear class 'taper' is installed; give "
+        f"{path}, line 2, column gear_class: gear 7: classified as taper, but no gear class 'taper' is installed; give "
         "gear_class explicitly or add the class (engine template import --class taper …)"]
 
 
 # --- bad files: every problem with its line, nothing stored ------------------------------
 
 BAD_ROWS = [
-    ("90009,,abc,19,,,,20,,,,,,,,", "line 3: module 'abc' is not a number"),
-    ("90009,,,19,,,,20,,,,,,,,", "line 3: module is missing"),
-    ("90009,,2,19.5,,,,20,,,,,,,,", "line 3: teeth '19.5' is not a positive whole number"),
-    ("90009,,2,0,,,,20,,,,,,,,", "line 3: teeth '0' is not a positive whole number"),
-    ("90009,,2,19,,,,0,,,,,,,,", "line 3: face_width 0 must be greater than 0"),
-    ("90009,,-2,19,,,,20,,,,,,,,", "line 3: module -2 must be greater than 0"),
-    ("90009,,2,19,,,,20,-42,,,,,,,", "line 3: tip_diameter -42 must be greater than 0"),
-    ("90009,,2,19,,60,R,20,,,,,,,,", "line 3: helix_angle 60 is outside [0, 60)"),
-    ("90009,,2,19,,-5,R,20,,,,,,,,", "line 3: helix_angle -5 is outside [0, 60)"),
-    ("90009,,2,19,,15,X,20,,,,,,,,", "line 3: hand 'X' must be L or R"),
-    ("90009,,2,19,,15,,20,,,,,,,,", "line 3: hand is missing; a helical gear (helix_angle 15)"),
-    ("90009,bevelx,2,19,,,,20,,,,,,,,", "line 3: gear class 'bevelx' does not exist; known leaf classes: "),
-    ("90009,gear,2,19,,,,20,,,,,,,,", "line 3: gear class 'gear' is not a leaf class"),
-    ("90001,,2,19,,,,20,,,,,,,,", "line 3: gear_id 90001 is already on line 2"),
-    ("90009,,2,19,,,,20,,,,,,,13,", "line 3: quality_grade 13 is outside 1..12"),
-    ("90009,,2,19,,,,20,,,,,,,0,", "line 3: quality_grade 0 is outside 1..12"),
-    ("90009,,2,19,,,,20,40,41,,,,,,", "line 3: root_diameter 41 is not smaller than tip_diameter 40"),
-    ("90009,,2,19,,,,20,,43,,,,,,", "line 3: root_diameter 43 is not smaller than computed tip_diameter 42"),
-    ("90009,,2,19,,,,20,,,,,,,,,extra", "line 3: value(s) 'extra' outside the named columns"),
+    ("90009,,abc,19,,,,20,,,,,,,,", "line 3, column module: 'abc' is not a number"),
+    ("90009,,,19,,,,20,,,,,,,,", "line 3, column module: is missing"),
+    ("90009,,2,19.5,,,,20,,,,,,,,", "line 3, column teeth: '19.5' is not a positive whole number"),
+    ("90009,,2,0,,,,20,,,,,,,,", "line 3, column teeth: '0' is not a positive whole number"),
+    ("90009,,2,19,,,,0,,,,,,,,", "line 3, column face_width: 0 must be greater than 0"),
+    ("90009,,-2,19,,,,20,,,,,,,,", "line 3, column module: -2 must be greater than 0"),
+    ("90009,,2,19,,,,20,-42,,,,,,,", "line 3, column tip_diameter: -42 must be greater than 0"),
+    ("90009,,2,19,,60,R,20,,,,,,,,", "line 3, column helix_angle: 60 is outside [0, 60)"),
+    ("90009,,2,19,,-5,R,20,,,,,,,,", "line 3, column helix_angle: -5 is outside [0, 60)"),
+    ("90009,,2,19,,15,X,20,,,,,,,,", "line 3, column hand: 'X' must be L or R"),
+    ("90009,,2,19,,15,,20,,,,,,,,", "line 3, column hand: is missing; a helical gear (helix_angle 15)"),
+    ("90009,bevelx,2,19,,,,20,,,,,,,,", "line 3, column gear_class: gear class 'bevelx' does not exist; known leaf classes: "),
+    ("90009,gear,2,19,,,,20,,,,,,,,", "line 3, column gear_class: gear class 'gear' is not a leaf class"),
+    ("90001,,2,19,,,,20,,,,,,,,", "line 3, column gear_id: 90001 is already on line 2"),
+    ("90009,,2,19,,,,20,,,,,,,13,", "line 3, column quality_grade: 13 is outside 1..12"),
+    ("90009,,2,19,,,,20,,,,,,,0,", "line 3, column quality_grade: 0 is outside 1..12"),
+    ("90009,,2,19,,,,20,40,41,,,,,,", "line 3, column root_diameter: 41 contradicts d_f = m_n·z/cos β − 2·m_n·(h*f − x) with x in -1 … 1.5"),
+    ("90009,,2,19,,,,20,,43,,,,,,", "line 3, column root_diameter: 43 contradicts d_f = m_n·z/cos β − 2·m_n·(h*f − x) with x in -1 … 1.5"),
+    ("90009,,2,19,,,,20,,,,,,,,,extra", "line 3: 17 cells, but the header names 16 columns"),
 ]
 
 
@@ -174,7 +174,8 @@ def test_a_bad_row_is_reported_with_its_line_and_nothing_is_stored(conn, tmp_pat
     with pytest.raises(GearImportError) as caught:
         import_gears(conn, path)
     assert str(caught.value) == f"{path}: 1 bad row(s); nothing imported"
-    assert len(caught.value.problems) == 1 and caught.value.problems[0].startswith(message)
+    assert caught.value.problems == [caught.value.problems[0]]
+    assert caught.value.problems[0].startswith(f"{path}, {message}"), caught.value.problems
     assert gear_count(conn) == before and not stored(conn, 90001)
 
 
@@ -187,10 +188,10 @@ def test_all_problems_of_all_rows_are_collected_in_file_order(conn, tmp_path):
     with pytest.raises(GearImportError) as caught:
         import_gears(conn, path)
     assert str(caught.value) == f"{path}: 2 bad row(s); nothing imported"
-    assert [problem.split(":")[0] for problem in caught.value.problems] == ["line 3"] * 2 + ["line 6"] * 2
-    assert caught.value.problems[0] == "line 3: helix_angle 75 is outside [0, 60)"
-    assert caught.value.problems[1] == "line 3: hand 'X' must be L or R"
-    assert caught.value.problems[3].startswith("line 6: gear class 'bevelx' does not exist")
+    assert [re.search(r", (line \d+)", problem)[1] for problem in caught.value.problems] == ["line 3"] * 2 + ["line 6"] * 2
+    assert caught.value.problems[0] == f"{path}, line 3, column helix_angle: 75 is outside [0, 60); write a number in degrees like 2.5"
+    assert caught.value.problems[1] == f"{path}, line 3, column hand: 'X' must be L or R; write L or R (the helix hand)"
+    assert caught.value.problems[3].startswith(f"{path}, line 6, column gear_class: gear class 'bevelx' does not exist")
 
 
 def test_unknown_and_missing_columns_are_named(conn, tmp_path):
@@ -207,7 +208,7 @@ def test_unknown_and_missing_columns_are_named(conn, tmp_path):
 @pytest.mark.parametrize("text", ["", f"{HEADER}\n", f"\n{HEADER}\n\n,,,\n"])
 def test_a_file_without_gear_rows_is_an_error(conn, tmp_path, text):
     path = write(tmp_path, text)
-    with pytest.raises(EngineError, match=f"^{re.escape(str(path))} has no gear rows$"):
+    with pytest.raises(EngineError, match=f"^{re.escape(str(path))}(: is empty| has no gear rows); "):
         import_gears(conn, path)
 
 

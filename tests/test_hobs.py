@@ -265,15 +265,16 @@ def test_a_bad_import_reports_every_bad_line_and_stores_nothing(run, tmp_path):
     assert lines[0] == f"error: {path}: 4 bad row(s); nothing imported"
     problems = [line.strip() for line in lines[1:]]
     # physical lines: header 1, H-OK-1 2, blank 3, H-BAD-MODULE 4, H-OK-2 5, H-BAD-MANY 6, ...
-    assert problems == [
-        "line 4: module 'two' is not a number",
-        "line 6: starts '1.5' is not a positive whole number",
-        "line 6: hand 'X' must be L or R",
-        "line 6: purpose 'bevel' is not one of cylindrical, worm_wheel",
-        "line 6: tip_diameter 8 is not greater than 2·2.25·module = 9 (two tooth depths)",
-        "line 7: id H-OK-1 is already on line 2",
-        "line 8: id is missing",
-    ]
+    assert problems == [f"{path}, {problem}" for problem in (
+        "line 4, column module: 'two' is not a number; write a number in mm like 2.5",
+        "line 6, column starts: '1.5' is not a positive whole number; write a whole number from 1 up",
+        "line 6, column hand: 'X' must be L or R; write L or R (the helix hand)",
+        "line 6, column purpose: 'bevel' is not one of cylindrical, worm_wheel; write one of cylindrical, worm_wheel",
+        "line 6, column tip_diameter: 8 is not greater than 2·2.25·module = 9 (two tooth depths); check the module "
+        "and the tip diameter",
+        "line 7, column id: H-OK-1 is already on line 2; give each hob once",
+        "line 8, column id: is missing; write an id like H-M2-AA-R1",
+    )]
     assert hob_rows(run.url) == before
 
 
@@ -282,7 +283,7 @@ def test_an_import_with_an_unknown_column_is_refused(run, tmp_path):
     path.write_text("id,module,diameter\nX,2,70\n", encoding="utf-8")
     result = run("hobs", "import", path)
     assert result.exit_code == 1
-    assert "unknown column(s) 'diameter'" in result.stderr and "missing required column(s)" in result.stderr
+    assert "line 1: unknown column(s) diameter" in result.stderr and "missing required column(s)" in result.stderr
 
 
 HEADER = "id,module,pressure_angle,starts,tip_diameter,length,hand,accuracy_class\n"
@@ -290,7 +291,7 @@ HEADER = "id,module,pressure_angle,starts,tip_diameter,length,hand,accuracy_clas
 
 @pytest.mark.parametrize("rows, words", [
     ("h-m2-aa-r1,2,20,1,70,150,R,AA\n", "hob h-m2-aa-r1 is hob H-M2-AA-R1 of the library"),
-    ("H-M9-A-R1,9,20,1,170,200,R,A\nh-m9-a-r1,9,20,1,170,200,R,A\n", "id h-m9-a-r1 is already on line 2"),
+    ("H-M9-A-R1,9,20,1,170,200,R,A\nh-m9-a-r1,9,20,1,170,200,R,A\n", "line 3, column id: h-m9-a-r1 is already on line 2"),
 ])
 def test_an_import_of_a_hob_id_differing_only_in_case_is_refused(run, tmp_path, rows, words):
     path = tmp_path / "hobs.csv"

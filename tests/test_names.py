@@ -22,6 +22,7 @@ INJECTED = "G0 X9999 Z-9999"    # the block that reached stored programs through
 NEWLINE = f"\n{INJECTED}"
 
 LINE_BREAK_IN_CELL = "a cell holds no line break"   # the CSV reader's refusal
+NUL_IN_FILE = "holds a NUL character"   # the CSV reader's refusal of a file with a NUL, before any cell
 
 # Per kind: names its rule refuses (a line break, a path, one character too many, bad first
 # characters, NUL) and names it takes, at the edges of the rule.
@@ -97,7 +98,7 @@ def test_a_gear_csv_with_an_unsafe_class_is_refused(run, tmp_path, name):
                                                    "40Cr", "250", "7", "50"])
     before = counts(run.url)
     message = refused(run("gears", "import", tmp_path / "gears.csv"))
-    assert "gear_class" in message or LINE_BREAK_IN_CELL in message   # the CSV reader refuses a broken line first
+    assert "gear_class" in message or LINE_BREAK_IN_CELL in message or NUL_IN_FILE in message   # the reader first
     assert counts(run.url) == before
 
 
@@ -107,7 +108,7 @@ def test_hobs_import_and_add_refuse_an_unsafe_id(run, tmp_path, name):
                                                  "cylindrical"])
     before = counts(run.url)
     message = refused(run("hobs", "import", tmp_path / "hobs.csv"))
-    assert "not a safe hob id" in message or LINE_BREAK_IN_CELL in message   # the CSV reader refuses a broken line first
+    assert "not a safe hob id" in message or LINE_BREAK_IN_CELL in message or NUL_IN_FILE in message   # the reader first
     assert "not a safe hob id" in refused(run("hobs", "add", "--id", name, "--module", 2, "--tip-diameter", 70,
                                               "--length", 100, "--hand", "R", "--accuracy-class", "AA"))
     assert counts(run.url) == before

@@ -76,13 +76,13 @@ def test_the_hob_must_copy_the_worm_of_the_converted_module(conn, tmp_path):
 
 
 @pytest.mark.parametrize("row, problem", [
-    (f"90103,worm_wheel,3,40,20,{GAMMA},R,25,,,,,CuSn12,90,8,1,", "module_kind is missing; a worm wheel needs axial"),
-    ("90103,spur,3,40,20,0,,25,,,,,45,200,8,1,axial", "module_kind axial is for worm wheels"),
-    ("90103,spur,3,40,20,0,,25,,,,,45,200,8,1,transverse", "module_kind 'transverse' must be normal or axial"),
+    (f"90103,worm_wheel,3,40,20,{GAMMA},R,25,,,,,CuSn12,90,8,1,", "is missing; a worm wheel needs axial"),
+    ("90103,spur,3,40,20,0,,25,,,,,45,200,8,1,axial", "axial is for worm wheels"),
+    ("90103,spur,3,40,20,0,,25,,,,,45,200,8,1,transverse", "'transverse' must be normal or axial"),
 ])
 def test_the_module_kind_of_a_worm_wheel_is_required_and_axial_is_only_for_worm_wheels(conn, tmp_path, row, problem):
     problems = import_refused(conn, write(tmp_path, row))
-    assert len(problems) == 1 and problems[0].startswith("line 2: ") and problem in problems[0]
+    assert len(problems) == 1 and ", line 2, column module_kind: " in problems[0] and problem in problems[0]
 
 
 def test_a_cylindrical_gear_without_a_module_kind_is_stored_as_normal(conn, tmp_path):
@@ -135,7 +135,7 @@ def test_steel_helical_and_other_gears_are_classified_as_before(gear, expected):
 def test_an_import_of_a_worm_wheel_without_a_class_is_refused_in_one_line_naming_the_gear(conn, tmp_path):
     problems = import_refused(conn, write(tmp_path, f"90105,,3,40,20,{GAMMA},R,25,,,,,CuSn12,90,8,1,axial"))
     assert len(problems) == 1
-    assert problems[0].startswith("line 2: gear 90105 looks like a worm wheel")
+    assert ", line 2, column gear_class: gear 90105 looks like a worm wheel" in problems[0]
     assert problems[0].endswith("give gear_class worm_wheel (or helical) explicitly")
 
 

@@ -18,15 +18,28 @@ for _command in GEAR_RECORD_COMMANDS:   # list, show, delete: engine.cli.gear_re
 
 @gears.command("import")
 @click.argument("csv_file", type=click.Path(dir_okay=False))
-@click.option("--json", "as_json", is_flag=True, help="Print one JSON object: {imported: N}.")
+@click.option("--replace", is_flag=True,
+              help="Overwrite gears whose gear_id is already stored, printing each changed field (old → new).")
+@click.option("--json", "as_json", is_flag=True,
+              help="Print one JSON object: {imported: N, replaced: [gear_id…], changes: [{gear_id, field, old, new}]}.")
 @click.pass_context
-def gears_import(ctx, csv_file, as_json):
-    """Import gears from CSV_FILE; any bad row stops the whole file (nothing stored)."""
+def gears_import(ctx, csv_file, replace, as_json):
+    """Import gears from CSV_FILE (`,` or `;` between the columns; with `;` a decimal comma is read as
+    a point). Any bad row stops the whole file (nothing stored). A gear_id already stored is refused
+    unless --replace. The tip and root diameters of cylindrical gears must fit m_n, z, β and x.
+
+    Example: engine gears import gears.csv --replace"""
     from ..gears.gear_import import import_gears
 
     with connection(ctx) as conn:
-        count = import_gears(conn, csv_file)
-    emit_json({"imported": count}) if as_json else click.echo(f"imported {count} gear(s) from {csv_file}")
+        result = import_gears(conn, csv_file, replace=replace)
+    if as_json:
+        emit_json(result.as_json())
+        return
+    for line in result.change_lines():
+        click.echo(line)
+    replaced = f" ({len(result.replaced)} replaced)" if result.replaced else ""
+    click.echo(f"imported {result.imported} gear(s) from {csv_file}{replaced}")
 
 
 @gears.command("units")

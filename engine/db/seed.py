@@ -5,22 +5,32 @@ from __future__ import annotations
 import csv
 import json
 import tempfile
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from pathlib import Path
 
 from psycopg import sql
 from psycopg.types.json import Jsonb
 
-from ..gears.gear_import import import_gears
-from ..gears.units import import_units
+from ..csv_reader import Column, CsvKind, parse_text, read_csv_file
+from ..gears.gear_import import GEAR_KIND, import_gears
+from ..gears.hob_library import HOB_COLUMNS
+from ..gears.records import Machine
+from ..gears.units import UNIT_KIND, import_units
 from ..paths import SEED_DIR
 from ..templates.rows import read_csv
 from ..templates.store import ensure_class, replace_template
 
-# table, CSV file, key column, columns (in file order); loaded in this order.
+# The seed tables' CSV kinds: every cell goes as text, and the database parses it into its column's type.
+CLASS_KIND = CsvKind("gear class", (Column("name", parse_text, required=True), Column("parent", parse_text),
+                                    Column("description", parse_text)))
+MACHINE_KIND = CsvKind("machine", tuple(Column(spec.name, parse_text, required=spec.name in ("name", "kind", "dialect"))
+                                        for spec in fields(Machine)))   # the columns of the machine table
+SEED_HOB_KIND = CsvKind("hob", tuple(Column(column.name, parse_text, column.required) for column in HOB_COLUMNS))
+
+# table, CSV file, key column, its kind; loaded in this order.
 SEED_TABLES = (
-    ("machine", "machines.csv", "name"),
-    ("hob", "hobs.csv", "id"),
+    ("machine", "machines.csv", "name", MACHINE_KIND),
+    ("hob", "hobs.csv", "id", SEED_HOB_KIND),
 )
 SHOP_TABLES = SEED_TABLES[:1]   # the machines; the hobs are samples
 
@@ -57,8 +67,8 @@ def seed(conn, directory: Path = SEED_DIR, *, samples: bool = True) -> SeedRepor
     report = SeedReport()
     with conn.transaction():
         _seed_classes(conn, directory, report)
-        for table, file_name, key in SEED_TABLES if samples else SHOP_TABLES:
-            report.count(table + "s", _insert_missing(conn, table, key, _read(directory / file_name)))
+        for table, file_name, key, kind in SEED_TABLES if samples else SHOP_TABLES:
+            report.count(table + "s", _insert_missing(conn, table, key, _read(directory / file_name, kind)))
         seeded = _seed_templates(conn, directory, report)
         if samples:
             _seed_samples(conn, directory, report)
@@ -112,14 +122,14 @@ def _release_seeded(conn, classes: list[str], report: SeedReport) -> None:
         report.count("template releases", len(released.fetchall()))
 
 
-def _read(path: Path) -> list[dict]:
-    with path.open(encoding="utf-8", newline="") as file:
-        return [{key: (value if value != "" else None) for key, value in row.items()}
-                for row in csv.DictReader(file)]
+def _read(path: Path, kind: CsvKind) -> list[dict]:
+    """The rows of a seed file as {column: text}, an empty cell None (the column's default)."""
+    return [{key: (value if value != "" else None) for key, value in row.items()}
+            for _, row in read_csv_file(path, kind).rows()]
 
 
 def _seed_classes(conn, directory: Path, report: SeedReport) -> None:
-    for row in _read(directory / "gear_classes.csv"):
+    for row in _read(directory / "gear_classes.csv", CLASS_KIND):
         if ensure_class(conn, row["name"], row["parent"], row["description"] or ""):
             report.count("gear classes")
             report.created.append(row["name"])
@@ -139,7 +149,7 @@ def _insert_missing(conn, table: str, key: str, rows: list[dict]) -> int:
 def _seed_templates(conn, directory: Path, report: SeedReport) -> list[str]:
     """Parents before the classes derived from them (the tree order of gear_classes.csv), so
     a derived class stores only the rows that differ from what it inherits."""
-    order = [row["name"] for row in _read(directory / "gear_classes.csv")]
+    order = [row["name"] for row in _read(directory / "gear_classes.csv", CLASS_KIND)]
     paths = sorted((directory / "classes").glob("*.csv"),
                    key=lambda path: (order.index(path.stem) if path.stem in order else len(order), path.stem))
     templated = []
@@ -157,10 +167,9 @@ def _seed_gears(conn, directory: Path, report: SeedReport) -> None:
     """Sample gears not yet in the database, through the same checks as `engine gears import`."""
     source = directory / "gears.csv"
     known = {row[0] for row in conn.execute("SELECT id FROM gear")}
-    with source.open(encoding="utf-8", newline="") as file:
-        reader = csv.DictReader(file)
-        missing = [row for row in reader if int(row["gear_id"]) not in known]
-        header = reader.fieldnames
+    file = read_csv_file(source, GEAR_KIND)
+    missing = [row for _, row in file.rows() if int(row["gear_id"]) not in known]
+    header = file.header
     if not missing:
         return
     with tempfile.TemporaryDirectory() as folder:
@@ -169,14 +178,14 @@ def _seed_gears(conn, directory: Path, report: SeedReport) -> None:
             writer = csv.DictWriter(file, header)
             writer.writeheader()
             writer.writerows(missing)
-        report.count("gears", import_gears(conn, subset))
+        report.count("gears", import_gears(conn, subset).imported)
 
 
 def _seed_units(conn, directory: Path, report: SeedReport) -> None:
     """Further units of the sample multi-unit gears, where the gear has none yet."""
     source = directory / "gear_units.csv"
     with_units = {row[0] for row in conn.execute("SELECT DISTINCT gear_id FROM gear_unit")}
-    rows = [row for row in _read(source) if int(row["gear_id"]) not in with_units]
+    rows = [row for row in _read(source, UNIT_KIND) if int(row["gear_id"]) not in with_units]
     if rows:
         report.count("gear units", import_units(conn, source, only_gears={int(r["gear_id"]) for r in rows}))
 

@@ -16,6 +16,8 @@ import psycopg
 from psycopg import sql
 
 from ..db.listing import records
+from ..csv_reader import (Column, CsvError, CsvKind, parse_number, parse_positive_whole, parse_text, parse_whole,
+                          read_csv_file, refuse)
 from ..errors import EngineError
 from ..paths import SEED_DIR
 from .case_base import CASE_COLUMNS, CUT_KINDS, CaseBase, KindProposal, feeds_per_minute, feeds_per_rev
@@ -30,6 +32,14 @@ VALUE_COLUMNS = ("hob_speed", "axial_feed", "radial_feed")   # r/min, mm/min, mm
 FLOAT_COLUMNS = ("module", "hardness", "hob_tip_diameter", *VALUE_COLUMNS)
 INTEGER_COLUMNS = ("teeth", "quality_grade", "hob_starts", "job_id")
 SEED_FILE = SEED_DIR / "cases.csv"
+_TYPES = {"module": (parse_number, "mm"), "teeth": (parse_positive_whole, ""), "hardness": (parse_number, "HB"),
+          "quality_grade": (parse_whole, ""), "hob_starts": (parse_positive_whole, ""),
+          "hob_tip_diameter": (parse_number, "mm"), "hob_speed": (parse_number, "r/min"),
+          "axial_feed": (parse_number, "mm/min"), "radial_feed": (parse_number, "mm/min")}
+CASE_KIND = CsvKind("case", tuple(
+    Column(name, _TYPES.get(name, (parse_text, ""))[0], required=name not in ("hob_coating", "source", "hardness", "quality_grade"),
+           unit=_TYPES.get(name, (parse_text, ""))[1])
+    for name in (*FEATURE_COLUMNS, "cut", *VALUE_COLUMNS, "source")))
 
 # Typical axial feed per workpiece revolution [mm/rev], single-start hob, steel, wet (§C):
 # the first row whose module is at least the gear's (the last row beyond).
@@ -179,19 +189,23 @@ def seed_cases(conn, path: Path = SEED_FILE) -> int:
     path = Path(path)
     if not path.is_file():
         raise EngineError(f"{path} does not exist; give the machining history seed file (columns of cutting_case)")
-    frame = pd.read_csv(path, dtype=str, keep_default_na=False)
-    missing = [c for c in (*FEATURE_COLUMNS, "cut", *VALUE_COLUMNS, "source") if c not in frame.columns]
-    if missing:
-        raise EngineError(f"{path}: missing column(s) {', '.join(missing)}")
+    file = read_csv_file(path, CASE_KIND)
+    rows, problems = [], []
+    for line, record in file.rows():
+        values = {column.name: file.cell(column, record.get(column.name, ""), line) for column in CASE_KIND.columns}
+        problems += [problem for _, problem in values.values() if problem]
+        rows.append((line, {name: value if value is not None or name not in ("hob_coating", "source") else ""
+                            for name, (value, _) in values.items()}))
+    if problems:
+        raise CsvError(path, problems, nothing="nothing seeded")
     added = 0
     with conn.transaction():
-        for line, row in enumerate(frame.to_dict("records"), start=2):
-            values = {column: (value if value != "" or column in ("hob_coating", "source") else None)
-                      for column, value in row.items()}
+        for line, values in rows:
             try:
                 added += _insert_if_missing(conn, values)
             except (psycopg.errors.DataError, psycopg.errors.IntegrityError) as error:
-                raise EngineError(f"{path.name} line {line}: {str(error).splitlines()[0]}; nothing seeded") from None
+                raise refuse(path, f"the database refused the case ({str(error).splitlines()[0]})",
+                             "correct the row; nothing seeded", line) from None
     return added
 
 

@@ -1,15 +1,15 @@
 """Workpieces from a gear CSV (design notes §9 columns).
 
-Every row is read and checked first; only when the whole file is good are all its gears
-upserted, in one transaction. A file with any bad row stores nothing and reports every
-problem, one line each, with the physical line number in the file (header = line 1).
-Numbers are kept as Decimal, so they are stored exactly as written.
+The file is read by the one CSV reader (engine.csv_reader: `,` or `;` with decimal commas). Every
+row is read and checked first (cells, class, module kind, the diameters of cylindrical gears against
+m_n, z, β and x); only when the whole file is good are all its gears stored, in one transaction. A
+file with any bad row stores nothing and reports every problem, one line each, as
+`<file>, line N, column C: what; what to do`. A gear_id already stored is refused unless `replace`,
+which reports every changed field. Numbers are kept as Decimal, so they are stored exactly as written.
 """
 from __future__ import annotations
 
-import csv
-import re
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from decimal import Decimal
 from pathlib import Path
 from typing import Any, Callable, Iterable
@@ -17,62 +17,22 @@ from typing import Any, Callable, Iterable
 import psycopg
 from psycopg import sql
 
-from ..errors import EngineError, csv_problem
-from ..names import NAME_RULES, is_safe, shown
+from ..csv_reader import (Column, CellError, CsvError, CsvFile, CsvKind, Problem, declare, parse_number,
+                          parse_positive_whole, parse_text, parse_whole, read_csv_file)
+from ..errors import EngineError
+from ..names import NAME_RULES, is_safe
 from .classify import Classification, classify, not_installed_message
+from .gear_geometry import diameter_problems, tip_from_shift
 from .module_kind import MODULE_KINDS, check_module_kind as _check_module_kind
-from .records import MAX_MAGNITUDE, derived_diameters, normal_module
+from .records import derived_diameters, normal_module
 
-NUMBER = re.compile(r"[+-]?(\d+(\.\d*)?|\.\d+)([eE][+-]?\d{1,3})?")
-INTEGER_MAX = 2_147_483_647  # PostgreSQL integer
-
-
-class GearImportError(EngineError):
-    """A gear file with bad rows. `problems` holds one line per problem, in file order."""
-
-    def __init__(self, path: Any, problems: list[str], bad_rows: int) -> None:
-        super().__init__(f"{path}: {bad_rows} bad row(s); nothing imported")
-        self.problems = problems
-        self.bad_rows = bad_rows
+__all__ = ["CellError", "Column", "GearImportError", "derived_diameters", "import_gears", "read_gears"]
 
 
-class CellError(ValueError):
-    """A cell that cannot be read; the message is what is wrong with it ("is not a number")."""
+GearImportError = CsvError   # a file of bad rows: `problems` holds one line per problem, in file order
 
 
-# --- cell parsers: text → value, or CellError ---------------------------------------------
-
-def parse_text(cell: str) -> str:
-    return cell
-
-
-def parse_number(cell: str) -> Decimal:
-    if not NUMBER.fullmatch(cell):
-        raise CellError("is not a number")
-    value = Decimal(cell)
-    if abs(value) > MAX_MAGNITUDE:
-        raise CellError(f"is larger than {MAX_MAGNITUDE:g} in size (no quantity of a gear or hob is that large)")
-    return value
-
-
-def parse_whole(cell: str) -> int:
-    if not NUMBER.fullmatch(cell):
-        raise CellError("is not a whole number")
-    value = Decimal(cell)
-    if value != value.to_integral_value() or abs(value) > INTEGER_MAX:
-        raise CellError("is not a whole number")
-    return int(value)
-
-
-def parse_positive_whole(cell: str) -> int:
-    try:
-        value = parse_whole(cell)
-    except CellError:
-        value = 0
-    if value <= 0:
-        raise CellError("is not a positive whole number")
-    return value
-
+# --- cell parsers of the gear columns: text → value, or CellError --------------------------
 
 def parse_hand(cell: str) -> str:
     if cell.upper() not in ("L", "R"):
@@ -95,134 +55,58 @@ def parse_class_name(cell: str) -> str:
     return name
 
 
+declare(parse_hand, "hand", "write L or R (the helix hand)")
+declare(parse_module_kind, "module kind", "write normal or axial")
+declare(parse_class_name, "gear class", "write the name of a leaf class (engine template list), or leave it empty")
+
+
 # --- the columns of design notes §9 ------------------------------------------------------
-
-@dataclass(frozen=True)
-class Column:
-    """One gear CSV column: how to read a cell, whether every row must give it, and what a
-    given value must satisfy (`check`, said as `rule` after the value)."""
-
-    name: str
-    parse: Callable[[str], Any]
-    required: bool = False
-    check: Callable[[Any], bool] | None = None
-    rule: str = ""
-    db_name: str | None = None
-
-    @property
-    def column(self) -> str:
-        return self.db_name or self.name
-
 
 POSITIVE = dict(check=lambda value: value > 0, rule="must be greater than 0")
 
 COLUMNS: tuple[Column, ...] = (
     Column("gear_id", parse_positive_whole, required=True, db_name="id"),
     Column("gear_class", parse_class_name),
-    Column("module", parse_number, required=True, **POSITIVE),
+    Column("module", parse_number, required=True, unit="mm", **POSITIVE),
     Column("teeth", parse_positive_whole, required=True),
-    Column("pressure_angle", parse_number, check=lambda v: 0 < v < 45, rule="is outside (0, 45)"),
-    Column("helix_angle", parse_number, check=lambda v: 0 <= v < 60, rule="is outside [0, 60)"),
+    Column("pressure_angle", parse_number, check=lambda v: 0 < v < 45, rule="is outside (0, 45)", unit="degrees"),
+    Column("helix_angle", parse_number, check=lambda v: 0 <= v < 60, rule="is outside [0, 60)", unit="degrees"),
     Column("hand", parse_hand),
-    Column("face_width", parse_number, required=True, **POSITIVE),
-    Column("tip_diameter", parse_number, **POSITIVE),
-    Column("root_diameter", parse_number, **POSITIVE),
-    Column("cone_angle", parse_number, check=lambda v: -45 < v < 45, rule="is outside (-45, 45)"),
-    Column("crowning", parse_number, check=lambda v: 0 <= v < 1, rule="is outside [0, 1) mm"),
+    Column("face_width", parse_number, required=True, unit="mm", **POSITIVE),
+    Column("tip_diameter", parse_number, unit="mm", **POSITIVE),
+    Column("root_diameter", parse_number, unit="mm", **POSITIVE),
+    Column("cone_angle", parse_number, check=lambda v: -45 < v < 45, rule="is outside (-45, 45)", unit="degrees"),
+    Column("crowning", parse_number, check=lambda v: 0 <= v < 1, rule="is outside [0, 1) mm", unit="mm"),
     Column("material", parse_text),
-    Column("hardness", parse_number, check=lambda v: 0 < v <= 700, rule="is outside (0, 700] HB (Brinell ends at 650)"),
+    Column("hardness", parse_number, check=lambda v: 0 < v <= 700, rule="is outside (0, 700] HB (Brinell ends at 650)",
+           unit="HB"),
     Column("quality_grade", parse_whole, check=lambda v: 1 <= v <= 12, rule="is outside 1..12"),
     Column("quantity", parse_positive_whole),
     Column("module_kind", parse_module_kind),
+    Column("profile_shift", parse_number, check=lambda v: -2 < v < 2, rule="is outside (-2, 2)", unit="modules"),
 )
-COLUMN_BY_NAME = {column.name: column for column in COLUMNS}
+GEAR_KIND = CsvKind("gear", COLUMNS)
 DEFAULTS = {"pressure_angle": Decimal(20), "helix_angle": Decimal(0)}
-
-
-# --- reading the file --------------------------------------------------------------------
-
-Record = tuple[int, list[str]]  # (physical line the record starts on, its cells)
-
-
-def read_records(path: Path) -> list[Record]:
-    """Every non-blank CSV record of the file with the line it starts on, cells stripped. No
-    cell of these files holds a line break, so a record over several lines is a quote left
-    open: refused at the line where it opens, before it swallows the rows after it."""
-    records: list[Record] = []
-    start = 1
-    try:
-        with open(path, encoding="utf-8-sig", newline="") as handle:
-            reader = csv.reader(handle, strict=True)
-            for record in reader:
-                if reader.line_num > start:
-                    raise EngineError(f"{path}: line {start}: a quote opened on this line is closed only on line "
-                                      f"{reader.line_num}; close it on line {start} (a cell holds no line break)")
-                cells = [cell.strip() for cell in record]
-                if any(cells):
-                    records.append((start, cells))
-                start = reader.line_num + 1
-    except FileNotFoundError:
-        raise EngineError(f"{path}: no such file") from None
-    except UnicodeDecodeError as error:
-        raise EngineError(f"{path}: not UTF-8 text (byte at offset {error.start})") from None
-    except OSError as error:
-        raise EngineError(f"{path}: cannot read it ({error.strerror or error})") from None
-    except csv.Error as error:
-        raise EngineError(f"{path}: line {start}: {csv_problem(error)}") from None
-    return records
-
-
-def _header_names(path: Path, header: list[str]) -> list[str]:
-    """The column name of each header cell ('' for a cell without a name), checked."""
-    names = [cell.lower() for cell in header]
-    unknown = [name for name in names if name and name not in COLUMN_BY_NAME]
-    twice = sorted({name for name in names if name and names.count(name) > 1})
-    missing = [column.name for column in COLUMNS if column.required and column.name not in names]
-    problems = []
-    if unknown:
-        problems.append(f"unknown column(s) {', '.join(unknown)} "
-                        f"(known: {', '.join(COLUMN_BY_NAME)})")
-    if twice:
-        problems.append(f"column(s) named twice: {', '.join(twice)}")
-    if missing:
-        problems.append(f"missing required column(s) {', '.join(missing)}")
-    if problems:
-        raise EngineError(f"{path}: " + "; ".join(problems))
-    return names
 
 
 # --- one row -----------------------------------------------------------------------------
 
-def _cells_by_name(names: list[str], cells: list[str]) -> tuple[dict[str, str], list[str]]:
-    """The row's cells by column name, and a problem for values outside the named columns."""
-    by_name = {name: cell for name, cell in zip(names, cells) if name}
-    stray = [cell for position, cell in enumerate(cells)
-             if cell and (position >= len(names) or not names[position])]
-    problems = [f"value(s) {', '.join(map(repr, stray))} outside the named columns"] if stray else []
-    return by_name, problems
+def _stray_problems(names: list[str], cells: list[str], line: int) -> list[Problem]:
+    """Values under a header cell without a name would be lost: refused."""
+    stray = [cell for name, cell in zip(names, cells) if cell and not name]
+    return [Problem(line, None, f"value(s) {', '.join(map(repr, stray))} outside the named columns",
+                    "name their column in the header, or delete them")] if stray else []
 
 
-def _parse_cell(column: Column, cell: str) -> tuple[Any, str | None]:
-    """(value, problem) of one cell; value None when the cell is empty (not given)."""
-    if not cell:
-        return None, (f"{column.name} is missing" if column.required else None)
-    try:
-        value = column.parse(cell)
-    except CellError as error:
-        return None, f"{column.name} {shown(cell)} {error}"
-    if column.check is not None and not column.check(value):
-        return value, f"{column.name} {cell} {column.rule}"
-    return value, None
-
-
-def _parse_row(names: list[str], cells: list[str]) -> tuple[dict[str, Any], list[str], set[str]]:
+def _parse_row(file: CsvFile, line: int, cells: list[str]) -> tuple[dict[str, Any], list[Problem], set[str]]:
     """The gear of one record (every column, None where not given), its cell problems and
     the names of the columns whose cells are bad."""
-    by_name, problems = _cells_by_name(names, cells)
+    by_name = {name: cell for name, cell in zip(file.header, cells) if name}
+    problems = _stray_problems(file.header, cells, line)
     gear: dict[str, Any] = {}
     bad: set[str] = set()
     for column in COLUMNS:
-        gear[column.name], problem = _parse_cell(column, by_name.get(column.name, ""))
+        gear[column.name], problem = file.cell(column, by_name.get(column.name, ""), line)
         if problem:
             problems.append(problem)
             bad.add(column.name)
@@ -230,87 +114,131 @@ def _parse_row(names: list[str], cells: list[str]) -> tuple[dict[str, Any], list
 
 
 # --- cross-column checks and completion of a parsed gear ---------------------------------
-# Each step gets the gear and the installed classes {name: has a template}, may
-# fill in what was not given, and returns a problem or None.
+# Each step gets the gear and the installed classes, may fill in what was not given, and
+# returns a problem (column, what is wrong; what to do) or None.
 
-def _apply_defaults(gear: dict[str, Any], classes: dict[str, bool]) -> str | None:
+Said = tuple[str, str] | None   # (column, "what is wrong; what to do")
+
+
+@dataclass(frozen=True)
+class Classes:
+    """The installed gear classes {name: has template rows, own or inherited} (a class gears can be in),
+    and those checked against the cylindrical-gear diameter formulas (engine.gears.gear_geometry)."""
+
+    templated: dict[str, bool]
+    cylindrical: frozenset[str] = field(default_factory=frozenset)
+
+
+def _apply_defaults(gear: dict[str, Any], classes: Classes) -> Said:
     for name, default in DEFAULTS.items():
         if gear[name] is None:
             gear[name] = default
     return None
 
 
-def _leaf_list(classes: dict[str, bool]) -> str:
-    return ", ".join(sorted(name for name, has_template in classes.items() if has_template))
+def _leaf_list(classes: Classes) -> str:
+    return ", ".join(sorted(name for name, has_template in classes.templated.items() if has_template))
 
 
-def _check_given_class(gear: dict[str, Any], classes: dict[str, bool]) -> str | None:
+def _check_given_class(gear: dict[str, Any], classes: Classes) -> Said:
     """A class named in the file must be installed and have template rows (own or inherited);
     inner nodes of the tree have none."""
     given = gear["gear_class"]
-    if given is None or classes.get(given):
+    if given is None or classes.templated.get(given):
         return None
-    if given not in classes:
-        return f"gear class '{given}' does not exist; known leaf classes: {_leaf_list(classes)}"
-    return (f"gear class '{given}' is not a leaf class (an inner node of the tree, without template "
-            f"rows); known leaf classes: {_leaf_list(classes)}")
+    if given not in classes.templated:
+        return "gear_class", f"gear class '{given}' does not exist; known leaf classes: {_leaf_list(classes)}"
+    return "gear_class", (f"gear class '{given}' is not a leaf class (an inner node of the tree, without template "
+                          f"rows); known leaf classes: {_leaf_list(classes)}")
 
 
-def _classify(gear: dict[str, Any], classes: dict[str, bool]) -> str | None:
+def _classify(gear: dict[str, Any], classes: Classes) -> Said:
     """A gear without a class gets the one `classify` finds, which must be installed."""
     if gear["gear_class"] is not None:
         return None
     classification = classify(gear)
     if classification.gear_class is None:
         named = f"gear {gear['gear_id']} " if classification.remedy != Classification.remedy else ""
-        return f"{named}{classification.problem}; {classification.remedy}"
+        return "gear_class", f"{named}{classification.problem}; {classification.remedy}"
     found = classification.gear_class
     gear["gear_class"] = found
-    return None if classes.get(found) else not_installed_message(gear["gear_id"], found)
+    return None if classes.templated.get(found) else ("gear_class", not_installed_message(gear["gear_id"], found))
 
 
-def _check_hand(gear: dict[str, Any], classes: dict[str, bool]) -> str | None:
+def _check_hand(gear: dict[str, Any], classes: Classes) -> Said:
     if gear["helix_angle"] != 0 and gear["hand"] is None:
-        return f"hand is missing; a helical gear (helix_angle {gear['helix_angle']}) needs L or R"
+        return "hand", f"is missing; a helical gear (helix_angle {gear['helix_angle']}) needs L or R"
     return None
 
 
-def _fill_diameters(gear: dict[str, Any], classes: dict[str, bool]) -> str | None:
-    """Compute tip and root diameters not given, from the normal module; root must stay positive
-    and below tip."""
+def _check_kind(gear: dict[str, Any], classes: Classes) -> Said:
+    problem = _check_module_kind(gear, classes.templated)
+    return ("module_kind", problem.removeprefix("module_kind ")) if problem else None
+
+
+def _fill_diameters(gear: dict[str, Any], classes: Classes) -> Said:
+    """Compute tip and root diameters not given, from the normal module (and the profile shift when
+    given); root must stay positive and below tip."""
     module = normal_module(gear["module"], gear["module_kind"], gear["helix_angle"])
-    tip, root = derived_diameters(module, gear["teeth"], gear["helix_angle"],
-                                  gear["tip_diameter"], gear["root_diameter"])
+    tip = gear["tip_diameter"]
+    if tip is None and gear["profile_shift"] is not None:
+        tip = Decimal(repr(round(tip_from_shift(gear, float(gear["profile_shift"])), 4)))
+    tip, root = derived_diameters(module, gear["teeth"], gear["helix_angle"], tip, gear["root_diameter"])
     tip_said = "tip_diameter" if gear["tip_diameter"] is not None else "computed tip_diameter"
     root_said = "root_diameter" if gear["root_diameter"] is not None else "computed root_diameter"
     gear["tip_diameter"], gear["root_diameter"] = tip, root
     if root <= 0:
-        return f"{root_said} {root:g} is not positive; give tip_diameter and root_diameter"
+        return "root_diameter", f"{root_said} {root:g} is not positive; give tip_diameter and root_diameter"
     if root >= tip:
-        return f"{root_said} {root:g} is not smaller than {tip_said} {tip:g}"
+        return "root_diameter", f"{root_said} {root:g} is not smaller than {tip_said} {tip:g}"
     return None
+
+
+def _check_geometry(gear: dict[str, Any], classes: Classes) -> list[Problem] | None:
+    """Given diameters of a cylindrical gear against m_n, z, β and x (engine.gears.gear_geometry)."""
+    return diameter_problems(gear) if gear["gear_class"] in classes.cylindrical else None
 
 
 # (columns a step reads, step): a step runs only when all the columns it reads are good,
 # so a row reports every problem without repeating one.
-COMPLETION_STEPS: tuple[tuple[tuple[str, ...], Callable[..., str | None]], ...] = (
+COMPLETION_STEPS: tuple[tuple[tuple[str, ...], Callable[..., Any]], ...] = (
     ((), _apply_defaults),
     (("gear_class",), _check_given_class),
     (("gear_id", "gear_class", "cone_angle", "crowning", "helix_angle", "material"), _classify),
     (("helix_angle", "hand"), _check_hand),
-    (("gear_class", "module_kind"), _check_module_kind),
-    (("module", "teeth", "helix_angle", "tip_diameter", "root_diameter", "module_kind"), _fill_diameters),
+    (("gear_class", "module_kind"), _check_kind),
+    (("gear_class", "module", "teeth", "helix_angle", "tip_diameter", "root_diameter", "module_kind",
+      "profile_shift"), _check_geometry),
+    (("module", "teeth", "helix_angle", "tip_diameter", "root_diameter", "module_kind", "profile_shift"),
+     _fill_diameters),
 )
 
 
-def _complete(gear: dict[str, Any], classes: dict[str, bool], bad: set[str]) -> list[str]:
-    problems = (step(gear, classes) for reads, step in COMPLETION_STEPS if bad.isdisjoint(reads))
-    return [problem for problem in problems if problem]
+def _as_problems(line: int, found: Any) -> list[Problem]:
+    """A step's finding as Problems of the line: a Said, or Problems of their own."""
+    if not found:
+        return []
+    if isinstance(found, list):
+        return [Problem(line, problem.column, problem.what, problem.todo) for problem in found]
+    column, text = found
+    what, _, todo = text.partition("; ")
+    return [Problem(line, column, what, todo)]
+
+
+def _complete(gear: dict[str, Any], classes: Classes, bad: set[str], line: int) -> list[Problem]:
+    """The steps in order; a column a step found bad is not read by the steps after it."""
+    problems: list[Problem] = []
+    for reads, step in COMPLETION_STEPS:
+        if bad.isdisjoint(reads):
+            found = _as_problems(line, step(gear, classes))
+            bad = bad | {problem.column for problem in found}
+            problems += found
+    return problems
 
 
 # --- the whole file ----------------------------------------------------------------------
 
-def _duplicate_problems(gears: Iterable[tuple[int, dict[str, Any]]]) -> list[tuple[int, str]]:
+def _duplicate_problems(gears: Iterable[tuple[int, dict[str, Any]]]) -> list[Problem]:
     first_line: dict[int, int] = {}
     problems = []
     for line, gear in gears:
@@ -318,47 +246,45 @@ def _duplicate_problems(gears: Iterable[tuple[int, dict[str, Any]]]) -> list[tup
         if gear_id is None:
             continue
         if gear_id in first_line:
-            problems.append((line, f"gear_id {gear_id} is already on line {first_line[gear_id]}"))
+            problems.append(Problem(line, "gear_id", f"{gear_id} is already on line {first_line[gear_id]}",
+                                    "give each gear once"))
         else:
             first_line[gear_id] = line
     return problems
 
 
-def _raise_problems(path: Path, problems: list[tuple[int, str]]) -> None:
-    if problems:
-        problems.sort(key=lambda problem: problem[0])  # stable: per line in column order
-        lines = [f"line {line}: {text}" for line, text in problems]
-        raise GearImportError(path, lines, len({line for line, _ in problems}))
-
-
-def read_gears(path: str | Path, classes: dict[str, bool]) -> list[dict[str, Any]]:
+def read_gears(path: str | Path, classes: Classes | dict[str, bool]) -> list[dict[str, Any]]:
     """Every gear of the CSV file at `path`, checked and completed (defaults, class,
-    diameters), keyed by column name. `classes` maps each installed gear class to whether
-    it has template rows (a class gears can be in). Raises GearImportError listing every problem, or EngineError."""
-    path = Path(path)
-    records = read_records(path)
-    if len(records) < 2:
-        raise EngineError(f"{path} has no gear rows")
-    names = _header_names(path, records[0][1])
+    diameters), keyed by column name, each with its `line`. `classes`: the installed classes
+    (a bare {name: has template rows} checks no geometry). Raises GearImportError listing every
+    problem, or EngineError."""
+    classes = classes if isinstance(classes, Classes) else Classes(classes)
+    file = read_csv_file(path, GEAR_KIND)
+    if not file.records:
+        raise EngineError(f"{path} has no gear rows; give one gear per line under the header")
     parsed, problems = [], []
-    for line, cells in records[1:]:
-        gear, row_problems, bad_columns = _parse_row(names, cells)
-        row_problems += _complete(gear, classes, bad_columns)
-        problems.extend((line, problem) for problem in row_problems)
+    for line, cells in file.records:
+        gear, row_problems, bad_columns = _parse_row(file, line, cells)
+        problems += row_problems + _complete(gear, classes, bad_columns, line)
         parsed.append((line, gear))
     problems.extend(_duplicate_problems(parsed))
-    _raise_problems(path, problems)
-    return [gear for _, gear in parsed]
+    if problems:
+        raise GearImportError(path, problems)
+    return [gear | {"line": line} for line, gear in parsed]
 
 
 # --- storing -----------------------------------------------------------------------------
 
-def installed_classes(conn: psycopg.Connection) -> dict[str, bool]:
-    """{gear class name: whether it has template rows, its own or inherited}: the classes a
-    gear can be in (leaves, and unit classes that others derive from, like spur)."""
-    rows = conn.execute(
-        "SELECT g.name, EXISTS (SELECT 1 FROM class_template(g.name)) FROM gear_class g").fetchall()
-    return {name: has_template for name, has_template in rows}
+INSTALLED = ("SELECT g.name, EXISTS (SELECT 1 FROM class_template(g.name)), "
+             "g.name IN (SELECT name FROM classes_and_below(ARRAY['cylindrical'])) FROM gear_class g")
+
+
+def installed_classes(conn: psycopg.Connection) -> Classes:
+    """The classes a gear can be in (leaves, and unit classes that others derive from, like spur),
+    and the cylindrical ones (whose diameters are checked)."""
+    rows = conn.execute(INSTALLED).fetchall()
+    return Classes({name: templated for name, templated, _ in rows},
+                   frozenset(name for name, _, cylindrical in rows if cylindrical))
 
 
 _COLUMN_LIST = sql.SQL(", ").join(sql.Identifier(column.column) for column in COLUMNS)
@@ -370,12 +296,80 @@ _UPSERT = sql.SQL(
     updates=sql.SQL(", ").join(
         sql.SQL("{0} = EXCLUDED.{0}").format(sql.Identifier(column.column))
         for column in COLUMNS if column.column != "id"))
+_EXISTING = sql.SQL("SELECT {} FROM gear WHERE id = ANY(%s) ORDER BY id FOR UPDATE").format(_COLUMN_LIST)
 
 
-def _store(conn: psycopg.Connection, path: Path, gears: list[dict[str, Any]]) -> None:
-    """Upsert all gears in one transaction: COPY into a temporary table, then one INSERT."""
+@dataclass(frozen=True)
+class GearChange:
+    """One field of a stored gear that an import with --replace changes: old → new."""
+
+    gear_id: int
+    field: str
+    old: Any
+    new: Any
+
+
+@dataclass(frozen=True)
+class GearImport:
+    """What an import did: how many gears it stored, which of them replaced stored gears, and what
+    changed in those (field by field)."""
+
+    imported: int
+    replaced: tuple[int, ...] = ()
+    changes: tuple[GearChange, ...] = ()
+
+    def change_lines(self) -> list[str]:
+        """One line per changed field (`gear 42: module 2 → 3`), and a line for a replaced gear the file
+        left as it was."""
+        changed = {change.gear_id for change in self.changes}
+        return ([f"gear {c.gear_id}: {c.field} {_said(c.old)} → {_said(c.new)}" for c in self.changes]
+                + [f"gear {gear_id}: unchanged" for gear_id in self.replaced if gear_id not in changed])
+
+    def as_json(self) -> dict[str, Any]:
+        return {"imported": self.imported, "replaced": list(self.replaced),
+                "changes": [{"gear_id": c.gear_id, "field": c.field, "old": _plain(c.old), "new": _plain(c.new)}
+                            for c in self.changes]}
+
+
+def _said(value: Any) -> str:
+    """A value as the change line shows it: numbers as written (2, not 2.000), nothing as (none)."""
+    return "(none)" if value is None else format(value.normalize(), "f") if isinstance(value, Decimal) \
+        else str(value)
+
+
+def _plain(value: Any) -> Any:
+    """A Decimal as the JSON number it is (whole numbers as int)."""
+    if not isinstance(value, Decimal):
+        return value
+    return int(value) if value == value.to_integral_value() else float(value)
+
+
+def _changes(stored: dict[int, tuple], gears: list[dict[str, Any]]) -> list[GearChange]:
+    """Per replaced gear, per field, the stored value and the file's, where they differ."""
+    return [GearChange(gear["gear_id"], column.name, old, gear[column.name])
+            for gear in gears if gear["gear_id"] in stored
+            for column, old in zip(COLUMNS, stored[gear["gear_id"]]) if old != gear[column.name]]
+
+
+def _refuse_existing(path: Path, stored: dict[int, tuple], gears: list[dict[str, Any]]) -> None:
+    """Without --replace, a gear_id already stored is refused: an import must not overwrite a gear
+    that jobs and programs were made for without saying so."""
+    problems = [Problem(gear["line"], "gear_id", f"gear {gear['gear_id']} already exists",
+                        "give a new gear_id, or import with --replace to overwrite it (the changes are printed)")
+                for gear in gears if gear["gear_id"] in stored]
+    if problems:
+        raise GearImportError(path, problems)
+
+
+def _store(conn: psycopg.Connection, path: Path, gears: list[dict[str, Any]], replace: bool) -> GearImport:
+    """All gears in one transaction: the stored ones read (and locked) first, refused unless `replace`;
+    then COPY into a temporary table and one INSERT … ON CONFLICT."""
     try:
         with conn.transaction():
+            rows = conn.execute(_EXISTING, ([gear["gear_id"] for gear in gears],)).fetchall()
+            stored = {row[0]: row for row in rows}
+            if not replace:
+                _refuse_existing(path, stored, gears)
             conn.execute("CREATE TEMPORARY TABLE gear_import (LIKE gear) ON COMMIT DROP")
             with conn.cursor().copy(_COPY) as copy:
                 for gear in gears:
@@ -386,12 +380,12 @@ def _store(conn: psycopg.Connection, path: Path, gears: list[dict[str, Any]]) ->
         message = error.diag.message_primary or str(error)
         raise EngineError(f"{path}: the database refused the gears ({message}); "
                           "nothing imported") from error
+    return GearImport(len(gears), tuple(sorted(stored)), tuple(_changes(stored, gears)))
 
 
-def import_gears(conn: psycopg.Connection, path: str | Path) -> int:
-    """Import (insert or update by gear_id) every gear of the CSV file at `path`, all or
-    nothing; return how many gears were imported or updated."""
+def import_gears(conn: psycopg.Connection, path: str | Path, *, replace: bool = False) -> GearImport:
+    """Import every gear of the CSV file at `path`, all or nothing. A gear_id already stored is
+    refused unless `replace`, which overwrites it and returns what changed."""
     path = Path(path)
     gears = read_gears(path, installed_classes(conn))
-    _store(conn, path, gears)
-    return len(gears)
+    return _store(conn, path, gears, replace)

@@ -14,22 +14,17 @@ from typing import Any
 import psycopg
 from psycopg import sql
 
+from ..csv_reader import (CellError, Column, CsvError, CsvKind, Problem, declare, parse_number, parse_positive_whole,
+                          parse_text, read_cell, read_csv_file)
 from ..errors import EngineError
-from ..names import NAME_RULES, is_safe, said, shown
-from .gear_import import (POSITIVE, CellError, Column, parse_hand, parse_number,
-                          parse_positive_whole, parse_text, read_records)
+from ..names import NAME_RULES, is_safe, said
+from .gear_import import POSITIVE, parse_hand
 from .hob_matching import ACCURACY_CLASSES, PURPOSES, HobChoice, choose_hob
 from .models import ancestry
 from .records import TOOTH_DEPTH, Hob, load_gear, load_hobs
 
 
-class HobImportError(EngineError):
-    """A hob file with bad rows. `problems` holds one line per problem, in file order."""
-
-    def __init__(self, path: Any, problems: list[str], bad_rows: int) -> None:
-        super().__init__(f"{path}: {bad_rows} bad row(s); nothing imported")
-        self.problems = problems
-        self.bad_rows = bad_rows
+HobImportError = CsvError   # a file of bad rows: `problems` holds one line per problem, in file order
 
 
 @dataclass(frozen=True)
@@ -59,14 +54,19 @@ def parse_purpose(cell: str) -> str:
     return cell.lower()
 
 
+declare(parse_accuracy_class, "accuracy class", f"write one of {', '.join(ACCURACY_CLASSES)}")
+declare(parse_hob_id, "hob id", "write an id like H-M2-AA-R1")
+declare(parse_purpose, "purpose", f"write one of {', '.join(PURPOSES)}")
+
 # In the order of the fields of records.Hob (and of seed_templates/hobs.csv).
 HOB_COLUMNS: tuple[Column, ...] = (
     Column("id", parse_hob_id, required=True),
-    Column("module", parse_number, required=True, **POSITIVE),
-    Column("pressure_angle", parse_number, required=True, check=lambda v: 0 < v < 45, rule="is outside (0, 45)"),
+    Column("module", parse_number, required=True, unit="mm", **POSITIVE),
+    Column("pressure_angle", parse_number, required=True, check=lambda v: 0 < v < 45, rule="is outside (0, 45)",
+           unit="degrees"),
     Column("starts", parse_positive_whole, required=True),
-    Column("tip_diameter", parse_number, required=True, **POSITIVE),
-    Column("length", parse_number, required=True, **POSITIVE),
+    Column("tip_diameter", parse_number, required=True, unit="mm", **POSITIVE),
+    Column("length", parse_number, required=True, unit="mm", **POSITIVE),
     Column("hand", parse_hand, required=True),
     Column("accuracy_class", parse_accuracy_class, required=True),
     Column("material", parse_text),
@@ -75,45 +75,42 @@ HOB_COLUMNS: tuple[Column, ...] = (
     Column("tool_number", parse_positive_whole, check=lambda v: v <= 32000, rule="is above 32000"),
 )
 COLUMN_NAMES = tuple(column.name for column in HOB_COLUMNS)
+HOB_KIND = CsvKind("hob", HOB_COLUMNS)
 DEFAULTS = {"material": "HSS", "coating": "", "purpose": "cylindrical", "tool_number": 1}
 assert COLUMN_NAMES == tuple(field.name for field in fields(Hob)), "HOB_COLUMNS must follow records.Hob"
 
 
 # --- one hob: cells → values and problems ------------------------------------------------
 
-def _parse_cell(column: Column, cell: str) -> tuple[Any, str | None]:
+def _parse_cell(column: Column, cell: str, line: int | None, separator: str) -> tuple[Any, Problem | None]:
     """(value, problem) of one cell; an empty cell is the default (or missing if required)."""
-    if not cell:
-        return DEFAULTS.get(column.name), (f"{column.name} is missing" if column.required else None)
-    try:
-        value = column.parse(cell)
-    except CellError as error:
-        return None, f"{column.name} {shown(cell)} {error}"
-    if column.check is not None and not column.check(value):
-        return None, f"{column.name} {cell} {column.rule}"
-    return value, None
+    value, problem = read_cell(column, cell, line, separator)
+    if problem and value is not None:   # a value that breaks its rule is not stored
+        value = None
+    return (DEFAULTS.get(column.name) if not cell else value), problem
 
 
-def _check_tip_diameter(hob: dict[str, Any]) -> str | None:
+def _check_tip_diameter(hob: dict[str, Any], line: int | None) -> Problem | None:
     """The hob's teeth are one tooth depth (2.25·m) high on each side of its body."""
     if hob["module"] is None or hob["tip_diameter"] is None:
         return None
     least = 2 * TOOTH_DEPTH * hob["module"]
     if hob["tip_diameter"] <= least:
-        return (f"tip_diameter {hob['tip_diameter']} is not greater than 2·2.25·module = {float(least):g} "
-                "(two tooth depths)")
+        return Problem(line, "tip_diameter", f"{hob['tip_diameter']} is not greater than 2·2.25·module = "
+                       f"{float(least):g} (two tooth depths)", "check the module and the tip diameter")
     return None
 
 
-def parse_hob(cells: dict[str, str]) -> tuple[dict[str, Any], list[str]]:
+def parse_hob(cells: dict[str, str], line: int | None = None,
+              separator: str = ",") -> tuple[dict[str, Any], list[Problem]]:
     """The hob of named cells (every column; missing cells are empty) and its problems."""
     hob: dict[str, Any] = {}
-    problems: list[str] = []
+    problems: list[Problem] = []
     for column in HOB_COLUMNS:
-        hob[column.name], problem = _parse_cell(column, cells.get(column.name, "").strip())
+        hob[column.name], problem = _parse_cell(column, cells.get(column.name, "").strip(), line, separator)
         if problem:
             problems.append(problem)
-    tip_problem = _check_tip_diameter(hob)
+    tip_problem = _check_tip_diameter(hob, line)
     return hob, problems + ([tip_problem] if tip_problem else [])
 
 
@@ -141,7 +138,8 @@ def add_hob(conn: psycopg.Connection, hob: Hob) -> None:
     """Store one new hob; refuse a bad one (every problem named) or an id already there."""
     values, problems = parse_hob({name: _cell(getattr(hob, name)) for name in COLUMN_NAMES})
     if problems:
-        raise EngineError(f"hob {said('hob', hob.id) if hob.id else '(no id)'}: {'; '.join(problems)}; nothing stored")
+        told = "; ".join(f"{problem.column} {problem.what}" for problem in problems)
+        raise EngineError(f"hob {said('hob', hob.id) if hob.id else '(no id)'}: {told}; nothing stored")
     exists = f"hob {values['id']} already exists; choose another id, or change it with `engine hobs import FILE.csv`"
     found = conn.execute("SELECT id FROM hob WHERE upper(id) = upper(%s)", (values["id"],)).fetchone()
     if found:
@@ -158,50 +156,27 @@ def add_hob(conn: psycopg.Connection, hob: Hob) -> None:
 
 # --- a CSV file of hobs ------------------------------------------------------------------
 
-def _header(path: Path, cells: list[str]) -> list[str]:
-    names = [cell.lower() for cell in cells]
-    unknown = [name for name in names if name not in COLUMN_NAMES]
-    twice = sorted({name for name in names if names.count(name) > 1})
-    missing = [column.name for column in HOB_COLUMNS if column.required and column.name not in names]
-    problems = ([f"unknown column(s) {', '.join(map(repr, unknown))} (known: {', '.join(COLUMN_NAMES)})"]
-                if unknown else [])
-    problems += [f"column(s) named twice: {', '.join(twice)}"] if twice else []
-    problems += [f"missing required column(s) {', '.join(missing)}"] if missing else []
-    if problems:
-        raise EngineError(f"{path}: " + "; ".join(problems))
-    return names
-
-
-def _row(names: list[str], cells: list[str]) -> tuple[dict[str, Any], list[str]]:
-    hob, problems = parse_hob(dict(zip(names, cells)))
-    if len(cells) > len(names) and any(cells[len(names):]):
-        problems.append(f"{len(cells)} cells but the header names {len(names)} columns")
-    return hob, problems
-
-
 def read_hobs(path: str | Path) -> list[dict[str, Any]]:
     """Every hob of the CSV file at `path`, checked, keyed by column name.
     Raises HobImportError listing every problem of every row, or EngineError."""
-    path = Path(path)
-    records = read_records(path)
-    if len(records) < 2:
-        raise EngineError(f"{path} has no hob rows")
-    names = _header(path, records[0][1])
-    hobs, problems, bad_lines, first_line = [], [], set(), {}
-    for line, cells in records[1:]:
-        hob, row_problems = _row(names, cells)
+    file = read_csv_file(path, HOB_KIND)
+    if not file.records:
+        raise EngineError(f"{path}: no hob rows; give one hob per line under the header")
+    hobs, problems, first_line = [], [], {}
+    for line, cells in file.rows():
+        hob, row_problems = parse_hob(cells, line, file.separator)
         folded = hob["id"].upper() if hob["id"] is not None else None
         if folded in first_line:
             earlier, earlier_id = first_line[folded]
             case = f" as {earlier_id} (ids that differ only in case name one hob)" if earlier_id != hob["id"] else ""
-            row_problems.append(f"id {hob['id']} is already on line {earlier}{case}")
+            row_problems.append(Problem(line, "id", f"{hob['id']} is already on line {earlier}{case}",
+                                        "give each hob once"))
         elif folded is not None:
             first_line[folded] = (line, hob["id"])
-        problems += [f"line {line}: {problem}" for problem in row_problems]
-        bad_lines |= {line} if row_problems else set()
+        problems += row_problems
         hobs.append(hob)
     if problems:
-        raise HobImportError(path, problems, len(bad_lines))
+        raise HobImportError(path, problems)
     return hobs
 
 

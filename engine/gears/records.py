@@ -6,6 +6,7 @@ from dataclasses import dataclass, fields, replace
 from decimal import Decimal
 from typing import Any
 
+from ..csv_reader import MAX_MAGNITUDE   # the CSV readers refuse larger numbers; so do the records
 from ..errors import EngineError
 
 TOOTH_DEPTH = Decimal("2.25")  # full tooth depth in modules: root = tip − 2·2.25·m
@@ -143,10 +144,6 @@ def _columns(record_type, exclude=frozenset()) -> str:
     return ", ".join(field.name for field in fields(record_type) if field.name not in exclude)
 
 
-# No dimension of a gear, hob or machine reaches a kilometre (mm), no speed a million (r/min):
-# a larger number is a slip of the keyboard, and 1e999, a valid numeric in PostgreSQL, is no
-# float at all (the models would compute with infinities). The CSV readers refuse the same.
-MAX_MAGNITUDE = 1e6
 
 
 def _as_float(record_type, row) -> object:

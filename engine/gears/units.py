@@ -6,21 +6,23 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from ..csv_reader import Column, CsvKind, Problem, parse_number, parse_positive_whole, read_csv_file
 from ..errors import EngineError
-from .gear_import import (POSITIVE, Column, GearImportError, _parse_cell, derived_diameters, parse_number,
-                          parse_positive_whole, read_records)
+from .gear_geometry import diameter_problems
+from .gear_import import POSITIVE, GearImportError, derived_diameters
 
 UNIT_COLUMNS: tuple[Column, ...] = (
     Column("gear_id", parse_positive_whole, required=True),
     Column("unit", parse_positive_whole, required=True, check=lambda v: v >= 2,
            rule="must be 2 or more (unit 1 is the gear row)"),
     Column("teeth", parse_positive_whole, required=True),
-    Column("face_width", parse_number, required=True, **POSITIVE),
-    Column("tip_diameter", parse_number, **POSITIVE),
-    Column("root_diameter", parse_number, **POSITIVE),
-    Column("z_top", parse_number, required=True, check=lambda v: v < 0,
+    Column("face_width", parse_number, required=True, unit="mm", **POSITIVE),
+    Column("tip_diameter", parse_number, unit="mm", **POSITIVE),
+    Column("root_diameter", parse_number, unit="mm", **POSITIVE),
+    Column("z_top", parse_number, required=True, check=lambda v: v < 0, unit="mm",
            rule="must be below the gear's top face (Z < 0)"),
 )
+UNIT_KIND = CsvKind("unit", UNIT_COLUMNS)
 INSERT_UNIT = """
 INSERT INTO gear_unit (gear_id, unit, teeth, face_width, tip_diameter, root_diameter, z_top)
 VALUES (%s, %s, %s, %s, %s, %s, %s)"""
@@ -30,51 +32,58 @@ def import_units(conn, path: str | Path, only_gears: set[int] | None = None) -> 
     """Store the units of the CSV at `path` (only those of `only_gears` if given); return
     how many. Raises GearImportError listing every problem."""
     path = Path(path)
-    records = read_records(path)
-    if len(records) < 2:
-        raise EngineError(f"{path} has no unit rows")
-    names = [cell.lower() for cell in records[0][1]]
-    missing = [c.name for c in UNIT_COLUMNS if c.required and c.name not in names]
-    if missing:
-        raise EngineError(f"{path}: missing column(s) {', '.join(missing)}")
+    file = read_csv_file(path, UNIT_KIND)
+    if not file.records:
+        raise EngineError(f"{path}: no unit rows; give one unit per line under the header")
     units, problems = [], []
-    for line, cells in records[1:]:
-        unit, row_problems = _parse_unit(dict(zip(names, cells)))
-        problems += [f"line {line}: {problem}" for problem in row_problems]
+    for line, cells in file.rows():
+        unit, row_problems = _parse_unit(file, line, cells)
+        problems += row_problems
         if not row_problems and (only_gears is None or unit["gear_id"] in only_gears):
             units.append((line, unit))
-    problems += [f"line {line}: {problem}" for line, problem in _database_problems(conn, units)]
+    problems += _database_problems(conn, units)
     if problems:
-        raise GearImportError(path, problems, len({p.split(":")[0] for p in problems}))
+        raise GearImportError(path, problems)
     _store(conn, [unit for _, unit in units])
     return len(units)
 
 
-def _parse_unit(cells: dict) -> tuple[dict, list[str]]:
+def _parse_unit(file, line: int, cells: dict) -> tuple[dict, list[Problem]]:
     unit, problems = {}, []
     for column in UNIT_COLUMNS:
-        unit[column.name], problem = _parse_cell(column, cells.get(column.name, "").strip())
+        unit[column.name], problem = file.cell(column, cells.get(column.name, ""), line)
         if problem:
             problems.append(problem)
     return unit, problems
 
 
-def _database_problems(conn, units: list) -> list[tuple[int, str]]:
-    """Each unit's gear must exist; diameters are completed from the gear's module."""
+UNIT_GEAR = ("SELECT module, face_width, gear_class IN (SELECT name FROM classes_and_below(ARRAY['cylindrical'])) "
+             "FROM gear WHERE id = %s")
+
+
+def _database_problems(conn, units: list) -> list[Problem]:
+    """Each unit's gear must exist; given diameters of a cylindrical gear's unit (a spur unit of the
+    gear's module) must fit the formulas (engine.gears.gear_geometry); the others are completed."""
     problems = []
     for line, unit in units:
-        gear = conn.execute("SELECT module, face_width FROM gear WHERE id = %s", (unit["gear_id"],)).fetchone()
+        gear = conn.execute(UNIT_GEAR, (unit["gear_id"],)).fetchone()
         if gear is None:
-            problems.append((line, f"gear {unit['gear_id']} does not exist; import the gear first"))
+            problems.append(Problem(line, "gear_id", f"gear {unit['gear_id']} does not exist", "import the gear first"))
             continue
-        module, face_width = gear
+        module, face_width, cylindrical = gear
+        spur = {**unit, "module": module, "helix_angle": 0, "module_kind": None, "profile_shift": None}
+        geometry = [Problem(line, p.column, p.what, p.todo) for p in diameter_problems(spur)] if cylindrical else []
+        problems += geometry
+        if geometry:
+            continue
         if unit["z_top"] > -face_width:
-            problems.append((line, f"z_top {unit['z_top']} lies inside unit 1 (Z0…{-face_width})"))
+            problems.append(Problem(line, "z_top", f"{unit['z_top']} lies inside unit 1 (Z0…{-face_width})",
+                                    "give a Z below the gear's first unit"))
         unit["tip_diameter"], unit["root_diameter"] = derived_diameters(
             module, unit["teeth"], 0, unit["tip_diameter"], unit["root_diameter"])
         if unit["root_diameter"] <= 0 or unit["root_diameter"] >= unit["tip_diameter"]:
-            problems.append((line, f"root diameter {unit['root_diameter']:g} does not fit tip diameter "
-                                   f"{unit['tip_diameter']:g}"))
+            problems.append(Problem(line, "root_diameter", f"{unit['root_diameter']:g} does not fit tip diameter "
+                                                           f"{unit['tip_diameter']:g}", "give both diameters"))
     return problems
 
 

@@ -39,8 +39,6 @@ the rows are being written.
 """
 from __future__ import annotations
 
-import csv
-import io
 import json
 import keyword
 import re
@@ -50,6 +48,8 @@ from pathlib import Path
 
 from psycopg.types.json import Jsonb
 
+from ..csv_reader import (Column, CsvKind, parse_number_or_text, parse_text, parse_whole, read_csv_file,
+                          refuse)
 from ..errors import EngineError
 from ..memory import no_cycle_collection
 from ..templates.functions import CONSTANTS, FUNCTIONS
@@ -182,6 +182,12 @@ def read_nc_lines(path) -> list[str]:
 RESERVED_NAMES = frozenset(FUNCTIONS) | frozenset(CONSTANTS) | {"template_version"}
 
 
+PARAMS_KIND = CsvKind("parameter", (Column("name", parse_text, required=True),
+                                    Column("value", parse_number_or_text)), every_column=True)
+MODULES_KIND = CsvKind("module type", (Column("line_no", parse_whole, required=True),
+                                       Column("t", parse_text, required=True)))
+
+
 def check_param_names(params: dict) -> None:
     for name in params:
         if not (isinstance(name, str) and name.isidentifier()) or keyword.iskeyword(name) \
@@ -192,8 +198,8 @@ def check_param_names(params: dict) -> None:
 
 def read_params(path) -> dict:
     """Job parameter values: a JSON object {name: value} or a CSV with columns name,value."""
-    text = _read_text(path, "parameters file")
     if str(path).lower().endswith(".json"):
+        text = _read_text(path, "parameters file")
         try:
             params = json.loads(text)
         except json.JSONDecodeError as error:
@@ -202,11 +208,7 @@ def read_params(path) -> dict:
         if not isinstance(params, dict):
             raise EngineError(f"{path}: give a JSON object {{\"name\": value, …}}, not {type(params).__name__}")
     else:
-        params = {}
-        for line, record in _csv_records(text, path, ("name", "value")):
-            if record["name"] in params:
-                raise EngineError(f"{path} line {line}: parameter {record['name']!r} appears twice")
-            params[record["name"]] = _csv_value(record["value"])
+        params = _csv_params(path)
     check_param_names(params)
     return params
 
@@ -214,12 +216,12 @@ def read_params(path) -> dict:
 def read_modules(path) -> dict[int, str]:
     """The engineer's module types for some lines: a CSV with columns line_no,t."""
     modules = {}
-    for line, record in _csv_records(_read_text(path, "modules file"), path, ("line_no", "t")):
-        if not re.fullmatch(r"[0-9]+", record["line_no"]):
-            raise EngineError(f"{path} line {line}: line_no must be a whole number, got {record['line_no']!r}")
-        if int(record["line_no"]) in modules:
-            raise EngineError(f"{path} line {line}: program line {record['line_no']} appears twice")
-        modules[int(record["line_no"])] = record["t"]
+    file = read_csv_file(path, MODULES_KIND)
+    for line, record in file.rows():
+        line_no = _cell_value(file, MODULES_KIND.column("line_no"), record, line)
+        if line_no in modules:
+            raise refuse(path, f"program line {line_no} appears twice", "give each line once", line, "line_no")
+        modules[line_no] = _cell_value(file, MODULES_KIND.column("t"), record, line)
     _checked_modules(modules, None)
     return modules
 
@@ -232,21 +234,24 @@ def _read_text(path, what: str) -> str:
         raise EngineError(f"cannot read {what} {path}: {reason}") from None
 
 
-def _csv_records(text: str, path, columns: tuple):
-    reader = csv.DictReader(io.StringIO(text))
-    if tuple(name.strip() for name in reader.fieldnames or ()) != columns:
-        raise EngineError(f"{path}: columns must be {','.join(columns)}; found {','.join(reader.fieldnames or ())}")
-    for record in reader:
-        if None in record or any(value is None for value in record.values()):
-            raise EngineError(f"{path} line {reader.line_num}: give exactly {len(columns)} cells")
-        yield reader.line_num, {key.strip(): value.strip() for key, value in record.items()}
+def _csv_params(path) -> dict:
+    """{name: value} of a CSV with columns name,value (a number as int or float, else the text)."""
+    params: dict = {}
+    file = read_csv_file(path, PARAMS_KIND)
+    for line, record in file.rows():
+        name = _cell_value(file, PARAMS_KIND.column("name"), record, line)
+        if name in params:
+            raise refuse(path, f"parameter {name!r} appears twice", "give each parameter once", line, "name")
+        value = _cell_value(file, PARAMS_KIND.column("value"), record, line)
+        params[name] = "" if value is None else value
+    return params
 
 
-def _csv_value(text: str):
-    """A whole number as int, another number as float, anything else as text."""
-    if re.fullmatch(r"[+-]?\d+", text):
-        return int(text)
-    return float(text) if re.fullmatch(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?", text) else text
+def _cell_value(file, column, record: dict, line: int):
+    value, problem = file.cell(column, record[column.name], line)
+    if problem:
+        raise EngineError(problem.said(file.source))
+    return value
 
 
 def _checked_modules(modules: dict | None, line_count: int | None) -> dict:

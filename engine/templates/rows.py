@@ -13,11 +13,17 @@ from dataclasses import astuple, dataclass, field
 from functools import cached_property
 from pathlib import Path
 
-from ..errors import EngineError, csv_problem
+from ..csv_reader import Column, CsvFile, CsvKind, parse_text, parse_whole, read_csv_file, read_csv_text, refuse
+from ..errors import EngineError
 
 CSV_COLUMNS = ("id", "t", "n", "p_calc", "s", "o", "p_emit")
 MODULE_ORDER = ("main", "prep", "sync", "shift", "cutcond", "cutmotion")   # the module types, in program order
 EXPRESSION_COLUMNS = ("p_calc", "s", "o", "p_emit")
+# An expression cell may hold line breaks, and is kept as written (not stripped): the rows' hash is
+# what a program records.
+TEMPLATE_KIND = CsvKind("template", (
+    Column("id", parse_whole, required=True), Column("t", parse_text), Column("n", parse_whole),
+    *(Column(name, parse_text) for name in EXPRESSION_COLUMNS)), multiline=True, strip=False, every_column=True)
 
 
 @dataclass(frozen=True)
@@ -80,67 +86,45 @@ def read_csv(path: Path | str) -> list[TemplateRow]:
         if path.stat().st_size > MAX_CSV_BYTES:
             raise EngineError(f"{path}: {path.stat().st_size} bytes, more than a template CSV may hold "
                               f"({MAX_CSV_BYTES} bytes); is it a template?")
-        data = path.read_bytes()
     except OSError as error:
         raise EngineError(f"cannot read {path}: {error.strerror}") from None
-    try:
-        text = data.decode("utf-8-sig")
-    except UnicodeDecodeError as error:
-        line = data.count(b"\n", 0, error.start) + 1
-        raise EngineError(f"{path} line {line}: not UTF-8 text (byte 0x{data[error.start]:02x} at offset "
-                          f"{error.start}); save the file as UTF-8") from None
-    return parse_csv(text, source=str(path))
+    return _rows(read_csv_file(path, TEMPLATE_KIND))
 
 
 def parse_csv(text: str, source: str = "template CSV") -> list[TemplateRow]:
     """Rows of a template CSV, read strictly: a quote left open is refused at the line where it
     opens, not read on to the end of the file (which would lose every row after it)."""
-    if "\x00" in text:
-        raise EngineError(f"{source} line {text.count(chr(10), 0, text.index(chr(0))) + 1}: holds a NUL "
-                          "character; a template is text")
-    reader, start = csv.reader(io.StringIO(text), strict=True), 1
-    try:
-        header = tuple(next(reader, ()))
-        if set(header) != set(CSV_COLUMNS) or len(header) != len(CSV_COLUMNS):
-            raise EngineError(f"{source}: columns must be {','.join(CSV_COLUMNS)}; found {','.join(header)}")
-        rows, seen, start = [], set(), reader.line_num + 1
-        for cells in reader:
-            if cells:
-                row = _row_from_record(_record(header, cells), source, start)
-                if row.id in seen:
-                    raise EngineError(f"{source} line {start}: row id {row.id} appears twice")
-                seen.add(row.id)
-                rows.append(row)
-            start = reader.line_num + 1
-    except csv.Error as error:
-        raise EngineError(f"{source} line {start}: {csv_problem(error)}") from None
+    return _rows(read_csv_text(text, source, TEMPLATE_KIND))
+
+
+def _rows(file: CsvFile) -> list[TemplateRow]:
+    rows, seen = [], set()
+    for line, record in file.rows():
+        row = _row_from_record(file, record, line)
+        if row.id in seen:
+            raise refuse(file.source, f"row id {row.id} appears twice", "give each row its own id", line, "id")
+        seen.add(row.id)
+        rows.append(row)
     if not rows:
-        raise EngineError(f"{source} has no template rows")
+        raise refuse(file.source, "has no template rows", f"give rows under the header {','.join(CSV_COLUMNS)}")
     return sorted(rows, key=lambda row: row.id)
 
 
-def _record(header: tuple, cells: list[str]) -> dict:
-    """The cells by column (missing ones None); extra cells under None, as csv.DictReader does."""
-    record = dict(zip(header, cells))
-    record.update((column, None) for column in header[len(cells):])
-    if len(cells) > len(header):
-        record[None] = cells[len(header):]
-    return record
+def _whole(file: CsvFile, column: str, text: str, line: int) -> int:
+    value, problem = file.cell(TEMPLATE_KIND.column(column), text.strip(), line)
+    if problem:
+        raise EngineError(problem.said(file.source))
+    return value
 
 
-def _row_from_record(record: dict, source: str, line: int) -> TemplateRow:
-    if None in record:
-        raise EngineError(f"{source} line {line}: more cells than columns (quote cells with commas)")
-    try:
-        row_id, n = int(record["id"]), int(record["n"] or 1)
-    except ValueError:
-        raise EngineError(f"{source} line {line}: id and n must be whole numbers, "
-                          f"got id={record['id']!r} n={record['n']!r}") from None
+def _row_from_record(file: CsvFile, record: dict, line: int) -> TemplateRow:
+    row_id, n = _whole(file, "id", record["id"], line), _whole(file, "n", record["n"], line)
+    n = 1 if n is None else n
     texts = {column: (record[column] if record[column] and record[column].strip() else None)
              for column in EXPRESSION_COLUMNS}
     swallowed = next((ROW_START.search(text) for text in texts.values() if text and ROW_START.search(text)), None)
     if swallowed:
-        raise EngineError(f"{source} line {line}: a cell runs on into what looks like a row "
-                          f"({swallowed.group().strip()!r}…): a quote opened on this line is not closed")
+        raise refuse(file.source, f"a cell runs on into what looks like a row ({swallowed.group().strip()!r}…): "
+                                  "a quote opened on this line is not closed", "close the quote", line)
     return TemplateRow(row_id, (record["t"] or "").strip(), n, texts["p_calc"], texts["s"],
                        texts["o"], texts["p_emit"])
