@@ -185,7 +185,7 @@ def test_add_then_list_shows_the_new_hob(run):
                  "--hand", "l", "--accuracy-class", "b", "--coating", "TiAlN")
     assert result.exit_code == 0, result.output
     listed = json.loads(run("hobs", "list", "--json").stdout)["hobs"]
-    added = next(h for h in listed if h["id"] == "H-M5-B-L1")
+    added = next(h for h in listed if h["hob_id"] == "H-M5-B-L1")
     assert added == {"id": "H-M5-B-L1", "module": 5, "pressure_angle": 20, "starts": 1, "tip_diameter": 110,
                      "length": 160, "hand": "L", "accuracy_class": "B", "material": "HSS",
                      "coating": "TiAlN", "purpose": "cylindrical", "tool_number": 1}
@@ -227,7 +227,7 @@ def test_import_adds_new_hobs_and_updates_existing_ones(run, tmp_path):
     result = run("hobs", "import", path, "--json")
     assert result.exit_code == 0, result.output
     assert json.loads(result.stdout) == {"added": 2, "updated": 1}
-    listed = {h["id"]: h for h in json.loads(run("hobs", "list", "--json").stdout)["hobs"]}
+    listed = {h["hob_id"]: h for h in json.loads(run("hobs", "list", "--json").stdout)["hobs"]}
     assert len(listed) == len(seeded_hob_ids()) + 2
     assert (listed["H-M2-AA-R1"]["length"], listed["H-M2-AA-R1"]["coating"]) == (150, "TiAlN")
     assert (listed["H-M6-B-R1"]["material"], listed["H-M6-B-R1"]["coating"],
@@ -320,7 +320,7 @@ def test_match_names_the_hob_of_the_seeded_gear_42(run):
     assert result.stdout.splitlines()[0] == "gear 42: hob H-M2-AA-R1"
     assert "class AA (grade 7 needs AA or better)" in result.stdout
     shifted = json.loads(run("hobs", "match", "--gear", 42, "--shift-travel", 20, "--json").stdout)
-    assert shifted["hob"] == "H-M2-AA-R1" and f"{GENERATING_M2 + 30:.1f} needed" in shifted["reason"]
+    assert shifted["hob_id"] == "H-M2-AA-R1" and f"{GENERATING_M2 + 30:.1f} needed" in shifted["reason"]
 
 
 def test_match_says_which_property_no_hob_has(run):

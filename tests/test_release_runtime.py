@@ -180,7 +180,7 @@ def check_lineage(run, program_id: int, path: Path) -> None:
     assert path.read_text() == "\n".join(lines) + "\n"
     found = run("programs", "show", "--hash", words.split(" INPUT ")[1][:8], "--json")
     assert found.exit_code == 0 and found.stdout.count("\n") == 1
-    assert program_id in [record["id"] for record in json.loads(found.stdout)["programs"]]
+    assert program_id in [record["program_id"] for record in json.loads(found.stdout)["programs"]]
 
 
 def test_every_seeded_gears_program_carries_its_lineage(run, tmp_path):
@@ -299,7 +299,7 @@ def test_programs_show_gives_the_record_and_refuses_in_one_line(run):
     shown = run("programs", "show", made["program_id"], "--json")
     assert shown.exit_code == 0 and shown.stdout.count("\n") == 1
     record = json.loads(shown.stdout)["programs"][0]
-    assert (record["id"], record["job_id"], record["gear_id"], record["gear_class"], record["draft"]) == \
+    assert (record["program_id"], record["job_id"], record["gear_id"], record["class"], record["draft"]) == \
         (made["program_id"], made["job_id"], 42, "spur", False)
     assert record["template_version"] == made["template_version"] and len(record["lines"]) == made["lines"]
     text = run("programs", "show", made["program_id"])

@@ -5,7 +5,7 @@ from dataclasses import asdict
 
 import click
 
-from .context import connection, emit_json
+from .context import connection, emit_json, keyed
 
 TABLE = (  # (heading, width, the cell of a hob)
     ("id", 14, lambda hob: hob.id),
@@ -37,7 +37,7 @@ def hobs_list(ctx, as_json):
     with connection(ctx) as conn:
         library = list_hobs(conn)
     if as_json:
-        emit_json({"hobs": [asdict(hob) for hob in library]})
+        emit_json({"hobs": [keyed(asdict(hob), id="hob_id") for hob in library]})
         return
     click.echo(" ".join(f"{heading:{width}}" for heading, width, _ in TABLE).rstrip())
     for hob in library:
@@ -96,7 +96,7 @@ def hobs_import(ctx, csv_file, as_json):
               help="Hob shift the job will use, mm (the hob must be this much longer).")
 @click.option("--purpose", type=click.Choice(["cylindrical", "worm_wheel"]),
               help="Hob purpose (default: worm_wheel for worm-wheel classes, else cylindrical).")
-@click.option("--json", "as_json", is_flag=True, help="Print one JSON object: {gear, hob, reason}.")
+@click.option("--json", "as_json", is_flag=True, help="Print one JSON object: {gear_id, hob_id, reason}.")
 @click.pass_context
 def hobs_match(ctx, gear_id, shift_travel, purpose, as_json):
     """The hob the engine would choose for a gear, and why (or which property no hob has)."""
@@ -105,7 +105,7 @@ def hobs_match(ctx, gear_id, shift_travel, purpose, as_json):
     with connection(ctx) as conn:
         choice = match_hob(conn, gear_id, purpose=purpose, shift_travel=shift_travel)
     if as_json:
-        emit_json({"gear": gear_id, "hob": choice.hob.id, "reason": choice.reason})
+        emit_json({"gear_id": gear_id, "hob_id": choice.hob.id, "reason": choice.reason})
     else:
         click.echo(f"gear {gear_id}: hob {choice.hob.id}")
         click.echo(f"  {choice.reason}")

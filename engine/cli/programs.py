@@ -28,7 +28,7 @@ def programs():
 @click.argument("program_id", type=int, required=False)
 @click.option("--hash", "prefix", metavar="H",
               help="8 or more hex digits of the INPUT or TEMPLATE hash on a program's lineage line; lists every match.")
-@click.option("--json", "as_json", is_flag=True, help="Print one JSON object: {programs: [{id, job_id, ..., lines}]}.")
+@click.option("--json", "as_json", is_flag=True, help="Print one JSON object: {programs: [{program_id, job_id, ..., lines}]}.")
 @click.pass_context
 def programs_show(ctx, program_id, prefix, as_json):
     """Show a stored program's record and its lines, by PROGRAM_ID or by --hash.

@@ -40,7 +40,10 @@ class ProgramRecord:
     lines: list[str]
 
     def as_dict(self) -> dict:
-        return {**asdict(self), "created_at": self.created_at.isoformat()}
+        """Under the key names of every --json: program_id, job_id, gear_id, class."""
+        record = asdict(self)
+        return {"program_id": record.pop("id"), "class": record.pop("gear_class"), **record,
+                "created_at": self.created_at.isoformat()}
 
 
 def find_programs(conn, program_id: int | None = None, prefix: str | None = None) -> list[ProgramRecord]:
