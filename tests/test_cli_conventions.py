@@ -64,7 +64,7 @@ def test_json_is_one_line_with_the_same_key_names_on_every_command(run, tmp_path
         ("template", "history", "--class", "spur", "--json"), ("test", "--class", "spur", "--json"),
         ("template", "diff", "--class", "spur", "--from", "1", "--to", "1", "--json"),
         ("instantiate", "--gears", "42-43", "--json"), ("import-dxf", tmp_path / "part.dxf", "--json"),
-        ("config", "show", "--json"),
+        ("config", "show", "--json"), ("test", "--coverage", "--class", "spur", "--json"),
     ]
     for args in invocations:
         payload = one_json_line(run(*args))
@@ -75,6 +75,7 @@ def test_json_is_one_line_with_the_same_key_names_on_every_command(run, tmp_path
     shown = one_json_line(run("programs", "show", program, "--json"))["programs"][0]
     assert (shown["program_id"], shown["class"]) == (made["program_id"], made["class"])
     assert one_json_line(run("template", "history", "--class", "spur", "--json"))["class"] == "spur"
+    assert one_json_line(run("simulate", "--program", program, "--json"))["program_id"] == made["program_id"]
 
 
 def test_the_nightly_refactor_appends_one_line_per_night(run, tmp_path):

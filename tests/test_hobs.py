@@ -186,7 +186,7 @@ def test_add_then_list_shows_the_new_hob(run):
     assert result.exit_code == 0, result.output
     listed = json.loads(run("hobs", "list", "--json").stdout)["hobs"]
     added = next(h for h in listed if h["hob_id"] == "H-M5-B-L1")
-    assert added == {"id": "H-M5-B-L1", "module": 5, "pressure_angle": 20, "starts": 1, "tip_diameter": 110,
+    assert added == {"hob_id": "H-M5-B-L1", "module": 5, "pressure_angle": 20, "starts": 1, "tip_diameter": 110,
                      "length": 160, "hand": "L", "accuracy_class": "B", "material": "HSS",
                      "coating": "TiAlN", "purpose": "cylindrical", "tool_number": 1}
     assert len(listed) == len(seeded_hob_ids()) + 1

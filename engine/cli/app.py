@@ -1,7 +1,8 @@
 """`engine`: the command group, its error handling, and every command registered on it; each
 command calls one library function (the command modules of engine.cli).
 
-Exit codes: 0 ok, 1 a handled error or bad input, option values included (one line on stderr),
+Exit codes: 0 ok, 1 a handled error or bad input, option values included (one line on stderr;
+with --json one JSON object {"error": ..., "exit": 1}),
 2 unexpected (--traceback shows it).
 """
 from __future__ import annotations
@@ -70,7 +71,7 @@ class EngineGroup(click.Group):
     """Reads the config file, turns errors into one-line messages (JSON with --json) and exit codes."""
 
     def make_context(self, info_name, args, parent=None, **extra):
-        """The config file's option defaults (engine.config) are the context's default_map."""
+        """The config file's option defaults (engine.programs.config) are the context's default_map."""
         config, defaults = _read_config(self, args, extra.get("resilient_parsing", False))
         extra.setdefault("default_map", defaults)
         ctx = super().make_context(info_name, args, parent, **extra)
@@ -118,10 +119,10 @@ class EngineGroup(click.Group):
 
 
 def _read_config(group: click.Group, args: list[str], completing: bool):
-    """The config file (engine.config) and its option defaults; a malformed file (an unknown
+    """The config file (engine.programs.config) and its option defaults; a malformed file (an unknown
     command or option too) ends the command with one line naming it (JSON with --json), exit 1,
     except while the shell completes a word (then no file)."""
-    from ..config import load_config
+    from ..programs.config import load_config
 
     try:
         config = load_config()

@@ -35,11 +35,11 @@ def emit_json(payload: dict) -> None:
     click.echo(json.dumps(payload, default=str))   # design notes §9: one JSON object on one line
 
 
-CONFIG = "engine.config"   # ctx.meta: the config file's settings (engine.config), read once per invocation
+CONFIG = "engine.config"   # ctx.meta: the config file's settings (engine.programs.config), read once per invocation
 
 
 def settings(ctx):
     """The settings of the config file (defaults when the command runs outside `engine`)."""
-    from ..config import Config
+    from ..programs.config import Config
 
     return ctx.meta.get(CONFIG) or Config()

@@ -3,7 +3,7 @@
 * an environment variable per option, ENGINE_<COMMAND>_<OPTION> (ENGINE_INSTANTIATE_MACHINE,
   ENGINE_HOBS_MATCH_SHIFT_TRAVEL, ENGINE_REFACTOR_JSON=1), after the variables it already had
   (DATABASE_URL before ENGINE_DATABASE_URL);
-* defaults of its options from the config file (engine.config; click's default_map);
+* defaults of its options from the config file (engine.programs.config; click's default_map);
 * an `Example:` line at the end of its --help (engine.cli.examples, or its own docstring's);
 * --json remembered, so that an error of a --json invocation is reported as JSON.
 
@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import click
 
-from ..config import Config, config_error
+from ..programs.config import Config, config_error
 from .examples import EXAMPLES
 
 # read by the engine itself, never generated for an option (test_cli_conventions checks it)

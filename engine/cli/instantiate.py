@@ -62,7 +62,7 @@ def instantiate(ctx, gear_id, job_id, gear_range, job_range, all_gears, out, for
     The program is checked against the machine's limits, stored with the template
     version it came from, printed (single program) and written to --out.
     """
-    from ..config import line_ending, output_folder
+    from ..programs.config import line_ending, output_folder
     from ..hobbing.choices import Choices
     from ..programs.instantiate import instantiate_gear, instantiate_gears
     from ..programs.outputs import line_endings

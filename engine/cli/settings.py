@@ -1,4 +1,4 @@
-"""`engine config path|show`: where the config file is, and what it sets (engine.config)."""
+"""`engine config path|show`: where the config file is, and what it sets (engine.programs.config)."""
 from __future__ import annotations
 
 import click
@@ -16,7 +16,7 @@ def config():
 def config_path_command():
     """Print the config file's path (ENGINE_CONFIG, else the user's config directory), and on
     stderr whether it exists."""
-    from ..config import config_path
+    from ..programs.config import config_path
 
     path = config_path()
     click.echo(str(path) if path else "")

@@ -16,7 +16,7 @@ name that would land outside --out, two programs of one run whose names differ o
 (the control does not tell case), and an existing file without --force.
 
 Lines end with LF, or with what `line_endings(...)` sets for the block (a control that wants
-CR LF; engine.config): only the bytes of the file change, never the stored lines.
+CR LF; engine.programs.config): only the bytes of the file change, never the stored lines.
 """
 from __future__ import annotations
 

@@ -23,8 +23,8 @@ import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from .errors import EngineError
-from .gears.records import DEFAULT_HOBBING_MACHINE
+from ..errors import EngineError
+from ..gears.records import DEFAULT_HOBBING_MACHINE
 
 try:
     import tomllib
