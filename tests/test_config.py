@@ -137,3 +137,13 @@ def test_no_option_variable_is_one_the_engine_reads_itself():
     names = [envvar_name(path, option) for path, command in walk(main) for option in options(command)]
     assert len(names) == len(set(names)) and not RESERVED_ENVVARS & set(names)
     assert "ENGINE_INSTANTIATE_MACHINE" in names and "ENGINE_HOBS_MATCH_SHIFT_TRAVEL" in names
+
+
+def test_the_file_in_the_users_config_directory_is_read(cli, tmp_path):
+    home = tmp_path / "xdg"
+    (home / "nc-template-engine").mkdir(parents=True)
+    (home / "nc-template-engine" / "config.toml").write_text("[lint]\njson = true\n")
+    environment = {"ENGINE_CONFIG": None, "XDG_CONFIG_HOME": str(home)}
+    assert json.loads(cli("lint", env=environment).stdout) == {"errors": []}
+    assert cli("config", "path", env=environment).stdout.strip() == str(home / "nc-template-engine" / "config.toml")
+    assert cli("lint", env={**environment, "ENGINE_CONFIG": ""}).stdout == ""   # ENGINE_CONFIG= reads none
