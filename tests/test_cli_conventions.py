@@ -9,6 +9,7 @@ from click.testing import CliRunner
 
 from engine.cli.app import main
 from engine.cli.conventions import walk
+from engine.cli.examples import EXAMPLES
 from test_dxf_read import seed_drawing
 
 COMMANDS = list(walk(main))
@@ -123,3 +124,22 @@ def test_an_unexpected_error_of_a_json_invocation_is_json_with_exit_2(run, monke
 def test_without_json_errors_stay_one_line_of_text(run):
     result = run("instantiate", "--gear", 999)
     assert result.exit_code == 1 and result.stderr.startswith("error: gear 999")
+
+
+def test_version_and_help_get_no_variable_and_an_own_epilog_is_kept(monkeypatch):
+    from engine.cli.conventions import apply_conventions
+
+    @click.command("probe", epilog="See also the README.")
+    @click.version_option("1.0", prog_name="engine")
+    @click.option("--level", type=int, default=1, help="A level.")
+    def probe(level):
+        """Probe the conventions."""
+        click.echo(f"level {level}")
+
+    monkeypatch.setitem(EXAMPLES, "engine probe", "engine probe --level 2")
+    group = click.Group("engine", commands={"probe": probe})
+    apply_conventions(group)
+    shown = CliRunner().invoke(group, ["probe", "--help"]).stdout
+    assert "See also the README." in shown and "Example: engine probe --level 2" in shown
+    ran = CliRunner().invoke(group, ["probe"], env={"ENGINE_PROBE_VERSION": "1", "ENGINE_PROBE_LEVEL": "3"})
+    assert ran.stdout == "level 3\n"

@@ -31,7 +31,10 @@ def walk(command: click.Command, path: str = "engine"):
 
 
 def options(command: click.Command) -> list[click.Option]:
-    return [param for param in command.params if isinstance(param, click.Option) and param.opts[0].startswith("-")]
+    """The options that give the command a value (not --help, --version: a variable ENGINE_VERSION
+    set for another purpose must not turn every command into printing the version)."""
+    return [param for param in command.params
+            if isinstance(param, click.Option) and param.expose_value and param.opts[0].startswith("-")]
 
 
 def option_name(option: click.Option) -> str:
@@ -62,7 +65,7 @@ def _add_example(path: str, command: click.Command) -> None:
         command.help = "\n".join(line for line in lines if not line.strip().startswith("Example:")).rstrip()
     examples = own or ([f"Example: {EXAMPLES[path]}"] if path in EXAMPLES else [])
     if examples:
-        command.epilog = "\b\n" + "\n".join(examples)
+        command.epilog = "\n\n".join(filter(None, [command.epilog, "\b\n" + "\n".join(examples)]))
 
 
 def _add_envvar(path: str, option: click.Option) -> None:
