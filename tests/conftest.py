@@ -11,6 +11,10 @@ import pytest
 from psycopg import sql
 from psycopg.conninfo import conninfo_to_dict, make_conninfo
 
+# No config file of the user running the suite (README, "Configuration"): the tests of the
+# config file name their own with ENGINE_CONFIG.
+os.environ["ENGINE_CONFIG"] = ""
+
 
 @pytest.fixture(scope="session")
 def server_url() -> str:

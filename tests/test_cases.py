@@ -272,7 +272,7 @@ def test_cli_suggest_prints_the_hob_cases_and_proposal(run):
     bounded = [line for line in out.splitlines() if "bounded to" in line]
     assert len(bounded) == 1 and "8.11" in bounded[0] and "3.00" in bounded[0] and "m2" in bounded[0]
     report = json.loads(run("suggest", "--gear", 42, "--json", "--top", 1).stdout)
-    assert report["hob"]["id"] == "H-M2-AA-R1" and report["hob_speed"] == PAPER_N0
+    assert report["hob"]["hob_id"] == "H-M2-AA-R1" and report["hob_speed"] == PAPER_N0
     assert (report["rough"]["axial_feed"], report["rough"]["radial_feed"]) == (BOUNDED_AXIAL, BOUNDED_RADIAL)
     assert len(report["cases"]) == 2
 

@@ -1,11 +1,13 @@
 """`engine`: the command group, its error handling, and every command registered on it; each
 command calls one library function (the command modules of engine.cli).
 
-Exit codes: 0 ok, 1 a handled error or bad input, option values included (one line on stderr),
+Exit codes: 0 ok, 1 a handled error or bad input, option values included (one line on stderr;
+with --json one JSON object {"error": ..., "exit": 1}),
 2 unexpected (--traceback shows it).
 """
 from __future__ import annotations
 
+import json
 import logging
 import sys
 import traceback
@@ -14,6 +16,8 @@ import click
 
 from ..errors import EngineError
 from .cases import cases, suggest
+from .context import CONFIG
+from .conventions import JSON_SEEN, apply_conventions, default_map
 from .db import db, demo, seed_command
 from .explain import explain
 from .gears import classify, gears
@@ -24,22 +28,59 @@ from .jobs import jobs
 from .nc_import import import_nc_command
 from .programs import programs
 from .refactor import refactor_command
+from .settings import config
 from .simulate import simulate
 from .templates import lint, template
 from .turning import import_dxf_command, plot_command
+
+JSON_ARGS = "engine.json_args"   # ctx.meta: --json among the invocation's arguments
 
 
 def usage_error_line(error: click.UsageError) -> None:
     """A bad option or argument (of any command): one line naming it and the value, exit 1."""
     where = f" (see {error.ctx.command_path} --help)" if error.ctx else ""
-    click.echo(f"error: {error.format_message()}{where}", err=True)
-    raise click.exceptions.Exit(1)
+    fail(f"{error.format_message()}{where}", 1)
+
+
+def fail(message: str, code: int, problems=(), prefix: str = "error: ", as_json: bool | None = None) -> None:
+    """The one line on stderr and the exit code; with --json the same as one JSON object,
+    {"error": ..., "exit": code} (and "problems" when the error lists them)."""
+    if as_json is None:
+        as_json = json_mode(click.get_current_context(silent=True))
+    if as_json:
+        click.echo(json.dumps({"error": message, "exit": code, **({"problems": list(problems)} if problems else {})},
+                              default=str), err=True)
+        raise click.exceptions.Exit(code)
+    click.echo(f"{prefix}{message}", err=True)
+    for problem in problems:
+        click.echo(f"  {problem}", err=True)
+    raise click.exceptions.Exit(code)
+
+
+def json_mode(ctx) -> bool:
+    """The invocation asked for JSON: its command's --json is on, or --json is among its arguments."""
+    return ctx is not None and bool(ctx.meta.get(JSON_SEEN) or ctx.meta.get(JSON_ARGS))
+
+
+def wants_json(args: list[str]) -> bool:
+    """--json among the arguments (before a `--`): known before any option is parsed, so a
+    usage error of a --json invocation is JSON too."""
+    return "--json" in (args[:args.index("--")] if "--" in args else args)
 
 
 class EngineGroup(click.Group):
-    """Turns errors into one-line messages and exit codes."""
+    """Reads the config file, turns errors into one-line messages (JSON with --json) and exit codes."""
+
+    def make_context(self, info_name, args, parent=None, **extra):
+        """The config file's option defaults (engine.programs.config) are the context's default_map."""
+        config, defaults = _read_config(self, args, extra.get("resilient_parsing", False))
+        extra.setdefault("default_map", defaults)
+        ctx = super().make_context(info_name, args, parent, **extra)
+        ctx.meta[CONFIG] = config
+        return ctx
 
     def parse_args(self, ctx, args):
+        ctx.meta[JSON_ARGS] = wants_json(args)
         try:
             return super().parse_args(ctx, args)
         except click.exceptions.NoArgsIsHelpError:
@@ -54,30 +95,43 @@ class EngineGroup(click.Group):
             raise
         except click.UsageError as error:
             usage_error_line(error)
-        except (click.exceptions.Exit, click.ClickException, click.Abort):
+        except (click.exceptions.Exit, click.Abort):
             raise
+        except click.ClickException as error:
+            if not json_mode(ctx):
+                raise
+            fail(error.format_message(), error.exit_code)
         except EngineError as error:
             if ctx.meta.get("traceback"):
                 raise
-            click.echo(f"error: {error}", err=True)
-            for problem in getattr(error, "problems", ()):
-                click.echo(f"  {problem}", err=True)
-            ctx.exit(1)
+            fail(str(error), 1, getattr(error, "problems", ()))
         except Exception as error:  # the promise: no stack trace without --traceback
             if ctx.meta.get("traceback"):
                 raise
             first_line = (str(error).strip().splitlines() or [""])[0]
             if _refused_by_role(error):   # a role without the right: a handled refusal, nothing was stored
-                click.echo(f"error: the database refused this for your role ({first_line}); its transaction was "
-                           "rolled back, nothing stored: ask for the role that may do it (engine_runner makes "
-                           "programs, engine_editor edits templates, engine_releaser releases them)", err=True)
-                ctx.exit(1)
+                fail(f"the database refused this for your role ({first_line}); its transaction was "
+                     "rolled back, nothing stored: ask for the role that may do it (engine_runner makes "
+                     "programs, engine_editor edits templates, engine_releaser releases them)", 1)
             if _database_failure(error):   # the server, not the engine: exit 1, and say what was kept
-                click.echo(f"error: {_database_failure_message(error, first_line)}", err=True)
-                ctx.exit(1)
-            click.echo(f"unexpected error: {type(error).__name__}: {first_line} "
-                       "(run with --traceback for details)", err=True)
-            ctx.exit(2)
+                fail(_database_failure_message(error, first_line), 1)
+            fail(f"unexpected error: {type(error).__name__}: {first_line} (run with --traceback for details)", 2,
+                 prefix="")
+
+
+def _read_config(group: click.Group, args: list[str], completing: bool):
+    """The config file (engine.programs.config) and its option defaults; a malformed file (an unknown
+    command or option too) ends the command with one line naming it (JSON with --json), exit 1,
+    except while the shell completes a word (then no file)."""
+    from ..programs.config import load_config
+
+    try:
+        config = load_config()
+        return config, default_map(group, config)
+    except EngineError as error:
+        if not completing:
+            fail(str(error), 1, as_json=wants_json(list(args)))
+        return None, None
 
 
 def _refused_by_role(error: Exception) -> bool:
@@ -126,7 +180,7 @@ def main(ctx, database_url, traceback):
 
 COMMANDS = (demo, db, seed_command, gears, classify, instantiate, explain, template, lint, hobs, suggest, cases,
             import_nc_command, refactor_command, import_dxf_command, plot_command, simulate, programs,
-            test_command, jobs)
+            test_command, jobs, config)
 
 
 def _register(group: click.Group, commands) -> None:
@@ -135,3 +189,4 @@ def _register(group: click.Group, commands) -> None:
 
 
 _register(main, COMMANDS)
+apply_conventions(main)   # environment variables, examples in --help, --json errors (engine.cli.conventions)

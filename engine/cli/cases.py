@@ -37,7 +37,7 @@ def suggest(ctx, gear_id, top, machine, as_json):
 
 
 def _suggestion_json(s) -> dict:
-    return {"gear_id": s.gear.id, "hob": {"id": s.hob.id, "reason": s.hob_reason}, "machine": s.machine.name,
+    return {"gear_id": s.gear.id, "hob": {"hob_id": s.hob.id, "reason": s.hob_reason}, "machine": s.machine.name,
             "hob_speed": s.cutting.hob_speed, "cutting_speed": round(s.cutting.cutting_speed, 1),
             "source": s.cutting.source, "notes": s.notes, "cases": _records(s.cases),
             **{cut: {**s.feeds(cut), "source": p.source, "case_ids": list(p.case_ids)}

@@ -24,5 +24,22 @@ def connection(ctx, migrated: bool = True):
         yield conn
 
 
+def keyed(record: dict, **names: str) -> dict:
+    """The record with its keys renamed to the names every --json uses (gear_id, job_id,
+    program_id, hob_id, class): keyed(asdict(hob), id="hob_id"); gear_class is always class."""
+    names = {"gear_class": "class", **names}
+    return {names.get(key, key): value for key, value in record.items()}
+
+
 def emit_json(payload: dict) -> None:
     click.echo(json.dumps(payload, default=str))   # design notes §9: one JSON object on one line
+
+
+CONFIG = "engine.config"   # ctx.meta: the config file's settings (engine.programs.config), read once per invocation
+
+
+def settings(ctx):
+    """The settings of the config file (defaults when the command runs outside `engine`)."""
+    from ..programs.config import Config
+
+    return ctx.meta.get(CONFIG) or Config()

@@ -6,7 +6,7 @@ import re
 import click
 
 from ..errors import EngineError
-from .context import connection, emit_json
+from .context import connection, emit_json, settings
 from .progress import progress_bar
 
 RANGE = re.compile(r"^\s*(\d+)\s*(?:-\s*(\d+))?\s*$")
@@ -78,8 +78,10 @@ def instantiate(ctx, gear_id, job_id, gear_range, job_range, all_gears, out, for
 
     Example: engine instantiate --gear 42 --out /srv/nc/
     """
+    from ..programs.config import line_ending, output_folder
     from ..hobbing.choices import Choices
     from ..programs.instantiate import instantiate_gear
+    from ..programs.outputs import line_endings
     from ..programs.remake import instantiate_job
 
     chosen = [name for name, value in (("--gear", gear_id), ("--job", job_id), ("--gears", gear_range),
@@ -96,11 +98,14 @@ def instantiate(ctx, gear_id, job_id, gear_range, job_range, all_gears, out, for
                       feed_mode=feed_mode, tailstock=tailstock, worm_feed=worm_feed,
                       allowance=allowance)
     overrides = {"hob_speed": hob_speed}
+    config = settings(ctx)   # the config file: the machine's output folder and line endings
+    new_job_written = not (dry_run or job_id is not None or job_range)   # a dry run writes no file
+    out = output_folder(config, machine, out) if new_job_written else out
     if force and not out:
         raise EngineError("--force replaces files in --out: give --out too")
     if skip_bad and not (gear_range or job_range or all_gears):
         raise EngineError("--skip-bad skips the bad gears of a batch: use it with --gears, --jobs or --all")
-    with connection(ctx) as conn:
+    with connection(ctx) as conn, line_endings(line_ending(config, machine)):
         if gear_id is not None:
             program = instantiate_gear(conn, gear_id, machine=machine, choices=choices, overrides=overrides, out=out,
                                        force=force, draft=draft, dry_run=dry_run)
@@ -135,7 +140,7 @@ def _refuse_new_job_choices_for_stored_jobs(ctx, stored_jobs: bool) -> None:
     """A stored job is made with its stored parameters: a choice given with --job/--jobs would
     silently do nothing."""
     given = [parameter for parameter in ctx.command.params if parameter.name in NEW_JOB_CHOICES
-             and ctx.get_parameter_source(parameter.name) is not click.core.ParameterSource.DEFAULT]
+             and ctx.get_parameter_source(parameter.name) is click.core.ParameterSource.COMMANDLINE]
     if stored_jobs and given:
         option = "/".join(given[0].opts + given[0].secondary_opts)
         raise EngineError(f"{option} applies to a new job (--gear, --gears, --all); a stored job is made with its "
@@ -149,7 +154,7 @@ def _report_program(program, as_json: bool, explain: bool) -> None:
     dry_run = program.program_id is None
     if as_json:
         emit_json({"program_id": program.program_id, "job_id": program.job_id, "name": program.name,
-                   "path": program.path, "lines": len(program.lines), "gear_class": program.gear_class,
+                   "path": program.path, "lines": len(program.lines), "class": program.gear_class,
                    "template_version": program.template_version, "template_hash": program.template_hash,
                    "notes": list(program.notes),
                    **({"explain": [row.as_dict() for row in rows]} if explain else {}),

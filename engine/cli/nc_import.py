@@ -5,7 +5,7 @@ from dataclasses import asdict
 
 import click
 
-from .context import connection, emit_json
+from .context import connection, emit_json, keyed
 
 
 @click.command("import-nc")
@@ -31,7 +31,7 @@ def import_nc_command(ctx, nc_file, gear_class, params_file, modules_file, paren
     with connection(ctx) as conn:
         report = import_nc(conn, nc_file, gear_class, params, modules, parent)
     if as_json:
-        emit_json(asdict(report))
+        emit_json(keyed(asdict(report)))
         return
     modules_text = ", ".join(f"{t} {count}" for t, count in report.modules.items())
     state = "created" if report.created else ("replaced" if report.changed else "unchanged (identical rows)")

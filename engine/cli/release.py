@@ -66,11 +66,11 @@ def _outcome(report) -> str:
 
 def _as_json(report) -> dict:
     impact = report.impact
-    return {"gear_class": report.gear_class, "version": report.version, "hash": report.hash,
+    return {"class": report.gear_class, "version": report.version, "hash": report.hash,
             "dry_run": report.dry_run, "released": report.release_id is not None, "release_id": report.release_id,
             "tests": report.tests, "checks": report.checks, "drafts_below": report.drafts_below,
             "impact": {"jobs": impact.jobs, "changed": impact.changed,
-                       "failures": [{"job_id": f.job_id, "gear_class": f.gear_class, "error": f.error}
+                       "failures": [{"job_id": f.job_id, "class": f.gear_class, "error": f.error}
                                     for f in impact.failures],
-                       "diffs": [{"job_id": d.job_id, "gear_class": d.gear_class, "diff": d.diff}
+                       "diffs": [{"job_id": d.job_id, "class": d.gear_class, "diff": d.diff}
                                  for d in impact.diffs]}}

@@ -26,7 +26,7 @@ def simulate(ctx, program_id, as_json):
     with connection(ctx) as conn:
         report = simulate_stored_program(conn, program_id)
     if as_json:
-        emit_json(report.as_dict())
+        emit_json({"program_id": program_id, **report.as_dict()})
     else:
         for line in report.lines():
             click.echo(line)

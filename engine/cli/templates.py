@@ -94,7 +94,7 @@ def template_history(ctx, gear_class, as_json):
     with connection(ctx) as conn:
         entries = history(conn, gear_class)
     if as_json:
-        return emit_json({"gear_class": gear_class, "versions": [_version_json(entry) for entry in entries]})
+        return emit_json({"class": gear_class, "versions": [_version_json(entry) for entry in entries]})
     for number, entry in enumerate(entries):
         click.echo(f"v{entry.version:<4} {entry.state:10} {entry.created_at:%Y-%m-%d %H:%M:%S} by "
                    f"{entry.created_by:14} {entry.rows:3} rows  "
@@ -147,7 +147,7 @@ def template_diff(ctx, gear_class, from_version, to_version, as_json):
     with connection(ctx) as conn:
         changes = diff(conn, gear_class, from_version, to_version)
     if as_json:
-        return emit_json({"gear_class": gear_class, "from": from_version, "to": to_version,
+        return emit_json({"class": gear_class, "from": from_version, "to": to_version,
                           "changes": [{"row_id": c.row_id, "kind": c.kind, "old": c.old, "new": c.new}
                                       for c in changes]})
     for change in changes:

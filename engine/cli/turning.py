@@ -8,7 +8,7 @@ import click
 
 from ..errors import EngineError
 from ..turning.defaults import DEFAULT_LATHE, PROFILE_DEFAULTS, STOCK_MARGIN
-from .context import connection, emit_json
+from .context import connection, emit_json, keyed
 
 
 
@@ -70,7 +70,7 @@ def import_dxf_command(ctx, dxf_file, machine, rough_depth, allowance, tool, spe
     with connection(ctx) as conn:
         report = import_dxf(conn, dxf_file, machine, options, parse_pair(alternate), program_name, draft)
     if as_json:
-        emit_json(asdict(report))
+        emit_json(keyed(asdict(report)))
         return
     click.echo(f"job {report.job_id}")
     click.echo(f"  {report.drawing} → {report.gear_class} on {report.machine}, {report.program_lines} program lines",

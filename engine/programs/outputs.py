@@ -14,10 +14,14 @@ which a kill at that moment can leave behind.
 Files are refused before anything is stored: a name that is not an 840D program name, a
 name that would land outside --out, two programs of one run whose names differ only in case
 (the control does not tell case), and an existing file without --force.
+
+Lines end with LF, or with what `line_endings(...)` sets for the block (a control that wants
+CR LF; engine.programs.config): only the bytes of the file change, never the stored lines.
 """
 from __future__ import annotations
 
 import contextlib
+import contextvars
 import errno
 import os
 import secrets
@@ -33,6 +37,7 @@ SUFFIX = ".MPF"
 # errno of open(O_TMPFILE) where the kernel or the file system does not support it
 NO_TMPFILE = (errno.EOPNOTSUPP, errno.EISDIR, errno.EINVAL, errno.ENOENT)
 PROC_FD = Path("/proc/self/fd")
+LINE_ENDING = contextvars.ContextVar("line_ending", default="\n")
 
 
 class ProgramFiles:
@@ -175,9 +180,20 @@ def _refuse_unwritable(folder: Path) -> None:
                           "nothing stored")
 
 
-def _ascii(name: str, lines: list[str]) -> bytes:
+@contextlib.contextmanager
+def line_endings(ending: str):
+    """Files planned in the block end their lines with `ending` ("\\n" or "\\r\\n")."""
+    token = LINE_ENDING.set(ending)
     try:
-        return ("\n".join(lines) + "\n").encode("ascii")
+        yield
+    finally:
+        LINE_ENDING.reset(token)
+
+
+def _ascii(name: str, lines: list[str]) -> bytes:
+    ending = LINE_ENDING.get()
+    try:
+        return (ending.join(lines) + ending).encode("ascii")
     except UnicodeEncodeError:
         raise EngineError(f"program {name} has non-ASCII characters; the control reads ASCII; nothing stored") from None
 

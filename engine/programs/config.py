@@ -1,0 +1,134 @@
+"""The shop's settings file: defaults of command options, the default machine, the output folder
+and line endings per machine (README, "Configuration").
+
+A TOML file in the user's config directory (platformdirs: ~/.config/nc-template-engine/config.toml
+on Linux), or the file ENGINE_CONFIG names (ENGINE_CONFIG="" reads none). Its values are only
+defaults: the command line and the environment (ENGINE_<COMMAND>_<OPTION>) win over them. A
+malformed file is refused naming the file and the line, so a typo never silently changes where
+programs go.
+
+    line_endings = "crlf"            # program files written with CR LF (the stored lines never change)
+    machine = "hobber-840d"          # the default machine of instantiate and suggest
+
+    [instantiate]                    # defaults of any command's options, by option name
+    cuts = 2
+
+    [machines.hobber-840d]
+    out = "/srv/nc/hobber"           # instantiate writes here when --out is not given
+"""
+from __future__ import annotations
+
+import os
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from ..errors import EngineError
+from ..gears.records import DEFAULT_HOBBING_MACHINE
+
+try:
+    import tomllib
+except ModuleNotFoundError:   # Python 3.10
+    import tomli as tomllib
+
+APP = "nc-template-engine"
+LINE_ENDINGS = {"lf": "\n", "crlf": "\r\n"}
+SETTINGS = ("machine", "line_endings", "machines")   # top-level keys that are not command options
+MACHINE_SETTINGS = ("out", "line_endings")
+
+
+@dataclass(frozen=True)
+class Config:
+    path: Path | None = None
+    commands: dict = field(default_factory=dict)   # everything that is not a setting: option defaults
+    machine: str | None = None
+    line_endings: str = "lf"
+    machines: dict = field(default_factory=dict)   # machine name -> {out, line_endings}
+    text: str = ""
+
+
+def config_path() -> Path | None:
+    """ENGINE_CONFIG if set (empty: no file), else config.toml in the user's config directory."""
+    if "ENGINE_CONFIG" in os.environ:
+        return Path(os.environ["ENGINE_CONFIG"]) if os.environ["ENGINE_CONFIG"] else None
+    import platformdirs
+
+    return Path(platformdirs.user_config_dir(APP)) / "config.toml"
+
+
+def load_config(path: Path | None = None, named: bool | None = None) -> Config:
+    """The settings of `path` (default config_path()). A missing default file is no settings; a
+    missing file that ENGINE_CONFIG names, or a malformed one, is an EngineError naming it."""
+    path = config_path() if path is None else path
+    named = "ENGINE_CONFIG" in os.environ if named is None else named
+    if path is None or (not path.exists() and not named):
+        return Config()
+    text = _read(path)
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as error:
+        raise EngineError(f"config file {path}: {error}; fix that line") from None
+    return _settings(path, text, data)
+
+
+def _read(path: Path) -> str:
+    try:
+        return path.read_text(encoding="utf-8")
+    except (OSError, UnicodeDecodeError) as error:
+        reason = getattr(error, "strerror", None) or str(error)
+        raise EngineError(f"config file {path}: cannot be read ({reason}); fix it or set ENGINE_CONFIG") from None
+
+
+def _settings(path: Path, text: str, data: dict) -> Config:
+    machines = data.get("machines", {})
+    config = Config(path, {key: value for key, value in data.items() if key not in SETTINGS},
+                    data.get("machine"), data.get("line_endings", "lf"), machines, text)
+    if config.machine is not None and not isinstance(config.machine, str):
+        raise config_error(config, "machine", "give a machine name in quotes, e.g. \"hobber-840d\"")
+    _check_line_endings(config, config.line_endings)
+    if not isinstance(machines, dict) or not all(isinstance(entry, dict) for entry in machines.values()):
+        raise config_error(config, "machines", "give a table per machine: [machines.hobber-840d] out = \"/srv/nc\"")
+    for entry in machines.values():
+        _check_machine(config, entry)
+    return config
+
+
+def _check_machine(config: Config, entry: dict) -> None:
+    for key, value in entry.items():
+        if key not in MACHINE_SETTINGS:
+            raise config_error(config, key, f"a machine's table takes {', '.join(MACHINE_SETTINGS)}")
+        if not isinstance(value, str):
+            raise config_error(config, key, "give the value in quotes")
+    _check_line_endings(config, entry.get("line_endings", "lf"))
+
+
+def _check_line_endings(config: Config, value) -> None:
+    if value not in LINE_ENDINGS:
+        raise config_error(config, "line_endings", f"{value!r} is not one of {', '.join(map(repr, LINE_ENDINGS))}")
+
+
+def config_error(config: Config, key: str, advice: str) -> EngineError:
+    """A value the file holds that the engine cannot use: the file, the key's line and what to do."""
+    return EngineError(f"config file {config.path}, line {key_line(config.text, key)}: {key}: {advice}")
+
+
+def key_line(text: str, key: str) -> int | str:
+    """The first line that sets `key` (TOML parsers give no positions of valid values)."""
+    pattern = re.compile(rf"^\s*(\[\s*)?[\"']?{re.escape(key)}\b", re.MULTILINE)
+    match = pattern.search(text)
+    return text.count("\n", 0, match.start()) + 1 if match else "?"
+
+
+def output_folder(config: Config, machine: str | None, out: str | None) -> str | None:
+    """Where instantiate writes programs: --out if given, else the machine's folder of the config
+    (ending in the separator, so one program goes into it too), else nowhere (printed)."""
+    folder = config.machines.get(machine or config.machine or DEFAULT_HOBBING_MACHINE, {}).get("out")
+    if out is not None or folder is None:
+        return out
+    return os.path.join(os.path.expanduser(folder), "")
+
+
+def line_ending(config: Config, machine: str | None = None) -> str:
+    """The line ending of written program files: the machine's, else the file's, else LF."""
+    entry = config.machines.get(machine or config.machine or DEFAULT_HOBBING_MACHINE, {})
+    return LINE_ENDINGS[entry.get("line_endings", config.line_endings)]
