@@ -273,10 +273,18 @@ def test_delete_with_yes_removes_the_row_and_only_it(run):
     (("jobs", "list", "--until", "yesterday"), ["--until", "yesterday"]),
     (("programs", "list", "--since", "2020-05-01", "--until", "2020-04-01"), ["--since 2020-05-01 is after"]),
     (("gears", "list", "--class", "no_such_class"), ["class 'no_such_class' does not exist"]),
-    (("jobs", "list", "--json", "--csv"), ["--json and --csv"]),
 ])
 def test_bad_input_is_one_line_and_exit_1(run, args, words):
     refused(run(*args), *words)
+
+
+def test_json_and_csv_together_are_refused_as_one_json_line(run):
+    """Given --json, the refusal itself is the JSON error line (issue 16: errors in --json mode)."""
+    result = run("jobs", "list", "--json", "--csv")
+    assert result.exit_code == 1 and result.stdout == ""
+    assert result.stderr.count("\n") == 1
+    error = json.loads(result.stderr)
+    assert error["exit"] == 1 and "--json and --csv" in error["error"]
 
 
 NEW_COMMANDS = (("gears", "list"), ("gears", "show"), ("gears", "delete"), ("jobs", "list"), ("jobs", "show"),

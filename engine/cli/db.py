@@ -75,7 +75,7 @@ def db_url(ctx):
     """Print the URL of the database in use (--database-url, DATABASE_URL, the PG* variables, else
     the embedded PostgreSQL, which is started if it is not running); where it came from on stderr.
 
-    Example: psql "$(engine db url)"
+    Example: engine db url  (then psql "$(engine db url)")
     """
     from ..db.connection import url_in_use
 

@@ -12,6 +12,7 @@ EXAMPLES = {
     "engine db": "engine db status",
     "engine db migrate": "DATABASE_URL=postgresql://engine@dbhost/gears engine db migrate",
     "engine db status": "engine db status",
+    "engine jobs": "engine jobs list --gear 42",
     "engine seed": "engine seed",
     "engine gears": "engine gears import gears.csv",
     "engine gears import": "engine gears import gears.csv --json",
