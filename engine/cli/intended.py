@@ -1,14 +1,13 @@
 """`engine refactor intend | intents | unintend`: thin shells over engine.library.intended."""
 from __future__ import annotations
 
-import csv
-import sys
-
 import click
 
-from .context import connection, emit_json
+from .context import connection
+from .output import Column, emit_list, list_options
 
-INTENT_HEADINGS = ("key", "t", "a", "b", "why", "marked_by", "marked_role", "marked_at")
+INTENT_COLUMNS = tuple(Column(key, key) for key in ("key", "t", "a", "b", "why", "marked_by", "marked_role",
+                                                     "marked_at"))
 
 
 @click.command("intend")
@@ -36,42 +35,18 @@ def intend_command(ctx, key, text_a, text_b, module_type, why):
 
 
 @click.command("intents")
-@click.option("--json", "as_json", is_flag=True, help="Print one JSON object: {intents: [{key, t, a, b, why, ...}]}.")
-@click.option("--csv", "as_csv", is_flag=True, help="Print CSV with a header line: " + ",".join(INTENT_HEADINGS) + ".")
+@list_options("intents")
 @click.pass_context
-def intents_command(ctx, as_json, as_csv):
+def intents_command(ctx, output):
     """List the near-duplicate pairs marked intended, oldest first, with who, why and when.
 
     Example: engine refactor intents --csv > intended.csv
     """
     from ..library.intended import intents
 
-    if as_json and as_csv:
-        raise click.UsageError("--json and --csv exclude each other; give one")
     with connection(ctx) as conn:
         marks = [mark.as_dict() for mark in intents(conn)]
-    if as_json:
-        emit_json({"intents": marks})
-    elif as_csv:
-        _write_csv(marks)
-    else:
-        _print_marks(marks)
-
-
-def _write_csv(marks: list[dict]) -> None:
-    writer = csv.DictWriter(sys.stdout, fieldnames=INTENT_HEADINGS, lineterminator="\n")
-    writer.writeheader()
-    writer.writerows(marks)
-
-
-def _print_marks(marks: list[dict]) -> None:
-    if not marks:
-        click.echo("no near-duplicate pair is marked intended")
-    for mark in marks:
-        click.echo(f"{mark['key']}  {mark['t']}  marked {mark['marked_at']} by {mark['marked_by']} "
-                   f"as {mark['marked_role']}: {mark['why']}")
-        click.echo(f"    {mark['a']}")
-        click.echo(f"    {mark['b']}")
+    emit_list(output, "intents", INTENT_COLUMNS, marks)
 
 
 @click.command("unintend")
