@@ -5,6 +5,9 @@ from __future__ import annotations
 import csv
 import io
 import json
+import subprocess
+import sys
+from pathlib import Path
 
 import psycopg
 import pytest
@@ -301,3 +304,28 @@ def test_every_list_and_show_command_gives_an_example(command):
     result = CliRunner().invoke(main, [*command, "--help"])
     assert result.exit_code == 0
     assert any(line.strip().startswith(f"Example: engine {command[0]} ") for line in result.stdout.splitlines())
+
+
+def test_migrations_and_shared_rows_list_as_json_and_csv(run):
+    """db status and template shared are lists too: one JSON line, or CSV with a header."""
+    migrations = listed(run, "db", "status")
+    names = sorted(path.name for path in (Path(__file__).resolve().parent.parent / "migrations").glob("*.sql"))
+    assert [record["migration"] for record in migrations] == names
+    assert {record["state"] for record in migrations} == {"applied"}
+    rows = listed(run, "template", "shared", "--class", "helical")
+    assert rows and all(record["class"] == "helical" for record in rows)
+    assert any("spur" in record["shared_with"] for record in rows)   # the refactor stores common lines once
+    table = list(csv.DictReader(io.StringIO(run("template", "shared", "--class", "helical", "--csv").stdout)))
+    assert [int(record["row_id"]) for record in table] == [record["row_id"] for record in rows]
+    assert [record["shared_with"] for record in table] == [" ".join(record["shared_with"]) for record in rows]
+
+
+def test_a_reader_that_leaves_early_gets_no_error_message(run):
+    """`engine gears list | head`: the pipe closes before the list is written; the command ends
+    quietly (exit 1, as Python's own tools do on EPIPE), not with 'unexpected error', exit 2."""
+    command = [sys.executable, "-m", "engine", "--database-url", run.url, "db", "status"]
+    child = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    child.stdout.close()   # the reader is gone before the engine writes
+    stderr = child.stderr.read().decode()
+    assert child.wait(timeout=120) == 1
+    assert stderr == ""

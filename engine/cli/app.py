@@ -7,7 +7,9 @@ with --json one JSON object {"error": ..., "exit": 1}),
 """
 from __future__ import annotations
 
+import io
 import json
+import os
 import logging
 import sys
 import traceback
@@ -105,6 +107,9 @@ class EngineGroup(click.Group):
             if ctx.meta.get("traceback"):
                 raise
             fail(str(error), 1, getattr(error, "problems", ()))
+        except BrokenPipeError:   # the reader left (engine … | head): it has what it wanted, no message
+            _silence_stdout()
+            ctx.exit(1)
         except Exception as error:  # the promise: no stack trace without --traceback
             if ctx.meta.get("traceback"):
                 raise
@@ -117,6 +122,15 @@ class EngineGroup(click.Group):
                 fail(_database_failure_message(error, first_line), 1)
             fail(f"unexpected error: {type(error).__name__}: {first_line} (run with --traceback for details)", 2,
                  prefix="")
+
+
+def _silence_stdout() -> None:
+    """Python flushes stdout again at exit, which would fail on the closed pipe a second time
+    (the recipe of the Python docs, 'Note on SIGPIPE')."""
+    try:
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+    except (OSError, ValueError, io.UnsupportedOperation):   # not a real file (a test runner's buffer)
+        pass
 
 
 def _read_config(group: click.Group, args: list[str], completing: bool):

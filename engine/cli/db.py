@@ -8,6 +8,7 @@ import os
 import click
 
 from .context import connection
+from .output import Column, emit_list, list_options
 
 
 @click.command()
@@ -54,9 +55,13 @@ def db_migrate(ctx):
     click.echo(f"applied {len(applied)} migration(s)" + "".join(f"\n  {m.path.name}" for m in applied))
 
 
+MIGRATION_COLUMNS = (Column("state", "state"), Column("migration", "migration"), Column("applied", "applied_at"))
+
+
 @db.command("status")
+@list_options("migrations")
 @click.pass_context
-def db_status(ctx):
+def db_status(ctx, output):
     """Show every migration: applied (when), pending, or CHANGED since applied.
 
     Example: engine db status
@@ -64,9 +69,14 @@ def db_status(ctx):
     from ..db.migrate import status
 
     with connection(ctx, migrated=False) as conn:
-        for state in status(conn):
-            when = f" {state.applied_at:%Y-%m-%d %H:%M}" if state.applied_at else ""
-            click.echo(f"{state.state:8} {state.migration.path.name}{when}")
+        states = status(conn)
+    if output:
+        records = [{"migration": state.migration.path.name, "state": state.state, "applied_at": state.applied_at}
+                   for state in states]
+        return emit_list(output, "migrations", MIGRATION_COLUMNS, records)
+    for state in states:
+        when = f" {state.applied_at:%Y-%m-%d %H:%M}" if state.applied_at else ""
+        click.echo(f"{state.state:8} {state.migration.path.name}{when}")
 
 
 @db.command("url")

@@ -34,6 +34,8 @@ def csv_cell(value: Any) -> Any:
     """A value as a CSV cell holds it: empty for none, times in ISO 8601, numbers in full."""
     if value is None:
         return ""
+    if isinstance(value, (list, tuple)):   # e.g. the classes a row is shared with: one cell, space-separated
+        return " ".join(str(item) for item in value)
     return value.isoformat() if isinstance(value, (datetime, date)) else value
 
 

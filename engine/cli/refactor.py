@@ -5,6 +5,7 @@ from __future__ import annotations
 import click
 
 from .context import connection, emit_json
+from .output import Column, emit_list, list_options
 from .intended import intend_command, intents_command, unintend_command
 from .progress import progress_bar
 
@@ -66,15 +67,24 @@ def _uses(rows, count: int) -> str:
     return listed + (f" and {count - len(rows)} more" if count > len(rows) else "")
 
 
+SHARED_COLUMNS = (Column("row", "row_id"), Column("t", "t"), Column("from", "inherited_from"),
+                  Column("shared with", "shared_with", lambda classes: ", ".join(classes) or "-"), Column("o", "o"))
+
+
 @click.command("shared")
 @click.option("--class", "gear_class", required=True, help="Gear class name.")
+@list_options("rows")
 @click.pass_context
-def template_shared(ctx, gear_class):
+def template_shared(ctx, gear_class, output):
     """Per row of the class's template: shared with other classes (which) or its own."""
     from ..library.refactor import shared_rows
 
     with connection(ctx) as conn:
         rows = shared_rows(conn, gear_class)
+    if output:
+        records = [{"class": gear_class, "row_id": row.id, "t": row.t, "o": row.o, "inherited_from": row.inherited_from,
+                    "shared_with": list(row.shared_with)} for row in rows]
+        return emit_list(output, "rows", SHARED_COLUMNS, records)
     for row in rows:
         where = "own" if row.inherited_from == gear_class else f"inherited from {row.inherited_from}"
         use = (f"shared with {len(row.shared_with)} class(es): {', '.join(row.shared_with)}"
