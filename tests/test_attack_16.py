@@ -78,3 +78,78 @@ def test_an_embedded_data_folder_that_cannot_be_used_is_one_line(engine):
     shown = engine("db", "url")
     assert shown.returncode == 1
     assert shown.stderr.startswith("error: ") and shown.stderr.count("\n") == 1, shown.stderr
+
+
+def test_a_gear_deleted_while_its_program_is_made_is_bad_input_not_a_bug(fresh_database_url):
+    """`engine gears delete 91501 --yes` committing while `instantiate --gear 91501` plans: the
+    gear is gone, which is said in one line (exit 1), not ForeignKeyViolation with exit 2."""
+    import os
+    import subprocess
+    import sys
+    import time
+
+    url = fresh_database_url
+    with psycopg.connect(url) as conn:
+        conn.execute("INSERT INTO gear (id, gear_class, module, teeth, helix_angle, face_width, material, hardness, "
+                     "quality_grade, quantity) VALUES (91501, 'spur', 2, 31, 0, 20, '40Cr', 250, 7, 50)")
+    deleter = psycopg.connect(url)
+    deleter.execute("DELETE FROM gear WHERE id = 91501")   # the delete, not yet committed
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(Path(__file__).resolve().parent.parent),
+                                                        os.environ.get("PYTHONPATH", "")]), "ENGINE_CONFIG": ""}
+    making = subprocess.Popen([sys.executable, "-m", "engine", "--database-url", url, "instantiate", "--gear",
+                               "91501"], env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    with psycopg.connect(url, autocommit=True) as watcher:
+        while making.poll() is None and not watcher.execute(
+                "SELECT count(*) FROM pg_stat_activity WHERE datname = current_database() "
+                "AND wait_event_type = 'Lock'").fetchone()[0]:
+            time.sleep(0.05)   # until instantiate waits for the delete's transaction
+    deleter.commit()
+    deleter.close()
+    stdout, stderr = making.communicate(timeout=120)
+    assert making.returncode == 1, stderr
+    assert stderr.startswith("error: ") and stderr.count("\n") == 1 and "91501" in stderr
+
+
+def invoke_with(url: str, env: dict, *args):
+    """The CLI in-process with the environment variables given (and no config file)."""
+    from click.testing import CliRunner
+
+    from engine.cli.app import main
+
+    return CliRunner().invoke(main, ["--database-url", url, *map(str, args)], env={"ENGINE_CONFIG": "", **env})
+
+
+@pytest.mark.parametrize("variable", ["ENGINE_INSTANTIATE_SKIP_BAD", "ENGINE_INSTANTIATE_WORKERS"])
+def test_a_batch_default_from_the_environment_does_not_refuse_one_gear(fresh_database_url, variable):
+    """A shop sets its batches' habit once (README: Configuration); `instantiate --gear 42`, on
+    which the user gave no batch option, must still make the program."""
+    value = "4" if variable.endswith("WORKERS") else "1"
+    result = invoke_with(fresh_database_url, {variable: value}, "instantiate", "--gear", 42)
+    assert result.exit_code == 0, result.output
+    assert result.stdout.rstrip().endswith("M30")
+
+
+def test_a_delete_is_confirmed_on_the_command_line_only(fresh_database_url):
+    """README: a delete without --yes says what it would delete and exits 1. An environment
+    variable (or a config file's [gears.delete] yes = true) must not confirm every delete."""
+    with psycopg.connect(fresh_database_url) as conn:
+        conn.execute("INSERT INTO gear (id, gear_class, module, teeth, helix_angle, face_width) "
+                     "VALUES (91502, 'spur', 2, 33, 0, 20)")
+    result = invoke_with(fresh_database_url, {"ENGINE_GEARS_DELETE_YES": "1"}, "gears", "delete", 91502)
+    assert result.exit_code == 1, result.output
+    with psycopg.connect(fresh_database_url) as conn:
+        assert conn.execute("SELECT count(*) FROM gear WHERE id = 91502").fetchone()[0] == 1
+
+
+def test_the_samples_do_not_hang_golden_tests_on_a_shops_own_gear(empty_database_url):
+    """A shop's own gear 42 (m3 z33), then `engine seed --samples`: the sample golden tests of
+    gear 42 (m2 z19) must not be attached to the shop's gear (which then can never be deleted)."""
+    for args in (("db", "migrate"), ("seed",)):
+        assert invoke_with(empty_database_url, {}, *args).exit_code == 0
+    with psycopg.connect(empty_database_url) as conn:
+        conn.execute("INSERT INTO gear (id, gear_class, module, teeth, helix_angle, face_width, material) "
+                     "VALUES (42, 'spur', 3, 33, 0, 20, 'C45')")
+    seeded = invoke_with(empty_database_url, {}, "seed", "--samples")
+    with psycopg.connect(empty_database_url) as conn:
+        attached = conn.execute("SELECT count(*) FROM template_test WHERE gear_id = 42").fetchone()[0]
+    assert seeded.exit_code == 1 or attached == 0, seeded.output
