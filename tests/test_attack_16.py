@@ -9,7 +9,7 @@ from pathlib import Path
 import psycopg
 import pytest
 
-from test_operate import Engine
+from test_operate import Engine, user_tables
 
 OUT_OF_RANGE_FILTERS = (   # a filter id beyond PostgreSQL's integer/bigint: bad input, not a bug
     ("jobs", "list", "--gear", "99999999999"),
@@ -153,3 +153,19 @@ def test_the_samples_do_not_hang_golden_tests_on_a_shops_own_gear(empty_database
     with psycopg.connect(empty_database_url) as conn:
         attached = conn.execute("SELECT count(*) FROM template_test WHERE gear_id = 42").fetchone()[0]
     assert seeded.exit_code == 1 or attached == 0, seeded.output
+
+
+def test_demo_leaves_a_shop_database_on_the_embedded_server_untouched(engine):
+    """Without a URL the embedded server is the shop's database (README: Operating the embedded
+    server). `engine demo` must not seed the samples into it, nor store a job and a program (a
+    record nobody deletes) for the shop's own gear 42."""
+    for args in (("db", "migrate"), ("seed",)):
+        assert engine(*args).returncode == 0
+    url = engine("db", "url").stdout.strip()
+    with psycopg.connect(url) as conn:
+        conn.execute("INSERT INTO gear (id, gear_class, module, teeth, helix_angle, face_width, material) "
+                     "VALUES (42, 'spur', 3, 33, 0, 20, 'C45')")
+    before = user_tables(url)
+    demo = engine("demo")
+    assert demo.returncode == 0, demo.stderr
+    assert user_tables(url) == before
