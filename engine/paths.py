@@ -2,14 +2,13 @@
 notes §3: top level of the checkout, where DBAs and reviewers read them).
 
 A checkout (an editable install, or PYTHONPATH on a worktree) reads them beside the `engine`
-package. A wheel ships the same folders as the package `engine_data` (setup.py maps them),
-found by importlib (a namespace package: its search locations), so `pip install .` is not an
-empty install."""
-from importlib.util import find_spec
+package. A wheel ships the same folders as `engine_data/` beside the installed `engine` package
+(setup.py maps them), so `pip install .` is not an empty install. The installed folder is taken
+by its place, not looked up on sys.path: `python -m engine` puts the current folder first, and an
+`engine_data/migrations/` there must not be applied."""
 from pathlib import Path
 
-SOURCE_ROOT = Path(__file__).resolve().parent.parent
-DATA_PACKAGE = "engine_data"
+SOURCE_ROOT = Path(__file__).resolve().parent.parent   # the checkout, or site-packages in a wheel install
 
 
 def _is_checkout(root: Path) -> bool:
@@ -17,13 +16,9 @@ def _is_checkout(root: Path) -> bool:
     return (root / "pyproject.toml").is_file() and (root / "schema" / "schema.sql").is_file()
 
 
-def data_folder(name: str) -> Path:
-    """The folder `name` (migrations, schema, seed_templates) of this installation."""
-    if _is_checkout(SOURCE_ROOT):
-        return SOURCE_ROOT / name
-    spec = find_spec(f"{DATA_PACKAGE}.{name}")
-    folders = [Path(location) for location in (spec.submodule_search_locations if spec else ())]
-    return next((folder for folder in folders if folder.is_dir()), SOURCE_ROOT / name)
+def data_folder(name: str, root: Path = SOURCE_ROOT) -> Path:
+    """The folder `name` (migrations, schema, seed_templates) of the installation at `root`."""
+    return root / name if _is_checkout(root) else root / "engine_data" / name
 
 
 MIGRATIONS_DIR = data_folder("migrations")

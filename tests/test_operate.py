@@ -125,11 +125,14 @@ def test_demo_leaves_the_database_it_was_pointed_at_untouched(engine, empty_data
     for result in (by_variable, by_option):
         assert result.returncode == 0, result.stderr
         assert result.stdout.rstrip().endswith("M30")
-        assert f"on the embedded PostgreSQL (data in {engine.data_dir})" in result.stderr
+        assert f"in the database engine_demo of the embedded PostgreSQL (data in {engine.data_dir})" in result.stderr
         assert "ignored" in result.stderr and "engine seed --samples" in result.stderr
     assert user_tables(empty_database_url) == before == {}
-    embedded = engine("db", "url").stdout.strip()
-    assert counts(embedded, "SELECT count(*) FROM gear WHERE id = 42", "SELECT count(*) FROM program") == [1, 2]
+    embedded = engine("db", "url").stdout.strip()   # the embedded server's own database: a shop's
+    assert user_tables(embedded) == {}
+    demo_database = embedded.replace("/engine?", "/engine_demo?")
+    assert demo_database != embedded
+    assert counts(demo_database, "SELECT count(*) FROM gear WHERE id = 42", "SELECT count(*) FROM program") == [1, 2]
 
 
 def test_db_url_prints_the_url_given_or_the_libpq_variables():
@@ -185,3 +188,19 @@ def test_operating_commands_show_an_example(command):
     result = CliRunner().invoke(main, [*command, "--help"])
     assert result.exit_code == 0
     assert any(line.strip().startswith("Example: ") for line in result.stdout.splitlines())
+
+
+def test_an_installed_engine_reads_its_own_data_not_the_current_folders(tmp_path, monkeypatch):
+    """A wheel puts engine_data/ beside engine/ in site-packages; `python -m engine` puts the
+    current folder first on sys.path, and an engine_data/migrations/ there must not be applied."""
+    from engine.paths import data_folder
+
+    site_packages, elsewhere = tmp_path / "site-packages", tmp_path / "cwd"
+    (site_packages / "engine_data" / "migrations").mkdir(parents=True)
+    (elsewhere / "engine_data" / "migrations").mkdir(parents=True)
+    (elsewhere / "engine_data" / "migrations" / "0099.from_cwd.sql").write_text("CREATE TABLE x ()")
+    monkeypatch.chdir(elsewhere)
+    monkeypatch.syspath_prepend(str(elsewhere))
+    assert data_folder("migrations", site_packages) == site_packages / "engine_data" / "migrations"
+    checkout = Path(__file__).resolve().parent.parent
+    assert data_folder("migrations", checkout) == checkout / "migrations"

@@ -15,12 +15,13 @@ from .output import Column, emit_list, list_options
 @click.option("--gear", "gear_id", default=42, show_default=True, help="Gear to instantiate.")
 @click.pass_context
 def demo(ctx, gear_id):
-    """Migrate, seed (with the samples) and instantiate one gear on the embedded PostgreSQL;
-    print the program. Never on another database: --database-url and DATABASE_URL are ignored.
+    """Migrate, seed (with the samples) and instantiate one gear in the database engine_demo of
+    the embedded PostgreSQL; print the program. Never on another database: --database-url and
+    DATABASE_URL are ignored, and the embedded server's own database `engine` is not touched.
 
     Example: engine demo --gear 43
     """
-    from ..programs.demo import run_demo
+    from ..programs.demo import DEMO_DATABASE, run_demo
 
     if ctx.obj["database_url"]:
         click.echo("demo: --database-url/DATABASE_URL ignored: the demo writes sample data and runs only on "
@@ -28,7 +29,7 @@ def demo(ctx, gear_id):
                    err=True)
     result = run_demo(gear_id)
     program = result.program
-    click.echo(f"demo: on the embedded PostgreSQL (data in {result.data_dir}); "
+    click.echo(f"demo: in the database {DEMO_DATABASE} of the embedded PostgreSQL (data in {result.data_dir}); "
                f"migrations applied: {result.applied}; {result.report}", err=True)
     click.echo(program.text, nl=False)
     click.echo(f"program {program.program_id} ({len(program.lines)} lines) from template "

@@ -6,8 +6,8 @@ import os
 from ..errors import EngineError
 from .embedded import embedded_data_dir, embedded_url
 
-LIBPQ_KEYWORDS = {"PGHOST": "host", "PGPORT": "port", "PGDATABASE": "dbname", "PGUSER": "user",
-                  "PGSERVICE": "service"}
+LIBPQ_KEYWORDS = {"PGHOST": "host", "PGHOSTADDR": "hostaddr", "PGPORT": "port", "PGDATABASE": "dbname",
+                  "PGUSER": "user", "PGSERVICE": "service"}   # each names a server of its own
 LIBPQ_VARIABLES = tuple(LIBPQ_KEYWORDS)
 
 

