@@ -9,6 +9,7 @@ import uuid
 import psycopg
 import pytest
 from psycopg.conninfo import conninfo_to_dict, make_conninfo
+from psycopg.pq import TransactionStatus
 
 from database_pool import DatabasePool, create_database
 
@@ -102,6 +103,23 @@ def conn(database_url):
     with psycopg.connect(database_url) as connection:
         with connection.transaction(force_rollback=True):
             yield connection
+        _vacuum_if_bloated(connection)
+
+
+DEAD_ROWS_BEFORE_VACUUM = 3000
+
+
+def _vacuum_if_bloated(connection) -> None:
+    """Every rolled-back insert leaves a dead row in the session's database, and autovacuum does
+    not keep up with a suite (on a shared server it is busy elsewhere): by the middle of the suite
+    assembly held 17,000 dead rows beside its 488 live ones and reading template_view took 1.7 s
+    instead of 0.02 s. VACUUM removes only rows no transaction can see."""
+    if connection.closed or connection.info.transaction_status != TransactionStatus.IDLE:
+        return
+    connection.autocommit = True
+    dead = connection.execute("SELECT coalesce(sum(n_dead_tup), 0) FROM pg_stat_all_tables").fetchone()[0]
+    if dead > DEAD_ROWS_BEFORE_VACUUM:
+        connection.execute("VACUUM")
 
 
 @pytest.fixture
