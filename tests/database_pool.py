@@ -8,7 +8,10 @@ here one thread copies the next databases while the current test runs, and anoth
 ones, several at once so that their checkpoints are shared.
 
 Copies are made from a template nobody connects to, so a test holding a connection to the session's
-database (`conn`) never stops the next copy.
+database (`conn`) never stops the next copy. Every database made here commits asynchronously
+(synchronous_commit = off, set on the database, so the engine's and the CLI's own connections get it
+too): a commit is visible to every other session at once either way; only a crash of the server
+itself could lose the last commits, and no test crashes the server or reads what survives one.
 """
 from __future__ import annotations
 
@@ -23,11 +26,12 @@ DROPS_AT_ONCE = 16   # concurrent DROP DATABASEs share one checkpoint
 
 
 def create_database(admin, name: str, template: str | None = None) -> None:
-    """CREATE DATABASE `name` (a copy of `template` if given)."""
+    """CREATE DATABASE `name` (a copy of `template` if given), committing asynchronously."""
     query = sql.SQL("CREATE DATABASE {}").format(sql.Identifier(name))
     if template:
         query = sql.SQL("CREATE DATABASE {} TEMPLATE {}").format(sql.Identifier(name), sql.Identifier(template))
     admin.execute(query)
+    admin.execute(sql.SQL("ALTER DATABASE {} SET synchronous_commit = off").format(sql.Identifier(name)))
 
 
 def drop_database(server_url: str, name: str) -> None:
