@@ -83,6 +83,8 @@ class DatabasePool:
                 self.changed.notify_all()
             self.changed.wait_for(lambda: kind.ready or self.error or self.closing)
             self._raise_error()
+            if not kind.ready:
+                raise RuntimeError("the test database pool is closed")
             return kind.ready.pop(0)
 
     def give_back(self, name: str) -> None:
