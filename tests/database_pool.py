@@ -22,7 +22,7 @@ from concurrent.futures import ThreadPoolExecutor
 import psycopg
 from psycopg import sql
 
-DROPS_AT_ONCE = 16   # concurrent DROP DATABASEs share one checkpoint
+DROPS_AT_ONCE = 8   # concurrent DROP DATABASEs share one checkpoint; few connections of a shared server
 
 
 def create_database(admin, name: str, template: str | None = None) -> None:
