@@ -4,7 +4,7 @@ A test that commits needs a private copy of the seeded database. Copying it (CRE
 TEMPLATE) costs the server about a quarter of a second, and dropping it more: DROP DATABASE waits
 for a checkpoint, which on a server other sessions share flushes their dirty pages too (a second
 and more). Done in the test's own setup and teardown that time adds up over hundreds of tests;
-here one thread copies the next databases while the current test runs, and another drops the used
+here two threads copy the next databases while the current test runs, and another drops the used
 ones, several at once so that their checkpoints are shared.
 
 Copies are made from a template nobody connects to, so a test holding a connection to the session's
@@ -22,6 +22,7 @@ from concurrent.futures import ThreadPoolExecutor
 import psycopg
 from psycopg import sql
 
+MAKERS = 2          # copies made at once: a run of quick CLI tests uses one every 0.1-0.3 s
 DROPS_AT_ONCE = 8   # concurrent DROP DATABASEs share one checkpoint; few connections of a shared server
 
 
@@ -47,12 +48,13 @@ class Kind:
     def __init__(self, template: str | None, prefix: str, hex_digits: int, ahead: int):
         self.template, self.prefix, self.hex_digits, self.ahead = template, prefix, hex_digits, ahead
         self.ready: list[str] = []
+        self.making = 0
 
     def new_name(self) -> str:
         return f"{self.prefix}_{uuid.uuid4().hex[:self.hex_digits]}"
 
     def short(self) -> bool:
-        return len(self.ready) < self.ahead
+        return len(self.ready) + self.making < self.ahead
 
 
 class DatabasePool:
@@ -67,11 +69,11 @@ class DatabasePool:
         self.closing = False
         self.changed = threading.Condition()
         self.threads = [threading.Thread(target=self._guarded, args=(work,), daemon=True)
-                        for work in (self._make_ahead, self._drop_behind)]
+                        for work in (self._make_ahead,) * MAKERS + (self._drop_behind,)]
         for thread in self.threads:
             thread.start()
 
-    def kind(self, template: str | None, prefix: str, hex_digits: int = 6, ahead: int = 2) -> Kind:
+    def kind(self, template: str | None, prefix: str, hex_digits: int = 6, ahead: int = 3) -> Kind:
         """A new kind of database; the maker starts copying `ahead` of them at the first take()."""
         return Kind(template, prefix, hex_digits, ahead)
 
@@ -125,6 +127,7 @@ class DatabasePool:
                 name = kind.new_name()
                 create_database(admin, name, kind.template)
                 with self.changed:
+                    kind.making -= 1
                     kind.ready.append(name)
                     self.changed.notify_all()
 
@@ -134,7 +137,9 @@ class DatabasePool:
             self.changed.wait_for(lambda: self.closing or any(kind.short() for kind in self.kinds))
             if self.closing:
                 return None
-            return min((kind for kind in self.kinds if kind.short()), key=lambda kind: len(kind.ready))
+            kind = min((kind for kind in self.kinds if kind.short()), key=lambda kind: len(kind.ready) + kind.making)
+            kind.making += 1
+            return kind
 
     def _drop_behind(self) -> None:
         while batch := self._next_drops():
