@@ -13,13 +13,14 @@ import os
 import logging
 import sys
 import traceback
+import unicodedata
 
 import click
 
 from ..errors import EngineError
 from .cases import cases, suggest
 from .context import CONFIG
-from .conventions import JSON_SEEN, apply_conventions, default_map
+from .conventions import JSON_SEEN, apply_conventions, default_map, json_from_defaults
 from .db import db, demo, seed_command
 from .explain import explain
 from .gears import classify, gears
@@ -39,9 +40,21 @@ JSON_ARGS = "engine.json_args"   # ctx.meta: --json among the invocation's argum
 
 
 def usage_error_line(error: click.UsageError) -> None:
-    """A bad option or argument (of any command): one line naming it and the value, exit 1."""
+    """A bad option or argument (of any command): one line naming it and the value, exit 1; JSON
+    also when the command's --json is on by the environment or the config file."""
     where = f" (see {error.ctx.command_path} --help)" if error.ctx else ""
-    fail(f"{error.format_message()}{where}", 1)
+    as_json = json_mode(click.get_current_context(silent=True)) or bool(error.ctx and json_from_defaults(error.ctx))
+    fail(f"{error.format_message()}{where}", 1, as_json=as_json)
+
+
+def one_line(text: str) -> str:
+    """The text with its control characters and line breaks escaped as repr escapes them (a
+    newline as \\n): an error naming a value typed with a newline or an escape sequence stays one
+    line, and a terminal shows the characters instead of obeying them."""
+    return "".join(repr(char)[1:-1] if unicodedata.category(char) in LINE_BREAKING else char for char in text)
+
+
+LINE_BREAKING = ("Cc", "Zl", "Zp")   # Unicode categories: control characters, line and paragraph separators
 
 
 def fail(message: str, code: int, problems=(), prefix: str = "error: ", as_json: bool | None = None) -> None:
@@ -49,6 +62,7 @@ def fail(message: str, code: int, problems=(), prefix: str = "error: ", as_json:
     {"error": ..., "exit": code} (and "problems" when the error lists them)."""
     if as_json is None:
         as_json = json_mode(click.get_current_context(silent=True))
+    message, problems = one_line(message), [one_line(str(problem)) for problem in problems]
     if as_json:
         click.echo(json.dumps({"error": message, "exit": code, **({"problems": list(problems)} if problems else {})},
                               default=str), err=True)
@@ -99,9 +113,7 @@ class EngineGroup(click.Group):
             usage_error_line(error)
         except (click.exceptions.Exit, click.Abort):
             raise
-        except click.ClickException as error:
-            if not json_mode(ctx):
-                raise
+        except click.ClickException as error:   # one line too (a file click could not open, …)
             fail(error.format_message(), error.exit_code)
         except EngineError as error:
             if ctx.meta.get("traceback"):

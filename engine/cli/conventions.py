@@ -4,6 +4,8 @@
   ENGINE_HOBS_MATCH_SHIFT_TRAVEL, ENGINE_REFACTOR_JSON=1), after the variables it already had
   (DATABASE_URL before ENGINE_DATABASE_URL);
 * defaults of its options from the config file (engine.programs.config; click's default_map);
+* except the options of COMMAND_LINE_ONLY, which confirm what cannot be undone: no variable,
+  and refused in the config file;
 * an `Example:` line at the end of its --help (engine.cli.examples, or its own docstring's);
 * --json remembered, so that an error of a --json invocation is reported as JSON.
 
@@ -21,6 +23,18 @@ from .examples import EXAMPLES
 RESERVED_ENVVARS = frozenset({"ENGINE_CONFIG", "ENGINE_DATA_DIR", "ENGINE_TEST_SERVERS"})
 MACHINE_DEFAULT_FOR = ("instantiate", "suggest")   # the commands the config's `machine` is the default of
 JSON_SEEN = "engine.json"   # ctx.meta: the invoked command's --json is on (command line, environment or config)
+
+DELETE = "it confirms a delete, which cannot be undone"
+COMMAND_LINE_ONLY = {   # (command path, option): why it is typed on each invocation, never a default
+    ("engine gears delete", "yes"): DELETE,
+    ("engine jobs delete", "yes"): DELETE,
+    ("engine hobs delete", "yes"): DELETE,
+    ("engine template release", "yes"): "it releases a draft to the shop floor without asking",
+    ("engine gears import", "replace"): "it overwrites stored gears",
+    ("engine instantiate", "force"): "it replaces program files in --out, which a machine may be loading",
+    ("engine instantiate", "skip-bad"): "it stores a batch without its bad gears",
+    ("engine instantiate", "draft"): "it makes programs of a draft that has not passed the release gate",
+}
 
 
 def walk(command: click.Command, path: str = "engine"):
@@ -56,6 +70,11 @@ def apply_conventions(group: click.Group) -> None:
             _remember_json(option)
 
 
+def command_line_only(path: str, option: click.Option) -> str | None:
+    """Why the option must be typed on the command line (COMMAND_LINE_ONLY), else None."""
+    return COMMAND_LINE_ONLY.get((path, option_name(option)))
+
+
 def _add_example(path: str, command: click.Command) -> None:
     """The docstring's own `Example:` lines, else the table's, as the help's last paragraph
     (\\b keeps click from rewrapping it into the text before)."""
@@ -70,6 +89,9 @@ def _add_example(path: str, command: click.Command) -> None:
 
 def _add_envvar(path: str, option: click.Option) -> None:
     name = envvar_name(path, option)
+    if command_line_only(path, option):
+        option.allow_from_autoenv = False   # nor a variable of click's own
+        return
     if name in RESERVED_ENVVARS:
         return
     existing = [option.envvar] if isinstance(option.envvar, str) else list(option.envvar or [])
@@ -100,17 +122,38 @@ def default_map(group: click.Group, config: Config) -> dict:
 
 def _defaults(command: click.Command, path: str, table: dict, config: Config) -> dict:
     subcommands = getattr(command, "commands", {})
-    names = {spelling: option.name for option in options(command)
+    names = {spelling: option for option in options(command)
              for spelling in (option_name(option), option_name(option).replace("-", "_"), option.name)}
     result = {}
     for key, value in table.items():
         if isinstance(value, dict) and key in subcommands:
             result[key] = _defaults(subcommands[key], f"{path} {key}", value, config)
         elif key in names and not isinstance(value, dict):
-            result[names[key]] = value
+            _refuse_command_line_only(config, path, key, names[key])
+            result[names[key].name] = value
         else:
             raise config_error(config, key, _unknown(path, key, command))
     return result
+
+
+def _refuse_command_line_only(config: Config, path: str, key: str, option: click.Option) -> None:
+    reason = command_line_only(path, option)
+    if reason:
+        raise config_error(config, key, f"--{option_name(option)} of `{path}` is given on the command line only "
+                                        f"({reason}); remove it from the file")
+
+
+def json_from_defaults(ctx: click.Context) -> bool:
+    """The command's --json is on by its environment variable or the config file: known even when
+    its options could not be parsed (a usage error), so that error is JSON too."""
+    option = next((option for option in options(ctx.command) if "--json" in option.opts), None)
+    if option is None:
+        return False
+    value, _source = option.consume_value(ctx, {})
+    try:
+        return bool(option.type_cast_value(ctx, value))
+    except click.BadParameter:   # a variable like ENGINE_LINT_JSON=maybe: its own error says so
+        return False
 
 
 def _unknown(path: str, key: str, command: click.Command) -> str:

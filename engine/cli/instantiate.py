@@ -88,11 +88,12 @@ def instantiate(ctx, gear_id, job_id, gear_range, job_range, all_gears, out, for
                                        ("--jobs", job_range), ("--all", all_gears)) if value]
     if len(chosen) != 1:
         raise EngineError("give exactly one of --gear ID, --job ID, --gears FIRST-LAST, --jobs FIRST-LAST, --all")
-    if workers > 1 and not (gear_range or all_gears):
-        raise EngineError("--workers plans a batch of gears: use it with --gears FIRST-LAST or --all")
-    if explain and (gear_range or job_range or all_gears):
-        raise EngineError("--explain explains one program: use it with --gear or --job, and "
-                          "`engine explain --program ID` for the programs of a batch")
+    batch = bool(gear_range or job_range or all_gears)
+    workers = where_it_applies(ctx, "workers", workers, workers == 1 or bool(gear_range or all_gears),
+                               "--workers plans a batch of gears: use it with --gears FIRST-LAST or --all")
+    explain = where_it_applies(ctx, "explain", explain, not (explain and batch),
+                               "--explain explains one program: use it with --gear or --job, and "
+                               "`engine explain --program ID` for the programs of a batch")
     _refuse_new_job_choices_for_stored_jobs(ctx, job_id is not None or bool(job_range))
     choices = Choices(cuts=cuts, coolant=coolant, shift_y=shift_y, shift_per_part=shift_per_part,
                       feed_mode=feed_mode, tailstock=tailstock, worm_feed=worm_feed,
@@ -103,8 +104,8 @@ def instantiate(ctx, gear_id, job_id, gear_range, job_range, all_gears, out, for
     out = output_folder(config, machine, out) if new_job_written else out
     if force and not out:
         raise EngineError("--force replaces files in --out: give --out too")
-    if skip_bad and not (gear_range or job_range or all_gears):
-        raise EngineError("--skip-bad skips the bad gears of a batch: use it with --gears, --jobs or --all")
+    skip_bad = where_it_applies(ctx, "skip_bad", skip_bad, not skip_bad or batch,
+                                "--skip-bad skips the bad gears of a batch: use it with --gears, --jobs or --all")
     with connection(ctx) as conn, line_endings(line_ending(config, machine)):
         if gear_id is not None:
             program = instantiate_gear(conn, gear_id, machine=machine, choices=choices, overrides=overrides, out=out,
@@ -130,6 +131,18 @@ def _batch(conn, job_range, gear_range, progress, machine, choices, overrides, w
     first, last = parse_range(gear_range) if gear_range else (None, None)
     return instantiate_gears(conn, first, last, machine=machine, choices=choices, overrides=overrides,
                              workers=workers, progress=progress, **common)
+
+
+def where_it_applies(ctx, name: str, value, applies: bool, refusal: str):
+    """The option's value where it applies to the invocation. Typed on the command line where it
+    does not, it is refused (it would silently do nothing); a default of the environment or the
+    config file (a shop's batch habit, e.g. ENGINE_INSTANTIATE_WORKERS=4) is for the invocations
+    it applies to, and is ignored by the others: the option's built-in default."""
+    if applies:
+        return value
+    if ctx.get_parameter_source(name) is click.core.ParameterSource.COMMANDLINE:
+        raise EngineError(refusal)
+    return next(parameter.default for parameter in ctx.command.params if parameter.name == name)
 
 
 NEW_JOB_CHOICES = ("machine", "cuts", "coolant", "shift_y", "shift_per_part", "feed_mode", "tailstock",

@@ -5,9 +5,8 @@ spreadsheet. Records are dicts with the common key names (gear_id, job_id, progr
 class), built by the library."""
 from __future__ import annotations
 
-import csv
 import functools
-import io
+import re
 from dataclasses import dataclass
 from datetime import date, datetime
 from typing import Any, Callable
@@ -31,12 +30,27 @@ def cell(value: Any) -> str:
 
 
 def csv_cell(value: Any) -> Any:
-    """A value as a CSV cell holds it: empty for none, times in ISO 8601, numbers in full."""
+    """A value as a CSV cell holds it: empty for none, times in ISO 8601, numbers in full, text
+    that a spreadsheet would run as a formula quoted (inert_text)."""
     if value is None:
         return ""
     if isinstance(value, (list, tuple)):   # e.g. the classes a row is shared with: one cell, space-separated
-        return " ".join(str(item) for item in value)
+        return inert_text(" ".join(str(item) for item in value))
+    if isinstance(value, str):
+        return inert_text(value)
     return value.isoformat() if isinstance(value, (datetime, date)) else value
+
+
+FORMULA_START = ("=", "+", "@", "\t", "\r")   # a cell beginning so is a formula to Excel and LibreOffice
+NUMBER_TEXT = re.compile(r"-(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?")   # -5, -0.25, -.5, -1e-3: a negative number, not a formula
+
+
+def inert_text(text: str) -> str:
+    """The text with a leading ' if a spreadsheet would take it for a formula (CSV injection,
+    OWASP's advice): a material or hob id like `=cmd|'/c calc'!A1` must open as text, never run.
+    A text starting with - is quoted unless the whole of it is a negative number."""
+    formula = text.startswith(FORMULA_START) or (text.startswith("-") and not NUMBER_TEXT.fullmatch(text))
+    return f"'{text}" if formula else text
 
 
 @dataclass(frozen=True)
@@ -72,14 +86,26 @@ def list_options(things: str) -> Callable:
     def decorate(command: Callable) -> Callable:
         @functools.wraps(command)
         def with_output(*args, as_json: bool, as_csv: bool, **kwargs):
-            if as_json and as_csv:
-                raise click.UsageError("--json and --csv: give one of the two")
-            return command(*args, output="json" if as_json else "csv" if as_csv else None, **kwargs)
+            chosen = one_of(click.get_current_context(), {"as_json": as_json, "as_csv": as_csv})
+            return command(*args, output={"as_json": "json", "as_csv": "csv"}.get(chosen), **kwargs)
         with_output = click.option("--csv", "as_csv", is_flag=True,
                                    help="Print CSV: a header line of keys, then one line per record.")(with_output)
         return click.option("--json", "as_json", is_flag=True,
                             help=f"Print one JSON line: {{\"{things}\": [...]}}.")(with_output)
     return decorate
+
+
+def one_of(ctx: click.Context, flags: dict[str, bool]) -> str | None:
+    """The one flag on of a pair that exclude each other (--json/--csv, --draft/--released), by
+    parameter name. A flag typed on the command line wins over one on by the environment or the
+    config file; two typed, or two on by default, is a usage error naming both."""
+    typed = [name for name, on in flags.items()
+             if on and ctx.get_parameter_source(name) is click.core.ParameterSource.COMMANDLINE]
+    chosen = typed or [name for name, on in flags.items() if on]
+    if len(chosen) > 1:
+        named = [f"--{name.removeprefix('as_').replace('_', '-')}" for name in chosen]
+        raise click.UsageError(f"{' and '.join(named)}: give one of the two")
+    return chosen[0] if chosen else None
 
 
 def emit_list(output: str | None, things: str, columns: tuple[Column, ...], records: list[dict]) -> None:
@@ -94,11 +120,22 @@ def emit_list(output: str | None, things: str, columns: tuple[Column, ...], reco
 
 
 def csv_text(columns: tuple[Column, ...], records: list[dict]) -> str:
-    buffer = io.StringIO()
-    writer = csv.writer(buffer, lineterminator="\n")
-    writer.writerow(column.key for column in columns)
-    writer.writerows([csv_cell(record.get(column.key)) for column in columns] for record in records)
-    return buffer.getvalue()
+    rows = [[column.key for column in columns]]
+    rows += [[csv_cell(record.get(column.key)) for column in columns] for record in records]
+    return "".join(csv_line(row) for row in rows)
+
+
+def csv_line(cells: list) -> str:
+    """One record, RFC 4180 quoting: a cell holding a comma, a quote, CR or LF in double quotes
+    (Python's csv writer leaves a lone CR bare when lines end in LF, which splits the record)."""
+    if cells == [""]:
+        return '""\n'   # else a blank line, which readers skip
+    return ",".join(_csv_field(str(cell)) for cell in cells) + "\n"
+
+
+def _csv_field(text: str) -> str:
+    quoted = any(special in text for special in ',"\r\n')
+    return '"' + text.replace('"', '""') + '"' if quoted else text
 
 
 def table_text(columns: tuple[Column, ...], records: list[dict]) -> str:

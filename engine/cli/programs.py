@@ -5,7 +5,7 @@ from __future__ import annotations
 import click
 
 from .context import connection, emit_json
-from .output import Column, day, day_options, emit_list, list_options
+from .output import Column, day, day_options, emit_list, list_options, one_of
 
 PROGRAM_COLUMNS = (
     Column("program", "program_id"), Column("name", "name"), Column("job", "job_id"), Column("gear", "gear_id"),
@@ -38,12 +38,12 @@ def programs():
 @click.option("--class", "gear_class", help="Only programs of this class.")
 @click.option("--gear", "gear_id", type=int, help="Only programs made for this gear.")
 @click.option("--job", "job_id", type=int, help="Only programs made from this job.")
-@click.option("--draft/--released", default=None,
-              help="Only programs made from a draft version (for trying), or only from released ones.")
+@click.option("--draft", is_flag=True, help="Only programs made from a draft version (for trying).")
+@click.option("--released", is_flag=True, help="Only programs made from a released version.")
 @day_options("programs stored")
 @list_options("programs")
 @click.pass_context
-def programs_list(ctx, gear_class, gear_id, job_id, draft, since, until, output):
+def programs_list(ctx, gear_class, gear_id, job_id, draft, released, since, until, output):
     """The programs stored, one line each: name, job, gear, class, template version and hash,
     draft or released, number of lines, when stored (the text: `engine programs show ID`).
 
@@ -51,8 +51,9 @@ def programs_list(ctx, gear_class, gear_id, job_id, draft, since, until, output)
     """
     from ..programs.lookup import list_programs
 
+    kind = {"draft": True, "released": False}.get(one_of(ctx, {"draft": draft, "released": released}))
     with connection(ctx) as conn:
-        found = list_programs(conn, gear_class, gear_id, job_id, draft, day(since), day(until))
+        found = list_programs(conn, gear_class, gear_id, job_id, kind, day(since), day(until))
     emit_list(output, "programs", PROGRAM_COLUMNS, found)
 
 
