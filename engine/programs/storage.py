@@ -11,8 +11,10 @@ block that no check read. The database refuses both too (migrations 0009, 0010);
 refused with a message that names the program."""
 from __future__ import annotations
 
+import contextlib
 from dataclasses import dataclass
 
+from psycopg.errors import ForeignKeyViolation
 from psycopg.types.json import Jsonb
 
 from ..errors import EngineError
@@ -41,6 +43,11 @@ PROGRAM_TYPES = ("int8", "int8", "text", "int4", "text", "text", "text[]", "int4
 def store_one(conn, planned: Planned, existing_job: int | None, path: str | None) -> Program:
     """The program (and its job, unless `existing_job`), its lineage line added."""
     refuse_unsafe(planned.name, planned.lines)
+    with deleted_meanwhile(conn, [planned.gear_id], [existing_job]), conn.transaction():
+        return _stored_one(conn, planned, existing_job, path)
+
+
+def _stored_one(conn, planned: Planned, existing_job: int | None, path: str | None) -> Program:
     job_id = existing_job
     if job_id is None:
         job_id = conn.execute(INSERT_JOB, (planned.gear_id, planned.gear_class, planned.machine, planned.hob_id,
@@ -76,7 +83,7 @@ def store_many(conn, encoded: list[Encoded], out=None, files=None) -> "Batch":
     the caller writes their files."""
     for item in encoded:
         refuse_unsafe(item.name, item.lines)
-    with conn.transaction():
+    with deleted_meanwhile(conn, [item.gear_id for item in encoded], []), conn.transaction():
         job_ids = _next_ids(conn, "job_id_seq", len(encoded))
         program_ids = _next_ids(conn, "program_id_seq", len(encoded))
         with conn.cursor().copy(COPY_JOB) as copy:
@@ -93,11 +100,38 @@ def store_programs(conn, encoded: list[Encoded], job_ids: list[int], out=None, f
     """Programs of stored jobs (made again), in one transaction through COPY."""
     for item in encoded:
         refuse_unsafe(item.name, item.lines)
-    with conn.transaction():
+    with deleted_meanwhile(conn, [], job_ids), conn.transaction():
         program_ids = _next_ids(conn, "program_id_seq", len(encoded))
         _stored_texts(files, _copy_programs(conn, program_ids, job_ids, encoded))
     return Batch(len(encoded), sum(len(item.lines) + 1 for item in encoded), min(program_ids), max(program_ids), out,
                  tuple(f"{item.name}: {note}" for item in encoded for note in item.notes))
+
+
+# The gears and jobs of a store that are no longer in the database.
+GONE = """SELECT 'gear', g FROM unnest(%s::bigint[]) AS g WHERE NOT EXISTS (SELECT 1 FROM gear WHERE id = g)
+UNION ALL SELECT 'job', j FROM unnest(%s::bigint[]) AS j WHERE NOT EXISTS (SELECT 1 FROM job WHERE id = j)
+ORDER BY 1, 2"""
+
+
+@contextlib.contextmanager
+def deleted_meanwhile(conn, gear_ids: list, job_ids: list):
+    """A gear or job deleted by another session while its program was made is said as such: the
+    store refused by its foreign key (rolled back, the block being a transaction or savepoint)
+    names what is gone. Another foreign key's refusal is left as it is (a bug)."""
+    try:
+        yield
+    except ForeignKeyViolation as error:
+        gone = conn.execute(GONE, ([i for i in gear_ids if i is not None], [i for i in job_ids if i is not None]))
+        named = [f"{kind} {number}" for kind, number in gone]
+        if not named:
+            raise
+        raise EngineError(_deleted_message(named)) from error
+
+
+def _deleted_message(named: list[str]) -> str:
+    if len(named) == 1:
+        return f"{named[0]} was deleted while its program was made; nothing stored"
+    return f"{', '.join(named)} were deleted while their programs were made; nothing stored"
 
 
 def refuse_unsafe(name: str, lines: list[str]) -> None:
