@@ -2,6 +2,7 @@
 says so in one line, exit 1, and stores nothing; it is not a foreign-key violation (exit 2)."""
 from __future__ import annotations
 
+import json
 import os
 import subprocess
 import sys
@@ -68,4 +69,17 @@ def test_a_gear_of_a_batch_deleted_meanwhile_is_named_and_nothing_is_stored(fres
     result = engine_while_deleting(url, "DELETE FROM gear WHERE id = 91522", "instantiate", "--gears", "91521-91523")
     assert result.returncode == 1, result.stderr
     assert result.stderr.startswith("error: gear 91522 was deleted") and result.stderr.count("\n") == 1
+    assert counts(url) == before
+
+
+def test_a_hob_deleted_while_a_program_is_made_with_it_is_said_in_one_line(run):
+    url = run.url
+    add_gears(url, 91531)
+    matched = run("hobs", "match", "--gear", 91531, "--json")
+    assert matched.exit_code == 0, matched.output
+    hob_id = json.loads(matched.stdout)["hob_id"]
+    before = counts(url)
+    result = engine_while_deleting(url, f"DELETE FROM hob WHERE id = '{hob_id}'", "instantiate", "--gear", 91531)
+    assert result.returncode == 1, result.stderr
+    assert result.stderr == f"error: hob {hob_id} was deleted while its program was made; nothing stored\n"
     assert counts(url) == before

@@ -43,7 +43,8 @@ PROGRAM_TYPES = ("int8", "int8", "text", "int4", "text", "text", "text[]", "int4
 def store_one(conn, planned: Planned, existing_job: int | None, path: str | None) -> Program:
     """The program (and its job, unless `existing_job`), its lineage line added."""
     refuse_unsafe(planned.name, planned.lines)
-    with deleted_meanwhile(conn, [planned.gear_id], [existing_job]), conn.transaction():
+    with deleted_meanwhile(conn, gears=[planned.gear_id], hobs=[planned.hob_id], jobs=[existing_job]), \
+            conn.transaction():
         return _stored_one(conn, planned, existing_job, path)
 
 
@@ -83,7 +84,8 @@ def store_many(conn, encoded: list[Encoded], out=None, files=None) -> "Batch":
     the caller writes their files."""
     for item in encoded:
         refuse_unsafe(item.name, item.lines)
-    with deleted_meanwhile(conn, [item.gear_id for item in encoded], []), conn.transaction():
+    with deleted_meanwhile(conn, gears=[item.gear_id for item in encoded], hobs=[item.hob_id for item in encoded]), \
+            conn.transaction():
         job_ids = _next_ids(conn, "job_id_seq", len(encoded))
         program_ids = _next_ids(conn, "program_id_seq", len(encoded))
         with conn.cursor().copy(COPY_JOB) as copy:
@@ -100,29 +102,29 @@ def store_programs(conn, encoded: list[Encoded], job_ids: list[int], out=None, f
     """Programs of stored jobs (made again), in one transaction through COPY."""
     for item in encoded:
         refuse_unsafe(item.name, item.lines)
-    with deleted_meanwhile(conn, [], job_ids), conn.transaction():
+    with deleted_meanwhile(conn, jobs=job_ids), conn.transaction():
         program_ids = _next_ids(conn, "program_id_seq", len(encoded))
         _stored_texts(files, _copy_programs(conn, program_ids, job_ids, encoded))
     return Batch(len(encoded), sum(len(item.lines) + 1 for item in encoded), min(program_ids), max(program_ids), out,
                  tuple(f"{item.name}: {note}" for item in encoded for note in item.notes))
 
 
-# The gears and jobs of a store that are no longer in the database.
-GONE = """SELECT 'gear', g FROM unnest(%s::bigint[]) AS g WHERE NOT EXISTS (SELECT 1 FROM gear WHERE id = g)
-UNION ALL SELECT 'job', j FROM unnest(%s::bigint[]) AS j WHERE NOT EXISTS (SELECT 1 FROM job WHERE id = j)
-ORDER BY 1, 2"""
+# The gears, hobs and jobs of a store that are no longer in the database.
+GONE = """SELECT 'gear', g::text FROM unnest(%s::bigint[]) AS g WHERE NOT EXISTS (SELECT 1 FROM gear WHERE id = g)
+UNION ALL SELECT 'hob', h FROM unnest(%s::text[]) AS h WHERE NOT EXISTS (SELECT 1 FROM hob WHERE id = h)
+UNION ALL SELECT 'job', j::text FROM unnest(%s::bigint[]) AS j WHERE NOT EXISTS (SELECT 1 FROM job WHERE id = j)"""
 
 
 @contextlib.contextmanager
-def deleted_meanwhile(conn, gear_ids: list, job_ids: list):
-    """A gear or job deleted by another session while its program was made is said as such: the
-    store refused by its foreign key (rolled back, the block being a transaction or savepoint)
+def deleted_meanwhile(conn, gears=(), hobs=(), jobs=()):
+    """A gear, hob or job deleted by another session while its program was made is said as such:
+    the store refused by its foreign key (rolled back, the block being a transaction or savepoint)
     names what is gone. Another foreign key's refusal is left as it is (a bug)."""
     try:
         yield
     except ForeignKeyViolation as error:
-        gone = conn.execute(GONE, ([i for i in gear_ids if i is not None], [i for i in job_ids if i is not None]))
-        named = [f"{kind} {number}" for kind, number in gone]
+        gone = conn.execute(GONE, tuple(sorted({i for i in ids if i is not None}) for ids in (gears, hobs, jobs)))
+        named = [f"{kind} {name}" for kind, name in gone]
         if not named:
             raise
         raise EngineError(_deleted_message(named)) from error
