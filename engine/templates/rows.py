@@ -136,6 +136,10 @@ def _row_from_record(file: CsvFile, record: dict, line: int) -> TemplateRow:
                        texts["o"], texts["p_emit"])
 
 
+# A string literal or f-string that mentions PROGRAM (what a lineage line starts with).
+LITERAL_START = re.compile(r"\s*[fFrRuU]{0,2}[\"'].*PROGRAM", re.IGNORECASE | re.DOTALL)
+
+
 def writes_lineage(o: str | None) -> bool:
     """True when the row's output is a text literal (or an f-string, its fields read as 0) that
     reads as the lineage line only the engine writes (engine.programs.lineage)."""
@@ -144,9 +148,11 @@ def writes_lineage(o: str | None) -> bool:
 
 
 def _literal_text(expression: str) -> str | None:
+    if not LITERAL_START.match(expression):   # parsed only if it may be a text literal: rows can be hostile
+        return None
     try:
         tree = ast.parse(expression.strip(), mode="eval").body
-    except (SyntaxError, ValueError):
+    except (SyntaxError, ValueError, RecursionError, MemoryError):
         return None
     if isinstance(tree, ast.Constant):
         return tree.value if isinstance(tree.value, str) else None
