@@ -4,6 +4,7 @@ from __future__ import annotations
 import click
 
 from .context import connection, emit_json
+from .ids import GEAR_ID, JOB_ID
 from .output import Column, emit_list, list_options
 
 CASE_TABLE_COLUMNS = {   # column -> heading, for the small tables printed
@@ -17,7 +18,7 @@ CASE_LIST_COLUMNS = tuple(Column(heading, "case_id" if key == "id" else key)
 
 
 @click.command()
-@click.option("--gear", "gear_id", type=int, required=True, help="Gear id to propose cutting data for.")
+@click.option("--gear", "gear_id", type=GEAR_ID, required=True, help="Gear id to propose cutting data for.")
 @click.option("--top", type=click.IntRange(min=1), default=3, show_default=True,
               help="Nearest cases per cut kind (rough, finish).")
 @click.option("--machine", help="Machine record (default hobber-840d): caps the hob speed.")
@@ -95,7 +96,7 @@ def cases_list(ctx, output):
 
 
 @cases.command("confirm")
-@click.option("--job", "job_id", type=int, required=True, help="Job whose stored cutting data proved good.")
+@click.option("--job", "job_id", type=JOB_ID, required=True, help="Job whose stored cutting data proved good.")
 @click.pass_context
 def cases_confirm(ctx, job_id):
     """Confirm a job: its stored cutting data become new cases (one per cut kind)."""

@@ -5,11 +5,12 @@ from __future__ import annotations
 import click
 
 from .context import connection, emit_json
+from .ids import PROGRAM_ID, ROW_ID
 
 
 @click.command()
-@click.option("--program", "program_id", type=int, required=True, help="Stored program id.")
-@click.option("--row", "row_id", type=int, help="Only this template row.")
+@click.option("--program", "program_id", type=PROGRAM_ID, required=True, help="Stored program id.")
+@click.option("--row", "row_id", type=ROW_ID, help="Only this template row.")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object: {program_id, rows: [...]}.")
 @click.pass_context
 def explain(ctx, program_id, row_id, as_json):

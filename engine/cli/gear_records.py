@@ -5,6 +5,7 @@ from __future__ import annotations
 import click
 
 from .context import connection, emit_json
+from .ids import GEAR_ID
 from .output import Column, day, day_options, emit_list, fields_text, list_options, section_text
 
 GEAR_COLUMNS = (
@@ -48,7 +49,7 @@ def gears_list(ctx, gear_class, since, until, output):
 
 
 @click.command("show")
-@click.argument("gear_id", type=int)
+@click.argument("gear_id", type=GEAR_ID)
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON line: {\"gear\": {..., units, jobs}}.")
 @click.pass_context
 def gears_show(ctx, gear_id, as_json):
@@ -69,7 +70,7 @@ def gears_show(ctx, gear_id, as_json):
 
 
 @click.command("delete")
-@click.argument("gear_id", type=int)
+@click.argument("gear_id", type=GEAR_ID)
 @click.option("--yes", is_flag=True, help="Delete it (without: say what would be deleted, exit 1).")
 @click.pass_context
 def gears_delete(ctx, gear_id, yes):

@@ -5,6 +5,7 @@ import click
 
 from .context import connection, emit_json
 from .gear_records import GEAR_RECORD_COMMANDS
+from .ids import GEAR_ID
 
 
 @click.group()
@@ -59,7 +60,7 @@ def gears_units(ctx, csv_file):
 
 
 @click.command()
-@click.option("--gear", "gear_id", type=int, required=True, help="Gear id.")
+@click.option("--gear", "gear_id", type=GEAR_ID, required=True, help="Gear id.")
 @click.pass_context
 def classify(ctx, gear_id):
     """Explain a gear's class: the group-technology decision path (face-width variation,

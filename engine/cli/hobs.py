@@ -6,6 +6,7 @@ from dataclasses import asdict
 import click
 
 from .context import connection, emit_json
+from .ids import GEAR_ID
 from .output import Column, emit_list, fields_text, list_options, section_text
 
 HOB_COLUMNS = (
@@ -126,7 +127,7 @@ def hobs_import(ctx, csv_file, as_json):
 
 
 @hobs.command("match")
-@click.option("--gear", "gear_id", type=int, required=True, help="Gear id.")
+@click.option("--gear", "gear_id", type=GEAR_ID, required=True, help="Gear id.")
 @click.option("--shift-travel", type=float, default=0.0, show_default=True,
               help="Hob shift the job will use, mm (the hob must be this much longer).")
 @click.option("--purpose", type=click.Choice(["cylindrical", "worm_wheel"]),

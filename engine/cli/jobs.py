@@ -7,6 +7,7 @@ import json
 import click
 
 from .context import connection, emit_json
+from .ids import GEAR_ID, JOB_ID
 from .output import Column, day, day_options, emit_list, fields_text, list_options, section_text
 
 JOB_COLUMNS = (
@@ -31,7 +32,7 @@ def jobs():
 
 @jobs.command("list")
 @click.option("--class", "gear_class", help="Only jobs of this class.")
-@click.option("--gear", "gear_id", type=int, help="Only jobs of this gear.")
+@click.option("--gear", "gear_id", type=GEAR_ID, help="Only jobs of this gear.")
 @day_options("jobs made")
 @list_options("jobs")
 @click.pass_context
@@ -48,7 +49,7 @@ def jobs_list(ctx, gear_class, gear_id, since, until, output):
 
 
 @jobs.command("show")
-@click.argument("job_id", type=int)
+@click.argument("job_id", type=JOB_ID)
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON line: {\"job\": {..., params, programs}}.")
 @click.pass_context
 def jobs_show(ctx, job_id, as_json):
@@ -68,7 +69,7 @@ def jobs_show(ctx, job_id, as_json):
 
 
 @jobs.command("delete")
-@click.argument("job_id", type=int)
+@click.argument("job_id", type=JOB_ID)
 @click.option("--yes", is_flag=True, help="Delete it (without: say what would be deleted, exit 1).")
 @click.pass_context
 def jobs_delete(ctx, job_id, yes):

@@ -5,6 +5,7 @@ from __future__ import annotations
 import click
 
 from .context import connection, emit_json
+from .ids import GEAR_ID, JOB_ID, PROGRAM_ID
 from .output import Column, day, day_options, emit_list, list_options, one_of
 
 PROGRAM_COLUMNS = (
@@ -36,8 +37,8 @@ def programs():
 
 @programs.command("list")
 @click.option("--class", "gear_class", help="Only programs of this class.")
-@click.option("--gear", "gear_id", type=int, help="Only programs made for this gear.")
-@click.option("--job", "job_id", type=int, help="Only programs made from this job.")
+@click.option("--gear", "gear_id", type=GEAR_ID, help="Only programs made for this gear.")
+@click.option("--job", "job_id", type=JOB_ID, help="Only programs made from this job.")
 @click.option("--draft", is_flag=True, help="Only programs made from a draft version (for trying).")
 @click.option("--released", is_flag=True, help="Only programs made from a released version.")
 @day_options("programs stored")
@@ -58,7 +59,7 @@ def programs_list(ctx, gear_class, gear_id, job_id, draft, released, since, unti
 
 
 @programs.command("show")
-@click.argument("program_id", type=int, required=False)
+@click.argument("program_id", type=PROGRAM_ID, required=False)
 @click.option("--hash", "prefix", metavar="H",
               help="8 or more hex digits of the INPUT or TEMPLATE hash on a program's lineage line; lists every match.")
 @click.option("--json", "as_json", is_flag=True,

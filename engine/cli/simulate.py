@@ -5,10 +5,11 @@ from __future__ import annotations
 import click
 
 from .context import connection, emit_json
+from .ids import PROGRAM_ID
 
 
 @click.command()
-@click.option("--program", "program_id", type=int, required=True, help="Stored program id.")
+@click.option("--program", "program_id", type=PROGRAM_ID, required=True, help="Stored program id.")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object on one line.")
 @click.pass_context
 def simulate(ctx, program_id, as_json):

@@ -7,6 +7,7 @@ import sys
 import click
 
 from .context import connection, emit_json
+from .ids import VERSION
 from .output import Column, emit_list, list_options
 from .refactor import template_shared
 from .release import template_release
@@ -136,8 +137,8 @@ def _release_json(release) -> dict | None:
 
 @template.command("diff")
 @click.option("--class", "gear_class", required=True, help="Gear class name.")
-@click.option("--from", "from_version", type=int, required=True, help="Earlier version (see `template history`).")
-@click.option("--to", "to_version", type=int, required=True, help="Later version.")
+@click.option("--from", "from_version", type=VERSION, required=True, help="Earlier version (see `template history`).")
+@click.option("--to", "to_version", type=VERSION, required=True, help="Later version.")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object: {changes: [{row_id, kind, old, new}]}.")
 @click.pass_context
 def template_diff(ctx, gear_class, from_version, to_version, as_json):
@@ -166,7 +167,7 @@ def _diff_lines(change) -> list[str]:
 
 @template.command("restore")
 @click.option("--class", "gear_class", required=True, help="Gear class name.")
-@click.option("--version", type=int, required=True, help="The version to bring back (see `template history`).")
+@click.option("--version", type=VERSION, required=True, help="The version to bring back (see `template history`).")
 @click.pass_context
 def template_restore(ctx, gear_class, version):
     """Make the class's template what it was in an earlier version, as a new version (history is kept)."""

@@ -9,6 +9,7 @@ import click
 from ..errors import EngineError
 from ..turning.defaults import DEFAULT_LATHE, PROFILE_DEFAULTS, STOCK_MARGIN
 from .context import connection, emit_json, keyed
+from .ids import JOB_ID
 
 
 
@@ -96,7 +97,7 @@ def parse_pair(text: str | None) -> list[int] | None:
 
 
 @click.command("plot")
-@click.option("--job", "job_id", type=int, required=True, help="Turning job id (from engine import-dxf).")
+@click.option("--job", "job_id", type=JOB_ID, required=True, help="Turning job id (from engine import-dxf).")
 @click.option("-o", "--out", required=True, type=click.Path(dir_okay=False),
               help="Picture to write: FILE.png or FILE.svg.")
 @click.pass_context

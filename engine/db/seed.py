@@ -12,7 +12,7 @@ from psycopg import sql
 from psycopg.types.json import Jsonb
 
 from ..csv_reader import Column, CsvKind, parse_text, read_csv_file
-from ..gears.gear_import import GEAR_KIND, import_gears
+from ..gears.gear_import import GEAR_KIND, identical_gears, import_gears, installed_classes, read_gears
 from ..gears.hob_library import HOB_COLUMNS
 from ..gears.records import Machine
 from ..gears.units import UNIT_KIND, import_units
@@ -39,14 +39,23 @@ SHOP_TABLES = SEED_TABLES[:1]   # the machines; the hobs are samples
 class SeedReport:
     added: dict = field(default_factory=dict)
     created: list = field(default_factory=list)   # the classes this seed created
+    # sample gear id → golden tests of it not added: the database's gear of that id is another
+    skipped_tests: dict = field(default_factory=dict)
 
     def count(self, what: str, number: int = 1) -> None:
         self.added[what] = self.added.get(what, 0) + number
 
     def __str__(self) -> str:
+        said = "seed: added " + ", ".join(f"{n} {what}" for what, n in self.added.items() if n)
         if not any(self.added.values()):
-            return "seed: everything was already there; nothing changed"
-        return "seed: added " + ", ".join(f"{n} {what}" for what, n in self.added.items() if n)
+            said = "seed: everything was already there; nothing changed"
+        return said + "".join(f"\n{line}" for line in self.skipped_lines())
+
+    def skipped_lines(self) -> list[str]:
+        """Why golden tests of the samples were left out, one line per sample gear."""
+        return [f"seed: skipped {n} golden test{'s' * (n != 1)} of sample gear {gear_id}: gear {gear_id} here is "
+                "not the sample (a gear of the shop's own), and a test of it would test that gear"
+                for gear_id, n in sorted(self.skipped_tests.items())]
 
 
 def seed(conn, directory: Path = SEED_DIR, *, samples: bool = True) -> SeedReport:
@@ -70,17 +79,20 @@ def seed(conn, directory: Path = SEED_DIR, *, samples: bool = True) -> SeedRepor
         for table, file_name, key, kind in SEED_TABLES if samples else SHOP_TABLES:
             report.count(table + "s", _insert_missing(conn, table, key, _read(directory / file_name, kind)))
         seeded = _seed_templates(conn, directory, report)
-        if samples:
-            _seed_samples(conn, directory, report)
-        _seed_template_tests(conn, directory, report, samples)
+        samples_stored = _seed_samples(conn, directory, report) if samples else None
+        _seed_template_tests(conn, directory, report, samples_stored)
         _release_seeded(conn, seeded, report)
     return report
 
 
-def _seed_samples(conn, directory: Path, report: SeedReport) -> None:
-    _seed_gears(conn, directory, report)
-    _seed_units(conn, directory, report)
+def _seed_samples(conn, directory: Path, report: SeedReport) -> set[int]:
+    """The samples; returns the ids of the sample gears the database holds as the samples give
+    them (added now, or identical): a shop's own gear under a sample's id gets no sample units
+    nor golden tests."""
+    samples_stored = _seed_gears(conn, directory, report)
+    _seed_units(conn, directory, report, samples_stored)
     _seed_cases(conn, directory, report)
+    return samples_stored
 
 
 RELEASE_SEEDED = ("SELECT release_template(g.name, g.template_version, v.hash, note => %s) FROM gear_class g "
@@ -93,16 +105,16 @@ INSERT_TEST = ("INSERT INTO template_test (gear_class, name, gear_id, params, ch
                "ON CONFLICT (gear_class, name) DO NOTHING RETURNING 1")
 
 
-def _seed_template_tests(conn, directory: Path, report: SeedReport, samples: bool = True) -> None:
+def _seed_template_tests(conn, directory: Path, report: SeedReport, samples_stored: set[int] | None) -> None:
     """The golden tests of the shipped templates (engine test), by class and name: a test a DBA
     edited stays edited; a missing one is added, like every seeded row. Those naming a sample
-    gear only with the samples."""
+    gear only with the samples, and only where that gear is the sample (`samples_stored`)."""
     path = directory / "template_tests.json"
     if not path.exists():
         return
-    added = 0
+    added, stored = 0, set(conn.execute("SELECT gear_class, name FROM template_test").fetchall())
     for test in json.loads(path.read_text(encoding="utf-8")):
-        if test.get("gear_id") is not None and not samples:
+        if (test["class"], test["name"]) in stored or not _of_a_sample(test.get("gear_id"), samples_stored, report):
             continue
         params = test.get("params")
         added += conn.execute(INSERT_TEST, (test["class"], test["name"], test.get("gear_id"),
@@ -110,6 +122,17 @@ def _seed_template_tests(conn, directory: Path, report: SeedReport, samples: boo
                                             Jsonb(test.get("choices", {})), test["expect"],
                                             test.get("description", ""), test["class"])).fetchone() is not None
     report.count("template tests", added)
+
+
+def _of_a_sample(gear_id: int | None, samples_stored: set[int] | None, report: SeedReport) -> bool:
+    """True for a test that names no gear, or a sample gear stored as the sample; a test of a
+    sample gear that is another gear here is counted as skipped. Without the samples
+    (`samples_stored` None) every test of a gear is left out, and none is counted."""
+    if gear_id is None or (samples_stored is not None and gear_id in samples_stored):
+        return True
+    if samples_stored is not None:
+        report.skipped_tests[gear_id] = report.skipped_tests.get(gear_id, 0) + 1
+    return False
 
 
 def _release_seeded(conn, classes: list[str], report: SeedReport) -> None:
@@ -163,9 +186,15 @@ def _seed_templates(conn, directory: Path, report: SeedReport) -> list[str]:
     return report.created + [name for name in templated if name not in report.created]
 
 
-def _seed_gears(conn, directory: Path, report: SeedReport) -> None:
-    """Sample gears not yet in the database, through the same checks as `engine gears import`."""
+def _seed_gears(conn, directory: Path, report: SeedReport) -> set[int]:
+    """Sample gears not yet in the database, through the same checks as `engine gears import`;
+    the ids of the sample gears stored as the samples give them (see _seed_samples)."""
     source = directory / "gears.csv"
+    _add_missing_gears(conn, source, report)
+    return identical_gears(conn, read_gears(source, installed_classes(conn)))
+
+
+def _add_missing_gears(conn, source: Path, report: SeedReport) -> None:
     known = {row[0] for row in conn.execute("SELECT id FROM gear")}
     file = read_csv_file(source, GEAR_KIND)
     missing = [row for _, row in file.rows() if int(row["gear_id"]) not in known]
@@ -181,11 +210,12 @@ def _seed_gears(conn, directory: Path, report: SeedReport) -> None:
         report.count("gears", import_gears(conn, subset).imported)
 
 
-def _seed_units(conn, directory: Path, report: SeedReport) -> None:
-    """Further units of the sample multi-unit gears, where the gear has none yet."""
+def _seed_units(conn, directory: Path, report: SeedReport, samples_stored: set[int]) -> None:
+    """Further units of the sample multi-unit gears, where the gear is the sample and has none yet."""
     source = directory / "gear_units.csv"
     with_units = {row[0] for row in conn.execute("SELECT DISTINCT gear_id FROM gear_unit")}
-    rows = [row for row in _read(source, UNIT_KIND) if int(row["gear_id"]) not in with_units]
+    rows = [row for row in _read(source, UNIT_KIND)
+            if int(row["gear_id"]) not in with_units and int(row["gear_id"]) in samples_stored]
     if rows:
         report.count("gear units", import_units(conn, source, only_gears={int(r["gear_id"]) for r in rows}))
 

@@ -389,3 +389,9 @@ def import_gears(conn: psycopg.Connection, path: str | Path, *, replace: bool = 
     path = Path(path)
     gears = read_gears(path, installed_classes(conn))
     return _store(conn, path, gears, replace)
+
+
+def identical_gears(conn: psycopg.Connection, gears: list[dict[str, Any]]) -> set[int]:
+    """The ids of `gears` (as read_gears gives them) that are stored with every field as given."""
+    stored = {row[0]: row for row in conn.execute(_EXISTING, ([gear["gear_id"] for gear in gears],))}
+    return set(stored) - {change.gear_id for change in _changes(stored, gears)}

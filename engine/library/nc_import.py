@@ -52,6 +52,8 @@ from ..csv_reader import (Column, CsvKind, parse_number_or_text, parse_text, par
                           refuse)
 from ..errors import EngineError
 from ..memory import no_cycle_collection
+from ..names import shown
+from ..programs.lineage import ENGINES_LINE, first_lineage_shaped
 from ..templates.functions import CONSTANTS, FUNCTIONS
 from ..templates.rows import MODULE_ORDER, TemplateRow
 from ..templates.store import ensure_class, load_template, replace_template
@@ -93,6 +95,7 @@ def _import(conn, path, gear_class: str, params: dict | None, modules: dict | No
     params = dict(params or {})
     check_param_names(params)
     lines = read_nc_lines(path)
+    refuse_lineage(path, lines)
     built = Builder(values_of(params), path)
     halves = in_halves(len(lines), partial(_read_lines, lines, built))
     assigned = assign_modules([facts for half in halves for facts in half[0]], _checked_modules(modules, len(lines)))
@@ -151,6 +154,16 @@ def _refuse_inherited(template, lines: list[str]) -> None:
 
 
 # --- reading -------------------------------------------------------------------------
+
+def refuse_lineage(path, lines: list[str]) -> None:
+    """A program printed by the engine carries its lineage line (`; PROGRAM 812 TEMPLATE …`, or a
+    dry run's `DRY-RUN`): imported as a row, every program of the class would carry a second one,
+    naming another program."""
+    number = first_lineage_shaped(lines)
+    if number is not None:
+        raise EngineError(f"{path} line {number} is a lineage line {shown(lines[number - 1])}; "
+                          f"remove that line and import the file again ({ENGINES_LINE})")
+
 
 _CONTROL = re.compile(r"[\x00-\x08\x0b\x0e-\x1f\x7f]")
 

@@ -60,19 +60,21 @@ class BadBatch(EngineError):
     """Bad gears or jobs in a batch: nothing stored. `problems` lists each (one line each) when
     there are several; one bad item is said in the message alone."""
 
-    def __init__(self, reasons: list[str], total: int, what: str, skip_bad: bool):
+    def __init__(self, reasons: list[str], total: int, what: str):
         self.problems = reasons if len(reasons) > 1 else []
         self.reasons = reasons
-        super().__init__(_bad_batch_message(reasons, total, what, skip_bad))
+        super().__init__(_bad_batch_message(reasons, total, what))
 
 
-def _bad_batch_message(reasons: list[str], total: int, what: str, skip_bad: bool) -> str:
+def _bad_batch_message(reasons: list[str], total: int, what: str) -> str:
     good = total - len(reasons)
-    advice = f"--skip-bad stores the other {good}" if good else f"every {what} of the batch is bad"
     if len(reasons) == 1:
+        advice = f"--skip-bad stores the other {good}" if good else f"the one {what} of the batch is bad"
         return f"{reasons[0]}; nothing stored ({advice})"
-    said = "every one" if skip_bad and not good else f"{len(reasons)} of {total}"
-    return f"{said} {what}s of the batch are bad, nothing stored ({advice}):"
+    if not good:
+        return f"every one of the {total} {what}s of the batch is bad, nothing stored:"
+    return (f"{len(reasons)} of {total} {what}s of the batch are bad, nothing stored "
+            f"(--skip-bad stores the other {good}):")
 
 
 def good_ones(outcomes: list, what: str, skip_bad: bool) -> tuple[list, tuple[str, ...]]:
@@ -81,7 +83,7 @@ def good_ones(outcomes: list, what: str, skip_bad: bool) -> tuple[list, tuple[st
     bad = [outcome.reason for outcome in outcomes if isinstance(outcome, Bad)]
     good = [outcome for outcome in outcomes if not isinstance(outcome, Bad)]
     if bad and (not skip_bad or not good):
-        raise BadBatch(bad, len(outcomes), what, skip_bad)
+        raise BadBatch(bad, len(outcomes), what)
     return good, tuple(bad)
 
 

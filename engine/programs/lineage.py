@@ -18,6 +18,21 @@ DEFAULT_COMMENT_FORM = "; {}"
 TEMPLATE_LINE = re.compile(r"^\s*[;(]\s*TEMPLATE\s", re.IGNORECASE)
 HEADER_LINE = re.compile(r"^\s*(%|;\$PATH|O\d)")
 SEARCHED_LINES = 40
+# What reads as a lineage line at the machine, in either comment form, whatever its id (a dry
+# run's says DRY-RUN): a template row must never write one, or the program would carry a second
+# lineage naming another program (migration 0021 refuses it in the database too).
+LINEAGE_SHAPE = re.compile(r"^\s*[;(]\s*PROGRAM\s+\S+\s+TEMPLATE(\s|\)|$)", re.IGNORECASE)
+ENGINES_LINE = "the engine writes the lineage line into every program it stores"
+
+
+def lineage_shaped(text: str) -> bool:
+    """True for a line that reads as a lineage line (`; PROGRAM 812 TEMPLATE …`, `(PROGRAM …)`)."""
+    return LINEAGE_SHAPE.match(text) is not None
+
+
+def first_lineage_shaped(lines: list[str]) -> int | None:
+    """The 1-based number of the first lineage-shaped line, or None."""
+    return next((number for number, text in enumerate(lines, 1) if lineage_shaped(text)), None)
 
 
 def lineage_words(program_id: int, gear_class: str, version: int, template_hash: str, input_hash: str,

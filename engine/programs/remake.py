@@ -113,7 +113,7 @@ def instantiate_job(conn, job_id: int, out: str | Path | None = None, force: boo
 def _stored_job(conn, job_id: int) -> tuple:
     job = conn.execute(f"SELECT {JOB_COLUMNS} FROM job WHERE id = %s", (job_id,)).fetchone()
     if job is None:
-        raise EngineError(f"job {job_id} does not exist; see `SELECT id, gear_id FROM job`")
+        raise EngineError(f"job {job_id} does not exist; `engine jobs list` shows what does")
     return job
 
 

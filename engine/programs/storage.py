@@ -11,13 +11,15 @@ block that no check read. The database refuses both too (migrations 0009, 0010);
 refused with a message that names the program."""
 from __future__ import annotations
 
+import contextlib
 from dataclasses import dataclass
 
+from psycopg.errors import ForeignKeyViolation
 from psycopg.types.json import Jsonb
 
 from ..errors import EngineError
 from ..names import checked, line_breaking, shown
-from .lineage import lineage_line, lineage_words, with_lineage
+from .lineage import first_lineage_shaped, lineage_line, lineage_words, with_lineage
 from .records import Encoded, Planned, Program
 
 # What a lineage line needs from the database: the hash of each job's stored parameters, each
@@ -41,6 +43,12 @@ PROGRAM_TYPES = ("int8", "int8", "text", "int4", "text", "text", "text[]", "int4
 def store_one(conn, planned: Planned, existing_job: int | None, path: str | None) -> Program:
     """The program (and its job, unless `existing_job`), its lineage line added."""
     refuse_unsafe(planned.name, planned.lines)
+    with deleted_meanwhile(conn, gears=[planned.gear_id], hobs=[planned.hob_id], jobs=[existing_job]), \
+            conn.transaction():
+        return _stored_one(conn, planned, existing_job, path)
+
+
+def _stored_one(conn, planned: Planned, existing_job: int | None, path: str | None) -> Program:
     job_id = existing_job
     if job_id is None:
         job_id = conn.execute(INSERT_JOB, (planned.gear_id, planned.gear_class, planned.machine, planned.hob_id,
@@ -76,7 +84,8 @@ def store_many(conn, encoded: list[Encoded], out=None, files=None) -> "Batch":
     the caller writes their files."""
     for item in encoded:
         refuse_unsafe(item.name, item.lines)
-    with conn.transaction():
+    with deleted_meanwhile(conn, gears=[item.gear_id for item in encoded], hobs=[item.hob_id for item in encoded]), \
+            conn.transaction():
         job_ids = _next_ids(conn, "job_id_seq", len(encoded))
         program_ids = _next_ids(conn, "program_id_seq", len(encoded))
         with conn.cursor().copy(COPY_JOB) as copy:
@@ -93,16 +102,44 @@ def store_programs(conn, encoded: list[Encoded], job_ids: list[int], out=None, f
     """Programs of stored jobs (made again), in one transaction through COPY."""
     for item in encoded:
         refuse_unsafe(item.name, item.lines)
-    with conn.transaction():
+    with deleted_meanwhile(conn, jobs=job_ids), conn.transaction():
         program_ids = _next_ids(conn, "program_id_seq", len(encoded))
         _stored_texts(files, _copy_programs(conn, program_ids, job_ids, encoded))
     return Batch(len(encoded), sum(len(item.lines) + 1 for item in encoded), min(program_ids), max(program_ids), out,
                  tuple(f"{item.name}: {note}" for item in encoded for note in item.notes))
 
 
+# The gears, hobs and jobs of a store that are no longer in the database.
+GONE = """SELECT 'gear', g::text FROM unnest(%s::bigint[]) AS g WHERE NOT EXISTS (SELECT 1 FROM gear WHERE id = g)
+UNION ALL SELECT 'hob', h FROM unnest(%s::text[]) AS h WHERE NOT EXISTS (SELECT 1 FROM hob WHERE id = h)
+UNION ALL SELECT 'job', j::text FROM unnest(%s::bigint[]) AS j WHERE NOT EXISTS (SELECT 1 FROM job WHERE id = j)"""
+
+
+@contextlib.contextmanager
+def deleted_meanwhile(conn, gears=(), hobs=(), jobs=()):
+    """A gear, hob or job deleted by another session while its program was made is said as such:
+    the store refused by its foreign key (rolled back, the block being a transaction or savepoint)
+    names what is gone. Another foreign key's refusal is left as it is (a bug)."""
+    try:
+        yield
+    except ForeignKeyViolation as error:
+        gone = conn.execute(GONE, tuple(sorted({i for i in ids if i is not None}) for ids in (gears, hobs, jobs)))
+        named = [f"{kind} {name}" for kind, name in gone]
+        if not named:
+            raise
+        raise EngineError(_deleted_message(named)) from error
+
+
+def _deleted_message(named: list[str]) -> str:
+    if len(named) == 1:
+        return f"{named[0]} was deleted while its program was made; nothing stored"
+    return f"{', '.join(named)} were deleted while their programs were made; nothing stored"
+
+
 def refuse_unsafe(name: str, lines: list[str]) -> None:
     """EngineError unless the program's name is an 840D program name and no line breaks."""
     checked("program", name, "program name", "set job.params.program_name in SQL; nothing stored")
+    refuse_lineage_shaped(name, lines)
     if line_breaking("".join(lines)) is None:
         return
     for number, line in enumerate(lines, 1):
@@ -111,6 +148,16 @@ def refuse_unsafe(name: str, lines: list[str]) -> None:
             raise EngineError(f"program {name} line {number} {shown(line)} holds {shown(found)}, which would start "
                               "another NC block: nothing stored; the job parameter or template row that made it "
                               "must not hold line breaks")
+
+
+def refuse_lineage_shaped(name: str, lines: list[str]) -> None:
+    """A template line that reads as a lineage line would give the program a second lineage,
+    naming another program or version, to whoever matches the file at the machine."""
+    number = first_lineage_shaped(lines)
+    if number is not None:
+        raise EngineError(f"program {name} line {number} {shown(lines[number - 1])} reads as a lineage line, "
+                          "which only the engine writes: nothing stored; remove the template row that writes it "
+                          "(engine lint names it)")
 
 
 def _copy_programs(conn, program_ids: list[int], job_ids: list[int], encoded: list[Encoded]) -> dict:

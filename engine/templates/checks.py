@@ -8,7 +8,7 @@ from dataclasses import dataclass
 from ..errors import EngineError
 from .budget import compiling, pay_time
 from .decision_table import TemplateError, compile_row
-from .rows import MODULE_ORDER, TemplateRow
+from .rows import MODULE_ORDER, TemplateRow, writes_lineage
 
 
 @dataclass(frozen=True)
@@ -62,5 +62,8 @@ def _row_structure(row: TemplateRow):
         yield "id", "id and n must not be negative"
     if row.o is None and row.s is None:
         yield "o", "row has neither o nor s: it does nothing"
+    if writes_lineage(row.o):
+        yield "o", ("writes a line that reads as a lineage line, which only the engine writes (one per "
+                    "program); remove the row")
     if row.p_calc is not None and row.s is None:
         yield "p_calc", "p_calc has no effect without s (use p_emit to decide output)"

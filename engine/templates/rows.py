@@ -3,6 +3,7 @@
 engineers export, edit and import."""
 from __future__ import annotations
 
+import ast
 import csv
 import hashlib
 import io
@@ -15,6 +16,8 @@ from pathlib import Path
 
 from ..csv_reader import Column, CsvFile, CsvKind, parse_text, parse_whole, read_csv_file, read_csv_text, refuse
 from ..errors import EngineError
+from ..names import shown
+from ..programs.lineage import ENGINES_LINE, lineage_shaped
 
 CSV_COLUMNS = ("id", "t", "n", "p_calc", "s", "o", "p_emit")
 MODULE_ORDER = ("main", "prep", "sync", "shift", "cutcond", "cutmotion")   # the module types, in program order
@@ -126,5 +129,33 @@ def _row_from_record(file: CsvFile, record: dict, line: int) -> TemplateRow:
     if swallowed:
         raise refuse(file.source, f"a cell runs on into what looks like a row ({swallowed.group().strip()!r}…): "
                                   "a quote opened on this line is not closed", "close the quote", line)
+    if writes_lineage(texts["o"]):
+        raise refuse(file.source, f"row {row_id} writes a lineage line {shown(texts['o'].strip())}",
+                     f"remove the row ({ENGINES_LINE})", line, "o")
     return TemplateRow(row_id, (record["t"] or "").strip(), n, texts["p_calc"], texts["s"],
                        texts["o"], texts["p_emit"])
+
+
+# A string literal or f-string that mentions PROGRAM (what a lineage line starts with).
+LITERAL_START = re.compile(r"\s*[fFrRuU]{0,2}[\"'].*PROGRAM", re.IGNORECASE | re.DOTALL)
+
+
+def writes_lineage(o: str | None) -> bool:
+    """True when the row's output is a text literal (or an f-string, its fields read as 0) that
+    reads as the lineage line only the engine writes (engine.programs.lineage)."""
+    literal = _literal_text(o) if o else None
+    return literal is not None and lineage_shaped(literal)
+
+
+def _literal_text(expression: str) -> str | None:
+    if not LITERAL_START.match(expression):   # parsed only if it may be a text literal: rows can be hostile
+        return None
+    try:
+        tree = ast.parse(expression.strip(), mode="eval").body
+    except (SyntaxError, ValueError, RecursionError, MemoryError):
+        return None
+    if isinstance(tree, ast.Constant):
+        return tree.value if isinstance(tree.value, str) else None
+    if isinstance(tree, ast.JoinedStr):
+        return "".join(part.value if isinstance(part, ast.Constant) else "0" for part in tree.values)
+    return None
