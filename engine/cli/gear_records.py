@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import click
 
-from .context import connection, emit_json
+from .context import connection
 from .ids import GEAR_ID
-from .output import Column, day, day_options, emit_list, fields_text, list_options, section_text
+from .output import Column, day, day_options, emit_list, emit_record, list_options
 
 GEAR_COLUMNS = (
     Column("gear", "gear_id"), Column("class", "class"), Column("m", "module"), Column("z", "teeth"),
@@ -61,12 +61,8 @@ def gears_show(ctx, gear_id, as_json):
 
     with connection(ctx) as conn:
         gear = gear_details(conn, gear_id)
-    if as_json:
-        emit_json({"gear": gear})
-        return
-    click.echo(fields_text(GEAR_FIELDS, gear))
-    click.echo(section_text("further units", UNIT_COLUMNS, gear["units"]))
-    click.echo(section_text("jobs", JOB_COLUMNS, gear["jobs"]))
+    emit_record(as_json, "gear", GEAR_FIELDS, gear, (("further units", UNIT_COLUMNS, "units"),
+                                                     ("jobs", JOB_COLUMNS, "jobs")))
 
 
 @click.command("delete")

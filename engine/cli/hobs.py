@@ -7,7 +7,7 @@ import click
 
 from .context import connection, emit_json
 from .ids import GEAR_ID
-from .output import Column, emit_list, fields_text, list_options, section_text
+from .output import Column, emit_list, emit_record, list_options
 
 HOB_COLUMNS = (
     Column("id", "hob_id"), Column("module", "module"), Column("α", "pressure_angle"), Column("starts", "starts"),
@@ -58,11 +58,7 @@ def hobs_show(ctx, hob_id, as_json):
 
     with connection(ctx) as conn:
         hob = hob_details(conn, hob_id)
-    if as_json:
-        emit_json({"hob": hob})
-        return
-    click.echo(fields_text(HOB_FIELDS, hob))
-    click.echo(section_text("jobs", JOB_COLUMNS, hob["jobs"]))
+    emit_record(as_json, "hob", HOB_FIELDS, hob, (("jobs", JOB_COLUMNS, "jobs"),))
 
 
 @hobs.command("delete")

@@ -6,9 +6,9 @@ import json
 
 import click
 
-from .context import connection, emit_json
+from .context import connection
 from .ids import GEAR_ID, JOB_ID
-from .output import Column, day, day_options, emit_list, fields_text, list_options, section_text
+from .output import Column, day, day_options, emit_list, emit_record, list_options
 
 JOB_COLUMNS = (
     Column("job", "job_id"), Column("gear", "gear_id"), Column("class", "class"), Column("machine", "machine"),
@@ -61,11 +61,7 @@ def jobs_show(ctx, job_id, as_json):
 
     with connection(ctx) as conn:
         job = job_details(conn, job_id)
-    if as_json:
-        emit_json({"job": job})
-        return
-    click.echo(fields_text(JOB_FIELDS, job))
-    click.echo(section_text("programs", PROGRAM_COLUMNS, job["programs"]))
+    emit_record(as_json, "job", JOB_FIELDS, job, (("programs", PROGRAM_COLUMNS, "programs"),))
 
 
 @jobs.command("delete")

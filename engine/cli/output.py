@@ -152,6 +152,18 @@ def fields_text(fields: tuple[Column, ...], record: dict) -> str:
     return "\n".join(f"{field.heading + ':':{width}}{field.format(record.get(field.key))}" for field in fields)
 
 
+def emit_record(as_json: bool, thing: str, fields: tuple[Column, ...], record: dict,
+                sections: tuple[tuple[str, tuple[Column, ...], str], ...] = ()) -> None:
+    """A show command's record: one JSON line {thing: record}, or its fields and then each
+    (title, columns, key) section of related records."""
+    if as_json:
+        emit_json({thing: record})
+        return
+    click.echo(fields_text(fields, record))
+    for title, columns, key in sections:
+        click.echo(section_text(title, columns, record[key]))
+
+
 def section_text(title: str, columns: tuple[Column, ...], records: list[dict]) -> str:
     """A show command's list of related records (a gear's jobs, a job's programs): a blank line,
     the title and count, the table if there is anything."""
