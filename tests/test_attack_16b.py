@@ -20,15 +20,34 @@ def _spur_with_row(run, tmp_path, o: str):
     return path
 
 
+def add_spur_row(url: str, o: str) -> None:
+    """An editor's row added in SQL (template_view), where no import checks it."""
+    with psycopg.connect(url) as conn:
+        conn.execute("INSERT INTO template_view (gear_class, id, t, n, o) VALUES ('spur', 651, 'main', 1, %s)", (o,))
+
+
 def test_a_row_building_a_lineage_line_is_named_by_lint_and_blocks_the_release(run, tmp_path):
-    """Storing refuses every program of such a template ("engine lint names it"): lint must name
-    the row, and the release gate must not hand the shop floor a template that makes no program."""
-    path = _spur_with_row(run, tmp_path, '"; PROG" + "RAM 1 TEMPLATE spur v9"')
-    assert run("template", "import", "--class", "spur", str(path)).exit_code == 0
+    """Storing refuses every program of such a template: the import refuses the row, lint names
+    it when it came in by SQL, and the release gate does not hand the shop floor a template
+    that makes no program."""
+    built = '"; PROG" + "RAM 1 TEMPLATE spur v9"'
+    imported = run("template", "import", "--class", "spur", str(_spur_with_row(run, tmp_path, built)))
+    assert imported.exit_code == 1 and "row 651" in imported.stderr, imported.output
+    add_spur_row(run.url, built)
     lint = run("lint")
     assert lint.exit_code == 1 and "651" in lint.output, lint.output
     release = run("template", "release", "--class", "spur", "--yes")
     assert release.exit_code == 1, release.output
+
+
+def test_a_row_computing_a_lineage_line_from_its_inputs_blocks_the_release(run):
+    """What lint cannot read (text computed from the gear at run time) is refused where every
+    program is made, so the golden tests fail and the gate refuses; a dry run refuses too."""
+    add_spur_row(run.url, '"; PROGRAM " + str(z2) + " TEMPLATE spur v9"')
+    release = run("template", "release", "--class", "spur", "--yes")
+    assert release.exit_code == 1, release.output
+    dry_run = run("instantiate", "--gear", 42, "--draft", "--dry-run")
+    assert dry_run.exit_code == 1 and "reads as a lineage line" in dry_run.stderr, dry_run.output
 
 
 def _import_nc(run, tmp_path, line: str, name: str):

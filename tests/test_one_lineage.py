@@ -18,8 +18,10 @@ LINEAGE_SHAPED = (   # as the engine writes it (840D, ISO, a dry run's, a draft'
     "; PROGRAM DRY-RUN TEMPLATE spur v3 0123abcd INPUT 4567cdef DRAFT",
     "(PROGRAM 812 TEMPLATE spur v3 0123abcd INPUT 4567cdef)",
     "  ;program 812 template spur",
+    "G0 X10 ; PROGRAM 812 TEMPLATE spur",   # after a move it reads the same at the control
+    "N10 ; PROGRAM 812 TEMPLATE spur",
 )
-NOT_LINEAGE = ("; PROGRAM START", "; TEMPLATE spur v3", "G0 X10 ; PROGRAM 812 TEMPLATE spur")
+NOT_LINEAGE = ("; PROGRAM START", "; TEMPLATE spur v3", "; program from template of spur")
 
 
 def template_version(url: str, gear_class: str) -> int:

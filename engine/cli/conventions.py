@@ -34,6 +34,11 @@ COMMAND_LINE_ONLY = {   # (command path, option): why it is typed on each invoca
     ("engine instantiate", "force"): "it replaces program files in --out, which a machine may be loading",
     ("engine instantiate", "skip-bad"): "it stores a batch without its bad gears",
     ("engine instantiate", "draft"): "it makes programs of a draft that has not passed the release gate",
+    # what instantiate makes programs of: a default would store programs (records nobody deletes)
+    # for every gear, or refuse the gear the user typed
+    **{("engine instantiate", selector): "it chooses what programs are made and stored"
+       for selector in ("gear", "job", "gears", "jobs", "all")},
+    ("engine seed", "samples"): "it loads sample gears, hobs and cases, which a shop's database must not get unasked",
 }
 
 

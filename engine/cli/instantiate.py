@@ -7,6 +7,7 @@ import click
 
 from ..errors import EngineError
 from .context import connection, emit_json, settings
+from .ids import GEAR_ID, JOB_ID
 from .progress import progress_bar
 
 RANGE = re.compile(r"^\s*(\d+)\s*(?:-\s*(\d+))?\s*$")
@@ -24,8 +25,8 @@ def parse_range(text: str, option: str = "--gears") -> tuple[int, int]:
 
 
 @click.command()
-@click.option("--gear", "gear_id", type=int, help="Gear id: compute a new job and its program.")
-@click.option("--job", "job_id", type=int, help="Stored job id: instantiate again with its (edited) parameters.")
+@click.option("--gear", "gear_id", type=GEAR_ID, help="Gear id: compute a new job and its program.")
+@click.option("--job", "job_id", type=JOB_ID, help="Stored job id: instantiate again with its (edited) parameters.")
 @click.option("--gears", "gear_range", help="Batch: gear ids FIRST-LAST (all stored, or none unless --skip-bad).")
 @click.option("--jobs", "job_range", help="Batch: stored job ids FIRST-LAST made again with their stored parameters.")
 @click.option("--all", "all_gears", is_flag=True, help="Batch: every gear.")
@@ -85,7 +86,8 @@ def instantiate(ctx, gear_id, job_id, gear_range, job_range, all_gears, out, for
     from ..programs.remake import instantiate_job
 
     chosen = [name for name, value in (("--gear", gear_id), ("--job", job_id), ("--gears", gear_range),
-                                       ("--jobs", job_range), ("--all", all_gears)) if value]
+                                       ("--jobs", job_range), ("--all", all_gears))
+              if value not in (None, False)]
     if len(chosen) != 1:
         raise EngineError("give exactly one of --gear ID, --job ID, --gears FIRST-LAST, --jobs FIRST-LAST, --all")
     batch = bool(gear_range or job_range or all_gears)

@@ -41,7 +41,9 @@ def csv_cell(value: Any) -> Any:
     return value.isoformat() if isinstance(value, (datetime, date)) else value
 
 
-FORMULA_START = ("=", "+", "@", "\t", "\r")   # a cell beginning so is a formula to Excel and LibreOffice
+# a cell beginning so is a formula to Excel and LibreOffice (the full-width forms too: Excel in
+# CJK locales reads them as the ASCII ones)
+FORMULA_START = ("=", "+", "@", "\t", "\r", "\uff1d", "\uff0b", "\uff20", "\uff0d")
 NUMBER_TEXT = re.compile(r"-(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?")   # -5, -0.25, -.5, -1e-3: a negative number, not a formula
 
 

@@ -21,18 +21,36 @@ SEARCHED_LINES = 40
 # What reads as a lineage line at the machine, in either comment form, whatever its id (a dry
 # run's says DRY-RUN): a template row must never write one, or the program would carry a second
 # lineage naming another program (migration 0021 refuses it in the database too).
-LINEAGE_SHAPE = re.compile(r"^\s*[;(]\s*PROGRAM\s+\S+\s+TEMPLATE(\s|\)|$)", re.IGNORECASE)
+# The comment may follow a block number or a move (`N10 ; PROGRAM 1 TEMPLATE …`): it reads the
+# same at the control. Only an id or DRY-RUN makes one (`; program from template of spur` is a
+# shop's comment). The spaces are spelled out, not \s, so the database's check (migration 0022,
+# whose \s depends on the server's locale) reads exactly the same lines.
+SPACE = "[ \t\v\f\r\n\u0085\u00a0\u1680\u2000-\u200a\u2028\u2029\u202f\u205f\u3000\u001c-\u001f]"
+LINEAGE_SHAPE = re.compile(rf"[;(]{SPACE}*PROGRAM{SPACE}+([0-9]+|DRY-RUN){SPACE}+TEMPLATE", re.IGNORECASE)
 ENGINES_LINE = "the engine writes the lineage line into every program it stores"
 
 
 def lineage_shaped(text: str) -> bool:
     """True for a line that reads as a lineage line (`; PROGRAM 812 TEMPLATE …`, `(PROGRAM …)`)."""
-    return LINEAGE_SHAPE.match(text) is not None
+    return LINEAGE_SHAPE.search(text) is not None
 
 
 def first_lineage_shaped(lines: list[str]) -> int | None:
     """The 1-based number of the first lineage-shaped line, or None."""
     return next((number for number, text in enumerate(lines, 1) if lineage_shaped(text)), None)
+
+
+def refuse_lineage_shaped(name: str, lines: list[str], shown) -> None:
+    """A template line that reads as a lineage line would give the program a second lineage,
+    naming another program or version, to whoever matches the file at the machine. Checked
+    where every program is made (engine.programs.verified_run), so golden tests, dry runs and
+    the release gate refuse such a template, not only storing."""
+    number = first_lineage_shaped(lines)
+    if number is not None:
+        from ..errors import EngineError
+
+        raise EngineError(f"program {name} line {number} {shown(lines[number - 1])} reads as a lineage line, "
+                          "which only the engine writes: nothing stored; remove the template row that writes it")
 
 
 def lineage_words(program_id: int, gear_class: str, version: int, template_hash: str, input_hash: str,

@@ -19,7 +19,7 @@ from psycopg.types.json import Jsonb
 
 from ..errors import EngineError
 from ..names import checked, line_breaking, shown
-from .lineage import first_lineage_shaped, lineage_line, lineage_words, with_lineage
+from .lineage import lineage_line, lineage_words, refuse_lineage_shaped, with_lineage
 from .records import Encoded, Planned, Program
 
 # What a lineage line needs from the database: the hash of each job's stored parameters, each
@@ -139,7 +139,7 @@ def _deleted_message(named: list[str]) -> str:
 def refuse_unsafe(name: str, lines: list[str]) -> None:
     """EngineError unless the program's name is an 840D program name and no line breaks."""
     checked("program", name, "program name", "set job.params.program_name in SQL; nothing stored")
-    refuse_lineage_shaped(name, lines)
+    refuse_lineage_shaped(name, lines, shown)
     if line_breaking("".join(lines)) is None:
         return
     for number, line in enumerate(lines, 1):
@@ -148,16 +148,6 @@ def refuse_unsafe(name: str, lines: list[str]) -> None:
             raise EngineError(f"program {name} line {number} {shown(line)} holds {shown(found)}, which would start "
                               "another NC block: nothing stored; the job parameter or template row that made it "
                               "must not hold line breaks")
-
-
-def refuse_lineage_shaped(name: str, lines: list[str]) -> None:
-    """A template line that reads as a lineage line would give the program a second lineage,
-    naming another program or version, to whoever matches the file at the machine."""
-    number = first_lineage_shaped(lines)
-    if number is not None:
-        raise EngineError(f"program {name} line {number} {shown(lines[number - 1])} reads as a lineage line, "
-                          "which only the engine writes: nothing stored; remove the template row that writes it "
-                          "(engine lint names it)")
 
 
 def _copy_programs(conn, program_ids: list[int], job_ids: list[int], encoded: list[Encoded]) -> dict:

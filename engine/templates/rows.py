@@ -136,26 +136,35 @@ def _row_from_record(file: CsvFile, record: dict, line: int) -> TemplateRow:
                        texts["o"], texts["p_emit"])
 
 
-# A string literal or f-string that mentions PROGRAM (what a lineage line starts with).
-LITERAL_START = re.compile(r"\s*[fFrRuU]{0,2}[\"'].*PROGRAM", re.IGNORECASE | re.DOTALL)
+# An output that begins with a text literal (an f-string too): parsed to see what text it writes.
+LITERAL_START = re.compile(r"\s*[fFrRuU]{0,2}[\"']")
+FOLDED_TEXTS = 64   # enough for any real row; a row folding to more is left to the run-time check
 
 
 def writes_lineage(o: str | None) -> bool:
-    """True when the row's output is a text literal (or an f-string, its fields read as 0) that
-    reads as the lineage line only the engine writes (engine.programs.lineage)."""
-    literal = _literal_text(o) if o else None
-    return literal is not None and lineage_shaped(literal)
-
-
-def _literal_text(expression: str) -> str | None:
-    if not LITERAL_START.match(expression):   # parsed only if it may be a text literal: rows can be hostile
-        return None
+    """True when the row's output is text, built from literals (concatenated, chosen by a
+    condition, an f-string with its fields read as 0), that reads as the lineage line only the
+    engine writes (engine.programs.lineage). What a row computes from its inputs is refused
+    when the program is made (engine.programs.verified_run), so golden tests and the release
+    gate catch it too."""
+    if not o or not LITERAL_START.match(o):   # parsed only if it may be text: rows can be hostile
+        return False
     try:
-        tree = ast.parse(expression.strip(), mode="eval").body
+        texts = _folded_texts(ast.parse(o.strip(), mode="eval").body)
     except (SyntaxError, ValueError, RecursionError, MemoryError):
-        return None
-    if isinstance(tree, ast.Constant):
-        return tree.value if isinstance(tree.value, str) else None
-    if isinstance(tree, ast.JoinedStr):
-        return "".join(part.value if isinstance(part, ast.Constant) else "0" for part in tree.values)
-    return None
+        return False
+    return any(lineage_shaped(text) for text in texts)
+
+
+def _folded_texts(node: ast.AST) -> list[str]:
+    """Every text the expression can write, if it is built from literals only; else []."""
+    if isinstance(node, ast.Constant):
+        return [node.value] if isinstance(node.value, str) else []
+    if isinstance(node, ast.JoinedStr):
+        return ["".join(part.value if isinstance(part, ast.Constant) else "0" for part in node.values)]
+    if isinstance(node, ast.BinOp) and isinstance(node.op, ast.Add):
+        pairs = [a + b for a in _folded_texts(node.left) for b in _folded_texts(node.right)]
+        return pairs[:FOLDED_TEXTS]
+    if isinstance(node, ast.IfExp):
+        return (_folded_texts(node.body) + _folded_texts(node.orelse))[:FOLDED_TEXTS]
+    return []
