@@ -359,3 +359,18 @@ def test_random_valid_gears_make_a_correct_program_or_a_one_line_refusal(conn, k
                                                              choice.get("worm_feed", "radial"), choice.get("tailstock", True)))
     problems = all_problems(read(program.text), case)
     assert not problems, f"{gear} {hob} {choice}:\n  " + "\n  ".join(problems) + "\n" + program.text
+
+
+@pytest.mark.parametrize("x", [-0.3, 0.0, 0.5])
+def test_a_taper_growing_downward_keeps_its_rapids_clear_of_the_large_end(conn, x):
+    """Once drawn by the random test above (every x and stock failed): m4, z96, β 8° R, b 56.9,
+    δ −5.83°, hob 2 starts d_a0 90 R, shift per part. `G0 Z35.022` between the cuts, at the retract
+    X, ran the hob into the blank's bottom face, d_a2/2 + b·tan|δ| = 5.81 mm larger in radius."""
+    gear = Gear("taper", 4, 8.0, "R", (Unit(96, 56.9, *cylindrical(4, 96, 8.0, x)),), cone=-5.83)
+    hob, choice = make_hob(4, "R", 2), {"shift_per_part": 2.5}
+    with conn.transaction(force_rollback=True):
+        only_hob(conn, insert_hob(conn, hob, gear.mn, "cylindrical"))
+        insert_gear(conn, 9399, gear, 0.0, STOCK)
+        program = instantiate_gear(conn, 9399, choices=Choices(**choice))
+    case = Case(gear, hob, read_machine(conn, DIN.name), Job(True, "per part", "radial", True))
+    assert all_problems(read(program.text), case) == []

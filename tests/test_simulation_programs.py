@@ -78,6 +78,18 @@ def test_a_coupled_retract_out_of_its_own_gaps_is_no_collision_but_a_feed_uncoup
     assert any("not coupled" in m for m in refusal(report, number_of(lines, "G1 X55.000 F100.0")))
 
 
+def test_a_coupled_rapid_back_along_z_through_its_own_gaps_is_a_collision(records, spur):
+    """After the pass the hob is pulled out only to X54 (tip contact (42 + 70)/2 = 56: 2 mm deep in
+    the teeth just cut, coupling still on) and rapids back up along Z: a rapid through the teeth
+    with C trailing the Z differential is no retract out of the gaps (a taper's rapid between its
+    cuts, inside the tip cone's large end, ran so)."""
+    cut = spur.cut()
+    lines = spur.lines(cut[:2] + ["G0 X54.000", f"G0 Z{spur.z_start:.3f}"] + cut[2:])
+    report = simulate_program(lines, spur.gear, spur.hob, records["machine"], "TEST")
+    assert not refusal(report, number_of(lines, "G0 X54.000"))
+    assert any("into unit 1" in m and "rapid" in m for m in refusal(report, number_of(lines, f"G0 Z{spur.z_start:.3f}")))
+
+
 def test_the_run_out_into_a_fixture_larger_than_the_root_is_refused(records, spur):
     machine = replace(records["machine"], fixture_diameter=40.0, fixture_gap=0.0)   # root Ø33 < 40
     lines = spur.lines()

@@ -82,7 +82,18 @@ def check_cuts(gear: Gear, hob: Hob, params: dict, module_params: dict) -> float
         found = infeed_clearance(gear, hob, cut, params["x_retract"])
         assert found >= MARGIN, f"{cut['cut_name']}: the infeed at Z{cut['z_from']} is {found:.2f} mm from the blank"
         least = min(least, found)
+    found = retract_clearance(gear, hob, module_params, params["x_retract"])
+    assert found >= MARGIN, f"the rapid along Z at X{params['x_retract']} is {found:.2f} mm from the blank"
     return least
+
+
+def retract_clearance(gear: Gear, hob: Hob, module_params: dict, x_retract: float) -> float:
+    """Between cuts the hob rapids along Z at the retract X from one pass's end to the next
+    pass's approach, past the whole face, the blank's large end included (the bottom face for δ < 0)."""
+    surface = hob_surface(hob.tip_diameter / 2, hob.length / 2, swivel(gear.helix_angle, gear.hand, hob))
+    corners = blank_corners(gear.tip_diameter, gear.cone_angle, gear.face_width)
+    zs = [z for cut in module_params.values() if cut.get("cut_on") for z in (cut["z_from"], cut["z_to"])]
+    return min(hob_clearance(surface, (x_retract, z), corners) for z in np.linspace(min(zs), max(zs), 60))
 
 
 # ------------------------------------------------------------------ every combination, on the model
@@ -158,3 +169,18 @@ def test_the_papers_gear_infeeds_clear_of_its_cone_in_the_program(conn, cone, fe
     for move in infeeds:
         found = hob_clearance(surface, (move.end["X"], move.end["Z"]), corners)
         assert found >= MARGIN, f"{nc.blocks[move.block].text}: {found:.2f} mm from the blank"
+
+
+# ------------------------------------------------------------------ a deep tooth on a cone growing downward
+
+def test_the_retract_clears_the_large_end_of_a_cone_growing_downward():
+    """Found by the random reference test: m4, z96, β 8° R, b 56.9, δ −5.83° (the blank grows
+    b·tan|δ| = 5.81 mm in radius to the bottom face), hob 2 starts d_a0 90. The retract X kept
+    5 mm over the cut line, not over the tip cone: with a 9 mm tooth the rapid between the cuts
+    ran the hob tip 1.8 mm inside the bottom face's tip radius (d_a2/2 + 5.81 = 203.70)."""
+    hob = Hob("H-M4-R2", 4.0, 20.0, 2, 90.0, 140.0, "R", "AA", None, None, None, 7)
+    gear = Gear(9412, "taper", 4.0, 96, 20.0, 8.0, "R", 56.9, 395.774, 377.774, -5.83, None, None, None, None, None)
+    job = TaperModel().job(gear, "taper", hob, MACHINE, CUTTING, Choices(shift_per_part=2.5))
+    check_cuts(gear, hob, job.params, job.module_params)
+    large_end = 395.774 / 2 + 56.9 * math.tan(math.radians(5.83))
+    assert job.params["x_retract"] - 45.0 > large_end + MARGIN

@@ -44,7 +44,15 @@ class TaperModel(CylindricalModel):
         # where the cone line runs inward, so it never reaches further out.)
         highest = setup.full_depth + (gear.face_width + max(setup.reach.approach, setup.reach.overrun)) * abs(slope)
         return Setup(setup.lead, setup.swivel, setup.full_depth, setup.reach,
-                     max(setup.x_retract, highest + RETRACT_CLEARANCE))
+                     max(setup.x_retract, highest + RETRACT_CLEARANCE, self.tip_clear(gear, hob)))
+
+    def tip_clear(self, gear, hob) -> float:
+        """The rapids between cuts run along Z at the retract X past the whole face: the hob tip
+        clears the blank's large end (the bottom face for δ < 0: d_a2/2 + b·tan|δ|) by
+        RETRACT_CLEARANCE, as on a cylindrical gear. No point of the hob lies nearer the work axis
+        than X − d_a0/2, whatever its swivel or shift."""
+        growth = max(0.0, -gear.face_width * math.tan(math.radians(gear.cone_angle)))
+        return (gear.tip_diameter + hob.tip_diameter) / 2 + growth + RETRACT_CLEARANCE
 
     def class_params(self, gear, hob, setup, choices) -> dict:
         """taper_slope = dX/dZ = tan δ, turned with Z on the machine (engine.hobbing.conventions)."""

@@ -2,7 +2,8 @@
 the intended cut. Intended: a G1 with the table coupled and the hob spindle turning, in a
 unit whose teeth the coupling generates, never below its intended root (less TOLERANCE). The
 gaps such cuts leave are free to the hob while the same coupling lasts (a coupled retract out
-of its own gaps). Anything else that enters material is a collision."""
+of its own gaps), except on a rapid along Z (engine.simulation.walk). Anything else that enters
+material is a collision."""
 from __future__ import annotations
 
 from dataclasses import dataclass

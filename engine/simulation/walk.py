@@ -238,7 +238,7 @@ class Walk:
         x, y, z = move_poses(start, end, motion == 0)
         teeth = self._cut_teeth() if cutting else None
         reason = self._reason(motion)
-        running = self.coupling is not None and self.spindle
+        running = self.coupling is not None and self.spindle and not _rapid_along_z(motion, start, end)
         for contact in follow(self.solids, self.body, swivel, x, y, z,
                               Motion(teeth, running, self.session, self.tailstock, reason)):
             self.report.add(step.number, step.line, self._contact_message(contact, reason, teeth))
@@ -334,3 +334,11 @@ class Walk:
 
 TAKERS = {"header": Walk._header, "comment": Walk._comment, "block": Walk._block,
           "statement": Walk._statement, "shift": Walk._shift}
+
+
+def _rapid_along_z(motion: int, start: dict, end: dict) -> bool:
+    """A G0 that moves Z runs the hob along the teeth at rapid rate, with C trailing the Z
+    differential: not a retract out of the hob's own gaps, so the gaps it cut are not free to it
+    (the rapid between two cuts of a taper, inside the large end of its tip cone, ran through them)."""
+    return motion == 0 and start.get("Z", end.get("Z")) != end.get("Z")
+
