@@ -1858,3 +1858,10 @@ RETURN line ~* ('[;(][ \t\v\f\r\n\u0085\u00a0\u1680\u2000-\u200a\u2028\u2029\u20
                 'PROGRAM[ \t\v\f\r\n\u0085\u00a0\u1680\u2000-\u200a\u2028\u2029\u202f\u205f\u3000\u001c-\u001f]+'
                 '([0-9]+|DRY-RUN)[ \t\v\f\r\n\u0085\u00a0\u1680\u2000-\u200a\u2028\u2029\u202f\u205f\u3000\u001c-\u001f]+'
                 'TEMPLATE');
+
+-- How an imported NC file ended its lines (issue 17): LF or CRLF, and whether its last line
+-- ended with one. The rows hold the lines without them, so `M17` of a CRLF file and of an LF
+-- file is one component; writing the class's program back uses these to give the file byte for byte.
+ALTER TABLE gear_class ADD COLUMN line_ending text NOT NULL DEFAULT E'\n'
+    CHECK (line_ending IN (E'\n', E'\r\n'));
+ALTER TABLE gear_class ADD COLUMN final_newline boolean NOT NULL DEFAULT true;

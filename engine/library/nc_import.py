@@ -30,11 +30,11 @@ engineer's corrections (`modules`: line number → type) are decisions too, so t
 after a corrected line follow it until a rule decides otherwise. N counts, per type, the
 runs of that type: it increases each time the type recurs after another type.
 
-Lines: the file is split at "\\n" (a final newline ends the last line, it adds no empty
-line; a "\\r" stays part of its line). Instantiating the import with the same parameters
-and writing the lines joined by "\\n" plus a final "\\n" gives the file byte for byte
-when it ended with a newline (every file of data/nc does); otherwise only that final
-newline differs. The import checks this itself before it commits (engine.library.nc_verify), while
+Lines: the file is split at its line ending, LF or CRLF (a final newline ends the last line, it
+adds no empty line); the rows hold the lines without endings, and the class keeps the ending
+and whether the file had a final newline (engine.library.nc_layout; a file mixing LF and CRLF
+is refused). Instantiating the import with the same parameters and writing the lines with that
+layout (nc_text) gives the file byte for byte. The import checks this itself before it commits (engine.library.nc_verify), while
 the rows are being written.
 """
 from __future__ import annotations
@@ -59,6 +59,7 @@ from ..templates.rows import MODULE_ORDER, TemplateRow
 from ..templates.store import ensure_class, load_template, replace_template
 from ..templates.versions import released_version
 from .nc_halves import in_halves
+from .nc_layout import NcLayout, split_nc_text, store_layout
 from .nc_rows import Builder, values_of
 from .nc_tokens import LABEL, SYMBOL, LineFacts, facts, tokenise
 from .nc_verify import Proof
@@ -94,7 +95,7 @@ def _import(conn, path, gear_class: str, params: dict | None, modules: dict | No
                           "starting with a letter")
     params = dict(params or {})
     check_param_names(params)
-    lines = read_nc_lines(path)
+    lines, layout = read_nc_file(path)
     refuse_lineage(path, lines)
     built = Builder(values_of(params), path)
     halves = in_halves(len(lines), partial(_read_lines, lines, built))
@@ -110,6 +111,7 @@ def _import(conn, path, gear_class: str, params: dict | None, modules: dict | No
         created = ensure_class(conn, gear_class, parent)
         changed = replace_template(conn, gear_class, rows, check=proof.start_on)   # proved while written
         _store_import_params(conn, gear_class, params)
+        store_layout(conn, gear_class, layout)
         template = load_template(conn, gear_class)
         _refuse_inherited(template, lines)
         proof.verdict(template.rows)
@@ -169,7 +171,12 @@ _CONTROL = re.compile(r"[\x00-\x08\x0b\x0e-\x1f\x7f]")
 
 
 def read_nc_lines(path) -> list[str]:
-    """The lines of a text NC file; a clear error for a missing, empty or binary file."""
+    """The lines of a text NC file, without their endings."""
+    return read_nc_file(path)[0]
+
+
+def read_nc_file(path) -> tuple[list[str], NcLayout]:
+    """The lines of a text NC file and its layout; a clear error for a missing, empty or binary file."""
     try:
         data = Path(path).read_bytes()
     except OSError as error:
@@ -186,10 +193,7 @@ def read_nc_lines(path) -> list[str]:
                           "it is binary, not a text NC program")
     if not text.strip():
         raise EngineError(f"{path} is empty; give an NC program with at least one line")
-    lines = text.split("\n")
-    if text.endswith("\n"):
-        lines.pop()
-    return lines
+    return split_nc_text(path, text)
 
 
 RESERVED_NAMES = frozenset(FUNCTIONS) | frozenset(CONSTANTS) | {"template_version"}

@@ -1,0 +1,56 @@
+"""How an imported NC file ends its lines (issue 17): LF or CRLF, and whether its last line ends
+with one. The rows hold the lines without their endings, so `M17` of a CRLF file and of an LF
+file is one component; the class keeps the layout (gear_class.line_ending, .final_newline) and
+its program is written back with it, byte for byte."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ..errors import EngineError
+from ..names import shown
+
+LF, CRLF = "\n", "\r\n"
+
+
+@dataclass(frozen=True)
+class NcLayout:
+    line_ending: str = LF
+    final_newline: bool = True
+
+
+def split_nc_text(path, text: str) -> tuple[list[str], NcLayout]:
+    """The lines of `text` without their endings, and its layout. A file mixing LF and CRLF is
+    refused: one ending per class is what the program is written back with."""
+    final_newline = text.endswith("\n")
+    lines = text.split("\n")
+    if final_newline:
+        lines.pop()
+    ended = lines if final_newline else lines[:-1]   # lines followed by "\n"
+    crlf = bool(ended) and ended[0].endswith("\r")
+    other = next((number for number, line in enumerate(ended, start=1) if line.endswith("\r") != crlf), None)
+    if other is not None:
+        names = ("CRLF", "LF") if crlf else ("LF", "CRLF")
+        raise EngineError(f"{path} mixes line endings: line 1 ends with {names[0]}, line {other} "
+                          f"{shown(lines[other - 1])} with {names[1]}; convert the file to one line ending")
+    if not crlf:
+        return lines, NcLayout(LF, final_newline)
+    return [line[:-1] for line in ended] + lines[len(ended):], NcLayout(CRLF, final_newline)
+
+
+def nc_text(lines: list[str], layout: NcLayout) -> str:
+    """The lines as the imported file wrote them."""
+    text = layout.line_ending.join(lines)
+    return text + layout.line_ending if layout.final_newline else text
+
+
+def store_layout(conn, gear_class: str, layout: NcLayout) -> None:
+    conn.execute("UPDATE gear_class SET line_ending = %s, final_newline = %s WHERE name = %s",
+                 (layout.line_ending, layout.final_newline, gear_class))
+
+
+def class_layout(conn, gear_class: str) -> NcLayout:
+    """The layout of the class's file (LF with a final newline for a class not imported)."""
+    row = conn.execute("SELECT line_ending, final_newline FROM gear_class WHERE name = %s", (gear_class,)).fetchone()
+    if row is None:
+        raise EngineError(f"class {gear_class!r} does not exist; see `engine template list`")
+    return NcLayout(row[0], row[1])

@@ -1,0 +1,92 @@
+"""Imported NC files come back byte for byte whatever their line ending (issue 17): the class
+keeps LF or CRLF and whether the file ended with a newline; the rows hold the lines without
+them, so a CRLF program shares its components with the LF one; a file mixing both is refused."""
+from __future__ import annotations
+
+import pytest
+
+from engine.errors import EngineError
+from engine.library.nc_import import import_nc
+from engine.library.nc_layout import class_layout, nc_text
+from engine.templates.decision_table import compiled_template
+from engine.templates.store import load_template
+
+from test_nc_import import DATA, PARAMS, class_name, real_files
+
+TWO_FILES = ["sinumerik/cam_840dsl/CAM_TEST.MPF", "emco_from_dxf/testNegDXF.cnc"]
+
+
+def written_back(conn, gear_class: str, params: dict) -> bytes:
+    """The class's program with the import's parameters, written with the class's layout."""
+    lines = compiled_template(load_template(conn, gear_class)).run(params).lines
+    return nc_text(lines, class_layout(conn, gear_class)).encode()
+
+
+def variant(tmp_path, relative: str, crlf: bool, final_newline: bool):
+    """A real file rewritten by hand: its lines with CRLF or LF, with or without a final newline."""
+    lines = (DATA / relative).read_bytes().split(b"\n")[:-1]   # every real file ends with LF
+    ending = b"\r\n" if crlf else b"\n"
+    data = ending.join(lines) + (ending if final_newline else b"")
+    path = tmp_path / (flat_name(relative) + ("_crlf" if crlf else "_lf") + ("_nl" if final_newline else ""))
+    path.write_bytes(data)
+    return path, data
+
+
+def flat_name(relative: str) -> str:
+    return relative.replace("/", "_").replace(".", "_")
+
+
+@pytest.mark.parametrize("relative", list(PARAMS))
+def test_every_real_file_is_written_back_byte_for_byte(conn, relative):
+    real_files()
+    import_nc(conn, DATA / relative, class_name(relative), PARAMS[relative])
+    assert written_back(conn, class_name(relative), PARAMS[relative]) == (DATA / relative).read_bytes()
+
+
+@pytest.mark.parametrize("relative", TWO_FILES)
+@pytest.mark.parametrize("crlf, final_newline", [(False, False), (True, True), (True, False)])
+def test_crlf_and_no_final_newline_are_written_back_byte_for_byte(conn, tmp_path, relative, crlf, final_newline):
+    path, data = variant(tmp_path, relative, crlf, final_newline)
+    assert data != (DATA / relative).read_bytes()
+    import_nc(conn, path, "nc_variant", PARAMS[relative])
+    assert written_back(conn, "nc_variant", PARAMS[relative]) == data
+
+
+def components(conn, gear_class: str) -> set[int]:
+    return {row[0] for row in conn.execute("SELECT component_id FROM class_template(%s)", (gear_class,))}
+
+
+@pytest.mark.parametrize("relative", TWO_FILES)
+def test_crlf_lines_share_components_with_the_lf_program(conn, tmp_path, relative):
+    import_nc(conn, DATA / relative, "nc_lf", PARAMS[relative])
+    path, _ = variant(tmp_path, relative, crlf=True, final_newline=True)
+    import_nc(conn, path, "nc_crlf", PARAMS[relative])
+    assert components(conn, "nc_crlf") == components(conn, "nc_lf")
+    stored = [row.o for row in load_template(conn, "nc_crlf").rows]
+    assert not any("\\r" in o or "\r" in o for o in stored)
+
+
+def test_m17_of_a_crlf_file_is_the_m17_of_an_lf_file(conn, tmp_path):
+    (tmp_path / "lf.SPF").write_bytes(b"G1 X10\nM17\n")
+    (tmp_path / "crlf.SPF").write_bytes(b"G0 Z5\r\nM17\r\n")
+    import_nc(conn, tmp_path / "lf.SPF", "nc_lf")
+    import_nc(conn, tmp_path / "crlf.SPF", "nc_crlf")
+    assert len(components(conn, "nc_lf") & components(conn, "nc_crlf")) == 1
+    assert written_back(conn, "nc_crlf", {}) == b"G0 Z5\r\nM17\r\n"
+
+
+@pytest.mark.parametrize("data, line", [(b"G0 Z5\r\nG1 X10\nM17\r\n", 2), (b"G0 Z5\r\nG1 X10\r\nM17\n", 3)])
+def test_a_file_mixing_line_endings_is_refused_naming_the_first_other_line(conn, tmp_path, data, line):
+    path = tmp_path / "mixed.SPF"
+    path.write_bytes(data)
+    with pytest.raises(EngineError, match=rf"mixes line endings: line 1 ends with CRLF, line {line} ") as refused:
+        import_nc(conn, path, "nc_mixed")
+    assert "\n" not in str(refused.value)
+    assert conn.execute("SELECT 1 FROM gear_class WHERE name = 'nc_mixed'").fetchone() is None
+
+
+def test_an_lf_file_whose_first_line_has_no_cr_but_a_later_one_has_is_refused(conn, tmp_path):
+    path = tmp_path / "mixed.SPF"
+    path.write_bytes(b"G0 Z5\nG1 X10\r\nM17\n")
+    with pytest.raises(EngineError, match=r"mixes line endings: line 1 ends with LF, line 2 .* with CRLF"):
+        import_nc(conn, path, "nc_mixed")
