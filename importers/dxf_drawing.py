@@ -98,7 +98,7 @@ def read_drawing(path: str | Path, profile_layer: str = PROFILE_LAYER) -> Drawin
     if not layer0.segments:
         raise DxfError(no_geometry_message(collected))
     chains = chain_segments([scaled(s, scale) for s in layer0.segments])
-    profile = find_profile(chains)
+    profile = find_profile(chains, layer=profile_layer)
     operations = [operation(name, number, collected.layers[name], scale, profile.mirrored)
                   for number, name in operation_layers(collected.layers)]
     tool_change = tool_change_point(layer0.points, scale, profile.mirrored)
@@ -225,7 +225,7 @@ def reading_notes(units: str, assumed: bool, collected: Collected, profile: Prof
         notes.append(f"not geometry, left out on layer 0 / operation layers: {listed}")
     if collected.other_layers:
         listed = ", ".join(f"{name!r} ({count})" for name, count in sorted(collected.other_layers.items()))
-        notes.append(f"layers that are neither 0 nor an operation number, left out: {listed}")
+        notes.append(f"layers that are neither the profile's nor an operation number, left out: {listed}")
     return notes
 
 

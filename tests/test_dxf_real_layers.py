@@ -73,3 +73,13 @@ def test_help_names_the_option_and_keeps_its_example(run):
     text = run("import-dxf", "--help").output
     assert "--profile-layer" in text
     assert any(line.strip().startswith("Example: engine import-dxf") for line in text.splitlines())
+
+
+def test_refusals_about_the_profile_name_the_layer_it_was_looked_for_on(tmp_path):
+    doc = ezdxf.new("R2010")
+    doc.layers.add("outline")
+    doc.modelspace().add_line((0, 5), (-10, -5), dxfattribs={"layer": "outline"})   # crosses the axis
+    doc.saveas(tmp_path / "cross.dxf")
+    with pytest.raises(DxfError, match=r"^layer outline has no closed profile") as caught:
+        read_drawing(tmp_path / "cross.dxf", "outline")
+    assert "layer 0" not in str(caught.value)
