@@ -24,6 +24,7 @@ from .dxf_profile import Profile, chain_segments, find_profile, scaled
 from .dxf_read import DxfError, ezdxf_warnings, load_drawing_file, summarised
 
 PROFILE_LAYER = "0"
+OR_NAME_IT = " or name its layer with --profile-layer"
 TEXT_TYPES = ("TEXT", "MTEXT")
 # Codes an operation kind cannot do without (a thread cannot be cut without its pitch).
 REQUIRED_CODES = {"THREAD": ("thread_pitch",)}
@@ -81,28 +82,40 @@ class Collected:
     layers: dict[str, LayerContent] = field(default_factory=lambda: defaultdict(LayerContent))
     skipped: Counter = field(default_factory=Counter)
     other_layers: Counter = field(default_factory=Counter)
+    profile_layer: str = PROFILE_LAYER
 
 
-def read_drawing(path: str | Path) -> Drawing:
+def read_drawing(path: str | Path, profile_layer: str = PROFILE_LAYER) -> Drawing:
     """Read a turning drawing; DxfError (one line naming the layer, handle or text) if it
-    cannot become a job."""
+    cannot become a job. profile_layer: where the part outline is (real CAD drawings keep
+    it on a layer like 'outline' rather than the seed-000 convention's layer 0)."""
     with ezdxf_warnings() as warnings, no_cycle_collection():
         drawing_file = load_drawing_file(path)
         units, scale, assumed = unit_scale(drawing_file.doc.header.get("$INSUNITS"))
-        collected = collect(drawing_file.doc.modelspace(), scale)
-    layer0 = collected.layers.get(PROFILE_LAYER, LayerContent())
+        profile_layer = existing_layer(drawing_file.doc, profile_layer)
+        collected = collect(drawing_file.doc.modelspace(), scale, profile_layer)
+    layer0 = collected.layers.pop(profile_layer, LayerContent())
     if not layer0.segments:
         raise DxfError(no_geometry_message(collected))
     chains = chain_segments([scaled(s, scale) for s in layer0.segments])
-    profile = find_profile(chains)
+    profile = find_profile(chains, layer=profile_layer)
     operations = [operation(name, number, collected.layers[name], scale, profile.mirrored)
                   for number, name in operation_layers(collected.layers)]
     tool_change = tool_change_point(layer0.points, scale, profile.mirrored)
     notes = reading_notes(units, assumed, collected, profile) + summarised(warnings)
     if len(chains) > 1:
-        notes.append(f"layer 0: {len(chains) - 1} other chain(s) are not part of the profile, left out")
+        notes.append(f"layer {profile_layer}: {len(chains) - 1} other chain(s) are not part of the profile, left out")
     return Drawing(drawing_file.path, units, scale, profile, [op for op in operations if op],
                    tool_change, drawing_file.repairs, notes)
+
+
+def existing_layer(doc, name: str) -> str:
+    """The layer as the drawing spells it (DXF layer names ignore case); a name the drawing
+    does not have is refused with the names it has, so the user can pick the outline's."""
+    if name == PROFILE_LAYER or name in doc.layers:
+        return doc.layers.get(name).dxf.name if name in doc.layers else name
+    names = ", ".join(repr(layer.dxf.name) for layer in doc.layers)
+    raise DxfError(f"profile layer {name!r} is not in the drawing; its layers are {names}")
 
 
 def operation_number(layer: str) -> int | None:
@@ -111,15 +124,15 @@ def operation_number(layer: str) -> int | None:
     return int(name) if name.isdecimal() and int(name) > 0 else None
 
 
-def is_relevant(layer: str) -> bool:
-    return layer == PROFILE_LAYER or operation_number(layer) is not None
+def is_relevant(layer: str, profile_layer: str) -> bool:
+    return layer == profile_layer or operation_number(layer) is not None
 
 
-def collect(modelspace, scale: float) -> Collected:
-    """One pass over model space: segments, texts and points of layer 0 and layers 1 … n
-    (scale: drawing units to mm)."""
+def collect(modelspace, scale: float, profile_layer: str = PROFILE_LAYER) -> Collected:
+    """One pass over model space: segments, texts and points of the profile layer and
+    layers 1 … n (scale: drawing units to mm)."""
     sagitta, reach = FLATTEN_TOLERANCE_MM / scale, MAX_COORDINATE_MM / scale
-    collected, own = Collected(), Context(sagitta, reach=reach)
+    collected, own = Collected(profile_layer=profile_layer), Context(sagitta, reach=reach)
     for entity in modelspace:
         with named_on_failure(entity):
             layer = entity.dxf.layer
@@ -135,7 +148,7 @@ def collect(modelspace, scale: float) -> Collected:
 
 def take(entity, layer: str, context: Context, collected: Collected) -> None:
     kind = entity.dxftype()
-    if not is_relevant(layer):
+    if not is_relevant(layer, collected.profile_layer):
         collected.other_layers[layer] += 1
         return
     content = collected.layers[layer]
@@ -212,15 +225,16 @@ def reading_notes(units: str, assumed: bool, collected: Collected, profile: Prof
         notes.append(f"not geometry, left out on layer 0 / operation layers: {listed}")
     if collected.other_layers:
         listed = ", ".join(f"{name!r} ({count})" for name, count in sorted(collected.other_layers.items()))
-        notes.append(f"layers that are neither 0 nor an operation number, left out: {listed}")
+        notes.append(f"layers that are neither the profile's nor an operation number, left out: {listed}")
     return notes
 
 
 def no_geometry_message(collected: Collected) -> str:
+    layer = collected.profile_layer
     elsewhere = {name: len(content.segments) for name, content in collected.layers.items() if content.segments}
     found = ", ".join(f"layer {name!r}: {count} segment(s)" for name, count in sorted(elsewhere.items()))
     found = found or ", ".join(f"layer {name!r}: {count} entities" for name, count in
                                sorted(collected.other_layers.items())[:5])
-    return ("layer 0 has no profile: no LINE, ARC, CIRCLE, polyline, SPLINE or ELLIPSE on layer 0 of "
+    return (f"layer {layer} has no profile: no LINE, ARC, CIRCLE, polyline, SPLINE or ELLIPSE on layer {layer} of "
             f"model space ({'found ' + found if found else 'model space has no geometry'}); "
-            "draw the part outline on layer 0")
+            f"draw the part outline on layer {layer}{OR_NAME_IT if layer == PROFILE_LAYER else ''}")

@@ -270,20 +270,20 @@ def oriented(candidate: Candidate) -> list[Segment]:
     return segments[first:] + segments[:first]
 
 
-def find_profile(chains: Sequence[Chain], tolerance: float = END_MATCH_TOLERANCE_MM) -> Profile:
-    """The profile among the chains of layer 0 (machine coordinates, mm), or DxfError."""
+def find_profile(chains: Sequence[Chain], tolerance: float = END_MATCH_TOLERANCE_MM, layer: str = "0") -> Profile:
+    """The profile among the chains of the profile layer (machine coordinates, mm), or DxfError."""
     if not chains:
-        raise DxfError("layer 0 has no profile: no LINE, ARC, CIRCLE, polyline, SPLINE or ELLIPSE "
-                       "in model space on layer 0; draw the part outline on layer 0")
+        raise DxfError(f"layer {layer} has no profile: no LINE, ARC, CIRCLE, polyline, SPLINE or ELLIPSE "
+                       f"in model space on layer {layer}; draw the part outline on layer {layer}")
     verdicts = [as_candidate(chain, tolerance) for chain in chains]
     candidates = [v for v in verdicts if isinstance(v, Candidate)]
     if not candidates:
         longest = max(range(len(chains)), key=lambda i: chains[i].length)
-        raise DxfError(no_profile_message(chains, longest, verdicts[longest]))
+        raise DxfError(no_profile_message(chains, longest, verdicts[longest], layer))
     best = max(candidates, key=lambda c: c.chain.length)
     total = sum(chain.length for chain in chains)
     if best.chain.length < PROFILE_SHARE_MIN * total:
-        raise DxfError(minor_profile_message(best, total, len(chains)))
+        raise DxfError(minor_profile_message(best, total, len(chains), layer))
     z_min, z_max, r_min, r_max = best.chain.bounds
     box = (z_min, z_max, -r_max, -r_min) if best.mirrored else best.chain.bounds
     return Profile(oriented(best), best.closed_by_axis, box, best.mirrored)
@@ -294,16 +294,16 @@ def handles_of(chain: Chain, limit: int = 5) -> str:
     return ", ".join(handles[:limit]) + (", …" if len(handles) > limit else "")
 
 
-def no_profile_message(chains: Sequence[Chain], longest: int, reason: str) -> str:
+def no_profile_message(chains: Sequence[Chain], longest: int, reason: str, layer: str = "0") -> str:
     chain = chains[longest]
-    return (f"layer 0 has no closed profile: none of its {len(chains)} chain(s) is closed or a "
+    return (f"layer {layer} has no closed profile: none of its {len(chains)} chain(s) is closed or a "
             f"half-profile the axis can close; the longest ({chain.length:.3f} mm, handles "
             f"{handles_of(chain)}) fails because {reason}")
 
 
-def minor_profile_message(best: Candidate, total: float, count: int) -> str:
-    return (f"layer 0 has no clear profile: the longest closed chain or half-profile (handles "
+def minor_profile_message(best: Candidate, total: float, count: int, layer: str = "0") -> str:
+    return (f"layer {layer} has no clear profile: the longest closed chain or half-profile (handles "
             f"{handles_of(best.chain)}, {best.chain.length:.3f} mm) is only "
-            f"{100 * best.chain.length / total:.0f}% of the {total:.3f} mm drawn on layer 0 in "
+            f"{100 * best.chain.length / total:.0f}% of the {total:.3f} mm drawn on layer {layer} in "
             f"{count} chains; join the outline into one chain (ends within {END_MATCH_TOLERANCE_MM} mm, "
             f"no T-junctions) and move other lines to another layer")

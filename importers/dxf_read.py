@@ -3,7 +3,7 @@
 The strict reader (`ezdxf.readfile`) is tried first because it is about 1.7x faster than
 `ezdxf.recover` on large files; when it fails, `ezdxf.recover` rebuilds what it can. In
 both cases the auditor runs and its fixes are reported. Files that are not ASCII DXF at
-all (binary DXF, DWG, other text, cut off before EOF) are refused before any parsing,
+all (DWG, other text, ASCII or binary DXF cut off before EOF) are refused before any parsing,
 with one line that says what the file is and what to do.
 """
 from __future__ import annotations
@@ -22,6 +22,7 @@ if TYPE_CHECKING:   # ezdxf takes a third of a second to import: only reading a 
 from engine.errors import EngineError
 
 BINARY_SENTINEL = b"AutoCAD Binary DXF"
+BINARY_EOF = b"\x00EOF\x00"   # the value of the last group (code 0), NUL-terminated
 DWG_MAGIC = re.compile(rb"^AC10\d\d")
 UTF8_BOM = b"\xef\xbb\xbf"
 HEAD_BYTES = 4096
@@ -43,7 +44,7 @@ class DrawingFile:
 
 
 def load_drawing_file(path: str | Path) -> DrawingFile:
-    """Open PATH as an ASCII DXF; refuse binary, DWG, non-DXF and truncated files."""
+    """Open PATH as an ASCII or binary DXF; refuse DWG, non-DXF and truncated files."""
     path = Path(path)
     check_is_ascii_dxf(path)
     repairs: list[str] = []
@@ -79,7 +80,8 @@ def audit_messages(doc: "EzdxfDocument") -> list[str]:
 
 
 def check_is_ascii_dxf(path: Path) -> None:
-    """Refuse, by looking at the first and last bytes only, what ezdxf should not parse."""
+    """Refuse, by looking at the first and last bytes only, what ezdxf should not parse.
+    Binary DXF (ezdxf reads it) only has to end with its EOF tag."""
     if not path.is_file():
         raise DxfError(f"{path}: no such file")
     size = path.stat().st_size
@@ -88,7 +90,7 @@ def check_is_ascii_dxf(path: Path) -> None:
         stream.seek(max(0, size - TAIL_BYTES))
         tail = stream.read()
     if head.startswith(BINARY_SENTINEL):
-        raise DxfError(f"{path}: binary DXF is not supported; save the drawing as ASCII DXF")
+        return check_binary_end(path, tail, size)
     if DWG_MAGIC.match(head):
         raise DxfError(f"{path}: this is a DWG file, not DXF; export it as ASCII DXF")
     if first_tag(head) != ("0", "SECTION"):
@@ -96,6 +98,14 @@ def check_is_ascii_dxf(path: Path) -> None:
                        "export the drawing as ASCII DXF")
     if not ends_with_eof(tail):
         raise DxfError(f"{path}: truncated DXF (no '0 / EOF' at the end, {size} bytes); "
+                       "copy or export the file again")
+
+
+def check_binary_end(path: Path, tail: bytes, size: int) -> None:
+    """A binary DXF ends with group code 0 and the string 'EOF' and its NUL terminator; a
+    copy cut off before it lost entities ezdxf would not notice are missing."""
+    if not tail.rstrip(b"\x1a").endswith(BINARY_EOF):
+        raise DxfError(f"{path}: truncated binary DXF (no EOF tag at the end, {size} bytes); "
                        "copy or export the file again")
 
 

@@ -37,7 +37,6 @@ NOTHING_ON_0 = "no geometry on layer 0"
 SCATTERED = "layer 0 is many pieces, none half of it"
 FULL_VIEW = "full side view symmetric about the axis, lines meet in T-junctions"
 CROSSES = "one polyline crossing the axis"
-BINARY = "binary DXF"
 HALF_PROFILE = "half-profile"
 CLOSED = "closed outline on the axis"
 REAL = {
@@ -62,7 +61,7 @@ REAL = {
     "ezdxf_AC1003_LINE_Example.dxf": (NOTHING_ON_0, "layer 0 has no profile"),
     "ezdxf_Leica_Disto_S910_R12.dxf": (NOTHING_ON_0, "layer 0 has no profile"),
     "ezdxf_POLI-ALL210_R12_polylines.dxf": (NOTHING_ON_0, "layer 0 has no profile"),
-    "ezdxf_binary_dxf_R2000.dxf": (BINARY, "binary DXF is not supported"),
+    "ezdxf_binary_dxf_R2000.dxf": (NOTHING_ON_0, "layer 0 has no profile"),   # binary: one TEXT
     "ezdxf_custom_blocks_R2010.dxf": (SCATTERED, "no clear profile"),
     "ezdxf_edgeminer_1_polylines_R2018.dxf": (SCATTERED, "no clear profile"),
     "ezdxf_uncommon_R2018.dxf": (SCATTERED, "no clear profile"),
@@ -125,9 +124,6 @@ def largest_piece_share(paths) -> float:
 
 
 def check_fact(name: str, category: str) -> None:
-    if category == BINARY:
-        assert (DXF / name).read_bytes().startswith(b"AutoCAD Binary DXF")
-        return
     paths = layer0_paths(name)
     if category == NOTHING_ON_0:
         assert paths == []
@@ -360,11 +356,30 @@ def test_operation_layer_without_type_is_refused(tmp_path):
         read_drawing(tmp_path / "untyped.dxf")
 
 
-def test_binary_dxf_is_refused_even_with_a_good_profile(tmp_path):
+def test_binary_dxf_is_read_like_the_same_drawing_in_ascii(tmp_path):
     seed_drawing(tmp_path / "part.dxf", fmt="bin")
+    seed_drawing(tmp_path / "ascii.dxf")
     assert (tmp_path / "part.dxf").read_bytes().startswith(b"AutoCAD Binary DXF")
-    with pytest.raises(DxfError, match="binary DXF is not supported; save the drawing as ASCII DXF"):
-        read_drawing(tmp_path / "part.dxf")
+    binary, ascii_ = read_drawing(tmp_path / "part.dxf"), read_drawing(tmp_path / "ascii.dxf")
+    assert binary.profile.segments == ascii_.profile.segments
+    assert binary.operations == ascii_.operations and binary.tool_change == ascii_.tool_change
+
+
+def test_the_real_binary_file_is_read_with_the_entities_ezdxf_reads():
+    name = "ezdxf_binary_dxf_R2000.dxf"
+    assert (DXF / name).read_bytes().startswith(b"AutoCAD Binary DXF")
+    expected = [(e.dxftype(), e.dxf.handle) for e in ezdxf.readfile(DXF / name).modelspace()]
+    loaded = load_drawing_file(DXF / name)
+    assert [(e.dxftype(), e.dxf.handle) for e in loaded.doc.modelspace()] == expected == [("TEXT", expected[0][1])]
+
+
+@pytest.mark.parametrize("keep", [0.5, 0.99])
+def test_a_truncated_binary_dxf_is_refused_in_one_line(tmp_path, keep):
+    whole = (DXF / "ezdxf_binary_dxf_R2000.dxf").read_bytes()
+    (tmp_path / "cut.dxf").write_bytes(whole[: int(len(whole) * keep)])
+    with pytest.raises(DxfError, match="truncated binary DXF") as caught:
+        read_drawing(tmp_path / "cut.dxf")
+    assert "\n" not in str(caught.value)
 
 
 def test_truncated_file_is_refused(tmp_path):

@@ -49,14 +49,16 @@ POSITIVE = FiniteFloatRange(min=0, min_open=True)
 @click.option("--program-name", metavar="NAME",
               help="The program's name (840D: letters, digits, _; two letters first; at most 24) "
                    "[default: the file name in upper case, - . and spaces as _].")
+@click.option("--profile-layer", default="0", show_default=True, metavar="NAME",
+              help="Layer holding the part's profile (CAD drawings often use 'outline' or 'Sketch').")
 @click.option("--draft", is_flag=True,
               help="Check the job's program with the turning class's draft, not its released template.")
 @click.option("--json", "as_json", is_flag=True,
               help="Print one JSON object: job_id, operations, repairs, notes, ...")
 @click.pass_context
 def import_dxf_command(ctx, dxf_file, machine, rough_depth, allowance, tool, speed, feed, stock_diameter,
-                       alternate, program_name, draft, as_json):
-    """Make DXF_FILE a turning job: profile on layer 0, operation n on layer n with its @-codes.
+                       alternate, program_name, profile_layer, draft, as_json):
+    """Make DXF_FILE a turning job: profile on layer 0 (or --profile-layer), operation n on layer n with its @-codes.
 
     A drawing with a profile only becomes a job when any of --rough-depth, --allowance,
     --tool, --speed, --feed, --stock-diameter is given: rough passes between blank and
@@ -69,7 +71,8 @@ def import_dxf_command(ctx, dxf_file, machine, rough_depth, allowance, tool, spe
 
     options = ProfileOptions(rough_depth, allowance, tool, speed, feed, stock_diameter)
     with connection(ctx) as conn:
-        report = import_dxf(conn, dxf_file, machine, options, parse_pair(alternate), program_name, draft)
+        report = import_dxf(conn, dxf_file, machine, options, parse_pair(alternate), program_name, draft,
+                            profile_layer)
     if as_json:
         emit_json(keyed(asdict(report)))
         return

@@ -39,21 +39,22 @@ class ImportReport:
 
 def import_dxf(conn, path: str | Path, machine_name: str | None = None,
                options: ProfileOptions = ProfileOptions(), alternate: list[int] | None = None,
-               program_name: str | None = None, draft: bool = False) -> ImportReport:
+               program_name: str | None = None, draft: bool = False, profile_layer: str = "0") -> ImportReport:
     """Read the drawing and store its job; EngineError (nothing stored) if it cannot become one.
-    The program is named `program_name`, else after the drawing's file name (job_params.drawing_names)."""
+    The program is named `program_name`, else after the drawing's file name (job_params.drawing_names);
+    the profile is read from layer `profile_layer`."""
     checked("drawing", Path(path).name, "drawing file name", "rename the file")   # said before the drawing's own problems
     if program_name is not None:
         checked("program", program_name, "--program-name")
     machine = lathe(conn, machine_name)
     gear_class = turning_class(machine)
     with no_cycle_collection():   # a large drawing: the profile, its parameters and passes
-        return _import(conn, path, machine, gear_class, options, alternate, program_name, draft)
+        return _import(conn, (path, profile_layer), machine, gear_class, options, alternate, program_name, draft)
 
 
-def _import(conn, path, machine, gear_class: str, options: ProfileOptions, alternate, program_name,
+def _import(conn, source: tuple, machine, gear_class: str, options: ProfileOptions, alternate, program_name,
             draft: bool) -> ImportReport:
-    drawing = read_drawing(path)
+    drawing = read_drawing(*source)   # (path, profile layer)
     with conn.transaction():
         job_id = conn.execute("SELECT nextval('job_id_seq')").fetchone()[0]
         program_number = (job_id - 1) % ISO_PROGRAM_NUMBERS + 1    # the job id, wrapped into O0001 … O8999
