@@ -1865,3 +1865,6 @@ RETURN line ~* ('[;(][ \t\v\f\r\n\u0085\u00a0\u1680\u2000-\u200a\u2028\u2029\u20
 ALTER TABLE gear_class ADD COLUMN line_ending text NOT NULL DEFAULT E'\n'
     CHECK (line_ending IN (E'\n', E'\r\n'));
 ALTER TABLE gear_class ADD COLUMN final_newline boolean NOT NULL DEFAULT true;
+-- Editors import NC programs (engine import-nc): they set the layout with the rows, as they set
+-- import_params (migration 0010); nobody else writes it.
+GRANT UPDATE (line_ending, final_newline) ON gear_class TO engine_editor;
