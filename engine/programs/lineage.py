@@ -9,6 +9,9 @@ from __future__ import annotations
 
 import re
 
+from ..errors import EngineError
+from ..names import shown
+
 LINEAGE_ROW_ID = -1
 # Comment forms by dialect: ISO/Fanuc comments are in parentheses, 840D ones follow `;`.
 COMMENT_FORMS = {"iso": "({})"}
@@ -40,15 +43,13 @@ def first_lineage_shaped(lines: list[str]) -> int | None:
     return next((number for number, text in enumerate(lines, 1) if lineage_shaped(text)), None)
 
 
-def refuse_lineage_shaped(name: str, lines: list[str], shown) -> None:
+def refuse_lineage_shaped(name: str, lines: list[str]) -> None:
     """A template line that reads as a lineage line would give the program a second lineage,
     naming another program or version, to whoever matches the file at the machine. Checked
     where every program is made (engine.programs.verified_run), so golden tests, dry runs and
     the release gate refuse such a template, not only storing."""
     number = first_lineage_shaped(lines)
     if number is not None:
-        from ..errors import EngineError
-
         raise EngineError(f"program {name} line {number} {shown(lines[number - 1])} reads as a lineage line, "
                           "which only the engine writes: nothing stored; remove the template row that writes it")
 

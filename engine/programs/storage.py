@@ -139,7 +139,7 @@ def _deleted_message(named: list[str]) -> str:
 def refuse_unsafe(name: str, lines: list[str]) -> None:
     """EngineError unless the program's name is an 840D program name and no line breaks."""
     checked("program", name, "program name", "set job.params.program_name in SQL; nothing stored")
-    refuse_lineage_shaped(name, lines, shown)
+    refuse_lineage_shaped(name, lines)
     if line_breaking("".join(lines)) is None:
         return
     for number, line in enumerate(lines, 1):

@@ -10,7 +10,6 @@ from dataclasses import dataclass
 
 from ..errors import EngineError
 from ..gears.records import Gear, Hob, Machine
-from ..names import shown
 from ..simulation import SimulationError, simulate_program
 from ..templates.decision_table import Result, compiled_template
 from ..templates.rows import Template
@@ -32,7 +31,7 @@ def run_template(template: Template, params: dict, module_params: dict, machine:
     result = compiled_template(template).run(params, module_params)
     name = params.get("program_name") if isinstance(params, dict) else None
     name = name if isinstance(name, str) else None
-    refuse_lineage_shaped(name or "the program", result.lines, shown)
+    refuse_lineage_shaped(name or "the program", result.lines)
     verify_program(result.lines, machine, name)
     if machine.kind == "hobber":
         prove(result.lines, machine, workpiece, name or "the program")
