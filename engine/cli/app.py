@@ -34,7 +34,8 @@ from .refactor import refactor_command
 from .settings import config
 from .simulate import simulate
 from .templates import lint, template
-from .turning import import_dxf_command, plot_command
+from .plot import plot_command
+from .turning import import_dxf_command
 
 JSON_ARGS = "engine.json_args"   # ctx.meta: --json among the invocation's arguments
 

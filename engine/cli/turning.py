@@ -1,4 +1,4 @@
-"""`engine import-dxf` and `engine plot`: turning jobs from lathe drawings (design notes §8)."""
+"""`engine import-dxf`: turning jobs from lathe drawings (design notes §8)."""
 from __future__ import annotations
 
 import math
@@ -9,7 +9,6 @@ import click
 from ..errors import EngineError
 from ..turning.defaults import DEFAULT_LATHE, PROFILE_DEFAULTS, STOCK_MARGIN
 from .context import connection, emit_json, keyed
-from .ids import JOB_ID
 
 
 
@@ -97,18 +96,3 @@ def parse_pair(text: str | None) -> list[int] | None:
     if len(parts) != 2 or not all(part.isdecimal() for part in parts) or parts[0] == parts[1]:
         raise EngineError(f"--alternate {text!r}: give two different operation numbers A,B, e.g. 1,2")
     return [int(part) for part in parts]
-
-
-@click.command("plot")
-@click.option("--job", "job_id", type=JOB_ID, required=True, help="Turning job id (from engine import-dxf).")
-@click.option("-o", "--out", required=True, type=click.Path(dir_okay=False),
-              help="Picture to write: FILE.png or FILE.svg.")
-@click.pass_context
-def plot_command(ctx, job_id, out):
-    """Draw a turning job: profile, blank and every pass, as instantiate computes them."""
-    from ..turning.job_plot import plot_turning_job
-
-    with connection(ctx) as conn:
-        drawn = plot_turning_job(conn, job_id, out)
-    listed = ", ".join(f"{label} T{tool} {passes} pass(es)" for label, tool, passes in drawn)
-    click.echo(f"job {job_id} drawn to {out}: {listed}")

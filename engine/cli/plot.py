@@ -1,0 +1,36 @@
+"""`engine plot`: a picture of a job (turning or hobbing) or of a stored program."""
+from __future__ import annotations
+
+import click
+
+from ..errors import EngineError
+from .context import connection, emit_json
+from .ids import JOB_ID, PROGRAM_ID
+
+
+@click.command("plot")
+@click.option("--job", "job_id", type=JOB_ID, help="Job id: a turning job (engine import-dxf) or a hobbing job.")
+@click.option("--program", "program_id", type=PROGRAM_ID, help="Stored program id: what its lines do, as the "
+              "simulation reads them.")
+@click.option("-o", "--out", required=True, type=click.Path(dir_okay=False),
+              help="Picture to write: FILE.png or FILE.svg.")
+@click.option("--json", "as_json", is_flag=True, help="Print one JSON object: job_id or program_id, path, drawn.")
+@click.pass_context
+def plot_command(ctx, job_id, program_id, out, as_json):
+    """Draw a job (turning: profile, blank, every pass, X as diameter; hobbing: side view of
+    blank, hob and passes) or a stored program, as PNG or SVG.
+
+    Example: engine plot --job 7 -o job7.svg
+    """
+    from ..programs.plots import plot_job, plot_program
+
+    if (job_id is None) == (program_id is None):
+        raise EngineError("give exactly one of --job ID, --program ID")
+    with connection(ctx) as conn:
+        drawn = plot_job(conn, job_id, out) if job_id is not None else plot_program(conn, program_id, out)
+    subject = {"job_id": job_id} if job_id is not None else {"program_id": program_id}
+    if as_json:
+        emit_json({**subject, "path": str(out), "drawn": drawn})
+        return
+    name = f"job {job_id}" if job_id is not None else f"program {program_id}"
+    click.echo(f"{name} drawn to {out}: " + "; ".join(drawn))

@@ -1,0 +1,45 @@
+"""Pictures of jobs and programs (issue 17): `engine plot --job ID` draws a turning job (the lathe's
+passes, X as a diameter) or a hobbing job (a side view of blank, units, hob and passes), picked
+by the kind of the job's machine; `engine plot --program ID` draws what a stored program does, by
+the simulation's reading of its lines. PNG or SVG by the file's suffix, written whole or not at all."""
+from __future__ import annotations
+
+from pathlib import Path
+
+from ..errors import EngineError
+
+JOB_MACHINE = "SELECT m.kind FROM job j JOIN machine m ON m.name = j.machine WHERE j.id = %s"
+
+
+def plot_job(conn, job_id: int, out: str | Path) -> list[str]:
+    """Draw the job to `out`; → one line per thing drawn (for the report)."""
+    row = conn.execute(JOB_MACHINE, (job_id,)).fetchone()
+    if row is None:
+        raise EngineError(f"job {job_id} does not exist; see `engine jobs list`")
+    plotter = JOB_PLOTTERS.get(row[0])
+    if plotter is None:
+        raise EngineError(f"job {job_id} runs on a {row[0]}, which has no plot; jobs of a lathe or a hobber are drawn")
+    return plotter(conn, job_id, out)
+
+
+def plot_program(conn, program_id: int, out: str | Path) -> list[str]:
+    """Draw the stored program to `out` as the simulation reads it; → one line per thing drawn."""
+    from ..hobbing.program_plot import plot_stored_program
+
+    return plot_stored_program(conn, program_id, out)
+
+
+def _turning(conn, job_id: int, out) -> list[str]:
+    from ..turning.job_plot import plot_turning_job
+
+    return [f"operation {label} T{tool}: {passes} pass(es)" for label, tool, passes in
+            plot_turning_job(conn, job_id, out)]
+
+
+def _hobbing(conn, job_id: int, out) -> list[str]:
+    from ..hobbing.job_plot import plot_hobbing_job
+
+    return plot_hobbing_job(conn, job_id, out)
+
+
+JOB_PLOTTERS = {"lathe": _turning, "hobber": _hobbing}
