@@ -1,27 +1,21 @@
 """`engine plot --job ID -o part.png|.svg`: the profile, the blank and every tool path of a
 turning job in the (Z, radius) plane: rapids dashed, cutting moves solid, one colour per
-tool. Written to a temporary file beside the target and renamed, so a failure leaves no
-half-written picture."""
+tool. Written whole or not at all (engine.pictures)."""
 from __future__ import annotations
 
 import math
-import os
-import tempfile
-from pathlib import Path
 from typing import Sequence
 
 from importers.dxf_geometry import Arc, Segment
 
-from ..errors import EngineError
+from ..pictures import new_figure, picture_target, save_atomically
 from .moves import Move, Pass
 from .region import arc_points
 
-FORMATS = {".png": "png", ".svg": "svg"}
 RAPID_STYLE = (0, (3, 2))   # dashes: 3 points on, 2 off
 # Angle step (degrees) for drawing an arc move as a polyline.
 ARC_STEP_DEG = 2.0
 FIGURE_SIZE_IN = (10.0, 5.0)
-PNG_DPI = 150
 OUTLINE_FILL = "0.85"   # light grey
 TOOL_COLOURS = ("tab:blue", "tab:red", "tab:green", "tab:orange", "tab:purple",
                 "tab:brown", "tab:pink", "tab:olive", "tab:cyan", "tab:gray")
@@ -29,26 +23,11 @@ TOOL_COLOURS = ("tab:blue", "tab:red", "tab:green", "tab:orange", "tab:purple",
 Stock = tuple[float, float, float]   # z_front, z_back, radius
 
 
-def plot_format(path: Path) -> str:
-    suffix = path.suffix.lower()
-    if suffix not in FORMATS:
-        raise EngineError(f"cannot draw a plot as {path.name!r}: give -o FILE.png or FILE.svg")
-    return FORMATS[suffix]
-
-
 def plot_job(path, outline: Sequence[Segment], stock: Stock | None,
              operations: Sequence[tuple[str, int, list[Pass]]]) -> None:
     """Draw the job to path (.png or .svg); EngineError for any other suffix."""
-    target = Path(path)
-    file_format = plot_format(target)
-    if not target.parent.is_dir():
-        raise EngineError(f"folder {str(target.parent)!r} does not exist; create it or give -o "
-                          "a file in an existing folder")
-    import matplotlib
-    matplotlib.use("Agg")
-    from matplotlib.figure import Figure
-
-    figure = Figure(figsize=FIGURE_SIZE_IN)
+    target, file_format = picture_target(path)
+    figure = new_figure(FIGURE_SIZE_IN)
     axes = figure.add_subplot()
     draw_outline(axes, outline)
     if stock is not None:
@@ -118,22 +97,3 @@ def finish_axes(axes) -> None:
     axes.axhline(0.0, color="0.5", linewidth=0.5, linestyle="-.")
     axes.grid(True, linewidth=0.3)
     axes.legend(loc="best", fontsize="small")
-
-
-def save_atomically(figure, target: Path, file_format: str) -> None:
-    handle, temporary = tempfile.mkstemp(prefix=f".{target.stem}.", suffix=target.suffix,
-                                         dir=target.parent)
-    os.close(handle)
-    try:
-        figure.savefig(temporary, format=file_format, dpi=PNG_DPI)
-        os.chmod(temporary, 0o666 & ~current_umask())   # mkstemp makes it private
-        os.replace(temporary, target)
-    except BaseException:
-        Path(temporary).unlink(missing_ok=True)
-        raise
-
-
-def current_umask() -> int:
-    mask = os.umask(0)
-    os.umask(mask)
-    return mask

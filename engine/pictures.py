@@ -1,0 +1,57 @@
+"""Writing a picture (engine plot): PNG or SVG by the file's suffix, drawn off-screen (Agg), written
+to a temporary file beside the target and renamed, so a failure leaves no half-written picture."""
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+
+from .errors import EngineError
+
+FORMATS = {".png": "png", ".svg": "svg"}
+PNG_DPI = 150
+
+
+def plot_format(path: Path) -> str:
+    suffix = path.suffix.lower()
+    if suffix not in FORMATS:
+        raise EngineError(f"cannot draw a plot as {path.name!r}: give -o FILE.png or FILE.svg")
+    return FORMATS[suffix]
+
+
+def picture_target(path) -> tuple[Path, str]:
+    """The file to write and its format; EngineError for another suffix or a missing folder."""
+    target = Path(path)
+    file_format = plot_format(target)
+    if not target.parent.is_dir():
+        raise EngineError(f"folder {str(target.parent)!r} does not exist; create it or give -o "
+                          "a file in an existing folder")
+    return target, file_format
+
+
+def new_figure(size_inches: tuple[float, float]):
+    """A matplotlib Figure not tied to any screen (the engine runs on servers)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    from matplotlib.figure import Figure
+
+    return Figure(figsize=size_inches)
+
+
+def save_atomically(figure, target: Path, file_format: str) -> None:
+    handle, temporary = tempfile.mkstemp(prefix=f".{target.stem}.", suffix=target.suffix,
+                                         dir=target.parent)
+    os.close(handle)
+    try:
+        figure.savefig(temporary, format=file_format, dpi=PNG_DPI)
+        os.chmod(temporary, 0o666 & ~current_umask())   # mkstemp makes it private
+        os.replace(temporary, target)
+    except BaseException:
+        Path(temporary).unlink(missing_ok=True)
+        raise
+
+
+def current_umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
