@@ -87,7 +87,7 @@ declare(parse_addresses, "address letters", "write the addresses it binds, such 
                                             "but G M N O T $)")
 
 
-NO_ADDRESS = "(no address)"
+NO_ADDRESS = "no address"   # the key of the numbers after no address (EMCO columns, cycle arguments)
 
 
 def binding_report(bound: dict[str, Binding], words: Counter) -> list[dict]:
