@@ -92,6 +92,7 @@ class Column:
     rule: str = ""
     db_name: str | None = None
     unit: str = ""
+    header_optional: bool = False   # the header may leave it out, even where the kind wants every column
 
     @property
     def column(self) -> str:
@@ -324,7 +325,7 @@ def _header(source: str, record: tuple[int, list[str]], kind: CsvKind) -> list[s
     unknown = [name for name in names if name and name not in kind.names]
     twice = sorted({name for name in names if name and names.count(name) > 1})
     missing = [column.name for column in kind.columns
-               if (column.required or kind.every_column) and column.name not in names]
+               if (column.required or (kind.every_column and not column.header_optional)) and column.name not in names]
     problems = [Problem(line, None, f"unknown column(s) {', '.join(unknown)}",
                         f"use the columns {', '.join(kind.names)}")] if unknown else []
     problems += [Problem(line, None, f"column(s) named twice: {', '.join(twice)}", "name each column once")] if twice else []

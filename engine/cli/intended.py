@@ -20,7 +20,8 @@ INTENT_COLUMNS = tuple(Column(key, key) for key in ("key", "t", "a", "b", "why",
 def intend_command(ctx, key, text_a, text_b, module_type, why):
     """Mark a near-duplicate pair intended: the nightly report no longer lists it, only counts it.
 
-    Name the pair by the KEY the refactor report prints, or by both texts (--a, --b).
+    Name the pair by the KEY the refactor report prints, or by both texts (--a, --b); a
+    family of lines differing only in the block number by its KEY or two of its lines.
     Who marked it (login and role), why and when are stored.
 
     Example: engine refactor intend 3f9c01a2b7de --why "helical coupling needs the differential"

@@ -12,12 +12,15 @@ from .context import connection, emit_json, keyed
 @click.argument("nc_file", type=click.Path(dir_okay=False))
 @click.option("--class", "gear_class", required=True, help="Class whose template the program becomes (created if new).")
 @click.option("--params", "params_file", type=click.Path(dir_okay=False),
-              help="The job's parameter values: JSON {name: value} or CSV name,value. "
-                   "Numbers equal to a value become references to it.")
+              help="The job's parameters: JSON {name: value} or {name: {\"value\": v, \"addresses\": [\"F\"]}}, "
+                   "or CSV name,value[,addresses]. A number equal to a value becomes a reference to it at the "
+                   "addresses the parameter names (plain value: every address but G M N O T $); equal numbers "
+                   "elsewhere are left as written and listed.")
 @click.option("--modules", "modules_file", type=click.Path(dir_okay=False),
               help="Corrections of the module assignment: CSV line_no,t (1-based program lines).")
 @click.option("--parent", help="Parent class in the tree, for a new class.")
-@click.option("--json", "as_json", is_flag=True, help="Print one JSON object (rows, parameterised, modules, ...).")
+@click.option("--json", "as_json", is_flag=True,
+              help="Print one JSON object (rows, parameterised, modules, bindings, left_alone, ...).")
 @click.pass_context
 def import_nc_command(ctx, nc_file, gear_class, params_file, modules_file, parent, as_json):
     """Import NC_FILE as the class's template: one row per line, all or nothing.
@@ -39,8 +42,20 @@ def import_nc_command(ctx, nc_file, gear_class, params_file, modules_file, paren
                f"{report.parameterised} parameter reference(s), version {report.version}")
     if report.released_version != report.version:
         click.echo(_draft_note(report), err=True)
+    for binding in report.bindings:
+        click.echo(_binding_line(binding))
     for value, names in report.ambiguous.items():
         click.echo(f"  value {value} belongs to {', '.join(names)}: used {names[0]}", err=True)
+    binds = {binding["parameter"]: binding["binds"] for binding in report.bindings}
+    for left in report.left_alone:
+        click.echo(f"  line {left['line']}: {left['word']} equals {left['parameter']}, which binds "
+                   f"{binds[left['parameter']]}: left as written", err=True)
+
+
+def _binding_line(binding: dict) -> str:
+    """`  feed → F: 3 word(s) (F 3)`: a parameter, the addresses it binds, the words it bound."""
+    at = ", ".join(f"{address} {count}" for address, count in binding["at"].items())
+    return f"  {binding['parameter']} → {binding['binds']}: {binding['words']} word(s)" + (f" ({at})" if at else "")
 
 
 def _draft_note(report) -> str:

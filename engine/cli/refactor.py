@@ -15,8 +15,10 @@ from .progress import progress_bar
               help="Report line pairs of one module type with this similarity or more (Sim < 1).")
 @click.option("--json", "as_json", is_flag=True,
               help="Print one JSON object: changed, components_before, components_after, shared, new, "
-                   "known, intended (counts) and near_duplicates (per pair: key, new, t, sim, texts a and "
-                   "b, uses_a/uses_b and the first 10 class:row uses of each; template_view has them all).")
+                   "known, intended, families (counts) and near_duplicates (per entry: key, new, kind, t, sim; "
+                   "a pair: texts a and b, members_a/members_b, uses_a/uses_b and the first 10 class:row uses "
+                   "of each; a family of lines differing only in the block number: members, uses, rows; "
+                   "template_view has them all).")
 @click.pass_context
 def refactor_command(ctx, threshold, as_json):
     """Merge identical component bodies and report near-duplicate lines to unify.
@@ -26,8 +28,9 @@ def refactor_command(ctx, threshold, as_json):
     changes nothing. Instantiations go on meanwhile; template writers wait. Meant to run
     every night (README: cron or a systemd timer); exit code 0 also when nothing changed.
 
-    Pairs no earlier run listed come first, marked new; pairs marked intended (the
-    subcommands) are not listed, only counted. Each pair has a key for `intend`.
+    Block numbers are left out: lines that differ only in theirs are one family, listed
+    once. Pairs no earlier run listed come first, marked new; pairs marked intended (the
+    subcommands) are not listed, only counted. Each pair and family has a key for `intend`.
 
     Example: engine refactor --threshold 0.85 --json >> refactor.jsonl
     """
@@ -53,13 +56,34 @@ def _print_report(report) -> None:
              else "nothing to merge (the library was already stored once)")
     click.echo(f"refactor: {state}; components {report.components_before} -> "
                f"{report.components_after}, {report.shared} used by two or more classes; "
-               f"every class's assembled template unchanged. {len(report.near_duplicates)} "
-               f"near-duplicate pair(s) with similarity >= {report.threshold:g} to unify by hand "
+               f"every class's assembled template unchanged. {len(report.near_duplicates) - report.families} "
+               f"near-duplicate pair(s) with similarity >= {report.threshold:g} and {report.families} "
+               f"family(ies) of lines differing only in the block number to unify by hand "
                f"({report.new} new, {report.known} known; {report.intended} marked intended, not listed).")
-    for pair in report.near_duplicates:
-        click.echo(f"\n  {'NEW ' if pair['new'] else ''}{pair['key']}  {pair['t']}  Sim {pair['sim']:.3f}")
-        click.echo(f"    {pair['a']}   ({_uses(pair['rows_a'], pair['uses_a'])})")
-        click.echo(f"    {pair['b']}   ({_uses(pair['rows_b'], pair['uses_b'])})")
+    for entry in report.near_duplicates:
+        (_print_family if entry["kind"] == "family" else _print_pair)(entry)
+
+
+def _print_pair(pair: dict) -> None:
+    click.echo(f"\n  {'NEW ' if pair['new'] else ''}{pair['key']}  {pair['t']}  Sim {pair['sim']:.3f}")
+    for side in "ab":
+        others = len(pair[f"members_{side}"]) - 1
+        family = f", and {others} more line(s) differing only in the block number" if others else ""
+        click.echo(f"    {pair[side]}   ({_uses(pair[f'rows_{side}'], pair[f'uses_{side}'])}{family})")
+
+
+def _print_family(family: dict) -> None:
+    """The family's members (the first USES_LISTED of them) and where they are used."""
+    members = family["members"]
+    click.echo(f"\n  {'NEW ' if family['new'] else ''}{family['key']}  {family['t']}  {len(members)} lines "
+               f"differing only in the block number ({_uses(family['rows'], family['uses'])})")
+    for text in members[:USES_LISTED]:
+        click.echo(f"    {text}")
+    if len(members) > USES_LISTED:
+        click.echo(f"    and {len(members) - USES_LISTED} more")
+
+
+USES_LISTED = 10   # members of a family printed; --json lists them all
 
 
 def _uses(rows, count: int) -> str:

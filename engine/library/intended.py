@@ -11,6 +11,12 @@ judgement about two texts holds for every row that has them. The module type bel
 texts are compared within one type only, and a decision about two sync lines says nothing about
 the same texts in another module. The order is not: (a, b) and (b, a) are one pair, the texts
 sorted by code point (not by a database collation, which varies between servers).
+
+Block numbers are not part of it (issue 17): a text is keyed by its line without the block
+number it starts with (engine.library.similarity.block_free), so `N0380 G1 X10` against `N0400
+G1 X11` is the pair `G1 X10`/`G1 X11`, and the lines that differ only in their block number are one
+family, keyed by their common line whatever members join it later. Its a and b in the tables
+are two of its members. A text without a block number keeps the key it always had.
 """
 from __future__ import annotations
 
@@ -23,6 +29,7 @@ from datetime import datetime
 import psycopg
 
 from ..errors import EngineError
+from .similarity import block_free
 
 KEY_SHOWN = 12      # hex digits of the key the report prints: unique among millions of pairs
 KEY_TYPED = 8       # the fewest hex digits `engine refactor intend KEY` accepts
@@ -34,6 +41,19 @@ def pair_key(t: str, a: str, b: str) -> str:
     the texts hold)."""
     identity = json.dumps([t, *sorted((a, b))], ensure_ascii=True)
     return hashlib.sha256(identity.encode("ascii")).hexdigest()
+
+
+def family_key(t: str, line: str) -> str:
+    """The key of the family of texts whose line without block number is `line`: sha256 of
+    [t, line] as JSON (two elements: never a pair's key)."""
+    identity = json.dumps([t, line], ensure_ascii=True)
+    return hashlib.sha256(identity.encode("ascii")).hexdigest()
+
+
+def near_duplicate_key(t: str, a: str, b: str) -> str:
+    """The key of what two texts are, their block numbers left out: one family, or a pair."""
+    line_a, line_b = block_free(a), block_free(b)
+    return family_key(t, line_a) if line_a == line_b else pair_key(t, line_a, line_b)
 
 
 def shown_key(full_key: str) -> str:
@@ -63,7 +83,7 @@ class Listed:
 def list_and_remember(conn, pairs: list[dict]) -> Listed:
     """Leave out the pairs marked intended, flag each other pair `new` (no earlier run listed
     it), put the new ones first (each part in its given order), and remember them all as seen."""
-    full = {id(pair): pair_key(pair["t"], pair["a"], pair["b"]) for pair in pairs}
+    full = {id(pair): near_duplicate_key(pair["t"], pair["a"], pair["b"]) for pair in pairs}
     keys = list(full.values())
     intended = {key for (key,) in conn.execute(INTENDED_AMONG, (keys,))}
     seen = {key for (key,) in conn.execute(SEEN_AMONG, (keys,))}
@@ -186,7 +206,7 @@ def _pair_of_texts(conn, texts: tuple[str, str] | None, t: str | None) -> tuple[
     if a == b:
         raise EngineError(f"--a and --b are the same text {a!r}; a near-duplicate pair is two different lines")
     t = _module_type(conn, a, b, t)
-    return pair_key(t, a, b), t, a, b
+    return near_duplicate_key(t, a, b), t, a, b
 
 
 def _module_type(conn, a: str, b: str, t: str | None) -> str:

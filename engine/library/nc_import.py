@@ -2,8 +2,11 @@
 
 Each line of the file becomes one template row, ids 10, 20, 30 … in line order. A number
 in the line whose value equals a job parameter (compared as Decimal: `F250.` matches 250)
-becomes a reference to that parameter; the numbers of G and M words (and of `$` and
-labels) never do, nor numbers inside comments and strings. A line with no reference is a
+becomes a reference to that parameter when the parameter binds the number's address
+(engine.library.nc_params: a plain parameter binds every address but G M N O T $, a bound one
+only the addresses it names); labels, comments and strings never do. An equal number at an
+address its parameter does not bind is left as written and reported (`left_alone`), and the
+report lists every parameter with the words it bound. A line with no reference is a
 constant row (`o` = a plain string literal); a line with references is an f-string.
 
 Exact spelling: the field that replaces a number is a format recipe read off the
@@ -19,7 +22,7 @@ Other values of the parameter print in the same style (same decimals, same paddi
 Every field is evaluated with the original value before it is used; a number whose recipe
 would not give its spelling back (a float that cannot hold all its digits), and a
 negative zero (`J-0`: the sign is not in the value), stay literal. When several
-parameters have the value of a number, the first one given is used (reported).
+parameters that bind a number's address have its value, the first one given is used (reported).
 
 Literal text is quoted exactly: backslashes and the quote character are escaped, braces
 doubled inside f-strings, and control characters (tabs) written as escapes.
@@ -42,14 +45,13 @@ from __future__ import annotations
 import json
 import keyword
 import re
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from functools import partial
 from pathlib import Path
 
 from psycopg.types.json import Jsonb
 
-from ..csv_reader import (Column, CsvKind, parse_number_or_text, parse_text, parse_whole, read_csv_file,
-                          refuse)
+from ..csv_reader import Column, CsvKind, parse_number_or_text, parse_text, parse_whole, read_csv_file, refuse
 from ..errors import EngineError
 from ..memory import no_cycle_collection
 from ..names import shown
@@ -60,7 +62,8 @@ from ..templates.store import ensure_class, load_template, replace_template
 from ..templates.versions import released_version
 from .nc_halves import in_halves
 from .nc_layout import NcLayout, split_nc_text, store_layout
-from .nc_rows import Builder, values_of
+from .nc_params import binding_report, bindings, parse_addresses, values
+from .nc_rows import Builder, Found
 from .nc_tokens import LABEL, SYMBOL, LineFacts, facts, tokenise
 from .nc_verify import Proof
 
@@ -80,6 +83,8 @@ class ImportReport:
     version: int
     ambiguous: dict = field(default_factory=dict)   # value → parameters having it (first used)
     released_version: int | None = None     # what runners get: the import is a draft until released
+    bindings: list = field(default_factory=list)    # per parameter: its addresses and the words it bound
+    left_alone: list = field(default_factory=list)  # equal numbers at addresses not bound: line, word, parameter
 
 
 def import_nc(conn, path, gear_class: str, params: dict | None = None, modules: dict | None = None,
@@ -93,19 +98,19 @@ def _import(conn, path, gear_class: str, params: dict | None, modules: dict | No
     if not CLASS_NAME.match(gear_class or ""):
         raise EngineError(f"class name {gear_class!r}: use lower-case letters, digits and _, "
                           "starting with a letter")
-    params = dict(params or {})
-    check_param_names(params)
+    check_param_names(params or {})
+    bound = bindings(params or {})
+    params = values(params or {})
     lines, layout = read_nc_file(path)
     refuse_lineage(path, lines)
-    built = Builder(values_of(params), path)
-    halves = in_halves(len(lines), partial(_read_lines, lines, built))
+    halves = in_halves(len(lines), partial(_read_lines, lines, Builder(bound, path)))
     assigned = assign_modules([facts for half in halves for facts in half[0]], _checked_modules(modules, len(lines)))
     texts = [o for half in halves for o in half[1]]
     rows = [TemplateRow(ROW_STEP * (index + 1), t, n, None, None, o, None) for index, (o, (t, n)) in
             enumerate(zip(texts, assigned))]
-    built.parameterised = sum(half[2] for half in halves)
-    for half in halves:
-        built.ambiguous.update((value, names) for value, names in half[3].items() if value not in built.ambiguous)
+    found = halves[0][2]
+    for half in halves[1:]:
+        found.add(half[2])
     proof = Proof(params, lines, path)
     with conn.transaction():
         created = ensure_class(conn, gear_class, parent)
@@ -116,21 +121,22 @@ def _import(conn, path, gear_class: str, params: dict | None, modules: dict | No
         _refuse_inherited(template, lines)
         proof.verdict(template.rows)
     counts = {t: sum(1 for row in rows if row.t == t) for t in MODULE_ORDER}
-    return ImportReport(gear_class, str(path), len(rows), built.parameterised,
+    return ImportReport(gear_class, str(path), len(rows), found.parameterised,
                         {t: c for t, c in counts.items() if c}, created, changed, template.version,
-                        built.ambiguous, released_version(conn, gear_class))
+                        found.ambiguous, released_version(conn, gear_class), binding_report(bound, found.bound),
+                        [asdict(left) for left in found.left_alone])
 
 
 def _read_lines(lines: list[str], built: Builder, start: int, end: int) -> tuple:
-    """Lines start…end: the facts of each (for its module), its row's `o`, and the references
-    made and the ambiguous values found in them."""
-    built.parameterised, built.ambiguous = 0, {}
+    """Lines start…end: the facts of each (for its module), its row's `o`, and what they gave
+    (references, ambiguous values, words bound, numbers left alone)."""
+    built.found = Found()
     line_facts, texts = [], []
     for number in range(start, end):
         tokens = tokenise(lines[number])
         line_facts.append(facts(tokens))
         texts.append(built.o(number + 1, lines[number], tokens))
-    return line_facts, texts, built.parameterised, built.ambiguous
+    return line_facts, texts, built.found
 
 
 def _store_import_params(conn, gear_class: str, params: dict) -> None:
@@ -200,7 +206,8 @@ RESERVED_NAMES = frozenset(FUNCTIONS) | frozenset(CONSTANTS) | {"template_versio
 
 
 PARAMS_KIND = CsvKind("parameter", (Column("name", parse_text, required=True),
-                                    Column("value", parse_number_or_text)), every_column=True)
+                                    Column("value", parse_number_or_text),
+                                    Column("addresses", parse_addresses, header_optional=True)), every_column=True)
 MODULES_KIND = CsvKind("module type", (Column("line_no", parse_whole, required=True),
                                        Column("t", parse_text, required=True)))
 
@@ -214,7 +221,9 @@ def check_param_names(params: dict) -> None:
 
 
 def read_params(path) -> dict:
-    """Job parameter values: a JSON object {name: value} or a CSV with columns name,value."""
+    """Job parameters in either form of engine.library.nc_params, checked: a JSON object
+    {name: value or {"value": …, "addresses": […]}}, or a CSV with columns name,value and an
+    optional column addresses (`F`, `X Z`; empty: the plain form)."""
     if str(path).lower().endswith(".json"):
         text = _read_text(path, "parameters file")
         try:
@@ -227,6 +236,7 @@ def read_params(path) -> dict:
     else:
         params = _csv_params(path)
     check_param_names(params)
+    bindings(params, str(path))
     return params
 
 
@@ -252,7 +262,8 @@ def _read_text(path, what: str) -> str:
 
 
 def _csv_params(path) -> dict:
-    """{name: value} of a CSV with columns name,value (a number as int or float, else the text)."""
+    """{name: value} of a CSV with columns name,value (a number as int or float, else the text);
+    a row with addresses gives {"value": value, "addresses": [...]}."""
     params: dict = {}
     file = read_csv_file(path, PARAMS_KIND)
     for line, record in file.rows():
@@ -260,12 +271,14 @@ def _csv_params(path) -> dict:
         if name in params:
             raise refuse(path, f"parameter {name!r} appears twice", "give each parameter once", line, "name")
         value = _cell_value(file, PARAMS_KIND.column("value"), record, line)
-        params[name] = "" if value is None else value
+        addresses = _cell_value(file, PARAMS_KIND.column("addresses"), record, line)
+        value = "" if value is None else value
+        params[name] = {"value": value, "addresses": addresses} if addresses else value
     return params
 
 
 def _cell_value(file, column, record: dict, line: int):
-    value, problem = file.cell(column, record[column.name], line)
+    value, problem = file.cell(column, record.get(column.name, ""), line)
     if problem:
         raise EngineError(problem.said(file.source))
     return value

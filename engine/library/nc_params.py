@@ -4,19 +4,27 @@ the G71 allowance `U0.01` is not the feed `F0.010`, and doubling the feed must n
 
 A parameters file (JSON) gives each parameter in one of two forms:
 * plain: `"feed": 0.01` binds the value at every address except the code addresses
-  G, M, N, O, T (their numbers are codes, block numbers, program and tool numbers);
-* bound: `"feed": {"value": 0.01, "addresses": ["F"]}` binds it only at F.
+  G, M, N, O, T (their numbers are codes, block numbers, program and tool numbers) and LinuxCNC's
+  `$` (the spindle a word is for), and a number after no address (a cycle's argument `CYCLE95(…, 2.5)`,
+  `R1=2.5`, `#<depth> = 2.5`, a column of an EMCO tape);
+* bound: `"feed": {"value": 0.01, "addresses": ["F"]}` binds it only at F (never a number after no
+  address).
 
 The class keeps the plain values (gear_class.import_params); instantiating it with other
 values changes exactly the words bound at import."""
 from __future__ import annotations
 
+from collections import Counter
 from dataclasses import dataclass
 
+from ..csv_reader import CellError, declare
 from ..errors import EngineError
 
 # Addresses whose numbers are codes, not quantities: a plain parameter never binds them.
-CODE_ADDRESSES = frozenset("GMNOT")
+CODE_ADDRESSES = frozenset("GMNOT$")
+# Of those, the addresses whose numbers name a function (G1, M3, $0): a parameter's value equal to
+# one is no quantity left behind, so the import does not warn about it.
+FUNCTION_ADDRESSES = frozenset("GM$")
 
 
 @dataclass(frozen=True)
@@ -29,8 +37,14 @@ class Binding:
     def binds(self, address: str | None) -> bool:
         """Whether a number written after `address` (None: no address) may become this parameter."""
         if self.addresses is None:
-            return address is not None and address.upper() not in CODE_ADDRESSES
+            return address is None or address.upper() not in CODE_ADDRESSES
         return address is not None and address.upper() in self.addresses
+
+    def described(self) -> str:
+        """The addresses as the import report names them: `F`, `X Z`, or the plain form's."""
+        if self.addresses is None:
+            return "every address but " + " ".join(sorted(CODE_ADDRESSES, key="GMNOT$".index))
+        return " ".join(sorted(self.addresses))
 
 
 def bindings(params: dict, source="parameters") -> dict[str, Binding]:
@@ -59,3 +73,31 @@ def _addresses(name: str, addresses, source) -> frozenset:
         raise EngineError(f"{source}: parameter {name!r}: addresses must be a non-empty list of address "
                           f"letters such as [\"F\"] or [\"X\", \"Z\"], not {addresses!r}")
     return frozenset(address.upper() for address in addresses)
+
+
+def parse_addresses(cell: str) -> list[str]:
+    """The addresses a parameter binds, as a CSV cell writes them: `F`, `X Z`."""
+    addresses = cell.split()
+    if not all(address.isascii() and address.isalpha() for address in addresses):
+        raise CellError("is not a list of address letters")
+    return addresses
+
+
+declare(parse_addresses, "address letters", "write the addresses it binds, such as F or X Z (none: every address "
+                                            "but G M N O T $)")
+
+
+NO_ADDRESS = "no address"   # the key of the numbers after no address (EMCO columns, cycle arguments)
+
+
+def binding_report(bound: dict[str, Binding], words: Counter) -> list[dict]:
+    """Each parameter in the order given, for the import report: the addresses it binds (None:
+    the plain form's, every address but the codes), the words it bound (`words`: (name, address)
+    → count) and how many at each address."""
+    report = []
+    for name, binding in bound.items():
+        at = {address or NO_ADDRESS: count for (bound_name, address), count in sorted(
+            words.items(), key=lambda item: item[0][1] or "") if bound_name == name}
+        report.append({"parameter": name, "addresses": sorted(binding.addresses) if binding.addresses else None,
+                       "binds": binding.described(), "words": sum(at.values()), "at": at})
+    return report

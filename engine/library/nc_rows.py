@@ -1,30 +1,61 @@
 """The rows of an imported program (engine.library.nc_import): each line's `o`, written out or
 as an f-string whose fields are the job's parameters, spelled as the line spells its numbers
-(the exact-spelling rules are in nc_import's docstring)."""
+(the exact-spelling rules are in nc_import's docstring). A number becomes a parameter only at an
+address the parameter binds (engine.library.nc_params); an equal number elsewhere is left as
+written and reported, since the G71 allowance `U0.01` is not the feed `F0.010`."""
 from __future__ import annotations
 
 import math
 import re
+from collections import Counter
+from dataclasses import dataclass, field
 from decimal import Decimal, InvalidOperation
 
 from ..errors import EngineError
 from ..templates.evaluator import evaluate
 from ..templates.expressions import MAX_EXPRESSION_LENGTH, compile_expression
-from .nc_tokens import NUMBER
+from .nc_params import FUNCTION_ADDRESSES, Binding
+from .nc_tokens import NUMBER, WORD
 
-CODE_ADDRESSES = frozenset({"G", "M", "$"})   # their numbers name a function, not a value
 
-
-def values_of(params: dict) -> dict:
-    """Decimal value → [(name, value)] of the numeric parameters, in the order given."""
+def values_of(bindings: dict[str, Binding]) -> dict:
+    """Decimal value → [Binding] of the numeric parameters, in the order given."""
     values: dict = {}
-    for name, value in params.items():
+    for binding in bindings.values():
+        value = binding.value
         if isinstance(value, bool) or not isinstance(value, (int, float, Decimal)):
             continue
         if isinstance(value, float) and not math.isfinite(value):
             continue
-        values.setdefault(Decimal(str(value)), []).append((name, value))
+        values.setdefault(Decimal(str(value)), []).append(binding)
     return values
+
+
+@dataclass(frozen=True)
+class LeftAlone:
+    """A number equal to a parameter's value at an address the parameter does not bind."""
+    line: int
+    word: str
+    parameter: str
+
+
+@dataclass
+class Found:
+    """What the lines read so far gave: the references made, the values two parameters binding
+    the same address share (the first is used), the words bound per (parameter, address), and
+    the equal numbers left alone, in line order."""
+    parameterised: int = 0
+    ambiguous: dict = field(default_factory=dict)
+    bound: Counter = field(default_factory=Counter)
+    left_alone: list = field(default_factory=list)
+
+    def add(self, later: "Found") -> None:
+        """Take in what the lines after these gave."""
+        self.parameterised += later.parameterised
+        for value, names in later.ambiguous.items():
+            self.ambiguous.setdefault(value, names)
+        self.bound.update(later.bound)
+        self.left_alone.extend(later.left_alone)
 
 
 _SPELLING = re.compile(r"([+-]?)([0-9]*)(\.?)([0-9]*)")
@@ -47,16 +78,16 @@ def number_field(name: str, spelling: str) -> str:
 
 
 class Builder:
-    """The `o` of each line, and the references made and the values found ambiguous so far."""
+    """The `o` of each line, and what the lines read so far gave (`found`)."""
 
-    def __init__(self, values: dict, path):
-        self.values, self.path = values, path
-        self.parameterised, self.ambiguous = 0, {}
+    def __init__(self, bindings: dict[str, Binding], path):
+        self.values, self.path = values_of(bindings), path
+        self.found = Found()
         self.spelled: dict[tuple, bool] = {}   # (field, name, number) -> the field gives the number back
 
     def o(self, line_number: int, line: str, tokens) -> str:
         """The row's `o`: the line written out, or an f-string with its references."""
-        parts = [self._part(token) for token in tokens]
+        parts = [self._part(line_number, tokens, index) for index in range(len(tokens))]
         fields = "".join(text for is_field, text in parts if is_field)
         literal = "".join(text for is_field, text in parts if not is_field)
         quote = "'" if '"' in literal and "'" not in literal + fields else '"'
@@ -68,26 +99,49 @@ class Builder:
         if len(o) > MAX_EXPRESSION_LENGTH:
             raise EngineError(f"{self.path} line {line_number}: {len(line)} characters, more than a "
                               f"template row holds ({MAX_EXPRESSION_LENGTH}); split the line")
-        self.parameterised += sum(1 for is_field, _ in parts if is_field)
+        self.found.parameterised += sum(1 for is_field, _ in parts if is_field)
         return o
 
-    def _part(self, token) -> tuple[bool, str]:
+    def _part(self, line_number: int, tokens, index: int) -> tuple[bool, str]:
         """(True, replacement field) for a number that becomes a reference, else (False, text)."""
-        if token.kind != NUMBER or token.address in CODE_ADDRESSES or _is_negative_zero(token.text):
+        token = tokens[index]
+        if token.kind != NUMBER or _is_negative_zero(token.text):
             return False, token.text
-        candidates = self.values.get(Decimal(token.text))
-        if not candidates:
+        equal = self.values.get(Decimal(token.text), ())
+        binding = [candidate for candidate in equal if candidate.binds(token.address)]
+        if not binding:
+            self._leave_alone(line_number, tokens, index, equal)
             return False, token.text
-        name, value = candidates[0]
-        source = number_field(name, token.text)
-        key = (source, name, token.text)   # the value is the parameter's, one per name
-        if key not in self.spelled:
-            self.spelled[key] = _evaluate(source, name, value) == token.text
-        if not self.spelled[key]:
+        source = number_field(binding[0].name, token.text)
+        if not self._spelled(source, binding[0], token.text):
             return False, token.text
-        if len(candidates) > 1:
-            self.ambiguous[str(Decimal(token.text))] = [n for n, _ in candidates]
+        if len(binding) > 1:
+            self.found.ambiguous[str(Decimal(token.text))] = [candidate.name for candidate in binding]
+        self.found.bound[(binding[0].name, token.address)] += 1
         return True, source
+
+    def _spelled(self, source: str, binding: Binding, spelling: str) -> bool:
+        """Whether the field gives the number back as written (evaluated once per spelling)."""
+        key = (source, binding.name, spelling)   # the value is the parameter's, one per name
+        if key not in self.spelled:
+            self.spelled[key] = _evaluate(source, binding.name, binding.value) == spelling
+        return self.spelled[key]
+
+    def _leave_alone(self, line_number: int, tokens, index: int, equal) -> None:
+        """Report the number to each parameter it equals (a function's number is no quantity)."""
+        if equal and (tokens[index].address or "") not in FUNCTION_ADDRESSES:
+            word = _word(tokens, index)
+            self.found.left_alone.extend(LeftAlone(line_number, word, binding.name) for binding in equal)
+
+
+def _word(tokens, index: int) -> str:
+    """The word a number is the value of, as written (`R0.3`, `A=-1.763`); the number alone
+    after no address."""
+    number = tokens[index]
+    for start in range(index - 1, max(index - 5, -1), -1):
+        if tokens[start].kind == WORD and tokens[start].text.upper() == number.address:
+            return "".join(token.text for token in tokens[start:index + 1])
+    return number.text
 
 
 def _is_negative_zero(spelling: str) -> bool:

@@ -2,7 +2,8 @@
 
 One transaction: identical component bodies are merged (found by hashing, linear), the
 near-duplicates a human should unify are reported (engine.library.similarity, within one module
-type; those not listed by an earlier run first, those marked intended only counted:
+type, block numbers left out: lines that differ only in theirs are one family, reported once;
+those not listed by an earlier run first, those marked intended only counted:
 engine.library.intended), and the invariants are checked before commit — lossless (every class's assembled
 template unchanged, compared by a digest the server computes per class), stored once (no
 two components with the same body).
@@ -17,7 +18,7 @@ import psycopg
 from ..errors import EngineError
 from ..templates.store import load_template
 from .intended import list_and_remember
-from .similarity import Units, nc_units, similar_pairs
+from .similarity import Units, block_free, nc_units, similar_pairs
 
 # Concurrent instantiations read either the old or the new library: writers wait for us,
 # readers (plain SELECT, foreign-key checks) are not blocked and see the last committed
@@ -90,11 +91,16 @@ class RefactorReport:
     known: int = 0       # listed pairs an earlier run listed
     intended: int = 0    # pairs found but not listed: marked intended (engine refactor intents)
 
+    @property
+    def families(self) -> int:
+        """Listed entries that are families of lines differing only in their block number."""
+        return sum(1 for entry in self.near_duplicates if entry["kind"] == "family")
+
     def as_dict(self) -> dict:
         return {"changed": self.changed, "components_before": self.components_before,
                 "components_after": self.components_after, "shared": self.shared,
                 "threshold": self.threshold, "new": self.new, "known": self.known, "intended": self.intended,
-                "near_duplicates": self.near_duplicates}
+                "families": self.families, "near_duplicates": self.near_duplicates}
 
 
 def refactor(conn, threshold: float = 0.8, progress=None) -> RefactorReport:
@@ -177,27 +183,51 @@ USES_LISTED = 10
 
 
 def near_duplicates(conn, threshold: float) -> list[dict]:
-    """Pairs of distinct line texts of one module type with threshold ≤ Sim < 1, where
-    Sim = K / (M + N − K) on NC unit lists (K the longest common subsequence); per text
-    its number of uses and the first USES_LISTED (class, row id)."""
+    """The families of texts of one module type that differ only in their block number (one
+    entry each, `kind` family, its members; Sim 1 without the block number), then the pairs of
+    texts with threshold ≤ Sim < 1, where Sim = K / (M + N − K) on the NC units of the lines
+    without block number (K the longest common subsequence); a side that is a family is one
+    text of the pair, its members listed. Per text or family its number of uses and the first
+    USES_LISTED (class, row id)."""
     uses: dict[tuple[str, str], tuple[int, list]] = {}
-    by_type: dict[str, dict[Units, list[str]]] = defaultdict(lambda: defaultdict(list))
+    members: dict[tuple[str, str], list[str]] = defaultdict(list)   # (t, line without block number) → texts
     for t, o, count, classes, row_ids in conn.execute(LINE_USES, {"listed": USES_LISTED}):
         uses[(t, o)] = (count, [[name, row_id] for name, row_id in zip(classes, row_ids)])
-        by_type[t][nc_units(o)].append(o)
+        members[(t, block_free(o))].append(o)
+    by_type: dict[str, dict[Units, list[str]]] = defaultdict(lambda: defaultdict(list))
+    for t, line in members:
+        by_type[t][nc_units(line)].append(line)
+    families = [_family(t, members[(t, line)], uses) for t, line in sorted(members) if len(members[(t, line)]) > 1]
     pairs = []
     for t in sorted(by_type):
-        texts_of = list(by_type[t].values())
+        lines_of = list(by_type[t].values())
         for i, j, sim in similar_pairs(list(by_type[t]), threshold):
-            pairs += [_pair(t, sim, text_a, text_b, uses) for text_a in texts_of[i] for text_b in texts_of[j]]
-    return sorted(pairs, key=lambda pair: (-pair["sim"], pair["t"], pair["a"], pair["b"]))
+            pairs += [_pair(t, sim, members[(t, a)], members[(t, b)], uses) for a in lines_of[i] for b in lines_of[j]]
+    return families + sorted(pairs, key=lambda pair: (-pair["sim"], pair["t"], pair["a"], pair["b"]))
 
 
-def _pair(t: str, sim: float, text_a: str, text_b: str, uses) -> dict:
-    text_a, text_b = sorted((text_a, text_b))
-    (uses_a, rows_a), (uses_b, rows_b) = uses[(t, text_a)], uses[(t, text_b)]
-    return {"t": t, "sim": round(sim, 4), "a": text_a, "b": text_b,
-            "uses_a": uses_a, "uses_b": uses_b, "rows_a": rows_a, "rows_b": rows_b}
+def _family(t: str, texts: list[str], uses) -> dict:
+    """Texts that differ only in their block number, in the order of their first use (program
+    order within a class); the first and the last are its a and b."""
+    texts = sorted(texts, key=lambda text: (uses[(t, text)][1][:1], text))
+    count, rows = _uses_of(t, texts, uses)
+    return {"kind": "family", "t": t, "sim": 1.0, "a": texts[0], "b": texts[-1], "members": texts,
+            "uses": count, "rows": rows}
+
+
+def _pair(t: str, sim: float, texts_a: list[str], texts_b: list[str], uses) -> dict:
+    """Two texts (or families, each shown by its first text) whose lines are near-duplicates."""
+    (texts_a, texts_b) = sorted((sorted(texts_a), sorted(texts_b)))
+    (uses_a, rows_a), (uses_b, rows_b) = _uses_of(t, texts_a, uses), _uses_of(t, texts_b, uses)
+    return {"kind": "pair", "t": t, "sim": round(sim, 4), "a": texts_a[0], "b": texts_b[0],
+            "uses_a": uses_a, "uses_b": uses_b, "rows_a": rows_a, "rows_b": rows_b,
+            "members_a": texts_a, "members_b": texts_b}
+
+
+def _uses_of(t: str, texts: list[str], uses) -> tuple[int, list]:
+    """The rows using any of the texts: how many, and the first USES_LISTED (class, row id)."""
+    count = sum(uses[(t, text)][0] for text in texts)
+    return count, sorted(row for text in texts for row in uses[(t, text)][1])[:USES_LISTED]
 
 
 @dataclass(frozen=True)

@@ -15,17 +15,29 @@ from __future__ import annotations
 
 import ast
 import math
+import re
 from collections import Counter, defaultdict
 from collections.abc import Iterator, Sequence
 
 from ..templates.guards import parse_python
 from .nc_tokens import NUMBER, SPACE, WORD, tokenise
 
-CODE_ADDRESSES = ("G", "M")   # their numbers name a function, they are never parameterised
+CODE_ADDRESSES = ("G", "M")   # their numbers name a function: `G1` is one unit, as `M8`
 # Float slack for Sim compared with a threshold: 0.8 * 10 must count as 8, not 8.000…1.
 TOLERANCE = 1e-9
 
 Units = tuple[str, ...]
+
+
+# The block number at the start of a line expression's NC line: `"N0380 G1 …"`, `f"/N20 X{x}"`.
+_BLOCK_NUMBER = re.compile(r"""^(\s*[fF]?["'][ \t]*/?[ \t]*)[Nn]\d+(?![\d.])[ \t]*""")
+
+
+def block_free(text: str) -> str:
+    """The line expression without the block number its NC line starts with. A block number
+    says where a line stands, not what it does: `N0380 G1 X10` and `N0400 G1 X10` are one line
+    (issue 17), compared and keyed without it."""
+    return _BLOCK_NUMBER.sub(r"\1", text, count=1)
 
 
 def nc_units(text: str) -> Units:

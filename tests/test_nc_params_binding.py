@@ -1,0 +1,211 @@
+"""A parameter binds the addresses it names (issue 17): `--params` with
+`{"diameter": {"value": 0.3, "addresses": ["D"]}}` turns only the D words of value 0.3 into
+references; an equal number at another address (the retract `R0.3` of LinuxCNC's G71 demo) stays as
+written and is reported with its line. The plain form binds every address but G M N O T $. What the
+tests expect is read off the real files' words here, by a regular expression of their own."""
+from __future__ import annotations
+
+import json
+import re
+from decimal import Decimal
+
+import psycopg
+import pytest
+from click.testing import CliRunner
+
+from engine.cli.app import main
+from engine.library import nc_halves
+from engine.library.nc_import import import_nc
+from engine.templates.decision_table import compiled_template
+from engine.templates.store import load_template
+
+from test_nc_import import DATA, real_files, stored_at
+from test_nc_line_endings import written_back
+
+DEMO = "linuxcnc/lathe_g70_71_demo.ngc"      # D0.3 (cutter compensation) and R0.3 (G71's retract)
+CAM = "sinumerik/cam_840dsl/CAM_TEST.MPF"    # I4.25 and J4.25 (arc centres)
+# (file, parameter, its value, the address it binds, the other value that keeps its spelling)
+CASES = [(DEMO, "diameter", "0.3", "D", "0.4"), (CAM, "radius", "4.25", "I", "4.75")]
+OTHER = {DEMO: {"feed": 400}, CAM: {"feed": 250}}
+
+WORD = re.compile(r"(?<![A-Za-z_$#])([A-Za-z])(\s*=?\s*)([+-]?(?:\d+\.?\d*|\.\d+))")
+COMMENT = re.compile(r";.*|\([^()]*\)")
+
+
+def words(relative: str) -> list[tuple[int, str, str, str]]:
+    """(line, address upper case, the word as written, its number) of every word outside comments."""
+    found = []
+    for number, line in enumerate((DATA / relative).read_text().splitlines(), start=1):
+        code = COMMENT.sub(lambda match: " " * len(match.group()), line)
+        found += [(number, match.group(1).upper(), match.group(), match.group(3)) for match in WORD.finditer(code)]
+    return found
+
+
+def equal_words(relative: str, value: str) -> list[tuple[int, str, str, str]]:
+    return [word for word in words(relative) if Decimal(word[3]) == Decimal(value)]
+
+
+def stored_rows(conn, gear_class: str) -> dict[int, str]:
+    """Line number → the stored `o` of its template row (row id 10 per line)."""
+    return {row_id // 10: o for row_id, o in conn.execute(
+        "SELECT t.id, c.o FROM class_template(%s) t JOIN component c ON c.id = t.component_id ORDER BY t.id",
+        (gear_class,))}
+
+
+def instantiated(conn, gear_class: str, params: dict) -> list[str]:
+    return compiled_template(load_template(conn, gear_class)).run(params).lines
+
+
+def bound_form(parameter: str, value: str, address: str, relative: str) -> dict:
+    return {parameter: {"value": float(value), "addresses": [address]}, **OTHER[relative]}
+
+
+@pytest.mark.parametrize("relative, parameter, value, address, other", CASES)
+def test_a_bound_parameter_becomes_a_reference_only_at_its_address(conn, relative, parameter, value, address, other):
+    real_files()
+    equal = equal_words(relative, value)
+    at_address = [word for word in equal if word[1] == address]
+    elsewhere = [word for word in equal if word[1] not in (address, "G", "M")]
+    assert at_address and elsewhere, "the file no longer holds the value at two addresses"
+    report = import_nc(conn, DATA / relative, "nc_bound", bound_form(parameter, value, address, relative))
+
+    rows = stored_rows(conn, "nc_bound")
+    assert {line for line, o in rows.items() if "{" + parameter in o} == {line for line, *_ in at_address}
+    for line, _, word, _ in elsewhere:
+        assert word in rows[line] and rows[line].count("{" + parameter) == sum(
+            1 for found in at_address if found[0] == line)
+    assert report.left_alone == [{"line": line, "word": word, "parameter": parameter}
+                                 for line, _, word, _ in elsewhere]
+    assert report.bindings[0] == {"parameter": parameter, "addresses": [address], "binds": address,
+                                  "words": len(at_address), "at": {address: len(at_address)}}
+
+
+@pytest.mark.parametrize("relative, parameter, value, address, other", CASES)
+def test_a_new_value_changes_only_the_bound_words(conn, relative, parameter, value, address, other):
+    params = bound_form(parameter, value, address, relative)
+    import_nc(conn, DATA / relative, "nc_bound", params)
+    original = (DATA / relative).read_text().splitlines()
+    expected = list(original)
+    for line, found_address, word, number in equal_words(relative, value):
+        if found_address == address:
+            expected[line - 1] = expected[line - 1].replace(word, word[:-len(number)] + other, 1)
+    assert expected != original
+    assert instantiated(conn, "nc_bound", {**OTHER[relative], parameter: float(other)}) == expected
+    assert written_back(conn, "nc_bound", {**OTHER[relative], parameter: float(value)}) == (DATA / relative).read_bytes()
+
+
+@pytest.mark.parametrize("relative, parameter, value, address, other", CASES)
+def test_the_plain_form_binds_every_address_but_the_codes(conn, relative, parameter, value, address, other):
+    report = import_nc(conn, DATA / relative, "nc_plain", {parameter: float(value), **OTHER[relative]})
+    equal = equal_words(relative, value)
+    quantities = [word for word in equal if word[1] not in "GMNOT"]
+    rows = stored_rows(conn, "nc_plain")
+    assert {line for line, o in rows.items() if "{" + parameter in o} == {line for line, *_ in quantities}
+    assert {found for found in (word[1] for word in quantities)} > {address}
+    assert report.left_alone == [{"line": line, "word": word, "parameter": parameter}
+                                 for line, found, word, _ in equal if found in "NOT"]
+    counts = {found: sum(1 for word in quantities if word[1] == found) for found in sorted({w[1] for w in quantities})}
+    assert report.bindings[0] == {"parameter": parameter, "addresses": None, "binds": "every address but G M N O T $",
+                                  "words": len(quantities), "at": counts}
+    assert conn.execute("SELECT import_params FROM gear_class WHERE name = 'nc_plain'").fetchone()[0] == \
+        {parameter: float(value), **OTHER[relative]}
+
+
+def test_the_class_keeps_the_plain_values_of_a_bound_form(conn):
+    import_nc(conn, DATA / DEMO, "nc_bound", bound_form("diameter", "0.3", "D", DEMO))
+    assert conn.execute("SELECT import_params FROM gear_class WHERE name = 'nc_bound'").fetchone()[0] == \
+        {"diameter": 0.3, "feed": 400}
+
+
+def test_a_tool_number_equal_to_a_plain_value_is_left_alone_and_reported(conn):
+    tools = [word for word in words(DEMO) if word[1] == "T"]
+    number = tools[0][3]
+    report = import_nc(conn, DATA / DEMO, "nc_tool", {"tool": int(number)})
+    equal = equal_words(DEMO, number)
+    assert report.left_alone == [{"line": line, "word": word, "parameter": "tool"}
+                                 for line, found, word, _ in equal if found in "NOT"]
+    assert any(left["word"] == tools[0][2] for left in report.left_alone)
+    assert report.bindings[0]["words"] == sum(1 for word in equal if word[1] not in "GMNOT")
+
+
+def test_the_lines_read_in_two_processes_report_what_one_process_reports(conn, monkeypatch):
+    params = bound_form("radius", "4.25", "I", CAM)
+    monkeypatch.setattr(nc_halves, "TWO_PROCESSES_FROM", 10**9)
+    alone = import_nc(conn, DATA / CAM, "nc_alone", params)
+    monkeypatch.setattr(nc_halves, "TWO_PROCESSES_FROM", 100)
+    forked = import_nc(conn, DATA / CAM, "nc_forked", params)
+    assert (forked.bindings, forked.left_alone) == (alone.bindings, alone.left_alone)
+    assert forked.left_alone[0]["line"] < len((DATA / CAM).read_text().splitlines()) / 2 < forked.left_alone[-1]["line"]
+
+
+def test_two_parameters_binding_the_same_address_use_the_first_given(conn):
+    params = {"first": {"value": 0.3, "addresses": ["R"]}, "second": {"value": 0.3, "addresses": ["R", "D"]}}
+    report = import_nc(conn, DATA / DEMO, "nc_shared", params)
+    equal = equal_words(DEMO, "0.3")
+    assert report.ambiguous == {"0.3": ["first", "second"]}
+    assert [(binding["parameter"], binding["at"]) for binding in report.bindings] == [
+        ("first", {"R": sum(1 for word in equal if word[1] == "R")}),
+        ("second", {"D": sum(1 for word in equal if word[1] == "D")})]
+
+
+# --- the command ---------------------------------------------------------------------------
+
+@pytest.fixture
+def run(fresh_database_url):
+    def invoke(*args):
+        return CliRunner().invoke(main, ["--database-url", fresh_database_url, *map(str, args)])
+    invoke.url = fresh_database_url
+    return invoke
+
+
+def rows_at(url, gear_class: str) -> dict[int, str]:
+    with psycopg.connect(url) as connection:
+        return stored_rows(connection, gear_class)
+
+
+def test_the_command_lists_bindings_and_warns_once_per_word_left_alone(run, tmp_path):
+    params = tmp_path / "p.json"
+    params.write_text(json.dumps(bound_form("diameter", "0.3", "D", DEMO)))
+    result = run("import-nc", DATA / DEMO, "--class", "nc_cli", "--params", params)
+    assert result.exit_code == 0, result.output
+    elsewhere = [word for word in equal_words(DEMO, "0.3") if word[1] != "D"]
+    warnings = [line for line in result.stderr.splitlines() if "left as written" in line]
+    assert len(warnings) == len(elsewhere)
+    for (line, _, word, _), warning in zip(elsewhere, warnings):
+        assert f"line {line}:" in warning and word in warning and "diameter" in warning
+    assert any(line.strip().startswith("diameter → D: 1 word(s)") for line in result.stdout.splitlines())
+    assert any(line.strip().startswith("feed → every address but G M N O T $") for line in result.stdout.splitlines())
+
+
+def test_the_csv_addresses_column_binds_as_the_json_form(run, tmp_path):
+    (tmp_path / "p.json").write_text(json.dumps({"diameter": {"value": 0.3, "addresses": ["D"]}, "feed": 400}))
+    (tmp_path / "p.csv").write_text("name,value,addresses\ndiameter,0.3,D\nfeed,400,\n")
+    (tmp_path / "semicolon.csv").write_text("name;value;addresses\ndiameter;0,3;D\nfeed;400;\n")
+    reports = {}
+    for name in ("p.json", "p.csv", "semicolon.csv"):
+        result = run("import-nc", DATA / DEMO, "--class", "nc_" + name.replace(".", "_"), "--params",
+                     tmp_path / name, "--json")
+        assert result.exit_code == 0, result.output
+        reports[name] = json.loads(result.stdout)
+    assert reports["p.csv"]["left_alone"] == reports["p.json"]["left_alone"] == reports["semicolon.csv"]["left_alone"]
+    assert reports["p.csv"]["left_alone"] and reports["p.csv"]["bindings"] == reports["p.json"]["bindings"]
+    assert rows_at(run.url, "nc_p_csv") == rows_at(run.url, "nc_p_json") == rows_at(run.url, "nc_semicolon_csv")
+
+
+@pytest.mark.parametrize("given, words_said", [
+    ('{"feed": {"value": 400}}', "parameter 'feed'"),
+    ('{"feed": {"value": 400, "addresses": "F"}}', "parameter 'feed'"),
+    ('{"feed": {"value": 400, "addresses": []}}', "parameter 'feed'"),
+    ('{"feed": {"value": 400, "addresses": ["F1"]}}', "parameter 'feed'"),
+    ('{"feed": {"value": 400, "adresses": ["F"]}}', "parameter 'feed'"),
+    ("name,value,addresses\nfeed,400,F1\n", "line 2, column addresses"),
+])
+def test_a_bad_bound_form_is_refused_in_one_line_and_nothing_is_stored(run, tmp_path, given, words_said):
+    params = tmp_path / ("p.json" if given.startswith("{") else "p.csv")
+    params.write_text(given)
+    before = stored_at(run.url)
+    result = run("import-nc", DATA / DEMO, "--class", "nc_refused", "--params", params)
+    assert result.exit_code == 1, result.output
+    message = result.stderr.strip()
+    assert len(message.splitlines()) == 1 and words_said in message and str(params) in message
+    assert stored_at(run.url) == before
