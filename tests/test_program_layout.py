@@ -194,13 +194,33 @@ def test_a_csv_without_the_layout_columns_leaves_the_class_layout(engine, tmp_pa
     assert class_layout_stored(engine.url, "spur") == (CRLF, False)
 
 
-def test_a_csv_giving_two_layouts_is_refused_naming_the_line(engine, tmp_path):
+def test_an_lf_class_exports_the_seven_columns_it_always_had(engine):
     exported = engine("template", "export", "--class", "spur").stdout
+    assert exported.splitlines()[0] == "id,t,n,p_calc,s,o,p_emit"
+
+
+def edited_layout(exported: str, cells: dict) -> str:
+    """The CSV with the layout cells of each row replaced: cells[line number] or else cells[None]."""
     lines = exported.splitlines()
-    assert lines[3].endswith(",lf,yes")
-    lines[3] = lines[3].removesuffix(",lf,yes") + ",crlf,yes"
+    assert all(line.endswith(",crlf,no") for line in lines[1:])   # no cell of the spur rows spans lines
+    return "\n".join([lines[0]] + [line.removesuffix(",crlf,no") + cells.get(number, cells[None])
+                                   for number, line in enumerate(lines[1:], start=2)]) + "\n"
+
+
+def test_the_csv_can_make_a_class_lf_again_and_blank_cells_take_the_others(engine, tmp_path):
+    set_layout(engine.url, "spur", CRLF, False)
     edited = tmp_path / "edited.csv"
-    edited.write_text("\n".join(lines) + "\n")
+    edited.write_text(edited_layout(engine("template", "export", "--class", "spur").stdout, {None: ",lf,yes", 3: ",,"}))
+    imported = engine("template", "import", "--class", "spur", edited)
+    assert imported.exit_code == 0 and "LF, final newline" in imported.stdout, imported.output
+    assert class_layout_stored(engine.url, "spur") == (LF, True)
+
+
+def test_a_csv_giving_two_layouts_is_refused_naming_the_line(engine, tmp_path):
+    set_layout(engine.url, "spur", CRLF, False)
+    edited = tmp_path / "edited.csv"
+    edited.write_text(edited_layout(engine("template", "export", "--class", "spur").stdout,
+                                    {None: ",lf,yes", 4: ",crlf,yes"}))
     refused = engine("template", "import", "--class", "spur", edited)
     assert refused.exit_code == 1 and f"{edited}, line 4, column line_ending" in refused.stderr, refused.output
-    assert class_layout_stored(engine.url, "spur") == (LF, True)
+    assert class_layout_stored(engine.url, "spur") == (CRLF, False)

@@ -19,7 +19,8 @@ CLASS_COLUMNS = (Column("class", "class"), Column("parent", "parent"), Column("v
 @click.group()
 def template():
     """Templates of gear classes: list, export and import as CSV (id,t,n,p_calc,s,o,p_emit, and
-    the class's line_ending,final_newline); history, diff and restore of their versions."""
+    line_ending,final_newline for a class not LF with a final newline); history, diff and restore
+    of their versions."""
 
 
 template.add_command(template_shared)   # which classes share each row: reported with the refactor
@@ -46,9 +47,9 @@ def template_list(ctx, output):
 @click.option("--out", type=click.Path(dir_okay=False), help="Write to this file instead of stdout.")
 @click.pass_context
 def template_export(ctx, gear_class, out):
-    """Print the class's assembled template as CSV, each row with the class's line ending and
-    final newline (line_ending lf|crlf, final_newline yes|no), so an import elsewhere writes the
-    same bytes."""
+    """Print the class's assembled template as CSV. A class whose programs are written other than
+    LF with a final newline (imported from such a file) gives that on every row (line_ending
+    lf|crlf, final_newline yes|no), so an import elsewhere writes the same bytes."""
     from ..library.nc_layout import class_layout
     from ..templates.rows import export_csv
     from ..templates.store import load_template

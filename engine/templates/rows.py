@@ -2,13 +2,14 @@
 (design notes §4), a class's assembled template with its content hash, and the CSV form
 engineers export, edit and import.
 
-The CSV carries the class's layout (issue 17: the line ending and final newline its programs are
-written with) in two optional columns after the rows' own, `line_ending` (lf or crlf) and
-`final_newline` (yes or no), given on every row, so that a class exported and imported elsewhere
-writes the same bytes. Columns, not a comment line: the one CSV reader and any spreadsheet read
-them as they read the rest. A blank cell takes the value the other rows give; rows that disagree
-are refused. A CSV without the two columns (older exports, hand-written files) leaves the class's
-stored layout as it is."""
+The CSV of a class whose programs are not written LF with a final newline (an imported CRLF
+file, or one without a final newline: issue 17) carries that layout in two more columns after the
+rows' own, `line_ending` (lf or crlf) and `final_newline` (yes or no), on every row, so that the
+class exported and imported into a fresh database writes the same bytes. Columns, not a comment
+line: the one CSV reader and any spreadsheet read them as they read the rest. A blank cell takes
+the value the other rows give; rows that disagree are refused. The CSV of any other class is as it
+always was (seven columns: scripts and hand-added rows keep working), and a CSV without the two
+columns leaves the class's stored layout as it is; to make a class LF again, give them (lf, yes)."""
 from __future__ import annotations
 
 import ast
@@ -105,13 +106,13 @@ class TemplateCsv:
     layout: NcLayout | None
 
 
-def export_csv(template: Template, layout: NcLayout | None = None) -> str:
-    """The assembled template as CSV: id,t,n,p_calc,s,o,p_emit (absent = empty cell), and with
-    `layout` the class's line_ending,final_newline on every row."""
+def export_csv(template: Template, layout: NcLayout = NcLayout()) -> str:
+    """The assembled template as CSV: id,t,n,p_calc,s,o,p_emit (absent = empty cell), and the
+    class's line_ending,final_newline on every row unless `layout` is LF with a final newline."""
     buffer = io.StringIO()
     writer = csv.writer(buffer, lineterminator="\n")
-    given = layout_cells(layout) if layout is not None else []
-    writer.writerow(CSV_COLUMNS + LAYOUT_COLUMNS if layout is not None else CSV_COLUMNS)
+    given = layout_cells(layout) if layout != NcLayout() else []
+    writer.writerow(CSV_COLUMNS + LAYOUT_COLUMNS if given else CSV_COLUMNS)
     for row in template.rows:
         writer.writerow(["" if value is None else value for value in astuple(row)] + given)
     return buffer.getvalue()
@@ -182,13 +183,14 @@ def _layout(file: CsvFile) -> NcLayout | None:
 
 def _one_value(file: CsvFile, column: str):
     """The one value the rows give in the column, None if none does; rows that differ are refused."""
-    given = [(line, _layout_value(file, column, line, record)) for line, record in file.rows()
-             if record[column].strip()]
-    other = next((line for line, value in given if value != given[0][1]), None)
+    given = [(line, record[column].strip(), _layout_value(file, column, line, record))
+             for line, record in file.rows() if record[column].strip()]
+    other = next(((line, cell) for line, cell, value in given if value != given[0][2]), None)
     if other is not None:
-        raise refuse(file.source, f"{column} differs from line {given[0][0]}'s", "a class has one layout: give the "
-                     "same value on every row, or leave the cell blank", other, column)
-    return given[0][1] if given else None
+        raise refuse(file.source, f"{other[1]!r} differs from {given[0][1]!r} on line {given[0][0]}",
+                     "a class has one layout: give the same value on every row, or leave the cell blank",
+                     other[0], column)
+    return given[0][2] if given else None
 
 
 def _layout_value(file: CsvFile, column: str, line: int, record: dict):
