@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import re
+from functools import partial
 
 import click
 
@@ -101,14 +102,14 @@ def instantiate(ctx, gear_id, job_id, gear_range, job_range, all_gears, out, for
                       feed_mode=feed_mode, tailstock=tailstock, worm_feed=worm_feed,
                       allowance=allowance)
     overrides = {"hob_speed": hob_speed}
-    config = settings(ctx)   # the config file: the machine's output folder and line endings
+    config = settings(ctx)   # the config file: the machine's output folder and line endings (over the class's)
     new_job_written = not (dry_run or job_id is not None or job_range)   # a dry run writes no file
     out = output_folder(config, machine, out) if new_job_written else out
     if force and not out:
         raise EngineError("--force replaces files in --out: give --out too")
     skip_bad = where_it_applies(ctx, "skip_bad", skip_bad, not skip_bad or batch,
                                 "--skip-bad skips the bad gears of a batch: use it with --gears, --jobs or --all")
-    with connection(ctx) as conn, line_endings(line_ending(config, machine)):
+    with connection(ctx) as conn, line_endings(partial(line_ending, config)):
         if gear_id is not None:
             program = instantiate_gear(conn, gear_id, machine=machine, choices=choices, overrides=overrides, out=out,
                                        force=force, draft=draft, dry_run=dry_run)

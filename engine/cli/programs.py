@@ -27,6 +27,7 @@ RECORD_FIELDS = (  # (label, the value of a ProgramRecord)
     ("input hash", lambda record: record.input_hash or "-"),
     ("stored by", lambda record: record.stored_by or "-"),
     ("stored at", lambda record: record.created_at.isoformat(timespec="seconds")),
+    ("layout", lambda record: record.layout.said),
 )
 
 
@@ -66,7 +67,8 @@ def programs_list(ctx, gear_class, gear_id, job_id, draft, released, since, unti
               help="Print one JSON line: {programs: [{program_id, job_id, gear_id, class, ..., lines}]}.")
 @click.pass_context
 def programs_show(ctx, program_id, prefix, as_json):
-    """Show a stored program's record and its lines, by PROGRAM_ID or by --hash.
+    """Show a stored program's record and its lines, by PROGRAM_ID or by --hash. The lines are
+    printed with the class's line ending and final newline (an imported class: its file's).
 
     The lineage line of a file on the control, e.g.
     `; PROGRAM 812 TEMPLATE spur v4 1f3a9c07 INPUT 5be02d11`, leads to its record
@@ -82,14 +84,14 @@ def programs_show(ctx, program_id, prefix, as_json):
         emit_json({"programs": [record.as_dict() for record in found]})
         return
     for number, record in enumerate(found):
-        if number:
-            click.echo("")
+        if number:   # a blank line between programs (after one without a final newline, its line ends first)
+            click.echo("" if found[number - 1].layout.final_newline else "\n")
         _echo_record(record)
 
 
 def _echo_record(record) -> None:
+    """The record, then the program with its class's line ending and final newline."""
     for label, value in RECORD_FIELDS:
         click.echo(f"{label + ':':15}{value(record)}")
     click.echo(f"{'lines:':15}{len(record.lines)}")
-    for line in record.lines:
-        click.echo(line)
+    click.echo(record.text, nl=False)

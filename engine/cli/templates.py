@@ -18,8 +18,9 @@ CLASS_COLUMNS = (Column("class", "class"), Column("parent", "parent"), Column("v
 
 @click.group()
 def template():
-    """Templates of gear classes: list, export and import as CSV (id,t,n,p_calc,s,o,p_emit);
-    history, diff and restore of their versions."""
+    """Templates of gear classes: list, export and import as CSV (id,t,n,p_calc,s,o,p_emit, and
+    line_ending,final_newline for a class not LF with a final newline); history, diff and restore
+    of their versions."""
 
 
 template.add_command(template_shared)   # which classes share each row: reported with the refactor
@@ -46,12 +47,15 @@ def template_list(ctx, output):
 @click.option("--out", type=click.Path(dir_okay=False), help="Write to this file instead of stdout.")
 @click.pass_context
 def template_export(ctx, gear_class, out):
-    """Print the class's assembled template as CSV."""
+    """Print the class's assembled template as CSV. A class whose programs are written other than
+    LF with a final newline (imported from such a file) gives that on every row (line_ending
+    lf|crlf, final_newline yes|no), so an import elsewhere writes the same bytes."""
+    from ..library.nc_layout import class_layout
     from ..templates.rows import export_csv
     from ..templates.store import load_template
 
     with connection(ctx) as conn:
-        text = export_csv(load_template(conn, gear_class))
+        text = export_csv(load_template(conn, gear_class), class_layout(conn, gear_class))
     if out:
         with open(out, "w", encoding="utf-8", newline="") as file:
             file.write(text)
@@ -65,18 +69,24 @@ def template_export(ctx, gear_class, out):
 @click.argument("csv_file", type=click.Path(dir_okay=False))
 @click.pass_context
 def template_import(ctx, gear_class, parent, csv_file):
-    """Replace the class's rows with CSV_FILE; every expression is checked first (all or nothing)."""
-    from ..templates.rows import read_csv
+    """Replace the class's rows with CSV_FILE; every expression is checked first (all or nothing).
+    The line_ending and final_newline columns, if the CSV has them, set the class's layout; a CSV
+    without them leaves it as it is."""
+    from ..library.nc_layout import class_layout, store_layout
+    from ..templates.rows import read_template_csv
     from ..templates.store import ensure_class, replace_template
 
-    rows = read_csv(csv_file)
+    read = read_template_csv(csv_file)
     with connection(ctx) as conn:
         with conn.transaction():
             created = ensure_class(conn, gear_class, parent)
-            changed = replace_template(conn, gear_class, rows)
+            changed = replace_template(conn, gear_class, read.rows)
+            if read.layout is not None:
+                store_layout(conn, gear_class, read.layout)
         version = conn.execute("SELECT template_version FROM gear_class WHERE name = %s", (gear_class,)).fetchone()[0]
+        layout = class_layout(conn, gear_class)
     state = "created" if created else ("replaced" if changed else "unchanged (identical rows)")
-    click.echo(f"class {gear_class}: {state}, {len(rows)} rows, version {version}")
+    click.echo(f"class {gear_class}: {state}, {len(read.rows)} rows, version {version}, {layout.said}")
 
 
 @template.command("history")

@@ -4,18 +4,31 @@ file is one component; the class keeps the layout (gear_class.line_ending, .fina
 its program is written back with it, byte for byte."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from ..errors import EngineError
 from ..names import shown
 
 LF, CRLF = "\n", "\r\n"
+ENDING_NAMES = {LF: "lf", CRLF: "crlf"}   # as the config file and a template CSV write them
 
 
 @dataclass(frozen=True)
 class NcLayout:
+    """LF with a final newline is what the engine's own classes write; an imported class keeps its file's."""
     line_ending: str = LF
     final_newline: bool = True
+
+    @property
+    def said(self) -> str:
+        """"CRLF, no final newline": the layout in words, for reports."""
+        ending = ENDING_NAMES[self.line_ending].upper()
+        return f"{ending}, {'final newline' if self.final_newline else 'no final newline'}"
+
+    def ending_from(self, ending: str | None) -> NcLayout:
+        """This layout with another line ending, if one is given (a machine's, from the config
+        file); the final newline stays the class's."""
+        return self if ending is None else replace(self, line_ending=ending)
 
 
 def split_nc_text(path, text: str) -> tuple[list[str], NcLayout]:

@@ -122,4 +122,4 @@ def dry_program(conn, planned: Planned, job_id: int | None) -> Program:
     lines, row_ids = lineage.added(DRY_RUN_ID, job_id, planned.machine, template.gear_class, template.version,
                                    template.hash, planned.result.lines, planned.result.row_ids)
     return Program(None, job_id, planned.name, lines, planned.gear_class, template.version, template.hash,
-                   None, planned.result.trace, row_ids, tuple(planned.notes))
+                   None, planned.result.trace, row_ids, tuple(planned.notes), planned.layout)

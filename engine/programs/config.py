@@ -15,6 +15,13 @@ programs go.
 
     [machines.hobber-840d]
     out = "/srv/nc/hobber"           # instantiate writes here when --out is not given
+    line_endings = "lf"              # this machine's files: LF, whatever the file-wide setting
+
+A program file is written with its class's layout (LF and a final newline, or what the file an
+imported class came from had: engine.library.nc_layout). A line ending set here overrides only the
+line ending, for the files of the machine it is set for (its table's, else the file-wide one); the
+final newline stays the class's. Unset, the class decides: a CRLF program imported from a file
+comes back CRLF.
 """
 from __future__ import annotations
 
@@ -25,6 +32,7 @@ from pathlib import Path
 
 from ..errors import EngineError
 from ..gears.records import DEFAULT_HOBBING_MACHINE
+from ..library.nc_layout import ENDING_NAMES
 
 try:
     import tomllib
@@ -32,7 +40,7 @@ except ModuleNotFoundError:   # Python 3.10
     import tomli as tomllib
 
 APP = "nc-template-engine"
-LINE_ENDINGS = {"lf": "\n", "crlf": "\r\n"}
+LINE_ENDINGS = {name: ending for ending, name in ENDING_NAMES.items()}   # "lf": "\n", "crlf": "\r\n"
 SETTINGS = ("machine", "line_endings", "machines")   # top-level keys that are not command options
 MACHINE_SETTINGS = ("out", "line_endings")
 
@@ -42,7 +50,7 @@ class Config:
     path: Path | None = None
     commands: dict = field(default_factory=dict)   # everything that is not a setting: option defaults
     machine: str | None = None
-    line_endings: str = "lf"
+    line_endings: str | None = None   # None: each class's own (engine.library.nc_layout)
     machines: dict = field(default_factory=dict)   # machine name -> {out, line_endings}
     text: str = ""
 
@@ -82,7 +90,7 @@ def _read(path: Path) -> str:
 def _settings(path: Path, text: str, data: dict) -> Config:
     machines = data.get("machines", {})
     config = Config(path, {key: value for key, value in data.items() if key not in SETTINGS},
-                    data.get("machine"), data.get("line_endings", "lf"), machines, text)
+                    data.get("machine"), data.get("line_endings"), machines, text)
     if config.machine is not None and not isinstance(config.machine, str):
         raise config_error(config, "machine", "give a machine name in quotes, e.g. \"hobber-840d\"")
     _check_line_endings(config, config.line_endings)
@@ -99,11 +107,11 @@ def _check_machine(config: Config, entry: dict) -> None:
             raise config_error(config, key, f"a machine's table takes {', '.join(MACHINE_SETTINGS)}")
         if not isinstance(value, str):
             raise config_error(config, key, "give the value in quotes")
-    _check_line_endings(config, entry.get("line_endings", "lf"))
+    _check_line_endings(config, entry.get("line_endings"))
 
 
 def _check_line_endings(config: Config, value) -> None:
-    if value not in LINE_ENDINGS:
+    if value is not None and value not in LINE_ENDINGS:
         raise config_error(config, "line_endings", f"{value!r} is not one of {', '.join(map(repr, LINE_ENDINGS))}")
 
 
@@ -128,7 +136,9 @@ def output_folder(config: Config, machine: str | None, out: str | None) -> str |
     return os.path.join(os.path.expanduser(folder), "")
 
 
-def line_ending(config: Config, machine: str | None = None) -> str:
-    """The line ending of written program files: the machine's, else the file's, else LF."""
+def line_ending(config: Config, machine: str | None = None) -> str | None:
+    """The line ending the file sets for the machine's program files: the machine's table's, else
+    the file-wide one; None when neither is set (each program's class decides)."""
     entry = config.machines.get(machine or config.machine or DEFAULT_HOBBING_MACHINE, {})
-    return LINE_ENDINGS[entry.get("line_endings", config.line_endings)]
+    name = entry.get("line_endings", config.line_endings)
+    return None if name is None else LINE_ENDINGS[name]

@@ -17,13 +17,14 @@ from ..gears.models import model_for_class
 from ..gears.process_notes import hunting_tooth_notes
 from ..gears.records import Gear, Machine, hobbing_machine, load_gear, load_gears, load_hobs
 from ..hobbing.choices import Choices
+from ..library.nc_layout import NcLayout, class_layout
 from ..memory import no_cycle_collection
 from ..templates.rows import Template
 from ..templates.versions import runnable_template
 from ..turning.names import TurningModel
 from .batches import Bad, checked, dry_batch, dry_program, good_ones, planned_or_bad, read_only, reason_of, \
     refuse_out_in_dry_run
-from .outputs import ProgramFiles, files_after_commit
+from .outputs import ProgramFiles, file_layouts, files_after_commit
 from .verified_run import Workpiece, run_template
 from .verifier import LimitError, check_table_speed
 from .records import Planned, Program
@@ -45,6 +46,7 @@ class Planner:
         self.choices = choices
         self.overrides = overrides or {}
         self._templates: dict[str, Template] = {}
+        self._layouts: dict[str, NcLayout] = {}   # each class's line ending and final newline, read with its template
         self._models: dict[str, object] = {}
         self._refused: dict[str, EngineError] = {}   # a class whose model or template failed, once
 
@@ -52,6 +54,7 @@ class Planner:
         if gear_class not in self._templates:
             self._templates[gear_class] = self._remembering_refusal(gear_class, runnable_template, self.conn,
                                                                     gear_class, self.draft)
+            self._layouts[gear_class] = class_layout(self.conn, gear_class)
         return self._templates[gear_class]
 
     def _remembering_refusal(self, gear_class: str, read, *args):
@@ -95,7 +98,7 @@ class Planner:
         record = job_cutting_record(cutting, gear, hob, kinds, case_ids)
         notes = [f"gear {gear.id}: {note}" for note in cutting.notes] + hunting_tooth_notes(gear, hob)
         return Planned(gear.id, gear.gear_class, self.machine.name, hob.id, job.params,
-                       job.module_params, template, result, record, notes)
+                       job.module_params, template, result, record, notes, self._layouts[gear.gear_class])
 
     def cutting_data(self, gear: Gear, hob) -> tuple:
         """Cutting data from the nearest cases of the machining history (overrides applied),
@@ -155,7 +158,7 @@ def instantiate_gears(conn, first: int | None = None, last: int | None = None, *
         encoded, skipped = good_ones(outcomes, "gear", skip_bad)
         if dry_run:
             return dry_batch(encoded, skipped)
-        files.plan([(item.name, item.lines) for item in encoded])
+        files.plan([(item.name, item.lines) for item in encoded], file_layouts(encoded))
         batch = store_many(conn, encoded, out, files)
     return replace(batch, skipped=skipped)
 
@@ -192,7 +195,7 @@ def store_planned(conn, planned: list[Planned], files: ProgramFiles,
                   existing_job: int | None = None) -> list[Program]:
     """Store the programs (and their jobs, unless `existing_job`); their files are checked now
     and written by `files` after the caller's COMMIT."""
-    paths = files.plan([(item.name, item.lines) for item in planned])
+    paths = files.plan([(item.name, item.lines) for item in planned], file_layouts(planned))
     programs = [store_one(conn, item, existing_job, paths.get(item.name)) for item in planned]
     files.replace_texts({program.name: program.lines for program in programs})
     return programs

@@ -1,7 +1,8 @@
 """A stored program found from what an operator has in hand (`engine programs show`): its id, or
 the hash on its lineage line (engine.programs.lineage) read off a file on the control, the INPUT
 hash of the job's parameters or the TEMPLATE hash of the version it was made from; and the
-programs stored, filtered (`engine programs list`)."""
+programs stored, filtered (`engine programs list`). A program is shown with its class's layout
+(line ending, final newline: engine.library.nc_layout)."""
 from __future__ import annotations
 
 import re
@@ -10,13 +11,14 @@ from datetime import date, datetime
 
 from ..db.listing import day_range, records, require_class
 from ..errors import EngineError
+from ..library.nc_layout import ENDING_NAMES, NcLayout, nc_text
 
 MIN_HASH_DIGITS = 8   # what the lineage line shows
 HASH_PREFIX = re.compile(r"[0-9a-f]{8,64}")
 RECORD = """
 SELECT p.id, p.job_id, j.gear_id, p.gear_class, p.template_version, p.draft, p.template_hash, p.input_hash,
-       p.stored_by, p.created_at, p.name, p.lines
-FROM program p JOIN job j ON j.id = p.job_id"""
+       p.stored_by, p.created_at, p.name, p.lines, c.line_ending, c.final_newline
+FROM program p JOIN job j ON j.id = p.job_id JOIN gear_class c ON c.name = p.gear_class"""
 BY_ID = RECORD + " WHERE p.id = %s"
 # left(…, 8) is what the indexes of migration 0015 hold; the LIKE then checks the longer prefix.
 BY_HASH = RECORD + """
@@ -40,12 +42,21 @@ class ProgramRecord:
     created_at: datetime
     name: str
     lines: list[str]
+    layout: NcLayout = NcLayout()   # the class's line ending and final newline
+
+    @property
+    def text(self) -> str:
+        """The program with its class's line ending and final newline."""
+        return nc_text(self.lines, self.layout)
 
     def as_dict(self) -> dict:
-        """The record with the common key names (program_id, class) and its lines."""
+        """The record with the common key names (program_id, class), its lines and its class's
+        layout as the config file and a template CSV name it (line_ending "lf" or "crlf")."""
         fields = asdict(self)
+        del fields["layout"]
         return {"program_id": fields.pop("id"), "class": fields.pop("gear_class"), **fields,
-                "created_at": self.created_at.isoformat()}
+                "created_at": self.created_at.isoformat(), "line_ending": ENDING_NAMES[self.layout.line_ending],
+                "final_newline": self.layout.final_newline}
 
 
 def find_programs(conn, program_id: int | None = None, prefix: str | None = None) -> list[ProgramRecord]:
@@ -61,17 +72,22 @@ def program_record(conn, program_id: int) -> ProgramRecord:
     if found is None:
         raise EngineError(f"program {program_id} does not exist; find it by its lineage line with "
                           "`engine programs show --hash H`")
-    return ProgramRecord(*found)
+    return _record(found)
 
 
 def programs_with_hash(conn, prefix: str) -> list[ProgramRecord]:
     """Every program whose INPUT hash or TEMPLATE hash starts with `prefix` (8 or more hex digits,
     as on the lineage line); EngineError if none does."""
     prefix = checked_prefix(prefix)
-    found = [ProgramRecord(*row) for row in conn.execute(BY_HASH, {"prefix": prefix})]
+    found = [_record(row) for row in conn.execute(BY_HASH, {"prefix": prefix})]
     if not found:
         raise EngineError(f"no program has an input or template hash starting with {prefix}")
     return found
+
+
+def _record(row: tuple) -> ProgramRecord:
+    *fields, line_ending, final_newline = row
+    return ProgramRecord(*fields, NcLayout(line_ending, final_newline))
 
 
 def checked_prefix(text: str) -> str:

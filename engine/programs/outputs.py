@@ -15,8 +15,12 @@ Files are refused before anything is stored: a name that is not an 840D program 
 name that would land outside --out, two programs of one run whose names differ only in case
 (the control does not tell case), and an existing file without --force.
 
-Lines end with LF, or with what `line_endings(...)` sets for the block (a control that wants
-CR LF; engine.programs.config): only the bytes of the file change, never the stored lines.
+A file is written with its class's layout (issue 17: gear_class.line_ending and final_newline,
+LF with a final newline unless the class was imported from a file that had another), so an
+imported program comes back byte for byte. A line ending configured for the program's machine
+(the config file, set for the block by `line_endings(...)`; engine.programs.config) replaces the
+class's line ending in that machine's files, for a control that wants CR LF; the final newline
+stays the class's. Only the bytes of the file change, never the stored lines.
 """
 from __future__ import annotations
 
@@ -26,18 +30,21 @@ import errno
 import os
 import secrets
 from pathlib import Path
+from typing import Callable
 
 import psycopg
 from psycopg.pq import TransactionStatus
 
 from ..errors import EngineError
+from ..library.nc_layout import NcLayout, nc_text
 from ..names import checked
 
 SUFFIX = ".MPF"
 # errno of open(O_TMPFILE) where the kernel or the file system does not support it
 NO_TMPFILE = (errno.EOPNOTSUPP, errno.EISDIR, errno.EINVAL, errno.ENOENT)
 PROC_FD = Path("/proc/self/fd")
-LINE_ENDING = contextvars.ContextVar("line_ending", default="\n")
+# machine name -> the line ending configured for its files, or None (its class's)
+CONFIGURED_ENDING = contextvars.ContextVar("configured_ending", default=None)
 
 
 class ProgramFiles:
@@ -52,15 +59,20 @@ class ProgramFiles:
         self.folder = batch or (out is not None and str(out).endswith(os.sep))
         self.texts: dict[Path, bytes] = {}
         self.paths: dict[str, Path] = {}
+        self.layouts: dict[str, NcLayout] = {}
 
-    def plan(self, programs: list[tuple[str, list[str]]]) -> dict[str, str]:
-        """{program name: path} for (name, lines) of each program; EngineError if any file cannot be written."""
+    def plan(self, programs: list[tuple[str, list[str]]],
+             layouts: dict[str, NcLayout] | None = None) -> dict[str, str]:
+        """{program name: path} for (name, lines) of each program, each file written with its
+        layout by name (file_layouts; LF and a final newline if none is given); EngineError if
+        any file cannot be written."""
         if self.out is None or not programs:
             return {}
         paths = self._targets([name for name, _ in programs])
         self._refuse_existing(list(paths.values()))
         _refuse_unwritable(paths[programs[0][0]].parent)
-        self.texts = {paths[name]: _ascii(name, lines) for name, lines in programs}
+        self.layouts = layouts or {}
+        self.texts = {paths[name]: self._bytes(name, lines) for name, lines in programs}
         self.paths = paths
         return {name: str(path) for name, path in paths.items()}
 
@@ -68,7 +80,14 @@ class ProgramFiles:
         """The planned files hold the programs as stored (with their lineage line), by program name."""
         for name, lines in stored.items():
             if name in self.paths:
-                self.texts[self.paths[name]] = _ascii(name, lines)
+                self.texts[self.paths[name]] = self._bytes(name, lines)
+
+    def _bytes(self, name: str, lines: list[str]) -> bytes:
+        try:
+            return nc_text(lines, self.layouts.get(name, NcLayout())).encode("ascii")
+        except UnicodeEncodeError:
+            raise EngineError(f"program {name} has non-ASCII characters; the control reads ASCII; nothing stored") \
+                from None
 
     def _targets(self, names: list[str]) -> dict[str, Path]:
         """One program: --out is the file (unless a folder is meant); a batch: --out is their folder."""
@@ -181,21 +200,22 @@ def _refuse_unwritable(folder: Path) -> None:
 
 
 @contextlib.contextmanager
-def line_endings(ending: str):
-    """Files planned in the block end their lines with `ending` ("\\n" or "\\r\\n")."""
-    token = LINE_ENDING.set(ending)
+def line_endings(configured: Callable[[str], str | None]):
+    """Files planned in the block for machine M end their lines with configured(M) ("\\n" or
+    "\\r\\n"), where it gives one; else with their class's."""
+    token = CONFIGURED_ENDING.set(configured)
     try:
         yield
     finally:
-        LINE_ENDING.reset(token)
+        CONFIGURED_ENDING.reset(token)
 
 
-def _ascii(name: str, lines: list[str]) -> bytes:
-    ending = LINE_ENDING.get()
-    try:
-        return (ending.join(lines) + ending).encode("ascii")
-    except UnicodeEncodeError:
-        raise EngineError(f"program {name} has non-ASCII characters; the control reads ASCII; nothing stored") from None
+def file_layouts(programs) -> dict[str, NcLayout]:
+    """{program name: the layout of its file} for programs (Planned or Encoded): the class's
+    layout, its line ending replaced by the one configured for the program's machine, if any."""
+    configured = CONFIGURED_ENDING.get()
+    return {item.name: item.layout.ending_from(configured(item.machine) if configured else None)
+            for item in programs}
 
 
 def _place(target: Path, data: bytes, replace: bool) -> None:

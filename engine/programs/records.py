@@ -6,6 +6,8 @@ import json
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
+from ..library.nc_layout import NcLayout, nc_text
+
 if TYPE_CHECKING:
     from ..templates.decision_table import Result
     from ..templates.rows import Template
@@ -24,6 +26,7 @@ class Planned:
     result: Result
     cutting: dict | None = None      # job.cutting: the cutting data chosen and their source
     notes: list = field(default_factory=list)   # what the operator should know, one line each (bounded feeds, …)
+    layout: NcLayout = NcLayout()    # the class's line ending and final newline (gear_class; issue 17)
 
     @property
     def name(self) -> str:
@@ -39,7 +42,7 @@ class Planned:
             if with_job else (None, None, None)
         return Encoded(self.gear_id, self.gear_class, self.machine, self.hob_id, *job, self.template.version,
                        self.template.hash, self.name, self.result.lines, self.result.row_ids,
-                       json.dumps(self.result.trace), tuple(self.notes))
+                       json.dumps(self.result.trace), tuple(self.notes), self.layout)
 
 
 @dataclass(frozen=True, slots=True)
@@ -60,6 +63,7 @@ class Encoded:
     row_ids: list[int]
     trace: str
     notes: tuple = ()
+    layout: NcLayout = NcLayout()
 
 
 @dataclass(frozen=True)
@@ -75,7 +79,9 @@ class Program:
     trace: dict | None = None        # engine.templates.trace: why each row emitted or not
     row_ids: list[int] | None = None  # the template row of each line
     notes: tuple = ()                 # what the operator should know, one line each (bounded feeds, …)
+    layout: NcLayout = NcLayout()     # the class's line ending and final newline
 
     @property
     def text(self) -> str:
-        return "\n".join(self.lines) + "\n"
+        """The program as its class writes it (an imported class: as its file did, byte for byte)."""
+        return nc_text(self.lines, self.layout)

@@ -15,12 +15,13 @@ from ..gears.process_notes import stored_feed_notes
 from ..gears.records import Hob, Machine, load_gear, load_hobs, load_machine
 from ..hobbing.cylindrical import program_name
 from ..hobbing.machine_job import with_cycle_time
+from ..library.nc_layout import NcLayout, class_layout
 from ..memory import no_cycle_collection
 from ..templates.rows import Template
 from ..templates.versions import runnable_template
 from .batches import checked, dry_batch, dry_program, good_ones, planned_or_bad, read_only, refuse_out_in_dry_run
 from .instantiate import store_planned
-from .outputs import files_after_commit
+from .outputs import file_layouts, files_after_commit
 from .verified_run import Workpiece, run_template
 from .records import Planned, Program
 from .storage import Batch, store_programs
@@ -37,9 +38,15 @@ class Remaker:
         self.draft = draft   # the classes' drafts (an editor trying them), not their released versions
         self._machines: dict[str, Machine] = {}
         self._templates: dict[str, Template] = {}
+        self._layouts: dict[str, NcLayout] = {}
         self._hobs: dict[str, Hob] | None = None
 
     def remade(self, job: tuple) -> Planned:
+        """The job's program planned again, to be written with its class's layout."""
+        planned = self._remade(job)
+        return replace(planned, layout=self.layout(planned.gear_class))
+
+    def _remade(self, job: tuple) -> Planned:
         job_id, gear_id, gear_class, machine_name, hob_id, params, module_params = job
         machine = self.machine(machine_name)
         if machine.kind == "lathe":   # a turning job: its passes are computed from its parameters
@@ -70,6 +77,11 @@ class Remaker:
         if name not in self._machines:
             self._machines[name] = load_machine(self.conn, name)
         return self._machines[name]
+
+    def layout(self, gear_class: str) -> NcLayout:
+        if gear_class not in self._layouts:
+            self._layouts[gear_class] = class_layout(self.conn, gear_class)
+        return self._layouts[gear_class]
 
     def template(self, gear_class: str) -> Template:
         if gear_class not in self._templates:
@@ -136,7 +148,7 @@ def instantiate_jobs(conn, first: int | None = None, last: int | None = None, *,
         good, skipped = good_ones(outcomes, "job", skip_bad)
         if dry_run:
             return dry_batch([item for _, item in good], skipped)
-        files.plan([(item.name, item.lines) for _, item in good])
+        files.plan([(item.name, item.lines) for _, item in good], file_layouts([item for _, item in good]))
         batch = store_programs(conn, [item for _, item in good], [job_id for job_id, _ in good], out, files)
     return replace(batch, skipped=skipped)
 

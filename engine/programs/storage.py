@@ -207,4 +207,4 @@ def _stored_texts(files, stored: dict) -> None:
 def _program(program_id: int, job_id: int, planned: Planned, path, lines, row_ids) -> Program:
     return Program(program_id, job_id, planned.name, lines, planned.gear_class,
                    planned.template.version, planned.template.hash, path, planned.result.trace,
-                   row_ids, tuple(planned.notes))
+                   row_ids, tuple(planned.notes), planned.layout)
