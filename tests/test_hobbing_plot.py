@@ -34,8 +34,7 @@ def drawn(conn, gear_id: int, choices: Choices):
 
 
 def artists(axes, gid: str) -> list:
-    found = [a for a in [*axes.patches, *axes.lines, *axes.texts] if a.get_gid() == gid]
-    return found
+    return [a for a in [*axes.patches, *axes.lines, *axes.texts] if a.get_gid() == gid]
 
 
 def artist(axes, gid: str):

@@ -25,9 +25,9 @@ def draw_hob_view(axes, scene) -> list[str]:
         axes.add_patch(Polygon(unit_section(unit), closed=True, facecolor=BLANK_FILL, edgecolor="0.3",
                                linewidth=0.7, gid=f"silhouette {unit.name}"))
     cut = last_cut_of(recording.cuts, recording.units[0].name)
+    pose = full_depth_pose(cut, recording.units[0]) if cut is not None else None
     drawn = ["hob view: no cut to show the hob at"]
-    if cut is not None:
-        pose = full_depth_pose(cut, recording.units[0])
+    if pose is not None:
         draw_hob(axes, scene, pose)
         drawn = draw_feeds_or_shift(axes, scene, pose)
         draw_travel(axes, scene, pose["Z"], recording.final_swivel)

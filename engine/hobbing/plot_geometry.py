@@ -93,16 +93,16 @@ def _moves_along(move, axis: str) -> bool:
     return axis in move.start and abs(move.end[axis] - move.start[axis]) > 1e-9
 
 
-def full_depth_pose(cut, unit) -> dict:
+def full_depth_pose(cut, unit) -> dict | None:
     """Where the cut stands at the unit's mid-face (its nominal full depth, §B3; a crowned gear's
     largest centre distance, §B11), else at the wheel's centre plane Y = 0 (tangential), else at
     its deepest (a plunge)."""
     middle = (unit.z_low + unit.z_high) / 2
     for axis, value in (("Z", middle), ("Y", 0.0)):
         pose = _crossing(cut.moves, axis, value)
-        if pose is not None:
+        if pose is not None and {"X", "Z"} <= pose.keys():
             return pose
-    return min((move.end for move in cut.moves), key=lambda pose: pose["X"])
+    return min(cut.poses, key=lambda pose: pose["X"], default=None)
 
 
 def _crossing(moves, axis: str, value: float) -> dict | None:
@@ -119,4 +119,4 @@ def _crossing(moves, axis: str, value: float) -> dict | None:
 
 def approach_pose(cuts) -> dict | None:
     """Where the hob stands before the first cut's first feed move: the approach (§B7)."""
-    return dict(cuts[0].moves[0].start) if cuts else None
+    return dict(cuts[0].poses[0]) if cuts and cuts[0].poses else None

@@ -67,20 +67,23 @@ def draw_setup(axes, solid) -> str:
 
 
 def draw_hob_poses(axes, scene) -> list[str]:
-    recording, hob = scene.recording, scene.hob
-    drawn = []
-    approach = approach_pose(recording.cuts)
-    if approach is not None:
-        draw_hob(axes, scene, approach, "hob at approach", "0.45", (0, (3, 2)))
-        drawn.append(f"hob {hob.id} ⌀{hob.tip_diameter:g} × {hob.length:g} at approach X{approach['X']:.3f} "
-                     f"Z{approach['Z']:.3f}")
-    for unit in recording.units:
-        cut = last_cut_of(recording.cuts, unit.name)
-        if cut is not None:
-            pose = full_depth_pose(cut, unit)
-            draw_hob(axes, scene, pose, f"hob at full depth {unit.name}", "black", "-", unit is recording.units[0])
+    """The hob at the approach (before the first feed move) and at full depth on every unit."""
+    drawn = [draw_approach(axes, scene)] if approach_pose(scene.recording.cuts) else []
+    first = scene.recording.units[0]
+    for unit in scene.recording.units:
+        cut = last_cut_of(scene.recording.cuts, unit.name)
+        pose = full_depth_pose(cut, unit) if cut is not None else None
+        if pose is not None:
+            draw_hob(axes, scene, pose, f"hob at full depth {unit.name}", "black", "-", unit is first)
             drawn.append(f"hob at full depth on {unit.name}: X{pose['X']:.3f} Z{pose['Z']:.3f}")
     return drawn
+
+
+def draw_approach(axes, scene) -> str:
+    hob, approach = scene.hob, approach_pose(scene.recording.cuts)
+    draw_hob(axes, scene, approach, "hob at approach", "0.45", (0, (3, 2)))
+    return (f"hob {hob.id} ⌀{hob.tip_diameter:g} × {hob.length:g} at approach X{approach['X']:.3f} "
+            f"Z{approach['Z']:.3f}")
 
 
 def last_cut_of(cuts, unit_name: str):
@@ -107,12 +110,11 @@ def draw_paths(axes, moves, prefix: str = "") -> None:
 
 
 def draw_pass(axes, cut, colour: str) -> str:
-    xs = [cut.moves[0].start["X"], *(move.end["X"] for move in cut.moves)]
-    zs = [cut.moves[0].start["Z"], *(move.end["Z"] for move in cut.moves)]
+    xs, zs = [pose["X"] for pose in cut.poses], [pose["Z"] for pose in cut.poses]
     axes.plot(xs, zs, color=colour, linewidth=2.0, gid=f"cut {cut.label}", label=cut.label)
     feed = cut_pass(cut)
-    if feed is None:
-        return f"{cut.label}: no feed move"
+    if feed is None or not {"X", "Z"} <= feed.start.keys():
+        return f"{cut.label}: no feed move from a known position"
     crowning = draw_crowning(axes, cut, colour) if feed.axis == "Z" else ""
     if feed.axis in ("X", "Z"):
         axes.annotate("", xy=(feed.end["X"], feed.end["Z"]), xytext=(feed.start["X"], feed.start["Z"]),
@@ -166,7 +168,7 @@ def frame_side_view(axes, scene) -> None:
     reach = hob_extent(r, scene.hob.length / 2, recording.final_swivel)
     xs = [x for unit in recording.units for x, _ in unit_section(unit)]
     zs = [z for unit in recording.units for _, z in unit_section(unit)]
-    for pose in (pose for cut in recording.cuts for move in cut.moves for pose in (move.start, move.end)):
+    for pose in (pose for cut in recording.cuts for pose in cut.poses):
         xs.append(pose["X"] + r)
         zs += [pose["Z"] - reach, pose["Z"] + reach]
     axes.set_xlim(min(xs) - MARGIN, max(xs) + MARGIN)
@@ -180,8 +182,8 @@ def draw_overview(axes, scene) -> str:
                                linewidth=0.6, gid=f"overview {unit.name}"))
     draw_paths(axes, scene.recording.moves, "overview ")
     for n, cut in enumerate(scene.recording.cuts):
-        axes.plot([m.start["X"] for m in cut.moves] + [cut.moves[-1].end["X"]],
-                  [m.start["Z"] for m in cut.moves] + [cut.moves[-1].end["Z"]], color=cut_colour(n), linewidth=1.6)
+        axes.plot([pose["X"] for pose in cut.poses], [pose["Z"] for pose in cut.poses], color=cut_colour(n),
+                  linewidth=1.6)
     draw_area(axes, scene.recording, "overview working area")
     axes.axvline(0.0, color="0.4", linewidth=0.6, linestyle="-.")
     axes.autoscale_view()

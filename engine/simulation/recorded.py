@@ -34,6 +34,12 @@ class RecordedCut:
     units: tuple           # names of the units whose material it entered
     label: str             # the program's `; CUT …` comment before it, else "cut N"
 
+    @property
+    def poses(self) -> list[dict]:
+        """Where the hob centre stands along the cut, from its start: the poses with X and Z known."""
+        every = [self.moves[0].start, *(move.end for move in self.moves)]
+        return [pose for pose in every if {"X", "Z"} <= pose.keys()]
+
 
 @dataclass
 class Recording:
