@@ -1,8 +1,85 @@
-"""`engine plot --program ID`: not drawn yet (issue 17, being built)."""
+"""`engine plot --program ID`: a stored hobbing program drawn as the simulation reads it
+(engine.simulation.recorded): the side view (blank, units, fixture, tailstock, hob at approach and
+at full depth, each pass with its direction, working area), the whole working area with every
+move, and the hob seen from its side with the shift range. The program's job supplies the gear,
+hob and machine, as `engine simulate --program ID` takes them. PNG or SVG, written whole or not
+at all (engine.pictures)."""
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 from ..errors import EngineError
+from ..gears.records import Gear, Hob, Machine, load_gear, load_machine
+from ..pictures import new_figure, picture_target, save_atomically
+from ..simulation.recorded import Recording, record_program
+from ..simulation.stored import load_hob
+from .hob_view import draw_hob_view
+from .side_view import draw_overview, draw_side_view
+
+FIGURE_SIZE_IN = (16.0, 9.0)
+PROGRAM_QUERY = """
+SELECT p.name, p.lines, p.job_id, j.gear_id, j.gear_class, j.hob_id, j.machine
+FROM program p JOIN job j ON j.id = p.job_id
+WHERE p.id = %s"""
+
+
+@dataclass(frozen=True)
+class Scene:
+    program_id: int
+    job_id: int
+    name: str
+    gear_class: str
+    gear: Gear
+    hob: Hob
+    machine: Machine
+    recording: Recording
+
+    @property
+    def title(self) -> str:
+        return (f"job {self.job_id} · gear {self.gear.id} ({self.gear_class}, m{self.gear.module:g} "
+                f"z{self.gear.teeth}) · hob {self.hob.id} · {self.machine.name} · program {self.name} "
+                f"(id {self.program_id})")
 
 
 def plot_stored_program(conn, program_id: int, out) -> list[str]:
-    raise EngineError(f"program {program_id}: program plots are not built yet")
+    """Draw the stored program to `out` (.png or .svg); → one line per thing drawn."""
+    target, file_format = picture_target(out)
+    figure, drawn = program_figure(load_scene(conn, program_id))
+    save_atomically(figure, target, file_format)
+    return drawn
+
+
+def load_scene(conn, program_id: int) -> Scene:
+    row = conn.execute(PROGRAM_QUERY, (program_id,)).fetchone()
+    if row is None:
+        raise EngineError(f"program {program_id} does not exist; see `SELECT id, name FROM program`")
+    name, lines, job_id, gear_id, gear_class, hob_id, machine_name = row
+    machine = load_machine(conn, machine_name)
+    if machine.kind != "hobber" or gear_id is None or hob_id is None:
+        raise EngineError(f"program {program_id} runs on {machine_name}, a {machine.kind}, not a hobbing program; "
+                          f"draw its job with `engine plot --job {job_id} -o FILE.png`")
+    gear, hob = load_gear(conn, gear_id), load_hob(conn, hob_id)
+    recording = record_program(list(lines), gear, hob, machine, name)
+    return Scene(program_id, job_id, name, gear_class, gear, hob, machine, recording)
+
+
+def program_figure(scene: Scene):
+    """The figure, built whole before anything is written (the tests read its artists)."""
+    figure = new_figure(FIGURE_SIZE_IN)
+    figure.set_layout_engine("constrained")
+    grid = figure.add_gridspec(2, 2, width_ratios=(3, 2))
+    drawn = draw_side_view(figure.add_subplot(grid[:, 0]), scene)
+    drawn.append(draw_overview(figure.add_subplot(grid[0, 1]), scene))
+    drawn += draw_hob_view(figure.add_subplot(grid[1, 1]), scene)
+    figure.suptitle(scene.title, fontsize="medium")
+    figure.legend(*figure.axes[0].get_legend_handles_labels(), loc="outside lower left", ncols=5, fontsize="small")
+    drawn.append(simulation_words(scene.recording))
+    return figure, drawn
+
+
+def simulation_words(recording: Recording) -> str:
+    refusals = recording.report.refusals
+    if not refusals:
+        return "drawn from the simulation's reading: it proves the program"
+    return (f"drawn from the simulation's reading: it refuses the program now ({len(refusals)} finding(s); "
+            f"see `engine simulate`)")

@@ -1,0 +1,125 @@
+"""The moves the simulation follows, kept for a picture (`engine plot`, issue 17): the same
+reading and the same walk as `engine simulate` (engine.simulation.run), with every move's start
+and end in the DIN frame, the swivel it ran at, whether it cut, the cuts as the walk closes them
+and the G25/G26 working area as the program sets it. A picture drawn from this shows what the
+simulation checked, not a second interpretation of the program text. A program with the
+hob-shift-per-part clamp is followed at both ends of its R11 interval (the Y range it cuts at,
+the part of the hob the shifting uses); the moves are those at the low end."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from ..gears.records import Gear, Hob, Machine
+from .reading import read_program
+from .report import Report, SimulationError
+from .run import SHIFT_ENDS
+from .solids import Solid, setup_solids, unit_solids
+from .walk import Walk
+
+
+@dataclass(frozen=True, slots=True)
+class Move:
+    number: int            # program line, from 1
+    line: str
+    motion: int            # 0 rapid, 1 feed
+    start: dict            # DIN positions before the move (axes not yet known are missing)
+    end: dict
+    swivel: float          # A in the DIN frame, degrees
+    cutting: bool          # part of a cut the walk follows (coupled, spindle turning, G1)
+
+
+@dataclass(frozen=True, slots=True)
+class RecordedCut:
+    moves: tuple           # the cut's Move records
+    units: tuple           # names of the units whose material it entered
+    label: str             # the program's `; CUT …` comment before it, else "cut N"
+
+    @property
+    def poses(self) -> list[dict]:
+        """Where the hob centre stands along the cut, from its start: the poses with X and Z known."""
+        every = [self.moves[0].start, *(move.end for move in self.moves)]
+        return [pose for pose in every if {"X", "Z"} <= pose.keys()]
+
+
+@dataclass
+class Recording:
+    report: Report
+    units: list[Solid]
+    setup: list[Solid]
+    moves: list[Move] = field(default_factory=list)
+    cuts: list[RecordedCut] = field(default_factory=list)
+    areas: dict = field(default_factory=dict)       # "lower"/"upper" -> {axis: DIN value}, as G25/G26 set them
+    area_words: dict = field(default_factory=dict)  # "lower"/"upper" -> {axis: program value}
+    cutting_y: tuple = (0.0, 0.0)                   # the lowest and highest Y (DIN) the hob cuts at
+
+    @property
+    def final_swivel(self) -> float:
+        return next((move.swivel for move in reversed(self.moves) if move.cutting), 0.0)
+
+
+class RecordingWalk(Walk):
+    """The simulation's walk, keeping what it follows."""
+
+    def __init__(self, recording: Recording, *args):
+        super().__init__(*args)
+        self.recording = recording
+        self.cut_moves: list[Move] = []
+        self.last_comment = ""
+
+    def take(self, step) -> None:
+        """The walk dispatches by the line's kind; what a picture needs is noted first."""
+        if step.kind == "comment":
+            self.last_comment = step.line.lstrip("; ").strip()
+        elif step.kind == "block" and step.item.area is not None:
+            self._note_area(step.item)
+        super().take(step)
+
+    def _note_area(self, block) -> None:
+        self.recording.area_words[block.area] = dict(block.positions)
+        self.recording.areas[block.area] = {axis: self.senses.position(axis, value)
+                                            for axis, value in block.positions.items()}
+
+    def _move(self, step, motion: int, program: dict, swivel: float | None = None) -> None:
+        start = dict(self.position)
+        super()._move(step, motion, program, swivel)
+        move = Move(step.number, step.line, motion, start, dict(self.position), self.swivel, self.cut is not None)
+        self.recording.moves.append(move)
+        if move.cutting:
+            self.cut_moves.append(move)
+
+    def _end_cut(self) -> None:
+        before = len(self.report.cuts)
+        super()._end_cut()
+        if self.cut_moves:
+            units = tuple(done.unit for done in self.report.cuts[before:])
+            label = self.last_comment if self.last_comment.upper().startswith("CUT") else \
+                f"cut {len(self.recording.cuts) + 1}"
+            self.recording.cuts.append(RecordedCut(tuple(self.cut_moves), units, label))
+            self.cut_moves = []
+
+
+def record_program(lines: list[str], gear: Gear, hob: Hob, machine: Machine, name: str = "the program") -> Recording:
+    """The recording of `lines` (a hobbing program for `gear`, `hob`, `machine`); SimulationError
+    for a program or machine the simulation cannot read."""
+    if machine.kind != "hobber":
+        raise SimulationError(f"machine {machine.name} is a {machine.kind}: the simulation follows hobbing programs")
+    steps = read_program(lines, machine, name)
+    ends = SHIFT_ENDS if any(step.kind == "shift" for step in steps) else SHIFT_ENDS[:1]
+    recordings = [_follow(steps, lines, gear, hob, machine, name, end) for end in ends]
+    held = [pose["Y"] for recording in recordings for move in recording.moves if move.cutting
+            for pose in (move.start, move.end) if "Y" in pose]
+    recording = recordings[0]
+    recording.cutting_y = (min(held), max(held)) if held else (0.0, 0.0)
+    return recording
+
+
+def _follow(steps, lines, gear: Gear, hob: Hob, machine: Machine, name: str, shift_end: int) -> Recording:
+    worm_wheel = hob.purpose == "worm_wheel"
+    units = unit_solids(gear, hob, worm_wheel)
+    setup = setup_solids(machine, units, hob)
+    recording = Recording(Report(name), units, setup)
+    walk = RecordingWalk(recording, recording.report, gear, hob, machine, units, setup, worm_wheel, shift_end)
+    for step in steps:
+        walk.take(step)
+    walk.finish(lines)
+    return recording

@@ -1,0 +1,227 @@
+"""`engine plot` for hobbing (issue 17): every sample gear's program drawn from the simulation's
+reading, the drawing read back from the figure before it is saved. Expected numbers come from the
+gear and hob records by the reference formulas (docs/reference/hobbing.md §B3) or from the
+program text, read here with a few lines of its own."""
+from __future__ import annotations
+
+import json
+import math
+import re
+
+import psycopg
+import pytest
+
+from engine.hobbing.choices import Choices
+from engine.hobbing.program_plot import load_scene, program_figure
+from engine.programs.instantiate import instantiate_gear
+
+SAMPLES = [   # gear, what, job choices: every hobbing class the samples hold
+    (42, "spur", Choices()), (42, "spur conventional", Choices(feed_mode="conventional")),
+    (42, "spur shift per part", Choices(shift_per_part=2.0)), (45, "spur rough + finish", Choices()),
+    (46, "spur 2-start hob", Choices()), (43, "helical right hand", Choices()), (44, "helical left hand", Choices()),
+    (47, "helical conventional-climb", Choices(feed_mode="conventional-climb", cuts=2)), (50, "taper", Choices()),
+    (51, "crowned", Choices()), (53, "worm wheel radial", Choices()),
+    (53, "worm wheel tangential", Choices(worm_feed="tangential")), (54, "duplex", Choices()),
+]
+CYLINDRICAL = [case for case in SAMPLES if case[0] in (42, 43, 44, 45, 46, 47, 54)]
+WORD = re.compile(r"\b([XYZ])=?(-?\d+(?:\.\d*)?)")
+
+
+def drawn(conn, gear_id: int, choices: Choices):
+    program = instantiate_gear(conn, gear_id, choices=choices)
+    figure, lines = program_figure(load_scene(conn, program.program_id))
+    return program, figure, lines
+
+
+def artists(axes, gid: str) -> list:
+    return [a for a in [*axes.patches, *axes.lines, *axes.texts] if a.get_gid() == gid]
+
+
+def artist(axes, gid: str):
+    found = artists(axes, gid)
+    assert len(found) == 1, f"{gid!r}: {len(found)} drawn"
+    return found[0]
+
+
+def units_of(conn, gear_id: int) -> list[tuple]:
+    """(name, teeth, face width, tip diameter, root diameter) of every unit, from the records:
+    tip d + 2·m and root d − 2.5·m where the record leaves them empty (§B3)."""
+    gear = conn.execute("SELECT module, teeth, helix_angle, face_width, tip_diameter, root_diameter FROM gear "
+                        "WHERE id = %s", (gear_id,)).fetchone()
+    module, teeth, helix = float(gear[0]), gear[1], float(gear[2])
+    rows = [(1, teeth, *gear[3:])] + conn.execute(
+        "SELECT unit, teeth, face_width, tip_diameter, root_diameter FROM gear_unit WHERE gear_id = %s ORDER BY unit",
+        (gear_id,)).fetchall()
+    result = []
+    for unit, z, width, tip, root in rows:
+        d = module * z / math.cos(math.radians(helix))
+        result.append((f"unit {unit} ({z} teeth)", z, float(width), float(tip or d + 2 * module),
+                       float(root or d - 2.5 * module)))
+    return result
+
+
+def hob_tip(conn, program_id: int) -> float:
+    return float(conn.execute("SELECT h.tip_diameter FROM program p JOIN job j ON j.id = p.job_id "
+                              "JOIN hob h ON h.id = j.hob_id WHERE p.id = %s", (program_id,)).fetchone()[0])
+
+
+def words(line: str) -> dict:
+    return {axis: float(value) for axis, value in WORD.findall(line.partition(";")[0])}
+
+
+def z_feeds(lines: list[str]) -> list[float]:
+    """The sign of every G1 move along Z, from the program text: where Z stood and where it goes."""
+    z, signs = None, []
+    for line in lines:
+        code = line.partition(";")[0]
+        if not re.match(r"G[01]\b", code.strip()):
+            continue
+        target = words(code).get("Z")
+        if target is not None and z is not None and code.strip().startswith("G1") and target != z:
+            signs.append(math.copysign(1.0, target - z))
+        z = target if target is not None else z
+    return signs
+
+
+@pytest.mark.parametrize("gear_id, what, choices", SAMPLES, ids=[case[1] for case in SAMPLES])
+def test_every_sample_class_is_drawn_with_each_unit_at_its_face_width_and_tip(conn, gear_id, what, choices):
+    program, figure, lines = drawn(conn, gear_id, choices)
+    side = figure.axes[0]
+    for name, _, width, tip, _ in units_of(conn, gear_id):
+        xs, zs = zip(*artist(side, name).get_xy()[:4])
+        assert max(zs) - min(zs) == pytest.approx(width)
+        assert max(xs) - min(xs) == pytest.approx(tip, abs=1e-6)
+    assert artist(side, "the fixture") and artists(side, "hob at approach")
+    assert "it proves the program" in lines[-1]
+    title = figure.get_suptitle()
+    assert f"gear {gear_id}" in title and program.name in title and "hobber-840d" in title
+
+
+@pytest.mark.parametrize("gear_id, what, choices", CYLINDRICAL, ids=[case[1] for case in CYLINDRICAL])
+def test_the_hob_at_full_depth_stands_at_the_reference_centre_distance(conn, gear_id, what, choices):
+    """a = (d_f2 + d_a0)/2 (§B3), for every unit of the gear (the program writes X to the
+    micrometre, so within half of one)."""
+    program, figure, _ = drawn(conn, gear_id, choices)
+    da0 = hob_tip(conn, program.program_id)
+    for name, _, width, _, root in units_of(conn, gear_id):
+        centre = artist(figure.axes[0], f"hob at full depth {name} centre")
+        assert centre.get_xdata()[0] == pytest.approx((root + da0) / 2, abs=5e-4)
+        outline = artist(figure.axes[0], f"hob at full depth {name}")
+        assert min(outline.get_xdata()) == pytest.approx(root / 2, abs=5e-4)   # the hob's tip at the root
+
+
+@pytest.mark.parametrize("gear_id, what, choices", [case for case in SAMPLES if "worm" not in case[1]],
+                         ids=[case[1] for case in SAMPLES if "worm" not in case[1]])
+def test_each_pass_arrow_points_the_way_the_program_feeds_along_z(conn, gear_id, what, choices):
+    """One arrow per `; CUT` of the program, pointing the way that cut's G1 moves go along Z."""
+    program, figure, _ = drawn(conn, gear_id, choices)
+    arrows = [text for text in figure.axes[0].texts if (text.get_gid() or "").startswith("pass ")]
+    text = "\n".join(program.lines)
+    cuts = [chunk.splitlines() for chunk in text.split("; CUT")[1:]]
+    assert len(arrows) == len(cuts) > 0
+    for arrow, cut in zip(arrows, cuts):
+        assert {math.copysign(1.0, arrow.xy[1] - arrow.xyann[1])} == set(z_feeds(cut))
+
+
+def test_conventional_and_climb_passes_point_opposite_ways(conn):
+    climb = drawn(conn, 42, Choices())[1].axes[0]
+    conventional = drawn(conn, 42, Choices(feed_mode="conventional"))[1].axes[0]
+
+    def direction(axes):
+        arrow = next(text for text in axes.texts if (text.get_gid() or "").startswith("pass "))
+        return math.copysign(1.0, arrow.xy[1] - arrow.xyann[1])
+    assert direction(climb) == -direction(conventional)
+
+
+def test_a_radial_plunge_and_a_tangential_pass_point_the_way_the_program_feeds(conn):
+    radial, figure, _ = drawn(conn, 53, Choices())
+    plunge = next(t for t in figure.axes[0].texts if (t.get_gid() or "").startswith("pass "))
+    infeed = [words(line)["X"] for line in radial.lines if line.startswith("G1 X")]
+    assert plunge.xy[0] == pytest.approx(infeed[-1]) and plunge.xyann[0] > plunge.xy[0]
+    tangential, figure, _ = drawn(conn, 53, Choices(worm_feed="tangential"))
+    feed = next(t for t in figure.axes[2].texts if (t.get_gid() or "").startswith("pass "))
+    pass_y = [words(line)["Y"] for line in tangential.lines if line.startswith("G1 Y")][0]
+    assert feed.xy[0] == pytest.approx(pass_y, abs=0.01) and math.copysign(1, feed.xy[0] - feed.xyann[0]) == \
+        math.copysign(1, pass_y)
+
+
+@pytest.mark.parametrize("gear_id, what, choices", [SAMPLES[0], SAMPLES[2], SAMPLES[-1]],
+                         ids=["spur", "shift per part", "duplex"])
+def test_the_working_area_is_drawn_at_the_programs_g25_and_g26(conn, gear_id, what, choices):
+    program, figure, lines = drawn(conn, gear_id, choices)
+    lower = words(next(line for line in program.lines if line.startswith("G25")))
+    upper = words(next(line for line in program.lines if line.startswith("G26")))
+    for axes, gid in zip(figure.axes[:2], ("working area", "overview working area")):
+        box = artist(axes, gid)
+        assert (box.get_x(), box.get_y()) == pytest.approx((lower["X"], lower["Z"]))
+        assert (box.get_width(), box.get_height()) == pytest.approx((upper["X"] - lower["X"], upper["Z"] - lower["Z"]))
+    swivel = words(next(line for line in program.lines if line.startswith("G0 A=")).replace("A=", "Y"))["Y"]
+    travel = artist(figure.axes[2], "working area Y")
+    cos_a = math.cos(math.radians(swivel))
+    assert list(travel.get_xdata()) == pytest.approx([lower["Y"] * cos_a, upper["Y"] * cos_a])
+    assert any(line.startswith("working area G25") for line in lines)
+
+
+def test_the_shift_range_covers_the_hob_length_the_shifting_uses(conn):
+    """R11 is clamped to −y … +y: the generating zone (§B15, L_gen = 2·2.25·m/tan α + π·m) sweeps
+    2y + L_gen of the hob."""
+    program, figure, lines = drawn(conn, 42, Choices(shift_per_part=2.0))
+    low, high = (float(v) for v in re.search(r"IF \(R11<(-?[\d.]+)\) OR \(R11>(-?[\d.]+)\)",
+                                             "\n".join(program.lines)).groups())
+    zone = 2 * 2.25 * 2 / math.tan(math.radians(20)) + math.pi * 2
+    band = artist(figure.axes[2], "shift range").get_xy()[:4]
+    along = max(math.dist(band[0], band[1]), math.dist(band[1], band[2]))
+    assert along == pytest.approx(high - low + zone, abs=1e-6)
+    assert any(f"Y{low:g} … Y{high:g}" in line for line in lines)
+
+
+def job_with_program(url: str, gear_id: int = 42) -> int:
+    with psycopg.connect(url) as conn:
+        return conn.execute("SELECT max(job_id) FROM program p JOIN job j ON j.id = p.job_id WHERE j.gear_id = %s",
+                            (gear_id,)).fetchone()[0]
+
+
+def test_plot_writes_png_and_svg_for_a_job_and_a_program(run, tmp_path):
+    assert run("instantiate", "--gear", 54).exit_code == 0
+    job_id = job_with_program(run.url, 54)
+    png, svg = tmp_path / "duplex.png", tmp_path / "duplex.svg"
+    result = run("plot", "--job", job_id, "-o", png)
+    assert result.exit_code == 0, result.output
+    assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert "unit 2 (19 teeth)" in result.stdout and "hob at full depth" in result.stdout
+    with psycopg.connect(run.url) as conn:
+        program_id = conn.execute("SELECT max(id) FROM program WHERE job_id = %s", (job_id,)).fetchone()[0]
+    assert run("plot", "--program", program_id, "-o", svg).exit_code == 0
+    text = svg.read_text(encoding="utf-8")
+    assert "<svg" in text[:2000] and 'id="hob at full depth unit 2 (19 teeth)"' in text
+    ids = re.findall(r'\bid="([^"]+)"', text)
+    assert len(ids) == len(set(ids))      # every drawn thing is named once
+
+
+def test_a_bad_suffix_or_a_job_without_a_program_is_refused_in_one_line_and_writes_nothing(run, tmp_path):
+    assert run("instantiate", "--gear", 42).exit_code == 0
+    job_id = job_with_program(run.url)
+    result = run("plot", "--job", job_id, "-o", tmp_path / "job.pdf")
+    assert result.exit_code == 1 and "FILE.png or FILE.svg" in result.stderr
+    assert len(result.stderr.strip().splitlines()) == 1
+    with psycopg.connect(run.url) as conn:
+        empty = conn.execute("INSERT INTO job (gear_id, gear_class, machine, hob_id, params) "
+                             "VALUES (42, 'spur', 'hobber-840d', 'H-M2-AA-R1', '{}') RETURNING id").fetchone()[0]
+    result = run("plot", "--job", empty, "-o", tmp_path / "empty.png")
+    assert result.exit_code == 1 and f"engine instantiate --job {empty}" in result.stderr
+    assert len(result.stderr.strip().splitlines()) == 1
+    result = run("plot", "--program", 999999, "-o", tmp_path / "none.svg")
+    assert result.exit_code == 1 and "program 999999 does not exist" in result.stderr
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_turning_program_is_refused_naming_the_plot_of_its_job(run, tmp_path):
+    from test_dxf_read import seed_drawing
+
+    seed_drawing(tmp_path / "part.dxf")
+    job_id = json.loads(run("import-dxf", tmp_path / "part.dxf", "--json").stdout)["job_id"]
+    program_id = json.loads(run("instantiate", "--job", job_id, "--json").stdout)["program_id"]
+    result = run("plot", "--program", program_id, "-o", tmp_path / "turned.png")
+    assert result.exit_code == 1 and len(result.stderr.strip().splitlines()) == 1
+    assert f"engine plot --job {job_id}" in result.stderr
+    assert not (tmp_path / "turned.png").exists()
