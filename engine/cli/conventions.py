@@ -37,7 +37,8 @@ COMMAND_LINE_ONLY = {   # (command path, option): why it is typed on each invoca
     # what instantiate makes programs of: a default would store programs (records nobody deletes)
     # for every gear, or refuse the gear the user typed
     **{("engine instantiate", selector): "it chooses what programs are made and stored"
-       for selector in ("gear", "job", "gears", "jobs", "all")},
+       for selector in ("gear", "job", "class", "gears", "jobs", "all")},
+    ("engine instantiate", "unverified"): "it stores a program no verifier read",
     ("engine seed", "samples"): "it loads sample gears, hobs and cases, which a shop's database must not get unasked",
 }
 

@@ -1,4 +1,4 @@
-"""`engine instantiate`: the program of a gear, a stored job, or a batch of gears."""
+"""`engine instantiate`: the program of a gear, a stored job, a class's job, or a batch of gears."""
 from __future__ import annotations
 
 import re
@@ -29,12 +29,22 @@ def parse_range(text: str, option: str = "--gears") -> tuple[int, int]:
 @click.option("--gear", "gear_id", type=GEAR_ID, help="Gear id: compute a new job and its program.")
 @click.option("--job", "job_id", type=JOB_ID, help="Stored job id: instantiate again with its (edited) parameters.")
 @click.option("--gears", "gear_range", help="Batch: gear ids FIRST-LAST (all stored, or none unless --skip-bad).")
+@click.option("--class", "gear_class", help="A class without a model (made by engine import-nc): a new job of it "
+              "with --params, on --machine, its program read by the machine's verifier.")
+@click.option("--params", "params_file", type=click.Path(dir_okay=False), help="With --class: parameter values, JSON "
+              "{name: value} (or {name: {\"value\": …, \"addresses\": […]}}) or CSV name,value, as import-nc's; "
+              "names not given keep the values the class was imported with, unknown names are refused.")
+@click.option("--unverified", is_flag=True, help="With --class: store the program without the verifier's reading "
+              "(a dialect it does not know, a program it refuses), marked UNVERIFIED in its record and lineage line. "
+              "Never written to a file (not with --out, nor a config output folder): a program that reaches the "
+              "machine is one the verifier read.")
 @click.option("--jobs", "job_range", help="Batch: stored job ids FIRST-LAST made again with their stored parameters.")
 @click.option("--all", "all_gears", is_flag=True, help="Batch: every gear.")
 @click.option("--out", type=click.Path(), help="Write the .MPF file here after the programs are committed: a "
               "batch always into this folder (made if missing), one program into it if it is a folder or ends with /.")
 @click.option("--force", is_flag=True, help="Replace files that exist in --out (else nothing is stored).")
-@click.option("--machine", help="Machine record (default hobber-840d).")
+@click.option("--machine", help="Machine record (default hobber-840d; with --class: the config file's machine, "
+              "else required).")
 @click.option("--cuts", type=click.IntRange(1, 2), help="1 = single cut, 2 = rough then finish (default by module).")
 @click.option("--coolant/--no-coolant", default=True, show_default=True, help="Coolant M8/M9.")
 @click.option("--shift-y", type=float, default=0.0, help="Hob shift position Y for this part, mm.")
@@ -62,10 +72,10 @@ def parse_range(text: str, option: str = "--gears") -> tuple[int, int]:
               "skipped (else any bad one stores nothing).")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object (program_id, path, lines, ...).")
 @click.pass_context
-def instantiate(ctx, gear_id, job_id, gear_range, job_range, all_gears, out, force, machine, cuts, coolant, shift_y,
+def instantiate(ctx, gear_id, job_id, gear_class, params_file, unverified, gear_range, job_range, all_gears, out, force, machine, cuts, coolant, shift_y,
                 shift_per_part, feed_mode, tailstock, worm_feed, allowance, hob_speed, workers, explain, draft,
                 dry_run, skip_bad, as_json):
-    """Produce the NC program of a gear (or a stored job, or a batch of gears).
+    """Produce the NC program of a gear (or a stored job, a job of an imported class, or a batch of gears).
 
     The program is checked against the machine's limits and proved by the
     simulation, stored with the template version it came from, printed (single
@@ -78,6 +88,10 @@ def instantiate(ctx, gear_id, job_id, gear_range, job_range, all_gears, out, for
     input, or any bad gear or job without --skip-bad, or none good: nothing
     stored; 2: a bug.
 
+    --class C --params P.json makes a job of a class without a model (engine
+    import-nc) on a lathe: its program is read by the machine's verifier, and
+    with its imported values it is the imported program again.
+
     Example: engine instantiate --gear 42 --out /srv/nc/
     """
     from ..programs.config import line_ending, output_folder
@@ -86,11 +100,13 @@ def instantiate(ctx, gear_id, job_id, gear_range, job_range, all_gears, out, for
     from ..programs.outputs import line_endings
     from ..programs.remake import instantiate_job
 
-    chosen = [name for name, value in (("--gear", gear_id), ("--job", job_id), ("--gears", gear_range),
-                                       ("--jobs", job_range), ("--all", all_gears))
+    chosen = [name for name, value in (("--gear", gear_id), ("--job", job_id), ("--class", gear_class),
+                                       ("--gears", gear_range), ("--jobs", job_range), ("--all", all_gears))
               if value not in (None, False)]
     if len(chosen) != 1:
-        raise EngineError("give exactly one of --gear ID, --job ID, --gears FIRST-LAST, --jobs FIRST-LAST, --all")
+        raise EngineError("give exactly one of --gear ID, --job ID, --class C, --gears FIRST-LAST, --jobs FIRST-LAST, "
+                          "--all")
+    _refuse_options_of_other_jobs(ctx, gear_class is not None)
     batch = bool(gear_range or job_range or all_gears)
     workers = where_it_applies(ctx, "workers", workers, workers == 1 or bool(gear_range or all_gears),
                                "--workers plans a batch of gears: use it with --gears FIRST-LAST or --all")
@@ -115,6 +131,9 @@ def instantiate(ctx, gear_id, job_id, gear_range, job_range, all_gears, out, for
                                        force=force, draft=draft, dry_run=dry_run)
         elif job_id is not None:
             program = instantiate_job(conn, job_id, out=out, force=force, draft=draft, dry_run=dry_run)
+        elif gear_class is not None:
+            return _class_job(conn, gear_class, params_file, machine, as_json, explain, out=out, force=force,
+                              draft=draft, dry_run=dry_run, unverified=unverified)
         else:
             with progress_bar("instantiate") as progress:
                 batch = _batch(conn, job_range, gear_range, progress, out=out, force=force, draft=draft,
@@ -152,18 +171,54 @@ NEW_JOB_CHOICES = ("machine", "cuts", "coolant", "shift_y", "shift_per_part", "f
                    "worm_feed", "allowance", "hob_speed")
 
 
+HOBBING_CHOICES = NEW_JOB_CHOICES[1:]   # all but --machine: what a hobbing model computes a job with
+CLASS_JOB_OPTIONS = ("params_file", "unverified")
+
+
+def _given(ctx, names) -> list[click.Parameter]:
+    """The options of `names` typed on the command line."""
+    return [parameter for parameter in ctx.command.params if parameter.name in names
+            and ctx.get_parameter_source(parameter.name) is click.core.ParameterSource.COMMANDLINE]
+
+
+def _spelled(parameter: click.Parameter) -> str:
+    return "/".join(parameter.opts + parameter.secondary_opts)
+
+
+def _refuse_options_of_other_jobs(ctx, class_job: bool) -> None:
+    """A class's job has no hob, cuts or feeds to choose; --params and --unverified are its alone:
+    given elsewhere, either would silently do nothing."""
+    given = _given(ctx, HOBBING_CHOICES) if class_job else _given(ctx, CLASS_JOB_OPTIONS)
+    if given and class_job:
+        raise EngineError(f"{_spelled(given[0])} is a choice of a hobbing job (--gear, --gears, --all); a job of "
+                          "--class takes its values from --params")
+    if given:
+        raise EngineError(f"{_spelled(given[0])} applies to a job of a class with --class C only")
+
+
 def _refuse_new_job_choices_for_stored_jobs(ctx, stored_jobs: bool) -> None:
     """A stored job is made with its stored parameters: a choice given with --job/--jobs would
     silently do nothing."""
-    given = [parameter for parameter in ctx.command.params if parameter.name in NEW_JOB_CHOICES
-             and ctx.get_parameter_source(parameter.name) is click.core.ParameterSource.COMMANDLINE]
+    given = _given(ctx, NEW_JOB_CHOICES)
     if stored_jobs and given:
-        option = "/".join(given[0].opts + given[0].secondary_opts)
+        option = _spelled(given[0])
         raise EngineError(f"{option} applies to a new job (--gear, --gears, --all); a stored job is made with its "
                           "stored parameters: edit job.params in SQL to change them")
 
 
-def _report_program(program, as_json: bool, explain: bool) -> None:
+def _class_job(conn, gear_class, params_file, machine, as_json, explain, **options) -> None:
+    from ..library.nc_import import read_params
+    from ..programs.class_jobs import instantiate_class
+
+    given = read_params(params_file) if params_file else {}
+    job = instantiate_class(conn, gear_class, given, machine=machine, source=params_file or "parameters", **options)
+    if job.taken and not as_json:
+        click.echo(f"imported values kept (not in --params): {', '.join(job.taken)}", err=True)
+    _report_program(job.program, as_json, explain, {"machine": job.machine, "given": list(job.given),
+                                                    "taken": list(job.taken)})
+
+
+def _report_program(program, as_json: bool, explain: bool, more: dict | None = None) -> None:
     from ..programs.explain import explained_rows
 
     rows = explained_rows(program.trace, program.lines, program.row_ids) if explain else []
@@ -172,7 +227,7 @@ def _report_program(program, as_json: bool, explain: bool) -> None:
         emit_json({"program_id": program.program_id, "job_id": program.job_id, "name": program.name,
                    "path": program.path, "lines": len(program.lines), "class": program.gear_class,
                    "template_version": program.template_version, "template_hash": program.template_hash,
-                   "notes": list(program.notes),
+                   "notes": list(program.notes), "unverified": program.unverified, **(more or {}),
                    **({"explain": [row.as_dict() for row in rows]} if explain else {}),
                    **({"dry_run": True, "text": program.text} if dry_run else {})})
         return
@@ -188,10 +243,11 @@ def _report_program(program, as_json: bool, explain: bool) -> None:
 def _program_summary(program) -> str:
     if program.program_id is None:
         job = f"job {program.job_id}, " if program.job_id is not None else ""
+        checked = "UNVERIFIED (not read by a verifier)" if program.unverified else "checked"
         return (f"dry run: program {program.name} ({job}{len(program.lines)} lines) from {program.gear_class} "
-                f"v{program.template_version} checked; nothing stored")
+                f"v{program.template_version} {checked}; nothing stored")
     return (f"program {program.program_id} (job {program.job_id}, {len(program.lines)} lines) "
-            f"from {program.gear_class} v{program.template_version}")
+            f"from {program.gear_class} v{program.template_version}" + (" UNVERIFIED" if program.unverified else ""))
 
 
 def _report_batch(batch, out, as_json: bool) -> None:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import click
 
+from ..programs.lineage import UNVERIFIED
 from .context import connection, emit_json
 from .ids import GEAR_ID, JOB_ID, PROGRAM_ID
 from .output import Column, day, day_options, emit_list, list_options, one_of
@@ -11,6 +12,7 @@ from .output import Column, day, day_options, emit_list, list_options, one_of
 PROGRAM_COLUMNS = (
     Column("program", "program_id"), Column("name", "name"), Column("job", "job_id"), Column("gear", "gear_id"),
     Column("class", "class"), Column("version", "template_version"), Column("draft", "draft"),
+    Column("verifier", "unverified", lambda unverified: UNVERIFIED if unverified else "read"),
     Column("template", "template_hash", lambda digest: digest[:8]),
     Column("input", "input_hash", lambda digest: (digest or "-")[:8]),
     Column("lines", "line_count"), Column("stored", "created_at"),
@@ -23,6 +25,8 @@ RECORD_FIELDS = (  # (label, the value of a ProgramRecord)
     ("gear", lambda record: record.gear_id if record.gear_id is not None else "-"),
     ("class", lambda record: record.gear_class),
     ("version", lambda record: f"v{record.template_version}" + (" (draft)" if record.draft else " (released)")),
+    ("verifier", lambda record: f"{UNVERIFIED}: no verifier read it, never written to a file" if record.unverified
+     else "read by the machine's verifier"),
     ("template hash", lambda record: record.template_hash),
     ("input hash", lambda record: record.input_hash or "-"),
     ("stored by", lambda record: record.stored_by or "-"),
@@ -47,7 +51,7 @@ def programs():
 @click.pass_context
 def programs_list(ctx, gear_class, gear_id, job_id, draft, released, since, until, output):
     """The programs stored, one line each: name, job, gear, class, template version and hash,
-    draft or released, number of lines, when stored (the text: `engine programs show ID`).
+    draft or released, read by the verifier or UNVERIFIED, number of lines, when stored (the text: `engine programs show ID`).
 
     Example: engine programs list --gear 42 --released --since 2026-11-01
     """

@@ -120,6 +120,6 @@ def dry_program(conn, planned: Planned, job_id: int | None) -> Program:
     lineage = Lineage(conn, [planned.machine], [(template.gear_class, template.version)],
                       [job_id] if job_id is not None else [], hashes)
     lines, row_ids = lineage.added(DRY_RUN_ID, job_id, planned.machine, template.gear_class, template.version,
-                                   template.hash, planned.result.lines, planned.result.row_ids)
+                                   template.hash, planned.result.lines, planned.result.row_ids, planned.unverified)
     return Program(None, job_id, planned.name, lines, planned.gear_class, template.version, template.hash,
-                   None, planned.result.trace, row_ids, tuple(planned.notes), planned.layout)
+                   None, planned.result.trace, row_ids, tuple(planned.notes), planned.layout, planned.unverified)

@@ -1,6 +1,7 @@
 """The lineage line every stored program carries (design notes §7, issue 15):
 `; PROGRAM <id> TEMPLATE <class> v<version> <hash8> INPUT <hash8>` (` DRAFT` appended for a
-program made from a draft), so an operator can match a file on the control to its record.
+program made from a draft, then ` UNVERIFIED` for one no verifier read: `engine instantiate --class
+--unverified`, migration 0024), so an operator can match a file on the control to its record.
 
 The engine writes it, not a template row: every program has it, whatever its template says.
 Its row id is -1 (no template row). The database checks it against the program, its template
@@ -13,6 +14,7 @@ from ..errors import EngineError
 from ..names import shown
 
 LINEAGE_ROW_ID = -1
+UNVERIFIED = "UNVERIFIED"   # the word of a program no verifier read, in its lineage line and listings
 # Comment forms by dialect: ISO/Fanuc comments are in parentheses, 840D ones follow `;`.
 COMMENT_FORMS = {"iso": "({})"}
 DEFAULT_COMMENT_FORM = "; {}"
@@ -55,10 +57,10 @@ def refuse_lineage_shaped(name: str, lines: list[str]) -> None:
 
 
 def lineage_words(program_id: int, gear_class: str, version: int, template_hash: str, input_hash: str,
-                  draft: bool) -> str:
+                  draft: bool, unverified: bool = False) -> str:
     """The words of the line, as the database's program_lineage() writes them."""
     words = f"PROGRAM {program_id} TEMPLATE {gear_class} v{version} {template_hash[:8]} INPUT {input_hash[:8]}"
-    return words + (" DRAFT" if draft else "")
+    return words + (" DRAFT" if draft else "") + (f" {UNVERIFIED}" if unverified else "")
 
 
 def lineage_line(words: str, dialect: str) -> str:

@@ -16,8 +16,8 @@ from ..library.nc_layout import ENDING_NAMES, NcLayout, nc_text
 MIN_HASH_DIGITS = 8   # what the lineage line shows
 HASH_PREFIX = re.compile(r"[0-9a-f]{8,64}")
 RECORD = """
-SELECT p.id, p.job_id, j.gear_id, p.gear_class, p.template_version, p.draft, p.template_hash, p.input_hash,
-       p.stored_by, p.created_at, p.name, p.lines, c.line_ending, c.final_newline
+SELECT p.id, p.job_id, j.gear_id, p.gear_class, p.template_version, p.draft, p.unverified, p.template_hash,
+       p.input_hash, p.stored_by, p.created_at, p.name, p.lines, c.line_ending, c.final_newline
 FROM program p JOIN job j ON j.id = p.job_id JOIN gear_class c ON c.name = p.gear_class"""
 BY_ID = RECORD + " WHERE p.id = %s"
 # left(…, 8) is what the indexes of migration 0015 hold; the LIKE then checks the longer prefix.
@@ -36,6 +36,7 @@ class ProgramRecord:
     gear_class: str
     template_version: int
     draft: bool
+    unverified: bool   # no verifier read it (instantiate --class --unverified): never written to a file
     template_hash: str
     input_hash: str | None
     stored_by: str | None
@@ -101,7 +102,7 @@ def checked_prefix(text: str) -> str:
 
 LIST_PROGRAMS = """
 SELECT p.id AS program_id, p.name, p.job_id, j.gear_id, p.gear_class AS class, p.template_version, p.draft,
-       p.template_hash, p.input_hash, cardinality(p.lines) AS line_count, p.stored_by, p.created_at
+       p.unverified, p.template_hash, p.input_hash, cardinality(p.lines) AS line_count, p.stored_by, p.created_at
 FROM program p JOIN job j ON j.id = p.job_id
 WHERE (%(class)s::text IS NULL OR p.gear_class = %(class)s)
   AND (%(gear)s::int IS NULL OR j.gear_id = %(gear)s)

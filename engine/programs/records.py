@@ -27,6 +27,7 @@ class Planned:
     cutting: dict | None = None      # job.cutting: the cutting data chosen and their source
     notes: list = field(default_factory=list)   # what the operator should know, one line each (bounded feeds, …)
     layout: NcLayout = NcLayout()    # the class's line ending and final newline (gear_class; issue 17)
+    unverified: bool = False   # no verifier read it (engine.programs.class_jobs): stored so marked, never written
 
     @property
     def name(self) -> str:
@@ -80,6 +81,7 @@ class Program:
     row_ids: list[int] | None = None  # the template row of each line
     notes: tuple = ()                 # what the operator should know, one line each (bounded feeds, …)
     layout: NcLayout = NcLayout()     # the class's line ending and final newline
+    unverified: bool = False          # no verifier read it: UNVERIFIED in its lineage line and record
 
     @property
     def text(self) -> str:

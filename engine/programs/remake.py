@@ -2,7 +2,9 @@
 instantiate --job ID`) or a range of them (`--jobs FIRST-LAST`), template rows only: no
 model, no hob choice, no cutting data. The programs are checked against the job's machine,
 stored with the template version they came from, and written after the database commit. A
-batch tries every job and names each bad one (engine.programs.batches)."""
+batch tries every job and names each bad one (engine.programs.batches). A job of a class without
+a model (engine.programs.class_jobs) is its class's rows run with its parameters, read by the
+verifier: one stored unverified is verified now, or refused."""
 from __future__ import annotations
 
 import re
@@ -20,6 +22,7 @@ from ..memory import no_cycle_collection
 from ..templates.rows import Template
 from ..templates.versions import runnable_template
 from .batches import checked, dry_batch, dry_program, good_ones, planned_or_bad, read_only, refuse_out_in_dry_run
+from .class_jobs import class_job
 from .instantiate import store_planned
 from .outputs import file_layouts, files_after_commit
 from .verified_run import Workpiece, run_template
@@ -40,6 +43,7 @@ class Remaker:
         self._templates: dict[str, Template] = {}
         self._layouts: dict[str, NcLayout] = {}
         self._hobs: dict[str, Hob] | None = None
+        self._modelled: dict[str, bool] = {}
 
     def remade(self, job: tuple) -> Planned:
         """The job's program planned again, to be written with its class's layout."""
@@ -49,6 +53,8 @@ class Remaker:
     def _remade(self, job: tuple) -> Planned:
         job_id, gear_id, gear_class, machine_name, hob_id, params, module_params = job
         machine = self.machine(machine_name)
+        if not self.modelled(gear_class):   # a job of an imported class (instantiate --class): its rows alone
+            return class_job(self.template(gear_class), machine, params, module_params)
         if machine.kind == "lathe":   # a turning job: its passes are computed from its parameters
             from ..turning.planning import plan_turning_job   # the tool paths: only for turning jobs
 
@@ -72,6 +78,12 @@ class Remaker:
         if hob is None:
             raise EngineError(f"hob {hob_id!r} of the job does not exist; see `engine hobs list`")
         return Workpiece(load_gear(self.conn, gear_id), hob)
+
+    def modelled(self, gear_class: str) -> bool:
+        """Whether the class has a model (hobbing, turning) that its jobs were computed with."""
+        if gear_class not in self._modelled:
+            self._modelled[gear_class] = model_for_class(self.conn, gear_class) is not None
+        return self._modelled[gear_class]
 
     def machine(self, name: str) -> Machine:
         if name not in self._machines:

@@ -33,7 +33,7 @@ INSERT_JOB = """
 INSERT INTO job (gear_id, gear_class, machine, hob_id, params, module_params, cutting)
 VALUES (%s, %s, %s, %s, %s, %s, %s) RETURNING id"""
 INSERT_PROGRAM = ("INSERT INTO program_submission (id, job_id, gear_class, template_version, template_hash, name, "
-                  "lines, row_ids, trace) VALUES (%s, %s, %s, %s, %s, %s, %s, %s, %s) RETURNING id")
+                  "lines, row_ids, trace, unverified) VALUES (%s, %s, %s, %s, %s, %s, %s, %s, %s, %s) RETURNING id")
 COPY_JOB = "COPY job (id, gear_id, gear_class, machine, hob_id, params, module_params, cutting) FROM STDIN"
 COPY_PROGRAM = ("COPY program_submission (id, job_id, gear_class, template_version, template_hash, name, lines, "
                 "row_ids, trace) FROM STDIN (FORMAT BINARY)")
@@ -41,8 +41,12 @@ PROGRAM_TYPES = ("int8", "int8", "text", "int4", "text", "text", "text[]", "int4
 
 
 def store_one(conn, planned: Planned, existing_job: int | None, path: str | None) -> Program:
-    """The program (and its job, unless `existing_job`), its lineage line added."""
+    """The program (and its job, unless `existing_job`), its lineage line added. An unverified
+    program (engine.programs.class_jobs) is stored only without a file for the machine."""
     refuse_unsafe(planned.name, planned.lines)
+    if planned.unverified and path is not None:
+        raise EngineError(f"program {planned.name} is unverified: it is never written to a file ({path}); "
+                          "nothing stored")
     with deleted_meanwhile(conn, gears=[planned.gear_id], hobs=[planned.hob_id], jobs=[existing_job]), \
             conn.transaction():
         return _stored_one(conn, planned, existing_job, path)
@@ -58,9 +62,9 @@ def _stored_one(conn, planned: Planned, existing_job: int | None, path: str | No
     template = planned.template
     lines, row_ids = Lineage(conn, [planned.machine], [(template.gear_class, template.version)], [job_id]).added(
         program_id, job_id, planned.machine, template.gear_class, template.version, template.hash,
-        planned.result.lines, planned.result.row_ids)
+        planned.result.lines, planned.result.row_ids, planned.unverified)
     conn.execute(INSERT_PROGRAM, (program_id, job_id, planned.gear_class, template.version, template.hash,
-                                  planned.name, lines, row_ids, Jsonb(planned.result.trace)))
+                                  planned.name, lines, row_ids, Jsonb(planned.result.trace), planned.unverified))
     return _program(program_id, job_id, planned, path, lines, row_ids)
 
 
@@ -73,9 +77,10 @@ class Lineage:
         classes, numbers = zip(*set(versions)) if versions else ((), ())
         self.drafts = {(c, v): draft for c, v, draft in conn.execute(DRAFTS, (list(classes), list(numbers)))}
 
-    def added(self, program_id, job_id, machine, gear_class, version, template_hash, lines, row_ids):
+    def added(self, program_id, job_id, machine, gear_class, version, template_hash, lines, row_ids,
+              unverified: bool = False):
         words = lineage_words(program_id, gear_class, version, template_hash, self.input_hashes[job_id],
-                              self.drafts[(gear_class, version)])
+                              self.drafts[(gear_class, version)], unverified)
         return with_lineage(list(lines), list(row_ids), lineage_line(words, self.dialects.get(machine, "")))
 
 
@@ -207,4 +212,4 @@ def _stored_texts(files, stored: dict) -> None:
 def _program(program_id: int, job_id: int, planned: Planned, path, lines, row_ids) -> Program:
     return Program(program_id, job_id, planned.name, lines, planned.gear_class,
                    planned.template.version, planned.template.hash, path, planned.result.trace,
-                   row_ids, tuple(planned.notes), planned.layout)
+                   row_ids, tuple(planned.notes), planned.layout, planned.unverified)

@@ -1,0 +1,265 @@
+"""`engine instantiate --class C --params P` (issue 17) as a user meets it, on real programs: an
+imported program comes back from its class with its own parameters, and with new values exactly
+the words bound to them change; the machine's verifier reads it, and what it cannot read (a dialect
+it has no grammar for, a program it refuses) is refused with one line and nothing stored, or stored
+with --unverified, marked UNVERIFIED in its lineage line and record and never written to a file.
+
+The verified chain is real end to end: a real lathe drawing becomes a turning job (import-dxf), its
+program is written to a file on the ISO lathe, and that file is imported (import-nc) as a class.
+The refused and unverified paths take real foreign programs (tests/data/nc)."""
+from __future__ import annotations
+
+import json
+import re
+
+import psycopg
+import pytest
+from psycopg import errors
+from psycopg.types.json import Jsonb
+
+from shared_data import shared_data
+
+DATA = shared_data()
+EMCO_DRAWING = DATA / "dxf" / "emco_lathe_testNegDXF_R14.dxf"
+PAWN = DATA / "nc" / "linuxcnc" / "lathe_pawn.ngc"          # LinuxCNC lathe program
+CAM = DATA / "nc" / "sinumerik" / "cam_840dsl" / "CAM_TEST.MPF"   # 840D sl CAM output
+EMCO_CNC = DATA / "nc" / "emco_from_dxf" / "testNegDXF.cnc"   # Emco fixed-column format
+SPEED = 600
+LINEAGE_ROW = -1
+# A LinuxCNC lathe as a shop would record it: a dialect the verifier has no grammar for.
+LINUXCNC_LATHE = ("INSERT INTO machine (name, kind, dialect, x_min, x_max, z_min, z_max, spindle_max) "
+                  "VALUES ('lathe-linuxcnc', 'lathe', 'linuxcnc', 0, 400, -600, 200, 4000)")
+SUBMIT = ("INSERT INTO program_submission (id, job_id, gear_class, template_version, template_hash, name, lines, "
+          "row_ids, trace, unverified) VALUES (%s, %s, %s, %s, %s, %s, %s, %s, %s, %s)")
+
+
+def ok(result):
+    assert result.exit_code == 0, result.output
+    return result
+
+
+def refused(result) -> str:
+    assert result.exit_code == 1, result.output
+    assert len(result.stderr.strip().splitlines()) == 1 and "Traceback" not in result.output, result.stderr
+    return result.stderr.strip()
+
+
+def stored_counts(url) -> tuple[int, int]:
+    with psycopg.connect(url) as conn:
+        return conn.execute("SELECT (SELECT count(*) FROM job), (SELECT count(*) FROM program)").fetchone()
+
+
+def stored_program(url, program_id: int) -> tuple[list[str], list[str], bool]:
+    """(the lines its template made, its lineage lines, its record's unverified)."""
+    with psycopg.connect(url) as conn:
+        lines, row_ids, unverified = conn.execute("SELECT lines, row_ids, unverified FROM program WHERE id = %s",
+                                                  (program_id,)).fetchone()
+    made = [text for text, row in zip(lines, row_ids) if row != LINEAGE_ROW]
+    return made, [text for text, row in zip(lines, row_ids) if row == LINEAGE_ROW], unverified
+
+
+def engine_program_file(run, tmp_path):
+    """A program the ISO lathe's verifier reads, made from a real drawing and written to a file;
+    imported as it is, its lineage line is refused, and it is taken out as the refusal says.
+    Returns the file and the feed of the drawing's operations."""
+    job = json.loads(ok(run("import-dxf", EMCO_DRAWING, "--speed", SPEED, "--program-name", "EMCO_NEG",
+                            "--json")).stdout)
+    written = tmp_path / "EMCO_NEG.NC"
+    ok(run("instantiate", "--job", job["job_id"], "--out", written))
+    refusal = refused(run("import-nc", written, "--class", "emco_neg"))
+    number = int(re.search(r" line (\d+) is a lineage line", refusal)[1])
+    lines = written.read_text().splitlines()
+    del lines[number - 1]
+    source = tmp_path / "emco_neg.nc"
+    source.write_text("\n".join(lines) + "\n")
+    return source, job["operations"][0]["feed"]
+
+
+def import_emco(run, tmp_path):
+    """The engine's program imported as class emco_neg, its speed and feed parameters: (file, lines)."""
+    source, feed = engine_program_file(run, tmp_path)
+    lines = source.read_text().splitlines()
+    bound = {word for line in lines for word in line.split() if re.fullmatch(rf"[A-Z]0*({SPEED}|150)(\.0*)?", word)}
+    assert feed == 150 and bound == {f"S{SPEED}", "F150.000"}   # so each value is bound at one address only
+    params = tmp_path / "params.json"
+    params.write_text(json.dumps({"program_name": "EMCO_NEG", "speed": SPEED, "feed": feed}))
+    ok(run("import-nc", source, "--class", "emco_neg", "--params", params))
+    return source, lines
+
+
+# --- verified: the imported program again, and new values --------------------------------------------
+
+def test_the_class_of_an_imported_program_gives_it_back_with_its_own_parameters(run, tmp_path):
+    source, lines = import_emco(run, tmp_path)
+    before = stored_counts(run.url)
+    made = ok(run("instantiate", "--class", "emco_neg", "--machine", "lathe-iso", "--draft"))
+    assert stored_counts(run.url) == (before[0] + 1, before[1] + 1)
+    with psycopg.connect(run.url) as conn:
+        program_id, job = conn.execute("SELECT max(id), max(job_id) FROM program").fetchone()
+        stored_job = conn.execute("SELECT gear_id, hob_id, gear_class, machine FROM job WHERE id = %s",
+                                  (job,)).fetchone()
+    assert stored_job == (None, None, "emco_neg", "lathe-iso")
+    template_lines, lineage, unverified = stored_program(run.url, program_id)
+    assert template_lines == lines
+    with psycopg.connect(run.url) as conn:
+        assert made.stdout.splitlines() == conn.execute("SELECT lines FROM program WHERE id = %s",
+                                                        (program_id,)).fetchone()[0]   # printed as stored
+    assert len(lineage) == 1 and lineage[0].startswith(f"(PROGRAM {program_id} TEMPLATE emco_neg v1 ")
+    assert "UNVERIFIED" not in lineage[0] and unverified is False
+    assert "(not in --params): " in made.stderr and {"speed", "feed", "program_name"} == set(
+        made.stderr.split("(not in --params): ")[1].splitlines()[0].split(", "))
+
+
+def test_new_values_change_exactly_the_words_bound_to_them_and_the_file_is_the_stored_program(run, tmp_path):
+    source, lines = import_emco(run, tmp_path)
+    params = tmp_path / "new.json"
+    params.write_text(json.dumps({"speed": 800, "feed": 120.5}))
+    out = tmp_path / "NEW.NC"
+    made = json.loads(ok(run("instantiate", "--class", "emco_neg", "--machine", "lathe-iso", "--draft",
+                             "--params", params, "--out", out, "--json")).stdout)
+    new_words = {f"S{SPEED}": "S800", "F150.000": "F120.500"}
+    expected = [" ".join(new_words.get(word, word) for word in line.split(" ")) for line in lines]
+    template_lines, lineage, unverified = stored_program(run.url, made["program_id"])
+    assert template_lines == expected and sum(a != b for a, b in zip(expected, lines)) == 4
+    assert (made["given"], made["taken"], made["unverified"]) == (["speed", "feed"], ["program_name"], False)
+    with psycopg.connect(run.url) as conn:
+        stored = conn.execute("SELECT lines FROM program WHERE id = %s", (made["program_id"],)).fetchone()[0]
+    assert out.read_text().splitlines() == stored   # written through the writer, after the COMMIT
+    again = json.loads(ok(run("instantiate", "--job", made["job_id"], "--draft", "--json")).stdout)
+    assert stored_program(run.url, again["program_id"])[0] == expected   # the job made again, verified again
+
+
+def test_a_dry_run_of_a_class_job_prints_the_program_and_stores_nothing(run, tmp_path):
+    source, lines = import_emco(run, tmp_path)
+    before = stored_counts(run.url)
+    dry = ok(run("instantiate", "--class", "emco_neg", "--machine", "lathe-iso", "--draft", "--dry-run"))
+    assert "(PROGRAM DRY-RUN TEMPLATE emco_neg v1 " in dry.stdout and "nothing stored" in dry.stderr
+    assert [line for line in dry.stdout.splitlines() if "PROGRAM DRY-RUN" not in line] == lines
+    assert stored_counts(run.url) == before
+
+
+# --- refused -----------------------------------------------------------------------------------------------
+
+def test_a_machine_whose_dialect_the_verifier_does_not_know_is_refused_and_nothing_is_stored(run):
+    with psycopg.connect(run.url) as conn:
+        conn.execute(LINUXCNC_LATHE)
+    ok(run("import-nc", PAWN, "--class", "pawn"))
+    before = stored_counts(run.url)
+    message = refused(run("instantiate", "--class", "pawn", "--machine", "lathe-linuxcnc", "--draft"))
+    assert "'linuxcnc'" in message and "lathe/iso" in message and "lathe/840d" in message
+    assert stored_counts(run.url) == before
+
+
+@pytest.mark.parametrize("path, machine", [(CAM, "lathe-840d"), (EMCO_CNC, "lathe-iso")],
+                         ids=["840D sl CAM program", "Emco program"])
+def test_a_real_program_the_verifier_refuses_is_refused_with_its_reason(run, path, machine):
+    ok(run("import-nc", path, "--class", "foreign"))
+    before = stored_counts(run.url)
+    message = refused(run("instantiate", "--class", "foreign", "--machine", machine, "--draft"))
+    lines = path.read_text().splitlines()
+    number = int(re.search(r"FOREIGN line (\d+) ", message)[1])
+    assert lines[number - 1].strip()[:20] in message and "not a word" in message, message
+    assert stored_counts(run.url) == before
+    made = json.loads(ok(run("instantiate", "--class", "foreign", "--machine", machine, "--draft", "--unverified",
+                             "--json")).stdout)
+    template_lines, lineage, unverified = stored_program(run.url, made["program_id"])
+    assert template_lines == lines and unverified and lineage[0].rstrip(")").endswith(" DRAFT UNVERIFIED")
+
+
+def test_unknown_parameter_names_a_modelled_class_and_a_hobber_are_refused_naming_what_to_do(run, tmp_path):
+    params = tmp_path / "pawn.json"
+    params.write_text(json.dumps({"spindle": 1000, "feed": 50.0}))
+    ok(run("import-nc", PAWN, "--class", "pawn", "--params", params))
+    typo = tmp_path / "typo.json"
+    typo.write_text(json.dumps({"spindel": 1200, "feed": 40.0}))
+    before = stored_counts(run.url)
+    refusals = {
+        ("--class", "pawn", "--machine", "lathe-iso", "--params", typo): ["'spindel'", "feed, program_name, spindle"],
+        ("--class", "spur", "--machine", "lathe-iso"): ["hobbing model", "--gear"],
+        ("--class", "turning_iso", "--machine", "lathe-iso"): ["turning class", "import-dxf"],
+        ("--class", "pawn", "--machine", "hobber-840d"): ["simulation", "gear and a hob"],
+        ("--class", "pawn"): ["--machine", "hobber-840d, lathe-840d, lathe-iso"],
+        ("--class", "pawn", "--machine", "lathe-iso", "--cuts", "2"): ["--cuts", "--params"],
+        ("--gear", "42", "--params", params): ["--params", "--class"],
+        ("--gear", "42", "--unverified"): ["--unverified", "--class"],
+    }
+    for args, words in refusals.items():
+        message = refused(run("instantiate", *args, "--draft"))
+        assert all(word in message for word in words), (args, message)
+    assert stored_counts(run.url) == before
+
+
+# --- unverified ---------------------------------------------------------------------------------------------
+
+def test_an_unverified_program_is_stored_and_shown_as_such_and_verified_when_made_again(run):
+    with psycopg.connect(run.url) as conn:
+        conn.execute(LINUXCNC_LATHE)
+    ok(run("import-nc", PAWN, "--class", "pawn"))
+    made = ok(run("instantiate", "--class", "pawn", "--machine", "lathe-linuxcnc", "--draft", "--unverified"))
+    assert "UNVERIFIED" in made.stderr.splitlines()[-1]
+    with psycopg.connect(run.url) as conn:
+        program_id, job_id = conn.execute("SELECT id, job_id FROM program ORDER BY id DESC LIMIT 1").fetchone()
+    template_lines, lineage, unverified = stored_program(run.url, program_id)
+    assert template_lines == PAWN.read_text().splitlines() and unverified is True
+    assert lineage == [made.stdout.splitlines()[0]] and lineage[0].endswith(" DRAFT UNVERIFIED")
+    listed = json.loads(ok(run("programs", "list", "--json")).stdout)["programs"]
+    assert [(p["program_id"], p["unverified"]) for p in listed if p["unverified"]] == [(program_id, True)]
+    table = ok(run("programs", "list", "--class", "pawn")).stdout
+    assert "UNVERIFIED" in table
+    shown = ok(run("programs", "show", program_id)).stdout
+    assert "verifier:      UNVERIFIED" in shown
+    assert json.loads(ok(run("programs", "show", program_id, "--json")).stdout)["programs"][0]["unverified"] is True
+    before = stored_counts(run.url)
+    remade = refused(run("instantiate", "--job", job_id, "--draft"))   # made again: read by the verifier
+    assert "'linuxcnc'" in remade and stored_counts(run.url) == before
+
+
+def test_an_unverified_program_is_never_written_to_a_file(run, tmp_path, monkeypatch):
+    with psycopg.connect(run.url) as conn:
+        conn.execute(LINUXCNC_LATHE)
+    ok(run("import-nc", PAWN, "--class", "pawn"))
+    before = stored_counts(run.url)
+    out = tmp_path / "PAWN.NGC"
+    message = refused(run("instantiate", "--class", "pawn", "--machine", "lathe-linuxcnc", "--draft", "--unverified",
+                          "--out", out))
+    assert "never written to a file" in message and not out.exists()
+    folder = tmp_path / "nc"
+    config = tmp_path / "config.toml"
+    config.write_text(f'machine = "lathe-linuxcnc"\n\n[machines.lathe-linuxcnc]\nout = "{folder}"\n')
+    monkeypatch.setenv("ENGINE_CONFIG", str(config))
+    message = refused(run("instantiate", "--class", "pawn", "--draft", "--unverified"))   # the config's machine
+    assert "never written to a file" in message and not folder.exists()
+    assert stored_counts(run.url) == before
+    help_text = " ".join(ok(run("instantiate", "--help")).stdout.split())
+    assert "Never written to a file" in help_text and "a program that reaches the machine is one the verifier read" \
+        in help_text
+
+
+# --- the database holds the record and the lineage line together --------------------------------------------
+
+def resubmit(conn, program_id: int, unverified: bool, lineage_of) -> None:
+    """The stored program submitted again under a new id, its lineage line made by lineage_of."""
+    job_id, gear_class, version, digest, name, lines, row_ids, trace = conn.execute(
+        "SELECT job_id, gear_class, template_version, template_hash, name, lines, row_ids, trace FROM program "
+        "WHERE id = %s", (program_id,)).fetchone()
+    new_id = conn.execute("SELECT nextval('program_id_seq')").fetchone()[0]
+    lines = [lineage_of(text.replace(f"PROGRAM {program_id} ", f"PROGRAM {new_id} ")) if row == LINEAGE_ROW else text
+             for text, row in zip(lines, row_ids)]
+    conn.execute(SUBMIT, (new_id, job_id, gear_class, version, digest, name, lines, row_ids, Jsonb(trace),
+                          unverified))
+
+
+def test_the_database_holds_the_unverified_word_to_the_record_and_refuses_it_for_hobbing(run):
+    with psycopg.connect(run.url) as conn:
+        conn.execute(LINUXCNC_LATHE)
+    ok(run("import-nc", PAWN, "--class", "pawn"))
+    unverified = json.loads(ok(run("instantiate", "--class", "pawn", "--machine", "lathe-linuxcnc", "--draft",
+                                   "--unverified", "--json")).stdout)["program_id"]
+    hobbing = json.loads(ok(run("instantiate", "--gear", 42, "--json")).stdout)["program_id"]
+    with psycopg.connect(run.url) as conn:
+        resubmit(conn, unverified, True, lambda line: line)   # the record and its line agree
+        for marked, lineage_of in ((False, lambda line: line), (True, lambda line: line[:-len(" UNVERIFIED")])):
+            with pytest.raises(errors.CheckViolation, match="lineage line"), conn.transaction():
+                resubmit(conn, unverified, marked, lineage_of)
+        with pytest.raises(errors.CheckViolation, match="never stored unverified"), conn.transaction():
+            resubmit(conn, hobbing, True, lambda line: line + " UNVERIFIED")
