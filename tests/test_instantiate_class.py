@@ -113,7 +113,7 @@ def test_the_class_of_an_imported_program_gives_it_back_with_its_own_parameters(
 def test_new_values_change_exactly_the_words_bound_to_them_and_the_file_is_the_stored_program(run, tmp_path):
     source, lines = import_emco(run, tmp_path)
     params = tmp_path / "new.json"
-    params.write_text(json.dumps({"speed": 800, "feed": 120.5}))
+    params.write_text(json.dumps({"speed": 800, "feed": {"value": 120.5, "addresses": ["F"]}}))   # both forms
     out = tmp_path / "NEW.NC"
     made = json.loads(ok(run("instantiate", "--class", "emco_neg", "--machine", "lathe-iso", "--draft",
                              "--params", params, "--out", out, "--json")).stdout)
@@ -129,12 +129,16 @@ def test_new_values_change_exactly_the_words_bound_to_them_and_the_file_is_the_s
     assert stored_program(run.url, again["program_id"])[0] == expected   # the job made again, verified again
 
 
-def test_a_dry_run_of_a_class_job_prints_the_program_and_stores_nothing(run, tmp_path):
+def test_a_dry_run_of_a_class_job_with_csv_parameters_prints_the_program_and_stores_nothing(run, tmp_path):
     source, lines = import_emco(run, tmp_path)
+    params = tmp_path / "new.csv"
+    params.write_text("name,value\nspeed,700\n")
     before = stored_counts(run.url)
-    dry = ok(run("instantiate", "--class", "emco_neg", "--machine", "lathe-iso", "--draft", "--dry-run"))
+    dry = ok(run("instantiate", "--class", "emco_neg", "--machine", "lathe-iso", "--draft", "--dry-run",
+                 "--params", params))
     assert "(PROGRAM DRY-RUN TEMPLATE emco_neg v1 " in dry.stdout and "nothing stored" in dry.stderr
-    assert [line for line in dry.stdout.splitlines() if "PROGRAM DRY-RUN" not in line] == lines
+    expected = [" ".join("S700" if word == f"S{SPEED}" else word for word in line.split(" ")) for line in lines]
+    assert [line for line in dry.stdout.splitlines() if "PROGRAM DRY-RUN" not in line] == expected != lines
     assert stored_counts(run.url) == before
 
 

@@ -3,7 +3,9 @@ table of a program that may be stored is made (new gears, stored jobs made again
 from drawings), so no route stores lines the verifier has not read. On a hobber the program is
 also simulated against the gear and hob records (engine.simulation): nothing the simulation
 refuses is stored. The records come from the database, not from the job's parameters, which
-a runner may have edited."""
+a runner may have edited. The one exception is a class job stored with --unverified
+(engine.programs.class_jobs): its record and lineage line say UNVERIFIED, and it is never
+written to a file for the machine."""
 from __future__ import annotations
 
 from dataclasses import dataclass
