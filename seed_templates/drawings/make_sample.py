@@ -11,6 +11,7 @@ Y the radius (programs write X as the diameter); lengths in mm.
 """
 from __future__ import annotations
 
+import contextlib
 import math
 from pathlib import Path
 
@@ -35,16 +36,17 @@ TOOL_CHANGE = (100.0, 100.0)   # layer 0 POINT: Z 100, X 200 (a diameter)
 
 # Layers 1 … n: operation n's @-codes and its tool-centre paths in the direction the tool
 # moves, each path (z, radius, bulge) vertices: two make a LINE, more an LWPOLYLINE. @F is
-# mm/min (G98): 0.25 mm/rev roughing, 0.05 grooving, 0.1 finishing.
+# mm/min (G98): 0.25 mm/rev roughing, 0.05 grooving, 0.1 finishing. The tools are the turret's
+# stations (roughing 1, finishing 3, grooving 5, threading 7), so @T is not the layer number.
 ROUGH_LEVELS = ((20.5, -70.0), (18.0, -44.5), (15.5, -44.5), (13.0, -44.5), (10.5, -25.5))  # (radius, end Z)
 OPERATIONS = (
     ("1", "TEXT", "@GROUGH @S1200 @F300 @T01 @M8",   # from the blank Ø44 to 0.5 mm over the part
      [((1.0, radius, 0), (end_z, radius, 0)) for radius, end_z in ROUGH_LEVELS]),
-    ("2", "MTEXT", "@GSLOT\\P@S900 @F45 @T02 @M8",    # a 2 mm grooving tool, two plunges
+    ("2", "MTEXT", "@GSLOT\\P@S900 @F45 @T05 @M8",    # a 2 mm grooving tool, two plunges
      [((-23.0, 10.5, 0), (-23.0, 8.5, 0)), ((-25.0, 10.5, 0), (-25.0, 8.5, 0))]),
     ("3", "TEXT", "@GFINISH @S1800 @F180 @T03 @M8",   # along the profile, the groove and faces left out
      [PROFILE[1:4], PROFILE[6:11]]),
-    ("4", "MTEXT", "@GTHREAD @S800 @T04\\P@P1.5 @D0.2 @A29.5 @M8",   # crest Ø20, root Ø18.16 (h3 0.92)
+    ("4", "MTEXT", "@GTHREAD @S800 @T07\\P@P1.5 @D0.2 @A29.5 @M8",   # crest Ø20, root Ø18.16 (h3 0.92)
      [((0.0, 10.0, 0), (-23.0, 10.0, 0)), ((0.0, 9.08, 0), (-23.0, 9.08, 0))]),   # runs out in the groove
 )
 LAYER_COLOURS = {"1": 1, "2": 3, "3": 5, "4": 6, "NOTES": 8}   # ACI: red, green, blue, magenta, grey
@@ -55,7 +57,24 @@ NOTES = ("nc-template-engine sample drawing (the project's own work): seed-000 c
 
 def sample_drawing(path: Path) -> Path:
     """Write the drawing to `path` (R2010 ASCII, the same bytes on every run) and return it."""
-    ezdxf.options.write_fixed_meta_data_for_testing = True   # no time stamps or GUIDs: diffs show changes only
+    with without_time_stamps():
+        drawing().saveas(path)
+    return path
+
+
+@contextlib.contextmanager
+def without_time_stamps():
+    """No creation or save time, no GUIDs in the file (ezdxf writes them at new() and at save),
+    so a diff of it shows what changed in the drawing."""
+    before = ezdxf.options.write_fixed_meta_data_for_testing
+    ezdxf.options.write_fixed_meta_data_for_testing = True
+    try:
+        yield
+    finally:
+        ezdxf.options.write_fixed_meta_data_for_testing = before
+
+
+def drawing():
     doc = ezdxf.new("R2010")
     doc.header["$INSUNITS"] = MILLIMETRES
     doc.header["$MEASUREMENT"] = 1   # metric
@@ -68,9 +87,9 @@ def sample_drawing(path: Path) -> Path:
         add_codes(msp, layer, text_type, codes, (10.0, 20.0 + 8.0 * number))
         for tool_path in paths:
             add_path(msp, layer, tool_path)
-    msp.add_mtext(NOTES, dxfattribs={"layer": "NOTES", "insert": (-70.0, -10.0), "char_height": TEXT_HEIGHT, "width": 80})
-    doc.saveas(path)
-    return path
+    msp.add_mtext(NOTES, dxfattribs={"layer": "NOTES", "insert": (-70.0, -10.0), "char_height": TEXT_HEIGHT,
+                                     "width": 80})
+    return doc
 
 
 TEXT_HEIGHT = 2.5   # mm on paper; TEXT calls it height, MTEXT char_height
