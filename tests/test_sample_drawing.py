@@ -14,7 +14,10 @@ from pathlib import Path
 
 import ezdxf
 import psycopg
+import pytest
+from click.testing import CliRunner
 
+from engine.cli.app import main
 from engine.gears.records import load_machine
 from engine.paths import SAMPLE_DRAWING, SEED_DIR, data_folder
 from engine.programs.demo import sample_turning_job
@@ -236,3 +239,10 @@ def entities(path: Path) -> list[tuple]:
                           for value in entity.dxfattribs(drop={"handle", "owner", "layer"}).values())
         found.append((kind, entity.dxf.layer, shape))
     return found
+
+
+def test_demo_turning_with_a_gear_is_refused_in_one_line(monkeypatch):
+    monkeypatch.setattr("engine.programs.demo.run_demo", lambda *args: pytest.fail("the demo ran"))
+    result = CliRunner().invoke(main, ["demo", "--turning", "--gear", "43"])
+    assert result.exit_code == 1 and len(result.stderr.strip().splitlines()) == 1
+    assert "--gear and --turning exclude each other" in result.stderr

@@ -7,6 +7,7 @@ import os
 
 import click
 
+from ..errors import EngineError
 from .context import connection
 from .output import Column, emit_list, list_options
 
@@ -38,6 +39,9 @@ def demo(ctx, gear_id, turning, sample_path):
 
     if sample_path:
         return click.echo(str(SAMPLE_DRAWING))
+    if turning and ctx.get_parameter_source("gear_id") is click.core.ParameterSource.COMMANDLINE:
+        raise EngineError("demo: --gear and --turning exclude each other: --turning instantiates the sample "
+                          "drawing's turning job, not a gear; leave one out")
     if ctx.obj["database_url"]:
         click.echo("demo: --database-url/DATABASE_URL ignored: the demo writes sample data and runs only on "
                    "the embedded PostgreSQL; to load the samples into that database run `engine seed --samples`",
