@@ -5,9 +5,10 @@ from setuptools import find_packages, setup
 
 DATA_FOLDERS = {"engine_data.migrations": "migrations", "engine_data.schema": "schema",
                 "engine_data.seed_templates": "seed_templates",
-                "engine_data.seed_templates.classes": "seed_templates/classes"}
+                "engine_data.seed_templates.classes": "seed_templates/classes",
+                "engine_data.seed_templates.drawings": "seed_templates/drawings"}
 
 setup(packages=find_packages(include=["engine", "engine.*", "importers", "importers.*"]) + list(DATA_FOLDERS),
       package_dir=DATA_FOLDERS,
-      package_data={"engine": ["py.typed"], **{package: ["*.sql", "*.csv", "*.json", "*.md"]
+      package_data={"engine": ["py.typed"], **{package: ["*.sql", "*.csv", "*.json", "*.md", "*.dxf"]
                                                for package in DATA_FOLDERS}})

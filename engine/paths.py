@@ -24,3 +24,5 @@ def data_folder(name: str, root: Path = SOURCE_ROOT) -> Path:
 MIGRATIONS_DIR = data_folder("migrations")
 SCHEMA_DIR = data_folder("schema")
 SEED_DIR = data_folder("seed_templates")
+# The project's sample turning drawing (seed-000 convention, design notes §8): users copy it.
+SAMPLE_DRAWING = SEED_DIR / "drawings" / "sample_shaft.dxf"

@@ -135,6 +135,18 @@ def test_demo_leaves_the_database_it_was_pointed_at_untouched(engine, empty_data
     assert counts(demo_database, "SELECT count(*) FROM gear WHERE id = 42", "SELECT count(*) FROM program") == [1, 2]
 
 
+def test_demo_turning_prints_the_sample_drawing_s_program_and_where_the_drawing_is(engine):
+    shown = engine("demo", "--sample-path")
+    assert (shown.returncode, shown.stdout) == (0, f"{SEED_DIR / 'drawings' / 'sample_shaft.dxf'}\n")
+    result = engine("demo", "--turning")
+    assert result.returncode == 0, result.stderr
+    lines = result.stdout.splitlines()
+    assert lines[-2:] == ["M30", "%"] and "(DRAWING sample_shaft.dxf)" in lines
+    assert [line.split()[2] for line in lines if line.startswith("(OP ")] == ["ROUGH", "SLOT", "FINISH", "THREAD"]
+    assert f"sample drawing {shown.stdout.strip()}" in result.stderr
+    assert "in the database engine_demo of the embedded PostgreSQL" in result.stderr
+
+
 def test_db_url_prints_the_url_given_or_the_libpq_variables():
     given = "postgresql://shop@db.example:5433/engine"
     shown = CliRunner().invoke(main, ["--database-url", given, "db", "url"])

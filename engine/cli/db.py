@@ -1,39 +1,69 @@
 """Setting up and operating the database: `engine db migrate|status`, `engine db url|psql|stop`
 (the embedded server), `engine seed [--samples]`, and `engine demo`, which migrates and seeds the
-embedded server's database and instantiates one gear."""
+embedded server's database and instantiates one gear (or, --turning, the sample drawing's turning job)."""
 from __future__ import annotations
 
 import os
 
 import click
 
+from ..errors import EngineError
 from .context import connection
 from .output import Column, emit_list, list_options
 
 
 @click.command()
-@click.option("--gear", "gear_id", default=42, show_default=True, help="Gear to instantiate.")
+@click.option("--gear", "gear_id", default=42, show_default=True, help="Gear to instantiate (without --turning).")
+@click.option("--turning", is_flag=True,
+              help="Instead of a gear: import the sample lathe drawing (seed-000 convention) as a turning "
+                   "job on the default lathe and instantiate it.")
+@click.option("--sample-path", is_flag=True,
+              help="Only print where the sample lathe drawing is, to copy it as the start of your own; "
+                   "no database.")
 @click.pass_context
-def demo(ctx, gear_id):
+def demo(ctx, gear_id, turning, sample_path):
     """Migrate, seed (with the samples) and instantiate one gear in the database engine_demo of
     the embedded PostgreSQL; print the program. Never on another database: --database-url and
     DATABASE_URL are ignored, and the embedded server's own database `engine` is not touched.
 
+    With --turning, the sample lathe drawing (profile on layer 0, ROUGH, SLOT, FINISH and THREAD
+    on layers 1-4, a tool-change POINT) becomes a turning job whose program is printed; stderr
+    says where the drawing is, to copy it.
+
     Example: engine demo --gear 43
+
+    Example: engine demo --turning
     """
+    from ..paths import SAMPLE_DRAWING
     from ..programs.demo import DEMO_DATABASE, run_demo
 
+    if sample_path:
+        return click.echo(str(SAMPLE_DRAWING))
+    if turning and ctx.get_parameter_source("gear_id") is click.core.ParameterSource.COMMANDLINE:
+        raise EngineError("demo: --gear and --turning exclude each other: --turning instantiates the sample "
+                          "drawing's turning job, not a gear; leave one out")
     if ctx.obj["database_url"]:
         click.echo("demo: --database-url/DATABASE_URL ignored: the demo writes sample data and runs only on "
                    "the embedded PostgreSQL; to load the samples into that database run `engine seed --samples`",
                    err=True)
-    result = run_demo(gear_id)
+    result = run_demo(gear_id, turning)
     program = result.program
     click.echo(f"demo: in the database {DEMO_DATABASE} of the embedded PostgreSQL (data in {result.data_dir}); "
                f"migrations applied: {result.applied}; {result.report}", err=True)
+    if result.sample:
+        say_sample(result.sample)
     click.echo(program.text, nl=False)
     click.echo(f"program {program.program_id} ({len(program.lines)} lines) from template "
                f"{program.gear_class} v{program.template_version} ({program.template_hash})", err=True)
+
+
+def say_sample(sample) -> None:
+    """Where the sample drawing is (to copy) and what its job holds, on stderr."""
+    from ..programs.demo import operations_line
+
+    click.echo(f"demo: sample drawing {sample.drawing} (copy it to start a drawing of your own; "
+               "`engine demo --sample-path` prints just the path)", err=True)
+    click.echo(f"demo: job {sample.job.job_id} on {sample.job.machine}: {operations_line(sample.job)}", err=True)
 
 
 @click.group()

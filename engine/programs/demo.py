@@ -4,7 +4,11 @@ The demo loads the sample gears, hobs and cases, so it never runs on a shop's da
 16): a DATABASE_URL or --database-url is ignored, never written to; and on the embedded server it
 uses a database of its own, `engine_demo`, because the embedded server's `engine` database is a
 shop's database too when it runs without a URL. A shop that wants the samples in its own
-database says so: `engine seed --samples`."""
+database says so: `engine seed --samples`.
+
+`engine demo --turning` makes a turning job of the project's sample drawing instead (issue 17:
+no real drawing carries operation layers, so users need one to copy): sample_turning_job
+imports it on the default lathe and instantiates it, on whatever connection it is given."""
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -12,8 +16,19 @@ from pathlib import Path
 
 from ..db.embedded import embedded_data_dir, embedded_url
 from ..db.seed import SeedReport
+from ..paths import SAMPLE_DRAWING
 
 DEMO_DATABASE = "engine_demo"
+# mm: the blank the sample drawing's roughing starts from (seed_templates/drawings/README.md);
+# the convention has no place for it in the drawing, so it is given as `--stock-diameter` would be.
+SAMPLE_STOCK_DIAMETER = 44.0
+
+
+@dataclass(frozen=True)
+class SampleJob:
+    drawing: Path           # the sample drawing, to copy as the start of one's own
+    job: object             # engine.turning.dxf_import's ImportReport
+    program: object         # engine.programs.instantiate's Program
 
 
 @dataclass(frozen=True)
@@ -22,10 +37,12 @@ class DemoResult:
     applied: int            # migrations applied by this run
     report: SeedReport
     program: object         # engine.programs.instantiate's Program
+    sample: SampleJob | None = None   # with --turning: the job the program was made for
 
 
-def run_demo(gear_id: int = 42) -> DemoResult:
-    """Migrate and seed (samples included) the embedded server's database, instantiate one gear."""
+def run_demo(gear_id: int = 42, turning: bool = False) -> DemoResult:
+    """Migrate and seed (samples included) the embedded server's database, then instantiate one
+    gear, or with `turning` the sample drawing's turning job."""
     from ..db.connection import connect
     from ..db.migrate import migrate
     from ..db.seed import seed
@@ -34,5 +51,23 @@ def run_demo(gear_id: int = 42) -> DemoResult:
     with connect(embedded_url(DEMO_DATABASE)) as conn:
         applied = migrate(conn)
         report = seed(conn, samples=True)
-        program = instantiate_gear(conn, gear_id)
-    return DemoResult(embedded_data_dir(), len(applied), report, program)
+        sample = sample_turning_job(conn) if turning else None
+        program = sample.program if sample else instantiate_gear(conn, gear_id)
+    return DemoResult(embedded_data_dir(), len(applied), report, program, sample)
+
+
+def sample_turning_job(conn, drawing: Path = SAMPLE_DRAWING) -> SampleJob:
+    """Import the sample drawing as a turning job on the default lathe (from the Ø44 blank) and
+    store its program, as `engine import-dxf` and `engine instantiate --job` do."""
+    from ..turning.dxf_import import import_dxf
+    from ..turning.job_params import ProfileOptions
+    from .remake import instantiate_job
+
+    job = import_dxf(conn, drawing, options=ProfileOptions(stock_diameter=SAMPLE_STOCK_DIAMETER))
+    return SampleJob(drawing, job, instantiate_job(conn, job.job_id))
+
+
+def operations_line(job) -> str:
+    """The job's operations as one line: number, kind, tool, spindle, feed (none for a thread)."""
+    return ", ".join(f"{op['operation']} {op['kind']} T{op['tool']} S{op['spindle_rpm']:g}"
+                     + (f" F{op['feed']:g}" if op["feed"] is not None else "") for op in job.operations)
