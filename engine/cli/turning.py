@@ -48,8 +48,9 @@ POSITIVE = FiniteFloatRange(min=0, min_open=True)
 @click.option("--program-name", metavar="NAME",
               help="The program's name (840D: letters, digits, _; two letters first; at most 24) "
                    "[default: the file name in upper case, - . and spaces as _].")
-@click.option("--profile-layer", default="0", show_default=True, metavar="NAME",
-              help="Layer holding the part's profile (CAD drawings often use 'outline' or 'Sketch').")
+@click.option("--profile-layer", metavar="NAME",
+              help="Layer holding the part's profile (CAD drawings often use 'outline' or 'Sketch') "
+                   "[default: 0; when layer 0 is empty, the one layer with one contour on the axis].")
 @click.option("--draft", is_flag=True,
               help="Check the job's program with the turning class's draft, not its released template.")
 @click.option("--json", "as_json", is_flag=True,
