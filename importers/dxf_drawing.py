@@ -22,7 +22,7 @@ from .dxf_layers import CENTRE, HIDDEN, chosen_profile_layer, layer_linetypes, l
 from .dxf_outline import hatch_polygons, profile_of
 from .dxf_geometry import (FLATTEN_TOLERANCE_MM, HANDLERS, MAX_COORDINATE_MM, Context, Line, Segment, check_finite,
                            check_reach, inserted_entities, named_on_failure, segments_of, unit_scale)
-from .dxf_profile import Profile, chain_segments, find_profile, scaled
+from .dxf_profile import Profile, chain_segments, scaled
 from .dxf_read import DxfError, ezdxf_warnings, load_drawing_file, summarised
 
 PROFILE_LAYER = "0"
