@@ -235,3 +235,44 @@ def test_two_layers_that_could_be_the_part_are_refused_naming_both(tmp_path):
         read_drawing(tmp_path / "two.dxf")
     message = str(refused.value)
     assert "'81' and 'Kontur'" in message and "--profile-layer" in message
+
+
+def upright_pin(path) -> None:
+    """A pin Ø16 drawn standing up about a vertical centre line at X 40 on a layer named 'axis':
+    its face at Y 0 rounded into its diameter by R2 fillets, its foot at Y -40."""
+    doc = ezdxf.new("R2010")
+    doc.header["$INSUNITS"] = 4
+    doc.layers.add("axis")
+    msp = doc.modelspace()
+    msp.add_line((34, 0), (46, 0))
+    msp.add_arc((46, -2), 2, 0, 90)
+    msp.add_arc((34, -2), 2, 90, 180)
+    msp.add_line((48, -2), (48, -40))
+    msp.add_line((48, -40), (32, -40))
+    msp.add_line((32, -40), (32, -2))
+    msp.add_line((40, 3), (40, -43), dxfattribs={"layer": "axis"})
+    doc.saveas(path)
+
+
+def test_an_upright_side_view_is_turned_to_lie_along_z(conn, tmp_path):
+    upright_pin(tmp_path / "pin.dxf")
+    profile = read_drawing(tmp_path / "pin.dxf").profile
+    fillet, side = profile.segments
+    assert fillet.start == pytest.approx((0, 6)) and fillet.end == pytest.approx((-2, 8))
+    assert fillet.centre == pytest.approx((-2, 6))
+    # The fillet bulges away from its centre: halfway along it lies at 45° on the R2 circle.
+    direction = 1.0 if fillet.ccw else -1.0
+    halfway = direction * math.pi / 4      # it starts at angle 0 about its centre
+    assert (-2 + 2 * math.cos(halfway), 6 + 2 * math.sin(halfway)) == pytest.approx(
+        (-2 + 2 * math.sqrt(0.5), 6 + 2 * math.sqrt(0.5)))
+    assert (side.start, side.end) == (pytest.approx((-2, 8)), pytest.approx((-40, 8)))
+    report = import_dxf(conn, tmp_path / "pin.dxf", "lathe-iso", ProfileOptions(rough_depth=1.0), program_name="PIN")
+    lines = instantiate_job(conn, report.job_id).lines
+    drawn = [[(y, x - 40) for x, y in line] for line in upper_polylines_xy(tmp_path / "pin.dxf")]
+    check_program_against_the_drawing(lines, drawn, (-40, 0))
+
+
+def upper_polylines_xy(path) -> list[list[tuple[float, float]]]:
+    """The layer-0 lines and arcs as drawn (x, y) chords."""
+    return [[(p.x, p.y) for p in ezdxf.path.make_path(e).flattening(FLATTENING_MM)]
+            for e in ezdxf.readfile(path).modelspace() if e.dxf.layer == "0"]
