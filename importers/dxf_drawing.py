@@ -200,7 +200,8 @@ def take(entity, layer: str, context: Context, collected: Collected) -> None:
     kind = entity.dxftype()
     if kind == "HATCH":
         collected.hatches.extend(hatch_polygons(entity))
-    role = line_role(entity, layer, collected.linetypes) if kind in HANDLERS else None
+    # Operation layers hold tool paths in whatever linetype: roles apply to the others.
+    role = line_role(entity, layer, collected.linetypes) if kind in HANDLERS and operation_number(layer) is None else None
     if role == CENTRE:
         check_finite(entity, context)
         segments = segments_of(entity, context)

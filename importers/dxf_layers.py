@@ -11,6 +11,7 @@ layer name, both compared in upper case).
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 from .dxf_profile import END_MATCH_TOLERANCE_MM, chain_segments
 from .dxf_read import DxfError
@@ -45,7 +46,12 @@ def effective_linetype(entity, layer_linetypes: dict[str, str], layer: str) -> s
 
 def line_role(entity, layer: str, layer_linetypes: dict[str, str]) -> str | None:
     """CENTRE, HIDDEN or None (an outline or anything else) for one entity."""
-    linetype, name = effective_linetype(entity, layer_linetypes, layer), layer.upper()
+    return role_of(effective_linetype(entity, layer_linetypes, layer), layer.upper())
+
+
+@lru_cache(maxsize=1024)
+def role_of(linetype: str, name: str) -> str | None:
+    """The role a linetype (upper case) or else a layer name (upper case) gives a line."""
     for rule in LINE_ROLES:
         if any(word in linetype for word in rule.linetype_words):
             return rule.role

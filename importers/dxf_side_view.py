@@ -88,8 +88,11 @@ def joined_groups(groups: list[list[Segment]], related) -> list[list[Segment]]:
             parent[i] = parent[parent[i]]
             i = parent[i]
         return i
-    for i in range(len(groups)):
-        for j in range(i + 1, len(groups)):
+    by_x = sorted(range(len(groups)), key=lambda i: boxes[i][0])
+    for place, i in enumerate(by_x):   # only extents overlapping along X can be related: a sweep
+        for j in (by_x[k] for k in range(place + 1, len(by_x))):
+            if boxes[j][0] > boxes[i][1] + END_MATCH_TOLERANCE_MM:
+                break
             if related(boxes[i], boxes[j]):
                 parent[root(i)] = root(j)
     found: dict[int, list[Segment]] = {}
@@ -116,9 +119,12 @@ def runs_through(axis: Axis, line: Line, view: list[Segment]) -> bool:
 
 
 def centred_views(segments: list[Segment], centre_lines: list[Line]) -> list[tuple[Axis, list[Segment]]]:
+    axes = [line for line in centre_lines if centre_axis(line) is not None]
+    if not axes:
+        return []
     found = []
     for view in views(segments):
-        for line in centre_lines:
+        for line in axes:
             axis = centre_axis(line)
             if axis is not None and runs_through(axis, line, view):
                 found.append((axis, view))
