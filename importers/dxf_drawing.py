@@ -20,6 +20,7 @@ from engine.memory import no_cycle_collection
 from .dxf_codes import CodeText, layer_codes
 from .dxf_layers import CENTRE, HIDDEN, chosen_profile_layer, layer_linetypes, line_role
 from .dxf_outline import hatch_polygons, profile_of
+from .dxf_side_view import Marks
 from .dxf_geometry import (FLATTEN_TOLERANCE_MM, HANDLERS, MAX_COORDINATE_MM, Context, Line, Segment, check_finite,
                            check_reach, inserted_entities, named_on_failure, segments_of, unit_scale)
 from .dxf_profile import Profile, chain_segments, scaled
@@ -90,6 +91,7 @@ class Collected:
     linetypes: dict[str, str] = field(default_factory=dict)   # layer name (upper case) → its linetype
     centre_lines: list[Segment] = field(default_factory=list)
     hidden: Counter = field(default_factory=Counter)
+    hidden_lines: list[Segment] = field(default_factory=list)
     hatches: list[list[tuple[float, float]]] = field(default_factory=list)
 
 
@@ -110,9 +112,7 @@ def read_drawing(path: str | Path, profile_layer: str | None = None) -> Drawing:
     if not layer0.segments:
         raise DxfError(no_geometry_message(collected))
     profile, outline_notes, chains = profile_of([scaled(s, scale) for s in layer0.segments],
-                                                [scaled(s, scale) for s in collected.centre_lines],
-                                                [[(x * scale, y * scale) for x, y in p] for p in collected.hatches],
-                                                profile_layer)
+                                                scaled_marks(collected, scale), profile_layer)
     side_view = bool(outline_notes)
     operations = [operation(name, number, collected.layers[name], scale, profile.mirrored)
                   for number, name in operation_layers(collected.layers)]
@@ -127,6 +127,12 @@ def read_drawing(path: str | Path, profile_layer: str | None = None) -> Drawing:
         notes.append(f"layer {profile_layer}: {len(chains) - 1} other chain(s) are not part of the profile, left out")
     return Drawing(drawing_file.path, units, scale, profile, [op for op in operations if op],
                    tool_change, drawing_file.repairs, notes)
+
+
+def scaled_marks(collected: Collected, scale: float) -> Marks:
+    return Marks([scaled(s, scale) for s in collected.centre_lines],
+                 [[(x * scale, y * scale) for x, y in polygon] for polygon in collected.hatches],
+                 [scaled(s, scale) for s in collected.hidden_lines])
 
 
 def all_dash_dot(layer0: LayerContent, collected: Collected, layer: str) -> list[str]:
@@ -211,7 +217,9 @@ def take(entity, layer: str, context: Context, collected: Collected) -> None:
             collected.layers[layer].entities += 1
         return
     if role == HIDDEN:
+        check_finite(entity, context)
         collected.hidden[layer] += 1
+        collected.hidden_lines.extend(segments_of(entity, context))
         return
     if not is_relevant(layer, collected.profile_layer):
         collected.other_layers[layer] += 1

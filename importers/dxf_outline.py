@@ -9,10 +9,10 @@ which lie inside others, is refused as the flat part (a plate) it is.
 """
 from __future__ import annotations
 
-from .dxf_geometry import Line, Segment
+from .dxf_geometry import Segment
 from .dxf_profile import Chain, Profile, chain_segments, find_profile, merged_bounds
 from .dxf_read import DxfError
-from .dxf_side_view import side_view, side_view_of, symmetry_axis
+from .dxf_side_view import Marks, side_view, side_view_of, symmetry_axis
 
 HATCH_FLATTENING = 0.01   # drawing units: hatching only tells where material is, not its edge
 
@@ -24,10 +24,9 @@ def hatch_polygons(hatch) -> list[list[tuple[float, float]]]:
     return [[(v.x, v.y) for v in loop.flattening(HATCH_FLATTENING)] for loop in path.from_hatch(hatch)]
 
 
-def profile_of(segments: list[Segment], centre_lines: list[Line], hatches, layer: str
-               ) -> tuple[Profile, list[str], list[Chain]]:
+def profile_of(segments: list[Segment], marks: Marks, layer: str) -> tuple[Profile, list[str], list[Chain]]:
     """(profile, notes, chains of the layer): notes are non-empty exactly for a side view."""
-    found = side_view_of(segments, centre_lines, hatches, layer)
+    found = side_view_of(segments, marks, layer)
     if found is not None:
         return found.profile, found.notes, []
     chains = chain_segments(segments)
@@ -37,7 +36,7 @@ def profile_of(segments: list[Segment], centre_lines: list[Line], hatches, layer
         axis = symmetry_axis(segments)
         if axis is None:
             raise plate_refusal(chains, layer) or refusal from None
-        found = side_view(axis, segments, hatches, f"layer {layer}")
+        found = side_view(axis, segments, marks, f"layer {layer}")
         return found.profile, found.notes, []
 
 

@@ -5,20 +5,21 @@ The axis is a straight, horizontal or vertical centre line (dxf_layers.LINE_ROLE
 the length of one view of the profile layer, with that view on both sides of it; without
 one, a drawing that is not a half-profile is tried for mirror symmetry about the middle
 of its extents. The view is moved so the centre line is the axis (a vertical one turned to
-lie along Z) and its outline above the axis is taken (dxf_envelope). Before that, what a
-lathe cannot make from outside is refused by name (VIEW_CHECKS): a view along the axis,
-a plate's holes, a section whose hatching leaves a bore, a prism such as a hexagon head.
+lie along Z) and its outline above the axis is taken (dxf_envelope), once dxf_turnable has
+found nothing a lathe cannot make from outside.
 """
 from __future__ import annotations
 
 import math
 from collections import defaultdict
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from .dxf_envelope import upper_envelope
 from .dxf_geometry import Arc, Line, Segment
 from .dxf_profile import END_MATCH_TOLERANCE_MM, Profile, bounds, merged_bounds, sweep
 from .dxf_read import DxfError
+from .dxf_turnable import (check_no_bore, check_no_hidden_bore, check_no_prism, check_not_an_end_view,
+                           check_reaches_the_axis)
 
 ALONG_SLACK_MM = 1.0       # a centre line may stop this short of its view's ends
 STRAIGHT = 1e-3            # |dy/dx| (or dx/dy) of a horizontal (vertical) centre line
@@ -27,12 +28,6 @@ SYMMETRY_TOLERANCE = 0.002  # of the drawing's size, at least END_MATCH_TOLERANC
 SAMPLES_PER_SEGMENT = 12
 GRID_CELLS = 100           # cells across the drawing for finding mirrored points
 MAX_SYMMETRY_SEGMENTS = 5000   # a drawing of more pieces is no single part's side view
-HATCH_SAMPLES = 200
-# Interior edges along the whole length of a cylinder-like span, as a share of its outline
-# radius, and what a side view with them shows: the faces of a prism, not a turned surface.
-PRISM_EDGES = ((0.5, "a hexagon seen across its corners (edges at ±e/4 inside its outline ±e/2)"),
-               (0.0, "a hexagon seen across its flats, or a square across its corners (an edge on the centre line)"))
-PRISM_SHARE_TOLERANCE = 0.03
 
 
 @dataclass(frozen=True)
@@ -51,6 +46,22 @@ class Axis:
             return Line(self.point(s.start), self.point(s.end), s.handle)
         # Swapping x and y (a vertical axis) mirrors the plane: arcs turn the other way.
         return Arc(self.point(s.start), self.point(s.end), self.point(s.centre), s.ccw != self.vertical, s.handle)
+
+
+@dataclass
+class Marks:
+    """What is drawn besides the outline, in mm: centre lines, hatching (boundary polygons) and
+    hidden lines, from every layer."""
+    centre_lines: list[Line] = field(default_factory=list)
+    hatches: list[list[tuple[float, float]]] = field(default_factory=list)
+    hidden: list[Segment] = field(default_factory=list)
+
+    def near(self, view: list[Segment]) -> "Marks":
+        """The hatching and hidden lines within the view's extents."""
+        box = merged_bounds(view)
+        hatches = [p for p in self.hatches if boxes_touch(box, (min(x for x, _ in p), max(x for x, _ in p),
+                                                                min(y for _, y in p), max(y for _, y in p)))]
+        return Marks(self.centre_lines, hatches, [s for s in self.hidden if boxes_touch(box, bounds(s))])
 
 
 @dataclass
@@ -196,91 +207,15 @@ def symmetry_axis(segments: list[Segment]) -> Axis | None:
     return None
 
 
-def check_not_an_end_view(framed: list[Segment], where: str) -> None:
-    """A circle (or an arc of more than half a turn) centred on the axis: the view looks along the axis."""
-    turned: dict[tuple, float] = {}
-    for s in framed:
-        if isinstance(s, Arc) and abs(s.centre[1]) <= END_MATCH_TOLERANCE_MM:
-            turn_key = (s.handle, round(s.centre[0], 3), round(s.radius, 3))
-            turned[turn_key] = turned.get(turn_key, 0.0) + sweep(s)
-    circles = sorted({2 * radius for (_, _, radius), turn in turned.items() if turn > math.pi + 1e-6})
-    if circles:
-        shown = ", ".join(f"Ø{d:g}" for d in circles[:4])
-        raise DxfError(f"{where} shows circles centred on its centre line ({shown}): a view along the axis, "
-                       "not a side view; draw the side view of the part (or its half-profile)")
-
-
-def check_reaches_the_axis(framed: list[Segment], where: str) -> None:
-    """A turned part's side view has lines across the axis (its end faces); a plate's holes do not."""
-    if any(bounds(s)[2] < -END_MATCH_TOLERANCE_MM and bounds(s)[3] > END_MATCH_TOLERANCE_MM
-           or max(abs(s.start[1]), abs(s.end[1])) <= END_MATCH_TOLERANCE_MM for s in framed):
-        return
-    handles = len({s.handle for s in framed})
-    raise DxfError(f"{where}: nothing drawn crosses or meets its centre line; it is {handles} separate outline(s) "
-                   "on either side (holes of a plate, a flat part), not a turned part")
-
-
-def lowest_hatched(polygons: list[list[tuple[float, float]]], z: float) -> tuple[float | None, float | None]:
-    """The smallest radius of hatched material at z above and below the axis (None: no hatch)."""
-    crossings = sorted(r0 + (z - z0) * (r1 - r0) / (z1 - z0) for polygon in polygons
-                       for (z0, r0), (z1, r1) in zip(polygon, polygon[1:] + polygon[:1])
-                       if (z0 <= z < z1) or (z1 <= z < z0))
-    inside = list(zip(crossings[0::2], crossings[1::2]))
-    above = [max(low, 0.0) for low, high in inside if high > 0.0]
-    below = [max(-high, 0.0) for low, high in inside if low < 0.0]
-    return (min(above) if above else None), (min(below) if below else None)
-
-
-def check_no_bore(polygons: list[list[tuple[float, float]]], z_min: float, z_max: float, where: str) -> None:
-    """In a section the hatching is the material: where it stops short of the axis, a bore is."""
-    if not polygons:
-        return
-    bored = []
-    for k in range(1, HATCH_SAMPLES):
-        z = z_min + (z_max - z_min) * k / HATCH_SAMPLES
-        lows = [low for low in lowest_hatched(polygons, z) if low is not None]
-        if lows and min(lows) > END_MATCH_TOLERANCE_MM:
-            bored.append((z, min(lows)))
-    if bored:
-        diameter = 2 * min(radius for _, radius in bored)
-        through = len(bored) == HATCH_SAMPLES - 1
-        span = (f"through the whole part (Z{z_min:.3f} to Z{z_max:.3f})" if through
-                else f"from Z{bored[0][0]:.3f} to Z{bored[-1][0]:.3f}")
-        raise DxfError(f"{where}: the section shows a bore Ø{diameter:.3f} {span} (its hatching stops short of "
-                       "the axis); cutting it needs internal turning, which is not supported")
-
-
-def check_no_prism(framed: list[Segment], outline: list[Segment], where: str) -> None:
-    """Edges along the whole length of a constant-radius span, at a radius a prism shows."""
-    spans = [(min(s.start[0], s.end[0]), max(s.start[0], s.end[0]), s.start[1]) for s in outline
-             if isinstance(s, Line) and abs(s.start[1] - s.end[1]) <= END_MATCH_TOLERANCE_MM
-             and abs(s.start[0] - s.end[0]) > END_MATCH_TOLERANCE_MM]
-    for s in framed:
-        if not isinstance(s, Line) or abs(s.start[1] - s.end[1]) > END_MATCH_TOLERANCE_MM or s.start[1] < -END_MATCH_TOLERANCE_MM:
-            continue
-        z0, z1, radius = min(s.start[0], s.end[0]), max(s.start[0], s.end[0]), s.start[1]
-        for a, b, outer in spans:
-            if abs(z0 - a) <= 5 * END_MATCH_TOLERANCE_MM and abs(z1 - b) <= 5 * END_MATCH_TOLERANCE_MM \
-                    and radius < outer - END_MATCH_TOLERANCE_MM:
-                check_prism_share(radius, outer, a, b, where)
-
-
-def check_prism_share(radius: float, outer: float, a: float, b: float, where: str) -> None:
-    for share, shows in PRISM_EDGES:
-        if abs(radius / outer - share) <= PRISM_SHARE_TOLERANCE:
-            raise DxfError(f"{where}: the part from Z{a:.3f} to Z{b:.3f} is not a turned surface: its side view has "
-                           f"edges at ±{radius:.3f} along its whole length inside its outline ±{outer:.3f}, as "
-                           f"{shows}; a lathe cannot make it as drawn")
-
-
-def side_view(axis: Axis, view: list[Segment], polygons, where: str) -> SideView:
+def side_view(axis: Axis, view: list[Segment], marks: Marks, where: str) -> SideView:
     """The upper half-profile of one view about its axis, or DxfError with what it is instead."""
     framed = [axis.segment(s) for s in view]
     check_not_an_end_view(framed, where)
     check_reaches_the_axis(framed, where)
     outline = upper_envelope(framed, where)
     z_min, z_max = outline[-1].end[0], outline[0].start[0]
-    check_no_bore([[axis.point(p) for p in polygon] for polygon in polygons], z_min, z_max, where)
+    check_no_bore([[axis.point(p) for p in polygon] for polygon in marks.hatches], z_min, z_max, where)
+    check_no_hidden_bore([axis.segment(s) for s in marks.hidden], outline, where)
     check_no_prism(framed, outline, where)
     profile = Profile(outline, True, merged_bounds(outline))
     inside = len({s.handle for s in framed})
@@ -291,28 +226,21 @@ def side_view(axis: Axis, view: list[Segment], polygons, where: str) -> SideView
     return SideView(profile, notes)
 
 
-def in_view(polygons, view: list[Segment]):
-    box = merged_bounds(view)
-    return [p for p in polygons if boxes_touch(box, (min(x for x, _ in p), max(x for x, _ in p),
-                                                     min(y for _, y in p), max(y for _, y in p)))]
-
-
-def side_view_of(segments: list[Segment], centre_lines: list[Line], polygons, layer: str) -> SideView | None:
+def side_view_of(segments: list[Segment], marks: Marks, layer: str) -> SideView | None:
     """The side view a centre line runs through, None when no centre line runs through a view;
     DxfError when only views along the axis are found or two side views compete."""
-    candidates = centred_views(segments, centre_lines)
+    candidates = centred_views(segments, marks.centre_lines)
     if not candidates:
         return None
     found, refusals = [], []
     for axis, view in candidates:
         try:
-            found.append(side_view(axis, view, in_view(polygons, view), f"layer {layer}"))
+            found.append(side_view(axis, view, marks.near(view), f"layer {layer}"))
         except DxfError as refusal:
             refusals.append(refusal)
     if len(found) == 1:
         others = len(views(segments)) - 1
-        extra = [f"layer {layer}: {others} other view(s) left out"] if others else []
-        found[0].notes.extend(extra)
+        found[0].notes.extend([f"layer {layer}: {others} other view(s) left out"] if others else [])
         return found[0]
     if found:
         raise DxfError(f"layer {layer} has {len(found)} side views about centre lines; keep one of them on the "

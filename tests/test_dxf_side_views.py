@@ -168,17 +168,17 @@ SHAFT = [(0, 8), (-12, 8), (-12, 12), (-35, 12), (-35, 10), (-50, 10)]
 AXIS_Y = 30.0
 
 
-def whole_shaft(path, *, second_layer: str | None = None) -> None:
+def whole_shaft(path, *, bore_depth: float | None = None) -> None:
     """The shaft's full outline, the lines across at its shoulders, a CENTER centre line,
-    hatching of the whole section, a dimension, a text and a hidden (DASHED) line."""
+    hatching of the whole section, a dimension, a text and a cross hole Ø4 at Z -25 in hidden
+    (DASHED) lines; with bore_depth, also a bore Ø6 that deep from the face, in hidden lines."""
     doc = ezdxf.new("R2010", setup=True)
     doc.header["$INSUNITS"] = 4
     doc.layers.add("Mittellinie", linetype="CENTER")
     msp = doc.modelspace()
     upper = [(z, AXIS_Y + r) for z, r in SHAFT]
     lower = [(z, AXIS_Y - r) for z, r in reversed(SHAFT)]
-    for layer in filter(None, ("0", second_layer)):
-        msp.add_lwpolyline(upper + lower, close=True, dxfattribs={"layer": layer})
+    msp.add_lwpolyline(upper + lower, close=True)
     for z, radius in ((-12, 8), (-35, 10)):   # where a diameter meets a shoulder face
         msp.add_line((z, AXIS_Y - radius), (z, AXIS_Y + radius))
     msp.add_line((5, AXIS_Y), (-55, AXIS_Y), dxfattribs={"layer": "Mittellinie"})
@@ -186,7 +186,10 @@ def whole_shaft(path, *, second_layer: str | None = None) -> None:
     hatch.paths.add_polyline_path(upper + lower, is_closed=True)
     msp.add_linear_dim(base=(0, AXIS_Y + 20), p1=(0, AXIS_Y + 8), p2=(-50, AXIS_Y + 10)).render()
     msp.add_text("SHAFT 1", dxfattribs={"height": 3}).set_placement((-40, AXIS_Y + 25))
-    msp.add_line((0, AXIS_Y + 3), (-20, AXIS_Y + 3), dxfattribs={"linetype": "DASHED"})
+    for z in (-23, -27):
+        msp.add_line((z, AXIS_Y - 12), (z, AXIS_Y + 12), dxfattribs={"linetype": "DASHED"})
+    for side in ((3, -3) if bore_depth else ()):
+        msp.add_line((0, AXIS_Y + side), (-bore_depth, AXIS_Y + side), dxfattribs={"linetype": "DASHED"})
     doc.saveas(path)
 
 
@@ -198,6 +201,15 @@ def test_a_whole_side_view_becomes_exactly_its_upper_half(tmp_path):
         [coordinate for corner in SHAFT for coordinate in corner])
     assert drawing.profile.closed_by_axis
     assert any("hidden" in note for note in drawing.notes)
+
+
+def test_a_bore_shown_by_hidden_lines_is_refused(tmp_path):
+    whole_shaft(tmp_path / "bored.dxf", bore_depth=20)
+    with pytest.raises(DxfError) as refused:
+        read_drawing(tmp_path / "bored.dxf")
+    message = str(refused.value)
+    assert "hidden lines show a bore Ø6.000 from Z-20.000 to Z0.000" in message
+    assert "internal turning, which is not supported" in message
 
 
 def test_a_whole_side_view_makes_a_checked_job(conn, tmp_path):
