@@ -223,7 +223,22 @@ def side_view(axis: Axis, view: list[Segment], marks: Marks, where: str) -> Side
     notes = [f"{where} is a side view: its half above {axis.source}{turn} is the profile, moved so that line is "
              f"the axis; the lines inside its outline (edges, thread roots, slots; {inside} entities drawn in all) "
              "are not turned surfaces and are left out"]
-    return SideView(profile, notes)
+    return SideView(profile, notes + open_face_notes(framed, outline, where))
+
+
+def open_face_notes(framed: list[Segment], outline: list[Segment], where: str) -> list[str]:
+    """An end face drawn only part of the way to the axis leaves a slot or recess open there,
+    which the job does not make: it faces the end to the axis."""
+    notes = []
+    for face in (outline[0].start[0], outline[-1].end[0]):
+        at_face = [s for s in framed if isinstance(s, Line) and max(s.start[1], s.end[1]) > 0.0
+                   and abs(s.start[0] - face) <= END_MATCH_TOLERANCE_MM >= abs(s.end[0] - face)]
+        lowest = min((max(min(s.start[1], s.end[1]), 0.0) for s in at_face), default=0.0)
+        if lowest > END_MATCH_TOLERANCE_MM:
+            notes.append(f"{where}: the end face at Z{face:.3f} is drawn down to radius {lowest:.3f} only; the slot or "
+                         f"recess it leaves open (Ø{2 * lowest:.3f} seen from the side) is not a turned surface and "
+                         "is not made: the job faces that end to the axis")
+    return notes
 
 
 def side_view_of(segments: list[Segment], marks: Marks, layer: str) -> SideView | None:

@@ -6,6 +6,7 @@ the hatching), and the programs are checked against the drawn lines by sampling,
 the engine's own geometry."""
 from __future__ import annotations
 
+import json
 import math
 import shutil
 
@@ -21,6 +22,7 @@ from importers.dxf_drawing import read_drawing
 from importers.dxf_read import DxfError
 from lathe_programs import distance_to_chord, motions, operation_lines
 from test_dxf_read import DXF
+from test_dxf_real_layers import outline_drawing
 
 FLATTENING_MM = 0.0005
 ON_DRAWING_MM = 0.01       # a finish end point this close to a drawn line is on it
@@ -106,6 +108,10 @@ def test_the_qcad_screw_becomes_its_upper_half_and_a_checked_job(conn):
     assert r_max == pytest.approx(high.y - axis_y)              # the extent above the centre line
     assert drawing.profile.closed_by_axis
     assert any("side view" in note and "centre line" in note for note in drawing.notes)
+    # The head's end face is drawn down to the screwdriver slot only: said, not made.
+    face_lines = [e for e in entities(name, "0") if e.dxftype() == "LINE" and e.dxf.start.x == e.dxf.end.x == low.x]
+    slot = min(abs(point.y - axis_y) for line in face_lines for point in (line.dxf.start, line.dxf.end))
+    assert any(f"end face at Z{low.x:.3f} is drawn down to radius {slot:.3f} only" in note for note in drawing.notes)
     report = import_dxf(conn, DXF / name, "lathe-iso", ProfileOptions(rough_depth=1.0), program_name="SCREW")
     lines = instantiate_job(conn, report.job_id).lines          # the engine's gouge and finish checks run here
     check_program_against_the_drawing(lines, upper_polylines(DXF / name, "0", axis_y), (low.x, high.x))
@@ -288,3 +294,14 @@ def upper_polylines_xy(path) -> list[list[tuple[float, float]]]:
     """The layer-0 lines and arcs as drawn (x, y) chords."""
     return [[(p.x, p.y) for p in ezdxf.path.make_path(e).flattening(FLATTENING_MM)]
             for e in ezdxf.readfile(path).modelspace() if e.dxf.layer == "0"]
+
+
+def test_the_import_report_says_what_was_read_in_text_and_json(run, tmp_path):
+    text = run("import-dxf", DXF / "qcad_screw_R2007.dxf", "--rough-depth", "1")
+    assert text.exit_code == 0, text.output
+    assert any(line.startswith("  note: layer 0 is a side view") for line in text.stderr.splitlines())
+    outline_drawing(tmp_path / "shaft.dxf")
+    made = run("import-dxf", tmp_path / "shaft.dxf", "--rough-depth", "1", "--program-name", "SHAFT", "--json")
+    assert made.exit_code == 0, made.output
+    notes = json.loads(made.stdout)["notes"]
+    assert any("layer 0 is empty" in note and "'outline'" in note for note in notes)
