@@ -120,13 +120,18 @@ def read_drawing(path: str | Path, profile_layer: str | None = None) -> Drawing:
         raise DxfError(f"layer {profile_layer} is a side view drawn whole; operation layers need the seed-000 "
                        "convention (the half-profile above the axis at drawing Y = 0): redraw it so")
     tool_change = None if side_view else tool_change_point(layer0.points, scale, profile.mirrored)
-    notes = chosen + outline_notes + reading_notes(units, assumed, collected, profile) + summarised(warnings)
-    if side_view and layer0.points:
-        notes.append(f"layer {profile_layer}: {len(layer0.points)} POINT(s) left out (a side view has no tool-change point)")
-    if len(chains) > 1 and not side_view:
-        notes.append(f"layer {profile_layer}: {len(chains) - 1} other chain(s) are not part of the profile, left out")
+    notes = (chosen + outline_notes + reading_notes(units, assumed, collected, profile) + summarised(warnings)
+             + left_out_notes(profile_layer, layer0, chains, side_view))
     return Drawing(drawing_file.path, units, scale, profile, [op for op in operations if op],
                    tool_change, drawing_file.repairs, notes)
+
+
+def left_out_notes(layer: str, content: LayerContent, chains: list, side_view: bool) -> list[str]:
+    """What the profile layer holds besides the profile: other chains, or a side view's POINTs."""
+    if side_view:
+        return [f"layer {layer}: {len(content.points)} POINT(s) left out (a side view has no tool-change "
+                "point)"] if content.points else []
+    return [f"layer {layer}: {len(chains) - 1} other chain(s) are not part of the profile, left out"] if len(chains) > 1 else []
 
 
 def scaled_marks(collected: Collected, scale: float) -> Marks:
@@ -151,7 +156,8 @@ def choose_layer(collected: Collected, scale: float) -> list[str]:
     named = {name: content for name, content in collected.layers.items()
              if name != PROFILE_LAYER and (operation_number(name) is None or not content.texts)}
     chosen = None
-    if not collected.layers.get(PROFILE_LAYER, LayerContent()).segments:
+    layer0 = collected.layers.get(PROFILE_LAYER, LayerContent())
+    if not (layer0.segments or layer0.centre):
         chosen = chosen_profile_layer({name: [scaled(s, scale) for s in content.segments]
                                        for name, content in named.items()})
     collected.profile_layer = chosen[0] if chosen else PROFILE_LAYER
