@@ -198,8 +198,9 @@ def symmetry_axis(segments: list[Segment]) -> Axis | None:
     tolerance = max(END_MATCH_TOLERANCE_MM, SYMMETRY_TOLERANCE * size)
     index = NearIndex(segments, max(size / GRID_CELLS, tolerance))
     points = [p for segment in segments for p in samples(segment)]
-    for axis in (Axis(False, (y_min + y_max) / 2.0, "geometric symmetry"),
-                 Axis(True, (x_min + x_max) / 2.0, "geometric symmetry")):
+    middle_y, middle_x = (y_min + y_max) / 2.0, (x_min + x_max) / 2.0
+    for axis in (Axis(False, middle_y, f"the line of symmetry at drawing Y {middle_y:.3f}"),
+                 Axis(True, middle_x, f"the line of symmetry at drawing X {middle_x:.3f}")):
         mirrored = [((2 * axis.offset - x, y) if axis.vertical else (x, 2 * axis.offset - y)) for x, y in points]
         near = sum(1 for p in mirrored if index.near(p, tolerance))
         if near >= SYMMETRY_SHARE * len(points):
@@ -211,7 +212,7 @@ def side_view(axis: Axis, view: list[Segment], marks: Marks, where: str) -> Side
     """The upper half-profile of one view about its axis, or DxfError with what it is instead."""
     framed = [axis.segment(s) for s in view]
     check_not_an_end_view(framed, where)
-    check_reaches_the_axis(framed, where)
+    check_reaches_the_axis(framed, where, axis.source)
     outline = upper_envelope(framed, where)
     z_min, z_max = outline[-1].end[0], outline[0].start[0]
     check_no_bore([[axis.point(p) for p in polygon] for polygon in marks.hatches], z_min, z_max, where)

@@ -39,14 +39,15 @@ def check_not_an_end_view(framed: list[Segment], where: str) -> None:
                        "not a side view; draw the side view of the part (or its half-profile)")
 
 
-def check_reaches_the_axis(framed: list[Segment], where: str) -> None:
-    """A turned part's side view has lines across the axis (its end faces); a plate's holes do not."""
+def check_reaches_the_axis(framed: list[Segment], where: str, axis: str) -> None:
+    """A turned part's side view has lines across the axis (its end faces); a plate's holes do not.
+    axis: how the axis was found (a centre line's handle, or the drawing's symmetry)."""
     if any(bounds(s)[2] < -END_MATCH_TOLERANCE_MM and bounds(s)[3] > END_MATCH_TOLERANCE_MM
            or max(abs(s.start[1]), abs(s.end[1])) <= END_MATCH_TOLERANCE_MM for s in framed):
         return
     handles = len({s.handle for s in framed})
-    raise DxfError(f"{where}: nothing drawn crosses or meets its centre line; it is {handles} separate outline(s) "
-                   "on either side (holes of a plate, a flat part), not a turned part")
+    raise DxfError(f"{where}: nothing drawn crosses or meets the axis ({axis}); it is {handles} separate "
+                   "outline(s) on either side (holes of a plate, a flat part), not a turned part")
 
 
 def lowest_hatched(polygons: list[list[tuple[float, float]]], z: float) -> tuple[float | None, float | None]:
@@ -75,8 +76,8 @@ def check_no_bore(polygons: list[list[tuple[float, float]]], z_min: float, z_max
         through = len(bored) == HATCH_SAMPLES - 1
         span = (f"through the whole part (Z{z_min:.3f} to Z{z_max:.3f})" if through
                 else f"from Z{bored[0][0]:.3f} to Z{bored[-1][0]:.3f}")
-        raise DxfError(f"{where}: the section shows a bore Ø{diameter:.3f} {span} (its hatching stops short of "
-                       "the axis); cutting it needs internal turning, which is not supported")
+        raise DxfError(f"{where}: the section shows a bore Ø{diameter:.3f} {span}: its hatching stops short of "
+                       "the axis; cutting it needs internal turning, which is not supported")
 
 
 def check_no_prism(framed: list[Segment], outline: list[Segment], where: str) -> None:

@@ -305,3 +305,15 @@ def test_the_import_report_says_what_was_read_in_text_and_json(run, tmp_path):
     assert made.exit_code == 0, made.output
     notes = json.loads(made.stdout)["notes"]
     assert any("layer 0 is empty" in note and "'outline'" in note for note in notes)
+
+
+def test_a_whole_view_without_a_centre_line_is_halved_at_its_symmetry(tmp_path):
+    doc = ezdxf.new("R2010")
+    doc.header["$INSUNITS"] = 4
+    doc.modelspace().add_lwpolyline(SHAFT + [(z, -r) for z, r in reversed(SHAFT)], close=True)
+    doc.saveas(tmp_path / "plain.dxf")
+    drawing = read_drawing(tmp_path / "plain.dxf")
+    corners = [drawing.profile.segments[0].start] + [s.end for s in drawing.profile.segments]
+    assert [coordinate for corner in corners for coordinate in corner] == pytest.approx(
+        [coordinate for corner in SHAFT for coordinate in corner])
+    assert any("line of symmetry at drawing Y 0.000" in note for note in drawing.notes)
