@@ -149,7 +149,7 @@ def overlapping_pairs(pieces: list[Piece]):
     ranges = {id(piece): r_range(piece) for piece in ordered}
     for index, first in enumerate(ordered):
         low, high = ranges[id(first)]
-        for second in ordered[index + 1:]:
+        for second in (ordered[k] for k in range(index + 1, len(ordered))):
             if second.z0 >= first.z1:
                 break
             other_low, other_high = ranges[id(second)]
