@@ -18,9 +18,12 @@ from typing import NamedTuple
 from engine.memory import no_cycle_collection
 
 from .dxf_codes import CodeText, layer_codes
-from .dxf_geometry import (FLATTEN_TOLERANCE_MM, HANDLERS, MAX_COORDINATE_MM, Context, Segment, check_finite,
+from .dxf_layers import CENTRE, HIDDEN, chosen_profile_layer, layer_linetypes, line_role
+from .dxf_outline import hatch_polygons, profile_of
+from .dxf_side_view import Marks
+from .dxf_geometry import (FLATTEN_TOLERANCE_MM, HANDLERS, MAX_COORDINATE_MM, Context, Line, Segment, check_finite,
                            check_reach, inserted_entities, named_on_failure, segments_of, unit_scale)
-from .dxf_profile import Profile, chain_segments, find_profile, scaled
+from .dxf_profile import Profile, chain_segments, scaled
 from .dxf_read import DxfError, ezdxf_warnings, load_drawing_file, summarised
 
 PROFILE_LAYER = "0"
@@ -73,6 +76,8 @@ class Drawing:
 @dataclass
 class LayerContent:
     segments: list[Segment] = field(default_factory=list)
+    centre: list[Segment] = field(default_factory=list)   # drawn in a centre-line linetype
+    entities: int = 0
     texts: list[CodeText] = field(default_factory=list)
     points: list[tuple[str, tuple[float, float]]] = field(default_factory=list)
 
@@ -82,31 +87,85 @@ class Collected:
     layers: dict[str, LayerContent] = field(default_factory=lambda: defaultdict(LayerContent))
     skipped: Counter = field(default_factory=Counter)
     other_layers: Counter = field(default_factory=Counter)
-    profile_layer: str = PROFILE_LAYER
+    profile_layer: str | None = PROFILE_LAYER   # None: every layer is collected, the profile's chosen after
+    linetypes: dict[str, str] = field(default_factory=dict)   # layer name (upper case) → its linetype
+    centre_lines: list[Segment] = field(default_factory=list)
+    hidden: Counter = field(default_factory=Counter)
+    hidden_lines: list[Segment] = field(default_factory=list)
+    hatches: list[list[tuple[float, float]]] = field(default_factory=list)
 
 
-def read_drawing(path: str | Path, profile_layer: str = PROFILE_LAYER) -> Drawing:
+def read_drawing(path: str | Path, profile_layer: str | None = None) -> Drawing:
     """Read a turning drawing; DxfError (one line naming the layer, handle or text) if it
     cannot become a job. profile_layer: where the part outline is (real CAD drawings keep
-    it on a layer like 'outline' rather than the seed-000 convention's layer 0)."""
+    it on a layer like 'outline' rather than the seed-000 convention's layer 0); None: layer
+    0, or when that is empty the one layer holding one contour on the axis (dxf_layers)."""
     with ezdxf_warnings() as warnings, no_cycle_collection():
         drawing_file = load_drawing_file(path)
         units, scale, assumed = unit_scale(drawing_file.doc.header.get("$INSUNITS"))
-        profile_layer = existing_layer(drawing_file.doc, profile_layer)
-        collected = collect(drawing_file.doc.modelspace(), scale, profile_layer)
+        given = None if profile_layer is None else existing_layer(drawing_file.doc, profile_layer)
+        collected = collect(drawing_file.doc.modelspace(), scale, given, layer_linetypes(drawing_file.doc))
+    chosen = choose_layer(collected, scale) if given is None else []
+    profile_layer = collected.profile_layer
     layer0 = collected.layers.pop(profile_layer, LayerContent())
+    chosen += all_dash_dot(layer0, collected, profile_layer)
     if not layer0.segments:
         raise DxfError(no_geometry_message(collected))
-    chains = chain_segments([scaled(s, scale) for s in layer0.segments])
-    profile = find_profile(chains, layer=profile_layer)
+    profile, outline_notes, chains = profile_of([scaled(s, scale) for s in layer0.segments],
+                                                scaled_marks(collected, scale), profile_layer)
+    side_view = bool(outline_notes)
     operations = [operation(name, number, collected.layers[name], scale, profile.mirrored)
                   for number, name in operation_layers(collected.layers)]
-    tool_change = tool_change_point(layer0.points, scale, profile.mirrored)
-    notes = reading_notes(units, assumed, collected, profile) + summarised(warnings)
-    if len(chains) > 1:
-        notes.append(f"layer {profile_layer}: {len(chains) - 1} other chain(s) are not part of the profile, left out")
+    if side_view and any(operations):
+        raise DxfError(f"layer {profile_layer} is a side view drawn whole; operation layers need the seed-000 "
+                       "convention (the half-profile above the axis at drawing Y = 0): redraw it so")
+    tool_change = None if side_view else tool_change_point(layer0.points, scale, profile.mirrored)
+    notes = (chosen + outline_notes + reading_notes(units, assumed, collected, profile) + summarised(warnings)
+             + left_out_notes(profile_layer, layer0, chains, side_view))
     return Drawing(drawing_file.path, units, scale, profile, [op for op in operations if op],
                    tool_change, drawing_file.repairs, notes)
+
+
+def left_out_notes(layer: str, content: LayerContent, chains: list, side_view: bool) -> list[str]:
+    """What the profile layer holds besides the profile: other chains, or a side view's POINTs."""
+    if side_view:
+        return [f"layer {layer}: {len(content.points)} POINT(s) left out (a side view has no tool-change "
+                "point)"] if content.points else []
+    return [f"layer {layer}: {len(chains) - 1} other chain(s) are not part of the profile, left out"] if len(chains) > 1 else []
+
+
+def scaled_marks(collected: Collected, scale: float) -> Marks:
+    return Marks([scaled(s, scale) for s in collected.centre_lines],
+                 [[(x * scale, y * scale) for x, y in polygon] for polygon in collected.hatches],
+                 [scaled(s, scale) for s in collected.hidden_lines])
+
+
+def all_dash_dot(layer0: LayerContent, collected: Collected, layer: str) -> list[str]:
+    """A profile layer drawn only in a centre-line linetype: its lines are the outline, not centre lines."""
+    if layer0.segments or not layer0.centre:
+        return []
+    layer0.segments, drawn = layer0.centre, {id(s) for s in layer0.centre}
+    collected.centre_lines = [s for s in collected.centre_lines if id(s) not in drawn]
+    return [f"layer {layer}: every line is drawn in a centre-line linetype; taken as the outline"]
+
+
+def choose_layer(collected: Collected, scale: float) -> list[str]:
+    """Layer 0 unless it is empty; then the one named layer with one contour on the axis (a note
+    says so). Layers not chosen are counted among the other layers."""
+    # A numbered layer without @-codes is no operation: when layer 0 is empty, it may hold the part.
+    named = {name: content for name, content in collected.layers.items()
+             if name != PROFILE_LAYER and (operation_number(name) is None or not content.texts)}
+    chosen = None
+    layer0 = collected.layers.get(PROFILE_LAYER, LayerContent())
+    if not (layer0.segments or layer0.centre):
+        chosen = chosen_profile_layer({name: [scaled(s, scale) for s in content.segments]
+                                       for name, content in named.items()})
+    collected.profile_layer = chosen[0] if chosen else PROFILE_LAYER
+    for name, content in named.items():
+        if name != collected.profile_layer and operation_number(name) is None:
+            collected.other_layers[name] += content.entities
+            del collected.layers[name]
+    return [chosen[1]] if chosen else []
 
 
 def existing_layer(doc, name: str) -> str:
@@ -124,15 +183,18 @@ def operation_number(layer: str) -> int | None:
     return int(name) if name.isdecimal() and int(name) > 0 else None
 
 
-def is_relevant(layer: str, profile_layer: str) -> bool:
-    return layer == profile_layer or operation_number(layer) is not None
+def is_relevant(layer: str, profile_layer: str | None) -> bool:
+    return profile_layer is None or layer == profile_layer or operation_number(layer) is not None
 
 
-def collect(modelspace, scale: float, profile_layer: str = PROFILE_LAYER) -> Collected:
-    """One pass over model space: segments, texts and points of the profile layer and
-    layers 1 … n (scale: drawing units to mm)."""
+def collect(modelspace, scale: float, profile_layer: str | None = PROFILE_LAYER,
+            linetypes: dict[str, str] | None = None) -> Collected:
+    """One pass over model space: segments, texts and points of the profile layer (every
+    layer when it is None) and layers 1 … n, centre lines and hatching of any layer, hidden
+    lines counted (scale: drawing units to mm)."""
     sagitta, reach = FLATTEN_TOLERANCE_MM / scale, MAX_COORDINATE_MM / scale
-    collected, own = Collected(profile_layer=profile_layer), Context(sagitta, reach=reach)
+    collected = Collected(profile_layer=profile_layer, linetypes=linetypes or {})
+    own = Context(sagitta, reach=reach)
     for entity in modelspace:
         with named_on_failure(entity):
             layer = entity.dxf.layer
@@ -148,10 +210,28 @@ def collect(modelspace, scale: float, profile_layer: str = PROFILE_LAYER) -> Col
 
 def take(entity, layer: str, context: Context, collected: Collected) -> None:
     kind = entity.dxftype()
+    if kind == "HATCH":
+        collected.hatches.extend(hatch_polygons(entity))
+    # Operation layers hold tool paths in whatever linetype: roles apply to the others.
+    role = line_role(entity, layer, collected.linetypes) if kind in HANDLERS and operation_number(layer) is None else None
+    if role == CENTRE:
+        check_finite(entity, context)
+        segments = segments_of(entity, context)
+        collected.centre_lines.extend(s for s in segments if isinstance(s, Line))
+        if is_relevant(layer, collected.profile_layer):
+            collected.layers[layer].centre.extend(segments)
+            collected.layers[layer].entities += 1
+        return
+    if role == HIDDEN:
+        check_finite(entity, context)
+        collected.hidden[layer] += 1
+        collected.hidden_lines.extend(segments_of(entity, context))
+        return
     if not is_relevant(layer, collected.profile_layer):
         collected.other_layers[layer] += 1
         return
     content = collected.layers[layer]
+    content.entities += 1
     handle = context.handle or entity.dxf.handle
     check_finite(entity, context)
     if kind in HANDLERS:
@@ -223,6 +303,9 @@ def reading_notes(units: str, assumed: bool, collected: Collected, profile: Prof
     if collected.skipped:
         listed = ", ".join(f"{count} {kind}" for kind, count in sorted(collected.skipped.items()))
         notes.append(f"not geometry, left out on layer 0 / operation layers: {listed}")
+    if collected.hidden:
+        listed = ", ".join(f"{name!r} ({count})" for name, count in sorted(collected.hidden.items()))
+        notes.append(f"hidden (dashed) lines left out, never cut from outside: {listed}")
     if collected.other_layers:
         listed = ", ".join(f"{name!r} ({count})" for name, count in sorted(collected.other_layers.items()))
         notes.append(f"layers that are neither the profile's nor an operation number, left out: {listed}")

@@ -17,13 +17,15 @@ from test_import_dxf_cli import job_count, one_line_refusal
 HALF_PROFILE = [(0, 0), (0, 10), (-15, 10), (-15, 14), (-40, 14), (-40, 0)]
 
 
-def outline_drawing(path, layer="outline"):
+def outline_drawing(path, layer="outline", copy_on=None):
+    """The half-profile on `layer` (and again on `copy_on`: two layers that could be the part)."""
     doc = ezdxf.new("R2010")
     doc.header["$INSUNITS"] = 4   # mm
-    doc.layers.add(layer)
     doc.layers.add("dims")
     msp = doc.modelspace()
-    msp.add_lwpolyline(HALF_PROFILE[:-1] + [HALF_PROFILE[-1]], dxfattribs={"layer": layer})
+    for name in filter(None, (layer, copy_on)):
+        doc.layers.add(name)
+        msp.add_lwpolyline(HALF_PROFILE[:-1] + [HALF_PROFILE[-1]], dxfattribs={"layer": name})
     msp.add_line((5, 0), (-45, 0), dxfattribs={"layer": "dims"})
     doc.saveas(path)
     return path
@@ -31,9 +33,13 @@ def outline_drawing(path, layer="outline"):
 
 def test_the_profile_is_read_from_the_named_layer(tmp_path):
     path = outline_drawing(tmp_path / "shaft.dxf")
-    with pytest.raises(DxfError, match=r"layer 0 has no profile.*--profile-layer"):
-        read_drawing(path)
-    profile = read_drawing(path, "outline").profile
+    chosen = read_drawing(path)   # layer 0 is empty: the one layer with a contour on the axis
+    assert chosen.profile.bounds == pytest.approx((-40, 0, 0, 14))
+    assert any("layer 0 is empty" in note and "'outline'" in note for note in chosen.notes)
+    two = outline_drawing(tmp_path / "two.dxf", copy_on="Sketch")
+    with pytest.raises(DxfError, match=r"layer 0 is empty and layers 'Sketch' and 'outline' .*--profile-layer"):
+        read_drawing(two)
+    profile = read_drawing(two, "outline").profile
     assert profile.closed_by_axis
     assert profile.bounds == pytest.approx((-40, 0, 0, 14))
 
@@ -53,12 +59,12 @@ def test_an_unknown_layer_is_refused_with_the_drawing_s_layers():
 
 
 def test_import_dxf_makes_a_job_from_the_named_layer_and_its_program(run, tmp_path):
-    path = outline_drawing(tmp_path / "shaft.dxf")
+    path = outline_drawing(tmp_path / "shaft.dxf", copy_on="Sketch2")
     before = job_count(run.url)
     refused = one_line_refusal(run("import-dxf", path, "--rough-depth", "1", "--program-name", "SHAFT"))
-    assert "layer 0 has no profile" in refused and job_count(run.url) == before
+    assert "'Sketch2' and 'outline'" in refused and "--profile-layer" in refused and job_count(run.url) == before
     unknown = one_line_refusal(run("import-dxf", path, "--profile-layer", "Sketch", "--rough-depth", "1"))
-    assert "'Sketch'" in unknown and "'outline'" in unknown and job_count(run.url) == before
+    assert "'Sketch'" in unknown and "'outline'" in unknown and "'Sketch2'" in unknown and job_count(run.url) == before
     made = run("import-dxf", path, "--profile-layer", "outline", "--rough-depth", "1",
                "--program-name", "SHAFT", "--json")
     assert made.exit_code == 0, made.output

@@ -48,8 +48,9 @@ POSITIVE = FiniteFloatRange(min=0, min_open=True)
 @click.option("--program-name", metavar="NAME",
               help="The program's name (840D: letters, digits, _; two letters first; at most 24) "
                    "[default: the file name in upper case, - . and spaces as _].")
-@click.option("--profile-layer", default="0", show_default=True, metavar="NAME",
-              help="Layer holding the part's profile (CAD drawings often use 'outline' or 'Sketch').")
+@click.option("--profile-layer", metavar="NAME",
+              help="Layer holding the part's profile (CAD drawings often use 'outline' or 'Sketch') "
+                   "[default: 0; when layer 0 is empty, the one layer with one contour on the axis].")
 @click.option("--draft", is_flag=True,
               help="Check the job's program with the turning class's draft, not its released template.")
 @click.option("--json", "as_json", is_flag=True,
@@ -58,6 +59,8 @@ POSITIVE = FiniteFloatRange(min=0, min_open=True)
 def import_dxf_command(ctx, dxf_file, machine, rough_depth, allowance, tool, speed, feed, stock_diameter,
                        alternate, program_name, profile_layer, draft, as_json):
     """Make DXF_FILE a turning job: profile on layer 0 (or --profile-layer), operation n on layer n with its @-codes.
+
+    A part drawn whole about a centre line (a side view) is turned as its upper half-profile.
 
     A drawing with a profile only becomes a job when any of --rough-depth, --allowance,
     --tool, --speed, --feed, --stock-diameter is given: rough passes between blank and

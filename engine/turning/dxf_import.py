@@ -39,10 +39,10 @@ class ImportReport:
 
 def import_dxf(conn, path: str | Path, machine_name: str | None = None,
                options: ProfileOptions = ProfileOptions(), alternate: list[int] | None = None,
-               program_name: str | None = None, draft: bool = False, profile_layer: str = "0") -> ImportReport:
+               program_name: str | None = None, draft: bool = False, profile_layer: str | None = None) -> ImportReport:
     """Read the drawing and store its job; EngineError (nothing stored) if it cannot become one.
     The program is named `program_name`, else after the drawing's file name (job_params.drawing_names);
-    the profile is read from layer `profile_layer`."""
+    the profile is read from layer `profile_layer` (None: layer 0, or the layer read_drawing chooses)."""
     checked("drawing", Path(path).name, "drawing file name", "rename the file")   # said before the drawing's own problems
     if program_name is not None:
         checked("program", program_name, "--program-name")
