@@ -204,3 +204,44 @@ def test_a_cut_comment_with_dollar_signs_is_drawn_not_a_bug(engine, tmp_path):
     target = tmp_path / "draft.png"
     result = engine("plot", "--program", program["program_id"], "-o", target)
     assert result.exit_code == 0 and target.is_file(), result.output
+
+
+def test_the_picture_of_a_job_is_of_the_program_that_reaches_the_machine(engine, tmp_path):
+    """`engine plot --job ID` draws the job's newest program. After an editor tries a draft on
+    the job (`instantiate --job ID --draft`), that is the draft's program: the operator's picture
+    of the job shows a program that never reaches the machine, and nothing in it says draft."""
+    released = made(engine("instantiate", "--gear", 45, "--json"))
+    exported = engine("template", "export", "--class", "spur").stdout
+    edited = tmp_path / "spur.csv"
+    edited.write_text(exported.replace("; CUT {cut_name}", "; CUT {cut_name} TRIAL"))
+    assert engine("template", "import", "--class", "spur", edited).exit_code == 0
+    draft = made(engine("instantiate", "--job", released["job_id"], "--draft", "--json"))
+    assert draft["program_id"] != released["program_id"]
+    drawn = made(engine("plot", "--job", released["job_id"], "-o", tmp_path / "job.png", "--json"))["drawn"]
+    assert drawn[0].startswith(f"program {released['program_id']} ") or "draft" in " ".join(drawn).lower(), drawn
+
+
+def figure_texts(figure) -> str:
+    """Every text a reader of the picture sees: titles, legends, annotations."""
+    texts = [figure._suptitle.get_text() if figure._suptitle else "", *(t.get_text() for t in figure.texts)]
+    for legend in figure.legends:
+        texts += [t.get_text() for t in legend.get_texts()]
+    for axes in figure.axes:
+        texts += [axes.get_title(), *(t.get_text() for t in axes.texts)]
+        if axes.get_legend():
+            texts += [t.get_text() for t in axes.get_legend().get_texts()]
+    return " ".join(texts)
+
+
+def test_the_picture_of_a_program_the_simulation_refuses_says_so(engine):
+    """A picture is passed around without the command's output: when the simulation refuses the
+    program now (its gear's face width was corrected after it was stored), only stdout says so,
+    and the picture looks like that of a proved program."""
+    from engine.hobbing.program_plot import load_scene, program_figure
+
+    program = made(engine("instantiate", "--gear", 42, "--json"))
+    with psycopg.connect(engine.url) as conn:
+        conn.execute("UPDATE gear SET face_width = 40 WHERE id = 42")
+        figure, drawn = program_figure(load_scene(conn, program["program_id"]))
+    assert "refuses" in drawn[-1]
+    assert "refus" in figure_texts(figure).lower()
