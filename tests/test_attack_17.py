@@ -245,3 +245,18 @@ def test_the_picture_of_a_program_the_simulation_refuses_says_so(engine):
         figure, drawn = program_figure(load_scene(conn, program["program_id"]))
     assert "refuses" in drawn[-1]
     assert "refus" in figure_texts(figure).lower()
+
+
+@pytest.mark.parametrize("breaking", ["\r", "\f", "\u0085", "\u2028"], ids=["CR", "FF", "NEL", "LS"])
+def test_an_nc_file_with_a_line_break_inside_a_line_is_refused_at_import(engine, tmp_path, breaking):
+    """`G1 X10<CR>G0 X0` in an LF file is one line to the import (one row, its module decided by
+    G0, one text to the refactor) and two blocks to a control or editor that breaks lines at a
+    bare CR; the database refuses such a line in every program (migration 0009), so the class
+    the import stores and calls a draft can never give a program. It should be refused naming
+    the line, as a control character is, with nothing stored."""
+    nc = tmp_path / "broken.nc"
+    nc.write_bytes(f"G1 X10{breaking}G0 X0\nM30\n".encode("utf-8"))
+    result = engine("import-nc", nc, "--class", "nc_broken")
+    assert one_line_error(result) and "line 1" in result.stderr, result.output
+    with psycopg.connect(engine.url) as conn:
+        assert conn.execute("SELECT count(*) FROM gear_class WHERE name = 'nc_broken'").fetchone()[0] == 0
