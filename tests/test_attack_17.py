@@ -260,3 +260,12 @@ def test_an_nc_file_with_a_line_break_inside_a_line_is_refused_at_import(engine,
     assert one_line_error(result) and "line 1" in result.stderr, result.output
     with psycopg.connect(engine.url) as conn:
         assert conn.execute("SELECT count(*) FROM gear_class WHERE name = 'nc_broken'").fetchone()[0] == 0
+
+
+def test_a_params_file_nested_too_deep_is_bad_input_not_a_bug(engine, tmp_path):
+    """A parameters file of 100,000 nested brackets (a generator gone wrong) is bad input:
+    json.loads raises RecursionError, exit 2."""
+    params = tmp_path / "deep.json"
+    params.write_text('{"feed": ' + "[" * 100_000 + "]" * 100_000 + "}")
+    result = engine("import-nc", DEMO, "--class", "nc_deep", "--params", params)
+    assert one_line_error(result) and str(params) in result.stderr, result.output
