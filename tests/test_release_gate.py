@@ -135,9 +135,36 @@ def test_a_conditional_second_write_or_one_reading_the_name_keeps_the_first():
     assert findings(conditional) == [] and findings(reading) == []
 
 
-def test_a_duplicate_row_is_found_wherever_it_is():
-    rows = [row(10, '"G90"'), row(20, '"G91"'), row(30, '"G90"'), row(40, '"G90"', p_emit="coolant")]
-    assert findings(rows) == [("duplicate-row", 30, "o")]
+def test_a_row_right_after_its_twin_is_a_pasted_duplicate():
+    rows = [row(10, '"G90"'), row(20, '"G90"'), row(30, '"G90"'), row(40, '"G90"', p_emit="coolant")]
+    found = analyse(Template("probe", 1, tuple(rows)), lambda t, n: frozenset({"coolant"}))
+    assert [(f.rule, f.row_id, f.column) for f in found] == [("duplicate-row", 20, "o"), ("duplicate-row", 30, "o")]
+    assert "repeats row 10" in found[0].message and "repeats row 20" in found[1].message   # each its own twin
+    assert all("pasted" in f.message for f in found)
+
+
+def test_a_plain_line_repeated_further_on_or_a_second_blank_line_is_the_programs_content():
+    """Real programs repeat a retract or a tool call, and blank lines come in pairs (tests/data/nc)."""
+    assert findings([row(10, '"G90"'), row(20, '"G91"'), row(30, '"G90"'), row(40, 'f"X{z2}"'),
+                     row(50, '"G91"'), row(60, 'f"X{z2}"')]) == []
+    assert findings([row(10, '"G90"'), row(20, '""'), row(30, '""'), row(40, '"G91"')]) == []
+
+
+def test_the_same_line_in_another_module_is_not_a_paste():
+    assert findings([row(10, '"G90"'), row(20, '"G90"', t="cutcond"), row(30, '"G90"', n=2)]) == []
+
+
+@pytest.mark.parametrize("computing", [
+    {"o": '"M8"', "p_emit": "coolant"},
+    {"p_calc": "coolant", "s": "half = z2 / 2"},
+    {"s": "half = z2 / 2"},
+], ids=["p_emit", "p_calc", "s"])
+def test_a_repeated_row_that_computes_is_found_wherever_it_is(computing):
+    rows = [row(10, **computing), row(20, 'f"; {z2}"'), row(30, 'f"; {half}"' if "s" in computing else '"G90"'),
+            row(40, **computing), row(50, 'f"; {half}"' if "s" in computing else '"G91"')]
+    found = analyse(Template("probe", 1, tuple(rows)), lambda t, n: frozenset({"z2", "coolant"}))
+    assert [(f.rule, f.row_id, f.column) for f in found] == [("duplicate-row", 40, "o")]
+    assert "repeats row 10" in found[0].message and "dead" in found[0].message
 
 
 def test_a_name_read_before_any_row_or_parameter_gives_it_is_found():

@@ -6,9 +6,11 @@ expression shows. Each rule below looks at the rows together, in evaluation orde
   never prints, for every job — an edit that switched a line off by accident;
 * two rows writing the same intermediate with nothing between them reading it, the second
   unconditionally: the first write is dead (a copied row whose name was not changed);
-* a row identical to an earlier one (t, n, p_calc, s, o, p_emit): the NC line or computation
-  doubled by a paste. No seeded template has one (a second `ENDIF` or retract sits in another
-  module, or under another condition), so any duplicate is refused, not only adjacent ones;
+* a row identical to an earlier one (t, n, p_calc, s, o, p_emit) where the repeat cannot be the
+  program's content (REPEAT_MISTAKES): right after its twin (a row pasted twice), or a row that
+  computes (its second identical condition or assignment is dead). Real programs repeat plain
+  lines far apart (a retract, a tool call: 1 to 26 rows per LinuxCNC file of tests/data/nc) and
+  blank lines side by side, so those repeats are content and an imported program can be released;
 * a name read before any row or parameter gives it: a row reads a name that its module's
   parameters do not hold and only a later row (or none) assigns.
 
@@ -89,13 +91,57 @@ def _names_read(row: CompiledRow) -> set[str]:
 
 
 def duplicates(rows: list[CompiledRow], known_names):
-    """A row identical (t, n, p_calc, s, o, p_emit) to an earlier row."""
+    """A row identical (t, n, p_calc, s, o, p_emit) to an earlier row, where a rule of
+    REPEAT_MISTAKES says the repeat is a mistake and not the program's content."""
     first: dict[tuple, int] = {}
+    previous = None
     for row in rows:
-        body = astuple(row.row)[1:]
-        if body in first:
-            yield row.row.id, "o", f"repeats row {first[body]} exactly (t, n, p_calc, s, o, p_emit)"
+        body = _body(row)
+        adjacent = previous is not None and _body(previous) == body
+        why = _mistake(row, adjacent) if body in first else None
+        if why is not None:
+            twin = previous.row.id if adjacent else first[body]
+            yield row.row.id, "o", f"repeats row {twin} exactly (t, n, p_calc, s, o, p_emit) {why}"
         first.setdefault(body, row.row.id)
+        previous = row
+
+
+def _body(row: CompiledRow) -> tuple:
+    return astuple(row.row)[1:]
+
+
+def _mistake(row: CompiledRow, adjacent: bool) -> str | None:
+    """Why the repeat is a mistake (the first rule of REPEAT_MISTAKES that holds), or None: content."""
+    return next((why for is_mistake, why in REPEAT_MISTAKES if is_mistake(row, adjacent)), None)
+
+
+def _computes(row: CompiledRow, adjacent: bool) -> bool:
+    """A condition or assignment: done again with the same inputs, it decides or gives nothing new."""
+    return any(getattr(row.row, column) for column in ("p_calc", "s", "p_emit"))
+
+
+def _pasted(row: CompiledRow, adjacent: bool) -> bool:
+    """The same line right after itself: a block said twice in a row is a paste (no program of
+    tests/data/nc has one), but blank lines do come in pairs (4 of its 12 LinuxCNC files)."""
+    return adjacent and not _prints_blank(row)
+
+
+def _prints_blank(row: CompiledRow) -> bool:
+    if row.o is None or row.o.names or row.o.calls:
+        return False
+    try:
+        line = evaluate(row.o, {})
+    except EvaluationError:
+        return False   # a line failing for every job is lint's to report
+    return isinstance(line, str) and not line.strip()
+
+
+# When a repeated row is a mistake, not the program's content: (is it(row, right after its twin), why).
+# A plain line repeated further on is content: a retract or tool call comes back in real programs.
+REPEAT_MISTAKES = (
+    (_computes, "and computes: the second identical condition or assignment is dead"),
+    (_pasted, "right after it: a row pasted twice"),
+)
 
 
 def read_before_given(rows: list[CompiledRow], known_names):
