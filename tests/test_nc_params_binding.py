@@ -74,8 +74,8 @@ def test_a_bound_parameter_becomes_a_reference_only_at_its_address(conn, relativ
     for line, _, word, _ in elsewhere:
         assert word in rows[line] and rows[line].count("{" + parameter) == sum(
             1 for found in at_address if found[0] == line)
-    assert report.left_alone == [{"line": line, "word": word, "parameter": parameter}
-                                 for line, _, word, _ in elsewhere]
+    assert report.left_alone == [{"line": line, "word": word, "parameter": parameter,
+                                  "why": f"{parameter} binds only {address}"} for line, _, word, _ in elsewhere]
     assert report.bindings[0] == {"parameter": parameter, "addresses": [address], "binds": address,
                                   "words": len(at_address), "at": {address: len(at_address)}}
 
@@ -122,10 +122,13 @@ def test_a_tool_number_equal_to_a_plain_value_is_left_alone_and_reported(conn):
     number = tools[0][3]
     report = import_nc(conn, DATA / DEMO, "nc_tool", {"tool": int(number)})
     equal = equal_words(DEMO, number)
-    assert report.left_alone == [{"line": line, "word": word, "parameter": "tool"}
-                                 for line, found, word, _ in equal if found in "NOT"]
-    assert any(left["word"] == tools[0][2] for left in report.left_alone)
-    assert report.bindings[0]["words"] == sum(1 for word in equal if word[1] not in "GMNOT")
+    # T names the tool; the demo's other 2 that names something is G42.1's L2, the cutter's
+    # orientation (a code: nc_references); its P2 is G70's count of passes, a quantity.
+    assert [(left["line"], left["word"]) for left in report.left_alone] == [
+        (line, word) for line, found, word, _ in equal if found in "NOTL"]
+    assert report.left_alone[0] == {"line": tools[0][0], "word": tools[0][2], "parameter": "tool",
+                                    "why": f"{tools[0][2]} names a tool"}
+    assert report.bindings[0]["words"] == sum(1 for word in equal if word[1] not in "GMNOTL")
 
 
 def test_the_lines_read_in_two_processes_report_what_one_process_reports(conn, monkeypatch):

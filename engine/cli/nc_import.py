@@ -14,8 +14,9 @@ from .context import connection, emit_json, keyed
 @click.option("--params", "params_file", type=click.Path(dir_okay=False),
               help="The job's parameters: JSON {name: value} or {name: {\"value\": v, \"addresses\": [\"F\"]}}, "
                    "or CSV name,value[,addresses]. A number equal to a value becomes a reference to it at the "
-                   "addresses the parameter names (plain value: every address but G M N O T $); equal numbers "
-                   "elsewhere are left as written and listed.")
+                   "addresses the parameter names (plain value: every address but G M N O T $, and never a number "
+                   "that names a block, program, tool edge or spindle); equal numbers elsewhere are left as "
+                   "written and listed with the reason. A bound form's value must be a number.")
 @click.option("--modules", "modules_file", type=click.Path(dir_okay=False),
               help="Corrections of the module assignment: CSV line_no,t (1-based program lines).")
 @click.option("--parent", help="Parent class in the tree, for a new class.")
@@ -46,10 +47,9 @@ def import_nc_command(ctx, nc_file, gear_class, params_file, modules_file, paren
         click.echo(_binding_line(binding))
     for value, names in report.ambiguous.items():
         click.echo(f"  value {value} belongs to {', '.join(names)}: used {names[0]}", err=True)
-    binds = {binding["parameter"]: binding["binds"] for binding in report.bindings}
     for left in report.left_alone:
-        click.echo(f"  line {left['line']}: {left['word']} equals {left['parameter']}, which binds "
-                   f"{binds[left['parameter']]}: left as written", err=True)
+        click.echo(f"  line {left['line']}: {left['word']} equals {left['parameter']}, but {left['why']}: "
+                   "left as written", err=True)
 
 
 def _binding_line(binding: dict) -> str:

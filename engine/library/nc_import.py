@@ -225,19 +225,37 @@ def read_params(path) -> dict:
     {name: value or {"value": …, "addresses": […]}}, or a CSV with columns name,value and an
     optional column addresses (`F`, `X Z`; empty: the plain form)."""
     if str(path).lower().endswith(".json"):
-        text = _read_text(path, "parameters file")
-        try:
-            params = json.loads(text)
-        except json.JSONDecodeError as error:
-            raise EngineError(f"{path}: not JSON ({error.msg}, line {error.lineno}); "
-                              "give an object {\"name\": value, …}") from None
-        if not isinstance(params, dict):
-            raise EngineError(f"{path}: give a JSON object {{\"name\": value, …}}, not {type(params).__name__}")
+        params = _json_params(path, _read_text(path, "parameters file"))
     else:
         params = _csv_params(path)
     check_param_names(params)
     bindings(params, str(path))
     return params
+
+
+def _json_params(path, text: str) -> dict:
+    """The JSON object of a parameters file; a name given twice, nesting deeper than Python
+    reads, or no object is refused in one line (NaN and Infinity by nc_params, naming the parameter)."""
+    try:
+        params = json.loads(text, object_pairs_hook=partial(_once, path))
+    except json.JSONDecodeError as error:
+        raise EngineError(f"{path}: not JSON ({error.msg}, line {error.lineno}); "
+                          "give an object {\"name\": value, …}") from None
+    except RecursionError:
+        raise EngineError(f"{path}: nested too deep to read; give an object {{\"name\": value, …}} "
+                          "whose values are numbers, text or {\"value\": …, \"addresses\": […]}") from None
+    if not isinstance(params, dict):
+        raise EngineError(f"{path}: give a JSON object {{\"name\": value, …}}, not {type(params).__name__}")
+    return params
+
+
+def _once(path, pairs: list) -> dict:
+    """An object whose keys are each given once (JSON keeps the last silently; a CSV refuses)."""
+    names = [name for name, _ in pairs]
+    twice = next((name for name in names if names.count(name) > 1), None)
+    if twice is not None:
+        raise EngineError(f"{path}: {twice!r} appears twice in one object; give each parameter and key once")
+    return dict(pairs)
 
 
 def read_modules(path) -> dict[int, str]:

@@ -6,16 +6,22 @@ A parameters file (JSON) gives each parameter in one of two forms:
 * plain: `"feed": 0.01` binds the value at every address except the code addresses
   G, M, N, O, T (their numbers are codes, block numbers, program and tool numbers) and LinuxCNC's
   `$` (the spindle a word is for), and a number after no address (a cycle's argument `CYCLE95(…, 2.5)`,
-  `R1=2.5`, `#<depth> = 2.5`, a column of an EMCO tape);
+  `R1=2.5`, `#<depth> = 2.5`, a column of an EMCO tape), but never a number that names something
+  (engine.library.nc_references: `G71.1 Q100`'s contour, the 840D tool edge `D1`, `SETMS(1)`);
+  a plain value may also be text or anything else the template reads (it binds no number);
 * bound: `"feed": {"value": 0.01, "addresses": ["F"]}` binds it only at F (never a number after no
-  address).
+  address); its value must be a finite number, since binding is all it is for. At an address
+  that names something it binds too (the user named it), except a block or program number,
+  which is refused.
 
 The class keeps the plain values (gear_class.import_params); instantiating it with other
 values changes exactly the words bound at import."""
 from __future__ import annotations
 
+import math
 from collections import Counter
 from dataclasses import dataclass
+from decimal import Decimal
 
 from ..csv_reader import CellError, declare
 from ..errors import EngineError
@@ -60,11 +66,28 @@ def values(params: dict, source="parameters") -> dict:
 
 def _binding(name: str, given, source) -> Binding:
     if not isinstance(given, dict):
-        return Binding(name, given)
+        return Binding(name, _finite(name, given, source))
     if set(given) != {"value", "addresses"}:
         raise EngineError(f"{source}: parameter {name!r} gives {sorted(given)}; write "
                           f"{{\"value\": 0.01, \"addresses\": [\"F\"]}} or a plain value")
-    return Binding(name, given["value"], _addresses(name, given["addresses"], source))
+    if not is_number(given["value"]):
+        raise EngineError(f"{source}: parameter {name!r} has the value {given['value']!r}, which binds no word; "
+                          f"a bound form's value is a number, such as {{\"value\": 0.01, \"addresses\": [\"F\"]}}")
+    value = _finite(name, given["value"], source)
+    return Binding(name, value, _addresses(name, given["addresses"], source))
+
+
+def is_number(value) -> bool:
+    """A value a word's number can equal: int, float or Decimal, not a truth value."""
+    return isinstance(value, (int, float, Decimal)) and not isinstance(value, bool)
+
+
+def _finite(name: str, value, source):
+    """The value, refused when it is a number no program can write (NaN, infinity)."""
+    if is_number(value) and not math.isfinite(value):
+        raise EngineError(f"{source}: parameter {name!r} is {value!r}: NaN and infinity are no number a "
+                          "program can write; give a finite value")
+    return value
 
 
 def _addresses(name: str, addresses, source) -> frozenset:

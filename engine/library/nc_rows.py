@@ -15,7 +15,8 @@ from ..errors import EngineError
 from ..templates.evaluator import evaluate
 from ..templates.expressions import MAX_EXPRESSION_LENGTH, compile_expression
 from .nc_params import FUNCTION_ADDRESSES, Binding
-from .nc_tokens import NUMBER, WORD
+from .nc_references import CODE_NAMES, block_context, reference_at
+from .nc_tokens import NUMBER, WORD, facts
 
 
 def values_of(bindings: dict[str, Binding]) -> dict:
@@ -33,10 +34,12 @@ def values_of(bindings: dict[str, Binding]) -> dict:
 
 @dataclass(frozen=True)
 class LeftAlone:
-    """A number equal to a parameter's value at an address the parameter does not bind."""
+    """A number equal to a parameter's value that it does not bind, and why (`Q100 names the
+    contour …`, `F400: feed binds only F`)."""
     line: int
     word: str
     parameter: str
+    why: str
 
 
 @dataclass
@@ -84,9 +87,11 @@ class Builder:
         self.values, self.path = values_of(bindings), path
         self.found = Found()
         self.spelled: dict[tuple, bool] = {}   # (field, name, number) -> the field gives the number back
+        self.context = None   # the codes and words of the line being read, once a number needs them
 
     def o(self, line_number: int, line: str, tokens) -> str:
         """The row's `o`: the line written out, or an f-string with its references."""
+        self.context = None
         parts = [self._part(line_number, tokens, index) for index in range(len(tokens))]
         fields = "".join(text for is_field, text in parts if is_field)
         literal = "".join(text for is_field, text in parts if not is_field)
@@ -108,9 +113,10 @@ class Builder:
         if token.kind != NUMBER or _is_negative_zero(token.text):
             return False, token.text
         equal = self.values.get(Decimal(token.text), ())
-        binding = [candidate for candidate in equal if candidate.binds(token.address)]
+        if not equal:
+            return False, token.text
+        binding = self._binding(line_number, tokens, index, equal)
         if not binding:
-            self._leave_alone(line_number, tokens, index, equal)
             return False, token.text
         source = number_field(binding[0].name, token.text)
         if not self._spelled(source, binding[0], token.text):
@@ -120,6 +126,26 @@ class Builder:
         self.found.bound[(binding[0].name, token.address)] += 1
         return True, source
 
+    def _binding(self, line_number: int, tokens, index: int, equal) -> list:
+        """The parameters of the number's value that bind it (nc_params; a reference, that names
+        something, only by a bound form naming its address: nc_references); the others are left
+        alone, and told why."""
+        reference = self._reference(tokens, index)
+        address = tokens[index].address
+        binding = [candidate for candidate in equal if candidate.binds(address) and (
+            reference is None or (reference.address and candidate.addresses is not None))]
+        if reference is not None and reference.target and binding:
+            raise EngineError(f"{self.path} line {line_number}: {_word(tokens, index)} names {reference.names}, "
+                              f"which no parameter may change ({binding[0].name} binds {address}); take {address} "
+                              f"out of its addresses")
+        self._leave_alone(line_number, tokens, index, [c for c in equal if c not in binding], reference)
+        return binding
+
+    def _reference(self, tokens, index: int):
+        if self.context is None:
+            self.context = block_context(facts(tokens))
+        return reference_at(tokens, index, self.context)
+
     def _spelled(self, source: str, binding: Binding, spelling: str) -> bool:
         """Whether the field gives the number back as written (evaluated once per spelling)."""
         key = (source, binding.name, spelling)   # the value is the parameter's, one per name
@@ -127,11 +153,21 @@ class Builder:
             self.spelled[key] = _evaluate(source, binding.name, binding.value) == spelling
         return self.spelled[key]
 
-    def _leave_alone(self, line_number: int, tokens, index: int, equal) -> None:
+    def _leave_alone(self, line_number: int, tokens, index: int, equal, reference) -> None:
         """Report the number to each parameter it equals (a function's number is no quantity)."""
         if equal and (tokens[index].address or "") not in FUNCTION_ADDRESSES:
             word = _word(tokens, index)
-            self.found.left_alone.extend(LeftAlone(line_number, word, binding.name) for binding in equal)
+            self.found.left_alone.extend(LeftAlone(line_number, word, binding.name, _why(
+                word, tokens[index].address, binding, reference)) for binding in equal)
+
+
+def _why(word: str, address: str | None, binding: Binding, reference) -> str:
+    """Why `binding` leaves the number alone: what it names, or the addresses it binds."""
+    if reference is not None:
+        return f"{word} names {reference.names}"
+    if address in CODE_NAMES and binding.addresses is None:
+        return f"{word} names {CODE_NAMES[address]}"
+    return f"{binding.name} binds only {binding.described()}"
 
 
 def _word(tokens, index: int) -> str:
