@@ -225,3 +225,15 @@ def test_a_turning_program_is_refused_naming_the_plot_of_its_job(run, tmp_path):
     assert result.exit_code == 1 and len(result.stderr.strip().splitlines()) == 1
     assert f"engine plot --job {job_id}" in result.stderr
     assert not (tmp_path / "turned.png").exists()
+
+
+@pytest.mark.parametrize("where", ["/proc/job.png", "NAME_TOO_LONG"], ids=["proc", "name-too-long"])
+def test_a_picture_that_cannot_be_written_is_refused_in_one_line_naming_the_file(run, tmp_path, where):
+    """/proc takes no new file, and 256 characters are more than a file name may have (Linux: 255):
+    the user is told which file and why, and no temporary file is left beside it."""
+    target = tmp_path / ("p" * 252 + ".png") if where == "NAME_TOO_LONG" else where
+    assert run("instantiate", "--gear", 42).exit_code == 0
+    result = run("plot", "--job", job_with_program(run.url), "-o", target)
+    assert result.exit_code == 1 and len(result.stderr.strip().splitlines()) == 1, result.output
+    assert f"cannot write the picture {str(target)!r}" in result.stderr
+    assert list(tmp_path.iterdir()) == []
