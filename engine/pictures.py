@@ -30,6 +30,13 @@ def picture_target(path) -> tuple[Path, str]:
     return target, file_format
 
 
+def literal(text: object) -> str:
+    """Text from programs and records (a `; CUT` comment, a name, a drawing's file name) as it
+    is written: matplotlib reads what stands between two `$` as TeX, which no shop's text means,
+    and `\\$` is its escape for a dollar sign drawn as such. Every such text is drawn through this."""
+    return str(text).replace("$", r"\$")
+
+
 def new_figure(size_inches: tuple[float, float]):
     """A matplotlib Figure not tied to any screen (the engine runs on servers)."""
     import matplotlib

@@ -237,3 +237,20 @@ def test_a_picture_that_cannot_be_written_is_refused_in_one_line_naming_the_file
     assert result.exit_code == 1 and len(result.stderr.strip().splitlines()) == 1, result.output
     assert f"cannot write the picture {str(target)!r}" in result.stderr
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_cut_comment_with_dollar_signs_is_drawn_as_written(conn, tmp_path):
+    """The legend names each pass by its `; CUT …` comment; matplotlib reads text between two `$`
+    as TeX. The picture shows the shop's words as written (the SVG carries each text it draws)."""
+    from dataclasses import replace
+
+    from engine.pictures import save_atomically
+    from engine.simulation.recorded import record_program
+
+    program = instantiate_gear(conn, 42, choices=Choices())
+    said = [line.replace("; CUT", "; CUT $\\frac$ costs 5 \\$", 1) for line in program.lines]
+    scene = load_scene(conn, program.program_id)
+    scene = replace(scene, recording=record_program(said, scene.gear, scene.hob, scene.machine, scene.name))
+    save_atomically(program_figure(scene)[0], tmp_path / "cut.svg", "svg")
+    comments = [line.lstrip("; ") for line in said if line.startswith("; CUT")]
+    assert comments and all(comment in (tmp_path / "cut.svg").read_text() for comment in comments)

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 from ..errors import EngineError
 from ..gears.records import Gear, Hob, Machine, load_gear, load_machine
-from ..pictures import new_figure, picture_target, save_atomically
+from ..pictures import literal, new_figure, picture_target, save_atomically
 from ..simulation.recorded import Recording, record_program
 from ..simulation.stored import load_hob
 from .hob_view import draw_hob_view
@@ -71,7 +71,7 @@ def program_figure(scene: Scene):
     drawn = draw_side_view(figure.add_subplot(grid[:, 0]), scene)
     drawn.append(draw_overview(figure.add_subplot(grid[0, 1]), scene))
     drawn += draw_hob_view(figure.add_subplot(grid[1, 1]), scene)
-    figure.suptitle(scene.title, fontsize="medium")
+    figure.suptitle(literal(scene.title), fontsize="medium")
     figure.legend(*figure.axes[0].get_legend_handles_labels(), loc="outside lower left", ncols=5, fontsize="small")
     drawn.append(simulation_words(scene.recording))
     return figure, drawn
