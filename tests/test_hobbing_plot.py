@@ -254,3 +254,29 @@ def test_a_cut_comment_with_dollar_signs_is_drawn_as_written(conn, tmp_path):
     save_atomically(program_figure(scene)[0], tmp_path / "cut.svg", "svg")
     comments = [line.lstrip("; ") for line in said if line.startswith("; CUT")]
     assert comments and all(comment in (tmp_path / "cut.svg").read_text() for comment in comments)
+
+
+def draft_of_spur(run, tmp_path) -> None:
+    """An editor's draft of the spur template: every `; CUT` comment says TRIAL."""
+    exported = run("template", "export", "--class", "spur").stdout
+    (tmp_path / "spur.csv").write_text(exported.replace("; CUT {cut_name}", "; CUT {cut_name} TRIAL"))
+    assert run("template", "import", "--class", "spur", tmp_path / "spur.csv").exit_code == 0
+
+
+def test_the_picture_of_a_job_is_of_its_released_program_not_a_draft_tried_on_it(run, tmp_path):
+    """The operator's picture of a job shows the program that reaches the machine; a draft is
+    drawn only for a job that has nothing else, and then the picture and the report say draft."""
+    released = json.loads(run("instantiate", "--gear", 45, "--json").stdout)
+    draft_of_spur(run, tmp_path)
+    assert run("instantiate", "--job", released["job_id"], "--draft").exit_code == 0
+    result = run("plot", "--job", released["job_id"], "-o", tmp_path / "job.svg", "--json")
+    drawn_lines = json.loads(result.stdout)["drawn"]
+    assert drawn_lines[0].startswith(f"program {released['program_id']} (") and "draft" not in drawn_lines[0]
+    assert "TRIAL" not in (tmp_path / "job.svg").read_text()
+    only_draft = json.loads(run("instantiate", "--gear", 42, "--draft", "--json").stdout)
+    result = run("plot", "--job", only_draft["job_id"], "-o", tmp_path / "draft.svg", "--json")
+    drawn_lines = json.loads(result.stdout)["drawn"]
+    assert drawn_lines[0].startswith(f"program {only_draft['program_id']} (a draft")
+    with psycopg.connect(run.url) as conn:
+        figure = program_figure(load_scene(conn, only_draft["program_id"]))[0]
+    assert "DRAFT" in figure.get_suptitle() and "TRIAL" in (tmp_path / "draft.svg").read_text()

@@ -17,8 +17,9 @@ from .hob_view import draw_hob_view
 from .side_view import draw_overview, draw_side_view
 
 FIGURE_SIZE_IN = (16.0, 9.0)
+DRAFT_WORDS = " · DRAFT: made from a template version not released, it never reaches the machine"
 PROGRAM_QUERY = """
-SELECT p.name, p.lines, p.job_id, j.gear_id, j.gear_class, j.hob_id, j.machine
+SELECT p.name, p.lines, p.draft, p.job_id, j.gear_id, j.gear_class, j.hob_id, j.machine
 FROM program p JOIN job j ON j.id = p.job_id
 WHERE p.id = %s"""
 
@@ -28,6 +29,7 @@ class Scene:
     program_id: int
     job_id: int
     name: str
+    draft: bool             # made from a template version not released: never reaches the machine
     gear_class: str
     gear: Gear
     hob: Hob
@@ -38,7 +40,7 @@ class Scene:
     def title(self) -> str:
         return (f"job {self.job_id} · gear {self.gear.id} ({self.gear_class}, m{self.gear.module:g} "
                 f"z{self.gear.teeth}) · hob {self.hob.id} · {self.machine.name} · program {self.name} "
-                f"(id {self.program_id})")
+                f"(id {self.program_id}){DRAFT_WORDS if self.draft else ''}")
 
 
 def plot_stored_program(conn, program_id: int, out) -> list[str]:
@@ -53,14 +55,14 @@ def load_scene(conn, program_id: int) -> Scene:
     row = conn.execute(PROGRAM_QUERY, (program_id,)).fetchone()
     if row is None:
         raise EngineError(f"program {program_id} does not exist; see `SELECT id, name FROM program`")
-    name, lines, job_id, gear_id, gear_class, hob_id, machine_name = row
+    name, lines, draft, job_id, gear_id, gear_class, hob_id, machine_name = row
     machine = load_machine(conn, machine_name)
     if machine.kind != "hobber" or gear_id is None or hob_id is None:
         raise EngineError(f"program {program_id} runs on {machine_name}, a {machine.kind}, not a hobbing program; "
                           f"draw its job with `engine plot --job {job_id} -o FILE.png`")
     gear, hob = load_gear(conn, gear_id), load_hob(conn, hob_id)
     recording = record_program(list(lines), gear, hob, machine, name)
-    return Scene(program_id, job_id, name, gear_class, gear, hob, machine, recording)
+    return Scene(program_id, job_id, name, draft, gear_class, gear, hob, machine, recording)
 
 
 def program_figure(scene: Scene):
