@@ -280,3 +280,18 @@ def test_the_picture_of_a_job_is_of_its_released_program_not_a_draft_tried_on_it
     with psycopg.connect(run.url) as conn:
         figure = program_figure(load_scene(conn, only_draft["program_id"]))[0]
     assert "DRAFT" in figure.get_suptitle() and "TRIAL" in (tmp_path / "draft.svg").read_text()
+
+
+def test_the_picture_of_a_program_the_simulation_refuses_says_so_in_red(conn):
+    """The gear's face width corrected after its program was stored (20 → 40 mm): the program no
+    longer hobs the whole face, the simulation refuses it, and the picture's title says so first."""
+    from matplotlib.colors import same_color
+
+    program = instantiate_gear(conn, 42, choices=Choices())
+    proved = program_figure(load_scene(conn, program.program_id))[0]
+    assert "REFUSED" not in proved.get_suptitle() and same_color(proved._suptitle.get_color(), "black")
+    conn.execute("UPDATE gear SET face_width = 40 WHERE id = 42")
+    figure, lines = program_figure(load_scene(conn, program.program_id))
+    assert "refuses" in lines[-1]
+    assert figure.get_suptitle().startswith("REFUSED BY THE SIMULATION: ")
+    assert same_color(figure._suptitle.get_color(), "red")

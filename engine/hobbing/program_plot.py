@@ -6,6 +6,7 @@ hob and machine, as `engine simulate --program ID` takes them. PNG or SVG, writt
 at all (engine.pictures)."""
 from __future__ import annotations
 
+import textwrap
 from dataclasses import dataclass
 
 from ..errors import EngineError
@@ -17,6 +18,8 @@ from .hob_view import draw_hob_view
 from .side_view import draw_overview, draw_side_view
 
 FIGURE_SIZE_IN = (16.0, 9.0)
+TITLE_WIDTH = 160          # characters of a title line at the figure's width
+TITLE_COLOURS = {False: "black", True: "red"}   # by whether the simulation refuses the program
 DRAFT_WORDS = " · DRAFT: made from a template version not released, it never reaches the machine"
 PROGRAM_QUERY = """
 SELECT p.name, p.lines, p.draft, p.job_id, j.gear_id, j.gear_class, j.hob_id, j.machine
@@ -73,10 +76,22 @@ def program_figure(scene: Scene):
     drawn = draw_side_view(figure.add_subplot(grid[:, 0]), scene)
     drawn.append(draw_overview(figure.add_subplot(grid[0, 1]), scene))
     drawn += draw_hob_view(figure.add_subplot(grid[1, 1]), scene)
-    figure.suptitle(literal(scene.title), fontsize="medium")
+    colour = TITLE_COLOURS[scene.recording.report.refused]
+    figure.suptitle(literal(figure_title(scene)), fontsize="medium", color=colour)
     figure.legend(*figure.axes[0].get_legend_handles_labels(), loc="outside lower left", ncols=5, fontsize="small")
     drawn.append(simulation_words(scene.recording))
     return figure, drawn
+
+
+def figure_title(scene: Scene) -> str:
+    """The title; for a program the simulation refuses now, the refusal first (a picture is passed
+    around without the command's output, and must not look like that of a proved program)."""
+    report = scene.recording.report
+    if not report.refused:
+        return scene.title
+    more = len(report.refusals) - 1
+    refusal = report.refusals[0].sentence(report.name) + (f" (and {more} more finding(s))" if more else "")
+    return "\n".join([*textwrap.wrap(f"REFUSED BY THE SIMULATION: {refusal}", TITLE_WIDTH), scene.title])
 
 
 def simulation_words(recording: Recording) -> str:
