@@ -225,3 +225,73 @@ def test_a_turning_program_is_refused_naming_the_plot_of_its_job(run, tmp_path):
     assert result.exit_code == 1 and len(result.stderr.strip().splitlines()) == 1
     assert f"engine plot --job {job_id}" in result.stderr
     assert not (tmp_path / "turned.png").exists()
+
+
+@pytest.mark.parametrize("where", ["/proc/job.png", "NAME_TOO_LONG"], ids=["proc", "name-too-long"])
+def test_a_picture_that_cannot_be_written_is_refused_in_one_line_naming_the_file(run, tmp_path, where):
+    """/proc takes no new file, and 256 characters are more than a file name may have (Linux: 255):
+    the user is told which file and why, and no temporary file is left beside it."""
+    target = tmp_path / ("p" * 252 + ".png") if where == "NAME_TOO_LONG" else where
+    assert run("instantiate", "--gear", 42).exit_code == 0
+    result = run("plot", "--job", job_with_program(run.url), "-o", target)
+    assert result.exit_code == 1 and len(result.stderr.strip().splitlines()) == 1, result.output
+    assert f"cannot write the picture {str(target)!r}" in result.stderr
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_a_cut_comment_with_dollar_signs_is_drawn_as_written(conn, tmp_path):
+    """The legend names each pass by its `; CUT …` comment; matplotlib reads text between two `$`
+    as TeX. The picture shows the shop's words as written (the SVG carries each text it draws)."""
+    from dataclasses import replace
+
+    from engine.pictures import save_atomically
+    from engine.simulation.recorded import record_program
+
+    program = instantiate_gear(conn, 42, choices=Choices())
+    said = [line.replace("; CUT", "; CUT $\\frac$ costs 5 \\$", 1) for line in program.lines]
+    scene = load_scene(conn, program.program_id)
+    scene = replace(scene, recording=record_program(said, scene.gear, scene.hob, scene.machine, scene.name))
+    save_atomically(program_figure(scene)[0], tmp_path / "cut.svg", "svg")
+    comments = [line.lstrip("; ") for line in said if line.startswith("; CUT")]
+    assert comments and all(comment in (tmp_path / "cut.svg").read_text() for comment in comments)
+
+
+def draft_of_spur(run, tmp_path) -> None:
+    """An editor's draft of the spur template: every `; CUT` comment says TRIAL."""
+    exported = run("template", "export", "--class", "spur").stdout
+    (tmp_path / "spur.csv").write_text(exported.replace("; CUT {cut_name}", "; CUT {cut_name} TRIAL"))
+    assert run("template", "import", "--class", "spur", tmp_path / "spur.csv").exit_code == 0
+
+
+def test_the_picture_of_a_job_is_of_its_released_program_not_a_draft_tried_on_it(run, tmp_path):
+    """The operator's picture of a job shows the program that reaches the machine; a draft is
+    drawn only for a job that has nothing else, and then the picture and the report say draft."""
+    released = json.loads(run("instantiate", "--gear", 45, "--json").stdout)
+    draft_of_spur(run, tmp_path)
+    assert run("instantiate", "--job", released["job_id"], "--draft").exit_code == 0
+    result = run("plot", "--job", released["job_id"], "-o", tmp_path / "job.svg", "--json")
+    drawn_lines = json.loads(result.stdout)["drawn"]
+    assert drawn_lines[0].startswith(f"program {released['program_id']} (") and "draft" not in drawn_lines[0]
+    assert "TRIAL" not in (tmp_path / "job.svg").read_text()
+    only_draft = json.loads(run("instantiate", "--gear", 42, "--draft", "--json").stdout)
+    result = run("plot", "--job", only_draft["job_id"], "-o", tmp_path / "draft.svg", "--json")
+    drawn_lines = json.loads(result.stdout)["drawn"]
+    assert drawn_lines[0].startswith(f"program {only_draft['program_id']} (a draft")
+    with psycopg.connect(run.url) as conn:
+        figure = program_figure(load_scene(conn, only_draft["program_id"]))[0]
+    assert "DRAFT" in figure.get_suptitle() and "TRIAL" in (tmp_path / "draft.svg").read_text()
+
+
+def test_the_picture_of_a_program_the_simulation_refuses_says_so_in_red(conn):
+    """The gear's face width corrected after its program was stored (20 → 40 mm): the program no
+    longer hobs the whole face, the simulation refuses it, and the picture's title says so first."""
+    from matplotlib.colors import same_color
+
+    program = instantiate_gear(conn, 42, choices=Choices())
+    proved = program_figure(load_scene(conn, program.program_id))[0]
+    assert "REFUSED" not in proved.get_suptitle() and same_color(proved._suptitle.get_color(), "black")
+    conn.execute("UPDATE gear SET face_width = 40 WHERE id = 42")
+    figure, lines = program_figure(load_scene(conn, program.program_id))
+    assert "refuses" in lines[-1]
+    assert figure.get_suptitle().startswith("REFUSED BY THE SIMULATION: ")
+    assert same_color(figure._suptitle.get_color(), "red")

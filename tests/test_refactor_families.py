@@ -5,13 +5,17 @@ stays when members join, and marking it intended keeps it out of the report. Wha
 expect is read off the program's text here (its lines without their block number)."""
 from __future__ import annotations
 
+import hashlib
+import json
 import re
 from collections import defaultdict
 
+import pytest
 from click.testing import CliRunner
 
 from engine.cli.app import main
-from engine.library.intended import intend
+from engine.errors import EngineError
+from engine.library.intended import intend, intents, shown_key, unintend
 from engine.library.nc_import import import_nc
 from engine.library.refactor import refactor
 
@@ -124,3 +128,52 @@ def test_the_command_prints_a_family_once_with_its_size(fresh_database_url):
     headers = [line for line in result.stdout.splitlines() if f"{size} lines differing only in the block number" in line]
     assert len(headers) == 1
     assert sum(1 for line in result.stdout.splitlines() if line.strip().endswith(f' {RETRACT}"')) == 10   # first 10 members
+
+
+def key_of_full_texts(t: str, a: str, b: str) -> str:
+    """The key a pair was stored under before issue 17: sha256 of [t, the two texts, block numbers
+    included, sorted] as JSON."""
+    return hashlib.sha256(json.dumps([t, *sorted((a, b))], ensure_ascii=True).encode("ascii")).hexdigest()
+
+
+def marked_before_issue_17(conn, t: str, a: str, b: str, why: str) -> str:
+    key = key_of_full_texts(t, a, b)
+    conn.execute("INSERT INTO near_duplicate_intended (pair_key, t, a, b, why) VALUES (%s, %s, %s, %s, %s)",
+                 (key, t, *sorted((a, b)), why))
+    return key
+
+
+def test_marks_and_seen_pairs_stored_before_block_numbers_left_the_keys_still_hold(conn):
+    """A shop marked two retracts (one family now) and two arcs (one pair of families now)
+    intended, under the keys of their full texts; the report still leaves both out and counts
+    them, the marks keep their key and who made them, and withdrawing one lists it again."""
+    import_nc(conn, CAM, "cam")
+    t_of = {o: t for t, o in rows(conn, "cam").values()}
+    retracts = sorted(f'"{line}"' for line in program_lines() if BLOCK_NUMBER.sub("", line) == RETRACT)[:2]
+    arcs = [next(f'"{line}"' for line in program_lines() if BLOCK_NUMBER.sub("", line) == arc) for arc in ARCS]
+    old_keys = [marked_before_issue_17(conn, t_of[texts[0]], *texts, "meant") for texts in (retracts, arcs)]
+    report = refactor(conn)
+    assert report.intended == 2
+    assert not [entry for entry in report.near_duplicates if set(retracts) <= listed(entry) or
+                set(arcs) <= listed(entry)]
+    assert sorted(mark.key for mark in intents(conn)) == sorted(shown_key(key) for key in old_keys)
+    with pytest.raises(EngineError, match="marked intended already"):
+        intend(conn, "again", texts=tuple(retracts))
+    unintend(conn, old_keys[1])
+    again = refactor(conn)
+    assert again.intended == 1 and len([entry for entry in again.near_duplicates if set(arcs) <= listed(entry)]) == 1
+
+
+def test_a_pair_listed_before_block_numbers_left_the_keys_is_not_new(conn):
+    import_nc(conn, CAM, "cam")
+    t_of = {o: t for t, o in rows(conn, "cam").values()}
+    arcs = [next(f'"{line}"' for line in program_lines() if BLOCK_NUMBER.sub("", line) == arc) for arc in ARCS]
+    conn.execute("INSERT INTO near_duplicate_seen (pair_key, t, a, b) VALUES (%s, %s, %s, %s)",
+                 (key_of_full_texts(t_of[arcs[0]], *arcs), t_of[arcs[0]], *sorted(arcs)))
+    report = refactor(conn)
+    assert [entry["new"] for entry in report.near_duplicates if set(arcs) <= listed(entry)] == [False]
+    assert report.new == len(report.near_duplicates) - 1
+
+
+def listed(entry: dict) -> set:
+    return set(entry.get("members") or entry["members_a"] + entry["members_b"])

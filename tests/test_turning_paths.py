@@ -382,7 +382,7 @@ def test_plot_failure_leaves_no_half_written_file(tmp_path, monkeypatch):
         raise OSError("disk full")
 
     monkeypatch.setattr(Figure, "savefig", broken)
-    with pytest.raises(OSError):
+    with pytest.raises(EngineError, match=r"cannot write the picture .*part\.png.*: disk full"):
         plot_job(tmp_path / "part.png", *plot_inputs())
     assert os.listdir(tmp_path) == []
 

@@ -11,6 +11,7 @@ import math
 
 from matplotlib.patches import Polygon
 
+from ..pictures import literal
 from ..simulation.rules import generating_length
 from .plot_geometry import Pass, along_hob, cut_pass, full_depth_pose, hob_centre, hob_front_corners, unit_section
 from .side_view import BLANK_FILL, cut_colour, last_cut_of
@@ -40,7 +41,7 @@ def draw_hob(axes, scene, pose: dict) -> None:
     hob, swivel = scene.hob, scene.recording.final_swivel
     y, z, half = pose.get("Y", 0.0), pose["Z"], hob.length / 2
     axes.add_patch(Polygon(hob_front_corners(y, z, hob.tip_diameter / 2, half, swivel), closed=True, fill=False,
-                           edgecolor="black", linewidth=1.0, gid="hob front", label=f"hob {hob.id}"))
+                           edgecolor="black", linewidth=1.0, gid="hob front", label=literal(f"hob {hob.id}")))
     axes.plot(*zip(along_hob(-half, y, z, swivel), along_hob(half, y, z, swivel)), color="0.3", linewidth=0.6,
               linestyle="-.", gid="hob axis")
 
@@ -98,7 +99,7 @@ def draw_tangential(axes, scene, cut, index: int, swivel: float) -> str:
     start, end = (hob_centre(pose["Y"], pose["Z"], swivel) for pose in (feed.start, feed.end))
     axes.annotate("", xy=end, xytext=start, gid=f"pass {cut.label}",
                   arrowprops=dict(arrowstyle="-|>", color=cut_colour(index), linewidth=1.6, mutation_scale=18))
-    axes.plot([], [], color=cut_colour(index), linewidth=1.6, label=f"{cut.label}: Y feed")
+    axes.plot([], [], color=cut_colour(index), linewidth=1.6, label=literal(f"{cut.label}: Y feed"))
     return f"{cut.label}: the hob feeds along its axis Y{feed.start['Y']:g} → Y{feed.end['Y']:g} (no shift range)"
 
 

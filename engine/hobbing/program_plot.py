@@ -6,19 +6,23 @@ hob and machine, as `engine simulate --program ID` takes them. PNG or SVG, writt
 at all (engine.pictures)."""
 from __future__ import annotations
 
+import textwrap
 from dataclasses import dataclass
 
 from ..errors import EngineError
 from ..gears.records import Gear, Hob, Machine, load_gear, load_machine
-from ..pictures import new_figure, picture_target, save_atomically
+from ..pictures import literal, new_figure, picture_target, save_atomically
 from ..simulation.recorded import Recording, record_program
 from ..simulation.stored import load_hob
 from .hob_view import draw_hob_view
 from .side_view import draw_overview, draw_side_view
 
 FIGURE_SIZE_IN = (16.0, 9.0)
+TITLE_WIDTH = 160          # characters of a title line at the figure's width
+TITLE_COLOURS = {False: "black", True: "red"}   # by whether the simulation refuses the program
+DRAFT_WORDS = " · DRAFT: made from a template version not released, it never reaches the machine"
 PROGRAM_QUERY = """
-SELECT p.name, p.lines, p.job_id, j.gear_id, j.gear_class, j.hob_id, j.machine
+SELECT p.name, p.lines, p.draft, p.job_id, j.gear_id, j.gear_class, j.hob_id, j.machine
 FROM program p JOIN job j ON j.id = p.job_id
 WHERE p.id = %s"""
 
@@ -28,6 +32,7 @@ class Scene:
     program_id: int
     job_id: int
     name: str
+    draft: bool             # made from a template version not released: never reaches the machine
     gear_class: str
     gear: Gear
     hob: Hob
@@ -38,7 +43,7 @@ class Scene:
     def title(self) -> str:
         return (f"job {self.job_id} · gear {self.gear.id} ({self.gear_class}, m{self.gear.module:g} "
                 f"z{self.gear.teeth}) · hob {self.hob.id} · {self.machine.name} · program {self.name} "
-                f"(id {self.program_id})")
+                f"(id {self.program_id}){DRAFT_WORDS if self.draft else ''}")
 
 
 def plot_stored_program(conn, program_id: int, out) -> list[str]:
@@ -53,14 +58,14 @@ def load_scene(conn, program_id: int) -> Scene:
     row = conn.execute(PROGRAM_QUERY, (program_id,)).fetchone()
     if row is None:
         raise EngineError(f"program {program_id} does not exist; see `SELECT id, name FROM program`")
-    name, lines, job_id, gear_id, gear_class, hob_id, machine_name = row
+    name, lines, draft, job_id, gear_id, gear_class, hob_id, machine_name = row
     machine = load_machine(conn, machine_name)
     if machine.kind != "hobber" or gear_id is None or hob_id is None:
         raise EngineError(f"program {program_id} runs on {machine_name}, a {machine.kind}, not a hobbing program; "
                           f"draw its job with `engine plot --job {job_id} -o FILE.png`")
     gear, hob = load_gear(conn, gear_id), load_hob(conn, hob_id)
     recording = record_program(list(lines), gear, hob, machine, name)
-    return Scene(program_id, job_id, name, gear_class, gear, hob, machine, recording)
+    return Scene(program_id, job_id, name, draft, gear_class, gear, hob, machine, recording)
 
 
 def program_figure(scene: Scene):
@@ -71,10 +76,22 @@ def program_figure(scene: Scene):
     drawn = draw_side_view(figure.add_subplot(grid[:, 0]), scene)
     drawn.append(draw_overview(figure.add_subplot(grid[0, 1]), scene))
     drawn += draw_hob_view(figure.add_subplot(grid[1, 1]), scene)
-    figure.suptitle(scene.title, fontsize="medium")
+    colour = TITLE_COLOURS[scene.recording.report.refused]
+    figure.suptitle(literal(figure_title(scene)), fontsize="medium", color=colour)
     figure.legend(*figure.axes[0].get_legend_handles_labels(), loc="outside lower left", ncols=5, fontsize="small")
     drawn.append(simulation_words(scene.recording))
     return figure, drawn
+
+
+def figure_title(scene: Scene) -> str:
+    """The title; for a program the simulation refuses now, the refusal first (a picture is passed
+    around without the command's output, and must not look like that of a proved program)."""
+    report = scene.recording.report
+    if not report.refused:
+        return scene.title
+    more = len(report.refusals) - 1
+    refusal = report.refusals[0].sentence(report.name) + (f" (and {more} more finding(s))" if more else "")
+    return "\n".join([*textwrap.wrap(f"REFUSED BY THE SIMULATION: {refusal}", TITLE_WIDTH), scene.title])
 
 
 def simulation_words(recording: Recording) -> str:

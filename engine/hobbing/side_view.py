@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from matplotlib.patches import Polygon, Rectangle
 
+from ..pictures import literal
 from .plot_geometry import (approach_pose, axial_profile, cut_pass, full_depth_pose, hob_extent, hob_side_outline,
                             unit_section)
 
@@ -61,7 +62,7 @@ def draw_setup(axes, solid) -> str:
         return f"{solid.name}: ⌀{2 * solid.radius_at_top:g} (outside the picture)"
     r = solid.radius_at_top
     axes.add_patch(Rectangle((-r, z_low), 2 * r, z_high - z_low, facecolor=SETUP_FILL, edgecolor="0.25",
-                             hatch=HATCHES.get(solid.name, "//"), linewidth=0.8, gid=solid.name, label=solid.name))
+                             hatch=HATCHES.get(solid.name, "//"), linewidth=0.8, gid=solid.name, label=literal(solid.name)))
     face = solid.z_high if solid.z_high < high else solid.z_low
     return f"{solid.name}: ⌀{2 * r:g} from Z{face:g}"
 
@@ -94,7 +95,7 @@ def draw_hob(axes, scene, pose: dict, gid: str, colour: str, style, in_legend: b
     xs, zs = hob_side_outline(pose["X"], pose["Z"], scene.hob.tip_diameter / 2, scene.hob.length / 2,
                               scene.recording.final_swivel)
     axes.plot(xs, zs, color=colour, linewidth=1.0, linestyle=style, gid=gid,
-              label=gid.split(" unit")[0] if in_legend else None)
+              label=literal(gid.split(" unit")[0]) if in_legend else None)
     axes.plot([pose["X"]], [pose["Z"]], marker="+", color=colour, gid=f"{gid} centre")
 
 
@@ -111,7 +112,7 @@ def draw_paths(axes, moves, prefix: str = "") -> None:
 
 def draw_pass(axes, cut, colour: str) -> str:
     xs, zs = [pose["X"] for pose in cut.poses], [pose["Z"] for pose in cut.poses]
-    axes.plot(xs, zs, color=colour, linewidth=2.0, gid=f"cut {cut.label}", label=cut.label)
+    axes.plot(xs, zs, color=colour, linewidth=2.0, gid=f"cut {cut.label}", label=literal(cut.label))
     feed = cut_pass(cut)
     if feed is None or not {"X", "Z"} <= feed.start.keys():
         return f"{cut.label}: no feed move from a known position"

@@ -17,6 +17,11 @@ number it starts with (engine.library.similarity.block_free), so `N0380 G1 X10` 
 G1 X11` is the pair `G1 X10`/`G1 X11`, and the lines that differ only in their block number are one
 family, keyed by their common line whatever members join it later. Its a and b in the tables
 are two of its members. A text without a block number keeps the key it always had.
+
+Marks and seen pairs stored before that carry the key of their full texts, block numbers
+included. Every row holds its texts (t, a, b), so a row is keyed again as it is read, the way
+this version keys them: a mark keeps working, and keeps who made it, when and why, and the key
+it was made under (`engine refactor unintend` takes it). Nothing is rewritten.
 """
 from __future__ import annotations
 
@@ -62,9 +67,10 @@ def shown_key(full_key: str) -> str:
 
 # --- what a refactor run reports --------------------------------------------------------------
 
-INTENDED_AMONG = """
-SELECT pair_key FROM near_duplicate_intended WHERE withdrawn_at IS NULL AND pair_key = ANY(%s)"""
-SEEN_AMONG = "SELECT pair_key FROM near_duplicate_seen WHERE pair_key = ANY(%s)"
+# Rows as stored, keyed again by near_duplicate_key as they are read. A seen row's a is one of the
+# texts it was listed with, whatever version stored it; marks are people's, few: all of them.
+MARKS_IN_FORCE = "SELECT pair_key, t, a, b FROM near_duplicate_intended WHERE withdrawn_at IS NULL"
+SEEN_AMONG = "SELECT pair_key, t, a, b FROM near_duplicate_seen WHERE a = ANY(%s)"
 REMEMBER_SEEN = """
 INSERT INTO near_duplicate_seen (pair_key, t, a, b)
 SELECT * FROM unnest(%s::text[], %s::text[], %s::text[], %s::text[])
@@ -85,14 +91,30 @@ def list_and_remember(conn, pairs: list[dict]) -> Listed:
     it), put the new ones first (each part in its given order), and remember them all as seen."""
     full = {id(pair): near_duplicate_key(pair["t"], pair["a"], pair["b"]) for pair in pairs}
     keys = list(full.values())
-    intended = {key for (key,) in conn.execute(INTENDED_AMONG, (keys,))}
-    seen = {key for (key,) in conn.execute(SEEN_AMONG, (keys,))}
+    intended = set(marks_in_force(conn)).intersection(keys)
+    seen = set(rekeyed(conn.execute(SEEN_AMONG, (listed_texts(pairs),)))).intersection(keys)
     listed = [dict(pair, key=shown_key(full[id(pair)]), new=full[id(pair)] not in seen)
               for pair in pairs if full[id(pair)] not in intended]
     listed.sort(key=lambda pair: not pair["new"])   # stable: the order within each part is kept
     _remember(conn, [(full[id(pair)], pair) for pair in pairs if full[id(pair)] not in intended])
     new = sum(pair["new"] for pair in listed)
     return Listed(listed, new, len(listed) - new, len(pairs) - len(listed))
+
+
+def listed_texts(pairs: list[dict]) -> list[str]:
+    """Every text the pairs list: both sides, each family's members."""
+    return sorted({text for pair in pairs
+                   for text in (pair.get("members") or pair["members_a"] + pair["members_b"])})
+
+
+def marks_in_force(conn) -> dict[str, str]:
+    """The marks in force: the key this version computes for the texts → the key stored."""
+    return rekeyed(conn.execute(MARKS_IN_FORCE))
+
+
+def rekeyed(rows) -> dict[str, str]:
+    """(stored key, t, a, b) rows → {key of (t, a, b) as near_duplicate_key computes it: stored key}."""
+    return {near_duplicate_key(t, a, b): stored for stored, t, a, b in rows}
 
 
 def _remember(conn, keyed: list[tuple[str, dict]]) -> None:
@@ -221,7 +243,9 @@ def _module_type(conn, a: str, b: str, t: str | None) -> str:
 
 
 def _refuse_marked_twice(conn, full: str) -> None:
-    mark = conn.execute(INTENT_BY_PREFIX, (len(full), full)).fetchone()
+    """A pair marked already, under this key or under the key of its full texts (before issue 17)."""
+    stored = marks_in_force(conn).get(full, full)
+    mark = conn.execute(INTENT_BY_PREFIX, (len(stored), stored)).fetchone()
     if mark:
         intent = _intent(mark)
         raise EngineError(f"pair {intent.key} is marked intended already (by {intent.marked_by}, "

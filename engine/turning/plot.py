@@ -15,7 +15,7 @@ from typing import Sequence
 
 from importers.dxf_geometry import Arc, Segment
 
-from ..pictures import new_figure, picture_target, save_atomically
+from ..pictures import literal, new_figure, picture_target, save_atomically
 from .moves import Move, Pass
 from .plot_frame import Frame, job_frame
 from .region import arc_points
@@ -154,8 +154,8 @@ def move_points(start: Point, move: Move) -> list[Point]:
 def draw_operation(axes, lines: dict[str, list[Point]], colour: str, label: str) -> None:
     """Feed moves solid (the legend entry of the operation), rapids dashed in the same colour."""
     feed, rapid = (list(zip(*lines[kind])) or [(), ()] for kind in ("feed", "rapid"))
-    axes.plot(*feed, color=colour, linewidth=FEED_WIDTH, label=label, zorder=3)
-    axes.plot(*rapid, color=colour, linewidth=RAPID_WIDTH, linestyle=RAPID_STYLE, label=f"_{label} rapid", zorder=2)
+    axes.plot(*feed, color=colour, linewidth=FEED_WIDTH, label=literal(label), zorder=3)
+    axes.plot(*rapid, color=colour, linewidth=RAPID_WIDTH, linestyle=RAPID_STYLE, label=literal(f"_{label} rapid"), zorder=2)
 
 
 def draw_line_styles(axes) -> None:
@@ -188,5 +188,5 @@ def finish_axes(figure, axes, frame: Frame, title: str) -> None:
     axes.axhline(0.0, color="0.4", linewidth=0.6, linestyle="-.", zorder=1)   # the spindle axis
     axes.grid(True, linewidth=0.3)
     if title:
-        axes.set_title(title, fontsize="medium")
+        axes.set_title(literal(title), fontsize="medium")
     figure.legend(loc="outside right upper", fontsize="small")
