@@ -70,7 +70,8 @@ def template_export(ctx, gear_class, out):
 @click.pass_context
 def template_import(ctx, gear_class, parent, csv_file):
     """Replace the class's rows with CSV_FILE; every expression is checked first (all or nothing).
-    The line_ending and final_newline columns, if the CSV has them, set the class's layout; a CSV
+    The line_ending and final_newline columns, if the CSV has them, set the class's layout (a change
+    of it is a new draft version, as a change of rows is, until `engine template release`); a CSV
     without them leaves it as it is."""
     from ..library.nc_layout import class_layout, store_layout
     from ..templates.rows import read_template_csv
@@ -81,11 +82,11 @@ def template_import(ctx, gear_class, parent, csv_file):
         with conn.transaction():
             created = ensure_class(conn, gear_class, parent)
             changed = replace_template(conn, gear_class, read.rows)
-            if read.layout is not None:
-                store_layout(conn, gear_class, read.layout)
+            relaid = read.layout is not None and store_layout(conn, gear_class, read.layout)
         version = conn.execute("SELECT template_version FROM gear_class WHERE name = %s", (gear_class,)).fetchone()[0]
         layout = class_layout(conn, gear_class)
-    state = "created" if created else ("replaced" if changed else "unchanged (identical rows)")
+    state = "created" if created else ("replaced" if changed else
+                                       "layout changed (identical rows)" if relaid else "unchanged (identical rows)")
     click.echo(f"class {gear_class}: {state}, {len(read.rows)} rows, version {version}, {layout.said}")
 
 
