@@ -126,3 +126,28 @@ def test_hob_ids_differing_only_in_case_stop_migration_0011_with_their_names(emp
         with pytest.raises(EngineError, match=r'0011\.hob_ids_ignore_case\.sql failed.*"H-M2-AA-R1" and "h-m2-aa-r1"'):
             migrate(conn, folder)
         assert conn.execute("SELECT count(*) FROM hob").fetchone()[0] == 3
+
+
+def test_versions_stored_before_0025_keep_the_layout_their_programs_were_written_with(empty_database_url, tmp_path):
+    """Before migration 0025 every program of a class was written with the class's one layout:
+    the versions already stored record it, so programs of them are shown as they were written."""
+    from engine.library.nc_layout import CRLF, NcLayout, class_layout
+    from engine.templates.rows import TemplateRow
+    from engine.templates.store import ensure_class, replace_template
+
+    folder = copy_migrations(tmp_path)
+    later = [path for path in folder.glob("*.sql") if path.name >= "0025"]
+    held = {path.name: path.read_text() for path in later}
+    for path in later:
+        path.unlink()
+    with psycopg.connect(empty_database_url) as conn:
+        migrate(conn, folder)
+        ensure_class(conn, "old_crlf")
+        replace_template(conn, "old_crlf", [TemplateRow(10, "main", 10, None, None, '"M30"', None)])
+        conn.execute("UPDATE gear_class SET line_ending = %s, final_newline = false WHERE name = 'old_crlf'", (CRLF,))
+        conn.commit()
+        for name, text in held.items():
+            (folder / name).write_text(text)
+        migrate(conn, folder)
+        assert class_layout(conn, "old_crlf", 1) == NcLayout(CRLF, False)
+        assert conn.execute("SELECT template_version FROM gear_class WHERE name = 'old_crlf'").fetchone()[0] == 1

@@ -17,6 +17,7 @@ import pytest
 from click.testing import CliRunner
 
 from engine.cli.app import main
+from engine.templates.release import release
 
 CRLF, LF = "\r\n", "\n"
 
@@ -35,9 +36,13 @@ def engine(fresh_database_url, tmp_path):
 
 
 def set_layout(url: str, gear_class: str, ending: str, final_newline: bool) -> None:
+    """The class's layout changed (a new draft version, migration 0025) and released, as an editor
+    and a releaser do: runners' programs are written with it from then on."""
     with psycopg.connect(url) as conn:
         conn.execute("UPDATE gear_class SET line_ending = %s, final_newline = %s WHERE name = %s",
                      (ending, final_newline, gear_class))
+    with psycopg.connect(url) as conn:
+        release(conn, gear_class)
 
 
 def stored(url: str, program_id: int) -> list[str]:

@@ -6,6 +6,7 @@ import sys
 
 import click
 
+from ..library.nc_layout import ENDING_NAMES, NcLayout
 from .context import connection, emit_json
 from .ids import VERSION
 from .output import Column, emit_list, list_options
@@ -70,7 +71,8 @@ def template_export(ctx, gear_class, out):
 @click.pass_context
 def template_import(ctx, gear_class, parent, csv_file):
     """Replace the class's rows with CSV_FILE; every expression is checked first (all or nothing).
-    The line_ending and final_newline columns, if the CSV has them, set the class's layout; a CSV
+    The line_ending and final_newline columns, if the CSV has them, set the class's layout (a change
+    of it is a new draft version, as a change of rows is, until `engine template release`); a CSV
     without them leaves it as it is."""
     from ..library.nc_layout import class_layout, store_layout
     from ..templates.rows import read_template_csv
@@ -81,11 +83,11 @@ def template_import(ctx, gear_class, parent, csv_file):
         with conn.transaction():
             created = ensure_class(conn, gear_class, parent)
             changed = replace_template(conn, gear_class, read.rows)
-            if read.layout is not None:
-                store_layout(conn, gear_class, read.layout)
+            relaid = read.layout is not None and store_layout(conn, gear_class, read.layout)
         version = conn.execute("SELECT template_version FROM gear_class WHERE name = %s", (gear_class,)).fetchone()[0]
         layout = class_layout(conn, gear_class)
-    state = "created" if created else ("replaced" if changed else "unchanged (identical rows)")
+    state = "created" if created else ("replaced" if changed else
+                                       "layout changed (identical rows)" if relaid else "unchanged (identical rows)")
     click.echo(f"class {gear_class}: {state}, {len(read.rows)} rows, version {version}, {layout.said}")
 
 
@@ -107,9 +109,10 @@ def template_history(ctx, gear_class, as_json):
     if as_json:
         return emit_json({"class": gear_class, "versions": [_version_json(entry) for entry in entries]})
     for number, entry in enumerate(entries):
+        layout = _layout_text(entry.layout, entries[number - 1].layout if number else NcLayout())
+        changes = _changes_text(entry.changes, first=number == 0, relaid=bool(layout))
         click.echo(f"v{entry.version:<4} {entry.state:10} {entry.created_at:%Y-%m-%d %H:%M:%S} by "
-                   f"{entry.created_by:14} {entry.rows:3} rows  "
-                   f"{_changes_text(entry.changes, first=number == 0)}".rstrip())
+                   f"{entry.created_by:14} {entry.rows:3} rows  {changes}{layout}".rstrip())
         if entry.release is not None:
             click.echo(f"      {_release_text(entry.release)}")
 
@@ -121,10 +124,16 @@ def _release_text(release) -> str:
             f"{release.tests} golden test(s){impact}{note}")
 
 
-def _changes_text(changes, first: bool) -> str:
+def _layout_text(layout, before) -> str:
+    """The layout a version's programs are written with, where it differs from the version
+    before (from LF with a final newline for the first)."""
+    return "" if layout == before else f"  layout {layout.said}"
+
+
+def _changes_text(changes, first: bool, relaid: bool = False) -> str:
     """Which rows a version changed: each row, or counts per operation when there are many."""
     if not changes:
-        return "" if first else "(rows inherited from a parent class changed)"
+        return "" if first or relaid else "(rows inherited from a parent class changed)"
     if len(changes) <= 6:
         return ", ".join(f"{operation} {row_id}" for row_id, operation in changes)
     operations = [operation for _, operation in changes]
@@ -134,7 +143,8 @@ def _changes_text(changes, first: bool) -> str:
 def _version_json(entry) -> dict:
     return {"version": entry.version, "created_at": entry.created_at.isoformat(), "created_by": entry.created_by,
             "rows": entry.rows, "state": entry.state, "release": _release_json(entry.release),
-            "changes": [{"row_id": row_id, "operation": operation} for row_id, operation in entry.changes]}
+            "changes": [{"row_id": row_id, "operation": operation} for row_id, operation in entry.changes],
+            "line_ending": ENDING_NAMES[entry.layout.line_ending], "final_newline": entry.layout.final_newline}
 
 
 def _release_json(release) -> dict | None:
@@ -152,15 +162,20 @@ def _release_json(release) -> dict | None:
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object: {changes: [{row_id, kind, old, new}]}.")
 @click.pass_context
 def template_diff(ctx, gear_class, from_version, to_version, as_json):
-    """Rows added (+), removed (-) and changed (~) between two versions of the class, with old and new values."""
-    from ..templates.history import diff
+    """Rows added (+), removed (-) and changed (~) between two versions of the class, with old and new
+    values, and the layout (line ending, final newline) if it changed."""
+    from ..templates.history import diff, layout_change
 
     with connection(ctx) as conn:
         changes = diff(conn, gear_class, from_version, to_version)
+        relaid = layout_change(conn, gear_class, from_version, to_version)
     if as_json:
         return emit_json({"class": gear_class, "from": from_version, "to": to_version,
                           "changes": [{"row_id": c.row_id, "kind": c.kind, "old": c.old, "new": c.new}
-                                      for c in changes]})
+                                      for c in changes],
+                          "layout": relaid and {"old": relaid[0].said, "new": relaid[1].said}})
+    if relaid:
+        click.echo(f"~ layout: {relaid[0].said} -> {relaid[1].said}")
     for change in changes:
         click.echo("\n".join(_diff_lines(change)))
     click.echo(f"{len(changes)} row(s) differ between v{from_version} and v{to_version}", err=True)

@@ -116,7 +116,7 @@ def _import(conn, path, gear_class: str, params: dict | None, modules: dict | No
         created = ensure_class(conn, gear_class, parent)
         changed = replace_template(conn, gear_class, rows, check=proof.start_on)   # proved while written
         _store_import_params(conn, gear_class, params)
-        store_layout(conn, gear_class, layout)
+        changed = store_layout(conn, gear_class, layout) or changed   # a new layout is a new version too
         template = load_template(conn, gear_class)
         _refuse_inherited(template, lines)
         proof.verdict(template.rows)

@@ -1,13 +1,15 @@
 """How an imported NC file ends its lines (issue 17): LF or CRLF, and whether its last line ends
 with one. The rows hold the lines without their endings, so `M17` of a CRLF file and of an LF
 file is one component; the class keeps the layout (gear_class.line_ending, .final_newline) and
-its program is written back with it, byte for byte."""
+its program is written back with it, byte for byte. The layout is part of the template: each
+stored version records it (template_version_rows, migration 0025), a change of it is a new draft
+version, and a program is written with its version's layout."""
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
 from ..errors import EngineError
-from ..names import shown
+from ..names import line_breaking, shown
 
 LF, CRLF = "\n", "\r\n"
 ENDING_NAMES = {LF: "lf", CRLF: "crlf"}   # as the config file and a template CSV write them
@@ -45,9 +47,20 @@ def split_nc_text(path, text: str) -> tuple[list[str], NcLayout]:
         names = ("CRLF", "LF") if crlf else ("LF", "CRLF")
         raise EngineError(f"{path} mixes line endings: line 1 ends with {names[0]}, line {other} "
                           f"{shown(lines[other - 1])} with {names[1]}; convert the file to one line ending")
-    if not crlf:
-        return lines, NcLayout(LF, final_newline)
-    return [line[:-1] for line in ended] + lines[len(ended):], NcLayout(CRLF, final_newline)
+    if crlf:
+        lines = [line[:-1] for line in ended] + lines[len(ended):]
+    refuse_broken_lines(path, lines)
+    return lines, NcLayout(CRLF if crlf else LF, final_newline)
+
+
+def refuse_broken_lines(path, lines: list[str]) -> None:
+    """A line holding a character that ends a line elsewhere (a CR alone, FF, NEL, LS, PS) is one
+    line here and two on a control or editor: no program may hold it (migration 0009)."""
+    for number, line in enumerate(lines, start=1):
+        breaking = line_breaking(line)
+        if breaking is not None:
+            raise EngineError(f"{path} line {number} {shown(line)} holds U+{ord(breaking):04X}, which breaks an NC "
+                              "line on a control; remove it or make it a line ending")
 
 
 def nc_text(lines: list[str], layout: NcLayout) -> str:
@@ -56,14 +69,28 @@ def nc_text(lines: list[str], layout: NcLayout) -> str:
     return text + layout.line_ending if layout.final_newline else text
 
 
-def store_layout(conn, gear_class: str, layout: NcLayout) -> None:
-    conn.execute("UPDATE gear_class SET line_ending = %s, final_newline = %s WHERE name = %s",
-                 (layout.line_ending, layout.final_newline, gear_class))
+def store_layout(conn, gear_class: str, layout: NcLayout) -> bool:
+    """Give the class this layout; True if that changed it. A change is a change of the class's
+    template: the database makes it a new version (a draft until released; migration 0025),
+    unless this transaction made one already."""
+    changed = conn.execute("UPDATE gear_class SET line_ending = %s, final_newline = %s WHERE name = %s "
+                           "AND (line_ending, final_newline) IS DISTINCT FROM (%s, %s) RETURNING name",
+                           (layout.line_ending, layout.final_newline, gear_class,
+                            layout.line_ending, layout.final_newline)).fetchone()
+    return changed is not None
 
 
-def class_layout(conn, gear_class: str) -> NcLayout:
-    """The layout of the class's file (LF with a final newline for a class not imported)."""
-    row = conn.execute("SELECT line_ending, final_newline FROM gear_class WHERE name = %s", (gear_class,)).fetchone()
+# The version's recorded layout; the class's own for its current version not stored yet.
+LAYOUT = """
+SELECT coalesce(v.line_ending, g.line_ending), coalesce(v.final_newline, g.final_newline)
+FROM gear_class g LEFT JOIN template_version_rows v ON v.gear_class = g.name AND v.version = %s
+WHERE g.name = %s"""
+
+
+def class_layout(conn, gear_class: str, version: int | None = None) -> NcLayout:
+    """The layout the class's template `version` writes (its current version if None): what
+    its programs of that version are written with, LF with a final newline for a class not imported."""
+    row = conn.execute(LAYOUT, (version, gear_class)).fetchone()
     if row is None:
         raise EngineError(f"class {gear_class!r} does not exist; see `engine template list`")
     return NcLayout(row[0], row[1])

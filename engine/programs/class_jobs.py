@@ -88,7 +88,7 @@ def _planned(conn, gear_class: str, given: dict, machine_name: str | None, sourc
         refuse_unread_dialect(machine)
     params, taken = job_params(gear_class, imported, values(given, source), source)
     template = runnable_template(conn, gear_class, draft)
-    layout = class_layout(conn, gear_class)   # the imported file's line ending and final newline
+    layout = class_layout(conn, gear_class, template.version)   # its version's line ending and final newline
     if unverified:
         return _unverified_job(template, machine, params, layout), taken
     return class_job(template, machine, params, {}, layout), taken

@@ -54,7 +54,7 @@ class Planner:
         if gear_class not in self._templates:
             self._templates[gear_class] = self._remembering_refusal(gear_class, runnable_template, self.conn,
                                                                     gear_class, self.draft)
-            self._layouts[gear_class] = class_layout(self.conn, gear_class)
+            self._layouts[gear_class] = class_layout(self.conn, gear_class, self._templates[gear_class].version)
         return self._templates[gear_class]
 
     def _remembering_refusal(self, gear_class: str, read, *args):

@@ -1,8 +1,9 @@
 """A stored program found from what an operator has in hand (`engine programs show`): its id, or
 the hash on its lineage line (engine.programs.lineage) read off a file on the control, the INPUT
 hash of the job's parameters or the TEMPLATE hash of the version it was made from; and the
-programs stored, filtered (`engine programs list`). A program is shown with its class's layout
-(line ending, final newline: engine.library.nc_layout)."""
+programs stored, filtered (`engine programs list`). A program is shown with the layout (line
+ending, final newline: engine.library.nc_layout) its template version records, the one its file was
+written with: a later change of the class's layout is a later version and leaves it as it was."""
 from __future__ import annotations
 
 import re
@@ -17,8 +18,9 @@ MIN_HASH_DIGITS = 8   # what the lineage line shows
 HASH_PREFIX = re.compile(r"[0-9a-f]{8,64}")
 RECORD = """
 SELECT p.id, p.job_id, j.gear_id, p.gear_class, p.template_version, p.draft, p.unverified, p.template_hash,
-       p.input_hash, p.stored_by, p.created_at, p.name, p.lines, c.line_ending, c.final_newline
-FROM program p JOIN job j ON j.id = p.job_id JOIN gear_class c ON c.name = p.gear_class"""
+       p.input_hash, p.stored_by, p.created_at, p.name, p.lines, v.line_ending, v.final_newline
+FROM program p JOIN job j ON j.id = p.job_id
+JOIN template_version_rows v ON v.gear_class = p.gear_class AND v.version = p.template_version"""
 BY_ID = RECORD + " WHERE p.id = %s"
 # left(…, 8) is what the indexes of migration 0015 hold; the LIKE then checks the longer prefix.
 BY_HASH = RECORD + """
@@ -43,15 +45,15 @@ class ProgramRecord:
     created_at: datetime
     name: str
     lines: list[str]
-    layout: NcLayout = NcLayout()   # the class's line ending and final newline
+    layout: NcLayout = NcLayout()   # its template version's line ending and final newline
 
     @property
     def text(self) -> str:
-        """The program with its class's line ending and final newline."""
+        """The program with its version's line ending and final newline, as its file was written."""
         return nc_text(self.lines, self.layout)
 
     def as_dict(self) -> dict:
-        """The record with the common key names (program_id, class), its lines and its class's
+        """The record with the common key names (program_id, class), its lines and its version's
         layout as the config file and a template CSV name it (line_ending "lf" or "crlf")."""
         fields = asdict(self)
         del fields["layout"]

@@ -15,8 +15,9 @@ Files are refused before anything is stored: a name that is not an 840D program 
 name that would land outside --out, two programs of one run whose names differ only in case
 (the control does not tell case), and an existing file without --force.
 
-A file is written with its class's layout (issue 17: gear_class.line_ending and final_newline,
-LF with a final newline unless the class was imported from a file that had another), so an
+A file is written with the layout of its template version (issue 17: the class's line_ending and
+final_newline as that version records them, migration 0025; LF with a final newline unless the
+class was imported from a file that had another), so an
 imported program comes back byte for byte. A line ending configured for the program's machine
 (the config file, set for the block by `line_endings(...)`; engine.programs.config) replaces the
 class's line ending in that machine's files, for a control that wants CR LF; the final newline

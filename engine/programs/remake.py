@@ -48,7 +48,7 @@ class Remaker:
     def remade(self, job: tuple) -> Planned:
         """The job's program planned again, to be written with its class's layout."""
         planned = self._remade(job)
-        return replace(planned, layout=self.layout(planned.gear_class))
+        return replace(planned, layout=self.layout(planned.gear_class, planned.template.version))
 
     def _remade(self, job: tuple) -> Planned:
         job_id, gear_id, gear_class, machine_name, hob_id, params, module_params = job
@@ -90,9 +90,10 @@ class Remaker:
             self._machines[name] = load_machine(self.conn, name)
         return self._machines[name]
 
-    def layout(self, gear_class: str) -> NcLayout:
+    def layout(self, gear_class: str, version: int) -> NcLayout:
+        """The layout of the class's version its programs are made from (one per class here)."""
         if gear_class not in self._layouts:
-            self._layouts[gear_class] = class_layout(self.conn, gear_class)
+            self._layouts[gear_class] = class_layout(self.conn, gear_class, version)
         return self._layouts[gear_class]
 
     def template(self, gear_class: str) -> Template:

@@ -1,7 +1,8 @@
 """Template versions of a class: history, diff between two versions, restore of one.
 
 Every committed version's assembled rows are in template_version_rows (written at commit by
-the trigger of migration 0006); template_audit says which rows each version changed.
+the trigger of migration 0006); template_audit says which rows each version changed; each version
+also records the layout its programs are written with (line ending, final newline; migration 0025).
 """
 from __future__ import annotations
 
@@ -9,6 +10,7 @@ from dataclasses import dataclass
 from datetime import datetime
 
 from ..errors import EngineError
+from ..library.nc_layout import NcLayout, class_layout, store_layout
 from .rows import CSV_COLUMNS, TemplateRow
 from .store import replace_template
 
@@ -22,6 +24,7 @@ class VersionEntry:
     changes: tuple[tuple[int, str], ...]   # (row id, INSERT/UPDATE/DELETE) from template_audit
     state: str = ""                        # released, retired, draft, superseded (template_version_state)
     release: "ReleaseEntry | None" = None  # the release of this version, if it was released
+    layout: NcLayout = NcLayout()          # the line ending and final newline its programs are written with
 
 
 @dataclass(frozen=True)
@@ -53,16 +56,16 @@ class RowChange:
 # (several bumps in one transaction store only the committed one).
 HISTORY = """
 WITH versions AS (
-    SELECT version, created_at, created_by, jsonb_array_length(rows) AS row_count,
+    SELECT version, created_at, created_by, jsonb_array_length(rows) AS row_count, line_ending, final_newline,
            lag(version, 1, -1) OVER (ORDER BY version) AS previous
     FROM template_version_rows WHERE gear_class = %(class)s)
-SELECT v.version, v.created_at, v.created_by, v.row_count,
+SELECT v.version, v.created_at, v.created_by, v.row_count, v.line_ending, v.final_newline,
        coalesce(array_agg(a.row_id ORDER BY a.id) FILTER (WHERE a.id IS NOT NULL), '{}'),
        coalesce(array_agg(a.operation ORDER BY a.id) FILTER (WHERE a.id IS NOT NULL), '{}')
 FROM versions v
 LEFT JOIN template_audit a ON a.gear_class = %(class)s
      AND a.template_version > v.previous AND a.template_version <= v.version
-GROUP BY v.version, v.created_at, v.created_by, v.row_count
+GROUP BY v.version, v.created_at, v.created_by, v.row_count, v.line_ending, v.final_newline
 ORDER BY v.version"""
 
 
@@ -80,8 +83,8 @@ def history(conn, gear_class: str) -> list[VersionEntry]:
     states = dict(conn.execute(STATES, (gear_class,)).fetchall())
     releases = {row[0]: ReleaseEntry(*row[1:]) for row in conn.execute(RELEASES, (gear_class,))}
     return [VersionEntry(version, created_at, created_by, row_count, tuple(zip(row_ids, operations)),
-                         states.get(version, ""), releases.get(version))
-            for version, created_at, created_by, row_count, row_ids, operations
+                         states.get(version, ""), releases.get(version), NcLayout(line_ending, final_newline))
+            for version, created_at, created_by, row_count, line_ending, final_newline, row_ids, operations
             in conn.execute(HISTORY, {"class": gear_class})]
 
 
@@ -93,14 +96,20 @@ def diff(conn, gear_class: str, from_version: int, to_version: int) -> list[RowC
             for row_id in sorted(old.keys() | new.keys()) if old.get(row_id) != new.get(row_id)]
 
 
+def layout_change(conn, gear_class: str, from_version: int, to_version: int) -> tuple[NcLayout, NcLayout] | None:
+    """The layouts of the two versions if they differ (the bytes of their programs do), else None."""
+    old, new = (class_layout(conn, gear_class, version) for version in (from_version, to_version))
+    return None if old == new else (old, new)
+
+
 def _row_change(row_id: int, old: dict | None, new: dict | None) -> RowChange:
     kind = "added" if old is None else "removed" if new is None else "changed"
     return RowChange(row_id, kind, old, new)
 
 
 def restore(conn, gear_class: str, version: int) -> tuple[bool, int]:
-    """Make the class's template what it was in `version`, as a new version (history stays
-    append-only). Returns (changed, the class's version now); unchanged if identical.
+    """Make the class's template what it was in `version`, its rows and its layout, as a new
+    version (history stays append-only). Returns (changed, the class's version now); unchanged if identical.
 
     The stored rows are the assembled template; replace_template keeps as the class's own
     rows only those that differ from what it inherits now."""
@@ -109,6 +118,7 @@ def restore(conn, gear_class: str, version: int) -> tuple[bool, int]:
         if not rows:
             raise EngineError(f"class {gear_class!r} version {version} has no template rows; nothing to restore")
         changed = replace_template(conn, gear_class, rows)
+        changed = store_layout(conn, gear_class, class_layout(conn, gear_class, version)) or changed
         current = conn.execute("SELECT template_version FROM gear_class WHERE name = %s", (gear_class,)).fetchone()[0]
     return changed, current
 

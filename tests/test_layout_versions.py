@@ -1,0 +1,155 @@
+"""The line layout of a class (line ending, final newline; issue 17) is part of its template and
+travels with its versions (migration 0025): an editor's change of it is a new draft version, the
+released version keeps the layout it was released with until a releaser releases the draft, and
+history, diff and restore treat it as they treat rows. The expected bytes are the stored lines
+read by SQL, joined here."""
+from __future__ import annotations
+
+import csv
+import io
+import json
+
+import psycopg
+import pytest
+from click.testing import CliRunner
+
+from engine.cli.app import main
+
+from test_records import logins
+
+CRLF, LF = "\r\n", "\n"
+
+
+@pytest.fixture
+def engine(fresh_database_url, tmp_path):
+    """The CLI on a private seeded database, with an empty config file of the test's own."""
+    config = tmp_path / "config.toml"
+    config.write_text("")
+
+    def invoke(*args):
+        return CliRunner().invoke(main, ["--database-url", fresh_database_url, *map(str, args)],
+                                  env={"ENGINE_CONFIG": str(config), "ENGINE_INSTANTIATE_OUT": None})
+    invoke.url = fresh_database_url
+    return invoke
+
+
+@pytest.fixture
+def login_in(server_url):
+    with logins(server_url) as create:
+        yield create
+
+
+def made(result) -> dict:
+    assert result.exit_code == 0, result.output
+    return json.loads(result.stdout)
+
+
+def stored(url: str, program_id: int) -> list[str]:
+    with psycopg.connect(url) as conn:
+        return conn.execute("SELECT lines FROM program WHERE id = %s", (program_id,)).fetchone()[0]
+
+
+def joined(lines: list[str], ending: str, final_newline: bool) -> bytes:
+    return (ending.join(lines) + (ending if final_newline else "")).encode("ascii")
+
+
+def with_layout(exported: str, ending: str, final_newline: str) -> str:
+    """The exported CSV with the layout columns on every row (the rows unchanged)."""
+    rows = list(csv.reader(io.StringIO(exported, newline="")))
+    buffer = io.StringIO()
+    csv.writer(buffer, lineterminator="\n").writerows([rows[0] + ["line_ending", "final_newline"]]
+                                                      + [row + [ending, final_newline] for row in rows[1:]])
+    return buffer.getvalue()
+
+
+def crlf_draft(engine, tmp_path) -> None:
+    """spur's rows as released, imported with the layout CR LF and no final newline."""
+    edited = tmp_path / "spur.csv"
+    edited.write_text(with_layout(engine("template", "export", "--class", "spur").stdout, "crlf", "no"))
+    imported = engine("template", "import", "--class", "spur", edited)
+    assert imported.exit_code == 0, imported.output
+    assert "layout changed (identical rows)" in imported.stdout and "version 2" in imported.stdout
+
+
+def written(engine, tmp_path, *options) -> tuple[dict, bytes]:
+    target = tmp_path / f"GEAR42_{len(list(tmp_path.iterdir()))}.MPF"
+    program = made(engine("instantiate", "--gear", 42, *options, "--out", target, "--json"))
+    return program, target.read_bytes()
+
+
+def test_a_layout_change_is_a_draft_until_it_is_released(engine, tmp_path):
+    crlf_draft(engine, tmp_path)
+    runner, runners_file = written(engine, tmp_path)
+    assert runner["template_version"] == 1
+    assert runners_file == joined(stored(engine.url, runner["program_id"]), LF, True)
+    editor, editors_file = written(engine, tmp_path, "--draft")
+    assert editor["template_version"] == 2
+    assert editors_file == joined(stored(engine.url, editor["program_id"]), CRLF, False)
+    released = engine("template", "release", "--class", "spur", "--yes")
+    assert released.exit_code == 0, released.output
+    after, file_after = written(engine, tmp_path)
+    assert after["template_version"] == 2
+    assert file_after == joined(stored(engine.url, after["program_id"]), CRLF, False)
+
+
+def test_programs_show_keeps_the_layout_of_the_version_a_program_was_made_from(engine, tmp_path):
+    before, file_before = written(engine, tmp_path)
+    crlf_draft(engine, tmp_path)
+    assert engine("template", "release", "--class", "spur", "--yes").exit_code == 0
+    shown = engine("programs", "show", before["program_id"])
+    assert shown.exit_code == 0 and shown.stdout_bytes.endswith(file_before), shown.output
+    record = made(engine("programs", "show", before["program_id"], "--json"))["programs"][0]
+    assert (record["line_ending"], record["final_newline"]) == ("lf", True)
+
+
+def test_history_diff_and_restore_carry_the_layout(engine, tmp_path):
+    crlf_draft(engine, tmp_path)
+    versions = made(engine("template", "history", "--class", "spur", "--json"))["versions"]
+    assert [(v["version"], v["line_ending"], v["final_newline"]) for v in versions] == \
+        [(1, "lf", True), (2, "crlf", False)]
+    history = engine("template", "history", "--class", "spur").stdout.splitlines()
+    assert history[-1].startswith("v2") and history[-1].endswith("layout CRLF, no final newline")
+    diff = engine("template", "diff", "--class", "spur", "--from", 1, "--to", 2)
+    assert diff.stdout == "~ layout: LF, final newline -> CRLF, no final newline\n", diff.output
+    assert made(engine("template", "diff", "--class", "spur", "--from", 1, "--to", 2, "--json"))["changes"] == []
+    restored = engine("template", "restore", "--class", "spur", "--version", 1)
+    assert restored.exit_code == 0 and "restored version 1 as version 3" in restored.stdout, restored.output
+    editor, editors_file = written(engine, tmp_path, "--draft")
+    assert editor["template_version"] == 3
+    assert editors_file == joined(stored(engine.url, editor["program_id"]), LF, True)
+
+
+def test_an_editor_changing_the_layout_makes_a_draft_and_the_released_version_keeps_its_own(
+        engine, login_in):
+    editor = login_in("engine_editor")
+    with psycopg.connect(editor.url(engine.url)) as conn:
+        conn.execute("SET ROLE engine_editor")
+        conn.execute("UPDATE gear_class SET line_ending = %s, final_newline = false WHERE name = 'spur'", (CRLF,))
+    with psycopg.connect(engine.url) as conn:
+        assert conn.execute("SELECT template_version, released_version(name) FROM gear_class "
+                            "WHERE name = 'spur'").fetchone() == (2, 1)
+        assert conn.execute("SELECT version, line_ending, final_newline FROM template_version_rows "
+                            "WHERE gear_class = 'spur' ORDER BY version").fetchall() == \
+            [(1, LF, True), (2, CRLF, False)]
+
+
+def test_a_layout_and_rows_changed_in_one_import_are_one_version(engine, tmp_path):
+    exported = engine("template", "export", "--class", "spur").stdout
+    edited = tmp_path / "spur.csv"
+    edited.write_text(with_layout(exported, "crlf", "yes").replace('"M30"', '"M30 ; END"', 1))
+    imported = engine("template", "import", "--class", "spur", edited)
+    assert imported.exit_code == 0 and "replaced" in imported.stdout and "version 2" in imported.stdout, \
+        imported.output
+
+
+def test_a_re_import_of_the_file_with_other_line_endings_is_a_new_version(engine, tmp_path):
+    lf_file, crlf_file = tmp_path / "lf.nc", tmp_path / "crlf.nc"
+    lf_file.write_bytes(b"G0 X10\nM30\n")
+    crlf_file.write_bytes(b"G0 X10\r\nM30\r\n")
+    first = engine("import-nc", lf_file, "--class", "nc_relaid", "--json")
+    assert first.exit_code == 0, first.output
+    again = engine("import-nc", crlf_file, "--class", "nc_relaid", "--json")
+    assert again.exit_code == 0, again.output
+    with psycopg.connect(engine.url) as conn:
+        assert conn.execute("SELECT version, line_ending FROM template_version_rows WHERE gear_class = 'nc_relaid' "
+                            "ORDER BY version").fetchall() == [(1, LF), (2, CRLF)]
