@@ -10,6 +10,7 @@ import ezdxf
 import psycopg
 import pytest
 
+from engine.paths import SAMPLE_DRAWING
 from lathe_programs import motions, operation_lines
 
 AXIS_Y = 30.0                 # drawing Y of the part's axis (the view is drawn off Y = 0)
@@ -129,3 +130,56 @@ def test_a_ring_drawn_as_its_section_is_not_turned_as_a_solid_bar(run, tmp_path)
                "--json")
     assert made.exit_code == 1, made.output
     assert made.stderr.count("\n") == 1 and counts(run.url) == before
+
+
+# --- drawn operations and the blank -------------------------------------------------------------------
+
+BLANK_DIAMETER = 44.0          # the sample's blank, as its NOTES layer says: Ø44 × 70, face at Z 0
+BLANK_Z = (-70.0, 0.0)
+INSIDE_MM = 0.01               # deeper than this inside the blank is through material
+SAMPLES_PER_MOVE = 40
+
+
+def without_layer(source, layer: str, path):
+    doc = ezdxf.readfile(source)
+    for entity in [e for e in doc.modelspace() if e.dxf.layer == layer]:
+        doc.modelspace().delete_entity(entity)
+    doc.saveas(path)
+    return path
+
+
+def inside_the_blank(point) -> bool:
+    z, radius = point
+    return (BLANK_Z[0] + INSIDE_MM < z < BLANK_Z[1] - INSIDE_MM
+            and radius < BLANK_DIAMETER / 2 - INSIDE_MM)
+
+
+def rapids_before_the_first_cut(lines: list[str]):
+    """The G0 moves before the program's first feed move: the blank is still whole then."""
+    found = []
+    for g, start, end in motions(lines):
+        if g != 0:
+            break
+        found.append((start, end))
+    return found
+
+
+def test_no_rapid_runs_into_the_uncut_blank_when_the_rough_layer_is_left_out(run, tmp_path):
+    """The sample drawing without its ROUGH layer (a shop that roughs on another machine draws
+    only SLOT, FINISH, THREAD) imported with its blank Ø44 given: the first operation's approach
+    is a rapid from outside the blank straight down to the slot's start, through 9.5 mm of
+    uncut steel. With the blank known the engine must keep rapids out of it or refuse."""
+    drawing_path = without_layer(SAMPLE_DRAWING, "1", tmp_path / "no_rough.dxf")
+    before = counts(run.url)
+    made = run("import-dxf", drawing_path, "--stock-diameter", BLANK_DIAMETER, "--json")
+    if made.exit_code == 1:
+        assert made.stderr.count("\n") == 1 and counts(run.url) == before, made.output
+        return
+    assert made.exit_code == 0, made.output
+    program = run("instantiate", "--job", json.loads(made.stdout)["job_id"], "--dry-run")
+    assert program.exit_code == 0, program.output
+    through = [(start, end) for start, end in rapids_before_the_first_cut(program.stdout.splitlines())
+               if any(inside_the_blank((start[0] + (end[0] - start[0]) * k / SAMPLES_PER_MOVE,
+                                        start[1] + (end[1] - start[1]) * k / SAMPLES_PER_MOVE))
+                      for k in range(SAMPLES_PER_MOVE + 1))]
+    assert through == []
