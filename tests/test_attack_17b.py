@@ -71,11 +71,19 @@ def centre_line_off_the_symmetry(msp) -> None:
 
 
 BORED = ("through_bore_solid", "blind_bore_solid", "section_without_hatch")
+def whole_view_off_y0_without_centre_line(msp) -> None:
+    """The whole shaft drawn about drawing Y 30, symmetric, no centre line: at Y 0 the engine halves
+    such a view at its symmetry; here it reads a ring Ø36…Ø84 about Y 0 and turns its outside
+    (Ø76/Ø84/Ø80) — not the shaft, and not the ring either, whose bore cannot be turned."""
+    outline(msp)
+
+
 HOSTILE_SIDE_VIEWS = {
     "through_bore_solid": through_bore_in_solid_lines,
     "blind_bore_solid": blind_bore_in_solid_lines,
     "section_without_hatch": section_halves_without_hatch,
     "centre_line_off_symmetry": centre_line_off_the_symmetry,
+    "whole_view_off_y0_without_centre_line": whole_view_off_y0_without_centre_line,
 }
 
 
