@@ -12,6 +12,7 @@ import pytest
 
 from engine.paths import SAMPLE_DRAWING
 from lathe_programs import motions, operation_lines
+from test_instantiate_class import import_emco
 
 AXIS_Y = 30.0                 # drawing Y of the part's axis (the view is drawn off Y = 0)
 # A stepped shaft, upper half (z, radius): Ø16 to Z-12, Ø24 to Z-35, Ø20 to Z-50.
@@ -191,3 +192,31 @@ def test_no_rapid_runs_into_the_uncut_blank_when_the_rough_layer_is_left_out(run
                                         start[1] + (end[1] - start[1]) * k / SAMPLES_PER_MOVE))
                       for k in range(SAMPLES_PER_MOVE + 1))]
     assert through == []
+
+
+# --- instantiate --class: the parameters file ------------------------------------------------------------
+
+def class_job_dry_run(run, tmp_path, text: str):
+    params = tmp_path / "params.json"
+    params.write_text(text)
+    return run("instantiate", "--class", "emco_neg", "--machine", "lathe-iso", "--draft", "--params", params,
+               "--dry-run")
+
+
+def test_a_deeply_nested_parameters_file_is_bad_input_not_a_bug(run, tmp_path):
+    """A parameters file that is not an object of values (here an array nested 100 000 deep) is
+    refused in one line, exit 1, like any other file that is not {"name": value}."""
+    import_emco(run, tmp_path)
+    made = class_job_dry_run(run, tmp_path, "[" * 100_000 + "]" * 100_000)
+    assert made.exit_code == 1, made.output
+    assert made.stderr.startswith("error: ") and made.stderr.count("\n") == 1
+
+
+def test_addresses_the_class_does_not_bind_are_not_silently_ignored(run, tmp_path):
+    """The class binds feed to F (import-nc --params). A file saying feed binds S asks for a
+    different program than the one made: the engine makes F100 and keeps S600 without a word.
+    It must refuse, naming the address the class binds."""
+    import_emco(run, tmp_path)
+    made = class_job_dry_run(run, tmp_path, json.dumps({"feed": {"value": 100, "addresses": ["S"]}}))
+    assert made.exit_code == 1, made.output
+    assert made.stderr.count("\n") == 1 and "F" in made.stderr
