@@ -220,3 +220,28 @@ def test_addresses_the_class_does_not_bind_are_not_silently_ignored(run, tmp_pat
     made = class_job_dry_run(run, tmp_path, json.dumps({"feed": {"value": 100, "addresses": ["S"]}}))
     assert made.exit_code == 1, made.output
     assert made.stderr.count("\n") == 1 and "F" in made.stderr
+
+
+LOWER_HALVES = {   # the lower half as drawn, (z, radius) below the centre line; the upper half is SHAFT
+    "collar_shorter_below": [(0, 8), (-12, 8), (-12, 12), (-30, 12), (-30, 10), (-50, 10)],
+    "every_radius_smaller_below": [(z, 0.9 * r) for z, r in SHAFT],
+}
+
+
+@pytest.mark.parametrize("name", LOWER_HALVES)
+def test_a_side_view_whose_halves_disagree_is_refused(run, tmp_path, name):
+    """A turned part is the same above and below its axis. When the drawn halves disagree (the
+    collar ends at Z-35 above and Z-30 below; Ø24 above and Ø21.6 below) the drawing does not say
+    which part to make; the engine silently takes the upper half."""
+    lower = LOWER_HALVES[name]
+
+    def draw(msp):
+        msp.add_lwpolyline([(z, AXIS_Y + r) for z, r in SHAFT] + [(z, AXIS_Y - r) for z, r in reversed(lower)],
+                           close=True)
+        centre_line(msp)
+    path = tmp_path / f"{name}.dxf"
+    drawing(path, draw)
+    before = counts(run.url)
+    made = run("import-dxf", path, "--rough-depth", "1", "--program-name", "HALVES", "--machine", "lathe-840d")
+    assert made.exit_code == 1, made.output
+    assert made.stderr.count("\n") == 1 and counts(run.url) == before
