@@ -245,3 +245,28 @@ def test_a_side_view_whose_halves_disagree_is_refused(run, tmp_path, name):
     made = run("import-dxf", path, "--rough-depth", "1", "--program-name", "HALVES", "--machine", "lathe-840d")
     assert made.exit_code == 1, made.output
     assert made.stderr.count("\n") == 1 and counts(run.url) == before
+
+
+def test_a_drawing_whose_header_says_imperial_is_not_turned_in_millimetres(run, tmp_path):
+    """$INSUNITS unset but $MEASUREMENT 0 (English): the drawing's numbers are inches. The shaft
+    drawn 0.945 in (Ø24 mm) across becomes a Ø0.945 mm job, with only a note that lengths were
+    taken as millimetres. Scale it, or refuse and ask for the units."""
+    inch = 25.4
+
+    def draw(msp):
+        msp.add_lwpolyline([(z / inch, r / inch) for z, r in SHAFT] + [(z / inch, -r / inch) for z, r in reversed(SHAFT)],
+                           close=True)
+    doc = ezdxf.new("R2010")
+    doc.header["$INSUNITS"] = 0
+    doc.header["$MEASUREMENT"] = 0
+    draw(doc.modelspace())
+    path = tmp_path / "imperial.dxf"
+    doc.saveas(path)
+    before = counts(run.url)
+    made = run("import-dxf", path, "--rough-depth", "0.1", "--program-name", "IMPERIAL", "--machine", "lathe-840d",
+               "--json")
+    if made.exit_code == 1:
+        assert made.stderr.count("\n") == 1 and counts(run.url) == before, made.output
+        return
+    assert made.exit_code == 0, made.output
+    assert finish_diameters(run, json.loads(made.stdout)["job_id"]) == pytest.approx(DRAWN_DIAMETERS, abs=0.01)
