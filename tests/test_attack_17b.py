@@ -270,3 +270,32 @@ def test_a_drawing_whose_header_says_imperial_is_not_turned_in_millimetres(run, 
         return
     assert made.exit_code == 0, made.output
     assert finish_diameters(run, json.loads(made.stdout)["job_id"]) == pytest.approx(DRAWN_DIAMETERS, abs=0.01)
+
+
+# A half-profile (seed-000 convention, radius = drawing Y) with an undercut: the collar Ø20 from
+# the face to Z-10 overhangs a pocket r 4…6 that reaches forward to Z-6 under it.
+UNDERCUT = [(0, 0), (0, 10), (-10, 10), (-10, 6), (-6, 6), (-6, 4), (-14, 4), (-14, 10), (-30, 10), (-30, 0)]
+OVERHANG_Z, OVERHANG_TOP = (-10.0, -6.0), 10.0
+
+
+def test_an_undercut_no_tool_from_outside_can_reach_is_refused(run, tmp_path):
+    """Between Z-10 and Z-6 the collar (up to r 10) lies over the pocket: a turning tool comes
+    from outside along X and cannot be under it without its holder going through the collar.
+    The engine's finish runs X12/X8 from Z-10 to Z-6 under the collar instead of refusing."""
+    doc = ezdxf.new("R2010")
+    doc.header["$INSUNITS"] = 4
+    doc.modelspace().add_lwpolyline(UNDERCUT)
+    doc.saveas(tmp_path / "undercut.dxf")
+    made = run("import-dxf", tmp_path / "undercut.dxf", "--rough-depth", "1", "--program-name", "UNDERCUT",
+               "--machine", "lathe-840d", "--json")
+    if made.exit_code == 1:
+        assert made.stderr.count("\n") == 1, made.output
+        return
+    assert made.exit_code == 0, made.output
+    program = run("instantiate", "--job", json.loads(made.stdout)["job_id"], "--dry-run")
+    under = sorted({(start, end) for g, start, end in motions(program.stdout.splitlines())
+             for k in range(SAMPLES_PER_MOVE + 1)
+             if OVERHANG_Z[0] + INSIDE_MM < start[0] + (end[0] - start[0]) * k / SAMPLES_PER_MOVE
+             < OVERHANG_Z[1] - INSIDE_MM
+             and start[1] + (end[1] - start[1]) * k / SAMPLES_PER_MOVE < OVERHANG_TOP - INSIDE_MM})
+    assert under == []
