@@ -129,6 +129,32 @@ def test_new_values_change_exactly_the_words_bound_to_them_and_the_file_is_the_s
     assert stored_program(run.url, again["program_id"])[0] == expected   # the job made again, verified again
 
 
+@pytest.mark.parametrize("addresses", [["S"], ["F", "S"], ["X"]])
+def test_a_bound_form_naming_addresses_the_class_does_not_bind_is_refused_naming_its_address(run, tmp_path,
+                                                                                               addresses):
+    """The class was imported with feed bound wherever the file wrote 150 (only at F150.000, as
+    import_emco checks in the file): a file asking for the feed at other addresses asks for a program
+    the class cannot make, and is refused naming F, not made at F alone."""
+    import_emco(run, tmp_path)
+    before = stored_counts(run.url)
+    params = tmp_path / "other.json"
+    params.write_text(json.dumps({"feed": {"value": 100, "addresses": addresses}}))
+    refusal = refused(run("instantiate", "--class", "emco_neg", "--machine", "lathe-iso", "--draft",
+                          "--params", params))
+    assert "feed is bound at F in class emco_neg" in refusal and '["F"]' in refusal
+    assert stored_counts(run.url) == before
+
+
+def test_a_bound_form_naming_the_class_s_address_in_lower_case_is_the_class_s_binding(run, tmp_path):
+    source, lines = import_emco(run, tmp_path)
+    params = tmp_path / "lower.json"
+    params.write_text(json.dumps({"feed": {"value": 100, "addresses": ["f"]}}))
+    made = ok(run("instantiate", "--class", "emco_neg", "--machine", "lathe-iso", "--draft", "--params", params,
+                  "--dry-run"))
+    assert sum("F100.000" in line.split(" ") for line in made.stdout.splitlines()) == \
+        sum("F150.000" in line.split(" ") for line in lines) > 0
+
+
 def test_a_dry_run_of_a_class_job_with_csv_parameters_prints_the_program_and_stores_nothing(run, tmp_path):
     source, lines = import_emco(run, tmp_path)
     params = tmp_path / "new.csv"

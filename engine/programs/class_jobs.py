@@ -17,6 +17,7 @@ machine, because a program that reaches the machine must be one the verifier rea
 """
 from __future__ import annotations
 
+import ast
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -24,7 +25,8 @@ from ..errors import EngineError
 from ..gears.models import model_for_class
 from ..gears.records import Machine, load_machine
 from ..library.nc_layout import NcLayout, class_layout
-from ..library.nc_params import values
+from ..library.nc_params import bindings, values
+from ..library.nc_tokens import NUMBER, tokenise
 from ..names import checked
 from ..templates.decision_table import compiled_template
 from ..templates.rows import Template
@@ -88,6 +90,7 @@ def _planned(conn, gear_class: str, given: dict, machine_name: str | None, sourc
         refuse_unread_dialect(machine)
     params, taken = job_params(gear_class, imported, values(given, source), source)
     template = runnable_template(conn, gear_class, draft)
+    refuse_other_addresses(template, given, source)
     layout = class_layout(conn, gear_class, template.version)   # its version's line ending and final newline
     if unverified:
         return _unverified_job(template, machine, params, layout), taken
@@ -149,6 +152,69 @@ def job_params(gear_class: str, imported: dict, given: dict, source: str) -> tup
     checked("program", params[PROGRAM_NAME], "program_name",
             f"give {PROGRAM_NAME} in the parameters file; nothing stored")
     return params, tuple(name for name in imported if name not in given)
+
+
+def refuse_other_addresses(template: Template, given: dict, source: str) -> None:
+    """A bound form (`{"value": 100, "addresses": ["S"]}`) asks for the value at those addresses,
+    but which words a parameter changes was fixed when the class was imported: a bound form naming
+    other addresses is refused, not made at the class's addresses without a word."""
+    for name, binding in bindings(given, source).items():
+        bound_at = bound_addresses(template, name)
+        if binding.addresses is not None and binding.addresses != bound_at:
+            raise EngineError(f"{source}: {name} is bound at {_spelled(bound_at)} in class {template.gear_class}, "
+                              f"not {' '.join(sorted(binding.addresses))}; give the plain form{_as_list(bound_at)}; "
+                              "nothing stored")
+
+
+def bound_addresses(template: Template, name: str) -> frozenset:
+    """The addresses (upper case; None for a number after no address) of the words the class's
+    rows bind to parameter `name`. The import made each bound number a replacement field naming
+    the parameter (engine.library.nc_rows), so the address is the one the NC tokeniser gives the
+    number in that field's place."""
+    return frozenset().union(*(_field_addresses(row.o, name) for row in template.rows if row.o))
+
+
+def _field_addresses(o: str, name: str) -> set:
+    """The addresses of the fields naming `name` in the f-string row `o` (none in another row):
+    each field is written as the number 1, and the tokens over a field's place give its address."""
+    try:
+        parts = ast.parse(o, mode="eval").body
+    except SyntaxError:
+        return set()
+    if not isinstance(parts, ast.JoinedStr):
+        return set()
+    line, places = "", set()
+    for part in parts.values:
+        if isinstance(part, ast.FormattedValue) and name in {node.id for node in ast.walk(part)
+                                                              if isinstance(node, ast.Name)}:
+            places.add(len(line))
+        line += part.value if isinstance(part, ast.Constant) else "1"
+    return _addresses_at(line, places)
+
+
+def _addresses_at(line: str, places: set) -> set:
+    """The addresses of the number tokens of `line` that cover one of the character positions."""
+    addresses, start = set(), 0
+    for token in tokenise(line):
+        end = start + len(token.text)
+        if token.kind == NUMBER and any(start <= place < end for place in places):
+            addresses.add(token.address)
+        start = end
+    return addresses
+
+
+def _spelled(addresses: frozenset) -> str:
+    named = " ".join(sorted(address for address in addresses if address))
+    if None in addresses:
+        named = f"{named} and numbers after no address" if named else "numbers after no address"
+    return named or "no word"
+
+
+def _as_list(addresses: frozenset) -> str:
+    """The bound form that matches the class, when there is one (a number after no address has none)."""
+    if not addresses or None in addresses:
+        return ""
+    return " or " + "[" + ", ".join(f'"{address}"' for address in sorted(addresses)) + "]"
 
 
 def _kind(value) -> str:
