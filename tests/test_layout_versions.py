@@ -153,3 +153,31 @@ def test_a_re_import_of_the_file_with_other_line_endings_is_a_new_version(engine
     with psycopg.connect(engine.url) as conn:
         assert conn.execute("SELECT version, line_ending FROM template_version_rows WHERE gear_class = 'nc_relaid' "
                             "ORDER BY version").fetchall() == [(1, LF), (2, CRLF)]
+
+
+def test_a_release_that_changes_only_the_layout_says_every_program_file_of_the_class_changes(engine, tmp_path):
+    written(engine, tmp_path)
+    written(engine, tmp_path)
+    with psycopg.connect(engine.url) as conn:
+        programs = conn.execute("SELECT count(DISTINCT p.job_id) FROM program p JOIN job j ON j.id = p.job_id "
+                                "WHERE j.gear_class = 'spur'").fetchone()[0]
+    assert programs >= 1
+    crlf_draft(engine, tmp_path)
+    shown = engine("template", "release", "--class", "spur", "--dry-run")
+    assert shown.exit_code == 0, shown.output
+    assert "0 program(s) change" in shown.stdout   # no line changes ...
+    assert (f"layout of spur: LF, final newline → CRLF, no final newline: the files of all {programs} stored "
+            "program(s) change bytes") in shown.stdout.splitlines()   # ... but every file's bytes do
+    impact = made(engine("template", "release", "--class", "spur", "--dry-run", "--json"))["impact"]
+    assert impact["layout"] == [{"class": "spur", "from": {"line_ending": "lf", "final_newline": True},
+                                 "to": {"line_ending": "crlf", "final_newline": False}, "programs": programs}]
+
+
+def test_a_release_of_rows_alone_names_no_layout_change(engine, tmp_path):
+    written(engine, tmp_path)
+    edited = tmp_path / "spur.csv"
+    edited.write_text(engine("template", "export", "--class", "spur").stdout.replace('"M9"', '"M9 ; COOLANT OFF"'))
+    assert engine("template", "import", "--class", "spur", edited).exit_code == 0
+    impact = made(engine("template", "release", "--class", "spur", "--dry-run", "--json"))["impact"]
+    assert impact["layout"] == [] and impact["jobs"] >= 1
+    assert "layout of" not in engine("template", "release", "--class", "spur", "--dry-run").stdout

@@ -47,6 +47,8 @@ def _show(report, diffs_shown: int) -> None:
                f"{len(report.tests)} golden test(s), static analysis")
     click.echo(f"impact: {impact.jobs} stored job(s) of {report.gear_class} and its descendants, "
                f"{impact.changed} program(s) change, {len(impact.failures)} fail with the draft")
+    for change in impact.layouts.values():
+        click.echo(change.said())
     for failure in impact.failures[:SHOWN_FAILURES]:
         click.echo(f"  job {failure.job_id} ({failure.gear_class}): {failure.error}")
     for diff in impact.diffs[:diffs_shown]:
@@ -73,4 +75,5 @@ def _as_json(report) -> dict:
                        "failures": [{"job_id": f.job_id, "class": f.gear_class, "error": f.error}
                                     for f in impact.failures],
                        "diffs": [{"job_id": d.job_id, "class": d.gear_class, "diff": d.diff}
-                                 for d in impact.diffs]}}
+                                 for d in impact.diffs],
+                       "layout": [change.as_json() for change in impact.layouts.values()]}}

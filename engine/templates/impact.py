@@ -6,7 +6,9 @@ without the verifier and the simulation, which the gate does not need to see a l
 The released program is the job's latest stored one (its lineage line left out) when it was made
 from the released version from the job's current parameters; otherwise the released template is
 evaluated too. The draft is evaluated as if it had the released version number, so the
-`; TEMPLATE class vN` line does not count as a change. Jobs with identical parameters are
+`; TEMPLATE class vN` line does not count as a change. A draft that only writes its lines with
+another layout (line ending, final newline: migration 0025) changes no line, but the bytes of
+every stored program's file of the class: said on its own, with how many programs. Jobs with identical parameters are
 evaluated once: 10,000 stored jobs of a class take seconds (bench/impact.py)."""
 from __future__ import annotations
 
@@ -17,8 +19,10 @@ from dataclasses import dataclass, field, replace
 from ..errors import EngineError
 from ..gears.models import model_for_class
 from ..gears.records import load_machine
+from ..library.nc_layout import ENDING_NAMES, NcLayout
 from ..programs.lineage import without_lineage
 from .decision_table import compiled_template
+from .history import layout_change
 from .rows import Template
 from .store import class_and_descendants
 from .versions import draft_template, released_template
@@ -55,6 +59,28 @@ class JobFailure:
 
 
 @dataclass
+class LayoutChange:
+    """A class whose draft writes its programs with another layout than its released version: the
+    files of all its stored programs change bytes, though no line changes."""
+    gear_class: str
+    old: NcLayout
+    new: NcLayout
+    programs: int = 0
+
+    def said(self) -> str:
+        return (f"layout of {self.gear_class}: {self.old.said} → {self.new.said}: the files of all {self.programs} "
+                "stored program(s) change bytes")
+
+    def as_json(self) -> dict:
+        return {"class": self.gear_class, "from": _layout_json(self.old), "to": _layout_json(self.new),
+                "programs": self.programs}
+
+
+def _layout_json(layout: NcLayout) -> dict:
+    return {"line_ending": ENDING_NAMES[layout.line_ending], "final_newline": layout.final_newline}
+
+
+@dataclass
 class Impact:
     """The impact of releasing a class's draft: jobs examined, programs that change, jobs the
     draft fails for, and the diffs of the changed programs (in job id order)."""
@@ -63,19 +89,21 @@ class Impact:
     changed: int = 0
     failures: list[JobFailure] = field(default_factory=list)
     diffs: list[JobDiff] = field(default_factory=list)
+    layouts: dict[str, LayoutChange] = field(default_factory=dict)   # class → its draft's other layout
 
     def summary(self) -> dict:
-        """What a release records: the counts, the changed and failing job ids."""
+        """What a release records: the counts, the changed and failing job ids, the layout changes."""
         return {"jobs": self.jobs, "changed": self.changed, "failed": len(self.failures),
                 "changed_jobs": [diff.job_id for diff in self.diffs][:1000],
-                "failed_jobs": [failure.job_id for failure in self.failures][:1000]}
+                "failed_jobs": [failure.job_id for failure in self.failures][:1000],
+                "layout": [change.as_json() for change in self.layouts.values()]}
 
 
 def impact(conn, gear_class: str) -> Impact:
     """Every stored job of the class and its descendants made with the draft, compared with the
     released program."""
     pairs = _template_pairs(conn, class_and_descendants(conn, gear_class))
-    report = Impact(gear_class)
+    report = Impact(gear_class, layouts=_layout_changes(conn, pairs))
     if not pairs:
         return report
     classes = list(pairs)
@@ -101,9 +129,21 @@ def _template_pairs(conn, classes: list[str]) -> dict[str, tuple[Template, Templ
     return pairs
 
 
+def _layout_changes(conn, pairs: dict[str, tuple[Template, Template, int]]) -> dict[str, LayoutChange]:
+    """The classes whose draft has another layout than their released version."""
+    changes = {}
+    for name, (released, _, draft_version) in pairs.items():
+        change = layout_change(conn, name, released.version, draft_version)
+        if change is not None:
+            changes[name] = LayoutChange(name, *change)
+    return changes
+
+
 def _compare(report: Impact, made: "_Made", job) -> None:
     job_id, gear_class, machine, params_text, modules_text, from_released, lines, row_ids = job
     report.jobs += 1
+    if gear_class in report.layouts and lines is not None:
+        report.layouts[gear_class].programs += 1
     if not made.has_draft(gear_class):
         return   # no draft: nothing changes
     key = gear_class, machine, params_text, modules_text
