@@ -155,6 +155,22 @@ def test_a_bound_form_naming_the_class_s_address_in_lower_case_is_the_class_s_bi
         sum("F150.000" in line.split(" ") for line in lines) > 0
 
 
+@pytest.mark.parametrize("gear_class", ["c_1", "c", "x9", "a" * 63])
+def test_a_class_imported_without_a_program_name_gets_an_840d_program_name_for_any_class_name(run, gear_class):
+    """import-nc accepts these class names (a lower-case letter, then letters, digits, _, 63 at
+    most); the class's name in capitals is no 840D program name when its second character is no
+    letter or it is longer than 24 (§A1), and the job must not be refused for a name the user never
+    gave. (A real LinuxCNC program, stored unverified: its header names no program.)"""
+    with psycopg.connect(run.url) as conn:
+        conn.execute(LINUXCNC_LATHE)
+    ok(run("import-nc", PAWN, "--class", gear_class))
+    ok(run("instantiate", "--class", gear_class, "--machine", "lathe-linuxcnc", "--draft", "--unverified"))
+    with psycopg.connect(run.url) as conn:
+        name = conn.execute("SELECT name FROM program ORDER BY id DESC LIMIT 1").fetchone()[0]
+    assert re.fullmatch(r"(?:[A-Z]{2}|_[A-Z])[A-Z0-9_]{0,22}", name), name   # §A1, in capitals like the class
+    assert name.lstrip("_") == gear_class.upper()[:len(name.lstrip("_"))]
+
+
 def test_a_dry_run_of_a_class_job_with_csv_parameters_prints_the_program_and_stores_nothing(run, tmp_path):
     source, lines = import_emco(run, tmp_path)
     params = tmp_path / "new.csv"

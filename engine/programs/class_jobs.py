@@ -148,10 +148,21 @@ def job_params(gear_class: str, imported: dict, given: dict, source: str) -> tup
                           f"parameter of class {gear_class} (its parameters: {known}); nothing stored")
     _refuse_other_kinds(gear_class, imported, given, source)
     params = {**imported, **given}
-    params.setdefault(PROGRAM_NAME, gear_class.upper())
+    params.setdefault(PROGRAM_NAME, default_program_name(gear_class))
     checked("program", params[PROGRAM_NAME], "program_name",
             f"give {PROGRAM_NAME} in the parameters file; nothing stored")
     return params, tuple(name for name in imported if name not in given)
+
+
+def default_program_name(gear_class: str) -> str:
+    """The program name of a job whose class was imported without one: the class name in capitals,
+    made an 840D program name (§A1: two letters, or _ and a letter, first; at most 24 characters)
+    for every class name import-nc accepts: `_` before one whose second character is no letter
+    (c_1 → _C_1, c → _C), and cut to 24 characters."""
+    name = gear_class.upper()
+    if not name[1:2].isalpha():
+        name = "_" + name
+    return name[:24]
 
 
 def refuse_other_addresses(template: Template, given: dict, source: str) -> None:
