@@ -4,7 +4,8 @@ Layer `0` holds the profile and at most one POINT (the tool-change position); la
 `1` … `n` hold the tool-centre path of operation n and its @-codes as TEXT/MTEXT. Only
 model space counts. Layers with other names (dimensions, hatch, centre lines) are left
 out and listed in `notes`; so are TEXTs on layer 0 (no @-codes there). Lengths come out
-in mm, in machine coordinates (z, radius), scaled by $INSUNITS (unitless: mm). @-code
+in mm, in machine coordinates (z, radius), scaled by $INSUNITS (unitless: mm, unless the header
+says English measurement; see units_doubted). @-code
 values are taken as written: r/min, mm/min or mm/rev, mm — the seed's units, whatever
 the drawing's length unit.
 """
@@ -114,6 +115,7 @@ def read_drawing(path: str | Path, profile_layer: str | None = None) -> Drawing:
     profile, outline_notes, chains = profile_of([scaled(s, scale) for s in layer0.segments],
                                                 scaled_marks(collected, scale), profile_layer)
     side_view = bool(outline_notes)
+    outline_notes += units_doubted(drawing_file, assumed)
     operations = [operation(name, number, collected.layers[name], scale, profile.mirrored)
                   for number, name in operation_layers(collected.layers)]
     if side_view and any(operations):
@@ -292,6 +294,27 @@ def tool_change_point(points: list[tuple[str, tuple[float, float]]], scale: floa
                        "one, the tool-change position: delete the others or move them to another layer")
     _, (x, y) = points[0]
     return MachinePoint(x * scale, (-y if mirror else y) * scale)
+
+
+ENGLISH = 0   # $MEASUREMENT: 0 English (imperial), 1 metric
+
+
+def units_doubted(drawing_file, assumed: bool) -> list[str]:
+    """A drawing without units whose header says English measurement ($MEASUREMENT 0) may be in
+    inches: refused, since taking it as mm would turn a part 25.4 times too small, and taking it
+    as inches would be as wrong for the many metric drawings made from an imperial template
+    ($MEASUREMENT sets hatch and linetype defaults, not the coordinate unit). Its dimension
+    suffix ($DIMPOST '<>mm') is the drafter's own word that the numbers are millimetres."""
+    header = drawing_file.doc.header
+    if not assumed or header.get("$MEASUREMENT") != ENGLISH:
+        return []
+    suffix = str(header.get("$DIMPOST") or "")
+    if "mm" in suffix.lower():
+        return [f"$MEASUREMENT 0 (English), but dimensions are written in mm ($DIMPOST {suffix!r}): "
+                "lengths taken as millimetres"]
+    raise DxfError(f"{drawing_file.path.name}: no drawing units ($INSUNITS unset or unitless) and the header says "
+                   "English measurement ($MEASUREMENT 0), so its lengths may be inches; set the drawing units "
+                   "in the CAD program ($INSUNITS 1 = inches, 4 = millimetres) and save it again")
 
 
 def reading_notes(units: str, assumed: bool, collected: Collected, profile: Profile) -> list[str]:

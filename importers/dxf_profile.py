@@ -5,7 +5,8 @@ Machine coordinates for turning: drawing X is the machine Z axis, drawing Y the 
 flips the sense of its arcs.
 
 What "closed" means for a lathe profile: either a chain whose end meets its start, lying
-on one side of the axis (a section of the part, e.g. with a bore), or a *half-profile*:
+on one side of the axis (a section of the part; one off the axis, with a bore, is read here
+and refused when the job is made, engine/turning/reach.py), or a *half-profile*:
 an open chain on one side of the axis whose two ends are its smallest and largest Z. Such
 a chain is closed by the radial lines from its ends down to the axis and by the axis
 between them (ends already on the axis make those lines zero long). Among all such

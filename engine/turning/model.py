@@ -18,6 +18,7 @@ from .moves import Move, Pass
 from .names import MAX_OPERATIONS, MAX_TOOL
 from .operations import KINDS, JobGeometry, job_geometry, operation_passes
 from .params import FIX, bool_param, integer_param, number_param
+from .reach import check_turnable_from_outside
 
 # O0001 … O8999: O9000 … O9999 hold the machine builder's macros on Fanuc-type controls, so a
 # program stored there would replace one (the verifier refuses such a number too).
@@ -62,6 +63,7 @@ def planned_passes(params: dict, module_params: dict) -> tuple[JobGeometry, dict
     for n in present:
         check_operation_params(module_params, n)
     geometry = job_geometry(params)
+    check_turnable_from_outside(geometry.edges, f"drawing {params.get('drawing') or '(params.profile)'}")
     passes = {n: operation_passes(geometry, module_params[key("cutmotion", n)], f"module_params.cutmotion:{n}")
               for n in present}
     pair = alternated_pair(params, module_params, passes)
