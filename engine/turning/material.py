@@ -1,0 +1,187 @@
+"""The material a turning job has not cut yet, in the (Z, radius) plane, and the rule that a
+rapid (G0) runs through air only: a rapid into uncut material breaks the tool or the machine.
+
+The blank. The stored stock (params.stock_diameter, stock_z_front, stock_z_back). Without a
+stored diameter (a drawing with operation layers imported without --stock-diameter) nothing
+says how large the blank is, so it is assumed as large as the job suggests (fail closed):
+between stock_z_back and stock_z_front (the profile's Z extent), of the larger radius of the
+profile's largest + ASSUMED_BLANK_MARGIN_MM (the blank import-dxf assumes for a profile-only
+drawing, STOCK_MARGIN on the diameter) and the largest radius a feed of the job cuts at.
+
+What a feed removes (the chip of a turning cut). An outside turning tool's body stands
+radially outside its tip, so wherever a feed takes the tip, the radial column above it is
+occupied by the tool and is air afterwards: a longitudinal feed removes the material radially
+outside its path, a radial feed (a plunge, a facing feed) only its own line and what lies
+above it — the engine knows no tool width. So the material left at each Z is what lies below
+the lowest point any feed reached at that Z (the part included: it is never cut).
+
+A rapid may run where there is no material: outside the blank, above that height, or back up
+the line a plunge just fed. One that runs more than AIR_TOLERANCE_MM through material is
+refused, naming the operation, the move and the length of its way through the material.
+"""
+from __future__ import annotations
+
+import math
+from collections import defaultdict
+from dataclasses import dataclass
+
+from importers.dxf_profile import merged_bounds
+
+from ..errors import EngineError
+from .defaults import STOCK_MARGIN
+from .gouge import move_points
+from .moves import Move, Pass
+from .operations import JobGeometry
+
+AIR_TOLERANCE_MM = 0.01        # a rapid touching the material within this is in the air (float noise)
+ASSUMED_BLANK_MARGIN_MM = STOCK_MARGIN / 2.0   # radial: import-dxf's default blank over the profile
+SAMPLE_STEP_MM = 0.05          # along a rapid: material thinner than this between samples is not seen
+COINCIDENT_MM = 1e-6           # a rapid back along a plunge runs at the plunge's own Z
+BISECTIONS = 30                # an entry into the material found to 2⁻³⁰ of a sample step
+BUCKET_MM = 1.0                # Z width of one cell of the cut index
+
+Point = tuple[float, float]
+
+
+@dataclass(frozen=True)
+class Blank:
+    """The material before the first cut: Z from z_back to z_front, radius 0 … radius."""
+    z_front: float
+    z_back: float
+    radius: float
+    assumed: bool
+
+
+def job_blank(stock: tuple[float, float, float] | None, profile_extent: tuple[float, float, float],
+              passes: dict[int, list[Pass]]) -> Blank:
+    """The stored stock (z_front, z_back, radius), else the blank assumed (see the module's docstring);
+    profile_extent is (z_front, z_back, largest radius) of the profile."""
+    if stock is not None:
+        return Blank(*stock, assumed=False)
+    z_front, z_back, top = profile_extent
+    cut_at = [move.x / 2.0 for found in passes.values() for one in found for move in one if move.kind != "rapid"]
+    return Blank(z_front, z_back, max([top + ASSUMED_BLANK_MARGIN_MM, *cut_at]), assumed=True)
+
+
+@dataclass(frozen=True)
+class Cut:
+    """One straight piece of a feed: the column above it is air."""
+    start: Point
+    end: Point
+
+    def covers(self, z: float) -> bool:
+        low, high = sorted((self.start[0], self.end[0]))
+        return low - COINCIDENT_MM <= z <= high + COINCIDENT_MM
+
+    def floor_at(self, z: float) -> float:
+        (z0, r0), (z1, r1) = self.start, self.end
+        if abs(z1 - z0) <= COINCIDENT_MM:
+            return min(r0, r1)
+        t = min(1.0, max(0.0, (z - z0) / (z1 - z0)))
+        return r0 + t * (r1 - r0)
+
+
+class Material:
+    """The blank less what the feeds so far have removed: a height over Z."""
+
+    def __init__(self, blank: Blank):
+        self.blank = blank
+        self.cells: dict[int, list[Cut]] = defaultdict(list)
+
+    def remove(self, start: Point, move: Move) -> None:
+        """A feed from start: the column above each piece of its path is air from now on."""
+        here = start
+        for point in move_points(start, move):
+            cut = Cut(here, point)
+            low, high = sorted((here[0], point[0]))
+            for cell in range(_cell(low - COINCIDENT_MM), _cell(high + COINCIDENT_MM) + 1):
+                self.cells[cell].append(cut)
+            here = point
+
+    def height(self, z: float) -> float:
+        """The radius below which material is left at Z (0 beyond the blank's faces)."""
+        if not self.blank.z_back < z < self.blank.z_front:
+            return 0.0
+        floors = [cut.floor_at(z) for cut in self.cells.get(_cell(z), ()) if cut.covers(z)]
+        return min([self.blank.radius, *floors])
+
+    def holds(self, point: Point) -> bool:
+        return point[1] < self.height(point[0])
+
+    def length_inside(self, start: Point, end: Point) -> tuple[float, Point | None]:
+        """(mm of the straight rapid start → end that runs through material, a point of its first stretch in it)."""
+        if min(start[1], end[1]) >= self.blank.radius or max(start[0], end[0]) <= self.blank.z_back \
+                or min(start[0], end[0]) >= self.blank.z_front:
+            return 0.0, None
+        along = _along(start, end)
+        count = max(1, math.ceil(math.dist(start, end) / SAMPLE_STEP_MM))
+        inside = [self.holds(along(k / count)) for k in range(count + 1)]
+        share, entry = 0.0, None
+        for k in range(count):
+            a, b = k / count, (k + 1) / count
+            if inside[k] or inside[k + 1]:
+                lo, hi = a, b
+                if inside[k] != inside[k + 1]:
+                    boundary = self._boundary(along, a, b, inside[k])
+                    lo, hi = (a, boundary) if inside[k] else (boundary, b)
+                share += hi - lo
+                entry = entry or along((lo + hi) / 2.0)
+        return share * math.dist(start, end), entry
+
+    def _boundary(self, along, a: float, b: float, a_inside: bool) -> float:
+        """The fraction between a and b where the rapid crosses the material's edge."""
+        for _ in range(BISECTIONS):
+            middle = (a + b) / 2.0
+            if self.holds(along(middle)) == a_inside:
+                a = middle
+            else:
+                b = middle
+        return (a + b) / 2.0
+
+
+def _along(start: Point, end: Point):
+    return lambda t: (start[0] + t * (end[0] - start[0]), start[1] + t * (end[1] - start[1]))
+
+
+def _cell(z: float) -> int:
+    return math.floor(z / BUCKET_MM)
+
+
+def check_job_rapids(geometry: JobGeometry, params: dict, module_params: dict, passes: dict[int, list[Pass]]) -> None:
+    """The one check of every turning job's rapids (model.planned_passes): import-dxf, and every
+    program made again from a stored job."""
+    z_back, z_front, _, top = merged_bounds(geometry.outline)
+    blank = job_blank(geometry.stock, (z_front, z_back, top), passes)
+    kinds = {n: module_params[f"cutmotion:{n}"]["kind"] for n in passes}
+    check_rapids_in_air(blank, passes, kinds, (float(params["tool_change_z"]), geometry.tool_change_radius))
+
+
+def check_rapids_in_air(blank: Blank, passes: dict[int, list[Pass]], kinds: dict[int, str],
+                        tool_change: Point) -> None:
+    """Runs the job's operations in program order, each from the tool-change point (the template's
+    tool-change block moves there first), removing what each feed cuts; EngineError at the first
+    rapid through material."""
+    material = Material(blank)
+    for n in sorted(passes):
+        here = tool_change
+        for move in [Move("rapid", tool_change[0], 2.0 * tool_change[1])] + [m for one in passes[n] for m in one]:
+            end = (move.z, move.x / 2.0)
+            if move.kind == "rapid":
+                _check_rapid(material, here, end, move, f"operation {n} {kinds[n]}")
+            else:
+                material.remove(here, move)
+            here = end
+
+
+def _check_rapid(material: Material, start: Point, end: Point, move: Move, where: str) -> None:
+    length, inside = material.length_inside(start, end)
+    if length <= AIR_TOLERANCE_MM:
+        return
+    blank = material.blank
+    uncut = material.height(inside[0]) >= blank.radius
+    what = ("uncut assumed blank (no params.stock_diameter: " if blank.assumed else "uncut blank (") if uncut \
+        else "material no earlier feed removed ("
+    raise EngineError(f"{where}: G00 X{move.x:.3f} Z{move.z:.3f} runs {length:.2f} mm through {what}"
+                      f"Ø{2 * material.height(inside[0]):g} at Z{inside[0]:g}): rough it first (a ROUGH layer "
+                      "before it), give the blank it starts from (--stock-diameter, params.stock_diameter) or "
+                      "draw its approach outside the material")
