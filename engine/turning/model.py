@@ -68,7 +68,7 @@ def planned_passes(params: dict, module_params: dict) -> tuple[JobGeometry, dict
     pair = alternated_pair(params, module_params, passes)
     if pair:
         first, second = pair
-        passes[first] = toolpaths.alternate(passes[first], passes.pop(second))
+        passes[first] = toolpaths.up_then_across(toolpaths.alternate(passes[first], passes.pop(second)))
     check_job_rapids(geometry, params, module_params, passes)
     return geometry, passes
 
