@@ -82,51 +82,72 @@ class Cut:
 
 
 class Material:
-    """The blank less what the feeds so far have removed: a height over Z."""
+    """The blank less what the feeds so far have removed: a height over Z. Indexed by Z cell: a
+    level cut over a whole cell is kept as the cell's floor, any other cut in the cell's list."""
 
     def __init__(self, blank: Blank):
         self.blank = blank
         self.cells: dict[int, list[Cut]] = defaultdict(list)
+        self.floors: dict[int, float] = {}
 
     def remove(self, start: Point, move: Move) -> None:
         """A feed from start: the column above each piece of its path is air from now on."""
+        if move.kind in ("feed", "thread"):
+            self._add(Cut(start, (move.z, move.x / 2.0)))
+            return
         here = start
         for point in move_points(start, move):
-            cut = Cut(here, point)
-            low, high = sorted((here[0], point[0]))
-            for cell in range(_cell(low - COINCIDENT_MM), _cell(high + COINCIDENT_MM) + 1):
-                self.cells[cell].append(cut)
+            self._add(Cut(here, point))
             here = point
+
+    def _add(self, cut: Cut) -> None:
+        (z0, r0), (z1, r1) = cut.start, cut.end
+        low, high = min(z0, z1) - COINCIDENT_MM, max(z0, z1) + COINCIDENT_MM
+        for cell in range(_cell(low), _cell(high) + 1):
+            if r0 == r1 and low <= cell * BUCKET_MM and (cell + 1) * BUCKET_MM <= high:
+                self.floors[cell] = min(self.floors.get(cell, r0), r0)
+            else:
+                self.cells[cell].append(cut)
 
     def height(self, z: float) -> float:
         """The radius below which material is left at Z (0 beyond the blank's faces)."""
         if not self.blank.z_back < z < self.blank.z_front:
             return 0.0
-        floors = [cut.floor_at(z) for cut in self.cells.get(_cell(z), ()) if cut.covers(z)]
-        return min([self.blank.radius, *floors])
+        cell = _cell(z)
+        floors = [cut.floor_at(z) for cut in self.cells.get(cell, ()) if cut.covers(z)]
+        return min([self.blank.radius, self.floors.get(cell, math.inf), *floors])
 
     def holds(self, point: Point) -> bool:
         return point[1] < self.height(point[0])
 
     def length_inside(self, start: Point, end: Point) -> tuple[float, Point | None]:
-        """(mm of the straight rapid start → end that runs through material, a point of its first stretch in it)."""
+        """(mm of the straight rapid start → end that runs through material, a point of its first
+        stretch in it)."""
         if min(start[1], end[1]) >= self.blank.radius or max(start[0], end[0]) <= self.blank.z_back \
                 or min(start[0], end[0]) >= self.blank.z_front:
             return 0.0, None
+        if start[0] == end[0]:
+            return self._radial_length_inside(start[0], *sorted((start[1], end[1])))
         along = _along(start, end)
         count = max(1, math.ceil(math.dist(start, end) / SAMPLE_STEP_MM))
         inside = [self.holds(along(k / count)) for k in range(count + 1)]
-        share, entry = 0.0, None
-        for k in range(count):
-            a, b = k / count, (k + 1) / count
-            if inside[k] or inside[k + 1]:
-                lo, hi = a, b
-                if inside[k] != inside[k + 1]:
-                    boundary = self._boundary(along, a, b, inside[k])
-                    lo, hi = (a, boundary) if inside[k] else (boundary, b)
-                share += hi - lo
-                entry = entry or along((lo + hi) / 2.0)
-        return share * math.dist(start, end), entry
+        stretches = [self._stretch(along, k / count, (k + 1) / count, inside[k], inside[k + 1])
+                     for k in range(count) if inside[k] or inside[k + 1]]
+        if not stretches:
+            return 0.0, None
+        return sum(hi - lo for lo, hi in stretches) * math.dist(start, end), along(sum(stretches[0]) / 2.0)
+
+    def _radial_length_inside(self, z: float, low: float, high: float) -> tuple[float, Point | None]:
+        """A rapid along X only: the material at its Z is one stretch, from the axis up to the height."""
+        top = min(high, self.height(z))
+        return (top - low, (z, (low + top) / 2.0)) if top > low else (0.0, None)
+
+    def _stretch(self, along, a: float, b: float, a_inside: bool, b_inside: bool) -> tuple[float, float]:
+        """The part of [a, b] (fractions of the rapid, one end inside) that lies in material."""
+        if a_inside and b_inside:
+            return a, b
+        boundary = self._boundary(along, a, b, a_inside)
+        return (a, boundary) if a_inside else (boundary, b)
 
     def _boundary(self, along, a: float, b: float, a_inside: bool) -> float:
         """The fraction between a and b where the rapid crosses the material's edge."""
