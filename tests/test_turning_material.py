@@ -88,6 +88,16 @@ def test_an_earlier_operation_clears_the_way_for_a_later_one_not_the_other_way_r
         "operation 1 SLOT: G00 X34.000 Z-20.000 runs 3.00 mm through uncut blank")
 
 
+def test_the_tool_change_between_operations_is_a_rapid_too():
+    """Operation 1 roughs from behind the blank to Z-30 and stops 1 mm above its cut; operation 2's
+    tool-change block (G00 X120 Z50) runs from there straight to the tool-change point, through the
+    uncut blank in front of Z-30 until it rises above R20: 4/44 of its way √(80² + 44²)."""
+    from_behind = [g0(-51, 60), g0(-51, 15), g1(-30, 15), g0(-30, 16)]
+    message = refusal(from_behind, [g0(-20, 60)], kinds=("ROUGH", "ROUGH"))
+    assert message.startswith(f"operation 2 ROUGH: G00 X120.000 Z50.000 runs {4 / 44 * math.hypot(80, 44):.2f} mm "
+                              "through uncut blank")
+
+
 def test_without_a_stored_blank_the_largest_the_job_suggests_is_assumed():
     """No stock: the profile's largest radius plus the 2 mm on the diameter import-dxf puts on a
     profile-only blank (1 mm on the radius), or the largest radius a feed cuts at, whichever is larger."""

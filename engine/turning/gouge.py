@@ -1,6 +1,7 @@
 """No move of a turning operation may enter the part: drawn tool paths and paths edited in
 SQL are checked against the profile, not trusted. (Thread passes cut below the drawn
-profile by design and are not checked here.)
+profile by design and are not checked here; that no rapid runs through the blank or the
+material the feeds left is engine.turning.material's check.)
 
 A move is sampled along its length; a sample point inside the part region deeper than
 GOUGE_TOLERANCE_MM (a finish pass runs on the profile itself) is a gouge. The edges are

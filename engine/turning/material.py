@@ -179,12 +179,11 @@ def check_job_rapids(geometry: JobGeometry, params: dict, module_params: dict, p
 
 def check_rapids_in_air(blank: Blank, passes: dict[int, list[Pass]], kinds: dict[int, str],
                         tool_change: Point) -> None:
-    """Runs the job's operations in program order, each from the tool-change point (the template's
-    tool-change block moves there first), removing what each feed cuts; EngineError at the first
-    rapid through material."""
-    material = Material(blank)
+    """Runs the job's operations in program order from the tool-change point, each entered by the
+    template's tool-change block (G00 to the point from where the one before ended), removing what
+    each feed cuts; EngineError at the first rapid through material."""
+    material, here = Material(blank), tool_change
     for n in sorted(passes):
-        here = tool_change
         for move in [Move("rapid", tool_change[0], 2.0 * tool_change[1])] + [m for one in passes[n] for m in one]:
             end = (move.z, move.x / 2.0)
             if move.kind == "rapid":
@@ -198,11 +197,15 @@ def _check_rapid(material: Material, start: Point, end: Point, move: Move, where
     length, inside = material.length_inside(start, end)
     if length <= AIR_TOLERANCE_MM:
         return
-    blank = material.blank
-    uncut = material.height(inside[0]) >= blank.radius
-    what = ("uncut assumed blank (no params.stock_diameter: " if blank.assumed else "uncut blank (") if uncut \
-        else "material no earlier feed removed ("
-    raise EngineError(f"{where}: G00 X{move.x:.3f} Z{move.z:.3f} runs {length:.2f} mm through {what}"
-                      f"Ø{2 * material.height(inside[0]):g} at Z{inside[0]:g}): rough it first (a ROUGH layer "
-                      "before it), give the blank it starts from (--stock-diameter, params.stock_diameter) or "
-                      "draw its approach outside the material")
+    z = inside[0]
+    raise EngineError(f"{where}: G00 X{move.x:.3f} Z{move.z:.3f} runs {length:.2f} mm through "
+                      f"{_material_named(material, z)}Ø{round(2 * material.height(z), 3):g} at Z{round(z, 3):g}): "
+                      "rough it first (a ROUGH layer before it), give the blank it starts from (--stock-diameter, "
+                      "params.stock_diameter) or draw its approach outside the material")
+
+
+def _material_named(material: Material, z: float) -> str:
+    """What the rapid runs into, as the refusal names it (the opening of its bracket included)."""
+    if material.height(z) < material.blank.radius:
+        return "material no earlier feed removed ("
+    return "uncut assumed blank (no params.stock_diameter: " if material.blank.assumed else "uncut blank ("
