@@ -36,7 +36,10 @@ COLLAR_OUTSIDE = [(0, 10), (-19, 10), (-19, 8), (-21, 8), (-21, 10), (-30, 10), 
 
 def collar_drawing(path: Path) -> None:
     """Shaft ⌀20 with a ⌀40 collar at Z −30…−40 and ⌀16 grooves at Z −19…−21 and −49…−51,
-    slotted by one plunge each (the grooves are part of the profile, as the convention has it)."""
+    slotted by one plunge each (the grooves are part of the profile, as the convention has it).
+    The shaft is roughed to ⌀21 on both sides of the collar, behind it from the free end at Z −61
+    towards the collar: the blank is at least the collar's ⌀40, and a plunge at Z −50 into an
+    unroughed blank would rapid through it."""
     doc = ezdxf.new("R2010")
     doc.header["$INSUNITS"] = 4
     for layer in ("1", "2", "3"):
@@ -46,6 +49,7 @@ def collar_drawing(path: Path) -> None:
     msp.add_point((20, 30))
     msp.add_text("@GROUGH @S500 @F200 @T01", dxfattribs={"layer": "1"})
     msp.add_line((1, 10.5), (-29.5, 10.5), dxfattribs={"layer": "1"})
+    msp.add_line((-61, 10.5), (-40.5, 10.5), dxfattribs={"layer": "1"})
     msp.add_text("@GSLOT @S300 @F20 @T02", dxfattribs={"layer": "2"})
     msp.add_line((-20, 10), (-20, 8), dxfattribs={"layer": "2"})
     msp.add_line((-50, 10), (-50, 8), dxfattribs={"layer": "2"})

@@ -1,6 +1,7 @@
 """No move of a turning operation may enter the part: drawn tool paths and paths edited in
 SQL are checked against the profile, not trusted. (Thread passes cut below the drawn
-profile by design and are not checked here.)
+profile by design and are not checked here; that no rapid runs through the blank or the
+material the feeds left is engine.turning.material's check.)
 
 A move is sampled along its length; a sample point inside the part region deeper than
 GOUGE_TOLERANCE_MM (a finish pass runs on the profile itself) is a gouge. The edges are
@@ -81,7 +82,7 @@ def _check_move(start: tuple[float, float], move: Move, index: PartIndex, where:
     lowest = min(start[1], end[1]) if move.kind in ("rapid", "feed") else -math.inf
     if lowest > index.top_over(start[0], end[0]) + GOUGE_TOLERANCE_MM:
         return
-    for z, radius in _samples(start, move):
+    for z, radius in move_points(start, move):
         depth = index.depth_inside(z, radius)
         if depth:
             word = "G0" if move.kind == "rapid" else {"feed": "G1", "cw": "G2", "ccw": "G3"}.get(move.kind, "G1")
@@ -89,7 +90,8 @@ def _check_move(start: tuple[float, float], move: Move, index: PartIndex, where:
                               f"the part at Z{z:.3f} X{2 * radius:.3f}; correct the drawn tool path or the profile")
 
 
-def _samples(start: tuple[float, float], move: Move) -> Iterator[tuple[float, float]]:
+def move_points(start: tuple[float, float], move: Move) -> Iterator[tuple[float, float]]:
+    """(z, radius) points along a move from `start`, SAMPLE_STEP_MM apart, its end included (arcs on the arc)."""
     if move.kind in ("cw", "ccw") and move.i is not None and move.k is not None:
         yield from _arc_samples(start, move)
         return

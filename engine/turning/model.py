@@ -14,6 +14,7 @@ from ..errors import EngineError
 from ..names import NAME_RULES, is_safe, shown
 from . import toolpaths
 from .arc_split import with_short_arcs
+from .material import check_job_rapids
 from .moves import Move, Pass
 from .names import MAX_OPERATIONS, MAX_TOOL
 from .operations import KINDS, JobGeometry, job_geometry, operation_passes
@@ -69,7 +70,8 @@ def planned_passes(params: dict, module_params: dict) -> tuple[JobGeometry, dict
     pair = alternated_pair(params, module_params, passes)
     if pair:
         first, second = pair
-        passes[first] = toolpaths.alternate(passes[first], passes.pop(second))
+        passes[first] = toolpaths.up_then_across(toolpaths.alternate(passes[first], passes.pop(second)))
+    check_job_rapids(geometry, params, module_params, passes)
     return geometry, passes
 
 

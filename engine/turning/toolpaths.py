@@ -21,7 +21,7 @@ from .region import (CHORD_TOLERANCE_MM, Edge, Surroundings, distance_to_region,
                      free_intervals, is_blocked, top_over)
 
 __all__ = ["finish_passes", "drawn_rough_passes", "slot_passes", "thread_passes",
-           "profile_rough_passes", "alternate", "standalone", "distance_to_region"]
+           "profile_rough_passes", "alternate", "up_then_across", "standalone", "distance_to_region"]
 
 # A drawn line counts as axial (radial) when its ends differ by at most this in radius (Z).
 STRAIGHT_TOLERANCE_MM = 0.001
@@ -256,6 +256,19 @@ def alternate(first: list[Pass], second: list[Pass]) -> list[Pass]:
     for index in range(max(len(first), len(second))):
         crossed += [passes[index] for passes in (first, second) if index < len(passes)]
     return crossed
+
+
+def up_then_across(passes: list[Pass]) -> list[Pass]:
+    """Passes run one after the other without a tool change between them (alternated work steps):
+    each is entered from the end of the one before by X up to the higher of both radii first, then
+    Z, then X down, never diagonally across the corner of material neither pass has cut."""
+    linked = passes[:1]
+    for one in passes[1:]:
+        end, start = linked[-1][-1], one[0]
+        top = max(end.x, start.x) / 2.0
+        here = Move("rapid", end.z, end.x)
+        linked.append(without_standstills([here, rapid(end.z, top), rapid(start.z, top), *one])[1:])
+    return linked
 
 
 def smallest_radius(outline: Sequence[Segment]) -> float:
