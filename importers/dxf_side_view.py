@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 
 from .dxf_envelope import upper_envelope
 from .dxf_geometry import Arc, Line, Segment
+from .dxf_inner_lines import Frame, check_halves_agree, distance_to, inner_lines_note
 from .dxf_profile import END_MATCH_TOLERANCE_MM, Profile, bounds, merged_bounds, sweep
 from .dxf_read import DxfError
 from .dxf_turnable import (check_no_bore, check_no_hidden_bore, check_no_prism, check_not_an_end_view,
@@ -142,19 +143,6 @@ def centred_views(segments: list[Segment], centre_lines: list[Line]) -> list[tup
     return found
 
 
-def distance_to(point: tuple[float, float], segment: Segment) -> float:
-    if isinstance(segment, Line):
-        (z0, r0), (z1, r1) = segment.start, segment.end
-        dz, dr = z1 - z0, r1 - r0
-        squared = dz * dz + dr * dr
-        t = 0.0 if squared == 0 else max(0.0, min(1.0, ((point[0] - z0) * dz + (point[1] - r0) * dr) / squared))
-        return math.dist(point, (z0 + t * dz, r0 + t * dr))
-    probe = Arc(segment.start, point, segment.centre, segment.ccw)
-    if sweep(probe) <= sweep(segment):
-        return abs(math.dist(point, segment.centre) - segment.radius)
-    return min(math.dist(point, segment.start), math.dist(point, segment.end))
-
-
 def samples(segment: Segment) -> list[tuple[float, float]]:
     if isinstance(segment, Line):
         (x0, y0), (x1, y1) = segment.start, segment.end
@@ -218,28 +206,49 @@ def side_view(axis: Axis, view: list[Segment], marks: Marks, where: str) -> Side
     check_no_bore([[axis.point(p) for p in polygon] for polygon in marks.hatches], z_min, z_max, where)
     check_no_hidden_bore([axis.segment(s) for s in marks.hidden], outline, where)
     check_no_prism(framed, outline, where)
+    check_symmetric_about(axis, view, framed, outline, where)
+    open_faces = open_radii(framed, outline)
+    inner = inner_lines_note(framed, Frame(outline, z_min, z_max, open_faces), where)
     profile = Profile(outline, True, merged_bounds(outline))
-    inside = len({s.handle for s in framed})
     turn = " (a vertical centre line: drawing Y is Z)" if axis.vertical else ""
     notes = [f"{where} is a side view: its half above {axis.source}{turn} is the profile, moved so that line is "
-             f"the axis; the lines inside its outline (edges, thread roots, slots; {inside} entities drawn in all) "
-             "are not turned surfaces and are left out"]
-    return SideView(profile, notes + open_face_notes(framed, outline, where))
+             f"the axis; {len({s.handle for s in framed})} entities drawn in all", inner]
+    return SideView(profile, notes + open_face_notes(open_faces, where))
 
 
-def open_face_notes(framed: list[Segment], outline: list[Segment], where: str) -> list[str]:
-    """An end face drawn only part of the way to the axis leaves a slot or recess open there,
-    which the job does not make: it faces the end to the axis."""
-    notes = []
+def check_symmetric_about(axis: Axis, view: list[Segment], framed: list[Segment], outline: list[Segment],
+                          where: str) -> None:
+    """A centre line is the axis only if the view is the same on both sides of it: a dash-dot
+    line beside the symmetry (a pitch line, a leader) is refused naming both lines."""
+    try:
+        check_halves_agree(framed, outline, where, axis.source)
+    except DxfError as refusal:
+        other = symmetry_axis(view)
+        if other is None or (other.vertical == axis.vertical and abs(other.offset - axis.offset)
+                             <= END_MATCH_TOLERANCE_MM):
+            raise
+        raise DxfError(f"{where}: {axis.source} (drawing {'X' if axis.vertical else 'Y'} {axis.offset:.3f}) is not "
+                       f"the view's axis: the view is symmetric about {other.source} instead; put the centre line "
+                       "on the part's axis") from refusal
+
+
+def open_radii(framed: list[Segment], outline: list[Segment]) -> dict[float, float]:
+    """Each end face's Z → the smallest radius it is drawn down to (0: to the axis)."""
+    found = {}
     for face in (outline[0].start[0], outline[-1].end[0]):
         at_face = [s for s in framed if isinstance(s, Line) and max(s.start[1], s.end[1]) > 0.0
                    and abs(s.start[0] - face) <= END_MATCH_TOLERANCE_MM >= abs(s.end[0] - face)]
-        lowest = min((max(min(s.start[1], s.end[1]), 0.0) for s in at_face), default=0.0)
-        if lowest > END_MATCH_TOLERANCE_MM:
-            notes.append(f"{where}: the end face at Z{face:.3f} is drawn down to radius {lowest:.3f} only; the slot or "
-                         f"recess it leaves open (Ø{2 * lowest:.3f} seen from the side) is not a turned surface and "
-                         "is not made: the job faces that end to the axis")
-    return notes
+        found[face] = min((max(min(s.start[1], s.end[1]), 0.0) for s in at_face), default=0.0)
+    return found
+
+
+def open_face_notes(open_faces: dict[float, float], where: str) -> list[str]:
+    """An end face drawn only part of the way to the axis leaves a slot or recess open there,
+    which the job does not make: it faces the end to the axis."""
+    return [f"{where}: the end face at Z{face:.3f} is drawn down to radius {lowest:.3f} only; the slot or "
+            f"recess it leaves open (Ø{2 * lowest:.3f} seen from the side) is not a turned surface and "
+            "is not made: the job faces that end to the axis"
+            for face, lowest in open_faces.items() if lowest > END_MATCH_TOLERANCE_MM]
 
 
 def side_view_of(segments: list[Segment], marks: Marks, layer: str) -> SideView | None:
