@@ -71,6 +71,37 @@ class SideView:
     notes: list[str]
 
 
+def split_section(segments: list[Segment], centre_lines: list[Line], where: str) -> DxfError | None:
+    """Outlines along a centre line on both sides of it, mirror images, none reaching it: the
+    cut faces of a bored part's section drawn without hatching, the bore between them."""
+    for line in centre_lines:
+        axis = centre_axis(line)
+        sides = [view for view in views(segments) if axis is not None and alongside(axis, line, view)]
+        framed = [axis.segment(s) for view in sides for s in view] if sides else []
+        if not framed or min(bounds(s)[2] for s in framed) >= 0.0 or max(bounds(s)[3] for s in framed) <= 0.0:
+            continue
+        try:
+            check_halves_agree(framed, upper_envelope(framed, where), where, axis.source)
+        except DxfError:
+            continue
+        z_min, z_max, _, _ = merged_bounds(framed)
+        bore = 2 * min(min(abs(bounds(s)[2]), abs(bounds(s)[3])) for s in framed)
+        return DxfError(f"{where}: the view about {axis.source} is drawn as outlines either side of it that leave "
+                        f"Ø{bore:.3f} open along the axis from Z{z_min:.3f} to Z{z_max:.3f}: a section of a part "
+                        "with a bore (drawn without hatching); cutting the bore needs internal turning, which is not "
+                        "supported")
+    return None
+
+
+def alongside(axis: Axis, line: Line, view: list[Segment]) -> bool:
+    """The view lies within the centre line's length, wholly on one side of it."""
+    x_min, x_max, y_min, y_max = merged_bounds(view)
+    along, across = ((y_min, y_max), (x_min, x_max)) if axis.vertical else ((x_min, x_max), (y_min, y_max))
+    ends = sorted((line.start[1], line.end[1]) if axis.vertical else (line.start[0], line.end[0]))
+    return (ends[0] - ALONG_SLACK_MM <= along[0] and along[1] <= ends[1] + ALONG_SLACK_MM
+            and (across[0] >= axis.offset - END_MATCH_TOLERANCE_MM or across[1] <= axis.offset + END_MATCH_TOLERANCE_MM))
+
+
 def centre_axis(line: Line) -> Axis | None:
     (x0, y0), (x1, y1) = line.start, line.end
     if abs(y1 - y0) <= STRAIGHT * abs(x1 - x0):
@@ -256,6 +287,9 @@ def side_view_of(segments: list[Segment], marks: Marks, layer: str) -> SideView 
     DxfError when only views along the axis are found or two side views compete."""
     candidates = centred_views(segments, marks.centre_lines)
     if not candidates:
+        split = split_section(segments, marks.centre_lines, f"layer {layer}")
+        if split is not None:
+            raise split
         return None
     found, refusals = [], []
     for axis, view in candidates:
