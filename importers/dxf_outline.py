@@ -10,7 +10,7 @@ which lie inside others, is refused as the flat part (a plate) it is.
 from __future__ import annotations
 
 from .dxf_geometry import Segment
-from .dxf_profile import Chain, Profile, chain_segments, find_profile, merged_bounds
+from .dxf_profile import END_MATCH_TOLERANCE_MM, Chain, Profile, chain_segments, find_profile, merged_bounds
 from .dxf_read import DxfError
 from .dxf_side_view import Marks, side_view, side_view_of, symmetry_axis
 
@@ -31,13 +31,33 @@ def profile_of(segments: list[Segment], marks: Marks, layer: str) -> tuple[Profi
         return found.profile, found.notes, []
     chains = chain_segments(segments)
     try:
-        return find_profile(chains, layer=layer), [], chains
+        profile = find_profile(chains, layer=layer)
     except DxfError as refusal:
         axis = symmetry_axis(segments)
         if axis is None:
             raise plate_refusal(chains, layer) or refusal from None
         found = side_view(axis, segments, marks, f"layer {layer}")
         return found.profile, found.notes, []
+    check_not_a_view_off_the_axis(profile, segments, layer)
+    return profile, [], chains
+
+
+def check_not_a_view_off_the_axis(profile: Profile, segments: list[Segment], layer: str) -> None:
+    """A closed outline away from drawing Y 0 and symmetric (about a line of either direction)
+    reads two ways: a ring's section in the seed-000 convention (radius = drawing Y) or the whole
+    side view of a part drawn off Y 0 without its centre line. Which part it is, the drawing does
+    not say, so neither is made."""
+    if profile.closed_by_axis or profile.bounds[2] <= END_MATCH_TOLERANCE_MM:
+        return
+    axis = symmetry_axis(segments)
+    if axis is None:
+        return
+    _, _, low, high = profile.bounds
+    side = "below" if profile.mirrored else "above"
+    raise DxfError(f"layer {layer}: its closed outline lies {side} drawing Y 0, at radius {low:.3f} to {high:.3f}, "
+                   f"and is symmetric about {axis.source}: either a ring's section (radius = drawing Y; its bore "
+                   "cannot be turned from outside) or a part's whole side view drawn off Y 0; draw a centre line "
+                   "on the part's axis (a side view), or its half-profile on Y 0")
 
 
 def plate_refusal(chains: list[Chain], layer: str) -> DxfError | None:
