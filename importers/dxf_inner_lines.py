@@ -100,8 +100,11 @@ def an_edge_across(segment: Segment, frame: Frame) -> bool:
 
 
 def a_thread_root(segment: Segment, frame: Frame) -> bool:
-    """A line along the axis close under the outline all along (THREAD_ROOT_SHARE)."""
-    return is_axial(segment) and all(
+    """A line along the axis close under the outline all along (THREAD_ROOT_SHARE), not from end
+    face to end face (that is a thin-walled bore's wall: a thread ends before a face or shoulder)."""
+    ends = sorted((segment.start[0], segment.end[0]))
+    through = ends[0] <= frame.z_min + END_MATCH_TOLERANCE_MM and ends[1] >= frame.z_max - END_MATCH_TOLERANCE_MM
+    return is_axial(segment) and not through and all(
         THREAD_ROOT_SHARE * frame.radius(z) <= abs(r) < frame.radius(z) + END_MATCH_TOLERANCE_MM
         for z, r in points_of(segment))
 
