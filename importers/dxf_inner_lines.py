@@ -37,6 +37,7 @@ class Frame:
     z_min: float
     z_max: float
     open_radius: dict[float, float]   # end face Z → the radius it is drawn down to
+    recess: frozenset[int] = frozenset()   # id() of the lines bounding an open end's slot or recess
 
     def radius(self, z: float) -> float:
         return radius_at(self.outline, z)
@@ -110,11 +111,30 @@ def a_thread_root(segment: Segment, frame: Frame) -> bool:
 
 
 def in_an_open_end(segment: Segment, frame: Frame) -> bool:
-    """Within the slot or recess an end face drawn only part of the way to the axis leaves open
-    (a screw head's slot): the job faces that end to the axis and says so."""
-    deepest = max(frame.open_radius.values(), default=0.0)
-    return deepest > END_MATCH_TOLERANCE_MM and all(abs(r) <= deepest + END_MATCH_TOLERANCE_MM
-                                                    for _, r in points_of(segment))
+    """A line of the slot or recess an end face drawn only part of the way to the axis leaves
+    open (a screw head's slot): the job faces that end to the axis and says so."""
+    return id(segment) in frame.recess
+
+
+def frame_of(framed: list[Segment], outline: list[Segment], open_radius: dict[float, float]) -> Frame:
+    recess = [line for face, radius in open_radius.items() if radius > END_MATCH_TOLERANCE_MM
+              for line in recess_lines(framed, face, radius)]
+    return Frame(outline, outline[-1].end[0], outline[0].start[0], open_radius, frozenset(map(id, recess)))
+
+
+def recess_lines(framed: list[Segment], face: float, radius: float) -> list[Segment]:
+    """The lines within the open radius that join, end to end, the open face's edges (face, ±radius):
+    the recess's walls and bottom, not a cavity elsewhere along the part."""
+    inside = [s for s in framed if all(abs(r) <= radius + END_MATCH_TOLERANCE_MM for _, r in points_of(s))]
+    reached, found = [(face, radius), (face, -radius)], []
+    grown = True
+    while grown:
+        joined = [s for s in inside if s not in found and any(math.dist(p, q) <= END_MATCH_TOLERANCE_MM
+                                                                  for p in (s.start, s.end) for q in reached)]
+        found += joined
+        reached += [p for s in joined for p in (s.start, s.end)]
+        grown = bool(joined)
+    return found
 
 
 INNER_LINE_KINDS: tuple[tuple[str, Callable[[Segment, Frame], bool]], ...] = (
@@ -132,13 +152,8 @@ def kind_of(segment: Segment, frame: Frame) -> str | None:
 
 def inner_lines_note(framed: list[Segment], frame: Frame, where: str) -> str:
     """A note counting the lines left out by kind; DxfError for a line no kind explains."""
-    kinds = Counter()
-    unplaced = []
-    for segment in framed:
-        kind = kind_of(segment, frame)
-        if kind is None:
-            unplaced.append(segment)
-        kinds[kind] += 1
+    kinds = Counter(kind_of(segment, frame) for segment in framed)
+    unplaced = [segment for segment in framed if kind_of(segment, frame) is None]
     if unplaced:
         raise unplaced_refusal(unplaced, frame, where)
     inside = "; ".join(f"{name}: {count}" for name, count in kinds.items() if name != "outline")

@@ -16,7 +16,7 @@ from dataclasses import dataclass, field
 
 from .dxf_envelope import upper_envelope
 from .dxf_geometry import Arc, Line, Segment
-from .dxf_inner_lines import Frame, check_halves_agree, distance_to, inner_lines_note
+from .dxf_inner_lines import check_halves_agree, frame_of, distance_to, inner_lines_note
 from .dxf_profile import END_MATCH_TOLERANCE_MM, Profile, bounds, merged_bounds, sweep
 from .dxf_read import DxfError
 from .dxf_turnable import (check_no_bore, check_no_hidden_bore, check_no_prism, check_not_an_end_view,
@@ -239,7 +239,7 @@ def side_view(axis: Axis, view: list[Segment], marks: Marks, where: str) -> Side
     check_no_prism(framed, outline, where)
     check_symmetric_about(axis, view, framed, outline, where)
     open_faces = open_radii(framed, outline)
-    inner = inner_lines_note(framed, Frame(outline, z_min, z_max, open_faces), where)
+    inner = inner_lines_note(framed, frame_of(framed, outline, open_faces), where)
     profile = Profile(outline, True, merged_bounds(outline))
     turn = " (a vertical centre line: drawing Y is Z)" if axis.vertical else ""
     notes = [f"{where} is a side view: its half above {axis.source}{turn} is the profile, moved so that line is "
