@@ -52,12 +52,13 @@ def check_not_a_view_off_the_axis(profile: Profile, segments: list[Segment], lay
     axis = symmetry_axis(segments)
     if axis is None:
         return
-    _, _, low, high = profile.bounds
+    z_min, z_max, low, high = profile.bounds
     side = "below" if profile.mirrored else "above"
-    raise DxfError(f"layer {layer}: its closed outline lies {side} drawing Y 0, at radius {low:.3f} to {high:.3f}, "
-                   f"and is symmetric about {axis.source}: either a ring's section (radius = drawing Y; its bore "
-                   "cannot be turned from outside) or a part's whole side view drawn off Y 0; draw a centre line "
-                   "on the part's axis (a side view), or its half-profile on Y 0")
+    raise DxfError(f"layer {layer}: its closed outline lies {side} drawing Y 0 (radius {low:g} … {high:g}, Z{z_min:g} … "
+                   f"Z{z_max:g}) and is symmetric about {axis.source}: as drawn (radius = drawing Y) it is a ring's "
+                   f"section with a bore Ø{2 * low:g}, and internal turning is not supported; as a whole side view "
+                   "drawn off Y 0 it lacks its centre line; draw the part's half-profile on Y 0, or a centre line "
+                   "on its axis")
 
 
 def plate_refusal(chains: list[Chain], layer: str) -> DxfError | None:

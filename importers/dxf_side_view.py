@@ -6,7 +6,10 @@ the length of one view of the profile layer, with that view on both sides of it;
 one, a drawing that is not a half-profile is tried for mirror symmetry about the middle
 of its extents. The view is moved so the centre line is the axis (a vertical one turned to
 lie along Z) and its outline above the axis is taken (dxf_envelope), once dxf_turnable has
-found nothing a lathe cannot make from outside.
+found nothing a lathe cannot make from outside and dxf_inner_lines has found both halves
+alike and every line inside the outline of a kind that leaves the turned surface as it is.
+Outlines mirrored either side of a centre line that none of them reaches are a bored part's
+section drawn without hatching, refused.
 """
 from __future__ import annotations
 
@@ -16,7 +19,7 @@ from dataclasses import dataclass, field
 
 from .dxf_envelope import upper_envelope
 from .dxf_geometry import Arc, Line, Segment
-from .dxf_inner_lines import check_halves_agree, frame_of, distance_to, inner_lines_note
+from .dxf_inner_lines import check_halves_agree, distance_to, frame_of, inner_lines_note
 from .dxf_profile import END_MATCH_TOLERANCE_MM, Profile, bounds, merged_bounds, sweep
 from .dxf_read import DxfError
 from .dxf_turnable import (check_no_bore, check_no_hidden_bore, check_no_prism, check_not_an_end_view,
@@ -76,21 +79,29 @@ def split_section(segments: list[Segment], centre_lines: list[Line], where: str)
     cut faces of a bored part's section drawn without hatching, the bore between them."""
     for line in centre_lines:
         axis = centre_axis(line)
-        sides = [view for view in views(segments) if axis is not None and alongside(axis, line, view)]
-        framed = [axis.segment(s) for view in sides for s in view] if sides else []
-        if not framed or min(bounds(s)[2] for s in framed) >= 0.0 or max(bounds(s)[3] for s in framed) <= 0.0:
-            continue
-        try:
-            check_halves_agree(framed, upper_envelope(framed, where), where, axis.source)
-        except DxfError:
-            continue
-        z_min, z_max, _, _ = merged_bounds(framed)
-        bore = 2 * min(min(abs(bounds(s)[2]), abs(bounds(s)[3])) for s in framed)
-        return DxfError(f"{where}: the view about {axis.source} is drawn as outlines either side of it that leave "
-                        f"Ø{bore:.3f} open along the axis from Z{z_min:.3f} to Z{z_max:.3f}: a section of a part "
-                        "with a bore (drawn without hatching); cutting the bore needs internal turning, which is not "
-                        "supported")
+        framed = [] if axis is None else [axis.segment(s) for view in views(segments)
+                                          if alongside(axis, line, view) for s in view]
+        if framed and min(bounds(s)[2] for s in framed) < 0.0 < max(bounds(s)[3] for s in framed) \
+                and mirror_images(framed, where, axis.source):
+            return split_section_refusal(framed, where, axis.source)
     return None
+
+
+def mirror_images(framed: list[Segment], where: str, axis: str) -> bool:
+    try:
+        check_halves_agree(framed, upper_envelope(framed, where), where, axis)
+    except DxfError:
+        return False
+    return True
+
+
+def split_section_refusal(framed: list[Segment], where: str, axis: str) -> DxfError:
+    z_min, z_max, _, _ = merged_bounds(framed)
+    bore = 2 * min(min(abs(bounds(s)[2]), abs(bounds(s)[3])) for s in framed)
+    return DxfError(f"{where}: the view about {axis} is drawn as outlines either side of it that leave "
+                    f"Ø{bore:.3f} open along the axis from Z{z_min:.3f} to Z{z_max:.3f}: a section of a part "
+                    "with a bore (drawn without hatching); cutting the bore needs internal turning, which is not "
+                    "supported")
 
 
 def alongside(axis: Axis, line: Line, view: list[Segment]) -> bool:

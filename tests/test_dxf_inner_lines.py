@@ -18,7 +18,7 @@ from test_dxf_side_views import AXIS_Y, SHAFT
 THREAD_D, THREAD_P, THREAD_END = 16.0, 2.0, -10.0
 
 
-def shaft_with_inner_lines(path, extra=None) -> None:
+def shaft_with_inner_lines(path, extra=None) -> str | None:
     """The shaft drawn whole with the lines a side view shows inside it (its thread's roots and
     end, its shoulders' edges) and, with `extra(msp)`, one line more."""
     doc = ezdxf.new("R2010", setup=True)
