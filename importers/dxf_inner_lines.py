@@ -10,12 +10,13 @@ else is refused by handle. Coordinates are machine (z, radius) about the view's 
 """
 from __future__ import annotations
 
+import bisect
 import math
 from collections import Counter
 from dataclasses import dataclass
 from typing import Callable
 
-from .dxf_envelope import pieces_of, upper_envelope
+from .dxf_envelope import SAME_Z, pieces_of, upper_envelope
 from .dxf_geometry import Arc, Line, Segment
 from .dxf_profile import END_MATCH_TOLERANCE_MM, merged_bounds, sweep
 from .dxf_read import DxfError
@@ -37,19 +38,36 @@ class Frame:
     z_min: float
     z_max: float
     open_radius: dict[float, float]   # end face Z → the radius it is drawn down to
-    recess: frozenset[int] = frozenset()   # id() of the lines bounding an open end's slot or recess
+    recess: frozenset[int]            # id() of the lines bounding an open end's slot or recess
+    radii: Radii
+    steps: list[Segment]              # the outline's radial lines (shoulders)
 
     def radius(self, z: float) -> float:
-        return radius_at(self.outline, z)
+        return self.radii.at(z)
 
     def on_outline(self, point: tuple[float, float]) -> bool:
-        mirrored = (point[0], abs(point[1]))
-        return any(distance_to(mirrored, s) <= END_MATCH_TOLERANCE_MM for s in self.outline)
+        """Within END_MATCH_TOLERANCE_MM of the outline or its mirror image below the axis: of a
+        shoulder, or of the outline's radius somewhere within that distance along Z."""
+        z, r, near = point[0], abs(point[1]), END_MATCH_TOLERANCE_MM
+        if any(distance_to((z, r), step) <= near for step in self.steps):
+            return True
+        radii = [self.radius(z - near), self.radius(z), self.radius(z + near)]
+        return min(radii) - near <= r <= max(radii) + near
 
 
-def radius_at(outline: list[Segment], z: float) -> float:
-    """The outline's largest radius at z (0 outside it)."""
-    return max((piece.r_at(z) for s in outline for piece in pieces_of(s) if piece.covers(z)), default=0.0)
+class Radii:
+    """An outline's radius along Z: its pieces by where they start, found by bisection (an
+    envelope's pieces follow one another along Z, so only the last two starting before z can
+    cover it)."""
+
+    def __init__(self, outline: list[Segment]):
+        self.pieces = sorted((piece for s in outline for piece in pieces_of(s)), key=lambda piece: piece.z0)
+        self.starts = [piece.z0 for piece in self.pieces]
+
+    def at(self, z: float) -> float:
+        """The largest radius at z (0 outside the outline)."""
+        found = bisect.bisect_right(self.starts, z + SAME_Z)
+        return max((piece.r_at(z) for piece in self.pieces[max(0, found - 2):found] if piece.covers(z)), default=0.0)
 
 
 def distance_to(point: tuple[float, float], segment: Segment) -> float:
@@ -119,7 +137,9 @@ def in_an_open_end(segment: Segment, frame: Frame) -> bool:
 def frame_of(framed: list[Segment], outline: list[Segment], open_radius: dict[float, float]) -> Frame:
     recess = [line for face, radius in open_radius.items() if radius > END_MATCH_TOLERANCE_MM
               for line in recess_lines(framed, face, radius)]
-    return Frame(outline, outline[-1].end[0], outline[0].start[0], open_radius, frozenset(map(id, recess)))
+    steps = [s for s in outline if is_radial(s)]
+    return Frame(outline, outline[-1].end[0], outline[0].start[0], open_radius, frozenset(map(id, recess)),
+                 Radii(outline), steps)
 
 
 def recess_lines(framed: list[Segment], face: float, radius: float) -> list[Segment]:
@@ -152,8 +172,9 @@ def kind_of(segment: Segment, frame: Frame) -> str | None:
 
 def inner_lines_note(framed: list[Segment], frame: Frame, where: str) -> str:
     """A note counting the lines left out by kind; DxfError for a line no kind explains."""
-    kinds = Counter(kind_of(segment, frame) for segment in framed)
-    unplaced = [segment for segment in framed if kind_of(segment, frame) is None]
+    found = [(segment, kind_of(segment, frame)) for segment in framed]
+    kinds = Counter(kind for _, kind in found)
+    unplaced = [segment for segment, kind in found if kind is None]
     if unplaced:
         raise unplaced_refusal(unplaced, frame, where)
     inside = "; ".join(f"{name}: {count}" for name, count in kinds.items() if name != "outline")
@@ -203,18 +224,19 @@ def mirror(segment: Segment) -> Segment:
 
 def halves_differ(upper: list[Segment], lower: list[Segment],
                   tolerance: float) -> list[tuple[float, float, float, float]]:
-    """(z from, z to, upper radius, lower radius) of the spans where the two outlines are further apart than tolerance,
-    sampled between each two successive ends of their pieces (where neither has a corner), a
-    half drawn shorter counting as radius 0 beyond its end."""
+    """(z from, z to, upper radius, lower radius) of the spans where the two outlines are further
+    apart than tolerance, sampled between each two successive ends of their pieces (where neither
+    has a corner), a half drawn shorter counting as radius 0 beyond its end."""
     ends = sorted({z for s in upper + lower for z in (s.start[0], s.end[0])})
+    radii = (Radii(upper), Radii(lower))
     found = []
     for z_a, z_b in zip(ends, ends[1:]):
-        apart = [(above, below) for above, below in sampled_radii(upper, lower, z_a, z_b)
+        apart = [(above, below) for above, below in sampled_radii(*radii, z_a, z_b)
                  if abs(above - below) > tolerance]
         found.extend([(z_a, z_b, *apart[0])] if apart else [])
     return found
 
 
-def sampled_radii(upper: list[Segment], lower: list[Segment], z_a: float, z_b: float) -> list[tuple[float, float]]:
+def sampled_radii(upper: Radii, lower: Radii, z_a: float, z_b: float) -> list[tuple[float, float]]:
     zs = [z_a + (z_b - z_a) * (k + 0.5) / HALVES_SAMPLES for k in range(HALVES_SAMPLES)]
-    return [(radius_at(upper, z), radius_at(lower, z)) for z in zs]
+    return [(upper.at(z), lower.at(z)) for z in zs]
