@@ -29,6 +29,7 @@ THREAD_ROOT_SHARE = 0.65
 HALVES_TOLERANCE = 0.002   # of the view's size, at least END_MATCH_TOLERANCE_MM
 HALVES_SAMPLES = 4         # Z positions compared between two successive ends of outline pieces
 NAMED_HANDLES = 6
+MIRROR_OVERLAP = 0.9       # share of a thread root's length its mirror image below the axis covers
 
 
 @dataclass(frozen=True)
@@ -41,6 +42,7 @@ class Frame:
     recess: frozenset[int]            # id() of the lines bounding an open end's slot or recess
     radii: Radii
     steps: list[Segment]              # the outline's radial lines (shoulders)
+    axial: list[Segment]              # the view's lines along the axis
 
     def radius(self, z: float) -> float:
         return self.radii.at(z)
@@ -123,9 +125,21 @@ def a_thread_root(segment: Segment, frame: Frame) -> bool:
     face to end face (that is a thin-walled bore's wall: a thread ends before a face or shoulder)."""
     ends = sorted((segment.start[0], segment.end[0]))
     through = ends[0] <= frame.z_min + END_MATCH_TOLERANCE_MM and ends[1] >= frame.z_max - END_MATCH_TOLERANCE_MM
-    return is_axial(segment) and not through and all(
+    return is_axial(segment) and not through and mirrored_in(segment, frame.axial) and all(
         THREAD_ROOT_SHARE * frame.radius(z) <= abs(r) < frame.radius(z) + END_MATCH_TOLERANCE_MM
         for z, r in points_of(segment))
+
+
+def mirrored_in(line: Segment, axial: list[Segment]) -> bool:
+    """A line along the axis at the same radius on the other side, over most (MIRROR_OVERLAP)
+    of its length: a thread's root shows on both sides of the axis."""
+    z0, z1 = sorted((line.start[0], line.end[0]))
+    for other in axial:
+        o0, o1 = sorted((other.start[0], other.end[0]))
+        if abs(other.start[1] + line.start[1]) <= END_MATCH_TOLERANCE_MM \
+                and min(z1, o1) - max(z0, o0) >= MIRROR_OVERLAP * (z1 - z0):
+            return True
+    return False
 
 
 def in_an_open_end(segment: Segment, frame: Frame) -> bool:
@@ -139,7 +153,7 @@ def frame_of(framed: list[Segment], outline: list[Segment], open_radius: dict[fl
               for line in recess_lines(framed, face, radius)]
     steps = [s for s in outline if is_radial(s)]
     return Frame(outline, outline[-1].end[0], outline[0].start[0], open_radius, frozenset(map(id, recess)),
-                 Radii(outline), steps)
+                 Radii(outline), steps, [s for s in framed if is_axial(s)])
 
 
 def recess_lines(framed: list[Segment], face: float, radius: float) -> list[Segment]:

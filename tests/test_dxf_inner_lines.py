@@ -95,3 +95,13 @@ def test_a_slot_in_one_end_does_not_excuse_a_bore_in_the_other(tmp_path):
     with pytest.raises(DxfError) as refused:
         read_drawing(tmp_path / "slot_and_bore.dxf")
     assert "bore Ø2.000 from Z-5.000 to Z0.000" in str(refused.value)
+
+
+def test_a_root_line_on_one_side_only_is_no_thread(tmp_path):
+    """A thread shows its root on both sides of the axis; a line close under the outline above
+    the axis only (a flat, a keyway's edge) is not placed: refused by its handle."""
+    handle = shaft_with_inner_lines(tmp_path / "one_sided.dxf",
+                                    lambda msp: msp.add_line((-15, AXIS_Y + 11), (-30, AXIS_Y + 11)))
+    with pytest.raises(DxfError) as refused:
+        read_drawing(tmp_path / "one_sided.dxf")
+    assert "cannot place" in str(refused.value) and handle in str(refused.value)
