@@ -10,7 +10,7 @@ which lie inside others, is refused as the flat part (a plate) it is.
 from __future__ import annotations
 
 from .dxf_geometry import Segment
-from .dxf_profile import Chain, Profile, chain_segments, find_profile, merged_bounds
+from .dxf_profile import END_MATCH_TOLERANCE_MM, Chain, Profile, chain_segments, find_profile, merged_bounds
 from .dxf_read import DxfError
 from .dxf_side_view import Marks, side_view, side_view_of, symmetry_axis
 
@@ -31,13 +31,34 @@ def profile_of(segments: list[Segment], marks: Marks, layer: str) -> tuple[Profi
         return found.profile, found.notes, []
     chains = chain_segments(segments)
     try:
-        return find_profile(chains, layer=layer), [], chains
+        profile = find_profile(chains, layer=layer)
     except DxfError as refusal:
         axis = symmetry_axis(segments)
         if axis is None:
             raise plate_refusal(chains, layer) or refusal from None
         found = side_view(axis, segments, marks, f"layer {layer}")
         return found.profile, found.notes, []
+    check_not_a_view_off_the_axis(profile, segments, layer)
+    return profile, [], chains
+
+
+def check_not_a_view_off_the_axis(profile: Profile, segments: list[Segment], layer: str) -> None:
+    """A closed outline away from drawing Y 0 and symmetric (about a line of either direction)
+    reads two ways: a ring's section in the seed-000 convention (radius = drawing Y) or the whole
+    side view of a part drawn off Y 0 without its centre line. Which part it is, the drawing does
+    not say, so neither is made."""
+    if profile.closed_by_axis or profile.bounds[2] <= END_MATCH_TOLERANCE_MM:
+        return
+    axis = symmetry_axis(segments)
+    if axis is None:
+        return
+    z_min, z_max, low, high = profile.bounds
+    side = "below" if profile.mirrored else "above"
+    raise DxfError(f"layer {layer}: its closed outline lies {side} drawing Y 0 (radius {low:g} … {high:g}, Z{z_min:g} … "
+                   f"Z{z_max:g}) and is symmetric about {axis.source}: as drawn (radius = drawing Y) it is a ring's "
+                   f"section with a bore Ø{2 * low:g}, and internal turning is not supported; as a whole side view "
+                   "drawn off Y 0 it lacks its centre line; draw the part's half-profile on Y 0, or a centre line "
+                   "on its axis")
 
 
 def plate_refusal(chains: list[Chain], layer: str) -> DxfError | None:

@@ -6,7 +6,10 @@ the length of one view of the profile layer, with that view on both sides of it;
 one, a drawing that is not a half-profile is tried for mirror symmetry about the middle
 of its extents. The view is moved so the centre line is the axis (a vertical one turned to
 lie along Z) and its outline above the axis is taken (dxf_envelope), once dxf_turnable has
-found nothing a lathe cannot make from outside.
+found nothing a lathe cannot make from outside and dxf_inner_lines has found both halves
+alike and every line inside the outline of a kind that leaves the turned surface as it is.
+Outlines mirrored either side of a centre line that none of them reaches are a bored part's
+section drawn without hatching, refused.
 """
 from __future__ import annotations
 
@@ -16,6 +19,7 @@ from dataclasses import dataclass, field
 
 from .dxf_envelope import upper_envelope
 from .dxf_geometry import Arc, Line, Segment
+from .dxf_inner_lines import check_halves_agree, distance_to, frame_of, inner_lines_note
 from .dxf_profile import END_MATCH_TOLERANCE_MM, Profile, bounds, merged_bounds, sweep
 from .dxf_read import DxfError
 from .dxf_turnable import (check_no_bore, check_no_hidden_bore, check_no_prism, check_not_an_end_view,
@@ -68,6 +72,45 @@ class Marks:
 class SideView:
     profile: Profile
     notes: list[str]
+
+
+def split_section(segments: list[Segment], centre_lines: list[Line], where: str) -> DxfError | None:
+    """Outlines along a centre line on both sides of it, mirror images, none reaching it: the
+    cut faces of a bored part's section drawn without hatching, the bore between them."""
+    for line in centre_lines:
+        axis = centre_axis(line)
+        framed = [] if axis is None else [axis.segment(s) for view in views(segments)
+                                          if alongside(axis, line, view) for s in view]
+        if framed and min(bounds(s)[2] for s in framed) < 0.0 < max(bounds(s)[3] for s in framed) \
+                and mirror_images(framed, where, axis.source):
+            return split_section_refusal(framed, where, axis.source)
+    return None
+
+
+def mirror_images(framed: list[Segment], where: str, axis: str) -> bool:
+    try:
+        check_halves_agree(framed, upper_envelope(framed, where), where, axis)
+    except DxfError:
+        return False
+    return True
+
+
+def split_section_refusal(framed: list[Segment], where: str, axis: str) -> DxfError:
+    z_min, z_max, _, _ = merged_bounds(framed)
+    bore = 2 * min(min(abs(bounds(s)[2]), abs(bounds(s)[3])) for s in framed)
+    return DxfError(f"{where}: the view about {axis} is drawn as outlines either side of it that leave "
+                    f"Ø{bore:.3f} open along the axis from Z{z_min:.3f} to Z{z_max:.3f}: a section of a part "
+                    "with a bore (drawn without hatching); cutting the bore needs internal turning, which is not "
+                    "supported")
+
+
+def alongside(axis: Axis, line: Line, view: list[Segment]) -> bool:
+    """The view lies within the centre line's length, wholly on one side of it."""
+    x_min, x_max, y_min, y_max = merged_bounds(view)
+    along, across = ((y_min, y_max), (x_min, x_max)) if axis.vertical else ((x_min, x_max), (y_min, y_max))
+    ends = sorted((line.start[1], line.end[1]) if axis.vertical else (line.start[0], line.end[0]))
+    return (ends[0] - ALONG_SLACK_MM <= along[0] and along[1] <= ends[1] + ALONG_SLACK_MM
+            and (across[0] >= axis.offset - END_MATCH_TOLERANCE_MM or across[1] <= axis.offset + END_MATCH_TOLERANCE_MM))
 
 
 def centre_axis(line: Line) -> Axis | None:
@@ -142,19 +185,6 @@ def centred_views(segments: list[Segment], centre_lines: list[Line]) -> list[tup
     return found
 
 
-def distance_to(point: tuple[float, float], segment: Segment) -> float:
-    if isinstance(segment, Line):
-        (z0, r0), (z1, r1) = segment.start, segment.end
-        dz, dr = z1 - z0, r1 - r0
-        squared = dz * dz + dr * dr
-        t = 0.0 if squared == 0 else max(0.0, min(1.0, ((point[0] - z0) * dz + (point[1] - r0) * dr) / squared))
-        return math.dist(point, (z0 + t * dz, r0 + t * dr))
-    probe = Arc(segment.start, point, segment.centre, segment.ccw)
-    if sweep(probe) <= sweep(segment):
-        return abs(math.dist(point, segment.centre) - segment.radius)
-    return min(math.dist(point, segment.start), math.dist(point, segment.end))
-
-
 def samples(segment: Segment) -> list[tuple[float, float]]:
     if isinstance(segment, Line):
         (x0, y0), (x1, y1) = segment.start, segment.end
@@ -218,28 +248,49 @@ def side_view(axis: Axis, view: list[Segment], marks: Marks, where: str) -> Side
     check_no_bore([[axis.point(p) for p in polygon] for polygon in marks.hatches], z_min, z_max, where)
     check_no_hidden_bore([axis.segment(s) for s in marks.hidden], outline, where)
     check_no_prism(framed, outline, where)
+    check_symmetric_about(axis, view, framed, outline, where)
+    open_faces = open_radii(framed, outline)
+    inner = inner_lines_note(framed, frame_of(framed, outline, open_faces), where)
     profile = Profile(outline, True, merged_bounds(outline))
-    inside = len({s.handle for s in framed})
     turn = " (a vertical centre line: drawing Y is Z)" if axis.vertical else ""
     notes = [f"{where} is a side view: its half above {axis.source}{turn} is the profile, moved so that line is "
-             f"the axis; the lines inside its outline (edges, thread roots, slots; {inside} entities drawn in all) "
-             "are not turned surfaces and are left out"]
-    return SideView(profile, notes + open_face_notes(framed, outline, where))
+             f"the axis; {len({s.handle for s in framed})} entities drawn in all", inner]
+    return SideView(profile, notes + open_face_notes(open_faces, where))
 
 
-def open_face_notes(framed: list[Segment], outline: list[Segment], where: str) -> list[str]:
-    """An end face drawn only part of the way to the axis leaves a slot or recess open there,
-    which the job does not make: it faces the end to the axis."""
-    notes = []
+def check_symmetric_about(axis: Axis, view: list[Segment], framed: list[Segment], outline: list[Segment],
+                          where: str) -> None:
+    """A centre line is the axis only if the view is the same on both sides of it: a dash-dot
+    line beside the symmetry (a pitch line, a leader) is refused naming both lines."""
+    try:
+        check_halves_agree(framed, outline, where, axis.source)
+    except DxfError as refusal:
+        other = symmetry_axis(view)
+        if other is None or (other.vertical == axis.vertical and abs(other.offset - axis.offset)
+                             <= END_MATCH_TOLERANCE_MM):
+            raise
+        raise DxfError(f"{where}: {axis.source} (drawing {'X' if axis.vertical else 'Y'} {axis.offset:.3f}) is not "
+                       f"the view's axis: the view is symmetric about {other.source} instead; put the centre line "
+                       "on the part's axis") from refusal
+
+
+def open_radii(framed: list[Segment], outline: list[Segment]) -> dict[float, float]:
+    """Each end face's Z → the smallest radius it is drawn down to (0: to the axis)."""
+    found = {}
     for face in (outline[0].start[0], outline[-1].end[0]):
         at_face = [s for s in framed if isinstance(s, Line) and max(s.start[1], s.end[1]) > 0.0
                    and abs(s.start[0] - face) <= END_MATCH_TOLERANCE_MM >= abs(s.end[0] - face)]
-        lowest = min((max(min(s.start[1], s.end[1]), 0.0) for s in at_face), default=0.0)
-        if lowest > END_MATCH_TOLERANCE_MM:
-            notes.append(f"{where}: the end face at Z{face:.3f} is drawn down to radius {lowest:.3f} only; the slot or "
-                         f"recess it leaves open (Ø{2 * lowest:.3f} seen from the side) is not a turned surface and "
-                         "is not made: the job faces that end to the axis")
-    return notes
+        found[face] = min((max(min(s.start[1], s.end[1]), 0.0) for s in at_face), default=0.0)
+    return found
+
+
+def open_face_notes(open_faces: dict[float, float], where: str) -> list[str]:
+    """An end face drawn only part of the way to the axis leaves a slot or recess open there,
+    which the job does not make: it faces the end to the axis."""
+    return [f"{where}: the end face at Z{face:.3f} is drawn down to radius {lowest:.3f} only; the slot or "
+            f"recess it leaves open (Ø{2 * lowest:.3f} seen from the side) is not a turned surface and "
+            "is not made: the job faces that end to the axis"
+            for face, lowest in open_faces.items() if lowest > END_MATCH_TOLERANCE_MM]
 
 
 def side_view_of(segments: list[Segment], marks: Marks, layer: str) -> SideView | None:
@@ -247,6 +298,9 @@ def side_view_of(segments: list[Segment], marks: Marks, layer: str) -> SideView 
     DxfError when only views along the axis are found or two side views compete."""
     candidates = centred_views(segments, marks.centre_lines)
     if not candidates:
+        split = split_section(segments, marks.centre_lines, f"layer {layer}")
+        if split is not None:
+            raise split
         return None
     found, refusals = [], []
     for axis, view in candidates:
