@@ -43,3 +43,20 @@ def test_a_rapid_from_one_plunge_to_the_next_across_the_material_between_is_refu
                Move("rapid", FIN_FRONT, 42), Move("rapid", FIN_FRONT, 20), Move("rapid", FIN_BACK, 20)]
     with pytest.raises(EngineError, match="G00"):
         check_rapids_in_air(Blank(0.0, -50.0, BLANK_RADIUS, False), {1: [plunges]}, {1: "GROOVE"}, (100.0, 50.0))
+
+
+def test_the_assumed_blank_reaches_as_far_in_z_as_the_job_feeds():
+    """Without a stored stock the blank is assumed as large as the job suggests (fail closed):
+    its radius covers every feed, and so must its Z. A facing feed at Z+1 in front of a profile
+    ending at Z0 says the blank stands 1 mm in front of the part; the rough's approach G00 to
+    Z+0.5 at Ø24 runs into that stock before the face is cut."""
+    from engine.turning.material import job_blank
+    profile_front, profile_back, profile_top = 0.0, -50.0, 15.0
+    face_z = 1.0
+    rough = [Move("rapid", 0.5, 24), Move("feed", -20.0, 24), Move("feed", -20.0, 40)]
+    face = [Move("rapid", face_z, 34), Move("feed", face_z, 0), Move("feed", face_z + 1, 0)]
+    passes = {1: [rough], 2: [face]}
+    blank = job_blank(None, (profile_front, profile_back, profile_top), passes)
+    assert blank.z_front >= face_z
+    with pytest.raises(EngineError, match="G00"):
+        check_rapids_in_air(blank, passes, {1: "ROUGH", 2: "FACE"}, (100.0, 50.0))
