@@ -3,6 +3,8 @@ through air only; a rapid that crosses material left standing by the job's own f
 tool, however thin the material is along the rapid's way."""
 from __future__ import annotations
 
+import json
+
 import pytest
 
 from engine.errors import EngineError
@@ -60,3 +62,65 @@ def test_the_assumed_blank_reaches_as_far_in_z_as_the_job_feeds():
     assert blank.z_front >= face_z
     with pytest.raises(EngineError, match="G00"):
         check_rapids_in_air(blank, passes, {1: "ROUGH", 2: "FACE"}, (100.0, 50.0))
+
+
+FACE_Z, FACE_TOP_RADIUS = 1.0, 17.0   # the drawn facing feed: Z+1 from radius 17 to the axis
+
+
+def facing_allowance_drawing(path) -> None:
+    """A Ø20 bar Z0…Z-50 (layer 0), a ROUGH path at radius 12 from Z+0.5 (layer 1) and a FACE
+    path at Z+1 from radius 17 down to the axis (layer 2): the drawing says the blank stands 1 mm
+    in front of the part's face and reaches radius 17."""
+    import ezdxf
+    doc = ezdxf.new("R2010")
+    doc.header["$INSUNITS"] = 4
+    for name in ("1", "2"):
+        doc.layers.add(name)
+    msp = doc.modelspace()
+    msp.add_line((0, 0), (0, 10))
+    msp.add_line((0, 10), (-50, 10))
+    msp.add_line((-50, 10), (-50, 0))
+    msp.add_text("@GROUGH @S500 @F200 @T01", dxfattribs={"layer": "1", "insert": (5, 40)})
+    msp.add_line((0.5, 12), (-20, 12), dxfattribs={"layer": "1"})
+    msp.add_text("@GFACE @S500 @F100 @T02", dxfattribs={"layer": "2", "insert": (5, 50)})
+    msp.add_line((FACE_Z, FACE_TOP_RADIUS), (FACE_Z, 0), dxfattribs={"layer": "2"})
+    doc.saveas(path)
+
+
+def g0_moves(lines: list[str]):
+    """(start, end) in (Z, radius) of every G0 line of a program, from the position before it
+    (X as a diameter, both words modal)."""
+    import re
+    z = x = None
+    found = []
+    for line in lines:
+        words = dict(re.findall(r"\b([XZ])(-?\d+(?:\.\d+)?)", line))
+        if not words:
+            continue
+        new_z, new_x = float(words.get("Z", z if z is not None else "nan")), float(words.get("X", x if x is not None else "nan"))
+        if z is not None and x is not None and re.match(r"\s*(N\d+\s+)?G0?0\b", line):
+            found.append(((z, x / 2), (new_z, new_x / 2)))
+        z, x = new_z, new_x
+    return found
+
+
+def in_front_stock(point) -> bool:
+    return 0.01 < point[0] < FACE_Z - 0.01 and point[1] < FACE_TOP_RADIUS - 0.01
+
+
+def test_no_rapid_runs_through_the_facing_allowance_the_drawing_shows(run, tmp_path):
+    """Without --stock-diameter the engine assumes the blank from the job; the FACE path at Z+1
+    shows stock in front of Z0, so the ROUGH's approach G00 down to Ø28 at Z+0.5 runs through it.
+    The import must refuse, or emit no G00 through that stock."""
+    path = tmp_path / "face.dxf"
+    facing_allowance_drawing(path)
+    made = run("import-dxf", path, "--machine", "lathe-840d", "--program-name", "FACEA", "--json")
+    if made.exit_code == 1:
+        return
+    assert made.exit_code == 0, made.output
+    program = run("instantiate", "--job", json.loads(made.stdout)["job_id"], "--dry-run")
+    assert program.exit_code == 0, program.output
+    through = [(start, end) for start, end in g0_moves(program.stdout.splitlines())
+               if any(in_front_stock((start[0] + (end[0] - start[0]) * k / 100, start[1] + (end[1] - start[1]) * k / 100))
+                      for k in range(101))]
+    assert through == []
