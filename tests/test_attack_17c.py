@@ -4,11 +4,13 @@ tool, however thin the material is along the rapid's way."""
 from __future__ import annotations
 
 import json
+import re
 
+import ezdxf
 import pytest
 
 from engine.errors import EngineError
-from engine.turning.material import Blank, check_rapids_in_air
+from engine.turning.material import Blank, check_rapids_in_air, job_blank
 from engine.turning.moves import Move
 
 BLANK_RADIUS = 20.0                       # a Ø40 blank, Z0 … Z-50
@@ -52,7 +54,6 @@ def test_the_assumed_blank_reaches_as_far_in_z_as_the_job_feeds():
     its radius covers every feed, and so must its Z. A facing feed at Z+1 in front of a profile
     ending at Z0 says the blank stands 1 mm in front of the part; the rough's approach G00 to
     Z+0.5 at Ø24 runs into that stock before the face is cut."""
-    from engine.turning.material import job_blank
     profile_front, profile_back, profile_top = 0.0, -50.0, 15.0
     face_z = 1.0
     rough = [Move("rapid", 0.5, 24), Move("feed", -20.0, 24), Move("feed", -20.0, 40)]
@@ -71,7 +72,6 @@ def facing_allowance_drawing(path) -> None:
     """A Ø20 bar Z0…Z-50 (layer 0), a ROUGH path at radius 12 from Z+0.5 (layer 1) and a FACE
     path at Z+1 from radius 17 down to the axis (layer 2): the drawing says the blank stands 1 mm
     in front of the part's face and reaches radius 17."""
-    import ezdxf
     doc = ezdxf.new("R2010")
     doc.header["$INSUNITS"] = 4
     for name in ("1", "2"):
@@ -90,7 +90,6 @@ def facing_allowance_drawing(path) -> None:
 def g0_moves(lines: list[str]):
     """(start, end) in (Z, radius) of every G0 line of a program, from the position before it
     (X as a diameter, both words modal)."""
-    import re
     z = x = None
     found = []
     for line in lines:
