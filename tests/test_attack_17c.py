@@ -59,10 +59,11 @@ def test_the_assumed_blank_reaches_as_far_in_z_as_the_job_feeds():
     rough = [Move("rapid", 0.5, 24), Move("feed", -20.0, 24), Move("feed", -20.0, 40)]
     face = [Move("rapid", face_z, 34), Move("feed", face_z, 0), Move("feed", face_z + 1, 0)]
     passes = {1: [rough], 2: [face]}
-    blank = job_blank(None, (profile_front, profile_back, profile_top), passes)
+    kinds = {1: "ROUGH", 2: "FACE"}   # the blank stands where a FACE operation cuts its face
+    blank = job_blank(None, (profile_front, profile_back, profile_top), passes, kinds)
     assert blank.z_front >= face_z
     with pytest.raises(EngineError, match="G00"):
-        check_rapids_in_air(blank, passes, {1: "ROUGH", 2: "FACE"}, (100.0, 50.0))
+        check_rapids_in_air(blank, passes, kinds, (100.0, 50.0))
 
 
 FACE_Z, FACE_TOP_RADIUS = 1.0, 17.0   # the drawn facing feed: Z+1 from radius 17 to the axis

@@ -100,11 +100,13 @@ def test_the_tool_change_between_operations_is_a_rapid_too():
 
 def test_without_a_stored_blank_the_largest_the_job_suggests_is_assumed():
     """No stock: the profile's largest radius plus the 2 mm on the diameter import-dxf puts on a
-    profile-only blank (1 mm on the radius), or the largest radius a feed cuts at, whichever is larger."""
+    profile-only blank (1 mm on the radius), or the largest radius a feed cuts at, whichever is larger;
+    in Z the profile's extent (stretched only by a FACE operation's cut: see the attack tests of issue 17)."""
     profile = (0.0, -40.0, 10.0)      # (Z front, Z back, largest radius)
     feeds_low = {1: [[g0(1, 30), g1(1, 9), g1(-40, 9)]]}
     feeds_high = {1: [[g0(1, 30), g1(1, 13), g1(-40, 13)]]}
     assert job_blank(None, profile, feeds_low) == Blank(0.0, -40.0, 10.0 + 2.0 / 2, assumed=True)
+    assert job_blank(None, profile, feeds_low, {1: "FACE"}) == Blank(1.0, -40.0, 10.0 + 2.0 / 2, assumed=True)
     assert job_blank(None, profile, feeds_high).radius == 13.0
     assert job_blank((2.0, -45.0, 25.0), profile, feeds_high) == Blank(2.0, -45.0, 25.0, assumed=False)
 

@@ -4,9 +4,10 @@ rapid (G0) runs through air only: a rapid into uncut material breaks the tool or
 The blank. The stored stock (params.stock_diameter, stock_z_front, stock_z_back). Without a
 stored diameter (a drawing with operation layers imported without --stock-diameter) nothing
 says how large the blank is, so it is assumed as large as the job suggests (fail closed):
-between stock_z_back and stock_z_front (the profile's Z extent), of the larger radius of the
-profile's largest + ASSUMED_BLANK_MARGIN_MM (the blank import-dxf assumes for a profile-only
-drawing, STOCK_MARGIN on the diameter) and the largest radius a feed of the job cuts at.
+between stock_z_back and stock_z_front (the profile's Z extent, stretched to every Z a feed of
+its FACE operations feed along X at: a facing cut at Z+1 says the blank stands in front of the part), of the larger
+radius of the profile's largest + ASSUMED_BLANK_MARGIN_MM (the blank import-dxf assumes for a
+profile-only drawing, STOCK_MARGIN on the diameter) and the largest radius a feed of the job cuts at.
 
 What a feed removes (the chip of a turning cut). An outside turning tool's body stands
 radially outside its tip, so wherever a feed takes the tip, the radial column above it is
@@ -35,8 +36,9 @@ from .operations import JobGeometry
 
 AIR_TOLERANCE_MM = 0.01        # a rapid touching the material within this is in the air (float noise)
 ASSUMED_BLANK_MARGIN_MM = STOCK_MARGIN / 2.0   # radial: import-dxf's default blank over the profile
-SAMPLE_STEP_MM = 0.05          # along a rapid: material thinner than this between samples is not seen
+SAMPLE_STEP_MM = 0.05          # along a rapid, between the Zs where the material's height changes course
 COINCIDENT_MM = 1e-6           # a rapid back along a plunge runs at the plunge's own Z
+TURN_NUDGE_MM = 1e-4           # beside a turn of the height: past COINCIDENT_MM, well inside AIR_TOLERANCE_MM
 BISECTIONS = 30                # an entry into the material found to 2⁻³⁰ of a sample step
 BUCKET_MM = 1.0                # Z width of one cell of the cut index
 
@@ -53,14 +55,28 @@ class Blank:
 
 
 def job_blank(stock: tuple[float, float, float] | None, profile_extent: tuple[float, float, float],
-              passes: dict[int, list[Pass]]) -> Blank:
+              passes: dict[int, list[Pass]], kinds: dict[int, str] | None = None) -> Blank:
     """The stored stock (z_front, z_back, radius), else the blank assumed (see the module's docstring);
     profile_extent is (z_front, z_back, largest radius) of the profile."""
     if stock is not None:
         return Blank(*stock, assumed=False)
     z_front, z_back, top = profile_extent
-    cut_at = [move.x / 2.0 for found in passes.values() for one in found for move in one if move.kind != "rapid"]
-    return Blank(z_front, z_back, max([top + ASSUMED_BLANK_MARGIN_MM, *cut_at]), assumed=True)
+    feeds = [move for found in passes.values() for one in found for move in one if move.kind != "rapid"]
+    faced = _facing_zs(passes, kinds or {})
+    return Blank(max([z_front, *faced]), min([z_back, *faced]),
+                 max([top + ASSUMED_BLANK_MARGIN_MM, *(move.x / 2.0 for move in feeds)]), assumed=True)
+
+
+def _facing_zs(passes: dict[int, list[Pass]], kinds: dict[int, str]) -> list[float]:
+    """The Zs where a FACE operation feeds along X: the face it cuts stands there, so the blank does
+    too. Other feeds say nothing about the blank's Z: an infeed or a run-in starts in the air in
+    front of the part."""
+    zs = []
+    for one in (one for n, found in passes.items() if kinds.get(n) == "FACE" for one in found):
+        for before, move in zip(one, one[1:]):
+            if move.kind != "rapid" and move.z == before.z and move.x != before.x:
+                zs.append(move.z)
+    return zs
 
 
 @dataclass(frozen=True)
@@ -130,12 +146,27 @@ class Material:
             return self._radial_length_inside(start[0], *sorted((start[1], end[1])))
         along = _along(start, end)
         count = max(1, math.ceil(math.dist(start, end) / SAMPLE_STEP_MM))
-        inside = [self.holds(along(k / count)) for k in range(count + 1)]
-        stretches = [self._stretch(along, k / count, (k + 1) / count, inside[k], inside[k + 1])
-                     for k in range(count) if inside[k] or inside[k + 1]]
+        fractions = sorted({k / count for k in range(count + 1)} | self._turns(start, end))
+        inside = [self.holds(along(t)) for t in fractions]
+        stretches = [self._stretch(along, a, b, inside[k], inside[k + 1])
+                     for k, (a, b) in enumerate(zip(fractions, fractions[1:])) if inside[k] or inside[k + 1]]
         if not stretches:
             return 0.0, None
         return sum(hi - lo for lo, hi in stretches) * math.dist(start, end), along(sum(stretches[0]) / 2.0)
+
+    def _turns(self, start: Point, end: Point) -> set[float]:
+        """Fractions of the rapid just either side of each Z where the material's height changes
+        course (an end of a cut, a cell's edge, a face of the blank): a rib narrower than the
+        sampling step stands between two such Zs, so it is sampled whatever its width."""
+        (z0, _), (z1, _) = start, end
+        if z0 == z1:
+            return set()
+        low, high = sorted((z0, z1))
+        cells = range(_cell(low), _cell(high) + 1)
+        edges = {self.blank.z_front, self.blank.z_back, *(cell * BUCKET_MM for cell in cells),
+                 *(cut_end[0] for cell in cells for cut in self.cells.get(cell, ()) for cut_end in (cut.start, cut.end))}
+        nudged = {edge + side * TURN_NUDGE_MM for edge in edges for side in (-1, 1)}
+        return {(z - z0) / (z1 - z0) for z in nudged if low < z < high}
 
     def _radial_length_inside(self, z: float, low: float, high: float) -> tuple[float, Point | None]:
         """A rapid along X only: the material at its Z is one stretch, from the axis up to the height."""
@@ -172,8 +203,8 @@ def check_job_rapids(geometry: JobGeometry, params: dict, module_params: dict, p
     """The one check of every turning job's rapids (model.planned_passes): import-dxf, and every
     program made again from a stored job."""
     z_back, z_front, _, top = merged_bounds(geometry.outline)
-    blank = job_blank(geometry.stock, (z_front, z_back, top), passes)
     kinds = {n: module_params[f"cutmotion:{n}"]["kind"] for n in passes}
+    blank = job_blank(geometry.stock, (z_front, z_back, top), passes, kinds)
     check_rapids_in_air(blank, passes, kinds, (float(params["tool_change_z"]), geometry.tool_change_radius))
 
 
