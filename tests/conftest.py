@@ -146,3 +146,21 @@ def run(fresh_database_url):
         return CliRunner().invoke(main, ["--database-url", fresh_database_url, *map(str, args)])
     invoke.url = fresh_database_url
     return invoke
+
+
+@pytest.fixture
+def engine(fresh_database_url, tmp_path):
+    """The CLI on a private seeded database, with an empty config file of the test's own (so a
+    developer's ENGINE_CONFIG or output folder never reaches a test): engine("instantiate", ...)."""
+    from click.testing import CliRunner
+
+    from engine.cli.app import main
+
+    config = tmp_path / "config.toml"
+    config.write_text("")
+
+    def invoke(*args):
+        return CliRunner().invoke(main, ["--database-url", fresh_database_url, *map(str, args)],
+                                  env={"ENGINE_CONFIG": str(config), "ENGINE_INSTANTIATE_OUT": None})
+    invoke.url, invoke.config = fresh_database_url, config
+    return invoke

@@ -10,9 +10,7 @@ import re
 
 import psycopg
 import pytest
-from click.testing import CliRunner
 
-from engine.cli.app import main
 from engine.library.nc_import import import_nc
 from engine.templates.decision_table import compiled_template
 from engine.templates.store import load_template
@@ -24,18 +22,6 @@ DEMO = NC / "linuxcnc" / "lathe_g70_71_demo.ngc"          # G71/G70 call the con
 CAM = NC / "sinumerik" / "cam_840dsl" / "CAM_TEST.MPF"     # Siemens: D1 (tool edge), SETMS(1) (spindle)
 CRLF, LF = "\r\n", "\n"
 
-
-@pytest.fixture
-def engine(fresh_database_url, tmp_path):
-    """The CLI on a private seeded database, with an empty config file of the test's own."""
-    config = tmp_path / "config.toml"
-    config.write_text("")
-
-    def invoke(*args):
-        return CliRunner().invoke(main, ["--database-url", fresh_database_url, *map(str, args)],
-                                  env={"ENGINE_CONFIG": str(config), "ENGINE_INSTANTIATE_OUT": None})
-    invoke.url = fresh_database_url
-    return invoke
 
 
 def one_line_error(result) -> bool:

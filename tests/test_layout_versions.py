@@ -11,26 +11,12 @@ import json
 
 import psycopg
 import pytest
-from click.testing import CliRunner
 
-from engine.cli.app import main
 
 from test_records import logins
 
 CRLF, LF = "\r\n", "\n"
 
-
-@pytest.fixture
-def engine(fresh_database_url, tmp_path):
-    """The CLI on a private seeded database, with an empty config file of the test's own."""
-    config = tmp_path / "config.toml"
-    config.write_text("")
-
-    def invoke(*args):
-        return CliRunner().invoke(main, ["--database-url", fresh_database_url, *map(str, args)],
-                                  env={"ENGINE_CONFIG": str(config), "ENGINE_INSTANTIATE_OUT": None})
-    invoke.url = fresh_database_url
-    return invoke
 
 
 @pytest.fixture

@@ -14,25 +14,11 @@ import re
 
 import psycopg
 import pytest
-from click.testing import CliRunner
 
-from engine.cli.app import main
 from engine.templates.release import release
 
 CRLF, LF = "\r\n", "\n"
 
-
-@pytest.fixture
-def engine(fresh_database_url, tmp_path):
-    """The CLI on a private seeded database with a config file of the test's own (engine.config)."""
-    config = tmp_path / "config.toml"
-    config.write_text("")
-
-    def invoke(*args):
-        return CliRunner().invoke(main, ["--database-url", fresh_database_url, *map(str, args)],
-                                  env={"ENGINE_CONFIG": str(config), "ENGINE_INSTANTIATE_OUT": None})
-    invoke.url, invoke.config = fresh_database_url, config
-    return invoke
 
 
 def set_layout(url: str, gear_class: str, ending: str, final_newline: bool) -> None:
