@@ -11,7 +11,7 @@ import pytest
 from psycopg.conninfo import conninfo_to_dict, make_conninfo
 from psycopg.pq import TransactionStatus
 
-from database_pool import DatabasePool, create_database
+from helpers.database_pool import DatabasePool, create_database
 
 # No config file of the user running the suite (README, "Configuration"): the tests of the
 # config file name their own with ENGINE_CONFIG.
@@ -52,7 +52,7 @@ def _create(server_url: str, database: str, template: str | None = None) -> str:
 
 @pytest.fixture(scope="session")
 def database_pool(server_url):
-    """The databases of the session's tests, made ahead and dropped behind (tests/database_pool.py)."""
+    """The databases of the session's tests, made ahead and dropped behind (tests/helpers/database_pool.py)."""
     pool = DatabasePool(server_url)
     yield pool
     pool.close()

@@ -11,7 +11,7 @@ import psycopg
 import pytest
 
 from engine.paths import SAMPLE_DRAWING
-from lathe_programs import motions, operation_lines
+from helpers.lathe_programs import motions, operation_lines
 from test_instantiate_class import import_emco
 
 AXIS_Y = 30.0                 # drawing Y of the part's axis (the view is drawn off Y = 0)

@@ -12,7 +12,7 @@ from pathlib import Path
 import psycopg
 import pytest
 from psycopg import sql
-from roles import as_role
+from helpers.roles import as_role
 
 from engine.programs.instantiate import instantiate_gear, instantiate_gears
 

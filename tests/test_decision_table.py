@@ -7,7 +7,7 @@ from engine.programs.instantiate import instantiate_gear
 from engine.templates.decision_table import CompiledTemplate, TemplateError
 from engine.templates.rows import TemplateRow
 from engine.templates.store import ensure_class, load_template, replace_template
-from releases import release_draft
+from helpers.releases import release_draft
 
 
 def make_template(conn, name, rows):

@@ -27,7 +27,7 @@ from engine.hobbing.choices import FEED_MODES, Choices
 from engine.hobbing.duplex import DuplexModel
 from engine.programs.instantiate import instantiate_gear
 
-from nc_reader import read_program
+from helpers.nc_reader import read_program
 
 SEED_HOBS = Path(__file__).resolve().parent.parent / "seed_templates" / "hobs.csv"
 MARGIN = 0.5            # mm: the least clearance a program may leave (the engine keeps more)

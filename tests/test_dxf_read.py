@@ -23,7 +23,7 @@ from importers.dxf_drawing import read_drawing
 from importers.dxf_geometry import FLATTEN_TOLERANCE_MM, Arc, Line
 from importers.dxf_profile import chain_segments
 from importers.dxf_read import DxfError, load_drawing_file
-from shared_data import shared_data
+from helpers.shared_data import shared_data
 
 
 DATA = shared_data()

@@ -1,6 +1,6 @@
 """The geometry of the programs of every gear class (issue 3), checked against formulas of
 docs/reference/hobbing.md computed here from the gear, hob and machine rows read with SQL, and
-read with tests/nc_reader.py (no engine code reads the programs).
+read with tests/helpers/nc_reader.py (no engine code reads the programs).
 
 Seeded gears: 50 the paper's taper gear (m2 z19 d_a 42.5 δ 6.5° 40Cr grade 7), 51 crowned
 (m2.5 z32 b30 C_β 0.02), 53 worm wheel (m3 z40 β 4.05° R), 54 duplex (m2 z30 b20 over a
@@ -17,7 +17,7 @@ from engine.errors import EngineError
 from engine.hobbing.choices import Choices
 from engine.programs.instantiate import instantiate_gear
 
-from nc_reader import read_program
+from helpers.nc_reader import read_program
 
 ROUND = 0.0015   # mm: the program writes 3 decimals; a difference of two rounded values
 

@@ -1,8 +1,8 @@
 """Every seeded gear under every set of job choices, and every golden turning job, instantiates to
-the bytes of its golden file (tests/golden_cases.py says how the files were made and why)."""
+the bytes of its golden file (tests/helpers/golden_cases.py says how the files were made and why)."""
 import pytest
 
-from golden_cases import (hobbing_cases, hobbing_file, hobbing_text, turning_cases, turning_file, turning_text,
+from helpers.golden_cases import (hobbing_cases, hobbing_file, hobbing_text, turning_cases, turning_file, turning_text,
                           without_iso_program_number)
 
 

@@ -1,4 +1,4 @@
-"""The 3-D hob envelope of the reference tests (tests/hobbing_envelope.py) against dense samples of
+"""The 3-D hob envelope of the reference tests (tests/helpers/hobbing_envelope.py) against dense samples of
 the hob's tip cylinder, on gear 43's infeed where the old XZ shadow saw a collision, and the taper's
 root-cone check on the paper's gear (reference §B3, §B12, §D)."""
 from __future__ import annotations
@@ -8,9 +8,9 @@ import math
 import numpy as np
 import pytest
 
-from hobbing_checks import Case, depth_problems
-from hobbing_envelope import Solid, Sweep, intrusion
-from hobbing_reference import Gear, Hob, Unit, read
+from helpers.hobbing_checks import Case, depth_problems
+from helpers.hobbing_envelope import Solid, Sweep, intrusion
+from helpers.hobbing_reference import Gear, Hob, Unit, read
 
 
 def sampled_depth(sweep: Sweep, solid: Solid, r0: float, length: float) -> float:

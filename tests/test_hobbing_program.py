@@ -2,7 +2,7 @@
 
 Every expected number is computed here, independently of the engine, from the formulas
 of the reference (docs/reference/hobbing.md §A5, §B) and the data in the gear, hob and
-machine tables (read with SQL). The programs are read with tests/nc_reader.py, which
+machine tables (read with SQL). The programs are read with tests/helpers/nc_reader.py, which
 shares no code with engine.programs.verifier.
 
 Seeded gears: 42 spur m2 z19 (one cut), 45 spur m4 z25 (rough + finish), 43 helical R
@@ -18,7 +18,7 @@ import pytest
 from engine.hobbing.choices import Choices
 from engine.programs.instantiate import instantiate_gear
 
-from nc_reader import Block, Move, Program, read_program
+from helpers.nc_reader import Block, Move, Program, read_program
 
 SPUR = [42, 45]
 HELICAL = [43, 44]

@@ -1,8 +1,8 @@
 """Acceptance tests of issue 14 ("Must show"), from the reference, not from the engine's code.
 
 Programs are made through the public library function (engine.programs.instantiate.instantiate_gear)
-and the CLI, for gears, hobs and a machine inserted here, and read with tests/hobbing_reference.py;
-the checks (tests/hobbing_checks.py) compute every expected number from docs/reference/hobbing.md
+and the CLI, for gears, hobs and a machine inserted here, and read with tests/helpers/hobbing_reference.py;
+the checks (tests/helpers/hobbing_checks.py) compute every expected number from docs/reference/hobbing.md
 §A5, §A7, §B, §C and design notes §7:
 
 * EGON B ratio −h_hob·z0 : z2, helical Z factor −h_gear·360 sinβ/(π mn z2), swivel A = h_hob·γ − h_gear·β,
@@ -30,13 +30,13 @@ from engine.errors import EngineError
 from engine.hobbing.choices import Choices
 from engine.programs.instantiate import instantiate_gear
 
-from hobbing_checks import (Case, Job, approach_problems, contract_problems, coupling_problems, depth_problems,
+from helpers.hobbing_checks import (Case, Job, approach_problems, contract_problems, coupling_problems, depth_problems,
                             envelope_problems, feed_problems)
-from hobbing_machine_checks import all_problems, cycle_time_problems, obstacle_problems, table_speed_problems
-from hobbing_reference import Gear, Hob, Unit, layout_cuttable, lead_angle, read
-from hobbing_reference_gears import (DIN, MIRROR, PAPER_STOCK, REVERSED, STOCK, cylindrical, insert_gear, insert_hob,
+from helpers.hobbing_machine_checks import all_problems, cycle_time_problems, obstacle_problems, table_speed_problems
+from helpers.hobbing_reference import Gear, Hob, Unit, layout_cuttable, lead_angle, read
+from helpers.hobbing_reference_gears import (DIN, MIRROR, PAPER_STOCK, REVERSED, STOCK, cylindrical, insert_gear, insert_hob,
                                      insert_machine, make_gear, make_hob, only_hob, read_machine, TOOL_NUMBER)
-from hobbing_reference_programs import HAND_WRITTEN
+from helpers.hobbing_reference_programs import HAND_WRITTEN
 
 
 

@@ -17,7 +17,7 @@ import pytest
 from psycopg import errors
 from psycopg.types.json import Jsonb
 
-from shared_data import shared_data
+from helpers.shared_data import shared_data
 
 DATA = shared_data()
 EMCO_DRAWING = DATA / "dxf" / "emco_lathe_testNegDXF_R14.dxf"

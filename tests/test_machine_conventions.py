@@ -14,7 +14,7 @@ import pytest
 
 from engine.hobbing.choices import Choices
 from engine.programs.instantiate import instantiate_gear
-from nc_reader import read_program
+from helpers.nc_reader import read_program
 from test_verifier import accepted, refusal
 
 # Seeded gears (seed_templates/gears.csv), one per class, and the helix given to classes whose

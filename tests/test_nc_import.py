@@ -28,7 +28,7 @@ from engine.templates.expressions import compile_expression
 from engine.templates.rows import export_csv, parse_csv
 from engine.templates.store import ensure_class, load_template, replace_template
 
-from shared_data import shared_data
+from helpers.shared_data import shared_data
 
 DATA = shared_data() / "nc"
 FAMILY = "linuxcnc/plasmac_family/"

@@ -20,7 +20,7 @@ from psycopg.types.json import Jsonb
 from engine.errors import EngineError
 from engine.gears.cases import confirm_job
 from engine.programs.instantiate import instantiate_gear, instantiate_gears
-from roles import as_role
+from helpers.roles import as_role
 
 # The engine's path for one program (engine.programs.storage): an id drawn from the sequence first,
 # so that the program's lineage line can name it.

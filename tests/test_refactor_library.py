@@ -21,7 +21,7 @@ from engine.templates.evaluator import evaluate
 from engine.templates.expressions import compile_expression
 from engine.templates.store import load_template, replace_template
 
-from lineage_text import id_masked
+from helpers.lineage_text import id_masked
 from test_nc_import import DATA, FAMILY, PARAMS, class_name, instantiate, real_files
 from test_refactor import bodies_stored_twice, component_count, duplicate_row_body, exports
 

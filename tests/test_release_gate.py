@@ -19,7 +19,7 @@ from engine.templates.rows import Template, TemplateRow
 from engine.templates.store import load_template
 from engine.templates.versions import released_template, released_version
 
-from roles import as_role
+from helpers.roles import as_role
 
 SEEDED_CLASSES = ("spur", "helical", "duplex", "taper", "crowned", "worm_wheel", "turning_iso", "turning_840d")
 COOLANT_ROW = 1800   # seed_templates/classes/spur.csv: cutcond 1, `"M8"` when coolant

@@ -20,8 +20,8 @@ from engine.library.nc_import import import_nc
 from engine.programs.class_jobs import instantiate_class
 from engine.templates.release import release
 
-from roles import as_role
-from shared_data import shared_data
+from helpers.roles import as_role
+from helpers.shared_data import shared_data
 from test_instantiate_class import PAWN, import_emco, ok, refused, stored_program
 
 NC = shared_data() / "nc"

@@ -18,9 +18,9 @@ from engine.errors import EngineError
 from engine.programs.instantiate import instantiate_gear
 from engine.programs.lineage import LINEAGE_ROW_ID
 from engine.simulation import simulate_stored_program
-from lineage_text import id_masked
-from releases import release_draft
-from roles import as_role
+from helpers.lineage_text import id_masked
+from helpers.releases import release_draft
+from helpers.roles import as_role
 from test_dxf_read import DXF, EMCO, seed_drawing
 
 SEEDED_GEARS = (42, 43, 44, 45, 46, 47, 50, 51, 53, 54)   # seed_templates/gears.csv: every hobbing class

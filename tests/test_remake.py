@@ -4,7 +4,7 @@ import json
 
 import psycopg
 
-from lineage_text import LINES_ID_MASKED
+from helpers.lineage_text import LINES_ID_MASKED
 
 
 def programs(url, where=""):

@@ -1,7 +1,7 @@
 """The sample drawing users copy (issue 17): seed_templates/drawings/sample_shaft.dxf, in the
 seed-000 convention, ships with the engine and becomes a job with exactly the operations it
 draws. Every expected value is read from the DXF here with ezdxf (codes, tool-change POINT,
-paths), and the program is read with tests/lathe_programs.py, not with the engine's reader."""
+paths), and the program is read with tests/helpers/lathe_programs.py, not with the engine's reader."""
 from __future__ import annotations
 
 import ast
@@ -22,7 +22,7 @@ from engine.gears.records import load_machine
 from engine.paths import SAMPLE_DRAWING, SEED_DIR, data_folder
 from engine.programs.demo import sample_turning_job
 from engine.programs.verifier import verify_program
-from lathe_programs import distance_to_drawn, drawn_polylines, motions, operation_lines, words
+from helpers.lathe_programs import distance_to_drawn, drawn_polylines, motions, operation_lines, words
 
 ROOT = Path(__file__).resolve().parent.parent
 KINDS = ["ROUGH", "SLOT", "FINISH", "THREAD"]

@@ -1,6 +1,6 @@
 """Wrong hobbing programs the simulation used to let through (issue 14's adversary), each
 hand-written for gear 43 (helical m3 z41 β15 R) and hob H-M3-AA-R1 (R, Ø80, L120) in the style
-of tests/simulation_programs.py, with every expected number from the reference
+of tests/helpers/simulation_programs.py, with every expected number from the reference
 (docs/reference/hobbing.md §B8, §B15, §C): each is refused on the line that makes it."""
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ import pytest
 from engine.gears.records import GearUnit, load_gear, load_hobs, load_machine
 from engine.simulation import simulate_program
 
-from simulation_programs import Hand, k_z, least_run_out, number_of, swivel
+from helpers.simulation_programs import Hand, k_z, least_run_out, number_of, swivel
 
 MACHINE = "hobber-840d"
 SPEED = 338.0                  # n0 of gear 43's seeded program: table n0·z0/z2 = 8.244 r/min (§B4)

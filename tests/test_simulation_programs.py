@@ -1,5 +1,5 @@
 """The simulation (engine.simulation) on hand-written programs whose every number comes from the
-reference (tests/simulation_programs.py): the right program is clean and its summary is the
+reference (tests/helpers/simulation_programs.py): the right program is clean and its summary is the
 reference's; each mistake is refused with the line that makes it."""
 from __future__ import annotations
 
@@ -13,7 +13,7 @@ from engine.errors import EngineError
 from engine.gears.records import GearUnit, load_gear, load_hobs, load_machine
 from engine.simulation import SimulationError, prove_program, simulate_program
 
-from simulation_programs import Hand, k_y, k_z, lead_angle, number_of, swivel, with_cycle_time
+from helpers.simulation_programs import Hand, k_y, k_z, lead_angle, number_of, swivel, with_cycle_time
 
 MACHINE = "hobber-840d"
 

@@ -20,7 +20,7 @@ from engine.programs.verifier import LimitError
 from engine.turning.dxf_import import import_dxf
 from engine.turning.job_params import ProfileOptions
 from engine.turning.names import MAX_OPERATIONS
-from lathe_programs import distance_to_drawn, drawn_polylines, motions, operation_lines, words
+from helpers.lathe_programs import distance_to_drawn, drawn_polylines, motions, operation_lines, words
 from test_dxf_read import DXF, EMCO, INCH, nc_arc_words, seed_drawing
 
 # ISO F words carry their decimal point (a Fanuc-type control reads F1300 by a parameter's unit).

@@ -16,7 +16,7 @@ from engine.programs.remake import instantiate_job
 from engine.turning.dxf_import import import_dxf
 from engine.turning.job_params import ProfileOptions
 from engine.turning.job_plot import turning_job_figure
-from lathe_programs import distance_to_drawn, drawn_polylines, operation_lines, words
+from helpers.lathe_programs import distance_to_drawn, drawn_polylines, operation_lines, words
 from test_dxf_read import DXF, INCH, seed_drawing
 from test_turning_jobs import two_rough_layers
 

@@ -17,7 +17,7 @@ from engine.turning.job_params import ProfileOptions, turning_job
 from engine.turning.model import job_passes
 from importers.dxf_drawing import read_drawing
 from importers.dxf_read import DxfError
-from lathe_programs import motions, operation_lines
+from helpers.lathe_programs import motions, operation_lines
 
 INCH_MM = 25.4
 ROUGH = ProfileOptions(rough_depth=1.0)

@@ -17,7 +17,7 @@ import pytest
 
 from engine.gears.records import load_machine
 from engine.programs.verifier import LimitError, verify_program
-from golden_cases import TURNING_CASES
+from helpers.golden_cases import TURNING_CASES
 from test_dxf_read import seed_drawing
 
 GOLDEN = Path(__file__).resolve().parent / "golden"

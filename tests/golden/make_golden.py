@@ -1,4 +1,4 @@
-"""Write the golden programs (tests/golden_cases.py): a seeded database is made on the server
+"""Write the golden programs (tests/helpers/golden_cases.py): a seeded database is made on the server
 of DATABASE_URL (admin URL; default the local server), every case is instantiated and rolled
 back, and its text written here. Run it only when programs are meant to change, and read the
 diff before committing it.
@@ -20,7 +20,7 @@ from psycopg.conninfo import conninfo_to_dict, make_conninfo
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))   # tests/: golden_cases and its makers
 
-from golden_cases import (hobbing_cases, hobbing_file, hobbing_text, turning_cases,  # noqa: E402
+from helpers.golden_cases import (hobbing_cases, hobbing_file, hobbing_text, turning_cases,  # noqa: E402
                           turning_file, turning_text)
 
 

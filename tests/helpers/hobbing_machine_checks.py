@@ -7,10 +7,10 @@ from __future__ import annotations
 import math
 import re
 
-from hobbing_checks import (Case, approach_problems, contract_problems, coupling_problems, depth_problems, din_move,
+from helpers.hobbing_checks import (Case, approach_problems, contract_problems, coupling_problems, depth_problems, din_move,
                             envelope_problems, feed_problems)
-from hobbing_envelope import Solid, hob_depths, known_xz, shift_limits
-from hobbing_reference import Nc, swivel
+from helpers.hobbing_envelope import Solid, hob_depths, known_xz, shift_limits
+from helpers.hobbing_reference import Nc, swivel
 
 ROUND = 0.002
 REACH = 1000.0      # mm: the fixture and tailstock are long cylinders along the work axis

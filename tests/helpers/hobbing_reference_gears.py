@@ -1,12 +1,12 @@
 """Gears, hobs and machines for the acceptance tests of issue 14, put into the database with SQL
-(never through the engine), and the test's own description of them (tests/hobbing_reference.py).
+(never through the engine), and the test's own description of them (tests/helpers/hobbing_reference.py).
 Diameters follow the reference: d = mn·z/cosβ, d_a = d + 2mn(1 + x), d_f = d_a − 2·2.25mn.
 """
 from __future__ import annotations
 
 import math
 
-from hobbing_reference import Gear, Hob, Machine, Unit, lead_angle
+from helpers.hobbing_reference import Gear, Hob, Machine, Unit, lead_angle
 
 DIN = Machine()
 MIRROR = Machine("hobber-mirror", a=-1, c=-1, z=-1)          # A, C and Z against DIN 66217

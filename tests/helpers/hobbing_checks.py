@@ -1,4 +1,4 @@
-"""The acceptance checks of issue 14 on a program read by tests/hobbing_reference.py.
+"""The acceptance checks of issue 14 on a program read by tests/helpers/hobbing_reference.py.
 
 Each `*_problems(nc, case)` returns one-line findings (empty = the program agrees with design notes
 §7 and the reference). `Case` holds what the test knows independently of the engine: the gear
@@ -10,8 +10,8 @@ import math
 import re
 from dataclasses import dataclass
 
-from hobbing_envelope import hob_depths, known_xz, shift_limits
-from hobbing_reference import (Gear, Hob, Machine, Move, Nc, Unit, approach_needed, b_ratio, full_depth, lead_angle,
+from helpers.hobbing_envelope import hob_depths, known_xz, shift_limits
+from helpers.hobbing_reference import (Gear, Hob, Machine, Move, Nc, Unit, approach_needed, b_ratio, full_depth, lead_angle,
                                root_solid, roughing_feed_max, swivel, taper_depth, tip_radius_at, unit_solid,
                                y_factor, z_factor)
 

@@ -20,7 +20,7 @@ from engine.programs.remake import instantiate_job
 from engine.turning.dxf_import import import_dxf
 from engine.turning.job_params import ProfileOptions
 
-GOLDEN = Path(__file__).resolve().parent / "golden"
+GOLDEN = Path(__file__).resolve().parents[1] / "golden"
 
 HOBBING_GEARS = (42, 43, 44, 45, 46, 47, 50, 51, 53, 54)   # seed_templates/gears.csv: every class
 CHOICE_SETS = {   # name -> (process choices, overrides)

@@ -1,6 +1,6 @@
 """An independent reader of hobbing programs and the reference's numbers, for acceptance tests.
 
-Shares no code with engine.programs.verifier, engine.hobbing or tests/nc_reader.py: the tests of
+Shares no code with engine.programs.verifier, engine.hobbing or tests/helpers/nc_reader.py: the tests of
 issue 14 must check the engine's programs against the reference (docs/reference/hobbing.md
 §A5, §A7, §B, §C and design notes §7), not against the engine's own idea of them.
 
@@ -20,7 +20,7 @@ import math
 import re
 from dataclasses import dataclass, field
 
-from hobbing_envelope import Solid, Sweep, intrusions, root_section_centre
+from helpers.hobbing_envelope import Solid, Sweep, intrusions, root_section_centre
 
 AXES = "XYZABC"
 NUMBER = r"[+-]?(?:\d+\.?\d*|\.\d+)"
@@ -217,7 +217,7 @@ class Machine:
     tailstock: tuple = (25.0, 0.0)      # diameter, gap above the top face, when clamped (M20)
     load: tuple = (300.0, 100.0)        # programmed X, Z of the final position
     # The defaults describe the hand-written programs' machine; engine programs are checked against
-    # the machine row the shop declared (tests/hobbing_reference_gears.read_machine).
+    # the machine row the shop declared (tests/helpers/hobbing_reference_gears.read_machine).
 
     def din(self, axis: str, value):
         """A programmed coordinate in the DIN 66217 frame (§A7: program = DIN × sense)."""
