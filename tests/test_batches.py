@@ -15,6 +15,7 @@ from psycopg import sql
 from helpers.roles import as_role
 
 from engine.programs.instantiate import instantiate_gear, instantiate_gears
+from helpers.batches import spoil
 
 CHECKOUT = Path(__file__).resolve().parent.parent
 
@@ -31,16 +32,6 @@ SPOILED = {
     51: "crowning 0.2 mm on a face of 4 mm",   # the crowning too steep for the face
 }
 GOOD = [43, 53, 54]
-
-
-def spoil(url: str) -> None:
-    with psycopg.connect(url) as conn:
-        conn.execute("UPDATE machine SET tailstock_diameter = 45 WHERE name = 'hobber-840d'")
-        conn.execute("UPDATE gear SET gear_class = NULL WHERE id = 44")
-        conn.execute("UPDATE gear SET module = 5, tip_diameter = 135, root_diameter = 112.5 WHERE id = 45")
-        conn.execute("UPDATE gear SET module = 1.25, tip_diameter = 62.5, root_diameter = 56.875 WHERE id = 46")
-        conn.execute("UPDATE gear SET crowning = 0.2, face_width = 4 WHERE id = 51")
-        conn.execute("UPDATE gear SET teeth = 2, tip_diameter = NULL, root_diameter = NULL WHERE id = 47")
 
 
 def everything(url: str) -> dict:

@@ -10,7 +10,7 @@ from click.testing import CliRunner
 from engine.cli.app import main
 from engine.cli.conventions import walk
 from engine.cli.examples import EXAMPLES
-from test_dxf_read import seed_drawing
+from helpers.drawings import seed_drawing
 
 COMMANDS = list(walk(main))
 
@@ -105,7 +105,7 @@ def json_error(result, code: int = 1) -> dict:
     (("template", "history", "--class", "nope", "--json"), {}, ["nope"]),
 ])
 def test_errors_of_a_json_invocation_are_json_on_stderr(run, args, env, words):
-    result = CliRunner().invoke(main, ["--database-url", run.url, *args], env={"ENGINE_CONFIG": "", **env})
+    result = run(*args, env=env)
     error = json_error(result)
     for word in words:
         assert word in error["error"]

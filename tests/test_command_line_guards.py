@@ -7,24 +7,9 @@ import json
 
 import psycopg
 import pytest
-from click.testing import CliRunner
 
 from engine.cli.app import main
 from engine.cli.conventions import COMMAND_LINE_ONLY, envvar_name, option_name, options, walk
-
-
-@pytest.fixture
-def cli(fresh_database_url, tmp_path):
-    """The CLI on a private copy of the seeded database, with environment variables of the test's
-    own and the config file cli.config (written by the test, else none)."""
-    config = tmp_path / "config.toml"
-
-    def invoke(*args, env=None):
-        environment = {"ENGINE_CONFIG": str(config) if config.exists() else "", **(env or {})}
-        return CliRunner().invoke(main, ["--database-url", fresh_database_url, *map(str, args)], env=environment)
-    invoke.config = config
-    invoke.url = fresh_database_url
-    return invoke
 
 
 def one_error_line(result) -> str:
@@ -54,22 +39,22 @@ def test_every_command_line_only_option_exists_and_has_no_variable():
         assert envvar_name(path, found[0]) not in (found[0].envvar or []), (path, name)
 
 
-def test_a_variable_does_not_confirm_a_hob_delete(cli):
-    added = cli("hobs", "add", "--id", "H-M5-B-L9", "--module", 5, "--tip-diameter", 100, "--length", 120,
+def test_a_variable_does_not_confirm_a_hob_delete(run):
+    added = run("hobs", "add", "--id", "H-M5-B-L9", "--module", 5, "--tip-diameter", 100, "--length", 120,
                 "--hand", "L", "--accuracy-class", "B")
     assert added.exit_code == 0, added.output
-    result = cli("hobs", "delete", "H-M5-B-L9", env={"ENGINE_HOBS_DELETE_YES": "1"})
+    result = run("hobs", "delete", "H-M5-B-L9", env={"ENGINE_HOBS_DELETE_YES": "1"})
     assert result.exit_code == 1
-    assert count(cli.url, "SELECT count(*) FROM hob WHERE id = 'H-M5-B-L9'") == 1
-    assert cli("hobs", "delete", "H-M5-B-L9", "--yes").exit_code == 0
-    assert count(cli.url, "SELECT count(*) FROM hob WHERE id = 'H-M5-B-L9'") == 0
+    assert count(run.url, "SELECT count(*) FROM hob WHERE id = 'H-M5-B-L9'") == 1
+    assert run("hobs", "delete", "H-M5-B-L9", "--yes").exit_code == 0
+    assert count(run.url, "SELECT count(*) FROM hob WHERE id = 'H-M5-B-L9'") == 0
 
 
-def test_a_variable_does_not_make_a_program_from_the_draft(cli):
-    result = cli("instantiate", "--gear", 42, "--json", env={"ENGINE_INSTANTIATE_DRAFT": "1"})
+def test_a_variable_does_not_make_a_program_from_the_draft(run):
+    result = run("instantiate", "--gear", 42, "--json", env={"ENGINE_INSTANTIATE_DRAFT": "1"})
     assert result.exit_code == 0, result.output
     program_id = json.loads(result.stdout)["program_id"]
-    assert count(cli.url, f"SELECT count(*) FROM program WHERE id = {int(program_id)} AND NOT draft") == 1
+    assert count(run.url, f"SELECT count(*) FROM program WHERE id = {int(program_id)} AND NOT draft") == 1
 
 
 @pytest.mark.parametrize("table, key, option", [
@@ -81,25 +66,25 @@ def test_a_variable_does_not_make_a_program_from_the_draft(cli):
     ("instantiate", "skip_bad", "--skip-bad"),
     ("instantiate", "skip-bad", "--skip-bad"),
 ])
-def test_a_confirming_option_in_the_config_file_is_refused_naming_it(cli, table, key, option):
-    cli.config.write_text(f"[{table}]\n{key} = true\n")
-    said = one_error_line(cli("gears", "delete", 42))
-    assert str(cli.config) in said and option in said and "command line only" in said and "line 2" in said
-    assert count(cli.url, "SELECT count(*) FROM gear WHERE id = 42") == 1
+def test_a_confirming_option_in_the_config_file_is_refused_naming_it(run, table, key, option):
+    run.config.write_text(f"[{table}]\n{key} = true\n")
+    said = one_error_line(run("gears", "delete", 42))
+    assert str(run.config) in said and option in said and "command line only" in said and "line 2" in said
+    assert count(run.url, "SELECT count(*) FROM gear WHERE id = 42") == 1
 
 
 # a default that does not apply to the invocation is ignored; typed, it is refused ---------------
 
-def test_the_config_files_batch_habits_leave_one_gear_alone(cli):
-    cli.config.write_text("[instantiate]\nworkers = 4\nexplain = true\n")
-    one = cli("instantiate", "--gear", 42)
+def test_the_config_files_batch_habits_leave_one_gear_alone(run):
+    run.config.write_text("[instantiate]\nworkers = 4\nexplain = true\n")
+    one = run("instantiate", "--gear", 42)
     assert one.exit_code == 0, one.output
     assert one.stdout.rstrip().endswith("M30")
     assert " emitted" in one.stderr   # the config file's explain applies to one program: it is explained
 
 
-def test_explain_from_the_environment_does_not_refuse_a_batch(cli):
-    result = cli("instantiate", "--gears", "42-43", "--dry-run", "--json", env={"ENGINE_INSTANTIATE_EXPLAIN": "1"})
+def test_explain_from_the_environment_does_not_refuse_a_batch(run):
+    result = run("instantiate", "--gears", "42-43", "--dry-run", "--json", env={"ENGINE_INSTANTIATE_EXPLAIN": "1"})
     assert result.exit_code == 0, result.output
     assert json.loads(result.stdout)["dry_run"] is True
 
@@ -108,45 +93,45 @@ def test_explain_from_the_environment_does_not_refuse_a_batch(cli):
     (("--gear", 42, "--workers", 2), "--workers"),
     (("--gears", "42-43", "--explain"), "--explain"),
 ])
-def test_a_batch_option_typed_where_it_does_not_apply_is_still_refused(cli, args, option):
-    assert option in one_error_line(cli("instantiate", *args))
+def test_a_batch_option_typed_where_it_does_not_apply_is_still_refused(run, args, option):
+    assert option in one_error_line(run("instantiate", *args))
 
 
 # exclusive flag pairs -----------------------------------------------------------------------------
 
-def test_released_and_draft_together_are_one_usage_error(cli):
-    said = one_error_line(cli("programs", "list", "--released", "--draft"))
+def test_released_and_draft_together_are_one_usage_error(run):
+    said = one_error_line(run("programs", "list", "--released", "--draft"))
     assert "--draft" in said and "--released" in said
 
 
-def test_a_flag_typed_wins_over_its_partner_from_the_environment(cli):
-    made = cli("instantiate", "--gear", 42, "--json")
+def test_a_flag_typed_wins_over_its_partner_from_the_environment(run):
+    made = run("instantiate", "--gear", 42, "--json")
     program_id = json.loads(made.stdout)["program_id"]
-    listed = cli("programs", "list", "--released", "--json", env={"ENGINE_PROGRAMS_LIST_DRAFT": "1"})
+    listed = run("programs", "list", "--released", "--json", env={"ENGINE_PROGRAMS_LIST_DRAFT": "1"})
     assert listed.exit_code == 0, listed.output
     assert [record["program_id"] for record in json.loads(listed.stdout)["programs"]] == [program_id]
-    table = cli("gears", "list", "--csv", env={"ENGINE_GEARS_LIST_JSON": "1"})
+    table = run("gears", "list", "--csv", env={"ENGINE_GEARS_LIST_JSON": "1"})
     assert table.exit_code == 0 and table.stdout.startswith("gear_id,")
 
 
 # errors: JSON when --json comes from the environment or the file; always one line ---------------
 
-def test_a_usage_error_is_json_when_the_environment_asks_for_json(cli):
-    said = one_json_error(cli("gears", "list", "--bogus", env={"ENGINE_GEARS_LIST_JSON": "1"}))
+def test_a_usage_error_is_json_when_the_environment_asks_for_json(run):
+    said = one_json_error(run("gears", "list", "--bogus", env={"ENGINE_GEARS_LIST_JSON": "1"}))
     assert "--bogus" in said
 
 
-def test_a_usage_error_is_json_when_the_config_file_asks_for_json(cli):
-    cli.config.write_text("[jobs.list]\njson = true\n")
-    said = one_json_error(cli("jobs", "list", "--gear", "forty-two"))
+def test_a_usage_error_is_json_when_the_config_file_asks_for_json(run):
+    run.config.write_text("[jobs.list]\njson = true\n")
+    said = one_json_error(run("jobs", "list", "--gear", "forty-two"))
     assert "forty-two" in said
 
 
 @pytest.mark.parametrize("typed, shown", [("X\n", "X\\n"), ("A\rB", "A\\rB"), ("H\x1b[31m", "H\\x1b[31m"),
                                           ("L\u2028M", "L\\u2028M")])
-def test_an_error_naming_a_value_with_a_line_break_is_one_line(cli, typed, shown):
-    assert shown in one_error_line(cli("hobs", "show", typed))
-    assert shown in one_json_error(cli("hobs", "show", typed, "--json"))
+def test_an_error_naming_a_value_with_a_line_break_is_one_line(run, typed, shown):
+    assert shown in one_error_line(run("hobs", "show", typed))
+    assert shown in one_json_error(run("hobs", "show", typed, "--json"))
 
 
 # CSV a spreadsheet opens as text ------------------------------------------------------------------
@@ -165,12 +150,12 @@ FORMULAS = {  # material as stored -> the cell a spreadsheet reads (OWASP: a lea
 }
 
 
-def test_a_text_cell_that_a_spreadsheet_would_run_is_quoted(cli):
-    with psycopg.connect(cli.url) as conn:
+def test_a_text_cell_that_a_spreadsheet_would_run_is_quoted(run):
+    with psycopg.connect(run.url) as conn:
         for number, material in enumerate(FORMULAS):
             conn.execute("INSERT INTO gear (id, gear_class, module, teeth, helix_angle, face_width, material) "
                          "VALUES (%s, 'spur', 2, 33, 0, 20, %s)", (93001 + number, material))
-    result = cli("gears", "list", "--csv")
+    result = run("gears", "list", "--csv")
     assert result.exit_code == 0, result.output
     rows = {row["gear_id"]: row for row in csv.DictReader(io.StringIO(result.stdout, newline=""))}
     assert [rows[str(93001 + number)]["material"] for number in range(len(FORMULAS))] == list(FORMULAS.values())

@@ -4,101 +4,80 @@ directory), with the precedence command line > environment > config file > built
 import json
 
 import pytest
-from click.testing import CliRunner
 
 from engine.cli.app import main
 from engine.cli.conventions import RESERVED_ENVVARS, envvar_name, options, walk
 
-NO_ENGINE_VARIABLES = {name: None for name in ("ENGINE_INSTANTIATE_MACHINE", "ENGINE_INSTANTIATE_OUT",
-                                                "ENGINE_LINT_JSON", "ENGINE_DATABASE_URL")}
-
-
-@pytest.fixture
-def cli(fresh_database_url, tmp_path):
-    """Invoke the CLI on a private database, with a config file (config.write(text)) and
-    environment variables of the test's own; the database is given by --database-url unless
-    url=False."""
-    config = tmp_path / "config.toml"
-
-    def invoke(*args, env=None, url=True):
-        environment = {**NO_ENGINE_VARIABLES, "ENGINE_CONFIG": str(config), **(env or {})}
-        given = ["--database-url", fresh_database_url] if url else []
-        return CliRunner().invoke(main, [*given, *map(str, args)], env=environment)
-    invoke.config = config
-    invoke.url = fresh_database_url
-    return invoke
-
-
-def test_an_environment_variable_sets_an_option(cli):
-    cli.config.write_text("")
-    result = cli("lint", env={"ENGINE_LINT_JSON": "1"})
+def test_an_environment_variable_sets_an_option(run):
+    run.config.write_text("")
+    result = run("lint", env={"ENGINE_LINT_JSON": "1"})
     assert result.exit_code == 0 and json.loads(result.stdout) == {"errors": []}
-    refused = cli("instantiate", "--gear", 42, env={"ENGINE_INSTANTIATE_MACHINE": "nope"})
+    refused = run("instantiate", "--gear", 42, env={"ENGINE_INSTANTIATE_MACHINE": "nope"})
     assert refused.exit_code == 1 and "machine 'nope'" in refused.stderr
 
 
-def test_the_config_file_gives_option_defaults(cli):
-    cli.config.write_text('[instantiate]\nmachine = "nope"\n\n[lint]\njson = true\n')
-    assert json.loads(cli("lint").stdout) == {"errors": []}
-    refused = cli("instantiate", "--gear", 42)
+def test_the_config_file_gives_option_defaults(run):
+    run.config.write_text('[instantiate]\nmachine = "nope"\n\n[lint]\njson = true\n')
+    assert json.loads(run("lint").stdout) == {"errors": []}
+    refused = run("instantiate", "--gear", 42)
     assert refused.exit_code == 1 and "machine 'nope'" in refused.stderr
 
 
-def test_the_default_machine_of_the_config_file(cli):
-    cli.config.write_text('machine = "lathe-iso"\n')
-    refused = cli("instantiate", "--gear", 42)
+def test_the_default_machine_of_the_config_file(run):
+    run.config.write_text('machine = "lathe-iso"\n')
+    refused = run("instantiate", "--gear", 42)
     assert refused.exit_code == 1 and "not a hobbing machine" in refused.stderr
 
 
-def test_command_line_beats_environment_beats_config_file(cli):
-    cli.config.write_text('[instantiate]\nmachine = "from-the-file"\n')
-    from_environment = cli("instantiate", "--gear", 42, env={"ENGINE_INSTANTIATE_MACHINE": "from-the-env"})
+def test_command_line_beats_environment_beats_config_file(run):
+    run.config.write_text('[instantiate]\nmachine = "from-the-file"\n')
+    from_environment = run("instantiate", "--gear", 42, env={"ENGINE_INSTANTIATE_MACHINE": "from-the-env"})
     assert "'from-the-env'" in from_environment.stderr
-    from_command_line = cli("instantiate", "--gear", 42, "--machine", "from-the-line",
+    from_command_line = run("instantiate", "--gear", 42, "--machine", "from-the-line",
                             env={"ENGINE_INSTANTIATE_MACHINE": "from-the-env"})
     assert "'from-the-line'" in from_command_line.stderr
-    cli.config.write_text('machine = "general"\n[instantiate]\nmachine = "from-the-table"\n')
-    assert "'from-the-table'" in cli("instantiate", "--gear", 42).stderr
+    run.config.write_text('machine = "general"\n[instantiate]\nmachine = "from-the-table"\n')
+    assert "'from-the-table'" in run("instantiate", "--gear", 42).stderr
 
 
-def test_database_url_keeps_working_and_engine_database_url_too(cli):
-    cli.config.write_text("")
+def test_database_url_keeps_working_and_engine_database_url_too(run):
+    run.config.write_text("")
     for variable in ("DATABASE_URL", "ENGINE_DATABASE_URL"):
-        result = cli("lint", "--json", env={"DATABASE_URL": None, variable: cli.url}, url=False)
+        result = run("lint", "--json", env={"DATABASE_URL": None, variable: run.url}, url=False)
         assert result.exit_code == 0, result.output
-    both = cli("lint", env={"DATABASE_URL": cli.url, "ENGINE_DATABASE_URL": "postgresql://nobody@127.0.0.1:1/x"},
+    both = run("lint", env={"DATABASE_URL": run.url, "ENGINE_DATABASE_URL": "postgresql://nobody@127.0.0.1:1/x"},
                url=False)
     assert both.exit_code == 0, both.output   # DATABASE_URL, as before, comes first
 
 
-def test_the_machine_folder_of_the_config_file_gets_the_program(cli, tmp_path):
+def test_the_machine_folder_of_the_config_file_gets_the_program(run, tmp_path):
     folder = tmp_path / "hobber"
-    cli.config.write_text(f'[machines.hobber-840d]\nout = "{folder}"\n')
-    result = cli("instantiate", "--gear", 42, "--json")
+    run.config.write_text(f'[machines.hobber-840d]\nout = "{folder}"\n')
+    result = run("instantiate", "--gear", 42, "--json")
     assert result.exit_code == 0, result.output
     assert json.loads(result.stdout)["path"] == str(folder / "GEAR42.MPF")
     assert (folder / "GEAR42.MPF").read_text().startswith("%_N_GEAR42_MPF\n")
     elsewhere = tmp_path / "ONE.MPF"
-    assert cli("instantiate", "--gear", 42, "--out", elsewhere).exit_code == 0 and elsewhere.exists()
+    assert run("instantiate", "--gear", 42, "--out", elsewhere).exit_code == 0 and elsewhere.exists()
 
 
-def test_crlf_line_endings_change_the_file_not_the_stored_program(cli, tmp_path):
+def test_crlf_line_endings_change_the_file_not_the_stored_program(run, tmp_path):
     import psycopg
 
-    cli.config.write_text('line_endings = "crlf"\n')
+    run.config.write_text('line_endings = "crlf"\n')
     target = tmp_path / "GEAR42.MPF"
-    made = json.loads(cli("instantiate", "--gear", 42, "--out", target, "--json").stdout)
+    made = json.loads(run("instantiate", "--gear", 42, "--out", target, "--json").stdout)
     data = target.read_bytes()
-    with psycopg.connect(cli.url) as conn:
+    with psycopg.connect(run.url) as conn:
         stored = conn.execute("SELECT lines FROM program WHERE id = %s", (made["program_id"],)).fetchone()[0]
     assert data == ("\r\n".join(stored) + "\r\n").encode("ascii")
     assert not any("\r" in line for line in stored)
 
 
-def test_a_stored_job_is_not_refused_for_a_configured_machine(cli):
-    cli.config.write_text('[instantiate]\nmachine = "hobber-840d"\ncuts = 2\n')
-    made = json.loads(cli("instantiate", "--gear", 42, "--json").stdout)
-    again = cli("instantiate", "--job", made["job_id"], "--json")
+def test_a_stored_job_is_not_refused_for_a_configured_machine(run):
+    run.config.write_text('[instantiate]\nmachine = "hobber-840d"\ncuts = 2\n')
+    made = json.loads(run("instantiate", "--gear", 42, "--json").stdout)
+    again = run("instantiate", "--job", made["job_id"], "--json")
     assert again.exit_code == 0, again.output
 
 
@@ -109,28 +88,28 @@ def test_a_stored_job_is_not_refused_for_a_configured_machine(cli):
     ('[hobs.match]\nshift-travel = 20\n[nope]\nx = 1\n', ["line 3", "nope"]),
     ('[machines.hobber-840d]\nfolder = "/srv"\n', ["line 2", "folder"]),
 ])
-def test_a_malformed_config_file_is_refused_naming_the_file_and_line(cli, text, words):
-    cli.config.write_text(text)
-    result = cli("lint")
+def test_a_malformed_config_file_is_refused_naming_the_file_and_line(run, text, words):
+    run.config.write_text(text)
+    result = run("lint")
     message = result.stderr.strip()
     assert result.exit_code == 1 and len(message.splitlines()) == 1 and "Traceback" not in result.output
-    for word in [str(cli.config), *words]:
+    for word in [str(run.config), *words]:
         assert word in message
 
 
-def test_a_config_file_named_but_missing_is_refused(cli, tmp_path):
-    result = cli("lint", env={"ENGINE_CONFIG": str(tmp_path / "missing.toml")})
+def test_a_config_file_named_but_missing_is_refused(run, tmp_path):
+    result = run("lint", env={"ENGINE_CONFIG": str(tmp_path / "missing.toml")})
     assert result.exit_code == 1 and "missing.toml" in result.stderr
 
 
-def test_config_show_says_what_the_file_sets(cli, tmp_path):
-    cli.config.write_text(f'line_endings = "crlf"\n[machines.hobber-840d]\nout = "{tmp_path}"\n'
+def test_config_show_says_what_the_file_sets(run, tmp_path):
+    run.config.write_text(f'line_endings = "crlf"\n[machines.hobber-840d]\nout = "{tmp_path}"\n'
                           '[hobs.match]\nshift-travel = 20\n')
-    shown = json.loads(cli("config", "show", "--json").stdout)
-    assert shown["path"] == str(cli.config) and shown["line_endings"] == "crlf"
+    shown = json.loads(run("config", "show", "--json").stdout)
+    assert shown["path"] == str(run.config) and shown["line_endings"] == "crlf"
     assert shown["machines"] == {"hobber-840d": {"out": str(tmp_path)}}
     assert shown["defaults"] == {"hobs": {"match": {"shift_travel": 20}}}
-    assert cli("config", "path").stdout.strip() == str(cli.config)
+    assert run("config", "path").stdout.strip() == str(run.config)
 
 
 def test_no_option_variable_is_one_the_engine_reads_itself():
@@ -139,11 +118,11 @@ def test_no_option_variable_is_one_the_engine_reads_itself():
     assert "ENGINE_INSTANTIATE_MACHINE" in names and "ENGINE_HOBS_MATCH_SHIFT_TRAVEL" in names
 
 
-def test_the_file_in_the_users_config_directory_is_read(cli, tmp_path):
+def test_the_file_in_the_users_config_directory_is_read(run, tmp_path):
     home = tmp_path / "xdg"
     (home / "nc-template-engine").mkdir(parents=True)
     (home / "nc-template-engine" / "config.toml").write_text("[lint]\njson = true\n")
     environment = {"ENGINE_CONFIG": None, "XDG_CONFIG_HOME": str(home)}
-    assert json.loads(cli("lint", env=environment).stdout) == {"errors": []}
-    assert cli("config", "path", env=environment).stdout.strip() == str(home / "nc-template-engine" / "config.toml")
-    assert cli("lint", env={**environment, "ENGINE_CONFIG": ""}).stdout == ""   # ENGINE_CONFIG= reads none
+    assert json.loads(run("lint", env=environment).stdout) == {"errors": []}
+    assert run("config", "path", env=environment).stdout.strip() == str(home / "nc-template-engine" / "config.toml")
+    assert run("lint", env={**environment, "ENGINE_CONFIG": ""}).stdout == ""   # ENGINE_CONFIG= reads none

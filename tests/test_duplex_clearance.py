@@ -11,9 +11,7 @@ approach Z), the axial pass and the retract (X back out at the end Z).
 """
 from __future__ import annotations
 
-import csv
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -21,19 +19,16 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from engine.errors import EngineError
-from engine.gears.cutting_data import CuttingData
-from engine.gears.records import Gear, GearUnit, Hob, Machine
+from engine.gears.records import Gear, GearUnit, Hob
 from engine.hobbing.choices import FEED_MODES, Choices
 from engine.hobbing.duplex import DuplexModel
 from engine.programs.instantiate import instantiate_gear
 
 from helpers.nc_reader import read_program
+from helpers.hob_clearance import CUTTING, MACHINE, hob_surface, seeded_hobs
 
-SEED_HOBS = Path(__file__).resolve().parent.parent / "seed_templates" / "hobs.csv"
 MARGIN = 0.5            # mm: the least clearance a program may leave (the engine keeps more)
 Z_STEP = 0.5            # mm between sampled hob centres along a pass
-MACHINE = Machine("wide", "hobber", "840d", 0, 2000, -300, 300, -2000, 500, 1000, None, None)
-CUTTING = CuttingData(60, 200, 2.5, 1.5, 1.0, "test")
 
 
 # ------------------------------------------------------------------ geometry, test side
@@ -41,19 +36,6 @@ CUTTING = CuttingData(60, 200, 2.5, 1.5, 1.0, "test")
 def swivel(module: float, starts: int, hob_tip: float) -> float:
     """η = γ for a spur gear, sin γ = z0·m/(d_a0 − 2.5·m) (reference §B1, §B2), radians."""
     return math.asin(starts * module / (hob_tip - 2.5 * module))
-
-
-def hob_surface(radius: float, half_length: float, eta: float) -> np.ndarray:
-    """Points on the hob's tip cylinder and end discs, relative to its centre (the contact
-    point's axial station), axis (0, cos η, sin η)."""
-    phi = np.linspace(0, 2 * np.pi, 181)[:-1]
-    along = np.linspace(-half_length, half_length, 61)
-    rho = np.linspace(0, radius, 12)
-    lateral = [(t, radius, p) for t in along for p in phi]
-    discs = [(t, r, p) for t in (-half_length, half_length) for r in rho for p in phi]
-    t, r, p = np.array(lateral + discs).T
-    axis, across = np.array([0, math.cos(eta), math.sin(eta)]), np.array([0, -math.sin(eta), math.cos(eta)])
-    return (np.outer(t, axis) + np.outer(r * np.cos(p), [1, 0, 0]) + np.outer(r * np.sin(p), across))
 
 
 def distance_to_unit(points: np.ndarray, radius: float, top: float, bottom: float) -> float:
@@ -78,13 +60,6 @@ def clearance(surface: np.ndarray, centres, unit: dict) -> float:
 
 
 # ------------------------------------------------------------------ layouts
-
-def seeded_hobs() -> list[Hob]:
-    with SEED_HOBS.open() as rows:
-        return [Hob(r["id"], float(r["module"]), float(r["pressure_angle"]), int(r["starts"]),
-                    float(r["tip_diameter"]), float(r["length"]), r["hand"], r["accuracy_class"],
-                    r["material"], r["coating"], r["purpose"])
-                for r in csv.DictReader(rows) if r["purpose"] == "cylindrical"]
 
 
 @st.composite

@@ -10,7 +10,7 @@ import pytest
 
 from importers.dxf_drawing import read_drawing
 from importers.dxf_read import DxfError
-from test_dxf_side_views import AXIS_Y, SHAFT
+from helpers.drawn_parts import AXIS_Y, SHAFT
 
 
 # An M16×2 thread on the shaft's Ø16 from the face to Z -10: its root (minor) diameter by ISO 68-1,

@@ -10,25 +10,9 @@ import pytest
 
 from importers.dxf_drawing import read_drawing
 from importers.dxf_read import DxfError
-from test_dxf_read import DXF
-from test_import_dxf_cli import job_count, one_line_refusal
-
-# z, radius in mm: a stepped shaft from the face (z 0) to z -40, closed by the axis.
-HALF_PROFILE = [(0, 0), (0, 10), (-15, 10), (-15, 14), (-40, 14), (-40, 0)]
-
-
-def outline_drawing(path, layer="outline", copy_on=None):
-    """The half-profile on `layer` (and again on `copy_on`: two layers that could be the part)."""
-    doc = ezdxf.new("R2010")
-    doc.header["$INSUNITS"] = 4   # mm
-    doc.layers.add("dims")
-    msp = doc.modelspace()
-    for name in filter(None, (layer, copy_on)):
-        doc.layers.add(name)
-        msp.add_lwpolyline(HALF_PROFILE[:-1] + [HALF_PROFILE[-1]], dxfattribs={"layer": name})
-    msp.add_line((5, 0), (-45, 0), dxfattribs={"layer": "dims"})
-    doc.saveas(path)
-    return path
+from helpers.drawings import DXF
+from helpers.outcomes import job_count, one_line_refusal
+from helpers.drawn_parts import outline_drawing
 
 
 def test_the_profile_is_read_from_the_named_layer(tmp_path):

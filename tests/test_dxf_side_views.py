@@ -21,8 +21,8 @@ from engine.turning.job_params import ProfileOptions
 from importers.dxf_drawing import read_drawing
 from importers.dxf_read import DxfError
 from helpers.lathe_programs import distance_to_chord, motions, operation_lines
-from test_dxf_read import DXF
-from test_dxf_real_layers import outline_drawing
+from helpers.drawings import DXF
+from helpers.drawn_parts import AXIS_Y, SHAFT, outline_drawing
 
 FLATTENING_MM = 0.0005
 ON_DRAWING_MM = 0.01       # a finish end point this close to a drawn line is on it
@@ -166,12 +166,6 @@ def test_the_pump_parts_sheet_is_refused_as_a_plate():
         read_drawing(DXF / "d2gp_pumpenteile_R2000.dxf")
     message = str(refused.value)
     assert "not a turned part" in message and "plate" in message and "inside another" in message
-
-
-# A stepped shaft drawn whole about a centre line at drawing Y = 30: (z, radius) corners of its
-# upper half, from the face Z 0 to Z -50.
-SHAFT = [(0, 8), (-12, 8), (-12, 12), (-35, 12), (-35, 10), (-50, 10)]
-AXIS_Y = 30.0
 
 
 def whole_shaft(path, *, bore_depth: float | None = None) -> None:

@@ -216,7 +216,7 @@ def test_a_bad_suffix_or_a_job_without_a_program_is_refused_in_one_line_and_writ
 
 
 def test_a_turning_program_is_refused_naming_the_plot_of_its_job(run, tmp_path):
-    from test_dxf_read import seed_drawing
+    from helpers.drawings import seed_drawing
 
     seed_drawing(tmp_path / "part.dxf")
     job_id = json.loads(run("import-dxf", tmp_path / "part.dxf", "--json").stdout)["job_id"]

@@ -31,11 +31,12 @@ from engine.hobbing.choices import Choices
 from engine.programs.instantiate import instantiate_gear
 
 from helpers.hobbing_checks import (Case, Job, approach_problems, contract_problems, coupling_problems, depth_problems,
-                            envelope_problems, feed_problems)
+                                    envelope_problems, feed_problems)
 from helpers.hobbing_machine_checks import all_problems, cycle_time_problems, obstacle_problems, table_speed_problems
 from helpers.hobbing_reference import Gear, Hob, Unit, layout_cuttable, lead_angle, read
-from helpers.hobbing_reference_gears import (DIN, MIRROR, PAPER_STOCK, REVERSED, STOCK, cylindrical, insert_gear, insert_hob,
-                                     insert_machine, make_gear, make_hob, only_hob, read_machine, TOOL_NUMBER)
+from helpers.hobbing_reference_gears import (DIN, MIRROR, PAPER_STOCK, REVERSED, STOCK, cylindrical, insert_gear,
+                                             insert_hob, insert_machine, make_gear, make_hob, only_hob, read_machine,
+                                             TOOL_NUMBER)
 from helpers.hobbing_reference_programs import HAND_WRITTEN
 
 

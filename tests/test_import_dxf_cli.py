@@ -8,7 +8,8 @@ import json
 import psycopg
 
 from engine.cli.app import main
-from test_dxf_read import DXF, EMCO, REAL, seed_drawing
+from helpers.drawings import DXF, EMCO, REAL, seed_drawing
+from helpers.outcomes import job_count, one_line_refusal
 
 PROFILE_ONLY = set(EMCO) | {"d2g_Turbocad_12.5_R14.dxf", "qcad_screw_R2007.dxf", "ezdxf_AC1003_LINE_Example.dxf",
                             "d2g_132_R14.dxf", "d2g_132_R2000.dxf", "d2g_132_R2004.dxf"}
@@ -21,17 +22,6 @@ NOT_TURNED_FROM_OUTSIDE = {"d2g_132_R14.dxf": "internal turning is not supported
                            "d2g_132_R2000.dxf": "internal turning is not supported",
                            "d2g_132_R2004.dxf": "an external tool cannot reach",
                            "ezdxf_AC1003_LINE_Example.dxf": "internal turning is not supported"}
-
-
-def job_count(url) -> int:
-    with psycopg.connect(url) as conn:
-        return conn.execute("SELECT count(*) FROM job").fetchone()[0]
-
-
-def one_line_refusal(result) -> str:
-    assert result.exit_code == 1, result.output
-    assert len(result.stderr.strip().splitlines()) == 1 and "Traceback" not in result.output
-    return result.stderr.strip()
 
 
 def test_every_real_drawing_becomes_a_job_or_is_refused_with_its_reason(run):

@@ -17,15 +17,10 @@ import pytest
 from psycopg import errors
 from psycopg.types.json import Jsonb
 
-from helpers.shared_data import shared_data
+from helpers.class_jobs import DATA, LINEAGE_ROW, PAWN, SPEED, import_emco, ok, refused, stored_program
 
-DATA = shared_data()
-EMCO_DRAWING = DATA / "dxf" / "emco_lathe_testNegDXF_R14.dxf"
-PAWN = DATA / "nc" / "linuxcnc" / "lathe_pawn.ngc"          # LinuxCNC lathe program
 CAM = DATA / "nc" / "sinumerik" / "cam_840dsl" / "CAM_TEST.MPF"   # 840D sl CAM output
 EMCO_CNC = DATA / "nc" / "emco_from_dxf" / "testNegDXF.cnc"   # Emco fixed-column format
-SPEED = 600
-LINEAGE_ROW = -1
 # A LinuxCNC lathe as a shop would record it: a dialect the verifier has no grammar for.
 LINUXCNC_LATHE = ("INSERT INTO machine (name, kind, dialect, x_min, x_max, z_min, z_max, spindle_max) "
                   "VALUES ('lathe-linuxcnc', 'lathe', 'linuxcnc', 0, 400, -600, 200, 4000)")
@@ -33,58 +28,9 @@ SUBMIT = ("INSERT INTO program_submission (id, job_id, gear_class, template_vers
           "row_ids, trace, unverified) VALUES (%s, %s, %s, %s, %s, %s, %s, %s, %s, %s)")
 
 
-def ok(result):
-    assert result.exit_code == 0, result.output
-    return result
-
-
-def refused(result) -> str:
-    assert result.exit_code == 1, result.output
-    assert len(result.stderr.strip().splitlines()) == 1 and "Traceback" not in result.output, result.stderr
-    return result.stderr.strip()
-
-
 def stored_counts(url) -> tuple[int, int]:
     with psycopg.connect(url) as conn:
         return conn.execute("SELECT (SELECT count(*) FROM job), (SELECT count(*) FROM program)").fetchone()
-
-
-def stored_program(url, program_id: int) -> tuple[list[str], list[str], bool]:
-    """(the lines its template made, its lineage lines, its record's unverified)."""
-    with psycopg.connect(url) as conn:
-        lines, row_ids, unverified = conn.execute("SELECT lines, row_ids, unverified FROM program WHERE id = %s",
-                                                  (program_id,)).fetchone()
-    made = [text for text, row in zip(lines, row_ids) if row != LINEAGE_ROW]
-    return made, [text for text, row in zip(lines, row_ids) if row == LINEAGE_ROW], unverified
-
-
-def engine_program_file(run, tmp_path):
-    """A program the ISO lathe's verifier reads, made from a real drawing and written to a file;
-    imported as it is, its lineage line is refused, and it is taken out as the refusal says.
-    Returns the file and the feed of the drawing's operations."""
-    job = json.loads(ok(run("import-dxf", EMCO_DRAWING, "--speed", SPEED, "--program-name", "EMCO_NEG",
-                            "--json")).stdout)
-    written = tmp_path / "EMCO_NEG.NC"
-    ok(run("instantiate", "--job", job["job_id"], "--out", written))
-    refusal = refused(run("import-nc", written, "--class", "emco_neg"))
-    number = int(re.search(r" line (\d+) is a lineage line", refusal)[1])
-    lines = written.read_text().splitlines()
-    del lines[number - 1]
-    source = tmp_path / "emco_neg.nc"
-    source.write_text("\n".join(lines) + "\n")
-    return source, job["operations"][0]["feed"]
-
-
-def import_emco(run, tmp_path):
-    """The engine's program imported as class emco_neg, its speed and feed parameters: (file, lines)."""
-    source, feed = engine_program_file(run, tmp_path)
-    lines = source.read_text().splitlines()
-    bound = {word for line in lines for word in line.split() if re.fullmatch(rf"[A-Z]?0*({SPEED}|150)(\.0*)?", word)}
-    assert feed == 150 and bound == {f"S{SPEED}", "F150.000"}   # so each value is bound at one address only
-    params = tmp_path / "params.json"
-    params.write_text(json.dumps({"program_name": "EMCO_NEG", "speed": SPEED, "feed": feed}))
-    ok(run("import-nc", source, "--class", "emco_neg", "--params", params))
-    return source, lines
 
 
 # --- verified: the imported program again, and new values --------------------------------------------
@@ -260,7 +206,7 @@ def test_an_unverified_program_is_stored_and_shown_as_such_and_verified_when_mad
     assert "'linuxcnc'" in remade and stored_counts(run.url) == before
 
 
-def test_an_unverified_program_is_never_written_to_a_file(run, tmp_path, monkeypatch):
+def test_an_unverified_program_is_never_written_to_a_file(run, tmp_path):
     with psycopg.connect(run.url) as conn:
         conn.execute(LINUXCNC_LATHE)
     ok(run("import-nc", PAWN, "--class", "pawn"))
@@ -270,9 +216,7 @@ def test_an_unverified_program_is_never_written_to_a_file(run, tmp_path, monkeyp
                           "--out", out))
     assert "never written to a file" in message and not out.exists()
     folder = tmp_path / "nc"
-    config = tmp_path / "config.toml"
-    config.write_text(f'machine = "lathe-linuxcnc"\n\n[machines.lathe-linuxcnc]\nout = "{folder}"\n')
-    monkeypatch.setenv("ENGINE_CONFIG", str(config))
+    run.config.write_text(f'machine = "lathe-linuxcnc"\n\n[machines.lathe-linuxcnc]\nout = "{folder}"\n')
     message = refused(run("instantiate", "--class", "pawn", "--draft", "--unverified"))   # the config's machine
     assert "never written to a file" in message and not folder.exists()
     assert stored_counts(run.url) == before

@@ -13,7 +13,7 @@ import psycopg
 import pytest
 
 
-from test_records import logins
+from helpers.roles import logins
 
 CRLF, LF = "\r\n", "\n"
 
@@ -48,70 +48,70 @@ def with_layout(exported: str, ending: str, final_newline: str) -> str:
     return buffer.getvalue()
 
 
-def crlf_draft(engine, tmp_path) -> None:
+def crlf_draft(run, tmp_path) -> None:
     """spur's rows as released, imported with the layout CR LF and no final newline."""
     edited = tmp_path / "spur.csv"
-    edited.write_text(with_layout(engine("template", "export", "--class", "spur").stdout, "crlf", "no"))
-    imported = engine("template", "import", "--class", "spur", edited)
+    edited.write_text(with_layout(run("template", "export", "--class", "spur").stdout, "crlf", "no"))
+    imported = run("template", "import", "--class", "spur", edited)
     assert imported.exit_code == 0, imported.output
     assert "layout changed (identical rows)" in imported.stdout and "version 2" in imported.stdout
 
 
-def written(engine, tmp_path, *options) -> tuple[dict, bytes]:
+def written(run, tmp_path, *options) -> tuple[dict, bytes]:
     target = tmp_path / f"GEAR42_{len(list(tmp_path.iterdir()))}.MPF"
-    program = made(engine("instantiate", "--gear", 42, *options, "--out", target, "--json"))
+    program = made(run("instantiate", "--gear", 42, *options, "--out", target, "--json"))
     return program, target.read_bytes()
 
 
-def test_a_layout_change_is_a_draft_until_it_is_released(engine, tmp_path):
-    crlf_draft(engine, tmp_path)
-    runner, runners_file = written(engine, tmp_path)
+def test_a_layout_change_is_a_draft_until_it_is_released(run, tmp_path):
+    crlf_draft(run, tmp_path)
+    runner, runners_file = written(run, tmp_path)
     assert runner["template_version"] == 1
-    assert runners_file == joined(stored(engine.url, runner["program_id"]), LF, True)
-    editor, editors_file = written(engine, tmp_path, "--draft")
+    assert runners_file == joined(stored(run.url, runner["program_id"]), LF, True)
+    editor, editors_file = written(run, tmp_path, "--draft")
     assert editor["template_version"] == 2
-    assert editors_file == joined(stored(engine.url, editor["program_id"]), CRLF, False)
-    released = engine("template", "release", "--class", "spur", "--yes")
+    assert editors_file == joined(stored(run.url, editor["program_id"]), CRLF, False)
+    released = run("template", "release", "--class", "spur", "--yes")
     assert released.exit_code == 0, released.output
-    after, file_after = written(engine, tmp_path)
+    after, file_after = written(run, tmp_path)
     assert after["template_version"] == 2
-    assert file_after == joined(stored(engine.url, after["program_id"]), CRLF, False)
+    assert file_after == joined(stored(run.url, after["program_id"]), CRLF, False)
 
 
-def test_programs_show_keeps_the_layout_of_the_version_a_program_was_made_from(engine, tmp_path):
-    before, file_before = written(engine, tmp_path)
-    crlf_draft(engine, tmp_path)
-    assert engine("template", "release", "--class", "spur", "--yes").exit_code == 0
-    shown = engine("programs", "show", before["program_id"])
+def test_programs_show_keeps_the_layout_of_the_version_a_program_was_made_from(run, tmp_path):
+    before, file_before = written(run, tmp_path)
+    crlf_draft(run, tmp_path)
+    assert run("template", "release", "--class", "spur", "--yes").exit_code == 0
+    shown = run("programs", "show", before["program_id"])
     assert shown.exit_code == 0 and shown.stdout_bytes.endswith(file_before), shown.output
-    record = made(engine("programs", "show", before["program_id"], "--json"))["programs"][0]
+    record = made(run("programs", "show", before["program_id"], "--json"))["programs"][0]
     assert (record["line_ending"], record["final_newline"]) == ("lf", True)
 
 
-def test_history_diff_and_restore_carry_the_layout(engine, tmp_path):
-    crlf_draft(engine, tmp_path)
-    versions = made(engine("template", "history", "--class", "spur", "--json"))["versions"]
+def test_history_diff_and_restore_carry_the_layout(run, tmp_path):
+    crlf_draft(run, tmp_path)
+    versions = made(run("template", "history", "--class", "spur", "--json"))["versions"]
     assert [(v["version"], v["line_ending"], v["final_newline"]) for v in versions] == \
         [(1, "lf", True), (2, "crlf", False)]
-    history = engine("template", "history", "--class", "spur").stdout.splitlines()
+    history = run("template", "history", "--class", "spur").stdout.splitlines()
     assert history[-1].startswith("v2") and history[-1].endswith("layout CRLF, no final newline")
-    diff = engine("template", "diff", "--class", "spur", "--from", 1, "--to", 2)
+    diff = run("template", "diff", "--class", "spur", "--from", 1, "--to", 2)
     assert diff.stdout == "~ layout: LF, final newline -> CRLF, no final newline\n", diff.output
-    assert made(engine("template", "diff", "--class", "spur", "--from", 1, "--to", 2, "--json"))["changes"] == []
-    restored = engine("template", "restore", "--class", "spur", "--version", 1)
+    assert made(run("template", "diff", "--class", "spur", "--from", 1, "--to", 2, "--json"))["changes"] == []
+    restored = run("template", "restore", "--class", "spur", "--version", 1)
     assert restored.exit_code == 0 and "restored version 1 as version 3" in restored.stdout, restored.output
-    editor, editors_file = written(engine, tmp_path, "--draft")
+    editor, editors_file = written(run, tmp_path, "--draft")
     assert editor["template_version"] == 3
-    assert editors_file == joined(stored(engine.url, editor["program_id"]), LF, True)
+    assert editors_file == joined(stored(run.url, editor["program_id"]), LF, True)
 
 
 def test_an_editor_changing_the_layout_makes_a_draft_and_the_released_version_keeps_its_own(
-        engine, login_in):
+        run, login_in):
     editor = login_in("engine_editor")
-    with psycopg.connect(editor.url(engine.url)) as conn:
+    with psycopg.connect(editor.url(run.url)) as conn:
         conn.execute("SET ROLE engine_editor")
         conn.execute("UPDATE gear_class SET line_ending = %s, final_newline = false WHERE name = 'spur'", (CRLF,))
-    with psycopg.connect(engine.url) as conn:
+    with psycopg.connect(run.url) as conn:
         assert conn.execute("SELECT template_version, released_version(name) FROM gear_class "
                             "WHERE name = 'spur'").fetchone() == (2, 1)
         assert conn.execute("SELECT version, line_ending, final_newline FROM template_version_rows "
@@ -119,51 +119,51 @@ def test_an_editor_changing_the_layout_makes_a_draft_and_the_released_version_ke
             [(1, LF, True), (2, CRLF, False)]
 
 
-def test_a_layout_and_rows_changed_in_one_import_are_one_version(engine, tmp_path):
-    exported = engine("template", "export", "--class", "spur").stdout
+def test_a_layout_and_rows_changed_in_one_import_are_one_version(run, tmp_path):
+    exported = run("template", "export", "--class", "spur").stdout
     edited = tmp_path / "spur.csv"
     edited.write_text(with_layout(exported, "crlf", "yes").replace('"M30"', '"M30 ; END"', 1))
-    imported = engine("template", "import", "--class", "spur", edited)
+    imported = run("template", "import", "--class", "spur", edited)
     assert imported.exit_code == 0 and "replaced" in imported.stdout and "version 2" in imported.stdout, \
         imported.output
 
 
-def test_a_re_import_of_the_file_with_other_line_endings_is_a_new_version(engine, tmp_path):
+def test_a_re_import_of_the_file_with_other_line_endings_is_a_new_version(run, tmp_path):
     lf_file, crlf_file = tmp_path / "lf.nc", tmp_path / "crlf.nc"
     lf_file.write_bytes(b"G0 X10\nM30\n")
     crlf_file.write_bytes(b"G0 X10\r\nM30\r\n")
-    first = engine("import-nc", lf_file, "--class", "nc_relaid", "--json")
+    first = run("import-nc", lf_file, "--class", "nc_relaid", "--json")
     assert first.exit_code == 0, first.output
-    again = engine("import-nc", crlf_file, "--class", "nc_relaid", "--json")
+    again = run("import-nc", crlf_file, "--class", "nc_relaid", "--json")
     assert again.exit_code == 0, again.output
-    with psycopg.connect(engine.url) as conn:
+    with psycopg.connect(run.url) as conn:
         assert conn.execute("SELECT version, line_ending FROM template_version_rows WHERE gear_class = 'nc_relaid' "
                             "ORDER BY version").fetchall() == [(1, LF), (2, CRLF)]
 
 
-def test_a_release_that_changes_only_the_layout_says_every_program_file_of_the_class_changes(engine, tmp_path):
-    written(engine, tmp_path)
-    written(engine, tmp_path)
-    with psycopg.connect(engine.url) as conn:
+def test_a_release_that_changes_only_the_layout_says_every_program_file_of_the_class_changes(run, tmp_path):
+    written(run, tmp_path)
+    written(run, tmp_path)
+    with psycopg.connect(run.url) as conn:
         programs = conn.execute("SELECT count(DISTINCT p.job_id) FROM program p JOIN job j ON j.id = p.job_id "
                                 "WHERE j.gear_class = 'spur'").fetchone()[0]
     assert programs >= 1
-    crlf_draft(engine, tmp_path)
-    shown = engine("template", "release", "--class", "spur", "--dry-run")
+    crlf_draft(run, tmp_path)
+    shown = run("template", "release", "--class", "spur", "--dry-run")
     assert shown.exit_code == 0, shown.output
     assert "0 program(s) change" in shown.stdout   # no line changes ...
     assert (f"layout of spur: LF, final newline → CRLF, no final newline: the files of all {programs} stored "
             "program(s) change bytes") in shown.stdout.splitlines()   # ... but every file's bytes do
-    impact = made(engine("template", "release", "--class", "spur", "--dry-run", "--json"))["impact"]
+    impact = made(run("template", "release", "--class", "spur", "--dry-run", "--json"))["impact"]
     assert impact["layout"] == [{"class": "spur", "from": {"line_ending": "lf", "final_newline": True},
                                  "to": {"line_ending": "crlf", "final_newline": False}, "programs": programs}]
 
 
-def test_a_release_of_rows_alone_names_no_layout_change(engine, tmp_path):
-    written(engine, tmp_path)
+def test_a_release_of_rows_alone_names_no_layout_change(run, tmp_path):
+    written(run, tmp_path)
     edited = tmp_path / "spur.csv"
-    edited.write_text(engine("template", "export", "--class", "spur").stdout.replace('"M9"', '"M9 ; COOLANT OFF"'))
-    assert engine("template", "import", "--class", "spur", edited).exit_code == 0
-    impact = made(engine("template", "release", "--class", "spur", "--dry-run", "--json"))["impact"]
+    edited.write_text(run("template", "export", "--class", "spur").stdout.replace('"M9"', '"M9 ; COOLANT OFF"'))
+    assert run("template", "import", "--class", "spur", edited).exit_code == 0
+    impact = made(run("template", "release", "--class", "spur", "--dry-run", "--json"))["impact"]
     assert impact["layout"] == [] and impact["jobs"] >= 1
-    assert "layout of" not in engine("template", "release", "--class", "spur", "--dry-run").stdout
+    assert "layout of" not in run("template", "release", "--class", "spur", "--dry-run").stdout

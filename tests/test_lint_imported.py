@@ -15,7 +15,7 @@ from engine.templates.lint import lint_class
 from engine.templates.rows import TemplateRow
 from engine.templates.store import ensure_class, load_template, replace_template
 
-from test_nc_import import DATA, PARAMS, class_name, real_files, write
+from helpers.nc_files import DATA, PARAMS, class_name, real_files, write
 
 CAM = "sinumerik/cam_840dsl/CAM_TEST.MPF"
 

@@ -15,7 +15,7 @@ import pytest
 from engine.hobbing.choices import Choices
 from engine.programs.instantiate import instantiate_gear
 from helpers.nc_reader import read_program
-from test_verifier import accepted, refusal
+from helpers.verifier_programs import accepted, refusal
 
 # Seeded gears (seed_templates/gears.csv), one per class, and the helix given to classes whose
 # seeded gear is straight, so that the gear's hand matters to the Z term.

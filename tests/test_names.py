@@ -16,7 +16,7 @@ from engine.names import NAME_RULES, is_safe
 from engine.paths import MIGRATIONS_DIR
 from engine.programs.instantiate import instantiate_gear
 from engine.turning.model import check_job_params
-from test_dxf_read import seed_drawing
+from helpers.drawings import seed_drawing
 
 INJECTED = "G0 X9999 Z-9999"    # the block that reached stored programs through each route
 NEWLINE = f"\n{INJECTED}"

@@ -10,76 +10,20 @@ from __future__ import annotations
 
 import json
 from decimal import Decimal
-from pathlib import Path
 
-import psycopg
 import pytest
-from click.testing import CliRunner
 from hypothesis import given, settings, strategies as st
 
-from engine.cli.app import main
 from engine.errors import EngineError
 from engine.library.nc_import import import_nc
 from engine.library.nc_rows import number_field
 from engine.library.nc_tokens import detokenise, tokenise
-from engine.templates.decision_table import compiled_template
 from engine.templates.evaluator import evaluate
 from engine.templates.expressions import compile_expression
 from engine.templates.rows import export_csv, parse_csv
 from engine.templates.store import ensure_class, load_template, replace_template
 
-from helpers.shared_data import shared_data
-
-DATA = shared_data() / "nc"
-FAMILY = "linuxcnc/plasmac_family/"
-MACROS = "linuxcnc/lathe_macros/"
-
-# The job parameters of each file: values read off the file by hand (comments, the
-# PlasmaC material line, the macro conversions).
-PARAMS = {
-    FAMILY + "metric_wrench.ngc": {"holes": 4, "path_tolerance": 0.125, "hole_x": 149.739, "hole_y": 27.45},
-    FAMILY + "imperial_wrench.ngc": {"holes": 4, "path_tolerance": 0.005, "hole_x": 5.8952, "hole_y": 1.0807},
-    FAMILY + "metric_ramp_pierce.ngc": {
-        "path_tolerance": 0.254, "tracking_tolerance": 0.025, "pierce_end_height": 2.5, "gouge_speed": 980,
-        "gouge_distance": 5, "creep_speed": 245, "cut_length": 60},
-    FAMILY + "imperial_ramp_pierce.ngc": {
-        "scale": 25.4, "path_tolerance": 0.005, "pierce_end_height": 2.5, "gouge_speed": 980,
-        "gouge_distance": 5, "creep_speed": 245, "cut_length": 60},
-    MACROS + "turning.ngc": {"mm_per_inch": 25.4, "m_per_ft": 0.3048, "finish_fraction": 0.6},
-    MACROS + "facing.ngc": {"mm_per_inch": 25.4, "m_per_ft": 0.3048},
-    MACROS + "boring.ngc": {"mm_per_inch": 25.4, "m_per_ft": 0.3048, "finish_factor": 1.5},
-    MACROS + "threading.ngc": {"mm_per_inch": 25.4, "m_per_ft": 0.3048, "depth_factor": 1.0825,
-                               "infeed_angle": 29.5, "feed_per_rev": 0.1, "max_rpm": 200},
-    "linuxcnc/lathe_pawn.ngc": {},
-    "linuxcnc/lathe_g70_71_demo.ngc": {"feed": 400, "stock_x": 15},
-    "linuxcnc/ngcgui_lathe/od.ngc": {"clearance": 0.025},
-    "linuxcnc/ngcgui_lathe/id.ngc": {"clearance": 0.025},
-    "sinumerik/cam_840dsl/CAM_TEST.MPF": {"feed": 250, "clear_z": 60, "approach_z": 53, "spindle_speed": 1061},
-    "emco_from_dxf/testNegDXF.cnc": {"feed": 100, "z_clear": 3000, "arc_k": -500},
-    "emco_from_dxf/testg02hemisphere.cnc": {"feed": 100, "z_clear": 3000},
-    "emco_from_dxf/testg03hemisphere.cnc": {"feed": 100, "z_clear": 3000},
-}
-
-
-def real_files():
-    assert DATA.is_dir(), f"the real NC files are missing: {DATA} (tests/data/README.md)"
-    found = sorted(str(p.relative_to(DATA)) for p in DATA.rglob("*") if p.is_file() and p.suffix != ".tsv")
-    assert set(found) == set(PARAMS), "a real file without parameters in PARAMS (or one gone)"
-    return found
-
-
-def class_name(relative: str) -> str:
-    return "nc_" + Path(relative).stem.lower()
-
-
-def instantiate(conn, gear_class: str, params: dict) -> str:
-    return "\n".join(compiled_template(load_template(conn, gear_class)).run(params).lines) + "\n"
-
-
-def write(tmp_path, text: str, name: str = "program.nc") -> Path:
-    path = tmp_path / name
-    path.write_bytes(text.encode())
-    return path
+from helpers.nc_files import DATA, FAMILY, MACROS, PARAMS, class_name, instantiate, real_files, stored, stored_at, write
 
 
 # --- tokens ------------------------------------------------------------------------------
@@ -301,10 +245,6 @@ def test_the_engineer_corrects_modules_and_following_lines_follow(conn, tmp_path
 
 # --- refusals: all or nothing --------------------------------------------------------------
 
-def stored(conn):
-    return conn.execute("SELECT (SELECT count(*) FROM gear_class), (SELECT count(*) FROM assembly), "
-                        "(SELECT count(*) FROM component)").fetchone()
-
 
 @pytest.mark.parametrize("content, words", [
     (b"", "is empty"),
@@ -342,18 +282,6 @@ def test_a_parent_without_rows_is_fine(conn, tmp_path):
 
 
 # --- the command ---------------------------------------------------------------------------
-
-@pytest.fixture
-def run(fresh_database_url):
-    def invoke(*args):
-        return CliRunner().invoke(main, ["--database-url", fresh_database_url, *map(str, args)])
-    invoke.url = fresh_database_url
-    return invoke
-
-
-def stored_at(url):
-    with psycopg.connect(url) as connection:
-        return stored(connection)
 
 
 def test_import_nc_command_reports_json_and_export_gives_the_rows(run, tmp_path):

@@ -7,19 +7,11 @@ import pytest
 
 from engine.errors import EngineError
 from engine.library.nc_import import import_nc
-from engine.library.nc_layout import class_layout, nc_text
-from engine.templates.decision_table import compiled_template
 from engine.templates.store import load_template
 
-from test_nc_import import DATA, PARAMS, class_name, real_files
+from helpers.nc_files import DATA, PARAMS, class_name, real_files, written_back
 
 TWO_FILES = ["sinumerik/cam_840dsl/CAM_TEST.MPF", "emco_from_dxf/testNegDXF.cnc"]
-
-
-def written_back(conn, gear_class: str, params: dict) -> bytes:
-    """The class's program with the import's parameters, written with the class's layout."""
-    lines = compiled_template(load_template(conn, gear_class)).run(params).lines
-    return nc_text(lines, class_layout(conn, gear_class)).encode()
 
 
 def variant(tmp_path, relative: str, crlf: bool, final_newline: bool):

@@ -11,16 +11,11 @@ from decimal import Decimal
 
 import psycopg
 import pytest
-from click.testing import CliRunner
 
-from engine.cli.app import main
 from engine.library import nc_halves
 from engine.library.nc_import import import_nc
-from engine.templates.decision_table import compiled_template
-from engine.templates.store import load_template
 
-from test_nc_import import DATA, real_files, stored_at
-from test_nc_line_endings import written_back
+from helpers.nc_files import DATA, instantiated, real_files, stored_at, stored_rows, written_back
 
 DEMO = "linuxcnc/lathe_g70_71_demo.ngc"      # D0.3 (cutter compensation) and R0.3 (G71's retract)
 CAM = "sinumerik/cam_840dsl/CAM_TEST.MPF"    # I4.25 and J4.25 (arc centres)
@@ -43,17 +38,6 @@ def words(relative: str) -> list[tuple[int, str, str, str]]:
 
 def equal_words(relative: str, value: str) -> list[tuple[int, str, str, str]]:
     return [word for word in words(relative) if Decimal(word[3]) == Decimal(value)]
-
-
-def stored_rows(conn, gear_class: str) -> dict[int, str]:
-    """Line number → the stored `o` of its template row (row id 10 per line)."""
-    return {row_id // 10: o for row_id, o in conn.execute(
-        "SELECT t.id, c.o FROM class_template(%s) t JOIN component c ON c.id = t.component_id ORDER BY t.id",
-        (gear_class,))}
-
-
-def instantiated(conn, gear_class: str, params: dict) -> list[str]:
-    return compiled_template(load_template(conn, gear_class)).run(params).lines
 
 
 def bound_form(parameter: str, value: str, address: str, relative: str) -> dict:
@@ -152,13 +136,6 @@ def test_two_parameters_binding_the_same_address_use_the_first_given(conn):
 
 
 # --- the command ---------------------------------------------------------------------------
-
-@pytest.fixture
-def run(fresh_database_url):
-    def invoke(*args):
-        return CliRunner().invoke(main, ["--database-url", fresh_database_url, *map(str, args)])
-    invoke.url = fresh_database_url
-    return invoke
 
 
 def rows_at(url, gear_class: str) -> dict[int, str]:

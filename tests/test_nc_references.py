@@ -10,13 +10,10 @@ import re
 
 import psycopg
 import pytest
-from click.testing import CliRunner
 
-from engine.cli.app import main
 from engine.library.nc_import import import_nc
 
-from test_nc_import import DATA, FAMILY, stored_at
-from test_nc_params_binding import instantiated, stored_rows
+from helpers.nc_files import DATA, FAMILY, instantiated, stored_at, stored_rows
 
 DEMO = "linuxcnc/lathe_g70_71_demo.ngc"
 CAM = "sinumerik/cam_840dsl/CAM_TEST.MPF"
@@ -100,13 +97,6 @@ def test_plasma_io_channels_stay_and_the_values_they_carry_bind(conn):
 
 
 # --- the command -------------------------------------------------------------------------------
-
-@pytest.fixture
-def run(fresh_database_url):
-    def invoke(*args):
-        return CliRunner().invoke(main, ["--database-url", fresh_database_url, *map(str, args)])
-    invoke.url = fresh_database_url
-    return invoke
 
 
 def one_line_error(result) -> bool:

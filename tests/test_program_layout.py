@@ -45,46 +45,46 @@ def made(result) -> dict:
     return json.loads(result.stdout)
 
 
-def test_a_crlf_class_without_final_newline_writes_its_file_so(engine, tmp_path):
-    set_layout(engine.url, "spur", CRLF, False)
+def test_a_crlf_class_without_final_newline_writes_its_file_so(run, tmp_path):
+    set_layout(run.url, "spur", CRLF, False)
     target = tmp_path / "GEAR42.MPF"
-    program = made(engine("instantiate", "--gear", 42, "--out", target, "--json"))
-    lines = stored(engine.url, program["program_id"])
+    program = made(run("instantiate", "--gear", 42, "--out", target, "--json"))
+    lines = stored(run.url, program["program_id"])
     assert target.read_bytes() == joined(lines, CRLF, False)
     assert not target.read_bytes().endswith(b"\n") and not any("\r" in line for line in lines)
 
 
-def test_an_lf_class_is_written_as_before(engine, tmp_path):
+def test_an_lf_class_is_written_as_before(run, tmp_path):
     target = tmp_path / "GEAR42.MPF"
-    program = made(engine("instantiate", "--gear", 42, "--out", target, "--json"))
-    assert target.read_bytes() == joined(stored(engine.url, program["program_id"]), LF, True)
+    program = made(run("instantiate", "--gear", 42, "--out", target, "--json"))
+    assert target.read_bytes() == joined(stored(run.url, program["program_id"]), LF, True)
     assert target.read_bytes().endswith(b"M30\n") and b"\r" not in target.read_bytes()
 
 
-def test_the_printed_program_and_programs_show_give_the_same_bytes(engine):
-    set_layout(engine.url, "spur", CRLF, False)
-    printed = engine("instantiate", "--gear", 42)
+def test_the_printed_program_and_programs_show_give_the_same_bytes(run):
+    set_layout(run.url, "spur", CRLF, False)
+    printed = run("instantiate", "--gear", 42)
     assert printed.exit_code == 0, printed.output
     program_id = int(re.search(r"program (\d+) ", printed.stderr).group(1))
-    expected = joined(stored(engine.url, program_id), CRLF, False)
+    expected = joined(stored(run.url, program_id), CRLF, False)
     assert printed.stdout_bytes == expected
-    shown = engine("programs", "show", program_id)
-    count = len(stored(engine.url, program_id))
+    shown = run("programs", "show", program_id)
+    count = len(stored(run.url, program_id))
     assert shown.exit_code == 0 and shown.stdout_bytes.endswith(f"\nlines:         {count}\n".encode() + expected)
     assert "layout:        CRLF, no final newline" in shown.stdout
-    record = made(engine("programs", "show", program_id, "--json"))["programs"][0]
+    record = made(run("programs", "show", program_id, "--json"))["programs"][0]
     assert (record["line_ending"], record["final_newline"]) == ("crlf", False)
 
 
-def test_a_dry_run_prints_the_program_with_its_class_layout(engine):
-    set_layout(engine.url, "spur", CRLF, False)
-    program = made(engine("instantiate", "--gear", 42, "--json"))
+def test_a_dry_run_prints_the_program_with_its_class_layout(run):
+    set_layout(run.url, "spur", CRLF, False)
+    program = made(run("instantiate", "--gear", 42, "--json"))
     # the dry run makes the same program; its lineage line says DRY-RUN where the stored one has the id
     lines = [line.replace(f"PROGRAM {program['program_id']} ", "PROGRAM DRY-RUN ")
-             for line in stored(engine.url, program["program_id"])]
-    dry = engine("instantiate", "--gear", 42, "--dry-run")
+             for line in stored(run.url, program["program_id"])]
+    dry = run("instantiate", "--gear", 42, "--dry-run")
     assert dry.exit_code == 0 and dry.stdout_bytes == joined(lines, CRLF, False)
-    text = made(engine("instantiate", "--gear", 42, "--dry-run", "--json"))["text"]
+    text = made(run("instantiate", "--gear", 42, "--dry-run", "--json"))["text"]
     assert text.encode("ascii") == joined(lines, CRLF, False)
 
 
@@ -99,48 +99,48 @@ def batch_files(url: str, folder, layouts: dict) -> dict:
 
 
 @pytest.mark.parametrize("workers", ["1", "2"])
-def test_a_batch_writes_each_program_with_its_own_class_layout(engine, tmp_path, workers):
-    set_layout(engine.url, "spur", CRLF, False)
+def test_a_batch_writes_each_program_with_its_own_class_layout(run, tmp_path, workers):
+    set_layout(run.url, "spur", CRLF, False)
     folder = tmp_path / "nc"
-    batch = engine("instantiate", "--gears", "42-47", "--workers", workers, "--out", folder)
+    batch = run("instantiate", "--gears", "42-47", "--workers", workers, "--out", folder)
     assert batch.exit_code == 0, batch.output
-    files = batch_files(engine.url, folder, {"spur": (CRLF, False)})
+    files = batch_files(run.url, folder, {"spur": (CRLF, False)})
     assert sorted(files) == sorted(path.name for path in folder.iterdir()) and len(files) == 6
     assert all(written == expected for written, expected in files.values())
     endings = {written.endswith(b"\n") for written, _ in files.values()}
     assert endings == {True, False}   # the helical gears' LF files and the spur gears' CRLF ones
 
 
-def test_stored_jobs_made_again_keep_their_class_layout(engine, tmp_path):
-    first = made(engine("instantiate", "--gear", 42, "--json"))
-    last = made(engine("instantiate", "--gear", 43, "--json"))
-    set_layout(engine.url, "spur", CRLF, False)
-    set_layout(engine.url, "helical", CRLF, True)
+def test_stored_jobs_made_again_keep_their_class_layout(run, tmp_path):
+    first = made(run("instantiate", "--gear", 42, "--json"))
+    last = made(run("instantiate", "--gear", 43, "--json"))
+    set_layout(run.url, "spur", CRLF, False)
+    set_layout(run.url, "helical", CRLF, True)
     one = tmp_path / "one.MPF"
-    again = made(engine("instantiate", "--job", first["job_id"], "--out", one, "--json"))
-    assert one.read_bytes() == joined(stored(engine.url, again["program_id"]), CRLF, False)
+    again = made(run("instantiate", "--job", first["job_id"], "--out", one, "--json"))
+    assert one.read_bytes() == joined(stored(run.url, again["program_id"]), CRLF, False)
     folder = tmp_path / "jobs"
-    assert engine("instantiate", "--jobs", f"{first['job_id']}-{last['job_id']}", "--out", folder).exit_code == 0
-    files = batch_files(engine.url, folder, {"spur": (CRLF, False), "helical": (CRLF, True)})
+    assert run("instantiate", "--jobs", f"{first['job_id']}-{last['job_id']}", "--out", folder).exit_code == 0
+    files = batch_files(run.url, folder, {"spur": (CRLF, False), "helical": (CRLF, True)})
     assert len(files) == 2 and all(written == expected for written, expected in files.values())
 
 
-def test_a_machine_line_ending_of_the_config_file_replaces_only_the_ending(engine, tmp_path):
-    set_layout(engine.url, "spur", CRLF, False)
-    engine.config.write_text('[machines.hobber-840d]\nline_endings = "lf"\n')
+def test_a_machine_line_ending_of_the_config_file_replaces_only_the_ending(run, tmp_path):
+    set_layout(run.url, "spur", CRLF, False)
+    run.config.write_text('[machines.hobber-840d]\nline_endings = "lf"\n')
     target = tmp_path / "GEAR42.MPF"
-    program = made(engine("instantiate", "--gear", 42, "--out", target, "--json"))
-    lines = stored(engine.url, program["program_id"])
+    program = made(run("instantiate", "--gear", 42, "--out", target, "--json"))
+    lines = stored(run.url, program["program_id"])
     assert target.read_bytes() == joined(lines, LF, False)   # the final newline stays the class's
-    assert engine("programs", "show", program["program_id"]).stdout_bytes.endswith(joined(lines, CRLF, False))
+    assert run("programs", "show", program["program_id"]).stdout_bytes.endswith(joined(lines, CRLF, False))
 
 
-def test_another_machine_line_ending_leaves_the_class_layout(engine, tmp_path):
-    set_layout(engine.url, "spur", CRLF, False)
-    engine.config.write_text('[machines.lathe-840d]\nline_endings = "lf"\n')
+def test_another_machine_line_ending_leaves_the_class_layout(run, tmp_path):
+    set_layout(run.url, "spur", CRLF, False)
+    run.config.write_text('[machines.lathe-840d]\nline_endings = "lf"\n')
     target = tmp_path / "GEAR42.MPF"
-    program = made(engine("instantiate", "--gear", 42, "--out", target, "--json"))
-    assert target.read_bytes() == joined(stored(engine.url, program["program_id"]), CRLF, False)
+    program = made(run("instantiate", "--gear", 42, "--out", target, "--json"))
+    assert target.read_bytes() == joined(stored(run.url, program["program_id"]), CRLF, False)
 
 
 def without_layout_columns(text: str) -> str:
@@ -157,36 +157,36 @@ def class_layout_stored(url: str, gear_class: str) -> tuple:
                             (gear_class,)).fetchone()
 
 
-def test_an_exported_template_carries_the_layout_into_another_class(engine, tmp_path):
-    set_layout(engine.url, "spur", CRLF, False)
+def test_an_exported_template_carries_the_layout_into_another_class(run, tmp_path):
+    set_layout(run.url, "spur", CRLF, False)
     exported = tmp_path / "spur.csv"
-    assert engine("template", "export", "--class", "spur", "--out", exported).exit_code == 0
+    assert run("template", "export", "--class", "spur", "--out", exported).exit_code == 0
     header, first = list(csv.reader(io.StringIO(exported.read_text(), newline="")))[:2]
     assert header[-2:] == ["line_ending", "final_newline"] and first[-2:] == ["crlf", "no"]
-    imported = engine("template", "import", "--class", "spur_copy", "--parent", "spur", exported)
+    imported = run("template", "import", "--class", "spur_copy", "--parent", "spur", exported)
     assert imported.exit_code == 0 and "CRLF, no final newline" in imported.stdout, imported.output
-    assert class_layout_stored(engine.url, "spur_copy") == (CRLF, False)
-    with psycopg.connect(engine.url) as conn:
+    assert class_layout_stored(run.url, "spur_copy") == (CRLF, False)
+    with psycopg.connect(run.url) as conn:
         conn.execute("UPDATE gear SET gear_class = 'spur_copy' WHERE id = 42")
     target = tmp_path / "GEAR42.MPF"
-    program = made(engine("instantiate", "--gear", 42, "--draft", "--out", target, "--json"))
+    program = made(run("instantiate", "--gear", 42, "--draft", "--out", target, "--json"))
     assert program["class"] == "spur_copy"
-    assert target.read_bytes() == joined(stored(engine.url, program["program_id"]), CRLF, False)
+    assert target.read_bytes() == joined(stored(run.url, program["program_id"]), CRLF, False)
 
 
-def test_a_csv_without_the_layout_columns_leaves_the_class_layout(engine, tmp_path):
-    set_layout(engine.url, "spur", CRLF, False)
-    exported = engine("template", "export", "--class", "spur")
+def test_a_csv_without_the_layout_columns_leaves_the_class_layout(run, tmp_path):
+    set_layout(run.url, "spur", CRLF, False)
+    exported = run("template", "export", "--class", "spur")
     old = tmp_path / "old.csv"
     old.write_text(without_layout_columns(exported.stdout))
     assert old.read_text().splitlines()[0] == "id,t,n,p_calc,s,o,p_emit"
-    imported = engine("template", "import", "--class", "spur", old)
+    imported = run("template", "import", "--class", "spur", old)
     assert imported.exit_code == 0, imported.output
-    assert class_layout_stored(engine.url, "spur") == (CRLF, False)
+    assert class_layout_stored(run.url, "spur") == (CRLF, False)
 
 
-def test_an_lf_class_exports_the_seven_columns_it_always_had(engine):
-    exported = engine("template", "export", "--class", "spur").stdout
+def test_an_lf_class_exports_the_seven_columns_it_always_had(run):
+    exported = run("template", "export", "--class", "spur").stdout
     assert exported.splitlines()[0] == "id,t,n,p_calc,s,o,p_emit"
 
 
@@ -198,20 +198,20 @@ def edited_layout(exported: str, cells: dict) -> str:
                                    for number, line in enumerate(lines[1:], start=2)]) + "\n"
 
 
-def test_the_csv_can_make_a_class_lf_again_and_blank_cells_take_the_others(engine, tmp_path):
-    set_layout(engine.url, "spur", CRLF, False)
+def test_the_csv_can_make_a_class_lf_again_and_blank_cells_take_the_others(run, tmp_path):
+    set_layout(run.url, "spur", CRLF, False)
     edited = tmp_path / "edited.csv"
-    edited.write_text(edited_layout(engine("template", "export", "--class", "spur").stdout, {None: ",lf,yes", 3: ",,"}))
-    imported = engine("template", "import", "--class", "spur", edited)
+    edited.write_text(edited_layout(run("template", "export", "--class", "spur").stdout, {None: ",lf,yes", 3: ",,"}))
+    imported = run("template", "import", "--class", "spur", edited)
     assert imported.exit_code == 0 and "LF, final newline" in imported.stdout, imported.output
-    assert class_layout_stored(engine.url, "spur") == (LF, True)
+    assert class_layout_stored(run.url, "spur") == (LF, True)
 
 
-def test_a_csv_giving_two_layouts_is_refused_naming_the_line(engine, tmp_path):
-    set_layout(engine.url, "spur", CRLF, False)
+def test_a_csv_giving_two_layouts_is_refused_naming_the_line(run, tmp_path):
+    set_layout(run.url, "spur", CRLF, False)
     edited = tmp_path / "edited.csv"
-    edited.write_text(edited_layout(engine("template", "export", "--class", "spur").stdout,
+    edited.write_text(edited_layout(run("template", "export", "--class", "spur").stdout,
                                     {None: ",lf,yes", 4: ",crlf,yes"}))
-    refused = engine("template", "import", "--class", "spur", edited)
+    refused = run("template", "import", "--class", "spur", edited)
     assert refused.exit_code == 1 and f"{edited}, line 4, column line_ending" in refused.stderr, refused.output
-    assert class_layout_stored(engine.url, "spur") == (CRLF, False)
+    assert class_layout_stored(run.url, "spur") == (CRLF, False)

@@ -7,57 +7,21 @@ from __future__ import annotations
 
 import math
 import re
-import uuid
-from contextlib import contextmanager
-from dataclasses import dataclass
 
 import psycopg
 import pytest
-from psycopg import errors, sql
-from psycopg.conninfo import conninfo_to_dict, make_conninfo
+from psycopg import errors
 from psycopg.types.json import Jsonb
 
 from engine.errors import EngineError
 from engine.gears.cases import confirm_job
 from engine.programs.instantiate import instantiate_gear, instantiate_gears
-from helpers.roles import as_role
+from helpers.roles import as_role, logins
 
 # The engine's path for one program (engine.programs.storage): an id drawn from the sequence first,
 # so that the program's lineage line can name it.
 SUBMIT = ("INSERT INTO program_submission (id, job_id, gear_class, template_version, template_hash, name, lines, "
           "row_ids, trace) VALUES (%s, %s, %s, %s, %s, %s, %s, %s, %s) RETURNING id")
-
-
-
-
-@dataclass(frozen=True)
-class Login:
-    """A login person of the cluster, member of an engine_* role, made for one test."""
-    name: str
-    password: str
-
-    def url(self, database_url: str) -> str:
-        return make_conninfo(**{**conninfo_to_dict(database_url), "user": self.name, "password": self.password})
-
-
-@contextmanager
-def logins(server_url):
-    """create("engine_editor") -> a new Login in that role; every one is dropped afterwards."""
-    made = []
-
-    def create(role: str) -> Login:
-        login = Login(f"records_{uuid.uuid4().hex[:12]}", uuid.uuid4().hex)
-        with psycopg.connect(server_url, autocommit=True) as admin:
-            admin.execute(sql.SQL("CREATE ROLE {} LOGIN PASSWORD {} IN ROLE {}").format(
-                sql.Identifier(login.name), sql.Literal(login.password), sql.Identifier(role)))
-        made.append(login)
-        return login
-    try:
-        yield create
-    finally:
-        with psycopg.connect(server_url, autocommit=True) as admin:
-            for login in made:
-                admin.execute(sql.SQL("DROP ROLE IF EXISTS {}").format(sql.Identifier(login.name)))
 
 
 @pytest.fixture

@@ -28,7 +28,7 @@ from engine.templates.rows import Template, TemplateRow, export_csv, rows_hash
 from engine.templates.store import load_template, replace_template
 from engine.templates.versions import draft_template
 
-from test_records import as_role, logins
+from helpers.roles import as_role, logins
 
 
 @pytest.fixture

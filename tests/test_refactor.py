@@ -13,38 +13,10 @@ from hypothesis import strategies as st
 from engine.errors import EngineError
 from engine.library.refactor import check_invariants, refactor, template_digests
 from engine.library.similarity import nc_units
-from engine.templates.rows import TemplateRow, export_csv
-from engine.templates.store import ensure_class, load_template, replace_template
+from engine.templates.rows import TemplateRow
+from engine.templates.store import ensure_class, replace_template
 
-from test_similarity import lcs_sim
-
-
-def exports(conn) -> dict[str, str]:
-    """Every class with rows, exported as the user would: `engine template export`."""
-    names = [name for (name,) in conn.execute(
-        "SELECT name FROM gear_class g WHERE EXISTS (SELECT 1 FROM class_template(g.name)) ORDER BY name")]
-    return {name: export_csv(load_template(conn, name)) for name in names}
-
-
-def component_count(conn) -> int:
-    return conn.execute("SELECT count(*) FROM component").fetchone()[0]
-
-
-def bodies_stored_twice(conn) -> int:
-    # GROUP BY puts NULLs together: equal groups are equal bodies, independent of the md5 key.
-    return conn.execute("SELECT count(*) FROM (SELECT 1 FROM component GROUP BY t, o, p_calc, s, p_emit "
-                        "HAVING count(*) > 1) d").fetchone()[0]
-
-
-def duplicate_row_body(conn, gear_class: str, row_id: int) -> tuple[int, int]:
-    """Store a copy of the row's component and point the row at it: (original id, copy id)."""
-    original = conn.execute("SELECT component_id FROM assembly WHERE gear_class = %s AND id = %s",
-                            (gear_class, row_id)).fetchone()[0]
-    copy = conn.execute("INSERT INTO component (t, o, p_calc, s, p_emit) SELECT t, o, p_calc, s, p_emit "
-                        "FROM component WHERE id = %s RETURNING id", (original,)).fetchone()[0]
-    conn.execute("UPDATE assembly SET component_id = %s WHERE gear_class = %s AND id = %s",
-                 (copy, gear_class, row_id))
-    return original, copy
+from helpers.refactor import bodies_stored_twice, component_count, duplicate_row_body, exports, lcs_sim
 
 
 def test_seeded_library_is_stored_once_and_a_run_changes_nothing(conn):

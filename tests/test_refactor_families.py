@@ -19,7 +19,7 @@ from engine.library.intended import intend, intents, shown_key, unintend
 from engine.library.nc_import import import_nc
 from engine.library.refactor import refactor
 
-from test_nc_import import DATA
+from helpers.nc_files import DATA
 
 CAM = DATA / "sinumerik/cam_840dsl/CAM_TEST.MPF"
 BLOCK_NUMBER = re.compile(r"^N\d+ *")

@@ -22,8 +22,8 @@ from engine.templates.expressions import compile_expression
 from engine.templates.store import load_template, replace_template
 
 from helpers.lineage_text import id_masked
-from test_nc_import import DATA, FAMILY, PARAMS, class_name, instantiate, real_files
-from test_refactor import bodies_stored_twice, component_count, duplicate_row_body, exports
+from helpers.nc_files import DATA, FAMILY, PARAMS, class_name, instantiate, real_files
+from helpers.refactor import bodies_stored_twice, component_count, duplicate_row_body, exports
 
 SEEDED_CLASSES = {"spur", "helical", "taper", "crowned", "worm_wheel", "duplex"}
 WAIT = 30   # seconds: no wait of this file blocks longer, so a bug fails instead of hanging

@@ -22,7 +22,7 @@ from engine.templates.release import release
 
 from helpers.roles import as_role
 from helpers.shared_data import shared_data
-from test_instantiate_class import PAWN, import_emco, ok, refused, stored_program
+from helpers.class_jobs import PAWN, import_emco, ok, refused, stored_program
 
 NC = shared_data() / "nc"
 REAL_PROGRAMS = sorted(path for path in NC.rglob("*") if path.is_file() and path.name != "PROVENANCE.tsv")

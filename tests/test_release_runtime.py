@@ -21,7 +21,7 @@ from engine.simulation import simulate_stored_program
 from helpers.lineage_text import id_masked
 from helpers.releases import release_draft
 from helpers.roles import as_role
-from test_dxf_read import DXF, EMCO, seed_drawing
+from helpers.drawings import DXF, EMCO, seed_drawing
 
 SEEDED_GEARS = (42, 43, 44, 45, 46, 47, 50, 51, 53, 54)   # seed_templates/gears.csv: every hobbing class
 BROKEN_EDIT = "UPDATE template_view SET o = 'M8 ; COOLANT ON' WHERE gear_class = 'spur' AND o = '\"M8\"'"

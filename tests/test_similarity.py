@@ -8,17 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from engine.library.similarity import nc_units, similar_pairs
-
-
-def lcs_sim(a, b) -> float:
-    if not a and not b:
-        return 1.0
-    table = [[0] * (len(b) + 1) for _ in range(len(a) + 1)]
-    for i, x in enumerate(a):
-        for j, y in enumerate(b):
-            table[i + 1][j + 1] = table[i][j] + 1 if x == y else max(table[i][j + 1], table[i + 1][j])
-    k = table[-1][-1]
-    return k / (len(a) + len(b) - k)
+from helpers.refactor import lcs_sim
 
 
 def every_pair(lines, threshold):

@@ -25,7 +25,7 @@ from engine.hobbing.taper import TaperModel
 from engine.programs.instantiate import instantiate_gear
 
 from helpers.nc_reader import read_program
-from test_duplex_clearance import CUTTING, MACHINE, hob_surface, seeded_hobs
+from helpers.hob_clearance import CUTTING, MACHINE, hob_surface, seeded_hobs
 
 MARGIN = 0.25           # mm: the least clearance an infeed may leave (the engine keeps more)
 

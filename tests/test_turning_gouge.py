@@ -15,11 +15,9 @@ from engine.errors import EngineError
 from engine.turning.dxf_import import import_dxf
 from engine.turning.gouge import GOUGE_TOLERANCE_MM, PartIndex, check_no_gouge
 from engine.turning.moves import Move
-from test_dxf_read import INCH, seed_drawing
-import test_turning_params
-from test_turning_params import refused_after
+from helpers.drawings import INCH, seed_drawing
+from helpers.turning_jobs import refused_after
 
-seed_job = test_turning_params.seed_job   # the fixture, shared
 
 # A shaft R10 from Z 0 to −60 with a collar R20 over Z −30 … −40, closed by the axis.
 CORNERS = [(0.0, 0.0), (0.0, 10.0), (-30.0, 10.0), (-30.0, 20.0), (-40.0, 20.0), (-40.0, 10.0),

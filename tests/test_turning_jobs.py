@@ -9,7 +9,6 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-import ezdxf
 import pytest
 from psycopg.types.json import Jsonb
 
@@ -21,7 +20,8 @@ from engine.turning.dxf_import import import_dxf
 from engine.turning.job_params import ProfileOptions
 from engine.turning.names import MAX_OPERATIONS
 from helpers.lathe_programs import distance_to_drawn, drawn_polylines, motions, operation_lines, words
-from test_dxf_read import DXF, EMCO, INCH, nc_arc_words, seed_drawing
+from helpers.drawings import DXF, EMCO, INCH, nc_arc_words, seed_drawing
+from helpers.drawn_parts import profile_only_drawing, two_rough_layers
 
 # ISO F words carry their decimal point (a Fanuc-type control reads F1300 by a parameter's unit).
 DIALECTS = {"lathe-iso": {"tools": ("T0101", "T0202"), "thread": "G32", "coolant": ("M08", "M09"),
@@ -93,16 +93,6 @@ def test_emco_finish_pass_follows_the_drawn_profile(conn, name):
     assert arc_words == nc_arc_words(name)[:2]
 
 
-def profile_only_drawing(path: Path) -> None:
-    """A mm half-profile from the axis to the axis: shoulder, taper, convex arc, step."""
-    doc = ezdxf.new("R2010")
-    doc.header["$INSUNITS"] = 4
-    doc.modelspace().add_lwpolyline(
-        [(0, 0, 0), (0, 8, 0), (-10, 8, 0), (-20, 12, 0.5), (-30, 12, 0), (-40, 12, 0), (-40, 15, 0),
-         (-50, 15, 0), (-50, 0, 0)], format="xyb")
-    doc.saveas(path)
-
-
 def test_profile_only_rough_passes_keep_the_allowance(conn, tmp_path):
     profile_only_drawing(tmp_path / "shaft.dxf")
     allowance = 0.5
@@ -117,22 +107,6 @@ def test_profile_only_rough_passes_keep_the_allowance(conn, tmp_path):
             assert distance_to_drawn(point, drawn) >= allowance - 0.001, point
     stock_radius = math.ceil(2 * 15 + 2) / 2           # default blank: largest diameter + 2 mm
     assert max(end[1] for _, end in feeds) <= stock_radius
-
-
-def two_rough_layers(path: Path, tool_two: str = "01") -> None:
-    doc = ezdxf.new("R2010")
-    doc.header["$INSUNITS"] = 4
-    for layer in ("1", "2"):
-        doc.layers.add(layer)
-    msp = doc.modelspace()
-    msp.add_lwpolyline([(0, 0), (0, 10), (-50, 10), (-50, 0)])
-    msp.add_text("@GROUGH @S500 @F200 @T01", dxfattribs={"layer": "1"})
-    for radius in (20, 18, 16):
-        msp.add_line((1, radius), (-20, radius), dxfattribs={"layer": "1"})
-    msp.add_text(f"@GROUGH @S500 @F200 @T{tool_two}", dxfattribs={"layer": "2"})
-    for radius in (25, 23):
-        msp.add_line((-25, radius), (-45, radius), dxfattribs={"layer": "2"})
-    doc.saveas(path)
 
 
 def test_alternate_machines_two_rough_operations_pass_by_pass(conn, tmp_path):

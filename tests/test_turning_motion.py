@@ -19,7 +19,7 @@ from engine.programs.remake import instantiate_job
 from engine.turning.dxf_import import import_dxf
 from engine.turning.job_params import ProfileOptions
 from helpers.lathe_programs import drawn_polylines, motions, words
-from test_dxf_read import DXF, EMCO, seed_drawing
+from helpers.drawings import DXF, EMCO, seed_drawing
 
 MACHINES = ("lathe-iso", "lathe-840d")
 SAMPLE_MM = 0.05

@@ -8,31 +8,11 @@ import pytest
 
 from engine.errors import EngineError
 from engine.gears.records import load_machine
-from engine.programs.remake import instantiate_job
 from engine.programs.verifier import LimitError, verify_program
 from engine.turning.dxf_import import import_dxf
-from test_dxf_read import seed_drawing
-from test_turning_jobs import two_rough_layers
-
-
-@pytest.fixture
-def seed_job(conn, tmp_path) -> int:
-    seed_drawing(tmp_path / "part.dxf")
-    return import_dxf(conn, tmp_path / "part.dxf").job_id
-
-
-def program_count(conn) -> int:
-    return conn.execute("SELECT count(*) FROM program").fetchone()[0]
-
-
-def refused_after(conn, job_id: int, set_sql: str, message: str) -> None:
-    """The job edited by `set_sql` (an UPDATE's SET) is refused with `message`; nothing stored."""
-    conn.execute(f"UPDATE job SET {set_sql} WHERE id = %s", (job_id,))
-    before = program_count(conn)
-    with pytest.raises(EngineError, match=message) as refused:
-        instantiate_job(conn, job_id)
-    assert "\n" not in str(refused.value)
-    assert program_count(conn) == before
+from helpers.drawings import seed_drawing
+from helpers.drawn_parts import two_rough_layers
+from helpers.turning_jobs import refused_after
 
 
 MODULE = "module_params = jsonb_set(module_params, '{%s}', '%s')"

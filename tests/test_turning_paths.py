@@ -24,7 +24,7 @@ from engine.turning.toolpaths import (alternate, distance_to_region, drawn_rough
                                       thread_passes)
 from importers.dxf_drawing import read_drawing
 from importers.dxf_geometry import Arc, Line
-from test_dxf_read import seed_drawing
+from helpers.drawings import seed_drawing
 
 INCH = 25.4
 CLEARANCE = 1.0

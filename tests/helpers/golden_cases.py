@@ -110,8 +110,8 @@ def turning_text(conn, folder: Path, name: str, lathe: str) -> str:
 def _drawing(folder: Path, name: str, maker: str) -> Path:
     """The drawing of a case: a real file as it is, or one made by the tests' own makers under
     a fixed name (the name is printed in the program's header)."""
-    from test_dxf_read import DXF, seed_drawing
-    from test_turning_jobs import profile_only_drawing, two_rough_layers
+    from helpers.drawings import DXF, seed_drawing
+    from helpers.drawn_parts import profile_only_drawing, two_rough_layers
 
     if maker.startswith("emco:"):
         return DXF / maker.removeprefix("emco:")

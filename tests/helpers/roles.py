@@ -6,6 +6,10 @@ from contextlib import contextmanager
 
 from psycopg import sql
 from psycopg.pq import TransactionStatus
+from dataclasses import dataclass
+from psycopg.conninfo import conninfo_to_dict, make_conninfo
+import psycopg
+import uuid
 
 
 @contextmanager
@@ -17,3 +21,33 @@ def as_role(conn, role):
     finally:
         if conn.info.transaction_status != TransactionStatus.INERROR:
             conn.execute("RESET ROLE")
+
+
+@dataclass(frozen=True)
+class Login:
+    """A login person of the cluster, member of an engine_* role, made for one test."""
+    name: str
+    password: str
+
+    def url(self, database_url: str) -> str:
+        return make_conninfo(**{**conninfo_to_dict(database_url), "user": self.name, "password": self.password})
+
+
+@contextmanager
+def logins(server_url):
+    """create("engine_editor") -> a new Login in that role; every one is dropped afterwards."""
+    made = []
+
+    def create(role: str) -> Login:
+        login = Login(f"records_{uuid.uuid4().hex[:12]}", uuid.uuid4().hex)
+        with psycopg.connect(server_url, autocommit=True) as admin:
+            admin.execute(sql.SQL("CREATE ROLE {} LOGIN PASSWORD {} IN ROLE {}").format(
+                sql.Identifier(login.name), sql.Literal(login.password), sql.Identifier(role)))
+        made.append(login)
+        return login
+    try:
+        yield create
+    finally:
+        with psycopg.connect(server_url, autocommit=True) as admin:
+            for login in made:
+                admin.execute(sql.SQL("DROP ROLE IF EXISTS {}").format(sql.Identifier(login.name)))

@@ -1,0 +1,90 @@
+"""The real NC programs of tests/data/nc as the import tests use them: the files with their
+parameters, the class each becomes, and the rows and programs read back from the database."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import psycopg
+
+from engine.library.nc_layout import class_layout, nc_text
+from engine.templates.decision_table import compiled_template
+from engine.templates.store import load_template
+from helpers.shared_data import shared_data
+
+DATA = shared_data() / "nc"
+FAMILY = "linuxcnc/plasmac_family/"
+MACROS = "linuxcnc/lathe_macros/"
+
+# The job parameters of each file: values read off the file by hand (comments, the
+# PlasmaC material line, the macro conversions).
+PARAMS = {
+    FAMILY + "metric_wrench.ngc": {"holes": 4, "path_tolerance": 0.125, "hole_x": 149.739, "hole_y": 27.45},
+    FAMILY + "imperial_wrench.ngc": {"holes": 4, "path_tolerance": 0.005, "hole_x": 5.8952, "hole_y": 1.0807},
+    FAMILY + "metric_ramp_pierce.ngc": {
+        "path_tolerance": 0.254, "tracking_tolerance": 0.025, "pierce_end_height": 2.5, "gouge_speed": 980,
+        "gouge_distance": 5, "creep_speed": 245, "cut_length": 60},
+    FAMILY + "imperial_ramp_pierce.ngc": {
+        "scale": 25.4, "path_tolerance": 0.005, "pierce_end_height": 2.5, "gouge_speed": 980,
+        "gouge_distance": 5, "creep_speed": 245, "cut_length": 60},
+    MACROS + "turning.ngc": {"mm_per_inch": 25.4, "m_per_ft": 0.3048, "finish_fraction": 0.6},
+    MACROS + "facing.ngc": {"mm_per_inch": 25.4, "m_per_ft": 0.3048},
+    MACROS + "boring.ngc": {"mm_per_inch": 25.4, "m_per_ft": 0.3048, "finish_factor": 1.5},
+    MACROS + "threading.ngc": {"mm_per_inch": 25.4, "m_per_ft": 0.3048, "depth_factor": 1.0825,
+                               "infeed_angle": 29.5, "feed_per_rev": 0.1, "max_rpm": 200},
+    "linuxcnc/lathe_pawn.ngc": {},
+    "linuxcnc/lathe_g70_71_demo.ngc": {"feed": 400, "stock_x": 15},
+    "linuxcnc/ngcgui_lathe/od.ngc": {"clearance": 0.025},
+    "linuxcnc/ngcgui_lathe/id.ngc": {"clearance": 0.025},
+    "sinumerik/cam_840dsl/CAM_TEST.MPF": {"feed": 250, "clear_z": 60, "approach_z": 53, "spindle_speed": 1061},
+    "emco_from_dxf/testNegDXF.cnc": {"feed": 100, "z_clear": 3000, "arc_k": -500},
+    "emco_from_dxf/testg02hemisphere.cnc": {"feed": 100, "z_clear": 3000},
+    "emco_from_dxf/testg03hemisphere.cnc": {"feed": 100, "z_clear": 3000},
+}
+
+
+def real_files():
+    assert DATA.is_dir(), f"the real NC files are missing: {DATA} (tests/data/README.md)"
+    found = sorted(str(p.relative_to(DATA)) for p in DATA.rglob("*") if p.is_file() and p.suffix != ".tsv")
+    assert set(found) == set(PARAMS), "a real file without parameters in PARAMS (or one gone)"
+    return found
+
+
+def class_name(relative: str) -> str:
+    return "nc_" + Path(relative).stem.lower()
+
+
+def instantiate(conn, gear_class: str, params: dict) -> str:
+    return "\n".join(compiled_template(load_template(conn, gear_class)).run(params).lines) + "\n"
+
+
+def write(tmp_path, text: str, name: str = "program.nc") -> Path:
+    path = tmp_path / name
+    path.write_bytes(text.encode())
+    return path
+
+
+def stored_at(url):
+    with psycopg.connect(url) as connection:
+        return stored(connection)
+
+
+def written_back(conn, gear_class: str, params: dict) -> bytes:
+    """The class's program with the import's parameters, written with the class's layout."""
+    lines = compiled_template(load_template(conn, gear_class)).run(params).lines
+    return nc_text(lines, class_layout(conn, gear_class)).encode()
+
+
+def stored_rows(conn, gear_class: str) -> dict[int, str]:
+    """Line number → the stored `o` of its template row (row id 10 per line)."""
+    return {row_id // 10: o for row_id, o in conn.execute(
+        "SELECT t.id, c.o FROM class_template(%s) t JOIN component c ON c.id = t.component_id ORDER BY t.id",
+        (gear_class,))}
+
+
+def instantiated(conn, gear_class: str, params: dict) -> list[str]:
+    return compiled_template(load_template(conn, gear_class)).run(params).lines
+
+
+def stored(conn):
+    return conn.execute("SELECT (SELECT count(*) FROM gear_class), (SELECT count(*) FROM assembly), "
+                        "(SELECT count(*) FROM component)").fetchone()
