@@ -167,3 +167,25 @@ def test_numbers_are_written_as_they_are():
 
     text = csv_text((Column("a", "a"), Column("b", "b")), [{"a": -5, "b": -0.25}])
     assert text == "a,b\n-5,-0.25\n"
+
+
+@pytest.mark.parametrize("variable", ["ENGINE_INSTANTIATE_SKIP_BAD", "ENGINE_INSTANTIATE_WORKERS"])
+def test_a_batch_default_from_the_environment_does_not_refuse_one_gear(run, variable):
+    """A shop sets its batches' habit once (README: Configuration); `instantiate --gear 42`, on
+    which the user gave no batch option, must still make the program."""
+    value = "4" if variable.endswith("WORKERS") else "1"
+    result = run("instantiate", "--gear", 42, env={variable: value})
+    assert result.exit_code == 0, result.output
+    assert result.stdout.rstrip().endswith("M30")
+
+
+def test_a_delete_is_confirmed_on_the_command_line_only(run):
+    """README: a delete without --yes says what it would delete and exits 1. An environment
+    variable (or a config file's [gears.delete] yes = true) must not confirm every delete."""
+    with psycopg.connect(run.url) as conn:
+        conn.execute("INSERT INTO gear (id, gear_class, module, teeth, helix_angle, face_width) "
+                     "VALUES (91502, 'spur', 2, 33, 0, 20)")
+    result = run("gears", "delete", 91502, env={"ENGINE_GEARS_DELETE_YES": "1"})
+    assert result.exit_code == 1, result.output
+    with psycopg.connect(run.url) as conn:
+        assert conn.execute("SELECT count(*) FROM gear WHERE id = 91502").fetchone()[0] == 1

@@ -83,3 +83,33 @@ def test_a_hob_deleted_while_a_program_is_made_with_it_is_said_in_one_line(run):
     assert result.returncode == 1, result.stderr
     assert result.stderr == f"error: hob {hob_id} was deleted while its program was made; nothing stored\n"
     assert counts(url) == before
+
+
+def test_a_gear_deleted_while_its_program_is_made_is_bad_input_not_a_bug(fresh_database_url):
+    """`engine gears delete 91501 --yes` committing while `instantiate --gear 91501` plans: the
+    gear is gone, which is said in one line (exit 1), not ForeignKeyViolation with exit 2."""
+    import os
+    import subprocess
+    import sys
+    import time
+
+    url = fresh_database_url
+    with psycopg.connect(url) as conn:
+        conn.execute("INSERT INTO gear (id, gear_class, module, teeth, helix_angle, face_width, material, hardness, "
+                     "quality_grade, quantity) VALUES (91501, 'spur', 2, 31, 0, 20, '40Cr', 250, 7, 50)")
+    deleter = psycopg.connect(url)
+    deleter.execute("DELETE FROM gear WHERE id = 91501")   # the delete, not yet committed
+    env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(Path(__file__).resolve().parent.parent),
+                                                        os.environ.get("PYTHONPATH", "")]), "ENGINE_CONFIG": ""}
+    making = subprocess.Popen([sys.executable, "-m", "engine", "--database-url", url, "instantiate", "--gear",
+                               "91501"], env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    with psycopg.connect(url, autocommit=True) as watcher:
+        while making.poll() is None and not watcher.execute(
+                "SELECT count(*) FROM pg_stat_activity WHERE datname = current_database() "
+                "AND wait_event_type = 'Lock'").fetchone()[0]:
+            time.sleep(0.05)   # until instantiate waits for the delete's transaction
+    deleter.commit()
+    deleter.close()
+    stdout, stderr = making.communicate(timeout=120)
+    assert making.returncode == 1, stderr
+    assert stderr.startswith("error: ") and stderr.count("\n") == 1 and "91501" in stderr

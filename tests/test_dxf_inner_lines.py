@@ -10,7 +10,10 @@ import pytest
 
 from importers.dxf_drawing import read_drawing
 from importers.dxf_read import DxfError
-from helpers.drawn_parts import AXIS_Y, SHAFT
+from helpers.drawn_parts import AXIS_Y, DRAWN_DIAMETERS, SHAFT, drawing
+from helpers.lathe_programs import finish_diameters
+from helpers.outcomes import counts
+import json
 
 
 # An M16×2 thread on the shaft's Ø16 from the face to Z -10: its root (minor) diameter by ISO 68-1,
@@ -105,3 +108,110 @@ def test_a_root_line_on_one_side_only_is_no_thread(tmp_path):
     with pytest.raises(DxfError) as refused:
         read_drawing(tmp_path / "one_sided.dxf")
     assert "cannot place" in str(refused.value) and handle in str(refused.value)
+
+
+BORE_RADIUS = 3.0             # a Ø6 bore along the axis
+
+
+def outline(msp, axis_y: float = AXIS_Y) -> None:
+    upper = [(z, axis_y + r) for z, r in SHAFT]
+    msp.add_lwpolyline(upper + [(z, axis_y - r) for z, r in reversed(SHAFT)], close=True)
+
+
+def centre_line(msp, y: float = AXIS_Y) -> None:
+    msp.add_line((5, y), (-55, y), dxfattribs={"layer": "Mittellinie"})
+
+
+def through_bore_in_solid_lines(msp) -> None:
+    """A section through a bored shaft drawn without hatching: the bore's walls are solid lines."""
+    outline(msp)
+    for side in (BORE_RADIUS, -BORE_RADIUS):
+        msp.add_line((0, AXIS_Y + side), (-50, AXIS_Y + side))
+    centre_line(msp)
+
+
+def blind_bore_in_solid_lines(msp) -> None:
+    """A bore Ø6 × 20 from the face, its walls and bottom drawn solid (a section without hatching)."""
+    outline(msp)
+    for side in (BORE_RADIUS, -BORE_RADIUS):
+        msp.add_line((0, AXIS_Y + side), (-20, AXIS_Y + side))
+    msp.add_line((-20, AXIS_Y - BORE_RADIUS), (-20, AXIS_Y + BORE_RADIUS))
+    centre_line(msp)
+
+
+def section_halves_without_hatch(msp) -> None:
+    """The usual section of a bored part: the two cut faces as closed outlines either side of the
+    bore, a centre line between them, no hatching."""
+    for sign in (1, -1):
+        cut = [(z, AXIS_Y + sign * r) for z, r in SHAFT]
+        msp.add_lwpolyline([(0, AXIS_Y + sign * BORE_RADIUS)] + cut + [(-50, AXIS_Y + sign * BORE_RADIUS)],
+                           close=True)
+    centre_line(msp)
+
+
+def centre_line_off_the_symmetry(msp) -> None:
+    """A dash-dot line 5 mm above the outline's symmetry (a pitch line, a leader): not the axis."""
+    outline(msp)
+    centre_line(msp, AXIS_Y + 5)
+
+
+BORED = ("through_bore_solid", "blind_bore_solid", "section_without_hatch")
+def whole_view_off_y0_without_centre_line(msp) -> None:
+    """The whole shaft drawn about drawing Y 30, symmetric, no centre line: at Y 0 the engine halves
+    such a view at its symmetry; here it reads a ring Ø36…Ø84 about Y 0 and turns its outside
+    (Ø76/Ø84/Ø80) — not the shaft, and not the ring either, whose bore cannot be turned."""
+    outline(msp)
+
+
+HOSTILE_SIDE_VIEWS = {
+    "through_bore_solid": through_bore_in_solid_lines,
+    "blind_bore_solid": blind_bore_in_solid_lines,
+    "section_without_hatch": section_halves_without_hatch,
+    "centre_line_off_symmetry": centre_line_off_the_symmetry,
+    "whole_view_off_y0_without_centre_line": whole_view_off_y0_without_centre_line,
+}
+
+
+@pytest.mark.parametrize("name", HOSTILE_SIDE_VIEWS)
+def test_a_side_view_is_turned_as_drawn_or_refused(run, tmp_path, name):
+    """A bore drawn with solid lines (a section without hatching) cannot be turned from outside,
+    and a dash-dot line off the outline's symmetry is not its axis: the engine refuses such a
+    drawing in one line, or its job finishes exactly the diameters drawn. A job that turns a solid
+    shaft where the drawing has a bore, or every diameter 10 mm under size, is a wrong part."""
+    path = tmp_path / f"{name}.dxf"
+    drawing(path, HOSTILE_SIDE_VIEWS[name])
+    before = counts(run.url)
+    made = run("import-dxf", path, "--rough-depth", "1", "--program-name", "ATTACK", "--machine", "lathe-840d",
+               "--json")
+    if made.exit_code == 1:
+        assert made.stderr.count("\n") == 1 and counts(run.url) == before, made.output
+        return
+    assert made.exit_code == 0, made.output
+    report = json.loads(made.stdout)
+    assert name not in BORED, f"a part with a Ø{2 * BORE_RADIUS:g} bore became job {report['job_id']}: {report['notes']}"
+    assert finish_diameters(run, json.loads(made.stdout)["job_id"]) == DRAWN_DIAMETERS
+
+
+LOWER_HALVES = {   # the lower half as drawn, (z, radius) below the centre line; the upper half is SHAFT
+    "collar_shorter_below": [(0, 8), (-12, 8), (-12, 12), (-30, 12), (-30, 10), (-50, 10)],
+    "every_radius_smaller_below": [(z, 0.9 * r) for z, r in SHAFT],
+}
+
+
+@pytest.mark.parametrize("name", LOWER_HALVES)
+def test_a_side_view_whose_halves_disagree_is_refused(run, tmp_path, name):
+    """A turned part is the same above and below its axis. When the drawn halves disagree (the
+    collar ends at Z-35 above and Z-30 below; Ø24 above and Ø21.6 below) the drawing does not say
+    which part to make; the engine silently takes the upper half."""
+    lower = LOWER_HALVES[name]
+
+    def draw(msp):
+        msp.add_lwpolyline([(z, AXIS_Y + r) for z, r in SHAFT] + [(z, AXIS_Y - r) for z, r in reversed(lower)],
+                           close=True)
+        centre_line(msp)
+    path = tmp_path / f"{name}.dxf"
+    drawing(path, draw)
+    before = counts(run.url)
+    made = run("import-dxf", path, "--rough-depth", "1", "--program-name", "HALVES", "--machine", "lathe-840d")
+    assert made.exit_code == 1, made.output
+    assert made.stderr.count("\n") == 1 and counts(run.url) == before

@@ -14,6 +14,7 @@ import pytest
 from engine.hobbing.choices import Choices
 from engine.hobbing.program_plot import load_scene, program_figure
 from engine.programs.instantiate import instantiate_gear
+from helpers.outcomes import made, one_line_error
 
 SAMPLES = [   # gear, what, job choices: every hobbing class the samples hold
     (42, "spur", Choices()), (42, "spur conventional", Choices(feed_mode="conventional")),
@@ -295,3 +296,70 @@ def test_the_picture_of_a_program_the_simulation_refuses_says_so_in_red(conn):
     assert "refuses" in lines[-1]
     assert figure.get_suptitle().startswith("REFUSED BY THE SIMULATION: ")
     assert same_color(figure._suptitle.get_color(), "red")
+
+
+def test_a_picture_with_a_long_file_name_is_not_a_bug(run, tmp_path):
+    """A name of 249 characters is a valid file name (Linux allows 255); the picture is written
+    beside it under `.NAME.<random>.png` first, which is too long: OSError, exit 2."""
+    program = made(run("instantiate", "--gear", 42, "--json"))
+    target = tmp_path / ("p" * 245 + ".png")
+    result = run("plot", "--program", program["program_id"], "-o", target)
+    assert result.exit_code != 2, result.output
+    assert (result.exit_code == 0 and target.is_file()) or one_line_error(result)
+    assert [path.name for path in tmp_path.iterdir() if path.suffix == ".png"] in ([], [target.name])
+
+
+def test_a_cut_comment_with_dollar_signs_is_drawn_not_a_bug(run, tmp_path):
+    """The picture's legend takes a cut's label from the program's `; CUT …` comment; matplotlib
+    reads text between two $ as TeX, so a draft whose comment says `$\\frac$` stores a program
+    (the simulation proves it) that `engine plot` cannot draw: ValueError, exit 2."""
+    exported = run("template", "export", "--class", "spur").stdout
+    assert exported.count("; CUT {cut_name}") == 2
+    edited = tmp_path / "spur.csv"
+    edited.write_text(exported.replace("; CUT {cut_name}", "; CUT {cut_name} $\\\\frac$"))
+    assert run("template", "import", "--class", "spur", edited).exit_code == 0
+    program = made(run("instantiate", "--gear", 42, "--draft", "--json"))
+    target = tmp_path / "draft.png"
+    result = run("plot", "--program", program["program_id"], "-o", target)
+    assert result.exit_code == 0 and target.is_file(), result.output
+
+
+def test_the_picture_of_a_job_is_of_the_program_that_reaches_the_machine(run, tmp_path):
+    """`engine plot --job ID` draws the job's newest program. After an editor tries a draft on
+    the job (`instantiate --job ID --draft`), that is the draft's program: the operator's picture
+    of the job shows a program that never reaches the machine, and nothing in it says draft."""
+    released = made(run("instantiate", "--gear", 45, "--json"))
+    exported = run("template", "export", "--class", "spur").stdout
+    edited = tmp_path / "spur.csv"
+    edited.write_text(exported.replace("; CUT {cut_name}", "; CUT {cut_name} TRIAL"))
+    assert run("template", "import", "--class", "spur", edited).exit_code == 0
+    draft = made(run("instantiate", "--job", released["job_id"], "--draft", "--json"))
+    assert draft["program_id"] != released["program_id"]
+    drawn = made(run("plot", "--job", released["job_id"], "-o", tmp_path / "job.png", "--json"))["drawn"]
+    assert drawn[0].startswith(f"program {released['program_id']} ") or "draft" in " ".join(drawn).lower(), drawn
+
+
+def figure_texts(figure) -> str:
+    """Every text a reader of the picture sees: titles, legends, annotations."""
+    texts = [figure._suptitle.get_text() if figure._suptitle else "", *(t.get_text() for t in figure.texts)]
+    for legend in figure.legends:
+        texts += [t.get_text() for t in legend.get_texts()]
+    for axes in figure.axes:
+        texts += [axes.get_title(), *(t.get_text() for t in axes.texts)]
+        if axes.get_legend():
+            texts += [t.get_text() for t in axes.get_legend().get_texts()]
+    return " ".join(texts)
+
+
+def test_the_picture_of_a_program_the_simulation_refuses_says_so(run):
+    """A picture is passed around without the command's output: when the simulation refuses the
+    program now (its gear's face width was corrected after it was stored), only stdout says so,
+    and the picture looks like that of a proved program."""
+    from engine.hobbing.program_plot import load_scene, program_figure
+
+    program = made(run("instantiate", "--gear", 42, "--json"))
+    with psycopg.connect(run.url) as conn:
+        conn.execute("UPDATE gear SET face_width = 40 WHERE id = 42")
+        figure, drawn = program_figure(load_scene(conn, program["program_id"]))
+    assert "refuses" in drawn[-1]
+    assert "refus" in figure_texts(figure).lower()

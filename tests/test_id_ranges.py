@@ -40,3 +40,25 @@ LARGEST = (("jobs", "list", "--gear", "2147483647"), ("programs", "list", "--job
 def test_the_largest_id_a_column_holds_is_a_filter_that_finds_nothing(run, args):
     result = run(*args, "--json")
     assert result.exit_code == 0, result.output
+
+
+OUT_OF_RANGE_FILTERS = (   # a filter id beyond PostgreSQL's integer/bigint: bad input, not a bug
+    ("jobs", "list", "--gear", "99999999999"),
+    ("programs", "list", "--gear", "99999999999"),
+    ("programs", "list", "--job", "99999999999999999999"),
+)
+
+
+@pytest.mark.parametrize("args", OUT_OF_RANGE_FILTERS, ids=" ".join)
+def test_a_filter_id_out_of_range_is_bad_input_not_a_bug(run, args):
+    result = run(*args)
+    assert result.exit_code == 1, result.output
+    assert result.stderr.startswith("error: ") and result.stderr.count("\n") == 1
+    assert args[-1] in result.stderr
+
+
+def test_instantiate_gear_0_names_the_gear(run):
+    """--gear 0 was given: the message must not say none was."""
+    result = run("instantiate", "--gear", 0, "--dry-run")
+    assert result.exit_code == 1
+    assert "give exactly one of" not in result.stderr and "0" in result.stderr, result.stderr

@@ -167,3 +167,48 @@ def test_a_release_of_rows_alone_names_no_layout_change(run, tmp_path):
     impact = made(run("template", "release", "--class", "spur", "--dry-run", "--json"))["impact"]
     assert impact["layout"] == [] and impact["jobs"] >= 1
     assert "layout of" not in run("template", "release", "--class", "spur", "--dry-run").stdout
+
+
+def with_layout_columns(exported: str, ending: str, final_newline: str) -> str:
+    """The exported CSV with the two layout columns added to every row (rows unchanged)."""
+    rows = list(csv.reader(io.StringIO(exported, newline="")))
+    buffer = io.StringIO()
+    writer = csv.writer(buffer, lineterminator="\n")
+    writer.writerow(rows[0] + ["line_ending", "final_newline"])
+    writer.writerows(row + [ending, final_newline] for row in rows[1:])
+    return buffer.getvalue()
+
+
+def test_a_csv_import_does_not_change_the_bytes_of_released_programs_without_a_release(run, tmp_path):
+    """`template import` is a draft until a releaser releases it (engine_releaser, not the
+    editor). A CSV with the very rows of the released version and the layout columns crlf,no
+    says 'unchanged (identical rows)', makes no version, and yet every released program of the
+    class is from then on written CR LF without a final newline: the bytes that reach the
+    machine changed with nobody releasing anything."""
+    before = tmp_path / "before.MPF"
+    made(run("instantiate", "--gear", 42, "--out", before, "--json"))
+    edited = tmp_path / "spur.csv"
+    edited.write_text(with_layout_columns(run("template", "export", "--class", "spur").stdout, "crlf", "no"))
+    imported = run("template", "import", "--class", "spur", edited)
+    assert imported.exit_code == 0, imported.output
+    after = tmp_path / "after.MPF"
+    program = made(run("instantiate", "--gear", 42, "--out", after, "--json"))   # released, not --draft
+    assert program["template_version"] == 1
+    assert b"\r" not in after.read_bytes() and after.read_bytes().endswith(b"\n")
+
+
+def test_programs_show_gives_the_bytes_its_file_was_written_with(run, tmp_path):
+    """A stored program is a record nobody rewrites: `programs show` joins its lines with the
+    class's layout of today, so after an editor changes the class's layout (one UPDATE, granted
+    to engine_editor) the program shows CR LF without a final newline, while the file the
+    control holds, written when it was stored, is LF with one."""
+    target = tmp_path / "GEAR42.MPF"
+    program = made(run("instantiate", "--gear", 42, "--out", target, "--json"))
+    written = target.read_bytes()
+    with psycopg.connect(run.url) as conn:
+        conn.execute("UPDATE gear_class SET line_ending = %s, final_newline = false WHERE name = 'spur'", (CRLF,))
+    shown = run("programs", "show", program["program_id"])
+    assert shown.exit_code == 0, shown.output
+    assert shown.stdout_bytes.endswith(written)
+    record = made(run("programs", "show", program["program_id"], "--json"))["programs"][0]
+    assert (record["line_ending"], record["final_newline"]) == ("lf", True)

@@ -10,6 +10,8 @@ from engine.library.nc_import import import_nc
 from engine.templates.store import load_template
 
 from helpers.nc_files import DATA, PARAMS, class_name, real_files, written_back
+from helpers.outcomes import one_line_error
+import psycopg
 
 TWO_FILES = ["sinumerik/cam_840dsl/CAM_TEST.MPF", "emco_from_dxf/testNegDXF.cnc"]
 
@@ -82,3 +84,18 @@ def test_an_lf_file_whose_first_line_has_no_cr_but_a_later_one_has_is_refused(co
     path.write_bytes(b"G0 Z5\nG1 X10\r\nM17\n")
     with pytest.raises(EngineError, match=r"mixes line endings: line 1 ends with LF, line 2 .* with CRLF"):
         import_nc(conn, path, "nc_mixed")
+
+
+@pytest.mark.parametrize("breaking", ["\r", "\f", "\u0085", "\u2028"], ids=["CR", "FF", "NEL", "LS"])
+def test_an_nc_file_with_a_line_break_inside_a_line_is_refused_at_import(run, tmp_path, breaking):
+    """`G1 X10<CR>G0 X0` in an LF file is one line to the import (one row, its module decided by
+    G0, one text to the refactor) and two blocks to a control or editor that breaks lines at a
+    bare CR; the database refuses such a line in every program (migration 0009), so the class
+    the import stores and calls a draft can never give a program. It should be refused naming
+    the line, as a control character is, with nothing stored."""
+    nc = tmp_path / "broken.nc"
+    nc.write_bytes(f"G1 X10{breaking}G0 X0\nM30\n".encode("utf-8"))
+    result = run("import-nc", nc, "--class", "nc_broken")
+    assert one_line_error(result) and "line 1" in result.stderr, result.output
+    with psycopg.connect(run.url) as conn:
+        assert conn.execute("SELECT count(*) FROM gear_class WHERE name = 'nc_broken'").fetchone()[0] == 0

@@ -16,6 +16,8 @@ from engine.library import nc_halves
 from engine.library.nc_import import import_nc
 
 from helpers.nc_files import DATA, instantiated, real_files, stored_at, stored_rows, written_back
+from helpers.outcomes import one_line_error
+from helpers.class_jobs import import_emco
 
 DEMO = "linuxcnc/lathe_g70_71_demo.ngc"      # D0.3 (cutter compensation) and R0.3 (G71's retract)
 CAM = "sinumerik/cam_840dsl/CAM_TEST.MPF"    # I4.25 and J4.25 (arc centres)
@@ -189,3 +191,58 @@ def test_a_bad_bound_form_is_refused_in_one_line_and_nothing_is_stored(run, tmp_
     message = result.stderr.strip()
     assert len(message.splitlines()) == 1 and words_said in message and str(params) in message
     assert stored_at(run.url) == before
+
+
+@pytest.mark.parametrize("value", ['{"a": 1}', "[400]", "true", "null", '"F400"'])
+def test_a_bound_parameter_whose_value_is_no_number_is_refused(run, tmp_path, value):
+    """Only a number binds a word: `{"feed": {"value": true, "addresses": ["F"]}}` asks for F to
+    be bound and binds nothing, F400 stays literal, no warning, exit 0; the user believes the
+    feed is a parameter of the class."""
+    params = tmp_path / "p.json"
+    params.write_text('{"feed": {"value": %s, "addresses": ["F"]}}' % value)
+    result = run("import-nc", DATA / DEMO, "--class", "nc_nonumber", "--params", params)
+    assert one_line_error(result) and "feed" in result.stderr, result.output
+
+
+def test_a_json_parameter_given_twice_is_refused_as_the_csv_one_is(run, tmp_path):
+    """A CSV naming a parameter twice is refused; the JSON form silently keeps the last value
+    ({"feed": 400, "feed": 3.0} binds 3.0 at I3.0 and leaves the feed F400 literal)."""
+    params = tmp_path / "p.json"
+    params.write_text('{"feed": 400, "feed": 3.0}')
+    result = run("import-nc", DATA / DEMO, "--class", "nc_twice", "--params", params)
+    assert one_line_error(result) and "feed" in result.stderr, result.output
+
+
+def test_a_params_file_nested_too_deep_is_bad_input_not_a_bug(run, tmp_path):
+    """A parameters file of 100,000 nested brackets (a generator gone wrong) is bad input:
+    json.loads raises RecursionError, exit 2."""
+    params = tmp_path / "deep.json"
+    params.write_text('{"feed": ' + "[" * 100_000 + "]" * 100_000 + "}")
+    result = run("import-nc", DEMO, "--class", "nc_deep", "--params", params)
+    assert one_line_error(result) and str(params) in result.stderr, result.output
+
+
+def class_job_dry_run(run, tmp_path, text: str):
+    params = tmp_path / "params.json"
+    params.write_text(text)
+    return run("instantiate", "--class", "emco_neg", "--machine", "lathe-iso", "--draft", "--params", params,
+               "--dry-run")
+
+
+def test_a_deeply_nested_parameters_file_is_bad_input_not_a_bug(run, tmp_path):
+    """A parameters file that is not an object of values (here an array nested 100 000 deep) is
+    refused in one line, exit 1, like any other file that is not {"name": value}."""
+    import_emco(run, tmp_path)
+    made = class_job_dry_run(run, tmp_path, "[" * 100_000 + "]" * 100_000)
+    assert made.exit_code == 1, made.output
+    assert made.stderr.startswith("error: ") and made.stderr.count("\n") == 1
+
+
+def test_addresses_the_class_does_not_bind_are_not_silently_ignored(run, tmp_path):
+    """The class binds feed to F (import-nc --params). A file saying feed binds S asks for a
+    different program than the one made: the engine makes F100 and keeps S600 without a word.
+    It must refuse, naming the address the class binds."""
+    import_emco(run, tmp_path)
+    made = class_job_dry_run(run, tmp_path, json.dumps({"feed": {"value": 100, "addresses": ["S"]}}))
+    assert made.exit_code == 1, made.output
+    assert made.stderr.count("\n") == 1 and "F" in made.stderr

@@ -14,6 +14,7 @@ import pytest
 from engine.library.nc_import import import_nc
 
 from helpers.nc_files import DATA, FAMILY, instantiated, stored_at, stored_rows
+from helpers.outcomes import one_line_error
 
 DEMO = "linuxcnc/lathe_g70_71_demo.ngc"
 CAM = "sinumerik/cam_840dsl/CAM_TEST.MPF"
@@ -99,10 +100,6 @@ def test_plasma_io_channels_stay_and_the_values_they_carry_bind(conn):
 # --- the command -------------------------------------------------------------------------------
 
 
-def one_line_error(result) -> bool:
-    return result.exit_code == 1 and result.stderr.startswith("error: ") and result.stderr.count("\n") == 1
-
-
 def test_a_bound_form_naming_the_contour_address_is_refused_and_nothing_stored(run, tmp_path):
     first_call = found(DEMO, r"^\s*G7[01]", r"\bQ100\b")[0][0]
     params = tmp_path / "p.json"
@@ -148,3 +145,31 @@ def test_a_name_given_twice_inside_a_bound_form_is_refused(run, tmp_path):
     params.write_text('{"feed": {"value": 400, "value": 3.0, "addresses": ["F"]}}')
     result = run("import-nc", DATA / DEMO, "--class", "nc_twice", "--params", params)
     assert one_line_error(result) and "'value' appears twice" in result.stderr, result.output
+
+
+def test_a_plain_parameter_does_not_turn_the_contour_a_g71_calls_into_a_quantity(conn):
+    """LinuxCNC's G71/G70 name the contour subroutine by Q (`G71.1 Q100` runs `O100 SUB`): Q100
+    is a program number, like the O it names. A plain parameter whose value is 100 (a depth, a
+    speed) binds those Q words, not the O100 label, so the class made with another value calls a
+    subroutine the program does not have (or another contour)."""
+    subs = {match for line in (DATA / DEMO).read_text().splitlines() for match in re.findall(r"^\s*O(\d+)\s+SUB", line)}
+    assert subs == {"100"}
+    import_nc(conn, DATA / DEMO, "nc_q", {"depth": 100, "feed": 400})
+    lines = instantiated(conn, "nc_q", {"depth": 200, "feed": 400})
+    called = {match for line in lines for match in re.findall(r"^\s*G7[01][.\d]*\s+Q(\d+)", line)}
+    defined = {match for line in lines for match in re.findall(r"^\s*O(\d+)\s+SUB", line)}
+    assert called and called <= defined, f"the G70/G71 lines call O{sorted(called)}, the program defines O{sorted(defined)}"
+
+
+def test_a_plain_parameter_does_not_rebind_the_tool_edge_or_the_spindle_number(conn):
+    """On the 840D, D1 selects the tool's cutting edge (as T selects the tool) and SETMS(1) the
+    master spindle: numbers that are codes. A plain parameter of value 1 (passes, a count) binds
+    every D1 and the SETMS argument of Siemens' CAM_TEST.MPF, so the class made with passes=2
+    cuts with edge D2's offsets on spindle 2."""
+    original = (DATA / CAM).read_text().splitlines()
+    edges = [line for line in original if re.search(r"\bD1\b", line)]
+    assert edges and any("SETMS(1)" in line for line in original)
+    import_nc(conn, DATA / CAM, "nc_d", {"passes": 1})
+    lines = instantiated(conn, "nc_d", {"passes": 2})
+    assert [line for line in lines if re.search(r"\bD1\b", line)] == edges
+    assert any("SETMS(1)" in line for line in lines)

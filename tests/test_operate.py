@@ -216,3 +216,46 @@ def test_an_installed_engine_reads_its_own_data_not_the_current_folders(tmp_path
     assert data_folder("migrations", site_packages) == site_packages / "engine_data" / "migrations"
     checkout = Path(__file__).resolve().parent.parent
     assert data_folder("migrations", checkout) == checkout / "migrations"
+
+
+@pytest.fixture
+def own_engine():
+    """Like `engine`, on an embedded data directory of the test's own (the test breaks it or
+    needs it new)."""
+    folder = Path(tempfile.mkdtemp(prefix="engine-own-"))
+    runner = Engine(folder)
+    yield runner
+    runner("db", "stop")
+    shutil.rmtree(folder, ignore_errors=True)
+
+
+def test_demo_ignores_pghostaddr_it_runs_on_the_embedded_server(own_engine):
+    """PGHOSTADDR (libpq's address of the shop's server) must not steer the demo's connection:
+    with it, libpq connected the embedded URL to the shop's server (and seeded it)."""
+    demo = own_engine("demo", PGHOSTADDR="192.0.2.1", PGCONNECT_TIMEOUT="3")
+    assert demo.returncode == 0, demo.stderr
+    assert demo.stdout.rstrip().endswith("M30")
+
+
+def test_an_embedded_data_folder_that_cannot_be_used_is_one_line(own_engine):
+    own_engine.data_dir.mkdir()
+    (own_engine.data_dir / "notes.txt").write_text("a shop's file, not a database\n")
+    shown = own_engine("db", "url")
+    assert shown.returncode == 1
+    assert shown.stderr.startswith("error: ") and shown.stderr.count("\n") == 1, shown.stderr
+
+
+def test_demo_leaves_a_shop_database_on_the_embedded_server_untouched(own_engine):
+    """Without a URL the embedded server is the shop's database (README: Operating the embedded
+    server). `engine demo` must not seed the samples into it, nor store a job and a program (a
+    record nobody deletes) for the shop's own gear 42."""
+    for args in (("db", "migrate"), ("seed",)):
+        assert own_engine(*args).returncode == 0
+    url = own_engine("db", "url").stdout.strip()
+    with psycopg.connect(url) as conn:
+        conn.execute("INSERT INTO gear (id, gear_class, module, teeth, helix_angle, face_width, material) "
+                     "VALUES (42, 'spur', 3, 33, 0, 20, 'C45')")
+    before = user_tables(url)
+    demo = own_engine("demo")
+    assert demo.returncode == 0, demo.stderr
+    assert user_tables(url) == before

@@ -20,6 +20,8 @@ from engine.library.nc_import import import_nc
 from engine.library.refactor import refactor
 
 from helpers.nc_files import DATA
+import psycopg
+from helpers.outcomes import made
 
 CAM = DATA / "sinumerik/cam_840dsl/CAM_TEST.MPF"
 BLOCK_NUMBER = re.compile(r"^N\d+ *")
@@ -177,3 +179,31 @@ def test_a_pair_listed_before_block_numbers_left_the_keys_is_not_new(conn):
 
 def listed(entry: dict) -> set:
     return set(entry.get("members") or entry["members_a"] + entry["members_b"])
+
+
+def key_before_issue_17(t: str, a: str, b: str) -> str:
+    """The key `engine refactor intend` stored for a pair before issue 17: sha256 of
+    [t, the two full texts sorted] as JSON (the texts with their block numbers)."""
+    return hashlib.sha256(json.dumps([t, *sorted((a, b))], ensure_ascii=True).encode("ascii")).hexdigest()
+
+
+def members(entry: dict) -> set:
+    """The texts a report entry lists: a family's members, or both sides of a pair."""
+    return set(entry.get("members") or entry["members_a"] + entry["members_b"])
+
+
+def test_a_pair_marked_intended_before_the_upgrade_stays_intended(run):
+    """A shop marked `N90 SUPA … D1` / `N140 SUPA … D1` intended (homing twice is meant) before
+    issue 17. Since block numbers are left out of the keys, the mark's key matches nothing:
+    the two lines come back in the nightly report, flagged NEW, as if nobody had decided."""
+    imported = run("import-nc", CAM, "--class", "cam")
+    assert imported.exit_code == 0, imported.output
+    a = '"N90 SUPA X=_X_HOME Y=_Y_HOME A=_A_HOME C=_C_HOME D1"'
+    b = '"N140 SUPA X=_X_HOME Y=_Y_HOME A=_A_HOME C=_C_HOME D1"'
+    with psycopg.connect(run.url) as conn:
+        assert conn.execute("SELECT count(DISTINCT o) FROM component WHERE o IN (%s, %s)", (a, b)).fetchone()[0] == 2
+        conn.execute("INSERT INTO near_duplicate_intended (pair_key, t, a, b, why) VALUES (%s, 'prep', %s, %s, "
+                     "'homing twice is meant')", (key_before_issue_17("prep", a, b), *sorted((a, b))))
+    report = made(run("refactor", "--threshold", "0.6", "--json"))
+    listed = [entry for entry in report["near_duplicates"] if {a, b} <= members(entry)]
+    assert listed == [] and report["intended"] >= 1

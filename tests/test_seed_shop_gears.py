@@ -21,6 +21,11 @@ def engine_on(url: str, *args):
     return result
 
 
+def invoke_with(url: str, env: dict, *args):
+    """The CLI in-process with the environment variables given (and no config file)."""
+    return CliRunner().invoke(main, ["--database-url", url, *map(str, args)], env={"ENGINE_CONFIG": "", **env})
+
+
 def sample_tests_of(gear_id: int) -> int:
     tests = json.loads((SEED_DIR / "template_tests.json").read_text(encoding="utf-8"))
     return sum(test.get("gear_id") == gear_id for test in tests)
@@ -46,3 +51,17 @@ def test_the_samples_leave_a_shops_own_gears_without_their_tests_and_units(empty
 def test_a_second_seed_of_the_samples_changes_nothing_and_says_nothing_skipped(fresh_database_url):
     seeded = engine_on(fresh_database_url, "seed", "--samples").stdout
     assert seeded == "seed: everything was already there; nothing changed\n"
+
+
+def test_the_samples_do_not_hang_golden_tests_on_a_shops_own_gear(empty_database_url):
+    """A shop's own gear 42 (m3 z33), then `engine seed --samples`: the sample golden tests of
+    gear 42 (m2 z19) must not be attached to the shop's gear (which then can never be deleted)."""
+    for args in (("db", "migrate"), ("seed",)):
+        assert invoke_with(empty_database_url, {}, *args).exit_code == 0
+    with psycopg.connect(empty_database_url) as conn:
+        conn.execute("INSERT INTO gear (id, gear_class, module, teeth, helix_angle, face_width, material) "
+                     "VALUES (42, 'spur', 3, 33, 0, 20, 'C45')")
+    seeded = invoke_with(empty_database_url, {}, "seed", "--samples")
+    with psycopg.connect(empty_database_url) as conn:
+        attached = conn.execute("SELECT count(*) FROM template_test WHERE gear_id = 42").fetchone()[0]
+    assert seeded.exit_code == 1 or attached == 0, seeded.output

@@ -17,7 +17,9 @@ from engine.turning.job_params import ProfileOptions, turning_job
 from engine.turning.model import job_passes
 from importers.dxf_drawing import read_drawing
 from importers.dxf_read import DxfError
-from helpers.lathe_programs import motions, operation_lines
+from helpers.lathe_programs import INSIDE_MM, SAMPLES_PER_MOVE, finish_diameters, motions, operation_lines
+from helpers.drawn_parts import DRAWN_DIAMETERS, drawing
+from helpers.outcomes import counts
 
 INCH_MM = 25.4
 ROUGH = ProfileOptions(rough_depth=1.0)
@@ -147,3 +149,73 @@ def test_the_disc_job_finishes_its_outside_diameter(run, tmp_path):
     finish = operation_lines(program.stdout.splitlines(), 2)
     along_z = {2 * start[1] for g, start, end in motions(finish) if g == 1 and start[1] == end[1] and start[0] != end[0]}
     assert along_z == {2 * OUTSIDE}
+
+
+def ring_section_off_the_axis(msp) -> None:
+    """A ring Ø70/Ø50 × 20 as its section in the seed-000 convention (radius = drawing Y): the closed
+    rectangle between the bore and the outside, not touching the axis."""
+    msp.add_lwpolyline([(0, 25), (-20, 25), (-20, 35), (0, 35)], close=True)
+
+
+def test_a_ring_drawn_as_its_section_is_not_turned_as_a_solid_bar(run, tmp_path):
+    """A closed profile that stays 25 mm off the axis is a ring: its bore Ø50 cannot be turned from
+    outside. The job turns the outside Ø70 only and says nothing of the bore — a solid disc where
+    the drawing has a ring."""
+    path = tmp_path / "ring.dxf"
+    drawing(path, ring_section_off_the_axis)
+    before = counts(run.url)
+    made = run("import-dxf", path, "--rough-depth", "1", "--program-name", "RING", "--machine", "lathe-840d",
+               "--json")
+    assert made.exit_code == 1, made.output
+    assert made.stderr.count("\n") == 1 and counts(run.url) == before
+
+
+def test_a_drawing_whose_header_says_imperial_is_not_turned_in_millimetres(run, tmp_path):
+    """$INSUNITS unset but $MEASUREMENT 0 (English): the drawing's numbers are inches. The shaft
+    drawn 0.945 in (Ø24 mm) across becomes a Ø0.945 mm job, with only a note that lengths were
+    taken as millimetres. Scale it, or refuse and ask for the units."""
+    inch = 25.4
+
+    def draw(msp):
+        msp.add_lwpolyline([(z / inch, r / inch) for z, r in SHAFT] + [(z / inch, -r / inch) for z, r in reversed(SHAFT)],
+                           close=True)
+    doc = ezdxf.new("R2010")
+    doc.header["$INSUNITS"] = 0
+    doc.header["$MEASUREMENT"] = 0
+    draw(doc.modelspace())
+    path = tmp_path / "imperial.dxf"
+    doc.saveas(path)
+    before = counts(run.url)
+    made = run("import-dxf", path, "--rough-depth", "0.1", "--program-name", "IMPERIAL", "--machine", "lathe-840d",
+               "--json")
+    if made.exit_code == 1:
+        assert made.stderr.count("\n") == 1 and counts(run.url) == before, made.output
+        return
+    assert made.exit_code == 0, made.output
+    assert finish_diameters(run, json.loads(made.stdout)["job_id"]) == pytest.approx(DRAWN_DIAMETERS, abs=0.01)
+
+
+OVERHANG_Z, OVERHANG_TOP = (-10.0, -6.0), 10.0
+
+
+def test_an_undercut_no_tool_from_outside_can_reach_is_refused(run, tmp_path):
+    """Between Z-10 and Z-6 the collar (up to r 10) lies over the pocket: a turning tool comes
+    from outside along X and cannot be under it without its holder going through the collar.
+    The engine's finish runs X12/X8 from Z-10 to Z-6 under the collar instead of refusing."""
+    doc = ezdxf.new("R2010")
+    doc.header["$INSUNITS"] = 4
+    doc.modelspace().add_lwpolyline(UNDERCUT)
+    doc.saveas(tmp_path / "undercut.dxf")
+    made = run("import-dxf", tmp_path / "undercut.dxf", "--rough-depth", "1", "--program-name", "UNDERCUT",
+               "--machine", "lathe-840d", "--json")
+    if made.exit_code == 1:
+        assert made.stderr.count("\n") == 1, made.output
+        return
+    assert made.exit_code == 0, made.output
+    program = run("instantiate", "--job", json.loads(made.stdout)["job_id"], "--dry-run")
+    under = sorted({(start, end) for g, start, end in motions(program.stdout.splitlines())
+             for k in range(SAMPLES_PER_MOVE + 1)
+             if OVERHANG_Z[0] + INSIDE_MM < start[0] + (end[0] - start[0]) * k / SAMPLES_PER_MOVE
+             < OVERHANG_Z[1] - INSIDE_MM
+             and start[1] + (end[1] - start[1]) * k / SAMPLES_PER_MOVE < OVERHANG_TOP - INSIDE_MM})
+    assert under == []

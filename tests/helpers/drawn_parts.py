@@ -1,5 +1,6 @@
 """Turned parts the tests draw themselves with ezdxf, in millimetres: a stepped shaft's
-half-profile on a named layer, the shaft of the side-view tests, two-layer roughing drawings."""
+half-profile on a named layer, the shaft of the side-view tests (and the diameters a job of it
+must finish), two-layer roughing drawings, a side view drawn by a function of the test."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -53,4 +54,17 @@ def two_rough_layers(path: Path, tool_two: str = "01") -> None:
     msp.add_text(f"@GROUGH @S500 @F200 @T{tool_two}", dxfattribs={"layer": "2"})
     for radius in (25, 23):
         msp.add_line((-25, radius), (-45, radius), dxfattribs={"layer": "2"})
+    doc.saveas(path)
+
+
+# The diameters (mm) a job of SHAFT must finish, as drawn.
+DRAWN_DIAMETERS = sorted({2 * r for _, r in SHAFT})
+
+
+def drawing(path, draw) -> None:
+    """A drawing in mm that `draw(modelspace)` fills, with a centre-line layer as German CAD names it."""
+    doc = ezdxf.new("R2010", setup=True)
+    doc.header["$INSUNITS"] = 4
+    doc.layers.add("Mittellinie", linetype="CENTER")
+    draw(doc.modelspace())
     doc.saveas(path)

@@ -1,5 +1,6 @@
 """Reading lathe programs (ISO and 840D) for tests, independently of the engine: the blocks of
-one operation, and the feed moves with their start and end points (Z, radius)."""
+one operation, and the feed moves with their start and end points (Z, radius); the diameters a
+job's finish turns; distances to the drawn geometry."""
 from __future__ import annotations
 
 import math
@@ -75,3 +76,17 @@ def distance_to_chord(point, a, b) -> float:
     length_sq = dz * dz + dr * dr
     t = 0.0 if length_sq == 0 else max(0.0, min(1.0, ((point[0] - z0) * dz + (point[1] - r0) * dr) / length_sq))
     return math.dist(point, (z0 + t * dz, r0 + t * dr))
+
+
+def finish_diameters(run, job_id: int) -> list[float]:
+    """The diameters the finish (operation 2 of a profile job) runs along Z at, read from the text."""
+    made = run("instantiate", "--job", job_id, "--dry-run")
+    assert made.exit_code == 0, made.output
+    finish = operation_lines(made.stdout.splitlines(), 2)
+    return sorted({round(2 * start[1], 3) for g, start, end in motions(finish)
+                   if g == 1 and start[1] == end[1] and start[0] != end[0]})
+
+
+# Sampling a move for material it crosses: points per move, and the depth (mm) that counts as inside.
+INSIDE_MM = 0.01               # deeper than this inside the blank is through material
+SAMPLES_PER_MOVE = 40
