@@ -145,6 +145,7 @@ def test_db_status_and_seed_are_idempotent(run):
     assert run("db", "migrate").stdout.startswith("applied 0 migration(s)")
 
 
+@pytest.mark.slow
 def test_demo_runs_on_the_embedded_server_from_nothing(tmp_path):
     """What a newcomer does first: no DATABASE_URL, a fresh data directory."""
     environment = {k: v for k, v in os.environ.items() if k != "DATABASE_URL" and not k.startswith("PG")}

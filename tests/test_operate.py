@@ -87,6 +87,7 @@ def test_an_install_without_migrations_is_refused_naming_the_folder(command, emp
     assert user_tables(empty_database_url) == {}   # not even the ledger
 
 
+@pytest.mark.slow
 def test_the_embedded_server_is_started_shown_opened_and_stopped(engine):
     assert engine("db", "stop").stdout.startswith("the embedded PostgreSQL is not running")
     shown = engine("db", "url")
@@ -118,6 +119,7 @@ def test_the_embedded_server_is_started_shown_opened_and_stopped(engine):
     assert server_state(engine.data_dir).running
 
 
+@pytest.mark.slow
 def test_demo_leaves_the_database_it_was_pointed_at_untouched(engine, empty_database_url):
     before = user_tables(empty_database_url)
     by_variable = engine("demo", DATABASE_URL=empty_database_url)
@@ -135,6 +137,7 @@ def test_demo_leaves_the_database_it_was_pointed_at_untouched(engine, empty_data
     assert counts(demo_database, "SELECT count(*) FROM gear WHERE id = 42", "SELECT count(*) FROM program") == [1, 2]
 
 
+@pytest.mark.slow
 def test_demo_turning_prints_the_sample_drawing_s_program_and_where_the_drawing_is(engine):
     shown = engine("demo", "--sample-path")
     assert (shown.returncode, shown.stdout) == (0, f"{SEED_DIR / 'drawings' / 'sample_shaft.dxf'}\n")
@@ -229,6 +232,7 @@ def own_engine():
     shutil.rmtree(folder, ignore_errors=True)
 
 
+@pytest.mark.slow
 def test_demo_ignores_pghostaddr_it_runs_on_the_embedded_server(own_engine):
     """PGHOSTADDR (libpq's address of the shop's server) must not steer the demo's connection:
     with it, libpq connected the embedded URL to the shop's server (and seeded it)."""
@@ -245,6 +249,7 @@ def test_an_embedded_data_folder_that_cannot_be_used_is_one_line(own_engine):
     assert shown.stderr.startswith("error: ") and shown.stderr.count("\n") == 1, shown.stderr
 
 
+@pytest.mark.slow
 def test_demo_leaves_a_shop_database_on_the_embedded_server_untouched(own_engine):
     """Without a URL the embedded server is the shop's database (README: Operating the embedded
     server). `engine demo` must not seed the samples into it, nor store a job and a program (a

@@ -246,6 +246,7 @@ def many_gears(url, count: int) -> None:
             FROM gear, generate_series(100000, 100000 + %s - 1) AS g WHERE id = 42""", (count,))
 
 
+@pytest.mark.slow
 def test_kill_9_during_the_files_of_a_batch_leaves_only_committed_programs_files(fresh_database_url, tmp_path):
     many_gears(fresh_database_url, BATCH_GEARS)
     out = tmp_path / "out"

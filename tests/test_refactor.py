@@ -120,6 +120,7 @@ library = st.lists(st.lists(st.tuples(st.sampled_from(range(len(POOL))), st.bool
                             min_size=1, max_size=6), min_size=2, max_size=4)
 
 
+@pytest.mark.slow
 @settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(classes=library, derive=st.booleans())
 def test_random_libraries_refactor_losslessly_once_and_idempotently(conn, classes, derive):
@@ -193,6 +194,7 @@ def expected_near_duplicates(conn, threshold: float) -> set[frozenset]:
     return found
 
 
+@pytest.mark.slow
 @settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(classes=random_library, threshold=st.sampled_from([0.5, 0.8]))
 def test_any_library_refactors_losslessly_stored_once_idempotently_with_every_near_duplicate(

@@ -7,6 +7,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -59,6 +60,7 @@ def _insert(conn, gear, unit) -> None:
         conn.execute(INSERT_UNIT, (GEAR_ID, *unit))
 
 
+@pytest.mark.slow
 @settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(case=gears())
 def test_random_gears_are_proved_or_refused_in_one_line(conn, case):
@@ -86,6 +88,7 @@ def hob_points(body: HobBody, swivel: float, centre, count: int = 200) -> np.nda
     return np.concatenate([p.reshape(-1, 3) for p in surface]) + np.asarray(centre)
 
 
+@pytest.mark.slow
 @settings(max_examples=40, deadline=None)
 @given(radius=st.floats(20, 50), length=st.floats(60, 160), swivel=st.floats(-35, 35), x=st.floats(25, 120),
        y=st.floats(-40, 40))

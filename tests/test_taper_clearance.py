@@ -138,6 +138,7 @@ def taper_gears(draw):
     return gear, hob, choices
 
 
+@pytest.mark.slow
 @settings(max_examples=120, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(taper_gears())
 def test_random_taper_gears_infeed_clear_of_the_blank(layout):
