@@ -122,7 +122,7 @@ def database_url(server_url, database_pool) -> str:
     (rolled back) or `fresh_database_url`. Right after seeding it is copied once more, as the
     template of every `fresh_database_url`, which no test connects to."""
     from engine.db.migrate import migrate
-    from engine.db.seed import seed
+    from engine.library.seed import seed
 
     name = f"engine_test_{uuid.uuid4().hex[:10]}"
     url = _create(server_url, name)

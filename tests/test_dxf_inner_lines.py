@@ -8,8 +8,8 @@ from __future__ import annotations
 import ezdxf
 import pytest
 
-from importers.dxf_drawing import read_drawing
-from importers.dxf_read import DxfError
+from engine.drawings.drawing import read_drawing
+from engine.drawings.read import DxfError
 from helpers.drawn_parts import AXIS_Y, DRAWN_DIAMETERS, SHAFT, drawing
 from helpers.lathe_programs import finish_diameters
 from helpers.outcomes import counts

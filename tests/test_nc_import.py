@@ -17,7 +17,7 @@ from hypothesis import given, settings, strategies as st
 from engine.errors import EngineError
 from engine.library.nc_import import import_nc
 from engine.library.nc_rows import number_field
-from engine.library.nc_tokens import detokenise, tokenise
+from engine.nc.tokens import detokenise, tokenise
 from engine.templates.evaluator import evaluate
 from engine.templates.expressions import compile_expression
 from engine.templates.rows import export_csv, parse_csv

@@ -9,7 +9,7 @@ from psycopg import errors
 from psycopg.types.json import Jsonb
 
 from engine.programs.instantiate import instantiate_gear
-from engine.programs.lineage import LINEAGE_ROW_ID
+from engine.nc.lineage import LINEAGE_ROW_ID
 import csv
 import io
 

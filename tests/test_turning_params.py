@@ -7,9 +7,9 @@ from __future__ import annotations
 import pytest
 
 from engine.errors import EngineError
-from engine.gears.records import load_machine
-from engine.programs.verifier import LimitError, verify_program
-from engine.turning.dxf_import import import_dxf
+from engine.machines.records import load_machine
+from engine.verifier import LimitError, verify_program
+from engine.programs.dxf_import import import_dxf
 from helpers.drawings import seed_drawing
 from helpers.drawn_parts import two_rough_layers
 from helpers.turning_jobs import refused_after

@@ -15,8 +15,8 @@ import pytest
 from engine.errors import EngineError
 from engine.turning.job_params import ProfileOptions, turning_job
 from engine.turning.model import job_passes
-from importers.dxf_drawing import read_drawing
-from importers.dxf_read import DxfError
+from engine.drawings.drawing import read_drawing
+from engine.drawings.read import DxfError
 from helpers.lathe_programs import INSIDE_MM, SAMPLES_PER_MOVE, finish_diameters, motions, operation_lines
 from helpers.drawn_parts import DRAWN_DIAMETERS, drawing
 from helpers.outcomes import counts

@@ -15,8 +15,8 @@ from pathlib import Path
 import psycopg
 import pytest
 
-from engine.gears.records import load_machine
-from engine.programs.verifier import LimitError, verify_program
+from engine.machines.records import load_machine
+from engine.verifier import LimitError, verify_program
 from helpers.golden_cases import TURNING_CASES
 from helpers.drawings import seed_drawing
 from helpers.verifier_programs import (HOBBING, LATHE_ISO, PRELUDES, accepted, one_line_exit_1, program, programs,

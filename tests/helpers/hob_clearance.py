@@ -9,7 +9,8 @@ from pathlib import Path
 import numpy as np
 
 from engine.gears.cutting_data import CuttingData
-from engine.gears.records import Hob, Machine
+from engine.gears.records import Hob
+from engine.machines.records import Machine
 
 SEED_HOBS = Path(__file__).resolve().parents[2] / "seed_templates" / "hobs.csv"
 

@@ -6,7 +6,7 @@ from pathlib import Path
 
 import psycopg
 
-from engine.library.nc_layout import class_layout, nc_text
+from engine.nc.layout import class_layout, nc_text
 from engine.templates.decision_table import compiled_template
 from engine.templates.store import load_template
 from helpers.shared_data import shared_data

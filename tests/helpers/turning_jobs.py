@@ -6,7 +6,7 @@ import pytest
 
 from engine.errors import EngineError
 from engine.programs.remake import instantiate_job
-from engine.turning.dxf_import import import_dxf
+from engine.programs.dxf_import import import_dxf
 from helpers.drawings import seed_drawing
 
 
