@@ -83,7 +83,7 @@ class Machine:
     spindle_max: float
     table_speed_max: float | None
     module_max: float | None
-    # Conventions and setup (migration 0013): each axis's sense relative to DIN 66217.
+    # Conventions and setup (the machine table): each axis's sense relative to DIN 66217.
     a_direction: int = 1
     b_direction: int = 1
     c_direction: int = 1

@@ -2,7 +2,7 @@
 with one. The rows hold the lines without their endings, so `M17` of a CRLF file and of an LF
 file is one component; the class keeps the layout (gear_class.line_ending, .final_newline) and
 its program is written back with it, byte for byte. The layout is part of the template: each
-stored version records it (template_version_rows, migration 0025), a change of it is a new draft
+stored version records it (template_version_rows), a change of it is a new draft
 version, and a program is written with its version's layout."""
 from __future__ import annotations
 
@@ -55,7 +55,7 @@ def split_nc_text(path, text: str) -> tuple[list[str], NcLayout]:
 
 def refuse_broken_lines(path, lines: list[str]) -> None:
     """A line holding a character that ends a line elsewhere (a CR alone, FF, NEL, LS, PS) is one
-    line here and two on a control or editor: no program may hold it (migration 0009)."""
+    line here and two on a control or editor: no program may hold it (program_lines_unbroken)."""
     for number, line in enumerate(lines, start=1):
         breaking = line_breaking(line)
         if breaking is not None:
@@ -71,7 +71,7 @@ def nc_text(lines: list[str], layout: NcLayout) -> str:
 
 def store_layout(conn, gear_class: str, layout: NcLayout) -> bool:
     """Give the class this layout; True if that changed it. A change is a change of the class's
-    template: the database makes it a new version (a draft until released; migration 0025),
+    template: the database makes it a new version (a draft until released; version_layout_change),
     unless this transaction made one already."""
     changed = conn.execute("UPDATE gear_class SET line_ending = %s, final_newline = %s WHERE name = %s "
                            "AND (line_ending, final_newline) IS DISTINCT FROM (%s, %s) RETURNING name",

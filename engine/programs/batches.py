@@ -9,8 +9,8 @@ A dry run computes and checks exactly as a stored run does (the template, the ma
 the simulation, the program's name and lines) inside a READ ONLY transaction that is rolled back:
 PostgreSQL itself refuses any write in it, nextval() included, so nothing is stored and no
 sequence advances. Its program shows the lineage line a stored one carries, but with `DRY-RUN`
-where the program id goes: no program id is drawn, and the database's lineage check (migration
-0015) refuses that line, so such a text can never be stored as a program.
+where the program id goes: no program id is drawn, and the database's lineage check
+(check_program_release) refuses that line, so such a text can never be stored as a program.
 """
 from __future__ import annotations
 

@@ -11,7 +11,7 @@ The program is read by the machine's verifier (engine.programs.verified_run) bef
 stored. A hobbing program must be proved by the simulation against a gear and a hob, which such a
 job has not, so no hobber makes one. With `unverified` the program is stored without the
 verifier's reading, for a dialect the verifier does not know or a program it refuses: its record
-and its lineage line say UNVERIFIED (migration 0024), and it is never written to a file for the
+and its lineage line say UNVERIFIED (program.unverified), and it is never written to a file for the
 machine, because a program that reaches the machine must be one the verifier read. Made again
 (`instantiate --job`, engine.programs.remake) the job is verified then, or refused.
 """

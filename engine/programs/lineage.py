@@ -1,11 +1,11 @@
 """The lineage line every stored program carries (design notes §7, issue 15):
 `; PROGRAM <id> TEMPLATE <class> v<version> <hash8> INPUT <hash8>` (` DRAFT` appended for a
 program made from a draft, then ` UNVERIFIED` for one no verifier read: `engine instantiate --class
---unverified`, migration 0024), so an operator can match a file on the control to its record.
+--unverified`), so an operator can match a file on the control to its record.
 
 The engine writes it, not a template row: every program has it, whatever its template says.
 Its row id is -1 (no template row). The database checks it against the program, its template
-version and the hash of its job's stored parameters (migration 0015, job_input_hash)."""
+version and the hash of its job's stored parameters (check_program_release, job_input_hash)."""
 from __future__ import annotations
 
 import re
@@ -25,10 +25,10 @@ HEADER_LINE = re.compile(r"^\s*(%|;\$PATH|O\d)")
 SEARCHED_LINES = 40
 # What reads as a lineage line at the machine, in either comment form, whatever its id (a dry
 # run's says DRY-RUN): a template row must never write one, or the program would carry a second
-# lineage naming another program (migration 0021 refuses it in the database too).
+# lineage naming another program (check_program_lines refuses it in the database too).
 # The comment may follow a block number or a move (`N10 ; PROGRAM 1 TEMPLATE …`): it reads the
 # same at the control. Only an id or DRY-RUN makes one (`; program from template of spur` is a
-# shop's comment). The spaces are spelled out, not \s, so the database's check (migration 0022,
+# shop's comment). The spaces are spelled out, not \s, so the database's check (lineage_shaped,
 # whose \s depends on the server's locale) reads exactly the same lines.
 SPACE = "[ \t\v\f\r\n\u0085\u00a0\u1680\u2000-\u200a\u2028\u2029\u202f\u205f\u3000\u001c-\u001f]"
 LINEAGE_SHAPE = re.compile(rf"[;(]{SPACE}*PROGRAM{SPACE}+([0-9]+|DRY-RUN){SPACE}+TEMPLATE", re.IGNORECASE)

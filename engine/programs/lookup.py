@@ -22,7 +22,7 @@ SELECT p.id, p.job_id, j.gear_id, p.gear_class, p.template_version, p.draft, p.u
 FROM program p JOIN job j ON j.id = p.job_id
 JOIN template_version_rows v ON v.gear_class = p.gear_class AND v.version = p.template_version"""
 BY_ID = RECORD + " WHERE p.id = %s"
-# left(…, 8) is what the indexes of migration 0015 hold; the LIKE then checks the longer prefix.
+# left(…, 8) is what the indexes program_input_hash, program_template_hash hold; the LIKE then checks the longer prefix.
 BY_HASH = RECORD + """
 WHERE (left(p.input_hash, 8) = left(%(prefix)s, 8) AND p.input_hash LIKE %(prefix)s || '%%')
    OR (left(p.template_hash, 8) = left(%(prefix)s, 8) AND p.template_hash LIKE %(prefix)s || '%%')

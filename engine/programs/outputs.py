@@ -16,7 +16,7 @@ name that would land outside --out, two programs of one run whose names differ o
 (the control does not tell case), and an existing file without --force.
 
 A file is written with the layout of its template version (issue 17: the class's line_ending and
-final_newline as that version records them, migration 0025; LF with a final newline unless the
+final_newline as that version records them, template_version_rows; LF with a final newline unless the
 class was imported from a file that had another), so an
 imported program comes back byte for byte. A line ending configured for the program's machine
 (the config file, set for the block by `line_endings(...)`; engine.programs.config) replaces the

@@ -7,7 +7,7 @@ The released program is the job's latest stored one (its lineage line left out) 
 from the released version from the job's current parameters; otherwise the released template is
 evaluated too. The draft is evaluated as if it had the released version number, so the
 `; TEMPLATE class vN` line does not count as a change. A draft that only writes its lines with
-another layout (line ending, final newline: migration 0025) changes no line, but the bytes of
+another layout (line ending, final newline: version_layout_change) changes no line, but the bytes of
 every stored program's file of the class: said on its own, with how many programs. Jobs with identical parameters are
 evaluated once: 10,000 stored jobs of a class take seconds (bench/impact.py)."""
 from __future__ import annotations
