@@ -26,7 +26,8 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
-from _common import add_database_argument, bench_database, delete_programs, median, verdict  # noqa: E402
+from _common import (add_database_argument, bench_database, delete_programs, median, parse_arguments,  # noqa: E402
+                     verdict)
 from engine.errors import EngineError  # noqa: E402
 from engine.gears.case_base import CUT_KINDS_BY_COUNT, job_cutting_record  # noqa: E402
 from engine.gears.hob_matching import choose_hob  # noqa: E402
@@ -230,11 +231,18 @@ def store(conn, planned: list[tuple]) -> None:
                 gear_id, gear_class, machine, hob_id, params, module_params = item[:6]
                 copy.write_row((job_id, gear_id, gear_class, machine, hob_id, Jsonb(params), Jsonb(module_params),
                                 Jsonb(item[11] or {})))
+        # Every stored program carries its lineage line (engine.programs.lineage), as store_many adds it.
+        lineage = storage.Lineage(conn, [item[2] for item in planned], [(item[1], item[6]) for item in planned],
+                                  job_ids)
         with conn.cursor().copy(storage.COPY_PROGRAM) as copy:
             if getattr(storage, "PROGRAM_TYPES", None):
                 copy.set_types(storage.PROGRAM_TYPES)
             for program_id, job_id, item in zip(program_ids, job_ids, planned):
-                copy.write_row((program_id, job_id, item[1], *item[6:11], None))   # a Jinja2 program has no trace
+                gear_class, machine, (version, template_hash, name, lines, row_ids) = item[1], item[2], item[6:11]
+                lines, row_ids = lineage.added(program_id, job_id, machine, gear_class, version, template_hash,
+                                               lines, row_ids)
+                copy.write_row((program_id, job_id, gear_class, version, template_hash, name, lines, row_ids,
+                                None))   # a Jinja2 program has no trace
 
 
 def run_jinja(conn, pipeline: JinjaPipeline, first: int, last: int) -> tuple[float, int]:
@@ -412,7 +420,7 @@ def main(argv=None) -> int:
     parser.add_argument("--profile-count", type=int, default=PROFILE_GEARS,
                         help=f"gears (the batch's first) that --profile times and profiles (default {PROFILE_GEARS})")
     parser.add_argument("--top", type=int, default=25, help="rows of each cProfile listing (default 25)")
-    args = parser.parse_args(argv)
+    args = parse_arguments(parser, argv, smoke={"count": 20, "reps": 1})
 
     import psycopg
 

@@ -23,7 +23,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from _common import add_database_argument, bench_database, median, verdict  # noqa: E402
+from _common import add_database_argument, bench_database, median, parse_arguments, verdict  # noqa: E402
 
 TARGET_RATIO = 2.0          # issue 12 (was 2.5)
 GEAR_ID = 42
@@ -104,7 +104,7 @@ def main(argv=None) -> int:
     parser.add_argument("--help-against", default=HELP_AGAINST, metavar="REV",
                         help=f"commit whose `engine --help` start-up is the baseline (default {HELP_AGAINST})")
     parser.add_argument("--no-help-startup", action="store_true", help="skip the `engine --help` comparison")
-    args = parser.parse_args(argv)
+    args = parse_arguments(parser, argv, smoke={"runs": 1})
 
     with bench_database(args.database_url, "bench_latency") as url:
         cli = [engine_command(), "--database-url", url, "instantiate", "--gear", str(GEAR_ID), "--json"]
