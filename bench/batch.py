@@ -132,11 +132,12 @@ def run_ours(conn, first: int, last: int, workers: int = 1) -> tuple[float, int]
     """Each run starts with no compiled template and no remembered row outcome, as a new
     `engine instantiate --gears` process does."""
     from engine.programs.instantiate import instantiate_gears
+    from engine.programs.options import RunMode
     from engine.templates import decision_table
 
     decision_table._CACHE.clear()
     start = time.perf_counter()
-    programs = instantiate_gears(conn, first, last, workers=workers)
+    programs = instantiate_gears(conn, first, last, mode=RunMode(workers=workers))
     conn.commit()
     return time.perf_counter() - start, len(programs)
 

@@ -19,7 +19,6 @@ from __future__ import annotations
 
 import ast
 from dataclasses import dataclass
-from pathlib import Path
 
 from ..errors import EngineError
 from ..gears.models import model_for_class
@@ -35,6 +34,7 @@ from ..turning.names import TurningModel
 from .batches import dry_program, read_only, refuse_out_in_dry_run
 from .instantiate import store_planned
 from .lineage import refuse_lineage_shaped
+from .options import NO_FILE, NORMAL_RUN, Output, RunMode
 from .outputs import files_after_commit
 from .records import Planned, Program
 from .verified_run import run_template
@@ -58,19 +58,20 @@ class ClassJob:
 
 
 def instantiate_class(conn, gear_class: str, given: dict, *, machine: str | None = None,
-                      source: str = "parameters", out: str | Path | None = None, force: bool = False,
-                      draft: bool = False, dry_run: bool = False, unverified: bool = False) -> ClassJob:
+                      source: str = "parameters", output: Output = NO_FILE, mode: RunMode = NORMAL_RUN,
+                      unverified: bool = False) -> ClassJob:
     """A job of the class with the parameters `given` (JSON of import-nc's --params, either form),
     its program verified for `machine` (or, `unverified`, not read), stored with the job and written
-    to `out` after the COMMIT. `dry_run`: the same checks, nothing stored."""
-    refuse_out_in_dry_run(dry_run, out)
-    refuse_unverified_file(unverified, out)
-    if dry_run:
+    to `output` after the COMMIT. `mode.draft`: the class's draft; `mode.dry_run`: the same checks,
+    nothing stored. The batch fields of `mode` do not apply."""
+    refuse_out_in_dry_run(output, mode)
+    refuse_unverified_file(unverified, output.out)
+    if mode.dry_run:
         with read_only(conn):
-            planned, taken = _planned(conn, gear_class, given, machine, source, draft, unverified)
+            planned, taken = _planned(conn, gear_class, given, machine, source, mode.draft, unverified)
             return ClassJob(dry_program(conn, planned, None), planned.machine, tuple(given), taken)
-    with files_after_commit(conn, out, force) as files:
-        planned, taken = _planned(conn, gear_class, given, machine, source, draft, unverified)
+    with files_after_commit(conn, output) as files:
+        planned, taken = _planned(conn, gear_class, given, machine, source, mode.draft, unverified)
         program = store_planned(conn, [planned], files)[0]
     return ClassJob(program, planned.machine, tuple(given), taken)
 
