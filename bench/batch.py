@@ -32,7 +32,7 @@ from engine.gears.case_base import CUT_KINDS_BY_COUNT, job_cutting_record  # noq
 from engine.gears.hob_matching import choose_hob  # noqa: E402
 from engine.hobbing.choices import Choices  # noqa: E402
 from engine.programs.instantiate import Planner, _check_machine_fits, _check_table_speed  # noqa: E402
-from engine.programs.verifier import verify_program  # noqa: E402
+from engine.verifier import verify_program  # noqa: E402
 
 FIRST_ID = 100_000
 TARGET_RATE = 5_000          # programs/s

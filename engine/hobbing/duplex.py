@@ -9,7 +9,7 @@ import math
 from dataclasses import dataclass
 
 from ..errors import EngineError
-from ..programs.verifier import check_table_speed
+from ..verifier import check_table_speed
 from . import shifting
 from .cylindrical import CylindricalModel, JobParameters
 from .envelope import half_length, reach_into_cylinder

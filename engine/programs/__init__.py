@@ -1,1 +1,1 @@
-"""Programs (design notes §7): instantiation, the fail-closed program verifier, storage and output files."""
+"""Programs (design notes §7): instantiation, storage and output files; each program is read by the verifier (engine.verifier) first."""

@@ -38,7 +38,7 @@ from .lineage import refuse_lineage_shaped
 from .outputs import files_after_commit
 from .records import Planned, Program
 from .verified_run import run_template
-from .verifier.grammar import DIALECTS
+from ..verifier.grammar import DIALECTS
 
 PROGRAM_NAME = "program_name"   # the job's program name: given or not, whatever the class was imported with
 IMPORT_PARAMS = "SELECT import_params FROM gear_class WHERE name = %s"

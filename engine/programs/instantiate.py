@@ -26,7 +26,7 @@ from .batches import Bad, checked, dry_batch, dry_program, good_ones, planned_or
     refuse_out_in_dry_run
 from .outputs import ProgramFiles, file_layouts, files_after_commit
 from .verified_run import Workpiece, run_template
-from .verifier import LimitError, check_table_speed
+from ..verifier import LimitError, check_table_speed
 from .records import Planned, Program
 from .storage import Batch, store_many, store_one
 from .workers import PLANNING, plan_in_workers

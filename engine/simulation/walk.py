@@ -12,8 +12,8 @@ import math
 import numpy as np
 
 from ..gears.records import Gear, Hob, Machine
-from ..programs.verifier.refusals import Refused
-from ..programs.verifier.shift_clamp import ShiftClamp
+from ..verifier.refusals import Refused
+from ..verifier.shift_clamp import ShiftClamp
 from .coupling import (Coupling, coupling_problems, generated_teeth_problem, hand_name, hand_sign, helix_of,
                        lead_angle, read_coupling, swivel_problem)
 from .contact import Motion, follow

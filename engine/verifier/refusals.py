@@ -2,7 +2,7 @@
 emitted (escaped, so the message stays one line whatever the block holds) and the reason."""
 from __future__ import annotations
 
-from ...errors import EngineError
+from ..errors import EngineError
 
 SHOWN_CHARACTERS = 80   # of a block or a name in a message; a longer one is cut and marked
 

@@ -1,10 +1,10 @@
-"""The value of each address word, read by its kind (engine.programs.verifier.grammar) and
+"""The value of each address word, read by its kind (engine.verifier.grammar) and
 checked where the check needs no machine: S, F and a thread's pitch above 0, F at most about a
 rapid traverse, tool and offset numbers in range, an arc radius not 0, a swivel within a turn.
-The machine's own limits (travel, spindle maximum) are engine.programs.verifier.limits."""
+The machine's own limits (travel, spindle maximum) are engine.verifier.limits."""
 from __future__ import annotations
 
-from ...turning.names import MAX_TOOL
+from ..turning.names import MAX_TOOL
 from .grammar import (ANGLE, CODE, FEED, OFFSET, PITCH, POSITION, RADIUS, SPEED, SPINDLE_POSITION, TOOL,
                       TOOL_AND_OFFSET)
 from .numbers import digits, plain_decimal

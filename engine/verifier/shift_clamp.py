@@ -9,7 +9,7 @@ the five lines below clamp it, so after them R11 lies in [lo, hi]:
     G0 Y=R11
 
 The move is checked at both ends of that interval. Exactly these lines, in this order, and
-nothing between them; any other R-parameter use is refused (engine.programs.verifier.numbers)."""
+nothing between them; any other R-parameter use is refused (engine.verifier.numbers)."""
 from __future__ import annotations
 
 import re

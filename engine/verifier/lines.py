@@ -1,4 +1,4 @@
-"""One emitted line read with the grammar of its dialect (engine.programs.verifier.grammar): a
+"""One emitted line read with the grammar of its dialect (engine.verifier.grammar): a
 header, a comment, a statement, a line of the hob-shift clamp, or a block of address words with
 an optional comment. Reading a line needs no machine and no other line, so what a line reads as
 (or why it is refused) is kept per dialect and text: a template's constant lines are read once."""

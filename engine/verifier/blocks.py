@@ -3,7 +3,7 @@ word by word with the dialect's tables, and its shape checked: each address once
 each modal group, G4/G25/G26 blocks with only their own words, an arc with its radius, a thread
 with its pitch, and every move with its motion G code in the same block (the verifier reads each
 block on its own, so it does not carry a modal G0/G1 over from earlier blocks). What the block
-does to the machine state is kept as its events (engine.programs.verifier.machine_state): its G
+does to the machine state is kept as its events (engine.verifier.machine_state): its G
 codes and keywords, which hold for its own motion, and its M codes and S, T, D words, which the
 motion must not wait for (when an M code is output, before or after the motion, is the machine
 builder's choice)."""

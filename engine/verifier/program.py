@@ -5,19 +5,19 @@ limit, with the program, the line number, the block and the reason.
 
 Followed in order: the headers where they must stand, naming the program itself (its own name,
 a safe 840D name; an ISO number outside the macro range); each motion and statement only in
-the machine state it needs (engine.programs.verifier.machine_state: the working area, units,
+the machine state it needs (engine.verifier.machine_state: the working area, units,
 modes, the spindle turning, the table coupled, a tool offset active); every X/Y/Z within the
 travel and, on a hobber, within the working area G25/G26, whose limits lie within the travel
 themselves; S at most the spindle's maximum and, with the coupling's ratio and differential
 terms at the program's feeds, the table's; a thread's lead × S at most the feed bound; a lathe
 arc whose radius reaches its ends, its extremes within the travel; the hob-shift clamp as
-engine.programs.verifier.shift_clamp says; M30 last (ISO: then the closing %)."""
+engine.verifier.shift_clamp says; M30 last (ISO: then the closing %)."""
 from __future__ import annotations
 
 import math
 
-from ...gears.records import Machine
-from ...names import NAME_RULES, is_safe
+from ..gears.records import Machine
+from ..names import NAME_RULES, is_safe
 from .arcs import arc_box, check_radius
 from .grammar import AXES, Dialect, dialect_for
 from .limits import check_coupled_move, check_spindle, check_table, check_thread, check_travel
@@ -50,7 +50,7 @@ def verify_program(lines: list[str], machine: Machine, program_name: str | None)
 
 
 class Walk:
-    """What the lines so far have set: the machine state (engine.programs.verifier.machine_state),
+    """What the lines so far have set: the machine state (engine.verifier.machine_state),
     the working area and the bounds it leaves each axis, the position, the spindle speed, the
     feed, the table's coupling ratio and differential factors, the hob-shift clamp."""
 
@@ -181,7 +181,7 @@ class Walk:
 
     def _check_differential(self, motion: int, positions: dict) -> None:
         """A leading axis moving while coupled turns the table by its factor: at the block's
-        feed, or for G0 at the machine's rapid rate (engine.programs.verifier.limits)."""
+        feed, or for G0 at the machine's rapid rate (engine.verifier.limits)."""
         check_coupled_move(motion == RAPID, self.feed, positions, (self.speed, self.ratio, self.differential),
                            self.machine, self.position)
 

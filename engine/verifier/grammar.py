@@ -3,7 +3,7 @@ dialect of the machine record (machine.kind, machine.dialect), the header lines 
 program name and number they carry), the comment form, the addresses and the kind of value
 each takes (and which need a decimal point), the G codes and M codes allowed with their modal
 groups, the keywords and statements, the word that gives a thread's lead, and the machine
-state each motion needs (engine.programs.verifier.machine_state).
+state each motion needs (engine.verifier.machine_state).
 
 Only what the seeded templates emit (and the controller reads the way the verifier assumes) is
 in a dialect. Anything else is refused: a code such as G91 changes what every later position
@@ -19,7 +19,7 @@ from dataclasses import dataclass, field, replace
 from .machine_state import HOBBING_STATE, LATHE_840D_STATE, LATHE_ISO_STATE, StateRules
 from .refusals import Refused
 
-# Value kinds of addresses (engine.programs.verifier.words reads and checks each).
+# Value kinds of addresses (engine.verifier.words reads and checks each).
 POSITION, ANGLE, FEED, SPEED, CODE, TOOL, TOOL_AND_OFFSET, OFFSET, RADIUS, PITCH = (
     "position", "angle", "feed", "speed", "code", "tool", "tool and offset", "offset", "radius", "pitch")
 SPINDLE_POSITION = "spindle position"   # SPOS=<degrees>: orients the stopped spindle, moves no axis
@@ -31,7 +31,7 @@ AXES = ("X", "Y", "Z")
 NAME = r"(?P<name>[A-Za-z0-9_]+)"
 # ISO: a comment ends at the first ")", so no "(" or ")" inside; and no "%", which ends the
 # file on a memory card or tape (other characters are printable ASCII anyway:
-# engine.programs.verifier.characters reads every line first).
+# engine.verifier.characters reads every line first).
 ISO_COMMENT_TEXT = r"[ -$&-'*-~]*"
 # ISO dimension words without a decimal point are read in the control's least input increment
 # on Fanuc-type controls with decimal-point input type I: X114 is 0.114 mm. An F without a point
@@ -63,8 +63,8 @@ class Dialect:
     m_codes: dict                         # code -> group: M3 and M5 in one block are both spindle
     state: StateRules                     # what each motion and statement needs, what each event does
     keywords: frozenset = frozenset()     # words without a value: WALIMON, DIAMON
-    statements: frozenset = frozenset()   # NAME(arguments) lines (engine.programs.verifier.statements)
-    shift_clamp: bool = False             # the hob-shift-per-part R11 clamp (engine.programs.verifier.shift_clamp)
+    statements: frozenset = frozenset()   # NAME(arguments) lines (engine.verifier.statements)
+    shift_clamp: bool = False             # the hob-shift-per-part R11 clamp (engine.verifier.shift_clamp)
     equals_allowed: bool = False          # 840D: `X=12.5` is `X12.5`; names of two letters need it (`CR=5`)
     arc_radius: str | None = None         # the address of an arc's radius
     needs_words: dict = field(default_factory=dict)   # G code -> the words its block must hold
