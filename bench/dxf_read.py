@@ -26,7 +26,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 import ezdxf  # noqa: E402
 
 from _common import add_database_argument, bench_database, median, verdict  # noqa: E402
-from importers.dxf_drawing import read_drawing  # noqa: E402
+from engine.drawings.drawing import read_drawing  # noqa: E402
 
 TARGET_RATIO = 1.5
 PITCH = 0.2  # mm along Z per profile wave: 2,000 waves stay within the lathe's Z travel

@@ -7,7 +7,6 @@ import ast
 from pathlib import Path
 
 import engine
-import importers
 
 DESIGN_FOLDERS = ("templates", "library", "gears", "hobbing", "turning", "programs", "db", "cli")
 CLI = "engine.cli"
@@ -100,7 +99,7 @@ def cli_importers(graph: dict[str, set[str]]) -> list[str]:
 
 
 def engine_graph():
-    return import_graph((Path(engine.__file__).parent, "engine"), (Path(importers.__file__).parent, "importers"))
+    return import_graph((Path(engine.__file__).parent, "engine"))
 
 
 def test_no_import_cycle_in_the_package():
@@ -138,8 +137,7 @@ def test_engine_is_laid_out_as_the_design_s_sections():
 
 
 def test_every_module_says_what_it_is_in_its_first_line():
-    for package in (engine, importers):
-        assert modules_not_saying_what_they_are(Path(package.__file__).parent) == []
+    assert modules_not_saying_what_they_are(Path(engine.__file__).parent) == []
 
 
 def test_the_layout_checks_find_a_missing_folder_a_loose_module_and_a_silent_module(tmp_path):

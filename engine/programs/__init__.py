@@ -1,1 +1,2 @@
-"""Programs (design notes §7): instantiation, storage and output files; each program is read by the verifier (engine.verifier) first."""
+"""Programs (design notes §7): instantiation, storage and output files; every program is read by
+the fail-closed verifier (engine.verifier) before it is stored or written."""

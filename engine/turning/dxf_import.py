@@ -12,7 +12,7 @@ from pathlib import Path
 
 from psycopg.types.json import Jsonb
 
-from importers.dxf_drawing import read_drawing
+from ..drawings.drawing import read_drawing
 
 from ..memory import no_cycle_collection
 from ..names import checked

@@ -8,8 +8,8 @@ import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from importers.dxf_drawing import Drawing, Operation
-from importers.dxf_profile import merged_bounds
+from ..drawings.drawing import Drawing, Operation
+from ..drawings.profile import merged_bounds
 
 from ..errors import EngineError
 from ..names import NAME_RULES, checked, is_safe, shown

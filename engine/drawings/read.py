@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:   # ezdxf takes a third of a second to import: only reading a drawing pays it
     from ezdxf.document import Drawing as EzdxfDocument
 
-from engine.errors import EngineError
+from ..errors import EngineError
 
 BINARY_SENTINEL = b"AutoCAD Binary DXF"
 BINARY_EOF = b"\x00EOF\x00"   # the value of the last group (code 0), NUL-terminated

@@ -1,5 +1,5 @@
 """Which reading of the profile layer makes the part: a half-profile in the seed-000
-convention (dxf_profile), or a side view drawn whole (dxf_side_view), or neither, said
+convention (profile), or a side view drawn whole (side_view), or neither, said
 by name (issue 17).
 
 A view a centre line runs through is a side view. Otherwise the layer is read as a
@@ -9,10 +9,10 @@ which lie inside others, is refused as the flat part (a plate) it is.
 """
 from __future__ import annotations
 
-from .dxf_geometry import Segment
-from .dxf_profile import END_MATCH_TOLERANCE_MM, Chain, Profile, chain_segments, find_profile, merged_bounds
-from .dxf_read import DxfError
-from .dxf_side_view import Marks, side_view, side_view_of, symmetry_axis
+from .geometry import Segment
+from .profile import END_MATCH_TOLERANCE_MM, Chain, Profile, chain_segments, find_profile, merged_bounds
+from .read import DxfError
+from .side_view import Marks, side_view, side_view_of, symmetry_axis
 
 HATCH_FLATTENING = 0.01   # drawing units: hatching only tells where material is, not its edge
 

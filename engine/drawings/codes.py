@@ -13,7 +13,7 @@ import re
 from dataclasses import dataclass
 from typing import Callable
 
-from .dxf_read import DxfError
+from .read import DxfError
 
 OPERATION_KINDS = ("ROUGH", "SLOT", "FINISH", "THREAD", "FACE", "PART")
 CODE = re.compile(r"@([A-Za-z])\s*[:=]?\s*([^@\s]*)")

@@ -13,9 +13,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from .dxf_geometry import Arc, Line, Segment
-from .dxf_profile import END_MATCH_TOLERANCE_MM, sweep
-from .dxf_read import DxfError
+from .geometry import Arc, Line, Segment
+from .profile import END_MATCH_TOLERANCE_MM, sweep
+from .read import DxfError
 
 SAME_Z = 1e-7          # breakpoints closer than this (mm) are one
 ON_PIECE = 1e-4        # two pieces this close (mm) at a bisected Z meet there

@@ -28,8 +28,8 @@ from dataclasses import dataclass
 from functools import cached_property
 from typing import Sequence
 
-from .dxf_geometry import Arc, Line, Point, Segment
-from .dxf_read import DxfError
+from .geometry import Arc, Line, Point, Segment
+from .read import DxfError
 
 # End points closer than this (mm) are the same point when chaining.
 END_MATCH_TOLERANCE_MM = 0.01

@@ -1,12 +1,12 @@
 """A turned part drawn whole, as a side view symmetric about its centre line → its upper
 half-profile (issue 17), or the reason it is not one.
 
-The axis is a straight, horizontal or vertical centre line (dxf_layers.LINE_ROLES) that runs
+The axis is a straight, horizontal or vertical centre line (layers.LINE_ROLES) that runs
 the length of one view of the profile layer, with that view on both sides of it; without
 one, a drawing that is not a half-profile is tried for mirror symmetry about the middle
 of its extents. The view is moved so the centre line is the axis (a vertical one turned to
-lie along Z) and its outline above the axis is taken (dxf_envelope), once dxf_turnable has
-found nothing a lathe cannot make from outside and dxf_inner_lines has found both halves
+lie along Z) and its outline above the axis is taken (envelope), once turnable has
+found nothing a lathe cannot make from outside and inner_lines has found both halves
 alike and every line inside the outline of a kind that leaves the turned surface as it is.
 Outlines mirrored either side of a centre line that none of them reaches are a bored part's
 section drawn without hatching, refused.
@@ -17,13 +17,12 @@ import math
 from collections import defaultdict
 from dataclasses import dataclass, field
 
-from .dxf_envelope import upper_envelope
-from .dxf_geometry import Arc, Line, Segment
-from .dxf_inner_lines import check_halves_agree, distance_to, frame_of, inner_lines_note
-from .dxf_profile import END_MATCH_TOLERANCE_MM, Profile, bounds, merged_bounds, sweep
-from .dxf_read import DxfError
-from .dxf_turnable import (check_no_bore, check_no_hidden_bore, check_no_prism, check_not_an_end_view,
-                           check_reaches_the_axis)
+from .envelope import upper_envelope
+from .geometry import Arc, Line, Segment
+from .inner_lines import check_halves_agree, distance_to, frame_of, inner_lines_note
+from .profile import END_MATCH_TOLERANCE_MM, Profile, bounds, merged_bounds, sweep
+from .read import DxfError
+from .turnable import check_no_bore, check_no_hidden_bore, check_no_prism, check_not_an_end_view, check_reaches_the_axis
 
 ALONG_SLACK_MM = 1.0       # a centre line may stop this short of its view's ends
 STRAIGHT = 1e-3            # |dy/dx| (or dx/dy) of a horizontal (vertical) centre line

@@ -12,9 +12,10 @@ from __future__ import annotations
 import contextlib
 import math
 from dataclasses import dataclass
-from typing import Callable, Iterator, Union
+from typing import Callable, Iterator
 
-from .dxf_read import DxfError, one_line
+from .geometry import Arc, Line, Point, Segment
+from .read import DxfError, one_line
 
 # Largest distance between a flattened SPLINE/ELLIPSE (or an arc outside the XY plane) and
 # its line approximation: 2 µm, a tenth of the IT6 band of a 30 mm diameter (1 µm doubled
@@ -28,38 +29,6 @@ DEGENERATE_LENGTH = 1e-9
 # number at all (NaN, inf, or 1e308 that overflows once scaled), is a broken entity. It is
 # refused where it is read, before chains, passes or a program are computed from it.
 MAX_COORDINATE_MM = 1_000_000.0
-
-Point = tuple[float, float]
-
-
-@dataclass(frozen=True, slots=True)
-class Line:
-    start: Point
-    end: Point
-    handle: str = ""
-
-    def reversed(self) -> "Line":
-        return Line(self.end, self.start, self.handle)
-
-
-@dataclass(frozen=True, slots=True)
-class Arc:
-    """A circular arc from start to end about centre; ccw: counter-clockwise seen from +Z."""
-    start: Point
-    end: Point
-    centre: Point
-    ccw: bool
-    handle: str = ""
-
-    def reversed(self) -> "Arc":
-        return Arc(self.end, self.start, self.centre, not self.ccw, self.handle)
-
-    @property
-    def radius(self) -> float:
-        return math.dist(self.start, self.centre)
-
-
-Segment = Union[Line, Arc]
 
 
 @dataclass(frozen=True)

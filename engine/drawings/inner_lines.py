@@ -16,10 +16,10 @@ from collections import Counter
 from dataclasses import dataclass
 from typing import Callable
 
-from .dxf_envelope import SAME_Z, pieces_of, upper_envelope
-from .dxf_geometry import Arc, Line, Segment
-from .dxf_profile import END_MATCH_TOLERANCE_MM, merged_bounds, sweep
-from .dxf_read import DxfError
+from .envelope import SAME_Z, pieces_of, upper_envelope
+from .geometry import Arc, Line, Segment
+from .profile import END_MATCH_TOLERANCE_MM, merged_bounds, sweep
+from .read import DxfError
 
 # A thread's root line lies under its outer diameter at no less than this share of it: the
 # minor diameter of ISO metric threads (ISO 68-1, d3 = d - 1.2269 P) is 0.69 d for the coarsest

@@ -16,16 +16,17 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import NamedTuple
 
-from engine.memory import no_cycle_collection
+from ..memory import no_cycle_collection
 
-from .dxf_codes import CodeText, layer_codes
-from .dxf_layers import CENTRE, HIDDEN, chosen_profile_layer, layer_linetypes, line_role
-from .dxf_outline import hatch_polygons, profile_of
-from .dxf_side_view import Marks
-from .dxf_geometry import (FLATTEN_TOLERANCE_MM, HANDLERS, MAX_COORDINATE_MM, Context, Line, Segment, check_finite,
-                           check_reach, inserted_entities, named_on_failure, segments_of, unit_scale)
-from .dxf_profile import Profile, chain_segments, scaled
-from .dxf_read import DxfError, ezdxf_warnings, load_drawing_file, summarised
+from .codes import CodeText, layer_codes
+from .layers import CENTRE, HIDDEN, chosen_profile_layer, layer_linetypes, line_role
+from .outline import hatch_polygons, profile_of
+from .side_view import Marks
+from .entities import (FLATTEN_TOLERANCE_MM, HANDLERS, MAX_COORDINATE_MM, Context, check_finite, check_reach,
+    inserted_entities, named_on_failure, segments_of, unit_scale)
+from .geometry import Line, Segment
+from .profile import Profile, chain_segments, scaled
+from .read import DxfError, ezdxf_warnings, load_drawing_file, summarised
 
 PROFILE_LAYER = "0"
 OR_NAME_IT = " or name its layer with --profile-layer"
@@ -100,7 +101,7 @@ def read_drawing(path: str | Path, profile_layer: str | None = None) -> Drawing:
     """Read a turning drawing; DxfError (one line naming the layer, handle or text) if it
     cannot become a job. profile_layer: where the part outline is (real CAD drawings keep
     it on a layer like 'outline' rather than the seed-000 convention's layer 0); None: layer
-    0, or when that is empty the one layer holding one contour on the axis (dxf_layers)."""
+    0, or when that is empty the one layer holding one contour on the axis (layers)."""
     with ezdxf_warnings() as warnings, no_cycle_collection():
         drawing_file = load_drawing_file(path)
         units, scale, assumed = unit_scale(drawing_file.doc.header.get("$INSUNITS"))

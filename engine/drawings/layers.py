@@ -13,8 +13,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from functools import lru_cache
 
-from .dxf_profile import END_MATCH_TOLERANCE_MM, chain_segments
-from .dxf_read import DxfError
+from .profile import END_MATCH_TOLERANCE_MM, chain_segments
+from .read import DxfError
 
 CENTRE, HIDDEN = "centre line", "hidden line"
 # A layer of more pieces than this (flattened curves, hatching, a site plan) is not looked at

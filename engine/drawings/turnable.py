@@ -13,9 +13,9 @@ from __future__ import annotations
 
 import math
 
-from .dxf_geometry import Arc, Line, Segment
-from .dxf_profile import END_MATCH_TOLERANCE_MM, bounds, sweep
-from .dxf_read import DxfError
+from .geometry import Arc, Line, Segment
+from .profile import END_MATCH_TOLERANCE_MM, bounds, sweep
+from .read import DxfError
 
 HATCH_SAMPLES = 200
 # Interior edges along the whole length of a cylinder-like span, as a share of its outline
