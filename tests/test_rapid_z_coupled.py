@@ -13,7 +13,7 @@ import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from engine.gears.records import Machine
+from engine.machines.records import Machine
 from engine.verifier import LimitError, verify_program
 
 TABLE_MAX = 120.0

@@ -10,7 +10,7 @@ from psycopg import sql
 
 from engine.errors import EngineError
 from engine.programs.instantiate import instantiate_gear
-from engine.programs.lineage import without_lineage
+from engine.nc.lineage import without_lineage
 from engine.templates.analysis import analyse, class_findings
 from engine.templates.golden import run_golden_tests
 from engine.templates.impact import impact

@@ -10,7 +10,7 @@ import pytest
 
 from engine.hobbing.choices import Choices
 from engine.programs.instantiate import instantiate_gear, instantiate_gears
-from engine.programs.lineage import LINEAGE_ROW_ID
+from engine.nc.lineage import LINEAGE_ROW_ID
 from engine.programs.remake import instantiate_job
 from engine.templates.store import load_template
 from engine.turning.dxf_import import import_dxf

@@ -7,7 +7,7 @@ from __future__ import annotations
 import pytest
 
 from engine.errors import EngineError
-from engine.gears.records import load_machine
+from engine.machines.records import load_machine
 from engine.programs.remake import instantiate_job
 from engine.verifier import LimitError, verify_program
 from engine.turning.dxf_import import import_dxf

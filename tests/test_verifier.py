@@ -15,7 +15,7 @@ from pathlib import Path
 import psycopg
 import pytest
 
-from engine.gears.records import load_machine
+from engine.machines.records import load_machine
 from engine.verifier import LimitError, verify_program
 from golden_cases import TURNING_CASES
 from test_dxf_read import seed_drawing

@@ -23,7 +23,7 @@ from pathlib import Path
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from engine.gears.records import Machine
+from engine.machines.records import Machine
 from engine.verifier import LimitError, verify_program
 
 SEED = Path(__file__).resolve().parent.parent / "seed_templates" / "machines.csv"

@@ -16,7 +16,7 @@ import math
 import psycopg
 import pytest
 
-from engine.gears.records import load_machine
+from engine.machines.records import load_machine
 from engine.verifier import LimitError, verify_program
 from test_verifier import HOBBING, LATHE_ISO, READY, accepted, one_line_exit_1, program, programs, refusal
 

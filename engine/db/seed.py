@@ -14,7 +14,7 @@ from psycopg.types.json import Jsonb
 from ..csv_reader import Column, CsvKind, parse_text, read_csv_file
 from ..gears.gear_import import GEAR_KIND, identical_gears, import_gears, installed_classes, read_gears
 from ..gears.hob_library import HOB_COLUMNS
-from ..gears.records import Machine
+from ..machines.records import Machine
 from ..gears.units import UNIT_KIND, import_units
 from ..paths import SEED_DIR
 from ..templates.rows import read_csv

@@ -5,7 +5,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ..gears.cutting_data import CuttingData
-from ..gears.records import Gear, Hob, Machine
+from ..gears.records import Gear, Hob
+from ..machines.records import Machine
 from . import conventions, geometry, shifting
 from .choices import Choices
 from .machine_job import SETUP_PARAMETERS, machine_job

@@ -23,10 +23,10 @@ from pathlib import Path
 
 from ..errors import EngineError
 from ..gears.models import model_for_class
-from ..gears.records import Machine, load_machine
-from ..library.nc_layout import NcLayout, class_layout
+from ..machines.records import Machine, load_machine
+from ..nc.layout import NcLayout, class_layout
 from ..library.nc_params import bindings, values
-from ..library.nc_tokens import NUMBER, tokenise
+from ..nc.tokens import NUMBER, tokenise
 from ..names import checked
 from ..templates.decision_table import compiled_template
 from ..templates.rows import Template
@@ -34,7 +34,7 @@ from ..templates.versions import runnable_template
 from ..turning.names import TurningModel
 from .batches import dry_program, read_only, refuse_out_in_dry_run
 from .instantiate import store_planned
-from .lineage import refuse_lineage_shaped
+from ..nc.lineage import refuse_lineage_shaped
 from .outputs import files_after_commit
 from .records import Planned, Program
 from .verified_run import run_template

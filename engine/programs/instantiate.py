@@ -15,9 +15,10 @@ from ..gears.case_base import CUT_KINDS_BY_COUNT, CaseBase, job_cutting_record
 from ..gears.hob_matching import choose_hob
 from ..gears.models import model_for_class
 from ..gears.process_notes import hunting_tooth_notes
-from ..gears.records import Gear, Machine, hobbing_machine, load_gear, load_gears, load_hobs
+from ..gears.records import Gear, load_gear, load_gears, load_hobs
+from ..machines.records import Machine, hobbing_machine
 from ..hobbing.choices import Choices
-from ..library.nc_layout import NcLayout, class_layout
+from ..nc.layout import NcLayout, class_layout
 from ..memory import no_cycle_collection
 from ..templates.rows import Template
 from ..templates.versions import runnable_template

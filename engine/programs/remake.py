@@ -14,10 +14,11 @@ from pathlib import Path
 from ..errors import EngineError
 from ..gears.models import model_for_class
 from ..gears.process_notes import stored_feed_notes
-from ..gears.records import Hob, Machine, load_gear, load_hobs, load_machine
+from ..gears.records import Hob, load_gear, load_hobs
+from ..machines.records import Machine, load_machine
 from ..hobbing.cylindrical import program_name
 from ..hobbing.machine_job import with_cycle_time
-from ..library.nc_layout import NcLayout, class_layout
+from ..nc.layout import NcLayout, class_layout
 from ..memory import no_cycle_collection
 from ..templates.rows import Template
 from ..templates.versions import runnable_template

@@ -11,11 +11,12 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ..errors import EngineError
-from ..gears.records import Gear, Hob, Machine
+from ..gears.records import Gear, Hob
+from ..machines.records import Machine
 from ..simulation import SimulationError, simulate_program
 from ..templates.decision_table import Result, compiled_template
 from ..templates.rows import Template
-from .lineage import refuse_lineage_shaped
+from ..nc.lineage import refuse_lineage_shaped
 from ..verifier import verify_program
 
 

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..gears.records import Machine
+from ..machines.records import Machine
 from ..verifier import grammar
 from ..verifier.blocks import TOKEN
 from ..verifier.lines import read_line

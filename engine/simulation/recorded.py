@@ -9,7 +9,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from ..gears.records import Gear, Hob, Machine
+from ..gears.records import Gear, Hob
+from ..machines.records import Machine
 from .reading import read_program
 from .report import Report, SimulationError
 from .run import SHIFT_ENDS

@@ -4,7 +4,8 @@ A program with the hob-shift-per-part clamp (R11 lies in an interval) is followe
 the shift at each end of it."""
 from __future__ import annotations
 
-from ..gears.records import Gear, Hob, Machine
+from ..gears.records import Gear, Hob
+from ..machines.records import Machine
 from .reading import read_program
 from .report import Report, SimulationError
 from .solids import setup_solids, unit_solids

@@ -11,7 +11,8 @@ import math
 
 import numpy as np
 
-from ..gears.records import Gear, Hob, Machine
+from ..gears.records import Gear, Hob
+from ..machines.records import Machine
 from ..verifier.refusals import Refused
 from ..verifier.shift_clamp import ShiftClamp
 from .coupling import (Coupling, coupling_problems, generated_teeth_problem, hand_name, hand_sign, helix_of,

@@ -18,9 +18,9 @@ from dataclasses import dataclass, field, replace
 
 from ..errors import EngineError
 from ..gears.models import model_for_class
-from ..gears.records import load_machine
-from ..library.nc_layout import ENDING_NAMES, NcLayout
-from ..programs.lineage import without_lineage
+from ..machines.records import load_machine
+from ..nc.layout import ENDING_NAMES, NcLayout
+from ..nc.lineage import without_lineage
 from .decision_table import compiled_template
 from .history import layout_change
 from .rows import Template

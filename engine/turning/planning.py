@@ -3,7 +3,7 @@ passes computed from them, then checked against the lathe. Nothing is stored her
 from __future__ import annotations
 
 from ..errors import EngineError
-from ..gears.records import Machine, load_machine
+from ..machines.records import Machine, load_machine
 from ..programs.records import Planned
 from ..programs.verified_run import run_template
 from ..templates.versions import runnable_template

@@ -3,7 +3,7 @@ table's maximum speed, the feed a thread's lead and spindle speed make. No progr
 one is stored or written."""
 from __future__ import annotations
 
-from ..gears.records import Machine
+from ..machines.records import Machine
 from .refusals import LimitError, Refused
 from .words import MAX_FEED
 

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import math
 
-from ..gears.records import Machine
+from ..machines.records import Machine
 from ..names import NAME_RULES, is_safe
 from .arcs import arc_box, check_radius
 from .grammar import AXES, Dialect, dialect_for

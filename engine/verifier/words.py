@@ -4,7 +4,7 @@ rapid traverse, tool and offset numbers in range, an arc radius not 0, a swivel 
 The machine's own limits (travel, spindle maximum) are engine.verifier.limits."""
 from __future__ import annotations
 
-from ..turning.names import MAX_TOOL
+from ..nc.words import MAX_TOOL
 from .grammar import (ANGLE, CODE, FEED, OFFSET, PITCH, POSITION, RADIUS, SPEED, SPINDLE_POSITION, TOOL,
                       TOOL_AND_OFFSET)
 from .numbers import digits, plain_decimal
