@@ -210,6 +210,7 @@ def template_restore(ctx, gear_class, version):
 @click.pass_context
 def lint(ctx, as_json):
     """Check every expression of every template: parses, is allowed, names known parameters."""
+    from .. import hobbing, turning  # noqa: F401  (importing them registers their models)
     from ..templates.lint import lint_all
 
     with connection(ctx) as conn:

@@ -21,6 +21,7 @@ import ast
 from dataclasses import dataclass
 from pathlib import Path
 
+from .. import hobbing, turning  # noqa: F401  (importing them registers their models)
 from ..errors import EngineError
 from ..gears.models import model_for_class
 from ..machines.records import Machine, load_machine

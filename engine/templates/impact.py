@@ -16,6 +16,7 @@ import difflib
 import json
 from dataclasses import dataclass, field, replace
 
+from .. import hobbing, turning  # noqa: F401  (importing them registers their models)
 from ..errors import EngineError
 from ..gears.models import model_for_class
 from ..machines.records import load_machine

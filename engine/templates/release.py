@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 from psycopg.errors import InsufficientPrivilege
 from psycopg.types.json import Jsonb
 
+from .. import hobbing, turning  # noqa: F401  (importing them registers their models)
 from ..errors import EngineError
 from .analysis import class_findings
 from .impact import Impact, impact

@@ -2,6 +2,8 @@
 parameters (for `engine lint`). Light on purpose: engine.turning registers its model on import."""
 from __future__ import annotations
 
+from ..gears.models import register_model
+
 # Operation slots in the turning templates (rows 1000·n + 10 … 80); a drawing with more
 # operation layers is refused. Nine covers the seed's jobs (rough, slot, thread, finish …)
 # with room; more slots are more rows, not more code.
@@ -22,6 +24,7 @@ MODULE_PARAMETERS = {
 }
 
 
+@register_model("turning")
 class TurningModel:
     """Names the turning templates may use (for `engine lint`)."""
 
