@@ -16,7 +16,7 @@ import ezdxf.path
 import pytest
 
 from engine.programs.remake import instantiate_job
-from engine.turning.dxf_import import import_dxf
+from engine.programs.dxf_import import import_dxf
 from engine.turning.job_params import ProfileOptions
 from engine.drawings.drawing import read_drawing
 from engine.drawings.read import DxfError

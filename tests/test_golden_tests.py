@@ -11,9 +11,9 @@ import psycopg
 import pytest
 
 from engine.programs.instantiate import instantiate_gear
-from engine.templates.coverage import coverage
+from engine.release.coverage import coverage
 from engine.templates.expectations import Context, first_difference
-from engine.templates.golden import run_golden_tests
+from engine.release.golden import run_golden_tests
 
 SEEDED_CLASSES = {"spur", "helical", "duplex", "taper", "crowned", "worm_wheel", "turning_iso", "turning_840d"}
 

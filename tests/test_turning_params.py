@@ -10,7 +10,7 @@ from engine.errors import EngineError
 from engine.machines.records import load_machine
 from engine.programs.remake import instantiate_job
 from engine.verifier import LimitError, verify_program
-from engine.turning.dxf_import import import_dxf
+from engine.programs.dxf_import import import_dxf
 from test_dxf_read import seed_drawing
 from test_turning_jobs import two_rough_layers
 

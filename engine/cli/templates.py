@@ -210,7 +210,8 @@ def template_restore(ctx, gear_class, version):
 @click.pass_context
 def lint(ctx, as_json):
     """Check every expression of every template: parses, is allowed, names known parameters."""
-    from .. import hobbing, turning  # noqa: F401  (importing them registers their models)
+    from .. import turning  # noqa: F401  (importing it registers the turning names model)
+    from ..hobbing import models as hobbing_models  # noqa: F401  (importing it registers the hobbing models)
     from ..templates.lint import lint_all
 
     with connection(ctx) as conn:

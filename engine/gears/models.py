@@ -1,8 +1,8 @@
 """Which model serves which gear class: the nearest ancestor that has one. Models register
 themselves here (`@register_model("cylindrical")` on the class), as ezdxf's entities do, so the
-gears section never imports the hobbing or turning sections above it: importing engine.hobbing
-or engine.turning registers their models, and the programs, release and command-line sections
-that use a model import them first."""
+gears section never imports the hobbing or turning sections above it: importing
+engine.hobbing.models or engine.turning registers their models, and the programs, release and
+command-line code that asks for a model imports them first."""
 from __future__ import annotations
 
 from typing import Any, Callable, Protocol
@@ -43,7 +43,7 @@ def registered_models() -> dict[str, NamedModel]:
     """The registry, refused while empty: a caller that reached a model before engine.hobbing was
     imported would otherwise see every class as having none (fail closed)."""
     if not MODELS:
-        raise EngineError("internal error: no gear model is registered; import engine.hobbing and "
+        raise EngineError("internal error: no gear model is registered; import engine.hobbing.models and "
                           "engine.turning before asking for one")
     return MODELS
 

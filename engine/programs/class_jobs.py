@@ -21,7 +21,8 @@ import ast
 from dataclasses import dataclass
 from pathlib import Path
 
-from .. import hobbing, turning  # noqa: F401  (importing them registers their models)
+from .. import turning  # noqa: F401  (importing it registers the turning names model)
+from ..hobbing import models as hobbing_models  # noqa: F401  (importing it registers the hobbing models)
 from ..errors import EngineError
 from ..gears.models import model_for_class
 from ..machines.records import Machine, load_machine

@@ -10,7 +10,8 @@ from __future__ import annotations
 from dataclasses import replace
 from pathlib import Path
 
-from .. import hobbing, turning  # noqa: F401  (importing them registers their models)
+from .. import turning  # noqa: F401  (importing it registers the turning names model)
+from ..hobbing import models as hobbing_models  # noqa: F401  (importing it registers the hobbing models)
 from ..errors import EngineError
 from ..gears.case_base import CUT_KINDS_BY_COUNT, CaseBase, job_cutting_record
 from ..gears.hob_matching import choose_hob

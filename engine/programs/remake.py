@@ -11,7 +11,8 @@ import re
 from dataclasses import replace
 from pathlib import Path
 
-from .. import hobbing, turning  # noqa: F401  (importing them registers their models)
+from .. import turning  # noqa: F401  (importing it registers the turning names model)
+from ..hobbing import models as hobbing_models  # noqa: F401  (importing it registers the hobbing models)
 from ..errors import EngineError
 from ..gears.models import model_for_class
 from ..gears.process_notes import stored_feed_notes
@@ -58,7 +59,7 @@ class Remaker:
         if not self.modelled(gear_class):   # a job of an imported class (instantiate --class): its rows alone
             return class_job(self.template(gear_class), machine, params, module_params)
         if machine.kind == "lathe":   # a turning job: its passes are computed from its parameters
-            from ..turning.planning import plan_turning_job   # the tool paths: only for turning jobs
+            from .turning_jobs import plan_turning_job   # the tool paths: only for turning jobs
 
             return plan_turning_job(self.conn, gear_class, machine, params, module_params, draft=self.draft)
         template = self.template(gear_class)

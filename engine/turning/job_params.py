@@ -10,7 +10,6 @@ from pathlib import Path
 
 from ..drawings.drawing import Drawing, Operation
 from ..drawings.profile import merged_bounds
-
 from ..errors import EngineError
 from ..names import NAME_RULES, checked, is_safe, shown
 from .defaults import (CLEARANCE, DEFAULT_FEED, DEFAULT_INFEED_ANGLE, DEFAULT_SPEED, DEFAULT_THREAD_DEPTH_PER_PASS,

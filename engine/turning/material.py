@@ -27,7 +27,6 @@ from collections import defaultdict
 from dataclasses import dataclass
 
 from ..drawings.profile import merged_bounds
-
 from ..errors import EngineError
 from .defaults import STOCK_MARGIN
 from .gouge import move_points

@@ -16,7 +16,6 @@ from functools import cached_property
 
 from ..drawings.geometry import Line, Segment
 from ..drawings.profile import END_MATCH_TOLERANCE_MM, Profile, merged_bounds
-
 from ..errors import EngineError
 from . import toolpaths
 from .gouge import PartIndex, check_no_gouge

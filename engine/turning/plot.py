@@ -14,7 +14,6 @@ from dataclasses import dataclass
 from typing import Sequence
 
 from ..drawings.geometry import Arc, Segment
-
 from ..pictures import literal, new_figure, picture_target, save_atomically
 from .moves import Move, Pass
 from .plot_frame import Frame, job_frame

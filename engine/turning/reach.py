@@ -22,7 +22,6 @@ from dataclasses import dataclass
 from typing import Sequence
 
 from ..drawings.profile import END_MATCH_TOLERANCE_MM
-
 from ..errors import EngineError
 from .region import CHORD_TOLERANCE_MM, Edge
 

@@ -12,7 +12,6 @@ import math
 
 from ..drawings.geometry import Arc, Line, Segment
 from ..drawings.profile import END_MATCH_TOLERANCE_MM
-
 from ..errors import EngineError
 
 DIGITS = 6             # mm to 1 nm: far below any drawing's accuracy, short in SQL

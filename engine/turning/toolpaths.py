@@ -14,7 +14,6 @@ from typing import Sequence
 
 from ..drawings.geometry import Arc, Line, Segment
 from ..drawings.profile import merged_bounds
-
 from ..errors import EngineError
 from .moves import Move, Pass
 from .region import (CHORD_TOLERANCE_MM, Edge, Surroundings, distance_to_region, flattened_outline,

@@ -14,10 +14,10 @@ from __future__ import annotations
 
 import string
 
-from ..templates.budget import paid
-from ..templates.guards import check_format_spec
-from .moves import MOVE_KINDS
+from .budget import paid
+from .guards import check_format_spec
 
+MOVE_KINDS = ("rapid", "feed", "cw", "ccw", "thread")   # engine.turning.moves.Move.kind, in the order of the formats
 FIELDS = ("x", "z", "r", "i", "k", "pitch")   # x a diameter; r, i, k arc radius and centre offsets
 MAX_PATH_BLOCKS = 200_000     # blocks one nc_path call may print
 MAX_BLOCK_LENGTH = 512        # characters of one printed block

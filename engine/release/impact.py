@@ -16,17 +16,18 @@ import difflib
 import json
 from dataclasses import dataclass, field, replace
 
-from .. import hobbing, turning  # noqa: F401  (importing them registers their models)
+from .. import turning  # noqa: F401  (importing it registers the turning names model)
+from ..hobbing import models as hobbing_models  # noqa: F401  (importing it registers the hobbing models)
 from ..errors import EngineError
 from ..gears.models import model_for_class
 from ..machines.records import load_machine
 from ..nc.layout import ENDING_NAMES, NcLayout
 from ..nc.lineage import without_lineage
-from .decision_table import compiled_template
-from .history import layout_change
-from .rows import Template
-from .store import class_and_descendants
-from .versions import draft_template, released_template
+from ..templates.decision_table import compiled_template
+from ..templates.history import layout_change
+from ..templates.rows import Template
+from ..templates.store import class_and_descendants
+from ..templates.versions import draft_template, released_template
 
 DIFFS_SHOWN = 5   # unified diffs the CLI prints (all of them with --json)
 

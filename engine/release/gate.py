@@ -4,7 +4,7 @@ A draft is released only if (1) every expression passes the static check (engine
 golden tests of the class and of its descendants pass against their drafts (engine test), and
 (3) static analysis finds nothing (engine.templates.analysis). Any failure refuses the release
 and names every row, column and test that failed. Then the impact: what the release changes in
-the programs of the stored jobs (engine.templates.impact). Not a dry run: the release is recorded
+the programs of the stored jobs (engine.release.impact). Not a dry run: the release is recorded
 (release_template, which only engine_releaser may run) in the transaction that read the draft, so
 what was checked is what is released."""
 from __future__ import annotations
@@ -14,13 +14,14 @@ from dataclasses import dataclass, field
 from psycopg.errors import InsufficientPrivilege
 from psycopg.types.json import Jsonb
 
-from .. import hobbing, turning  # noqa: F401  (importing them registers their models)
+from .. import turning  # noqa: F401  (importing it registers the turning names model)
+from ..hobbing import models as hobbing_models  # noqa: F401  (importing it registers the hobbing models)
 from ..errors import EngineError
-from .analysis import class_findings
+from ..templates.analysis import class_findings
 from .impact import Impact, impact
-from .lint import lint_class
-from .store import class_and_descendants
-from .versions import draft_template
+from ..templates.lint import lint_class
+from ..templates.store import class_and_descendants
+from ..templates.versions import draft_template
 
 RELEASER_ROLE = "engine_releaser"
 RELEASE = "SELECT release_template(%s, %s, %s, %s, %s, %s)"

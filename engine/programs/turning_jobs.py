@@ -7,8 +7,8 @@ from ..machines.records import Machine, load_machine
 from ..programs.records import Planned
 from ..programs.verified_run import run_template
 from ..templates.versions import runnable_template
-from .defaults import DEFAULT_LATHE
-from .model import template_module_params
+from ..turning.defaults import DEFAULT_LATHE
+from ..turning.model import template_module_params
 
 TURNING_CLASS_OF_DIALECT = {"iso": "turning_iso", "840d": "turning_840d"}
 

@@ -2,7 +2,7 @@
 workpiece (a seeded gear, or a job's parameters), the job's choices and what its program must
 show. The release gate runs them against a class's draft before it is released; an editor runs
 them after a change. Nothing is stored: the program is made in memory as `engine instantiate`
-would make it (engine.templates.golden_runs), with the verifier and the simulation, so a
+would make it (engine.release.golden_runs), with the verifier and the simulation, so a
 program they refuse fails its test with their reason, and so does a broken expression (the
 message names class, row and column).
 
@@ -12,9 +12,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ..errors import EngineError
-from .expectations import Context, first_difference
+from ..templates.expectations import Context, first_difference
 from .golden_runs import GoldenTest, made_program
-from .versions import runnable_template
+from ..templates.versions import runnable_template
 
 TESTS = ("SELECT id, gear_class, name, gear_id, params, choices, expect, description FROM template_test "
          "WHERE %(all)s OR gear_class = ANY(%(classes)s) ORDER BY gear_class, name")

@@ -13,12 +13,11 @@ from pathlib import Path
 from psycopg.types.json import Jsonb
 
 from ..drawings.drawing import read_drawing
-
 from ..memory import no_cycle_collection
 from ..names import checked
-from .job_params import ProfileOptions, turning_job
-from .model import ISO_PROGRAM_NUMBERS, job_passes, key, present_operations
-from .planning import lathe, plan_turning_job, turning_class
+from ..turning.job_params import ProfileOptions, turning_job
+from ..turning.model import ISO_PROGRAM_NUMBERS, job_passes, key, present_operations
+from .turning_jobs import lathe, plan_turning_job, turning_class
 
 INSERT_TURNING_JOB = """
 INSERT INTO job (id, gear_id, gear_class, machine, hob_id, params, module_params)

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 from ..errors import EngineError
 from .golden import run_golden_tests
-from .versions import draft_template
+from ..templates.versions import draft_template
 
 # Rows that the class's programs stored in the last N days emitted (row_ids) or ran (the trace).
 PROGRAM_ROWS = """
