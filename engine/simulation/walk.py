@@ -36,7 +36,10 @@ DWELL = 4
 MAX_SWIVEL = 80.0        # degrees from horizontal the hob axis may stand (helix angles stay well below)
 
 
-class Walk:
+class BlockSimulation:
+    """One hobbing program followed block by block: the axes, the hob's poses against the solids,
+    the coupling, the cuts, the table speed and the cycle time, each problem into the report."""
+
     def __init__(self, report: Report, gear: Gear, hob: Hob, machine: Machine, units: list[Solid],
                  setup: list[Solid], worm_wheel: bool, shift_end: int):
         self.report, self.gear, self.hob, self.machine = report, gear, hob, machine
@@ -333,8 +336,8 @@ class Walk:
                     return
 
 
-TAKERS = {"header": Walk._header, "comment": Walk._comment, "block": Walk._block,
-          "statement": Walk._statement, "shift": Walk._shift}
+TAKERS = {"header": BlockSimulation._header, "comment": BlockSimulation._comment,
+          "block": BlockSimulation._block, "statement": BlockSimulation._statement, "shift": BlockSimulation._shift}
 
 
 def _rapid_along_z(motion: int, start: dict, end: dict) -> bool:

@@ -37,7 +37,7 @@ def verify_program(lines: list[str], machine: Machine, program_name: str | None)
         dialect = dialect_for(machine)
     except Refused as refusal:
         raise LimitError(f"machine {machine.name}: {refusal}; nothing stored") from None
-    walk = Walk(dialect, machine, len(lines), program_name)
+    walk = ProgramReading(dialect, machine, len(lines), program_name)
     remembered, number = remembered_lines(dialect), 0
     try:
         for number, line in enumerate(lines, start=1):
@@ -49,7 +49,7 @@ def verify_program(lines: list[str], machine: Machine, program_name: str | None)
                            str(refusal)) from None
 
 
-class Walk:
+class ProgramReading:
     """What the lines so far have set: the machine state (engine.verifier.machine_state),
     the working area and the bounds it leaves each axis, the position, the spindle speed, the
     feed, the table's coupling ratio and differential factors, the hob-shift clamp."""
@@ -227,7 +227,7 @@ class Walk:
             self.state.apply(frozenset({Y_POSITION}))
 
 
-TAKERS = {"header": Walk._header, "comment": Walk._comment, "block": Walk._block,
-          "statement": Walk._statement, "shift": Walk._shift}
-STATEMENT_TAKERS = {"EGDEF": Walk._define_coupling, "EGON": Walk._couple, "EGOFS": Walk._uncouple,
-                    "EGDEL": Walk._delete_coupling}
+TAKERS = {"header": ProgramReading._header, "comment": ProgramReading._comment, "block": ProgramReading._block,
+          "statement": ProgramReading._statement, "shift": ProgramReading._shift}
+STATEMENT_TAKERS = {"EGDEF": ProgramReading._define_coupling, "EGON": ProgramReading._couple,
+                    "EGOFS": ProgramReading._uncouple, "EGDEL": ProgramReading._delete_coupling}
