@@ -65,7 +65,7 @@ def bench_database(server_url: str, prefix: str, *, seeded: bool = True):
         url = url_of(server_url, name)
         if seeded:
             from engine.db.migrate import migrate
-            from engine.db.seed import seed
+            from engine.library.seed import seed
 
             with psycopg.connect(url) as conn:
                 migrate(conn)

@@ -33,7 +33,7 @@ from engine.gears.case_base import CUT_KINDS_BY_COUNT, job_cutting_record  # noq
 from engine.gears.hob_matching import choose_hob  # noqa: E402
 from engine.hobbing.choices import Choices  # noqa: E402
 from engine.programs.instantiate import Planner, _check_machine_fits, _check_table_speed  # noqa: E402
-from engine.programs.verifier import verify_program  # noqa: E402
+from engine.verifier import verify_program  # noqa: E402
 
 FIRST_ID = 100_000
 TARGET_RATE = 5_000          # programs/s
@@ -232,7 +232,7 @@ def store(conn, planned: list[tuple]) -> None:
                 gear_id, gear_class, machine, hob_id, params, module_params = item[:6]
                 copy.write_row((job_id, gear_id, gear_class, machine, hob_id, Jsonb(params), Jsonb(module_params),
                                 Jsonb(item[11] or {})))
-        # Every stored program carries its lineage line (engine.programs.lineage), as store_many adds it.
+        # Every stored program carries its lineage line (engine.nc.lineage), as store_many adds it.
         lineage = storage.Lineage(conn, [item[2] for item in planned], [(item[1], item[6]) for item in planned],
                                   job_ids)
         with conn.cursor().copy(storage.COPY_PROGRAM) as copy:

@@ -26,7 +26,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 import ezdxf  # noqa: E402
 
 from _common import add_database_argument, bench_database, median, parse_arguments, verdict  # noqa: E402
-from importers.dxf_drawing import read_drawing  # noqa: E402
+from engine.drawings.drawing import read_drawing  # noqa: E402
 
 TARGET_RATIO = 1.5
 PITCH = 0.2  # mm along Z per profile wave: 2,000 waves stay within the lathe's Z travel
@@ -124,7 +124,7 @@ def measure(path: Path, url: str, runs: int) -> tuple[list, list, list]:
     """Alternated runs of the three; each import stores one job (committed)."""
     import psycopg
 
-    from engine.turning.dxf_import import import_dxf
+    from engine.programs.dxf_import import import_dxf
 
     plain, read, imported = [], [], []
     with psycopg.connect(url) as conn:

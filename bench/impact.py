@@ -60,7 +60,7 @@ def stored_jobs(conn, count: int) -> None:
 
 def run_impact(conn) -> tuple[float, int]:
     from engine.templates import decision_table
-    from engine.templates.impact import impact
+    from engine.release.impact import impact
 
     decision_table._CACHE.clear()   # as a new process: nothing compiled, nothing remembered
     start = time.perf_counter()

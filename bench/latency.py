@@ -63,10 +63,13 @@ def help_command(tree: Path) -> list[str]:
 
 
 def source_tree_of(revision: str, into: Path) -> Path | None:
-    """The engine/ and importers/ folders of `revision`, unpacked into `into`; None when this
-    checkout does not have the commit (a shallow clone, an unpacked archive)."""
-    archived = subprocess.run(["git", "-C", str(REPO), "archive", revision, "engine", "importers"],
-                              capture_output=True)
+    """The engine/ folder of `revision` (and engine/drawings/, which held the DXF reader before issue 25
+    moved it to engine/drawings/), unpacked into `into`; None when this checkout does not have the
+    commit (a shallow clone, an unpacked archive)."""
+    had_importers = subprocess.run(["git", "-C", str(REPO), "cat-file", "-e", f"{revision}:importers"],
+                                   capture_output=True).returncode == 0
+    archived = subprocess.run(["git", "-C", str(REPO), "archive", revision, "engine",
+                               *(["importers"] if had_importers else [])], capture_output=True)
     if archived.returncode != 0:
         return None
     subprocess.run(["tar", "-x", "-C", str(into)], input=archived.stdout, check=True)

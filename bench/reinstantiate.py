@@ -59,7 +59,7 @@ def run_bare(conn) -> tuple[float, int]:
 
 
 def store_bare(conn, programs: list[tuple]) -> int:
-    """COPY the programs as the engine does, each with its lineage line (engine.programs.lineage:
+    """COPY the programs as the engine does, each with its lineage line (engine.nc.lineage:
     the database refuses a program without one); the number of lines stored."""
     from engine.programs.storage import COPY_PROGRAM, PROGRAM_TYPES, Lineage, _next_ids
 

@@ -4,7 +4,7 @@ version, who stored it recorded) against the path before migration 0010 (COPY an
 straight into program, foreign keys only) in the same run, on the same programs. The earlier
 path is rebuilt inside a transaction that is rolled back: the checking triggers switched off and
 the version foreign key dropped. Runs alternate; every run is rolled back. Each program carries
-the lineage line of its id (engine.programs.lineage), made before the clock starts: the timed
+the lineage line of its id (engine.nc.lineage), made before the clock starts: the timed
 part is the database storing it.
 
     python bench/storage.py [--count 10000] [--singles 1000] [--reps 5] [--database-url URL]

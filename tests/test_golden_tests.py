@@ -12,9 +12,9 @@ import pytest
 
 from engine.programs.instantiate import instantiate_gear
 from engine.programs.options import RunMode
-from engine.templates.coverage import coverage
+from engine.release.coverage import coverage
 from engine.templates.expectations import Context, first_difference
-from engine.templates.golden import run_golden_tests
+from engine.release.golden import run_golden_tests
 
 SEEDED_CLASSES = {"spur", "helical", "duplex", "taper", "crowned", "worm_wheel", "turning_iso", "turning_840d"}
 

@@ -247,7 +247,7 @@ def test_hob_ids_differing_only_in_case_stop_migration_0011_with_their_names(emp
 def test_versions_stored_before_0025_keep_the_layout_their_programs_were_written_with(empty_database_url, tmp_path):
     """Before migration 0025 every program of a class was written with the class's one layout:
     the versions already stored record it, so programs of them are shown as they were written."""
-    from engine.library.nc_layout import CRLF, NcLayout, class_layout
+    from engine.nc.layout import CRLF, NcLayout, class_layout
     from engine.templates.rows import TemplateRow
     from engine.templates.store import ensure_class, replace_template
 

@@ -15,7 +15,7 @@ import re
 import psycopg
 import pytest
 
-from engine.templates.release import release
+from engine.release.gate import release
 
 CRLF, LF = "\r\n", "\n"
 

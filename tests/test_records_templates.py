@@ -19,7 +19,7 @@ from engine.cli.app import main
 from engine.library import refactor as refactoring
 from engine.library.nc_import import import_nc
 from engine.programs.instantiate import instantiate_gear
-from engine.programs.lineage import without_lineage
+from engine.nc.lineage import without_lineage
 from engine.programs.options import RunMode
 from engine.programs.records import Planned
 from engine.programs.storage import store_one

@@ -10,12 +10,12 @@ from psycopg import sql
 
 from engine.errors import EngineError
 from engine.programs.instantiate import instantiate_gear
-from engine.programs.lineage import without_lineage
+from engine.nc.lineage import without_lineage
 from engine.programs.options import RunMode
 from engine.templates.analysis import analyse, class_findings
-from engine.templates.golden import run_golden_tests
-from engine.templates.impact import impact
-from engine.templates.release import release
+from engine.release.golden import run_golden_tests
+from engine.release.impact import impact
+from engine.release.gate import release
 from engine.templates.rows import Template, TemplateRow
 from engine.templates.store import load_template
 from engine.templates.versions import released_template, released_version

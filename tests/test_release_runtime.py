@@ -16,7 +16,7 @@ from psycopg.types.json import Jsonb
 
 from engine.errors import EngineError
 from engine.programs.instantiate import instantiate_gear
-from engine.programs.lineage import LINEAGE_ROW_ID
+from engine.nc.lineage import LINEAGE_ROW_ID
 from engine.programs.options import RunMode
 from engine.simulation import simulate_stored_program
 from lineage_text import id_masked

@@ -20,12 +20,14 @@ from __future__ import annotations
 import ast
 from dataclasses import dataclass
 
+from .. import turning  # noqa: F401  (importing it registers the turning names model)
+from ..hobbing import models as hobbing_models  # noqa: F401  (importing it registers the hobbing models)
 from ..errors import EngineError
 from ..gears.models import model_for_class
-from ..gears.records import Machine, load_machine
-from ..library.nc_layout import NcLayout, class_layout
+from ..machines.records import Machine, load_machine
+from ..nc.layout import NcLayout, class_layout
 from ..library.nc_params import bindings, values
-from ..library.nc_tokens import NUMBER, tokenise
+from ..nc.tokens import NUMBER, tokenise
 from ..names import checked
 from ..templates.decision_table import compiled_template
 from ..templates.rows import Template
@@ -33,12 +35,12 @@ from ..templates.versions import runnable_template
 from ..turning.names import TurningModel
 from .batches import dry_program, read_only, refuse_out_in_dry_run
 from .instantiate import store_planned
-from .lineage import refuse_lineage_shaped
+from ..nc.lineage import refuse_lineage_shaped
 from .options import NO_FILE, NORMAL_RUN, Output, RunMode
 from .outputs import files_after_commit
 from .records import Planned, Program
 from .verified_run import run_template
-from .verifier.grammar import DIALECTS
+from ..verifier.grammar import DIALECTS
 
 PROGRAM_NAME = "program_name"   # the job's program name: given or not, whatever the class was imported with
 IMPORT_PARAMS = "SELECT import_params FROM gear_class WHERE name = %s"

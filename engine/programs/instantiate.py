@@ -9,14 +9,17 @@ from __future__ import annotations
 
 from dataclasses import replace
 
+from .. import turning  # noqa: F401  (importing it registers the turning names model)
+from ..hobbing import models as hobbing_models  # noqa: F401  (importing it registers the hobbing models)
 from ..errors import EngineError
 from ..gears.case_base import CUT_KINDS_BY_COUNT, CaseBase, job_cutting_record
 from ..gears.hob_matching import choose_hob
 from ..gears.models import model_for_class
 from ..gears.process_notes import hunting_tooth_notes
-from ..gears.records import Gear, Machine, hobbing_machine, load_gear, load_gears, load_hobs
+from ..gears.records import Gear, load_gear, load_gears, load_hobs
+from ..machines.records import Machine, hobbing_machine
 from ..hobbing.choices import Choices
-from ..library.nc_layout import NcLayout, class_layout
+from ..nc.layout import NcLayout, class_layout
 from ..memory import no_cycle_collection
 from ..templates.rows import Template
 from ..templates.versions import runnable_template
@@ -26,7 +29,7 @@ from .batches import Bad, batch_stage, checked, dry_batch, dry_program, good_one
 from .options import NO_FILE, NORMAL_RUN, Output, RunMode
 from .outputs import ProgramFiles, file_layouts, files_after_commit
 from .verified_run import Workpiece, run_template
-from .verifier import LimitError, check_table_speed
+from ..verifier import LimitError, check_table_speed
 from .records import Planned, Program
 from .storage import Batch, store_many, store_one
 from .workers import PLANNING, plan_in_workers

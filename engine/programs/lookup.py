@@ -1,8 +1,8 @@
 """A stored program found from what an operator has in hand (`engine programs show`): its id, or
-the hash on its lineage line (engine.programs.lineage) read off a file on the control, the INPUT
+the hash on its lineage line (engine.nc.lineage) read off a file on the control, the INPUT
 hash of the job's parameters or the TEMPLATE hash of the version it was made from; and the
 programs stored, filtered (`engine programs list`). A program is shown with the layout (line
-ending, final newline: engine.library.nc_layout) its template version records, the one its file was
+ending, final newline: engine.nc.layout) its template version records, the one its file was
 written with: a later change of the class's layout is a later version and leaves it as it was."""
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ from datetime import date, datetime
 
 from ..db.listing import day_range, records, require_class
 from ..errors import EngineError
-from ..library.nc_layout import ENDING_NAMES, NcLayout, nc_text
+from ..nc.layout import ENDING_NAMES, NcLayout, nc_text
 
 MIN_HASH_DIGITS = 8   # what the lineage line shows
 HASH_PREFIX = re.compile(r"[0-9a-f]{8,64}")

@@ -37,7 +37,7 @@ import psycopg
 from psycopg.pq import TransactionStatus
 
 from ..errors import EngineError
-from ..library.nc_layout import NcLayout, nc_text
+from ..nc.layout import NcLayout, nc_text
 from ..names import checked
 from .options import Output
 

@@ -10,13 +10,16 @@ from __future__ import annotations
 import re
 from dataclasses import replace
 
+from .. import turning  # noqa: F401  (importing it registers the turning names model)
+from ..hobbing import models as hobbing_models  # noqa: F401  (importing it registers the hobbing models)
 from ..errors import EngineError
 from ..gears.models import model_for_class
 from ..gears.process_notes import stored_feed_notes
-from ..gears.records import Hob, Machine, load_gear, load_hobs, load_machine
+from ..gears.records import Hob, load_gear, load_hobs
+from ..machines.records import Machine, load_machine
 from ..hobbing.cylindrical import program_name
 from ..hobbing.machine_job import with_cycle_time
-from ..library.nc_layout import NcLayout, class_layout
+from ..nc.layout import NcLayout, class_layout
 from ..memory import no_cycle_collection
 from ..templates.rows import Template
 from ..templates.versions import runnable_template
@@ -57,7 +60,7 @@ class Remaker:
         if not self.modelled(gear_class):   # a job of an imported class (instantiate --class): its rows alone
             return class_job(self.template(gear_class), machine, params, module_params)
         if machine.kind == "lathe":   # a turning job: its passes are computed from its parameters
-            from ..turning.planning import plan_turning_job   # the tool paths: only for turning jobs
+            from .turning_jobs import plan_turning_job   # the tool paths: only for turning jobs
 
             return plan_turning_job(self.conn, gear_class, machine, params, module_params, draft=self.draft)
         template = self.template(gear_class)

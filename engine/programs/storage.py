@@ -19,7 +19,7 @@ from psycopg.types.json import Jsonb
 
 from ..errors import EngineError
 from ..names import checked, line_breaking, shown
-from .lineage import lineage_line, lineage_words, refuse_lineage_shaped, with_lineage
+from ..nc.lineage import lineage_line, lineage_words, refuse_lineage_shaped, with_lineage
 from .records import Encoded, Planned, Program
 
 # What a lineage line needs from the database: the hash of each job's stored parameters, each

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 from datetime import datetime
 
 from ..errors import EngineError
-from ..library.nc_layout import NcLayout, class_layout, store_layout
+from ..nc.layout import NcLayout, class_layout, store_layout
 from .rows import CSV_COLUMNS, TemplateRow
 from .store import replace_template
 
