@@ -11,6 +11,7 @@ import psycopg
 import pytest
 
 from engine.programs.instantiate import instantiate_gear
+from engine.programs.options import RunMode
 from engine.release.coverage import coverage
 from engine.templates.expectations import Context, first_difference
 from engine.release.golden import run_golden_tests
@@ -116,7 +117,7 @@ def test_coverage_lists_a_new_draft_row_until_a_program_emits_it(conn):
     conn.execute("INSERT INTO template_view (gear_class, id, t, n, o, p_emit) "
                  "VALUES ('spur', 3190, 'main', 1, '\"; CHECKED BY QA\"', 'gear_id == 46')")
     assert 3190 in {row.row_id for row in coverage(conn, classes=["spur"])}
-    program = instantiate_gear(conn, 46, draft=True)
+    program = instantiate_gear(conn, 46, mode=RunMode(draft=True))
     assert 3190 in program.row_ids
     assert 3190 not in {row.row_id for row in coverage(conn, classes=["spur"])}
 

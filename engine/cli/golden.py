@@ -38,7 +38,7 @@ def test_command(ctx, gear_class, released, show_coverage, days, as_json):
 
 
 def _report_tests(conn, classes, gear_class, released, as_json) -> None:
-    from ..templates.golden import run_golden_tests
+    from ..release.golden import run_golden_tests
 
     results = run_golden_tests(conn, classes, draft=not released)
     failed = [result for result in results if not result.passed]
@@ -65,7 +65,7 @@ def _result_line(result) -> str:
 
 
 def _report_coverage(conn, classes, days, as_json) -> None:
-    from ..templates.coverage import coverage
+    from ..release.coverage import coverage
 
     rows = coverage(conn, days, classes)
     if as_json:

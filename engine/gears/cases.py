@@ -24,7 +24,8 @@ from .case_base import CASE_COLUMNS, CUT_KINDS, CaseBase, KindProposal, feeds_pe
 from .cutting_data import CuttingData
 from .hob_matching import choose_hob
 from .models import model_for_class
-from .records import Gear, Hob, Machine, hobbing_machine, load_gear, load_hobs
+from .records import Gear, Hob, load_gear, load_hobs
+from ..machines.records import Machine, hobbing_machine
 
 FEATURE_COLUMNS = ("module", "teeth", "material", "hardness", "quality_grade", "hob_material",
                    "hob_coating", "hob_starts", "hob_tip_diameter")

@@ -18,7 +18,7 @@ programs go.
     line_endings = "lf"              # this machine's files: LF, whatever the file-wide setting
 
 A program file is written with its class's layout (LF and a final newline, or what the file an
-imported class came from had: engine.library.nc_layout). A line ending set here overrides only the
+imported class came from had: engine.nc.layout). A line ending set here overrides only the
 line ending, for the files of the machine it is set for (its table's, else the file-wide one); the
 final newline stays the class's. Unset, the class decides: a CRLF program imported from a file
 comes back CRLF.
@@ -31,8 +31,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..errors import EngineError
-from ..gears.records import DEFAULT_HOBBING_MACHINE
-from ..library.nc_layout import ENDING_NAMES
+from ..machines.records import DEFAULT_HOBBING_MACHINE
+from ..nc.layout import ENDING_NAMES
 
 try:
     import tomllib
@@ -50,7 +50,7 @@ class Config:
     path: Path | None = None
     commands: dict = field(default_factory=dict)   # everything that is not a setting: option defaults
     machine: str | None = None
-    line_endings: str | None = None   # None: each class's own (engine.library.nc_layout)
+    line_endings: str | None = None   # None: each class's own (engine.nc.layout)
     machines: dict = field(default_factory=dict)   # machine name -> {out, line_endings}
     text: str = ""
 

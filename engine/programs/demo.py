@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from ..db.embedded import embedded_data_dir, embedded_url
-from ..db.seed import SeedReport
+from ..library.seed import SeedReport
 from ..paths import SAMPLE_DRAWING
 
 DEMO_DATABASE = "engine_demo"
@@ -27,7 +27,7 @@ SAMPLE_STOCK_DIAMETER = 44.0
 @dataclass(frozen=True)
 class SampleJob:
     drawing: Path           # the sample drawing, to copy as the start of one's own
-    job: object             # engine.turning.dxf_import's ImportReport
+    job: object             # engine.programs.dxf_import's ImportReport
     program: object         # engine.programs.instantiate's Program
 
 
@@ -45,7 +45,7 @@ def run_demo(gear_id: int = 42, turning: bool = False) -> DemoResult:
     gear, or with `turning` the sample drawing's turning job."""
     from ..db.connection import connect
     from ..db.migrate import migrate
-    from ..db.seed import seed
+    from ..library.seed import seed
     from .instantiate import instantiate_gear
 
     with connect(embedded_url(DEMO_DATABASE)) as conn:
@@ -59,7 +59,7 @@ def run_demo(gear_id: int = 42, turning: bool = False) -> DemoResult:
 def sample_turning_job(conn, drawing: Path = SAMPLE_DRAWING) -> SampleJob:
     """Import the sample drawing as a turning job on the default lathe (from the Ø44 blank) and
     store its program, as `engine import-dxf` and `engine instantiate --job` do."""
-    from ..turning.dxf_import import import_dxf
+    from .dxf_import import import_dxf
     from ..turning.job_params import ProfileOptions
     from .remake import instantiate_job
 

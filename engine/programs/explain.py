@@ -10,7 +10,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ..errors import EngineError
-from .lineage import LINEAGE_ROW_ID
+from ..nc.lineage import LINEAGE_ROW_ID
 
 MAX_LISTED_LINES = 1   # lines of a row quoted in its sentence (a tool path prints hundreds)
 

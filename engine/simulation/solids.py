@@ -13,7 +13,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..gears.records import Gear, Hob, Machine
+from ..gears.records import Gear, Hob
+from ..machines.records import Machine
 
 HEIGHT_STEP = 0.5       # mm between the heights a solid is followed at (its faces included; the
                         # clearance is convex in height, so between two it errs by < step²/(8·r0))

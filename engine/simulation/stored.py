@@ -3,7 +3,8 @@ its lines, the job's gear (with its units), hob and machine as the database hold
 from __future__ import annotations
 
 from ..errors import EngineError
-from ..gears.records import Hob, load_gear, load_hobs, load_machine
+from ..gears.records import Hob, load_gear, load_hobs
+from ..machines.records import load_machine
 from .report import Report
 from .run import simulate_program
 

@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 from functools import partial
 
 from ..errors import EngineError
-from ..turning.nc_path import NcLines
+from .nc_path import NcLines
 from .budget import Budget, compiling, pay_time, seconds_for, spending
 from .evaluator import EvaluationError, Evaluator, base_symbols
 from .expressions import Compiled, ExpressionError, compile_expression, compile_statements

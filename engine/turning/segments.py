@@ -10,9 +10,8 @@ from __future__ import annotations
 
 import math
 
-from importers.dxf_geometry import Arc, Line, Segment
-from importers.dxf_profile import END_MATCH_TOLERANCE_MM
-
+from ..drawings.geometry import Arc, Line, Segment
+from ..drawings.profile import END_MATCH_TOLERANCE_MM
 from ..errors import EngineError
 
 DIGITS = 6             # mm to 1 nm: far below any drawing's accuracy, short in SQL
