@@ -18,12 +18,11 @@ import pytest
 from psycopg.conninfo import conninfo_to_dict, make_conninfo
 from psycopg.pq import TransactionStatus
 
-from helpers.database_pool import DatabasePool, create_database
-
-pytest_plugins = ["helpers.turning_jobs"]
-
 import engine.hobbing.models  # noqa: F401  (the models register with engine.gears.models, as the commands
 import engine.turning  # noqa: F401   that use a model import these packages first)
+from helpers.database_pool import DatabasePool, create_database
+
+pytest_plugins = ["helpers.turning_jobs"]   # fixtures shared by several test modules
 
 # No config file of the user running the suite (README, "Configuration"): the tests of the
 # config file name their own with ENGINE_CONFIG. No shop database either: the engine reads
