@@ -73,7 +73,7 @@ def bare_program(template, evaluator, params: dict, module_params: dict) -> tupl
             scope = {**params, **module_params.get(f"{module[0]}:{module[1]}", {}), **intermediates,
                      **template.symbols, "template_version": template.template.version}
 
-        def value(expression):
+        def value(expression, scope=scope):   # this row's scope, bound now (called within the row)
             return evaluator.evaluate(expression.tree, expression.text, scope)
         if row.s:
             if row.p_calc is not None and not value(row.p_calc):

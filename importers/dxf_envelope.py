@@ -80,7 +80,7 @@ def arc_parts(arc: Arc) -> list[tuple[float, float, Arc]]:
     if radius > abs(cr):
         crossing = math.asin(-cr / radius)
         cuts += [crossing, math.pi - crossing]
-    inner = sorted(((cut - begin) % (2 * math.pi) for cut in cuts))
+    inner = sorted((cut - begin) % (2 * math.pi) for cut in cuts)
     offsets = [0.0] + [offset for offset in inner if 1e-12 < offset < turn - 1e-12] + [turn]
     return [(begin + a, begin + b, ccw) for a, b in zip(offsets, offsets[1:])]
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 import contextlib
 import math
 from dataclasses import dataclass
-from typing import Callable, Iterator, Union
+from typing import Callable, Iterator
 
 from .dxf_read import DxfError, one_line
 
@@ -38,7 +38,7 @@ class Line:
     end: Point
     handle: str = ""
 
-    def reversed(self) -> "Line":
+    def reversed(self) -> Line:
         return Line(self.end, self.start, self.handle)
 
 
@@ -51,7 +51,7 @@ class Arc:
     ccw: bool
     handle: str = ""
 
-    def reversed(self) -> "Arc":
+    def reversed(self) -> Arc:
         return Arc(self.end, self.start, self.centre, not self.ccw, self.handle)
 
     @property
@@ -59,7 +59,7 @@ class Arc:
         return math.dist(self.start, self.centre)
 
 
-Segment = Union[Line, Arc]
+Segment = Line | Arc
 
 
 @dataclass(frozen=True)

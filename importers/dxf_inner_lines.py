@@ -230,7 +230,9 @@ def check_halves_agree(framed: list[Segment], outline: list[Segment], where: str
 
 
 def mirror(segment: Segment) -> Segment:
-    flip = (lambda p: (p[0], -p[1]))
+    def flip(p):
+        return p[0], -p[1]
+
     if isinstance(segment, Line):
         return Line(flip(segment.start), flip(segment.end), segment.handle)
     return Arc(flip(segment.start), flip(segment.end), flip(segment.centre), not segment.ccw, segment.handle)

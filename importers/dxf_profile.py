@@ -129,7 +129,7 @@ class Chain:
     def bounds(self) -> tuple[float, float, float, float]:
         return merged_bounds(self.segments)
 
-    def reversed(self) -> "Chain":
+    def reversed(self) -> Chain:
         return Chain([s.reversed() for s in reversed(self.segments)], self.closed)
 
 

@@ -60,7 +60,7 @@ class Marks:
     hatches: list[list[tuple[float, float]]] = field(default_factory=list)
     hidden: list[Segment] = field(default_factory=list)
 
-    def near(self, view: list[Segment]) -> "Marks":
+    def near(self, view: list[Segment]) -> Marks:
         """The hatching and hidden lines within the view's extents."""
         box = merged_bounds(view)
         hatches = [p for p in self.hatches if boxes_touch(box, (min(x for x, _ in p), max(x for x, _ in p),

@@ -173,12 +173,12 @@ def coupling_problems(nc: Nc, case: Case) -> list[str]:
     if not egons:
         return ["no EGON"]
     lead = "Y" if case.tangential else "Z" if gear.beta and gear.gear_class != "worm_wheel" else None
-    for index, args in nc.calls("EGDEF"):
+    for _, args in nc.calls("EGDEF"):
         wanted = ("C", "B", "1") + ((lead, "1") if lead else ())
         if args != wanted:
             problems.append(f"EGDEF{args} expected EGDEF{wanted}")
     teeth = {u.z2 for u in gear.units}
-    for index, args in egons:
+    for _, args in egons:
         problems += _egon_problems(args, case, lead, teeth)
     coupled = {args[4] for _, args in egons if len(args) > 4}
     problems += [f"no EGON with denominator z2 = {z2} for unit z{z2}" for z2 in sorted(teeth) if str(z2) not in coupled]

@@ -120,7 +120,7 @@ def test_a_bound_parameter_whose_value_is_no_number_is_refused(engine, tmp_path,
     be bound and binds nothing, F400 stays literal, no warning, exit 0; the user believes the
     feed is a parameter of the class."""
     params = tmp_path / "p.json"
-    params.write_text('{"feed": {"value": %s, "addresses": ["F"]}}' % value)
+    params.write_text(f'{{"feed": {{"value": {value}, "addresses": ["F"]}}}}')
     result = engine("import-nc", DEMO, "--class", "nc_nonumber", "--params", params)
     assert one_line_error(result) and "feed" in result.stderr, result.output
 
@@ -241,7 +241,7 @@ def test_an_nc_file_with_a_line_break_inside_a_line_is_refused_at_import(engine,
     the import stores and calls a draft can never give a program. It should be refused naming
     the line, as a control character is, with nothing stored."""
     nc = tmp_path / "broken.nc"
-    nc.write_bytes(f"G1 X10{breaking}G0 X0\nM30\n".encode("utf-8"))
+    nc.write_bytes(f"G1 X10{breaking}G0 X0\nM30\n".encode())
     result = engine("import-nc", nc, "--class", "nc_broken")
     assert one_line_error(result) and "line 1" in result.stderr, result.output
     with psycopg.connect(engine.url) as conn:

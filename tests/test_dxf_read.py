@@ -157,7 +157,7 @@ def test_the_list_covers_every_real_drawing():
 
 
 def test_a_damaged_file_is_read_tolerantly_and_the_repair_reported():
-    with pytest.raises(Exception):
+    with pytest.raises(ezdxf.DXFStructureError):
         ezdxf.readfile(DXF / "ezdxf_AC1003_LINE_Example.dxf")
     loaded = load_drawing_file(DXF / "ezdxf_AC1003_LINE_Example.dxf")
     assert len(loaded.doc.modelspace()) == 22  # 13 LINE + 9 ARC on layer 1, as ezdxf.recover counts

@@ -263,7 +263,7 @@ def test_a_runner_confirms_a_job_the_engine_made(conn, program):
 
 
 def set_rough(field, value):
-    return ("UPDATE job SET cutting = jsonb_set(cutting, '{rough,%s}', '%s') WHERE id = %%(job)s" % (field, value))
+    return f"UPDATE job SET cutting = jsonb_set(cutting, '{{rough,{field}}}', '{value}') WHERE id = %(job)s"
 
 
 REFUSED_CASES = [   # (why, statements run as the owner first, words of the message)

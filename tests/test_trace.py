@@ -72,7 +72,7 @@ def values_read(entry, inputs, computed) -> dict:
 
 def check_origins(entry, inputs, params, module_params, computed):
     """Each value read is the job's, its module's, or the value a named row computed."""
-    for column, reads in entry.get("read", {}).items():
+    for reads in entry.get("read", {}).values():
         for name, origin in reads.items():
             value = None if origin.startswith("row ") else inputs[origin][name]
             if origin == "job":
@@ -158,7 +158,7 @@ def test_engine_explain_says_why_a_line_is_missing(run):
     assert explained.exit_code == 0
     assert explained.stdout == "1800 not emitted: p_emit coolant = False (job)\n"
     whole = run("explain", "--program", program_id).stdout.splitlines()
-    assert 'EGON(C,"FINE",B,-1,19) emitted' in whole[next(i for i, l in enumerate(whole) if l.startswith("1500 "))]
+    assert 'EGON(C,"FINE",B,-1,19) emitted' in whole[next(i for i, line in enumerate(whole) if line.startswith("1500 "))]
     assert "z2 = 19 (job)" in next(line for line in whole if line.startswith("1500 "))
 
 

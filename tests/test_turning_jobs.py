@@ -83,7 +83,7 @@ def test_emco_finish_pass_follows_the_drawn_profile(conn, name):
     finish = operation_lines(lines, 2)
     cuts = [(g, start, end) for g, start, end in motions(finish) if g in (1, 2, 3)]
     drawn = drawn_polylines(DXF / name)
-    for _, start, end in cuts:
+    for _, _, end in cuts:
         assert distance_to_drawn(end, drawn) <= 0.01, end
     vertices = {point for line in drawn for point in (line[0], line[-1])}
     reached = [end for _, _, end in cuts]

@@ -51,7 +51,7 @@ def _suggestion_text(s) -> str:
              f"{'' if gear.hardness is None else f'{gear.hardness:g} HB '}grade {gear.quality_grade or '?'}",
              f"hob {s.hob.id}: {s.hob_reason}",
              f"machine {s.machine.name} (hob spindle max {s.machine.spindle_max:g} r/min)"]
-    for cut, proposal in s.proposals.items():
+    for cut in s.proposals:
         cases = s.cases[s.cases.cut == cut]
         lines += ["", f"{cut} cases (nearest {len(cases)}):" if len(cases) else f"{cut}: no cases in the history"]
         if len(cases):

@@ -68,11 +68,11 @@ class CaseBase:
                               if record["cut"] == cut] for cut in CUT_KINDS}
 
     @classmethod
-    def load(cls, conn) -> "CaseBase":
+    def load(cls, conn) -> CaseBase:
         rows = conn.execute(LOAD_CASES).fetchall()
         return cls([{name: _plain(value) for name, value in zip(CASE_COLUMNS, row)} for row in rows])
 
-    def nearest(self, query: dict, top: int) -> list[tuple[float, "_Case"]]:
+    def nearest(self, query: dict, top: int) -> list[tuple[float, _Case]]:
         """(distance, case) of the `top` nearest cases of the query's cut kind, nearest first
         (ties by case id)."""
         wanted = _features(query)
@@ -144,7 +144,7 @@ class _Case:
     radial_per_rev: float
 
     @classmethod
-    def of(cls, position: int, r: dict) -> "_Case":
+    def of(cls, position: int, r: dict) -> _Case:
         table_speed = r["hob_speed"] * r["hob_starts"] / r["teeth"]
         return cls(position, r["id"], _features(r), math.pi * r["hob_tip_diameter"] * r["hob_speed"] / 1000,
                    r["axial_feed"] / table_speed, r["radial_feed"] / table_speed)

@@ -52,7 +52,7 @@ class Found:
     bound: Counter = field(default_factory=Counter)
     left_alone: list = field(default_factory=list)
 
-    def add(self, later: "Found") -> None:
+    def add(self, later: Found) -> None:
         """Take in what the lines after these gave."""
         self.parameterised += later.parameterised
         for value, names in later.ambiguous.items():

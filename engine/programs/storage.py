@@ -84,7 +84,7 @@ class Lineage:
         return with_lineage(list(lines), list(row_ids), lineage_line(words, self.dialects.get(machine, "")))
 
 
-def store_many(conn, encoded: list[Encoded], out=None, files=None) -> "Batch":
+def store_many(conn, encoded: list[Encoded], out=None, files=None) -> Batch:
     """All jobs and programs in one transaction, through COPY (the batch path); `out` is where
     the caller writes their files."""
     for item in encoded:
@@ -103,7 +103,7 @@ def store_many(conn, encoded: list[Encoded], out=None, files=None) -> "Batch":
                  tuple(f"{item.name}: {note}" for item in encoded for note in item.notes))
 
 
-def store_programs(conn, encoded: list[Encoded], job_ids: list[int], out=None, files=None) -> "Batch":
+def store_programs(conn, encoded: list[Encoded], job_ids: list[int], out=None, files=None) -> Batch:
     """Programs of stored jobs (made again), in one transaction through COPY."""
     for item in encoded:
         refuse_unsafe(item.name, item.lines)

@@ -23,7 +23,7 @@ class VersionEntry:
     rows: int
     changes: tuple[tuple[int, str], ...]   # (row id, INSERT/UPDATE/DELETE) from template_audit
     state: str = ""                        # released, retired, draft, superseded (template_version_state)
-    release: "ReleaseEntry | None" = None  # the release of this version, if it was released
+    release: ReleaseEntry | None = None  # the release of this version, if it was released
     layout: NcLayout = NcLayout()          # the line ending and final newline its programs are written with
 
 

@@ -139,7 +139,7 @@ def _layout_changes(conn, pairs: dict[str, tuple[Template, Template, int]]) -> d
     return changes
 
 
-def _compare(report: Impact, made: "_Made", job) -> None:
+def _compare(report: Impact, made: _Made, job) -> None:
     job_id, gear_class, machine, params_text, modules_text, from_released, lines, row_ids = job
     report.jobs += 1
     if gear_class in report.layouts and lines is not None:

@@ -57,11 +57,11 @@ def main() -> int:
     try:
         for gear_id, choice_set in hobbing_cases():
             write(hobbing_file(gear_id, choice_set),
-                  rolled_back(url, lambda conn: hobbing_text(conn, gear_id, choice_set)))
+                  rolled_back(url, lambda conn, gear_id=gear_id, choice_set=choice_set: hobbing_text(conn, gear_id, choice_set)))
         with tempfile.TemporaryDirectory() as folder:
             for case, lathe in turning_cases():
                 write(turning_file(case, lathe),
-                      rolled_back(url, lambda conn: turning_text(conn, Path(folder), case, lathe)))
+                      rolled_back(url, lambda conn, case=case, lathe=lathe: turning_text(conn, Path(folder), case, lathe)))
     finally:
         with psycopg.connect(args.database_url, autocommit=True) as admin:
             admin.execute(sql.SQL("DROP DATABASE IF EXISTS {} WITH (FORCE)").format(sql.Identifier(name)))

@@ -58,7 +58,7 @@ class Needs:
         self.required = frozenset(need.fact for need in needs if need.present)
         self.forbidden = frozenset(need.fact for need in needs if not need.present)
 
-    def __add__(self, other: "Needs") -> "Needs":
+    def __add__(self, other: Needs) -> Needs:
         return Needs(*self.needs, *other.needs)
 
     def check(self, facts: set) -> None:
