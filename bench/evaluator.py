@@ -87,7 +87,8 @@ def main(argv=None) -> int:
     add_database_argument(parser)
     parser.add_argument("--count", type=int, default=2000, help="gears whose jobs are evaluated (default 2000)")
     parser.add_argument("--reps", type=int, default=3, help="alternated runs of each (default 3)")
-    parser.add_argument("--against", default=AGAINST, metavar="REV", help=f"the compiled evaluator's commit ({AGAINST})")
+    parser.add_argument("--against", default=AGAINST, metavar="REV",
+                        help=f"the compiled evaluator's commit ({AGAINST})")
     args = parser.parse_args(argv)
     with bench_database(args.database_url, "bench_evaluator") as url, tempfile.TemporaryDirectory() as folder:
         data = Path(folder) / "jobs.pickle"

@@ -133,7 +133,9 @@ def left_out_notes(layer: str, content: LayerContent, chains: list, side_view: b
     if side_view:
         return [f"layer {layer}: {len(content.points)} POINT(s) left out (a side view has no tool-change "
                 "point)"] if content.points else []
-    return [f"layer {layer}: {len(chains) - 1} other chain(s) are not part of the profile, left out"] if len(chains) > 1 else []
+    if len(chains) <= 1:
+        return []
+    return [f"layer {layer}: {len(chains) - 1} other chain(s) are not part of the profile, left out"]
 
 
 def scaled_marks(collected: Collected, scale: float) -> Marks:
@@ -215,7 +217,8 @@ def take(entity, layer: str, context: Context, collected: Collected) -> None:
     if kind == "HATCH":
         collected.hatches.extend(hatch_polygons(entity))
     # Operation layers hold tool paths in whatever linetype: roles apply to the others.
-    role = line_role(entity, layer, collected.linetypes) if kind in HANDLERS and operation_number(layer) is None else None
+    role = (line_role(entity, layer, collected.linetypes)
+            if kind in HANDLERS and operation_number(layer) is None else None)
     if role == CENTRE:
         check_finite(entity, context)
         segments = segments_of(entity, context)

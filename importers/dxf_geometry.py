@@ -90,7 +90,8 @@ def segments_of(entity, context: Context) -> list[Segment]:
     with named_on_failure(entity, context.handle):
         segments = list(handler(entity, context))
     for segment in segments:
-        check_reach(entity, context, segment.start, segment.end, *([segment.centre] if isinstance(segment, Arc) else []))
+        check_reach(entity, context, segment.start, segment.end,
+                    *([segment.centre] if isinstance(segment, Arc) else []))
     return segments
 
 

@@ -92,7 +92,8 @@ def points_of(segment: Segment, count: int = 8) -> list[tuple[float, float]]:
     (cz, cr), radius, turn = segment.centre, segment.radius, sweep(segment)
     begin = math.atan2(segment.start[1] - cr, segment.start[0] - cz)
     sense = 1.0 if segment.ccw else -1.0
-    return [(cz + radius * math.cos(begin + sense * turn * k / count), cr + radius * math.sin(begin + sense * turn * k / count))
+    return [(cz + radius * math.cos(begin + sense * turn * k / count),
+             cr + radius * math.sin(begin + sense * turn * k / count))
             for k in range(count + 1)]
 
 

@@ -110,7 +110,8 @@ def alongside(axis: Axis, line: Line, view: list[Segment]) -> bool:
     along, across = ((y_min, y_max), (x_min, x_max)) if axis.vertical else ((x_min, x_max), (y_min, y_max))
     ends = sorted((line.start[1], line.end[1]) if axis.vertical else (line.start[0], line.end[0]))
     return (ends[0] - ALONG_SLACK_MM <= along[0] and along[1] <= ends[1] + ALONG_SLACK_MM
-            and (across[0] >= axis.offset - END_MATCH_TOLERANCE_MM or across[1] <= axis.offset + END_MATCH_TOLERANCE_MM))
+            and (across[0] >= axis.offset - END_MATCH_TOLERANCE_MM
+                 or across[1] <= axis.offset + END_MATCH_TOLERANCE_MM))
 
 
 def centre_axis(line: Line) -> Axis | None:

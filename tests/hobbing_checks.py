@@ -278,7 +278,8 @@ def _taper_depth_problems(nc: Nc, last: Cut, case: Case) -> list[str]:
 
 def _root_problems(nc: Nc, all_cuts: list[Cut], case: Case) -> list[str]:
     pairs = [(move, cut.unit) for cut in all_cuts for move in passes(cut)]
-    depths = _deepest([(move, root_solid(case.gear, unit)) for move, unit in pairs], case, shift_limits(nc, case.machine))
+    depths = _deepest([(move, root_solid(case.gear, unit)) for move, unit in pairs], case,
+                      shift_limits(nc, case.machine))
     return [f"pass block {move.block}: the hob (3-D) reaches {depth:.3f} mm below unit z{unit.z2}'s root cone"
             for (move, unit), depth in zip(pairs, depths) if depth > DEPTH]
 

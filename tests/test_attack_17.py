@@ -97,7 +97,8 @@ def test_a_plain_parameter_does_not_turn_the_contour_a_g71_calls_into_a_quantity
     lines = instantiated(conn, "nc_q", {"depth": 200, "feed": 400})
     called = {match for line in lines for match in re.findall(r"^\s*G7[01][.\d]*\s+Q(\d+)", line)}
     defined = {match for line in lines for match in re.findall(r"^\s*O(\d+)\s+SUB", line)}
-    assert called and called <= defined, f"the G70/G71 lines call O{sorted(called)}, the program defines O{sorted(defined)}"
+    assert called and called <= defined, \
+        f"the G70/G71 lines call O{sorted(called)}, the program defines O{sorted(defined)}"
 
 
 def test_a_plain_parameter_does_not_rebind_the_tool_edge_or_the_spindle_number(conn):

@@ -118,7 +118,8 @@ def test_a_side_view_is_turned_as_drawn_or_refused(run, tmp_path, name):
         return
     assert made.exit_code == 0, made.output
     report = json.loads(made.stdout)
-    assert name not in BORED, f"a part with a Ø{2 * BORE_RADIUS:g} bore became job {report['job_id']}: {report['notes']}"
+    assert name not in BORED, \
+        f"a part with a Ø{2 * BORE_RADIUS:g} bore became job {report['job_id']}: {report['notes']}"
     assert finish_diameters(run, json.loads(made.stdout)["job_id"]) == DRAWN_DIAMETERS
 
 
@@ -254,7 +255,8 @@ def test_a_drawing_whose_header_says_imperial_is_not_turned_in_millimetres(run, 
     inch = 25.4
 
     def draw(msp):
-        msp.add_lwpolyline([(z / inch, r / inch) for z, r in SHAFT] + [(z / inch, -r / inch) for z, r in reversed(SHAFT)],
+        msp.add_lwpolyline([(z / inch, r / inch) for z, r in SHAFT] + [(z / inch, -r / inch)
+                                                                       for z, r in reversed(SHAFT)],
                            close=True)
     doc = ezdxf.new("R2010")
     doc.header["$INSUNITS"] = 0

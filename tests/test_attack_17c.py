@@ -97,7 +97,8 @@ def g0_moves(lines: list[str]):
         words = dict(re.findall(r"\b([XZ])(-?\d+(?:\.\d+)?)", line))
         if not words:
             continue
-        new_z, new_x = float(words.get("Z", z if z is not None else "nan")), float(words.get("X", x if x is not None else "nan"))
+        new_z = float(words.get("Z", z if z is not None else "nan"))
+        new_x = float(words.get("X", x if x is not None else "nan"))
         if z is not None and x is not None and re.match(r"\s*(N\d+\s+)?G0?0\b", line):
             found.append(((z, x / 2), (new_z, new_x / 2)))
         z, x = new_z, new_x
@@ -121,6 +122,7 @@ def test_no_rapid_runs_through_the_facing_allowance_the_drawing_shows(run, tmp_p
     program = run("instantiate", "--job", json.loads(made.stdout)["job_id"], "--dry-run")
     assert program.exit_code == 0, program.output
     through = [(start, end) for start, end in g0_moves(program.stdout.splitlines())
-               if any(in_front_stock((start[0] + (end[0] - start[0]) * k / 100, start[1] + (end[1] - start[1]) * k / 100))
+               if any(in_front_stock((start[0] + (end[0] - start[0]) * k / 100,
+                                      start[1] + (end[1] - start[1]) * k / 100))
                       for k in range(101))]
     assert through == []

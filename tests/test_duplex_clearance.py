@@ -132,7 +132,8 @@ def check_program_cuts(gear: Gear, hob: Hob, params: dict, module_params: dict) 
             low, high = sorted((cut["z_from"], cut["z_to"]))
             assert low < own["top"] - own["b"] and high > own["top"], (
                 f"unit {number}: the pass {cut['z_from']}…{cut['z_to']} does not carry the hob centre past both faces")
-            found = clearance(surface, cut_centres(params["x_retract"], cut["cut_x"], cut["z_from"], cut["z_to"]), other)
+            found = clearance(surface, cut_centres(params["x_retract"], cut["cut_x"], cut["z_from"], cut["z_to"]),
+                              other)
             assert found >= MARGIN, (f"unit {number} {cut['cut_name']}: the hob comes {found:.2f} mm near "
                                      f"the other unit (at least {MARGIN} expected)")
             least = min(least, found)

@@ -315,7 +315,8 @@ def test_spline_and_ellipse_are_lines_within_the_tolerance(tmp_path):
                         for t in (t0 + (t1 - t0) * k / 50 for k in range(51)))
         assert deviation <= FLATTEN_TOLERANCE_MM * 1.01
     exact = [(v.x, v.y) for v in spline.construction_tool().approximate(400)]
-    on_spline = [s for s in profile.segments if -35 - 1e-9 <= min(s.start[0], s.end[0]) and max(s.start[0], s.end[0]) <= -20 + 1e-9]
+    on_spline = [s for s in profile.segments
+                 if -35 - 1e-9 <= min(s.start[0], s.end[0]) and max(s.start[0], s.end[0]) <= -20 + 1e-9]
     for point in exact:
         assert min(distance_to_segment(point, s) for s in on_spline) <= FLATTEN_TOLERANCE_MM * 1.01
 

@@ -412,7 +412,8 @@ def test_last_cut_reaches_full_depth(case, gear_id):
     last = c.cuts()[-1]["x"]
     expected = c.full_depth()
     assert abs(last - expected) <= DIAMETER_TOLERANCE, \
-        f"gear {gear_id}: last cut X{last}, full depth (d_f2 + d_a0)/2 = ({c.gear['df2']} + {c.hob['da0']})/2 = {expected:.3f}"
+        f"gear {gear_id}: last cut X{last}, full depth (d_f2 + d_a0)/2 = " \
+        f"({c.gear['df2']} + {c.hob['da0']})/2 = {expected:.3f}"
 
 
 @pytest.mark.parametrize("gear_id, count", [(42, 1), (45, 2)])

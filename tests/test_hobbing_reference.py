@@ -356,7 +356,8 @@ def test_random_valid_gears_make_a_correct_program_or_a_one_line_refusal(conn, k
             return
     shift = {5.0: 5.0}.get(choice.get("shift_y"), "per part" if choice.get("shift_per_part") else 0.0)
     case = Case(gear, hob, read_machine(conn, DIN.name), Job(choice.get("coolant", True), shift,
-                                                             choice.get("worm_feed", "radial"), choice.get("tailstock", True)))
+                                                             choice.get("worm_feed", "radial"),
+                                                             choice.get("tailstock", True)))
     problems = all_problems(read(program.text), case)
     assert not problems, f"{gear} {hob} {choice}:\n  " + "\n  ".join(problems) + "\n" + program.text
 

@@ -140,7 +140,8 @@ def test_tangential_worm_wheels_of_both_hands_keep_the_y_factor_positive(conn, h
 def test_z_and_y_positions_mirror_on_a_machine_whose_z_and_y_point_the_other_way(conn, gear_id):
     add_flipped_machine(conn)
     choices = {"worm_feed": "tangential"} if gear_id == 53 else {"shift_y": 3.0}
-    din, flipped = (read_program(instantiate(conn, gear_id, machine, **choices)) for machine in ("hobber-840d", FLIPPED))
+    din, flipped = (read_program(instantiate(conn, gear_id, machine, **choices))
+                    for machine in ("hobber-840d", FLIPPED))
 
     def positions(nc, axis):
         return [m.end[axis] for m in nc.moves if m.block < nc.index("EGOFS") and axis in m.changed]

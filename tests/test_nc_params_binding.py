@@ -91,7 +91,8 @@ def test_a_new_value_changes_only_the_bound_words(conn, relative, parameter, val
             expected[line - 1] = expected[line - 1].replace(word, word[:-len(number)] + other, 1)
     assert expected != original
     assert instantiated(conn, "nc_bound", {**OTHER[relative], parameter: float(other)}) == expected
-    assert written_back(conn, "nc_bound", {**OTHER[relative], parameter: float(value)}) == (DATA / relative).read_bytes()
+    assert written_back(conn, "nc_bound",
+                        {**OTHER[relative], parameter: float(value)}) == (DATA / relative).read_bytes()
 
 
 @pytest.mark.parametrize("relative, parameter, value, address, other", CASES)

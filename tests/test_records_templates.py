@@ -134,7 +134,8 @@ def test_no_class_lies_deeper_than_the_lineage_the_templates_follow(conn):
         for statement, params in [("INSERT INTO gear_class (name, parent) VALUES ('records_deeper', %s)", (chain[-1],)),
                                   ("UPDATE gear_class SET parent = %s WHERE name = %s", (chain[-1], chain[1])),
                                   ("UPDATE gear_class SET parent = %s WHERE name = 'duplex'", (chain[-1],))]:
-            with pytest.raises(errors.CheckViolation, match="cannot derive|at most 50 classes above"), conn.transaction():
+            with pytest.raises(errors.CheckViolation,
+                               match="cannot derive|at most 50 classes above"), conn.transaction():
                 conn.execute(statement, params)
     assert ancestors(conn, chain[-1]) == 50 and ancestors(conn, "duplex") == ancestors(conn, "spur") + 1
 
@@ -228,7 +229,8 @@ def test_a_stored_version_is_the_class_as_it_was_and_stays_so(conn):
     version = versions(conn, "spur")[0]
     refusals = [("INSERT INTO template_version_rows (gear_class, version, rows) VALUES ('spur', %s, '[]')"
                  % (version + 1), errors.IntegrityConstraintViolation),
-                ("UPDATE template_version_rows SET rows = '[]' WHERE gear_class = 'spur'", errors.InsufficientPrivilege),
+                ("UPDATE template_version_rows SET rows = '[]' WHERE gear_class = 'spur'",
+                 errors.InsufficientPrivilege),
                 ("DELETE FROM template_version_rows WHERE gear_class = 'spur'", errors.InsufficientPrivilege),
                 ("TRUNCATE template_version_rows CASCADE", errors.InsufficientPrivilege)]
     for statement, error in refusals:

@@ -289,7 +289,8 @@ def test_help_texts(run, args, words):
 def test_a_text_used_by_many_classes_lists_ten_uses_and_counts_them_all(conn):
     for number in range(12):
         ensure_class(conn, f"many_{number}")
-        replace_template(conn, f"many_{number}", [TemplateRow(100, "main", 1, None, None, '"G90 G71 G94 ; MANY"', None)])
+        replace_template(conn, f"many_{number}",
+                         [TemplateRow(100, "main", 1, None, None, '"G90 G71 G94 ; MANY"', None)])
     ensure_class(conn, "few")
     replace_template(conn, "few", [TemplateRow(100, "main", 1, None, None, '"G90 G71 G94 ; FEW"', None)])
     report = refactor(conn, threshold=0.6)

@@ -125,9 +125,11 @@ def test_the_command_prints_a_family_once_with_its_size(fresh_database_url):
     result = run("refactor")
     assert result.exit_code == 0, result.output
     size = sum(1 for line in program_lines() if BLOCK_NUMBER.sub("", line) == RETRACT)
-    headers = [line for line in result.stdout.splitlines() if f"{size} lines differing only in the block number" in line]
+    headers = [line for line in result.stdout.splitlines()
+               if f"{size} lines differing only in the block number" in line]
     assert len(headers) == 1
-    assert sum(1 for line in result.stdout.splitlines() if line.strip().endswith(f' {RETRACT}"')) == 10   # first 10 members
+    # first 10 members
+    assert sum(1 for line in result.stdout.splitlines() if line.strip().endswith(f' {RETRACT}"')) == 10
 
 
 def key_of_full_texts(t: str, a: str, b: str) -> str:

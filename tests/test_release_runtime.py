@@ -141,7 +141,8 @@ def released_rows(conn, gear_class: str) -> list[tuple]:
 def test_a_parents_release_leaves_the_childrens_released_rows_alone(conn):
     duplex_before, duplex_lines = released_rows(conn, "duplex"), runner_lines(conn, 54)
     with as_role(conn, "engine_editor"):
-        conn.execute("UPDATE template_view SET o = '\"G90 G71 G94 ; SPUR EDIT\"' WHERE gear_class = 'spur' AND id = 800")
+        conn.execute("UPDATE template_view SET o = '\"G90 G71 G94 ; SPUR EDIT\"' "
+                     "WHERE gear_class = 'spur' AND id = 800")
     assert has_draft(conn, "spur") and has_draft(conn, "duplex")
     release_draft(conn, "spur")
     assert released_rows(conn, "duplex") == duplex_before

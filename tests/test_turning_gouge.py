@@ -59,7 +59,8 @@ def test_a_move_over_the_collar_is_refused_and_one_above_it_passes():
     through = [[Move("rapid", -20.0, 30.0), Move("feed", -50.0, 30.0)]]   # R15 under the R20 collar
     with pytest.raises(EngineError, match=r"test: the G1 move to X30\.000 Z-50\.000 cuts") as refused:
         check_no_gouge(through, index, "test")
-    depth, z = (float(v) for v in re.search(r"cuts (\S+) mm into the part at Z(\S+) X30\.000", str(refused.value)).groups())
+    depth, z = (float(v) for v in re.search(r"cuts (\S+) mm into the part at Z(\S+) X30\.000",
+                                            str(refused.value)).groups())
     assert -40.0 <= z <= -30.0                                   # in the collar's span
     assert depth == pytest.approx(distance_to_outline(z, 15.0), abs=1e-3)
 

@@ -50,7 +50,8 @@ JOB = "params = jsonb_set(params, '{%s}', '%s')"
     (MODULE % ("prep:1,tool", "123"), r"prep:1\.tool = 123 must be a whole number 1 … 99"),
     (MODULE % ("prep:1,tool", "1.5"), r"prep:1\.tool = 1\.5 must be a whole number"),
     (MODULE % ("prep:1,tool_offset", '"a"'), r"prep:1\.tool_offset = 'a' must be a whole number 1 … 99"),
-    (MODULE % ("prep:1,tool_offset", "0"), r"prep:1\.tool_offset = 0 must be a whole number 1 … 99"),   # T0100: no offset
+    # T0100: no offset
+    (MODULE % ("prep:1,tool_offset", "0"), r"prep:1\.tool_offset = 0 must be a whole number 1 … 99"),
     (MODULE % ("cutmotion:2,op_present", '"false"'), r"cutmotion:2\.op_present = 'false' must be true or false"),
     (MODULE % ("cutcond:2,coolant", '"no"'), r"cutcond:2\.coolant = 'no' must be true or false"),
     (MODULE % ("cutmotion:1,kind", '"rough"'), r"cutmotion:1\.kind = 'rough' is not one of"),

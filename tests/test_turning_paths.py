@@ -281,7 +281,8 @@ def step(z, low, high, kind, size):
         return [Arc((z, low), (z - size, low + size), (z, low + size), ccw=False),
                 Line((z - size, low + size), (z - size, high))]
     # the outer corner rounded: from the centre's right to above it
-    return [Line((z, low), (z, high - size)), Arc((z, high - size), (z - size, high), (z - size, high - size), ccw=True)]
+    return [Line((z, low), (z, high - size)),
+            Arc((z, high - size), (z - size, high), (z - size, high - size), ccw=True)]
 
 
 @settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])

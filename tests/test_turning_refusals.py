@@ -145,5 +145,6 @@ def test_the_disc_job_finishes_its_outside_diameter(run, tmp_path):
     assert made.exit_code == 0, made.output
     program = run("instantiate", "--job", json.loads(made.stdout)["job_id"], "--dry-run")
     finish = operation_lines(program.stdout.splitlines(), 2)
-    along_z = {2 * start[1] for g, start, end in motions(finish) if g == 1 and start[1] == end[1] and start[0] != end[0]}
+    along_z = {2 * start[1] for g, start, end in motions(finish)
+               if g == 1 and start[1] == end[1] and start[0] != end[0]}
     assert along_z == {2 * OUTSIDE}

@@ -72,7 +72,8 @@ def parse_range(text: str, option: str = "--gears") -> tuple[int, int]:
               "skipped (else any bad one stores nothing).")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object (program_id, path, lines, ...).")
 @click.pass_context
-def instantiate(ctx, gear_id, job_id, gear_class, params_file, unverified, gear_range, job_range, all_gears, out, force, machine, cuts, coolant, shift_y,
+def instantiate(ctx, gear_id, job_id, gear_class, params_file, unverified, gear_range, job_range, all_gears, out, force,
+                machine, cuts, coolant, shift_y,
                 shift_per_part, feed_mode, tailstock, worm_feed, allowance, hob_speed, workers, explain, draft,
                 dry_run, skip_bad, as_json):
     """Produce the NC program of a gear (or a stored job, a job of an imported class, or a batch of gears).

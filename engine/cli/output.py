@@ -44,7 +44,8 @@ def csv_cell(value: Any) -> Any:
 # a cell beginning so is a formula to Excel and LibreOffice (the full-width forms too: Excel in
 # CJK locales reads them as the ASCII ones)
 FORMULA_START = ("=", "+", "@", "\t", "\r", "\uff1d", "\uff0b", "\uff20", "\uff0d")
-NUMBER_TEXT = re.compile(r"-(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?")   # -5, -0.25, -.5, -1e-3: a negative number, not a formula
+# -5, -0.25, -.5, -1e-3: a negative number, not a formula
+NUMBER_TEXT = re.compile(r"-(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?")
 
 
 def inert_text(text: str) -> str:

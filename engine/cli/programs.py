@@ -51,7 +51,8 @@ def programs():
 @click.pass_context
 def programs_list(ctx, gear_class, gear_id, job_id, draft, released, since, until, output):
     """The programs stored, one line each: name, job, gear, class, template version and hash,
-    draft or released, read by the verifier or UNVERIFIED, number of lines, when stored (the text: `engine programs show ID`).
+    draft or released, read by the verifier or UNVERIFIED, number of lines, when stored
+    (the text: `engine programs show ID`).
 
     Example: engine programs list --gear 42 --released --since 2026-11-01
     """

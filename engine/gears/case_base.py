@@ -86,7 +86,8 @@ class CaseBase:
         if not found:
             axial = defaults.axial_feed_rough if cut == "rough" else defaults.axial_feed_finish
             radial = defaults.radial_feed if cut == "rough" else RADIAL_TO_AXIAL * axial
-            return KindProposal(cut, defaults.cutting_speed, axial, radial, f"{cut}: no cases, {defaults.source}"), found
+            return KindProposal(cut, defaults.cutting_speed, axial, radial,
+                                f"{cut}: no cases, {defaults.source}"), found
         exact = [(1.0, case) for d, case in found if d <= EXACT]
         weighted = exact or [(1.0 / d, case) for d, case in found]
         total = sum(weight for weight, _ in weighted)

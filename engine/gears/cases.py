@@ -37,7 +37,8 @@ _TYPES = {"module": (parse_number, "mm"), "teeth": (parse_positive_whole, ""), "
           "hob_tip_diameter": (parse_number, "mm"), "hob_speed": (parse_number, "r/min"),
           "axial_feed": (parse_number, "mm/min"), "radial_feed": (parse_number, "mm/min")}
 CASE_KIND = CsvKind("case", tuple(
-    Column(name, _TYPES.get(name, (parse_text, ""))[0], required=name not in ("hob_coating", "source", "hardness", "quality_grade"),
+    Column(name, _TYPES.get(name, (parse_text, ""))[0],
+           required=name not in ("hob_coating", "source", "hardness", "quality_grade"),
            unit=_TYPES.get(name, (parse_text, ""))[1])
     for name in (*FEATURE_COLUMNS, "cut", *VALUE_COLUMNS, "source")))
 
@@ -136,7 +137,8 @@ def plausibility_notes(gear: Gear, hob: Hob, machine: Machine, cutting: CuttingD
     exact_speed = 1000 * cutting.cutting_speed / (math.pi * hob.tip_diameter)
     if exact_speed > machine.spindle_max:
         notes.append(f"hob speed {exact_speed:.0f} r/min capped at {machine.name}'s spindle maximum "
-                     f"{machine.spindle_max:g} r/min: v is {math.pi * hob.tip_diameter * cutting.hob_speed / 1000:.1f} m/min")
+                     f"{machine.spindle_max:g} r/min: "
+                     f"v is {math.pi * hob.tip_diameter * cutting.hob_speed / 1000:.1f} m/min")
     table_speed = cutting.hob_speed * hob.starts / gear.teeth
     if machine.table_speed_max is not None and table_speed > machine.table_speed_max:
         notes.append(f"table speed {table_speed:.1f} r/min exceeds {machine.name}'s {machine.table_speed_max:g} r/min; "

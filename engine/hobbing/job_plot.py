@@ -22,7 +22,8 @@ def plot_hobbing_job(conn, job_id: int, out) -> list[str]:
 def program_to_draw(conn, job_id: int) -> tuple[int, bool]:
     row = conn.execute(PROGRAM_TO_DRAW, (job_id,)).fetchone()
     if row is None:
-        raise EngineError(f"job {job_id} has no stored program to draw; make one with `engine instantiate --job {job_id}`")
+        raise EngineError(f"job {job_id} has no stored program to draw; "
+                          f"make one with `engine instantiate --job {job_id}`")
     return row
 
 

@@ -51,7 +51,8 @@ def draw_unit(axes, unit) -> str:
         axes.plot(unit.intended_root, unit.heights, color="0.3", linewidth=0.7, linestyle=":",
                   gid=f"root {unit.name}")
     tip = 2 * unit.largest_radius
-    return f"{unit.name}: blank tip ⌀{tip:.3f} × face {unit.z_high - unit.z_low:g} mm, Z{unit.z_high:g} … {unit.z_low:g}"
+    return (f"{unit.name}: blank tip ⌀{tip:.3f} × face {unit.z_high - unit.z_low:g} mm, "
+            f"Z{unit.z_high:g} … {unit.z_low:g}")
 
 
 def draw_setup(axes, solid) -> str:
@@ -62,7 +63,8 @@ def draw_setup(axes, solid) -> str:
         return f"{solid.name}: ⌀{2 * solid.radius_at_top:g} (outside the picture)"
     r = solid.radius_at_top
     axes.add_patch(Rectangle((-r, z_low), 2 * r, z_high - z_low, facecolor=SETUP_FILL, edgecolor="0.25",
-                             hatch=HATCHES.get(solid.name, "//"), linewidth=0.8, gid=solid.name, label=literal(solid.name)))
+                             hatch=HATCHES.get(solid.name, "//"), linewidth=0.8, gid=solid.name,
+                             label=literal(solid.name)))
     face = solid.z_high if solid.z_high < high else solid.z_low
     return f"{solid.name}: ⌀{2 * r:g} from Z{face:g}"
 

@@ -37,7 +37,8 @@ Lines: the file is split at its line ending, LF or CRLF (a final newline ends th
 adds no empty line); the rows hold the lines without endings, and the class keeps the ending
 and whether the file had a final newline (engine.library.nc_layout; a file mixing LF and CRLF
 is refused). Instantiating the import with the same parameters and writing the lines with that
-layout (nc_text) gives the file byte for byte. The import checks this itself before it commits (engine.library.nc_verify), while
+layout (nc_text) gives the file byte for byte. The import checks this itself before it commits
+(engine.library.nc_verify), while
 the rows are being written.
 """
 from __future__ import annotations

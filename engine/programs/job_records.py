@@ -21,7 +21,8 @@ WHERE (%(class)s::text IS NULL OR j.gear_class = %(class)s)
 ORDER BY j.id"""
 ONE_JOB = JOB_COLUMNS + ", j.params, j.module_params, j.cutting FROM job j WHERE j.id = %s"
 JOB_PROGRAMS = """
-SELECT id AS program_id, name, template_version, draft, unverified, created_at FROM program WHERE job_id = %s ORDER BY id"""
+SELECT id AS program_id, name, template_version, draft, unverified, created_at
+FROM program WHERE job_id = %s ORDER BY id"""
 
 JOB_DELETION = Deletion(
     kind="job",

@@ -202,8 +202,9 @@ class Walk:
         self.report.table_speed = max(self.report.table_speed, speed)
         limit = self.machine.table_speed_max
         if limit is not None and speed > limit + 1e-9:
-            self.report.add(step.number, step.line, f"the table turns at {speed:.1f} r/min, above {self.machine.name}'s "
-                                                    f"{limit:g} r/min (hob, Z and Y terms at this move's speeds)")
+            self.report.add(step.number, step.line,
+                            f"the table turns at {speed:.1f} r/min, above {self.machine.name}'s "
+                            f"{limit:g} r/min (hob, Z and Y terms at this move's speeds)")
 
     def _check_cut(self, step, start: dict, end: dict) -> None:
         moving = frozenset(axis for axis in AXES if axis in start and abs(end[axis] - start[axis]) > 1e-9)

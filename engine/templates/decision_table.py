@@ -286,7 +286,8 @@ def _compile_row(gear_class: str, row: TemplateRow, translations=None) -> Compil
     statements = tuple(compiled("s", compile_statements) or ())
     p_calc = compiled("p_calc", expression)
     o, p_emit = compiled("o", expression), compiled("p_emit", expression)
-    return CompiledRow(row, o, p_calc, statements, p_emit, _inputs(p_calc if statements else None, statements, o, p_emit))
+    return CompiledRow(row, o, p_calc, statements, p_emit,
+                       _inputs(p_calc if statements else None, statements, o, p_emit))
 
 
 def _inputs(p_calc, statements, o, p_emit) -> tuple[str, ...]:

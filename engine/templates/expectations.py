@@ -18,7 +18,8 @@ engine adds when it stores a program):
         Properties: `EGON ratio` (Z1/N1 of the B axis in the first EGON; `last EGON ratio`),
         `EGON Z factor` (any leading axis: `EGON Y factor`), `first|last|min|max [G0|G1] <address>`
         (e.g. `last X`, `max G1 X`: the values of that address over the blocks, optionally only
-        blocks in that modal motion; G25/G26 limit blocks are not positions and are left out), `XZ slope` (dX/dZ of the last block moving X and Z),
+        blocks in that modal motion; G25/G26 limit blocks are not positions and are left out),
+        `XZ slope` (dX/dZ of the last block moving X and Z),
         `count of G1` (blocks holding the word), `line count`.
         Default tolerance: 1e-6 plus half a unit in the last digit the program printed (0.0005
         for `X51.500`).
@@ -134,7 +135,8 @@ def check_numeric(name: str, expression: str, tolerance: str | None, context: Co
     reading = read_property(name, context.lines)
     allowed = _tolerance(tolerance, reading)
     value = _shown(expected, reading)
-    shown = f"{name.strip()} = {expression.strip()}{'' if value == expression.strip() else ' = ' + value} ± {allowed:.3g}"
+    computed = "" if value == expression.strip() else " = " + value
+    shown = f"{name.strip()} = {expression.strip()}{computed} ± {allowed:.3g}"
     if reading is None:
         return f"expected {shown}, program has no {name.strip()}"
     if abs(reading.value - expected) <= allowed:

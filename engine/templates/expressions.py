@@ -245,7 +245,8 @@ def _formats_with_percent(node: ast.AST) -> bool:
     """`'…' % x` on a written text: refused here as the guard refuses it at run time (its width
     is not bounded), so that lint names it without a job."""
     return isinstance(node, ast.BinOp) and isinstance(node.op, ast.Mod) and (
-        isinstance(node.left, ast.JoinedStr) or isinstance(node.left, ast.Constant) and isinstance(node.left.value, str))
+        isinstance(node.left, ast.JoinedStr)
+        or isinstance(node.left, ast.Constant) and isinstance(node.left.value, str))
 
 
 def _check_spec_fields(spec: ast.JoinedStr) -> None:
@@ -322,7 +323,8 @@ def _guard_of(node: ast.AST, walk: Walk) -> ast.AST:
     if kind is ast.JoinedStr:
         return node if walk.slots[id(node)][1] == "format_spec" else _call("_guard", [node], node)
     if kind is ast.List or kind is ast.Tuple:   # a display of constants is bounded by the text
-        return node if all(isinstance(element, ast.Constant) for element in node.elts) else _call("_guard", [node], node)
+        constants = all(isinstance(element, ast.Constant) for element in node.elts)
+        return node if constants else _call("_guard", [node], node)
     if kind is ast.Subscript:                   # a slice copies what it cuts: paid like any built value
         return _call("_built", [node], node) if isinstance(node.slice, ast.Slice) else node
     if kind is ast.FormattedValue:

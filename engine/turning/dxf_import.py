@@ -43,7 +43,8 @@ def import_dxf(conn, path: str | Path, machine_name: str | None = None,
     """Read the drawing and store its job; EngineError (nothing stored) if it cannot become one.
     The program is named `program_name`, else after the drawing's file name (job_params.drawing_names);
     the profile is read from layer `profile_layer` (None: layer 0, or the layer read_drawing chooses)."""
-    checked("drawing", Path(path).name, "drawing file name", "rename the file")   # said before the drawing's own problems
+    # said before the drawing's own problems
+    checked("drawing", Path(path).name, "drawing file name", "rename the file")
     if program_name is not None:
         checked("program", program_name, "--program-name")
     machine = lathe(conn, machine_name)

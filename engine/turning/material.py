@@ -164,7 +164,8 @@ class Material:
         low, high = sorted((z0, z1))
         cells = range(_cell(low), _cell(high) + 1)
         edges = {self.blank.z_front, self.blank.z_back, *(cell * BUCKET_MM for cell in cells),
-                 *(cut_end[0] for cell in cells for cut in self.cells.get(cell, ()) for cut_end in (cut.start, cut.end))}
+                 *(cut_end[0] for cell in cells for cut in self.cells.get(cell, ())
+                   for cut_end in (cut.start, cut.end))}
         nudged = {edge + side * TURN_NUDGE_MM for edge in edges for side in (-1, 1)}
         return {(z - z0) / (z1 - z0) for z in nudged if low < z < high}
 

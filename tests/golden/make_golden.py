@@ -12,6 +12,7 @@ import os
 import sys
 import tempfile
 import uuid
+from functools import partial
 from pathlib import Path
 
 import psycopg
@@ -57,11 +58,11 @@ def main() -> int:
     try:
         for gear_id, choice_set in hobbing_cases():
             write(hobbing_file(gear_id, choice_set),
-                  rolled_back(url, lambda conn, gear_id=gear_id, choice_set=choice_set: hobbing_text(conn, gear_id, choice_set)))
+                  rolled_back(url, partial(hobbing_text, gear_id=gear_id, choice_set=choice_set)))
         with tempfile.TemporaryDirectory() as folder:
             for case, lathe in turning_cases():
                 write(turning_file(case, lathe),
-                      rolled_back(url, lambda conn, case=case, lathe=lathe: turning_text(conn, Path(folder), case, lathe)))
+                      rolled_back(url, partial(turning_text, folder=Path(folder), name=case, lathe=lathe)))
     finally:
         with psycopg.connect(args.database_url, autocommit=True) as admin:
             admin.execute(sql.SQL("DROP DATABASE IF EXISTS {} WITH (FORCE)").format(sql.Identifier(name)))
