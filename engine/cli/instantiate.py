@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import re
 from functools import partial
+from typing import TYPE_CHECKING
 
 import click
 
@@ -10,6 +11,9 @@ from ..errors import EngineError
 from .context import connection, emit_json, settings
 from .ids import GEAR_ID, JOB_ID
 from .progress import progress_bar
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
 RANGE = re.compile(r"^\s*(\d+)\s*(?:-\s*(\d+))?\s*$")
 
@@ -144,7 +148,7 @@ def instantiate(ctx, gear_id, job_id, gear_class, params_file, unverified, gear_
     _report_program(program, as_json, explain)
 
 
-def _batch(conn, job_range, gear_range, progress, machine, choices, overrides, workers, **common):
+def _batch(conn: Connection, job_range, gear_range, progress, machine, choices, overrides, workers, **common):
     """A batch of stored jobs made again (--jobs), or of gears (--gears, --all)."""
     from ..programs.instantiate import instantiate_gears
     from ..programs.remake import instantiate_jobs
@@ -207,7 +211,7 @@ def _refuse_new_job_choices_for_stored_jobs(ctx, stored_jobs: bool) -> None:
                           "stored parameters: edit job.params in SQL to change them")
 
 
-def _class_job(conn, gear_class, params_file, machine, as_json, explain, **options) -> None:
+def _class_job(conn: Connection, gear_class, params_file, machine, as_json, explain, **options) -> None:
     from ..library.nc_import import read_params
     from ..programs.class_jobs import instantiate_class
 

@@ -6,11 +6,15 @@ import hashlib
 import re
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from psycopg import sql
 
 from ..errors import EngineError
 from ..paths import MIGRATIONS_DIR
+
+if TYPE_CHECKING:
+    from .connection import Connection
 
 MIGRATION_FILE = re.compile(r"^(\d{4})\.([a-z0-9_-]+)\.sql$")
 # Any constant works: all engines on one database agree on it.
@@ -73,7 +77,7 @@ def discover(directory: Path | None = None) -> list[Migration]:
     return migrations
 
 
-def status(conn, directory: Path | None = None) -> list[MigrationState]:
+def status(conn: Connection, directory: Path | None = None) -> list[MigrationState]:
     applied = _applied(conn)
     states = []
     for migration in discover(directory):
@@ -86,7 +90,7 @@ def status(conn, directory: Path | None = None) -> list[MigrationState]:
     return states
 
 
-def migrate(conn, directory: Path | None = None) -> list[Migration]:
+def migrate(conn: Connection, directory: Path | None = None) -> list[Migration]:
     """Apply every pending migration; return those applied. Refuses if an applied file changed.
     Each migration commits on its own, so the connection must not be inside a transaction."""
     from psycopg.pq import TransactionStatus
@@ -104,7 +108,7 @@ def migrate(conn, directory: Path | None = None) -> list[Migration]:
         conn.autocommit = autocommit
 
 
-def _apply_pending(conn, directory: Path | None) -> list[Migration]:
+def _apply_pending(conn: Connection, directory: Path | None) -> list[Migration]:
     states = status(conn, directory)
     changed = [s.migration.path.name for s in states if s.changed]
     if changed:
@@ -120,7 +124,7 @@ def _apply_pending(conn, directory: Path | None) -> list[Migration]:
     return done
 
 
-def _apply(conn, migration: Migration) -> None:
+def _apply(conn: Connection, migration: Migration) -> None:
     import psycopg
 
     try:
@@ -137,7 +141,7 @@ def _apply(conn, migration: Migration) -> None:
         ) from error
 
 
-def _applied(conn) -> dict[str, tuple[str, object]]:
+def _applied(conn: Connection) -> dict[str, tuple[str, object]]:
     exists = conn.execute("SELECT to_regclass('schema_migration') IS NOT NULL").fetchone()[0]
     if not exists:
         return {}
@@ -145,7 +149,7 @@ def _applied(conn) -> dict[str, tuple[str, object]]:
     return {version: (checksum, applied_at) for version, checksum, applied_at in rows}
 
 
-def require_current(conn) -> None:
+def require_current(conn: Connection) -> None:
     """Refuse to work on a database whose schema is behind the code."""
     pending = [s.migration.path.name for s in status(conn) if s.state != "applied"]
     if pending:

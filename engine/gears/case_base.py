@@ -14,11 +14,15 @@ from __future__ import annotations
 import heapq
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 
 from ..errors import EngineError
 from .cutting_data import (FEED_EPSILON, RADIAL_TO_AXIAL, CuttingData, default_cutting_data, feed_maximum,
                            hob_speed, per_minute)
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
 CUT_KINDS = ("rough", "finish")
 CUT_KINDS_BY_COUNT = {1: ("rough",), 2: ("rough", "finish")}   # a single cut is a rough cut, as in the paper
@@ -68,7 +72,7 @@ class CaseBase:
                               if record["cut"] == cut] for cut in CUT_KINDS}
 
     @classmethod
-    def load(cls, conn) -> CaseBase:
+    def load(cls, conn: Connection) -> CaseBase:
         rows = conn.execute(LOAD_CASES).fetchall()
         return cls([{name: _plain(value) for name, value in zip(CASE_COLUMNS, row)} for row in rows])
 

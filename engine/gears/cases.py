@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pandas as pd
 import psycopg
@@ -25,6 +26,9 @@ from .cutting_data import CuttingData
 from .hob_matching import choose_hob
 from .models import model_for_class
 from .records import Gear, Hob, Machine, hobbing_machine, load_gear, load_hobs
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
 FEATURE_COLUMNS = ("module", "teeth", "material", "hardness", "quality_grade", "hob_material",
                    "hob_coating", "hob_starts", "hob_tip_diameter")
@@ -85,13 +89,13 @@ SELECT id AS case_id, module, teeth, material, hardness, quality_grade, hob_mate
 FROM cutting_case ORDER BY id"""
 
 
-def case_records(conn) -> list[dict]:
+def case_records(conn: Connection) -> list[dict]:
     """The machining history as a person looks into it (`engine cases list`): one record per case,
     its id under case_id, numbers as floats."""
     return records(conn.execute(CASE_RECORDS))
 
 
-def list_cases(conn) -> pd.DataFrame:
+def list_cases(conn: Connection) -> pd.DataFrame:
     """The machining history, one row per case, numbers as floats."""
     query = sql.SQL("SELECT {} FROM cutting_case ORDER BY id").format(
         sql.SQL(", ").join(map(sql.Identifier, CASE_COLUMNS)))
@@ -100,12 +104,12 @@ def list_cases(conn) -> pd.DataFrame:
                          **{column: "Int64" for column in INTEGER_COLUMNS}})
 
 
-def suggest(conn, gear: Gear, hob: Hob, machine: Machine, *, top: int = 3) -> Suggestion:
+def suggest(conn: Connection, gear: Gear, hob: Hob, machine: Machine, *, top: int = 3) -> Suggestion:
     """Cutting data for this gear, hob and machine from the `top` nearest cases per cut kind."""
     return suggest_from(load_case_base(conn), gear, hob, machine, top=top)
 
 
-def load_case_base(conn) -> CaseBase:
+def load_case_base(conn: Connection) -> CaseBase:
     """The history read once for many suggestions (a batch)."""
     return CaseBase.load(conn)
 
@@ -121,7 +125,7 @@ def suggest_from(base: CaseBase, gear: Gear, hob: Hob, machine: Machine, *, top:
     return Suggestion(gear, hob, machine, cutting, table, proposals, notes)
 
 
-def suggest_for_gear(conn, gear_id: int, machine_name: str | None = None, *, top: int = 3) -> Suggestion:
+def suggest_for_gear(conn: Connection, gear_id: int, machine_name: str | None = None, *, top: int = 3) -> Suggestion:
     """`engine suggest`: the hob the library chooses for the gear, and its cutting data."""
     gear = load_gear(conn, gear_id)
     machine = hobbing_machine(conn, machine_name)
@@ -175,7 +179,7 @@ def _speed_notes(gear: Gear, hob: Hob, proposals: dict) -> list[str]:
     return notes
 
 
-def confirm_job(conn, job_id: int) -> list[int]:
+def confirm_job(conn: Connection, job_id: int) -> list[int]:
     """A proven job joins the history: one case per cut kind of its stored cutting data. The database
     decides (confirm_job_cases): only a job the engine made a program for, with cutting data its
     machine can run, becomes a case; runners cannot add cases any other way."""
@@ -186,7 +190,7 @@ def confirm_job(conn, job_id: int) -> list[int]:
         raise EngineError(error.diag.message_primary) from None
 
 
-def seed_cases(conn, path: Path = SEED_FILE) -> int:
+def seed_cases(conn: Connection, path: Path = SEED_FILE) -> int:
     """Add the cases of the seed file not yet in the history (same features, cut and source)."""
     path = Path(path)
     if not path.is_file():
@@ -219,7 +223,7 @@ SEED_CASE = sql.SQL("INSERT INTO cutting_case ({}) VALUES ({})").format(
     sql.SQL(", ").join(map(sql.Identifier, SEED_COLUMNS)), sql.SQL(", ").join(map(sql.Placeholder, SEED_COLUMNS)))
 
 
-def _insert_if_missing(conn, values: dict) -> int:
+def _insert_if_missing(conn: Connection, values: dict) -> int:
     # Values go as text: the server parses them into the column types (numeric exactly).
     if conn.execute(FIND_CASE, values).fetchone():
         return 0

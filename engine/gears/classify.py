@@ -17,12 +17,15 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass, field
-from typing import Any, Callable, Collection, Mapping
+from typing import TYPE_CHECKING, Any, Callable, Collection, Mapping
 
 from ..errors import EngineError
 from .hob_matching import choose_hob
 from .models import MODELS, ancestry
 from .records import load_gear, load_hobs
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
 DEFAULT_CLASS = "spur"
 
@@ -182,7 +185,7 @@ class GearClassReport:
         return said
 
 
-def explain_gear(conn, gear_id: int) -> GearClassReport:
+def explain_gear(conn: Connection, gear_id: int) -> GearClassReport:
     """Classify a stored gear again and say how; also the model and hob it gets."""
     gear = load_gear(conn, gear_id)
     classification = classify({"gear_id": gear.id, "cone_angle": gear.cone_angle, "crowning": gear.crowning,

@@ -1,12 +1,17 @@
 """Which hobbing model serves which gear class: the nearest ancestor that has one."""
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from ..hobbing.crowned import CrownedModel
 from ..hobbing.cylindrical import CylindricalModel
 from ..hobbing.duplex import DuplexModel
 from ..hobbing.taper import TaperModel
 from ..hobbing.worm_wheel import WormWheelModel
 from ..turning.names import TurningModel
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
 # The hobbing model of a node of the group-technology tree serves it and every class below
 # it that has no model of its own.
@@ -28,12 +33,12 @@ WITH RECURSIVE up(name, parent, depth) AS (
 SELECT name FROM up ORDER BY depth"""
 
 
-def ancestry(conn, gear_class: str) -> list[str]:
+def ancestry(conn: Connection, gear_class: str) -> list[str]:
     """The class and its ancestors, nearest first."""
     return [row[0] for row in conn.execute(CLASS_ANCESTRY, (gear_class,))]
 
 
-def model_for_class(conn, gear_class: str):
+def model_for_class(conn: Connection, gear_class: str):
     for name in ancestry(conn, gear_class):
         if name in MODELS:
             return MODELS[name]

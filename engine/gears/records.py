@@ -4,10 +4,13 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, fields, replace
 from decimal import Decimal
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..csv_reader import MAX_MAGNITUDE   # the CSV readers refuse larger numbers; so do the records
 from ..errors import EngineError
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
 TOOTH_DEPTH = Decimal("2.25")  # full tooth depth in modules: root = tip − 2·2.25·m
 
@@ -164,14 +167,15 @@ HOB_QUERY = f"SELECT {_columns(Hob)} FROM hob"
 MACHINE_QUERY = f"SELECT {_columns(Machine)} FROM machine"
 
 
-def load_gear(conn, gear_id: int) -> Gear:
+def load_gear(conn: Connection, gear_id: int) -> Gear:
     row = conn.execute(GEAR_QUERY + " WHERE id = %s", (gear_id,)).fetchone()
     if row is None:
         raise EngineError(f"gear {gear_id} does not exist; import it with `engine gears import FILE.csv`")
     return _with_units(_completed(_as_float(Gear, row)), _load_units(conn, gear_id, gear_id))
 
 
-def load_gears(conn, first: int | None = None, last: int | None = None, refused: dict | None = None) -> list[Gear]:
+def load_gears(conn: Connection, first: int | None = None, last: int | None = None,
+               refused: dict | None = None) -> list[Gear]:
     """The gears first…last; with `refused`, a gear that cannot be completed is left out and its
     message kept there by id (a batch names every bad gear), else it stops the load."""
     rows = conn.execute(GEAR_QUERY + " WHERE id BETWEEN %s AND %s ORDER BY id",
@@ -207,7 +211,7 @@ def _completed(gear: Gear) -> Gear:
     return replace(gear, tip_diameter=tip, root_diameter=root)
 
 
-def _load_units(conn, first: int, last: int) -> dict[int, tuple]:
+def _load_units(conn: Connection, first: int, last: int) -> dict[int, tuple]:
     """Further units of the gears first…last, by gear id, in unit order."""
     found: dict[int, list] = {}
     for row in conn.execute(UNIT_QUERY + " WHERE gear_id BETWEEN %s AND %s ORDER BY gear_id, unit", (first, last)):
@@ -219,14 +223,14 @@ def _with_units(gear: Gear, units: dict) -> Gear:
     return replace(gear, units=units.get(gear.id, ())) if gear.id in units else gear
 
 
-def load_hobs(conn) -> list[Hob]:
+def load_hobs(conn: Connection) -> list[Hob]:
     return [_as_float(Hob, row) for row in conn.execute(HOB_QUERY + " ORDER BY id")]
 
 
 DEFAULT_HOBBING_MACHINE = "hobber-840d"
 
 
-def hobbing_machine(conn, name: str | None) -> Machine:
+def hobbing_machine(conn: Connection, name: str | None) -> Machine:
     """The machine record, which must be a hobbing machine (default: the seeded 840D hobber)."""
     machine = load_machine(conn, name or DEFAULT_HOBBING_MACHINE)
     if machine.kind != "hobber":
@@ -235,7 +239,7 @@ def hobbing_machine(conn, name: str | None) -> Machine:
     return machine
 
 
-def load_machine(conn, name: str) -> Machine:
+def load_machine(conn: Connection, name: str) -> Machine:
     row = conn.execute(MACHINE_QUERY + " WHERE name = %s", (name,)).fetchone()
     if row is None:
         known = ", ".join(r[0] for r in conn.execute("SELECT name FROM machine ORDER BY name"))

@@ -49,6 +49,7 @@ import re
 from dataclasses import asdict, dataclass, field
 from functools import partial
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from psycopg.types.json import Jsonb
 
@@ -67,6 +68,9 @@ from .nc_params import binding_report, bindings, parse_addresses, values
 from .nc_rows import Builder, Found
 from .nc_tokens import LABEL, SYMBOL, LineFacts, facts, tokenise
 from .nc_verify import Proof
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
 CLASS_NAME = re.compile(r"^[a-z][a-z0-9_]*$")
 ROW_STEP = 10
@@ -88,14 +92,15 @@ class ImportReport:
     left_alone: list = field(default_factory=list)  # equal numbers at addresses not bound: line, word, parameter
 
 
-def import_nc(conn, path, gear_class: str, params: dict | None = None, modules: dict | None = None,
+def import_nc(conn: Connection, path, gear_class: str, params: dict | None = None, modules: dict | None = None,
               parent: str | None = None) -> ImportReport:
     """Store the NC program at `path` as the template of `gear_class`: all or nothing."""
     with no_cycle_collection():   # tokens and checked trees of every line: millions of objects
         return _import(conn, path, gear_class, params, modules, parent)
 
 
-def _import(conn, path, gear_class: str, params: dict | None, modules: dict | None, parent: str | None) -> ImportReport:
+def _import(conn: Connection, path, gear_class: str, params: dict | None, modules: dict | None,
+            parent: str | None) -> ImportReport:
     if not CLASS_NAME.match(gear_class or ""):
         raise EngineError(f"class name {gear_class!r}: use lower-case letters, digits and _, "
                           "starting with a letter")
@@ -140,7 +145,7 @@ def _read_lines(lines: list[str], built: Builder, start: int, end: int) -> tuple
     return line_facts, texts, built.found
 
 
-def _store_import_params(conn, gear_class: str, params: dict) -> None:
+def _store_import_params(conn: Connection, gear_class: str, params: dict) -> None:
     """Keep the parameters the class was imported with: lint checks its names against them."""
     conn.execute("UPDATE gear_class SET import_params = %s WHERE name = %s",
                  (Jsonb(params, dumps=_params_json), gear_class))

@@ -20,6 +20,7 @@ from __future__ import annotations
 import ast
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ..errors import EngineError
 from ..gears.models import model_for_class
@@ -40,6 +41,9 @@ from .records import Planned, Program
 from .verified_run import run_template
 from .verifier.grammar import DIALECTS
 
+if TYPE_CHECKING:
+    from ..db.connection import Connection
+
 PROGRAM_NAME = "program_name"   # the job's program name: given or not, whatever the class was imported with
 IMPORT_PARAMS = "SELECT import_params FROM gear_class WHERE name = %s"
 MACHINES = "SELECT name FROM machine ORDER BY name"
@@ -57,7 +61,7 @@ class ClassJob:
     taken: tuple[str, ...]
 
 
-def instantiate_class(conn, gear_class: str, given: dict, *, machine: str | None = None,
+def instantiate_class(conn: Connection, gear_class: str, given: dict, *, machine: str | None = None,
                       source: str = "parameters", out: str | Path | None = None, force: bool = False,
                       draft: bool = False, dry_run: bool = False, unverified: bool = False) -> ClassJob:
     """A job of the class with the parameters `given` (JSON of import-nc's --params, either form),
@@ -81,7 +85,7 @@ def refuse_unverified_file(unverified: bool, out) -> None:
                           "(and the machine's out in the config file); nothing stored")
 
 
-def _planned(conn, gear_class: str, given: dict, machine_name: str | None, source: str, draft: bool,
+def _planned(conn: Connection, gear_class: str, given: dict, machine_name: str | None, source: str, draft: bool,
              unverified: bool) -> tuple[Planned, tuple[str, ...]]:
     imported = _imported_values(conn, gear_class)
     refuse_modelled(conn, gear_class)
@@ -97,14 +101,14 @@ def _planned(conn, gear_class: str, given: dict, machine_name: str | None, sourc
     return class_job(template, machine, params, {}, layout), taken
 
 
-def _imported_values(conn, gear_class: str) -> dict:
+def _imported_values(conn: Connection, gear_class: str) -> dict:
     row = conn.execute(IMPORT_PARAMS, (gear_class,)).fetchone()
     if row is None:
         raise EngineError(f"class {gear_class!r} does not exist; see `engine template list`")
     return values(row[0] or {}, f"class {gear_class}'s imported parameters")
 
 
-def refuse_modelled(conn, gear_class: str) -> None:
+def refuse_modelled(conn: Connection, gear_class: str) -> None:
     """A class with a model makes its jobs from what the model reads: a gear or a drawing."""
     model = model_for_class(conn, gear_class)
     if isinstance(model, TurningModel):
@@ -115,7 +119,7 @@ def refuse_modelled(conn, gear_class: str) -> None:
                           "(engine instantiate --gear ID), not from --class")
 
 
-def class_machine(conn, name: str | None) -> Machine:
+def class_machine(conn: Connection, name: str | None) -> Machine:
     """The machine record; a hobber is refused: its programs are proved against a gear and hob."""
     if name is None:
         known = ", ".join(row[0] for row in conn.execute(MACHINES))

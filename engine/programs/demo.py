@@ -13,10 +13,14 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ..db.embedded import embedded_data_dir, embedded_url
 from ..db.seed import SeedReport
 from ..paths import SAMPLE_DRAWING
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
 DEMO_DATABASE = "engine_demo"
 # mm: the blank the sample drawing's roughing starts from (seed_templates/drawings/README.md);
@@ -56,7 +60,7 @@ def run_demo(gear_id: int = 42, turning: bool = False) -> DemoResult:
     return DemoResult(embedded_data_dir(), len(applied), report, program, sample)
 
 
-def sample_turning_job(conn, drawing: Path = SAMPLE_DRAWING) -> SampleJob:
+def sample_turning_job(conn: Connection, drawing: Path = SAMPLE_DRAWING) -> SampleJob:
     """Import the sample drawing as a turning job on the default lathe (from the Ø44 blank) and
     store its program, as `engine import-dxf` and `engine instantiate --job` do."""
     from ..turning.dxf_import import import_dxf

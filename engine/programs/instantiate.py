@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ..errors import EngineError
 from ..gears.case_base import CUT_KINDS_BY_COUNT, CaseBase, job_cutting_record
@@ -31,11 +32,14 @@ from .records import Planned, Program
 from .storage import Batch, store_many, store_one
 from .workers import PLANNING, plan_in_workers
 
+if TYPE_CHECKING:
+    from ..db.connection import Connection
+
 
 class Planner:
     """Everything shared by the gears of one run: machine, hob library, templates."""
 
-    def __init__(self, conn, machine: str | None = None, choices: Choices = Choices(), overrides=None,
+    def __init__(self, conn: Connection, machine: str | None = None, choices: Choices = Choices(), overrides=None,
                  draft: bool = False):
         self.conn = conn
         self.draft = draft   # the classes' drafts (an editor trying them), not their released versions
@@ -124,7 +128,7 @@ def _check_table_speed(gear: Gear, starts: int, hob_speed: float, machine: Machi
     check_table_speed(gear.id, gear.teeth, starts, hob_speed, machine)
 
 
-def instantiate_gear(conn, gear_id: int, *, machine: str | None = None, choices: Choices = Choices(),
+def instantiate_gear(conn: Connection, gear_id: int, *, machine: str | None = None, choices: Choices = Choices(),
                      overrides: dict | None = None, out: str | Path | None = None, force: bool = False,
                      draft: bool = False, dry_run: bool = False) -> Program:
     """Compute, check and store the program of one gear; write it to `out` if given (after the
@@ -142,7 +146,7 @@ def instantiate_gear(conn, gear_id: int, *, machine: str | None = None, choices:
     return program
 
 
-def instantiate_gears(conn, first: int | None = None, last: int | None = None, *,
+def instantiate_gears(conn: Connection, first: int | None = None, last: int | None = None, *,
                       machine: str | None = None, choices: Choices = Choices(), overrides=None,
                       out: str | Path | None = None, force: bool = False, progress=None, workers: int = 1,
                       draft: bool = False, skip_bad: bool = False, dry_run: bool = False) -> Batch:
@@ -191,7 +195,7 @@ def _counted(outcome, done: int, total: int, progress):
     return outcome
 
 
-def store_planned(conn, planned: list[Planned], files: ProgramFiles,
+def store_planned(conn: Connection, planned: list[Planned], files: ProgramFiles,
                   existing_job: int | None = None) -> list[Program]:
     """Store the programs (and their jobs, unless `existing_job`); their files are checked now
     and written by `files` after the caller's COMMIT."""

@@ -31,7 +31,7 @@ import errno
 import os
 import secrets
 from pathlib import Path
-from typing import Callable
+from typing import TYPE_CHECKING, Callable
 
 import psycopg
 from psycopg.pq import TransactionStatus
@@ -39,6 +39,9 @@ from psycopg.pq import TransactionStatus
 from ..errors import EngineError
 from ..library.nc_layout import NcLayout, nc_text
 from ..names import checked
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
 SUFFIX = ".MPF"
 # errno of open(O_TMPFILE) where the kernel or the file system does not support it
@@ -132,7 +135,7 @@ class ProgramFiles:
 
 
 @contextlib.contextmanager
-def files_after_commit(conn, out, force: bool = False, batch: bool = False):
+def files_after_commit(conn: Connection, out, force: bool = False, batch: bool = False):
     """Yield ProgramFiles for the block, which runs in a transaction that commits for real when
     the block ends; only then are the planned files written. Without --out (out None) the block
     may run inside the caller's transaction (a savepoint), as nothing is written."""
@@ -146,7 +149,7 @@ def files_after_commit(conn, out, force: bool = False, batch: bool = False):
 
 
 @contextlib.contextmanager
-def _committed(conn):
+def _committed(conn: Connection):
     """conn.transaction(), with a failed COMMIT said in one line (no file is written then)."""
     transaction = conn.transaction()
     transaction.__enter__()

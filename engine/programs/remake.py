@@ -10,6 +10,7 @@ from __future__ import annotations
 import re
 from dataclasses import replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ..errors import EngineError
 from ..gears.models import model_for_class
@@ -30,13 +31,16 @@ from .records import Planned, Program
 from .storage import Batch, store_programs
 from .workers import PLANNING
 
+if TYPE_CHECKING:
+    from ..db.connection import Connection
+
 JOB_COLUMNS = "id, gear_id, gear_class, machine, hob_id, params, module_params"
 
 
 class Remaker:
     """Machines and templates read once for all the jobs made again in one run."""
 
-    def __init__(self, conn, draft: bool = False):
+    def __init__(self, conn: Connection, draft: bool = False):
         self.conn = conn
         self.draft = draft   # the classes' drafts (an editor trying them), not their released versions
         self._machines: dict[str, Machine] = {}
@@ -102,7 +106,7 @@ class Remaker:
         return self._templates[gear_class]
 
 
-def check_program_name(conn, job_id: int, gear_id: int, params: dict) -> None:
+def check_program_name(conn: Connection, job_id: int, gear_id: int, params: dict) -> None:
     """A hobbing job's program may be renamed (a part number), but never to another gear's
     program name, GEAR<id> or the name another gear's job carries: its file would replace that
     gear's program on the control (names compared as the control does, ignoring case)."""
@@ -115,13 +119,13 @@ def check_program_name(conn, job_id: int, gear_id: int, params: dict) -> None:
                           f"or make a new job with `engine instantiate --gear {gear_id}`; nothing stored")
 
 
-def _other_gear_named(conn, name, gear_id: int) -> int | None:
+def _other_gear_named(conn: Connection, name, gear_id: int) -> int | None:
     row = conn.execute("SELECT gear_id FROM job WHERE upper(params ->> 'program_name') = upper(%s) "
                        "AND gear_id <> %s ORDER BY id LIMIT 1", (name, gear_id)).fetchone()
     return row[0] if row else None
 
 
-def instantiate_job(conn, job_id: int, out: str | Path | None = None, force: bool = False,
+def instantiate_job(conn: Connection, job_id: int, out: str | Path | None = None, force: bool = False,
                     draft: bool = False, dry_run: bool = False) -> Program:
     """Instantiate a stored job again with its stored (possibly edited) parameters. With `dry_run`,
     the same checks, nothing stored (engine.programs.batches): the program returned."""
@@ -135,14 +139,14 @@ def instantiate_job(conn, job_id: int, out: str | Path | None = None, force: boo
     return program
 
 
-def _stored_job(conn, job_id: int) -> tuple:
+def _stored_job(conn: Connection, job_id: int) -> tuple:
     job = conn.execute(f"SELECT {JOB_COLUMNS} FROM job WHERE id = %s", (job_id,)).fetchone()
     if job is None:
         raise EngineError(f"job {job_id} does not exist; `engine jobs list` shows what does")
     return job
 
 
-def instantiate_jobs(conn, first: int | None = None, last: int | None = None, *,
+def instantiate_jobs(conn: Connection, first: int | None = None, last: int | None = None, *,
                      out: str | Path | None = None, force: bool = False, progress=None, draft: bool = False,
                      skip_bad: bool = False, dry_run: bool = False) -> Batch:
     """Every stored job with first ≤ id ≤ last made again, every one tried: all programs stored,

@@ -19,11 +19,15 @@ Every expression is compiled and evaluated through the expression gate
 from __future__ import annotations
 
 from dataclasses import astuple, dataclass
+from typing import TYPE_CHECKING
 
 from .decision_table import CompiledRow, compile_row
 from .evaluator import EvaluationError, evaluate
 from .lint import known_names_of
 from .rows import Template
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
 CONDITION_COLUMNS = ("p_calc", "p_emit")
 
@@ -187,6 +191,6 @@ RULES = (
 )
 
 
-def class_findings(conn, gear_class: str, template: Template) -> list[Finding]:
+def class_findings(conn: Connection, gear_class: str, template: Template) -> list[Finding]:
     """The analysis of a stored class's template, with the names its model (or import) provides."""
     return analyse(template, known_names_of(conn, gear_class))

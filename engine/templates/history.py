@@ -8,11 +8,15 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from datetime import datetime
+from typing import TYPE_CHECKING
 
 from ..errors import EngineError
 from ..library.nc_layout import NcLayout, class_layout, store_layout
 from .rows import CSV_COLUMNS, TemplateRow
 from .store import replace_template
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
 
 @dataclass(frozen=True)
@@ -76,7 +80,7 @@ SELECT version, released_at, released_by, role, jsonb_array_length(tests), (impa
 FROM template_release WHERE gear_class = %s"""
 
 
-def history(conn, gear_class: str) -> list[VersionEntry]:
+def history(conn: Connection, gear_class: str) -> list[VersionEntry]:
     """Every stored version of the class, oldest first, with who made it, which rows changed, its
     state (released, retired, draft, superseded) and its release."""
     _require_class(conn, gear_class)
@@ -88,7 +92,7 @@ def history(conn, gear_class: str) -> list[VersionEntry]:
             in conn.execute(HISTORY, {"class": gear_class})]
 
 
-def diff(conn, gear_class: str, from_version: int, to_version: int) -> list[RowChange]:
+def diff(conn: Connection, gear_class: str, from_version: int, to_version: int) -> list[RowChange]:
     """Rows added, removed or changed from one version to the other, in row id order."""
     old = {row["id"]: row for row in version_rows_json(conn, gear_class, from_version)}
     new = {row["id"]: row for row in version_rows_json(conn, gear_class, to_version)}
@@ -96,7 +100,8 @@ def diff(conn, gear_class: str, from_version: int, to_version: int) -> list[RowC
             for row_id in sorted(old.keys() | new.keys()) if old.get(row_id) != new.get(row_id)]
 
 
-def layout_change(conn, gear_class: str, from_version: int, to_version: int) -> tuple[NcLayout, NcLayout] | None:
+def layout_change(conn: Connection, gear_class: str, from_version: int, to_version: int) -> tuple[NcLayout,
+                                                                                                  NcLayout] | None:
     """The layouts of the two versions if they differ (the bytes of their programs do), else None."""
     old, new = (class_layout(conn, gear_class, version) for version in (from_version, to_version))
     return None if old == new else (old, new)
@@ -107,7 +112,7 @@ def _row_change(row_id: int, old: dict | None, new: dict | None) -> RowChange:
     return RowChange(row_id, kind, old, new)
 
 
-def restore(conn, gear_class: str, version: int) -> tuple[bool, int]:
+def restore(conn: Connection, gear_class: str, version: int) -> tuple[bool, int]:
     """Make the class's template what it was in `version`, its rows and its layout, as a new
     version (history stays append-only). Returns (changed, the class's version now); unchanged if identical.
 
@@ -123,7 +128,7 @@ def restore(conn, gear_class: str, version: int) -> tuple[bool, int]:
     return changed, current
 
 
-def version_rows_json(conn, gear_class: str, version: int) -> list[dict]:
+def version_rows_json(conn: Connection, gear_class: str, version: int) -> list[dict]:
     """The class's assembled rows in `version`; an error naming the stored versions if absent."""
     found = conn.execute("SELECT rows FROM template_version_rows WHERE gear_class = %s AND version = %s",
                          (gear_class, version)).fetchone()
@@ -134,12 +139,12 @@ def version_rows_json(conn, gear_class: str, version: int) -> list[dict]:
     return found[0]
 
 
-def _version_list(conn, gear_class: str) -> str:
+def _version_list(conn: Connection, gear_class: str) -> str:
     versions = [row[0] for row in conn.execute(
         "SELECT version FROM template_version_rows WHERE gear_class = %s ORDER BY version", (gear_class,))]
     return ", ".join(map(str, versions)) or "none"
 
 
-def _require_class(conn, gear_class: str) -> None:
+def _require_class(conn: Connection, gear_class: str) -> None:
     if conn.execute("SELECT 1 FROM gear_class WHERE name = %s", (gear_class,)).fetchone() is None:
         raise EngineError(f"gear class {gear_class!r} does not exist; see `engine template list`")

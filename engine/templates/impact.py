@@ -15,6 +15,7 @@ from __future__ import annotations
 import difflib
 import json
 from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING
 
 from ..errors import EngineError
 from ..gears.models import model_for_class
@@ -26,6 +27,9 @@ from .history import layout_change
 from .rows import Template
 from .store import class_and_descendants
 from .versions import draft_template, released_template
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
 DIFFS_SHOWN = 5   # unified diffs the CLI prints (all of them with --json)
 
@@ -99,7 +103,7 @@ class Impact:
                 "layout": [change.as_json() for change in self.layouts.values()]}
 
 
-def impact(conn, gear_class: str) -> Impact:
+def impact(conn: Connection, gear_class: str) -> Impact:
     """Every stored job of the class and its descendants made with the draft, compared with the
     released program."""
     pairs = _template_pairs(conn, class_and_descendants(conn, gear_class))
@@ -115,7 +119,7 @@ def impact(conn, gear_class: str) -> Impact:
     return report
 
 
-def _template_pairs(conn, classes: list[str]) -> dict[str, tuple[Template, Template, int]]:
+def _template_pairs(conn: Connection, classes: list[str]) -> dict[str, tuple[Template, Template, int]]:
     """(released, draft evaluated as the released version, the draft's own version) of each class
     that has a released template; the draft is the released one for a class without a draft."""
     pairs = {}
@@ -129,7 +133,7 @@ def _template_pairs(conn, classes: list[str]) -> dict[str, tuple[Template, Templ
     return pairs
 
 
-def _layout_changes(conn, pairs: dict[str, tuple[Template, Template, int]]) -> dict[str, LayoutChange]:
+def _layout_changes(conn: Connection, pairs: dict[str, tuple[Template, Template, int]]) -> dict[str, LayoutChange]:
     """The classes whose draft has another layout than their released version."""
     changes = {}
     for name, (released, _, draft_version) in pairs.items():
@@ -161,7 +165,7 @@ class _Made:
     """The programs of distinct job inputs, made once: with the draft (or its failure) and, where the
     stored program is not the released one, with the released template."""
 
-    def __init__(self, conn, pairs: dict[str, tuple[Template, Template, int]]):
+    def __init__(self, conn: Connection, pairs: dict[str, tuple[Template, Template, int]]):
         self.pairs, self.inputs = pairs, _JobInputs(conn)
         self.drafts: dict[tuple, list[str] | EngineError] = {}
         self.releases: dict[tuple, list[str]] = {}
@@ -204,7 +208,7 @@ class _JobInputs:
     """A stored job's parameters as its template reads them, as engine.programs.remake makes them:
     a hobbing job's cycle time from its stored feeds, a turning job's moves from its passes."""
 
-    def __init__(self, conn):
+    def __init__(self, conn: Connection):
         self.conn, self.machines, self.shapes = conn, {}, {}
 
     def of(self, gear_class: str, machine_name: str, params_text: str, modules_text: str) -> tuple[dict, dict]:

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from psycopg.types.json import Jsonb
 
@@ -19,6 +20,9 @@ from ..names import checked
 from .job_params import ProfileOptions, turning_job
 from .model import ISO_PROGRAM_NUMBERS, job_passes, key, present_operations
 from .planning import lathe, plan_turning_job, turning_class
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
 INSERT_TURNING_JOB = """
 INSERT INTO job (id, gear_id, gear_class, machine, hob_id, params, module_params)
@@ -37,7 +41,7 @@ class ImportReport:
     notes: list[str] = field(default_factory=list)
 
 
-def import_dxf(conn, path: str | Path, machine_name: str | None = None,
+def import_dxf(conn: Connection, path: str | Path, machine_name: str | None = None,
                options: ProfileOptions = ProfileOptions(), alternate: list[int] | None = None,
                program_name: str | None = None, draft: bool = False, profile_layer: str | None = None) -> ImportReport:
     """Read the drawing and store its job; EngineError (nothing stored) if it cannot become one.
@@ -53,7 +57,7 @@ def import_dxf(conn, path: str | Path, machine_name: str | None = None,
         return _import(conn, (path, profile_layer), machine, gear_class, options, alternate, program_name, draft)
 
 
-def _import(conn, source: tuple, machine, gear_class: str, options: ProfileOptions, alternate, program_name,
+def _import(conn: Connection, source: tuple, machine, gear_class: str, options: ProfileOptions, alternate, program_name,
             draft: bool) -> ImportReport:
     drawing = read_drawing(*source)   # (path, profile layer)
     with conn.transaction():
