@@ -12,6 +12,7 @@ if TYPE_CHECKING:
     from typing import TypeAlias
 
     import psycopg
+    from psycopg import Cursor
     from psycopg.rows import TupleRow
 
     # every connection the engine opens reads rows as tuples (psycopg's default row factory)
@@ -82,3 +83,10 @@ def connect(database_url: str | None = None, **kwargs: Any) -> Connection:
         raise EngineError(f"cannot connect to {where}: {first_line}") from error
     read_bounded_json(conn)
     return conn
+
+
+def scalar(cursor: Cursor[TupleRow]) -> Any:
+    """The first column of the one row a query always returns (a count, EXISTS, a function's value)."""
+    row = cursor.fetchone()
+    assert row is not None, "a query that always returns a row returned none"
+    return row[0]

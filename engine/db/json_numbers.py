@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import math
+from typing import Any
 from typing import TYPE_CHECKING
 
 from ..errors import EngineError
@@ -22,7 +23,7 @@ WHOLE_RUN = "'[^0-9.][0-9]{16,}[^0-9.]'"   # a whole number of 16 digits or more
 FIND_JOBS = f"SELECT id FROM job WHERE params::text ~ {WHOLE_RUN} OR module_params::text ~ {WHOLE_RUN}"
 
 
-def bounded_loads(text: str | bytes):
+def bounded_loads(text: str | bytes) -> Any:
     """json.loads, refusing numbers no parameter can be (EngineError)."""
     return json.loads(text, parse_int=_whole, parse_float=_decimal)
 

@@ -12,6 +12,7 @@ from psycopg import sql
 
 from ..errors import EngineError
 from ..paths import MIGRATIONS_DIR
+from .connection import scalar
 
 if TYPE_CHECKING:
     from .connection import Connection
@@ -84,8 +85,8 @@ def status(conn: Connection, directory: Path | None = None) -> list[MigrationSta
         record = applied.get(migration.version)
         states.append(MigrationState(
             migration,
-            record[1] if record else None,
-            bool(record) and record[0] != migration.checksum,
+            record[1] if record is not None else None,
+            record is not None and record[0] != migration.checksum,
         ))
     return states
 
@@ -142,7 +143,7 @@ def _apply(conn: Connection, migration: Migration) -> None:
 
 
 def _applied(conn: Connection) -> dict[str, tuple[str, object]]:
-    exists = conn.execute("SELECT to_regclass('schema_migration') IS NOT NULL").fetchone()[0]
+    exists = scalar(conn.execute("SELECT to_regclass('schema_migration') IS NOT NULL"))
     if not exists:
         return {}
     rows = conn.execute("SELECT version, checksum, applied_at FROM schema_migration").fetchall()

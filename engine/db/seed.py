@@ -7,7 +7,7 @@ import json
 import tempfile
 from dataclasses import dataclass, field, fields
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from psycopg import sql
 from psycopg.types.json import Jsonb
@@ -41,10 +41,10 @@ SHOP_TABLES = SEED_TABLES[:1]   # the machines; the hobs are samples
 
 @dataclass
 class SeedReport:
-    added: dict = field(default_factory=dict)
-    created: list = field(default_factory=list)   # the classes this seed created
+    added: dict[str, int] = field(default_factory=dict)
+    created: list[str] = field(default_factory=list)   # the classes this seed created
     # sample gear id → golden tests of it not added: the database's gear of that id is another
-    skipped_tests: dict = field(default_factory=dict)
+    skipped_tests: dict[int, int] = field(default_factory=dict)
 
     def count(self, what: str, number: int = 1) -> None:
         self.added[what] = self.added.get(what, 0) + number
@@ -150,7 +150,7 @@ def _release_seeded(conn: Connection, classes: list[str], report: SeedReport) ->
         report.count("template releases", len(released.fetchall()))
 
 
-def _read(path: Path, kind: CsvKind) -> list[dict]:
+def _read(path: Path, kind: CsvKind) -> list[dict[str, Any]]:
     """The rows of a seed file as {column: text}, an empty cell None (the column's default)."""
     return [{key: (value if value != "" else None) for key, value in row.items()}
             for _, row in read_csv_file(path, kind).rows()]
@@ -163,7 +163,7 @@ def _seed_classes(conn: Connection, directory: Path, report: SeedReport) -> None
             report.created.append(row["name"])
 
 
-def _insert_missing(conn: Connection, table: str, key: str, rows: list[dict]) -> int:
+def _insert_missing(conn: Connection, table: str, key: str, rows: list[dict[str, Any]]) -> int:
     added = 0
     for row in rows:
         row = {column: value for column, value in row.items() if value is not None}   # empty: the default
@@ -208,8 +208,8 @@ def _add_missing_gears(conn: Connection, source: Path, report: SeedReport) -> No
         return
     with tempfile.TemporaryDirectory() as folder:
         subset = Path(folder) / source.name
-        with subset.open("w", encoding="utf-8", newline="") as file:
-            writer = csv.DictWriter(file, header)
+        with subset.open("w", encoding="utf-8", newline="") as written:
+            writer = csv.DictWriter(written, header)
             writer.writeheader()
             writer.writerows(missing)
         report.count("gears", import_gears(conn, subset).imported)
