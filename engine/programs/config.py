@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import os
 import re
+import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -34,9 +35,9 @@ from ..errors import EngineError
 from ..gears.records import DEFAULT_HOBBING_MACHINE
 from ..library.nc_layout import ENDING_NAMES
 
-try:
+if sys.version_info >= (3, 11):
     import tomllib
-except ModuleNotFoundError:   # Python 3.10
+else:   # Python 3.10
     import tomli as tomllib
 
 APP = "nc-template-engine"
