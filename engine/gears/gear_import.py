@@ -62,7 +62,7 @@ declare(parse_class_name, "gear class", "write the name of a leaf class (engine 
 
 # --- the columns of design notes §9 ------------------------------------------------------
 
-POSITIVE = dict(check=lambda value: value > 0, rule="must be greater than 0")
+POSITIVE: dict[str, Any] = dict(check=lambda value: value > 0, rule="must be greater than 0")
 
 COLUMNS: tuple[Column, ...] = (
     Column("gear_id", parse_positive_whole, required=True, db_name="id"),
@@ -231,7 +231,7 @@ def _complete(gear: dict[str, Any], classes: Classes, bad: set[str], line: int) 
     for reads, step in COMPLETION_STEPS:
         if bad.isdisjoint(reads):
             found = _as_problems(line, step(gear, classes))
-            bad = bad | {problem.column for problem in found}
+            bad = bad | {problem.column for problem in found if problem.column is not None}
             problems += found
     return problems
 

@@ -42,8 +42,9 @@ class Walk:
         self.units, self.solids, self.worm_wheel, self.shift_end = units, units + setup, worm_wheel, shift_end
         self.senses = Senses.of(machine)
         self.body = HobBody(hob.tip_diameter / 2, hob.length / 2)
-        load = (machine.load_x, machine.load_z)
-        self.program = {"X": load[0], "Z": load[1]} if None not in load else {}   # program values, for time
+        load_x, load_z = machine.load_x, machine.load_z
+        # program values, for time
+        self.program = {"X": load_x, "Z": load_z} if load_x is not None and load_z is not None else {}
         self.position = {axis: self.senses.position(axis, value) for axis, value in self.program.items()}
         self.swivel = 0.0
         self.swivel_known = False
@@ -94,21 +95,21 @@ class Walk:
         code = step.line.partition(";")[0].strip()
         self.coupling = read_coupling(code, self.senses)
         self.session += 1
-        teeth = [unit.teeth for unit in self.units]
+        teeth = [unit.teeth for unit in self.units if unit.teeth is not None]   # every unit is toothed
         problem = generated_teeth_problem(self.coupling, self.hob, teeth)
         if problem:
             self.report.add(step.number, step.line, problem)
-        self._describe_coupling()
+        self._describe_coupling(self.coupling)
 
-    def _describe_coupling(self) -> None:
-        teeth = self.coupling.teeth(self.hob.starts)
+    def _describe_coupling(self, coupling: Coupling) -> None:
+        teeth = coupling.teeth(self.hob.starts)
         self.report.teeth.append(f"{teeth:g}")
         if self.worm_wheel:
             beta = lead_angle(self.hob) * hand_sign(self.hob.hand) - self.swivel
-            hand = "R" if beta >= 0 else "L"
-            self.report.helix.append(f"{hand_name(hand)} β {abs(beta):.3f}° (hob lead and swivel)")
+            side = "R" if beta >= 0 else "L"
+            self.report.helix.append(f"{hand_name(side)} β {abs(beta):.3f}° (hob lead and swivel)")
             return
-        beta, hand, lead = helix_of(self.coupling.factors.get("Z", 0.0), self.gear, round(teeth) or 1)
+        beta, hand, lead = helix_of(coupling.factors.get("Z", 0.0), self.gear, round(teeth) or 1)
         self.report.helix.append("spur" if hand is None else f"{hand_name(hand)} β {beta:.3f}° lead {lead:.1f} mm")
 
     def _shift(self, step) -> None:
@@ -209,7 +210,7 @@ class Walk:
     def _check_cut(self, step, start: dict, end: dict) -> None:
         moving = frozenset(axis for axis in AXES if axis in start and abs(end[axis] - start[axis]) > 1e-9)
         teeth = self._cut_teeth()
-        problems = []
+        problems: list[str | None] = []   # None: no problem
         if "Y" not in self.position:
             problems.append("Y (the hob shift) is not positioned before the cut: the generating zone lies "
                             "wherever the last program left the hob")
@@ -220,14 +221,20 @@ class Walk:
         if "Y" in self.position and not self.worm_wheel:
             problems.append(zone_problem(self.position["Y"], self.gear, self.hob))
         if teeth is not None:
-            problems += coupling_problems(self.coupling, self.gear, self.hob, teeth, self.worm_wheel, moving)
+            problems += coupling_problems(self._coupled, self.gear, self.hob, teeth, self.worm_wheel, moving)
         for problem in filter(None, problems):
             if (self.session, problem) not in self.said:
                 self.said.add((self.session, problem))
                 self.report.add(step.number, step.line, problem)
 
+    @property
+    def _coupled(self) -> Coupling:
+        """The coupling, where the walk cuts (a cut is one only while the table is coupled)."""
+        assert self.coupling is not None
+        return self.coupling
+
     def _cut_teeth(self) -> int | None:
-        teeth = self.coupling.teeth(self.hob.starts)
+        teeth = self._coupled.teeth(self.hob.starts)
         return int(round(teeth)) if abs(teeth - round(teeth)) < 1e-9 else None
 
     def _contacts(self, step, motion: int, cutting: bool, start: dict, end: dict) -> None:
@@ -268,13 +275,14 @@ class Walk:
         teeth = self._cut_teeth()
         if teeth is None:
             return
+        assert self.speed is not None   # a cut is one only with the spindle turning at an S above 0
         if self.cut is None or self.cut.teeth != teeth:
             self._end_cut()
-            table = abs(self.coupling.k_b) * self.speed
+            table = abs(self._coupled.k_b) * self.speed
             before = {id(unit): unit.reach.copy() for unit in self.units if unit.teeth == teeth}
             self.cut = Cut(step.number, step.line, teeth, table, before)
         self.cut.add(start, end, velocities)
-        table = abs(self.coupling.k_b) * self.speed        # the spindle speed now, not the cut's first
+        table = abs(self._coupled.k_b) * self.speed        # the spindle speed now, not the cut's first
         if not self.worm_wheel and table > 0 and velocities.get("Z"):
             self._refuse(step, feed_problem(abs(velocities["Z"]) / table, self.gear, self.hob))
         if table > 0 and velocities.keys() == {"X"}:          # the radial infeed is bounded by §C too
@@ -313,7 +321,7 @@ class Walk:
             self.report.add(*last, "no `; CYCLE TIME <m> MIN` header line: a hobbing program states its cycle "
                                    f"time (the simulation takes {self.report.cycle_time:.2f} min)")
 
-    def _check_depth(self, unit: Solid, last: tuple) -> None:
+    def _check_depth(self, unit: Solid, last: tuple[int, str]) -> None:
         cut = self.last_cut_of.get(id(unit))
         if cut is None:
             self.report.add(*last, f"{unit.name} is never cut")
