@@ -90,7 +90,7 @@ class Collected:
     other_layers: Counter = field(default_factory=Counter)
     profile_layer: str | None = PROFILE_LAYER   # None: every layer is collected, the profile's chosen after
     linetypes: dict[str, str] = field(default_factory=dict)   # layer name (upper case) → its linetype
-    centre_lines: list[Segment] = field(default_factory=list)
+    centre_lines: list[Line] = field(default_factory=list)
     hidden: Counter = field(default_factory=Counter)
     hidden_lines: list[Segment] = field(default_factory=list)
     hatches: list[list[tuple[float, float]]] = field(default_factory=list)
@@ -108,6 +108,7 @@ def read_drawing(path: str | Path, profile_layer: str | None = None) -> Drawing:
         collected = collect(drawing_file.doc.modelspace(), scale, given, layer_linetypes(drawing_file.doc))
     chosen = choose_layer(collected, scale) if given is None else []
     profile_layer = collected.profile_layer
+    assert profile_layer is not None   # the one given, or choose_layer's
     layer0 = collected.layers.pop(profile_layer, LayerContent())
     chosen += all_dash_dot(layer0, collected, profile_layer)
     if not layer0.segments:
@@ -275,7 +276,7 @@ def operation(name: str, number: int, content: LayerContent, scale: float,
         raise DxfError(f"layer {name!r} (operation {number}) has a tool path of {len(content.segments)} "
                        f"segment(s) but no @G code; add a TEXT like '@GROUGH' on that layer "
                        f"(types: ROUGH SLOT FINISH THREAD FACE PART)")
-    kind = codes.pop("kind")
+    kind = str(codes.pop("kind"))   # layer_codes reads @G as text
     if not content.segments:
         raise DxfError(f"layer {name!r} (operation {number}, @G {kind}) has no tool path; "
                        "draw the tool-centre path on that layer")

@@ -203,7 +203,7 @@ def _field_addresses(o: str, name: str) -> set:
         if isinstance(part, ast.FormattedValue) and name in {node.id for node in ast.walk(part)
                                                               if isinstance(node, ast.Name)}:
             places.add(len(line))
-        line += part.value if isinstance(part, ast.Constant) else "1"
+        line += str(part.value) if isinstance(part, ast.Constant) else "1"   # an f-string's text is str
     return _addresses_at(line, places)
 
 

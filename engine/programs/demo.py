@@ -21,6 +21,8 @@ from ..paths import SAMPLE_DRAWING
 
 if TYPE_CHECKING:
     from ..db.connection import Connection
+    from ..turning.dxf_import import ImportReport
+    from .records import Program
 
 DEMO_DATABASE = "engine_demo"
 # mm: the blank the sample drawing's roughing starts from (seed_templates/drawings/README.md);
@@ -31,8 +33,8 @@ SAMPLE_STOCK_DIAMETER = 44.0
 @dataclass(frozen=True)
 class SampleJob:
     drawing: Path           # the sample drawing, to copy as the start of one's own
-    job: object             # engine.turning.dxf_import's ImportReport
-    program: object         # engine.programs.instantiate's Program
+    job: ImportReport
+    program: Program
 
 
 @dataclass(frozen=True)
@@ -40,7 +42,7 @@ class DemoResult:
     data_dir: Path          # where the embedded server keeps its data (database engine_demo)
     applied: int            # migrations applied by this run
     report: SeedReport
-    program: object         # engine.programs.instantiate's Program
+    program: Program
     sample: SampleJob | None = None   # with --turning: the job the program was made for
 
 

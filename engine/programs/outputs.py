@@ -48,7 +48,8 @@ SUFFIX = ".MPF"
 NO_TMPFILE = (errno.EOPNOTSUPP, errno.EISDIR, errno.EINVAL, errno.ENOENT)
 PROC_FD = Path("/proc/self/fd")
 # machine name -> the line ending configured for its files, or None (its class's)
-CONFIGURED_ENDING = contextvars.ContextVar("configured_ending", default=None)
+CONFIGURED_ENDING: contextvars.ContextVar[Callable[[str], str | None] | None] = contextvars.ContextVar(
+    "configured_ending", default=None)
 
 
 class ProgramFiles:
@@ -95,12 +96,14 @@ class ProgramFiles:
 
     def _targets(self, names: list[str]) -> dict[str, Path]:
         """One program: --out is the file (unless a folder is meant); a batch: --out is their folder."""
-        if len(names) == 1 and not self.folder and not self.out.is_dir():
-            return {names[0]: self.out}
-        if self.out.exists() and not self.out.is_dir():
-            raise EngineError(f"--out {self.out} is a file; give a folder for a batch of programs")
-        _refuse_same_program_twice(names, self.out)
-        return {name: _inside(self.out, name) for name in names}
+        out = self.out
+        assert out is not None   # write() plans files only for an --out
+        if len(names) == 1 and not self.folder and not out.is_dir():
+            return {names[0]: out}
+        if out.exists() and not out.is_dir():
+            raise EngineError(f"--out {out} is a file; give a folder for a batch of programs")
+        _refuse_same_program_twice(names, out)
+        return {name: _inside(out, name) for name in names}
 
     def _refuse_existing(self, targets: list[Path]) -> None:
         """An existing file is replaced only with --force; a file naming the same program in
