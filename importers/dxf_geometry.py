@@ -76,7 +76,10 @@ def unit_scale(insunits: int | None) -> tuple[str, float, bool]:
     try:
         from ezdxf import units
 
-        return units.decode(insunits), units.conversion_factor(insunits, units.MM), False
+        name = units.decode(insunits)
+        assert name is not None   # only 0, unitless, has no name
+        # ezdxf annotates InsertUnits, an IntEnum, and indexes its table with any $INSUNITS int
+        return name, units.conversion_factor(insunits, units.MM), False   # type: ignore[arg-type]
     except (KeyError, IndexError, ValueError):
         raise DxfError(f"$INSUNITS = {insunits} is not a known unit code; set the drawing units "
                        "(e.g. 4 = millimetres) in the CAD program") from None

@@ -81,7 +81,7 @@ def split_section(segments: list[Segment], centre_lines: list[Line], where: str)
         axis = centre_axis(line)
         framed = [] if axis is None else [axis.segment(s) for view in views(segments)
                                           if alongside(axis, line, view) for s in view]
-        if framed and min(bounds(s)[2] for s in framed) < 0.0 < max(bounds(s)[3] for s in framed) \
+        if axis is not None and framed and min(bounds(s)[2] for s in framed) < 0.0 < max(bounds(s)[3] for s in framed) \
                 and mirror_images(framed, where, axis.source):
             return split_section_refusal(framed, where, axis.source)
     return None

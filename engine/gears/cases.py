@@ -16,6 +16,7 @@ import pandas as pd
 import psycopg
 from psycopg import sql
 
+from ..db.connection import scalar
 from ..db.listing import records
 from ..csv_reader import (Column, CsvError, CsvKind, parse_number, parse_positive_whole, parse_text, parse_whole,
                           read_csv_file, refuse)
@@ -185,7 +186,7 @@ def confirm_job(conn: Connection, job_id: int) -> list[int]:
     machine can run, becomes a case; runners cannot add cases any other way."""
     try:
         with conn.transaction():
-            return conn.execute("SELECT confirm_job_cases(%s)", (job_id,)).fetchone()[0]
+            return scalar(conn.execute("SELECT confirm_job_cases(%s)", (job_id,)))
     except (psycopg.errors.CheckViolation, psycopg.errors.NoDataFound) as error:
         raise EngineError(error.diag.message_primary) from None
 

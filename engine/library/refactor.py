@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING
 
 import psycopg
 
+from ..db.connection import scalar
 from ..errors import EngineError
 from ..templates.store import load_template
 from .intended import list_and_remember
@@ -138,7 +139,7 @@ def _refactor_once(conn: Connection, threshold: float, step) -> RefactorReport:
         check_invariants(conn, snapshot)
         return RefactorReport(changed=bool(repointed or deleted), components_before=before,
                               components_after=_count_components(conn),
-                              shared=conn.execute(COMPONENTS_SHARED).fetchone()[0],
+                              shared=scalar(conn.execute(COMPONENTS_SHARED)),
                               near_duplicates=listed.pairs, threshold=threshold,
                               new=listed.new, known=listed.known, intended=listed.intended)
 
@@ -154,7 +155,7 @@ def _stepper(progress):
 
 
 def _count_components(conn: Connection) -> int:
-    return conn.execute("SELECT count(*)::int FROM component").fetchone()[0]
+    return scalar(conn.execute("SELECT count(*)::int FROM component"))
 
 
 def template_digests(conn: Connection) -> dict[str, tuple[int, str]]:

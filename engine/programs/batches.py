@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING
 
 from psycopg.types.json import Jsonb
 
+from ..db.connection import scalar
 from ..errors import EngineError
 from .records import Planned, Program
 from .storage import Batch, Lineage, refuse_unsafe
@@ -120,7 +121,7 @@ def dry_program(conn: Connection, planned: Planned, job_id: int | None) -> Progr
     checked(planned)
     template = planned.template
     hashes = {} if job_id is not None else \
-        {None: conn.execute(NEW_INPUT_HASH, (Jsonb(planned.params), Jsonb(planned.module_params))).fetchone()[0]}
+        {None: scalar(conn.execute(NEW_INPUT_HASH, (Jsonb(planned.params), Jsonb(planned.module_params))))}
     lineage = Lineage(conn, [planned.machine], [(template.gear_class, template.version)],
                       [job_id] if job_id is not None else [], hashes)
     lines, row_ids = lineage.added(DRY_RUN_ID, job_id, planned.machine, template.gear_class, template.version,

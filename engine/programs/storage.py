@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING
 from psycopg.errors import ForeignKeyViolation
 from psycopg.types.json import Jsonb
 
+from ..db.connection import scalar
 from ..errors import EngineError
 from ..names import checked, line_breaking, shown
 from .lineage import lineage_line, lineage_words, refuse_lineage_shaped, with_lineage
@@ -59,9 +60,9 @@ def store_one(conn: Connection, planned: Planned, existing_job: int | None, path
 def _stored_one(conn: Connection, planned: Planned, existing_job: int | None, path: str | None) -> Program:
     job_id = existing_job
     if job_id is None:
-        job_id = conn.execute(INSERT_JOB, (planned.gear_id, planned.gear_class, planned.machine, planned.hob_id,
-                                           Jsonb(planned.params), Jsonb(planned.module_params),
-                                           Jsonb(planned.cutting or {}))).fetchone()[0]
+        job_id = scalar(conn.execute(INSERT_JOB, (planned.gear_id, planned.gear_class, planned.machine,
+                                                  planned.hob_id, Jsonb(planned.params), Jsonb(planned.module_params),
+                                                  Jsonb(planned.cutting or {}))))
     program_id = _next_ids(conn, "program_id_seq", 1)[0]
     template = planned.template
     lines, row_ids = Lineage(conn, [planned.machine], [(template.gear_class, template.version)], [job_id]).added(

@@ -10,6 +10,7 @@ from dataclasses import dataclass
 from datetime import datetime
 from typing import TYPE_CHECKING
 
+from ..db.connection import scalar
 from ..errors import EngineError
 from ..library.nc_layout import NcLayout, class_layout, store_layout
 from .rows import CSV_COLUMNS, TemplateRow
@@ -124,7 +125,7 @@ def restore(conn: Connection, gear_class: str, version: int) -> tuple[bool, int]
             raise EngineError(f"class {gear_class!r} version {version} has no template rows; nothing to restore")
         changed = replace_template(conn, gear_class, rows)
         changed = store_layout(conn, gear_class, class_layout(conn, gear_class, version)) or changed
-        current = conn.execute("SELECT template_version FROM gear_class WHERE name = %s", (gear_class,)).fetchone()[0]
+        current = scalar(conn.execute("SELECT template_version FROM gear_class WHERE name = %s", (gear_class,)))
     return changed, current
 
 

@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING
 from psycopg.errors import InsufficientPrivilege
 from psycopg.types.json import Jsonb
 
+from ..db.connection import scalar
 from ..errors import EngineError
 from .analysis import class_findings
 from .impact import Impact, impact
@@ -120,7 +121,8 @@ def drafts_below(conn: Connection, gear_class: str) -> list[str]:
 def _record(conn: Connection, report: ReleaseReport) -> int:
     try:
         with conn.transaction():
-            return conn.execute(RELEASE, (report.gear_class, report.version, report.hash, Jsonb(report.tests),
-                                          Jsonb(report.impact.summary()), Jsonb(report.checks))).fetchone()[0]
+            return scalar(conn.execute(RELEASE, (report.gear_class, report.version, report.hash,
+                                                 Jsonb(report.tests), Jsonb(report.impact.summary()),
+                                                 Jsonb(report.checks))))
     except InsufficientPrivilege:
-        raise EngineError(_role_needed(conn.execute("SELECT current_user").fetchone()[0])) from None
+        raise EngineError(_role_needed(scalar(conn.execute("SELECT current_user")))) from None

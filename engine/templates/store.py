@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING
 
 from psycopg.types.json import Jsonb
 
+from ..db.connection import scalar
 from ..db.listing import records
 from ..errors import EngineError
 from ..names import checked
@@ -99,7 +100,7 @@ def replace_template(conn: Connection, gear_class: str, rows: list[TemplateRow],
     with conn.transaction():
         inherited = inherited_rows(conn, gear_class)
         check(gear_class, merge_rows(inherited, rows))
-        changed = conn.execute(REPLACE, (gear_class, Jsonb([asdict(row) for row in rows]))).fetchone()[0]
+        changed = scalar(conn.execute(REPLACE, (gear_class, Jsonb([asdict(row) for row in rows]))))
         if changed:
             store_translations(conn, rows)
     return changed

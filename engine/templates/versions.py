@@ -9,6 +9,7 @@ from __future__ import annotations
 from dataclasses import replace
 from typing import TYPE_CHECKING
 
+from ..db.connection import scalar
 from ..errors import EngineError
 from .rows import Template, TemplateRow
 from .store import load_template
@@ -41,7 +42,7 @@ def draft_template(conn: Connection, gear_class: str) -> Template:
     """The class's current rows (its draft, or its released version if it has no draft), marked
     whether they are a draft."""
     template = load_template(conn, gear_class)
-    released = conn.execute(RELEASED_VERSION, (gear_class,)).fetchone()[0]
+    released = scalar(conn.execute(RELEASED_VERSION, (gear_class,)))
     return replace(template, draft=released != template.version)
 
 
@@ -51,4 +52,4 @@ def runnable_template(conn: Connection, gear_class: str, draft: bool = False) ->
 
 
 def released_version(conn: Connection, gear_class: str) -> int | None:
-    return conn.execute(RELEASED_VERSION, (gear_class,)).fetchone()[0]
+    return scalar(conn.execute(RELEASED_VERSION, (gear_class,)))

@@ -15,6 +15,7 @@ from psycopg.types.json import Jsonb
 
 from importers.dxf_drawing import read_drawing
 
+from ..db.connection import scalar
 from ..memory import no_cycle_collection
 from ..names import checked
 from .job_params import ProfileOptions, turning_job
@@ -61,7 +62,7 @@ def _import(conn: Connection, source: tuple, machine, gear_class: str, options: 
             draft: bool) -> ImportReport:
     drawing = read_drawing(*source)   # (path, profile layer)
     with conn.transaction():
-        job_id = conn.execute("SELECT nextval('job_id_seq')").fetchone()[0]
+        job_id = scalar(conn.execute("SELECT nextval('job_id_seq')"))
         program_number = (job_id - 1) % ISO_PROGRAM_NUMBERS + 1    # the job id, wrapped into O0001 … O8999
         job = turning_job(drawing, machine.name, gear_class, program_number, options, alternate, program_name)
         passes = job_passes(job.params, job.module_params)
