@@ -4,12 +4,16 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, fields, replace
 from decimal import Decimal
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, TypeVar
 
 from ..csv_reader import MAX_MAGNITUDE   # the CSV readers refuse larger numbers; so do the records
 from ..errors import EngineError
 
 if TYPE_CHECKING:
+    from collections.abc import Sequence
+
+    from _typeshed import DataclassInstance
+
     from ..db.connection import Connection
 
 TOOTH_DEPTH = Decimal("2.25")  # full tooth depth in modules: root = tip − 2·2.25·m
@@ -149,7 +153,10 @@ def _columns(record_type, exclude=frozenset()) -> str:
 
 
 
-def _as_float(record_type, row) -> object:
+Record = TypeVar("Record", bound="DataclassInstance")   # Gear, Hob, Machine
+
+
+def _as_float(record_type: type[Record], row: Sequence[Any]) -> Record:
     """numeric columns arrive as Decimal; models compute in float, so each must be a finite
     float of a plausible size (a record edited in SQL is read as strictly as a file)."""
     values = [float(v) if isinstance(v, Decimal) else v for v in row]

@@ -9,6 +9,8 @@ working area with every move, the load position included. Every artist carries a
 name in the SVG, and what the tests read)."""
 from __future__ import annotations
 
+from typing import Any
+
 from matplotlib.patches import Polygon, Rectangle
 
 from ..pictures import literal
@@ -18,7 +20,7 @@ from .plot_geometry import (approach_pose, axial_profile, cut_pass, full_depth_p
 BLANK_FILL = "0.82"
 SETUP_FILL = "0.65"
 RAPID_STYLE = (0, (4, 3))
-AREA_STYLE = dict(fill=False, edgecolor="tab:red", linestyle=(0, (8, 3)), linewidth=1.0)
+AREA_STYLE: dict[str, Any] = dict(fill=False, edgecolor="tab:red", linestyle=(0, (8, 3)), linewidth=1.0)
 CUT_COLOURS = ("tab:blue", "tab:orange", "tab:green", "tab:purple", "tab:brown", "tab:pink", "tab:olive")
 HATCHES = {"the fixture": "//", "the tailstock": "\\\\"}
 CROWNING_VISIBLE = 1.0  # mm: a pass whose X varies less than this is drawn magnified beside the view
@@ -84,6 +86,7 @@ def draw_hob_poses(axes, scene) -> list[str]:
 
 def draw_approach(axes, scene) -> str:
     hob, approach = scene.hob, approach_pose(scene.recording.cuts)
+    assert approach is not None   # drawn only where the recording has one
     draw_hob(axes, scene, approach, "hob at approach", "0.45", (0, (3, 2)))
     return (f"hob {hob.id} ⌀{hob.tip_diameter:g} × {hob.length:g} at approach X{approach['X']:.3f} "
             f"Z{approach['Z']:.3f}")

@@ -153,8 +153,9 @@ def axial_line(path: list[Segment]) -> tuple[float, float, float] | None:
 
 def crest_and_root(paths: list[list[Segment]]) -> tuple[tuple[float, float, float], float]:
     """((start z, end z, radius) of the crest line, root radius) of a THREAD layer."""
-    lines = [axial_line(path) for path in paths]
-    if len(lines) != 2 or None in lines:
+    found = [axial_line(path) for path in paths]
+    lines = [line for line in found if line is not None]
+    if len(found) != 2 or len(lines) != 2:
         raise EngineError(f"the THREAD layer holds {len(paths)} path(s), not two axial lines; draw "
                           "the crest line and the root line, each one line along drawing X")
     crest, root = sorted(lines, key=lambda line: -line[2])
