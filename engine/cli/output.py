@@ -90,7 +90,8 @@ def list_options(things: str) -> Callable:
         @functools.wraps(command)
         def with_output(*args, as_json: bool, as_csv: bool, **kwargs):
             chosen = one_of(click.get_current_context(), {"as_json": as_json, "as_csv": as_csv})
-            return command(*args, output={"as_json": "json", "as_csv": "csv"}.get(chosen), **kwargs)
+            output = {"as_json": "json", "as_csv": "csv"}.get(chosen) if chosen is not None else None
+            return command(*args, output=output, **kwargs)
         with_output = click.option("--csv", "as_csv", is_flag=True,
                                    help="Print CSV: a header line of keys, then one line per record.")(with_output)
         return click.option("--json", "as_json", is_flag=True,

@@ -58,7 +58,8 @@ def programs_list(ctx, gear_class, gear_id, job_id, draft, released, since, unti
     """
     from ..programs.lookup import list_programs
 
-    kind = {"draft": True, "released": False}.get(one_of(ctx, {"draft": draft, "released": released}))
+    chosen = one_of(ctx, {"draft": draft, "released": released})
+    kind = {"draft": True, "released": False}.get(chosen) if chosen is not None else None
     with connection(ctx) as conn:
         found = list_programs(conn, gear_class, gear_id, job_id, kind, day(since), day(until))
     emit_list(output, "programs", PROGRAM_COLUMNS, found)

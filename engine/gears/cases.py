@@ -207,9 +207,9 @@ def seed_cases(conn: Connection, path: Path = SEED_FILE) -> int:
         raise CsvError(path, problems, nothing="nothing seeded")
     added = 0
     with conn.transaction():
-        for line, values in rows:
+        for line, case in rows:
             try:
-                added += _insert_if_missing(conn, values)
+                added += _insert_if_missing(conn, case)
             except (psycopg.errors.DataError, psycopg.errors.IntegrityError) as error:
                 raise refuse(path, f"the database refused the case ({str(error).splitlines()[0]})",
                              "correct the row; nothing seeded", line) from None

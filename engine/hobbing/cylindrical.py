@@ -3,6 +3,7 @@ code needs. Formulas: docs/reference/hobbing.md §B. The other classes' models d
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from ..gears.cutting_data import CuttingData
 from ..gears.records import Gear, Hob, Machine
@@ -10,6 +11,9 @@ from . import conventions, geometry, shifting
 from .choices import Choices
 from .machine_job import SETUP_PARAMETERS, machine_job
 from .passes import Cut, Reach, feeds, hob_reach, pass_ends, plan_cuts, working_area
+
+if TYPE_CHECKING:
+    from .duplex import UnitGear
 
 RETRACT_CLEARANCE = 5.0   # mm between hob tip and gear tip when retracted
 # The infeed at the approach Z is in air: rapid to this far outside the cut's centre distance,
@@ -66,7 +70,8 @@ class CylindricalModel:
         """Hob length the shift choice needs beyond the generating zone (for hob matching)."""
         return shifting.travel_needed(choices)
 
-    def setup(self, gear: Gear, hob: Hob) -> Setup:
+    def setup(self, gear: Gear | UnitGear, hob: Hob) -> Setup:
+        assert gear.root_diameter is not None and gear.tip_diameter is not None   # a loaded gear is completed
         lead = geometry.lead_angle(hob.module, hob.starts, hob.tip_diameter)
         swivel = conventions.swivel(gear.helix_angle, gear.hand, lead, hob.hand)
         full_depth = geometry.full_depth_centre_distance(gear.root_diameter, hob.tip_diameter)

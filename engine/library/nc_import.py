@@ -337,7 +337,8 @@ CUT_CODES = frozenset({"G1", "G2", "G3"})
 def _is_frame(f: LineFacts) -> bool:
     """`%` header, `O<name> sub`/`endsub`, a lone program number, the end of the program."""
     program_label = any(label.startswith("O") for label in f.labels) and (
-        f.words & {"SUB", "ENDSUB"} or (len(f.labels) == 1 and f.first.kind == LABEL and not f.words))
+        f.words & {"SUB", "ENDSUB"}
+        or (len(f.labels) == 1 and f.first is not None and f.first.kind == LABEL and not f.words))
     starts_with_percent = f.first is not None and f.first.kind == SYMBOL and f.first.text == "%"
     return bool(starts_with_percent or program_label or f.codes & END_CODES or "PROC" in f.words)
 
@@ -361,7 +362,8 @@ MODULE_RULES = (
 def assign_modules(lines: list[LineFacts], corrections: dict | None = None) -> list[tuple[str, int]]:
     """(t, n) of every line: by the engineer's correction, else by MODULE_RULES, else as before."""
     corrections = corrections or {}
-    state, current, runs, assigned = _State(), "main", {t: 0 for t in MODULE_ORDER}, []
+    state, current, runs = _State(), "main", {t: 0 for t in MODULE_ORDER}
+    assigned: list[tuple[str, int]] = []
     for number, line in enumerate(lines, start=1):
         decided = corrections.get(number) or next(
             (t for t, _, holds in MODULE_RULES if holds(line, state)), current)

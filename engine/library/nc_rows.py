@@ -66,7 +66,9 @@ _SPELLING = re.compile(r"([+-]?)([0-9]*)(\.?)([0-9]*)")
 
 def number_field(name: str, spelling: str) -> str:
     """The f-string replacement field that prints `name` in the style of `spelling`."""
-    sign, integer, point, fraction = _SPELLING.fullmatch(spelling).groups()
+    spelled = _SPELLING.fullmatch(spelling)
+    assert spelled is not None   # the text of a number the tokeniser read
+    sign, integer, point, fraction = spelled.groups()
     digits = len(fraction)
     if not integer:
         scale = 10 ** digits
@@ -87,7 +89,8 @@ class Builder:
         self.values, self.path = values_of(bindings), path
         self.found = Found()
         self.spelled: dict[tuple, bool] = {}   # (field, name, number) -> the field gives the number back
-        self.context = None   # the codes and words of the line being read, once a number needs them
+        # the codes and words of the line being read, once a number needs them
+        self.context: frozenset[str] | None = None
 
     def o(self, line_number: int, line: str, tokens) -> str:
         """The row's `o`: the line written out, or an f-string with its references."""

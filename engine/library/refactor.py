@@ -121,6 +121,7 @@ def refactor(conn: Connection, threshold: float = 0.8, progress=None) -> Refacto
             if attempt == DEADLOCK_RETRIES:
                 raise EngineError(f"refactor deadlocked {attempt} times with other writers of the template "
                                   "library; nothing was changed, run it again when they are done") from None
+    raise AssertionError("unreachable: the last attempt returns or raises")
 
 
 def _refactor_once(conn: Connection, threshold: float, step) -> RefactorReport:

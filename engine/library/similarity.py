@@ -73,7 +73,7 @@ def _literal_pieces(node, in_sum: bool = False) -> list[tuple[str, bool]] | None
     return [("{" + ast.unparse(node) + "}", True)] if in_sum else None
 
 
-def _placeholder(field: ast.FormattedValue) -> str:
+def _placeholder(field: ast.expr) -> str:   # a replacement field of an f-string
     """`{x_in:.3f}`: the field with its conversion and format, as one unit."""
     return ast.unparse(ast.JoinedStr(values=[field]))[2:-1]
 

@@ -70,7 +70,10 @@ def find_programs(conn: Connection, program_id: int | None = None, prefix: str |
     """The program with this id, or every program matching the hash prefix (one of the two)."""
     if (program_id is None) == (prefix is None):
         raise EngineError("give a program id or --hash H (8 or more hex digits of its lineage line), one of the two")
-    return [program_record(conn, program_id)] if program_id is not None else programs_with_hash(conn, prefix)
+    if program_id is not None:
+        return [program_record(conn, program_id)]
+    assert prefix is not None   # one of the two
+    return programs_with_hash(conn, prefix)
 
 
 def program_record(conn: Connection, program_id: int) -> ProgramRecord:
@@ -94,7 +97,8 @@ def programs_with_hash(conn: Connection, prefix: str) -> list[ProgramRecord]:
 
 def _record(row: tuple) -> ProgramRecord:
     *fields, line_ending, final_newline = row
-    return ProgramRecord(*fields, NcLayout(line_ending, final_newline))
+    # mypy counts *fields (of unknown length) as filling every field, the layout as one too many
+    return ProgramRecord(*fields, NcLayout(line_ending, final_newline))   # type: ignore[call-arg]
 
 
 def checked_prefix(text: str) -> str:

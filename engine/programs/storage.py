@@ -78,7 +78,7 @@ class Lineage:
 
     def __init__(self, conn: Connection, machines, versions, job_ids, input_hashes: dict | None = None):
         self.input_hashes = dict(conn.execute(INPUT_HASHES, (list(job_ids),)).fetchall()) | (input_hashes or {})
-        self.dialects = dict(conn.execute(DIALECTS, (list(set(machines)),)).fetchall())
+        self.dialects: dict[str, str] = dict(conn.execute(DIALECTS, (list(set(machines)),)).fetchall())
         classes, numbers = zip(*set(versions)) if versions else ((), ())
         self.drafts = {(c, v): draft for c, v, draft in conn.execute(DRAFTS, (list(classes), list(numbers)))}
 
@@ -176,7 +176,7 @@ def _copy_programs(conn: Connection, program_ids: list[int], job_ids: list[int],
     return stored
 
 
-def _json(text: str) -> Jsonb:
+def _json(text: str | None) -> Jsonb:
     """JSON encoded already (by a batch worker): passed on as it is."""
     return Jsonb(text, dumps=_as_is)
 

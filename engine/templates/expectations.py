@@ -32,10 +32,14 @@ from __future__ import annotations
 import math
 import re
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from ..errors import EngineError
 from .evaluator import evaluate
 from .program_properties import Reading, UnknownProperty, property_reader, read_property
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
 
 ABSOLUTE_TOLERANCE = 1e-6
 TEXT_KINDS = (   # (pattern, kind); the first that matches the expectation's text wins
@@ -121,8 +125,9 @@ def _stripped(lines: list[str]) -> list[str]:
     return [line.strip() for line in lines]
 
 
-TEXT_CHECKS = {"line": _line_present, "no line": _line_absent, "line n": _line_at, "last line": _last_line,
-               "match": _matches, "no match": _no_match}
+TEXT_CHECKS: dict[str, Callable[..., str | None]] = {
+    "line": _line_present, "no line": _line_absent, "line n": _line_at, "last line": _last_line,
+    "match": _matches, "no match": _no_match}
 
 
 def check_numeric(name: str, expression: str, tolerance: str | None, context: Context) -> str | None:

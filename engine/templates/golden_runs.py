@@ -66,6 +66,7 @@ def _planned_gear(conn: Connection, test: GoldenTest, gear: Gear, draft: bool) -
 
 
 def _planned_params(conn: Connection, test: GoldenTest, draft: bool) -> Planned:
+    assert test.params is not None   # a test of no gear gives its parameters
     params = dict(test.params)
     module_params = params.pop(MODULE_PARAMS_KEY, None) or {}
     machine = test.choices.get("machine") or params.get("machine") or DEFAULT_LATHE

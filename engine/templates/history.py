@@ -85,7 +85,7 @@ def history(conn: Connection, gear_class: str) -> list[VersionEntry]:
     """Every stored version of the class, oldest first, with who made it, which rows changed, its
     state (released, retired, draft, superseded) and its release."""
     _require_class(conn, gear_class)
-    states = dict(conn.execute(STATES, (gear_class,)).fetchall())
+    states: dict[int, str] = dict(conn.execute(STATES, (gear_class,)).fetchall())   # version -> state
     releases = {row[0]: ReleaseEntry(*row[1:]) for row in conn.execute(RELEASES, (gear_class,))}
     return [VersionEntry(version, created_at, created_by, row_count, tuple(zip(row_ids, operations)),
                          states.get(version, ""), releases.get(version), NcLayout(line_ending, final_newline))

@@ -30,6 +30,7 @@ from .versions import draft_template, released_template
 
 if TYPE_CHECKING:
     from ..db.connection import Connection
+    from ..gears.records import Machine
 
 DIFFS_SHOWN = 5   # unified diffs the CLI prints (all of them with --json)
 
@@ -209,7 +210,9 @@ class _JobInputs:
     a hobbing job's cycle time from its stored feeds, a turning job's moves from its passes."""
 
     def __init__(self, conn: Connection):
-        self.conn, self.machines, self.shapes = conn, {}, {}
+        self.conn = conn
+        self.machines: dict[str, Machine] = {}
+        self.shapes: dict[str, str] = {}   # class -> its model's cut shape
 
     def of(self, gear_class: str, machine_name: str, params_text: str, modules_text: str) -> tuple[dict, dict]:
         params, modules = json.loads(params_text), json.loads(modules_text or "{}")

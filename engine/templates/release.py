@@ -74,7 +74,9 @@ def release(conn: Connection, gear_class: str, dry_run: bool = False, confirm=No
 
 
 def _require_releaser(conn: Connection) -> None:
-    role, allowed = conn.execute(MAY_RELEASE).fetchone()
+    found = conn.execute(MAY_RELEASE).fetchone()
+    assert found is not None   # a SELECT without FROM returns its one row
+    role, allowed = found
     if not allowed:
         raise EngineError(_role_needed(role))
 

@@ -5,6 +5,7 @@ from the defaults (engine.turning.defaults) and said in `notes`."""
 from __future__ import annotations
 
 import math
+from typing import Any
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -143,7 +144,7 @@ def add_drawn_operation(job: TurningJob, op: Operation) -> None:
     if n > MAX_OPERATIONS:
         raise EngineError(f"layer {op.layer!r}: operation {n} is beyond the turning templates' "
                           f"{MAX_OPERATIONS} operation slots; renumber the layers 1 … {MAX_OPERATIONS}")
-    codes = op.codes
+    codes: dict[str, Any] = op.codes   # each @-code's value has its own type
     tool = codes.get("tool") or _assumed(job, op, "@T", "tool", n, " (the operation number, by convention)")
     speed = codes.get("spindle_rpm") or _assumed(job, op, "@S", "spindle_rpm", DEFAULT_SPEED)
     cutmotion = {"kind": op.kind, "paths": [path_param(path) for path in op.paths], "op_present": True}

@@ -229,6 +229,7 @@ def _check_rapid(material: Material, start: Point, end: Point, move: Move, where
     length, inside = material.length_inside(start, end)
     if length <= AIR_TOLERANCE_MM:
         return
+    assert inside is not None   # the move runs through the material
     z = inside[0]
     raise EngineError(f"{where}: G00 X{move.x:.3f} Z{move.z:.3f} runs {length:.2f} mm through "
                       f"{_material_named(material, z)}Ø{round(2 * material.height(z), 3):g} at Z{round(z, 3):g}): "
