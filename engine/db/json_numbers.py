@@ -9,13 +9,12 @@ from __future__ import annotations
 
 import json
 import math
-from typing import Any
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from ..errors import EngineError
 
 if TYPE_CHECKING:
-    from .connection import Connection
+    import psycopg
 
 MAX_WHOLE_DIGITS = 15
 SHOWN_DIGITS = 12
@@ -28,7 +27,7 @@ def bounded_loads(text: str | bytes) -> Any:
     return json.loads(text, parse_int=_whole, parse_float=_decimal)
 
 
-def read_bounded_json(conn: Connection) -> None:
+def read_bounded_json(conn: psycopg.Connection[Any]) -> None:
     """Every json/jsonb value this connection reads is read with bounded_loads."""
     from psycopg.types.json import set_json_loads
 

@@ -3,7 +3,7 @@ code needs. Formulas: docs/reference/hobbing.md §B. The other classes' models d
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 from ..gears.cutting_data import CuttingData
 from ..gears.records import Gear, Hob, Machine
@@ -12,14 +12,28 @@ from .choices import Choices
 from .machine_job import SETUP_PARAMETERS, machine_job
 from .passes import Cut, Reach, feeds, hob_reach, pass_ends, plan_cuts, working_area
 
-if TYPE_CHECKING:
-    from .duplex import UnitGear
-
 RETRACT_CLEARANCE = 5.0   # mm between hob tip and gear tip when retracted
 # The infeed at the approach Z is in air: rapid to this far outside the cut's centre distance,
 # then feed. The run-in clears the blank at the cut's own X, so any X beyond it is clear too;
 # the millimetre absorbs the rapid's following error before the feed takes over.
 RAPID_SHORT_OF_CUT = 1.0
+
+
+class GearShape(Protocol):
+    """What setup reads of a gear (mm, degrees): a Gear, or one unit of a duplex gear (UnitGear)."""
+
+    @property
+    def module(self) -> float: ...
+    @property
+    def pressure_angle(self) -> float: ...
+    @property
+    def helix_angle(self) -> float: ...
+    @property
+    def hand(self) -> str | None: ...
+    @property
+    def tip_diameter(self) -> float | None: ...
+    @property
+    def root_diameter(self) -> float | None: ...
 
 
 @dataclass(frozen=True)
@@ -70,7 +84,7 @@ class CylindricalModel:
         """Hob length the shift choice needs beyond the generating zone (for hob matching)."""
         return shifting.travel_needed(choices)
 
-    def setup(self, gear: Gear | UnitGear, hob: Hob) -> Setup:
+    def setup(self, gear: GearShape, hob: Hob) -> Setup:
         assert gear.root_diameter is not None and gear.tip_diameter is not None   # a loaded gear is completed
         lead = geometry.lead_angle(hob.module, hob.starts, hob.tip_diameter)
         swivel = conventions.swivel(gear.helix_angle, gear.hand, lead, hob.hand)
