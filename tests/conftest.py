@@ -16,7 +16,7 @@ from database_pool import DatabasePool, create_database
 import engine.hobbing.models  # noqa: F401  (the models register with engine.gears.models, as the commands
 import engine.turning  # noqa: F401   that use a model import these packages first)
 
-# No config file of the user running the suite (README, "Configuration"): the tests of the
+# No config file of the user running the suite (docs/guide/configuration.md): the tests of the
 # config file name their own with ENGINE_CONFIG.
 os.environ["ENGINE_CONFIG"] = ""
 

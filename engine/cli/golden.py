@@ -23,7 +23,7 @@ def test_command(ctx, gear_class, released, show_coverage, days, as_json):
     `FAIL … <first difference>`, then a summary. Exit 1 if any test fails or none exists.
 
     The expectations are `line: M30`, `no line: M8`, `match: REGEX`, `no match: REGEX`,
-    `last X = (df2 + da0)/2 ± 0.01` and the like (README, "Golden tests").
+    `last X = (df2 + da0)/2 ± 0.01` and the like (docs/guide/release-and-golden-tests.md).
 
     Example: engine test --class spur --json
     """

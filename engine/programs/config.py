@@ -1,5 +1,5 @@
 """The shop's settings file: defaults of command options, the default machine, the output folder
-and line endings per machine (README, "Configuration").
+and line endings per machine (docs/guide/configuration.md).
 
 A TOML file in the user's config directory (platformdirs: ~/.config/nc-template-engine/config.toml
 on Linux), or the file ENGINE_CONFIG names (ENGINE_CONFIG="" reads none). Its values are only

@@ -6,7 +6,7 @@ would make it (engine.release.golden_runs), with the verifier and the simulation
 program they refuse fails its test with their reason, and so does a broken expression (the
 message names class, row and column).
 
-The expectation language is engine.templates.expectations's (README "Golden tests")."""
+The expectation language is engine.templates.expectations's (docs/guide/release-and-golden-tests.md)."""
 from __future__ import annotations
 
 from dataclasses import dataclass
