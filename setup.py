@@ -8,7 +8,7 @@ DATA_FOLDERS = {"engine_data.migrations": "migrations", "engine_data.schema": "s
                 "engine_data.seed_templates.classes": "seed_templates/classes",
                 "engine_data.seed_templates.drawings": "seed_templates/drawings"}
 
-setup(packages=find_packages(include=["engine", "engine.*", "importers", "importers.*"]) + list(DATA_FOLDERS),
+setup(packages=find_packages(include=["engine", "engine.*"]) + list(DATA_FOLDERS),
       package_dir=DATA_FOLDERS,
       package_data={"engine": ["py.typed"], **{package: ["*.sql", "*.csv", "*.json", "*.md", "*.dxf"]
                                                for package in DATA_FOLDERS}})

@@ -1,5 +1,9 @@
-"""Shared by the benchmarks: the server's admin URL, a private database that is always
-dropped, medians and the PASS/MISS wording. Benchmarks report; they never fail on a target."""
+"""Shared by the benchmarks: the server's admin URL, the smoke mode, a private database that is
+always dropped, medians and the PASS/MISS wording. Benchmarks report; they never fail on a target.
+
+`--smoke` (bench/smoke.py, .ci/run) runs a benchmark at small sizes with one repetition, to show
+that it still runs: its figures are printed but not judged, since sizes that small say nothing
+about the targets. Options given on the command line win over the smoke sizes."""
 from __future__ import annotations
 
 import argparse
@@ -9,6 +13,8 @@ import statistics
 import uuid
 
 DEFAULT_ADMIN_URL = "postgresql://postgres@127.0.0.1:5432/postgres"
+NOT_JUDGED = "not judged (--smoke)"
+_smoke = False   # set by parse_arguments: the run is a smoke run, its verdicts are not given
 
 
 def add_database_argument(parser: argparse.ArgumentParser) -> None:
@@ -16,6 +22,25 @@ def add_database_argument(parser: argparse.ArgumentParser) -> None:
         "--database-url", default=os.environ.get("DATABASE_URL") or DEFAULT_ADMIN_URL,
         help="admin URL of the PostgreSQL server; the benchmark creates (and drops) its own database "
              "there (default: DATABASE_URL, else %(default)s)")
+
+
+def parse_arguments(parser: argparse.ArgumentParser, argv, smoke: dict) -> argparse.Namespace:
+    """The parsed command line; with --smoke, `smoke` (option dest -> value) replaces the defaults."""
+    global _smoke
+    sizes = ", ".join(_option(name, value) for name, value in smoke.items())
+    parser.add_argument("--smoke", action="store_true",
+                        help=f"check that the benchmark runs: {sizes or 'as by default'}; figures not judged")
+    args = parser.parse_args(argv)
+    if args.smoke:
+        parser.set_defaults(**smoke)
+        args = parser.parse_args(argv)
+    _smoke = args.smoke
+    return args
+
+
+def _option(name: str, value) -> str:
+    flag = "--" + name.replace("_", "-")
+    return flag if value is True else f"{flag} {value}"
 
 
 def url_of(server_url: str, database: str) -> str:
@@ -40,7 +65,7 @@ def bench_database(server_url: str, prefix: str, *, seeded: bool = True):
         url = url_of(server_url, name)
         if seeded:
             from engine.db.migrate import migrate
-            from engine.db.seed import seed
+            from engine.library.seed import seed
 
             with psycopg.connect(url) as conn:
                 migrate(conn)
@@ -67,4 +92,6 @@ def median(values) -> float:
 
 
 def verdict(ok: bool) -> str:
+    if _smoke:
+        return NOT_JUDGED
     return "PASS" if ok else "MISS"

@@ -26,13 +26,14 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
-from _common import add_database_argument, bench_database, delete_programs, median, verdict  # noqa: E402
+from _common import (add_database_argument, bench_database, delete_programs, median, parse_arguments,  # noqa: E402
+                     verdict)
 from engine.errors import EngineError  # noqa: E402
 from engine.gears.case_base import CUT_KINDS_BY_COUNT, job_cutting_record  # noqa: E402
 from engine.gears.hob_matching import choose_hob  # noqa: E402
 from engine.hobbing.choices import Choices  # noqa: E402
 from engine.programs.instantiate import Planner, _check_machine_fits, _check_table_speed  # noqa: E402
-from engine.programs.verifier import verify_program  # noqa: E402
+from engine.verifier import verify_program  # noqa: E402
 
 FIRST_ID = 100_000
 TARGET_RATE = 5_000          # programs/s
@@ -131,11 +132,12 @@ def run_ours(conn, first: int, last: int, workers: int = 1) -> tuple[float, int]
     """Each run starts with no compiled template and no remembered row outcome, as a new
     `engine instantiate --gears` process does."""
     from engine.programs.instantiate import instantiate_gears
+    from engine.programs.options import RunMode
     from engine.templates import decision_table
 
     decision_table._CACHE.clear()
     start = time.perf_counter()
-    programs = instantiate_gears(conn, first, last, workers=workers)
+    programs = instantiate_gears(conn, first, last, mode=RunMode(workers=workers))
     conn.commit()
     return time.perf_counter() - start, len(programs)
 
@@ -230,11 +232,18 @@ def store(conn, planned: list[tuple]) -> None:
                 gear_id, gear_class, machine, hob_id, params, module_params = item[:6]
                 copy.write_row((job_id, gear_id, gear_class, machine, hob_id, Jsonb(params), Jsonb(module_params),
                                 Jsonb(item[11] or {})))
+        # Every stored program carries its lineage line (engine.nc.lineage), as store_many adds it.
+        lineage = storage.Lineage(conn, [item[2] for item in planned], [(item[1], item[6]) for item in planned],
+                                  job_ids)
         with conn.cursor().copy(storage.COPY_PROGRAM) as copy:
             if getattr(storage, "PROGRAM_TYPES", None):
                 copy.set_types(storage.PROGRAM_TYPES)
             for program_id, job_id, item in zip(program_ids, job_ids, planned):
-                copy.write_row((program_id, job_id, item[1], *item[6:11], None))   # a Jinja2 program has no trace
+                gear_class, machine, (version, template_hash, name, lines, row_ids) = item[1], item[2], item[6:11]
+                lines, row_ids = lineage.added(program_id, job_id, machine, gear_class, version, template_hash,
+                                               lines, row_ids)
+                copy.write_row((program_id, job_id, gear_class, version, template_hash, name, lines, row_ids,
+                                None))   # a Jinja2 program has no trace
 
 
 def run_jinja(conn, pipeline: JinjaPipeline, first: int, last: int) -> tuple[float, int]:
@@ -412,7 +421,7 @@ def main(argv=None) -> int:
     parser.add_argument("--profile-count", type=int, default=PROFILE_GEARS,
                         help=f"gears (the batch's first) that --profile times and profiles (default {PROFILE_GEARS})")
     parser.add_argument("--top", type=int, default=25, help="rows of each cProfile listing (default 25)")
-    args = parser.parse_args(argv)
+    args = parse_arguments(parser, argv, smoke={"count": 20, "reps": 1})
 
     import psycopg
 

@@ -25,8 +25,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 import ezdxf  # noqa: E402
 
-from _common import add_database_argument, bench_database, median, verdict  # noqa: E402
-from importers.dxf_drawing import read_drawing  # noqa: E402
+from _common import add_database_argument, bench_database, median, parse_arguments, verdict  # noqa: E402
+from engine.drawings.drawing import read_drawing  # noqa: E402
 
 TARGET_RATIO = 1.5
 PITCH = 0.2  # mm along Z per profile wave: 2,000 waves stay within the lathe's Z travel
@@ -104,7 +104,7 @@ def main() -> None:
     parser.add_argument("--entities", type=int, default=10_000)
     parser.add_argument("--runs", type=int, default=7)
     parser.add_argument("--keep", type=Path, help="also write the generated drawing here")
-    args = parser.parse_args()
+    args = parse_arguments(parser, None, smoke={"entities": 300, "runs": 1})
     with tempfile.TemporaryDirectory() as folder, bench_database(args.database_url, "bench_dxf") as url:
         path = args.keep or Path(folder) / "bench.dxf"
         make_drawing(path, args.entities)
@@ -124,7 +124,7 @@ def measure(path: Path, url: str, runs: int) -> tuple[list, list, list]:
     """Alternated runs of the three; each import stores one job (committed)."""
     import psycopg
 
-    from engine.turning.dxf_import import import_dxf
+    from engine.programs.dxf_import import import_dxf
 
     plain, read, imported = [], [], []
     with psycopg.connect(url) as conn:

@@ -26,7 +26,7 @@ HERE = Path(__file__).resolve().parent
 REPO = HERE.parent
 sys.path.insert(0, str(HERE))
 
-from _common import add_database_argument, bench_database, median  # noqa: E402
+from _common import add_database_argument, bench_database, median, parse_arguments  # noqa: E402
 from latency import source_tree_of  # noqa: E402
 
 AGAINST = "6710955"   # main just before asteval became the evaluator (issue 12)
@@ -89,7 +89,7 @@ def main(argv=None) -> int:
     parser.add_argument("--reps", type=int, default=3, help="alternated runs of each (default 3)")
     parser.add_argument("--against", default=AGAINST, metavar="REV",
                         help=f"the compiled evaluator's commit ({AGAINST})")
-    args = parser.parse_args(argv)
+    args = parse_arguments(parser, argv, smoke={"count": 20, "reps": 1})
     with bench_database(args.database_url, "bench_evaluator") as url, tempfile.TemporaryDirectory() as folder:
         data = Path(folder) / "jobs.pickle"
         data.write_bytes(pickle.dumps(planned_jobs(url, args.count)))

@@ -19,7 +19,7 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
-from _common import add_database_argument, bench_database, median, verdict  # noqa: E402
+from _common import add_database_argument, bench_database, median, parse_arguments, verdict  # noqa: E402
 
 TARGET_SECONDS = 10.0
 FIRST_GEAR = 100_000
@@ -38,8 +38,9 @@ def stored_jobs(conn, count: int) -> None:
     from engine.templates.decision_table import compiled_template
     from engine.templates.versions import released_template
 
-    insert_gears(conn, generate_gears(FIRST_GEAR, MADE_GEARS))
-    instantiate_gears(conn, FIRST_GEAR, FIRST_GEAR + MADE_GEARS - 1)
+    made_gears = min(MADE_GEARS, count)   # a smaller batch (--smoke) makes fewer
+    insert_gears(conn, generate_gears(FIRST_GEAR, made_gears))
+    instantiate_gears(conn, FIRST_GEAR, FIRST_GEAR + made_gears - 1)
     conn.commit()
     made = conn.execute("SELECT gear_id, machine, hob_id, params, module_params FROM job WHERE gear_class = %s",
                         (GEAR_CLASS,)).fetchall()
@@ -52,13 +53,14 @@ def stored_jobs(conn, count: int) -> None:
         encoded.append(Encoded(gear_id, GEAR_CLASS, machine, hob_id, json.dumps(params), json.dumps(modules), "{}",
                                released.template.version, released.template.hash, params["program_name"],
                                result.lines, result.row_ids, "{}"))
-    store_many(conn, encoded)
+    if encoded:
+        store_many(conn, encoded)
     conn.commit()
 
 
 def run_impact(conn) -> tuple[float, int]:
     from engine.templates import decision_table
-    from engine.templates.impact import impact
+    from engine.release.impact import impact
 
     decision_table._CACHE.clear()   # as a new process: nothing compiled, nothing remembered
     start = time.perf_counter()
@@ -86,7 +88,7 @@ def main(argv=None) -> int:
     add_database_argument(parser)
     parser.add_argument("--count", type=int, default=10_000, help="stored jobs of the class (default 10000)")
     parser.add_argument("--reps", type=int, default=3, help="alternated runs of each (default 3)")
-    args = parser.parse_args(argv)
+    args = parse_arguments(parser, argv, smoke={"count": 40, "reps": 1})
 
     import psycopg
 

@@ -29,7 +29,7 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 sys.path.insert(0, str(HERE.parent))
 
-from _common import add_database_argument, bench_database, median, url_of, verdict  # noqa: E402
+from _common import add_database_argument, bench_database, median, parse_arguments, url_of, verdict  # noqa: E402
 
 TARGET_SECONDS = 10.0      # issue 13: 100,000 lines in at most 10 s
 LINEAR = 11.0              # 10x the lines in at most 11x the time counts as linear
@@ -121,7 +121,7 @@ def main(argv=None) -> int:
     parser.add_argument("--lines", type=int, default=10_000, help="lines of the small program; the large has 10x")
     parser.add_argument("--reps", type=int, default=3, help="alternated runs of each (default 3)")
     parser.add_argument("--keep", type=Path, help="also write the large program here")
-    args = parser.parse_args(argv)
+    args = parse_arguments(parser, argv, smoke={"lines": 200, "reps": 1})
     from psycopg.conninfo import conninfo_to_dict
 
     sizes = {"small": args.lines, "large": 10 * args.lines}

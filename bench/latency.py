@@ -23,7 +23,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 
-from _common import add_database_argument, bench_database, median, verdict  # noqa: E402
+from _common import add_database_argument, bench_database, median, parse_arguments, verdict  # noqa: E402
 
 TARGET_RATIO = 2.0          # issue 12 (was 2.5)
 GEAR_ID = 42
@@ -63,10 +63,13 @@ def help_command(tree: Path) -> list[str]:
 
 
 def source_tree_of(revision: str, into: Path) -> Path | None:
-    """The engine/ and importers/ folders of `revision`, unpacked into `into`; None when this
-    checkout does not have the commit (a shallow clone, an unpacked archive)."""
-    archived = subprocess.run(["git", "-C", str(REPO), "archive", revision, "engine", "importers"],
-                              capture_output=True)
+    """The engine/ folder of `revision` (and engine/drawings/, which held the DXF reader before issue 25
+    moved it to engine/drawings/), unpacked into `into`; None when this checkout does not have the
+    commit (a shallow clone, an unpacked archive)."""
+    had_importers = subprocess.run(["git", "-C", str(REPO), "cat-file", "-e", f"{revision}:importers"],
+                                   capture_output=True).returncode == 0
+    archived = subprocess.run(["git", "-C", str(REPO), "archive", revision, "engine",
+                               *(["importers"] if had_importers else [])], capture_output=True)
     if archived.returncode != 0:
         return None
     subprocess.run(["tar", "-x", "-C", str(into)], input=archived.stdout, check=True)
@@ -105,7 +108,7 @@ def main(argv=None) -> int:
     parser.add_argument("--help-against", default=HELP_AGAINST, metavar="REV",
                         help=f"commit whose `engine --help` start-up is the baseline (default {HELP_AGAINST})")
     parser.add_argument("--no-help-startup", action="store_true", help="skip the `engine --help` comparison")
-    args = parser.parse_args(argv)
+    args = parse_arguments(parser, argv, smoke={"runs": 1})
 
     with bench_database(args.database_url, "bench_latency") as url:
         cli = [engine_command(), "--database-url", url, "instantiate", "--gear", str(GEAR_ID), "--json"]

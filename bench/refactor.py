@@ -34,7 +34,7 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
-from _common import add_database_argument, bench_database, median, verdict  # noqa: E402
+from _common import add_database_argument, bench_database, median, parse_arguments, verdict  # noqa: E402
 
 TARGET_SECONDS = 10.0
 TARGET_SCALING = 12.0
@@ -241,7 +241,7 @@ def main(argv=None) -> int:
     parser.add_argument("--reps", type=int, default=3, help="repetitions per size (default 3; the 10x "
                         "size runs max(1, reps // 2))")
     parser.add_argument("--seed", type=int, default=20261122, help="random seed of the generated library")
-    args = parser.parse_args(argv)
+    args = parse_arguments(parser, argv, smoke={"classes": 20, "rows": 20, "scale": 2, "reps": 1})
 
     small = measure(args.database_url, args.classes, args.rows, args.reps, args.seed)
     describe("1x", small)

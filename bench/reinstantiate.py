@@ -17,7 +17,8 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
-from _common import add_database_argument, bench_database, delete_programs, median, verdict  # noqa: E402
+from _common import (add_database_argument, bench_database, delete_programs, median, parse_arguments,  # noqa: E402
+                     verdict)
 
 TARGET_RATIO = 1.5
 FIRST_ID = 100_000
@@ -42,7 +43,6 @@ def run_ours(conn) -> tuple[float, int]:
 
 def run_bare(conn) -> tuple[float, int]:
     """The same rows evaluated by asteval alone, and a COPY of the programs."""
-    from engine.programs.storage import COPY_PROGRAM, PROGRAM_TYPES, _next_ids
     from engine.templates.decision_table import CompiledTemplate
     from engine.templates.evaluator import Evaluator
     from engine.templates.store import load_template
@@ -51,17 +51,33 @@ def run_bare(conn) -> tuple[float, int]:
     jobs = conn.execute(JOBS).fetchall()
     compiled = {name: CompiledTemplate(load_template(conn, name)) for name in {job[2] for job in jobs}}
     evaluator = Evaluator()
-    programs = [(job[0], job[2], compiled[job[2]], *bare_program(compiled[job[2]], evaluator, job[5], job[6]))
+    programs = [(job[0], job[3], compiled[job[2]], *bare_program(compiled[job[2]], evaluator, job[5], job[6]))
                 for job in jobs]
+    stored = store_bare(conn, programs)
+    conn.commit()
+    return time.perf_counter() - start, stored
+
+
+def store_bare(conn, programs: list[tuple]) -> int:
+    """COPY the programs as the engine does, each with its lineage line (engine.nc.lineage:
+    the database refuses a program without one); the number of lines stored."""
+    from engine.programs.storage import COPY_PROGRAM, PROGRAM_TYPES, Lineage, _next_ids
+
+    stored = 0
     with conn.transaction():
         ids = _next_ids(conn, "program_id_seq", len(programs))
+        lineage = Lineage(conn, [p[1] for p in programs], [(p[2].template.gear_class, p[2].template.version)
+                                                          for p in programs], [p[0] for p in programs])
         with conn.cursor().copy(COPY_PROGRAM) as copy:
             copy.set_types(PROGRAM_TYPES)
-            for program_id, (job_id, gear_class, template, lines, row_ids) in zip(ids, programs):
-                copy.write_row((program_id, job_id, gear_class, template.template.version, template.template.hash,
-                                "BARE", lines, row_ids, None))
-    conn.commit()
-    return time.perf_counter() - start, sum(len(program[3]) for program in programs)
+            for program_id, (job_id, machine, template, lines, row_ids) in zip(ids, programs):
+                gear_class, version, template_hash = (template.template.gear_class, template.template.version,
+                                                      template.template.hash)
+                lines, row_ids = lineage.added(program_id, job_id, machine, gear_class, version, template_hash,
+                                               lines, row_ids)
+                copy.write_row((program_id, job_id, gear_class, version, template_hash, "BARE", lines, row_ids, None))
+                stored += len(lines)
+    return stored
 
 
 def bare_program(template, evaluator, params: dict, module_params: dict) -> tuple[list, list]:
@@ -93,7 +109,7 @@ def main(argv=None) -> int:
     add_database_argument(parser)
     parser.add_argument("--count", type=int, default=10_000, help="stored jobs made again (default 10000)")
     parser.add_argument("--reps", type=int, default=3, help="alternated runs of each (default 3)")
-    args = parser.parse_args(argv)
+    args = parse_arguments(parser, argv, smoke={"count": 20, "reps": 1})
 
     import psycopg
 

@@ -16,7 +16,7 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
-from _common import add_database_argument, bench_database, median  # noqa: E402
+from _common import add_database_argument, bench_database, median, parse_arguments  # noqa: E402
 from batch import FIRST_ID, clear_jobs, generate_gears, insert_gears, run_ours  # noqa: E402
 from engine.programs import verified_run  # noqa: E402
 
@@ -59,7 +59,7 @@ def main(argv=None) -> int:
     parser.add_argument("--reps", type=int, default=3, help="alternated repetitions (default 3)")
     parser.add_argument("--profile", action="store_true", help="also print cProfile hotspots of a simulated run")
     parser.add_argument("--top", type=int, default=30)
-    args = parser.parse_args(argv)
+    args = parse_arguments(parser, argv, smoke={"count": 20, "reps": 1})
 
     import psycopg
 

@@ -2,8 +2,10 @@
 batch, store_program for one; each program checked against its job and the stored template
 version, who stored it recorded) against the path before migration 0010 (COPY and INSERT
 straight into program, foreign keys only) in the same run, on the same programs. The earlier
-path is rebuilt inside a transaction that is rolled back: the checking trigger switched off and
-the version foreign key dropped. Runs alternate; every run is rolled back.
+path is rebuilt inside a transaction that is rolled back: the checking triggers switched off and
+the version foreign key dropped. Runs alternate; every run is rolled back. Each program carries
+the lineage line of its id (engine.nc.lineage), made before the clock starts: the timed
+part is the database storing it.
 
     python bench/storage.py [--count 10000] [--singles 1000] [--reps 5] [--database-url URL]
 
@@ -19,7 +21,7 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
-from _common import add_database_argument, bench_database, median  # noqa: E402
+from _common import add_database_argument, bench_database, median, parse_arguments  # noqa: E402
 from engine.programs import storage  # noqa: E402
 
 GEARS = (42, 43, 44, 45, 46, 47, 50, 51, 53, 54)   # the seeded gears, every hobbing class
@@ -27,7 +29,8 @@ EARLIER_COPY = ("COPY program (id, job_id, gear_class, template_version, templat
                 "FROM STDIN (FORMAT BINARY)")
 EARLIER_INSERT = ("INSERT INTO program (job_id, gear_class, template_version, template_hash, name, lines, row_ids, "
                   "trace) VALUES (%s, %s, %s, %s, %s, %s, %s, %s) RETURNING id")
-AS_BEFORE_0010 = ("ALTER TABLE program DISABLE TRIGGER check_program",
+# Every trigger on program came with migration 0010 or later (the checks of 0010, 0015 and 0021).
+AS_BEFORE_0010 = ("ALTER TABLE program DISABLE TRIGGER USER",
                   "ALTER TABLE program DROP CONSTRAINT program_template_version")
 
 
@@ -47,24 +50,40 @@ def planned_programs(conn) -> list:
     return list(zip(job_ids, encoded))
 
 
+def with_lineage(conn, programs: list, ids: list[int]) -> list[tuple]:
+    """The rows to store under `ids` (the programs repeated), each with the lineage line of its id."""
+    lineage = storage.Lineage(conn, [item.machine for _, item in programs],
+                              [(item.gear_class, item.template_version) for _, item in programs],
+                              [job_id for job_id, _ in programs])
+    rows = []
+    for number, program_id in enumerate(ids):
+        job_id, item = programs[number % len(programs)]
+        lines, row_ids = lineage.added(program_id, job_id, item.machine, item.gear_class, item.template_version,
+                                       item.template_hash, item.lines, item.row_ids)
+        rows.append((program_id, job_id, item.gear_class, item.template_version, item.template_hash, item.name,
+                     lines, row_ids, item.trace))
+    return rows
+
+
 def batch(conn, programs: list, count: int, statement: str) -> float:
-    ids = storage._next_ids(conn, "program_id_seq", count)
+    rows = with_lineage(conn, programs, storage._next_ids(conn, "program_id_seq", count))
     start = time.perf_counter()
     with conn.cursor().copy(statement) as copy:
         copy.set_types(storage.PROGRAM_TYPES)
-        for number, program_id in enumerate(ids):
-            job_id, item = programs[number % len(programs)]
-            copy.write_row((program_id, job_id, item.gear_class, item.template_version, item.template_hash, item.name,
-                            item.lines, item.row_ids, storage._json(item.trace)))
+        for *values, trace in rows:
+            copy.write_row((*values, storage._json(trace)))
     return time.perf_counter() - start
 
 
 def singles(conn, programs: list, count: int, statement: str) -> float:
+    """The engine's INSERT names the program's id (drawn first, as store_one does) and whether it
+    is unverified; the earlier one let the id default."""
+    rows = with_lineage(conn, programs, storage._next_ids(conn, "program_id_seq", count))
+    engine_path = statement == storage.INSERT_PROGRAM
     start = time.perf_counter()
-    for number in range(count):
-        job_id, item = programs[number % len(programs)]
-        conn.execute(statement, (job_id, item.gear_class, item.template_version, item.template_hash, item.name,
-                                 item.lines, item.row_ids, storage._json(item.trace))).fetchone()
+    for program_id, *values, trace in rows:
+        given = (program_id, *values, storage._json(trace), False) if engine_path else (*values, storage._json(trace))
+        conn.execute(statement, given).fetchone()
     return time.perf_counter() - start
 
 
@@ -84,7 +103,7 @@ def main(argv=None) -> int:
     parser.add_argument("--count", type=int, default=10_000, help="programs in a batch (default 10000)")
     parser.add_argument("--singles", type=int, default=1_000, help="programs stored one by one (default 1000)")
     parser.add_argument("--reps", type=int, default=5, help="alternated repetitions (default 5)")
-    args = parser.parse_args(argv)
+    args = parse_arguments(parser, argv, smoke={"count": 50, "singles": 10, "reps": 1})
 
     import psycopg
 

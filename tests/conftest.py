@@ -13,7 +13,10 @@ from psycopg.pq import TransactionStatus
 
 from database_pool import DatabasePool, create_database
 
-# No config file of the user running the suite (README, "Configuration"): the tests of the
+import engine.hobbing.models  # noqa: F401  (the models register with engine.gears.models, as the commands
+import engine.turning  # noqa: F401   that use a model import these packages first)
+
+# No config file of the user running the suite (docs/guide/configuration.md): the tests of the
 # config file name their own with ENGINE_CONFIG.
 os.environ["ENGINE_CONFIG"] = ""
 
@@ -64,7 +67,7 @@ def database_url(server_url, database_pool) -> str:
     (rolled back) or `fresh_database_url`. Right after seeding it is copied once more, as the
     template of every `fresh_database_url`, which no test connects to."""
     from engine.db.migrate import migrate
-    from engine.db.seed import seed
+    from engine.library.seed import seed
 
     name = f"engine_test_{uuid.uuid4().hex[:10]}"
     url = _create(server_url, name)

@@ -1,6 +1,6 @@
 """An independent reader of hobbing programs and the reference's numbers, for acceptance tests.
 
-Shares no code with engine.programs.verifier, engine.hobbing or tests/nc_reader.py: the tests of
+Shares no code with engine.verifier, engine.hobbing or tests/nc_reader.py: the tests of
 issue 14 must check the engine's programs against the reference (docs/reference/hobbing.md
 §A5, §A7, §B, §C and design notes §7), not against the engine's own idea of them.
 

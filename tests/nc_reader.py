@@ -1,6 +1,6 @@
 """A small reader of Siemens 840D main programs, for tests only.
 
-Written independently of `engine.programs.verifier` on purpose: the tests must not share code with
+Written independently of `engine.verifier` on purpose: the tests must not share code with
 the engine they check. It understands the subset the hobbing templates write:
 
 * blocks with an optional `N…` number and a `;` comment;

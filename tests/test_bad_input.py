@@ -16,7 +16,7 @@ from psycopg.conninfo import conninfo_to_dict
 
 from engine.gears.records import load_gear
 from engine.templates import rows as template_rows
-from importers.dxf_geometry import MAX_COORDINATE_MM
+from engine.drawings.entities import MAX_COORDINATE_MM
 from test_dxf_read import seed_drawing
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -15,6 +15,7 @@ from psycopg import sql
 from roles import as_role
 
 from engine.programs.instantiate import instantiate_gear, instantiate_gears
+from engine.programs.options import RunMode
 
 CHECKOUT = Path(__file__).resolve().parent.parent
 
@@ -238,8 +239,8 @@ def test_a_reader_may_look_at_a_program_that_only_a_runner_may_store(conn):
     """A dry run writes nothing, so the role that only reads (engine_reader) may make one; the
     stored run is the database's to refuse it. Inside the caller's transaction it is a savepoint."""
     with as_role(conn, "engine_reader"):
-        program = instantiate_gear(conn, 42, dry_run=True)
-        batch = instantiate_gears(conn, 42, 47, dry_run=True)
+        program = instantiate_gear(conn, 42, mode=RunMode(dry_run=True))
+        batch = instantiate_gears(conn, 42, 47, mode=RunMode(dry_run=True))
     assert program.program_id is None and program.name == "GEAR42"
     assert sum(line.startswith("; PROGRAM DRY-RUN TEMPLATE spur v") for line in program.lines) == 1
     assert batch.dry_run and batch.programs == 6 and batch.first_program_id is None

@@ -4,6 +4,7 @@ import pytest
 from engine.errors import EngineError
 from engine.hobbing.choices import Choices
 from engine.programs.instantiate import instantiate_gear
+from engine.programs.options import RunMode
 from engine.templates.decision_table import CompiledTemplate, TemplateError
 from engine.templates.rows import TemplateRow
 from engine.templates.store import ensure_class, load_template, replace_template
@@ -114,7 +115,7 @@ def test_a_failing_row_stores_nothing_of_the_instantiation(conn):
     replace_template(conn, "spur", [TemplateRow(*row) for row in broken])
     before = count_rows(conn)
     with pytest.raises(TemplateError, match="ZeroDivisionError"):
-        instantiate_gear(conn, 42, draft=True)   # the editor tries the draft
+        instantiate_gear(conn, 42, mode=RunMode(draft=True))   # the editor tries the draft
     assert count_rows(conn) == before
 
 

@@ -22,7 +22,8 @@ from hypothesis import strategies as st
 
 from engine.errors import EngineError
 from engine.gears.cutting_data import CuttingData
-from engine.gears.records import Gear, GearUnit, Hob, Machine
+from engine.gears.records import Gear, GearUnit, Hob
+from engine.machines.records import Machine
 from engine.hobbing.choices import FEED_MODES, Choices
 from engine.hobbing.duplex import DuplexModel
 from engine.programs.instantiate import instantiate_gear

@@ -8,8 +8,8 @@ from __future__ import annotations
 import ezdxf
 import pytest
 
-from importers.dxf_drawing import read_drawing
-from importers.dxf_read import DxfError
+from engine.drawings.drawing import read_drawing
+from engine.drawings.read import DxfError
 from test_dxf_side_views import AXIS_Y, SHAFT
 
 

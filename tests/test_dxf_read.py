@@ -18,11 +18,12 @@ import ezdxf.path
 import pytest
 from ezdxf.math import bulge_center
 
-from importers.dxf_codes import CodeText, codes_in, layer_codes
-from importers.dxf_drawing import read_drawing
-from importers.dxf_geometry import FLATTEN_TOLERANCE_MM, Arc, Line
-from importers.dxf_profile import chain_segments
-from importers.dxf_read import DxfError, load_drawing_file
+from engine.drawings.codes import CodeText, codes_in, layer_codes
+from engine.drawings.drawing import read_drawing
+from engine.drawings.entities import FLATTEN_TOLERANCE_MM
+from engine.drawings.geometry import Arc, Line
+from engine.drawings.profile import chain_segments
+from engine.drawings.read import DxfError, load_drawing_file
 from shared_data import shared_data
 
 

@@ -8,8 +8,8 @@ import json
 import ezdxf
 import pytest
 
-from importers.dxf_drawing import read_drawing
-from importers.dxf_read import DxfError
+from engine.drawings.drawing import read_drawing
+from engine.drawings.read import DxfError
 from test_dxf_read import DXF
 from test_import_dxf_cli import job_count, one_line_refusal
 

@@ -16,10 +16,10 @@ import ezdxf.path
 import pytest
 
 from engine.programs.remake import instantiate_job
-from engine.turning.dxf_import import import_dxf
+from engine.programs.dxf_import import import_dxf
 from engine.turning.job_params import ProfileOptions
-from importers.dxf_drawing import read_drawing
-from importers.dxf_read import DxfError
+from engine.drawings.drawing import read_drawing
+from engine.drawings.read import DxfError
 from lathe_programs import distance_to_chord, motions, operation_lines
 from test_dxf_read import DXF
 from test_dxf_real_layers import outline_drawing

@@ -16,6 +16,7 @@ import pytest
 from engine.errors import EngineError
 from engine.hobbing.choices import Choices
 from engine.programs.instantiate import instantiate_gear
+from engine.programs.options import RunMode
 
 from nc_reader import read_program
 
@@ -226,7 +227,7 @@ def test_duplex_inherits_spur_rows_and_stores_only_its_own(conn):
     assert assembled == (own + spur, spur) and own < spur
     conn.execute("""UPDATE template_view SET o = 'f"G0 X{x_retract:.3f} Z{z_start:.3f} ; SPUR"'
                     WHERE gear_class = 'spur' AND id = 1250""")
-    program = instantiate_gear(conn, 54, draft=True)
+    program = instantiate_gear(conn, 54, mode=RunMode(draft=True))
     assert sum(line.endswith("; SPUR") for line in program.lines) == 1, "spur's edit reaches duplex's draft"
 
 

@@ -11,9 +11,10 @@ import psycopg
 import pytest
 
 from engine.programs.instantiate import instantiate_gear
-from engine.templates.coverage import coverage
+from engine.programs.options import RunMode
+from engine.release.coverage import coverage
 from engine.templates.expectations import Context, first_difference
-from engine.templates.golden import run_golden_tests
+from engine.release.golden import run_golden_tests
 
 SEEDED_CLASSES = {"spur", "helical", "duplex", "taper", "crowned", "worm_wheel", "turning_iso", "turning_840d"}
 
@@ -117,7 +118,7 @@ def test_coverage_lists_a_new_draft_row_until_a_program_emits_it(conn):
     conn.execute("INSERT INTO template_view (gear_class, id, t, n, o, p_emit) "
                  "VALUES ('spur', 3190, 'main', 1, '\"; CHECKED BY QA\"', 'gear_id == 46')")
     assert 3190 in {row.row_id for row in coverage(conn, classes=["spur"])}
-    program = instantiate_gear(conn, 46, draft=True)
+    program = instantiate_gear(conn, 46, mode=RunMode(draft=True))
     assert 3190 in program.row_ids
     assert 3190 not in {row.row_id for row in coverage(conn, classes=["spur"])}
 

@@ -3,7 +3,7 @@
 Every expected number is computed here, independently of the engine, from the formulas
 of the reference (docs/reference/hobbing.md §A5, §B) and the data in the gear, hob and
 machine tables (read with SQL). The programs are read with tests/nc_reader.py, which
-shares no code with engine.programs.verifier.
+shares no code with engine.verifier.
 
 Seeded gears: 42 spur m2 z19 (one cut), 45 spur m4 z25 (rough + finish), 43 helical R
 m3 z41 β15, 44 helical L m2 z30 β15.

@@ -1,15 +1,38 @@
-"""The house (issue 11): engine/ is laid out as the design's sections, no two modules import each
-other in a circle (imports inside functions count: a cycle is a cycle of the design, whenever it
-runs; so does a package's __init__, which runs when any module below it is first imported), and
-nothing below the command line imports it. The walker reads the source with `ast`; each check is
-also run on a small package of its own that has the fault."""
+"""The house (issues 11, 25): engine/ is laid out as the design's sections, stacked in LAYERS so a
+folder imports only folders in lower layers, no two modules import each other in a circle (imports
+inside functions count: a cycle is a cycle of the design, whenever it runs; so does a package's
+__init__, which runs when any module below it is first imported), and nothing below the command
+line imports it. The walker reads the source with `ast`; each check is also run on a small package
+of its own that has the fault."""
 import ast
 from pathlib import Path
 
-import engine
-import importers
+import pytest
 
-DESIGN_FOLDERS = ("templates", "library", "gears", "hobbing", "turning", "programs", "db", "cli")
+import engine
+
+# engine/'s folders, bottom to top: a folder may import only folders of a lower entry, never one in
+# its own entry nor above. "top" is engine's loose modules (errors, names, paths, memory,
+# csv_reader, pictures) and its __init__: they import nothing of the engine but each other.
+LAYERS = [
+    ("top",),
+    ("db",),                                  # connection, embedded server, migrations, records
+    ("nc",),                                  # NC text primitives: tokens, layout, lineage, words
+    ("machines",),                            # the machine record
+    ("gears",),                               # gears and hobs, classes, cutting data, model registry
+    ("verifier",),                            # the fail-closed reader of every program
+    ("templates", "simulation", "drawings"),  # decision table; hobbing simulation; DXF reading
+    ("library", "hobbing", "turning"),        # module library and seed; the models
+    ("programs",),                            # instantiation, storage, jobs
+    ("release",),                             # golden tests, impact, the release gate
+    ("cli",),                                 # the command line (and engine/__main__.py)
+]
+# Rules beyond the order, kept if the order ever changes: (importer, imported) -> why not.
+FORBIDDEN = {
+    ("simulation", "hobbing"): "the simulation never imports the models that made the program",
+    ("simulation", "turning"): "the simulation never imports the models that made the program",
+}
+DESIGN_FOLDERS = tuple(folder for layer in LAYERS[1:] for folder in layer)
 CLI = "engine.cli"
 CLI_ENTRY_POINTS = {"engine.__main__"}     # `python -m engine` is the command line itself
 
@@ -100,7 +123,7 @@ def cli_importers(graph: dict[str, set[str]]) -> list[str]:
 
 
 def engine_graph():
-    return import_graph((Path(engine.__file__).parent, "engine"), (Path(importers.__file__).parent, "importers"))
+    return import_graph((Path(engine.__file__).parent, "engine"))
 
 
 def test_no_import_cycle_in_the_package():
@@ -139,8 +162,7 @@ def test_engine_is_laid_out_as_the_design_s_sections():
 
 
 def test_every_module_says_what_it_is_in_its_first_line():
-    for package in (engine, importers):
-        assert modules_not_saying_what_they_are(Path(package.__file__).parent) == []
+    assert modules_not_saying_what_they_are(Path(engine.__file__).parent) == []
 
 
 def test_the_layout_checks_find_a_missing_folder_a_loose_module_and_a_silent_module(tmp_path):
@@ -148,10 +170,10 @@ def test_the_layout_checks_find_a_missing_folder_a_loose_module_and_a_silent_mod
         (tmp_path / name).mkdir()
         (tmp_path / name / "__init__.py").write_text(f'"""The {name} section."""\n')
     (tmp_path / "gear_import.py").write_text('# a comment first\n"""Gears from CSV."""\n')
-    (tmp_path / "db" / "seed.py").write_text("import csv\n")
-    assert missing_design_folders(tmp_path) == ["templates"]
+    (tmp_path / "library" / "seed.py").write_text("import csv\n")
+    assert missing_design_folders(tmp_path) == [DESIGN_FOLDERS[0]]
     assert loose_modules(tmp_path) == ["gear_import.py"]
-    assert modules_not_saying_what_they_are(tmp_path) == ["db/seed.py", "gear_import.py"]
+    assert modules_not_saying_what_they_are(tmp_path) == ["gear_import.py", "library/seed.py"]
 
 
 def _package(tmp_path, files: dict[str, str]):
@@ -198,3 +220,134 @@ def test_the_walker_finds_a_module_outside_the_cli_that_imports_it(tmp_path):
     assert cli_importers(renamed) == ["engine.lib -> engine.cli", "engine.lib -> engine.cli.app"]
     assert cycles(renamed) == [["engine.cli", "engine.cli.app", "engine.lib", "engine.cli"],
                                ["engine.cli.app", "engine.lib", "engine.cli.app"]]
+
+
+# --- layers (issue 25) -----------------------------------------------------------------------------
+
+def folder_of(module: str, folders: set[str], root: str = "engine") -> str:
+    """The section a module belongs to: its folder under `root`, "cli" for `root.__main__`, else
+    "top" (the package's __init__ and its loose modules)."""
+    parts = module.split(".")
+    if module == f"{root}.__main__":
+        return "cli"
+    return parts[1] if len(parts) > 1 and parts[1] in folders else "top"
+
+
+def folders_in(package: Path) -> set[str]:
+    """The folders (packages) directly inside a package's folder."""
+    return {path.parent.name for path in package.glob("*/__init__.py")}
+
+
+ENGINE_FOLDERS = folders_in(Path(engine.__file__).parent)
+
+
+def layer_problems(graph: dict[str, set[str]], folders=ENGINE_FOLDERS, layers=LAYERS, forbidden=FORBIDDEN,
+                   root: str = "engine") -> list[str]:
+    """`a -> b: why` for every import from a folder into one of the same or a higher layer, or that
+    a rule of FORBIDDEN names."""
+    rank = {folder: index for index, layer in enumerate(layers) for folder in layer}
+    problems = []
+    for module, targets in sorted(graph.items()):
+        for target in sorted(targets):
+            mine, theirs = folder_of(module, folders, root), folder_of(target, folders, root)
+            if mine == theirs:
+                continue
+            if (mine, theirs) in forbidden:
+                problems.append(f"{module} -> {target}: {forbidden[mine, theirs]}")
+            elif rank[theirs] >= rank[mine]:
+                where = "above it" if rank[theirs] > rank[mine] else "beside it, in the same layer"
+                problems.append(f"{module} -> {target}: {mine} may not import {theirs} ({where})")
+    return problems
+
+
+def two_way_folder_pairs(graph: dict[str, set[str]], folders=ENGINE_FOLDERS,
+                         root: str = "engine") -> list[tuple[str, str]]:
+    """Pairs of folders that import each other, either way round through any modules."""
+    edges = {(folder_of(module, folders, root), folder_of(target, folders, root))
+             for module, targets in graph.items() for target in targets}
+    return sorted({tuple(sorted(edge)) for edge in edges if edge[0] != edge[1] and edge[::-1] in edges})
+
+
+def folders_missing_from_layers(folders=ENGINE_FOLDERS, layers=LAYERS) -> list[str]:
+    return sorted(set(folders) - {folder for layer in layers for folder in layer})
+
+
+def test_every_folder_imports_only_folders_below_it():
+    graph = engine_graph()
+    assert "engine.machines.records" in graph["engine.gears.cases"]   # the walk sees imports between folders
+    assert layer_problems(graph) == []
+
+
+def test_no_two_folders_import_each_other():
+    assert two_way_folder_pairs(engine_graph()) == []
+
+
+def test_the_simulation_never_imports_the_models():
+    graph = engine_graph()
+    found = [f"{module} -> {target}" for module, targets in graph.items() if module.startswith("engine.simulation")
+             for target in targets if target.startswith(("engine.hobbing", "engine.turning"))]
+    assert any(target.startswith("engine.verifier") for target in graph["engine.simulation.reading"])
+    assert found == []
+
+
+def test_every_folder_of_the_engine_has_its_layer():
+    assert ENGINE_FOLDERS >= {"cli", "db", "verifier", "release"}   # the walk sees the folders
+    assert folders_missing_from_layers() == []
+    assert {folder for layer in LAYERS for folder in layer} - ENGINE_FOLDERS == {"top"}   # and no stale name
+
+
+FAKE_LAYERS = [("top",), ("db",), ("gears",), ("simulation",), ("hobbing", "turning"), ("cli",)]
+
+
+def test_the_layer_check_finds_a_folder_importing_one_above_or_beside_it(tmp_path):
+    graph = _package(tmp_path, {
+        "__init__.py": "",
+        "errors.py": "",
+        "db/__init__.py": "from ..errors import x\n",      # down to the loose modules: allowed
+        "gears/__init__.py": "",
+        "gears/models.py": "def f():\n    from ..hobbing.crowned import Model\n",
+        "hobbing/__init__.py": "",
+        "hobbing/crowned.py": "from ..gears import models\nfrom ..turning import names\n",
+        "turning/__init__.py": "",
+        "turning/names.py": "from ..db import x\n",
+        "tools/__init__.py": "",
+    })
+    folders = folders_in(tmp_path / "pkg")
+    assert layer_problems(graph, folders, FAKE_LAYERS, {}, root="pkg") == [
+        "pkg.gears.models -> pkg.hobbing: gears may not import hobbing (above it)",
+        "pkg.gears.models -> pkg.hobbing.crowned: gears may not import hobbing (above it)",
+        "pkg.hobbing.crowned -> pkg.turning: hobbing may not import turning (beside it, in the same layer)",
+        "pkg.hobbing.crowned -> pkg.turning.names: hobbing may not import turning (beside it, in the same layer)",
+    ]
+    assert two_way_folder_pairs(graph, folders, root="pkg") == [("gears", "hobbing")]
+    assert folders_missing_from_layers(folders, FAKE_LAYERS) == ["tools"]
+
+
+def test_the_layer_check_finds_the_simulation_importing_a_model(tmp_path):
+    graph = _package(tmp_path, {
+        "__init__.py": "",
+        "simulation/__init__.py": "",
+        "simulation/walk.py": "from ..gears import records\n",
+        "simulation/run.py": "from ..hobbing.cylindrical import Model\n",
+        "gears/__init__.py": "",
+        "gears/records.py": "",
+        "hobbing/__init__.py": "",
+        "hobbing/cylindrical.py": "from ..simulation.walk import x\n",
+    })
+    layers_allowing_it = [("top",), ("gears",), ("hobbing",), ("simulation",)]   # a reordered list
+    folders = folders_in(tmp_path / "pkg")
+    assert layer_problems(graph, folders, layers_allowing_it, root="pkg") == [
+        "pkg.hobbing.cylindrical -> pkg.simulation: hobbing may not import simulation (above it)",
+        "pkg.hobbing.cylindrical -> pkg.simulation.walk: hobbing may not import simulation (above it)",
+        "pkg.simulation.run -> pkg.hobbing: the simulation never imports the models that made the program",
+        "pkg.simulation.run -> pkg.hobbing.cylindrical: the simulation never imports the models that made the program",
+    ]
+    assert two_way_folder_pairs(graph, folders, root="pkg") == [("hobbing", "simulation")]
+
+
+def test_the_model_registry_fails_closed_while_empty(monkeypatch):
+    from engine.errors import EngineError
+    from engine.gears import models
+    monkeypatch.setattr(models, "MODELS", {})
+    with pytest.raises(EngineError, match="no gear model is registered"):
+        models.model_for_class(None, "cylindrical")

@@ -1,5 +1,5 @@
 """The line layout of a class (line ending, final newline; issue 17) is part of its template and
-travels with its versions (migration 0025): an editor's change of it is a new draft version, the
+travels with its versions (template_version_rows): an editor's change of it is a new draft version, the
 released version keeps the layout it was released with until a releaser releases the draft, and
 history, diff and restore treat it as they treat rows. The expected bytes are the stored lines
 read by SQL, joined here."""

@@ -56,7 +56,7 @@ def test_the_seeded_classes_give_the_same_programs_with_and_without_the_memo(con
     from engine.programs.instantiate import instantiate_gear
 
     choice_sets = [Choices(), Choices(cuts=2), Choices(coolant=False), Choices(shift_per_part=0.5)]
-    from engine.programs.lineage import without_lineage
+    from engine.nc.lineage import without_lineage
 
     def made(gear, choices):   # the template's lines: the lineage line names each program's own id
         program = instantiate_gear(conn, gear, choices=choices)

@@ -1,5 +1,6 @@
 """Migrations: applied in order, recorded with checksums, refused when edited, serialized,
 and producing exactly the readable schema in schema/."""
+import re
 import shutil
 import threading
 
@@ -10,37 +11,152 @@ from engine.db.migrate import discover, migrate, status
 from engine.errors import EngineError
 from engine.paths import MIGRATIONS_DIR, SCHEMA_DIR
 
+# The readable schema: every table, function, trigger and view once, in its final form, by
+# concern, loaded in this order (each file uses only objects of the files before it).
+SCHEMA_FILES = ("core.sql", "templates.sql", "versions.sql", "editing.sql", "records.sql", "programs.sql",
+                "release.sql", "roles.sql")
+
+# Each query lists one kind of object as (key, definition) rows: the key names the object.
+ACL = "(SELECT array_agg(format('%s %s', CASE WHEN a.grantee = 0 THEN 'PUBLIC' ELSE a.grantee::regrole::text END, " \
+      "a.privilege_type) ORDER BY 1) FROM aclexplode({}) a)"
+RELATION_ACL = """coalesce(relacl, acldefault(CASE relkind WHEN 'S' THEN 's' ELSE 'r' END::"char", relowner))"""
 CATALOG_QUERIES = {
-    "columns": """SELECT table_name, column_name, data_type, is_nullable, column_default
-                  FROM information_schema.columns WHERE table_schema = 'public'
-                  AND table_name <> 'schema_migration' ORDER BY 1, 2""",
-    "constraints": """SELECT conrelid::regclass::text, conname, pg_get_constraintdef(oid) FROM pg_constraint
-                      WHERE connamespace = 'public'::regnamespace
-                      AND conrelid::regclass::text <> 'schema_migration' ORDER BY 1, 2""",
-    "indexes": """SELECT indexname, indexdef FROM pg_indexes WHERE schemaname = 'public'
-                  AND tablename <> 'schema_migration' ORDER BY 1""",
-    "views": "SELECT viewname, pg_get_viewdef(viewname::regclass) FROM pg_views WHERE schemaname = 'public' ORDER BY 1",
-    "functions": """SELECT proname, pg_get_functiondef(oid) FROM pg_proc
-                    WHERE pronamespace = 'public'::regnamespace ORDER BY 1, 2""",
-    "triggers": """SELECT tgrelid::regclass::text, tgname, pg_get_triggerdef(oid) FROM pg_trigger
-                   WHERE NOT tgisinternal ORDER BY 1, 2""",
-    "roles": "SELECT rolname, rolcanlogin FROM pg_roles WHERE rolname LIKE 'engine\\_%' ORDER BY 1",
-    "module types": "SELECT code, position FROM module_type ORDER BY position",
+    "column": """SELECT table_name || '.' || column_name, concat_ws(' ', data_type, is_nullable, column_default)
+                 FROM information_schema.columns WHERE table_schema = 'public'
+                 AND table_name <> 'schema_migration'""",
+    "constraint": """SELECT conrelid::regclass::text || '.' || conname, pg_get_constraintdef(oid) FROM pg_constraint
+                     WHERE connamespace = 'public'::regnamespace AND conrelid::regclass::text <> 'schema_migration'""",
+    "index": """SELECT indexname, indexdef FROM pg_indexes WHERE schemaname = 'public'
+                AND tablename <> 'schema_migration'""",
+    "view": "SELECT viewname, pg_get_viewdef(viewname::regclass) FROM pg_views WHERE schemaname = 'public'",
+    "function": """SELECT oid::regprocedure::text, pg_get_functiondef(oid) FROM pg_proc
+                   WHERE pronamespace = 'public'::regnamespace""",
+    "trigger": """SELECT tgrelid::regclass::text || '.' || tgname, pg_get_triggerdef(oid) || ' ' || tgenabled::text
+                  FROM pg_trigger WHERE NOT tgisinternal""",
+    "role": "SELECT rolname, rolcanlogin::text FROM pg_roles WHERE rolname LIKE 'engine\\_%'",
+    "module type": "SELECT code, position::text FROM module_type",
+    "privileges on": f"""SELECT relname, {ACL.format(RELATION_ACL)}::text
+                         FROM pg_class WHERE relnamespace = 'public'::regnamespace
+                         AND relkind IN ('r', 'v', 'S') AND relname <> 'schema_migration'""",
+    "column privileges on": f"""SELECT attrelid::regclass::text || '.' || attname, {ACL.format("attacl")}::text
+                                FROM pg_attribute WHERE attacl IS NOT NULL
+                                AND attrelid::regclass::text NOT LIKE 'pg\\_%'""",
+    "execute privileges on": f"""SELECT oid::regprocedure::text, {ACL.format("coalesce(proacl, acldefault('f', proowner))")}::text
+                                 FROM pg_proc WHERE pronamespace = 'public'::regnamespace""",
+    "schema privileges on": f"SELECT nspname, {ACL.format('nspacl')}::text FROM pg_namespace WHERE nspname = 'public'",
+    "default privileges of": f"""SELECT defaclrole::regrole::text || ' ' || defaclobjtype::text, {ACL.format('defaclacl')}::text
+                                 FROM pg_default_acl WHERE defaclnamespace = 'public'::regnamespace""",
 }
 
 
-def catalog(url):
+def catalog(url) -> dict[str, dict[str, str]]:
+    """Every object of the database by kind: {kind: {object: its definition}}."""
     with psycopg.connect(url) as conn:
-        return {name: conn.execute(query).fetchall() for name, query in CATALOG_QUERIES.items()}
+        return {kind: dict(conn.execute(query).fetchall()) for kind, query in CATALOG_QUERIES.items()}
+
+
+def load_schema(url) -> None:
+    with psycopg.connect(url) as conn:
+        for name in SCHEMA_FILES:
+            conn.execute((SCHEMA_DIR / name).read_text(encoding="utf-8"))
+        conn.commit()
+
+
+def differences(from_schema, from_migrations) -> list[str]:
+    """One line per object that schema/ and migrations/ do not define alike."""
+    found = []
+    for kind, objects in from_migrations.items():
+        theirs = from_schema[kind]
+        found += [f"{kind} {key}: only the migrations make it" for key in sorted(objects.keys() - theirs.keys())]
+        found += [f"{kind} {key}: only schema/ makes it" for key in sorted(theirs.keys() - objects.keys())]
+        found += [f"{kind} {key} differs" for key in sorted(objects.keys() & theirs.keys())
+                  if objects[key] != theirs[key]]
+    return found
+
+
+def test_schema_folder_lists_its_files_in_load_order():
+    assert sorted(path.name for path in SCHEMA_DIR.glob("*.sql")) == sorted(SCHEMA_FILES)
 
 
 def test_migrations_produce_exactly_the_readable_schema(empty_database_url, database_url):
+    load_schema(empty_database_url)
+    assert differences(catalog(empty_database_url), catalog(database_url)) == []
+
+
+def test_a_difference_from_the_migrations_is_named_by_its_object(empty_database_url, database_url):
+    load_schema(empty_database_url)
     with psycopg.connect(empty_database_url) as conn:
-        conn.execute((SCHEMA_DIR / "schema.sql").read_text())
+        conn.execute("CREATE OR REPLACE FUNCTION class_depth_limit() RETURNS integer LANGUAGE sql IMMUTABLE "
+                     "PARALLEL SAFE RETURN 40")
+        conn.execute("ALTER TABLE hob DROP CONSTRAINT hob_safe_id")
         conn.commit()
-    from_schema, from_migrations = catalog(empty_database_url), catalog(database_url)
-    for part in CATALOG_QUERIES:
-        assert from_schema[part] == from_migrations[part], f"schema/schema.sql differs in {part}"
+    assert differences(catalog(empty_database_url), catalog(database_url)) == [
+        "constraint hob.hob_safe_id: only the migrations make it", "function class_depth_limit() differs"]
+
+
+# A definition in schema/: what it makes (function, view, trigger, table, index) and its identity.
+DEFINITION = re.compile(r"\bCREATE\s+(?:OR\s+REPLACE\s+)?(?:UNIQUE\s+)?(?:CONSTRAINT\s+)?"
+                        r"(FUNCTION|VIEW|TRIGGER|TABLE|INDEX)\s+(\w+)", re.IGNORECASE)
+TRIGGER_TABLE = re.compile(r"\bON\s+(\w+)", re.IGNORECASE)
+
+
+def argument_types(text: str, start: int) -> str:
+    """The types of a function's parameters whose list opens at text[start]: an overload is another function."""
+    depth, end = 0, start
+    for end in range(start, len(text)):
+        depth += {"(": 1, ")": -1}.get(text[end], 0)
+        if depth == 0:
+            break
+    types = []
+    for parameter in re.split(r",(?![^(]*\))", text[start + 1:end]):
+        words = re.split(r"\s+DEFAULT\s+|\s*=\s*", parameter.strip(), flags=re.IGNORECASE)[0].split()
+        types.append(" ".join(words[1:] if len(words) > 1 else words))
+    return ", ".join(t for t in types if t)
+
+
+def definitions(text: str) -> list[str]:
+    """Every object the SQL text creates, named so that two definitions of one object read alike."""
+    text = re.sub(r"--[^\n]*", "", text)
+    named = []
+    for match in DEFINITION.finditer(text):
+        kind, name = match.group(1).lower(), match.group(2)
+        if kind == "function":
+            name += f"({argument_types(text, match.end() + text[match.end():].index('('))})"
+        elif kind == "trigger":
+            name += " on " + TRIGGER_TABLE.search(text, match.end()).group(1)
+        named.append(f"{kind} {name}")
+    return named
+
+
+def defined_twice(text: str) -> list[str]:
+    named = definitions(text)
+    return sorted({name for name in named if named.count(name) > 1})
+
+
+def schema_text() -> str:
+    return "\n".join((SCHEMA_DIR / name).read_text(encoding="utf-8") for name in SCHEMA_FILES)
+
+
+def test_schema_folder_defines_each_object_once():
+    assert defined_twice(schema_text()) == []
+    assert "OR REPLACE" not in schema_text().upper()   # a later definition would silently win
+
+
+def test_a_second_definition_in_the_schema_folder_is_found():
+    second = ("CREATE OR REPLACE FUNCTION check_program() RETURNS trigger LANGUAGE plpgsql AS $$ BEGIN RETURN NEW; "
+              "END $$;\nCREATE TRIGGER check_program BEFORE INSERT ON program FOR EACH ROW EXECUTE FUNCTION x();\n"
+              "CREATE OR REPLACE VIEW result_line AS SELECT 1;\n")
+    assert defined_twice(schema_text() + second) == [
+        "function check_program()", "trigger check_program on program", "view result_line"]
+
+
+def test_overloads_and_like_named_triggers_are_not_second_definitions():
+    text = ("CREATE FUNCTION f(a integer) RETURNS int RETURN 1;\nCREATE FUNCTION f(a integer, b text DEFAULT 'x') "
+            "RETURNS int RETURN 2;\nCREATE TRIGGER t BEFORE INSERT ON one FOR EACH ROW EXECUTE FUNCTION g();\n"
+            "CREATE TRIGGER t BEFORE INSERT ON two FOR EACH ROW EXECUTE FUNCTION g();\n")
+    assert definitions(text) == ["function f(integer)", "function f(integer, text)", "trigger t on one",
+                                 "trigger t on two"]
+    assert defined_twice(text + "CREATE FUNCTION f(b integer) RETURNS int RETURN 3;") == ["function f(integer)"]
 
 
 def test_status_lists_every_migration_as_applied(database_url):
@@ -131,7 +247,7 @@ def test_hob_ids_differing_only_in_case_stop_migration_0011_with_their_names(emp
 def test_versions_stored_before_0025_keep_the_layout_their_programs_were_written_with(empty_database_url, tmp_path):
     """Before migration 0025 every program of a class was written with the class's one layout:
     the versions already stored record it, so programs of them are shown as they were written."""
-    from engine.library.nc_layout import CRLF, NcLayout, class_layout
+    from engine.nc.layout import CRLF, NcLayout, class_layout
     from engine.templates.rows import TemplateRow
     from engine.templates.store import ensure_class, replace_template
 

@@ -21,7 +21,7 @@ from engine.cli.app import main
 from engine.errors import EngineError
 from engine.library.nc_import import import_nc
 from engine.library.nc_rows import number_field
-from engine.library.nc_tokens import detokenise, tokenise
+from engine.nc.tokens import detokenise, tokenise
 from engine.templates.decision_table import compiled_template
 from engine.templates.evaluator import evaluate
 from engine.templates.expressions import compile_expression

@@ -7,7 +7,7 @@ import pytest
 
 from engine.errors import EngineError
 from engine.library.nc_import import import_nc
-from engine.library.nc_layout import class_layout, nc_text
+from engine.nc.layout import class_layout, nc_text
 from engine.templates.decision_table import compiled_template
 from engine.templates.store import load_template
 

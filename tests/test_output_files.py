@@ -19,6 +19,7 @@ import pytest
 from engine.errors import EngineError
 from engine.programs import outputs
 from engine.programs.instantiate import instantiate_gear
+from engine.programs.options import Output
 
 REPOSITORY = Path(__file__).resolve().parent.parent
 
@@ -220,14 +221,14 @@ def test_a_server_lost_at_commit_leaves_no_file(run, tmp_path):
 def test_files_are_refused_inside_a_caller_s_transaction(conn, tmp_path):
     """conn.transaction() there is only a savepoint: files written then would precede the COMMIT."""
     with pytest.raises(EngineError, match="only after their programs are committed"):
-        instantiate_gear(conn, 42, out=tmp_path / "GEAR42.MPF")
+        instantiate_gear(conn, 42, output=Output(tmp_path / "GEAR42.MPF"))
     assert instantiate_gear(conn, 42).lines[-1] == "M30"   # without files, a savepoint is all it needs
     assert everything_under(tmp_path) == []
 
 
 def test_a_committed_program_is_what_its_file_holds(fresh_database_url, tmp_path):
     with psycopg.connect(fresh_database_url) as conn:
-        program = instantiate_gear(conn, 42, out=tmp_path / "GEAR42.MPF")
+        program = instantiate_gear(conn, 42, output=Output(tmp_path / "GEAR42.MPF"))
     assert (tmp_path / "GEAR42.MPF").read_bytes() == latest_text(fresh_database_url, "GEAR42")
     assert program.path == str(tmp_path / "GEAR42.MPF")
 

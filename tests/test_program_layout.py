@@ -15,14 +15,14 @@ import re
 import psycopg
 import pytest
 
-from engine.templates.release import release
+from engine.release.gate import release
 
 CRLF, LF = "\r\n", "\n"
 
 
 
 def set_layout(url: str, gear_class: str, ending: str, final_newline: bool) -> None:
-    """The class's layout changed (a new draft version, migration 0025) and released, as an editor
+    """The class's layout changed (a new draft version: version_layout_change) and released, as an editor
     and a releaser do: runners' programs are written with it from then on."""
     with psycopg.connect(url) as conn:
         conn.execute("UPDATE gear_class SET line_ending = %s, final_newline = %s WHERE name = %s",

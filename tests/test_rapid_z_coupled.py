@@ -13,8 +13,8 @@ import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from engine.gears.records import Machine
-from engine.programs.verifier import LimitError, verify_program
+from engine.machines.records import Machine
+from engine.verifier import LimitError, verify_program
 
 TABLE_MAX = 120.0
 PRELUDE = ["%_N_RAPID_MPF", ";$PATH=/_N_MPF_DIR", "G90 G71 G94", "G54", "G25 X50.000 Y-30.000 Z-200.000",

@@ -20,6 +20,7 @@ from psycopg.types.json import Jsonb
 from engine.errors import EngineError
 from engine.gears.cases import confirm_job
 from engine.programs.instantiate import instantiate_gear, instantiate_gears
+from engine.programs.options import RunMode
 from roles import as_role
 
 # The engine's path for one program (engine.programs.storage): an id drawn from the sequence first,
@@ -225,9 +226,9 @@ def test_who_stored_a_program_is_the_login_person_and_the_role(database_url, log
 
 def test_a_program_made_inside_an_edit_fixes_its_version_and_the_next_edit_makes_another(conn):
     conn.execute("UPDATE template_view SET o = '\"G90 G71 G94 ; ONE\"' WHERE gear_class = 'spur' AND id = 800")
-    made = instantiate_gear(conn, 42, draft=True)   # the editor tries each draft
+    made = instantiate_gear(conn, 42, mode=RunMode(draft=True))   # the editor tries each draft
     conn.execute("UPDATE template_view SET o = '\"G90 G71 G94 ; TWO\"' WHERE gear_class = 'spur' AND id = 800")
-    later = instantiate_gear(conn, 42, draft=True)
+    later = instantiate_gear(conn, 42, mode=RunMode(draft=True))
     assert "G90 G71 G94 ; ONE" in made.lines and "G90 G71 G94 ; TWO" in later.lines
     assert later.template_version == made.template_version + 1
     for program in (made, later):   # each records the rows it was made from, stored for its version

@@ -19,7 +19,8 @@ from engine.cli.app import main
 from engine.library import refactor as refactoring
 from engine.library.nc_import import import_nc
 from engine.programs.instantiate import instantiate_gear
-from engine.programs.lineage import without_lineage
+from engine.nc.lineage import without_lineage
+from engine.programs.options import RunMode
 from engine.programs.records import Planned
 from engine.programs.storage import store_one
 from engine.templates.decision_table import CompiledTemplate
@@ -101,7 +102,8 @@ def test_reparenting_is_versioned_and_audited_for_the_class_and_below(conn):
         conn.execute("UPDATE gear_class SET parent = 'records_base' WHERE name = 'spur'")
     assert versions(conn, "spur", "duplex", "helical") == [before[0] + 1, before[1] + 1, before[2]]
     assert audit_rows(conn, "spur")[-1] == ("engine_editor", conn.info.user, 750, "INSERT")
-    assert "; SHOP STANDARD" in instantiate_gear(conn, 42, draft=True).lines   # spur's draft, tried by the editor
+    # spur's draft, tried by the editor
+    assert "; SHOP STANDARD" in instantiate_gear(conn, 42, mode=RunMode(draft=True)).lines
 
 
 def test_a_class_cannot_derive_from_itself_or_below_itself(conn):
@@ -313,7 +315,7 @@ def test_every_route_of_an_edit_keeps_each_programs_version_equal_to_its_rows(fr
         with psycopg.connect(url) as conn:
             edit(conn)
             conn.commit()
-            made.append(instantiate_gear(conn, 42, draft=True).program_id)   # the editor tries each edit
+            made.append(instantiate_gear(conn, 42, mode=RunMode(draft=True)).program_id)   # the editor tries each edit
             conn.commit()
 
     def import_part(conn, x):

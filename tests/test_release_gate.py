@@ -10,11 +10,12 @@ from psycopg import sql
 
 from engine.errors import EngineError
 from engine.programs.instantiate import instantiate_gear
-from engine.programs.lineage import without_lineage
+from engine.nc.lineage import without_lineage
+from engine.programs.options import RunMode
 from engine.templates.analysis import analyse, class_findings
-from engine.templates.golden import run_golden_tests
-from engine.templates.impact import impact
-from engine.templates.release import release
+from engine.release.golden import run_golden_tests
+from engine.release.impact import impact
+from engine.release.gate import release
 from engine.templates.rows import Template, TemplateRow
 from engine.templates.store import load_template
 from engine.templates.versions import released_template, released_version
@@ -206,7 +207,7 @@ def test_impact_counts_the_stored_programs_whose_lines_the_draft_changes(conn):
     assert report.jobs == len(below_spur) and report.failures == []
     assert report.changed == len(expected) > 0 and {diff.job_id for diff in report.diffs} == expected
     assert all("-M8" in diff.diff for diff in report.diffs)
-    drafted = {gear: instantiate_gear(conn, gear, draft=True) for gear in below_spur}
+    drafted = {gear: instantiate_gear(conn, gear, mode=RunMode(draft=True)) for gear in below_spur}
     differing = {released[gear].job_id for gear in below_spur
                  if _without_version(conn, released[gear]) != _without_version(conn, drafted[gear])}
     assert differing == expected

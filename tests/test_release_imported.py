@@ -18,7 +18,7 @@ import pytest
 from engine.errors import EngineError
 from engine.library.nc_import import import_nc
 from engine.programs.class_jobs import instantiate_class
-from engine.templates.release import release
+from engine.release.gate import release
 
 from roles import as_role
 from shared_data import shared_data

@@ -16,7 +16,8 @@ from psycopg.types.json import Jsonb
 
 from engine.errors import EngineError
 from engine.programs.instantiate import instantiate_gear
-from engine.programs.lineage import LINEAGE_ROW_ID
+from engine.nc.lineage import LINEAGE_ROW_ID
+from engine.programs.options import RunMode
 from engine.simulation import simulate_stored_program
 from lineage_text import id_masked
 from releases import release_draft
@@ -67,7 +68,7 @@ def test_a_broken_edit_through_the_view_does_not_reach_runners(conn):
     assert runner_lines(conn, 42) == released
     assert runner_lines(conn, 54) == duplex   # duplex inherits the row: its runners keep theirs too
     with pytest.raises(EngineError, match="class spur row 1800 column o"):
-        instantiate_gear(conn, 42, draft=True)   # only the editor trying the draft meets it
+        instantiate_gear(conn, 42, mode=RunMode(draft=True))   # only the editor trying the draft meets it
 
 
 def test_a_valid_edit_of_a_number_is_the_drafts_only(conn):
@@ -75,7 +76,7 @@ def test_a_valid_edit_of_a_number_is_the_drafts_only(conn):
     with as_role(conn, "engine_editor"):
         conn.execute(FEED_EDIT)
     assert runner_lines(conn, 42) == released
-    draft = instantiate_gear(conn, 42, draft=True)
+    draft = instantiate_gear(conn, 42, mode=RunMode(draft=True))
     # both printed to 0.1: the half is off by 0.05 at most, half the released one by 0.025
     assert abs(radial_feed(draft.lines) - radial_feed(released) / 2) <= 0.075 + 1e-9
     assert draft.template_version == current_version(conn, "spur") and states(conn, "spur")[draft.template_version] \
@@ -120,11 +121,11 @@ def test_a_runner_cannot_store_a_draft_program_an_editor_who_runs_can(conn):
     conn.execute(FEED_EDIT)
     with pytest.raises(errors.InsufficientPrivilege, match="only an editor"), conn.transaction(), \
             as_role(conn, "engine_runner"):
-        instantiate_gear(conn, 42, draft=True)
+        instantiate_gear(conn, 42, mode=RunMode(draft=True))
     both = "release_runtime_editor_runner"
     conn.execute(sql.SQL("CREATE ROLE {} NOLOGIN IN ROLE engine_editor, engine_runner").format(sql.Identifier(both)))
     with as_role(conn, both):
-        program = instantiate_gear(conn, 42, draft=True)
+        program = instantiate_gear(conn, 42, mode=RunMode(draft=True))
     draft, stored_role = conn.execute("SELECT draft, stored_role FROM program WHERE id = %s",
                                       (program.program_id,)).fetchone()
     lineage = [line for line, row in zip(program.lines, program.row_ids) if row == LINEAGE_ROW_ID]
@@ -149,7 +150,7 @@ def test_a_parents_release_leaves_the_childrens_released_rows_alone(conn):
     assert runner_lines(conn, 54) == duplex_lines and "G90 G71 G94 ; SPUR EDIT" not in duplex_lines
     assert "G90 G71 G94 ; SPUR EDIT" in runner_lines(conn, 42)
     assert has_draft(conn, "duplex") and not has_draft(conn, "spur")
-    assert "G90 G71 G94 ; SPUR EDIT" in instantiate_gear(conn, 54, draft=True).lines
+    assert "G90 G71 G94 ; SPUR EDIT" in instantiate_gear(conn, 54, mode=RunMode(draft=True)).lines
 
 
 # --- every program carries its lineage -----------------------------------------------------------------

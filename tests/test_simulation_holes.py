@@ -9,7 +9,8 @@ from dataclasses import replace
 
 import pytest
 
-from engine.gears.records import GearUnit, load_gear, load_hobs, load_machine
+from engine.gears.records import GearUnit, load_gear, load_hobs
+from engine.machines.records import load_machine
 from engine.simulation import simulate_program
 
 from simulation_programs import Hand, k_z, least_run_out, number_of, swivel

@@ -10,7 +10,8 @@ from dataclasses import replace
 import pytest
 
 from engine.errors import EngineError
-from engine.gears.records import GearUnit, load_gear, load_hobs, load_machine
+from engine.gears.records import GearUnit, load_gear, load_hobs
+from engine.machines.records import load_machine
 from engine.simulation import SimulationError, prove_program, simulate_program
 
 from simulation_programs import Hand, k_y, k_z, lead_angle, number_of, swivel, with_cycle_time

@@ -8,7 +8,8 @@ import json
 import pytest
 
 from engine.errors import EngineError
-from engine.gears.records import load_gear, load_hobs, load_machine
+from engine.gears.records import load_gear, load_hobs
+from engine.machines.records import load_machine
 from engine.hobbing.choices import Choices
 from engine.programs import verified_run
 from engine.programs.instantiate import instantiate_gear

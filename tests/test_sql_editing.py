@@ -9,6 +9,7 @@ from psycopg import errors, sql
 
 from engine.library.refactor import refactor
 from engine.programs.instantiate import instantiate_gear
+from engine.programs.options import RunMode
 from engine.templates.rows import TemplateRow, export_csv
 from engine.templates.store import load_template, replace_template
 from releases import release_draft
@@ -194,7 +195,7 @@ def test_an_update_that_changes_nothing_is_no_change(conn):
 def test_a_program_records_the_version_the_edit_made(conn):
     before = versions(conn)["spur"]
     conn.execute("UPDATE template_view SET o = '\"G90 G71 G94 ; V\"' WHERE gear_class = 'spur' AND id = 800")
-    program = instantiate_gear(conn, 42, draft=True)   # the editor tries the edit
+    program = instantiate_gear(conn, 42, mode=RunMode(draft=True))   # the editor tries the edit
     assert program.template_version == before + 1 == versions(conn)["spur"]
     assert '"G90 G71 G94 ; V"'.strip('"') in program.lines
 

@@ -12,7 +12,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from engine.errors import EngineError
-from engine.turning.dxf_import import import_dxf
+from engine.programs.dxf_import import import_dxf
 from engine.turning.gouge import GOUGE_TOLERANCE_MM, PartIndex, check_no_gouge
 from engine.turning.moves import Move
 from test_dxf_read import INCH, seed_drawing

@@ -16,8 +16,8 @@ from psycopg.types.json import Jsonb
 from engine.errors import EngineError
 from engine.library.refactor import refactor
 from engine.programs.remake import instantiate_job
-from engine.programs.verifier import LimitError
-from engine.turning.dxf_import import import_dxf
+from engine.verifier import LimitError
+from engine.programs.dxf_import import import_dxf
 from engine.turning.job_params import ProfileOptions
 from engine.turning.names import MAX_OPERATIONS
 from lathe_programs import distance_to_drawn, drawn_polylines, motions, operation_lines, words

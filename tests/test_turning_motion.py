@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 from engine.programs.remake import instantiate_job
-from engine.turning.dxf_import import import_dxf
+from engine.programs.dxf_import import import_dxf
 from engine.turning.job_params import ProfileOptions
 from lathe_programs import drawn_polylines, motions, words
 from test_dxf_read import DXF, EMCO, seed_drawing

@@ -7,10 +7,10 @@ from __future__ import annotations
 import pytest
 
 from engine.errors import EngineError
-from engine.gears.records import load_machine
+from engine.machines.records import load_machine
 from engine.programs.remake import instantiate_job
-from engine.programs.verifier import LimitError, verify_program
-from engine.turning.dxf_import import import_dxf
+from engine.verifier import LimitError, verify_program
+from engine.programs.dxf_import import import_dxf
 from test_dxf_read import seed_drawing
 from test_turning_jobs import two_rough_layers
 

@@ -22,8 +22,8 @@ from engine.turning.region import CHORD_TOLERANCE_MM
 from engine.turning.toolpaths import (alternate, distance_to_region, drawn_rough_passes,
                                       finish_passes, profile_rough_passes, slot_passes,
                                       thread_passes)
-from importers.dxf_drawing import read_drawing
-from importers.dxf_geometry import Arc, Line
+from engine.drawings.drawing import read_drawing
+from engine.drawings.geometry import Arc, Line
 from test_dxf_read import seed_drawing
 
 INCH = 25.4

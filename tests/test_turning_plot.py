@@ -13,7 +13,7 @@ import math
 import pytest
 
 from engine.programs.remake import instantiate_job
-from engine.turning.dxf_import import import_dxf
+from engine.programs.dxf_import import import_dxf
 from engine.turning.job_params import ProfileOptions
 from engine.turning.job_plot import turning_job_figure
 from lathe_programs import distance_to_drawn, drawn_polylines, operation_lines, words

@@ -15,8 +15,8 @@ import pytest
 from engine.errors import EngineError
 from engine.turning.job_params import ProfileOptions, turning_job
 from engine.turning.model import job_passes
-from importers.dxf_drawing import read_drawing
-from importers.dxf_read import DxfError
+from engine.drawings.drawing import read_drawing
+from engine.drawings.read import DxfError
 from lathe_programs import motions, operation_lines
 
 INCH_MM = 25.4

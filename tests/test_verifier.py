@@ -15,8 +15,8 @@ from pathlib import Path
 import psycopg
 import pytest
 
-from engine.gears.records import load_machine
-from engine.programs.verifier import LimitError, verify_program
+from engine.machines.records import load_machine
+from engine.verifier import LimitError, verify_program
 from golden_cases import TURNING_CASES
 from test_dxf_read import seed_drawing
 
@@ -30,7 +30,7 @@ HOBBING = ["%_N_TEST_MPF", ";$PATH=/_N_MPF_DIR", "; GEAR 42", "G90 G71 G94 G54",
 LATHE_840D = ["%_N_TEST_MPF", ";$PATH=/_N_MPF_DIR", "; DRAWING part.dxf", "G18 G71 G90 G40 DIAMON"]
 LATHE_ISO = ["%", "O0001 (TEST)", "(DRAWING part.dxf)", "G21 G18 G40 G90"]
 PRELUDES = {"hobber-840d": HOBBING, "lathe-840d": LATHE_840D, "lathe-iso": LATHE_ISO}
-# What a cut needs (engine.programs.verifier.machine_state): the table coupled and the hob
+# What a cut needs (engine.verifier.machine_state): the table coupled and the hob
 # turning (S246/19 = 12.9 r/min of C, below hobber-840d's 120); a tool with its offset, the
 # spindle turning, the feed mode stated.
 READY = {"hobber-840d": ["G0 Y0.000", "EGDEF(C,B,1)", 'EGON(C,"FINE",B,-1,19)', "M3 S246"],

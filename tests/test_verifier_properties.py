@@ -23,8 +23,8 @@ from pathlib import Path
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
-from engine.gears.records import Machine
-from engine.programs.verifier import LimitError, verify_program
+from engine.machines.records import Machine
+from engine.verifier import LimitError, verify_program
 
 SEED = Path(__file__).resolve().parent.parent / "seed_templates" / "machines.csv"
 MAX_FEED = 20000.0        # mm/min: the feed bound the lathe check has always had (about a rapid traverse)

@@ -16,8 +16,8 @@ import math
 import psycopg
 import pytest
 
-from engine.gears.records import load_machine
-from engine.programs.verifier import LimitError, verify_program
+from engine.machines.records import load_machine
+from engine.verifier import LimitError, verify_program
 from test_verifier import HOBBING, LATHE_ISO, READY, accepted, one_line_exit_1, program, programs, refusal
 
 MAX_FEED = 20000.0           # mm/min: the verifier's feed bound (about a rapid traverse)

@@ -30,6 +30,8 @@ def suggest(ctx, gear_id, top, machine, as_json):
     Prints the hob the library chooses, the nearest cases per cut kind with their distance,
     the proposal (n0, v, feeds in mm/min and mm per workpiece revolution) and plausibility notes.
     """
+    from .. import turning  # noqa: F401  (importing it registers the turning names model)
+    from ..hobbing import models as hobbing_models  # noqa: F401  (importing it registers the hobbing models)
     from ..gears.cases import suggest_for_gear
 
     with connection(ctx) as conn:

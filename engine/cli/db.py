@@ -167,7 +167,7 @@ def seed_command(ctx, samples):
 
     Example: engine seed --samples
     """
-    from ..db.seed import seed
+    from ..library.seed import seed
 
     with connection(ctx) as conn:
         click.echo(str(seed(conn, samples=samples)))

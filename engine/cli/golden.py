@@ -28,7 +28,7 @@ def test_command(ctx, gear_class, released, show_coverage, days, as_json):
     `FAIL … <first difference>`, then a summary. Exit 1 if any test fails or none exists.
 
     The expectations are `line: M30`, `no line: M8`, `match: REGEX`, `no match: REGEX`,
-    `last X = (df2 + da0)/2 ± 0.01` and the like (README, "Golden tests").
+    `last X = (df2 + da0)/2 ± 0.01` and the like (docs/guide/release-and-golden-tests.md).
 
     Example: engine test --class spur --json
     """
@@ -43,7 +43,7 @@ def test_command(ctx, gear_class, released, show_coverage, days, as_json):
 
 
 def _report_tests(conn: Connection, classes, gear_class, released, as_json) -> None:
-    from ..templates.golden import run_golden_tests
+    from ..release.golden import run_golden_tests
 
     results = run_golden_tests(conn, classes, draft=not released)
     failed = [result for result in results if not result.passed]
@@ -70,7 +70,7 @@ def _result_line(result) -> str:
 
 
 def _report_coverage(conn: Connection, classes, days, as_json) -> None:
-    from ..templates.coverage import coverage
+    from ..release.coverage import coverage
 
     rows = coverage(conn, days, classes)
     if as_json:

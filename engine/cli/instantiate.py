@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import re
+from dataclasses import replace
 from functools import partial
 from typing import TYPE_CHECKING
 
@@ -76,10 +77,9 @@ def parse_range(text: str, option: str = "--gears") -> tuple[int, int]:
               "skipped (else any bad one stores nothing).")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object (program_id, path, lines, ...).")
 @click.pass_context
-def instantiate(ctx, gear_id, job_id, gear_class, params_file, unverified, gear_range, job_range, all_gears, out, force,
-                machine, cuts, coolant, shift_y,
-                shift_per_part, feed_mode, tailstock, worm_feed, allowance, hob_speed, workers, explain, draft,
-                dry_run, skip_bad, as_json):
+def instantiate(ctx, gear_id, job_id, gear_class, params_file, unverified, gear_range, job_range, all_gears, out,
+                force, machine, cuts, coolant, shift_y, shift_per_part, feed_mode, tailstock, worm_feed, allowance,
+                hob_speed, workers, explain, draft, dry_run, skip_bad, as_json):
     """Produce the NC program of a gear (or a stored job, a job of an imported class, or a batch of gears).
 
     The program is checked against the machine's limits and proved by the
@@ -99,18 +99,14 @@ def instantiate(ctx, gear_id, job_id, gear_class, params_file, unverified, gear_
 
     Example: engine instantiate --gear 42 --out /srv/nc/
     """
-    from ..programs.config import line_ending, output_folder
     from ..hobbing.choices import Choices
+    from ..programs.config import line_ending
     from ..programs.instantiate import instantiate_gear
+    from ..programs.options import RunMode
     from ..programs.outputs import line_endings
     from ..programs.remake import instantiate_job
 
-    chosen = [name for name, value in (("--gear", gear_id), ("--job", job_id), ("--class", gear_class),
-                                       ("--gears", gear_range), ("--jobs", job_range), ("--all", all_gears))
-              if value not in (None, False)]
-    if len(chosen) != 1:
-        raise EngineError("give exactly one of --gear ID, --job ID, --class C, --gears FIRST-LAST, --jobs FIRST-LAST, "
-                          "--all")
+    _refuse_all_but_one_job(gear_id, job_id, gear_class, gear_range, job_range, all_gears)
     _refuse_options_of_other_jobs(ctx, gear_class is not None)
     batch = bool(gear_range or job_range or all_gears)
     workers = where_it_applies(ctx, "workers", workers, workers == 1 or bool(gear_range or all_gears),
@@ -124,40 +120,60 @@ def instantiate(ctx, gear_id, job_id, gear_class, params_file, unverified, gear_
                       allowance=allowance)
     overrides = {"hob_speed": hob_speed}
     config = settings(ctx)   # the config file: the machine's output folder and line endings (over the class's)
-    new_job_written = not (dry_run or job_id is not None or job_range)   # a dry run writes no file
-    out = output_folder(config, machine, out) if new_job_written else out
-    if force and not out:
-        raise EngineError("--force replaces files in --out: give --out too")
+    output = _output(config, machine, out, force, new_job_written=not (dry_run or job_id is not None or job_range))
     skip_bad = where_it_applies(ctx, "skip_bad", skip_bad, not skip_bad or batch,
                                 "--skip-bad skips the bad gears of a batch: use it with --gears, --jobs or --all")
+    mode = RunMode(draft=draft, dry_run=dry_run, skip_bad=skip_bad, workers=workers)
     with connection(ctx) as conn, line_endings(partial(line_ending, config)):
         if gear_id is not None:
-            program = instantiate_gear(conn, gear_id, machine=machine, choices=choices, overrides=overrides, out=out,
-                                       force=force, draft=draft, dry_run=dry_run)
+            program = instantiate_gear(conn, gear_id, machine=machine, choices=choices, overrides=overrides,
+                                       output=output, mode=mode)
         elif job_id is not None:
-            program = instantiate_job(conn, job_id, out=out, force=force, draft=draft, dry_run=dry_run)
+            program = instantiate_job(conn, job_id, output=output, mode=mode)
         elif gear_class is not None:
-            return _class_job(conn, gear_class, params_file, machine, as_json, explain, out=out, force=force,
-                              draft=draft, dry_run=dry_run, unverified=unverified)
+            job = _class_job(conn, gear_class, params_file, machine, output, mode, unverified)
+            return _report_class_job(job, as_json, explain)
         else:
-            with progress_bar("instantiate") as progress:
-                batch = _batch(conn, job_range, gear_range, progress, out=out, force=force, draft=draft,
-                               skip_bad=skip_bad, dry_run=dry_run, machine=machine, choices=choices,
-                               overrides=overrides, workers=workers)
-            return _report_batch(batch, out, as_json)
+            return _report_batch(_batch(conn, job_range, gear_range, machine, choices, overrides, output, mode),
+                                 output.out, as_json)
     _report_program(program, as_json, explain)
 
 
-def _batch(conn: Connection, job_range, gear_range, progress, machine, choices, overrides, workers, **common):
-    """A batch of stored jobs made again (--jobs), or of gears (--gears, --all)."""
+def _refuse_all_but_one_job(gear_id, job_id, gear_class, gear_range, job_range, all_gears) -> None:
+    """One invocation makes one kind of job: a gear's, a stored one's, a class's, or a batch."""
+    chosen = [name for name, value in (("--gear", gear_id), ("--job", job_id), ("--class", gear_class),
+                                       ("--gears", gear_range), ("--jobs", job_range), ("--all", all_gears))
+              if value not in (None, False)]
+    if len(chosen) != 1:
+        raise EngineError("give exactly one of --gear ID, --job ID, --class C, --gears FIRST-LAST, --jobs FIRST-LAST, "
+                          "--all")
+
+
+def _output(config, machine: str | None, out, force: bool, new_job_written: bool):
+    """Where the files go: --out, else (a new job, not a dry run) the machine's output folder of
+    the config file, else nowhere. --force with nowhere to write would replace nothing: refused."""
+    from ..programs.config import output_folder
+    from ..programs.options import Output
+
+    out = output_folder(config, machine, out) if new_job_written else out   # a dry run writes no file
+    if force and not out:
+        raise EngineError("--force replaces files in --out: give --out too")
+    return Output(out=out, force=force)
+
+
+def _batch(conn: Connection, job_range, gear_range, machine, choices, overrides, output, mode):
+    """A batch of stored jobs made again (--jobs), or of gears (--gears, --all), with a progress
+    bar on a terminal."""
     from ..programs.instantiate import instantiate_gears
     from ..programs.remake import instantiate_jobs
 
-    if job_range:
-        return instantiate_jobs(conn, *parse_range(job_range, "--jobs"), progress=progress, **common)
-    first, last = parse_range(gear_range) if gear_range else (None, None)
-    return instantiate_gears(conn, first, last, machine=machine, choices=choices, overrides=overrides,
-                             workers=workers, progress=progress, **common)
+    with progress_bar("instantiate") as progress:
+        mode = replace(mode, progress=progress)
+        if job_range:
+            return instantiate_jobs(conn, *parse_range(job_range, "--jobs"), output=output, mode=mode)
+        first, last = parse_range(gear_range) if gear_range else (None, None)
+        return instantiate_gears(conn, first, last, machine=machine, choices=choices, overrides=overrides,
+                                 output=output, mode=mode)
 
 
 def where_it_applies(ctx, name: str, value, applies: bool, refusal: str):
@@ -211,12 +227,17 @@ def _refuse_new_job_choices_for_stored_jobs(ctx, stored_jobs: bool) -> None:
                           "stored parameters: edit job.params in SQL to change them")
 
 
-def _class_job(conn: Connection, gear_class, params_file, machine, as_json, explain, **options) -> None:
+def _class_job(conn: Connection, gear_class, params_file, machine, output, mode, unverified):
+    """The job of the class with the values of --params (the class's imported ones without it)."""
     from ..library.nc_import import read_params
     from ..programs.class_jobs import instantiate_class
 
     given = read_params(params_file) if params_file else {}
-    job = instantiate_class(conn, gear_class, given, machine=machine, source=params_file or "parameters", **options)
+    return instantiate_class(conn, gear_class, given, machine=machine, source=params_file or "parameters",
+                             output=output, mode=mode, unverified=unverified)
+
+
+def _report_class_job(job, as_json: bool, explain: bool) -> None:
     if job.taken and not as_json:
         click.echo(f"imported values kept (not in --params): {', '.join(job.taken)}", err=True)
     _report_program(job.program, as_json, explain, {"machine": job.machine, "given": list(job.given),

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import click
 
-from ..programs.lineage import UNVERIFIED
+from ..nc.lineage import UNVERIFIED
 from .context import connection, emit_json
 from .ids import GEAR_ID, JOB_ID, PROGRAM_ID
 from .output import Column, day, day_options, emit_list, list_options, one_of

@@ -6,7 +6,7 @@ import sys
 
 import click
 
-from ..library.nc_layout import ENDING_NAMES, NcLayout
+from ..nc.layout import ENDING_NAMES, NcLayout
 from .context import connection, emit_json
 from .ids import VERSION
 from .output import Column, emit_list, list_options
@@ -51,7 +51,7 @@ def template_export(ctx, gear_class, out):
     """Print the class's assembled template as CSV. A class whose programs are written other than
     LF with a final newline (imported from such a file) gives that on every row (line_ending
     lf|crlf, final_newline yes|no), so an import elsewhere writes the same bytes."""
-    from ..library.nc_layout import class_layout
+    from ..nc.layout import class_layout
     from ..templates.rows import export_csv
     from ..templates.store import load_template
 
@@ -74,7 +74,7 @@ def template_import(ctx, gear_class, parent, csv_file):
     The line_ending and final_newline columns, if the CSV has them, set the class's layout (a change
     of it is a new draft version, as a change of rows is, until `engine template release`); a CSV
     without them leaves it as it is."""
-    from ..library.nc_layout import class_layout, store_layout
+    from ..nc.layout import class_layout, store_layout
     from ..templates.rows import read_template_csv
     from ..templates.store import ensure_class, replace_template
 
@@ -210,6 +210,8 @@ def template_restore(ctx, gear_class, version):
 @click.pass_context
 def lint(ctx, as_json):
     """Check every expression of every template: parses, is allowed, names known parameters."""
+    from .. import turning  # noqa: F401  (importing it registers the turning names model)
+    from ..hobbing import models as hobbing_models  # noqa: F401  (importing it registers the hobbing models)
     from ..templates.lint import lint_all
 
     with connection(ctx) as conn:

@@ -26,7 +26,8 @@ from .case_base import CASE_COLUMNS, CUT_KINDS, CaseBase, KindProposal, feeds_pe
 from .cutting_data import CuttingData
 from .hob_matching import choose_hob
 from .models import model_for_class
-from .records import Gear, Hob, Machine, hobbing_machine, load_gear, load_hobs
+from .records import Gear, Hob, load_gear, load_hobs
+from ..machines.records import Machine, hobbing_machine
 
 if TYPE_CHECKING:
     from ..db.connection import Connection

@@ -21,7 +21,7 @@ from typing import TYPE_CHECKING, Any, Callable, Collection, Mapping
 
 from ..errors import EngineError
 from .hob_matching import choose_hob
-from .models import MODELS, ancestry
+from .models import ancestry, registered_models
 from .records import load_gear, load_hobs
 
 if TYPE_CHECKING:
@@ -191,10 +191,11 @@ def explain_gear(conn: Connection, gear_id: int) -> GearClassReport:
     classification = classify({"gear_id": gear.id, "cone_angle": gear.cone_angle, "crowning": gear.crowning,
                                "helix_angle": gear.helix_angle, "units": len(gear.units), "material": gear.material})
     lineage = ancestry(conn, gear.gear_class) if gear.gear_class else []
-    model_class = next((name for name in lineage if name in MODELS), None)
+    models = registered_models()
+    model_class = next((name for name in lineage if name in models), None)
     hob = None
     if model_class:
-        model = MODELS[model_class]
+        model = models[model_class]
         try:
             chosen = choose_hob(gear, load_hobs(conn), purpose=model.hob_purpose)
             hob = chosen.reason

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 from typing import Callable
 
 from ..errors import EngineError
-from ..hobbing.geometry import generating_length, lead_angle
+from .hob_geometry import generating_length, lead_angle
 from .records import Gear, Hob
 
 # Hob accuracy classes from best to coarsest (DIN 3968 / GB/T 6084).

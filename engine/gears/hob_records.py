@@ -1,5 +1,5 @@
 """The hob library as a person looks into it (`engine hobs list|show|delete`). A hob id is one hob
-whatever its case (migration 0011), so H-M2-AA-R1 and h-m2-aa-r1 find the same record. A hob a
+whatever its case (index hob_id_ignoring_case), so H-M2-AA-R1 and h-m2-aa-r1 find the same record. A hob a
 job refers to is kept: the job's programs were cut with it."""
 from __future__ import annotations
 

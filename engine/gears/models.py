@@ -1,28 +1,55 @@
-"""Which hobbing model serves which gear class: the nearest ancestor that has one."""
+"""Which model serves which gear class: the nearest ancestor that has one. Models register
+themselves here (`@register_model("cylindrical")` on the class), as ezdxf's entities do, so the
+gears section never imports the hobbing or turning sections above it: importing
+engine.hobbing.models or engine.turning registers their models, and the programs, release and
+command-line code that asks for a model imports them first."""
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any, Callable, Protocol
 
-from ..hobbing.crowned import CrownedModel
-from ..hobbing.cylindrical import CylindricalModel
-from ..hobbing.duplex import DuplexModel
-from ..hobbing.taper import TaperModel
-from ..hobbing.worm_wheel import WormWheelModel
-from ..turning.names import TurningModel
+from ..errors import EngineError
 
 if TYPE_CHECKING:
     from ..db.connection import Connection
 
-# The hobbing model of a node of the group-technology tree serves it and every class below
-# it that has no model of its own.
-MODELS = {
-    "cylindrical": CylindricalModel(),
-    "duplex": DuplexModel(),
-    "taper": TaperModel(),
-    "crowned": CrownedModel(),
-    "worm_wheel": WormWheelModel(),
-    "turning": TurningModel(),   # names only (for lint): turning jobs come from drawings
-}
+
+class NamedModel(Protocol):
+    """What `engine lint` asks of every model: the parameter names a module's rows may read."""
+
+    def parameter_names(self, t: str, n: int) -> frozenset: ...
+
+
+class HobbingModel(NamedModel, Protocol):
+    """What the instantiation asks of a hobbing model (engine.hobbing.cylindrical and its kin)."""
+    hob_purpose: str           # which hobs of the library may cut the class (engine.gears.hob_matching)
+    cut_shape: str             # the pass its template emits (engine.hobbing.cycle_time.PASSES)
+
+    def shift_travel(self, choices: Any) -> float: ...
+
+    def job(self, gear: Any, gear_class: str, hob: Any, machine: Any, cutting: Any, choices: Any) -> Any: ...
+
+
+# The model of a node of the group-technology tree serves it and every class below it that has
+# no model of its own. Filled by register_model as the model modules are imported.
+MODELS: dict[str, NamedModel] = {}
+
+
+def register_model(gear_class: str) -> Callable[[type], type]:
+    """Class decorator: one instance of the model serves `gear_class` and the classes below it."""
+    def register(model_type: type) -> type:
+        MODELS[gear_class] = model_type()
+        return model_type
+    return register
+
+
+def registered_models() -> dict[str, NamedModel]:
+    """The registry, refused while empty: a caller that reached a model before engine.hobbing was
+    imported would otherwise see every class as having none (fail closed)."""
+    if not MODELS:
+        raise EngineError("internal error: no gear model is registered; import engine.hobbing.models and "
+                          "engine.turning before asking for one")
+    return MODELS
+
 
 CLASS_ANCESTRY = """
 WITH RECURSIVE up(name, parent, depth) AS (
@@ -38,8 +65,11 @@ def ancestry(conn: Connection, gear_class: str) -> list[str]:
     return [row[0] for row in conn.execute(CLASS_ANCESTRY, (gear_class,))]
 
 
-def model_for_class(conn: Connection, gear_class: str):
+def model_for_class(conn: Connection, gear_class: str) -> Any:
+    """The model of the class's nearest ancestor that has one (a HobbingModel, or the turning
+    names model), or None when no class on the path up has one."""
+    models = registered_models()
     for name in ancestry(conn, gear_class):
-        if name in MODELS:
-            return MODELS[name]
+        if name in models:
+            return models[name]
     return None

@@ -1,20 +1,19 @@
-"""Workpieces, hobs and machines as read from the database."""
+"""Workpieces and hobs as read from the database (machines: engine.machines.records)."""
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass, replace
 from decimal import Decimal
-from typing import TYPE_CHECKING, Any, TypeVar
+from typing import TYPE_CHECKING, Any
 
-from ..csv_reader import MAX_MAGNITUDE   # the CSV readers refuse larger numbers; so do the records
+from ..db.records import as_float, columns
 from ..errors import EngineError
 
 if TYPE_CHECKING:
     from collections.abc import Sequence
 
-    from _typeshed import DataclassInstance
-
     from ..db.connection import Connection
+    from ..db.records import Record
 
 TOOTH_DEPTH = Decimal("2.25")  # full tooth depth in modules: root = tip − 2·2.25·m
 
@@ -76,39 +75,6 @@ class Hob:
     tool_number: int = 1
 
 
-@dataclass(frozen=True)
-class Machine:
-    name: str
-    kind: str
-    dialect: str
-    x_min: float
-    x_max: float
-    y_min: float
-    y_max: float
-    z_min: float
-    z_max: float
-    spindle_max: float
-    table_speed_max: float | None
-    module_max: float | None
-    # Conventions and setup (migration 0013): each axis's sense relative to DIN 66217.
-    a_direction: int = 1
-    b_direction: int = 1
-    c_direction: int = 1
-    y_direction: int = 1
-    z_direction: int = 1
-    work_offset: str = "G54"
-    fixture_diameter: float = 0.0
-    fixture_gap: float = 0.0
-    tailstock_diameter: float = 0.0
-    tailstock_gap: float = 0.0
-    load_x: float | None = None
-    load_z: float | None = None
-    rapid_rate: float = 5000.0
-    orient_before_coupling: bool = False
-    door_close_m: int | None = None
-    door_open_m: int | None = None
-
-
 def normal_module(module: Any, module_kind: str | None, helix_angle: Any) -> Any:
     """m_n = m_x·cos γ for a module stated as the worm's axial module (γ, the worm's lead angle,
     is the wheel's helix angle: reference §B10, ΔC = 360·ΔY/(π·m_x·z2) = 360·cos γ·ΔY/(π·m_n·z2));
@@ -147,31 +113,14 @@ def derived_diameters(module: Any, teeth: int, helix_angle: Any = 0,
     return tip, root
 
 
-def _columns(record_type, exclude=frozenset()) -> str:
-    return ", ".join(field.name for field in fields(record_type) if field.name not in exclude)
-
-
-
-
-Record = TypeVar("Record", bound="DataclassInstance")   # Gear, Hob, Machine
-
-
 def _as_float(record_type: type[Record], row: Sequence[Any]) -> Record:
-    """numeric columns arrive as Decimal; models compute in float, so each must be a finite
-    float of a plausible size (a record edited in SQL is read as strictly as a file)."""
-    values = [float(v) if isinstance(v, Decimal) else v for v in row]
-    for field, value, stored in zip(fields(record_type), values, row):
-        if isinstance(value, float) and not abs(value) <= MAX_MAGNITUDE:   # NaN fails too
-            raise EngineError(f"{_KINDS.get(record_type, 'record')} {row[0]}: {field.name} {stored} is not a number "
-                              f"of at most {MAX_MAGNITUDE:g} in size; correct it (in the database or the CSV file)")
-    return record_type(*values)
+    return as_float(record_type, row, _KINDS.get(record_type, "record"))
 
 
-_KINDS = {Gear: "gear", GearUnit: "unit", Hob: "hob", Machine: "machine"}
-GEAR_QUERY = f"SELECT {_columns(Gear, exclude={'units'})} FROM gear"  # static, from the dataclass
-UNIT_QUERY = f"SELECT gear_id, {_columns(GearUnit)} FROM gear_unit"
-HOB_QUERY = f"SELECT {_columns(Hob)} FROM hob"
-MACHINE_QUERY = f"SELECT {_columns(Machine)} FROM machine"
+_KINDS = {Gear: "gear", GearUnit: "unit", Hob: "hob"}
+GEAR_QUERY = f"SELECT {columns(Gear, exclude={'units'})} FROM gear"  # static, from the dataclass
+UNIT_QUERY = f"SELECT gear_id, {columns(GearUnit)} FROM gear_unit"
+HOB_QUERY = f"SELECT {columns(Hob)} FROM hob"
 
 
 def load_gear(conn: Connection, gear_id: int) -> Gear:
@@ -232,23 +181,3 @@ def _with_units(gear: Gear, units: dict) -> Gear:
 
 def load_hobs(conn: Connection) -> list[Hob]:
     return [_as_float(Hob, row) for row in conn.execute(HOB_QUERY + " ORDER BY id")]
-
-
-DEFAULT_HOBBING_MACHINE = "hobber-840d"
-
-
-def hobbing_machine(conn: Connection, name: str | None) -> Machine:
-    """The machine record, which must be a hobbing machine (default: the seeded 840D hobber)."""
-    machine = load_machine(conn, name or DEFAULT_HOBBING_MACHINE)
-    if machine.kind != "hobber":
-        raise EngineError(f"machine {machine.name} is a {machine.kind}, not a hobbing machine; "
-                          f"use --machine {DEFAULT_HOBBING_MACHINE}")
-    return machine
-
-
-def load_machine(conn: Connection, name: str) -> Machine:
-    row = conn.execute(MACHINE_QUERY + " WHERE name = %s", (name,)).fetchone()
-    if row is None:
-        known = ", ".join(r[0] for r in conn.execute("SELECT name FROM machine ORDER BY name"))
-        raise EngineError(f"machine {name!r} does not exist; known machines: {known or 'none (run engine seed)'}")
-    return _as_float(Machine, row)

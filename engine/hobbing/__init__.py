@@ -1,1 +1,2 @@
-"""Hobbing models: gear + hob + machine + process choices → the parameters of a template."""
+"""Hobbing models: gear + hob + machine + process choices → the parameters of a template.
+Importing engine.hobbing.models registers every model with engine.gears.models."""

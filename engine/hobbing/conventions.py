@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import math
 
-from ..gears.records import Machine
+from ..machines.records import Machine
 
 # Quantity -> the machine's direction fields whose product turns the DIN value into the
 # program's: the table follows the hob (C per B), the helical differential (C per Z), the

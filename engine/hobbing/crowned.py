@@ -12,6 +12,7 @@ import math
 from functools import lru_cache
 
 from ..errors import EngineError
+from ..gears.models import register_model
 from . import geometry
 from .cylindrical import RAPID_SHORT_OF_CUT, CylindricalModel
 from .passes import APPROACH_SAFETY
@@ -23,6 +24,7 @@ MAX_FACE_SLOPE = 0.5  # dX/dZ of the crowned root at the faces (26.6°); crownin
 VERTICES = tuple(f"crown_x_{k}" for k in range(CROWN_SEGMENTS + 1))
 
 
+@register_model("crowned")
 class CrownedModel(CylindricalModel):
     class_parameters = frozenset({"crowning", "crown_depth", "z_mid"})
     cut_parameters = CylindricalModel.cut_parameters | {"face_from", "face_to"} | set(VERTICES)

@@ -6,7 +6,9 @@ from dataclasses import dataclass
 from typing import Protocol
 
 from ..gears.cutting_data import CuttingData
-from ..gears.records import Gear, Hob, Machine
+from ..gears.models import register_model
+from ..gears.records import Gear, Hob
+from ..machines.records import Machine
 from . import conventions, geometry, shifting
 from .choices import Choices
 from .machine_job import SETUP_PARAMETERS, machine_job
@@ -68,6 +70,7 @@ def program_name(gear_id: int) -> str:
     return f"GEAR{gear_id}"
 
 
+@register_model("cylindrical")
 class CylindricalModel:
     """Spur and helical gears: radial infeed in air, axial pass with overrun, per cut."""
 

@@ -9,7 +9,8 @@ import math
 from dataclasses import dataclass
 
 from ..errors import EngineError
-from ..programs.verifier import check_table_speed
+from ..gears.models import register_model
+from ..verifier import check_table_speed
 from . import shifting
 from .cylindrical import CylindricalModel, JobParameters
 from .envelope import half_length, reach_into_cylinder
@@ -26,6 +27,7 @@ MIN_OVERRUN = 1.0   # mm the pass carries the hob centre beyond the face it leav
 FACING_END = {(True, True): "z_to", (True, False): "z_from", (False, True): "z_from", (False, False): "z_to"}
 
 
+@register_model("duplex")
 class DuplexModel(CylindricalModel):
     def parameter_names(self, t: str, n: int) -> frozenset:
         names = super().parameter_names(t, n)

@@ -4,30 +4,12 @@ from __future__ import annotations
 
 import math
 
-ADDENDUM_FACTOR = 1.0     # tip = d + 2·m
-DEDENDUM_FACTOR = 1.25    # root = d − 2·1.25·m
-TOOTH_DEPTH_FACTOR = ADDENDUM_FACTOR + DEDENDUM_FACTOR   # h = 2.25·m
+# The hob's own geometry is below, in engine.gears (hob matching needs it); the models read it here too.
+from ..gears.hob_geometry import generating_length, hob_reference_diameter, lead_angle  # noqa: F401
 
 
 def reference_diameter(module: float, teeth: int, helix_angle: float = 0.0) -> float:
     return module * teeth / math.cos(math.radians(helix_angle))
-
-
-def hob_reference_diameter(hob_tip_diameter: float, module: float) -> float:
-    """d_m0 ≈ d_a0 − 2·1.25·m_n (§B1)."""
-    return hob_tip_diameter - 2 * DEDENDUM_FACTOR * module
-
-
-def lead_angle(module: float, starts: int, hob_tip_diameter: float) -> float:
-    """Hob lead angle γ: sin γ = z0·m_n/d_m0 (§B1)."""
-    return math.degrees(math.asin(starts * module / hob_reference_diameter(hob_tip_diameter, module)))
-
-
-def generating_length(module: float, pressure_angle: float) -> float:
-    """Axial length of the hob that generates the tooth: 2·h/tan α_n + π·m_n with
-    h = 2.25·m_n (§B15); the hob must be this long plus the shift and its margins."""
-    depth = TOOTH_DEPTH_FACTOR * module
-    return 2 * depth / math.tan(math.radians(pressure_angle)) + math.pi * module
 
 
 def full_depth_centre_distance(root_diameter: float, hob_tip_diameter: float) -> float:

@@ -2,7 +2,7 @@
 reads it (engine.hobbing.program_plot), so the picture shows what the machine will do, not a
 second reading of the job's parameters. The program is the newest one made from a released
 template version, the one that reaches the machine: an editor's draft tried on the job
-(`instantiate --job ID --draft`, program.draft, migration 0015) never does. Only when the job has
+(`instantiate --job ID --draft`, program.draft) never does. Only when the job has
 nothing but drafts is the newest draft drawn, and the picture and the report say draft."""
 from __future__ import annotations
 

@@ -4,7 +4,8 @@ blocks, spindle orientation), the working area widened to the load position, and
 time of the program the template will write (engine.hobbing.cycle_time)."""
 from __future__ import annotations
 
-from ..gears.records import Hob, Machine
+from ..gears.records import Hob
+from ..machines.records import Machine
 from . import conventions
 from .cycle_time import cycle_time
 from .passes import LIMIT_MARGIN

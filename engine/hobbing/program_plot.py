@@ -11,7 +11,8 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from ..errors import EngineError
-from ..gears.records import Gear, Hob, Machine, load_gear, load_machine
+from ..gears.records import Gear, Hob, load_gear
+from ..machines.records import Machine, load_machine
 from ..pictures import literal, new_figure, picture_target, save_atomically
 from ..simulation.recorded import Recording, record_program
 from ..simulation.stored import load_hob

@@ -6,7 +6,7 @@ import math
 
 from ..errors import EngineError
 from .choices import Choices
-from .geometry import generating_length, lead_angle
+from ..gears.hob_geometry import generating_length, lead_angle
 
 SHIFT_MARGIN = 5.0          # mm kept free at each end of the hob
 PITCH_MULTIPLE_TOLERANCE = 0.05   # mm: a step this close to n axial pitches repeats the same teeth

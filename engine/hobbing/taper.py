@@ -7,6 +7,7 @@ import math
 
 from ..errors import EngineError
 from ..gears.cutting_data import programmed_feed
+from ..gears.models import register_model
 from .root_contact import centre_on_root_cone
 from .cylindrical import RETRACT_CLEARANCE, CylindricalModel, Setup
 from .envelope import clearance_to_cone
@@ -19,6 +20,7 @@ RUN_IN_TOLERANCE = 0.005
 CONTACT_MARGIN = 0.5    # mm the contact point passes the face it leaves
 
 
+@register_model("taper")
 class TaperModel(CylindricalModel):
     class_parameters = frozenset({"cone_angle", "taper_slope"})
     cut_parameters = CylindricalModel.cut_parameters | {"feed_slant"}

@@ -13,6 +13,7 @@ from dataclasses import replace
 
 from ..errors import EngineError
 from ..gears.cutting_data import per_minute, programmed_feed
+from ..gears.models import register_model
 from . import conventions
 from .cylindrical import RAPID_SHORT_OF_CUT, CylindricalModel, JobParameters
 from .passes import APPROACH_SAFETY, feeds, plan_cuts, working_area
@@ -20,6 +21,7 @@ from .passes import APPROACH_SAFETY, feeds, plan_cuts, working_area
 DWELL_TABLE_TURNS = 2.0   # table revolutions at full depth after a radial plunge (enveloping cuts)
 
 
+@register_model("worm_wheel")
 class WormWheelModel(CylindricalModel):
     hob_purpose = "worm_wheel"
     class_parameters = frozenset({"z_mid", "tangential", "y_start", "y_end", "tangential_factor"})

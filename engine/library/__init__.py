@@ -1,2 +1,2 @@
-"""The module library (design notes §5): NC tokens, line similarity, the nightly refactor and
-importing proven NC programs as standard code."""
+"""The module library (design notes §5): line similarity, the nightly refactor, importing proven
+NC programs as standard code, and `engine seed` loading the standard code and sample data."""

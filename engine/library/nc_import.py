@@ -35,7 +35,7 @@ runs of that type: it increases each time the type recurs after another type.
 
 Lines: the file is split at its line ending, LF or CRLF (a final newline ends the last line, it
 adds no empty line); the rows hold the lines without endings, and the class keeps the ending
-and whether the file had a final newline (engine.library.nc_layout; a file mixing LF and CRLF
+and whether the file had a final newline (engine.nc.layout; a file mixing LF and CRLF
 is refused). Instantiating the import with the same parameters and writing the lines with that
 layout (nc_text) gives the file byte for byte. The import checks this itself before it commits
 (engine.library.nc_verify), while
@@ -57,16 +57,16 @@ from ..csv_reader import Column, CsvKind, parse_number_or_text, parse_text, pars
 from ..errors import EngineError
 from ..memory import no_cycle_collection
 from ..names import shown
-from ..programs.lineage import ENGINES_LINE, first_lineage_shaped
+from ..nc.lineage import ENGINES_LINE, first_lineage_shaped
 from ..templates.functions import CONSTANTS, FUNCTIONS
 from ..templates.rows import MODULE_ORDER, TemplateRow
 from ..templates.store import ensure_class, load_template, replace_template
 from ..templates.versions import released_version
 from .nc_halves import in_halves
-from .nc_layout import NcLayout, split_nc_text, store_layout
+from ..nc.layout import NcLayout, split_nc_text, store_layout
 from .nc_params import binding_report, bindings, parse_addresses, values
 from .nc_rows import Builder, Found
-from .nc_tokens import LABEL, SYMBOL, LineFacts, facts, tokenise
+from ..nc.tokens import LABEL, SYMBOL, LineFacts, facts, tokenise
 from .nc_verify import Proof
 
 if TYPE_CHECKING:

@@ -17,7 +17,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from .nc_tokens import NAME, SPACE, SYMBOL, WORD, LineFacts
+from ..nc.tokens import NAME, SPACE, SYMBOL, WORD, LineFacts
 
 
 @dataclass(frozen=True)

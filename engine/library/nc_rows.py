@@ -16,7 +16,7 @@ from ..templates.evaluator import evaluate
 from ..templates.expressions import MAX_EXPRESSION_LENGTH, compile_expression
 from .nc_params import FUNCTION_ADDRESSES, Binding
 from .nc_references import CODE_NAMES, block_context, reference_at
-from .nc_tokens import NUMBER, WORD, facts
+from ..nc.tokens import NUMBER, WORD, facts
 
 
 def values_of(bindings: dict[str, Binding]) -> dict:

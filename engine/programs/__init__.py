@@ -1,1 +1,2 @@
-"""Programs (design notes §7): instantiation, the fail-closed program verifier, storage and output files."""
+"""Programs (design notes §7): instantiation, storage and output files; every program is read by
+the fail-closed verifier (engine.verifier) before it is stored or written."""

@@ -9,8 +9,8 @@ A dry run computes and checks exactly as a stored run does (the template, the ma
 the simulation, the program's name and lines) inside a READ ONLY transaction that is rolled back:
 PostgreSQL itself refuses any write in it, nextval() included, so nothing is stored and no
 sequence advances. Its program shows the lineage line a stored one carries, but with `DRY-RUN`
-where the program id goes: no program id is drawn, and the database's lineage check (migration
-0015) refuses that line, so such a text can never be stored as a program.
+where the program id goes: no program id is drawn, and the database's lineage check
+(check_program_release) refuses that line, so such a text can never be stored as a program.
 """
 from __future__ import annotations
 
@@ -23,6 +23,8 @@ from psycopg.types.json import Jsonb
 
 from ..db.connection import scalar
 from ..errors import EngineError
+from .options import Output, RunMode
+from .outputs import files_after_commit
 from .records import Planned, Program
 from .storage import Batch, Lineage, refuse_unsafe
 
@@ -98,12 +100,20 @@ def dry_batch(encoded: list, skipped: tuple[str, ...]) -> Batch:
                  tuple(f"{item.name}: {note}" for item in encoded for note in item.notes), skipped, dry_run=True)
 
 
-def refuse_out_in_dry_run(dry_run: bool, out) -> None:
+def refuse_out_in_dry_run(output: Output, mode: RunMode) -> None:
     """A file in --out is what an operator loads into the machine and must be a program the
     database holds, byte for byte; a dry run holds none, so it writes no file."""
-    if dry_run and out is not None:
+    if mode.dry_run and output.out is not None:
         raise EngineError("--dry-run stores nothing and writes no file: leave out --out (the program is printed; "
                           "a batch's dry run reports what it would store)")
+
+
+def batch_stage(conn, output: Output, mode: RunMode):
+    """The one transaction of a batch: for a dry run READ ONLY and rolled back (its block gets
+    None), else one that commits for real and then writes the files (its block gets ProgramFiles).
+    A dry run with --out is refused first."""
+    refuse_out_in_dry_run(output, mode)
+    return read_only(conn) if mode.dry_run else files_after_commit(conn, output, batch=True)
 
 
 @contextlib.contextmanager

@@ -11,7 +11,7 @@ The program is read by the machine's verifier (engine.programs.verified_run) bef
 stored. A hobbing program must be proved by the simulation against a gear and a hob, which such a
 job has not, so no hobber makes one. With `unverified` the program is stored without the
 verifier's reading, for a dialect the verifier does not know or a program it refuses: its record
-and its lineage line say UNVERIFIED (migration 0024), and it is never written to a file for the
+and its lineage line say UNVERIFIED (program.unverified), and it is never written to a file for the
 machine, because a program that reaches the machine must be one the verifier read. Made again
 (`instantiate --job`, engine.programs.remake) the job is verified then, or refused.
 """
@@ -19,15 +19,16 @@ from __future__ import annotations
 
 import ast
 from dataclasses import dataclass
-from pathlib import Path
 from typing import TYPE_CHECKING
 
+from .. import turning  # noqa: F401  (importing it registers the turning names model)
+from ..hobbing import models as hobbing_models  # noqa: F401  (importing it registers the hobbing models)
 from ..errors import EngineError
 from ..gears.models import model_for_class
-from ..gears.records import Machine, load_machine
-from ..library.nc_layout import NcLayout, class_layout
+from ..machines.records import Machine, load_machine
+from ..nc.layout import NcLayout, class_layout
 from ..library.nc_params import bindings, values
-from ..library.nc_tokens import NUMBER, tokenise
+from ..nc.tokens import NUMBER, tokenise
 from ..names import checked
 from ..templates.decision_table import compiled_template
 from ..templates.rows import Template
@@ -35,11 +36,12 @@ from ..templates.versions import runnable_template
 from ..turning.names import TurningModel
 from .batches import dry_program, read_only, refuse_out_in_dry_run
 from .instantiate import store_planned
-from .lineage import refuse_lineage_shaped
+from ..nc.lineage import refuse_lineage_shaped
+from .options import NO_FILE, NORMAL_RUN, Output, RunMode
 from .outputs import files_after_commit
 from .records import Planned, Program
 from .verified_run import run_template
-from .verifier.grammar import DIALECTS
+from ..verifier.grammar import DIALECTS
 
 if TYPE_CHECKING:
     from ..db.connection import Connection
@@ -62,19 +64,20 @@ class ClassJob:
 
 
 def instantiate_class(conn: Connection, gear_class: str, given: dict, *, machine: str | None = None,
-                      source: str = "parameters", out: str | Path | None = None, force: bool = False,
-                      draft: bool = False, dry_run: bool = False, unverified: bool = False) -> ClassJob:
+                      source: str = "parameters", output: Output = NO_FILE, mode: RunMode = NORMAL_RUN,
+                      unverified: bool = False) -> ClassJob:
     """A job of the class with the parameters `given` (JSON of import-nc's --params, either form),
     its program verified for `machine` (or, `unverified`, not read), stored with the job and written
-    to `out` after the COMMIT. `dry_run`: the same checks, nothing stored."""
-    refuse_out_in_dry_run(dry_run, out)
-    refuse_unverified_file(unverified, out)
-    if dry_run:
+    to `output` after the COMMIT. `mode.draft`: the class's draft; `mode.dry_run`: the same checks,
+    nothing stored. The batch fields of `mode` do not apply."""
+    refuse_out_in_dry_run(output, mode)
+    refuse_unverified_file(unverified, output.out)
+    if mode.dry_run:
         with read_only(conn):
-            planned, taken = _planned(conn, gear_class, given, machine, source, draft, unverified)
+            planned, taken = _planned(conn, gear_class, given, machine, source, mode.draft, unverified)
             return ClassJob(dry_program(conn, planned, None), planned.machine, tuple(given), taken)
-    with files_after_commit(conn, out, force) as files:
-        planned, taken = _planned(conn, gear_class, given, machine, source, draft, unverified)
+    with files_after_commit(conn, output) as files:
+        planned, taken = _planned(conn, gear_class, given, machine, source, mode.draft, unverified)
         program = store_planned(conn, [planned], files)[0]
     return ClassJob(program, planned.machine, tuple(given), taken)
 

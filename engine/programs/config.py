@@ -1,5 +1,5 @@
 """The shop's settings file: defaults of command options, the default machine, the output folder
-and line endings per machine (README, "Configuration").
+and line endings per machine (docs/guide/configuration.md).
 
 A TOML file in the user's config directory (platformdirs: ~/.config/nc-template-engine/config.toml
 on Linux), or the file ENGINE_CONFIG names (ENGINE_CONFIG="" reads none). Its values are only
@@ -18,7 +18,7 @@ programs go.
     line_endings = "lf"              # this machine's files: LF, whatever the file-wide setting
 
 A program file is written with its class's layout (LF and a final newline, or what the file an
-imported class came from had: engine.library.nc_layout). A line ending set here overrides only the
+imported class came from had: engine.nc.layout). A line ending set here overrides only the
 line ending, for the files of the machine it is set for (its table's, else the file-wide one); the
 final newline stays the class's. Unset, the class decides: a CRLF program imported from a file
 comes back CRLF.
@@ -32,8 +32,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from ..errors import EngineError
-from ..gears.records import DEFAULT_HOBBING_MACHINE
-from ..library.nc_layout import ENDING_NAMES
+from ..machines.records import DEFAULT_HOBBING_MACHINE
+from ..nc.layout import ENDING_NAMES
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -51,7 +51,7 @@ class Config:
     path: Path | None = None
     commands: dict = field(default_factory=dict)   # everything that is not a setting: option defaults
     machine: str | None = None
-    line_endings: str | None = None   # None: each class's own (engine.library.nc_layout)
+    line_endings: str | None = None   # None: each class's own (engine.nc.layout)
     machines: dict = field(default_factory=dict)   # machine name -> {out, line_endings}
     text: str = ""
 

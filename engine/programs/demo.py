@@ -16,12 +16,12 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ..db.embedded import embedded_data_dir, embedded_url
-from ..db.seed import SeedReport
+from ..library.seed import SeedReport
 from ..paths import SAMPLE_DRAWING
 
 if TYPE_CHECKING:
     from ..db.connection import Connection
-    from ..turning.dxf_import import ImportReport
+    from .dxf_import import ImportReport
     from .records import Program
 
 DEMO_DATABASE = "engine_demo"
@@ -51,7 +51,7 @@ def run_demo(gear_id: int = 42, turning: bool = False) -> DemoResult:
     gear, or with `turning` the sample drawing's turning job."""
     from ..db.connection import connect
     from ..db.migrate import migrate
-    from ..db.seed import seed
+    from ..library.seed import seed
     from .instantiate import instantiate_gear
 
     with connect(embedded_url(DEMO_DATABASE)) as conn:
@@ -65,7 +65,7 @@ def run_demo(gear_id: int = 42, turning: bool = False) -> DemoResult:
 def sample_turning_job(conn: Connection, drawing: Path = SAMPLE_DRAWING) -> SampleJob:
     """Import the sample drawing as a turning job on the default lathe (from the Ø44 blank) and
     store its program, as `engine import-dxf` and `engine instantiate --job` do."""
-    from ..turning.dxf_import import import_dxf
+    from .dxf_import import import_dxf
     from ..turning.job_params import ProfileOptions
     from .remake import instantiate_job
 

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from ..errors import EngineError
-from .lineage import LINEAGE_ROW_ID
+from ..nc.lineage import LINEAGE_ROW_ID
 
 if TYPE_CHECKING:
     from ..db.connection import Connection

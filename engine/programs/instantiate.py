@@ -8,26 +8,29 @@ written only after the COMMIT).
 from __future__ import annotations
 
 from dataclasses import replace
-from pathlib import Path
 from typing import TYPE_CHECKING
 
+from .. import turning  # noqa: F401  (importing it registers the turning names model)
+from ..hobbing import models as hobbing_models  # noqa: F401  (importing it registers the hobbing models)
 from ..errors import EngineError
 from ..gears.case_base import CUT_KINDS_BY_COUNT, CaseBase, job_cutting_record
 from ..gears.hob_matching import choose_hob
 from ..gears.models import model_for_class
 from ..gears.process_notes import hunting_tooth_notes
-from ..gears.records import Gear, Machine, hobbing_machine, load_gear, load_gears, load_hobs
+from ..gears.records import Gear, load_gear, load_gears, load_hobs
+from ..machines.records import Machine, hobbing_machine
 from ..hobbing.choices import Choices
-from ..library.nc_layout import NcLayout, class_layout
+from ..nc.layout import NcLayout, class_layout
 from ..memory import no_cycle_collection
 from ..templates.rows import Template
 from ..templates.versions import runnable_template
 from ..turning.names import TurningModel
-from .batches import Bad, checked, dry_batch, dry_program, good_ones, planned_or_bad, read_only, reason_of, \
-    refuse_out_in_dry_run
+from .batches import Bad, batch_stage, checked, dry_batch, dry_program, good_ones, planned_or_bad, read_only, \
+    reason_of, refuse_out_in_dry_run
+from .options import NO_FILE, NORMAL_RUN, Output, RunMode
 from .outputs import ProgramFiles, file_layouts, files_after_commit
 from .verified_run import Workpiece, run_template
-from .verifier import LimitError, check_table_speed
+from ..verifier import LimitError, check_table_speed
 from .records import Planned, Program
 from .storage import Batch, store_many, store_one
 from .workers import PLANNING, plan_in_workers
@@ -129,18 +132,18 @@ def _check_table_speed(gear: Gear, starts: int, hob_speed: float, machine: Machi
 
 
 def instantiate_gear(conn: Connection, gear_id: int, *, machine: str | None = None, choices: Choices = Choices(),
-                     overrides: dict | None = None, out: str | Path | None = None, force: bool = False,
-                     draft: bool = False, dry_run: bool = False) -> Program:
-    """Compute, check and store the program of one gear; write it to `out` if given (after the
-    COMMIT; an existing file only with `force`). With `draft`, from the class's draft. With
-    `dry_run`, the same checks, nothing stored (engine.programs.batches): the program returned."""
-    refuse_out_in_dry_run(dry_run, out)
-    if dry_run:
+                     overrides: dict | None = None, output: Output = NO_FILE, mode: RunMode = NORMAL_RUN) -> Program:
+    """Compute, check and store the program of one gear; write it to `output.out` if given (after
+    the COMMIT; an existing file only with `output.force`). With `mode.draft`, from the class's
+    draft. With `mode.dry_run`, the same checks, nothing stored (engine.programs.batches): the
+    program returned. The batch fields of `mode` do not apply."""
+    refuse_out_in_dry_run(output, mode)
+    if mode.dry_run:
         with read_only(conn):
-            return dry_program(conn, Planner(conn, machine, choices, overrides, draft).plan(load_gear(conn, gear_id)),
-                               None)
-    with files_after_commit(conn, out, force) as files:
-        planner = Planner(conn, machine, choices, overrides, draft)
+            planner = Planner(conn, machine, choices, overrides, mode.draft)
+            return dry_program(conn, planner.plan(load_gear(conn, gear_id)), None)
+    with files_after_commit(conn, output) as files:
+        planner = Planner(conn, machine, choices, overrides, mode.draft)
         planned = planner.plan(load_gear(conn, gear_id))
         program = store_planned(conn, [planned], files)[0]
     return program
@@ -148,36 +151,34 @@ def instantiate_gear(conn: Connection, gear_id: int, *, machine: str | None = No
 
 def instantiate_gears(conn: Connection, first: int | None = None, last: int | None = None, *,
                       machine: str | None = None, choices: Choices = Choices(), overrides=None,
-                      out: str | Path | None = None, force: bool = False, progress=None, workers: int = 1,
-                      draft: bool = False, skip_bad: bool = False, dry_run: bool = False) -> Batch:
+                      output: Output = NO_FILE, mode: RunMode = NORMAL_RUN) -> Batch:
     """All gears with first ≤ id ≤ last, every one planned: all programs stored, or none if any
-    gear is bad (BadBatch names each); with `skip_bad` the good ones are stored and the bad ones
-    listed in Batch.skipped. Files are written after the COMMIT. With workers > 1 the gears are
-    planned in that many processes (engine.programs.workers). `dry_run`: what would be stored,
-    nothing stored. `progress(stage, done, total)` as the gears are planned."""
-    refuse_out_in_dry_run(dry_run, out)
-    stage = read_only(conn) if dry_run else files_after_commit(conn, out, force, batch=True)
-    with stage as files, no_cycle_collection():   # planning and storing build the batch
-        outcomes = _planned_gears(Planner(conn, machine, choices, overrides, draft), first, last, workers, progress)
-        encoded, skipped = good_ones(outcomes, "gear", skip_bad)
-        if dry_run:
+    gear is bad (BadBatch names each); with `mode.skip_bad` the good ones are stored and the bad
+    ones listed in Batch.skipped. Files are written to `output` after the COMMIT. With
+    mode.workers > 1 the gears are planned in that many processes (engine.programs.workers).
+    `mode.dry_run`: what would be stored, nothing stored. `mode.progress(stage, done, total)` as
+    the gears are planned."""
+    with batch_stage(conn, output, mode) as files, no_cycle_collection():   # planning and storing build the batch
+        outcomes = _planned_gears(Planner(conn, machine, choices, overrides, mode.draft), first, last, mode)
+        encoded, skipped = good_ones(outcomes, "gear", mode.skip_bad)
+        if mode.dry_run:
             return dry_batch(encoded, skipped)
         files.plan([(item.name, item.lines) for item in encoded], file_layouts(encoded))
-        batch = store_many(conn, encoded, out, files)
+        batch = store_many(conn, encoded, output.out, files)
     return replace(batch, skipped=skipped)
 
 
-def _planned_gears(planner: Planner, first, last, workers: int, progress) -> list:
+def _planned_gears(planner: Planner, first, last, mode: RunMode) -> list:
     """Each gear's program encoded for storage, or Bad with its reason, in gear order (a gear
     whose record cannot even be completed among them)."""
     refused: dict[int, str] = {}
     gears = load_gears(planner.conn, first, last, refused)
     if not gears and not refused:
         raise EngineError(f"no gears with ids in {first or 'the start'}…{last or 'the end'}")
-    if workers > 1 and len(gears) > 1:
-        planned = plan_in_workers(planner, gears, workers, _plan_in_batch, progress)
+    if mode.workers > 1 and len(gears) > 1:
+        planned = plan_in_workers(planner, gears, _plan_in_batch, mode)
     else:
-        planned = [_counted(_plan_in_batch(planner, gear), done, len(gears), progress)
+        planned = [_counted(_plan_in_batch(planner, gear), done, len(gears), mode.progress)
                    for done, gear in enumerate(gears, 1)]
     by_gear = dict(zip([gear.id for gear in gears], planned)) | {gear_id: Bad(reason_of(f"gear {gear_id}", message))
                                                                   for gear_id, message in refused.items()}

@@ -1,8 +1,8 @@
 """A stored program found from what an operator has in hand (`engine programs show`): its id, or
-the hash on its lineage line (engine.programs.lineage) read off a file on the control, the INPUT
+the hash on its lineage line (engine.nc.lineage) read off a file on the control, the INPUT
 hash of the job's parameters or the TEMPLATE hash of the version it was made from; and the
 programs stored, filtered (`engine programs list`). A program is shown with the layout (line
-ending, final newline: engine.library.nc_layout) its template version records, the one its file was
+ending, final newline: engine.nc.layout) its template version records, the one its file was
 written with: a later change of the class's layout is a later version and leaves it as it was."""
 from __future__ import annotations
 
@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING
 
 from ..db.listing import day_range, records, require_class
 from ..errors import EngineError
-from ..library.nc_layout import ENDING_NAMES, NcLayout, nc_text
+from ..nc.layout import ENDING_NAMES, NcLayout, nc_text
 
 if TYPE_CHECKING:
     from ..db.connection import Connection
@@ -26,7 +26,7 @@ SELECT p.id, p.job_id, j.gear_id, p.gear_class, p.template_version, p.draft, p.u
 FROM program p JOIN job j ON j.id = p.job_id
 JOIN template_version_rows v ON v.gear_class = p.gear_class AND v.version = p.template_version"""
 BY_ID = RECORD + " WHERE p.id = %s"
-# left(…, 8) is what the indexes of migration 0015 hold; the LIKE then checks the longer prefix.
+# left(…, 8) is what the indexes program_input_hash, program_template_hash hold; the LIKE then checks the longer prefix.
 BY_HASH = RECORD + """
 WHERE (left(p.input_hash, 8) = left(%(prefix)s, 8) AND p.input_hash LIKE %(prefix)s || '%%')
    OR (left(p.template_hash, 8) = left(%(prefix)s, 8) AND p.template_hash LIKE %(prefix)s || '%%')

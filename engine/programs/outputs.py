@@ -16,7 +16,7 @@ name that would land outside --out, two programs of one run whose names differ o
 (the control does not tell case), and an existing file without --force.
 
 A file is written with the layout of its template version (issue 17: the class's line_ending and
-final_newline as that version records them, migration 0025; LF with a final newline unless the
+final_newline as that version records them, template_version_rows; LF with a final newline unless the
 class was imported from a file that had another), so an
 imported program comes back byte for byte. A line ending configured for the program's machine
 (the config file, set for the block by `line_endings(...)`; engine.programs.config) replaces the
@@ -37,8 +37,9 @@ import psycopg
 from psycopg.pq import TransactionStatus
 
 from ..errors import EngineError
-from ..library.nc_layout import NcLayout, nc_text
+from ..nc.layout import NcLayout, nc_text
 from ..names import checked
+from .options import Output
 
 if TYPE_CHECKING:
     from ..db.connection import Connection
@@ -138,12 +139,12 @@ class ProgramFiles:
 
 
 @contextlib.contextmanager
-def files_after_commit(conn: Connection, out, force: bool = False, batch: bool = False):
+def files_after_commit(conn: Connection, output: Output, batch: bool = False):
     """Yield ProgramFiles for the block, which runs in a transaction that commits for real when
-    the block ends; only then are the planned files written. Without --out (out None) the block
-    may run inside the caller's transaction (a savepoint), as nothing is written."""
-    files = ProgramFiles(out, force, batch)
-    if out is not None and conn.info.transaction_status != TransactionStatus.IDLE:
+    the block ends; only then are the planned files written. Without --out (output.out None) the
+    block may run inside the caller's transaction (a savepoint), as nothing is written."""
+    files = ProgramFiles(output.out, output.force, batch)
+    if output.out is not None and conn.info.transaction_status != TransactionStatus.IDLE:
         raise EngineError("program files are written only after their programs are committed, but this "
                           "connection is inside a transaction its caller commits: commit first, or store without --out")
     with _committed(conn):

@@ -6,7 +6,7 @@ import json
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
-from ..library.nc_layout import NcLayout, nc_text
+from ..nc.layout import NcLayout, nc_text
 
 if TYPE_CHECKING:
     from ..templates.decision_table import Result

@@ -9,22 +9,26 @@ from __future__ import annotations
 
 import re
 from dataclasses import replace
-from pathlib import Path
 from typing import TYPE_CHECKING
 
+from .. import turning  # noqa: F401  (importing it registers the turning names model)
+from ..hobbing import models as hobbing_models  # noqa: F401  (importing it registers the hobbing models)
 from ..errors import EngineError
 from ..gears.models import model_for_class
 from ..gears.process_notes import stored_feed_notes
-from ..gears.records import Hob, Machine, load_gear, load_hobs, load_machine
+from ..gears.records import Hob, load_gear, load_hobs
+from ..machines.records import Machine, load_machine
 from ..hobbing.cylindrical import program_name
 from ..hobbing.machine_job import with_cycle_time
-from ..library.nc_layout import NcLayout, class_layout
+from ..nc.layout import NcLayout, class_layout
 from ..memory import no_cycle_collection
 from ..templates.rows import Template
 from ..templates.versions import runnable_template
-from .batches import checked, dry_batch, dry_program, good_ones, planned_or_bad, read_only, refuse_out_in_dry_run
+from .batches import batch_stage, checked, dry_batch, dry_program, good_ones, planned_or_bad, read_only, \
+    refuse_out_in_dry_run
 from .class_jobs import class_job
 from .instantiate import store_planned
+from .options import NO_FILE, NORMAL_RUN, Output, RunMode
 from .outputs import file_layouts, files_after_commit
 from .verified_run import Workpiece, run_template
 from .records import Planned, Program
@@ -60,7 +64,7 @@ class Remaker:
         if not self.modelled(gear_class):   # a job of an imported class (instantiate --class): its rows alone
             return class_job(self.template(gear_class), machine, params, module_params)
         if machine.kind == "lathe":   # a turning job: its passes are computed from its parameters
-            from ..turning.planning import plan_turning_job   # the tool paths: only for turning jobs
+            from .turning_jobs import plan_turning_job   # the tool paths: only for turning jobs
 
             return plan_turning_job(self.conn, gear_class, machine, params, module_params, draft=self.draft)
         template = self.template(gear_class)
@@ -125,17 +129,17 @@ def _other_gear_named(conn: Connection, name, gear_id: int) -> int | None:
     return row[0] if row else None
 
 
-def instantiate_job(conn: Connection, job_id: int, out: str | Path | None = None, force: bool = False,
-                    draft: bool = False, dry_run: bool = False) -> Program:
-    """Instantiate a stored job again with its stored (possibly edited) parameters. With `dry_run`,
-    the same checks, nothing stored (engine.programs.batches): the program returned."""
-    refuse_out_in_dry_run(dry_run, out)
-    if dry_run:
+def instantiate_job(conn: Connection, job_id: int, *, output: Output = NO_FILE, mode: RunMode = NORMAL_RUN) -> Program:
+    """Instantiate a stored job again with its stored (possibly edited) parameters, its file
+    written to `output`. With `mode.dry_run`, the same checks, nothing stored
+    (engine.programs.batches): the program returned. The batch fields of `mode` do not apply."""
+    refuse_out_in_dry_run(output, mode)
+    if mode.dry_run:
         with read_only(conn):
-            return dry_program(conn, Remaker(conn, draft).remade(_stored_job(conn, job_id)), job_id)
-    with files_after_commit(conn, out, force) as files:
+            return dry_program(conn, Remaker(conn, mode.draft).remade(_stored_job(conn, job_id)), job_id)
+    with files_after_commit(conn, output) as files:
         job = _stored_job(conn, job_id)
-        program = store_planned(conn, [Remaker(conn, draft).remade(job)], files, existing_job=job_id)[0]
+        program = store_planned(conn, [Remaker(conn, mode.draft).remade(job)], files, existing_job=job_id)[0]
     return program
 
 
@@ -147,27 +151,30 @@ def _stored_job(conn: Connection, job_id: int) -> tuple:
 
 
 def instantiate_jobs(conn: Connection, first: int | None = None, last: int | None = None, *,
-                     out: str | Path | None = None, force: bool = False, progress=None, draft: bool = False,
-                     skip_bad: bool = False, dry_run: bool = False) -> Batch:
+                     output: Output = NO_FILE, mode: RunMode = NORMAL_RUN) -> Batch:
     """Every stored job with first ≤ id ≤ last made again, every one tried: all programs stored,
-    or none if any job is bad (BadBatch names each); with `skip_bad` the good ones are stored and
-    the bad ones listed in Batch.skipped. Files are written after the COMMIT. `dry_run`: what
-    would be stored, nothing stored. `progress(stage, done, total)` as the jobs are made."""
-    refuse_out_in_dry_run(dry_run, out)
-    stage = read_only(conn) if dry_run else files_after_commit(conn, out, force, batch=True)
-    with stage as files, no_cycle_collection():   # making and storing build the batch
-        jobs = conn.execute(f"SELECT {JOB_COLUMNS} FROM job WHERE id BETWEEN %s AND %s ORDER BY id",
-                            (first if first is not None else 0, last if last is not None else 2**62)).fetchall()
-        if not jobs:
-            raise EngineError(f"no jobs with ids in {first or 'the start'}…{last or 'the end'}")
-        remaker = Remaker(conn, draft)
-        outcomes = [_remade_in_batch(remaker, job, done, len(jobs), progress) for done, job in enumerate(jobs, 1)]
-        good, skipped = good_ones(outcomes, "job", skip_bad)
-        if dry_run:
+    or none if any job is bad (BadBatch names each); with `mode.skip_bad` the good ones are stored
+    and the bad ones listed in Batch.skipped. Files are written to `output` after the COMMIT.
+    `mode.dry_run`: what would be stored, nothing stored. `mode.progress(stage, done, total)` as
+    the jobs are made (one process: `mode.workers` plans gears, not jobs)."""
+    with batch_stage(conn, output, mode) as files, no_cycle_collection():   # making and storing build the batch
+        good, skipped = good_ones(_remade_jobs(conn, first, last, mode), "job", mode.skip_bad)
+        if mode.dry_run:
             return dry_batch([item for _, item in good], skipped)
         files.plan([(item.name, item.lines) for _, item in good], file_layouts([item for _, item in good]))
-        batch = store_programs(conn, [item for _, item in good], [job_id for job_id, _ in good], out, files)
+        batch = store_programs(conn, [item for _, item in good], [job_id for job_id, _ in good], output.out, files)
     return replace(batch, skipped=skipped)
+
+
+def _remade_jobs(conn, first: int | None, last: int | None, mode: RunMode) -> list:
+    """(job id, its program encoded for storage), or Bad with its reason, for each stored job with
+    first ≤ id ≤ last, in job order."""
+    jobs = conn.execute(f"SELECT {JOB_COLUMNS} FROM job WHERE id BETWEEN %s AND %s ORDER BY id",
+                        (first if first is not None else 0, last if last is not None else 2**62)).fetchall()
+    if not jobs:
+        raise EngineError(f"no jobs with ids in {first or 'the start'}…{last or 'the end'}")
+    remaker = Remaker(conn, mode.draft)
+    return [_remade_in_batch(remaker, job, done, len(jobs), mode.progress) for done, job in enumerate(jobs, 1)]
 
 
 def _remade_in_batch(remaker: Remaker, job: tuple, done: int, total: int, progress):

@@ -4,10 +4,10 @@ here: engine.programs.outputs writes them after the COMMIT of the caller's files
 Programs are records (design notes §10): no role may write the program table. The engine stores
 them through the database's own path, which checks each program against its job and the stored
 template version and records who stored it: the view program_submission, one INSERT or a
-batch through COPY (migration 0010). Each program gets its lineage line here (engine.programs.
-lineage), checked by the database too (migration 0015). A program is stored only with a safe name
+batch through COPY (check_program, schema/programs.sql). Each program gets its lineage line here (engine.programs.
+lineage), checked by the database too (check_program_release). A program is stored only with a safe name
 (engine/names.py) and lines that are one NC line each: a line break inside a line would be a
-block that no check read. The database refuses both too (migrations 0009, 0010); here they are
+block that no check read. The database refuses both too (program_safe_name, check_program); here they are
 refused with a message that names the program."""
 from __future__ import annotations
 
@@ -21,7 +21,7 @@ from psycopg.types.json import Jsonb
 from ..db.connection import scalar
 from ..errors import EngineError
 from ..names import checked, line_breaking, shown
-from .lineage import lineage_line, lineage_words, refuse_lineage_shaped, with_lineage
+from ..nc.lineage import lineage_line, lineage_words, refuse_lineage_shaped, with_lineage
 from .records import Encoded, Planned, Program
 
 if TYPE_CHECKING:

@@ -11,12 +11,13 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from ..errors import EngineError
-from ..gears.records import Gear, Hob, Machine
+from ..gears.records import Gear, Hob
+from ..machines.records import Machine
 from ..simulation import SimulationError, simulate_program
 from ..templates.decision_table import Result, compiled_template
 from ..templates.rows import Template
-from .lineage import refuse_lineage_shaped
-from .verifier import verify_program
+from ..nc.lineage import refuse_lineage_shaped
+from ..verifier import verify_program
 
 
 @dataclass(frozen=True, slots=True)
@@ -28,7 +29,7 @@ class Workpiece:
 
 def run_template(template: Template, params: dict, module_params: dict, machine: Machine,
                  workpiece: Workpiece | None = None) -> Result:
-    """Evaluate the decision table, verify the program for the machine (engine.programs.verifier)
+    """Evaluate the decision table, verify the program for the machine (engine.verifier)
     and, on a hobber, prove it by simulation against `workpiece`."""
     result = compiled_template(template).run(params, module_params)
     name = params.get("program_name") if isinstance(params, dict) else None

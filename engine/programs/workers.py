@@ -13,31 +13,39 @@ import multiprocessing
 
 from ..errors import EngineError
 from ..templates.decision_table import compiled_template
+from .options import RunMode
+
 SLICES_PER_WORKER = 8   # small enough to balance the workers, large enough to amortise sending jobs
 
 PLANNING = "planning"   # the stage a batch's progress callback is told while its gears are planned
 _BATCH: list = []   # (planner, gears, plan function) of the batch being planned, inherited by the forked workers
 
 
-def plan_in_workers(planner, gears: list, workers: int, plan_one, progress=None) -> list:
-    """`plan_one(planner, gear)` for every gear, in `workers` forked processes, in gear order: what
-    it returns comes back pickled (a job encoded for storage, engine.programs.records.Encoded, or
-    the reason a gear is bad); `progress(stage, done, total)` as slices come back."""
+def plan_in_workers(planner, gears: list, plan_one, mode: RunMode) -> list:
+    """`plan_one(planner, gear)` for every gear, in `mode.workers` forked processes, in gear order:
+    what it returns comes back pickled (a job encoded for storage, engine.programs.records.Encoded,
+    or the reason a gear is bad); `mode.progress(stage, done, total)` as slices come back."""
     for gear_class in {gear.gear_class for gear in gears if gear.gear_class is not None}:
         _ready(planner, gear_class)
-    size = max(1, len(gears) // (workers * SLICES_PER_WORKER))
+    size = max(1, len(gears) // (mode.workers * SLICES_PER_WORKER))
     slices = [(start, min(start + size, len(gears))) for start in range(0, len(gears), size)]
     _BATCH[:] = [planner, gears, plan_one]
     try:
-        with multiprocessing.get_context("fork").Pool(workers, initializer=_in_worker) as pool:
-            outcomes = []
-            for planned in pool.imap(_plan_slice, slices):
-                outcomes += planned
-                if progress:
-                    progress(PLANNING, len(outcomes), len(gears))
-            return outcomes
+        return _planned_in_pool(slices, len(gears), mode)
     finally:
         _BATCH.clear()
+
+
+def _planned_in_pool(slices: list[tuple[int, int]], total: int, mode: RunMode) -> list:
+    """The slices planned by `mode.workers` forked processes, in order; progress told as each
+    slice comes back (`total` gears in all)."""
+    with multiprocessing.get_context("fork").Pool(mode.workers, initializer=_in_worker) as pool:
+        outcomes = []
+        for planned in pool.imap(_plan_slice, slices):
+            outcomes += planned
+            if mode.progress:
+                mode.progress(PLANNING, len(outcomes), total)
+        return outcomes
 
 
 def _ready(planner, gear_class: str) -> None:

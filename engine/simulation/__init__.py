@@ -3,7 +3,13 @@ the program text, the gear, the hob and the machine (never the model code that m
 program) and follows every axis block by block in the DIN 66217 frame: the hob envelope against
 the blank, its units, the fixture and the tailstock; the coupling's teeth, hand and lead and the
 swivel against the gear; the depth per cut, the run-out, the table speed, the feed per workpiece
-revolution and the cycle time."""
+revolution and the cycle time.
+
+One part per machine kind: today every module here serves the hobbing machine (the only kind
+whose programs are simulated; a lathe program's rapids are checked against the blank by
+engine.turning.material). A second kind gets its own subfolder. The simulation imports the
+verifier's reader, never the models that made the program (engine.hobbing, engine.turning):
+tests/test_house.py enforces it."""
 from .report import Finding, Report, SimulationError
 from .run import prove_program, simulate_program
 from .stored import simulate_stored_program

@@ -1,6 +1,6 @@
 """The electronic gearbox as the simulation follows it (reference §A5, §A7): the signed terms of
 `EGON(C,"FINE",B,<num>,<den>[,Z,<num>,<den>][,Y,<num>,<den>])`, which the verifier has read and
-bounded (engine.programs.verifier.statements keeps only their sizes), turned into the DIN frame,
+bounded (engine.verifier.statements keeps only their sizes), turned into the DIN frame,
 and what the gear and hob need them to be:
 
 * B → C: k_B = −h_hob·z0/z2, so the hob of z0 starts generates z0/|k_B| teeth;

@@ -11,7 +11,7 @@ CLAIM = re.compile(r"\b(GEAR|HOB|MACHINE|CYCLE|ALLOWANCE)", re.IGNORECASE)
 CANONICAL = (re.compile(r"; GEAR \S+( .*)?"), re.compile(r"; HOB \S+( .*)?"), re.compile(r"; MACHINE \S+"),
              re.compile(r"; CYCLE TIME [0-9]+(\.[0-9]+)? MIN"), re.compile(r"; ALLOWANCE [0-9]+(\.[0-9]+)? MM( .*)?"))
 REMARKS = ("HOB SHIFT PER PART",)     # the templates' note on the shift parameter's line
-# The template's version line and the engine's lineage line (engine.programs.lineage): a class name
+# The template's version line and the engine's lineage line (engine.nc.lineage): a class name
 # may hold a header word (`gear_x`, `hobbed`), but they state no header fact; the database checked the
 # lineage line when the program was stored.
 CLASS_LINES = (re.compile(r"; TEMPLATE \S+ v[0-9]+"),

@@ -9,12 +9,13 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from ..gears.records import Gear, Hob, Machine
+from ..gears.records import Gear, Hob
+from ..machines.records import Machine
 from .reading import read_program
 from .report import Report, SimulationError
 from .run import SHIFT_ENDS
 from .solids import Solid, setup_solids, unit_solids
-from .walk import Walk
+from .walk import BlockSimulation
 
 
 @dataclass(frozen=True, slots=True)
@@ -57,7 +58,7 @@ class Recording:
         return next((move.swivel for move in reversed(self.moves) if move.cutting), 0.0)
 
 
-class RecordingWalk(Walk):
+class RecordingSimulation(BlockSimulation):
     """The simulation's walk, keeping what it follows."""
 
     def __init__(self, recording: Recording, *args):
@@ -118,7 +119,7 @@ def _follow(steps, lines, gear: Gear, hob: Hob, machine: Machine, name: str, shi
     units = unit_solids(gear, hob, worm_wheel)
     setup = setup_solids(machine, units, hob)
     recording = Recording(Report(name), units, setup)
-    walk = RecordingWalk(recording, recording.report, gear, hob, machine, units, setup, worm_wheel, shift_end)
+    walk = RecordingSimulation(recording, recording.report, gear, hob, machine, units, setup, worm_wheel, shift_end)
     for step in steps:
         walk.take(step)
     walk.finish(lines)

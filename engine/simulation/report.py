@@ -6,7 +6,7 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass, field
 
 from ..errors import EngineError
-from ..programs.verifier.refusals import shown, shown_name
+from ..verifier.refusals import shown, shown_name
 
 
 class SimulationError(EngineError):

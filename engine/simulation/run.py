@@ -4,11 +4,12 @@ A program with the hob-shift-per-part clamp (R11 lies in an interval) is followe
 the shift at each end of it."""
 from __future__ import annotations
 
-from ..gears.records import Gear, Hob, Machine
+from ..gears.records import Gear, Hob
+from ..machines.records import Machine
 from .reading import read_program
 from .report import Report, SimulationError
 from .solids import setup_solids, unit_solids
-from .walk import Walk
+from .walk import BlockSimulation
 
 SHIFT_ENDS = (0, 1)     # the low and the high end of the R11 interval
 
@@ -41,7 +42,7 @@ def _follow(steps, lines, gear: Gear, hob: Hob, machine: Machine, name: str, shi
     worm_wheel = hob.purpose == "worm_wheel"
     units = unit_solids(gear, hob, worm_wheel)
     report = Report(name)
-    walk = Walk(report, gear, hob, machine, units, setup_solids(machine, units, hob), worm_wheel, shift_end)
+    walk = BlockSimulation(report, gear, hob, machine, units, setup_solids(machine, units, hob), worm_wheel, shift_end)
     for step in steps:
         walk.take(step)
     walk.finish(lines)

@@ -5,7 +5,8 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from ..errors import EngineError
-from ..gears.records import Hob, load_gear, load_hobs, load_machine
+from ..gears.records import Hob, load_gear, load_hobs
+from ..machines.records import load_machine
 from .report import Report
 from .run import simulate_program
 

@@ -11,9 +11,10 @@ import math
 
 import numpy as np
 
-from ..gears.records import Gear, Hob, Machine
-from ..programs.verifier.refusals import Refused
-from ..programs.verifier.shift_clamp import ShiftClamp
+from ..gears.records import Gear, Hob
+from ..machines.records import Machine
+from ..verifier.refusals import Refused
+from ..verifier.shift_clamp import ShiftClamp
 from .coupling import (Coupling, coupling_problems, generated_teeth_problem, hand_name, hand_sign, helix_of,
                        lead_angle, read_coupling, swivel_problem)
 from .contact import Motion, follow
@@ -35,7 +36,10 @@ DWELL = 4
 MAX_SWIVEL = 80.0        # degrees from horizontal the hob axis may stand (helix angles stay well below)
 
 
-class Walk:
+class BlockSimulation:
+    """One hobbing program followed block by block: the axes, the hob's poses against the solids,
+    the coupling, the cuts, the table speed and the cycle time, each problem into the report."""
+
     def __init__(self, report: Report, gear: Gear, hob: Hob, machine: Machine, units: list[Solid],
                  setup: list[Solid], worm_wheel: bool, shift_end: int):
         self.report, self.gear, self.hob, self.machine = report, gear, hob, machine
@@ -341,8 +345,8 @@ class Walk:
                     return
 
 
-TAKERS = {"header": Walk._header, "comment": Walk._comment, "block": Walk._block,
-          "statement": Walk._statement, "shift": Walk._shift}
+TAKERS = {"header": BlockSimulation._header, "comment": BlockSimulation._comment,
+          "block": BlockSimulation._block, "statement": BlockSimulation._statement, "shift": BlockSimulation._shift}
 
 
 def _rapid_along_z(motion: int, start: dict, end: dict) -> bool:

@@ -20,7 +20,7 @@ from functools import partial
 from typing import Any
 
 from ..errors import EngineError
-from ..turning.nc_path import NcLines
+from .nc_path import NcLines
 from .budget import Budget, compiling, pay_time, seconds_for, spending
 from .evaluator import EvaluationError, Evaluator, base_symbols
 from .expressions import Compiled, ExpressionError, compile_expression, compile_statements

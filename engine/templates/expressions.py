@@ -29,7 +29,7 @@ from ..errors import EngineError
 from .functions import CONSTANTS, FUNCTIONS
 from .guards import MAX_INT_BITS, check_format_spec, parse_python
 from .plain_lines import plain
-from .tree_walk import Walk
+from .tree_walk import ExpressionTree
 
 MAX_EXPRESSION_LENGTH = 4_000      # characters of one expression or statement block
 MAX_NODES = 400                    # AST nodes of one expression
@@ -82,7 +82,7 @@ def compile_expression(text: str, translations: Mapping[str, str] | None = None)
 
 def _fully_checked(text: str, tree: ast.Expression, is_sql: bool) -> Compiled:
     """The whole gate on a parsed expression: checked, its constant parts evaluated, guarded."""
-    walk = Walk(tree, MAX_DEPTH, ExpressionError(f"nested too deeply (at most {MAX_DEPTH} levels)"))
+    walk = ExpressionTree(tree, MAX_DEPTH, ExpressionError(f"nested too deeply (at most {MAX_DEPTH} levels)"))
     _check_tree(walk, sql_helpers=is_sql)
     names = frozenset(_read_names(walk))
     parts = walk.parts_without(_is_parameter)
@@ -216,7 +216,7 @@ def _parse_sql(text: str, python_error: SyntaxError) -> ast.Expression:
         ) from None
 
 
-def _check_tree(walk: Walk, sql_helpers: bool = False) -> None:
+def _check_tree(walk: ExpressionTree, sql_helpers: bool = False) -> None:
     """The gate: only allowed nodes, named functions and names; bounded in size and depth (the
     walk refused a deeper tree). `_sql_*` helpers only in the translation of a SQL condition,
     never in Python text."""
@@ -265,7 +265,7 @@ def _check_spec_fields(spec: ast.JoinedStr) -> None:
             raise ExpressionError("a format spec may take only a name or a constant in its {field}")
 
 
-def _function_names_as_values(walk: Walk):
+def _function_names_as_values(walk: ExpressionTree):
     """Names of functions used other than as the called name: an NC line would print
     `<function …>`."""
     called = {id(node.func) for node in walk.of_type(ast.Call)}
@@ -295,7 +295,7 @@ def _describe(node: ast.AST) -> str:
     return descriptions.get(type(node), type(node).__name__)
 
 
-def _read_names(walk: Walk):
+def _read_names(walk: ExpressionTree):
     for node in walk.of_type(ast.Name):
         if node.id not in FUNCTIONS and node.id not in CONSTANTS and not node.id.startswith("_sql_"):
             yield node.id
@@ -307,7 +307,7 @@ def _constant_spec(spec: ast.JoinedStr) -> str | None:
     return "".join(texts) if len(texts) == len(spec.values) else None
 
 
-def _guarded(walk: Walk) -> dict[int, ast.AST]:
+def _guarded(walk: ExpressionTree) -> dict[int, ast.AST]:
     """Route the operators that can allocate without bound through the guards, in place, children
     before their parents. Returns the node that took the place of each node replaced (a part's
     guarded form). A format spec is checked, never wrapped."""
@@ -320,7 +320,7 @@ def _guarded(walk: Walk) -> dict[int, ast.AST]:
     return replaced
 
 
-def _guard_of(node: ast.AST, walk: Walk) -> ast.AST:
+def _guard_of(node: ast.AST, walk: ExpressionTree) -> ast.AST:
     if type(node) is ast.BinOp:
         guard = GUARDED_OPERATORS.get(type(node.op))
         return node if guard is None else _call(guard, [node.left, node.right], node)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import math
 from typing import Any, Callable
 
-from ..turning.nc_path import nc_path
+from .nc_path import nc_path
 from .guards import safe_format, safe_int, safe_round, safe_str
 
 _MATH = ("sin", "cos", "tan", "asin", "acos", "atan", "atan2", "radians", "degrees", "sqrt",
@@ -15,5 +15,5 @@ FUNCTIONS.update({
     "abs": abs, "min": min, "max": max, "round": safe_round, "int": safe_int, "float": float,
     "str": safe_str, "bool": bool, "len": len, "format": safe_format,
 })
-FUNCTIONS["nc_path"] = nc_path   # a tool path, one NC block per move (engine.turning.nc_path)
+FUNCTIONS["nc_path"] = nc_path   # a tool path, one NC block per move (engine.templates.nc_path)
 CONSTANTS = {"pi": math.pi, "e": math.e, "True": True, "False": False, "None": None}

@@ -1,8 +1,8 @@
 """Template versions of a class: history, diff between two versions, restore of one.
 
 Every committed version's assembled rows are in template_version_rows (written at commit by
-the trigger of migration 0006); template_audit says which rows each version changed; each version
-also records the layout its programs are written with (line ending, final newline; migration 0025).
+the trigger template_rows_match_version); template_audit says which rows each version changed; each version
+also records the layout its programs are written with (line ending, final newline).
 """
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 
 from ..db.connection import scalar
 from ..errors import EngineError
-from ..library.nc_layout import NcLayout, class_layout, store_layout
+from ..nc.layout import NcLayout, class_layout, store_layout
 from .rows import CSV_COLUMNS, TemplateRow
 from .store import replace_template
 

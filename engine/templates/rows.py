@@ -26,9 +26,9 @@ from pathlib import Path
 from ..csv_reader import CellError, Column, CsvFile, CsvKind, declare, parse_text, parse_whole, read_csv_file, \
     read_csv_text, refuse
 from ..errors import EngineError
-from ..library.nc_layout import ENDING_NAMES, NcLayout
+from ..nc.layout import ENDING_NAMES, NcLayout
 from ..names import shown
-from ..programs.lineage import ENGINES_LINE, lineage_shaped
+from ..nc.lineage import ENGINES_LINE, lineage_shaped
 
 CSV_COLUMNS = ("id", "t", "n", "p_calc", "s", "o", "p_emit")
 LAYOUT_COLUMNS = ("line_ending", "final_newline")   # optional: the class's layout, the same on every row
@@ -245,7 +245,7 @@ FOLDED_TEXTS = 64   # enough for any real row; a row folding to more is left to 
 def writes_lineage(o: str | None) -> bool:
     """True when the row's output is text, built from literals (concatenated, chosen by a
     condition, an f-string with its fields read as 0), that reads as the lineage line only the
-    engine writes (engine.programs.lineage). What a row computes from its inputs is refused
+    engine writes (engine.nc.lineage). What a row computes from its inputs is refused
     when the program is made (engine.programs.verified_run), so golden tests and the release
     gate catch it too."""
     if not o or not LITERAL_START.match(o):   # parsed only if it may be text: rows can be hostile

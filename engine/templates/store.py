@@ -70,7 +70,7 @@ def ensure_class(conn: Connection, name: str, parent: str | None = None, descrip
     return created is not None
 
 
-# The database's own walk down the class tree (migration 0010): the class first, then those below it.
+# The database's own walk down the class tree (classes_and_below): the class first, then those below it.
 CLASS_AND_BELOW = "SELECT name FROM classes_and_below(ARRAY[%(class)s]) ORDER BY name <> %(class)s, name"
 
 

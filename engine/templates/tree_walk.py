@@ -12,7 +12,7 @@ from collections import deque
 COMPUTING = (ast.BinOp, ast.UnaryOp, ast.BoolOp, ast.Compare, ast.IfExp, ast.Call, ast.Subscript)
 
 
-class Walk:
+class ExpressionTree:
     """The nodes of one tree, breadth first (as ast.walk), the children of each, and where each
     node sits in its parent: (parent, field, index in the field's list or None)."""
     __slots__ = ("nodes", "children", "slots")

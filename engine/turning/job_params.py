@@ -9,9 +9,8 @@ from typing import Any
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from importers.dxf_drawing import Drawing, Operation
-from importers.dxf_profile import merged_bounds
-
+from ..drawings.drawing import Drawing, Operation
+from ..drawings.profile import merged_bounds
 from ..errors import EngineError
 from ..names import NAME_RULES, checked, is_safe, shown
 from .defaults import (CLEARANCE, DEFAULT_FEED, DEFAULT_INFEED_ANGLE, DEFAULT_SPEED, DEFAULT_THREAD_DEPTH_PER_PASS,

@@ -26,8 +26,7 @@ import math
 from collections import defaultdict
 from dataclasses import dataclass
 
-from importers.dxf_profile import merged_bounds
-
+from ..drawings.profile import merged_bounds
 from ..errors import EngineError
 from .defaults import STOCK_MARGIN
 from .gouge import move_points

@@ -1,11 +1,11 @@
 """Tool moves of a turning job, in machine coordinates: Z along the axis (mm), X as a
 diameter (mm), as a program states them. The template rows decide how each kind is
-written (engine.turning.nc_path), so the dialects live in rows, not here."""
+written (engine.templates.nc_path), so the dialects live in rows, not here."""
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-MOVE_KINDS = ("rapid", "feed", "cw", "ccw", "thread")
+from ..templates.nc_path import MOVE_KINDS  # noqa: F401  (the kinds nc_path prints, each in its format)
 
 
 @dataclass(frozen=True, slots=True)

@@ -1,12 +1,13 @@
 """The names of a turning job and its templates: operation slots, the job and module
-parameters (for `engine lint`). Light on purpose: engine.gears.models imports it on every start."""
+parameters (for `engine lint`). Light on purpose: engine.turning registers its model on import."""
 from __future__ import annotations
+
+from ..gears.models import register_model
 
 # Operation slots in the turning templates (rows 1000·n + 10 … 80); a drawing with more
 # operation layers is refused. Nine covers the seed's jobs (rough, slot, thread, finish …)
 # with room; more slots are more rows, not more code.
 MAX_OPERATIONS = 9
-MAX_TOOL = 99   # two digits: ISO T0101 is tool 01, offset 01; 840D T1 D1
 
 # Defaults in job.params, overridden per module by the operation's own parameters.
 SLOT_DEFAULTS = {"op_present": False, "operation": 0, "kind": "", "tool": 0, "tool_offset": 0,
@@ -23,6 +24,7 @@ MODULE_PARAMETERS = {
 }
 
 
+@register_model("turning")
 class TurningModel:
     """Names the turning templates may use (for `engine lint`)."""
 

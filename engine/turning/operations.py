@@ -14,9 +14,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from functools import cached_property
 
-from importers.dxf_geometry import Line, Segment
-from importers.dxf_profile import END_MATCH_TOLERANCE_MM, Profile, merged_bounds
-
+from ..drawings.geometry import Line, Segment
+from ..drawings.profile import END_MATCH_TOLERANCE_MM, Profile, merged_bounds
 from ..errors import EngineError
 from . import toolpaths
 from .gouge import PartIndex, check_no_gouge

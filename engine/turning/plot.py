@@ -13,8 +13,7 @@ import math
 from dataclasses import dataclass
 from typing import Sequence
 
-from importers.dxf_geometry import Arc, Segment
-
+from ..drawings.geometry import Arc, Segment
 from ..pictures import literal, new_figure, picture_target, save_atomically
 from .moves import Move, Pass
 from .plot_frame import Frame, job_frame

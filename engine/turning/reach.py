@@ -21,8 +21,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Sequence
 
-from importers.dxf_profile import END_MATCH_TOLERANCE_MM
-
+from ..drawings.profile import END_MATCH_TOLERANCE_MM
 from ..errors import EngineError
 from .region import CHORD_TOLERANCE_MM, Edge
 

@@ -12,8 +12,8 @@ from dataclasses import dataclass
 from functools import cached_property
 from typing import Iterable, Sequence
 
-from importers.dxf_geometry import Arc, Point, Segment
-from importers.dxf_profile import sweep
+from ..drawings.geometry import Arc, Point, Segment
+from ..drawings.profile import sweep
 
 CHORD_TOLERANCE_MM = 0.001   # 1 µm: largest gap between an arc and its chords
 # Slopes and lengths below this (mm) count as zero in the interval algebra.

@@ -11,9 +11,8 @@ from __future__ import annotations
 import math
 from typing import NoReturn
 
-from importers.dxf_geometry import Arc, Line, Segment
-from importers.dxf_profile import END_MATCH_TOLERANCE_MM
-
+from ..drawings.geometry import Arc, Line, Segment
+from ..drawings.profile import END_MATCH_TOLERANCE_MM
 from ..errors import EngineError
 
 DIGITS = 6             # mm to 1 nm: far below any drawing's accuracy, short in SQL

@@ -12,9 +12,8 @@ from __future__ import annotations
 import math
 from typing import Sequence
 
-from importers.dxf_geometry import Arc, Line, Segment
-from importers.dxf_profile import merged_bounds
-
+from ..drawings.geometry import Arc, Line, Segment
+from ..drawings.profile import merged_bounds
 from ..errors import EngineError
 from .moves import Move, Pass
 from .region import (CHORD_TOLERANCE_MM, Edge, Surroundings, distance_to_region, flattened_outline,

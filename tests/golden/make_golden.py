@@ -27,7 +27,7 @@ from golden_cases import (hobbing_cases, hobbing_file, hobbing_text, turning_cas
 
 def seeded_database(admin_url: str) -> tuple[str, str]:
     from engine.db.migrate import migrate
-    from engine.db.seed import seed
+    from engine.library.seed import seed
 
     name = f"engine_golden_{uuid.uuid4().hex[:10]}"
     with psycopg.connect(admin_url, autocommit=True) as admin:

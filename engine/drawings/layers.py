@@ -1,0 +1,95 @@
+"""What a line is for, by its linetype or its layer's name, and which layer holds the part
+when layer 0 is empty (issue 17).
+
+CAD drawings mark centre lines with a dash-dot linetype (CENTER, DASHDOT, ISO 04/08/10) or
+keep them on a layer named for them (center, Mitte, Achse, axis), and hidden edges with a
+dashed linetype (HIDDEN, DASHED, ISO 02) or on a layer like 'hidden' or 'verdeckt'. Neither
+is part of a turned outline: a centre line may be the turning axis, a hidden edge is never
+cut from outside. The rules are the tables LINE_ROLES (first match wins, linetype before
+layer name, both compared in upper case).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+
+from .profile import END_MATCH_TOLERANCE_MM, chain_segments
+from .read import DxfError
+
+CENTRE, HIDDEN = "centre line", "hidden line"
+# A layer of more pieces than this (flattened curves, hatching, a site plan) is not looked at
+# as the part's: the choice stays fast and such a layer is named with --profile-layer.
+MAX_CHOICE_SEGMENTS = 20_000
+
+
+@dataclass(frozen=True)
+class LineRole:
+    role: str
+    linetype_words: tuple[str, ...]   # a linetype whose name contains one of these
+    layer_words: tuple[str, ...]      # a layer whose name contains one of these
+
+
+LINE_ROLES = (
+    LineRole(CENTRE, ("CENTER", "CENTRE", "DASHDOT", "ISO04", "ISO08", "ISO10", "STRICHPUNKT"),
+             ("CENTER", "CENTRE", "MITTE", "ACHSE", "AXIS")),
+    LineRole(HIDDEN, ("HIDDEN", "DASHED", "ISO02", "VERDECKT", "STRICH"),
+             ("HIDDEN", "VERDECKT", "DASHED")),
+)
+UNSET_LINETYPES = ("", "BYLAYER", "BYBLOCK")
+
+
+def effective_linetype(entity, layer_linetypes: dict[str, str], layer: str) -> str:
+    """The entity's own linetype, else its layer's (DXF: BYLAYER is the default)."""
+    own = str(entity.dxf.get("linetype", "BYLAYER") or "").upper()
+    return own if own not in UNSET_LINETYPES else layer_linetypes.get(layer.upper(), "").upper()
+
+
+def line_role(entity, layer: str, layer_linetypes: dict[str, str]) -> str | None:
+    """CENTRE, HIDDEN or None (an outline or anything else) for one entity."""
+    return role_of(effective_linetype(entity, layer_linetypes, layer), layer.upper())
+
+
+@lru_cache(maxsize=1024)
+def role_of(linetype: str, name: str) -> str | None:
+    """The role a linetype (upper case) or else a layer name (upper case) gives a line."""
+    for rule in LINE_ROLES:
+        if any(word in linetype for word in rule.linetype_words):
+            return rule.role
+    for rule in LINE_ROLES:
+        if any(word in name for word in rule.layer_words):
+            return rule.role
+    return None
+
+
+def layer_linetypes(doc) -> dict[str, str]:
+    return {layer.dxf.name.upper(): str(layer.dxf.get("linetype", "") or "") for layer in doc.layers}
+
+
+def axis_contours(segments, tolerance: float = END_MATCH_TOLERANCE_MM) -> int:
+    """How many chains of a layer could be a turned part: a closed contour that touches or
+    straddles the axis (drawing Y = 0), or a half-contour with both ends on it."""
+    count = 0
+    for chain in chain_segments(segments):
+        _, _, r_min, r_max = chain.bounds
+        if chain.closed and r_min <= tolerance and r_max > tolerance:
+            count += 1
+        elif not chain.closed and abs(chain.start[1]) <= tolerance and abs(chain.end[1]) <= tolerance \
+                and max(abs(r_min), abs(r_max)) > tolerance:
+            count += 1
+    return count
+
+
+def chosen_profile_layer(segments_by_layer: dict[str, list]) -> tuple[str, str] | None:
+    """(layer, note) when layer 0 is empty and exactly one layer holds exactly one contour on
+    the axis; None when no layer does (the caller says layer 0 has no profile); DxfError naming
+    the layers when two or more do, since either could be the part."""
+    found = sorted(name for name, segments in segments_by_layer.items()
+                   if segments and len(segments) <= MAX_CHOICE_SEGMENTS and axis_contours(segments) == 1)
+    if len(found) > 1:
+        named = " and ".join(repr(name) for name in found)
+        raise DxfError(f"layer 0 is empty and layers {named} each hold one contour on the axis; "
+                       f"name the part's layer with --profile-layer (e.g. --profile-layer {found[0]!r})")
+    if not found:
+        return None
+    return found[0], (f"layer 0 is empty: the profile was taken from layer {found[0]!r}, the only layer "
+                      "with one contour touching or straddling the axis (--profile-layer names another)")

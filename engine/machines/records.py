@@ -1,0 +1,68 @@
+"""Machines as read from the database: the record of one machine (its kind, NC dialect, axis
+travel in mm, spindle and table limits, axis senses and setup) and loading it by name."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from ..db.records import as_float, columns
+from ..errors import EngineError
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
+
+
+@dataclass(frozen=True)
+class Machine:
+    name: str
+    kind: str
+    dialect: str
+    x_min: float
+    x_max: float
+    y_min: float
+    y_max: float
+    z_min: float
+    z_max: float
+    spindle_max: float
+    table_speed_max: float | None
+    module_max: float | None
+    # Conventions and setup (the machine table): each axis's sense relative to DIN 66217.
+    a_direction: int = 1
+    b_direction: int = 1
+    c_direction: int = 1
+    y_direction: int = 1
+    z_direction: int = 1
+    work_offset: str = "G54"
+    fixture_diameter: float = 0.0
+    fixture_gap: float = 0.0
+    tailstock_diameter: float = 0.0
+    tailstock_gap: float = 0.0
+    load_x: float | None = None
+    load_z: float | None = None
+    rapid_rate: float = 5000.0
+    orient_before_coupling: bool = False
+    door_close_m: int | None = None
+    door_open_m: int | None = None
+
+
+MACHINE_QUERY = f"SELECT {columns(Machine)} FROM machine"  # static, from the dataclass
+
+
+DEFAULT_HOBBING_MACHINE = "hobber-840d"
+
+
+def hobbing_machine(conn: Connection, name: str | None) -> Machine:
+    """The machine record, which must be a hobbing machine (default: the seeded 840D hobber)."""
+    machine = load_machine(conn, name or DEFAULT_HOBBING_MACHINE)
+    if machine.kind != "hobber":
+        raise EngineError(f"machine {machine.name} is a {machine.kind}, not a hobbing machine; "
+                          f"use --machine {DEFAULT_HOBBING_MACHINE}")
+    return machine
+
+
+def load_machine(conn: Connection, name: str) -> Machine:
+    row = conn.execute(MACHINE_QUERY + " WHERE name = %s", (name,)).fetchone()
+    if row is None:
+        known = ", ".join(r[0] for r in conn.execute("SELECT name FROM machine ORDER BY name"))
+        raise EngineError(f"machine {name!r} does not exist; known machines: {known or 'none (run engine seed)'}")
+    return as_float(Machine, row, "machine")

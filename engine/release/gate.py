@@ -1,0 +1,132 @@
+"""`engine template release`: the gate between a class's draft and the shop floor (issue 15).
+
+A draft is released only if (1) every expression passes the static check (engine lint), (2) the
+golden tests of the class and of its descendants pass against their drafts (engine test), and
+(3) static analysis finds nothing (engine.templates.analysis). Any failure refuses the release
+and names every row, column and test that failed. Then the impact: what the release changes in
+the programs of the stored jobs (engine.release.impact). Not a dry run: the release is recorded
+(release_template, which only engine_releaser may run) in the transaction that read the draft, so
+what was checked is what is released."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+from psycopg.errors import InsufficientPrivilege
+from psycopg.types.json import Jsonb
+
+from .. import turning  # noqa: F401  (importing it registers the turning names model)
+from ..hobbing import models as hobbing_models  # noqa: F401  (importing it registers the hobbing models)
+from ..db.connection import scalar
+from ..errors import EngineError
+from ..templates.analysis import class_findings
+from .impact import Impact, impact
+from ..templates.lint import lint_class
+from ..templates.store import class_and_descendants
+from ..templates.versions import draft_template
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
+
+RELEASER_ROLE = "engine_releaser"
+RELEASE = "SELECT release_template(%s, %s, %s, %s, %s, %s)"
+MAY_RELEASE = ("SELECT current_user, has_function_privilege("
+               "'release_template(text, integer, text, jsonb, jsonb, jsonb, text)', 'EXECUTE')")
+
+
+class GateRefusal(EngineError):
+    """The gate refused a release: `problems` lists every failed check, one line each."""
+
+    def __init__(self, gear_class: str, version: int, problems: list[str]):
+        self.problems = problems
+        more = f" (and {len(problems) - 1} more, listed below)" if len(problems) > 1 else ""
+        super().__init__(f"class {gear_class} v{version} not released: {problems[0]}{more}")
+
+
+@dataclass
+class ReleaseReport:
+    gear_class: str
+    version: int
+    hash: str
+    dry_run: bool
+    tests: list[dict]
+    impact: Impact
+    checks: dict
+    release_id: int | None = None
+    drafts_below: list[str] = field(default_factory=list)   # descendants whose drafts need their own release
+
+
+def release(conn: Connection, gear_class: str, dry_run: bool = False, confirm=None) -> ReleaseReport:
+    """Gate, impact and (not a dry run) the release of the class's draft, in one transaction.
+    `confirm(report)`, if given, is asked after the impact and before recording; False releases
+    nothing."""
+    with conn.transaction():
+        draft = draft_template(conn, gear_class)
+        if not draft.draft:
+            raise EngineError(f"class {gear_class} has no draft: version {draft.version} is released; edit its "
+                              "rows (template_view, engine template import) to make one")
+        if not dry_run:
+            _require_releaser(conn)
+        tests, checks = gate(conn, gear_class, draft)
+        report = ReleaseReport(gear_class, draft.version, draft.hash, dry_run, tests, impact(conn, gear_class),
+                               checks, drafts_below=drafts_below(conn, gear_class))
+        if not dry_run and (confirm is None or confirm(report)):
+            report.release_id = _record(conn, report)
+    return report
+
+
+def _require_releaser(conn: Connection) -> None:
+    found = conn.execute(MAY_RELEASE).fetchone()
+    assert found is not None   # a SELECT without FROM returns its one row
+    role, allowed = found
+    if not allowed:
+        raise EngineError(_role_needed(role))
+
+
+def _role_needed(role: str) -> str:
+    return f"releasing a template needs the role {RELEASER_ROLE}; {role} may not (nothing released)"
+
+
+def gate(conn: Connection, gear_class: str, draft) -> tuple[list[dict], dict]:
+    """The three checks; GateRefusal naming every failure. Returns the tests run and the checks."""
+    lint_problems = [str(problem) for problem in lint_class(conn, gear_class)]
+    results = _golden_results(conn, gear_class)
+    problems = lint_problems + [f"golden {result.failure}"
+                                for result in results if not result.passed]
+    if not lint_problems:   # rows that do not compile cannot be analysed: lint named them
+        problems += [str(finding) for finding in class_findings(conn, gear_class, draft)]
+    if problems:
+        raise GateRefusal(gear_class, draft.version, problems)
+    tests = [{"class": result.gear_class, "name": result.name, "passed": result.passed} for result in results]
+    return tests, {"lint": "passed", "analysis": "no finding", "golden_tests": len(tests)}
+
+
+def _golden_results(conn: Connection, gear_class: str) -> list:
+    from .golden import run_golden_tests   # the golden tests' language (engine test)
+
+    return run_golden_tests(conn, class_and_descendants(conn, gear_class), draft=True)
+
+
+# Classes below (not the class itself) with rows whose current version is not the released one.
+DRAFTS_BELOW = """
+SELECT g.name FROM classes_and_below(ARRAY[%(class)s]) b JOIN gear_class g ON g.name = b.name
+WHERE g.name <> %(class)s AND g.template_version IS DISTINCT FROM released_version(g.name)
+  AND EXISTS (SELECT 1 FROM assembled_row r WHERE r.gear_class = g.name)
+ORDER BY g.name"""
+
+
+def drafts_below(conn: Connection, gear_class: str) -> list[str]:
+    """The descendants whose current rows are not released: the class's change gave them drafts
+    (or they had their own), which need their own release. An inner node without rows has nothing
+    to release."""
+    return [row[0] for row in conn.execute(DRAFTS_BELOW, {"class": gear_class})]
+
+
+def _record(conn: Connection, report: ReleaseReport) -> int:
+    try:
+        with conn.transaction():
+            return scalar(conn.execute(RELEASE, (report.gear_class, report.version, report.hash,
+                                                 Jsonb(report.tests), Jsonb(report.impact.summary()),
+                                                 Jsonb(report.checks))))
+    except InsufficientPrivilege:
+        raise EngineError(_role_needed(scalar(conn.execute("SELECT current_user")))) from None

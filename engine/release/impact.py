@@ -1,0 +1,240 @@
+"""What a release would change on the shop floor (issue 15): every stored job of a class and of
+its descendants made again with the draft template and compared with its program from the
+released version. Template rows only (as engine.programs.remake makes a stored job again,
+without the verifier and the simulation, which the gate does not need to see a line change).
+
+The released program is the job's latest stored one (its lineage line left out) when it was made
+from the released version from the job's current parameters; otherwise the released template is
+evaluated too. The draft is evaluated as if it had the released version number, so the
+`; TEMPLATE class vN` line does not count as a change. A draft that only writes its lines with
+another layout (line ending, final newline: version_layout_change) changes no line, but the bytes of
+every stored program's file of the class: said on its own, with how many programs. Jobs with identical parameters are
+evaluated once: 10,000 stored jobs of a class take seconds (bench/impact.py)."""
+from __future__ import annotations
+
+import difflib
+import json
+from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING
+
+from .. import turning  # noqa: F401  (importing it registers the turning names model)
+from ..hobbing import models as hobbing_models  # noqa: F401  (importing it registers the hobbing models)
+from ..errors import EngineError
+from ..gears.models import model_for_class
+from ..machines.records import load_machine
+from ..nc.layout import ENDING_NAMES, NcLayout
+from ..nc.lineage import without_lineage
+from ..templates.decision_table import compiled_template
+from ..templates.history import layout_change
+from ..templates.rows import Template
+from ..templates.store import class_and_descendants
+from ..templates.versions import draft_template, released_template
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
+    from ..machines.records import Machine
+
+DIFFS_SHOWN = 5   # unified diffs the CLI prints (all of them with --json)
+
+# Every job of the classes with its latest program, and whether that program came from the
+# released version (class, version, hash) and the job's current parameters.
+JOBS = """
+WITH released(gear_class, version, hash) AS (SELECT * FROM unnest(%s::text[], %s::int[], %s::text[]))
+SELECT j.id, j.gear_class, j.machine, j.params::text, j.module_params::text,
+       coalesce(p.template_version = r.version AND p.template_hash = r.hash
+                AND p.input_hash = job_input_hash(j.params, j.module_params), false),
+       p.lines, p.row_ids
+FROM job j
+JOIN released r ON r.gear_class = j.gear_class
+LEFT JOIN (SELECT DISTINCT ON (job_id) job_id, template_version, template_hash, input_hash, lines, row_ids
+           FROM program ORDER BY job_id, id DESC) p ON p.job_id = j.id
+ORDER BY j.id"""
+
+
+@dataclass(frozen=True)
+class JobDiff:
+    job_id: int
+    gear_class: str
+    diff: str   # unified diff, released → draft
+
+
+@dataclass(frozen=True)
+class JobFailure:
+    job_id: int
+    gear_class: str
+    error: str
+
+
+@dataclass
+class LayoutChange:
+    """A class whose draft writes its programs with another layout than its released version: the
+    files of all its stored programs change bytes, though no line changes."""
+    gear_class: str
+    old: NcLayout
+    new: NcLayout
+    programs: int = 0
+
+    def said(self) -> str:
+        return (f"layout of {self.gear_class}: {self.old.said} → {self.new.said}: the files of all {self.programs} "
+                "stored program(s) change bytes")
+
+    def as_json(self) -> dict:
+        return {"class": self.gear_class, "from": _layout_json(self.old), "to": _layout_json(self.new),
+                "programs": self.programs}
+
+
+def _layout_json(layout: NcLayout) -> dict:
+    return {"line_ending": ENDING_NAMES[layout.line_ending], "final_newline": layout.final_newline}
+
+
+@dataclass
+class Impact:
+    """The impact of releasing a class's draft: jobs examined, programs that change, jobs the
+    draft fails for, and the diffs of the changed programs (in job id order)."""
+    gear_class: str
+    jobs: int = 0
+    changed: int = 0
+    failures: list[JobFailure] = field(default_factory=list)
+    diffs: list[JobDiff] = field(default_factory=list)
+    layouts: dict[str, LayoutChange] = field(default_factory=dict)   # class → its draft's other layout
+
+    def summary(self) -> dict:
+        """What a release records: the counts, the changed and failing job ids, the layout changes."""
+        return {"jobs": self.jobs, "changed": self.changed, "failed": len(self.failures),
+                "changed_jobs": [diff.job_id for diff in self.diffs][:1000],
+                "failed_jobs": [failure.job_id for failure in self.failures][:1000],
+                "layout": [change.as_json() for change in self.layouts.values()]}
+
+
+def impact(conn: Connection, gear_class: str) -> Impact:
+    """Every stored job of the class and its descendants made with the draft, compared with the
+    released program."""
+    pairs = _template_pairs(conn, class_and_descendants(conn, gear_class))
+    report = Impact(gear_class, layouts=_layout_changes(conn, pairs))
+    if not pairs:
+        return report
+    classes = list(pairs)
+    versions = [pairs[name][0].version for name in classes]
+    hashes = [pairs[name][0].hash for name in classes]
+    made = _Made(conn, pairs)
+    for job in conn.cursor(binary=True).execute(JOBS, (classes, versions, hashes)):
+        _compare(report, made, job)
+    return report
+
+
+def _template_pairs(conn: Connection, classes: list[str]) -> dict[str, tuple[Template, Template, int]]:
+    """(released, draft evaluated as the released version, the draft's own version) of each class
+    that has a released template; the draft is the released one for a class without a draft."""
+    pairs = {}
+    for name in classes:
+        try:
+            released = released_template(conn, name)
+        except EngineError:
+            continue   # a class without rows (an inner node of the tree) has no jobs of its own
+        draft = draft_template(conn, name)
+        pairs[name] = released, replace(draft, version=released.version, draft=False), draft.version
+    return pairs
+
+
+def _layout_changes(conn: Connection, pairs: dict[str, tuple[Template, Template, int]]) -> dict[str, LayoutChange]:
+    """The classes whose draft has another layout than their released version."""
+    changes = {}
+    for name, (released, _, draft_version) in pairs.items():
+        change = layout_change(conn, name, released.version, draft_version)
+        if change is not None:
+            changes[name] = LayoutChange(name, *change)
+    return changes
+
+
+def _compare(report: Impact, made: _Made, job) -> None:
+    job_id, gear_class, machine, params_text, modules_text, from_released, lines, row_ids = job
+    report.jobs += 1
+    if gear_class in report.layouts and lines is not None:
+        report.layouts[gear_class].programs += 1
+    if not made.has_draft(gear_class):
+        return   # no draft: nothing changes
+    key = gear_class, machine, params_text, modules_text
+    new_lines = made.draft_lines(key)
+    if isinstance(new_lines, EngineError):
+        report.failures.append(JobFailure(job_id, gear_class, str(new_lines)))
+        return
+    old_lines = without_lineage(lines, row_ids) if from_released else made.released_lines(key)
+    if old_lines != new_lines:
+        report.changed += 1
+        report.diffs.append(JobDiff(job_id, gear_class, made.diff(gear_class, old_lines, new_lines)))
+
+
+class _Made:
+    """The programs of distinct job inputs, made once: with the draft (or its failure) and, where the
+    stored program is not the released one, with the released template."""
+
+    def __init__(self, conn: Connection, pairs: dict[str, tuple[Template, Template, int]]):
+        self.pairs, self.inputs = pairs, _JobInputs(conn)
+        self.drafts: dict[tuple, list[str] | EngineError] = {}
+        self.releases: dict[tuple, list[str]] = {}
+
+    def has_draft(self, gear_class: str) -> bool:
+        released, draft, _ = self.pairs[gear_class]
+        return released.hash != draft.hash
+
+    def released(self, gear_class: str) -> Template:
+        return self.pairs[gear_class][0]
+
+    def diff(self, gear_class: str, old: list[str], new: list[str]) -> str:
+        released, _, draft_version = self.pairs[gear_class]
+        return unified_diff(old, new, f"{gear_class} v{released.version} (released)",
+                            f"{gear_class} v{draft_version} (draft)")
+
+    def draft_lines(self, key: tuple) -> list[str] | EngineError:
+        if key not in self.drafts:
+            try:
+                self.drafts[key] = compiled_template(self.pairs[key[0]][1]).run(*self.inputs.of(*key)).lines
+            except EngineError as error:
+                self.drafts[key] = error
+        return self.drafts[key]
+
+    def released_lines(self, key: tuple) -> list[str]:
+        """The released template's lines for the job (none if it fails: every draft line is a change)."""
+        if key not in self.releases:
+            try:
+                self.releases[key] = compiled_template(self.released(key[0])).run(*self.inputs.of(*key)).lines
+            except EngineError:
+                self.releases[key] = []
+        return self.releases[key]
+
+
+def unified_diff(old: list[str], new: list[str], old_label: str, new_label: str) -> str:
+    return "\n".join(difflib.unified_diff(old, new, old_label, new_label, lineterm=""))
+
+
+class _JobInputs:
+    """A stored job's parameters as its template reads them, as engine.programs.remake makes them:
+    a hobbing job's cycle time from its stored feeds, a turning job's moves from its passes."""
+
+    def __init__(self, conn: Connection):
+        self.conn = conn
+        self.machines: dict[str, Machine] = {}
+        self.shapes: dict[str, str] = {}   # class -> its model's cut shape
+
+    def of(self, gear_class: str, machine_name: str, params_text: str, modules_text: str) -> tuple[dict, dict]:
+        params, modules = json.loads(params_text), json.loads(modules_text or "{}")
+        machine = self.machine(machine_name)
+        if machine.kind == "lathe":
+            from ..turning.model import template_module_params   # the tool paths: only for turning jobs
+
+            return params, template_module_params(params, modules)
+        if "cycle_time" in params:
+            from ..hobbing.machine_job import with_cycle_time
+
+            params = with_cycle_time(params, modules, self.cut_shape(gear_class), machine)
+        return params, modules
+
+    def cut_shape(self, gear_class: str) -> str:
+        if gear_class not in self.shapes:
+            self.shapes[gear_class] = model_for_class(self.conn, gear_class).cut_shape
+        return self.shapes[gear_class]
+
+    def machine(self, name: str):
+        if name not in self.machines:
+            self.machines[name] = load_machine(self.conn, name)
+        return self.machines[name]

@@ -1,0 +1,199 @@
+"""The dialects the verifier reads, declared as data: for each machine kind and controller
+dialect of the machine record (machine.kind, machine.dialect), the header lines (and the
+program name and number they carry), the comment form, the addresses and the kind of value
+each takes (and which need a decimal point), the G codes and M codes allowed with their modal
+groups, the keywords and statements, the word that gives a thread's lead, and the machine
+state each motion needs (engine.verifier.machine_state).
+
+Only what the seeded templates emit (and the controller reads the way the verifier assumes) is
+in a dialect. Anything else is refused: a code such as G91 changes what every later position
+means in a way a block-by-block reading cannot see, so it is not guessed at. The hobber selects
+its work offset G54…G57 from the machine record (design notes §7); the positions are read in
+that frame, the frame the working area and travel of the record are stated in. The door M
+functions are the machine record's own (dialect_for)."""
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING
+
+from .machine_state import HOBBING_STATE, LATHE_840D_STATE, LATHE_ISO_STATE, StateRules
+from .refusals import Refused
+
+if TYPE_CHECKING:
+    from ..machines.records import Machine
+
+# Value kinds of addresses (engine.verifier.words reads and checks each).
+POSITION, ANGLE, FEED, SPEED, CODE, TOOL, TOOL_AND_OFFSET, OFFSET, RADIUS, PITCH = (
+    "position", "angle", "feed", "speed", "code", "tool", "tool and offset", "offset", "radius", "pitch")
+SPINDLE_POSITION = "spindle position"   # SPOS=<degrees>: orients the stopped spindle, moves no axis
+MOTION = "motion"          # the modal group of G0, G1, G2, G3 and threading
+AXES = ("X", "Y", "Z")
+
+# 840D program names (reference §A1): letters, digits and _, read in through `%_N_<name>_MPF`;
+# the name read is then held to the program's own name and to engine.names (program).
+NAME = r"(?P<name>[A-Za-z0-9_]+)"
+# ISO: a comment ends at the first ")", so no "(" or ")" inside; and no "%", which ends the
+# file on a memory card or tape (other characters are printable ASCII anyway:
+# engine.verifier.characters reads every line first).
+ISO_COMMENT_TEXT = r"[ -$&-'*-~]*"
+# ISO dimension words without a decimal point are read in the control's least input increment
+# on Fanuc-type controls with decimal-point input type I: X114 is 0.114 mm. An F without a point
+# is read by a parameter's unit, or as a one-digit feed code F1…F9.
+POINT_REASON = ("needs a decimal point: a Fanuc-type control with decimal-point input type I reads "
+                "a number without one in its least input increment (X114 is 0.114 mm), and F by a "
+                "parameter's unit or as a one-digit feed code")
+
+
+@dataclass(frozen=True)
+class Header:
+    """A whole line of fixed form that may stand only at the given places ("first", "second",
+    "last" line of the program), and must stand at those of `required`: a second `%_N_…_MPF`
+    would start another program, and a program without its own would be stored by the
+    control under whatever name it last read."""
+    what: str
+    pattern: re.Pattern[str]
+    places: frozenset[str]
+    required: frozenset[str] = frozenset()
+
+
+@dataclass(frozen=True)
+class Dialect:
+    name: str
+    headers: tuple[Header, ...]
+    comment: str                          # "semicolon": `; text` to the end; "parentheses": `(text)`
+    addresses: dict[str, str]             # address -> value kind
+    g_codes: dict[int, str]               # code -> modal group: two of one group in a block are refused
+    m_codes: dict[int, str]               # code -> group: M3 and M5 in one block are both spindle
+    state: StateRules                     # what each motion and statement needs, what each event does
+    keywords: frozenset[str] = frozenset()   # words without a value: WALIMON, DIAMON
+    statements: frozenset[str] = frozenset()   # NAME(arguments) lines (engine.verifier.statements)
+    shift_clamp: bool = False             # the hob-shift-per-part R11 clamp (engine.verifier.shift_clamp)
+    equals_allowed: bool = False          # 840D: `X=12.5` is `X12.5`; names of two letters need it (`CR=5`)
+    arc_radius: str | None = None         # the address of an arc's radius
+    needs_words: dict[int, str] = field(default_factory=dict)   # G code -> the words its block must hold
+    thread_lead: dict[int, str] = field(default_factory=dict)   # thread G code -> the address of its lead (mm/rev)
+    point_required: frozenset[str] = frozenset()      # addresses whose number must hold a decimal point
+    program_numbers: range | None = None  # ISO O numbers a program may have
+
+    def code_group(self, letter: str, code: int) -> str:
+        codes = self.m_codes if letter == "M" else self.g_codes
+        if code not in codes:
+            known = ", ".join(f"{letter}{c}" for c in sorted(codes))
+            refused = REFUSED_G_CODES.get(code) if letter == "G" else None
+            raise Refused((refused or f"{letter}{code} is not a{'n' if letter == 'M' else ''} {letter} code of the "
+                           f"{self.name} grammar") + f" (it has {known})")
+        return codes[code]
+
+
+# G codes that are refused with a reason: what they would do to the positions the verifier reads.
+REFUSED_G_CODES = {
+    91: "incremental G91 moves cannot be verified; program absolute positions (G90)",
+    70: "G70 programs inches (840D) or runs a finishing cycle (ISO); neither can be verified",
+    20: "G20 programs inches; every limit is in mm (G21)",
+    95: "G95 feeds per revolution; F is bounded in mm/min (G94)",
+    99: "G99 feeds per revolution; F is bounded in mm/min (G98)",
+    96: "G96 constant cutting speed leaves the spindle speed unbounded; program r/min (G97)",
+    **{code: f"G{code} shifts every position by a work offset the verifier cannot see"
+       for code in (54, 55, 56, 57, 58, 59, 92, 500)},
+    **{code: f"G{code} moves by way of a reference point the verifier cannot see" for code in (28, 74, 75)},
+}
+
+# A block that holds one of these G codes holds no other G code and only these words.
+BLOCK_SHAPES = {
+    4: ("dwell", frozenset({"F"})),
+    25: ("lower working-area limit", frozenset(AXES)),
+    26: ("upper working-area limit", frozenset(AXES)),
+}
+WORKING_AREA = {25: "lower", 26: "upper"}
+DWELL = 4                   # its F is a time in seconds, not a feed
+# Words that mean something only together with one of these G codes in the same block.
+WORD_NEEDS_CODE = {"R": frozenset({2, 3}), "CR": frozenset({2, 3}), "K": frozenset({33})}
+# M codes by what they switch: two of one group in a block contradict each other (M3 M5).
+M_GROUPS = {3: "spindle", 5: "spindle", 8: "coolant", 9: "coolant", 20: "tailstock", 21: "tailstock",
+            30: "program end"}
+WORK_OFFSETS = (54, 55, 56, 57)   # the settable work offsets a hobber's record may name (machine.work_offset)
+DOOR_GROUP = "door"
+PROGRAM_HEADER_840D = Header("program header %_N_<NAME>_MPF", re.compile(rf"%_N_{NAME}_MPF"),
+                             frozenset({"first"}), frozenset({"first"}))
+PATH_LINE_840D = Header("path line ;$PATH=/_N_MPF_DIR", re.compile(r";\$PATH=/_N_MPF_DIR"), frozenset({"second"}))
+
+HOBBING_840D = Dialect(
+    name="840D hobbing",
+    headers=(PROGRAM_HEADER_840D, PATH_LINE_840D),
+    comment="semicolon",
+    addresses={"X": POSITION, "Y": POSITION, "Z": POSITION, "A": ANGLE, "F": FEED, "S": SPEED,
+               "T": TOOL, "D": OFFSET, "SPOS": SPINDLE_POSITION, "G": CODE, "M": CODE},
+    g_codes={0: MOTION, 1: MOTION, 4: "dwell", 25: "working area", 26: "working area", 71: "units",
+             90: "distance", 94: "feed type", **{code: "work offset" for code in WORK_OFFSETS},
+             60: "path mode", 64: "path mode"},
+    m_codes={code: M_GROUPS[code] for code in (3, 5, 8, 9, 20, 21, 30)},
+    state=HOBBING_STATE,
+    keywords=frozenset({"WALIMON"}),
+    statements=frozenset({"EGDEF", "EGON", "EGOFS", "EGDEL"}),
+    shift_clamp=True,
+    equals_allowed=True,
+)
+
+LATHE_840D = Dialect(
+    name="840D lathe",
+    headers=HOBBING_840D.headers,
+    comment="semicolon",
+    addresses={"X": POSITION, "Z": POSITION, "F": FEED, "S": SPEED, "T": TOOL, "D": OFFSET, "CR": RADIUS,
+               "K": PITCH, "G": CODE, "M": CODE},
+    g_codes={0: MOTION, 1: MOTION, 2: MOTION, 3: MOTION, 33: MOTION, 18: "plane", 40: "tool radius",
+             71: "units", 90: "distance", 94: "feed type", 97: "spindle speed"},
+    m_codes={code: M_GROUPS[code] for code in (3, 5, 8, 9, 30)},
+    state=LATHE_840D_STATE,
+    keywords=frozenset({"DIAMON"}),
+    equals_allowed=True,
+    arc_radius="CR",
+    needs_words={2: "CR", 3: "CR", 33: "K"},
+    thread_lead={33: "K"},
+)
+
+LATHE_ISO = Dialect(
+    name="ISO lathe",
+    headers=(Header("tape mark %", re.compile(r"%"), frozenset({"first", "last"}), frozenset({"first", "last"})),
+             Header("program number O<nnnn> (NAME)",
+                    re.compile(rf"O(?P<number>\d{{4}}) \((?P<name>{ISO_COMMENT_TEXT})\)"),
+                    frozenset({"second"}), frozenset({"second"}))),
+    comment="parentheses",
+    addresses={"X": POSITION, "Z": POSITION, "F": FEED, "S": SPEED, "T": TOOL_AND_OFFSET, "R": RADIUS,
+               "G": CODE, "M": CODE},
+    g_codes={0: MOTION, 1: MOTION, 2: MOTION, 3: MOTION, 32: MOTION, 18: "plane", 21: "units",
+             40: "tool radius", 90: "distance", 97: "spindle speed", 98: "feed type"},
+    m_codes={code: M_GROUPS[code] for code in (3, 5, 8, 9, 30)},
+    state=LATHE_ISO_STATE,
+    arc_radius="R",
+    needs_words={2: "R", 3: "R", 32: "F"},
+    thread_lead={32: "F"},
+    point_required=frozenset({"X", "Z", "R", "F"}),
+    # O9000 … O9999 hold the builder's macros on Fanuc-type controls: a program there replaces one.
+    program_numbers=range(1, 9000),
+)
+
+# machine.kind, machine.dialect -> the grammar its programs are read with.
+DIALECTS = {("hobber", "840d"): HOBBING_840D, ("lathe", "840d"): LATHE_840D, ("lathe", "iso"): LATHE_ISO}
+
+
+def dialect_for(machine: Machine) -> Dialect:
+    """The grammar of a machine's programs: its dialect, and on a hobber the door M functions
+    its record names (they are the machine builder's, so no dialect holds them)."""
+    found = dialect_of(machine.kind, machine.dialect)
+    doors = tuple(code for code in (machine.door_close_m, machine.door_open_m) if code is not None)
+    if machine.kind != "hobber" or not doors:
+        return found
+    codes = {**found.m_codes, **{int(code): DOOR_GROUP for code in doors}}
+    name = f"{found.name} with doors {'/'.join(f'M{int(code)}' for code in doors)}"
+    return replace(found, name=name, m_codes=codes)
+
+
+def dialect_of(kind: str, dialect: str) -> Dialect:
+    """The grammar of a machine record; a record the verifier has no grammar for makes no program."""
+    found = DIALECTS.get((kind, dialect))
+    if found is None:
+        known = ", ".join(f"{k}/{d}" for k, d in DIALECTS)
+        raise Refused(f"no verifier grammar for a {kind} with dialect {dialect!r} (known: {known}); "
+                      "set machine.kind and machine.dialect")
+    return found

@@ -1,1 +1,0 @@
-"""Importers that turn outside files into jobs and templates."""
