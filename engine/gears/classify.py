@@ -17,11 +17,11 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, Callable, Collection, Mapping
+from typing import TYPE_CHECKING, Any, Callable, Collection, Mapping, cast
 
 from ..errors import EngineError
 from .hob_matching import choose_hob
-from .models import ancestry, registered_models
+from .models import HobbingModel, ancestry, registered_models
 from .records import load_gear, load_hobs
 
 if TYPE_CHECKING:
@@ -195,7 +195,7 @@ def explain_gear(conn: Connection, gear_id: int) -> GearClassReport:
     model_class = next((name for name in lineage if name in models), None)
     hob = None
     if model_class:
-        model = models[model_class]
+        model = cast(HobbingModel, models[model_class])   # a gear's class is served by a hobbing model
         try:
             chosen = choose_hob(gear, load_hobs(conn), purpose=model.hob_purpose)
             hob = chosen.reason
