@@ -57,8 +57,8 @@ print(json.dumps({"seconds": time.perf_counter() - start, "lines": lines}))
 def planned_jobs(url: str, count: int) -> tuple[dict, list]:
     """The templates' rows and every gear's job parameters, as this tree's Planner makes them."""
     import psycopg
-
     from batch import generate_gears, insert_gears
+
     from engine.programs.instantiate import Planner
     from engine.programs.records import Planned
 

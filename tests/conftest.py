@@ -8,10 +8,9 @@ import uuid
 
 import psycopg
 import pytest
+from database_pool import DatabasePool, create_database
 from psycopg.conninfo import conninfo_to_dict, make_conninfo
 from psycopg.pq import TransactionStatus
-
-from database_pool import DatabasePool, create_database
 
 import engine.hobbing.models  # noqa: F401  (the models register with engine.gears.models, as the commands
 import engine.turning  # noqa: F401   that use a model import these packages first)

@@ -11,9 +11,26 @@ import re
 from dataclasses import dataclass
 
 from hobbing_envelope import hob_depths, known_xz, shift_limits
-from hobbing_reference import (Gear, Hob, Machine, Move, Nc, Unit, approach_needed, b_ratio, full_depth, lead_angle,
-                               root_solid, roughing_feed_max, swivel, taper_depth, tip_radius_at, unit_solid,
-                               y_factor, z_factor)
+from hobbing_reference import (
+    Gear,
+    Hob,
+    Machine,
+    Move,
+    Nc,
+    Unit,
+    approach_needed,
+    b_ratio,
+    full_depth,
+    lead_angle,
+    root_solid,
+    roughing_feed_max,
+    swivel,
+    taper_depth,
+    tip_radius_at,
+    unit_solid,
+    y_factor,
+    z_factor,
+)
 
 ROUND = 0.002        # mm or degrees: coordinates and angles are written with 3 decimals
 DEPTH = 0.01         # mm, last cut against (d_f2 + d_a0)/2 (Contract), and below the root at most

@@ -8,7 +8,6 @@ from pathlib import Path
 
 import psycopg
 import pytest
-
 from test_operate import Engine, user_tables
 
 OUT_OF_RANGE_FILTERS = (   # a filter id beyond PostgreSQL's integer/bigint: bad input, not a bug

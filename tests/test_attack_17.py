@@ -10,12 +10,11 @@ import re
 
 import psycopg
 import pytest
+from shared_data import shared_data
 
 from engine.library.nc_import import import_nc
 from engine.templates.decision_table import compiled_template
 from engine.templates.store import load_template
-
-from shared_data import shared_data
 
 NC = shared_data() / "nc"
 DEMO = NC / "linuxcnc" / "lathe_g70_71_demo.ngc"          # G71/G70 call the contour O100 by Q100

@@ -9,10 +9,10 @@ import json
 import ezdxf
 import psycopg
 import pytest
-
-from engine.paths import SAMPLE_DRAWING
 from lathe_programs import motions, operation_lines
 from test_instantiate_class import import_emco
+
+from engine.paths import SAMPLE_DRAWING
 
 AXIS_Y = 30.0                 # drawing Y of the part's axis (the view is drawn off Y = 0)
 # A stepped shaft, upper half (z, radius): Ø16 to Z-12, Ø24 to Z-35, Ø20 to Z-50.

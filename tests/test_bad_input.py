@@ -13,11 +13,11 @@ import ezdxf
 import psycopg
 import pytest
 from psycopg.conninfo import conninfo_to_dict
+from test_dxf_read import seed_drawing
 
+from engine.drawings.entities import MAX_COORDINATE_MM
 from engine.gears.records import load_gear
 from engine.templates import rows as template_rows
-from engine.drawings.entities import MAX_COORDINATE_MM
-from test_dxf_read import seed_drawing
 
 ROOT = Path(__file__).resolve().parents[1]
 HEADER = ("gear_id,gear_class,module,teeth,pressure_angle,helix_angle,hand,face_width,tip_diameter,"

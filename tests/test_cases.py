@@ -6,15 +6,15 @@ import json
 import math
 from dataclasses import replace
 
-from psycopg import sql
 import pytest
+from psycopg import sql
 
 from engine.errors import EngineError
 from engine.gears.case_base import job_cutting_record
 from engine.gears.cases import confirm_job, list_cases, seed_cases, suggest
 from engine.gears.records import load_gear, load_hobs
-from engine.machines.records import load_machine
 from engine.hobbing.choices import Choices
+from engine.machines.records import load_machine
 from engine.paths import SEED_DIR
 from engine.programs.instantiate import instantiate_gear
 

@@ -13,8 +13,6 @@ from click.testing import CliRunner
 from engine.cli.app import main
 
 
-
-
 def stored_counts(url):
     with psycopg.connect(url) as conn:
         return conn.execute("SELECT (SELECT count(*) FROM job), (SELECT count(*) FROM program), "

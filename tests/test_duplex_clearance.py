@@ -19,16 +19,15 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from nc_reader import read_program
 
 from engine.errors import EngineError
 from engine.gears.cutting_data import CuttingData
 from engine.gears.records import Gear, GearUnit, Hob
-from engine.machines.records import Machine
 from engine.hobbing.choices import FEED_MODES, Choices
 from engine.hobbing.duplex import DuplexModel
+from engine.machines.records import Machine
 from engine.programs.instantiate import instantiate_gear
-
-from nc_reader import read_program
 
 SEED_HOBS = Path(__file__).resolve().parent.parent / "seed_templates" / "hobs.csv"
 MARGIN = 0.5            # mm: the least clearance a program may leave (the engine keeps more)

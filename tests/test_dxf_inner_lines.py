@@ -7,11 +7,10 @@ from __future__ import annotations
 
 import ezdxf
 import pytest
+from test_dxf_side_views import AXIS_Y, SHAFT
 
 from engine.drawings.drawing import read_drawing
 from engine.drawings.read import DxfError
-from test_dxf_side_views import AXIS_Y, SHAFT
-
 
 # An M16×2 thread on the shaft's Ø16 from the face to Z -10: its root (minor) diameter by ISO 68-1,
 # d3 = d - 1.2269 P, drawn as thin lines under the outline, and its end as a line across.

@@ -13,10 +13,11 @@ import re
 from pathlib import Path
 
 import ezdxf
-import ezdxf.recover
 import ezdxf.path
+import ezdxf.recover
 import pytest
 from ezdxf.math import bulge_center
+from shared_data import shared_data
 
 from engine.drawings.codes import CodeText, codes_in, layer_codes
 from engine.drawings.drawing import read_drawing
@@ -24,8 +25,6 @@ from engine.drawings.entities import FLATTEN_TOLERANCE_MM
 from engine.drawings.geometry import Arc, Line
 from engine.drawings.profile import chain_segments
 from engine.drawings.read import DxfError, load_drawing_file
-from shared_data import shared_data
-
 
 DATA = shared_data()
 DXF = DATA / "dxf"

@@ -7,11 +7,11 @@ import json
 
 import ezdxf
 import pytest
+from test_dxf_read import DXF
+from test_import_dxf_cli import job_count, one_line_refusal
 
 from engine.drawings.drawing import read_drawing
 from engine.drawings.read import DxfError
-from test_dxf_read import DXF
-from test_import_dxf_cli import job_count, one_line_refusal
 
 # z, radius in mm: a stepped shaft from the face (z 0) to z -40, closed by the axis.
 HALF_PROFILE = [(0, 0), (0, 10), (-15, 10), (-15, 14), (-40, 14), (-40, 0)]

@@ -13,8 +13,8 @@ import pytest
 from engine.programs.instantiate import instantiate_gear
 from engine.programs.options import RunMode
 from engine.release.coverage import coverage
-from engine.templates.expectations import Context, first_difference
 from engine.release.golden import run_golden_tests
+from engine.templates.expectations import Context, first_difference
 
 SEEDED_CLASSES = {"spur", "helical", "duplex", "taper", "crowned", "worm_wheel", "turning_iso", "turning_840d"}
 

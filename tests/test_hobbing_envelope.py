@@ -7,7 +7,6 @@ import math
 
 import numpy as np
 import pytest
-
 from hobbing_checks import Case, depth_problems
 from hobbing_envelope import Solid, Sweep, intrusion
 from hobbing_reference import Gear, Hob, Unit, read

@@ -14,11 +14,10 @@ import math
 import re
 
 import pytest
+from nc_reader import Block, Move, Program, read_program
 
 from engine.hobbing.choices import Choices
 from engine.programs.instantiate import instantiate_gear
-
-from nc_reader import Block, Move, Program, read_program
 
 SPUR = [42, 45]
 HELICAL = [43, 44]

@@ -21,24 +21,43 @@ import uuid
 
 import psycopg
 import pytest
-from psycopg import sql
-from psycopg.conninfo import conninfo_to_dict, make_conninfo
+from hobbing_checks import (
+    Case,
+    Job,
+    approach_problems,
+    contract_problems,
+    coupling_problems,
+    depth_problems,
+    envelope_problems,
+    feed_problems,
+)
+from hobbing_machine_checks import all_problems, cycle_time_problems, obstacle_problems, table_speed_problems
+from hobbing_reference import Gear, Hob, Unit, layout_cuttable, lead_angle, read
+from hobbing_reference_gears import (
+    DIN,
+    MIRROR,
+    PAPER_STOCK,
+    REVERSED,
+    STOCK,
+    TOOL_NUMBER,
+    cylindrical,
+    insert_gear,
+    insert_hob,
+    insert_machine,
+    make_gear,
+    make_hob,
+    only_hob,
+    read_machine,
+)
+from hobbing_reference_programs import HAND_WRITTEN
 from hypothesis import HealthCheck, Phase, given, settings
 from hypothesis import strategies as st
+from psycopg import sql
+from psycopg.conninfo import conninfo_to_dict, make_conninfo
 
 from engine.errors import EngineError
 from engine.hobbing.choices import Choices
 from engine.programs.instantiate import instantiate_gear
-
-from hobbing_checks import (Case, Job, approach_problems, contract_problems, coupling_problems, depth_problems,
-                            envelope_problems, feed_problems)
-from hobbing_machine_checks import all_problems, cycle_time_problems, obstacle_problems, table_speed_problems
-from hobbing_reference import Gear, Hob, Unit, layout_cuttable, lead_angle, read
-from hobbing_reference_gears import (DIN, MIRROR, PAPER_STOCK, REVERSED, STOCK, cylindrical, insert_gear, insert_hob,
-                                     insert_machine, make_gear, make_hob, only_hob, read_machine, TOOL_NUMBER)
-from hobbing_reference_programs import HAND_WRITTEN
-
-
 
 # ---------------------------------------------------------------- the reader and checks on known programs
 

@@ -16,7 +16,6 @@ import psycopg
 import pytest
 from psycopg import errors
 from psycopg.types.json import Jsonb
-
 from shared_data import shared_data
 
 DATA = shared_data()

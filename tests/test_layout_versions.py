@@ -11,8 +11,6 @@ import json
 
 import psycopg
 import pytest
-
-
 from test_records import logins
 
 CRLF, LF = "\r\n", "\n"

@@ -11,11 +11,11 @@ from __future__ import annotations
 import math
 
 import pytest
+from nc_reader import read_program
+from test_verifier import accepted, refusal
 
 from engine.hobbing.choices import Choices
 from engine.programs.instantiate import instantiate_gear
-from nc_reader import read_program
-from test_verifier import accepted, refusal
 
 # Seeded gears (seed_templates/gears.csv), one per class, and the helix given to classes whose
 # seeded gear is straight, so that the gear's hand matters to the Z term.

@@ -9,6 +9,7 @@ import shutil
 import psycopg
 import pytest
 from psycopg.errors import CheckViolation
+from test_dxf_read import seed_drawing
 
 from engine.db.migrate import migrate
 from engine.errors import EngineError
@@ -16,7 +17,6 @@ from engine.names import NAME_RULES, is_safe
 from engine.paths import MIGRATIONS_DIR
 from engine.programs.instantiate import instantiate_gear
 from engine.turning.model import check_job_params
-from test_dxf_read import seed_drawing
 
 INJECTED = "G0 X9999 Z-9999"    # the block that reached stored programs through each route
 NEWLINE = f"\n{INJECTED}"

@@ -15,7 +15,9 @@ from pathlib import Path
 import psycopg
 import pytest
 from click.testing import CliRunner
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from shared_data import shared_data
 
 from engine.cli.app import main
 from engine.errors import EngineError
@@ -27,8 +29,6 @@ from engine.templates.evaluator import evaluate
 from engine.templates.expressions import compile_expression
 from engine.templates.rows import export_csv, parse_csv
 from engine.templates.store import ensure_class, load_template, replace_template
-
-from shared_data import shared_data
 
 DATA = shared_data() / "nc"
 FAMILY = "linuxcnc/plasmac_family/"

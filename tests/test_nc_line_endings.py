@@ -4,14 +4,13 @@ them, so a CRLF program shares its components with the LF one; a file mixing bot
 from __future__ import annotations
 
 import pytest
+from test_nc_import import DATA, PARAMS, class_name, real_files
 
 from engine.errors import EngineError
 from engine.library.nc_import import import_nc
 from engine.nc.layout import class_layout, nc_text
 from engine.templates.decision_table import compiled_template
 from engine.templates.store import load_template
-
-from test_nc_import import DATA, PARAMS, class_name, real_files
 
 TWO_FILES = ["sinumerik/cam_840dsl/CAM_TEST.MPF", "emco_from_dxf/testNegDXF.cnc"]
 

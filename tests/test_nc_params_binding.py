@@ -12,15 +12,14 @@ from decimal import Decimal
 import psycopg
 import pytest
 from click.testing import CliRunner
+from test_nc_import import DATA, real_files, stored_at
+from test_nc_line_endings import written_back
 
 from engine.cli.app import main
 from engine.library import nc_halves
 from engine.library.nc_import import import_nc
 from engine.templates.decision_table import compiled_template
 from engine.templates.store import load_template
-
-from test_nc_import import DATA, real_files, stored_at
-from test_nc_line_endings import written_back
 
 DEMO = "linuxcnc/lathe_g70_71_demo.ngc"      # D0.3 (cutter compensation) and R0.3 (G71's retract)
 CAM = "sinumerik/cam_840dsl/CAM_TEST.MPF"    # I4.25 and J4.25 (arc centres)

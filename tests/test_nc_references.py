@@ -11,12 +11,11 @@ import re
 import psycopg
 import pytest
 from click.testing import CliRunner
+from test_nc_import import DATA, FAMILY, stored_at
+from test_nc_params_binding import instantiated, stored_rows
 
 from engine.cli.app import main
 from engine.library.nc_import import import_nc
-
-from test_nc_import import DATA, FAMILY, stored_at
-from test_nc_params_binding import instantiated, stored_rows
 
 DEMO = "linuxcnc/lathe_g70_71_demo.ngc"
 CAM = "sinumerik/cam_840dsl/CAM_TEST.MPF"

@@ -8,8 +8,8 @@ import pytest
 from psycopg import errors
 from psycopg.types.json import Jsonb
 
-from engine.programs.instantiate import instantiate_gear
 from engine.nc.lineage import LINEAGE_ROW_ID
+from engine.programs.instantiate import instantiate_gear
 
 SUBMIT = ("INSERT INTO program_submission (id, job_id, gear_class, template_version, template_hash, name, lines, "
           "row_ids, trace) VALUES (%s, %s, %s, %s, %s, %s, %s, %s, %s)")

@@ -16,12 +16,12 @@ import pytest
 from psycopg import errors, sql
 from psycopg.conninfo import conninfo_to_dict, make_conninfo
 from psycopg.types.json import Jsonb
+from roles import as_role
 
 from engine.errors import EngineError
 from engine.gears.cases import confirm_job
 from engine.programs.instantiate import instantiate_gear, instantiate_gears
 from engine.programs.options import RunMode
-from roles import as_role
 
 # The engine's path for one program (engine.programs.storage): an id drawn from the sequence first,
 # so that the program's lineage line can name it.

@@ -14,12 +14,13 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from psycopg import errors
 from psycopg.types.json import Jsonb
+from test_records import as_role, logins
 
 from engine.cli.app import main
 from engine.library import refactor as refactoring
 from engine.library.nc_import import import_nc
-from engine.programs.instantiate import instantiate_gear
 from engine.nc.lineage import without_lineage
+from engine.programs.instantiate import instantiate_gear
 from engine.programs.options import RunMode
 from engine.programs.records import Planned
 from engine.programs.storage import store_one
@@ -28,8 +29,6 @@ from engine.templates.history import restore
 from engine.templates.rows import Template, TemplateRow, export_csv, rows_hash
 from engine.templates.store import load_template, replace_template
 from engine.templates.versions import draft_template
-
-from test_records import as_role, logins
 
 
 @pytest.fixture

@@ -9,14 +9,13 @@ import psycopg
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from test_similarity import lcs_sim
 
 from engine.errors import EngineError
 from engine.library.refactor import check_invariants, refactor, template_digests
 from engine.library.similarity import nc_units
 from engine.templates.rows import TemplateRow, export_csv
 from engine.templates.store import ensure_class, load_template, replace_template
-
-from test_similarity import lcs_sim
 
 
 def exports(conn) -> dict[str, str]:

@@ -12,14 +12,13 @@ from collections import defaultdict
 
 import pytest
 from click.testing import CliRunner
+from test_nc_import import DATA
 
 from engine.cli.app import main
 from engine.errors import EngineError
 from engine.library.intended import intend, intents, shown_key, unintend
 from engine.library.nc_import import import_nc
 from engine.library.refactor import refactor
-
-from test_nc_import import DATA
 
 CAM = DATA / "sinumerik/cam_840dsl/CAM_TEST.MPF"
 BLOCK_NUMBER = re.compile(r"^N\d+ *")

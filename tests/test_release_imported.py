@@ -14,15 +14,14 @@ import json
 
 import psycopg
 import pytest
+from roles import as_role
+from shared_data import shared_data
+from test_instantiate_class import PAWN, import_emco, ok, refused, stored_program
 
 from engine.errors import EngineError
 from engine.library.nc_import import import_nc
 from engine.programs.class_jobs import instantiate_class
 from engine.release.gate import release
-
-from roles import as_role
-from shared_data import shared_data
-from test_instantiate_class import PAWN, import_emco, ok, refused, stored_program
 
 NC = shared_data() / "nc"
 REAL_PROGRAMS = sorted(path for path in NC.rglob("*") if path.is_file() and path.name != "PROVENANCE.tsv")

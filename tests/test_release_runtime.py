@@ -11,18 +11,18 @@ from pathlib import Path
 
 import psycopg
 import pytest
+from lineage_text import id_masked
 from psycopg import errors, sql
 from psycopg.types.json import Jsonb
-
-from engine.errors import EngineError
-from engine.programs.instantiate import instantiate_gear
-from engine.nc.lineage import LINEAGE_ROW_ID
-from engine.programs.options import RunMode
-from engine.simulation import simulate_stored_program
-from lineage_text import id_masked
 from releases import release_draft
 from roles import as_role
 from test_dxf_read import DXF, EMCO, seed_drawing
+
+from engine.errors import EngineError
+from engine.nc.lineage import LINEAGE_ROW_ID
+from engine.programs.instantiate import instantiate_gear
+from engine.programs.options import RunMode
+from engine.simulation import simulate_stored_program
 
 SEEDED_GEARS = (42, 43, 44, 45, 46, 47, 50, 51, 53, 54)   # seed_templates/gears.csv: every hobbing class
 BROKEN_EDIT = "UPDATE template_view SET o = 'M8 ; COOLANT ON' WHERE gear_class = 'spur' AND o = '\"M8\"'"

@@ -8,13 +8,12 @@ import math
 from dataclasses import replace
 
 import pytest
+from simulation_programs import Hand, k_y, k_z, lead_angle, number_of, swivel, with_cycle_time
 
 from engine.errors import EngineError
 from engine.gears.records import GearUnit, load_gear, load_hobs
 from engine.machines.records import load_machine
 from engine.simulation import SimulationError, prove_program, simulate_program
-
-from simulation_programs import Hand, k_y, k_z, lead_angle, number_of, swivel, with_cycle_time
 
 MACHINE = "hobber-840d"
 

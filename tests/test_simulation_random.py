@@ -16,7 +16,6 @@ from engine.programs.instantiate import instantiate_gear
 from engine.simulation import simulate_stored_program
 from engine.simulation.envelope import HobBody, centres, nearest_radius
 
-
 GEAR_ID = 900001
 INSERT_GEAR = """
 INSERT INTO gear (id, gear_class, module, teeth, pressure_angle, helix_angle, hand, face_width, tip_diameter,

@@ -6,14 +6,14 @@ engine_editor."""
 import psycopg
 import pytest
 from psycopg import errors, sql
+from releases import release_draft
+from roles import as_role
 
 from engine.library.refactor import refactor
 from engine.programs.instantiate import instantiate_gear
 from engine.programs.options import RunMode
 from engine.templates.rows import TemplateRow, export_csv
 from engine.templates.store import load_template, replace_template
-from releases import release_draft
-from roles import as_role
 
 ROW_COLUMNS = ("id", "t", "n", "p_calc", "s", "o", "p_emit")
 

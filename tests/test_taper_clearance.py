@@ -17,15 +17,14 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from nc_reader import read_program
+from test_duplex_clearance import CUTTING, MACHINE, hob_surface, seeded_hobs
 
 from engine.errors import EngineError
 from engine.gears.records import Gear, Hob
 from engine.hobbing.choices import FEED_MODES, Choices
 from engine.hobbing.taper import TaperModel
 from engine.programs.instantiate import instantiate_gear
-
-from nc_reader import read_program
-from test_duplex_clearance import CUTTING, MACHINE, hob_surface, seeded_hobs
 
 MARGIN = 0.25           # mm: the least clearance an infeed may leave (the engine keeps more)
 

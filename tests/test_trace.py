@@ -7,14 +7,14 @@ import re
 
 import psycopg
 import pytest
+from test_dxf_read import seed_drawing
 
 from engine.hobbing.choices import Choices
-from engine.programs.instantiate import instantiate_gear, instantiate_gears
 from engine.nc.lineage import LINEAGE_ROW_ID
+from engine.programs.dxf_import import import_dxf
+from engine.programs.instantiate import instantiate_gear, instantiate_gears
 from engine.programs.remake import instantiate_job
 from engine.templates.store import load_template
-from engine.programs.dxf_import import import_dxf
-from test_dxf_read import seed_drawing
 
 SEEDED_GEARS = {42: "spur", 43: "helical", 45: "spur", 50: "taper", 51: "crowned", 53: "worm_wheel", 54: "duplex"}
 CHOICES = (Choices(), Choices(cuts=2, coolant=False, tailstock=False, feed_mode="conventional-climb"),

@@ -8,16 +8,16 @@ import re
 
 import ezdxf
 import pytest
+import test_turning_params
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from test_dxf_read import INCH, seed_drawing
+from test_turning_params import refused_after
 
 from engine.errors import EngineError
 from engine.programs.dxf_import import import_dxf
 from engine.turning.gouge import GOUGE_TOLERANCE_MM, PartIndex, check_no_gouge
 from engine.turning.moves import Move
-from test_dxf_read import INCH, seed_drawing
-import test_turning_params
-from test_turning_params import refused_after
 
 seed_job = test_turning_params.seed_job   # the fixture, shared
 

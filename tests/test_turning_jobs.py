@@ -11,17 +11,17 @@ from pathlib import Path
 
 import ezdxf
 import pytest
+from lathe_programs import distance_to_drawn, drawn_polylines, motions, operation_lines, words
 from psycopg.types.json import Jsonb
+from test_dxf_read import DXF, EMCO, INCH, nc_arc_words, seed_drawing
 
 from engine.errors import EngineError
 from engine.library.refactor import refactor
-from engine.programs.remake import instantiate_job
-from engine.verifier import LimitError
 from engine.programs.dxf_import import import_dxf
+from engine.programs.remake import instantiate_job
 from engine.turning.job_params import ProfileOptions
 from engine.turning.names import MAX_OPERATIONS
-from lathe_programs import distance_to_drawn, drawn_polylines, motions, operation_lines, words
-from test_dxf_read import DXF, EMCO, INCH, nc_arc_words, seed_drawing
+from engine.verifier import LimitError
 
 # ISO F words carry their decimal point (a Fanuc-type control reads F1300 by a parameter's unit).
 DIALECTS = {"lathe-iso": {"tools": ("T0101", "T0202"), "thread": "G32", "coolant": ("M08", "M09"),

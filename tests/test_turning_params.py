@@ -5,14 +5,14 @@ two-layer drawing; each test rolled back."""
 from __future__ import annotations
 
 import pytest
+from test_dxf_read import seed_drawing
+from test_turning_jobs import two_rough_layers
 
 from engine.errors import EngineError
 from engine.machines.records import load_machine
+from engine.programs.dxf_import import import_dxf
 from engine.programs.remake import instantiate_job
 from engine.verifier import LimitError, verify_program
-from engine.programs.dxf_import import import_dxf
-from test_dxf_read import seed_drawing
-from test_turning_jobs import two_rough_layers
 
 
 @pytest.fixture

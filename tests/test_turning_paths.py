@@ -14,17 +14,23 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from test_dxf_read import seed_drawing
 
+from engine.drawings.drawing import read_drawing
+from engine.drawings.geometry import Arc, Line
 from engine.errors import EngineError
 from engine.turning.moves import Move
 from engine.turning.plot import plot_job
 from engine.turning.region import CHORD_TOLERANCE_MM
-from engine.turning.toolpaths import (alternate, distance_to_region, drawn_rough_passes,
-                                      finish_passes, profile_rough_passes, slot_passes,
-                                      thread_passes)
-from engine.drawings.drawing import read_drawing
-from engine.drawings.geometry import Arc, Line
-from test_dxf_read import seed_drawing
+from engine.turning.toolpaths import (
+    alternate,
+    distance_to_region,
+    drawn_rough_passes,
+    finish_passes,
+    profile_rough_passes,
+    slot_passes,
+    thread_passes,
+)
 
 INCH = 25.4
 CLEARANCE = 1.0

@@ -11,13 +11,13 @@ import json
 import ezdxf
 import psycopg
 import pytest
+from lathe_programs import motions, operation_lines
 
+from engine.drawings.drawing import read_drawing
+from engine.drawings.read import DxfError
 from engine.errors import EngineError
 from engine.turning.job_params import ProfileOptions, turning_job
 from engine.turning.model import job_passes
-from engine.drawings.drawing import read_drawing
-from engine.drawings.read import DxfError
-from lathe_programs import motions, operation_lines
 
 INCH_MM = 25.4
 ROUGH = ProfileOptions(rough_depth=1.0)

@@ -14,11 +14,11 @@ from pathlib import Path
 
 import psycopg
 import pytest
+from golden_cases import TURNING_CASES
+from test_dxf_read import seed_drawing
 
 from engine.machines.records import load_machine
 from engine.verifier import LimitError, verify_program
-from golden_cases import TURNING_CASES
-from test_dxf_read import seed_drawing
 
 GOLDEN = Path(__file__).resolve().parent / "golden"
 

@@ -4,7 +4,6 @@ gear is named)."""
 import json
 
 import psycopg
-
 from lineage_text import LINES_ID_MASKED
 
 

@@ -31,8 +31,8 @@ def suggest(ctx, gear_id, top, machine, as_json):
     the proposal (n0, v, feeds in mm/min and mm per workpiece revolution) and plausibility notes.
     """
     from .. import turning  # noqa: F401  (importing it registers the turning names model)
-    from ..hobbing import models as hobbing_models  # noqa: F401  (importing it registers the hobbing models)
     from ..gears.cases import suggest_for_gear
+    from ..hobbing import models as hobbing_models  # noqa: F401  (importing it registers the hobbing models)
 
     with connection(ctx) as conn:
         suggestion = suggest_for_gear(conn, gear_id, machine, top=top)

@@ -5,8 +5,8 @@ from __future__ import annotations
 import click
 
 from .context import connection, emit_json
-from .output import Column, emit_list, list_options
 from .intended import intend_command, intents_command, unintend_command
+from .output import Column, emit_list, list_options
 from .progress import progress_bar
 
 

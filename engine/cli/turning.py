@@ -11,7 +11,6 @@ from ..turning.defaults import DEFAULT_LATHE, PROFILE_DEFAULTS, STOCK_MARGIN
 from .context import connection, emit_json, keyed
 
 
-
 class FiniteFloatRange(click.FloatRange):
     """click.FloatRange lets nan and inf through (no comparison fails for nan)."""
 

@@ -7,7 +7,7 @@ from dataclasses import fields
 from decimal import Decimal
 from typing import TYPE_CHECKING, Any, TypeVar
 
-from ..csv_reader import MAX_MAGNITUDE   # the CSV readers refuse larger numbers; so do the records
+from ..csv_reader import MAX_MAGNITUDE  # the CSV readers refuse larger numbers; so do the records
 from ..errors import EngineError
 
 if TYPE_CHECKING:

@@ -17,16 +17,25 @@ from pathlib import Path
 from typing import NamedTuple
 
 from ..memory import no_cycle_collection
-
 from .codes import CodeText, layer_codes
+from .entities import (
+    FLATTEN_TOLERANCE_MM,
+    HANDLERS,
+    MAX_COORDINATE_MM,
+    Context,
+    check_finite,
+    check_reach,
+    inserted_entities,
+    named_on_failure,
+    segments_of,
+    unit_scale,
+)
+from .geometry import Line, Segment
 from .layers import CENTRE, HIDDEN, chosen_profile_layer, layer_linetypes, line_role
 from .outline import hatch_polygons, profile_of
-from .side_view import Marks
-from .entities import (FLATTEN_TOLERANCE_MM, HANDLERS, MAX_COORDINATE_MM, Context, check_finite, check_reach,
-    inserted_entities, named_on_failure, segments_of, unit_scale)
-from .geometry import Line, Segment
 from .profile import Profile, chain_segments, scaled
 from .read import DxfError, ezdxf_warnings, load_drawing_file, summarised
+from .side_view import Marks
 
 PROFILE_LAYER = "0"
 OR_NAME_IT = " or name its layer with --profile-layer"

@@ -13,8 +13,8 @@ from __future__ import annotations
 import bisect
 import math
 from collections import Counter
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 from .envelope import SAME_Z, pieces_of, upper_envelope
 from .geometry import Arc, Line, Segment

@@ -24,9 +24,10 @@ from __future__ import annotations
 
 import math
 from collections import defaultdict
+from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cached_property
-from typing import Sequence, overload
+from typing import overload
 
 from .geometry import Arc, Line, Point, Segment
 from .read import DxfError

@@ -16,10 +16,16 @@ import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-
 from ..errors import EngineError
-from .cutting_data import (FEED_EPSILON, RADIAL_TO_AXIAL, CuttingData, default_cutting_data, feed_maximum,
-                           hob_speed, per_minute)
+from .cutting_data import (
+    FEED_EPSILON,
+    RADIAL_TO_AXIAL,
+    CuttingData,
+    default_cutting_data,
+    feed_maximum,
+    hob_speed,
+    per_minute,
+)
 
 if TYPE_CHECKING:
     from ..db.connection import Connection

@@ -16,18 +16,27 @@ import pandas as pd
 import psycopg
 from psycopg import sql
 
+from ..csv_reader import (
+    Column,
+    CsvError,
+    CsvKind,
+    parse_number,
+    parse_positive_whole,
+    parse_text,
+    parse_whole,
+    read_csv_file,
+    refuse,
+)
 from ..db.connection import scalar
 from ..db.listing import records
-from ..csv_reader import (Column, CsvError, CsvKind, parse_number, parse_positive_whole, parse_text, parse_whole,
-                          read_csv_file, refuse)
 from ..errors import EngineError
+from ..machines.records import Machine, hobbing_machine
 from ..paths import SEED_DIR
 from .case_base import CASE_COLUMNS, CUT_KINDS, CaseBase, KindProposal, feeds_per_minute, feeds_per_rev
 from .cutting_data import CuttingData
 from .hob_matching import choose_hob
 from .models import model_for_class
 from .records import Gear, Hob, load_gear, load_hobs
-from ..machines.records import Machine, hobbing_machine
 
 if TYPE_CHECKING:
     from ..db.connection import Connection

@@ -16,8 +16,9 @@ on a bronze blank, scrapped.
 from __future__ import annotations
 
 import re
+from collections.abc import Callable, Collection, Mapping
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Any, Callable, Collection, Mapping, cast
+from typing import TYPE_CHECKING, Any, cast
 
 from ..errors import EngineError
 from .hob_matching import choose_hob

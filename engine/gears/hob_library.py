@@ -14,8 +14,19 @@ from typing import Any
 import psycopg
 from psycopg import sql
 
-from ..csv_reader import (CellError, Column, CsvError, CsvKind, Problem, declare, parse_number, parse_positive_whole,
-                          parse_text, read_cell, read_csv_file)
+from ..csv_reader import (
+    CellError,
+    Column,
+    CsvError,
+    CsvKind,
+    Problem,
+    declare,
+    parse_number,
+    parse_positive_whole,
+    parse_text,
+    read_cell,
+    read_csv_file,
+)
 from ..db.connection import scalar
 from ..errors import EngineError
 from ..names import NAME_RULES, is_safe, said
@@ -23,7 +34,6 @@ from .gear_import import POSITIVE, parse_hand
 from .hob_matching import ACCURACY_CLASSES, PURPOSES, HobChoice, choose_hob
 from .models import ancestry
 from .records import TOOTH_DEPTH, Hob, load_gear, load_hobs
-
 
 HobImportError = CsvError   # a file of bad rows: `problems` holds one line per problem, in file order
 

@@ -7,8 +7,8 @@ coarsest sufficient class (fine hobs are kept for fine gears), then the id.
 """
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 from ..errors import EngineError
 from .hob_geometry import generating_length, lead_angle

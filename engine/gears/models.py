@@ -5,7 +5,8 @@ engine.hobbing.models or engine.turning registers their models, and the programs
 command-line code that asks for a model imports them first."""
 from __future__ import annotations
 
-from typing import TYPE_CHECKING, Any, Callable, Protocol
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any, Protocol
 
 from ..errors import EngineError
 

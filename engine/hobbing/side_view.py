@@ -14,8 +14,15 @@ from typing import Any
 from matplotlib.patches import Polygon, Rectangle
 
 from ..pictures import literal
-from .plot_geometry import (approach_pose, axial_profile, cut_pass, full_depth_pose, hob_extent, hob_side_outline,
-                            unit_section)
+from .plot_geometry import (
+    approach_pose,
+    axial_profile,
+    cut_pass,
+    full_depth_pose,
+    hob_extent,
+    hob_side_outline,
+    unit_section,
+)
 
 BLANK_FILL = "0.82"
 SETUP_FILL = "0.65"

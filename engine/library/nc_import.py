@@ -57,16 +57,16 @@ from ..csv_reader import Column, CsvKind, parse_number_or_text, parse_text, pars
 from ..errors import EngineError
 from ..memory import no_cycle_collection
 from ..names import shown
+from ..nc.layout import NcLayout, split_nc_text, store_layout
 from ..nc.lineage import ENGINES_LINE, first_lineage_shaped
+from ..nc.tokens import LABEL, SYMBOL, LineFacts, facts, tokenise
 from ..templates.functions import CONSTANTS, FUNCTIONS
 from ..templates.rows import MODULE_ORDER, TemplateRow
 from ..templates.store import ensure_class, load_template, replace_template
 from ..templates.versions import released_version
 from .nc_halves import in_halves
-from ..nc.layout import NcLayout, split_nc_text, store_layout
 from .nc_params import binding_report, bindings, parse_addresses, values
 from .nc_rows import Builder, Found
-from ..nc.tokens import LABEL, SYMBOL, LineFacts, facts, tokenise
 from .nc_verify import Proof
 
 if TYPE_CHECKING:

@@ -12,11 +12,11 @@ from dataclasses import dataclass, field
 from decimal import Decimal, InvalidOperation
 
 from ..errors import EngineError
+from ..nc.tokens import NUMBER, WORD, facts
 from ..templates.evaluator import evaluate
 from ..templates.expressions import MAX_EXPRESSION_LENGTH, compile_expression
 from .nc_params import FUNCTION_ADDRESSES, Binding
 from .nc_references import CODE_NAMES, block_context, reference_at
-from ..nc.tokens import NUMBER, WORD, facts
 
 
 def values_of(bindings: dict[str, Binding]) -> dict:

@@ -15,8 +15,8 @@ from psycopg.types.json import Jsonb
 from ..csv_reader import Column, CsvKind, parse_text, read_csv_file
 from ..gears.gear_import import GEAR_KIND, identical_gears, import_gears, installed_classes, read_gears
 from ..gears.hob_library import HOB_COLUMNS
-from ..machines.records import Machine
 from ..gears.units import UNIT_KIND, import_units
+from ..machines.records import Machine
 from ..paths import SEED_DIR
 from ..templates.rows import read_csv
 from ..templates.store import ensure_class, replace_template
@@ -227,6 +227,6 @@ def _seed_units(conn: Connection, directory: Path, report: SeedReport, samples_s
 
 def _seed_cases(conn: Connection, directory: Path, report: SeedReport) -> None:
     """The machining history's seed cases (the paper's example among them)."""
-    from ..gears.cases import seed_cases   # pandas: loaded only when the history is seeded
+    from ..gears.cases import seed_cases  # pandas: loaded only when the history is seeded
 
     report.count("cases", seed_cases(conn, directory / "cases.csv"))

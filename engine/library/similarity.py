@@ -19,8 +19,8 @@ import re
 from collections import Counter, defaultdict
 from collections.abc import Iterator, Sequence
 
-from ..templates.guards import parse_python
 from ..nc.tokens import NUMBER, SPACE, WORD, tokenise
+from ..templates.guards import parse_python
 
 CODE_ADDRESSES = ("G", "M")   # their numbers name a function: `G1` is one unit, as `M8`
 # Float slack for Sim compared with a threshold: 0.8 * 10 must count as 8, not 8.000…1.

@@ -22,26 +22,26 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from .. import turning  # noqa: F401  (importing it registers the turning names model)
-from ..hobbing import models as hobbing_models  # noqa: F401  (importing it registers the hobbing models)
 from ..errors import EngineError
 from ..gears.models import model_for_class
-from ..machines.records import Machine, load_machine
-from ..nc.layout import NcLayout, class_layout
+from ..hobbing import models as hobbing_models  # noqa: F401  (importing it registers the hobbing models)
 from ..library.nc_params import bindings, values
-from ..nc.tokens import NUMBER, tokenise
+from ..machines.records import Machine, load_machine
 from ..names import checked
+from ..nc.layout import NcLayout, class_layout
+from ..nc.lineage import refuse_lineage_shaped
+from ..nc.tokens import NUMBER, tokenise
 from ..templates.decision_table import compiled_template
 from ..templates.rows import Template
 from ..templates.versions import runnable_template
 from ..turning.names import TurningModel
+from ..verifier.grammar import DIALECTS
 from .batches import dry_program, read_only, refuse_out_in_dry_run
 from .instantiate import store_planned
-from ..nc.lineage import refuse_lineage_shaped
 from .options import NO_FILE, NORMAL_RUN, Output, RunMode
 from .outputs import files_after_commit
 from .records import Planned, Program
 from .verified_run import run_template
-from ..verifier.grammar import DIALECTS
 
 if TYPE_CHECKING:
     from ..db.connection import Connection

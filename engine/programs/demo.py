@@ -65,8 +65,8 @@ def run_demo(gear_id: int = 42, turning: bool = False) -> DemoResult:
 def sample_turning_job(conn: Connection, drawing: Path = SAMPLE_DRAWING) -> SampleJob:
     """Import the sample drawing as a turning job on the default lathe (from the Ø44 blank) and
     store its program, as `engine import-dxf` and `engine instantiate --job` do."""
-    from .dxf_import import import_dxf
     from ..turning.job_params import ProfileOptions
+    from .dxf_import import import_dxf
     from .remake import instantiate_job
 
     job = import_dxf(conn, drawing, options=ProfileOptions(stock_diameter=SAMPLE_STOCK_DIAMETER))

@@ -11,28 +11,38 @@ from dataclasses import replace
 from typing import TYPE_CHECKING
 
 from .. import turning  # noqa: F401  (importing it registers the turning names model)
-from ..hobbing import models as hobbing_models  # noqa: F401  (importing it registers the hobbing models)
 from ..errors import EngineError
 from ..gears.case_base import CUT_KINDS_BY_COUNT, CaseBase, job_cutting_record
 from ..gears.hob_matching import choose_hob
 from ..gears.models import model_for_class
 from ..gears.process_notes import hunting_tooth_notes
 from ..gears.records import Gear, load_gear, load_gears, load_hobs
-from ..machines.records import Machine, hobbing_machine
+from ..hobbing import models as hobbing_models  # noqa: F401  (importing it registers the hobbing models)
 from ..hobbing.choices import Choices
-from ..nc.layout import NcLayout, class_layout
+from ..machines.records import Machine, hobbing_machine
 from ..memory import no_cycle_collection
+from ..nc.layout import NcLayout, class_layout
 from ..templates.rows import Template
 from ..templates.versions import runnable_template
 from ..turning.names import TurningModel
-from .batches import Bad, batch_stage, checked, dry_batch, dry_program, good_ones, planned_or_bad, read_only, \
-    reason_of, refuse_out_in_dry_run
+from ..verifier import LimitError, check_table_speed
+from .batches import (
+    Bad,
+    batch_stage,
+    checked,
+    dry_batch,
+    dry_program,
+    good_ones,
+    planned_or_bad,
+    read_only,
+    reason_of,
+    refuse_out_in_dry_run,
+)
 from .options import NO_FILE, NORMAL_RUN, Output, RunMode
 from .outputs import ProgramFiles, file_layouts, files_after_commit
-from .verified_run import Workpiece, run_template
-from ..verifier import LimitError, check_table_speed
 from .records import Planned, Program
 from .storage import Batch, store_many, store_one
+from .verified_run import Workpiece, run_template
 from .workers import PLANNING, plan_in_workers
 
 if TYPE_CHECKING:

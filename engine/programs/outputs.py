@@ -30,15 +30,16 @@ import contextvars
 import errno
 import os
 import secrets
+from collections.abc import Callable
 from pathlib import Path
-from typing import TYPE_CHECKING, Callable
+from typing import TYPE_CHECKING
 
 import psycopg
 from psycopg.pq import TransactionStatus
 
 from ..errors import EngineError
-from ..nc.layout import NcLayout, nc_text
 from ..names import checked
+from ..nc.layout import NcLayout, nc_text
 from .options import Output
 
 if TYPE_CHECKING:

@@ -12,27 +12,35 @@ from dataclasses import replace
 from typing import TYPE_CHECKING
 
 from .. import turning  # noqa: F401  (importing it registers the turning names model)
-from ..hobbing import models as hobbing_models  # noqa: F401  (importing it registers the hobbing models)
 from ..errors import EngineError
 from ..gears.models import model_for_class
 from ..gears.process_notes import stored_feed_notes
 from ..gears.records import Hob, load_gear, load_hobs
-from ..machines.records import Machine, load_machine
+from ..hobbing import models as hobbing_models  # noqa: F401  (importing it registers the hobbing models)
 from ..hobbing.cylindrical import program_name
 from ..hobbing.machine_job import with_cycle_time
-from ..nc.layout import NcLayout, class_layout
+from ..machines.records import Machine, load_machine
 from ..memory import no_cycle_collection
+from ..nc.layout import NcLayout, class_layout
 from ..templates.rows import Template
 from ..templates.versions import runnable_template
-from .batches import batch_stage, checked, dry_batch, dry_program, good_ones, planned_or_bad, read_only, \
-    refuse_out_in_dry_run
+from .batches import (
+    batch_stage,
+    checked,
+    dry_batch,
+    dry_program,
+    good_ones,
+    planned_or_bad,
+    read_only,
+    refuse_out_in_dry_run,
+)
 from .class_jobs import class_job
 from .instantiate import store_planned
 from .options import NO_FILE, NORMAL_RUN, Output, RunMode
 from .outputs import file_layouts, files_after_commit
-from .verified_run import Workpiece, run_template
 from .records import Planned, Program
 from .storage import Batch, store_programs
+from .verified_run import Workpiece, run_template
 from .workers import PLANNING
 
 if TYPE_CHECKING:
@@ -64,7 +72,7 @@ class Remaker:
         if not self.modelled(gear_class):   # a job of an imported class (instantiate --class): its rows alone
             return class_job(self.template(gear_class), machine, params, module_params)
         if machine.kind == "lathe":   # a turning job: its passes are computed from its parameters
-            from .turning_jobs import plan_turning_job   # the tool paths: only for turning jobs
+            from .turning_jobs import plan_turning_job  # the tool paths: only for turning jobs
 
             return plan_turning_job(self.conn, gear_class, machine, params, module_params, draft=self.draft)
         template = self.template(gear_class)

@@ -7,8 +7,8 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from ..errors import EngineError
-from .golden import run_golden_tests
 from ..templates.versions import draft_template
+from .golden import run_golden_tests
 
 if TYPE_CHECKING:
     from ..db.connection import Connection

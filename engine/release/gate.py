@@ -16,14 +16,14 @@ from psycopg.errors import InsufficientPrivilege
 from psycopg.types.json import Jsonb
 
 from .. import turning  # noqa: F401  (importing it registers the turning names model)
-from ..hobbing import models as hobbing_models  # noqa: F401  (importing it registers the hobbing models)
 from ..db.connection import scalar
 from ..errors import EngineError
+from ..hobbing import models as hobbing_models  # noqa: F401  (importing it registers the hobbing models)
 from ..templates.analysis import class_findings
-from .impact import Impact, impact
 from ..templates.lint import lint_class
 from ..templates.store import class_and_descendants
 from ..templates.versions import draft_template
+from .impact import Impact, impact
 
 if TYPE_CHECKING:
     from ..db.connection import Connection
@@ -102,7 +102,7 @@ def gate(conn: Connection, gear_class: str, draft) -> tuple[list[dict], dict]:
 
 
 def _golden_results(conn: Connection, gear_class: str) -> list:
-    from .golden import run_golden_tests   # the golden tests' language (engine test)
+    from .golden import run_golden_tests  # the golden tests' language (engine test)
 
     return run_golden_tests(conn, class_and_descendants(conn, gear_class), draft=True)
 

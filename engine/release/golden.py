@@ -14,8 +14,8 @@ from typing import TYPE_CHECKING
 
 from ..errors import EngineError
 from ..templates.expectations import Context, first_difference
-from .golden_runs import GoldenTest, made_program
 from ..templates.versions import runnable_template
+from .golden_runs import GoldenTest, made_program
 
 if TYPE_CHECKING:
     from ..db.connection import Connection

@@ -18,9 +18,9 @@ from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
 
 from .. import turning  # noqa: F401  (importing it registers the turning names model)
-from ..hobbing import models as hobbing_models  # noqa: F401  (importing it registers the hobbing models)
 from ..errors import EngineError
 from ..gears.models import model_for_class
+from ..hobbing import models as hobbing_models  # noqa: F401  (importing it registers the hobbing models)
 from ..machines.records import load_machine
 from ..nc.layout import ENDING_NAMES, NcLayout
 from ..nc.lineage import without_lineage
@@ -220,7 +220,7 @@ class _JobInputs:
         params, modules = json.loads(params_text), json.loads(modules_text or "{}")
         machine = self.machine(machine_name)
         if machine.kind == "lathe":
-            from ..turning.model import template_module_params   # the tool paths: only for turning jobs
+            from ..turning.model import template_module_params  # the tool paths: only for turning jobs
 
             return params, template_module_params(params, modules)
         if "cycle_time" in params:

@@ -15,20 +15,40 @@ from ..gears.records import Gear, Hob
 from ..machines.records import Machine
 from ..verifier.refusals import Refused
 from ..verifier.shift_clamp import ShiftClamp
-from .coupling import (Coupling, coupling_problems, generated_teeth_problem, hand_name, hand_sign, helix_of,
-                       lead_angle, read_coupling, swivel_problem)
+from .allowance import depth_problem, header_allowance
 from .contact import Motion, follow
+from .coupling import (
+    Coupling,
+    coupling_problems,
+    generated_teeth_problem,
+    hand_name,
+    hand_sign,
+    helix_of,
+    lead_angle,
+    read_coupling,
+    swivel_problem,
+)
 from .cuts import Cut, summary
 from .envelope import HobBody
 from .frame import Senses
 from .headers import comment_problem, header_place_problem
 from .paths import move_poses
 from .report import Report, SimulationError, where
+from .rules import (
+    block_record_problem,
+    coupled_shift_problem,
+    coupled_swivel_problem,
+    coupled_tool_problem,
+    feed_problem,
+    least_run_out,
+    moves,
+    record_header_problem,
+    recut_problem,
+    run_out_problem,
+    setup_advice,
+    zone_problem,
+)
 from .solids import Solid
-from .allowance import depth_problem, header_allowance
-from .rules import (block_record_problem, coupled_shift_problem, coupled_tool_problem, coupled_swivel_problem,
-                    feed_problem, record_header_problem, least_run_out, moves, recut_problem, run_out_problem,
-                    setup_advice, zone_problem)
 from .timing import feed_minutes, header_minutes, header_problem, rapid_minutes
 
 AXES = ("X", "Y", "Z")

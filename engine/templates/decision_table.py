@@ -20,11 +20,11 @@ from functools import partial
 from typing import Any
 
 from ..errors import EngineError
-from .nc_path import NcLines
 from .budget import Budget, compiling, pay_time, seconds_for, spending
 from .evaluator import EvaluationError, Evaluator, base_symbols
 from .expressions import Compiled, ExpressionError, compile_expression, compile_statements
 from .guards import MAX_STRING_LENGTH, short_repr, size
+from .nc_path import NcLines
 from .rows import Template, TemplateRow
 from .trace import Outcome, RowTrace, keep_entry, memo_key
 

@@ -151,7 +151,7 @@ def check_numeric(name: str, expression: str, tolerance: str | None, context: Co
 
 def expected_value(expression: str, names: dict) -> float:
     """The expression over the test's names, by the templates' own checked evaluator."""
-    from .expressions import compile_expression   # the gate: only what a template expression may be
+    from .expressions import compile_expression  # the gate: only what a template expression may be
 
     try:
         value = evaluate(compile_expression(expression.strip()), names)

@@ -98,7 +98,7 @@ def _check_constant_parts(guarded: list, parts: list, source: str, is_sql: bool)
     """Every part that reads no parameter (`[[0] * 65536] * 65536`, `10 ** 10 ** 6`) is evaluated
     here, under the bounds of one instantiation: one that fails would fail for every job, so the
     template is refused where it enters (import, lint, compile), not at its first job."""
-    from .evaluator import EvaluationError, evaluate_part   # asteval: only where a template is compiled
+    from .evaluator import EvaluationError, evaluate_part  # asteval: only where a template is compiled
 
     for part, original in zip(guarded, parts):
         try:
@@ -203,7 +203,7 @@ def _sql_tree(text: str, python_error: SyntaxError, translations: Mapping[str, s
 
 
 def _parse_sql(text: str, python_error: SyntaxError) -> ast.Expression:
-    from .sqlcond.translate import translate   # sqlglot: only where a condition is translated
+    from .sqlcond.translate import translate  # sqlglot: only where a condition is translated
 
     try:
         return ast.Expression(body=translate(text))

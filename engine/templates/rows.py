@@ -23,11 +23,21 @@ from dataclasses import astuple, dataclass, field
 from functools import cached_property
 from pathlib import Path
 
-from ..csv_reader import CellError, Column, CsvFile, CsvKind, declare, parse_text, parse_whole, read_csv_file, \
-    read_csv_text, refuse
+from ..csv_reader import (
+    CellError,
+    Column,
+    CsvFile,
+    CsvKind,
+    declare,
+    parse_text,
+    parse_whole,
+    read_csv_file,
+    read_csv_text,
+    refuse,
+)
 from ..errors import EngineError
-from ..nc.layout import ENDING_NAMES, NcLayout
 from ..names import shown
+from ..nc.layout import ENDING_NAMES, NcLayout
 from ..nc.lineage import ENGINES_LINE, lineage_shaped
 
 CSV_COLUMNS = ("id", "t", "n", "p_calc", "s", "o", "p_emit")

@@ -5,16 +5,25 @@ from the defaults (engine.turning.defaults) and said in `notes`."""
 from __future__ import annotations
 
 import math
-from typing import Any
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 from ..drawings.drawing import Drawing, Operation
 from ..drawings.profile import merged_bounds
 from ..errors import EngineError
 from ..names import NAME_RULES, checked, is_safe, shown
-from .defaults import (CLEARANCE, DEFAULT_FEED, DEFAULT_INFEED_ANGLE, DEFAULT_SPEED, DEFAULT_THREAD_DEPTH_PER_PASS,
-                       FEED_PER_REV_NOTE, PROFILE_DEFAULTS, STOCK_MARGIN, TOOL_CHANGE_DISTANCE)
+from .defaults import (
+    CLEARANCE,
+    DEFAULT_FEED,
+    DEFAULT_INFEED_ANGLE,
+    DEFAULT_SPEED,
+    DEFAULT_THREAD_DEPTH_PER_PASS,
+    FEED_PER_REV_NOTE,
+    PROFILE_DEFAULTS,
+    STOCK_MARGIN,
+    TOOL_CHANGE_DISTANCE,
+)
 from .model import key
 from .names import MAX_OPERATIONS, SLOT_DEFAULTS
 from .segments import path_param

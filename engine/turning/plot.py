@@ -10,8 +10,8 @@ whole or not at all (engine.pictures)."""
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Sequence
 
 from ..drawings.geometry import Arc, Segment
 from ..pictures import literal, new_figure, picture_target, save_atomically

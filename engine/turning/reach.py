@@ -18,8 +18,8 @@ section there is the same all along the span.
 """
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Sequence
 
 from ..drawings.profile import END_MATCH_TOLERANCE_MM
 from ..errors import EngineError

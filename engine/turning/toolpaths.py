@@ -10,14 +10,22 @@ the drawing holds the tool-centre path, its direction included.
 from __future__ import annotations
 
 import math
-from typing import Sequence
+from collections.abc import Sequence
 
 from ..drawings.geometry import Arc, Line, Segment
 from ..drawings.profile import merged_bounds
 from ..errors import EngineError
 from .moves import Move, Pass
-from .region import (CHORD_TOLERANCE_MM, Edge, Surroundings, distance_to_region, flattened_outline,
-                     free_intervals, is_blocked, top_over)
+from .region import (
+    CHORD_TOLERANCE_MM,
+    Edge,
+    Surroundings,
+    distance_to_region,
+    flattened_outline,
+    free_intervals,
+    is_blocked,
+    top_over,
+)
 
 __all__ = ["finish_passes", "drawn_rough_passes", "slot_passes", "thread_passes",
            "profile_rough_passes", "alternate", "up_then_across", "standalone", "distance_to_region"]

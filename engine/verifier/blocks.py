@@ -13,8 +13,22 @@ import re
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, ClassVar, Literal
 
-from .grammar import (ANGLE, AXES, BLOCK_SHAPES, CODE, DWELL, MOTION, OFFSET, POINT_REASON, SPEED, TOOL,
-                      TOOL_AND_OFFSET, WORD_NEEDS_CODE, WORKING_AREA, Dialect)
+from .grammar import (
+    ANGLE,
+    AXES,
+    BLOCK_SHAPES,
+    CODE,
+    DWELL,
+    MOTION,
+    OFFSET,
+    POINT_REASON,
+    SPEED,
+    TOOL,
+    TOOL_AND_OFFSET,
+    WORD_NEEDS_CODE,
+    WORKING_AREA,
+    Dialect,
+)
 from .machine_state import OFFSET_OFF, OFFSET_ON, TOOL_CHANGE
 from .numbers import why_not_plain
 from .refusals import Refused

@@ -21,8 +21,7 @@ from psycopg.conninfo import conninfo_to_dict, make_conninfo
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))   # tests/: golden_cases and its makers
 
-from golden_cases import (hobbing_cases, hobbing_file, hobbing_text, turning_cases,  # noqa: E402
-                          turning_file, turning_text)
+from golden_cases import hobbing_cases, hobbing_file, hobbing_text, turning_cases, turning_file, turning_text  # noqa: E402
 
 
 def seeded_database(admin_url: str) -> tuple[str, str]:
