@@ -51,7 +51,7 @@ def _suggestion_text(s) -> str:
     gear, cutting = s.gear, s.cutting
     lines = [f"gear {gear.id}: m{gear.module:g} z{gear.teeth} {gear.material or '?'} "
              f"{'' if gear.hardness is None else f'{gear.hardness:g} HB '}grade {gear.quality_grade or '?'}",
-             f"hob {s.hob.id}: {s.hob_reason}",
+             f"hob {s.hob_reason}",   # the reason starts with the hob id
              f"machine {s.machine.name} (hob spindle max {s.machine.spindle_max:g} r/min)"]
     for cut in s.proposals:
         cases = s.cases[s.cases.cut == cut]
