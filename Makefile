@@ -36,4 +36,4 @@ bench-smoke: | $(PYTHON)    ## every benchmark once at small sizes, figures not 
 $(PYTHON):
 	python3 -m venv $(VENV)
 	$(PYTHON) -m pip install --quiet --upgrade pip
-	$(PYTHON) -m pip install --quiet -e '.[test,bench]' ruff mypy
+	$(PYTHON) -m pip install --quiet -e '.[test,dev,bench]'

@@ -26,8 +26,8 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
-from _common import (add_database_argument, bench_database, delete_programs, median, parse_arguments,  # noqa: E402
-                     verdict)
+from _common import add_database_argument, bench_database, delete_programs, median, parse_arguments, verdict  # noqa: E402
+
 from engine.errors import EngineError  # noqa: E402
 from engine.gears.case_base import CUT_KINDS_BY_COUNT, job_cutting_record  # noqa: E402
 from engine.gears.hob_matching import choose_hob  # noqa: E402

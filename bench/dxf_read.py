@@ -24,8 +24,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 import ezdxf  # noqa: E402
-
 from _common import add_database_argument, bench_database, median, parse_arguments, verdict  # noqa: E402
+
 from engine.drawings.drawing import read_drawing  # noqa: E402
 
 TARGET_RATIO = 1.5

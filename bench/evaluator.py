@@ -57,8 +57,8 @@ print(json.dumps({"seconds": time.perf_counter() - start, "lines": lines}))
 def planned_jobs(url: str, count: int) -> tuple[dict, list]:
     """The templates' rows and every gear's job parameters, as this tree's Planner makes them."""
     import psycopg
-
     from batch import generate_gears, insert_gears
+
     from engine.programs.instantiate import Planner
     from engine.programs.records import Planned
 
@@ -87,7 +87,8 @@ def main(argv=None) -> int:
     add_database_argument(parser)
     parser.add_argument("--count", type=int, default=2000, help="gears whose jobs are evaluated (default 2000)")
     parser.add_argument("--reps", type=int, default=3, help="alternated runs of each (default 3)")
-    parser.add_argument("--against", default=AGAINST, metavar="REV", help=f"the compiled evaluator's commit ({AGAINST})")
+    parser.add_argument("--against", default=AGAINST, metavar="REV",
+                        help=f"the compiled evaluator's commit ({AGAINST})")
     args = parse_arguments(parser, argv, smoke={"count": 20, "reps": 1})
     with bench_database(args.database_url, "bench_evaluator") as url, tempfile.TemporaryDirectory() as folder:
         data = Path(folder) / "jobs.pickle"

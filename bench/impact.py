@@ -32,6 +32,7 @@ EDIT = "UPDATE template_view SET o = %s WHERE gear_class = %s AND id = 1800"   #
 def stored_jobs(conn, count: int) -> None:
     """`count` spur jobs with their released programs, copied from jobs the engine made."""
     from batch import generate_gears, insert_gears
+
     from engine.programs.instantiate import instantiate_gears
     from engine.programs.records import Encoded
     from engine.programs.storage import store_many
@@ -59,8 +60,8 @@ def stored_jobs(conn, count: int) -> None:
 
 
 def run_impact(conn) -> tuple[float, int]:
-    from engine.templates import decision_table
     from engine.release.impact import impact
+    from engine.templates import decision_table
 
     decision_table._CACHE.clear()   # as a new process: nothing compiled, nothing remembered
     start = time.perf_counter()

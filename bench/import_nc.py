@@ -59,7 +59,8 @@ def program(lines: int, seed: int = 13) -> list[str]:
         z_top, z_bottom = round(rng.uniform(2, 8), 3), round(-rng.uniform(20, 60), 3)
         y = round(y + 2.5, 3) if rng.random() < 0.2 else round(rng.uniform(-40, 40), 3)
         for text in (f"; PASS {block // 10} DEPTH {round(85 - x, 3)}", f"G0 X85 Y{y} Z60", f"G0 Z{z_top}",
-                     f"G1 X{x} F1.6", f"G1 Z{z_bottom} F{rng.choice(['1.6', '0.8', str(round(rng.uniform(0.5, 2), 2))])}",
+                     f"G1 X{x} F1.6",
+                     f"G1 Z{z_bottom} F{rng.choice(['1.6', '0.8', str(round(rng.uniform(0.5, 2), 2))])}",
                      f"R1={round(rng.uniform(0, 5), 3)}", "G1 X=R1+85", "G0 X85", "G0 Z60"):
             add(text)
     while len(out) < lines - 1:
@@ -139,13 +140,15 @@ def main(argv=None) -> int:
                 cpu[name].append(CPU[-1])
     small, large = median(times["small"]), median(times["large"])
     client, server = (median(values) for values in zip(*cpu["large"]))
-    print(f"import-nc: 840D programs of {sizes['small']} and {sizes['large']} numbered lines, {args.reps} alternated runs")
+    print(f"import-nc: 840D programs of {sizes['small']} and {sizes['large']} numbered lines, "
+          f"{args.reps} alternated runs")
     for name in sizes:
         print(f"  {sizes[name]:7d} lines: median {median(times[name]):6.2f} s "
               f"({median(times[name]) / sizes[name] * 1e6:5.1f} us per line); runs "
               + ", ".join(f"{t:.2f}" for t in times[name]))
-    print(f"the large import (medians): {client:.2f} s of CPU in this process and its fork, {server:.2f} s in the database "
-          f"server; load average now {', '.join(f'{load:.2f}' for load in os.getloadavg())} on {os.cpu_count()} cores")
+    print(f"the large import (medians): {client:.2f} s of CPU in this process and its fork, "
+          f"{server:.2f} s in the database server; "
+          f"load average now {', '.join(f'{load:.2f}' for load in os.getloadavg())} on {os.cpu_count()} cores")
     growth = large / small
     print(f"growth: 10x the lines took {growth:.2f}x the time (linear <= {LINEAR}x): {verdict(growth <= LINEAR)}")
     print(f"{sizes['large']} lines in {large:.2f} s (target <= {TARGET_SECONDS} s for 100,000): "

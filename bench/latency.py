@@ -94,7 +94,8 @@ def help_startup(revision: str, runs: int) -> None:
                 check(completed, f"engine --help ({what})")
                 times[what].append(seconds)
     now, before = median(times["this tree"]), median(times[revision])
-    print(f"engine --help, this tree               : median {now * 1000:7.1f} ms (min {min(times['this tree']) * 1000:.1f})")
+    print(f"engine --help, this tree               : median {now * 1000:7.1f} ms "
+          f"(min {min(times['this tree']) * 1000:.1f})")
     print(f"engine --help at {revision:<22}: median {before * 1000:7.1f} ms (min {min(times[revision]) * 1000:.1f})")
     print(f"ratio this tree/{revision} = {now / before:.2f}x (target <= {HELP_TARGET_RATIO}x): "
           f"{verdict(now / before <= HELP_TARGET_RATIO)}")

@@ -17,8 +17,7 @@ from pathlib import Path
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
-from _common import (add_database_argument, bench_database, delete_programs, median, parse_arguments,  # noqa: E402
-                     verdict)
+from _common import add_database_argument, bench_database, delete_programs, median, parse_arguments, verdict  # noqa: E402
 
 TARGET_RATIO = 1.5
 FIRST_ID = 100_000
@@ -89,7 +88,7 @@ def bare_program(template, evaluator, params: dict, module_params: dict) -> tupl
             scope = {**params, **module_params.get(f"{module[0]}:{module[1]}", {}), **intermediates,
                      **template.symbols, "template_version": template.template.version}
 
-        def value(expression):
+        def value(expression, scope=scope):   # this row's scope, bound now (called within the row)
             return evaluator.evaluate(expression.tree, expression.text, scope)
         if row.s:
             if row.p_calc is not None and not value(row.p_calc):
@@ -112,8 +111,8 @@ def main(argv=None) -> int:
     args = parse_arguments(parser, argv, smoke={"count": 20, "reps": 1})
 
     import psycopg
-
     from batch import generate_gears, insert_gears
+
     from engine.programs.instantiate import instantiate_gears
 
     with bench_database(args.database_url, "bench_reinstantiate") as url, psycopg.connect(url) as conn:

@@ -18,6 +18,7 @@ sys.path.insert(0, str(HERE))
 
 from _common import add_database_argument, bench_database, median, parse_arguments  # noqa: E402
 from batch import FIRST_ID, clear_jobs, generate_gears, insert_gears, run_ours  # noqa: E402
+
 from engine.programs import verified_run  # noqa: E402
 
 WARMUP_GEARS = 100

@@ -22,6 +22,7 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
 from _common import add_database_argument, bench_database, median, parse_arguments  # noqa: E402
+
 from engine.programs import storage  # noqa: E402
 
 GEARS = (42, 43, 44, 45, 46, 47, 50, 51, 53, 54)   # the seeded gears, every hobbing class

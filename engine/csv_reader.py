@@ -17,10 +17,11 @@ from __future__ import annotations
 import csv
 import io
 import re
+from collections.abc import Callable
 from dataclasses import dataclass
 from decimal import Decimal
 from pathlib import Path
-from typing import Any, Callable
+from typing import Any
 
 from .errors import EngineError
 from .names import shown
@@ -257,7 +258,8 @@ def _text_of(path: Path) -> str:
     except FileNotFoundError:
         raise refuse(path, "no such file", "give the path of an existing CSV file") from None
     except OSError as error:
-        raise refuse(path, f"cannot read it ({error.strerror or error})", "check the path and its permissions") from None
+        raise refuse(path, f"cannot read it ({error.strerror or error})",
+                     "check the path and its permissions") from None
     try:
         return data.decode("utf-8-sig")
     except UnicodeDecodeError as error:
@@ -269,7 +271,8 @@ def _text_of(path: Path) -> str:
 def read_csv_text(text: str, source: str, kind: CsvKind) -> CsvFile:
     """`text` read as `kind`: separator, header and records, each record checked for its cell count."""
     if "\x00" in text:
-        raise refuse(source, "holds a NUL character", "save the file as text", line=text.count("\n", 0, text.index("\0")) + 1)
+        raise refuse(source, "holds a NUL character", "save the file as text",
+                     line=text.count("\n", 0, text.index("\0")) + 1)
     separator = _separator(text, source)
     records = _records(text, source, separator, kind)
     if not records:
@@ -328,7 +331,8 @@ def _header(source: str, record: tuple[int, list[str]], kind: CsvKind) -> list[s
                if (column.required or (kind.every_column and not column.header_optional)) and column.name not in names]
     problems = [Problem(line, None, f"unknown column(s) {', '.join(unknown)}",
                         f"use the columns {', '.join(kind.names)}")] if unknown else []
-    problems += [Problem(line, None, f"column(s) named twice: {', '.join(twice)}", "name each column once")] if twice else []
+    problems += [Problem(line, None, f"column(s) named twice: {', '.join(twice)}",
+                         "name each column once")] if twice else []
     problems += [Problem(line, None, f"missing required column(s) {', '.join(missing)}",
                          f"add them to the header ({', '.join(kind.names)})")] if missing else []
     if problems:

@@ -62,7 +62,7 @@ def shown(value: object) -> str:
 
 def said(kind: str, name: object) -> str:
     """A name in a message: as it is when it is safe, else shown (quoted and escaped)."""
-    return name if is_safe(kind, name) else shown(name)
+    return name if isinstance(name, str) and is_safe(kind, name) else shown(name)   # a safe name is text
 
 
 def is_safe(kind: str, name: object) -> bool:
@@ -71,7 +71,7 @@ def is_safe(kind: str, name: object) -> bool:
 
 def checked(kind: str, name: object, what: str, remedy: str = "") -> str:
     """The name if it fits its kind's rule, else EngineError naming `what` (e.g. "hob id")."""
-    if is_safe(kind, name):
+    if isinstance(name, str) and is_safe(kind, name):   # a safe name is text
         return name
     advice = f"; {remedy}" if remedy else ""
     raise EngineError(f"{what} {shown(name)} is not a safe {kind} name: use {NAME_RULES[kind].rule}{advice}")

@@ -15,16 +15,16 @@ from urllib.parse import urlsplit, urlunsplit
 
 import psycopg
 import pytest
+from helpers.database_pool import DatabasePool, create_database
 from psycopg.conninfo import conninfo_to_dict, make_conninfo
 from psycopg.pq import TransactionStatus
 
 import engine.hobbing.models  # noqa: F401  (the models register with engine.gears.models, as the commands
 import engine.turning  # noqa: F401   that use a model import these packages first)
-from helpers.database_pool import DatabasePool, create_database
 
 pytest_plugins = ["helpers.turning_jobs"]   # fixtures shared by several test modules
 
-# No config file of the user running the suite (README, "Configuration"): the tests of the
+# No config file of the user running the suite (docs/guide/configuration.md): the tests of the
 # config file name their own with ENGINE_CONFIG. No shop database either: the engine reads
 # DATABASE_URL (and ENGINE_DATABASE_URL) when no --database-url is given.
 os.environ["ENGINE_CONFIG"] = ""

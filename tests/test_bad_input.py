@@ -12,12 +12,12 @@ from pathlib import Path
 import ezdxf
 import psycopg
 import pytest
+from helpers.drawings import seed_drawing
 from psycopg.conninfo import conninfo_to_dict
 
+from engine.drawings.entities import MAX_COORDINATE_MM
 from engine.gears.records import load_gear
 from engine.templates import rows as template_rows
-from engine.drawings.entities import MAX_COORDINATE_MM
-from helpers.drawings import seed_drawing
 
 ROOT = Path(__file__).resolve().parents[1]
 HEADER = ("gear_id,gear_class,module,teeth,pressure_angle,helix_angle,hand,face_width,tip_diameter,"
@@ -50,7 +50,8 @@ def refusal(result) -> str:
                    rows.__setitem__(3, rows[3].replace("40Cr", '40Cr"'))), "line 3: a quote opened on this line"),
     (lambda rows: rows.__setitem__(3, rows[3].replace(",220,", ",1e999,")), "line 5, column hardness: '1e999'"),
     (lambda rows: rows.__setitem__(3, rows[3].replace(",220,", ",900,")), "line 5, column hardness: 900 is outside"),
-    (lambda rows: rows.__setitem__(3, rows[3].replace(",,20,,,,,40Cr", ",,1e999,,,,,40Cr")), "line 5, column face_width: '1e999'"),
+    (lambda rows: rows.__setitem__(3, rows[3].replace(",,20,,,,,40Cr", ",,1e999,,,,,40Cr")),
+     "line 5, column face_width: '1e999'"),
 ])
 def test_a_bad_gear_file_imports_nothing_and_names_the_line(run, tmp_path, edit, words):
     rows = gear_rows()
@@ -151,7 +152,8 @@ DXF_EDITS = {
     "profile line 1e308": (lambda msp: setattr(first(msp, "LINE").dxf, "end", (0, HUGE, 0)), "LINE", REACH),
     "tool path NaN": (lambda msp: setattr(first(msp, "LINE", "1").dxf, "start", (NAN, 0.9, 0)), "LINE", "not a number"),
     "thread line 1e308": (lambda msp: setattr(first(msp, "LINE", "3").dxf, "start", (-HUGE, 0.5, 0)), "LINE", REACH),
-    "tool change NaN": (lambda msp: setattr(first(msp, "POINT").dxf, "location", (NAN, 1.5, 0)), "POINT", "not a number"),
+    "tool change NaN": (lambda msp: setattr(first(msp, "POINT").dxf, "location", (NAN, 1.5, 0)), "POINT",
+                        "not a number"),
     "arc radius NaN": (lambda msp: setattr(first(msp, "ARC").dxf, "radius", NAN), "ARC", "radius holds nan"),
     "arc radius 1e308": (lambda msp: setattr(first(msp, "ARC").dxf, "radius", HUGE), "ARC", REACH),
     "block scale 1e308": (lambda msp: setattr(first(msp, "INSERT").dxf, "xscale", HUGE), "LINE", REACH),

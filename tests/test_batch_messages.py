@@ -3,7 +3,6 @@ job that does not exist is looked up with `engine jobs list`."""
 from __future__ import annotations
 
 import pytest
-
 from helpers.batches import spoil
 
 

@@ -11,11 +11,11 @@ from pathlib import Path
 
 import psycopg
 import pytest
-from psycopg import sql
+from helpers.batches import spoil
 from helpers.roles import as_role
+from psycopg import sql
 
 from engine.programs.instantiate import instantiate_gear, instantiate_gears
-from helpers.batches import spoil
 from engine.programs.options import RunMode
 
 CHECKOUT = Path(__file__).resolve().parent.parent

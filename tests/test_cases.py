@@ -6,15 +6,15 @@ import json
 import math
 from dataclasses import replace
 
-from psycopg import sql
 import pytest
+from psycopg import sql
 
 from engine.errors import EngineError
 from engine.gears.case_base import job_cutting_record
 from engine.gears.cases import confirm_job, list_cases, seed_cases, suggest
 from engine.gears.records import load_gear, load_hobs
-from engine.machines.records import load_machine
 from engine.hobbing.choices import Choices
+from engine.machines.records import load_machine
 from engine.paths import SEED_DIR
 from engine.programs.instantiate import instantiate_gear
 
@@ -258,7 +258,8 @@ def test_the_seed_holds_the_paper_case_alone_at_its_features():
              == ("2", "19", "40Cr", "7", "rough")]
     assert len(paper) == 1 and paper[0]["source"].startswith("CAO/YAN/GUO 2015")
     assert (paper[0]["hob_speed"], paper[0]["axial_feed"], paper[0]["radial_feed"]) == ("246", "105", "36")
-    assert {r["cut"] for r in rows} == {"rough", "finish"} and {"45", "20CrMnTi", "40Cr"} <= {r["material"] for r in rows}
+    assert {r["cut"] for r in rows} == {"rough", "finish"}
+    assert {"45", "20CrMnTi", "40Cr"} <= {r["material"] for r in rows}
 
 
 

@@ -13,8 +13,6 @@ from click.testing import CliRunner
 from engine.cli.app import main
 
 
-
-
 def stored_counts(url):
     with psycopg.connect(url) as conn:
         return conn.execute("SELECT (SELECT count(*) FROM job), (SELECT count(*) FROM program), "
@@ -28,7 +26,8 @@ def all_commands(group, prefix=()):
             yield from all_commands(command, prefix + (name,))
 
 
-@pytest.mark.parametrize("path, command", list(all_commands(main)), ids=lambda v: " ".join(v) if isinstance(v, tuple) else "")
+@pytest.mark.parametrize("path, command", list(all_commands(main)),
+                         ids=lambda v: " ".join(v) if isinstance(v, tuple) else "")
 def test_every_command_explains_itself(path, command):
     assert command.help and len(command.help.strip()) > 20
     result = CliRunner().invoke(main, [*path, "--help"])

@@ -6,11 +6,11 @@ import json
 import click
 import pytest
 from click.testing import CliRunner
+from helpers.drawings import seed_drawing
 
 from engine.cli.app import main
 from engine.cli.conventions import walk
 from engine.cli.examples import EXAMPLES
-from helpers.drawings import seed_drawing
 
 COMMANDS = list(walk(main))
 

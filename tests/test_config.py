@@ -8,6 +8,7 @@ import pytest
 from engine.cli.app import main
 from engine.cli.conventions import RESERVED_ENVVARS, envvar_name, options, walk
 
+
 def test_an_environment_variable_sets_an_option(run):
     run.config.write_text("")
     result = run("lint", env={"ENGINE_LINT_JSON": "1"})

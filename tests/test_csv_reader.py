@@ -150,7 +150,8 @@ def test_every_kind_of_csv_says_a_bad_cell_alike(conn, tmp_path, kind):
     read, header, row, column, said = KINDS[kind]
     path = write(tmp_path, f"{header}\n{row}\n", f"{kind}.csv")
     message = refusal(lambda: read(conn, path))
-    assert re.search(rf"^{re.escape(str(path))}, line 2, column {column}: '[^']*' {said}; write ", message, re.M), message
+    assert re.search(rf"^{re.escape(str(path))}, line 2, column {column}: '[^']*' {said}; write ", message,
+                     re.M), message
 
 
 @pytest.mark.parametrize("kind", [*KINDS, "parameters"])
@@ -199,7 +200,8 @@ def test_replace_prints_each_changed_field_in_json_too(run, tmp_path):
     path = write(tmp_path, "gear_id,gear_class,module,teeth,face_width,tip_diameter\n42,spur,2,19,25,42\n")
     result = run("gears", "import", path, "--replace", "--json")
     assert result.exit_code == 0 and result.stdout.count("\n") == 1
-    changes = {change["field"]: (change["old"], change["new"]) for change in __import__("json").loads(result.stdout)["changes"]}
+    changes = {change["field"]: (change["old"], change["new"])
+               for change in __import__("json").loads(result.stdout)["changes"]}
     assert changes["face_width"] == (20, 25)
     assert "module" not in changes and "tip_diameter" not in changes
 
@@ -218,13 +220,15 @@ def root(module, teeth, beta=0.0, x=0.0):
     return reference(module, teeth, beta) - 2 * module * (1.25 - x)
 
 
-HEADER = "gear_id,gear_class,module,teeth,helix_angle,hand,face_width,tip_diameter,root_diameter,profile_shift,module_kind"
+HEADER = ("gear_id,gear_class,module,teeth,helix_angle,hand,face_width,tip_diameter,root_diameter,"
+          "profile_shift,module_kind")
 
 
 def test_diameters_that_fit_the_formulas_are_stored_with_their_profile_shift(conn, tmp_path):
     da, df = round(tip(3, 41, 15, 0.2), 2), round(root(3, 41, 15, 0.2), 2)
     spur_tip = round(tip(2, 19, 0, 0.125), 2)   # reference §D: d_a = 42.5 fits x = +0.125
-    path = write(tmp_path, f"{HEADER}\n90211,helical,3,41,15,R,30,{da},{df},0.2,\n90212,spur,2,19,0,,20,{spur_tip},,,\n")
+    path = write(tmp_path,
+                 f"{HEADER}\n90211,helical,3,41,15,R,30,{da},{df},0.2,\n90212,spur,2,19,0,,20,{spur_tip},,,\n")
     import_gears(conn, path)
     stored = conn.execute("SELECT tip_diameter, root_diameter, profile_shift FROM gear WHERE id = 90211").fetchone()
     assert [float(value) for value in stored] == [da, df, 0.2]
@@ -250,7 +254,8 @@ def test_a_given_profile_shift_pins_the_diameters_to_the_tolerance(conn, tmp_pat
     message = refusal(lambda: import_gears(conn, write(tmp_path, far, "far.csv")))
     assert f"column tip_diameter: {da + 3 * DIAMETER_TOLERANCE:.3f} contradicts" in message
     shortened = da - 2 * TIP_SHORTENING_MAX * 2   # a tip may be shortened by k·m_n, never lengthened
-    assert f"= {shortened:.3f} … {da:.3f} mm for m_n 2, z 30, β 0°, x 0.3 (tolerance ±{DIAMETER_TOLERANCE} mm)" in message
+    assert (f"= {shortened:.3f} … {da:.3f} mm for m_n 2, z 30, β 0°, x 0.3 "
+            f"(tolerance ±{DIAMETER_TOLERANCE} mm)") in message
 
 
 def test_a_tip_and_root_less_than_a_tooth_depth_apart_are_refused(conn, tmp_path):
@@ -273,7 +278,9 @@ def test_worm_wheels_and_taper_gears_are_not_held_to_the_cylindrical_formulas(co
 
 def test_a_further_unit_of_a_duplex_gear_is_held_to_the_formulas_of_its_module(conn, tmp_path):
     # gear 54 (seeded): duplex, m = 2; a spur unit of z = 19 has d_a = 2·19 + 2·2 = 42 at x = 0
-    good = write(tmp_path, f"gear_id,unit,teeth,face_width,tip_diameter,z_top\n54,2,19,15,{tip(2, 19):g},-75\n", "u.csv")
+    good = write(tmp_path, f"gear_id,unit,teeth,face_width,tip_diameter,z_top\n54,2,19,15,{tip(2, 19):g},-75\n",
+                 "u.csv")
     assert import_units(conn, good) == 1
-    wrong = write(tmp_path, f"gear_id,unit,teeth,face_width,tip_diameter,z_top\n54,2,19,15,{tip(3, 19):g},-75\n", "w.csv")
+    wrong = write(tmp_path, f"gear_id,unit,teeth,face_width,tip_diameter,z_top\n54,2,19,15,{tip(3, 19):g},-75\n",
+                  "w.csv")
     assert f"line 2, column tip_diameter: {tip(3, 19):g} contradicts d_a" in refusal(lambda: import_units(conn, wrong))

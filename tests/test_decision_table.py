@@ -1,5 +1,6 @@
 """The decision table of design notes §4, step by step, on templates stored in PostgreSQL."""
 import pytest
+from helpers.releases import release_draft
 
 from engine.errors import EngineError
 from engine.hobbing.choices import Choices
@@ -8,7 +9,6 @@ from engine.programs.options import RunMode
 from engine.templates.decision_table import CompiledTemplate, TemplateError
 from engine.templates.rows import TemplateRow
 from engine.templates.store import ensure_class, load_template, replace_template
-from helpers.releases import release_draft
 
 
 def make_template(conn, name, rows):

@@ -15,6 +15,8 @@ import math
 
 import numpy as np
 import pytest
+from helpers.hob_clearance import CUTTING, MACHINE, hob_surface, seeded_hobs
+from helpers.nc_reader import read_program
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -23,9 +25,6 @@ from engine.gears.records import Gear, GearUnit, Hob
 from engine.hobbing.choices import FEED_MODES, Choices
 from engine.hobbing.duplex import DuplexModel
 from engine.programs.instantiate import instantiate_gear
-
-from helpers.nc_reader import read_program
-from helpers.hob_clearance import CUTTING, MACHINE, hob_surface, seeded_hobs
 
 MARGIN = 0.5            # mm: the least clearance a program may leave (the engine keeps more)
 Z_STEP = 0.5            # mm between sampled hob centres along a pass
@@ -107,7 +106,8 @@ def check_program_cuts(gear: Gear, hob: Hob, params: dict, module_params: dict) 
             low, high = sorted((cut["z_from"], cut["z_to"]))
             assert low < own["top"] - own["b"] and high > own["top"], (
                 f"unit {number}: the pass {cut['z_from']}…{cut['z_to']} does not carry the hob centre past both faces")
-            found = clearance(surface, cut_centres(params["x_retract"], cut["cut_x"], cut["z_from"], cut["z_to"]), other)
+            found = clearance(surface, cut_centres(params["x_retract"], cut["cut_x"], cut["z_from"], cut["z_to"]),
+                              other)
             assert found >= MARGIN, (f"unit {number} {cut['cut_name']}: the hob comes {found:.2f} mm near "
                                      f"the other unit (at least {MARGIN} expected)")
             least = min(least, found)

@@ -5,16 +5,16 @@ reader cannot place is refused, nothing made. Every drawing is built here with e
 diameters come from ISO 68-1."""
 from __future__ import annotations
 
+import json
+
 import ezdxf
 import pytest
-
-from engine.drawings.drawing import read_drawing
-from engine.drawings.read import DxfError
 from helpers.drawn_parts import AXIS_Y, DRAWN_DIAMETERS, SHAFT, drawing
 from helpers.lathe_programs import finish_diameters
 from helpers.outcomes import counts
-import json
 
+from engine.drawings.drawing import read_drawing
+from engine.drawings.read import DxfError
 
 # An M16×2 thread on the shaft's Ø16 from the face to Z -10: its root (minor) diameter by ISO 68-1,
 # d3 = d - 1.2269 P, drawn as thin lines under the outline, and its end as a line across.
@@ -188,7 +188,8 @@ def test_a_side_view_is_turned_as_drawn_or_refused(run, tmp_path, name):
         return
     assert made.exit_code == 0, made.output
     report = json.loads(made.stdout)
-    assert name not in BORED, f"a part with a Ø{2 * BORE_RADIUS:g} bore became job {report['job_id']}: {report['notes']}"
+    assert name not in BORED, \
+        f"a part with a Ø{2 * BORE_RADIUS:g} bore became job {report['job_id']}: {report['notes']}"
     assert finish_diameters(run, json.loads(made.stdout)["job_id"]) == DRAWN_DIAMETERS
 
 

@@ -12,10 +12,23 @@ import random
 import re
 
 import ezdxf
-import ezdxf.recover
 import ezdxf.path
+import ezdxf.recover
 import pytest
 from ezdxf.math import bulge_center
+from helpers.drawings import (
+    CROSSES,
+    DXF,
+    EMCO,
+    FULL_VIEW,
+    HALF_PROFILE,
+    INCH,
+    NOTHING_ON_0,
+    REAL,
+    SCATTERED,
+    nc_arc_words,
+    seed_drawing,
+)
 
 from engine.drawings.codes import CodeText, codes_in, layer_codes
 from engine.drawings.drawing import read_drawing
@@ -23,9 +36,6 @@ from engine.drawings.entities import FLATTEN_TOLERANCE_MM
 from engine.drawings.geometry import Arc, Line
 from engine.drawings.profile import chain_segments
 from engine.drawings.read import DxfError, load_drawing_file
-from helpers.drawings import (CROSSES, DXF, EMCO, FULL_VIEW, HALF_PROFILE, INCH, NOTHING_ON_0, REAL, SCATTERED,
-                              nc_arc_words, seed_drawing)
-
 
 GEOMETRY = {"LINE", "ARC", "CIRCLE", "LWPOLYLINE", "POLYLINE", "SPLINE", "ELLIPSE"}
 
@@ -116,7 +126,7 @@ def test_the_list_covers_every_real_drawing():
 
 
 def test_a_damaged_file_is_read_tolerantly_and_the_repair_reported():
-    with pytest.raises(Exception):
+    with pytest.raises(ezdxf.DXFStructureError):
         ezdxf.readfile(DXF / "ezdxf_AC1003_LINE_Example.dxf")
     loaded = load_drawing_file(DXF / "ezdxf_AC1003_LINE_Example.dxf")
     assert len(loaded.doc.modelspace()) == 22  # 13 LINE + 9 ARC on layer 1, as ezdxf.recover counts
@@ -234,7 +244,8 @@ def test_spline_and_ellipse_are_lines_within_the_tolerance(tmp_path):
                         for t in (t0 + (t1 - t0) * k / 50 for k in range(51)))
         assert deviation <= FLATTEN_TOLERANCE_MM * 1.01
     exact = [(v.x, v.y) for v in spline.construction_tool().approximate(400)]
-    on_spline = [s for s in profile.segments if -35 - 1e-9 <= min(s.start[0], s.end[0]) and max(s.start[0], s.end[0]) <= -20 + 1e-9]
+    on_spline = [s for s in profile.segments
+                 if -35 - 1e-9 <= min(s.start[0], s.end[0]) and max(s.start[0], s.end[0]) <= -20 + 1e-9]
     for point in exact:
         assert min(distance_to_segment(point, s) for s in on_spline) <= FLATTEN_TOLERANCE_MM * 1.01
 

@@ -7,12 +7,12 @@ import json
 
 import ezdxf
 import pytest
+from helpers.drawings import DXF
+from helpers.drawn_parts import outline_drawing
+from helpers.outcomes import job_count, one_line_refusal
 
 from engine.drawings.drawing import read_drawing
 from engine.drawings.read import DxfError
-from helpers.drawings import DXF
-from helpers.outcomes import job_count, one_line_refusal
-from helpers.drawn_parts import outline_drawing
 
 
 def test_the_profile_is_read_from_the_named_layer(tmp_path):

@@ -14,15 +14,15 @@ import ezdxf
 import ezdxf.bbox
 import ezdxf.path
 import pytest
-
-from engine.programs.remake import instantiate_job
-from engine.programs.dxf_import import import_dxf
-from engine.turning.job_params import ProfileOptions
-from engine.drawings.drawing import read_drawing
-from engine.drawings.read import DxfError
-from helpers.lathe_programs import distance_to_chord, motions, operation_lines
 from helpers.drawings import DXF
 from helpers.drawn_parts import AXIS_Y, SHAFT, outline_drawing
+from helpers.lathe_programs import distance_to_chord, motions, operation_lines
+
+from engine.drawings.drawing import read_drawing
+from engine.drawings.read import DxfError
+from engine.programs.dxf_import import import_dxf
+from engine.programs.remake import instantiate_job
+from engine.turning.job_params import ProfileOptions
 
 FLATTENING_MM = 0.0005
 ON_DRAWING_MM = 0.01       # a finish end point this close to a drawn line is on it

@@ -1,7 +1,8 @@
 """Template expressions: what users write works; what an attacker writes is refused
 before it runs, or stopped by a limit, with a message that names the problem."""
 import pytest
-from hypothesis import given, settings, strategies as st
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from engine.errors import EngineError
 from engine.templates.evaluator import evaluate as evaluate_compiled

@@ -12,13 +12,12 @@ import math
 
 import psycopg
 import pytest
+from helpers.nc_reader import read_program
 
 from engine.errors import EngineError
 from engine.hobbing.choices import Choices
 from engine.programs.instantiate import instantiate_gear
 from engine.programs.options import RunMode
-
-from helpers.nc_reader import read_program
 
 ROUND = 0.0015   # mm: the program writes 3 decimals; a difference of two rounded values
 

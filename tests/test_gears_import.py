@@ -11,7 +11,8 @@ from engine.errors import EngineError
 from engine.gears.classify import RULES, classify, classify_installed
 from engine.gears.gear_import import GearImportError, derived_diameters, import_gears, read_gears
 
-HEADER = "gear_id,gear_class,module,teeth,pressure_angle,helix_angle,hand,face_width,tip_diameter,root_diameter,cone_angle,crowning,material,hardness,quality_grade,quantity"
+HEADER = ("gear_id,gear_class,module,teeth,pressure_angle,helix_angle,hand,face_width,tip_diameter,root_diameter,"
+          "cone_angle,crowning,material,hardness,quality_grade,quantity")
 SPUR = "90001,,2,19,,,,20,,,,,40Cr,220,7,5"
 HELICAL = "90002,,3,30,20,15,R,25.125,,,,,,,,"
 GOOD = f"{HEADER}\n{SPUR}\n{HELICAL}\n"
@@ -156,13 +157,16 @@ BAD_ROWS = [
     ("90009,,2,19,,-5,R,20,,,,,,,,", "line 3, column helix_angle: -5 is outside [0, 60)"),
     ("90009,,2,19,,15,X,20,,,,,,,,", "line 3, column hand: 'X' must be L or R"),
     ("90009,,2,19,,15,,20,,,,,,,,", "line 3, column hand: is missing; a helical gear (helix_angle 15)"),
-    ("90009,bevelx,2,19,,,,20,,,,,,,,", "line 3, column gear_class: gear class 'bevelx' does not exist; known leaf classes: "),
+    ("90009,bevelx,2,19,,,,20,,,,,,,,",
+     "line 3, column gear_class: gear class 'bevelx' does not exist; known leaf classes: "),
     ("90009,gear,2,19,,,,20,,,,,,,,", "line 3, column gear_class: gear class 'gear' is not a leaf class"),
     ("90001,,2,19,,,,20,,,,,,,,", "line 3, column gear_id: 90001 is already on line 2"),
     ("90009,,2,19,,,,20,,,,,,,13,", "line 3, column quality_grade: 13 is outside 1..12"),
     ("90009,,2,19,,,,20,,,,,,,0,", "line 3, column quality_grade: 0 is outside 1..12"),
-    ("90009,,2,19,,,,20,40,41,,,,,,", "line 3, column root_diameter: 41 contradicts d_f = m_n·z/cos β − 2·m_n·(h*f − x) with x in -1 … 1.5"),
-    ("90009,,2,19,,,,20,,43,,,,,,", "line 3, column root_diameter: 43 contradicts d_f = m_n·z/cos β − 2·m_n·(h*f − x) with x in -1 … 1.5"),
+    ("90009,,2,19,,,,20,40,41,,,,,,",
+     "line 3, column root_diameter: 41 contradicts d_f = m_n·z/cos β − 2·m_n·(h*f − x) with x in -1 … 1.5"),
+    ("90009,,2,19,,,,20,,43,,,,,,",
+     "line 3, column root_diameter: 43 contradicts d_f = m_n·z/cos β − 2·m_n·(h*f − x) with x in -1 … 1.5"),
     ("90009,,2,19,,,,20,,,,,,,,,extra", "line 3: 17 cells, but the header names 16 columns"),
 ]
 
@@ -188,8 +192,10 @@ def test_all_problems_of_all_rows_are_collected_in_file_order(conn, tmp_path):
     with pytest.raises(GearImportError) as caught:
         import_gears(conn, path)
     assert str(caught.value) == f"{path}: 2 bad row(s); nothing imported"
-    assert [re.search(r", (line \d+)", problem)[1] for problem in caught.value.problems] == ["line 3"] * 2 + ["line 6"] * 2
-    assert caught.value.problems[0] == f"{path}, line 3, column helix_angle: 75 is outside [0, 60); write a number in degrees like 2.5"
+    assert ([re.search(r", (line \d+)", problem)[1] for problem in caught.value.problems]
+            == ["line 3"] * 2 + ["line 6"] * 2)
+    assert caught.value.problems[0] == (f"{path}, line 3, column helix_angle: 75 is outside [0, 60); "
+                                        "write a number in degrees like 2.5")
     assert caught.value.problems[1] == f"{path}, line 3, column hand: 'X' must be L or R; write L or R (the helix hand)"
     assert caught.value.problems[3].startswith(f"{path}, line 6, column gear_class: gear class 'bevelx' does not exist")
 

@@ -1,9 +1,15 @@
 """Every seeded gear under every set of job choices, and every golden turning job, instantiates to
 the bytes of its golden file (tests/helpers/golden_cases.py says how the files were made and why)."""
 import pytest
-
-from helpers.golden_cases import (hobbing_cases, hobbing_file, hobbing_text, turning_cases, turning_file, turning_text,
-                                  without_iso_program_number)
+from helpers.golden_cases import (
+    hobbing_cases,
+    hobbing_file,
+    hobbing_text,
+    turning_cases,
+    turning_file,
+    turning_text,
+    without_iso_program_number,
+)
 
 
 def test_every_case_has_its_golden_file_and_no_file_is_left_over():

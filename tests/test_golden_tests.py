@@ -13,8 +13,8 @@ import pytest
 from engine.programs.instantiate import instantiate_gear
 from engine.programs.options import RunMode
 from engine.release.coverage import coverage
-from engine.templates.expectations import Context, first_difference
 from engine.release.golden import run_golden_tests
+from engine.templates.expectations import Context, first_difference
 
 SEEDED_CLASSES = {"spur", "helical", "duplex", "taper", "crowned", "worm_wheel", "turning_iso", "turning_840d"}
 
@@ -81,7 +81,8 @@ def test_every_seeded_test_passes_on_the_seeded_templates(conn):
 def test_seeded_expectations_are_the_reference_formulas(conn):
     """The seeded gear 43 (m3 z41 beta 15 right, hob z0 1 right): its test states k_B = -z0/z2
     and the differential -360 sin(beta)/(pi mn z2) (hobbing.md §A7)."""
-    expect = conn.execute("SELECT expect FROM template_test WHERE gear_class = 'helical' AND gear_id = 43").fetchone()[0]
+    expect = conn.execute("SELECT expect FROM template_test "
+                          "WHERE gear_class = 'helical' AND gear_id = 43").fetchone()[0]
     lines = ['EGON(C,"FINE",B,-1,41,Z,-0.241126,1)']
     assert first_difference([e for e in expect if e.startswith("EGON")], Context(lines, NAMES)) is None
     assert round(-360 * math.sin(math.radians(15)) / (math.pi * 3 * 41), 6) == -0.241126

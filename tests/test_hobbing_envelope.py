@@ -7,7 +7,6 @@ import math
 
 import numpy as np
 import pytest
-
 from helpers.hobbing_checks import Case, depth_problems
 from helpers.hobbing_envelope import Solid, Sweep, intrusion
 from helpers.hobbing_reference import Gear, Hob, Unit, read

@@ -10,11 +10,11 @@ import re
 
 import psycopg
 import pytest
+from helpers.outcomes import made, one_line_error
 
 from engine.hobbing.choices import Choices
 from engine.hobbing.program_plot import load_scene, program_figure
 from engine.programs.instantiate import instantiate_gear
-from helpers.outcomes import made, one_line_error
 
 SAMPLES = [   # gear, what, job choices: every hobbing class the samples hold
     (42, "spur", Choices()), (42, "spur conventional", Choices(feed_mode="conventional")),
@@ -104,7 +104,7 @@ def test_the_hob_at_full_depth_stands_at_the_reference_centre_distance(conn, gea
     micrometre, so within half of one)."""
     program, figure, _ = drawn(conn, gear_id, choices)
     da0 = hob_tip(conn, program.program_id)
-    for name, _, width, _, root in units_of(conn, gear_id):
+    for name, _, _width, _, root in units_of(conn, gear_id):
         centre = artist(figure.axes[0], f"hob at full depth {name} centre")
         assert centre.get_xdata()[0] == pytest.approx((root + da0) / 2, abs=5e-4)
         outline = artist(figure.axes[0], f"hob at full depth {name}")

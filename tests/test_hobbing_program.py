@@ -14,11 +14,10 @@ import math
 import re
 
 import pytest
+from helpers.nc_reader import Block, Move, Program, read_program
 
 from engine.hobbing.choices import Choices
 from engine.programs.instantiate import instantiate_gear
-
-from helpers.nc_reader import Block, Move, Program, read_program
 
 SPUR = [42, 45]
 HELICAL = [43, 44]
@@ -412,7 +411,8 @@ def test_last_cut_reaches_full_depth(case, gear_id):
     last = c.cuts()[-1]["x"]
     expected = c.full_depth()
     assert abs(last - expected) <= DIAMETER_TOLERANCE, \
-        f"gear {gear_id}: last cut X{last}, full depth (d_f2 + d_a0)/2 = ({c.gear['df2']} + {c.hob['da0']})/2 = {expected:.3f}"
+        f"gear {gear_id}: last cut X{last}, full depth (d_f2 + d_a0)/2 = " \
+        f"({c.gear['df2']} + {c.hob['da0']})/2 = {expected:.3f}"
 
 
 @pytest.mark.parametrize("gear_id, count", [(42, 1), (45, 2)])

@@ -21,25 +21,43 @@ import uuid
 
 import psycopg
 import pytest
-from psycopg import sql
-from psycopg.conninfo import conninfo_to_dict, make_conninfo
+from helpers.hobbing_checks import (
+    Case,
+    Job,
+    approach_problems,
+    contract_problems,
+    coupling_problems,
+    depth_problems,
+    envelope_problems,
+    feed_problems,
+)
+from helpers.hobbing_machine_checks import all_problems, cycle_time_problems, obstacle_problems, table_speed_problems
+from helpers.hobbing_reference import Gear, Hob, Unit, layout_cuttable, lead_angle, read
+from helpers.hobbing_reference_gears import (
+    DIN,
+    MIRROR,
+    PAPER_STOCK,
+    REVERSED,
+    STOCK,
+    TOOL_NUMBER,
+    cylindrical,
+    insert_gear,
+    insert_hob,
+    insert_machine,
+    make_gear,
+    make_hob,
+    only_hob,
+    read_machine,
+)
+from helpers.hobbing_reference_programs import HAND_WRITTEN
 from hypothesis import HealthCheck, Phase, given, settings
 from hypothesis import strategies as st
+from psycopg import sql
+from psycopg.conninfo import conninfo_to_dict, make_conninfo
 
 from engine.errors import EngineError
 from engine.hobbing.choices import Choices
 from engine.programs.instantiate import instantiate_gear
-
-from helpers.hobbing_checks import (Case, Job, approach_problems, contract_problems, coupling_problems, depth_problems,
-                                    envelope_problems, feed_problems)
-from helpers.hobbing_machine_checks import all_problems, cycle_time_problems, obstacle_problems, table_speed_problems
-from helpers.hobbing_reference import Gear, Hob, Unit, layout_cuttable, lead_angle, read
-from helpers.hobbing_reference_gears import (DIN, MIRROR, PAPER_STOCK, REVERSED, STOCK, cylindrical, insert_gear,
-                                             insert_hob, insert_machine, make_gear, make_hob, only_hob, read_machine,
-                                             TOOL_NUMBER)
-from helpers.hobbing_reference_programs import HAND_WRITTEN
-
-
 
 # ---------------------------------------------------------------- the reader and checks on known programs
 
@@ -357,7 +375,8 @@ def test_random_valid_gears_make_a_correct_program_or_a_one_line_refusal(conn, k
             return
     shift = {5.0: 5.0}.get(choice.get("shift_y"), "per part" if choice.get("shift_per_part") else 0.0)
     case = Case(gear, hob, read_machine(conn, DIN.name), Job(choice.get("coolant", True), shift,
-                                                             choice.get("worm_feed", "radial"), choice.get("tailstock", True)))
+                                                             choice.get("worm_feed", "radial"),
+                                                             choice.get("tailstock", True)))
     problems = all_problems(read(program.text), case)
     assert not problems, f"{gear} {hob} {choice}:\n  " + "\n  ".join(problems) + "\n" + program.text
 

@@ -291,7 +291,8 @@ HEADER = "id,module,pressure_angle,starts,tip_diameter,length,hand,accuracy_clas
 
 @pytest.mark.parametrize("rows, words", [
     ("h-m2-aa-r1,2,20,1,70,150,R,AA\n", "hob h-m2-aa-r1 is hob H-M2-AA-R1 of the library"),
-    ("H-M9-A-R1,9,20,1,170,200,R,A\nh-m9-a-r1,9,20,1,170,200,R,A\n", "line 3, column id: h-m9-a-r1 is already on line 2"),
+    ("H-M9-A-R1,9,20,1,170,200,R,A\nh-m9-a-r1,9,20,1,170,200,R,A\n",
+     "line 3, column id: h-m9-a-r1 is already on line 2"),
 ])
 def test_an_import_of_a_hob_id_differing_only_in_case_is_refused(run, tmp_path, rows, words):
     path = tmp_path / "hobs.csv"

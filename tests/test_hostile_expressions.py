@@ -77,7 +77,8 @@ def engine(url, *args):
 def put_row(conn, gear_class, row_id, columns):
     s, o, p_emit = columns
     conn.execute("DELETE FROM template_view WHERE gear_class = %s AND id = %s", (gear_class, row_id))
-    conn.execute("INSERT INTO template_view (gear_class, id, t, n, s, o, p_emit) VALUES (%s, %s, 'main', 1, %s, %s, %s)",
+    conn.execute("INSERT INTO template_view (gear_class, id, t, n, s, o, p_emit) "
+                 "VALUES (%s, %s, 'main', 1, %s, %s, %s)",
                  (gear_class, row_id, s, o, p_emit))
 
 
@@ -195,7 +196,8 @@ def test_hundreds_of_large_integers_keep_a_bounded_trace_or_are_refused(fresh_da
             assert counts(conn) == before
             return
         assert done.returncode == 0, done.stderr
-        trace, size = conn.execute("SELECT trace, octet_length(trace::text) FROM program ORDER BY id DESC LIMIT 1").fetchone()
+        trace, size = conn.execute("SELECT trace, octet_length(trace::text) "
+                                   "FROM program ORDER BY id DESC LIMIT 1").fetchone()
     assert size <= MAX_TRACE_BYTES + 64 * 1024   # the row entries, and the job's inputs once
     assert trace["omitted"]["rows"] > 0 and trace["omitted"]["from_row"] > 90001
     kept = [entry for entry in trace["rows"] if entry["row"] > 90000]

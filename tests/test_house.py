@@ -157,7 +157,8 @@ def modules_not_saying_what_they_are(folder: Path) -> list[str]:
 def test_engine_is_laid_out_as_the_design_s_sections():
     folder = Path(engine.__file__).parent
     assert missing_design_folders(folder) == []
-    assert loose_modules(folder) == ["csv_reader.py", "errors.py", "memory.py", "names.py", "paths.py", "pictures.py"]   # below every section
+    # below every section
+    assert loose_modules(folder) == ["csv_reader.py", "errors.py", "memory.py", "names.py", "paths.py", "pictures.py"]
 
 
 def test_every_module_says_what_it_is_in_its_first_line():

@@ -6,10 +6,10 @@ from __future__ import annotations
 import json
 
 import psycopg
-
-from engine.cli.app import main
 from helpers.drawings import DXF, EMCO, REAL, seed_drawing
 from helpers.outcomes import job_count, one_line_refusal
+
+from engine.cli.app import main
 
 PROFILE_ONLY = set(EMCO) | {"d2g_Turbocad_12.5_R14.dxf", "qcad_screw_R2007.dxf", "ezdxf_AC1003_LINE_Example.dxf",
                             "d2g_132_R14.dxf", "d2g_132_R2000.dxf", "d2g_132_R2004.dxf"}

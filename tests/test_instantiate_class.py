@@ -14,10 +14,9 @@ import re
 
 import psycopg
 import pytest
+from helpers.class_jobs import DATA, LINEAGE_ROW, PAWN, SPEED, import_emco, ok, refused, stored_program
 from psycopg import errors
 from psycopg.types.json import Jsonb
-
-from helpers.class_jobs import DATA, LINEAGE_ROW, PAWN, SPEED, import_emco, ok, refused, stored_program
 
 CAM = DATA / "nc" / "sinumerik" / "cam_840dsl" / "CAM_TEST.MPF"   # 840D sl CAM output
 EMCO_CNC = DATA / "nc" / "emco_from_dxf" / "testNegDXF.cnc"   # Emco fixed-column format

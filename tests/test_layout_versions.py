@@ -11,8 +11,6 @@ import json
 
 import psycopg
 import pytest
-
-
 from helpers.roles import logins
 
 CRLF, LF = "\r\n", "\n"

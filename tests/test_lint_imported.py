@@ -7,6 +7,7 @@ import json
 from dataclasses import replace
 
 import pytest
+from helpers.nc_files import DATA, PARAMS, class_name, real_files, write
 
 from engine.errors import EngineError
 from engine.library.nc_import import import_nc
@@ -14,8 +15,6 @@ from engine.templates.checks import LintProblem
 from engine.templates.lint import lint_class
 from engine.templates.rows import TemplateRow
 from engine.templates.store import ensure_class, load_template, replace_template
-
-from helpers.nc_files import DATA, PARAMS, class_name, real_files, write
 
 CAM = "sinumerik/cam_840dsl/CAM_TEST.MPF"
 

@@ -11,11 +11,11 @@ from __future__ import annotations
 import math
 
 import pytest
+from helpers.nc_reader import read_program
+from helpers.verifier_programs import accepted, refusal
 
 from engine.hobbing.choices import Choices
 from engine.programs.instantiate import instantiate_gear
-from helpers.nc_reader import read_program
-from helpers.verifier_programs import accepted, refusal
 
 # Seeded gears (seed_templates/gears.csv), one per class, and the helix given to classes whose
 # seeded gear is straight, so that the gear's hand matters to the Z term.
@@ -140,7 +140,8 @@ def test_tangential_worm_wheels_of_both_hands_keep_the_y_factor_positive(conn, h
 def test_z_and_y_positions_mirror_on_a_machine_whose_z_and_y_point_the_other_way(conn, gear_id):
     add_flipped_machine(conn)
     choices = {"worm_feed": "tangential"} if gear_id == 53 else {"shift_y": 3.0}
-    din, flipped = (read_program(instantiate(conn, gear_id, machine, **choices)) for machine in ("hobber-840d", FLIPPED))
+    din, flipped = (read_program(instantiate(conn, gear_id, machine, **choices))
+                    for machine in ("hobber-840d", FLIPPED))
 
     def positions(nc, axis):
         return [m.end[axis] for m in nc.moves if m.block < nc.index("EGOFS") and axis in m.changed]

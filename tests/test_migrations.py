@@ -20,6 +20,7 @@ SCHEMA_FILES = ("core.sql", "templates.sql", "versions.sql", "editing.sql", "rec
 ACL = "(SELECT array_agg(format('%s %s', CASE WHEN a.grantee = 0 THEN 'PUBLIC' ELSE a.grantee::regrole::text END, " \
       "a.privilege_type) ORDER BY 1) FROM aclexplode({}) a)"
 RELATION_ACL = """coalesce(relacl, acldefault(CASE relkind WHEN 'S' THEN 's' ELSE 'r' END::"char", relowner))"""
+FUNCTION_ACL = "coalesce(proacl, acldefault('f', proowner))"   # a function's NULL acl: its owner's and PUBLIC's EXECUTE
 CATALOG_QUERIES = {
     "column": """SELECT table_name || '.' || column_name, concat_ws(' ', data_type, is_nullable, column_default)
                  FROM information_schema.columns WHERE table_schema = 'public'
@@ -41,10 +42,11 @@ CATALOG_QUERIES = {
     "column privileges on": f"""SELECT attrelid::regclass::text || '.' || attname, {ACL.format("attacl")}::text
                                 FROM pg_attribute WHERE attacl IS NOT NULL
                                 AND attrelid::regclass::text NOT LIKE 'pg\\_%'""",
-    "execute privileges on": f"""SELECT oid::regprocedure::text, {ACL.format("coalesce(proacl, acldefault('f', proowner))")}::text
+    "execute privileges on": f"""SELECT oid::regprocedure::text, {ACL.format(FUNCTION_ACL)}::text
                                  FROM pg_proc WHERE pronamespace = 'public'::regnamespace""",
     "schema privileges on": f"SELECT nspname, {ACL.format('nspacl')}::text FROM pg_namespace WHERE nspname = 'public'",
-    "default privileges of": f"""SELECT defaclrole::regrole::text || ' ' || defaclobjtype::text, {ACL.format('defaclacl')}::text
+    "default privileges of": f"""SELECT defaclrole::regrole::text || ' ' || defaclobjtype::text,
+                                        {ACL.format('defaclacl')}::text
                                  FROM pg_default_acl WHERE defaclnamespace = 'public'::regnamespace""",
 }
 

@@ -8,6 +8,7 @@ import shutil
 
 import psycopg
 import pytest
+from helpers.drawings import seed_drawing
 from psycopg.errors import CheckViolation
 
 from engine.db.migrate import migrate
@@ -16,7 +17,6 @@ from engine.names import NAME_RULES, is_safe
 from engine.paths import MIGRATIONS_DIR
 from engine.programs.instantiate import instantiate_gear
 from engine.turning.model import check_job_params
-from helpers.drawings import seed_drawing
 
 INJECTED = "G0 X9999 Z-9999"    # the block that reached stored programs through each route
 NEWLINE = f"\n{INJECTED}"
@@ -108,7 +108,8 @@ def test_hobs_import_and_add_refuse_an_unsafe_id(run, tmp_path, name):
                                                  "cylindrical"])
     before = counts(run.url)
     message = refused(run("hobs", "import", tmp_path / "hobs.csv"))
-    assert "not a safe hob id" in message or LINE_BREAK_IN_CELL in message or NUL_IN_FILE in message   # the reader first
+    # the reader first
+    assert "not a safe hob id" in message or LINE_BREAK_IN_CELL in message or NUL_IN_FILE in message
     assert "not a safe hob id" in refused(run("hobs", "add", "--id", name, "--module", 2, "--tip-diameter", 70,
                                               "--length", 100, "--hand", "R", "--accuracy-class", "AA"))
     assert counts(run.url) == before
@@ -204,7 +205,8 @@ def test_names_written_in_sql_are_refused(conn):
 def test_a_program_with_an_unsafe_name_or_a_broken_line_is_refused_in_sql(conn):
     program = instantiate_gear(conn, 42)
     insert = ("INSERT INTO program (job_id, gear_class, template_version, template_hash, name, lines, row_ids) "
-              "VALUES (%s, 'spur', %s, %s, %s, %s, %s)")   # the version and hash it was made from: only the name or line is wrong
+              # the version and hash it was made from: only the name or line is wrong
+              "VALUES (%s, 'spur', %s, %s, %s, %s, %s)")
     made_from = (program.template_version, program.template_hash)
     for name in UNSAFE["program"]:
         if "\x00" not in name:

@@ -12,7 +12,9 @@ import json
 from decimal import Decimal
 
 import pytest
-from hypothesis import given, settings, strategies as st
+from helpers.nc_files import DATA, FAMILY, MACROS, PARAMS, class_name, instantiate, real_files, stored, stored_at, write
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from engine.errors import EngineError
 from engine.library.nc_import import import_nc
@@ -22,9 +24,6 @@ from engine.templates.evaluator import evaluate
 from engine.templates.expressions import compile_expression
 from engine.templates.rows import export_csv, parse_csv
 from engine.templates.store import ensure_class, load_template, replace_template
-
-from helpers.nc_files import DATA, FAMILY, MACROS, PARAMS, class_name, instantiate, real_files, stored, stored_at, write
-
 
 # --- tokens ------------------------------------------------------------------------------
 

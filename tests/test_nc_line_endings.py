@@ -3,15 +3,14 @@ keeps LF or CRLF and whether the file ended with a newline; the rows hold the li
 them, so a CRLF program shares its components with the LF one; a file mixing both is refused."""
 from __future__ import annotations
 
+import psycopg
 import pytest
+from helpers.nc_files import DATA, PARAMS, class_name, real_files, written_back
+from helpers.outcomes import one_line_error
 
 from engine.errors import EngineError
 from engine.library.nc_import import import_nc
 from engine.templates.store import load_template
-
-from helpers.nc_files import DATA, PARAMS, class_name, real_files, written_back
-from helpers.outcomes import one_line_error
-import psycopg
 
 TWO_FILES = ["sinumerik/cam_840dsl/CAM_TEST.MPF", "emco_from_dxf/testNegDXF.cnc"]
 
@@ -94,7 +93,7 @@ def test_an_nc_file_with_a_line_break_inside_a_line_is_refused_at_import(run, tm
     the import stores and calls a draft can never give a program. It should be refused naming
     the line, as a control character is, with nothing stored."""
     nc = tmp_path / "broken.nc"
-    nc.write_bytes(f"G1 X10{breaking}G0 X0\nM30\n".encode("utf-8"))
+    nc.write_bytes(f"G1 X10{breaking}G0 X0\nM30\n".encode())
     result = run("import-nc", nc, "--class", "nc_broken")
     assert one_line_error(result) and "line 1" in result.stderr, result.output
     with psycopg.connect(run.url) as conn:

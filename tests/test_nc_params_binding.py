@@ -11,13 +11,12 @@ from decimal import Decimal
 
 import psycopg
 import pytest
+from helpers.class_jobs import import_emco
+from helpers.nc_files import DATA, instantiated, real_files, stored_at, stored_rows, written_back
+from helpers.outcomes import one_line_error
 
 from engine.library import nc_halves
 from engine.library.nc_import import import_nc
-
-from helpers.nc_files import DATA, instantiated, real_files, stored_at, stored_rows, written_back
-from helpers.outcomes import one_line_error
-from helpers.class_jobs import import_emco
 
 DEMO = "linuxcnc/lathe_g70_71_demo.ngc"      # D0.3 (cutter compensation) and R0.3 (G71's retract)
 CAM = "sinumerik/cam_840dsl/CAM_TEST.MPF"    # I4.25 and J4.25 (arc centres)
@@ -77,7 +76,8 @@ def test_a_new_value_changes_only_the_bound_words(conn, relative, parameter, val
             expected[line - 1] = expected[line - 1].replace(word, word[:-len(number)] + other, 1)
     assert expected != original
     assert instantiated(conn, "nc_bound", {**OTHER[relative], parameter: float(other)}) == expected
-    assert written_back(conn, "nc_bound", {**OTHER[relative], parameter: float(value)}) == (DATA / relative).read_bytes()
+    assert written_back(conn, "nc_bound",
+                        {**OTHER[relative], parameter: float(value)}) == (DATA / relative).read_bytes()
 
 
 @pytest.mark.parametrize("relative, parameter, value, address, other", CASES)
@@ -199,7 +199,7 @@ def test_a_bound_parameter_whose_value_is_no_number_is_refused(run, tmp_path, va
     be bound and binds nothing, F400 stays literal, no warning, exit 0; the user believes the
     feed is a parameter of the class."""
     params = tmp_path / "p.json"
-    params.write_text('{"feed": {"value": %s, "addresses": ["F"]}}' % value)
+    params.write_text(f'{{"feed": {{"value": {value}, "addresses": ["F"]}}}}')
     result = run("import-nc", DATA / DEMO, "--class", "nc_nonumber", "--params", params)
     assert one_line_error(result) and "feed" in result.stderr, result.output
 

@@ -11,7 +11,8 @@ from engine.turning.moves import Move
 
 ISO = ('nc_path(moves, "G00 X{x:.3f} Z{z:.3f}", "G01 X{x:.3f} Z{z:.3f}", "G02 X{x:.3f} Z{z:.3f} R{r:.3f}", '
        '"G03 X{x:.3f} Z{z:.3f} R{r:.3f}", "G32 X{x:.3f} Z{z:.3f} F{pitch:.3f}")')
-SINUMERIK = ('nc_path(moves, "G0 X{x:.3f} Z{z:.3f}", "G1 X{x:.3f} Z{z:.3f}", "G2 X{x:.3f} Z{z:.3f} I={i:.3f} K={k:.3f}", '
+SINUMERIK = ('nc_path(moves, "G0 X{x:.3f} Z{z:.3f}", "G1 X{x:.3f} Z{z:.3f}", '
+             '"G2 X{x:.3f} Z{z:.3f} I={i:.3f} K={k:.3f}", '
              '"G3 X{x:.3f} Z{z:.3f} CR={r:.3f}", "G33 Z{z:.3f} K{pitch:.3f}")')
 MOVES = [Move("rapid", 2.0, 40.0), Move("feed", 0.0, 30.0), Move("ccw", -5.0, 40.0, radius=5.0, i=0.0, k=-5.0),
          Move("cw", -10.0, 30.0, radius=5.0, i=-5.0, k=0.0), Move("thread", -30.0, 29.0, pitch=1.5)]

@@ -10,11 +10,10 @@ import re
 
 import psycopg
 import pytest
-
-from engine.library.nc_import import import_nc
-
 from helpers.nc_files import DATA, FAMILY, instantiated, stored_at, stored_rows
 from helpers.outcomes import one_line_error
+
+from engine.library.nc_import import import_nc
 
 DEMO = "linuxcnc/lathe_g70_71_demo.ngc"
 CAM = "sinumerik/cam_840dsl/CAM_TEST.MPF"
@@ -158,7 +157,8 @@ def test_a_plain_parameter_does_not_turn_the_contour_a_g71_calls_into_a_quantity
     lines = instantiated(conn, "nc_q", {"depth": 200, "feed": 400})
     called = {match for line in lines for match in re.findall(r"^\s*G7[01][.\d]*\s+Q(\d+)", line)}
     defined = {match for line in lines for match in re.findall(r"^\s*O(\d+)\s+SUB", line)}
-    assert called and called <= defined, f"the G70/G71 lines call O{sorted(called)}, the program defines O{sorted(defined)}"
+    assert called and called <= defined, \
+        f"the G70/G71 lines call O{sorted(called)}, the program defines O{sorted(defined)}"
 
 
 def test_a_plain_parameter_does_not_rebind_the_tool_edge_or_the_spindle_number(conn):

@@ -3,15 +3,16 @@ no template row and no program stored may add a second line that reads as one, o
 matching a file on the control to its record would be told another program and version."""
 from __future__ import annotations
 
+import csv
+import io
+
 import psycopg
 import pytest
 from psycopg import errors
 from psycopg.types.json import Jsonb
 
-from engine.programs.instantiate import instantiate_gear
 from engine.nc.lineage import LINEAGE_ROW_ID
-import csv
-import io
+from engine.programs.instantiate import instantiate_gear
 
 SUBMIT = ("INSERT INTO program_submission (id, job_id, gear_class, template_version, template_hash, name, lines, "
           "row_ids, trace) VALUES (%s, %s, %s, %s, %s, %s, %s, %s, %s)")

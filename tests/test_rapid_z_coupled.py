@@ -31,7 +31,8 @@ def table_speed(speed: float, teeth: int, factor: float, velocity: float) -> flo
 
 
 def coupled(teeth: int, factor: float, speed: int, *blocks: str) -> list[str]:
-    return PRELUDE + ["G0 X200.000 Z50.000", "G0 Y0.000", "EGDEF(C,B,1,Z,1)", f'EGON(C,"FINE",B,-1,{teeth},Z,{factor:.6f},1)',
+    return PRELUDE + ["G0 X200.000 Z50.000", "G0 Y0.000", "EGDEF(C,B,1,Z,1)",
+                      f'EGON(C,"FINE",B,-1,{teeth},Z,{factor:.6f},1)',
                       f"M3 S{speed}", *blocks, "M5", "EGOFS(C)", "EGDEL(C)", "M30"]
 
 

@@ -10,13 +10,13 @@ import re
 
 import psycopg
 import pytest
+from helpers.roles import as_role, logins
 from psycopg import errors
 from psycopg.types.json import Jsonb
 
 from engine.errors import EngineError
 from engine.gears.cases import confirm_job
 from engine.programs.instantiate import instantiate_gear, instantiate_gears
-from helpers.roles import as_role, logins
 from engine.programs.options import RunMode
 
 # The engine's path for one program (engine.programs.storage): an id drawn from the sequence first,
@@ -228,12 +228,13 @@ def test_a_runner_confirms_a_job_the_engine_made(conn, program):
 
 
 def set_rough(field, value):
-    return ("UPDATE job SET cutting = jsonb_set(cutting, '{rough,%s}', '%s') WHERE id = %%(job)s" % (field, value))
+    return f"UPDATE job SET cutting = jsonb_set(cutting, '{{rough,{field}}}', '{value}') WHERE id = %(job)s"
 
 
 REFUSED_CASES = [   # (why, statements run as the owner first, words of the message)
     ("no program", ["INSERT INTO job (gear_id, gear_class, machine, hob_id, params, cutting) SELECT gear_id, "
-                    "gear_class, machine, hob_id, params, cutting FROM job WHERE id = %(job)s"], "has no stored program"),
+                    "gear_class, machine, hob_id, params, cutting FROM job WHERE id = %(job)s"],
+                    "has no stored program"),
     ("zero feed", [set_rough("axial_feed", 0)], "need a positive hob_speed, axial_feed and radial_feed"),
     ("negative feed", [set_rough("radial_feed", -36)], "need a positive"),
     ("feed not a number", [set_rough("axial_feed", '"fast"')], "need a positive"),
@@ -275,8 +276,9 @@ CASE_VALUES = [(246, 105, 36), (2800, 105, 36), (2700, 105, 36), (246, 259, 36),
 @pytest.mark.parametrize("speed, axial, radial", CASE_VALUES)
 def test_every_case_is_physically_plausible_whoever_adds_it(conn, speed, axial, radial):
     numbers = [float(value) for value in (speed, axial, radial)]
-    plausible = all(math.isfinite(value) and value > 0 for value in numbers) and cutting_speed(70, numbers[0]) <= 600 and all(
-        feed_per_rev(feed, numbers[0], 1, 19) <= 10 * 2 for feed in numbers[1:])
+    plausible = (all(math.isfinite(value) and value > 0 for value in numbers)
+                 and cutting_speed(70, numbers[0]) <= 600
+                 and all(feed_per_rev(feed, numbers[0], 1, 19) <= 10 * 2 for feed in numbers[1:]))
     insert = ("INSERT INTO cutting_case (module, teeth, material, hob_material, hob_starts, hob_tip_diameter, cut, "
               "hob_speed, axial_feed, radial_feed) VALUES (2, 19, '40Cr', 'HSS', 1, 70, 'rough', %s, %s, %s)")
     if plausible:

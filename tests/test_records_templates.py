@@ -10,6 +10,7 @@ import threading
 
 import psycopg
 import pytest
+from helpers.roles import as_role, logins
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from psycopg import errors
@@ -18,8 +19,8 @@ from psycopg.types.json import Jsonb
 from engine.cli.app import main
 from engine.library import refactor as refactoring
 from engine.library.nc_import import import_nc
-from engine.programs.instantiate import instantiate_gear
 from engine.nc.lineage import without_lineage
+from engine.programs.instantiate import instantiate_gear
 from engine.programs.options import RunMode
 from engine.programs.records import Planned
 from engine.programs.storage import store_one
@@ -28,8 +29,6 @@ from engine.templates.history import restore
 from engine.templates.rows import Template, TemplateRow, export_csv, rows_hash
 from engine.templates.store import load_template, replace_template
 from engine.templates.versions import draft_template
-
-from helpers.roles import as_role, logins
 
 
 @pytest.fixture
@@ -136,7 +135,8 @@ def test_no_class_lies_deeper_than_the_lineage_the_templates_follow(conn):
         for statement, params in [("INSERT INTO gear_class (name, parent) VALUES ('records_deeper', %s)", (chain[-1],)),
                                   ("UPDATE gear_class SET parent = %s WHERE name = %s", (chain[-1], chain[1])),
                                   ("UPDATE gear_class SET parent = %s WHERE name = 'duplex'", (chain[-1],))]:
-            with pytest.raises(errors.CheckViolation, match="cannot derive|at most 50 classes above"), conn.transaction():
+            with pytest.raises(errors.CheckViolation,
+                               match="cannot derive|at most 50 classes above"), conn.transaction():
                 conn.execute(statement, params)
     assert ancestors(conn, chain[-1]) == 50 and ancestors(conn, "duplex") == ancestors(conn, "spur") + 1
 
@@ -230,7 +230,8 @@ def test_a_stored_version_is_the_class_as_it_was_and_stays_so(conn):
     version = versions(conn, "spur")[0]
     refusals = [("INSERT INTO template_version_rows (gear_class, version, rows) VALUES ('spur', %s, '[]')"
                  % (version + 1), errors.IntegrityConstraintViolation),
-                ("UPDATE template_version_rows SET rows = '[]' WHERE gear_class = 'spur'", errors.InsufficientPrivilege),
+                ("UPDATE template_version_rows SET rows = '[]' WHERE gear_class = 'spur'",
+                 errors.InsufficientPrivilege),
                 ("DELETE FROM template_version_rows WHERE gear_class = 'spur'", errors.InsufficientPrivilege),
                 ("TRUNCATE template_version_rows CASCADE", errors.InsufficientPrivilege)]
     for statement, error in refusals:

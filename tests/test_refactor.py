@@ -7,6 +7,7 @@ import json
 
 import psycopg
 import pytest
+from helpers.refactor import bodies_stored_twice, component_count, duplicate_row_body, exports, lcs_sim
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -15,8 +16,6 @@ from engine.library.refactor import check_invariants, refactor, template_digests
 from engine.library.similarity import nc_units
 from engine.templates.rows import TemplateRow
 from engine.templates.store import ensure_class, replace_template
-
-from helpers.refactor import bodies_stored_twice, component_count, duplicate_row_body, exports, lcs_sim
 
 
 def test_seeded_library_is_stored_once_and_a_run_changes_nothing(conn):
@@ -263,7 +262,8 @@ def test_help_texts(run, args, words):
 def test_a_text_used_by_many_classes_lists_ten_uses_and_counts_them_all(conn):
     for number in range(12):
         ensure_class(conn, f"many_{number}")
-        replace_template(conn, f"many_{number}", [TemplateRow(100, "main", 1, None, None, '"G90 G71 G94 ; MANY"', None)])
+        replace_template(conn, f"many_{number}",
+                         [TemplateRow(100, "main", 1, None, None, '"G90 G71 G94 ; MANY"', None)])
     ensure_class(conn, "few")
     replace_template(conn, "few", [TemplateRow(100, "main", 1, None, None, '"G90 G71 G94 ; FEW"', None)])
     report = refactor(conn, threshold=0.6)

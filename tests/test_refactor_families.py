@@ -10,18 +10,17 @@ import json
 import re
 from collections import defaultdict
 
+import psycopg
 import pytest
 from click.testing import CliRunner
+from helpers.nc_files import DATA
+from helpers.outcomes import made
 
 from engine.cli.app import main
 from engine.errors import EngineError
 from engine.library.intended import intend, intents, shown_key, unintend
 from engine.library.nc_import import import_nc
 from engine.library.refactor import refactor
-
-from helpers.nc_files import DATA
-import psycopg
-from helpers.outcomes import made
 
 CAM = DATA / "sinumerik/cam_840dsl/CAM_TEST.MPF"
 BLOCK_NUMBER = re.compile(r"^N\d+ *")
@@ -127,9 +126,11 @@ def test_the_command_prints_a_family_once_with_its_size(fresh_database_url):
     result = run("refactor")
     assert result.exit_code == 0, result.output
     size = sum(1 for line in program_lines() if BLOCK_NUMBER.sub("", line) == RETRACT)
-    headers = [line for line in result.stdout.splitlines() if f"{size} lines differing only in the block number" in line]
+    headers = [line for line in result.stdout.splitlines()
+               if f"{size} lines differing only in the block number" in line]
     assert len(headers) == 1
-    assert sum(1 for line in result.stdout.splitlines() if line.strip().endswith(f' {RETRACT}"')) == 10   # first 10 members
+    # first 10 members
+    assert sum(1 for line in result.stdout.splitlines() if line.strip().endswith(f' {RETRACT}"')) == 10
 
 
 def key_of_full_texts(t: str, a: str, b: str) -> str:

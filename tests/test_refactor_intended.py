@@ -9,14 +9,13 @@ import json
 
 import psycopg
 import pytest
+from helpers.roles import as_role
 
 from engine.errors import EngineError
 from engine.library.intended import intend, intents, unintend
 from engine.library.refactor import refactor
 from engine.templates.rows import TemplateRow
 from engine.templates.store import ensure_class, replace_template
-
-from helpers.roles import as_role
 
 # Seeded coupling lines: the worm wheel couples Y, helical, taper and crowned couple Z. Their NC units
 # differ in one of 12 (Sim = 11/13 ≥ 0.8), so the seeded library reports this pair at 0.8.

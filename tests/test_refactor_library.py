@@ -13,6 +13,9 @@ from dataclasses import replace
 
 import psycopg
 import pytest
+from helpers.lineage_text import id_masked
+from helpers.nc_files import DATA, FAMILY, PARAMS, class_name, instantiate, real_files
+from helpers.refactor import bodies_stored_twice, component_count, duplicate_row_body, exports
 
 from engine.library.nc_import import import_nc
 from engine.library.refactor import STAGES, refactor
@@ -20,10 +23,6 @@ from engine.programs.instantiate import instantiate_gear
 from engine.templates.evaluator import evaluate
 from engine.templates.expressions import compile_expression
 from engine.templates.store import load_template, replace_template
-
-from helpers.lineage_text import id_masked
-from helpers.nc_files import DATA, FAMILY, PARAMS, class_name, instantiate, real_files
-from helpers.refactor import bodies_stored_twice, component_count, duplicate_row_body, exports
 
 SEEDED_CLASSES = {"spur", "helical", "taper", "crowned", "worm_wheel", "duplex"}
 WAIT = 30   # seconds: no wait of this file blocks longer, so a bug fails instead of hanging

@@ -6,21 +6,20 @@ import json
 
 import psycopg
 import pytest
+from helpers.roles import as_role
 from psycopg import sql
 
 from engine.errors import EngineError
-from engine.programs.instantiate import instantiate_gear
 from engine.nc.lineage import without_lineage
+from engine.programs.instantiate import instantiate_gear
 from engine.programs.options import RunMode
-from engine.templates.analysis import analyse, class_findings
+from engine.release.gate import release
 from engine.release.golden import run_golden_tests
 from engine.release.impact import impact
-from engine.release.gate import release
+from engine.templates.analysis import analyse, class_findings
 from engine.templates.rows import Template, TemplateRow
 from engine.templates.store import load_template
 from engine.templates.versions import released_template, released_version
-
-from helpers.roles import as_role
 
 SEEDED_CLASSES = ("spur", "helical", "duplex", "taper", "crowned", "worm_wheel", "turning_iso", "turning_840d")
 COOLANT_ROW = 1800   # seed_templates/classes/spur.csv: cutcond 1, `"M8"` when coolant

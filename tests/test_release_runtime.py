@@ -11,18 +11,18 @@ from pathlib import Path
 
 import psycopg
 import pytest
+from helpers.drawings import DXF, EMCO, seed_drawing
+from helpers.lineage_text import id_masked
+from helpers.releases import release_draft
+from helpers.roles import as_role
 from psycopg import errors, sql
 from psycopg.types.json import Jsonb
 
 from engine.errors import EngineError
-from engine.programs.instantiate import instantiate_gear
 from engine.nc.lineage import LINEAGE_ROW_ID
+from engine.programs.instantiate import instantiate_gear
 from engine.programs.options import RunMode
 from engine.simulation import simulate_stored_program
-from helpers.lineage_text import id_masked
-from helpers.releases import release_draft
-from helpers.roles import as_role
-from helpers.drawings import DXF, EMCO, seed_drawing
 
 SEEDED_GEARS = (42, 43, 44, 45, 46, 47, 50, 51, 53, 54)   # seed_templates/gears.csv: every hobbing class
 BROKEN_EDIT = "UPDATE template_view SET o = 'M8 ; COOLANT ON' WHERE gear_class = 'spur' AND o = '\"M8\"'"
@@ -142,7 +142,8 @@ def released_rows(conn, gear_class: str) -> list[tuple]:
 def test_a_parents_release_leaves_the_childrens_released_rows_alone(conn):
     duplex_before, duplex_lines = released_rows(conn, "duplex"), runner_lines(conn, 54)
     with as_role(conn, "engine_editor"):
-        conn.execute("UPDATE template_view SET o = '\"G90 G71 G94 ; SPUR EDIT\"' WHERE gear_class = 'spur' AND id = 800")
+        conn.execute("UPDATE template_view SET o = '\"G90 G71 G94 ; SPUR EDIT\"' "
+                     "WHERE gear_class = 'spur' AND id = 800")
     assert has_draft(conn, "spur") and has_draft(conn, "duplex")
     release_draft(conn, "spur")
     assert released_rows(conn, "duplex") == duplex_before

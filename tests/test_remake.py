@@ -3,7 +3,6 @@ programs of their stored parameters, all stored in one transaction or none."""
 import json
 
 import psycopg
-
 from helpers.lineage_text import LINES_ID_MASKED
 
 

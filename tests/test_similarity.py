@@ -4,11 +4,11 @@ here by a plain longest-common-subsequence table."""
 from __future__ import annotations
 
 import pytest
+from helpers.refactor import lcs_sim
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from engine.library.similarity import nc_units, similar_pairs
-from helpers.refactor import lcs_sim
 
 
 def every_pair(lines, threshold):

@@ -8,12 +8,11 @@ import math
 from dataclasses import replace
 
 import pytest
+from helpers.simulation_programs import Hand, k_z, least_run_out, number_of, swivel
 
 from engine.gears.records import GearUnit, load_gear, load_hobs
 from engine.machines.records import load_machine
 from engine.simulation import simulate_program
-
-from helpers.simulation_programs import Hand, k_z, least_run_out, number_of, swivel
 
 MACHINE = "hobber-840d"
 SPEED = 338.0                  # n0 of gear 43's seeded program: table n0·z0/z2 = 8.244 r/min (§B4)

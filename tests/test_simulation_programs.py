@@ -8,13 +8,12 @@ import math
 from dataclasses import replace
 
 import pytest
+from helpers.simulation_programs import Hand, k_y, k_z, lead_angle, number_of, swivel, with_cycle_time
 
 from engine.errors import EngineError
 from engine.gears.records import GearUnit, load_gear, load_hobs
 from engine.machines.records import load_machine
 from engine.simulation import SimulationError, prove_program, simulate_program
-
-from helpers.simulation_programs import Hand, k_y, k_z, lead_angle, number_of, swivel, with_cycle_time
 
 MACHINE = "hobber-840d"
 
@@ -88,7 +87,8 @@ def test_a_coupled_rapid_back_along_z_through_its_own_gaps_is_a_collision(record
     lines = spur.lines(cut[:2] + ["G0 X54.000", f"G0 Z{spur.z_start:.3f}"] + cut[2:])
     report = simulate_program(lines, spur.gear, spur.hob, records["machine"], "TEST")
     assert not refusal(report, number_of(lines, "G0 X54.000"))
-    assert any("into unit 1" in m and "rapid" in m for m in refusal(report, number_of(lines, f"G0 Z{spur.z_start:.3f}")))
+    assert any("into unit 1" in m and "rapid" in m
+               for m in refusal(report, number_of(lines, f"G0 Z{spur.z_start:.3f}")))
 
 
 def test_the_run_out_into_a_fixture_larger_than_the_root_is_refused(records, spur):

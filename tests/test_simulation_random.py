@@ -17,7 +17,6 @@ from engine.programs.instantiate import instantiate_gear
 from engine.simulation import simulate_stored_program
 from engine.simulation.envelope import HobBody, centres, nearest_radius
 
-
 GEAR_ID = 900001
 INSERT_GEAR = """
 INSERT INTO gear (id, gear_class, module, teeth, pressure_angle, helix_angle, hand, face_width, tip_diameter,
@@ -78,7 +77,8 @@ def test_random_gears_are_proved_or_refused_in_one_line(conn, case):
 def hob_points(body: HobBody, swivel: float, centre, count: int = 200) -> np.ndarray:
     """Points of the tip cylinder and both end faces, sampled on a grid, DIN coordinates."""
     a = math.radians(swivel)
-    axis, e1, e2 = np.array([0, math.cos(a), math.sin(a)]), np.array([1.0, 0, 0]), np.array([0, -math.sin(a), math.cos(a)])
+    axis, e1, e2 = (np.array([0, math.cos(a), math.sin(a)]), np.array([1.0, 0, 0]),
+                    np.array([0, -math.sin(a), math.cos(a)]))
     t, phi = np.meshgrid(np.linspace(-body.half_length, body.half_length, count), np.linspace(0, 2 * math.pi, count))
     ring = np.cos(phi)[..., None] * -e1 + np.sin(phi)[..., None] * e2
     surface = [t[..., None] * axis + body.radius * ring]

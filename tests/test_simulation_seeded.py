@@ -9,8 +9,8 @@ import pytest
 
 from engine.errors import EngineError
 from engine.gears.records import load_gear, load_hobs
-from engine.machines.records import load_machine
 from engine.hobbing.choices import Choices
+from engine.machines.records import load_machine
 from engine.programs import verified_run
 from engine.programs.instantiate import instantiate_gear
 from engine.simulation import simulate_program, simulate_stored_program

@@ -5,6 +5,8 @@ engine_editor."""
 
 import psycopg
 import pytest
+from helpers.releases import release_draft
+from helpers.roles import as_role
 from psycopg import errors, sql
 
 from engine.library.refactor import refactor
@@ -12,8 +14,6 @@ from engine.programs.instantiate import instantiate_gear
 from engine.programs.options import RunMode
 from engine.templates.rows import TemplateRow, export_csv
 from engine.templates.store import load_template, replace_template
-from helpers.releases import release_draft
-from helpers.roles import as_role
 
 ROW_COLUMNS = ("id", "t", "n", "p_calc", "s", "o", "p_emit")
 
@@ -225,7 +225,8 @@ REFUSALS = [
      errors.UniqueViolation, "class spur row 800 column id: the class already has row 900 (its own)"),
     ("unknown class",
      "INSERT INTO template_view (gear_class, id, t, o) VALUES ('no_such_class', 10, 'main', '\"G90\"')",
-     errors.ForeignKeyViolation, "class no_such_class row 10 column gear_class: gear class 'no_such_class' does not exist"),
+     errors.ForeignKeyViolation,
+     "class no_such_class row 10 column gear_class: gear class 'no_such_class' does not exist"),
     ("negative id",
      "UPDATE template_view SET id = -5 WHERE gear_class = 'spur' AND id = 800",
      errors.CheckViolation, "class spur row -5 column id: id must not be negative"),
@@ -365,7 +366,8 @@ FORBIDDEN = [
     ("engine_editor", "UPDATE program SET name = 'x'"),
     ("engine_editor", "DELETE FROM job"),
     ("engine_editor", "DELETE FROM cutting_case"),
-    ("engine_editor", "INSERT INTO template_audit (gear_class, row_id, operation, new) VALUES ('spur', 1, 'INSERT', '{}')"),
+    ("engine_editor",
+     "INSERT INTO template_audit (gear_class, row_id, operation, new) VALUES ('spur', 1, 'INSERT', '{}')"),
     ("engine_editor", "DELETE FROM template_audit"),
     ("engine_editor", "UPDATE template_audit SET changed_by = 'someone else'"),
     ("engine_runner", "UPDATE template_view SET o = '\"X\"' WHERE gear_class = 'spur' AND id = 800"),
@@ -381,8 +383,10 @@ FORBIDDEN = [
     ("engine_reader", "INSERT INTO component (t, o) VALUES ('main', '\"X\"')"),
     ("engine_reader", "INSERT INTO gear_class (name) VALUES ('x')"),
     ("engine_reader", "INSERT INTO cutting_case (module, teeth, material, hob_material, hob_starts, hob_tip_diameter, "
-                      "cut, hob_speed, axial_feed, radial_feed) VALUES (2, 20, 'C45', 'HSS', 1, 80, 'rough', 100, 1, 1)"),
-    ("engine_reader", "INSERT INTO template_audit (gear_class, row_id, operation, new) VALUES ('spur', 1, 'INSERT', '{}')"),
+                      "cut, hob_speed, axial_feed, radial_feed) "
+                      "VALUES (2, 20, 'C45', 'HSS', 1, 80, 'rough', 100, 1, 1)"),
+    ("engine_reader",
+     "INSERT INTO template_audit (gear_class, row_id, operation, new) VALUES ('spur', 1, 'INSERT', '{}')"),
     ("engine_reader", "SELECT audit_class_change('spur', '{}')"),
 ]
 
@@ -406,7 +410,8 @@ def test_a_reader_reads_everything(conn):
 
 def test_an_editor_edits_templates_a_releaser_releases_and_a_runner_instantiates_them(conn):
     with as_role(conn, "engine_editor"):
-        conn.execute("UPDATE template_view SET o = '\"G90 G71 G94 ; BY EDITOR\"' WHERE gear_class = 'spur' AND id = 800")
+        conn.execute("UPDATE template_view SET o = '\"G90 G71 G94 ; BY EDITOR\"' "
+                     "WHERE gear_class = 'spur' AND id = 800")
         conn.execute("UPDATE gear_class SET description = description || '.' WHERE name = 'spur'")
     with as_role(conn, "engine_releaser"):
         release_draft(conn, "spur")

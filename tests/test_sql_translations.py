@@ -45,7 +45,8 @@ def test_no_engine_role_may_write_a_translation(conn):
     for role in ("engine_runner", "engine_editor"):
         with pytest.raises(psycopg.errors.InsufficientPrivilege), conn.transaction():
             conn.execute(f"SET LOCAL ROLE {role}")
-            conn.execute("INSERT INTO sql_translation (text_hash, sql, python) VALUES ('x', 'coolant AND 1 = 1', 'True')")
+            conn.execute("INSERT INTO sql_translation (text_hash, sql, python) "
+                         "VALUES ('x', 'coolant AND 1 = 1', 'True')")
 
 
 def test_lint_names_a_translation_that_is_not_sqlglot_s(run):

@@ -15,6 +15,8 @@ import math
 
 import numpy as np
 import pytest
+from helpers.hob_clearance import CUTTING, MACHINE, hob_surface, seeded_hobs
+from helpers.nc_reader import read_program
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -23,9 +25,6 @@ from engine.gears.records import Gear, Hob
 from engine.hobbing.choices import FEED_MODES, Choices
 from engine.hobbing.taper import TaperModel
 from engine.programs.instantiate import instantiate_gear
-
-from helpers.nc_reader import read_program
-from helpers.hob_clearance import CUTTING, MACHINE, hob_surface, seeded_hobs
 
 MARGIN = 0.25           # mm: the least clearance an infeed may leave (the engine keeps more)
 
@@ -157,7 +156,8 @@ def test_random_taper_gears_infeed_clear_of_the_blank(layout):
 def test_the_papers_gear_infeeds_clear_of_its_cone_in_the_program(conn, cone, feed_mode):
     """Seeded gear 50 (the paper's: cone 6.5°, conventional-climb was 0.62 mm inside)."""
     conn.execute("UPDATE gear SET cone_angle = %s WHERE id = 50", (cone,))
-    row = conn.execute("SELECT module, teeth, face_width, tip_diameter, root_diameter FROM gear WHERE id = 50").fetchone()
+    row = conn.execute("SELECT module, teeth, face_width, tip_diameter, root_diameter "
+                       "FROM gear WHERE id = 50").fetchone()
     gear = Gear(50, "taper", float(row[0]), row[1], 20.0, 0.0, None, float(row[2]), float(row[3]), float(row[4]),
                 cone, None, None, None, None, None)
     program = instantiate_gear(conn, 50, choices=Choices(feed_mode=feed_mode, cuts=2))

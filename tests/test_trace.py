@@ -7,19 +7,20 @@ import re
 
 import psycopg
 import pytest
+from helpers.drawings import seed_drawing
 
 from engine.hobbing.choices import Choices
-from engine.programs.instantiate import instantiate_gear, instantiate_gears
 from engine.nc.lineage import LINEAGE_ROW_ID
+from engine.programs.dxf_import import import_dxf
+from engine.programs.instantiate import instantiate_gear, instantiate_gears
 from engine.programs.remake import instantiate_job
 from engine.templates.store import load_template
-from engine.programs.dxf_import import import_dxf
-from helpers.drawings import seed_drawing
 
 SEEDED_GEARS = {42: "spur", 43: "helical", 45: "spur", 50: "taper", 51: "crowned", 53: "worm_wheel", 54: "duplex"}
 CHOICES = (Choices(), Choices(cuts=2, coolant=False, tailstock=False, feed_mode="conventional-climb"),
            Choices(shift_per_part=0.5), Choices(worm_feed="tangential"))
-SQL_WORDS = ((r"\bAND\b", " and "), (r"\bOR\b", " or "), (r"\bNOT\b", " not "), (r"<>", "!="), (r"(?<![<>!=])=(?!=)", "=="))
+SQL_WORDS = ((r"\bAND\b", " and "), (r"\bOR\b", " or "), (r"\bNOT\b", " not "), (r"<>", "!="),
+             (r"(?<![<>!=])=(?!=)", "=="))
 FUNCTIONS = {name: getattr(math, name) for name in ("sqrt", "sin", "cos", "tan", "radians", "degrees", "ceil",
                                                     "floor", "fabs", "atan", "atan2", "hypot")}
 FUNCTIONS.update({"abs": abs, "min": min, "max": max, "round": round, "int": int, "float": float, "len": len})
@@ -72,7 +73,7 @@ def values_read(entry, inputs, computed) -> dict:
 
 def check_origins(entry, inputs, params, module_params, computed):
     """Each value read is the job's, its module's, or the value a named row computed."""
-    for column, reads in entry.get("read", {}).items():
+    for reads in entry.get("read", {}).values():
         for name, origin in reads.items():
             value = None if origin.startswith("row ") else inputs[origin][name]
             if origin == "job":
@@ -158,7 +159,8 @@ def test_engine_explain_says_why_a_line_is_missing(run):
     assert explained.exit_code == 0
     assert explained.stdout == "1800 not emitted: p_emit coolant = False (job)\n"
     whole = run("explain", "--program", program_id).stdout.splitlines()
-    assert 'EGON(C,"FINE",B,-1,19) emitted' in whole[next(i for i, l in enumerate(whole) if l.startswith("1500 "))]
+    assert 'EGON(C,"FINE",B,-1,19) emitted' in whole[next(i for i, line in enumerate(whole)
+                                                          if line.startswith("1500 "))]
     assert "z2 = 19 (job)" in next(line for line in whole if line.startswith("1500 "))
 
 
@@ -181,7 +183,8 @@ def test_explain_errors_are_one_line(run, args, words):
 COPY_WITHOUT_TRACE = """
 INSERT INTO program_submission (id, job_id, gear_class, template_version, template_hash, name, lines, row_ids, trace)
 SELECT n.id, p.job_id, p.gear_class, p.template_version, p.template_hash, p.name,
-       ARRAY(SELECT CASE WHEN l.row_id = -1 THEN regexp_replace(l.text, 'PROGRAM \\d+', 'PROGRAM ' || n.id) ELSE l.text END
+       ARRAY(SELECT CASE WHEN l.row_id = -1 THEN regexp_replace(l.text, 'PROGRAM \\d+', 'PROGRAM ' || n.id)
+                         ELSE l.text END
              FROM unnest(p.lines, p.row_ids) WITH ORDINALITY AS l (text, row_id, number) ORDER BY l.number),
        p.row_ids, NULL
 FROM program p, (SELECT nextval('program_id_seq') AS id) n WHERE p.id = %s RETURNING id"""

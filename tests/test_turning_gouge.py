@@ -8,6 +8,8 @@ import re
 
 import ezdxf
 import pytest
+from helpers.drawings import INCH, seed_drawing
+from helpers.turning_jobs import refused_after
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
@@ -15,9 +17,6 @@ from engine.errors import EngineError
 from engine.programs.dxf_import import import_dxf
 from engine.turning.gouge import GOUGE_TOLERANCE_MM, PartIndex, check_no_gouge
 from engine.turning.moves import Move
-from helpers.drawings import INCH, seed_drawing
-from helpers.turning_jobs import refused_after
-
 
 # A shaft R10 from Z 0 to −60 with a collar R20 over Z −30 … −40, closed by the axis.
 CORNERS = [(0.0, 0.0), (0.0, 10.0), (-30.0, 10.0), (-30.0, 20.0), (-40.0, 20.0), (-40.0, 10.0),
@@ -57,7 +56,8 @@ def test_a_move_over_the_collar_is_refused_and_one_above_it_passes():
     through = [[Move("rapid", -20.0, 30.0), Move("feed", -50.0, 30.0)]]   # R15 under the R20 collar
     with pytest.raises(EngineError, match=r"test: the G1 move to X30\.000 Z-50\.000 cuts") as refused:
         check_no_gouge(through, index, "test")
-    depth, z = (float(v) for v in re.search(r"cuts (\S+) mm into the part at Z(\S+) X30\.000", str(refused.value)).groups())
+    depth, z = (float(v) for v in re.search(r"cuts (\S+) mm into the part at Z(\S+) X30\.000",
+                                            str(refused.value)).groups())
     assert -40.0 <= z <= -30.0                                   # in the collar's span
     assert depth == pytest.approx(distance_to_outline(z, 15.0), abs=1e-3)
 

@@ -10,18 +10,18 @@ import math
 from pathlib import Path
 
 import pytest
+from helpers.drawings import DXF, EMCO, INCH, nc_arc_words, seed_drawing
+from helpers.drawn_parts import profile_only_drawing, two_rough_layers
+from helpers.lathe_programs import distance_to_drawn, drawn_polylines, motions, operation_lines, words
 from psycopg.types.json import Jsonb
 
 from engine.errors import EngineError
 from engine.library.refactor import refactor
-from engine.programs.remake import instantiate_job
-from engine.verifier import LimitError
 from engine.programs.dxf_import import import_dxf
+from engine.programs.remake import instantiate_job
 from engine.turning.job_params import ProfileOptions
 from engine.turning.names import MAX_OPERATIONS
-from helpers.lathe_programs import distance_to_drawn, drawn_polylines, motions, operation_lines, words
-from helpers.drawings import DXF, EMCO, INCH, nc_arc_words, seed_drawing
-from helpers.drawn_parts import profile_only_drawing, two_rough_layers
+from engine.verifier import LimitError
 
 # ISO F words carry their decimal point (a Fanuc-type control reads F1300 by a parameter's unit).
 DIALECTS = {"lathe-iso": {"tools": ("T0101", "T0202"), "thread": "G32", "coolant": ("M08", "M09"),
@@ -83,7 +83,7 @@ def test_emco_finish_pass_follows_the_drawn_profile(conn, name):
     finish = operation_lines(lines, 2)
     cuts = [(g, start, end) for g, start, end in motions(finish) if g in (1, 2, 3)]
     drawn = drawn_polylines(DXF / name)
-    for _, start, end in cuts:
+    for _, _, end in cuts:
         assert distance_to_drawn(end, drawn) <= 0.01, end
     vertices = {point for line in drawn for point in (line[0], line[-1])}
     reached = [end for _, _, end in cuts]

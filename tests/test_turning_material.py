@@ -6,19 +6,19 @@ from __future__ import annotations
 
 import json
 import math
+import re
 
 import ezdxf
 import psycopg
 import pytest
+from helpers.lathe_programs import INSIDE_MM, SAMPLES_PER_MOVE, motions
 from psycopg.types.json import Jsonb
 
 from engine.errors import EngineError
+from engine.paths import SAMPLE_DRAWING
 from engine.turning.defaults import CLEARANCE
 from engine.turning.material import Blank, check_rapids_in_air, job_blank
 from engine.turning.moves import Move
-from engine.paths import SAMPLE_DRAWING
-from helpers.lathe_programs import INSIDE_MM, SAMPLES_PER_MOVE, motions
-import re
 
 BLANK = Blank(z_front=0.0, z_back=-50.0, radius=20.0, assumed=False)   # Ø40 × 50, face at Z 0
 TOOL_CHANGE = (50.0, 60.0)                                              # (Z, radius), far outside
@@ -311,7 +311,8 @@ def g0_moves(lines: list[str]):
         words = dict(re.findall(r"\b([XZ])(-?\d+(?:\.\d+)?)", line))
         if not words:
             continue
-        new_z, new_x = float(words.get("Z", z if z is not None else "nan")), float(words.get("X", x if x is not None else "nan"))
+        new_z = float(words.get("Z", z if z is not None else "nan"))
+        new_x = float(words.get("X", x if x is not None else "nan"))
         if z is not None and x is not None and re.match(r"\s*(N\d+\s+)?G0?0\b", line):
             found.append(((z, x / 2), (new_z, new_x / 2)))
         z, x = new_z, new_x
@@ -335,6 +336,7 @@ def test_no_rapid_runs_through_the_facing_allowance_the_drawing_shows(run, tmp_p
     program = run("instantiate", "--job", json.loads(made.stdout)["job_id"], "--dry-run")
     assert program.exit_code == 0, program.output
     through = [(start, end) for start, end in g0_moves(program.stdout.splitlines())
-               if any(in_front_stock((start[0] + (end[0] - start[0]) * k / 100, start[1] + (end[1] - start[1]) * k / 100))
+               if any(in_front_stock((start[0] + (end[0] - start[0]) * k / 100,
+                                      start[1] + (end[1] - start[1]) * k / 100))
                       for k in range(101))]
     assert through == []

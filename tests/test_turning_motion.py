@@ -14,12 +14,12 @@ from pathlib import Path
 import ezdxf
 import numpy as np
 import pytest
-
-from engine.programs.remake import instantiate_job
-from engine.programs.dxf_import import import_dxf
-from engine.turning.job_params import ProfileOptions
-from helpers.lathe_programs import drawn_polylines, motions, words
 from helpers.drawings import DXF, EMCO, seed_drawing
+from helpers.lathe_programs import drawn_polylines, motions, words
+
+from engine.programs.dxf_import import import_dxf
+from engine.programs.remake import instantiate_job
+from engine.turning.job_params import ProfileOptions
 
 MACHINES = ("lathe-iso", "lathe-840d")
 SAMPLE_MM = 0.05

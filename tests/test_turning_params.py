@@ -5,15 +5,14 @@ two-layer drawing; each test rolled back."""
 from __future__ import annotations
 
 import pytest
-
-from engine.errors import EngineError
-from engine.machines.records import load_machine
-from engine.verifier import LimitError, verify_program
-from engine.programs.dxf_import import import_dxf
 from helpers.drawings import seed_drawing
 from helpers.drawn_parts import two_rough_layers
 from helpers.turning_jobs import refused_after
 
+from engine.errors import EngineError
+from engine.machines.records import load_machine
+from engine.programs.dxf_import import import_dxf
+from engine.verifier import LimitError, verify_program
 
 MODULE = "module_params = jsonb_set(module_params, '{%s}', '%s')"
 DROP = "module_params = module_params #- '{%s}'"
@@ -30,7 +29,8 @@ JOB = "params = jsonb_set(params, '{%s}', '%s')"
     (MODULE % ("prep:1,tool", "123"), r"prep:1\.tool = 123 must be a whole number 1 … 99"),
     (MODULE % ("prep:1,tool", "1.5"), r"prep:1\.tool = 1\.5 must be a whole number"),
     (MODULE % ("prep:1,tool_offset", '"a"'), r"prep:1\.tool_offset = 'a' must be a whole number 1 … 99"),
-    (MODULE % ("prep:1,tool_offset", "0"), r"prep:1\.tool_offset = 0 must be a whole number 1 … 99"),   # T0100: no offset
+    # T0100: no offset
+    (MODULE % ("prep:1,tool_offset", "0"), r"prep:1\.tool_offset = 0 must be a whole number 1 … 99"),
     (MODULE % ("cutmotion:2,op_present", '"false"'), r"cutmotion:2\.op_present = 'false' must be true or false"),
     (MODULE % ("cutcond:2,coolant", '"no"'), r"cutcond:2\.coolant = 'no' must be true or false"),
     (MODULE % ("cutmotion:1,kind", '"rough"'), r"cutmotion:1\.kind = 'rough' is not one of"),

@@ -12,19 +12,25 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from helpers.drawings import seed_drawing
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from engine.drawings.drawing import read_drawing
+from engine.drawings.geometry import Arc, Line
 from engine.errors import EngineError
 from engine.turning.moves import Move
 from engine.turning.plot import plot_job
 from engine.turning.region import CHORD_TOLERANCE_MM
-from engine.turning.toolpaths import (alternate, distance_to_region, drawn_rough_passes,
-                                      finish_passes, profile_rough_passes, slot_passes,
-                                      thread_passes)
-from engine.drawings.drawing import read_drawing
-from engine.drawings.geometry import Arc, Line
-from helpers.drawings import seed_drawing
+from engine.turning.toolpaths import (
+    alternate,
+    distance_to_region,
+    drawn_rough_passes,
+    finish_passes,
+    profile_rough_passes,
+    slot_passes,
+    thread_passes,
+)
 
 INCH = 25.4
 CLEARANCE = 1.0
@@ -281,7 +287,8 @@ def step(z, low, high, kind, size):
         return [Arc((z, low), (z - size, low + size), (z, low + size), ccw=False),
                 Line((z - size, low + size), (z - size, high))]
     # the outer corner rounded: from the centre's right to above it
-    return [Line((z, low), (z, high - size)), Arc((z, high - size), (z - size, high), (z - size, high - size), ccw=True)]
+    return [Line((z, low), (z, high - size)),
+            Arc((z, high - size), (z - size, high), (z - size, high - size), ccw=True)]
 
 
 @settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])

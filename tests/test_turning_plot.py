@@ -11,14 +11,14 @@ import json
 import math
 
 import pytest
-
-from engine.programs.remake import instantiate_job
-from engine.programs.dxf_import import import_dxf
-from engine.turning.job_params import ProfileOptions
-from engine.turning.job_plot import turning_job_figure
-from helpers.lathe_programs import distance_to_drawn, drawn_polylines, operation_lines, words
 from helpers.drawings import DXF, INCH, seed_drawing
 from helpers.drawn_parts import two_rough_layers
+from helpers.lathe_programs import distance_to_drawn, drawn_polylines, operation_lines, words
+
+from engine.programs.dxf_import import import_dxf
+from engine.programs.remake import instantiate_job
+from engine.turning.job_params import ProfileOptions
+from engine.turning.job_plot import turning_job_figure
 
 HEMISPHERE = "emco_lathe_testg02hemisphere_R14.dxf"
 PRINTED_MM = 0.0005   # the program states positions to 0.001 mm, rounded

@@ -11,15 +11,15 @@ import json
 import ezdxf
 import psycopg
 import pytest
+from helpers.drawn_parts import DRAWN_DIAMETERS, drawing
+from helpers.lathe_programs import INSIDE_MM, SAMPLES_PER_MOVE, finish_diameters, motions, operation_lines
+from helpers.outcomes import counts
 
+from engine.drawings.drawing import read_drawing
+from engine.drawings.read import DxfError
 from engine.errors import EngineError
 from engine.turning.job_params import ProfileOptions, turning_job
 from engine.turning.model import job_passes
-from engine.drawings.drawing import read_drawing
-from engine.drawings.read import DxfError
-from helpers.lathe_programs import INSIDE_MM, SAMPLES_PER_MOVE, finish_diameters, motions, operation_lines
-from helpers.drawn_parts import DRAWN_DIAMETERS, drawing
-from helpers.outcomes import counts
 
 INCH_MM = 25.4
 ROUGH = ProfileOptions(rough_depth=1.0)
@@ -147,7 +147,8 @@ def test_the_disc_job_finishes_its_outside_diameter(run, tmp_path):
     assert made.exit_code == 0, made.output
     program = run("instantiate", "--job", json.loads(made.stdout)["job_id"], "--dry-run")
     finish = operation_lines(program.stdout.splitlines(), 2)
-    along_z = {2 * start[1] for g, start, end in motions(finish) if g == 1 and start[1] == end[1] and start[0] != end[0]}
+    along_z = {2 * start[1] for g, start, end in motions(finish)
+               if g == 1 and start[1] == end[1] and start[0] != end[0]}
     assert along_z == {2 * OUTSIDE}
 
 
@@ -177,7 +178,8 @@ def test_a_drawing_whose_header_says_imperial_is_not_turned_in_millimetres(run, 
     inch = 25.4
 
     def draw(msp):
-        msp.add_lwpolyline([(z / inch, r / inch) for z, r in SHAFT] + [(z / inch, -r / inch) for z, r in reversed(SHAFT)],
+        msp.add_lwpolyline([(z / inch, r / inch) for z, r in SHAFT] + [(z / inch, -r / inch)
+                                                                       for z, r in reversed(SHAFT)],
                            close=True)
     doc = ezdxf.new("R2010")
     doc.header["$INSUNITS"] = 0

@@ -14,13 +14,21 @@ from pathlib import Path
 
 import psycopg
 import pytest
+from helpers.drawings import seed_drawing
+from helpers.golden_cases import TURNING_CASES
+from helpers.verifier_programs import (
+    HOBBING,
+    LATHE_ISO,
+    PRELUDES,
+    accepted,
+    one_line_exit_1,
+    program,
+    programs,
+    refusal,
+)
 
 from engine.machines.records import load_machine
 from engine.verifier import LimitError, verify_program
-from helpers.golden_cases import TURNING_CASES
-from helpers.drawings import seed_drawing
-from helpers.verifier_programs import (HOBBING, LATHE_ISO, PRELUDES, accepted, one_line_exit_1, program, programs,
-                                       refusal)
 
 GOLDEN = Path(__file__).resolve().parent / "golden"
 

@@ -15,10 +15,10 @@ import math
 
 import psycopg
 import pytest
+from helpers.verifier_programs import HOBBING, LATHE_ISO, READY, accepted, one_line_exit_1, program, programs, refusal
 
 from engine.machines.records import load_machine
 from engine.verifier import LimitError, verify_program
-from helpers.verifier_programs import HOBBING, LATHE_ISO, READY, accepted, one_line_exit_1, program, programs, refusal
 
 MAX_FEED = 20000.0           # mm/min: the verifier's feed bound (about a rapid traverse)
 MAX_DIFFERENTIAL = 360.0     # °/mm: one table turn per mm of travel, a lead of 1 mm

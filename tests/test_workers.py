@@ -4,7 +4,6 @@ gear is named)."""
 import json
 
 import psycopg
-
 from helpers.lineage_text import LINES_ID_MASKED
 
 

@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import io
 import json
-import os
 import logging
+import os
 import sys
 import traceback
 import unicodedata
@@ -29,12 +29,12 @@ from .hobs import hobs
 from .instantiate import instantiate
 from .jobs import jobs
 from .nc_import import import_nc_command
+from .plot import plot_command
 from .programs import programs
 from .refactor import refactor_command
 from .settings import config
 from .simulate import simulate
 from .templates import lint, template
-from .plot import plot_command
 from .turning import import_dxf_command
 
 JSON_ARGS = "engine.json_args"   # ctx.meta: --json among the invocation's arguments

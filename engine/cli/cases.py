@@ -31,8 +31,8 @@ def suggest(ctx, gear_id, top, machine, as_json):
     the proposal (n0, v, feeds in mm/min and mm per workpiece revolution) and plausibility notes.
     """
     from .. import turning  # noqa: F401  (importing it registers the turning names model)
-    from ..hobbing import models as hobbing_models  # noqa: F401  (importing it registers the hobbing models)
     from ..gears.cases import suggest_for_gear
+    from ..hobbing import models as hobbing_models  # noqa: F401  (importing it registers the hobbing models)
 
     with connection(ctx) as conn:
         suggestion = suggest_for_gear(conn, gear_id, machine, top=top)
@@ -51,9 +51,9 @@ def _suggestion_text(s) -> str:
     gear, cutting = s.gear, s.cutting
     lines = [f"gear {gear.id}: m{gear.module:g} z{gear.teeth} {gear.material or '?'} "
              f"{'' if gear.hardness is None else f'{gear.hardness:g} HB '}grade {gear.quality_grade or '?'}",
-             f"hob {s.hob.id}: {s.hob_reason}",
+             f"hob {s.hob_reason}",   # the reason starts with the hob id
              f"machine {s.machine.name} (hob spindle max {s.machine.spindle_max:g} r/min)"]
-    for cut, proposal in s.proposals.items():
+    for cut in s.proposals:
         cases = s.cases[s.cases.cut == cut]
         lines += ["", f"{cut} cases (nearest {len(cases)}):" if len(cases) else f"{cut}: no cases in the history"]
         if len(cases):

@@ -2,10 +2,15 @@
 (Named golden.py, not tests.py, so pytest does not collect it.)"""
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import click
 
 from ..errors import EngineError
 from .context import connection, emit_json
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
 
 @click.command("test")
@@ -23,7 +28,7 @@ def test_command(ctx, gear_class, released, show_coverage, days, as_json):
     `FAIL … <first difference>`, then a summary. Exit 1 if any test fails or none exists.
 
     The expectations are `line: M30`, `no line: M8`, `match: REGEX`, `no match: REGEX`,
-    `last X = (df2 + da0)/2 ± 0.01` and the like (README, "Golden tests").
+    `last X = (df2 + da0)/2 ± 0.01` and the like (docs/guide/release-and-golden-tests.md).
 
     Example: engine test --class spur --json
     """
@@ -37,7 +42,7 @@ def test_command(ctx, gear_class, released, show_coverage, days, as_json):
         _report_tests(conn, classes, gear_class, released, as_json)
 
 
-def _report_tests(conn, classes, gear_class, released, as_json) -> None:
+def _report_tests(conn: Connection, classes, gear_class, released, as_json) -> None:
     from ..release.golden import run_golden_tests
 
     results = run_golden_tests(conn, classes, draft=not released)
@@ -64,7 +69,7 @@ def _result_line(result) -> str:
     return f"FAIL {result.label} v{result.version}{state}: {failure}"
 
 
-def _report_coverage(conn, classes, days, as_json) -> None:
+def _report_coverage(conn: Connection, classes, days, as_json) -> None:
     from ..release.coverage import coverage
 
     rows = coverage(conn, days, classes)

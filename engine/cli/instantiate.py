@@ -4,6 +4,7 @@ from __future__ import annotations
 import re
 from dataclasses import replace
 from functools import partial
+from typing import TYPE_CHECKING
 
 import click
 
@@ -11,6 +12,9 @@ from ..errors import EngineError
 from .context import connection, emit_json, settings
 from .ids import GEAR_ID, JOB_ID
 from .progress import progress_bar
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
 RANGE = re.compile(r"^\s*(\d+)\s*(?:-\s*(\d+))?\s*$")
 
@@ -157,7 +161,7 @@ def _output(config, machine: str | None, out, force: bool, new_job_written: bool
     return Output(out=out, force=force)
 
 
-def _batch(conn, job_range, gear_range, machine, choices, overrides, output, mode):
+def _batch(conn: Connection, job_range, gear_range, machine, choices, overrides, output, mode):
     """A batch of stored jobs made again (--jobs), or of gears (--gears, --all), with a progress
     bar on a terminal."""
     from ..programs.instantiate import instantiate_gears
@@ -223,7 +227,7 @@ def _refuse_new_job_choices_for_stored_jobs(ctx, stored_jobs: bool) -> None:
                           "stored parameters: edit job.params in SQL to change them")
 
 
-def _class_job(conn, gear_class, params_file, machine, output, mode, unverified):
+def _class_job(conn: Connection, gear_class, params_file, machine, output, mode, unverified):
     """The job of the class with the values of --params (the class's imported ones without it)."""
     from ..library.nc_import import read_params
     from ..programs.class_jobs import instantiate_class

@@ -7,9 +7,10 @@ from __future__ import annotations
 
 import functools
 import re
+from collections.abc import Callable
 from dataclasses import dataclass
 from datetime import date, datetime
-from typing import Any, Callable
+from typing import Any
 
 import click
 
@@ -44,7 +45,8 @@ def csv_cell(value: Any) -> Any:
 # a cell beginning so is a formula to Excel and LibreOffice (the full-width forms too: Excel in
 # CJK locales reads them as the ASCII ones)
 FORMULA_START = ("=", "+", "@", "\t", "\r", "\uff1d", "\uff0b", "\uff20", "\uff0d")
-NUMBER_TEXT = re.compile(r"-(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?")   # -5, -0.25, -.5, -1e-3: a negative number, not a formula
+# -5, -0.25, -.5, -1e-3: a negative number, not a formula
+NUMBER_TEXT = re.compile(r"-(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?")
 
 
 def inert_text(text: str) -> str:
@@ -89,7 +91,8 @@ def list_options(things: str) -> Callable:
         @functools.wraps(command)
         def with_output(*args, as_json: bool, as_csv: bool, **kwargs):
             chosen = one_of(click.get_current_context(), {"as_json": as_json, "as_csv": as_csv})
-            return command(*args, output={"as_json": "json", "as_csv": "csv"}.get(chosen), **kwargs)
+            output = {"as_json": "json", "as_csv": "csv"}.get(chosen) if chosen is not None else None
+            return command(*args, output=output, **kwargs)
         with_output = click.option("--csv", "as_csv", is_flag=True,
                                    help="Print CSV: a header line of keys, then one line per record.")(with_output)
         return click.option("--json", "as_json", is_flag=True,

@@ -51,13 +51,15 @@ def programs():
 @click.pass_context
 def programs_list(ctx, gear_class, gear_id, job_id, draft, released, since, until, output):
     """The programs stored, one line each: name, job, gear, class, template version and hash,
-    draft or released, read by the verifier or UNVERIFIED, number of lines, when stored (the text: `engine programs show ID`).
+    draft or released, read by the verifier or UNVERIFIED, number of lines, when stored
+    (the text: `engine programs show ID`).
 
     Example: engine programs list --gear 42 --released --since 2026-11-01
     """
     from ..programs.lookup import list_programs
 
-    kind = {"draft": True, "released": False}.get(one_of(ctx, {"draft": draft, "released": released}))
+    chosen = one_of(ctx, {"draft": draft, "released": released})
+    kind = {"draft": True, "released": False}.get(chosen) if chosen is not None else None
     with connection(ctx) as conn:
         found = list_programs(conn, gear_class, gear_id, job_id, kind, day(since), day(until))
     emit_list(output, "programs", PROGRAM_COLUMNS, found)

@@ -21,4 +21,4 @@ def progress_bar(label: str):
             bar.label = stage
             bar.update(done - bar.pos)
         yield update
-        bar.update(bar.length - bar.pos)
+        bar.update((bar.length or 0) - bar.pos)   # the length is set (at least 1) by the first update

@@ -5,8 +5,8 @@ from __future__ import annotations
 import click
 
 from .context import connection, emit_json
-from .output import Column, emit_list, list_options
 from .intended import intend_command, intents_command, unintend_command
+from .output import Column, emit_list, list_options
 from .progress import progress_bar
 
 
@@ -26,7 +26,7 @@ def refactor_command(ctx, threshold, as_json):
     One transaction: every class's assembled template stays exactly as it was (checked
     before commit, else nothing is changed and the class is named), and a second run
     changes nothing. Instantiations go on meanwhile; template writers wait. Meant to run
-    every night (README: cron or a systemd timer); exit code 0 also when nothing changed.
+    every night (docs/guide/refactor-and-library.md: cron or a systemd timer); exit code 0 also when nothing changed.
 
     Block numbers are left out: lines that differ only in theirs are one family, listed
     once. Pairs no earlier run listed come first, marked new; pairs marked intended (the

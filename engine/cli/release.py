@@ -22,8 +22,8 @@ def template_release(ctx, gear_class, dry_run, yes, as_json):
 
     Example: engine template release --class spur --dry-run
     """
-    from ..release.impact import DIFFS_SHOWN
     from ..release.gate import release
+    from ..release.impact import DIFFS_SHOWN
 
     def confirm(report) -> bool:
         if yes:

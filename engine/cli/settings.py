@@ -9,7 +9,7 @@ from .context import emit_json, settings
 @click.group("config")
 def config():
     """The config file: option defaults, the default machine, output folder and line endings per
-    machine (README, "Configuration"). Command line and ENGINE_* variables win over it."""
+    machine (docs/guide/configuration.md). Command line and ENGINE_* variables win over it."""
 
 
 @config.command("path")

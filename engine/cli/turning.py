@@ -11,7 +11,6 @@ from ..turning.defaults import DEFAULT_LATHE, PROFILE_DEFAULTS, STOCK_MARGIN
 from .context import connection, emit_json, keyed
 
 
-
 class FiniteFloatRange(click.FloatRange):
     """click.FloatRange lets nan and inf through (no comparison fails for nan)."""
 
@@ -30,7 +29,8 @@ POSITIVE = FiniteFloatRange(min=0, min_open=True)
 @click.option("--machine", default=DEFAULT_LATHE, show_default=True,
               help="Lathe record (lathe-iso or lathe-840d); its dialect picks the template class.")
 @click.option("--rough-depth", type=POSITIVE,
-              help=f"Profile-only drawings: radial depth per rough pass, mm [default: {PROFILE_DEFAULTS['rough_depth']:g}].")
+              help=f"Profile-only drawings: radial depth per rough pass, mm "
+                   f"[default: {PROFILE_DEFAULTS['rough_depth']:g}].")
 @click.option("--allowance", type=FiniteFloatRange(min=0),
               help=f"Profile-only drawings: material left on the profile by roughing, mm "
                    f"[default: {PROFILE_DEFAULTS['allowance']:g}].")

@@ -2,9 +2,21 @@
 from __future__ import annotations
 
 import os
+from typing import TYPE_CHECKING, Any
 
 from ..errors import EngineError
 from .embedded import embedded_data_dir, embedded_url
+
+if TYPE_CHECKING:
+    from collections.abc import Sequence
+    from typing import TypeAlias
+
+    import psycopg
+    from psycopg import Cursor
+    from psycopg.rows import TupleRow
+
+    # every connection the engine opens reads rows as tuples (psycopg's default row factory)
+    Connection: TypeAlias = psycopg.Connection[TupleRow]
 
 LIBPQ_KEYWORDS = {"PGHOST": "host", "PGHOSTADDR": "hostaddr", "PGPORT": "port", "PGDATABASE": "dbname",
                   "PGUSER": "user", "PGSERVICE": "service"}   # each names a server of its own
@@ -40,7 +52,7 @@ def _libpq_conninfo() -> str:
                             if os.environ.get(name)})
 
 
-def psql_command(database_url: str | None, args=()) -> list[str]:
+def psql_command(database_url: str | None, args: Sequence[str] = ()) -> list[str]:
     """`engine db psql`: the psql command line on the database in use; refused, with the
     command to run once a PostgreSQL client is installed, if no psql is found."""
     import shlex
@@ -55,7 +67,7 @@ def psql_command(database_url: str | None, args=()) -> list[str]:
     return [psql, "--dbname", url, *args]
 
 
-def connect(database_url: str | None = None, **kwargs):
+def connect(database_url: str | None = None, **kwargs: Any) -> Connection:
     """A psycopg connection to the resolved database; its JSON numbers are read bounded
     (engine.db.json_numbers)."""
     import psycopg
@@ -71,3 +83,10 @@ def connect(database_url: str | None = None, **kwargs):
         raise EngineError(f"cannot connect to {where}: {first_line}") from error
     read_bounded_json(conn)
     return conn
+
+
+def scalar(cursor: Cursor[TupleRow]) -> Any:
+    """The first column of the one row a query always returns (a count, EXISTS, a function's value)."""
+    row = cursor.fetchone()
+    assert row is not None, "a query that always returns a row returned none"
+    return row[0]

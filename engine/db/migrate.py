@@ -6,11 +6,16 @@ import hashlib
 import re
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from psycopg import sql
 
 from ..errors import EngineError
 from ..paths import MIGRATIONS_DIR
+from .connection import scalar
+
+if TYPE_CHECKING:
+    from .connection import Connection
 
 MIGRATION_FILE = re.compile(r"^(\d{4})\.([a-z0-9_-]+)\.sql$")
 # Any constant works: all engines on one database agree on it.
@@ -73,20 +78,20 @@ def discover(directory: Path | None = None) -> list[Migration]:
     return migrations
 
 
-def status(conn, directory: Path | None = None) -> list[MigrationState]:
+def status(conn: Connection, directory: Path | None = None) -> list[MigrationState]:
     applied = _applied(conn)
     states = []
     for migration in discover(directory):
         record = applied.get(migration.version)
         states.append(MigrationState(
             migration,
-            record[1] if record else None,
-            bool(record) and record[0] != migration.checksum,
+            record[1] if record is not None else None,
+            record is not None and record[0] != migration.checksum,
         ))
     return states
 
 
-def migrate(conn, directory: Path | None = None) -> list[Migration]:
+def migrate(conn: Connection, directory: Path | None = None) -> list[Migration]:
     """Apply every pending migration; return those applied. Refuses if an applied file changed.
     Each migration commits on its own, so the connection must not be inside a transaction."""
     from psycopg.pq import TransactionStatus
@@ -104,7 +109,7 @@ def migrate(conn, directory: Path | None = None) -> list[Migration]:
         conn.autocommit = autocommit
 
 
-def _apply_pending(conn, directory: Path | None) -> list[Migration]:
+def _apply_pending(conn: Connection, directory: Path | None) -> list[Migration]:
     states = status(conn, directory)
     changed = [s.migration.path.name for s in states if s.changed]
     if changed:
@@ -120,7 +125,7 @@ def _apply_pending(conn, directory: Path | None) -> list[Migration]:
     return done
 
 
-def _apply(conn, migration: Migration) -> None:
+def _apply(conn: Connection, migration: Migration) -> None:
     import psycopg
 
     try:
@@ -137,15 +142,15 @@ def _apply(conn, migration: Migration) -> None:
         ) from error
 
 
-def _applied(conn) -> dict[str, tuple[str, object]]:
-    exists = conn.execute("SELECT to_regclass('schema_migration') IS NOT NULL").fetchone()[0]
+def _applied(conn: Connection) -> dict[str, tuple[str, object]]:
+    exists = scalar(conn.execute("SELECT to_regclass('schema_migration') IS NOT NULL"))
     if not exists:
         return {}
     rows = conn.execute("SELECT version, checksum, applied_at FROM schema_migration").fetchall()
     return {version: (checksum, applied_at) for version, checksum, applied_at in rows}
 
 
-def require_current(conn) -> None:
+def require_current(conn: Connection) -> None:
     """Refuse to work on a database whose schema is behind the code."""
     pending = [s.migration.path.name for s in status(conn) if s.state != "applied"]
     if pending:

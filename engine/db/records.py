@@ -2,19 +2,26 @@
 taken from the dataclass, and a row read with its numeric columns as checked floats."""
 from __future__ import annotations
 
+from collections.abc import Collection, Sequence
 from dataclasses import fields
 from decimal import Decimal
+from typing import TYPE_CHECKING, Any, TypeVar
 
-from ..csv_reader import MAX_MAGNITUDE   # the CSV readers refuse larger numbers; so do the records
+from ..csv_reader import MAX_MAGNITUDE  # the CSV readers refuse larger numbers; so do the records
 from ..errors import EngineError
 
+if TYPE_CHECKING:
+    from _typeshed import DataclassInstance
 
-def columns(record_type, exclude=frozenset()) -> str:
+Record = TypeVar("Record", bound="DataclassInstance")   # Gear, Hob, Machine, ...
+
+
+def columns(record_type: type[DataclassInstance], exclude: Collection[str] = frozenset()) -> str:
     """`a, b, c`: the record's fields as the columns of a static SELECT (never user input)."""
     return ", ".join(field.name for field in fields(record_type) if field.name not in exclude)
 
 
-def as_float(record_type, row, kind: str = "record") -> object:
+def as_float(record_type: type[Record], row: Sequence[Any], kind: str = "record") -> Record:
     """numeric columns arrive as Decimal; models compute in float, so each must be a finite
     float of a plausible size (a record edited in SQL is read as strictly as a file)."""
     values = [float(v) if isinstance(v, Decimal) else v for v in row]

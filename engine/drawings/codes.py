@@ -10,8 +10,8 @@ error naming the layer, the TEXT/MTEXT handle and the text.
 from __future__ import annotations
 
 import re
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 from .read import DxfError
 

@@ -17,16 +17,25 @@ from pathlib import Path
 from typing import NamedTuple
 
 from ..memory import no_cycle_collection
-
 from .codes import CodeText, layer_codes
+from .entities import (
+    FLATTEN_TOLERANCE_MM,
+    HANDLERS,
+    MAX_COORDINATE_MM,
+    Context,
+    check_finite,
+    check_reach,
+    inserted_entities,
+    named_on_failure,
+    segments_of,
+    unit_scale,
+)
+from .geometry import Line, Segment
 from .layers import CENTRE, HIDDEN, chosen_profile_layer, layer_linetypes, line_role
 from .outline import hatch_polygons, profile_of
-from .side_view import Marks
-from .entities import (FLATTEN_TOLERANCE_MM, HANDLERS, MAX_COORDINATE_MM, Context, check_finite, check_reach,
-    inserted_entities, named_on_failure, segments_of, unit_scale)
-from .geometry import Line, Segment
 from .profile import Profile, chain_segments, scaled
 from .read import DxfError, ezdxf_warnings, load_drawing_file, summarised
+from .side_view import Marks
 
 PROFILE_LAYER = "0"
 OR_NAME_IT = " or name its layer with --profile-layer"
@@ -91,7 +100,7 @@ class Collected:
     other_layers: Counter = field(default_factory=Counter)
     profile_layer: str | None = PROFILE_LAYER   # None: every layer is collected, the profile's chosen after
     linetypes: dict[str, str] = field(default_factory=dict)   # layer name (upper case) → its linetype
-    centre_lines: list[Segment] = field(default_factory=list)
+    centre_lines: list[Line] = field(default_factory=list)
     hidden: Counter = field(default_factory=Counter)
     hidden_lines: list[Segment] = field(default_factory=list)
     hatches: list[list[tuple[float, float]]] = field(default_factory=list)
@@ -109,6 +118,7 @@ def read_drawing(path: str | Path, profile_layer: str | None = None) -> Drawing:
         collected = collect(drawing_file.doc.modelspace(), scale, given, layer_linetypes(drawing_file.doc))
     chosen = choose_layer(collected, scale) if given is None else []
     profile_layer = collected.profile_layer
+    assert profile_layer is not None   # the one given, or choose_layer's
     layer0 = collected.layers.pop(profile_layer, LayerContent())
     chosen += all_dash_dot(layer0, collected, profile_layer)
     if not layer0.segments:
@@ -134,7 +144,9 @@ def left_out_notes(layer: str, content: LayerContent, chains: list, side_view: b
     if side_view:
         return [f"layer {layer}: {len(content.points)} POINT(s) left out (a side view has no tool-change "
                 "point)"] if content.points else []
-    return [f"layer {layer}: {len(chains) - 1} other chain(s) are not part of the profile, left out"] if len(chains) > 1 else []
+    if len(chains) <= 1:
+        return []
+    return [f"layer {layer}: {len(chains) - 1} other chain(s) are not part of the profile, left out"]
 
 
 def scaled_marks(collected: Collected, scale: float) -> Marks:
@@ -216,7 +228,8 @@ def take(entity, layer: str, context: Context, collected: Collected) -> None:
     if kind == "HATCH":
         collected.hatches.extend(hatch_polygons(entity))
     # Operation layers hold tool paths in whatever linetype: roles apply to the others.
-    role = line_role(entity, layer, collected.linetypes) if kind in HANDLERS and operation_number(layer) is None else None
+    role = (line_role(entity, layer, collected.linetypes)
+            if kind in HANDLERS and operation_number(layer) is None else None)
     if role == CENTRE:
         check_finite(entity, context)
         segments = segments_of(entity, context)
@@ -273,7 +286,7 @@ def operation(name: str, number: int, content: LayerContent, scale: float,
         raise DxfError(f"layer {name!r} (operation {number}) has a tool path of {len(content.segments)} "
                        f"segment(s) but no @G code; add a TEXT like '@GROUGH' on that layer "
                        f"(types: ROUGH SLOT FINISH THREAD FACE PART)")
-    kind = codes.pop("kind")
+    kind = str(codes.pop("kind"))   # layer_codes reads @G as text
     if not content.segments:
         raise DxfError(f"layer {name!r} (operation {number}, @G {kind}) has no tool path; "
                        "draw the tool-centre path on that layer")

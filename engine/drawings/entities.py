@@ -11,8 +11,8 @@ from __future__ import annotations
 
 import contextlib
 import math
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
-from typing import Callable, Iterator
 
 from .geometry import Arc, Line, Point, Segment
 from .read import DxfError, one_line
@@ -45,7 +45,10 @@ def unit_scale(insunits: int | None) -> tuple[str, float, bool]:
     try:
         from ezdxf import units
 
-        return units.decode(insunits), units.conversion_factor(insunits, units.MM), False
+        name = units.decode(insunits)
+        assert name is not None   # only 0, unitless, has no name
+        # ezdxf annotates InsertUnits, an IntEnum, and indexes its table with any $INSUNITS int
+        return name, units.conversion_factor(insunits, units.MM), False   # type: ignore[arg-type]
     except (KeyError, IndexError, ValueError):
         raise DxfError(f"$INSUNITS = {insunits} is not a known unit code; set the drawing units "
                        "(e.g. 4 = millimetres) in the CAD program") from None
@@ -59,7 +62,8 @@ def segments_of(entity, context: Context) -> list[Segment]:
     with named_on_failure(entity, context.handle):
         segments = list(handler(entity, context))
     for segment in segments:
-        check_reach(entity, context, segment.start, segment.end, *([segment.centre] if isinstance(segment, Arc) else []))
+        check_reach(entity, context, segment.start, segment.end,
+                    *([segment.centre] if isinstance(segment, Arc) else []))
     return segments
 
 

@@ -80,7 +80,7 @@ def arc_parts(arc: Arc) -> list[tuple[float, float, Arc]]:
     if radius > abs(cr):
         crossing = math.asin(-cr / radius)
         cuts += [crossing, math.pi - crossing]
-    inner = sorted(((cut - begin) % (2 * math.pi) for cut in cuts))
+    inner = sorted((cut - begin) % (2 * math.pi) for cut in cuts)
     offsets = [0.0] + [offset for offset in inner if 1e-12 < offset < turn - 1e-12] + [turn]
     return [(begin + a, begin + b, ccw) for a, b in zip(offsets, offsets[1:])]
 
@@ -170,7 +170,7 @@ def breakpoints(pieces: list[Piece]) -> list[float]:
 def top_pieces(pieces: list[Piece]) -> list[tuple[float, float, Piece | None]]:
     """(z_a, z_b, highest piece or None where nothing is drawn) between breakpoints."""
     zs = breakpoints(pieces)
-    spans = []
+    spans: list[tuple[float, float, Piece | None]] = []
     for z_a, z_b in zip(zs, zs[1:]):
         middle = (z_a + z_b) / 2.0
         covering = [piece for piece in pieces if piece.covers(middle)]
@@ -195,6 +195,7 @@ def upper_envelope(segments: list[Segment], where: str) -> list[Segment]:
                            "drawn there above the centre line); close the outline")
     path: list[Segment] = []
     for z_a, z_b, top in reversed(spans):
+        assert top is not None   # a gap was refused above
         high = (z_b, top.r_at(z_b))
         if path and abs(path[-1].end[1] - high[1]) > END_MATCH_TOLERANCE_MM:
             path.append(Line(path[-1].end, high))   # a radial step where the highest line jumps

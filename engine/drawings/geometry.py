@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import Union
 
 Point = tuple[float, float]
 
@@ -15,7 +14,7 @@ class Line:
     end: Point
     handle: str = ""
 
-    def reversed(self) -> "Line":
+    def reversed(self) -> Line:
         return Line(self.end, self.start, self.handle)
 
 
@@ -28,7 +27,7 @@ class Arc:
     ccw: bool
     handle: str = ""
 
-    def reversed(self) -> "Arc":
+    def reversed(self) -> Arc:
         return Arc(self.end, self.start, self.centre, not self.ccw, self.handle)
 
     @property
@@ -36,4 +35,4 @@ class Arc:
         return math.dist(self.start, self.centre)
 
 
-Segment = Union[Line, Arc]
+Segment = Line | Arc

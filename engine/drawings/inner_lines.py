@@ -13,8 +13,8 @@ from __future__ import annotations
 import bisect
 import math
 from collections import Counter
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 from .envelope import SAME_Z, pieces_of, upper_envelope
 from .geometry import Arc, Line, Segment
@@ -92,7 +92,8 @@ def points_of(segment: Segment, count: int = 8) -> list[tuple[float, float]]:
     (cz, cr), radius, turn = segment.centre, segment.radius, sweep(segment)
     begin = math.atan2(segment.start[1] - cr, segment.start[0] - cz)
     sense = 1.0 if segment.ccw else -1.0
-    return [(cz + radius * math.cos(begin + sense * turn * k / count), cr + radius * math.sin(begin + sense * turn * k / count))
+    return [(cz + radius * math.cos(begin + sense * turn * k / count),
+             cr + radius * math.sin(begin + sense * turn * k / count))
             for k in range(count + 1)]
 
 
@@ -230,7 +231,9 @@ def check_halves_agree(framed: list[Segment], outline: list[Segment], where: str
 
 
 def mirror(segment: Segment) -> Segment:
-    flip = (lambda p: (p[0], -p[1]))
+    def flip(p):
+        return p[0], -p[1]
+
     if isinstance(segment, Line):
         return Line(flip(segment.start), flip(segment.end), segment.handle)
     return Arc(flip(segment.start), flip(segment.end), flip(segment.centre), not segment.ccw, segment.handle)

@@ -54,7 +54,8 @@ def check_not_a_view_off_the_axis(profile: Profile, segments: list[Segment], lay
         return
     z_min, z_max, low, high = profile.bounds
     side = "below" if profile.mirrored else "above"
-    raise DxfError(f"layer {layer}: its closed outline lies {side} drawing Y 0 (radius {low:g} … {high:g}, Z{z_min:g} … "
+    raise DxfError(f"layer {layer}: its closed outline lies {side} drawing Y 0 "
+                   f"(radius {low:g} … {high:g}, Z{z_min:g} … "
                    f"Z{z_max:g}) and is symmetric about {axis.source}: as drawn (radius = drawing Y) it is a ring's "
                    f"section with a bore Ø{2 * low:g}, and internal turning is not supported; as a whole side view "
                    "drawn off Y 0 it lacks its centre line; draw the part's half-profile on Y 0, or a centre line "

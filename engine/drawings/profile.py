@@ -24,9 +24,10 @@ from __future__ import annotations
 
 import math
 from collections import defaultdict
+from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import cached_property
-from typing import Sequence
+from typing import overload
 
 from .geometry import Arc, Line, Point, Segment
 from .read import DxfError
@@ -39,6 +40,10 @@ TWO_PI = 2.0 * math.pi
 HALF_PI = math.pi / 2.0
 
 
+@overload
+def scaled(segment: Line, scale: float, mirror: bool = False) -> Line: ...
+@overload
+def scaled(segment: Arc, scale: float, mirror: bool = False) -> Arc: ...
 def scaled(segment: Segment, scale: float, mirror: bool = False) -> Segment:
     """Drawing (x, y) → machine (z, radius) in mm; mirror maps radius −r to r."""
     if scale == 1.0 and not mirror:
@@ -129,7 +134,7 @@ class Chain:
     def bounds(self) -> tuple[float, float, float, float]:
         return merged_bounds(self.segments)
 
-    def reversed(self) -> "Chain":
+    def reversed(self) -> Chain:
         return Chain([s.reversed() for s in reversed(self.segments)], self.closed)
 
 
@@ -280,7 +285,9 @@ def find_profile(chains: Sequence[Chain], tolerance: float = END_MATCH_TOLERANCE
     candidates = [v for v in verdicts if isinstance(v, Candidate)]
     if not candidates:
         longest = max(range(len(chains)), key=lambda i: chains[i].length)
-        raise DxfError(no_profile_message(chains, longest, verdicts[longest], layer))
+        reason = verdicts[longest]
+        assert isinstance(reason, str)   # no chain is a candidate: each verdict is why not
+        raise DxfError(no_profile_message(chains, longest, reason, layer))
     best = max(candidates, key=lambda c: c.chain.length)
     total = sum(chain.length for chain in chains)
     if best.chain.length < PROFILE_SHARE_MIN * total:

@@ -13,7 +13,6 @@ import logging
 import re
 from dataclasses import dataclass, field
 from pathlib import Path
-
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:   # ezdxf takes a third of a second to import: only reading a drawing pays it
@@ -39,7 +38,7 @@ class DxfError(EngineError):
 class DrawingFile:
     """An opened drawing: the ezdxf document and what the reader repaired or assumed."""
     path: Path
-    doc: "EzdxfDocument"
+    doc: EzdxfDocument
     repairs: list[str] = field(default_factory=list)
 
 
@@ -59,7 +58,7 @@ def load_drawing_file(path: str | Path) -> DrawingFile:
     return DrawingFile(path, doc, repairs)
 
 
-def recover_document(path: Path) -> "EzdxfDocument":
+def recover_document(path: Path) -> EzdxfDocument:
     """ezdxf.recover rebuilds sections, tables and links; a file whose group codes and values
     are out of step is refused (its explore mode would guess, and a guessed coordinate
     makes a wrong part)."""
@@ -73,7 +72,7 @@ def recover_document(path: Path) -> "EzdxfDocument":
     return doc
 
 
-def audit_messages(doc: "EzdxfDocument") -> list[str]:
+def audit_messages(doc: EzdxfDocument) -> list[str]:
     auditor = doc.audit()
     return ([f"fixed: {entry.message}" for entry in auditor.fixes]
             + [f"error: {entry.message}" for entry in auditor.errors])

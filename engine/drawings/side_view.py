@@ -59,7 +59,7 @@ class Marks:
     hatches: list[list[tuple[float, float]]] = field(default_factory=list)
     hidden: list[Segment] = field(default_factory=list)
 
-    def near(self, view: list[Segment]) -> "Marks":
+    def near(self, view: list[Segment]) -> Marks:
         """The hatching and hidden lines within the view's extents."""
         box = merged_bounds(view)
         hatches = [p for p in self.hatches if boxes_touch(box, (min(x for x, _ in p), max(x for x, _ in p),
@@ -80,7 +80,7 @@ def split_section(segments: list[Segment], centre_lines: list[Line], where: str)
         axis = centre_axis(line)
         framed = [] if axis is None else [axis.segment(s) for view in views(segments)
                                           if alongside(axis, line, view) for s in view]
-        if framed and min(bounds(s)[2] for s in framed) < 0.0 < max(bounds(s)[3] for s in framed) \
+        if axis is not None and framed and min(bounds(s)[2] for s in framed) < 0.0 < max(bounds(s)[3] for s in framed) \
                 and mirror_images(framed, where, axis.source):
             return split_section_refusal(framed, where, axis.source)
     return None
@@ -109,7 +109,8 @@ def alongside(axis: Axis, line: Line, view: list[Segment]) -> bool:
     along, across = ((y_min, y_max), (x_min, x_max)) if axis.vertical else ((x_min, x_max), (y_min, y_max))
     ends = sorted((line.start[1], line.end[1]) if axis.vertical else (line.start[0], line.end[0]))
     return (ends[0] - ALONG_SLACK_MM <= along[0] and along[1] <= ends[1] + ALONG_SLACK_MM
-            and (across[0] >= axis.offset - END_MATCH_TOLERANCE_MM or across[1] <= axis.offset + END_MATCH_TOLERANCE_MM))
+            and (across[0] >= axis.offset - END_MATCH_TOLERANCE_MM
+                 or across[1] <= axis.offset + END_MATCH_TOLERANCE_MM))
 
 
 def centre_axis(line: Line) -> Axis | None:

@@ -86,7 +86,8 @@ def check_no_prism(framed: list[Segment], outline: list[Segment], where: str) ->
              if isinstance(s, Line) and abs(s.start[1] - s.end[1]) <= END_MATCH_TOLERANCE_MM
              and abs(s.start[0] - s.end[0]) > END_MATCH_TOLERANCE_MM]
     for s in framed:
-        if not isinstance(s, Line) or abs(s.start[1] - s.end[1]) > END_MATCH_TOLERANCE_MM or s.start[1] < -END_MATCH_TOLERANCE_MM:
+        if (not isinstance(s, Line) or abs(s.start[1] - s.end[1]) > END_MATCH_TOLERANCE_MM
+                or s.start[1] < -END_MATCH_TOLERANCE_MM):
             continue
         z0, z1, radius = min(s.start[0], s.end[0]), max(s.start[0], s.end[0]), s.start[1]
         for a, b, outer in spans:

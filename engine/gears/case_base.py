@@ -14,11 +14,21 @@ from __future__ import annotations
 import heapq
 import math
 from dataclasses import dataclass
-
+from typing import TYPE_CHECKING
 
 from ..errors import EngineError
-from .cutting_data import (FEED_EPSILON, RADIAL_TO_AXIAL, CuttingData, default_cutting_data, feed_maximum,
-                           hob_speed, per_minute)
+from .cutting_data import (
+    FEED_EPSILON,
+    RADIAL_TO_AXIAL,
+    CuttingData,
+    default_cutting_data,
+    feed_maximum,
+    hob_speed,
+    per_minute,
+)
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
 CUT_KINDS = ("rough", "finish")
 CUT_KINDS_BY_COUNT = {1: ("rough",), 2: ("rough", "finish")}   # a single cut is a rough cut, as in the paper
@@ -68,11 +78,11 @@ class CaseBase:
                               if record["cut"] == cut] for cut in CUT_KINDS}
 
     @classmethod
-    def load(cls, conn) -> "CaseBase":
+    def load(cls, conn: Connection) -> CaseBase:
         rows = conn.execute(LOAD_CASES).fetchall()
         return cls([{name: _plain(value) for name, value in zip(CASE_COLUMNS, row)} for row in rows])
 
-    def nearest(self, query: dict, top: int) -> list[tuple[float, "_Case"]]:
+    def nearest(self, query: dict, top: int) -> list[tuple[float, _Case]]:
         """(distance, case) of the `top` nearest cases of the query's cut kind, nearest first
         (ties by case id)."""
         wanted = _features(query)
@@ -86,7 +96,8 @@ class CaseBase:
         if not found:
             axial = defaults.axial_feed_rough if cut == "rough" else defaults.axial_feed_finish
             radial = defaults.radial_feed if cut == "rough" else RADIAL_TO_AXIAL * axial
-            return KindProposal(cut, defaults.cutting_speed, axial, radial, f"{cut}: no cases, {defaults.source}"), found
+            return KindProposal(cut, defaults.cutting_speed, axial, radial,
+                                f"{cut}: no cases, {defaults.source}"), found
         exact = [(1.0, case) for d, case in found if d <= EXACT]
         weighted = exact or [(1.0 / d, case) for d, case in found]
         total = sum(weight for weight, _ in weighted)
@@ -144,7 +155,7 @@ class _Case:
     radial_per_rev: float
 
     @classmethod
-    def of(cls, position: int, r: dict) -> "_Case":
+    def of(cls, position: int, r: dict) -> _Case:
         table_speed = r["hob_speed"] * r["hob_starts"] / r["teeth"]
         return cls(position, r["id"], _features(r), math.pi * r["hob_tip_diameter"] * r["hob_speed"] / 1000,
                    r["axial_feed"] / table_speed, r["radial_feed"] / table_speed)

@@ -10,22 +10,36 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field, replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pandas as pd
 import psycopg
 from psycopg import sql
 
+from ..csv_reader import (
+    Column,
+    CsvError,
+    CsvKind,
+    parse_number,
+    parse_positive_whole,
+    parse_text,
+    parse_whole,
+    read_csv_file,
+    refuse,
+)
+from ..db.connection import scalar
 from ..db.listing import records
-from ..csv_reader import (Column, CsvError, CsvKind, parse_number, parse_positive_whole, parse_text, parse_whole,
-                          read_csv_file, refuse)
 from ..errors import EngineError
+from ..machines.records import Machine, hobbing_machine
 from ..paths import SEED_DIR
 from .case_base import CASE_COLUMNS, CUT_KINDS, CaseBase, KindProposal, feeds_per_minute, feeds_per_rev
 from .cutting_data import CuttingData
 from .hob_matching import choose_hob
 from .models import model_for_class
 from .records import Gear, Hob, load_gear, load_hobs
-from ..machines.records import Machine, hobbing_machine
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
 FEATURE_COLUMNS = ("module", "teeth", "material", "hardness", "quality_grade", "hob_material",
                    "hob_coating", "hob_starts", "hob_tip_diameter")
@@ -38,7 +52,8 @@ _TYPES = {"module": (parse_number, "mm"), "teeth": (parse_positive_whole, ""), "
           "hob_tip_diameter": (parse_number, "mm"), "hob_speed": (parse_number, "r/min"),
           "axial_feed": (parse_number, "mm/min"), "radial_feed": (parse_number, "mm/min")}
 CASE_KIND = CsvKind("case", tuple(
-    Column(name, _TYPES.get(name, (parse_text, ""))[0], required=name not in ("hob_coating", "source", "hardness", "quality_grade"),
+    Column(name, _TYPES.get(name, (parse_text, ""))[0],
+           required=name not in ("hob_coating", "source", "hardness", "quality_grade"),
            unit=_TYPES.get(name, (parse_text, ""))[1])
     for name in (*FEATURE_COLUMNS, "cut", *VALUE_COLUMNS, "source")))
 
@@ -85,13 +100,13 @@ SELECT id AS case_id, module, teeth, material, hardness, quality_grade, hob_mate
 FROM cutting_case ORDER BY id"""
 
 
-def case_records(conn) -> list[dict]:
+def case_records(conn: Connection) -> list[dict]:
     """The machining history as a person looks into it (`engine cases list`): one record per case,
     its id under case_id, numbers as floats."""
     return records(conn.execute(CASE_RECORDS))
 
 
-def list_cases(conn) -> pd.DataFrame:
+def list_cases(conn: Connection) -> pd.DataFrame:
     """The machining history, one row per case, numbers as floats."""
     query = sql.SQL("SELECT {} FROM cutting_case ORDER BY id").format(
         sql.SQL(", ").join(map(sql.Identifier, CASE_COLUMNS)))
@@ -100,12 +115,12 @@ def list_cases(conn) -> pd.DataFrame:
                          **{column: "Int64" for column in INTEGER_COLUMNS}})
 
 
-def suggest(conn, gear: Gear, hob: Hob, machine: Machine, *, top: int = 3) -> Suggestion:
+def suggest(conn: Connection, gear: Gear, hob: Hob, machine: Machine, *, top: int = 3) -> Suggestion:
     """Cutting data for this gear, hob and machine from the `top` nearest cases per cut kind."""
     return suggest_from(load_case_base(conn), gear, hob, machine, top=top)
 
 
-def load_case_base(conn) -> CaseBase:
+def load_case_base(conn: Connection) -> CaseBase:
     """The history read once for many suggestions (a batch)."""
     return CaseBase.load(conn)
 
@@ -121,7 +136,7 @@ def suggest_from(base: CaseBase, gear: Gear, hob: Hob, machine: Machine, *, top:
     return Suggestion(gear, hob, machine, cutting, table, proposals, notes)
 
 
-def suggest_for_gear(conn, gear_id: int, machine_name: str | None = None, *, top: int = 3) -> Suggestion:
+def suggest_for_gear(conn: Connection, gear_id: int, machine_name: str | None = None, *, top: int = 3) -> Suggestion:
     """`engine suggest`: the hob the library chooses for the gear, and its cutting data."""
     gear = load_gear(conn, gear_id)
     machine = hobbing_machine(conn, machine_name)
@@ -137,7 +152,8 @@ def plausibility_notes(gear: Gear, hob: Hob, machine: Machine, cutting: CuttingD
     exact_speed = 1000 * cutting.cutting_speed / (math.pi * hob.tip_diameter)
     if exact_speed > machine.spindle_max:
         notes.append(f"hob speed {exact_speed:.0f} r/min capped at {machine.name}'s spindle maximum "
-                     f"{machine.spindle_max:g} r/min: v is {math.pi * hob.tip_diameter * cutting.hob_speed / 1000:.1f} m/min")
+                     f"{machine.spindle_max:g} r/min: "
+                     f"v is {math.pi * hob.tip_diameter * cutting.hob_speed / 1000:.1f} m/min")
     table_speed = cutting.hob_speed * hob.starts / gear.teeth
     if machine.table_speed_max is not None and table_speed > machine.table_speed_max:
         notes.append(f"table speed {table_speed:.1f} r/min exceeds {machine.name}'s {machine.table_speed_max:g} r/min; "
@@ -174,18 +190,18 @@ def _speed_notes(gear: Gear, hob: Hob, proposals: dict) -> list[str]:
     return notes
 
 
-def confirm_job(conn, job_id: int) -> list[int]:
+def confirm_job(conn: Connection, job_id: int) -> list[int]:
     """A proven job joins the history: one case per cut kind of its stored cutting data. The database
     decides (confirm_job_cases): only a job the engine made a program for, with cutting data its
     machine can run, becomes a case; runners cannot add cases any other way."""
     try:
         with conn.transaction():
-            return conn.execute("SELECT confirm_job_cases(%s)", (job_id,)).fetchone()[0]
+            return scalar(conn.execute("SELECT confirm_job_cases(%s)", (job_id,)))
     except (psycopg.errors.CheckViolation, psycopg.errors.NoDataFound) as error:
         raise EngineError(error.diag.message_primary) from None
 
 
-def seed_cases(conn, path: Path = SEED_FILE) -> int:
+def seed_cases(conn: Connection, path: Path = SEED_FILE) -> int:
     """Add the cases of the seed file not yet in the history (same features, cut and source)."""
     path = Path(path)
     if not path.is_file():
@@ -201,9 +217,9 @@ def seed_cases(conn, path: Path = SEED_FILE) -> int:
         raise CsvError(path, problems, nothing="nothing seeded")
     added = 0
     with conn.transaction():
-        for line, values in rows:
+        for line, case in rows:
             try:
-                added += _insert_if_missing(conn, values)
+                added += _insert_if_missing(conn, case)
             except (psycopg.errors.DataError, psycopg.errors.IntegrityError) as error:
                 raise refuse(path, f"the database refused the case ({str(error).splitlines()[0]})",
                              "correct the row; nothing seeded", line) from None
@@ -218,7 +234,7 @@ SEED_CASE = sql.SQL("INSERT INTO cutting_case ({}) VALUES ({})").format(
     sql.SQL(", ").join(map(sql.Identifier, SEED_COLUMNS)), sql.SQL(", ").join(map(sql.Placeholder, SEED_COLUMNS)))
 
 
-def _insert_if_missing(conn, values: dict) -> int:
+def _insert_if_missing(conn: Connection, values: dict) -> int:
     # Values go as text: the server parses them into the column types (numeric exactly).
     if conn.execute(FIND_CASE, values).fetchone():
         return 0

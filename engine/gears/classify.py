@@ -16,13 +16,17 @@ on a bronze blank, scrapped.
 from __future__ import annotations
 
 import re
+from collections.abc import Callable, Collection, Mapping
 from dataclasses import dataclass, field
-from typing import Any, Callable, Collection, Mapping
+from typing import TYPE_CHECKING, Any, cast
 
 from ..errors import EngineError
 from .hob_matching import choose_hob
-from .models import ancestry, registered_models
+from .models import HobbingModel, ancestry, registered_models
 from .records import load_gear, load_hobs
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
 DEFAULT_CLASS = "spur"
 
@@ -182,7 +186,7 @@ class GearClassReport:
         return said
 
 
-def explain_gear(conn, gear_id: int) -> GearClassReport:
+def explain_gear(conn: Connection, gear_id: int) -> GearClassReport:
     """Classify a stored gear again and say how; also the model and hob it gets."""
     gear = load_gear(conn, gear_id)
     classification = classify({"gear_id": gear.id, "cone_angle": gear.cone_angle, "crowning": gear.crowning,
@@ -192,7 +196,7 @@ def explain_gear(conn, gear_id: int) -> GearClassReport:
     model_class = next((name for name in lineage if name in models), None)
     hob = None
     if model_class:
-        model = models[model_class]
+        model = cast(HobbingModel, models[model_class])   # a gear's class is served by a hobbing model
         try:
             chosen = choose_hob(gear, load_hobs(conn), purpose=model.hob_purpose)
             hob = chosen.reason

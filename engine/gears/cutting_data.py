@@ -52,11 +52,11 @@ class CuttingData:
     def finish_radial_feed(self) -> float:
         return self.radial_feed if self.radial_feed_finish is None else self.radial_feed_finish
 
-    def of_cuts(self, cut_kinds) -> "CuttingData":
+    def of_cuts(self, cut_kinds) -> CuttingData:
         """The same data with only the notes of these cut kinds (a single-cut job has no finish)."""
         return replace(self, notes=tuple(note for note in self.notes if note.split(":")[0] in cut_kinds))
 
-    def with_overrides(self, module: float = 0.0, starts: int = 1, **overrides) -> "CuttingData":
+    def with_overrides(self, module: float = 0.0, starts: int = 1, **overrides) -> CuttingData:
         """A speed or feed of 0 or below stops the hob or the feed: refused as it is given. An
         axial feed (mm per workpiece revolution) above the maximum for the module is refused too:
         the table's maximum is already the upper end of practice; a shop that proved more

@@ -98,6 +98,7 @@ def diameter_problems(gear: dict[str, Any]) -> list[Problem]:
         difference = gear["tip_diameter"] - gear["root_diameter"]
         problems.append(_outside("root_diameter", difference, (ADDENDUM + shallowest) * module - shortening,
                                  (ADDENDUM + deepest) * module,
-                                 f"the tooth depth: tip_diameter − root_diameter = 2·m_n·(1 + h*f + k), {dedenda}", gear,
+                                 f"the tooth depth: tip_diameter − root_diameter = 2·m_n·(1 + h*f + k), {dedenda}",
+                                 gear,
                                  said=f"{gear['root_diameter']} (tip_diameter − root_diameter = {difference})"))
     return [problem for problem in problems if problem]

@@ -9,21 +9,35 @@ which reports every changed field. Numbers are kept as Decimal, so they are stor
 """
 from __future__ import annotations
 
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from decimal import Decimal
 from pathlib import Path
-from typing import Any, Callable, Iterable
+from typing import Any
 
 import psycopg
 from psycopg import sql
 
-from ..csv_reader import (Column, CellError, CsvError, CsvFile, CsvKind, Problem, declare, parse_number,
-                          parse_positive_whole, parse_text, parse_whole, read_csv_file)
+from ..csv_reader import (
+    CellError,
+    Column,
+    CsvError,
+    CsvFile,
+    CsvKind,
+    Problem,
+    declare,
+    parse_number,
+    parse_positive_whole,
+    parse_text,
+    parse_whole,
+    read_csv_file,
+)
 from ..errors import EngineError
 from ..names import NAME_RULES, is_safe
 from .classify import Classification, classify, not_installed_message
 from .gear_geometry import diameter_problems, tip_from_shift
-from .module_kind import MODULE_KINDS, check_module_kind as _check_module_kind
+from .module_kind import MODULE_KINDS
+from .module_kind import check_module_kind as _check_module_kind
 from .records import derived_diameters, normal_module
 
 __all__ = ["CellError", "Column", "GearImportError", "derived_diameters", "import_gears", "read_gears"]
@@ -62,7 +76,7 @@ declare(parse_class_name, "gear class", "write the name of a leaf class (engine 
 
 # --- the columns of design notes §9 ------------------------------------------------------
 
-POSITIVE = dict(check=lambda value: value > 0, rule="must be greater than 0")
+POSITIVE: dict[str, Any] = dict(check=lambda value: value > 0, rule="must be greater than 0")
 
 COLUMNS: tuple[Column, ...] = (
     Column("gear_id", parse_positive_whole, required=True, db_name="id"),
@@ -231,7 +245,7 @@ def _complete(gear: dict[str, Any], classes: Classes, bad: set[str], line: int) 
     for reads, step in COMPLETION_STEPS:
         if bad.isdisjoint(reads):
             found = _as_problems(line, step(gear, classes))
-            bad = bad | {problem.column for problem in found}
+            bad = bad | {problem.column for problem in found if problem.column is not None}
             problems += found
     return problems
 

@@ -4,8 +4,12 @@ to is kept: the job's programs were cut from it."""
 from __future__ import annotations
 
 from datetime import date
+from typing import TYPE_CHECKING
 
 from ..db.listing import Deletion, Reference, day_range, delete_row, one_record, records, require_class
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
 GEAR_COLUMNS = """
 SELECT g.id AS gear_id, g.gear_class AS class, g.module, g.module_kind, g.teeth, g.pressure_angle,
@@ -41,7 +45,7 @@ GEAR_DELETION = Deletion(
 )
 
 
-def list_gears(conn, gear_class: str | None = None, since: date | None = None,
+def list_gears(conn: Connection, gear_class: str | None = None, since: date | None = None,
                until: date | None = None) -> list[dict]:
     """Every gear of the class (any class if None) stored from `since` to `until` (whole days,
     both included), by id."""
@@ -49,13 +53,13 @@ def list_gears(conn, gear_class: str | None = None, since: date | None = None,
     return records(conn.execute(LIST_GEARS, {"class": gear_class, **day_range(since, until)}))
 
 
-def gear_details(conn, gear_id: int) -> dict:
+def gear_details(conn: Connection, gear_id: int) -> dict:
     """The gear as stored, its further toothed units (unit 1 is the gear itself) and its jobs."""
     gear = one_record(conn.execute(ONE_GEAR, (gear_id,)), "gear", gear_id, "engine gears list")
     return {**gear, "units": records(conn.execute(GEAR_UNITS, (gear_id,))),
             "jobs": records(conn.execute(GEAR_JOBS, (gear_id,)))}
 
 
-def delete_gear(conn, gear_id: int, yes: bool) -> str:
+def delete_gear(conn: Connection, gear_id: int, yes: bool) -> str:
     """Delete the gear (and its units) if no job or golden test refers to it; what was deleted."""
     return delete_row(conn, GEAR_DELETION, gear_id, yes)

@@ -14,15 +14,26 @@ from typing import Any
 import psycopg
 from psycopg import sql
 
-from ..csv_reader import (CellError, Column, CsvError, CsvKind, Problem, declare, parse_number, parse_positive_whole,
-                          parse_text, read_cell, read_csv_file)
+from ..csv_reader import (
+    CellError,
+    Column,
+    CsvError,
+    CsvKind,
+    Problem,
+    declare,
+    parse_number,
+    parse_positive_whole,
+    parse_text,
+    read_cell,
+    read_csv_file,
+)
+from ..db.connection import scalar
 from ..errors import EngineError
 from ..names import NAME_RULES, is_safe, said
 from .gear_import import POSITIVE, parse_hand
 from .hob_matching import ACCURACY_CLASSES, PURPOSES, HobChoice, choose_hob
 from .models import ancestry
 from .records import TOOTH_DEPTH, Hob, load_gear, load_hobs
-
 
 HobImportError = CsvError   # a file of bad rows: `problems` holds one line per problem, in file order
 
@@ -162,7 +173,8 @@ def read_hobs(path: str | Path) -> list[dict[str, Any]]:
     file = read_csv_file(path, HOB_KIND)
     if not file.records:
         raise EngineError(f"{path}: no hob rows; give one hob per line under the header")
-    hobs, problems, first_line = [], [], {}
+    hobs, problems = [], []
+    first_line: dict[str, tuple[int, str]] = {}   # id in upper case -> (line, id) where it is first
     for line, cells in file.rows():
         hob, row_problems = parse_hob(cells, line, file.separator)
         folded = hob["id"].upper() if hob["id"] is not None else None
@@ -190,7 +202,7 @@ def import_hobs(conn: psycopg.Connection, path: str | Path) -> HobImport:
         raise EngineError(f"{path}: {_same_but_case(twin[1], twin[0])}; nothing imported")
     try:
         with conn.transaction():
-            existing = conn.execute("SELECT count(*) FROM hob WHERE id = ANY(%s)", (ids,)).fetchone()[0]
+            existing = scalar(conn.execute("SELECT count(*) FROM hob WHERE id = ANY(%s)", (ids,)))
             with conn.cursor() as cursor:
                 cursor.executemany(_UPSERT, [[hob[name] for name in COLUMN_NAMES] for hob in hobs])
     except (psycopg.errors.IntegrityError, psycopg.errors.DataError) as error:

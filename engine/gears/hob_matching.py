@@ -7,8 +7,8 @@ coarsest sufficient class (fine hobs are kept for fine gears), then the id.
 """
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Callable
 
 from ..errors import EngineError
 from .hob_geometry import generating_length, lead_angle
@@ -175,9 +175,10 @@ def choose_hob(gear: Gear, hobs: list[Hob], *, purpose: str = "cylindrical",
     tests = [test for test in HOB_TESTS if purpose in test.purposes]
     candidates = list(hobs)
     for position, test in enumerate(tests):
-        if not test.required:
+        fits = test.fits
+        if fits is None:   # not required: a preference only orders the hobs
             continue
-        passing = [hob for hob in candidates if test.fits(gear, hob, need)]
+        passing = [hob for hob in candidates if fits(gear, hob, need)]
         if not passing:
             raise NoHobError(_refusal(gear, need, test, tests[:position], candidates), test.name)
         candidates = passing
@@ -189,21 +190,25 @@ def choose_hob(gear: Gear, hobs: list[Hob], *, purpose: str = "cylindrical",
 
 def _closest(gear: Gear, need: Need, test: HobTest, hobs: list[Hob], groups: int = 3) -> str:
     """What the hobs offer for the test's property, closest to the need first, with ids."""
+    offered, distance = test.offered, test.distance
+    assert offered is not None and distance is not None   # a required test says both
     by_value: dict[str, list[Hob]] = {}
     for hob in hobs:
-        by_value.setdefault(test.offered(hob), []).append(hob)
+        by_value.setdefault(offered(hob), []).append(hob)
     ordered = sorted(by_value.items(),
-                     key=lambda item: min(abs(test.distance(gear, hob, need)) for hob in item[1]))
+                     key=lambda item: min(abs(distance(gear, hob, need)) for hob in item[1]))
     shown = [f"{value} ({', '.join(hob.id for hob in group[:3])}{', …' if len(group) > 3 else ''})"
              for value, group in ordered[:groups]]
     return ", ".join(shown) + (", …" if len(ordered) > groups else "")
 
 
 def _refusal(gear: Gear, need: Need, test: HobTest, earlier: list[HobTest], candidates: list[Hob]) -> str:
-    earlier_wanted = [t.wanted(gear, need) for t in earlier if t.required]
+    wanted = [t.wanted for t in earlier if t.required]
+    earlier_wanted = [said(gear, need) for said in wanted if said is not None]   # a required test says it
     among = f" among those with {', '.join(earlier_wanted)}" if earlier_wanted else ""
     if not candidates:
         offered = "the hob library is empty"
     else:
         offered = ("they have " if earlier_wanted else "the library has ") + _closest(gear, need, test, candidates)
+    assert test.wanted is not None   # the test refused is a required one
     return f"gear {gear.id}: no hob has {test.wanted(gear, need)}{among}: {offered}; {ADD_A_HOB}"

@@ -4,9 +4,13 @@ job refers to is kept: the job's programs were cut with it."""
 from __future__ import annotations
 
 from dataclasses import asdict
+from typing import TYPE_CHECKING
 
 from ..db.listing import Deletion, Reference, delete_row, one_record, records
 from .records import load_hobs
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
 ONE_HOB = """
 SELECT id AS hob_id, module, pressure_angle, starts, tip_diameter, length, hand, accuracy_class, material,
@@ -27,7 +31,7 @@ HOB_DELETION = Deletion(
 )
 
 
-def hob_records(conn) -> list[dict]:
+def hob_records(conn: Connection) -> list[dict]:
     """Every hob of the library by id, its id under the common key hob_id."""
     return [_record(asdict(hob)) for hob in load_hobs(conn)]
 
@@ -36,12 +40,12 @@ def _record(fields: dict) -> dict:
     return {"hob_id": fields.pop("id"), **fields}
 
 
-def hob_details(conn, hob_id: str) -> dict:
+def hob_details(conn: Connection, hob_id: str) -> dict:
     """The hob as stored and the jobs that use it."""
     hob = one_record(conn.execute(ONE_HOB, (hob_id,)), "hob", hob_id, "engine hobs list")
     return {**hob, "jobs": records(conn.execute(HOB_JOBS, (hob_id,)))}
 
 
-def delete_hob(conn, hob_id: str, yes: bool) -> str:
+def delete_hob(conn: Connection, hob_id: str, yes: bool) -> str:
     """Delete the hob if no job refers to it; what was deleted."""
     return delete_row(conn, HOB_DELETION, hob_id, yes)

@@ -5,9 +5,13 @@ engine.hobbing.models or engine.turning registers their models, and the programs
 command-line code that asks for a model imports them first."""
 from __future__ import annotations
 
-from typing import Any, Callable, Protocol
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any, Protocol
 
 from ..errors import EngineError
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
 
 class NamedModel(Protocol):
@@ -57,12 +61,12 @@ WITH RECURSIVE up(name, parent, depth) AS (
 SELECT name FROM up ORDER BY depth"""
 
 
-def ancestry(conn, gear_class: str) -> list[str]:
+def ancestry(conn: Connection, gear_class: str) -> list[str]:
     """The class and its ancestors, nearest first."""
     return [row[0] for row in conn.execute(CLASS_ANCESTRY, (gear_class,))]
 
 
-def model_for_class(conn, gear_class: str) -> Any:
+def model_for_class(conn: Connection, gear_class: str) -> Any:
     """The model of the class's nearest ancestor that has one (a HobbingModel, or the turning
     names model), or None when no class on the path up has one."""
     models = registered_models()

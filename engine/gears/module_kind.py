@@ -21,6 +21,7 @@ def check_module_kind(gear: dict[str, Any], classes: dict[str, bool]) -> str | N
         return ("module_kind is missing; a worm wheel needs axial (the worm's axial module m_x, as worm "
                 "drawings give it) or normal")
     if kind == "axial" and not is_worm_wheel:
-        return f"module_kind axial is for worm wheels (the worm's axial module); a {gear['gear_class']} gear's module is normal"
+        return (f"module_kind axial is for worm wheels (the worm's axial module); "
+                f"a {gear['gear_class']} gear's module is normal")
     gear["module_kind"] = kind or "normal"
     return None

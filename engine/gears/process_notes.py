@@ -21,7 +21,8 @@ def hunting_tooth_notes(gear, hob) -> list[str]:
 def _note(gear_id: int, hob, teeth: int) -> str:
     factor = math.gcd(hob.starts, teeth)
     return (f"gear {gear_id}: hob {hob.id} has {hob.starts} starts and the gear {teeth} teeth, common factor {factor} "
-            f"(no hunting tooth): each hob thread cuts only one gap in {factor}, so the hob's errors repeat on the gear; "
+            f"(no hunting tooth): each hob thread cuts only one gap in {factor}, "
+            "so the hob's errors repeat on the gear; "
             f"choose a hob whose starts share no factor with {teeth} where the grade needs it")
 
 

@@ -4,10 +4,16 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 from decimal import Decimal
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from ..db.records import as_float, columns
 from ..errors import EngineError
+
+if TYPE_CHECKING:
+    from collections.abc import Sequence
+
+    from ..db.connection import Connection
+    from ..db.records import Record
 
 TOOTH_DEPTH = Decimal("2.25")  # full tooth depth in modules: root = tip − 2·2.25·m
 
@@ -107,7 +113,7 @@ def derived_diameters(module: Any, teeth: int, helix_angle: Any = 0,
     return tip, root
 
 
-def _as_float(record_type, row) -> object:
+def _as_float(record_type: type[Record], row: Sequence[Any]) -> Record:
     return as_float(record_type, row, _KINDS.get(record_type, "record"))
 
 
@@ -117,14 +123,15 @@ UNIT_QUERY = f"SELECT gear_id, {columns(GearUnit)} FROM gear_unit"
 HOB_QUERY = f"SELECT {columns(Hob)} FROM hob"
 
 
-def load_gear(conn, gear_id: int) -> Gear:
+def load_gear(conn: Connection, gear_id: int) -> Gear:
     row = conn.execute(GEAR_QUERY + " WHERE id = %s", (gear_id,)).fetchone()
     if row is None:
         raise EngineError(f"gear {gear_id} does not exist; import it with `engine gears import FILE.csv`")
     return _with_units(_completed(_as_float(Gear, row)), _load_units(conn, gear_id, gear_id))
 
 
-def load_gears(conn, first: int | None = None, last: int | None = None, refused: dict | None = None) -> list[Gear]:
+def load_gears(conn: Connection, first: int | None = None, last: int | None = None,
+               refused: dict | None = None) -> list[Gear]:
     """The gears first…last; with `refused`, a gear that cannot be completed is left out and its
     message kept there by id (a batch names every bad gear), else it stops the load."""
     rows = conn.execute(GEAR_QUERY + " WHERE id BETWEEN %s AND %s ORDER BY id",
@@ -160,7 +167,7 @@ def _completed(gear: Gear) -> Gear:
     return replace(gear, tip_diameter=tip, root_diameter=root)
 
 
-def _load_units(conn, first: int, last: int) -> dict[int, tuple]:
+def _load_units(conn: Connection, first: int, last: int) -> dict[int, tuple]:
     """Further units of the gears first…last, by gear id, in unit order."""
     found: dict[int, list] = {}
     for row in conn.execute(UNIT_QUERY + " WHERE gear_id BETWEEN %s AND %s ORDER BY gear_id, unit", (first, last)):
@@ -172,5 +179,5 @@ def _with_units(gear: Gear, units: dict) -> Gear:
     return replace(gear, units=units.get(gear.id, ())) if gear.id in units else gear
 
 
-def load_hobs(conn) -> list[Hob]:
+def load_hobs(conn: Connection) -> list[Hob]:
     return [_as_float(Hob, row) for row in conn.execute(HOB_QUERY + " ORDER BY id")]

@@ -5,11 +5,15 @@ The units of every gear in the file replace that gear's units."""
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ..csv_reader import Column, CsvKind, Problem, parse_number, parse_positive_whole, read_csv_file
 from ..errors import EngineError
 from .gear_geometry import diameter_problems
 from .gear_import import POSITIVE, GearImportError, derived_diameters
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
 UNIT_COLUMNS: tuple[Column, ...] = (
     Column("gear_id", parse_positive_whole, required=True),
@@ -28,7 +32,7 @@ INSERT INTO gear_unit (gear_id, unit, teeth, face_width, tip_diameter, root_diam
 VALUES (%s, %s, %s, %s, %s, %s, %s)"""
 
 
-def import_units(conn, path: str | Path, only_gears: set[int] | None = None) -> int:
+def import_units(conn: Connection, path: str | Path, only_gears: set[int] | None = None) -> int:
     """Store the units of the CSV at `path` (only those of `only_gears` if given); return
     how many. Raises GearImportError listing every problem."""
     path = Path(path)
@@ -61,7 +65,7 @@ UNIT_GEAR = ("SELECT module, face_width, gear_class IN (SELECT name FROM classes
              "FROM gear WHERE id = %s")
 
 
-def _database_problems(conn, units: list) -> list[Problem]:
+def _database_problems(conn: Connection, units: list) -> list[Problem]:
     """Each unit's gear must exist; given diameters of a cylindrical gear's unit (a spur unit of the
     gear's module) must fit the formulas (engine.gears.gear_geometry); the others are completed."""
     problems = []
@@ -87,7 +91,7 @@ def _database_problems(conn, units: list) -> list[Problem]:
     return problems
 
 
-def _store(conn, units: list[dict]) -> None:
+def _store(conn: Connection, units: list[dict]) -> None:
     with conn.transaction():
         gear_ids = sorted({unit["gear_id"] for unit in units})
         conn.execute("DELETE FROM gear_unit WHERE gear_id = ANY(%s)", (gear_ids,))

@@ -36,7 +36,8 @@ class CrownedModel(CylindricalModel):
                               f"got {gear.crowning}; set crowning or choose another class")
         face_slope = 4 * crown_depth(gear) / gear.face_width   # a'(Z) at the faces
         if face_slope > MAX_FACE_SLOPE:
-            raise EngineError(f"gear {gear.id}: crowning {gear.crowning:g} mm on a face of {gear.face_width:g} mm slopes "
+            raise EngineError(f"gear {gear.id}: crowning {gear.crowning:g} mm "
+                              f"on a face of {gear.face_width:g} mm slopes "
                               f"the root by {math.degrees(math.atan(face_slope)):.0f}° at the faces (at most "
                               f"{math.degrees(math.atan(MAX_FACE_SLOPE)):.0f}°: beyond it a 24-segment polyline no "
                               f"longer follows it); reduce the crowning or check the face width")
@@ -46,7 +47,8 @@ class CrownedModel(CylindricalModel):
     def cut_params(self, cut, gear, hob, cutting, setup) -> dict:
         params = super().cut_params(cut, gear, hob, cutting, setup)
         top, bottom = 0.0, -gear.face_width
-        params["face_from"], params["face_to"] = beyond_faces(gear, hob, *((top, bottom) if cut.climb else (bottom, top)))
+        ends = (top, bottom) if cut.climb else (bottom, top)
+        params["face_from"], params["face_to"] = beyond_faces(gear, hob, *ends)
         # the pass starts no later and ends no earlier than the polyline (it never runs back)
         down = 1 if cut.climb else -1
         params["z_from"] = round(down * max(down * params["z_from"], down * params["face_from"]), 3)

@@ -3,6 +3,7 @@ code needs. Formulas: docs/reference/hobbing.md §B. The other classes' models d
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Protocol
 
 from ..gears.cutting_data import CuttingData
 from ..gears.models import register_model
@@ -18,6 +19,23 @@ RETRACT_CLEARANCE = 5.0   # mm between hob tip and gear tip when retracted
 # then feed. The run-in clears the blank at the cut's own X, so any X beyond it is clear too;
 # the millimetre absorbs the rapid's following error before the feed takes over.
 RAPID_SHORT_OF_CUT = 1.0
+
+
+class GearShape(Protocol):
+    """What setup reads of a gear (mm, degrees): a Gear, or one unit of a duplex gear (UnitGear)."""
+
+    @property
+    def module(self) -> float: ...
+    @property
+    def pressure_angle(self) -> float: ...
+    @property
+    def helix_angle(self) -> float: ...
+    @property
+    def hand(self) -> str | None: ...
+    @property
+    def tip_diameter(self) -> float | None: ...
+    @property
+    def root_diameter(self) -> float | None: ...
 
 
 @dataclass(frozen=True)
@@ -69,7 +87,8 @@ class CylindricalModel:
         """Hob length the shift choice needs beyond the generating zone (for hob matching)."""
         return shifting.travel_needed(choices)
 
-    def setup(self, gear: Gear, hob: Hob) -> Setup:
+    def setup(self, gear: GearShape, hob: Hob) -> Setup:
+        assert gear.root_diameter is not None and gear.tip_diameter is not None   # a loaded gear is completed
         lead = geometry.lead_angle(hob.module, hob.starts, hob.tip_diameter)
         swivel = conventions.swivel(gear.helix_angle, gear.hand, lead, hob.hand)
         full_depth = geometry.full_depth_centre_distance(gear.root_diameter, hob.tip_diameter)

@@ -79,7 +79,7 @@ class UnitGear:
     z_top: float
 
     @classmethod
-    def of(cls, gear, teeth, face_width, tip_diameter, root_diameter, z_top) -> "UnitGear":
+    def of(cls, gear, teeth, face_width, tip_diameter, root_diameter, z_top) -> UnitGear:
         tip = tip_diameter or gear.module * (teeth + 2)
         root = root_diameter or tip - 2 * TOOTH_DEPTH_MODULES * gear.module
         return cls(gear.id, gear.module, gear.pressure_angle, gear.helix_angle, gear.hand, teeth,

@@ -44,7 +44,8 @@ def clearance_to_cone(hob_radius: float, half_length: float, swivel: float, cent
     widest = max(radius, radius - width * slope)
     if x - hob_radius >= widest:
         return x - hob_radius - widest
-    y_max = min(math.sqrt(widest ** 2 - max(x - hob_radius, 0.0) ** 2), half_length * math.cos(eta) + hob_radius * math.sin(eta))
+    y_max = min(math.sqrt(widest ** 2 - max(x - hob_radius, 0.0) ** 2),
+                half_length * math.cos(eta) + hob_radius * math.sin(eta))
     half = y_max * math.sin(eta)
     scaled_z = z * math.cos(eta)
     trapezoid = [(0.0, 0.0), (radius, 0.0), (radius - width * slope, -width * math.cos(eta)),

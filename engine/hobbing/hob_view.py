@@ -93,9 +93,10 @@ def draw_tangential(axes, scene, cut, index: int, swivel: float) -> str:
     """A tangential worm-wheel pass feeds the hob along its own axis (§B10): the hob where the
     pass begins and ends, and the arrow of its feed; no shift range (Y is the feed)."""
     feed, r, half = cut_pass(cut), scene.hob.tip_diameter / 2, scene.hob.length / 2
-    for pose, end in ((feed.start, "begins"), (feed.end, "ends")):
+    assert feed is not None   # a tangential cut feeds along Y
+    for pose, where in ((feed.start, "begins"), (feed.end, "ends")):
         axes.add_patch(Polygon(hob_front_corners(pose["Y"], pose["Z"], r, half, swivel), closed=True, fill=False,
-                               edgecolor="0.45", linestyle=(0, (3, 2)), gid=f"hob where {cut.label} {end}"))
+                               edgecolor="0.45", linestyle=(0, (3, 2)), gid=f"hob where {cut.label} {where}"))
     start, end = (hob_centre(pose["Y"], pose["Z"], swivel) for pose in (feed.start, feed.end))
     axes.annotate("", xy=end, xytext=start, gid=f"pass {cut.label}",
                   arrowprops=dict(arrowstyle="-|>", color=cut_colour(index), linewidth=1.6, mutation_scale=18))

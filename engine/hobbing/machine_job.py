@@ -20,8 +20,9 @@ def machine_setup(machine: Machine, hob: Hob) -> dict:
     has_load = machine.load_x is not None and machine.load_z is not None
     return {"work_offset": machine.work_offset, "tool_number": hob.tool_number,
             "door_close_m": machine.door_close_m or 0, "door_open_m": machine.door_open_m or 0,
-            "load_position": has_load, "load_x": float(machine.load_x) if has_load else 0.0,
-            "load_z": float(machine.load_z) if has_load else 0.0,
+            "load_position": has_load,
+            "load_x": float(machine.load_x) if machine.load_x is not None and has_load else 0.0,
+            "load_z": float(machine.load_z) if machine.load_z is not None and has_load else 0.0,
             "orient_before_coupling": bool(machine.orient_before_coupling)}
 
 

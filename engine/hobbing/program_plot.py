@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import textwrap
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from ..errors import EngineError
 from ..gears.records import Gear, Hob, load_gear
@@ -17,6 +18,9 @@ from ..simulation.recorded import Recording, record_program
 from ..simulation.stored import load_hob
 from .hob_view import draw_hob_view
 from .side_view import draw_overview, draw_side_view
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
 FIGURE_SIZE_IN = (16.0, 9.0)
 TITLE_WIDTH = 160          # characters of a title line at the figure's width
@@ -47,7 +51,7 @@ class Scene:
                 f"(id {self.program_id}){DRAFT_WORDS if self.draft else ''}")
 
 
-def plot_stored_program(conn, program_id: int, out) -> list[str]:
+def plot_stored_program(conn: Connection, program_id: int, out) -> list[str]:
     """Draw the stored program to `out` (.png or .svg); → one line per thing drawn."""
     target, file_format = picture_target(out)
     figure, drawn = program_figure(load_scene(conn, program_id))
@@ -55,7 +59,7 @@ def plot_stored_program(conn, program_id: int, out) -> list[str]:
     return drawn
 
 
-def load_scene(conn, program_id: int) -> Scene:
+def load_scene(conn: Connection, program_id: int) -> Scene:
     row = conn.execute(PROGRAM_QUERY, (program_id,)).fetchone()
     if row is None:
         raise EngineError(f"program {program_id} does not exist; see `SELECT id, name FROM program`")

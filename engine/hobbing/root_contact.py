@@ -8,7 +8,7 @@ the cylinder (sampled, then sampled again finely around the worst point)."""
 from __future__ import annotations
 
 import math
-from typing import Callable
+from collections.abc import Callable
 
 import numpy as np
 

@@ -5,8 +5,8 @@ from __future__ import annotations
 import math
 
 from ..errors import EngineError
-from .choices import Choices
 from ..gears.hob_geometry import generating_length, lead_angle
+from .choices import Choices
 
 SHIFT_MARGIN = 5.0          # mm kept free at each end of the hob
 PITCH_MULTIPLE_TOLERANCE = 0.05   # mm: a step this close to n axial pitches repeats the same teeth

@@ -9,16 +9,25 @@ working area with every move, the load position included. Every artist carries a
 name in the SVG, and what the tests read)."""
 from __future__ import annotations
 
+from typing import Any
+
 from matplotlib.patches import Polygon, Rectangle
 
 from ..pictures import literal
-from .plot_geometry import (approach_pose, axial_profile, cut_pass, full_depth_pose, hob_extent, hob_side_outline,
-                            unit_section)
+from .plot_geometry import (
+    approach_pose,
+    axial_profile,
+    cut_pass,
+    full_depth_pose,
+    hob_extent,
+    hob_side_outline,
+    unit_section,
+)
 
 BLANK_FILL = "0.82"
 SETUP_FILL = "0.65"
 RAPID_STYLE = (0, (4, 3))
-AREA_STYLE = dict(fill=False, edgecolor="tab:red", linestyle=(0, (8, 3)), linewidth=1.0)
+AREA_STYLE: dict[str, Any] = dict(fill=False, edgecolor="tab:red", linestyle=(0, (8, 3)), linewidth=1.0)
 CUT_COLOURS = ("tab:blue", "tab:orange", "tab:green", "tab:purple", "tab:brown", "tab:pink", "tab:olive")
 HATCHES = {"the fixture": "//", "the tailstock": "\\\\"}
 CROWNING_VISIBLE = 1.0  # mm: a pass whose X varies less than this is drawn magnified beside the view
@@ -51,7 +60,8 @@ def draw_unit(axes, unit) -> str:
         axes.plot(unit.intended_root, unit.heights, color="0.3", linewidth=0.7, linestyle=":",
                   gid=f"root {unit.name}")
     tip = 2 * unit.largest_radius
-    return f"{unit.name}: blank tip ⌀{tip:.3f} × face {unit.z_high - unit.z_low:g} mm, Z{unit.z_high:g} … {unit.z_low:g}"
+    return (f"{unit.name}: blank tip ⌀{tip:.3f} × face {unit.z_high - unit.z_low:g} mm, "
+            f"Z{unit.z_high:g} … {unit.z_low:g}")
 
 
 def draw_setup(axes, solid) -> str:
@@ -62,7 +72,8 @@ def draw_setup(axes, solid) -> str:
         return f"{solid.name}: ⌀{2 * solid.radius_at_top:g} (outside the picture)"
     r = solid.radius_at_top
     axes.add_patch(Rectangle((-r, z_low), 2 * r, z_high - z_low, facecolor=SETUP_FILL, edgecolor="0.25",
-                             hatch=HATCHES.get(solid.name, "//"), linewidth=0.8, gid=solid.name, label=literal(solid.name)))
+                             hatch=HATCHES.get(solid.name, "//"), linewidth=0.8, gid=solid.name,
+                             label=literal(solid.name)))
     face = solid.z_high if solid.z_high < high else solid.z_low
     return f"{solid.name}: ⌀{2 * r:g} from Z{face:g}"
 
@@ -82,6 +93,7 @@ def draw_hob_poses(axes, scene) -> list[str]:
 
 def draw_approach(axes, scene) -> str:
     hob, approach = scene.hob, approach_pose(scene.recording.cuts)
+    assert approach is not None   # drawn only where the recording has one
     draw_hob(axes, scene, approach, "hob at approach", "0.45", (0, (3, 2)))
     return (f"hob {hob.id} ⌀{hob.tip_diameter:g} × {hob.length:g} at approach X{approach['X']:.3f} "
             f"Z{approach['Z']:.3f}")

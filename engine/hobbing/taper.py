@@ -8,10 +8,10 @@ import math
 from ..errors import EngineError
 from ..gears.cutting_data import programmed_feed
 from ..gears.models import register_model
-from .root_contact import centre_on_root_cone
 from .cylindrical import RETRACT_CLEARANCE, CylindricalModel, Setup
 from .envelope import clearance_to_cone
 from .passes import Reach, pass_ends
+from .root_contact import centre_on_root_cone
 
 MAX_CONE_ANGLE = 15.0   # degrees: beyond a small taper the hob's generating geometry no longer holds
 INFEED_CLEARANCE = 0.5  # mm between the hob envelope and the conical blank at the infeed

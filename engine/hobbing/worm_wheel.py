@@ -2,7 +2,8 @@
 axis lies in the wheel's mid-plane at a shaft angle of 90°, and there is no axial pass. Its
 swivel is the general A = h_hob·γ − h_gear·β (§A7): 0 when the hob's lead angle is the wheel's
 helix, and the small difference otherwise (an oversize or resharpened hob, within the hob
-match's tolerance), so the hob's thread lies along the teeth. Radial: X plunges to the full-depth centre distance and dwells while the table turns.
+match's tolerance), so the hob's thread lies along the teeth. Radial: X plunges to the full-depth
+centre distance and dwells while the table turns.
 Tangential: the centre distance is set in air, the hob feeds along its own axis (Y) through
 the wheel, and the table gets the extra rotation 360·cos γ/(π·m_n·z2) degrees per mm of Y."""
 from __future__ import annotations

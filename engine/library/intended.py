@@ -30,11 +30,15 @@ import json
 import re
 from dataclasses import dataclass
 from datetime import datetime
+from typing import TYPE_CHECKING
 
 import psycopg
 
 from ..errors import EngineError
 from .similarity import block_free
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
 KEY_SHOWN = 12      # hex digits of the key the report prints: unique among millions of pairs
 KEY_TYPED = 8       # the fewest hex digits `engine refactor intend KEY` accepts
@@ -86,7 +90,7 @@ class Listed:
     intended: int
 
 
-def list_and_remember(conn, pairs: list[dict]) -> Listed:
+def list_and_remember(conn: Connection, pairs: list[dict]) -> Listed:
     """Leave out the pairs marked intended, flag each other pair `new` (no earlier run listed
     it), put the new ones first (each part in its given order), and remember them all as seen."""
     full = {id(pair): near_duplicate_key(pair["t"], pair["a"], pair["b"]) for pair in pairs}
@@ -107,7 +111,7 @@ def listed_texts(pairs: list[dict]) -> list[str]:
                    for text in (pair.get("members") or pair["members_a"] + pair["members_b"])})
 
 
-def marks_in_force(conn) -> dict[str, str]:
+def marks_in_force(conn: Connection) -> dict[str, str]:
     """The marks in force: the key this version computes for the texts → the key stored."""
     return rekeyed(conn.execute(MARKS_IN_FORCE))
 
@@ -117,7 +121,7 @@ def rekeyed(rows) -> dict[str, str]:
     return {near_duplicate_key(t, a, b): stored for stored, t, a, b in rows}
 
 
-def _remember(conn, keyed: list[tuple[str, dict]]) -> None:
+def _remember(conn: Connection, keyed: list[tuple[str, dict]]) -> None:
     columns = ([key for key, _ in keyed], [pair["t"] for _, pair in keyed],
                [pair["a"] for _, pair in keyed], [pair["b"] for _, pair in keyed])
     conn.execute(REMEMBER_SEEN, columns)
@@ -161,7 +165,7 @@ SELECT c.t FROM component c JOIN assembly s ON s.component_id = c.id WHERE c.o =
 ORDER BY 1"""
 
 
-def intents(conn) -> list[Intent]:
+def intents(conn: Connection) -> list[Intent]:
     """The marks in force, oldest first."""
     return [_intent(row) for row in conn.execute(INTENTS)]
 
@@ -171,7 +175,7 @@ def _intent(row) -> Intent:
     return Intent(shown_key(full), *rest)
 
 
-def intend(conn, why: str, key: str | None = None, texts: tuple[str, str] | None = None,
+def intend(conn: Connection, why: str, key: str | None = None, texts: tuple[str, str] | None = None,
            t: str | None = None) -> Intent:
     """Mark a pair intended, named by the key a report printed or by its two texts (and module
     type when the texts are lines of more than one). Refused: an empty why, an unknown pair,
@@ -191,7 +195,7 @@ def intend(conn, why: str, key: str | None = None, texts: tuple[str, str] | None
                           "engine refactor intents shows the mark") from None
 
 
-def unintend(conn, key: str) -> Intent:
+def unintend(conn: Connection, key: str) -> Intent:
     """Withdraw the mark in force of the pair KEY: the next refactor run reports the pair again."""
     with conn.transaction():
         mark = _one(conn.execute(INTENT_BY_PREFIX, _prefix(key)).fetchall(), key, "pairs marked intended",
@@ -200,7 +204,7 @@ def unintend(conn, key: str) -> Intent:
         return _intent(mark)
 
 
-def _reported_pair(conn, key: str) -> tuple[str, str, str, str]:
+def _reported_pair(conn: Connection, key: str) -> tuple[str, str, str, str]:
     return _one(conn.execute(SEEN_BY_PREFIX, _prefix(key)).fetchall(), key, "pairs a refactor run reported",
                 "run engine refactor for the current keys, or give --a and --b")
 
@@ -221,7 +225,7 @@ def _one(rows: list, key: str, among: str, hint: str):
     return rows[0]
 
 
-def _pair_of_texts(conn, texts: tuple[str, str] | None, t: str | None) -> tuple[str, str, str, str]:
+def _pair_of_texts(conn: Connection, texts: tuple[str, str] | None, t: str | None) -> tuple[str, str, str, str]:
     if texts is None or not all(texts):
         raise EngineError("name the pair: its KEY from the refactor report, or both texts with --a and --b")
     a, b = sorted(texts)
@@ -231,7 +235,7 @@ def _pair_of_texts(conn, texts: tuple[str, str] | None, t: str | None) -> tuple[
     return near_duplicate_key(t, a, b), t, a, b
 
 
-def _module_type(conn, a: str, b: str, t: str | None) -> str:
+def _module_type(conn: Connection, a: str, b: str, t: str | None) -> str:
     types = [found for (found,) in conn.execute(TYPES_OF_BOTH, (a, b))]
     if not types or (t is not None and t not in types):
         where = f"module type {t!r}" if t is not None else "one module type"
@@ -242,7 +246,7 @@ def _module_type(conn, a: str, b: str, t: str | None) -> str:
     return t or types[0]
 
 
-def _refuse_marked_twice(conn, full: str) -> None:
+def _refuse_marked_twice(conn: Connection, full: str) -> None:
     """A pair marked already, under this key or under the key of its full texts (before issue 17)."""
     stored = marks_in_force(conn).get(full, full)
     mark = conn.execute(INTENT_BY_PREFIX, (len(stored), stored)).fetchone()

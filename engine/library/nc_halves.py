@@ -7,8 +7,8 @@ forked before the import starts any thread."""
 from __future__ import annotations
 
 import multiprocessing
+from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor
-from typing import Callable
 
 TWO_PROCESSES_FROM = 20_000   # lines: below this, forking costs more than it saves
 _WORK: list = []              # the work of the import being read, inherited by the fork

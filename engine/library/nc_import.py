@@ -37,7 +37,8 @@ Lines: the file is split at its line ending, LF or CRLF (a final newline ends th
 adds no empty line); the rows hold the lines without endings, and the class keeps the ending
 and whether the file had a final newline (engine.nc.layout; a file mixing LF and CRLF
 is refused). Instantiating the import with the same parameters and writing the lines with that
-layout (nc_text) gives the file byte for byte. The import checks this itself before it commits (engine.library.nc_verify), while
+layout (nc_text) gives the file byte for byte. The import checks this itself before it commits
+(engine.library.nc_verify), while
 the rows are being written.
 """
 from __future__ import annotations
@@ -48,6 +49,7 @@ import re
 from dataclasses import asdict, dataclass, field
 from functools import partial
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from psycopg.types.json import Jsonb
 
@@ -55,17 +57,20 @@ from ..csv_reader import Column, CsvKind, parse_number_or_text, parse_text, pars
 from ..errors import EngineError
 from ..memory import no_cycle_collection
 from ..names import shown
+from ..nc.layout import NcLayout, split_nc_text, store_layout
 from ..nc.lineage import ENGINES_LINE, first_lineage_shaped
+from ..nc.tokens import LABEL, SYMBOL, LineFacts, facts, tokenise
 from ..templates.functions import CONSTANTS, FUNCTIONS
 from ..templates.rows import MODULE_ORDER, TemplateRow
 from ..templates.store import ensure_class, load_template, replace_template
 from ..templates.versions import released_version
 from .nc_halves import in_halves
-from ..nc.layout import NcLayout, split_nc_text, store_layout
 from .nc_params import binding_report, bindings, parse_addresses, values
 from .nc_rows import Builder, Found
-from ..nc.tokens import LABEL, SYMBOL, LineFacts, facts, tokenise
 from .nc_verify import Proof
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
 CLASS_NAME = re.compile(r"^[a-z][a-z0-9_]*$")
 ROW_STEP = 10
@@ -87,14 +92,15 @@ class ImportReport:
     left_alone: list = field(default_factory=list)  # equal numbers at addresses not bound: line, word, parameter
 
 
-def import_nc(conn, path, gear_class: str, params: dict | None = None, modules: dict | None = None,
+def import_nc(conn: Connection, path, gear_class: str, params: dict | None = None, modules: dict | None = None,
               parent: str | None = None) -> ImportReport:
     """Store the NC program at `path` as the template of `gear_class`: all or nothing."""
     with no_cycle_collection():   # tokens and checked trees of every line: millions of objects
         return _import(conn, path, gear_class, params, modules, parent)
 
 
-def _import(conn, path, gear_class: str, params: dict | None, modules: dict | None, parent: str | None) -> ImportReport:
+def _import(conn: Connection, path, gear_class: str, params: dict | None, modules: dict | None,
+            parent: str | None) -> ImportReport:
     if not CLASS_NAME.match(gear_class or ""):
         raise EngineError(f"class name {gear_class!r}: use lower-case letters, digits and _, "
                           "starting with a letter")
@@ -139,7 +145,7 @@ def _read_lines(lines: list[str], built: Builder, start: int, end: int) -> tuple
     return line_facts, texts, built.found
 
 
-def _store_import_params(conn, gear_class: str, params: dict) -> None:
+def _store_import_params(conn: Connection, gear_class: str, params: dict) -> None:
     """Keep the parameters the class was imported with: lint checks its names against them."""
     conn.execute("UPDATE gear_class SET import_params = %s WHERE name = %s",
                  (Jsonb(params, dumps=_params_json), gear_class))
@@ -331,7 +337,8 @@ CUT_CODES = frozenset({"G1", "G2", "G3"})
 def _is_frame(f: LineFacts) -> bool:
     """`%` header, `O<name> sub`/`endsub`, a lone program number, the end of the program."""
     program_label = any(label.startswith("O") for label in f.labels) and (
-        f.words & {"SUB", "ENDSUB"} or (len(f.labels) == 1 and f.first.kind == LABEL and not f.words))
+        f.words & {"SUB", "ENDSUB"}
+        or (len(f.labels) == 1 and f.first is not None and f.first.kind == LABEL and not f.words))
     starts_with_percent = f.first is not None and f.first.kind == SYMBOL and f.first.text == "%"
     return bool(starts_with_percent or program_label or f.codes & END_CODES or "PROC" in f.words)
 
@@ -355,7 +362,8 @@ MODULE_RULES = (
 def assign_modules(lines: list[LineFacts], corrections: dict | None = None) -> list[tuple[str, int]]:
     """(t, n) of every line: by the engineer's correction, else by MODULE_RULES, else as before."""
     corrections = corrections or {}
-    state, current, runs, assigned = _State(), "main", {t: 0 for t in MODULE_ORDER}, []
+    state, current, runs = _State(), "main", {t: 0 for t in MODULE_ORDER}
+    assigned: list[tuple[str, int]] = []
     for number, line in enumerate(lines, start=1):
         decided = corrections.get(number) or next(
             (t for t, _, holds in MODULE_RULES if holds(line, state)), current)

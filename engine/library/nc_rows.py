@@ -12,11 +12,11 @@ from dataclasses import dataclass, field
 from decimal import Decimal, InvalidOperation
 
 from ..errors import EngineError
+from ..nc.tokens import NUMBER, WORD, facts
 from ..templates.evaluator import evaluate
 from ..templates.expressions import MAX_EXPRESSION_LENGTH, compile_expression
 from .nc_params import FUNCTION_ADDRESSES, Binding
 from .nc_references import CODE_NAMES, block_context, reference_at
-from ..nc.tokens import NUMBER, WORD, facts
 
 
 def values_of(bindings: dict[str, Binding]) -> dict:
@@ -52,7 +52,7 @@ class Found:
     bound: Counter = field(default_factory=Counter)
     left_alone: list = field(default_factory=list)
 
-    def add(self, later: "Found") -> None:
+    def add(self, later: Found) -> None:
         """Take in what the lines after these gave."""
         self.parameterised += later.parameterised
         for value, names in later.ambiguous.items():
@@ -66,7 +66,9 @@ _SPELLING = re.compile(r"([+-]?)([0-9]*)(\.?)([0-9]*)")
 
 def number_field(name: str, spelling: str) -> str:
     """The f-string replacement field that prints `name` in the style of `spelling`."""
-    sign, integer, point, fraction = _SPELLING.fullmatch(spelling).groups()
+    spelled = _SPELLING.fullmatch(spelling)
+    assert spelled is not None   # the text of a number the tokeniser read
+    sign, integer, point, fraction = spelled.groups()
     digits = len(fraction)
     if not integer:
         scale = 10 ** digits
@@ -87,7 +89,8 @@ class Builder:
         self.values, self.path = values_of(bindings), path
         self.found = Found()
         self.spelled: dict[tuple, bool] = {}   # (field, name, number) -> the field gives the number back
-        self.context = None   # the codes and words of the line being read, once a number needs them
+        # the codes and words of the line being read, once a number needs them
+        self.context: frozenset[str] | None = None
 
     def o(self, line_number: int, line: str, tokens) -> str:
         """The row's `o`: the line written out, or an f-string with its references."""

@@ -12,13 +12,18 @@ from __future__ import annotations
 
 from collections import defaultdict
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import psycopg
 
+from ..db.connection import scalar
 from ..errors import EngineError
 from ..templates.store import load_template
 from .intended import list_and_remember
 from .similarity import Units, block_free, nc_units, similar_pairs
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
 # Concurrent instantiations read either the old or the new library: writers wait for us,
 # readers (plain SELECT, foreign-key checks) are not blocked and see the last committed
@@ -103,7 +108,7 @@ class RefactorReport:
                 "families": self.families, "near_duplicates": self.near_duplicates}
 
 
-def refactor(conn, threshold: float = 0.8, progress=None) -> RefactorReport:
+def refactor(conn: Connection, threshold: float = 0.8, progress=None) -> RefactorReport:
     """Merge identical bodies, report near-duplicates (threshold ≤ Sim < 1), check the
     invariants; all in one transaction that rolls back if an invariant breaks.
     `progress(stage, done, total)` is called before each stage."""
@@ -116,9 +121,10 @@ def refactor(conn, threshold: float = 0.8, progress=None) -> RefactorReport:
             if attempt == DEADLOCK_RETRIES:
                 raise EngineError(f"refactor deadlocked {attempt} times with other writers of the template "
                                   "library; nothing was changed, run it again when they are done") from None
+    raise AssertionError("unreachable: the last attempt returns or raises")
 
 
-def _refactor_once(conn, threshold: float, step) -> RefactorReport:
+def _refactor_once(conn: Connection, threshold: float, step) -> RefactorReport:
     with conn.transaction():
         conn.execute(LOCK)
         conn.execute(NO_JIT)
@@ -134,7 +140,7 @@ def _refactor_once(conn, threshold: float, step) -> RefactorReport:
         check_invariants(conn, snapshot)
         return RefactorReport(changed=bool(repointed or deleted), components_before=before,
                               components_after=_count_components(conn),
-                              shared=conn.execute(COMPONENTS_SHARED).fetchone()[0],
+                              shared=scalar(conn.execute(COMPONENTS_SHARED)),
                               near_duplicates=listed.pairs, threshold=threshold,
                               new=listed.new, known=listed.known, intended=listed.intended)
 
@@ -149,16 +155,16 @@ def _stepper(progress):
     return step
 
 
-def _count_components(conn) -> int:
-    return conn.execute("SELECT count(*)::int FROM component").fetchone()[0]
+def _count_components(conn: Connection) -> int:
+    return scalar(conn.execute("SELECT count(*)::int FROM component"))
 
 
-def template_digests(conn) -> dict[str, tuple[int, str]]:
+def template_digests(conn: Connection) -> dict[str, tuple[int, str]]:
     """Per class with rows of its own: (row count, digest of those rows); computed by the server."""
     return {name: (count, digest) for name, count, digest in conn.execute(OWN_ROW_DIGESTS)}
 
 
-def check_invariants(conn, snapshot: dict[str, tuple[int, str]]) -> None:
+def check_invariants(conn: Connection, snapshot: dict[str, tuple[int, str]]) -> None:
     """Lossless and stored once, or an EngineError naming the class that broke."""
     now = template_digests(conn)
     for name in sorted(set(snapshot) | set(now)):
@@ -182,7 +188,7 @@ def _shown(digest: tuple[int, str] | None) -> str:
 USES_LISTED = 10
 
 
-def near_duplicates(conn, threshold: float) -> list[dict]:
+def near_duplicates(conn: Connection, threshold: float) -> list[dict]:
     """The families of texts of one module type that differ only in their block number (one
     entry each, `kind` family, its members; Sim 1 without the block number), then the pairs of
     texts with threshold ≤ Sim < 1, where Sim = K / (M + N − K) on the NC units of the lines
@@ -253,7 +259,7 @@ GROUP BY v.id, v.t, v.o, v.inherited_from
 ORDER BY v.id"""
 
 
-def shared_rows(conn, gear_class: str) -> list[SharedRow]:
+def shared_rows(conn: Connection, gear_class: str) -> list[SharedRow]:
     """Per row of the class's assembled template: which other classes use the same body."""
     load_template(conn, gear_class)   # names a missing class or a class without rows
     return [SharedRow(row_id, t, o, owner, tuple(others))

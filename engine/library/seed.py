@@ -7,6 +7,7 @@ import json
 import tempfile
 from dataclasses import dataclass, field, fields
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 from psycopg import sql
 from psycopg.types.json import Jsonb
@@ -14,11 +15,14 @@ from psycopg.types.json import Jsonb
 from ..csv_reader import Column, CsvKind, parse_text, read_csv_file
 from ..gears.gear_import import GEAR_KIND, identical_gears, import_gears, installed_classes, read_gears
 from ..gears.hob_library import HOB_COLUMNS
-from ..machines.records import Machine
 from ..gears.units import UNIT_KIND, import_units
+from ..machines.records import Machine
 from ..paths import SEED_DIR
 from ..templates.rows import read_csv
 from ..templates.store import ensure_class, replace_template
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
 # The seed tables' CSV kinds: every cell goes as text, and the database parses it into its column's type.
 CLASS_KIND = CsvKind("gear class", (Column("name", parse_text, required=True), Column("parent", parse_text),
@@ -37,10 +41,10 @@ SHOP_TABLES = SEED_TABLES[:1]   # the machines; the hobs are samples
 
 @dataclass
 class SeedReport:
-    added: dict = field(default_factory=dict)
-    created: list = field(default_factory=list)   # the classes this seed created
+    added: dict[str, int] = field(default_factory=dict)
+    created: list[str] = field(default_factory=list)   # the classes this seed created
     # sample gear id → golden tests of it not added: the database's gear of that id is another
-    skipped_tests: dict = field(default_factory=dict)
+    skipped_tests: dict[int, int] = field(default_factory=dict)
 
     def count(self, what: str, number: int = 1) -> None:
         self.added[what] = self.added.get(what, 0) + number
@@ -58,7 +62,7 @@ class SeedReport:
                 for gear_id, n in sorted(self.skipped_tests.items())]
 
 
-def seed(conn, directory: Path = SEED_DIR, *, samples: bool = True) -> SeedReport:
+def seed(conn: Connection, directory: Path = SEED_DIR, *, samples: bool = True) -> SeedReport:
     """Load what is missing, in one transaction.
 
     What every shop needs (`engine seed`): the class tree and the standard code of each class,
@@ -85,7 +89,7 @@ def seed(conn, directory: Path = SEED_DIR, *, samples: bool = True) -> SeedRepor
     return report
 
 
-def _seed_samples(conn, directory: Path, report: SeedReport) -> set[int]:
+def _seed_samples(conn: Connection, directory: Path, report: SeedReport) -> set[int]:
     """The samples; returns the ids of the sample gears the database holds as the samples give
     them (added now, or identical): a shop's own gear under a sample's id gets no sample units
     nor golden tests."""
@@ -105,7 +109,8 @@ INSERT_TEST = ("INSERT INTO template_test (gear_class, name, gear_id, params, ch
                "ON CONFLICT (gear_class, name) DO NOTHING RETURNING 1")
 
 
-def _seed_template_tests(conn, directory: Path, report: SeedReport, samples_stored: set[int] | None) -> None:
+def _seed_template_tests(conn: Connection, directory: Path, report: SeedReport,
+                         samples_stored: set[int] | None) -> None:
     """The golden tests of the shipped templates (engine test), by class and name: a test a DBA
     edited stays edited; a missing one is added, like every seeded row. Those naming a sample
     gear only with the samples, and only where that gear is the sample (`samples_stored`)."""
@@ -135,7 +140,7 @@ def _of_a_sample(gear_id: int | None, samples_stored: set[int] | None, report: S
     return False
 
 
-def _release_seeded(conn, classes: list[str], report: SeedReport) -> None:
+def _release_seeded(conn: Connection, classes: list[str], report: SeedReport) -> None:
     """The templates the seed loaded are released: they are the shipped, tested templates."""
     for gear_class in classes:
         conn.execute("SELECT store_current_version(%s) WHERE NOT EXISTS (SELECT 1 FROM template_version_rows v "
@@ -145,20 +150,20 @@ def _release_seeded(conn, classes: list[str], report: SeedReport) -> None:
         report.count("template releases", len(released.fetchall()))
 
 
-def _read(path: Path, kind: CsvKind) -> list[dict]:
+def _read(path: Path, kind: CsvKind) -> list[dict[str, Any]]:
     """The rows of a seed file as {column: text}, an empty cell None (the column's default)."""
     return [{key: (value if value != "" else None) for key, value in row.items()}
             for _, row in read_csv_file(path, kind).rows()]
 
 
-def _seed_classes(conn, directory: Path, report: SeedReport) -> None:
+def _seed_classes(conn: Connection, directory: Path, report: SeedReport) -> None:
     for row in _read(directory / "gear_classes.csv", CLASS_KIND):
         if ensure_class(conn, row["name"], row["parent"], row["description"] or ""):
             report.count("gear classes")
             report.created.append(row["name"])
 
 
-def _insert_missing(conn, table: str, key: str, rows: list[dict]) -> int:
+def _insert_missing(conn: Connection, table: str, key: str, rows: list[dict[str, Any]]) -> int:
     added = 0
     for row in rows:
         row = {column: value for column, value in row.items() if value is not None}   # empty: the default
@@ -169,7 +174,7 @@ def _insert_missing(conn, table: str, key: str, rows: list[dict]) -> int:
     return added
 
 
-def _seed_templates(conn, directory: Path, report: SeedReport) -> list[str]:
+def _seed_templates(conn: Connection, directory: Path, report: SeedReport) -> list[str]:
     """Parents before the classes derived from them (the tree order of gear_classes.csv), so
     a derived class stores only the rows that differ from what it inherits."""
     order = [row["name"] for row in _read(directory / "gear_classes.csv", CLASS_KIND)]
@@ -186,7 +191,7 @@ def _seed_templates(conn, directory: Path, report: SeedReport) -> list[str]:
     return report.created + [name for name in templated if name not in report.created]
 
 
-def _seed_gears(conn, directory: Path, report: SeedReport) -> set[int]:
+def _seed_gears(conn: Connection, directory: Path, report: SeedReport) -> set[int]:
     """Sample gears not yet in the database, through the same checks as `engine gears import`;
     the ids of the sample gears stored as the samples give them (see _seed_samples)."""
     source = directory / "gears.csv"
@@ -194,7 +199,7 @@ def _seed_gears(conn, directory: Path, report: SeedReport) -> set[int]:
     return identical_gears(conn, read_gears(source, installed_classes(conn)))
 
 
-def _add_missing_gears(conn, source: Path, report: SeedReport) -> None:
+def _add_missing_gears(conn: Connection, source: Path, report: SeedReport) -> None:
     known = {row[0] for row in conn.execute("SELECT id FROM gear")}
     file = read_csv_file(source, GEAR_KIND)
     missing = [row for _, row in file.rows() if int(row["gear_id"]) not in known]
@@ -203,14 +208,14 @@ def _add_missing_gears(conn, source: Path, report: SeedReport) -> None:
         return
     with tempfile.TemporaryDirectory() as folder:
         subset = Path(folder) / source.name
-        with subset.open("w", encoding="utf-8", newline="") as file:
-            writer = csv.DictWriter(file, header)
+        with subset.open("w", encoding="utf-8", newline="") as written:
+            writer = csv.DictWriter(written, header)
             writer.writeheader()
             writer.writerows(missing)
         report.count("gears", import_gears(conn, subset).imported)
 
 
-def _seed_units(conn, directory: Path, report: SeedReport, samples_stored: set[int]) -> None:
+def _seed_units(conn: Connection, directory: Path, report: SeedReport, samples_stored: set[int]) -> None:
     """Further units of the sample multi-unit gears, where the gear is the sample and has none yet."""
     source = directory / "gear_units.csv"
     with_units = {row[0] for row in conn.execute("SELECT DISTINCT gear_id FROM gear_unit")}
@@ -220,8 +225,8 @@ def _seed_units(conn, directory: Path, report: SeedReport, samples_stored: set[i
         report.count("gear units", import_units(conn, source, only_gears={int(r["gear_id"]) for r in rows}))
 
 
-def _seed_cases(conn, directory: Path, report: SeedReport) -> None:
+def _seed_cases(conn: Connection, directory: Path, report: SeedReport) -> None:
     """The machining history's seed cases (the paper's example among them)."""
-    from ..gears.cases import seed_cases   # pandas: loaded only when the history is seeded
+    from ..gears.cases import seed_cases  # pandas: loaded only when the history is seeded
 
     report.count("cases", seed_cases(conn, directory / "cases.csv"))

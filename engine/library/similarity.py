@@ -19,8 +19,8 @@ import re
 from collections import Counter, defaultdict
 from collections.abc import Iterator, Sequence
 
-from ..templates.guards import parse_python
 from ..nc.tokens import NUMBER, SPACE, WORD, tokenise
+from ..templates.guards import parse_python
 
 CODE_ADDRESSES = ("G", "M")   # their numbers name a function: `G1` is one unit, as `M8`
 # Float slack for Sim compared with a threshold: 0.8 * 10 must count as 8, not 8.000…1.
@@ -73,7 +73,7 @@ def _literal_pieces(node, in_sum: bool = False) -> list[tuple[str, bool]] | None
     return [("{" + ast.unparse(node) + "}", True)] if in_sum else None
 
 
-def _placeholder(field: ast.FormattedValue) -> str:
+def _placeholder(field: ast.expr) -> str:   # a replacement field of an f-string
     """`{x_in:.3f}`: the field with its conversion and format, as one unit."""
     return ast.unparse(ast.JoinedStr(values=[field]))[2:-1]
 

@@ -3,9 +3,13 @@ travel in mm, spindle and table limits, axis senses and setup) and loading it by
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from ..db.records import as_float, columns
 from ..errors import EngineError
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
 
 @dataclass(frozen=True)
@@ -47,7 +51,7 @@ MACHINE_QUERY = f"SELECT {columns(Machine)} FROM machine"  # static, from the da
 DEFAULT_HOBBING_MACHINE = "hobber-840d"
 
 
-def hobbing_machine(conn, name: str | None) -> Machine:
+def hobbing_machine(conn: Connection, name: str | None) -> Machine:
     """The machine record, which must be a hobbing machine (default: the seeded 840D hobber)."""
     machine = load_machine(conn, name or DEFAULT_HOBBING_MACHINE)
     if machine.kind != "hobber":
@@ -56,7 +60,7 @@ def hobbing_machine(conn, name: str | None) -> Machine:
     return machine
 
 
-def load_machine(conn, name: str) -> Machine:
+def load_machine(conn: Connection, name: str) -> Machine:
     row = conn.execute(MACHINE_QUERY + " WHERE name = %s", (name,)).fetchone()
     if row is None:
         known = ", ".join(r[0] for r in conn.execute("SELECT name FROM machine ORDER BY name"))

@@ -7,9 +7,13 @@ version, and a program is written with its version's layout."""
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
 
 from ..errors import EngineError
 from ..names import line_breaking, shown
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
 LF, CRLF = "\n", "\r\n"
 ENDING_NAMES = {LF: "lf", CRLF: "crlf"}   # as the config file and a template CSV write them
@@ -69,7 +73,7 @@ def nc_text(lines: list[str], layout: NcLayout) -> str:
     return text + layout.line_ending if layout.final_newline else text
 
 
-def store_layout(conn, gear_class: str, layout: NcLayout) -> bool:
+def store_layout(conn: Connection, gear_class: str, layout: NcLayout) -> bool:
     """Give the class this layout; True if that changed it. A change is a change of the class's
     template: the database makes it a new version (a draft until released; version_layout_change),
     unless this transaction made one already."""
@@ -87,7 +91,7 @@ FROM gear_class g LEFT JOIN template_version_rows v ON v.gear_class = g.name AND
 WHERE g.name = %s"""
 
 
-def class_layout(conn, gear_class: str, version: int | None = None) -> NcLayout:
+def class_layout(conn: Connection, gear_class: str, version: int | None = None) -> NcLayout:
     """The layout the class's template `version` writes (its current version if None): what
     its programs of that version are written with, LF with a final newline for a class not imported."""
     row = conn.execute(LAYOUT, (version, gear_class)).fetchone()

@@ -108,7 +108,9 @@ def _word_or_name(line: str, position: int, context: _Context) -> tuple[str, int
     letters, end = found.group(), found.end()
     digits_follow = end < len(line) and line[end] in "0123456789"
     if "_" in letters or letters.startswith("$") or (len(letters) > 1 and digits_follow):
-        return NAME, _NAME_REST.match(line, end).end()
+        rest = _NAME_REST.match(line, end)
+        assert rest is not None   # [A-Za-z0-9_]* matches the empty text too
+        return NAME, rest.end()
     return WORD, end
 
 

@@ -17,14 +17,19 @@ from __future__ import annotations
 import contextlib
 import re
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from psycopg.types.json import Jsonb
 
+from ..db.connection import scalar
 from ..errors import EngineError
 from .options import Output, RunMode
 from .outputs import files_after_commit
 from .records import Planned, Program
 from .storage import Batch, Lineage, refuse_unsafe
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
 DRY_RUN_ID = "DRY-RUN"   # in the lineage line where a stored program has its id
 NEW_INPUT_HASH = "SELECT job_input_hash(%s, %s)"   # the hash a new job's parameters would get stored
@@ -112,7 +117,7 @@ def batch_stage(conn, output: Output, mode: RunMode):
 
 
 @contextlib.contextmanager
-def read_only(conn):
+def read_only(conn: Connection):
     """A transaction in which PostgreSQL refuses every write (nextval() too), rolled back at the
     end; inside a caller's transaction a savepoint, rolled back the same way."""
     with conn.transaction(force_rollback=True):
@@ -120,13 +125,13 @@ def read_only(conn):
         yield
 
 
-def dry_program(conn, planned: Planned, job_id: int | None) -> Program:
+def dry_program(conn: Connection, planned: Planned, job_id: int | None) -> Program:
     """The program as it would be stored (checked like a stored one), its lineage line saying
     DRY-RUN for the program id; the job id of a stored job made again, else None (no job)."""
     checked(planned)
     template = planned.template
     hashes = {} if job_id is not None else \
-        {None: conn.execute(NEW_INPUT_HASH, (Jsonb(planned.params), Jsonb(planned.module_params))).fetchone()[0]}
+        {None: scalar(conn.execute(NEW_INPUT_HASH, (Jsonb(planned.params), Jsonb(planned.module_params))))}
     lineage = Lineage(conn, [planned.machine], [(template.gear_class, template.version)],
                       [job_id] if job_id is not None else [], hashes)
     lines, row_ids = lineage.added(DRY_RUN_ID, job_id, planned.machine, template.gear_class, template.version,

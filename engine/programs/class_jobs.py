@@ -19,28 +19,32 @@ from __future__ import annotations
 
 import ast
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from .. import turning  # noqa: F401  (importing it registers the turning names model)
-from ..hobbing import models as hobbing_models  # noqa: F401  (importing it registers the hobbing models)
 from ..errors import EngineError
 from ..gears.models import model_for_class
-from ..machines.records import Machine, load_machine
-from ..nc.layout import NcLayout, class_layout
+from ..hobbing import models as hobbing_models  # noqa: F401  (importing it registers the hobbing models)
 from ..library.nc_params import bindings, values
-from ..nc.tokens import NUMBER, tokenise
+from ..machines.records import Machine, load_machine
 from ..names import checked
+from ..nc.layout import NcLayout, class_layout
+from ..nc.lineage import refuse_lineage_shaped
+from ..nc.tokens import NUMBER, tokenise
 from ..templates.decision_table import compiled_template
 from ..templates.rows import Template
 from ..templates.versions import runnable_template
 from ..turning.names import TurningModel
+from ..verifier.grammar import DIALECTS
 from .batches import dry_program, read_only, refuse_out_in_dry_run
 from .instantiate import store_planned
-from ..nc.lineage import refuse_lineage_shaped
 from .options import NO_FILE, NORMAL_RUN, Output, RunMode
 from .outputs import files_after_commit
 from .records import Planned, Program
 from .verified_run import run_template
-from ..verifier.grammar import DIALECTS
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
 PROGRAM_NAME = "program_name"   # the job's program name: given or not, whatever the class was imported with
 IMPORT_PARAMS = "SELECT import_params FROM gear_class WHERE name = %s"
@@ -59,7 +63,7 @@ class ClassJob:
     taken: tuple[str, ...]
 
 
-def instantiate_class(conn, gear_class: str, given: dict, *, machine: str | None = None,
+def instantiate_class(conn: Connection, gear_class: str, given: dict, *, machine: str | None = None,
                       source: str = "parameters", output: Output = NO_FILE, mode: RunMode = NORMAL_RUN,
                       unverified: bool = False) -> ClassJob:
     """A job of the class with the parameters `given` (JSON of import-nc's --params, either form),
@@ -84,7 +88,7 @@ def refuse_unverified_file(unverified: bool, out) -> None:
                           "(and the machine's out in the config file); nothing stored")
 
 
-def _planned(conn, gear_class: str, given: dict, machine_name: str | None, source: str, draft: bool,
+def _planned(conn: Connection, gear_class: str, given: dict, machine_name: str | None, source: str, draft: bool,
              unverified: bool) -> tuple[Planned, tuple[str, ...]]:
     imported = _imported_values(conn, gear_class)
     refuse_modelled(conn, gear_class)
@@ -100,14 +104,14 @@ def _planned(conn, gear_class: str, given: dict, machine_name: str | None, sourc
     return class_job(template, machine, params, {}, layout), taken
 
 
-def _imported_values(conn, gear_class: str) -> dict:
+def _imported_values(conn: Connection, gear_class: str) -> dict:
     row = conn.execute(IMPORT_PARAMS, (gear_class,)).fetchone()
     if row is None:
         raise EngineError(f"class {gear_class!r} does not exist; see `engine template list`")
     return values(row[0] or {}, f"class {gear_class}'s imported parameters")
 
 
-def refuse_modelled(conn, gear_class: str) -> None:
+def refuse_modelled(conn: Connection, gear_class: str) -> None:
     """A class with a model makes its jobs from what the model reads: a gear or a drawing."""
     model = model_for_class(conn, gear_class)
     if isinstance(model, TurningModel):
@@ -118,7 +122,7 @@ def refuse_modelled(conn, gear_class: str) -> None:
                           "(engine instantiate --gear ID), not from --class")
 
 
-def class_machine(conn, name: str | None) -> Machine:
+def class_machine(conn: Connection, name: str | None) -> Machine:
     """The machine record; a hobber is refused: its programs are proved against a gear and hob."""
     if name is None:
         known = ", ".join(row[0] for row in conn.execute(MACHINES))
@@ -202,7 +206,7 @@ def _field_addresses(o: str, name: str) -> set:
         if isinstance(part, ast.FormattedValue) and name in {node.id for node in ast.walk(part)
                                                               if isinstance(node, ast.Name)}:
             places.add(len(line))
-        line += part.value if isinstance(part, ast.Constant) else "1"
+        line += str(part.value) if isinstance(part, ast.Constant) else "1"   # an f-string's text is str
     return _addresses_at(line, places)
 
 

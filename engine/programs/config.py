@@ -1,5 +1,5 @@
 """The shop's settings file: defaults of command options, the default machine, the output folder
-and line endings per machine (README, "Configuration").
+and line endings per machine (docs/guide/configuration.md).
 
 A TOML file in the user's config directory (platformdirs: ~/.config/nc-template-engine/config.toml
 on Linux), or the file ENGINE_CONFIG names (ENGINE_CONFIG="" reads none). Its values are only
@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import os
 import re
+import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -34,9 +35,9 @@ from ..errors import EngineError
 from ..machines.records import DEFAULT_HOBBING_MACHINE
 from ..nc.layout import ENDING_NAMES
 
-try:
+if sys.version_info >= (3, 11):
     import tomllib
-except ModuleNotFoundError:   # Python 3.10
+else:   # Python 3.10
     import tomli as tomllib
 
 APP = "nc-template-engine"

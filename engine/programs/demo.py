@@ -13,10 +13,16 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ..db.embedded import embedded_data_dir, embedded_url
 from ..library.seed import SeedReport
 from ..paths import SAMPLE_DRAWING
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
+    from .dxf_import import ImportReport
+    from .records import Program
 
 DEMO_DATABASE = "engine_demo"
 # mm: the blank the sample drawing's roughing starts from (seed_templates/drawings/README.md);
@@ -27,8 +33,8 @@ SAMPLE_STOCK_DIAMETER = 44.0
 @dataclass(frozen=True)
 class SampleJob:
     drawing: Path           # the sample drawing, to copy as the start of one's own
-    job: object             # engine.programs.dxf_import's ImportReport
-    program: object         # engine.programs.instantiate's Program
+    job: ImportReport
+    program: Program
 
 
 @dataclass(frozen=True)
@@ -36,7 +42,7 @@ class DemoResult:
     data_dir: Path          # where the embedded server keeps its data (database engine_demo)
     applied: int            # migrations applied by this run
     report: SeedReport
-    program: object         # engine.programs.instantiate's Program
+    program: Program
     sample: SampleJob | None = None   # with --turning: the job the program was made for
 
 
@@ -56,11 +62,11 @@ def run_demo(gear_id: int = 42, turning: bool = False) -> DemoResult:
     return DemoResult(embedded_data_dir(), len(applied), report, program, sample)
 
 
-def sample_turning_job(conn, drawing: Path = SAMPLE_DRAWING) -> SampleJob:
+def sample_turning_job(conn: Connection, drawing: Path = SAMPLE_DRAWING) -> SampleJob:
     """Import the sample drawing as a turning job on the default lathe (from the Ø44 blank) and
     store its program, as `engine import-dxf` and `engine instantiate --job` do."""
-    from .dxf_import import import_dxf
     from ..turning.job_params import ProfileOptions
+    from .dxf_import import import_dxf
     from .remake import instantiate_job
 
     job = import_dxf(conn, drawing, options=ProfileOptions(stock_diameter=SAMPLE_STOCK_DIAMETER))

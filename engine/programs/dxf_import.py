@@ -9,15 +9,20 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from psycopg.types.json import Jsonb
 
+from ..db.connection import scalar
 from ..drawings.drawing import read_drawing
 from ..memory import no_cycle_collection
 from ..names import checked
 from ..turning.job_params import ProfileOptions, turning_job
 from ..turning.model import ISO_PROGRAM_NUMBERS, job_passes, key, present_operations
 from .turning_jobs import lathe, plan_turning_job, turning_class
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
 INSERT_TURNING_JOB = """
 INSERT INTO job (id, gear_id, gear_class, machine, hob_id, params, module_params)
@@ -36,13 +41,14 @@ class ImportReport:
     notes: list[str] = field(default_factory=list)
 
 
-def import_dxf(conn, path: str | Path, machine_name: str | None = None,
+def import_dxf(conn: Connection, path: str | Path, machine_name: str | None = None,
                options: ProfileOptions = ProfileOptions(), alternate: list[int] | None = None,
                program_name: str | None = None, draft: bool = False, profile_layer: str | None = None) -> ImportReport:
     """Read the drawing and store its job; EngineError (nothing stored) if it cannot become one.
     The program is named `program_name`, else after the drawing's file name (job_params.drawing_names);
     the profile is read from layer `profile_layer` (None: layer 0, or the layer read_drawing chooses)."""
-    checked("drawing", Path(path).name, "drawing file name", "rename the file")   # said before the drawing's own problems
+    # said before the drawing's own problems
+    checked("drawing", Path(path).name, "drawing file name", "rename the file")
     if program_name is not None:
         checked("program", program_name, "--program-name")
     machine = lathe(conn, machine_name)
@@ -51,11 +57,11 @@ def import_dxf(conn, path: str | Path, machine_name: str | None = None,
         return _import(conn, (path, profile_layer), machine, gear_class, options, alternate, program_name, draft)
 
 
-def _import(conn, source: tuple, machine, gear_class: str, options: ProfileOptions, alternate, program_name,
+def _import(conn: Connection, source: tuple, machine, gear_class: str, options: ProfileOptions, alternate, program_name,
             draft: bool) -> ImportReport:
     drawing = read_drawing(*source)   # (path, profile layer)
     with conn.transaction():
-        job_id = conn.execute("SELECT nextval('job_id_seq')").fetchone()[0]
+        job_id = scalar(conn.execute("SELECT nextval('job_id_seq')"))
         program_number = (job_id - 1) % ISO_PROGRAM_NUMBERS + 1    # the job id, wrapped into O0001 … O8999
         job = turning_job(drawing, machine.name, gear_class, program_number, options, alternate, program_name)
         passes = job_passes(job.params, job.module_params)

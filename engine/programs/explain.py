@@ -8,9 +8,13 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from ..errors import EngineError
 from ..nc.lineage import LINEAGE_ROW_ID
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
 MAX_LISTED_LINES = 1   # lines of a row quoted in its sentence (a tool path prints hundreds)
 
@@ -58,7 +62,7 @@ def _values_read(entry: dict, values: dict) -> dict:
             for column, reads in entry.get("read", {}).items()}
 
 
-def explain_program(conn, program_id: int, row: int | None = None) -> list[ExplainedRow]:
+def explain_program(conn: Connection, program_id: int, row: int | None = None) -> list[ExplainedRow]:
     """The stored program's rows, explained from its stored trace."""
     found = conn.execute("SELECT lines, row_ids, trace FROM program WHERE id = %s", (program_id,)).fetchone()
     if found is None:

@@ -8,37 +8,51 @@ written only after the COMMIT).
 from __future__ import annotations
 
 from dataclasses import replace
+from typing import TYPE_CHECKING
 
 from .. import turning  # noqa: F401  (importing it registers the turning names model)
-from ..hobbing import models as hobbing_models  # noqa: F401  (importing it registers the hobbing models)
 from ..errors import EngineError
 from ..gears.case_base import CUT_KINDS_BY_COUNT, CaseBase, job_cutting_record
 from ..gears.hob_matching import choose_hob
 from ..gears.models import model_for_class
 from ..gears.process_notes import hunting_tooth_notes
 from ..gears.records import Gear, load_gear, load_gears, load_hobs
-from ..machines.records import Machine, hobbing_machine
+from ..hobbing import models as hobbing_models  # noqa: F401  (importing it registers the hobbing models)
 from ..hobbing.choices import Choices
-from ..nc.layout import NcLayout, class_layout
+from ..machines.records import Machine, hobbing_machine
 from ..memory import no_cycle_collection
+from ..nc.layout import NcLayout, class_layout
 from ..templates.rows import Template
 from ..templates.versions import runnable_template
 from ..turning.names import TurningModel
-from .batches import Bad, batch_stage, checked, dry_batch, dry_program, good_ones, planned_or_bad, read_only, \
-    reason_of, refuse_out_in_dry_run
+from ..verifier import LimitError, check_table_speed
+from .batches import (
+    Bad,
+    batch_stage,
+    checked,
+    dry_batch,
+    dry_program,
+    good_ones,
+    planned_or_bad,
+    read_only,
+    reason_of,
+    refuse_out_in_dry_run,
+)
 from .options import NO_FILE, NORMAL_RUN, Output, RunMode
 from .outputs import ProgramFiles, file_layouts, files_after_commit
-from .verified_run import Workpiece, run_template
-from ..verifier import LimitError, check_table_speed
 from .records import Planned, Program
 from .storage import Batch, store_many, store_one
+from .verified_run import Workpiece, run_template
 from .workers import PLANNING, plan_in_workers
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
 
 class Planner:
     """Everything shared by the gears of one run: machine, hob library, templates."""
 
-    def __init__(self, conn, machine: str | None = None, choices: Choices = Choices(), overrides=None,
+    def __init__(self, conn: Connection, machine: str | None = None, choices: Choices = Choices(), overrides=None,
                  draft: bool = False):
         self.conn = conn
         self.draft = draft   # the classes' drafts (an editor trying them), not their released versions
@@ -127,7 +141,7 @@ def _check_table_speed(gear: Gear, starts: int, hob_speed: float, machine: Machi
     check_table_speed(gear.id, gear.teeth, starts, hob_speed, machine)
 
 
-def instantiate_gear(conn, gear_id: int, *, machine: str | None = None, choices: Choices = Choices(),
+def instantiate_gear(conn: Connection, gear_id: int, *, machine: str | None = None, choices: Choices = Choices(),
                      overrides: dict | None = None, output: Output = NO_FILE, mode: RunMode = NORMAL_RUN) -> Program:
     """Compute, check and store the program of one gear; write it to `output.out` if given (after
     the COMMIT; an existing file only with `output.force`). With `mode.draft`, from the class's
@@ -145,7 +159,7 @@ def instantiate_gear(conn, gear_id: int, *, machine: str | None = None, choices:
     return program
 
 
-def instantiate_gears(conn, first: int | None = None, last: int | None = None, *,
+def instantiate_gears(conn: Connection, first: int | None = None, last: int | None = None, *,
                       machine: str | None = None, choices: Choices = Choices(), overrides=None,
                       output: Output = NO_FILE, mode: RunMode = NORMAL_RUN) -> Batch:
     """All gears with first ≤ id ≤ last, every one planned: all programs stored, or none if any
@@ -192,7 +206,7 @@ def _counted(outcome, done: int, total: int, progress):
     return outcome
 
 
-def store_planned(conn, planned: list[Planned], files: ProgramFiles,
+def store_planned(conn: Connection, planned: list[Planned], files: ProgramFiles,
                   existing_job: int | None = None) -> list[Program]:
     """Store the programs (and their jobs, unless `existing_job`); their files are checked now
     and written by `files` after the caller's COMMIT."""

@@ -5,8 +5,12 @@ cases of the machining history."""
 from __future__ import annotations
 
 from datetime import date
+from typing import TYPE_CHECKING
 
 from ..db.listing import Deletion, Reference, day_range, delete_row, one_record, records, require_class
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
 JOB_COLUMNS = """
 SELECT j.id AS job_id, j.gear_id, j.gear_class AS class, j.machine, j.hob_id,
@@ -21,7 +25,8 @@ WHERE (%(class)s::text IS NULL OR j.gear_class = %(class)s)
 ORDER BY j.id"""
 ONE_JOB = JOB_COLUMNS + ", j.params, j.module_params, j.cutting FROM job j WHERE j.id = %s"
 JOB_PROGRAMS = """
-SELECT id AS program_id, name, template_version, draft, unverified, created_at FROM program WHERE job_id = %s ORDER BY id"""
+SELECT id AS program_id, name, template_version, draft, unverified, created_at
+FROM program WHERE job_id = %s ORDER BY id"""
 
 JOB_DELETION = Deletion(
     kind="job",
@@ -35,7 +40,7 @@ JOB_DELETION = Deletion(
 )
 
 
-def list_jobs(conn, gear_class: str | None = None, gear_id: int | None = None, since: date | None = None,
+def list_jobs(conn: Connection, gear_class: str | None = None, gear_id: int | None = None, since: date | None = None,
               until: date | None = None) -> list[dict]:
     """Every job of the class and gear (any if None) made from `since` to `until` (whole days,
     both included), by id."""
@@ -44,12 +49,12 @@ def list_jobs(conn, gear_class: str | None = None, gear_id: int | None = None, s
     return records(conn.execute(LIST_JOBS, filters))
 
 
-def job_details(conn, job_id: int) -> dict:
+def job_details(conn: Connection, job_id: int) -> dict:
     """The job as stored (its parameters and cutting data included) and its programs."""
     job = one_record(conn.execute(ONE_JOB, (job_id,)), "job", job_id, "engine jobs list")
     return {**job, "programs": records(conn.execute(JOB_PROGRAMS, (job_id,)))}
 
 
-def delete_job(conn, job_id: int, yes: bool) -> str:
+def delete_job(conn: Connection, job_id: int, yes: bool) -> str:
     """Delete the job if no program and no cutting case refers to it; what was deleted."""
     return delete_row(conn, JOB_DELETION, job_id, yes)

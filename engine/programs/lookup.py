@@ -9,10 +9,14 @@ from __future__ import annotations
 import re
 from dataclasses import asdict, dataclass
 from datetime import date, datetime
+from typing import TYPE_CHECKING
 
 from ..db.listing import day_range, records, require_class
 from ..errors import EngineError
 from ..nc.layout import ENDING_NAMES, NcLayout, nc_text
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
 MIN_HASH_DIGITS = 8   # what the lineage line shows
 HASH_PREFIX = re.compile(r"[0-9a-f]{8,64}")
@@ -62,14 +66,17 @@ class ProgramRecord:
                 "final_newline": self.layout.final_newline}
 
 
-def find_programs(conn, program_id: int | None = None, prefix: str | None = None) -> list[ProgramRecord]:
+def find_programs(conn: Connection, program_id: int | None = None, prefix: str | None = None) -> list[ProgramRecord]:
     """The program with this id, or every program matching the hash prefix (one of the two)."""
     if (program_id is None) == (prefix is None):
         raise EngineError("give a program id or --hash H (8 or more hex digits of its lineage line), one of the two")
-    return [program_record(conn, program_id)] if program_id is not None else programs_with_hash(conn, prefix)
+    if program_id is not None:
+        return [program_record(conn, program_id)]
+    assert prefix is not None   # one of the two
+    return programs_with_hash(conn, prefix)
 
 
-def program_record(conn, program_id: int) -> ProgramRecord:
+def program_record(conn: Connection, program_id: int) -> ProgramRecord:
     """The program with this id; EngineError if there is none."""
     found = conn.execute(BY_ID, (program_id,)).fetchone()
     if found is None:
@@ -78,7 +85,7 @@ def program_record(conn, program_id: int) -> ProgramRecord:
     return _record(found)
 
 
-def programs_with_hash(conn, prefix: str) -> list[ProgramRecord]:
+def programs_with_hash(conn: Connection, prefix: str) -> list[ProgramRecord]:
     """Every program whose INPUT hash or TEMPLATE hash starts with `prefix` (8 or more hex digits,
     as on the lineage line); EngineError if none does."""
     prefix = checked_prefix(prefix)
@@ -90,7 +97,8 @@ def programs_with_hash(conn, prefix: str) -> list[ProgramRecord]:
 
 def _record(row: tuple) -> ProgramRecord:
     *fields, line_ending, final_newline = row
-    return ProgramRecord(*fields, NcLayout(line_ending, final_newline))
+    # mypy counts *fields (of unknown length) as filling every field, the layout as one too many
+    return ProgramRecord(*fields, NcLayout(line_ending, final_newline))   # type: ignore[call-arg]
 
 
 def checked_prefix(text: str) -> str:
@@ -115,7 +123,8 @@ WHERE (%(class)s::text IS NULL OR p.gear_class = %(class)s)
 ORDER BY p.id"""
 
 
-def list_programs(conn, gear_class: str | None = None, gear_id: int | None = None, job_id: int | None = None,
+def list_programs(conn: Connection, gear_class: str | None = None, gear_id: int | None = None,
+                  job_id: int | None = None,
                   draft: bool | None = None, since: date | None = None, until: date | None = None) -> list[dict]:
     """Every program matching all filters given (None: any), by id: its record without its lines.
     draft True: made from a draft version (for trying only); False: from a released one."""

@@ -30,23 +30,28 @@ import contextvars
 import errno
 import os
 import secrets
+from collections.abc import Callable
 from pathlib import Path
-from typing import Callable
+from typing import TYPE_CHECKING
 
 import psycopg
 from psycopg.pq import TransactionStatus
 
 from ..errors import EngineError
-from ..nc.layout import NcLayout, nc_text
 from ..names import checked
+from ..nc.layout import NcLayout, nc_text
 from .options import Output
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
 SUFFIX = ".MPF"
 # errno of open(O_TMPFILE) where the kernel or the file system does not support it
 NO_TMPFILE = (errno.EOPNOTSUPP, errno.EISDIR, errno.EINVAL, errno.ENOENT)
 PROC_FD = Path("/proc/self/fd")
 # machine name -> the line ending configured for its files, or None (its class's)
-CONFIGURED_ENDING = contextvars.ContextVar("configured_ending", default=None)
+CONFIGURED_ENDING: contextvars.ContextVar[Callable[[str], str | None] | None] = contextvars.ContextVar(
+    "configured_ending", default=None)
 
 
 class ProgramFiles:
@@ -93,12 +98,14 @@ class ProgramFiles:
 
     def _targets(self, names: list[str]) -> dict[str, Path]:
         """One program: --out is the file (unless a folder is meant); a batch: --out is their folder."""
-        if len(names) == 1 and not self.folder and not self.out.is_dir():
-            return {names[0]: self.out}
-        if self.out.exists() and not self.out.is_dir():
-            raise EngineError(f"--out {self.out} is a file; give a folder for a batch of programs")
-        _refuse_same_program_twice(names, self.out)
-        return {name: _inside(self.out, name) for name in names}
+        out = self.out
+        assert out is not None   # write() plans files only for an --out
+        if len(names) == 1 and not self.folder and not out.is_dir():
+            return {names[0]: out}
+        if out.exists() and not out.is_dir():
+            raise EngineError(f"--out {out} is a file; give a folder for a batch of programs")
+        _refuse_same_program_twice(names, out)
+        return {name: _inside(out, name) for name in names}
 
     def _refuse_existing(self, targets: list[Path]) -> None:
         """An existing file is replaced only with --force; a file naming the same program in
@@ -133,7 +140,7 @@ class ProgramFiles:
 
 
 @contextlib.contextmanager
-def files_after_commit(conn, output: Output, batch: bool = False):
+def files_after_commit(conn: Connection, output: Output, batch: bool = False):
     """Yield ProgramFiles for the block, which runs in a transaction that commits for real when
     the block ends; only then are the planned files written. Without --out (output.out None) the
     block may run inside the caller's transaction (a savepoint), as nothing is written."""
@@ -147,7 +154,7 @@ def files_after_commit(conn, output: Output, batch: bool = False):
 
 
 @contextlib.contextmanager
-def _committed(conn):
+def _committed(conn: Connection):
     """conn.transaction(), with a failed COMMIT said in one line (no file is written then)."""
     transaction = conn.transaction()
     transaction.__enter__()

@@ -5,13 +5,17 @@ the simulation's reading of its lines. PNG or SVG by the file's suffix, written 
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ..errors import EngineError
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
 JOB_MACHINE = "SELECT m.kind FROM job j JOIN machine m ON m.name = j.machine WHERE j.id = %s"
 
 
-def plot_job(conn, job_id: int, out: str | Path) -> list[str]:
+def plot_job(conn: Connection, job_id: int, out: str | Path) -> list[str]:
     """Draw the job to `out`; → one line per thing drawn (for the report)."""
     row = conn.execute(JOB_MACHINE, (job_id,)).fetchone()
     if row is None:
@@ -22,21 +26,21 @@ def plot_job(conn, job_id: int, out: str | Path) -> list[str]:
     return plotter(conn, job_id, out)
 
 
-def plot_program(conn, program_id: int, out: str | Path) -> list[str]:
+def plot_program(conn: Connection, program_id: int, out: str | Path) -> list[str]:
     """Draw the stored program to `out` as the simulation reads it; → one line per thing drawn."""
     from ..hobbing.program_plot import plot_stored_program
 
     return plot_stored_program(conn, program_id, out)
 
 
-def _turning(conn, job_id: int, out) -> list[str]:
+def _turning(conn: Connection, job_id: int, out) -> list[str]:
     from ..turning.job_plot import plot_turning_job
 
     return [f"operation {label} T{tool}: {passes} pass(es)" for label, tool, passes in
             plot_turning_job(conn, job_id, out)]
 
 
-def _hobbing(conn, job_id: int, out) -> list[str]:
+def _hobbing(conn: Connection, job_id: int, out) -> list[str]:
     from ..hobbing.job_plot import plot_hobbing_job
 
     return plot_hobbing_job(conn, job_id, out)

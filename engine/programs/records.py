@@ -39,8 +39,9 @@ class Planned:
 
     def encoded(self, with_job: bool = True) -> Encoded:
         """For storage; without the job's JSON when only the program is stored (a job made again)."""
-        job = (json.dumps(self.params), json.dumps(self.module_params), json.dumps(self.cutting or {})) \
-            if with_job else (None, None, None)
+        job: tuple[str | None, str | None, str | None] = (
+            (json.dumps(self.params), json.dumps(self.module_params), json.dumps(self.cutting or {}))
+            if with_job else (None, None, None))
         return Encoded(self.gear_id, self.gear_class, self.machine, self.hob_id, *job, self.template.version,
                        self.template.hash, self.name, self.result.lines, self.result.row_ids,
                        json.dumps(self.result.trace), tuple(self.notes), self.layout)

@@ -9,30 +9,42 @@ from __future__ import annotations
 
 import re
 from dataclasses import replace
+from typing import TYPE_CHECKING
 
 from .. import turning  # noqa: F401  (importing it registers the turning names model)
-from ..hobbing import models as hobbing_models  # noqa: F401  (importing it registers the hobbing models)
 from ..errors import EngineError
 from ..gears.models import model_for_class
 from ..gears.process_notes import stored_feed_notes
 from ..gears.records import Hob, load_gear, load_hobs
-from ..machines.records import Machine, load_machine
+from ..hobbing import models as hobbing_models  # noqa: F401  (importing it registers the hobbing models)
 from ..hobbing.cylindrical import program_name
 from ..hobbing.machine_job import with_cycle_time
-from ..nc.layout import NcLayout, class_layout
+from ..machines.records import Machine, load_machine
 from ..memory import no_cycle_collection
+from ..nc.layout import NcLayout, class_layout
 from ..templates.rows import Template
 from ..templates.versions import runnable_template
-from .batches import batch_stage, checked, dry_batch, dry_program, good_ones, planned_or_bad, read_only, \
-    refuse_out_in_dry_run
+from .batches import (
+    batch_stage,
+    checked,
+    dry_batch,
+    dry_program,
+    good_ones,
+    planned_or_bad,
+    read_only,
+    refuse_out_in_dry_run,
+)
 from .class_jobs import class_job
 from .instantiate import store_planned
 from .options import NO_FILE, NORMAL_RUN, Output, RunMode
 from .outputs import file_layouts, files_after_commit
-from .verified_run import Workpiece, run_template
 from .records import Planned, Program
 from .storage import Batch, store_programs
+from .verified_run import Workpiece, run_template
 from .workers import PLANNING
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
 JOB_COLUMNS = "id, gear_id, gear_class, machine, hob_id, params, module_params"
 
@@ -40,7 +52,7 @@ JOB_COLUMNS = "id, gear_id, gear_class, machine, hob_id, params, module_params"
 class Remaker:
     """Machines and templates read once for all the jobs made again in one run."""
 
-    def __init__(self, conn, draft: bool = False):
+    def __init__(self, conn: Connection, draft: bool = False):
         self.conn = conn
         self.draft = draft   # the classes' drafts (an editor trying them), not their released versions
         self._machines: dict[str, Machine] = {}
@@ -60,7 +72,7 @@ class Remaker:
         if not self.modelled(gear_class):   # a job of an imported class (instantiate --class): its rows alone
             return class_job(self.template(gear_class), machine, params, module_params)
         if machine.kind == "lathe":   # a turning job: its passes are computed from its parameters
-            from .turning_jobs import plan_turning_job   # the tool paths: only for turning jobs
+            from .turning_jobs import plan_turning_job  # the tool paths: only for turning jobs
 
             return plan_turning_job(self.conn, gear_class, machine, params, module_params, draft=self.draft)
         template = self.template(gear_class)
@@ -106,7 +118,7 @@ class Remaker:
         return self._templates[gear_class]
 
 
-def check_program_name(conn, job_id: int, gear_id: int, params: dict) -> None:
+def check_program_name(conn: Connection, job_id: int, gear_id: int, params: dict) -> None:
     """A hobbing job's program may be renamed (a part number), but never to another gear's
     program name, GEAR<id> or the name another gear's job carries: its file would replace that
     gear's program on the control (names compared as the control does, ignoring case)."""
@@ -119,13 +131,13 @@ def check_program_name(conn, job_id: int, gear_id: int, params: dict) -> None:
                           f"or make a new job with `engine instantiate --gear {gear_id}`; nothing stored")
 
 
-def _other_gear_named(conn, name, gear_id: int) -> int | None:
+def _other_gear_named(conn: Connection, name, gear_id: int) -> int | None:
     row = conn.execute("SELECT gear_id FROM job WHERE upper(params ->> 'program_name') = upper(%s) "
                        "AND gear_id <> %s ORDER BY id LIMIT 1", (name, gear_id)).fetchone()
     return row[0] if row else None
 
 
-def instantiate_job(conn, job_id: int, *, output: Output = NO_FILE, mode: RunMode = NORMAL_RUN) -> Program:
+def instantiate_job(conn: Connection, job_id: int, *, output: Output = NO_FILE, mode: RunMode = NORMAL_RUN) -> Program:
     """Instantiate a stored job again with its stored (possibly edited) parameters, its file
     written to `output`. With `mode.dry_run`, the same checks, nothing stored
     (engine.programs.batches): the program returned. The batch fields of `mode` do not apply."""
@@ -139,14 +151,14 @@ def instantiate_job(conn, job_id: int, *, output: Output = NO_FILE, mode: RunMod
     return program
 
 
-def _stored_job(conn, job_id: int) -> tuple:
+def _stored_job(conn: Connection, job_id: int) -> tuple:
     job = conn.execute(f"SELECT {JOB_COLUMNS} FROM job WHERE id = %s", (job_id,)).fetchone()
     if job is None:
         raise EngineError(f"job {job_id} does not exist; `engine jobs list` shows what does")
     return job
 
 
-def instantiate_jobs(conn, first: int | None = None, last: int | None = None, *,
+def instantiate_jobs(conn: Connection, first: int | None = None, last: int | None = None, *,
                      output: Output = NO_FILE, mode: RunMode = NORMAL_RUN) -> Batch:
     """Every stored job with first ≤ id ≤ last made again, every one tried: all programs stored,
     or none if any job is bad (BadBatch names each); with `mode.skip_bad` the good ones are stored

@@ -13,14 +13,19 @@ from __future__ import annotations
 
 import contextlib
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from psycopg.errors import ForeignKeyViolation
 from psycopg.types.json import Jsonb
 
+from ..db.connection import scalar
 from ..errors import EngineError
 from ..names import checked, line_breaking, shown
 from ..nc.lineage import lineage_line, lineage_words, refuse_lineage_shaped, with_lineage
 from .records import Encoded, Planned, Program
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
 # What a lineage line needs from the database: the hash of each job's stored parameters, each
 # machine's dialect (its comment form), whether each template version is a draft (not released).
@@ -40,7 +45,7 @@ COPY_PROGRAM = ("COPY program_submission (id, job_id, gear_class, template_versi
 PROGRAM_TYPES = ("int8", "int8", "text", "int4", "text", "text", "text[]", "int4[]", "jsonb")
 
 
-def store_one(conn, planned: Planned, existing_job: int | None, path: str | None) -> Program:
+def store_one(conn: Connection, planned: Planned, existing_job: int | None, path: str | None) -> Program:
     """The program (and its job, unless `existing_job`), its lineage line added. An unverified
     program (engine.programs.class_jobs) is stored only without a file for the machine."""
     refuse_unsafe(planned.name, planned.lines)
@@ -52,12 +57,12 @@ def store_one(conn, planned: Planned, existing_job: int | None, path: str | None
         return _stored_one(conn, planned, existing_job, path)
 
 
-def _stored_one(conn, planned: Planned, existing_job: int | None, path: str | None) -> Program:
+def _stored_one(conn: Connection, planned: Planned, existing_job: int | None, path: str | None) -> Program:
     job_id = existing_job
     if job_id is None:
-        job_id = conn.execute(INSERT_JOB, (planned.gear_id, planned.gear_class, planned.machine, planned.hob_id,
-                                           Jsonb(planned.params), Jsonb(planned.module_params),
-                                           Jsonb(planned.cutting or {}))).fetchone()[0]
+        job_id = scalar(conn.execute(INSERT_JOB, (planned.gear_id, planned.gear_class, planned.machine,
+                                                  planned.hob_id, Jsonb(planned.params), Jsonb(planned.module_params),
+                                                  Jsonb(planned.cutting or {}))))
     program_id = _next_ids(conn, "program_id_seq", 1)[0]
     template = planned.template
     lines, row_ids = Lineage(conn, [planned.machine], [(template.gear_class, template.version)], [job_id]).added(
@@ -71,9 +76,9 @@ def _stored_one(conn, planned: Planned, existing_job: int | None, path: str | No
 class Lineage:
     """Lineage lines for the programs of one store: what they need read in three queries."""
 
-    def __init__(self, conn, machines, versions, job_ids, input_hashes: dict | None = None):
+    def __init__(self, conn: Connection, machines, versions, job_ids, input_hashes: dict | None = None):
         self.input_hashes = dict(conn.execute(INPUT_HASHES, (list(job_ids),)).fetchall()) | (input_hashes or {})
-        self.dialects = dict(conn.execute(DIALECTS, (list(set(machines)),)).fetchall())
+        self.dialects: dict[str, str] = dict(conn.execute(DIALECTS, (list(set(machines)),)).fetchall())
         classes, numbers = zip(*set(versions)) if versions else ((), ())
         self.drafts = {(c, v): draft for c, v, draft in conn.execute(DRAFTS, (list(classes), list(numbers)))}
 
@@ -84,7 +89,7 @@ class Lineage:
         return with_lineage(list(lines), list(row_ids), lineage_line(words, self.dialects.get(machine, "")))
 
 
-def store_many(conn, encoded: list[Encoded], out=None, files=None) -> "Batch":
+def store_many(conn: Connection, encoded: list[Encoded], out=None, files=None) -> Batch:
     """All jobs and programs in one transaction, through COPY (the batch path); `out` is where
     the caller writes their files."""
     for item in encoded:
@@ -103,7 +108,7 @@ def store_many(conn, encoded: list[Encoded], out=None, files=None) -> "Batch":
                  tuple(f"{item.name}: {note}" for item in encoded for note in item.notes))
 
 
-def store_programs(conn, encoded: list[Encoded], job_ids: list[int], out=None, files=None) -> "Batch":
+def store_programs(conn: Connection, encoded: list[Encoded], job_ids: list[int], out=None, files=None) -> Batch:
     """Programs of stored jobs (made again), in one transaction through COPY."""
     for item in encoded:
         refuse_unsafe(item.name, item.lines)
@@ -121,7 +126,7 @@ UNION ALL SELECT 'job', j::text FROM unnest(%s::bigint[]) AS j WHERE NOT EXISTS 
 
 
 @contextlib.contextmanager
-def deleted_meanwhile(conn, gears=(), hobs=(), jobs=()):
+def deleted_meanwhile(conn: Connection, gears=(), hobs=(), jobs=()):
     """A gear, hob or job deleted by another session while its program was made is said as such:
     the store refused by its foreign key (rolled back, the block being a transaction or savepoint)
     names what is gone. Another foreign key's refusal is left as it is (a bug)."""
@@ -155,7 +160,7 @@ def refuse_unsafe(name: str, lines: list[str]) -> None:
                               "must not hold line breaks")
 
 
-def _copy_programs(conn, program_ids: list[int], job_ids: list[int], encoded: list[Encoded]) -> dict:
+def _copy_programs(conn: Connection, program_ids: list[int], job_ids: list[int], encoded: list[Encoded]) -> dict:
     """COPY the programs with their lineage lines; {program name: lines as stored}."""
     lineage = Lineage(conn, [item.machine for item in encoded],
                       [(item.gear_class, item.template_version) for item in encoded], job_ids)
@@ -171,7 +176,7 @@ def _copy_programs(conn, program_ids: list[int], job_ids: list[int], encoded: li
     return stored
 
 
-def _json(text: str) -> Jsonb:
+def _json(text: str | None) -> Jsonb:
     """JSON encoded already (by a batch worker): passed on as it is."""
     return Jsonb(text, dumps=_as_is)
 
@@ -198,7 +203,7 @@ class Batch:
         return self.programs
 
 
-def _next_ids(conn, sequence: str, count: int) -> list[int]:
+def _next_ids(conn: Connection, sequence: str, count: int) -> list[int]:
     rows = conn.execute("SELECT nextval(%s::regclass) FROM generate_series(1, %s)", (sequence, count))
     return [row[0] for row in rows]
 

@@ -2,6 +2,8 @@
 passes computed from them, then checked against the lathe. Nothing is stored here."""
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from ..errors import EngineError
 from ..machines.records import Machine, load_machine
 from ..programs.records import Planned
@@ -10,10 +12,13 @@ from ..templates.versions import runnable_template
 from ..turning.defaults import DEFAULT_LATHE
 from ..turning.model import template_module_params
 
+if TYPE_CHECKING:
+    from ..db.connection import Connection
+
 TURNING_CLASS_OF_DIALECT = {"iso": "turning_iso", "840d": "turning_840d"}
 
 
-def lathe(conn, name: str | None) -> Machine:
+def lathe(conn: Connection, name: str | None) -> Machine:
     """The machine record, which must be a lathe."""
     machine = load_machine(conn, name or DEFAULT_LATHE)
     if machine.kind != "lathe":
@@ -31,7 +36,7 @@ def turning_class(machine: Machine) -> str:
     return TURNING_CLASS_OF_DIALECT[machine.dialect]
 
 
-def plan_turning_job(conn, gear_class: str, machine: Machine, params: dict, module_params: dict,
+def plan_turning_job(conn: Connection, gear_class: str, machine: Machine, params: dict, module_params: dict,
                      passes: dict | None = None, draft: bool = False):
     """→ Planned (engine.programs.records): the program computed and checked, not stored.
     `passes`: the job's passes (model.job_passes) if the caller has them already; `draft`: the class's

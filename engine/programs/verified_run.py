@@ -13,10 +13,10 @@ from dataclasses import dataclass
 from ..errors import EngineError
 from ..gears.records import Gear, Hob
 from ..machines.records import Machine
+from ..nc.lineage import refuse_lineage_shaped
 from ..simulation import SimulationError, simulate_program
 from ..templates.decision_table import Result, compiled_template
 from ..templates.rows import Template
-from ..nc.lineage import refuse_lineage_shaped
 from ..verifier import verify_program
 
 

@@ -4,10 +4,14 @@ a row a change could break unnoticed: a DBA adds a test that reaches it, or reti
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from ..errors import EngineError
-from .golden import run_golden_tests
 from ..templates.versions import draft_template
+from .golden import run_golden_tests
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
 # Rows that the class's programs stored in the last N days emitted (row_ids) or ran (the trace).
 PROGRAM_ROWS = """
@@ -33,7 +37,7 @@ class UncoveredRow:
         return {"class": self.gear_class, "row": self.row_id, "t": self.t, "o": self.o}
 
 
-def coverage(conn, days: int = 30, classes: list[str] | None = None) -> list[UncoveredRow]:
+def coverage(conn: Connection, days: int = 30, classes: list[str] | None = None) -> list[UncoveredRow]:
     """The current rows of each class (all classes with rows if None) that no golden test and no
     program of the class stored in the last `days` days emitted or ran."""
     if days < 0:
@@ -50,7 +54,7 @@ def _tested_rows(results) -> dict[str, set[int]]:
     return rows
 
 
-def _uncovered(conn, gear_class: str, days: int, tested: set[int]) -> list[UncoveredRow]:
+def _uncovered(conn: Connection, gear_class: str, days: int, tested: set[int]) -> list[UncoveredRow]:
     template = draft_template(conn, gear_class)
     stored = {row[0] for row in conn.execute(PROGRAM_ROWS, {"class": gear_class, "days": days})}
     covered = tested | stored

@@ -10,18 +10,23 @@ what was checked is what is released."""
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 from psycopg.errors import InsufficientPrivilege
 from psycopg.types.json import Jsonb
 
 from .. import turning  # noqa: F401  (importing it registers the turning names model)
-from ..hobbing import models as hobbing_models  # noqa: F401  (importing it registers the hobbing models)
+from ..db.connection import scalar
 from ..errors import EngineError
+from ..hobbing import models as hobbing_models  # noqa: F401  (importing it registers the hobbing models)
 from ..templates.analysis import class_findings
-from .impact import Impact, impact
 from ..templates.lint import lint_class
 from ..templates.store import class_and_descendants
 from ..templates.versions import draft_template
+from .impact import Impact, impact
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
 RELEASER_ROLE = "engine_releaser"
 RELEASE = "SELECT release_template(%s, %s, %s, %s, %s, %s)"
@@ -51,7 +56,7 @@ class ReleaseReport:
     drafts_below: list[str] = field(default_factory=list)   # descendants whose drafts need their own release
 
 
-def release(conn, gear_class: str, dry_run: bool = False, confirm=None) -> ReleaseReport:
+def release(conn: Connection, gear_class: str, dry_run: bool = False, confirm=None) -> ReleaseReport:
     """Gate, impact and (not a dry run) the release of the class's draft, in one transaction.
     `confirm(report)`, if given, is asked after the impact and before recording; False releases
     nothing."""
@@ -70,8 +75,10 @@ def release(conn, gear_class: str, dry_run: bool = False, confirm=None) -> Relea
     return report
 
 
-def _require_releaser(conn) -> None:
-    role, allowed = conn.execute(MAY_RELEASE).fetchone()
+def _require_releaser(conn: Connection) -> None:
+    found = conn.execute(MAY_RELEASE).fetchone()
+    assert found is not None   # a SELECT without FROM returns its one row
+    role, allowed = found
     if not allowed:
         raise EngineError(_role_needed(role))
 
@@ -80,7 +87,7 @@ def _role_needed(role: str) -> str:
     return f"releasing a template needs the role {RELEASER_ROLE}; {role} may not (nothing released)"
 
 
-def gate(conn, gear_class: str, draft) -> tuple[list[dict], dict]:
+def gate(conn: Connection, gear_class: str, draft) -> tuple[list[dict], dict]:
     """The three checks; GateRefusal naming every failure. Returns the tests run and the checks."""
     lint_problems = [str(problem) for problem in lint_class(conn, gear_class)]
     results = _golden_results(conn, gear_class)
@@ -94,8 +101,8 @@ def gate(conn, gear_class: str, draft) -> tuple[list[dict], dict]:
     return tests, {"lint": "passed", "analysis": "no finding", "golden_tests": len(tests)}
 
 
-def _golden_results(conn, gear_class: str) -> list:
-    from .golden import run_golden_tests   # the golden tests' language (engine test)
+def _golden_results(conn: Connection, gear_class: str) -> list:
+    from .golden import run_golden_tests  # the golden tests' language (engine test)
 
     return run_golden_tests(conn, class_and_descendants(conn, gear_class), draft=True)
 
@@ -108,17 +115,18 @@ WHERE g.name <> %(class)s AND g.template_version IS DISTINCT FROM released_versi
 ORDER BY g.name"""
 
 
-def drafts_below(conn, gear_class: str) -> list[str]:
+def drafts_below(conn: Connection, gear_class: str) -> list[str]:
     """The descendants whose current rows are not released: the class's change gave them drafts
     (or they had their own), which need their own release. An inner node without rows has nothing
     to release."""
     return [row[0] for row in conn.execute(DRAFTS_BELOW, {"class": gear_class})]
 
 
-def _record(conn, report: ReleaseReport) -> int:
+def _record(conn: Connection, report: ReleaseReport) -> int:
     try:
         with conn.transaction():
-            return conn.execute(RELEASE, (report.gear_class, report.version, report.hash, Jsonb(report.tests),
-                                          Jsonb(report.impact.summary()), Jsonb(report.checks))).fetchone()[0]
+            return scalar(conn.execute(RELEASE, (report.gear_class, report.version, report.hash,
+                                                 Jsonb(report.tests), Jsonb(report.impact.summary()),
+                                                 Jsonb(report.checks))))
     except InsufficientPrivilege:
-        raise EngineError(_role_needed(conn.execute("SELECT current_user").fetchone()[0])) from None
+        raise EngineError(_role_needed(scalar(conn.execute("SELECT current_user")))) from None

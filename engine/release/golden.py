@@ -6,15 +6,19 @@ would make it (engine.release.golden_runs), with the verifier and the simulation
 program they refuse fails its test with their reason, and so does a broken expression (the
 message names class, row and column).
 
-The expectation language is engine.templates.expectations's (README "Golden tests")."""
+The expectation language is engine.templates.expectations's (docs/guide/release-and-golden-tests.md)."""
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from ..errors import EngineError
 from ..templates.expectations import Context, first_difference
-from .golden_runs import GoldenTest, made_program
 from ..templates.versions import runnable_template
+from .golden_runs import GoldenTest, made_program
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
 TESTS = ("SELECT id, gear_class, name, gear_id, params, choices, expect, description FROM template_test "
          "WHERE %(all)s OR gear_class = ANY(%(classes)s) ORDER BY gear_class, name")
@@ -40,18 +44,19 @@ class GoldenResult:
                 "passed": self.passed, "failure": self.failure}
 
 
-def load_tests(conn, classes: list[str] | None = None) -> list[GoldenTest]:
+def load_tests(conn: Connection, classes: list[str] | None = None) -> list[GoldenTest]:
     rows = conn.execute(TESTS, {"all": classes is None, "classes": list(classes or [])}).fetchall()
-    return [GoldenTest(*row[:6], tuple(row[6]), row[7]) for row in rows]
+    # mypy counts row[:6] (of unknown length) as filling every field, the last two as too many
+    return [GoldenTest(*row[:6], tuple(row[6]), row[7]) for row in rows]   # type: ignore[call-arg]
 
 
-def run_golden_tests(conn, classes: list[str] | None = None, draft: bool = True) -> list[GoldenResult]:
+def run_golden_tests(conn: Connection, classes: list[str] | None = None, draft: bool = True) -> list[GoldenResult]:
     """Every test of `classes` (None: all). draft=True tests each class's current rows (its draft,
     or its released version if it has none); False tests the released versions."""
     return [run_golden_test(conn, test, draft) for test in load_tests(conn, classes)]
 
 
-def run_golden_test(conn, test: GoldenTest, draft: bool = True) -> GoldenResult:
+def run_golden_test(conn: Connection, test: GoldenTest, draft: bool = True) -> GoldenResult:
     """One test: its program made in memory and checked against its expectations."""
     version, is_draft = _template_version(conn, test.gear_class, draft)
     try:
@@ -66,7 +71,7 @@ def run_golden_test(conn, test: GoldenTest, draft: bool = True) -> GoldenResult:
                         _emitted(result.row_ids), ran_rows(result.trace))
 
 
-def _template_version(conn, gear_class: str, draft: bool) -> tuple[int, bool]:
+def _template_version(conn: Connection, gear_class: str, draft: bool) -> tuple[int, bool]:
     """The version a test runs against, for its result line even when the run fails."""
     try:
         template = runnable_template(conn, gear_class, draft)

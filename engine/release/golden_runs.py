@@ -9,6 +9,7 @@ record's fields (gear_<field>) and its further units' (unit<N>_<field>)."""
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass, fields
+from typing import TYPE_CHECKING
 
 from ..errors import EngineError
 from ..gears.records import Gear, load_gear
@@ -17,6 +18,9 @@ from ..programs.instantiate import Planner
 from ..programs.records import Planned
 from ..programs.remake import Remaker
 from ..turning.defaults import DEFAULT_LATHE
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
 HAND_SIGNS = {"R": 1, "L": -1}
 MODULE_PARAMS_KEY = "module_params"   # a params test's module parameters, inside its params object
@@ -40,7 +44,7 @@ class GoldenTest:
         return f"{self.gear_class}/{self.name}"
 
 
-def made_program(conn, test: GoldenTest, draft: bool) -> tuple[Planned, dict]:
+def made_program(conn: Connection, test: GoldenTest, draft: bool) -> tuple[Planned, dict]:
     """(the program planned in memory, the names its expectations may read)."""
     if test.gear_id is not None:
         gear = load_gear(conn, test.gear_id)
@@ -50,7 +54,7 @@ def made_program(conn, test: GoldenTest, draft: bool) -> tuple[Planned, dict]:
     return planned, expectation_names(planned.params)
 
 
-def _planned_gear(conn, test: GoldenTest, gear: Gear, draft: bool) -> Planned:
+def _planned_gear(conn: Connection, test: GoldenTest, gear: Gear, draft: bool) -> Planned:
     if gear.gear_class != test.gear_class:
         raise EngineError(f"gear {gear.id} is of class {gear.gear_class}, not {test.gear_class}")
     choices = dict(test.choices)
@@ -61,7 +65,8 @@ def _planned_gear(conn, test: GoldenTest, gear: Gear, draft: bool) -> Planned:
     return Planner(conn, machine, Choices(**choices), draft=draft).plan(gear)
 
 
-def _planned_params(conn, test: GoldenTest, draft: bool) -> Planned:
+def _planned_params(conn: Connection, test: GoldenTest, draft: bool) -> Planned:
+    assert test.params is not None   # a test of no gear gives its parameters
     params = dict(test.params)
     module_params = params.pop(MODULE_PARAMS_KEY, None) or {}
     machine = test.choices.get("machine") or params.get("machine") or DEFAULT_LATHE

@@ -15,11 +15,12 @@ from __future__ import annotations
 import difflib
 import json
 from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING
 
 from .. import turning  # noqa: F401  (importing it registers the turning names model)
-from ..hobbing import models as hobbing_models  # noqa: F401  (importing it registers the hobbing models)
 from ..errors import EngineError
 from ..gears.models import model_for_class
+from ..hobbing import models as hobbing_models  # noqa: F401  (importing it registers the hobbing models)
 from ..machines.records import load_machine
 from ..nc.layout import ENDING_NAMES, NcLayout
 from ..nc.lineage import without_lineage
@@ -28,6 +29,10 @@ from ..templates.history import layout_change
 from ..templates.rows import Template
 from ..templates.store import class_and_descendants
 from ..templates.versions import draft_template, released_template
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
+    from ..machines.records import Machine
 
 DIFFS_SHOWN = 5   # unified diffs the CLI prints (all of them with --json)
 
@@ -101,7 +106,7 @@ class Impact:
                 "layout": [change.as_json() for change in self.layouts.values()]}
 
 
-def impact(conn, gear_class: str) -> Impact:
+def impact(conn: Connection, gear_class: str) -> Impact:
     """Every stored job of the class and its descendants made with the draft, compared with the
     released program."""
     pairs = _template_pairs(conn, class_and_descendants(conn, gear_class))
@@ -117,7 +122,7 @@ def impact(conn, gear_class: str) -> Impact:
     return report
 
 
-def _template_pairs(conn, classes: list[str]) -> dict[str, tuple[Template, Template, int]]:
+def _template_pairs(conn: Connection, classes: list[str]) -> dict[str, tuple[Template, Template, int]]:
     """(released, draft evaluated as the released version, the draft's own version) of each class
     that has a released template; the draft is the released one for a class without a draft."""
     pairs = {}
@@ -131,7 +136,7 @@ def _template_pairs(conn, classes: list[str]) -> dict[str, tuple[Template, Templ
     return pairs
 
 
-def _layout_changes(conn, pairs: dict[str, tuple[Template, Template, int]]) -> dict[str, LayoutChange]:
+def _layout_changes(conn: Connection, pairs: dict[str, tuple[Template, Template, int]]) -> dict[str, LayoutChange]:
     """The classes whose draft has another layout than their released version."""
     changes = {}
     for name, (released, _, draft_version) in pairs.items():
@@ -141,7 +146,7 @@ def _layout_changes(conn, pairs: dict[str, tuple[Template, Template, int]]) -> d
     return changes
 
 
-def _compare(report: Impact, made: "_Made", job) -> None:
+def _compare(report: Impact, made: _Made, job) -> None:
     job_id, gear_class, machine, params_text, modules_text, from_released, lines, row_ids = job
     report.jobs += 1
     if gear_class in report.layouts and lines is not None:
@@ -163,7 +168,7 @@ class _Made:
     """The programs of distinct job inputs, made once: with the draft (or its failure) and, where the
     stored program is not the released one, with the released template."""
 
-    def __init__(self, conn, pairs: dict[str, tuple[Template, Template, int]]):
+    def __init__(self, conn: Connection, pairs: dict[str, tuple[Template, Template, int]]):
         self.pairs, self.inputs = pairs, _JobInputs(conn)
         self.drafts: dict[tuple, list[str] | EngineError] = {}
         self.releases: dict[tuple, list[str]] = {}
@@ -206,14 +211,16 @@ class _JobInputs:
     """A stored job's parameters as its template reads them, as engine.programs.remake makes them:
     a hobbing job's cycle time from its stored feeds, a turning job's moves from its passes."""
 
-    def __init__(self, conn):
-        self.conn, self.machines, self.shapes = conn, {}, {}
+    def __init__(self, conn: Connection):
+        self.conn = conn
+        self.machines: dict[str, Machine] = {}
+        self.shapes: dict[str, str] = {}   # class -> its model's cut shape
 
     def of(self, gear_class: str, machine_name: str, params_text: str, modules_text: str) -> tuple[dict, dict]:
         params, modules = json.loads(params_text), json.loads(modules_text or "{}")
         machine = self.machine(machine_name)
         if machine.kind == "lathe":
-            from ..turning.model import template_module_params   # the tool paths: only for turning jobs
+            from ..turning.model import template_module_params  # the tool paths: only for turning jobs
 
             return params, template_module_params(params, modules)
         if "cycle_time" in params:

@@ -79,6 +79,7 @@ def _cut(solid: Solid, motion: Motion, index, radius) -> Contact | None:
         solid.cut_sessions.add(motion.session)
     np.minimum.at(solid.reach, index[finite], radius[finite])
     np.minimum.at(solid.session_reach, index[finite], radius[finite])
+    assert solid.intended_root is not None   # a unit the hob cuts has its intended root
     below = solid.intended_root[index] - radius
     return _deepest(solid, index, below, below > TOLERANCE, True)
 

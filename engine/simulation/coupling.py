@@ -148,4 +148,4 @@ def swivel_problem(swivel_din: float, gear: Gear, hob: Hob) -> str | None:
 
 
 def hand_name(hand: str | None) -> str:
-    return {"R": "right-hand", "L": "left-hand"}.get(hand, "spur")
+    return {"R": "right-hand", "L": "left-hand"}.get(hand, "spur") if hand is not None else "spur"

@@ -27,7 +27,8 @@ class Cut:
         self.moves.append((start, end, velocities))
 
     def pass_moves(self, axis: str) -> list:
-        return [move for move in self.moves if axis in move[1] and abs(move[1][axis] - move[0].get(axis, move[1][axis])) > 1e-9]
+        return [move for move in self.moves
+                if axis in move[1] and abs(move[1][axis] - move[0].get(axis, move[1][axis])) > 1e-9]
 
 
 def run_out(cut: Cut, unit: Solid, half_length: float) -> float | None:

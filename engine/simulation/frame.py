@@ -19,7 +19,7 @@ class Senses:
     z: int
 
     @classmethod
-    def of(cls, machine: Machine) -> "Senses":
+    def of(cls, machine: Machine) -> Senses:
         return cls(*(1 if int(getattr(machine, f"{axis}_direction")) >= 0 else -1 for axis in "abcyz"))
 
     def position(self, axis: str, value: float) -> float:

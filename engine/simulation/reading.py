@@ -10,7 +10,7 @@ from dataclasses import dataclass
 from ..machines.records import Machine
 from ..verifier import grammar
 from ..verifier.blocks import TOKEN
-from ..verifier.lines import read_line
+from ..verifier.lines import Line, read_line
 from ..verifier.refusals import Refused
 from .report import SimulationError, where
 
@@ -19,7 +19,7 @@ from .report import SimulationError, where
 class Step:
     number: int        # line number, from 1
     line: str          # as emitted
-    item: object       # what the verifier read it as (kind: header, comment, block, statement, shift)
+    item: Line         # what the verifier read it as (kind: header, comment, block, statement, shift)
     g_codes: frozenset = frozenset()
     m_codes: frozenset = frozenset()
 
@@ -49,9 +49,11 @@ def _step(dialect, number: int, line: str, name: str) -> Step:
                               "a program it cannot follow is refused") from None
     if item.kind != "block":
         return Step(number, line, item)
-    codes = {"G": set(), "M": set()}
+    codes: dict[str, set[int]] = {"G": set(), "M": set()}
     for token in line.partition(";")[0].split():
-        address, equals, text = TOKEN.fullmatch(token).groups()
+        word = TOKEN.fullmatch(token)
+        assert word is not None   # the verifier read the block word by word
+        address, equals, text = word.groups()
         if address in codes and not equals:
             codes[address].add(int(text))
     return Step(number, line, item, frozenset(codes["G"]), frozenset(codes["M"]))

@@ -10,11 +10,15 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..gears.records import Gear, Hob
 from ..machines.records import Machine
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
 
 HEIGHT_STEP = 0.5       # mm between the heights a solid is followed at (its faces included; the
                         # clearance is convex in height, so between two it errs by < step²/(8·r0))
@@ -30,7 +34,7 @@ class Solid:
     slope: float = 0.0            # dR/dz (a taper's tan δ)
     teeth: int | None = None      # a toothed unit: the teeth the coupling must generate to cut it
     clamped_only: bool = False    # the tailstock: there only between M20 and M21
-    root: object = None           # heights -> intended root radius (units)
+    root: Callable[[np.ndarray], np.ndarray] | None = None   # heights -> intended root radius (units)
     heights: np.ndarray = field(init=False)
     radius: np.ndarray = field(init=False)
     reach: np.ndarray = field(init=False)

@@ -2,11 +2,16 @@
 its lines, the job's gear (with its units), hob and machine as the database holds them now."""
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from ..errors import EngineError
 from ..gears.records import Hob, load_gear, load_hobs
 from ..machines.records import load_machine
 from .report import Report
 from .run import simulate_program
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
 PROGRAM_QUERY = """
 SELECT p.name, p.lines, j.gear_id, j.hob_id, j.machine
@@ -14,7 +19,7 @@ FROM program p JOIN job j ON j.id = p.job_id
 WHERE p.id = %s"""
 
 
-def simulate_stored_program(conn, program_id: int) -> Report:
+def simulate_stored_program(conn: Connection, program_id: int) -> Report:
     row = conn.execute(PROGRAM_QUERY, (program_id,)).fetchone()
     if row is None:
         raise EngineError(f"program {program_id} does not exist; see `SELECT id, name FROM program`")
@@ -26,7 +31,7 @@ def simulate_stored_program(conn, program_id: int) -> Report:
     return simulate_program(list(lines), load_gear(conn, gear_id), load_hob(conn, hob_id), machine, name)
 
 
-def load_hob(conn, hob_id: str) -> Hob:
+def load_hob(conn: Connection, hob_id: str) -> Hob:
     """The hob record (the library is small: read whole, as instantiation reads it)."""
     found = next((hob for hob in load_hobs(conn) if hob.id == hob_id), None)
     if found is None:

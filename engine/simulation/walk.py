@@ -15,20 +15,40 @@ from ..gears.records import Gear, Hob
 from ..machines.records import Machine
 from ..verifier.refusals import Refused
 from ..verifier.shift_clamp import ShiftClamp
-from .coupling import (Coupling, coupling_problems, generated_teeth_problem, hand_name, hand_sign, helix_of,
-                       lead_angle, read_coupling, swivel_problem)
+from .allowance import depth_problem, header_allowance
 from .contact import Motion, follow
+from .coupling import (
+    Coupling,
+    coupling_problems,
+    generated_teeth_problem,
+    hand_name,
+    hand_sign,
+    helix_of,
+    lead_angle,
+    read_coupling,
+    swivel_problem,
+)
 from .cuts import Cut, summary
 from .envelope import HobBody
 from .frame import Senses
 from .headers import comment_problem, header_place_problem
 from .paths import move_poses
 from .report import Report, SimulationError, where
+from .rules import (
+    block_record_problem,
+    coupled_shift_problem,
+    coupled_swivel_problem,
+    coupled_tool_problem,
+    feed_problem,
+    least_run_out,
+    moves,
+    record_header_problem,
+    recut_problem,
+    run_out_problem,
+    setup_advice,
+    zone_problem,
+)
 from .solids import Solid
-from .allowance import depth_problem, header_allowance
-from .rules import (block_record_problem, coupled_shift_problem, coupled_tool_problem, coupled_swivel_problem,
-                    feed_problem, record_header_problem, least_run_out, moves, recut_problem, run_out_problem,
-                    setup_advice, zone_problem)
 from .timing import feed_minutes, header_minutes, header_problem, rapid_minutes
 
 AXES = ("X", "Y", "Z")
@@ -46,8 +66,9 @@ class BlockSimulation:
         self.units, self.solids, self.worm_wheel, self.shift_end = units, units + setup, worm_wheel, shift_end
         self.senses = Senses.of(machine)
         self.body = HobBody(hob.tip_diameter / 2, hob.length / 2)
-        load = (machine.load_x, machine.load_z)
-        self.program = {"X": load[0], "Z": load[1]} if None not in load else {}   # program values, for time
+        load_x, load_z = machine.load_x, machine.load_z
+        # program values, for time
+        self.program = {"X": load_x, "Z": load_z} if load_x is not None and load_z is not None else {}
         self.position = {axis: self.senses.position(axis, value) for axis, value in self.program.items()}
         self.swivel = 0.0
         self.swivel_known = False
@@ -98,21 +119,21 @@ class BlockSimulation:
         code = step.line.partition(";")[0].strip()
         self.coupling = read_coupling(code, self.senses)
         self.session += 1
-        teeth = [unit.teeth for unit in self.units]
+        teeth = [unit.teeth for unit in self.units if unit.teeth is not None]   # every unit is toothed
         problem = generated_teeth_problem(self.coupling, self.hob, teeth)
         if problem:
             self.report.add(step.number, step.line, problem)
-        self._describe_coupling()
+        self._describe_coupling(self.coupling)
 
-    def _describe_coupling(self) -> None:
-        teeth = self.coupling.teeth(self.hob.starts)
+    def _describe_coupling(self, coupling: Coupling) -> None:
+        teeth = coupling.teeth(self.hob.starts)
         self.report.teeth.append(f"{teeth:g}")
         if self.worm_wheel:
             beta = lead_angle(self.hob) * hand_sign(self.hob.hand) - self.swivel
-            hand = "R" if beta >= 0 else "L"
-            self.report.helix.append(f"{hand_name(hand)} β {abs(beta):.3f}° (hob lead and swivel)")
+            side = "R" if beta >= 0 else "L"
+            self.report.helix.append(f"{hand_name(side)} β {abs(beta):.3f}° (hob lead and swivel)")
             return
-        beta, hand, lead = helix_of(self.coupling.factors.get("Z", 0.0), self.gear, round(teeth) or 1)
+        beta, hand, lead = helix_of(coupling.factors.get("Z", 0.0), self.gear, round(teeth) or 1)
         self.report.helix.append("spur" if hand is None else f"{hand_name(hand)} β {beta:.3f}° lead {lead:.1f} mm")
 
     def _shift(self, step) -> None:
@@ -206,13 +227,14 @@ class BlockSimulation:
         self.report.table_speed = max(self.report.table_speed, speed)
         limit = self.machine.table_speed_max
         if limit is not None and speed > limit + 1e-9:
-            self.report.add(step.number, step.line, f"the table turns at {speed:.1f} r/min, above {self.machine.name}'s "
-                                                    f"{limit:g} r/min (hob, Z and Y terms at this move's speeds)")
+            self.report.add(step.number, step.line,
+                            f"the table turns at {speed:.1f} r/min, above {self.machine.name}'s "
+                            f"{limit:g} r/min (hob, Z and Y terms at this move's speeds)")
 
     def _check_cut(self, step, start: dict, end: dict) -> None:
         moving = frozenset(axis for axis in AXES if axis in start and abs(end[axis] - start[axis]) > 1e-9)
         teeth = self._cut_teeth()
-        problems = []
+        problems: list[str | None] = []   # None: no problem
         if "Y" not in self.position:
             problems.append("Y (the hob shift) is not positioned before the cut: the generating zone lies "
                             "wherever the last program left the hob")
@@ -223,14 +245,20 @@ class BlockSimulation:
         if "Y" in self.position and not self.worm_wheel:
             problems.append(zone_problem(self.position["Y"], self.gear, self.hob))
         if teeth is not None:
-            problems += coupling_problems(self.coupling, self.gear, self.hob, teeth, self.worm_wheel, moving)
+            problems += coupling_problems(self._coupled, self.gear, self.hob, teeth, self.worm_wheel, moving)
         for problem in filter(None, problems):
             if (self.session, problem) not in self.said:
                 self.said.add((self.session, problem))
                 self.report.add(step.number, step.line, problem)
 
+    @property
+    def _coupled(self) -> Coupling:
+        """The coupling, where the walk cuts (a cut is one only while the table is coupled)."""
+        assert self.coupling is not None
+        return self.coupling
+
     def _cut_teeth(self) -> int | None:
-        teeth = self.coupling.teeth(self.hob.starts)
+        teeth = self._coupled.teeth(self.hob.starts)
         return int(round(teeth)) if abs(teeth - round(teeth)) < 1e-9 else None
 
     def _contacts(self, step, motion: int, cutting: bool, start: dict, end: dict) -> None:
@@ -271,13 +299,14 @@ class BlockSimulation:
         teeth = self._cut_teeth()
         if teeth is None:
             return
+        assert self.speed is not None   # a cut is one only with the spindle turning at an S above 0
         if self.cut is None or self.cut.teeth != teeth:
             self._end_cut()
-            table = abs(self.coupling.k_b) * self.speed
+            table = abs(self._coupled.k_b) * self.speed
             before = {id(unit): unit.reach.copy() for unit in self.units if unit.teeth == teeth}
             self.cut = Cut(step.number, step.line, teeth, table, before)
         self.cut.add(start, end, velocities)
-        table = abs(self.coupling.k_b) * self.speed        # the spindle speed now, not the cut's first
+        table = abs(self._coupled.k_b) * self.speed        # the spindle speed now, not the cut's first
         if not self.worm_wheel and table > 0 and velocities.get("Z"):
             self._refuse(step, feed_problem(abs(velocities["Z"]) / table, self.gear, self.hob))
         if table > 0 and velocities.keys() == {"X"}:          # the radial infeed is bounded by §C too
@@ -316,7 +345,7 @@ class BlockSimulation:
             self.report.add(*last, "no `; CYCLE TIME <m> MIN` header line: a hobbing program states its cycle "
                                    f"time (the simulation takes {self.report.cycle_time:.2f} min)")
 
-    def _check_depth(self, unit: Solid, last: tuple) -> None:
+    def _check_depth(self, unit: Solid, last: tuple[int, str]) -> None:
         cut = self.last_cut_of.get(id(unit))
         if cut is None:
             self.report.add(*last, f"{unit.name} is never cut")

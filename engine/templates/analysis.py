@@ -19,11 +19,15 @@ Every expression is compiled and evaluated through the expression gate
 from __future__ import annotations
 
 from dataclasses import astuple, dataclass
+from typing import TYPE_CHECKING
 
 from .decision_table import CompiledRow, compile_row
 from .evaluator import EvaluationError, evaluate
 from .lint import known_names_of
 from .rows import Template
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
 CONDITION_COLUMNS = ("p_calc", "p_emit")
 
@@ -100,7 +104,7 @@ def duplicates(rows: list[CompiledRow], known_names):
         adjacent = previous is not None and _body(previous) == body
         why = _mistake(row, adjacent) if body in first else None
         if why is not None:
-            twin = previous.row.id if adjacent else first[body]
+            twin = previous.row.id if adjacent and previous is not None else first[body]
             yield row.row.id, "o", f"repeats row {twin} exactly (t, n, p_calc, s, o, p_emit) {why}"
         first.setdefault(body, row.row.id)
         previous = row
@@ -146,7 +150,7 @@ REPEAT_MISTAKES = (
 
 def read_before_given(rows: list[CompiledRow], known_names):
     """A name a row reads that its module's parameters do not hold and no earlier row assigns."""
-    assigned_at = {}
+    assigned_at: dict[str, int] = {}   # name -> the row that first assigns it
     for row in rows:
         for name, _ in row.s:
             assigned_at.setdefault(name, row.row.id)
@@ -187,6 +191,6 @@ RULES = (
 )
 
 
-def class_findings(conn, gear_class: str, template: Template) -> list[Finding]:
+def class_findings(conn: Connection, gear_class: str, template: Template) -> list[Finding]:
     """The analysis of a stored class's template, with the names its model (or import) provides."""
     return analyse(template, known_names_of(conn, gear_class))

@@ -6,7 +6,7 @@ from __future__ import annotations
 import sys
 
 if "asteval.asteval" not in sys.modules and "numpy" not in sys.modules:
-    sys.modules["numpy"] = None   # asteval's `import numpy` then fails: HAS_NUMPY is False
+    sys.modules["numpy"] = None   # type: ignore[assignment]  # None blocks an import (typeshed omits it); asteval's `import numpy` then fails: HAS_NUMPY is False
     try:
         import asteval.astutils
     finally:

@@ -17,13 +17,14 @@ from __future__ import annotations
 import threading
 from dataclasses import dataclass, field
 from functools import partial
+from typing import Any
 
 from ..errors import EngineError
-from .nc_path import NcLines
 from .budget import Budget, compiling, pay_time, seconds_for, spending
 from .evaluator import EvaluationError, Evaluator, base_symbols
 from .expressions import Compiled, ExpressionError, compile_expression, compile_statements
 from .guards import MAX_STRING_LENGTH, short_repr, size
+from .nc_path import NcLines
 from .rows import Template, TemplateRow
 from .trace import Outcome, RowTrace, keep_entry, memo_key
 
@@ -57,7 +58,7 @@ class CompiledRow:
 class Result:
     """The result table of one instantiation: emitted lines, the row id of each, and the trace
     (engine.templates.trace): the input values by origin, and an entry for every row."""
-    lines: list[str] = field(default_factory=list)
+    lines: list[Any] = field(default_factory=list)   # text; an nc_path row's NcLines until _one_line_each
     row_ids: list[int] = field(default_factory=list)
     trace: dict = field(default_factory=lambda: {"inputs": {}, "rows": []})
 
@@ -114,7 +115,9 @@ class _Job:
         _refuse_engine_names(compiled, params, "job parameter")
         self.scope = {**params, **compiled.symbols, "template_version": compiled.template.version}
         self.intermediates: dict[str, int] = {}      # name -> id of the row that computed it
-        self.module, self.module_names, self.module_key = None, (), None
+        self.module: tuple[str, int] | None = None   # (T, N) of the module the rows are in
+        self.module_names: tuple[str, ...] = ()
+        self.module_key: str | None = None
         self.budget, self.evaluator = budget, compiled.evaluator
         self.result, self.trace_bytes = Result(), 0
 
@@ -237,6 +240,7 @@ def _text(value, row: CompiledRow, gear_class: str):
         problem = f"gives a line longer than {MAX_STRING_LENGTH} characters"
     else:
         return value
+    assert row.o is not None   # the value is the row's o
     raise TemplateError(gear_class, row.row.id, "o", row.o.text, problem[:300])
 
 
@@ -286,12 +290,14 @@ def _compile_row(gear_class: str, row: TemplateRow, translations=None) -> Compil
     statements = tuple(compiled("s", compile_statements) or ())
     p_calc = compiled("p_calc", expression)
     o, p_emit = compiled("o", expression), compiled("p_emit", expression)
-    return CompiledRow(row, o, p_calc, statements, p_emit, _inputs(p_calc if statements else None, statements, o, p_emit))
+    return CompiledRow(row, o, p_calc, statements, p_emit,
+                       _inputs(p_calc if statements else None, statements, o, p_emit))
 
 
 def _inputs(p_calc, statements, o, p_emit) -> tuple[str, ...]:
     """Names the row reads before it assigns them itself, in evaluation order."""
-    seen, assigned = {}, set()
+    seen: dict[str, None] = {}   # an ordered set
+    assigned = set()
     for expression, target in [(p_calc, None), *((value, name) for name, value in statements), (o, None),
                                (p_emit, None)]:
         if expression is not None:

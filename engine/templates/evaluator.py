@@ -14,8 +14,17 @@ from ..errors import EngineError
 from .asteval_import import ALL_NODES, Interpreter
 from .budget import Budget, paid, running, spending
 from .functions import CONSTANTS, FUNCTIONS
-from .guards import (built, check_printable, guard_size, safe_add, safe_format, safe_lshift, safe_mod, safe_mult,
-                     safe_pow)
+from .guards import (
+    built,
+    check_printable,
+    guard_size,
+    safe_add,
+    safe_format,
+    safe_lshift,
+    safe_mod,
+    safe_mult,
+    safe_pow,
+)
 
 # The asteval node handlers a checked expression needs; every other node is switched off.
 NODES = ("expression", "binop", "unaryop", "boolop", "compare", "ifexp", "call", "name", "constant",
@@ -29,7 +38,7 @@ def base_symbols(uses_sql: bool) -> dict:
     """What every expression may name besides the job's parameters and intermediates."""
     symbols = {**FUNCTIONS, **CONSTANTS, **GUARDS}
     if uses_sql:
-        from .sqlcond.runtime import SQL_RUNTIME   # the helpers translated SQL conditions call
+        from .sqlcond.runtime import SQL_RUNTIME  # the helpers translated SQL conditions call
 
         symbols.update(SQL_RUNTIME)
     return symbols

@@ -18,7 +18,8 @@ engine adds when it stores a program):
         Properties: `EGON ratio` (Z1/N1 of the B axis in the first EGON; `last EGON ratio`),
         `EGON Z factor` (any leading axis: `EGON Y factor`), `first|last|min|max [G0|G1] <address>`
         (e.g. `last X`, `max G1 X`: the values of that address over the blocks, optionally only
-        blocks in that modal motion; G25/G26 limit blocks are not positions and are left out), `XZ slope` (dX/dZ of the last block moving X and Z),
+        blocks in that modal motion; G25/G26 limit blocks are not positions and are left out),
+        `XZ slope` (dX/dZ of the last block moving X and Z),
         `count of G1` (blocks holding the word), `line count`.
         Default tolerance: 1e-6 plus half a unit in the last digit the program printed (0.0005
         for `X51.500`).
@@ -31,10 +32,14 @@ from __future__ import annotations
 import math
 import re
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from ..errors import EngineError
 from .evaluator import evaluate
 from .program_properties import Reading, UnknownProperty, property_reader, read_property
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
 
 ABSOLUTE_TOLERANCE = 1e-6
 TEXT_KINDS = (   # (pattern, kind); the first that matches the expectation's text wins
@@ -120,8 +125,9 @@ def _stripped(lines: list[str]) -> list[str]:
     return [line.strip() for line in lines]
 
 
-TEXT_CHECKS = {"line": _line_present, "no line": _line_absent, "line n": _line_at, "last line": _last_line,
-               "match": _matches, "no match": _no_match}
+TEXT_CHECKS: dict[str, Callable[..., str | None]] = {
+    "line": _line_present, "no line": _line_absent, "line n": _line_at, "last line": _last_line,
+    "match": _matches, "no match": _no_match}
 
 
 def check_numeric(name: str, expression: str, tolerance: str | None, context: Context) -> str | None:
@@ -134,7 +140,8 @@ def check_numeric(name: str, expression: str, tolerance: str | None, context: Co
     reading = read_property(name, context.lines)
     allowed = _tolerance(tolerance, reading)
     value = _shown(expected, reading)
-    shown = f"{name.strip()} = {expression.strip()}{'' if value == expression.strip() else ' = ' + value} ± {allowed:.3g}"
+    computed = "" if value == expression.strip() else " = " + value
+    shown = f"{name.strip()} = {expression.strip()}{computed} ± {allowed:.3g}"
     if reading is None:
         return f"expected {shown}, program has no {name.strip()}"
     if abs(reading.value - expected) <= allowed:
@@ -144,7 +151,7 @@ def check_numeric(name: str, expression: str, tolerance: str | None, context: Co
 
 def expected_value(expression: str, names: dict) -> float:
     """The expression over the test's names, by the templates' own checked evaluator."""
-    from .expressions import compile_expression   # the gate: only what a template expression may be
+    from .expressions import compile_expression  # the gate: only what a template expression may be
 
     try:
         value = evaluate(compile_expression(expression.strip()), names)

@@ -23,6 +23,7 @@ import ast
 import re
 from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import Literal, overload
 
 from ..errors import EngineError
 from .functions import CONSTANTS, FUNCTIONS
@@ -97,7 +98,7 @@ def _check_constant_parts(guarded: list, parts: list, source: str, is_sql: bool)
     """Every part that reads no parameter (`[[0] * 65536] * 65536`, `10 ** 10 ** 6`) is evaluated
     here, under the bounds of one instantiation: one that fails would fail for every job, so the
     template is refused where it enters (import, lint, compile), not at its first job."""
-    from .evaluator import EvaluationError, evaluate_part   # asteval: only where a template is compiled
+    from .evaluator import EvaluationError, evaluate_part  # asteval: only where a template is compiled
 
     for part, original in zip(guarded, parts):
         try:
@@ -112,6 +113,10 @@ def _is_parameter(name: str) -> bool:
     return name not in FUNCTIONS and name not in CONSTANTS and not name.startswith("_")
 
 
+@overload
+def _parsed(text: str, mode: Literal["eval"]) -> ast.Expression: ...
+@overload
+def _parsed(text: str, mode: Literal["exec"]) -> ast.Module: ...
 def _parsed(text: str, mode: str) -> ast.AST:
     """ast.parse, with a nesting too deep for the parser refused like any other bad text."""
     try:
@@ -150,6 +155,7 @@ _LINES = re.compile(r"[^\r\n]*(?:\r\n|\r|\n|$)")   # the lines as Python's parse
 def _source_of(lines: list[str], node: ast.expr) -> str:
     """The text of `node` (ast.get_source_segment splits the whole text again for each node:
     quadratic in a block of a few hundred statements). Offsets count UTF-8 bytes."""
+    assert node.end_lineno is not None and node.end_col_offset is not None   # a parsed node has its end
     first, last = node.lineno - 1, node.end_lineno - 1
     if first == last:
         return lines[first].encode()[node.col_offset:node.end_col_offset].decode()
@@ -197,7 +203,7 @@ def _sql_tree(text: str, python_error: SyntaxError, translations: Mapping[str, s
 
 
 def _parse_sql(text: str, python_error: SyntaxError) -> ast.Expression:
-    from .sqlcond.translate import translate   # sqlglot: only where a condition is translated
+    from .sqlcond.translate import translate  # sqlglot: only where a condition is translated
 
     try:
         return ast.Expression(body=translate(text))
@@ -219,7 +225,7 @@ def _check_tree(walk: ExpressionTree, sql_helpers: bool = False) -> None:
             raise ExpressionError(f"{_describe(node)} is not allowed in a template expression")
         if isinstance(node, ast.Constant):
             _check_constant(node.value)
-        if isinstance(node, ast.FormattedValue) and node.format_spec is not None:
+        if isinstance(node, ast.FormattedValue) and isinstance(node.format_spec, ast.JoinedStr):   # or None
             _check_spec_fields(node.format_spec)
         if isinstance(node, ast.Call):
             _check_call(node, sql_helpers)
@@ -245,7 +251,8 @@ def _formats_with_percent(node: ast.AST) -> bool:
     """`'…' % x` on a written text: refused here as the guard refuses it at run time (its width
     is not bounded), so that lint names it without a job."""
     return isinstance(node, ast.BinOp) and isinstance(node.op, ast.Mod) and (
-        isinstance(node.left, ast.JoinedStr) or isinstance(node.left, ast.Constant) and isinstance(node.left.value, str))
+        isinstance(node.left, ast.JoinedStr)
+        or isinstance(node.left, ast.Constant) and isinstance(node.left.value, str))
 
 
 def _check_spec_fields(spec: ast.JoinedStr) -> None:
@@ -296,9 +303,8 @@ def _read_names(walk: ExpressionTree):
 
 def _constant_spec(spec: ast.JoinedStr) -> str | None:
     """The text of a format spec without replacement fields, else None."""
-    if all(isinstance(part, ast.Constant) for part in spec.values):
-        return "".join(part.value for part in spec.values)
-    return None
+    texts = [part.value for part in spec.values if isinstance(part, ast.Constant) and isinstance(part.value, str)]
+    return "".join(texts) if len(texts) == len(spec.values) else None
 
 
 def _guarded(walk: ExpressionTree) -> dict[int, ast.AST]:
@@ -315,17 +321,17 @@ def _guarded(walk: ExpressionTree) -> dict[int, ast.AST]:
 
 
 def _guard_of(node: ast.AST, walk: ExpressionTree) -> ast.AST:
-    kind = type(node)
-    if kind is ast.BinOp:
+    if type(node) is ast.BinOp:
         guard = GUARDED_OPERATORS.get(type(node.op))
         return node if guard is None else _call(guard, [node.left, node.right], node)
-    if kind is ast.JoinedStr:
+    if type(node) is ast.JoinedStr:
         return node if walk.slots[id(node)][1] == "format_spec" else _call("_guard", [node], node)
-    if kind is ast.List or kind is ast.Tuple:   # a display of constants is bounded by the text
-        return node if all(isinstance(element, ast.Constant) for element in node.elts) else _call("_guard", [node], node)
-    if kind is ast.Subscript:                   # a slice copies what it cuts: paid like any built value
+    if type(node) is ast.List or type(node) is ast.Tuple:   # a display of constants is bounded by the text
+        constants = all(isinstance(element, ast.Constant) for element in node.elts)
+        return node if constants else _call("_guard", [node], node)
+    if type(node) is ast.Subscript:                 # a slice copies what it cuts: paid like any built value
         return _call("_built", [node], node) if isinstance(node.slice, ast.Slice) else node
-    if kind is ast.FormattedValue:
+    if type(node) is ast.FormattedValue:
         return _field(node)
     return node
 
@@ -339,10 +345,12 @@ def _field(node: ast.FormattedValue) -> ast.FormattedValue:
     if node.conversion != -1:
         raise ExpressionError("conversions (!r, !s, !a) are not allowed in f-strings")
     spec = node.format_spec
-    if spec is None or _constant_spec(spec) is not None:
-        if spec is not None:
+    assert spec is None or isinstance(spec, ast.JoinedStr)   # Python parses a format spec as an f-string
+    constant = None if spec is None else _constant_spec(spec)
+    if spec is None or constant is not None:
+        if constant is not None:
             try:
-                check_format_spec(_constant_spec(spec))
+                check_format_spec(constant)
             except ValueError as error:
                 raise ExpressionError(str(error)) from None
         return node

@@ -3,10 +3,11 @@ builtins and nc_path. The whitelist checks calls against it; evaluation runs wit
 from __future__ import annotations
 
 import math
-from typing import Any, Callable
+from collections.abc import Callable
+from typing import Any
 
-from .nc_path import nc_path
 from .guards import safe_format, safe_int, safe_round, safe_str
+from .nc_path import nc_path
 
 _MATH = ("sin", "cos", "tan", "asin", "acos", "atan", "atan2", "radians", "degrees", "sqrt",
          "hypot", "ceil", "floor", "trunc", "fabs", "copysign", "exp", "log", "log10", "isclose")

@@ -15,6 +15,7 @@ import re
 import reprlib
 import threading
 from decimal import Decimal
+from typing import Literal, overload
 
 from .asteval_import import asteval_safe_pow
 from .budget import paid
@@ -38,6 +39,12 @@ _SHORT.maxlevel = 2
 _PARSING = threading.Lock()
 
 
+@overload
+def parse_python(text: str, mode: Literal["eval"] = "eval") -> ast.Expression: ...
+@overload
+def parse_python(text: str, mode: Literal["exec"]) -> ast.Module: ...
+@overload
+def parse_python(text: str, mode: str) -> ast.AST: ...
 def parse_python(text: str, mode: str = "eval") -> ast.AST:
     """ast.parse, one thread at a time."""
     with _PARSING:

@@ -8,11 +8,16 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from datetime import datetime
+from typing import TYPE_CHECKING
 
+from ..db.connection import scalar
 from ..errors import EngineError
 from ..nc.layout import NcLayout, class_layout, store_layout
 from .rows import CSV_COLUMNS, TemplateRow
 from .store import replace_template
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
 
 @dataclass(frozen=True)
@@ -23,7 +28,7 @@ class VersionEntry:
     rows: int
     changes: tuple[tuple[int, str], ...]   # (row id, INSERT/UPDATE/DELETE) from template_audit
     state: str = ""                        # released, retired, draft, superseded (template_version_state)
-    release: "ReleaseEntry | None" = None  # the release of this version, if it was released
+    release: ReleaseEntry | None = None  # the release of this version, if it was released
     layout: NcLayout = NcLayout()          # the line ending and final newline its programs are written with
 
 
@@ -76,11 +81,11 @@ SELECT version, released_at, released_by, role, jsonb_array_length(tests), (impa
 FROM template_release WHERE gear_class = %s"""
 
 
-def history(conn, gear_class: str) -> list[VersionEntry]:
+def history(conn: Connection, gear_class: str) -> list[VersionEntry]:
     """Every stored version of the class, oldest first, with who made it, which rows changed, its
     state (released, retired, draft, superseded) and its release."""
     _require_class(conn, gear_class)
-    states = dict(conn.execute(STATES, (gear_class,)).fetchall())
+    states: dict[int, str] = dict(conn.execute(STATES, (gear_class,)).fetchall())   # version -> state
     releases = {row[0]: ReleaseEntry(*row[1:]) for row in conn.execute(RELEASES, (gear_class,))}
     return [VersionEntry(version, created_at, created_by, row_count, tuple(zip(row_ids, operations)),
                          states.get(version, ""), releases.get(version), NcLayout(line_ending, final_newline))
@@ -88,7 +93,7 @@ def history(conn, gear_class: str) -> list[VersionEntry]:
             in conn.execute(HISTORY, {"class": gear_class})]
 
 
-def diff(conn, gear_class: str, from_version: int, to_version: int) -> list[RowChange]:
+def diff(conn: Connection, gear_class: str, from_version: int, to_version: int) -> list[RowChange]:
     """Rows added, removed or changed from one version to the other, in row id order."""
     old = {row["id"]: row for row in version_rows_json(conn, gear_class, from_version)}
     new = {row["id"]: row for row in version_rows_json(conn, gear_class, to_version)}
@@ -96,7 +101,8 @@ def diff(conn, gear_class: str, from_version: int, to_version: int) -> list[RowC
             for row_id in sorted(old.keys() | new.keys()) if old.get(row_id) != new.get(row_id)]
 
 
-def layout_change(conn, gear_class: str, from_version: int, to_version: int) -> tuple[NcLayout, NcLayout] | None:
+def layout_change(conn: Connection, gear_class: str, from_version: int, to_version: int) -> tuple[NcLayout,
+                                                                                                  NcLayout] | None:
     """The layouts of the two versions if they differ (the bytes of their programs do), else None."""
     old, new = (class_layout(conn, gear_class, version) for version in (from_version, to_version))
     return None if old == new else (old, new)
@@ -107,7 +113,7 @@ def _row_change(row_id: int, old: dict | None, new: dict | None) -> RowChange:
     return RowChange(row_id, kind, old, new)
 
 
-def restore(conn, gear_class: str, version: int) -> tuple[bool, int]:
+def restore(conn: Connection, gear_class: str, version: int) -> tuple[bool, int]:
     """Make the class's template what it was in `version`, its rows and its layout, as a new
     version (history stays append-only). Returns (changed, the class's version now); unchanged if identical.
 
@@ -119,11 +125,11 @@ def restore(conn, gear_class: str, version: int) -> tuple[bool, int]:
             raise EngineError(f"class {gear_class!r} version {version} has no template rows; nothing to restore")
         changed = replace_template(conn, gear_class, rows)
         changed = store_layout(conn, gear_class, class_layout(conn, gear_class, version)) or changed
-        current = conn.execute("SELECT template_version FROM gear_class WHERE name = %s", (gear_class,)).fetchone()[0]
+        current = scalar(conn.execute("SELECT template_version FROM gear_class WHERE name = %s", (gear_class,)))
     return changed, current
 
 
-def version_rows_json(conn, gear_class: str, version: int) -> list[dict]:
+def version_rows_json(conn: Connection, gear_class: str, version: int) -> list[dict]:
     """The class's assembled rows in `version`; an error naming the stored versions if absent."""
     found = conn.execute("SELECT rows FROM template_version_rows WHERE gear_class = %s AND version = %s",
                          (gear_class, version)).fetchone()
@@ -134,12 +140,12 @@ def version_rows_json(conn, gear_class: str, version: int) -> list[dict]:
     return found[0]
 
 
-def _version_list(conn, gear_class: str) -> str:
+def _version_list(conn: Connection, gear_class: str) -> str:
     versions = [row[0] for row in conn.execute(
         "SELECT version FROM template_version_rows WHERE gear_class = %s ORDER BY version", (gear_class,))]
     return ", ".join(map(str, versions)) or "none"
 
 
-def _require_class(conn, gear_class: str) -> None:
+def _require_class(conn: Connection, gear_class: str) -> None:
     if conn.execute("SELECT 1 FROM gear_class WHERE name = %s", (gear_class,)).fetchone() is None:
         raise EngineError(f"gear class {gear_class!r} does not exist; see `engine template list`")

@@ -4,6 +4,7 @@ or earlier rows compute."""
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from ..gears.models import model_for_class
 from .checks import LintProblem, structural_problems
@@ -12,15 +13,18 @@ from .expressions import translated_python
 from .store import load_template
 from .translations import store_translations
 
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
-def lint_class(conn, gear_class: str) -> list[LintProblem]:
+
+def lint_class(conn: Connection, gear_class: str) -> list[LintProblem]:
     """Every problem of one class's template, including unknown parameter names (its rows
     compiled once, within the time of one compile)."""
     with rows_compiled_once():
         return _class_problems(conn, gear_class)
 
 
-def _class_problems(conn, gear_class: str) -> list[LintProblem]:
+def _class_problems(conn: Connection, gear_class: str) -> list[LintProblem]:
     template = load_template(conn, gear_class)
     problems = structural_problems(gear_class, list(template.rows)) + _translation_problems(template)
     if problems:
@@ -33,13 +37,13 @@ def _class_problems(conn, gear_class: str) -> list[LintProblem]:
     return list(_unknown_names(gear_class, template.rows, name_source))
 
 
-def _name_source(conn, gear_class: str):
+def _name_source(conn: Connection, gear_class: str):
     """What tells the parameters a class's rows may read: an imported class's rows name the
     parameters of its program, even under a parent with a model; else the class's model."""
     return _imported_names(conn, gear_class) or model_for_class(conn, gear_class)
 
 
-def known_names_of(conn, gear_class: str):
+def known_names_of(conn: Connection, gear_class: str):
     """`(t, n) -> frozenset` of the parameter names a module's rows may read, or None when the
     class has no model nor import to say (engine lint reports that)."""
     source = _name_source(conn, gear_class)
@@ -64,7 +68,7 @@ class _ImportedNames:
         return self.names
 
 
-def _imported_names(conn, gear_class: str) -> _ImportedNames | None:
+def _imported_names(conn: Connection, gear_class: str) -> _ImportedNames | None:
     found = conn.execute("SELECT import_params FROM gear_class WHERE name = %s", (gear_class,)).fetchone()
     if found is None or found[0] is None:
         return None
@@ -95,7 +99,7 @@ def _in_evaluation_order(compiled):
             yield column, expression
 
 
-def lint_all(conn) -> list[LintProblem]:
+def lint_all(conn: Connection) -> list[LintProblem]:
     names = [row[0] for row in conn.execute(
         "SELECT DISTINCT gear_class FROM assembly ORDER BY gear_class")]
     problems = []

@@ -26,8 +26,10 @@ def plain(body: ast.expr, max_nodes: int) -> tuple[ast.expr, frozenset] | None:
         if type(value) is ast.Constant and type(value.value) is str:
             nodes += 1
         elif type(value) is ast.FormattedValue and _plain_field(value):
-            names.append(value.value.id)
-            nodes += 3 + (0 if value.format_spec is None else 1 + len(value.format_spec.values))
+            name, spec = value.value, value.format_spec
+            assert isinstance(name, ast.Name) and (spec is None or isinstance(spec, ast.JoinedStr))   # a plain field
+            names.append(name.id)
+            nodes += 3 + (0 if spec is None else 1 + len(spec.values))
         else:
             return None
     if nodes > max_nodes:
@@ -55,7 +57,8 @@ def _plain_field(field: ast.FormattedValue) -> bool:
     if type(spec) is not ast.JoinedStr or not all(type(part) is ast.Constant for part in spec.values):
         return False
     try:
-        check_format_spec("".join(part.value for part in spec.values))
+        check_format_spec("".join(part.value for part in spec.values
+                                  if isinstance(part, ast.Constant) and isinstance(part.value, str)))
     except ValueError:
         return False
     return True

@@ -103,7 +103,8 @@ class SlopeXZ:
     positions followed block by block."""
 
     def readings(self, lines: list[str]) -> list[Reading]:
-        found, position, motion = [], {}, None
+        found, motion = [], None
+        position: dict[str, float] = {}
         for number, line in enumerate(lines, 1):
             block = words(line)
             motion = _motion(block, motion)

@@ -23,11 +23,21 @@ from dataclasses import astuple, dataclass, field
 from functools import cached_property
 from pathlib import Path
 
-from ..csv_reader import CellError, Column, CsvFile, CsvKind, declare, parse_text, parse_whole, read_csv_file, \
-    read_csv_text, refuse
+from ..csv_reader import (
+    CellError,
+    Column,
+    CsvFile,
+    CsvKind,
+    declare,
+    parse_text,
+    parse_whole,
+    read_csv_file,
+    read_csv_text,
+    refuse,
+)
 from ..errors import EngineError
-from ..nc.layout import ENDING_NAMES, NcLayout
 from ..names import shown
+from ..nc.layout import ENDING_NAMES, NcLayout
 from ..nc.lineage import ENGINES_LINE, lineage_shaped
 
 CSV_COLUMNS = ("id", "t", "n", "p_calc", "s", "o", "p_emit")
@@ -230,7 +240,7 @@ def _row_from_record(file: CsvFile, record: dict, line: int) -> TemplateRow:
     if swallowed:
         raise refuse(file.source, f"a cell runs on into what looks like a row ({swallowed.group().strip()!r}…): "
                                   "a quote opened on this line is not closed", "close the quote", line)
-    if writes_lineage(texts["o"]):
+    if texts["o"] is not None and writes_lineage(texts["o"]):
         raise refuse(file.source, f"row {row_id} writes a lineage line {shown(texts['o'].strip())}",
                      f"remove the row ({ENGINES_LINE})", line, "o")
     return TemplateRow(row_id, (record["t"] or "").strip(), n, texts["p_calc"], texts["s"],
@@ -262,7 +272,7 @@ def _folded_texts(node: ast.AST) -> list[str]:
     if isinstance(node, ast.Constant):
         return [node.value] if isinstance(node.value, str) else []
     if isinstance(node, ast.JoinedStr):
-        return ["".join(part.value if isinstance(part, ast.Constant) else "0" for part in node.values)]
+        return ["".join(str(part.value) if isinstance(part, ast.Constant) else "0" for part in node.values)]
     if isinstance(node, ast.BinOp) and isinstance(node.op, ast.Add):
         pairs = [a + b for a in _folded_texts(node.left) for b in _folded_texts(node.right)]
         return pairs[:FOLDED_TEXTS]

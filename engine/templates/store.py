@@ -7,15 +7,20 @@ class's assembly (row id, module number N, component). See design notes §4, §5
 from __future__ import annotations
 
 from dataclasses import asdict
+from typing import TYPE_CHECKING
 
 from psycopg.types.json import Jsonb
 
+from ..db.connection import scalar
 from ..db.listing import records
 from ..errors import EngineError
 from ..names import checked
 from .checks import check_rows
 from .rows import Template, TemplateRow
 from .translations import load_translations, store_translations
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
 # A class's rows: its own and those it inherits from its ancestors (nearest wins by id).
 LOAD_ROWS = """
@@ -33,7 +38,7 @@ LEFT JOIN component c ON c.id = r.component_id
 WHERE g.name = %s ORDER BY r.id"""
 
 
-def load_template(conn, gear_class: str) -> Template:
+def load_template(conn: Connection, gear_class: str) -> Template:
     """The class's assembled template; an error if the class does not exist or has no rows."""
     found = conn.execute(LOAD_TEMPLATE, (gear_class,)).fetchall()
     if not found:
@@ -45,7 +50,7 @@ def load_template(conn, gear_class: str) -> Template:
     return Template(gear_class, found[0][0], rows, load_translations(conn, rows))
 
 
-def class_records(conn) -> list[dict]:
+def class_records(conn: Connection) -> list[dict]:
     """Every class by name: its parent, template version, row count (own and inherited), description."""
     return records(conn.execute("""
         SELECT g.name AS class, g.parent, g.template_version, count(r.id)::int AS rows, g.description
@@ -53,7 +58,7 @@ def class_records(conn) -> list[dict]:
         GROUP BY g.name ORDER BY g.name"""))
 
 
-def ensure_class(conn, name: str, parent: str | None = None, description: str = "") -> bool:
+def ensure_class(conn: Connection, name: str, parent: str | None = None, description: str = "") -> bool:
     """Create the class if it is new; return True if created. A class name is printed in its
     programs' comments: one that is not a safe class name (engine/names.py) is refused."""
     checked("class", name, "class name")
@@ -69,7 +74,7 @@ def ensure_class(conn, name: str, parent: str | None = None, description: str = 
 CLASS_AND_BELOW = "SELECT name FROM classes_and_below(ARRAY[%(class)s]) ORDER BY name <> %(class)s, name"
 
 
-def class_and_descendants(conn, gear_class: str) -> list[str]:
+def class_and_descendants(conn: Connection, gear_class: str) -> list[str]:
     """The class, then every class derived from it (their templates inherit its rows)."""
     found = [row[0] for row in conn.execute(CLASS_AND_BELOW, {"class": gear_class})]
     if not found:
@@ -77,11 +82,11 @@ def class_and_descendants(conn, gear_class: str) -> list[str]:
     return found
 
 
-def _class_exists(conn, name: str) -> bool:
+def _class_exists(conn: Connection, name: str) -> bool:
     return conn.execute("SELECT 1 FROM gear_class WHERE name = %s", (name,)).fetchone() is not None
 
 
-def replace_template(conn, gear_class: str, rows: list[TemplateRow], check=check_rows) -> bool:
+def replace_template(conn: Connection, gear_class: str, rows: list[TemplateRow], check=check_rows) -> bool:
     """Make `rows` the class's template, reusing identical component bodies.
 
     A derived class (one whose ancestors have rows) stores only the rows that differ from
@@ -95,7 +100,7 @@ def replace_template(conn, gear_class: str, rows: list[TemplateRow], check=check
     with conn.transaction():
         inherited = inherited_rows(conn, gear_class)
         check(gear_class, merge_rows(inherited, rows))
-        changed = conn.execute(REPLACE, (gear_class, Jsonb([asdict(row) for row in rows]))).fetchone()[0]
+        changed = scalar(conn.execute(REPLACE, (gear_class, Jsonb([asdict(row) for row in rows]))))
         if changed:
             store_translations(conn, rows)
     return changed
@@ -105,7 +110,7 @@ def replace_template(conn, gear_class: str, rows: list[TemplateRow], check=check
 REPLACE = "SELECT replace_class_template(%s, %s)"
 
 
-def inherited_rows(conn, gear_class: str) -> list[TemplateRow]:
+def inherited_rows(conn: Connection, gear_class: str) -> list[TemplateRow]:
     """The rows the class would have with no rows of its own: its parent's assembled template."""
     parent = conn.execute("SELECT parent FROM gear_class WHERE name = %s", (gear_class,)).fetchone()
     if parent is None or parent[0] is None:

@@ -8,10 +8,14 @@ import functools
 import hashlib
 import re
 from importlib.metadata import version
+from typing import TYPE_CHECKING
 
 from psycopg.errors import InsufficientPrivilege
 
 from .guards import parse_python
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
 TRANSLATOR = "sqlcond-1"   # a change of our translator's output changes this, and so every key
 
@@ -40,7 +44,7 @@ def sql_texts(rows) -> set[str]:
     return {text for text in expression_texts(rows) if not _is_python(text)}
 
 
-def load_translations(conn, rows) -> dict[str, str]:
+def load_translations(conn: Connection, rows) -> dict[str, str]:
     """Stored translations of the rows' SQL conditions: text → Python expression."""
     texts = sql_texts(rows)
     if not texts:
@@ -49,7 +53,7 @@ def load_translations(conn, rows) -> dict[str, str]:
     return {sql: python for sql, python in found if sql in texts}
 
 
-def store_translations(conn, rows) -> int:
+def store_translations(conn: Connection, rows) -> int:
     """Translate the rows' SQL conditions that have no stored translation and keep them; a role
     that may not write them (runners) leaves them to be translated when used. The number stored."""
     from .expressions import translated_python

@@ -18,7 +18,9 @@ class ExpressionTree:
     __slots__ = ("nodes", "children", "slots")
 
     def __init__(self, tree: ast.AST, max_depth: int, too_deep: Exception):
-        self.nodes, self.children, self.slots = [], {}, {}
+        self.nodes: list[ast.AST] = []
+        self.children: dict[int, list[ast.AST]] = {}          # id(node) -> its children
+        self.slots: dict[int, tuple[ast.AST, str, int | None]] = {}   # id(node) -> where it sits
         pending = deque(((tree, 1),))
         while pending:
             node, depth = pending.popleft()
@@ -59,7 +61,8 @@ class ExpressionTree:
         (below the root Expression)."""
         if not any(isinstance(node, COMPUTING) for node in self.nodes):
             return []
-        reading, computing = set(), set()
+        reading: set[int] = set()     # ids of nodes
+        computing: set[int] = set()
         for node in reversed(self.nodes):   # children before their parents
             inner = self.children[id(node)]
             if isinstance(node, ast.Name) and reads(node.id) or not reading.isdisjoint(map(id, inner)):

@@ -7,11 +7,16 @@ current version is its draft until `engine template release` records it in templ
 from __future__ import annotations
 
 from dataclasses import replace
+from typing import TYPE_CHECKING
 
+from ..db.connection import scalar
 from ..errors import EngineError
 from .rows import Template, TemplateRow
 from .store import load_template
 from .translations import load_translations
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
 RELEASED = """
 SELECT v.version, v.rows FROM template_release r
@@ -20,7 +25,7 @@ WHERE r.gear_class = %s ORDER BY r.id DESC LIMIT 1"""
 RELEASED_VERSION = "SELECT released_version(%s)"
 
 
-def released_template(conn, gear_class: str) -> Template:
+def released_template(conn: Connection, gear_class: str) -> Template:
     """The class's latest released template: what the shop floor runs."""
     found = conn.execute(RELEASED, (gear_class,)).fetchone()
     if found is None:
@@ -33,18 +38,18 @@ def released_template(conn, gear_class: str) -> Template:
     return Template(gear_class, found[0], rows, load_translations(conn, rows))
 
 
-def draft_template(conn, gear_class: str) -> Template:
+def draft_template(conn: Connection, gear_class: str) -> Template:
     """The class's current rows (its draft, or its released version if it has no draft), marked
     whether they are a draft."""
     template = load_template(conn, gear_class)
-    released = conn.execute(RELEASED_VERSION, (gear_class,)).fetchone()[0]
+    released = scalar(conn.execute(RELEASED_VERSION, (gear_class,)))
     return replace(template, draft=released != template.version)
 
 
-def runnable_template(conn, gear_class: str, draft: bool = False) -> Template:
+def runnable_template(conn: Connection, gear_class: str, draft: bool = False) -> Template:
     """The template a job of the class is made with: the draft if asked for, else the released one."""
     return draft_template(conn, gear_class) if draft else released_template(conn, gear_class)
 
 
-def released_version(conn, gear_class: str) -> int | None:
-    return conn.execute(RELEASED_VERSION, (gear_class,)).fetchone()[0]
+def released_version(conn: Connection, gear_class: str) -> int | None:
+    return scalar(conn.execute(RELEASED_VERSION, (gear_class,)))

@@ -30,6 +30,7 @@ def with_short_arcs(moves: list[Move]) -> list[Move]:
 
 def pieces(previous: Move, arc: Move) -> list[Move]:
     """[arc] or its equal pieces; X is a diameter, i the radial centre offset as a radius."""
+    assert arc.i is not None and arc.k is not None   # an arc move has its centre
     start_z, start_r = previous.z, previous.x / 2.0
     centre_z, centre_r = start_z + arc.k, start_r + arc.i
     a0 = math.atan2(start_r - centre_r, start_z - centre_z)

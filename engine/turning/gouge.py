@@ -102,6 +102,7 @@ def move_points(start: tuple[float, float], move: Move) -> Iterator[tuple[float,
 
 
 def _arc_samples(start: tuple[float, float], move: Move) -> Iterator[tuple[float, float]]:
+    assert move.i is not None and move.k is not None   # an arc move has its centre
     centre = (start[0] + move.k, start[1] + move.i)
     radius = math.dist(start, centre)
     begin = math.atan2(start[1] - centre[1], start[0] - centre[0])

@@ -7,13 +7,23 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 from ..drawings.drawing import Drawing, Operation
 from ..drawings.profile import merged_bounds
 from ..errors import EngineError
 from ..names import NAME_RULES, checked, is_safe, shown
-from .defaults import (CLEARANCE, DEFAULT_FEED, DEFAULT_INFEED_ANGLE, DEFAULT_SPEED, DEFAULT_THREAD_DEPTH_PER_PASS,
-                       FEED_PER_REV_NOTE, PROFILE_DEFAULTS, STOCK_MARGIN, TOOL_CHANGE_DISTANCE)
+from .defaults import (
+    CLEARANCE,
+    DEFAULT_FEED,
+    DEFAULT_INFEED_ANGLE,
+    DEFAULT_SPEED,
+    DEFAULT_THREAD_DEPTH_PER_PASS,
+    FEED_PER_REV_NOTE,
+    PROFILE_DEFAULTS,
+    STOCK_MARGIN,
+    TOOL_CHANGE_DISTANCE,
+)
 from .model import key
 from .names import MAX_OPERATIONS, SLOT_DEFAULTS
 from .segments import path_param
@@ -142,7 +152,7 @@ def add_drawn_operation(job: TurningJob, op: Operation) -> None:
     if n > MAX_OPERATIONS:
         raise EngineError(f"layer {op.layer!r}: operation {n} is beyond the turning templates' "
                           f"{MAX_OPERATIONS} operation slots; renumber the layers 1 … {MAX_OPERATIONS}")
-    codes = op.codes
+    codes: dict[str, Any] = op.codes   # each @-code's value has its own type
     tool = codes.get("tool") or _assumed(job, op, "@T", "tool", n, " (the operation number, by convention)")
     speed = codes.get("spindle_rpm") or _assumed(job, op, "@S", "spindle_rpm", DEFAULT_SPEED)
     cutmotion = {"kind": op.kind, "paths": [path_param(path) for path in op.paths], "op_present": True}

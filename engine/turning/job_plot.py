@@ -4,10 +4,14 @@ what identifies it on the shop floor: the job, its drawing, its machine and its 
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ..errors import EngineError
 from .model import key, planned_passes
 from .plot import JobPicture, job_figure, plot_picture
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
 
 # The machine is the job row's (the one the program is made for); drawing and program name are
 # job parameters (engine.turning.job_params), editable in SQL like the rest.
@@ -15,19 +19,19 @@ JOB_ROW = ("SELECT j.params, j.module_params, m.kind, j.machine FROM job j JOIN 
            "WHERE j.id = %s")
 
 
-def plot_turning_job(conn, job_id: int, out: str | Path) -> list[tuple[str, int, int]]:
+def plot_turning_job(conn: Connection, job_id: int, out: str | Path) -> list[tuple[str, int, int]]:
     """Draw the job to `out` (.png or .svg); → (label, tool, passes) per operation drawn."""
     picture = job_picture(conn, job_id)
     plot_picture(out, picture)
     return [(label.removeprefix("OP "), tool, len(passes)) for label, tool, passes in picture.operations]
 
 
-def turning_job_figure(conn, job_id: int):
+def turning_job_figure(conn: Connection, job_id: int):
     """The job's picture as a matplotlib Figure, not written (to read what is drawn)."""
     return job_figure(job_picture(conn, job_id))
 
 
-def job_picture(conn, job_id: int) -> JobPicture:
+def job_picture(conn: Connection, job_id: int) -> JobPicture:
     params, module_params, machine = turning_job_row(conn, job_id)
     geometry, planned = planned_passes(params, module_params)
     operations = [(operation_label(n, params, module_params), operation_tool(n, module_params), passes)
@@ -36,7 +40,7 @@ def job_picture(conn, job_id: int) -> JobPicture:
     return JobPicture(geometry.outline, geometry.stock, operations, job_title(job_id, params, machine), tool_change)
 
 
-def turning_job_row(conn, job_id: int) -> tuple[dict, dict, str]:
+def turning_job_row(conn: Connection, job_id: int) -> tuple[dict, dict, str]:
     row = conn.execute(JOB_ROW, (job_id,)).fetchone()
     if row is None:
         raise EngineError(f"job {job_id} does not exist; see `SELECT id, gear_class FROM job`")

@@ -163,7 +163,8 @@ class Material:
         low, high = sorted((z0, z1))
         cells = range(_cell(low), _cell(high) + 1)
         edges = {self.blank.z_front, self.blank.z_back, *(cell * BUCKET_MM for cell in cells),
-                 *(cut_end[0] for cell in cells for cut in self.cells.get(cell, ()) for cut_end in (cut.start, cut.end))}
+                 *(cut_end[0] for cell in cells for cut in self.cells.get(cell, ())
+                   for cut_end in (cut.start, cut.end))}
         nudged = {edge + side * TURN_NUDGE_MM for edge in edges for side in (-1, 1)}
         return {(z - z0) / (z1 - z0) for z in nudged if low < z < high}
 
@@ -227,6 +228,7 @@ def _check_rapid(material: Material, start: Point, end: Point, move: Move, where
     length, inside = material.length_inside(start, end)
     if length <= AIR_TOLERANCE_MM:
         return
+    assert inside is not None   # the move runs through the material
     z = inside[0]
     raise EngineError(f"{where}: G00 X{move.x:.3f} Z{move.z:.3f} runs {length:.2f} mm through "
                       f"{_material_named(material, z)}Ø{round(2 * material.height(z), 3):g} at Z{round(z, 3):g}): "

@@ -12,12 +12,12 @@ from __future__ import annotations
 
 from ..errors import EngineError
 from ..names import NAME_RULES, is_safe, shown
+from ..nc.words import MAX_TOOL
 from . import toolpaths
 from .arc_split import with_short_arcs
 from .material import check_job_rapids
 from .moves import Move, Pass
 from .names import MAX_OPERATIONS
-from ..nc.words import MAX_TOOL
 from .operations import KINDS, JobGeometry, job_geometry, operation_passes
 from .params import FIX, bool_param, integer_param, number_param
 from .reach import check_turnable_from_outside

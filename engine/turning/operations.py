@@ -63,7 +63,7 @@ def job_geometry(params: dict) -> JobGeometry:
         stock = (float(params["stock_z_front"]), float(params["stock_z_back"]), params["stock_diameter"] / 2.0)
     finish_path = off_the_axis(profile) if closed_by_axis else outer_side(profile)
     clearance, tool_change_radius = float(params["clearance"]), params["tool_change_x"] / 2.0
-    return JobGeometry(profile, finish_path, profile + closing, stock, clearance, tool_change_radius)
+    return JobGeometry(profile, finish_path, [*profile, *closing], stock, clearance, tool_change_radius)
 
 
 def off_the_axis(profile: list[Segment]) -> list[Segment]:

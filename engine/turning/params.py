@@ -3,6 +3,7 @@ value with its JSON type checked, or an error naming the parameter and what to d
 from __future__ import annotations
 
 import math
+from typing import Any
 
 from ..errors import EngineError
 
@@ -12,7 +13,7 @@ FIX = "set it in SQL (job.params / job.module_params) and instantiate the job ag
 def number_param(values: dict, key: str, where: str, minimum: float | None = None,
                  above: bool = False) -> float:
     """A number from stored parameters (at least, or above, `minimum`), or an error naming it."""
-    value = values.get(key)
+    value: Any = values.get(key)
     wrong = isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value)
     if not wrong and minimum is not None:
         wrong = value <= minimum if above else value < minimum

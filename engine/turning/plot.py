@@ -10,8 +10,8 @@ whole or not at all (engine.pictures)."""
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Sequence
 
 from ..drawings.geometry import Arc, Segment
 from ..pictures import literal, new_figure, picture_target, save_atomically
@@ -154,7 +154,8 @@ def draw_operation(axes, lines: dict[str, list[Point]], colour: str, label: str)
     """Feed moves solid (the legend entry of the operation), rapids dashed in the same colour."""
     feed, rapid = (list(zip(*lines[kind])) or [(), ()] for kind in ("feed", "rapid"))
     axes.plot(*feed, color=colour, linewidth=FEED_WIDTH, label=literal(label), zorder=3)
-    axes.plot(*rapid, color=colour, linewidth=RAPID_WIDTH, linestyle=RAPID_STYLE, label=literal(f"_{label} rapid"), zorder=2)
+    axes.plot(*rapid, color=colour, linewidth=RAPID_WIDTH, linestyle=RAPID_STYLE, label=literal(f"_{label} rapid"),
+              zorder=2)
 
 
 def draw_line_styles(axes) -> None:

@@ -12,8 +12,8 @@ frame's edge. The figure's size follows the frame's proportions at true shape.""
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
-from typing import Iterable, Sequence
 
 Point = tuple[float, float]   # (z, diameter)
 

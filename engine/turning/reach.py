@@ -18,8 +18,8 @@ section there is the same all along the span.
 """
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Sequence
 
 from ..drawings.profile import END_MATCH_TOLERANCE_MM
 from ..errors import EngineError
@@ -106,7 +106,8 @@ def check_turnable_from_outside(edges: Sequence[Edge], part: str) -> None:
 
 def bore_message(bored: list[Slice], part: str) -> str:
     smallest, largest = (2.0 * f(piece.spans[0][0] for piece in bored) for f in (min, max))
-    diameters = f"Ø{smallest:.6g}" if largest - smallest <= 2 * DRAWING_TOLERANCE_MM else f"Ø{smallest:.6g} … Ø{largest:.6g}"
+    one = largest - smallest <= 2 * DRAWING_TOLERANCE_MM
+    diameters = f"Ø{smallest:.6g}" if one else f"Ø{smallest:.6g} … Ø{largest:.6g}"
     where = ", ".join(f"Z{low:g} … Z{high:g}" for low, high in z_ranges(bored))
     return (f"{part} is a part with a bore {diameters} at {where} (its section does not reach the axis "
             "there): internal turning is not supported; to turn the outside only, draw its half-profile "

@@ -8,9 +8,9 @@ exact one; callers that must keep a distance add the tolerance to it.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from functools import cached_property
-from typing import Iterable, Sequence
 
 from ..drawings.geometry import Arc, Point, Segment
 from ..drawings.profile import sweep

@@ -9,6 +9,7 @@ ccw: counter-clockwise seen with Z to the right and the radius up (G03 on a lath
 from __future__ import annotations
 
 import math
+from typing import NoReturn
 
 from ..drawings.geometry import Arc, Line, Segment
 from ..drawings.profile import END_MATCH_TOLERANCE_MM
@@ -36,7 +37,7 @@ def path_from_param(items, where: str) -> list[Segment]:
     if not isinstance(items, list):
         raise EngineError(f"{where} must be a list of segments, not {type(items).__name__}; "
                           f"fix it in SQL (job.params / job.module_params)")
-    segments = []
+    segments: list[Segment] = []
     for index, item in enumerate(items):
         segment = _segment(item)
         if segment is None:
@@ -71,7 +72,7 @@ def _segment(item) -> Segment | None:
     return None
 
 
-def _refuse(item, where: str) -> None:
+def _refuse(item, where: str) -> NoReturn:
     shape = '["line", z0, r0, z1, r1] or ["arc", z0, r0, z1, r1, zc, rc, ccw]'
     if type(item) is not list or not item or item[0] not in ("line", "arc"):
         raise EngineError(f"{where} = {item!r} is not a segment; write {shape}")

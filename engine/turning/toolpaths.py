@@ -10,14 +10,22 @@ the drawing holds the tool-centre path, its direction included.
 from __future__ import annotations
 
 import math
-from typing import Sequence
+from collections.abc import Sequence
 
 from ..drawings.geometry import Arc, Line, Segment
 from ..drawings.profile import merged_bounds
 from ..errors import EngineError
 from .moves import Move, Pass
-from .region import (CHORD_TOLERANCE_MM, Edge, Surroundings, distance_to_region, flattened_outline,
-                     free_intervals, is_blocked, top_over)
+from .region import (
+    CHORD_TOLERANCE_MM,
+    Edge,
+    Surroundings,
+    distance_to_region,
+    flattened_outline,
+    free_intervals,
+    is_blocked,
+    top_over,
+)
 
 __all__ = ["finish_passes", "drawn_rough_passes", "slot_passes", "thread_passes",
            "profile_rough_passes", "alternate", "up_then_across", "standalone", "distance_to_region"]
@@ -152,8 +160,9 @@ def axial_line(path: list[Segment]) -> tuple[float, float, float] | None:
 
 def crest_and_root(paths: list[list[Segment]]) -> tuple[tuple[float, float, float], float]:
     """((start z, end z, radius) of the crest line, root radius) of a THREAD layer."""
-    lines = [axial_line(path) for path in paths]
-    if len(lines) != 2 or None in lines:
+    found = [axial_line(path) for path in paths]
+    lines = [line for line in found if line is not None]
+    if len(found) != 2 or len(lines) != 2:
         raise EngineError(f"the THREAD layer holds {len(paths)} path(s), not two axial lines; draw "
                           "the crest line and the root line, each one line along drawing X")
     crest, root = sorted(lines, key=lambda line: -line[2])

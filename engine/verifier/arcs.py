@@ -7,6 +7,8 @@ import math
 
 from .refusals import Refused
 
+Point = tuple[float, float]   # (z, r) in mm
+
 # mm by which half the chord may exceed the radius: the rounding of end points and radius to
 # three decimals moves them by less; a control alarms (or, worse, guesses a centre) beyond its own.
 ARC_TOLERANCE = 0.002
@@ -20,7 +22,7 @@ def check_radius(start_x: float, start_z: float, end_x: float, end_z: float, rad
                       "no circle of that radius passes through both ends")
 
 
-def arc_extremes(start, end, radius: float, ccw: bool) -> list[tuple[float, float]]:
+def arc_extremes(start: Point, end: Point, radius: float, ccw: bool) -> list[Point]:
     """The end points and the quadrant points the arc passes, in (z, r). ccw is G3 with Z to the
     right and the radius up; R > 0 the arc up to 180°, R < 0 the longer one."""
     centre = arc_centre(start, end, radius, ccw)
@@ -36,7 +38,7 @@ def arc_extremes(start, end, radius: float, ccw: bool) -> list[tuple[float, floa
     return points
 
 
-def arc_centre(start, end, radius: float, ccw: bool) -> tuple[float, float]:
+def arc_centre(start: Point, end: Point, radius: float, ccw: bool) -> Point:
     dz, dr = end[0] - start[0], end[1] - start[1]
     chord = math.hypot(dz, dr)
     if chord == 0:
@@ -47,7 +49,8 @@ def arc_centre(start, end, radius: float, ccw: bool) -> tuple[float, float]:
             (start[1] + end[1]) / 2.0 + side * rise * dz / chord)
 
 
-def arc_box(start_x: float, start_z: float, end_x: float, end_z: float, radius: float, ccw: bool) -> dict:
+def arc_box(start_x: float, start_z: float, end_x: float, end_z: float, radius: float,
+            ccw: bool) -> dict[str, tuple[float, float]]:
     """{axis: (lowest, highest)} the arc reaches, X as a diameter."""
     points = arc_extremes((start_z, start_x / 2.0), (end_z, end_x / 2.0), radius, ccw)
     zs, rs = [z for z, _ in points], [r for _, r in points]

@@ -11,47 +11,67 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, ClassVar, Literal
 
-from .grammar import (ANGLE, AXES, BLOCK_SHAPES, CODE, DWELL, MOTION, OFFSET, POINT_REASON, SPEED, TOOL,
-                      TOOL_AND_OFFSET, WORD_NEEDS_CODE, WORKING_AREA, Dialect)
+from .grammar import (
+    ANGLE,
+    AXES,
+    BLOCK_SHAPES,
+    CODE,
+    DWELL,
+    MOTION,
+    OFFSET,
+    POINT_REASON,
+    SPEED,
+    TOOL,
+    TOOL_AND_OFFSET,
+    WORD_NEEDS_CODE,
+    WORKING_AREA,
+    Dialect,
+)
 from .machine_state import OFFSET_OFF, OFFSET_ON, TOOL_CHANGE
 from .numbers import why_not_plain
 from .refusals import Refused
 from .words import READERS
 
+if TYPE_CHECKING:
+    from collections.abc import Callable
+
 TOKEN = re.compile(r"([A-Z]+)(=?)(.*)")
 EQUALS_KINDS = frozenset({"position", "angle", "feed", "speed", "radius", "pitch", "spindle position"})
 
 
-def _offset(number: int) -> str:
+def _offset(number: float) -> str:
     return OFFSET_ON if number else OFFSET_OFF
 
 
 # The events of a word, by its kind: an S gives the spindle a speed; a T changes the tool; D (840D)
 # is the offset, D0 none; an ISO T<tool><offset> changes the tool and sets or cancels its offset.
-WORD_EVENTS = {SPEED: lambda value: ("S",), TOOL: lambda value: (TOOL_CHANGE,),
-               OFFSET: lambda number: (_offset(number),),
-               TOOL_AND_OFFSET: lambda number: (TOOL_CHANGE, _offset(number % 100))}
+WORD_EVENTS: dict[str, Callable[[float], tuple[str, ...]]] = {
+    SPEED: lambda value: ("S",), TOOL: lambda value: (TOOL_CHANGE,), OFFSET: lambda number: (_offset(number),),
+    TOOL_AND_OFFSET: lambda number: (TOOL_CHANGE, _offset(number % 100))}
 
 
 @dataclass(frozen=True, slots=True)
 class Block:
-    kind = "block"
-    values: dict               # address -> value (G and M codes apart)
+    kind: ClassVar[Literal["block"]] = "block"
+    values: dict[str, float]   # address -> value (G and M codes apart)
     motion: int | None         # the block's G0/G1/G2/G3/thread code
     area: str | None           # "lower" (G25) or "upper" (G26)
-    positions: dict            # X/Y/Z of the block
+    positions: dict[str, float]   # X/Y/Z of the block
     moves: bool                # the block moves an axis (X, Y, Z or the swivel A)
-    modal: frozenset           # its G codes ("G90") and keywords: they hold for the block's own motion
-    events: frozenset          # its M codes ("M3") and word events (S, tool change, offset on/off)
+    modal: frozenset[str]      # its G codes ("G90") and keywords: they hold for the block's own motion
+    events: frozenset[str]     # its M codes ("M3") and word events (S, tool change, offset on/off)
     speed: float | None        # S
     feed: float | None         # F where it is a feed (not a G4 dwell's time)
     needs: str | None          # the motion whose needs the block must meet ("G1"), if it moves
 
 
 def read_block(dialect: Dialect, code: str) -> Block:
-    codes: dict[str, list] = {"G": [], "M": []}
-    values, keywords, events = {}, set(), []
+    codes: dict[str, list[int]] = {"G": [], "M": []}
+    values: dict[str, float] = {}
+    keywords: set[str] = set()
+    events: list[str] = []
     for token in code.split():
         _read_token(dialect, token, codes, values, keywords, events)
     groups = _groups(dialect, codes)
@@ -59,7 +79,8 @@ def read_block(dialect: Dialect, code: str) -> Block:
     return _block(dialect, codes, groups, values, keywords, events)
 
 
-def _block(dialect: Dialect, codes: dict, groups: dict, values: dict, keywords: set, events: list) -> Block:
+def _block(dialect: Dialect, codes: dict[str, list[int]], groups: dict[int, str], values: dict[str, float],
+           keywords: set[str], events: list[str]) -> Block:
     motion = area = None
     for code in codes["G"]:
         motion = code if groups[code] == MOTION else motion
@@ -70,13 +91,14 @@ def _block(dialect: Dialect, codes: dict, groups: dict, values: dict, keywords: 
         raise Refused("a move without its G0/G1 (or G2/G3) in the same block: each block is verified on its own")
     effects = dialect.state.effects.keys()     # only events that change the state are kept
     modal = frozenset(effects & {*(f"G{code}" for code in codes["G"]), *keywords})
-    events = frozenset(effects & {*(f"M{code}" for code in codes["M"]), *events})
+    kept = frozenset(effects & {*(f"M{code}" for code in codes["M"]), *events})
     feed = None if DWELL in codes["G"] else values.get("F")
     needs = f"G{motion}" if moves and area is None else None
-    return Block(values, motion, area, positions, moves, modal, events, values.get("S"), feed, needs)
+    return Block(values, motion, area, positions, moves, modal, kept, values.get("S"), feed, needs)
 
 
-def _read_token(dialect: Dialect, token: str, codes: dict, values: dict, keywords: set, events: list) -> None:
+def _read_token(dialect: Dialect, token: str, codes: dict[str, list[int]], values: dict[str, float],
+                keywords: set[str], events: list[str]) -> None:
     match = TOKEN.fullmatch(token)
     address, equals, text = match.groups() if match else ("", "", token)
     if address in dialect.keywords and not (equals or text):
@@ -93,7 +115,7 @@ def _read_token(dialect: Dialect, token: str, codes: dict, values: dict, keyword
     if kind in WORD_EVENTS:
         events.extend(WORD_EVENTS[kind](value))
     if kind == CODE:
-        codes[address].append(value)
+        codes[address].append(int(value))   # a G or M code is read as a whole number
     elif address in values:
         raise Refused(f"{address} twice in one block")
     else:
@@ -114,10 +136,10 @@ def _check_equals(dialect: Dialect, address: str, kind: str, equals: str) -> Non
         raise Refused(f"{address} needs = before its value ({address}=…)")
 
 
-def _groups(dialect: Dialect, codes: dict) -> dict:
+def _groups(dialect: Dialect, codes: dict[str, list[int]]) -> dict[int, str]:
     groups = {}
     for letter in ("G", "M"):
-        seen = {}
+        seen: dict[str, int] = {}
         for code in codes[letter]:
             group = dialect.code_group(letter, code)
             if group in seen:
@@ -128,7 +150,7 @@ def _groups(dialect: Dialect, codes: dict) -> dict:
     return groups
 
 
-def _check_shape(dialect: Dialect, codes: dict, values: dict, keywords: set) -> None:
+def _check_shape(dialect: Dialect, codes: dict[str, list[int]], values: dict[str, float], keywords: set[str]) -> None:
     for code in codes["G"]:
         _check_alone(code, codes, values, keywords)
         needed = dialect.needs_words.get(code)
@@ -140,7 +162,7 @@ def _check_shape(dialect: Dialect, codes: dict, values: dict, keywords: set) -> 
             raise Refused(f"{address} belongs to {wanted} in the same block")
 
 
-def _check_alone(code: int, codes: dict, values: dict, keywords: set) -> None:
+def _check_alone(code: int, codes: dict[str, list[int]], values: dict[str, float], keywords: set[str]) -> None:
     """G4, G25 and G26 stand in a block of their own with only their words; G25/G26 give all of
     X, Y and Z, so no axis is left without a working-area limit."""
     if code not in BLOCK_SHAPES:

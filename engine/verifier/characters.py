@@ -12,7 +12,7 @@ CHARACTER_NAMES = {"\n": "a line feed (LF)", "\r": "a carriage return (CR)", "\x
                    "\t": "a tab", "\x7f": "a DEL", "\x0c": "a form feed", "\x0b": "a vertical tab"}
 
 
-def check_characters(line) -> None:
+def check_characters(line: object) -> None:
     if not isinstance(line, str):
         raise Refused(f"a line must be text, not {type(line).__name__}")
     if PRINTABLE_ASCII.fullmatch(line):

@@ -15,9 +15,13 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING
 
 from .machine_state import HOBBING_STATE, LATHE_840D_STATE, LATHE_ISO_STATE, StateRules
 from .refusals import Refused
+
+if TYPE_CHECKING:
+    from ..machines.records import Machine
 
 # Value kinds of addresses (engine.verifier.words reads and checks each).
 POSITION, ANGLE, FEED, SPEED, CODE, TOOL, TOOL_AND_OFFSET, OFFSET, RADIUS, PITCH = (
@@ -48,28 +52,28 @@ class Header:
     would start another program, and a program without its own would be stored by the
     control under whatever name it last read."""
     what: str
-    pattern: re.Pattern
-    places: frozenset
-    required: frozenset = frozenset()
+    pattern: re.Pattern[str]
+    places: frozenset[str]
+    required: frozenset[str] = frozenset()
 
 
 @dataclass(frozen=True)
 class Dialect:
     name: str
-    headers: tuple
+    headers: tuple[Header, ...]
     comment: str                          # "semicolon": `; text` to the end; "parentheses": `(text)`
-    addresses: dict                       # address -> value kind
-    g_codes: dict                         # code -> modal group: two of one group in a block are refused
-    m_codes: dict                         # code -> group: M3 and M5 in one block are both spindle
+    addresses: dict[str, str]             # address -> value kind
+    g_codes: dict[int, str]               # code -> modal group: two of one group in a block are refused
+    m_codes: dict[int, str]               # code -> group: M3 and M5 in one block are both spindle
     state: StateRules                     # what each motion and statement needs, what each event does
-    keywords: frozenset = frozenset()     # words without a value: WALIMON, DIAMON
-    statements: frozenset = frozenset()   # NAME(arguments) lines (engine.verifier.statements)
+    keywords: frozenset[str] = frozenset()   # words without a value: WALIMON, DIAMON
+    statements: frozenset[str] = frozenset()   # NAME(arguments) lines (engine.verifier.statements)
     shift_clamp: bool = False             # the hob-shift-per-part R11 clamp (engine.verifier.shift_clamp)
     equals_allowed: bool = False          # 840D: `X=12.5` is `X12.5`; names of two letters need it (`CR=5`)
     arc_radius: str | None = None         # the address of an arc's radius
-    needs_words: dict = field(default_factory=dict)   # G code -> the words its block must hold
-    thread_lead: dict = field(default_factory=dict)   # thread G code -> the address of its lead (mm/rev)
-    point_required: frozenset = frozenset()           # addresses whose number must hold a decimal point
+    needs_words: dict[int, str] = field(default_factory=dict)   # G code -> the words its block must hold
+    thread_lead: dict[int, str] = field(default_factory=dict)   # thread G code -> the address of its lead (mm/rev)
+    point_required: frozenset[str] = frozenset()      # addresses whose number must hold a decimal point
     program_numbers: range | None = None  # ISO O numbers a program may have
 
     def code_group(self, letter: str, code: int) -> str:
@@ -173,7 +177,7 @@ LATHE_ISO = Dialect(
 DIALECTS = {("hobber", "840d"): HOBBING_840D, ("lathe", "840d"): LATHE_840D, ("lathe", "iso"): LATHE_ISO}
 
 
-def dialect_for(machine) -> Dialect:
+def dialect_for(machine: Machine) -> Dialect:
     """The grammar of a machine's programs: its dialect, and on a hobber the door M functions
     its record names (they are the machine builder's, so no dialect holds them)."""
     found = dialect_of(machine.kind, machine.dialect)

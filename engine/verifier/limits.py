@@ -26,7 +26,8 @@ def check_spindle(speed: float, machine: Machine) -> None:
         raise Refused(f"spindle speed S{speed:g} exceeds {machine.name}'s {machine.spindle_max:g} r/min")
 
 
-def check_table(speed: float, ratio: float, machine: Machine, differential: tuple = (), motion: str = "") -> None:
+def check_table(speed: float, ratio: float, machine: Machine, differential: tuple[tuple[str, float, float], ...] = (),
+                motion: str = "") -> None:
     """The table turns at n0·z0/z2 (reference §B4) plus, for each differential axis moving at v
     mm/min with k degrees of C per mm, k·v/360 r/min (reference §A5: n_C = (z0/z2)·n_B ±
     k_Y·v_Y ± k_Z·v_Z). `differential`: (axis, k, v) of each moving leading axis; the terms
@@ -53,8 +54,9 @@ def leading_velocity(rapid: bool, feed: float | None, machine: Machine) -> float
     return feed or MAX_FEED
 
 
-def check_coupled_move(rapid: bool, feed: float | None, positions: dict, coupling: tuple, machine: Machine,
-                       held: dict | None = None) -> None:
+def check_coupled_move(rapid: bool, feed: float | None, positions: dict[str, float],
+                       coupling: tuple[float | None, float, dict[str, float]], machine: Machine,
+                       held: dict[str, float] | None = None) -> None:
     """A leading axis of the EG coupling that moves turns the table by its factor k (degrees of
     C per mm) on top of the generating ratio (reference §A5): a G0 Z on a helical coupling adds
     k_Z·rapid_rate/360 r/min. `coupling`: (hob speed, B→C ratio, {axis: factor}). `held`: the
@@ -68,7 +70,7 @@ def check_coupled_move(rapid: bool, feed: float | None, positions: dict, couplin
         check_table(speed or 0.0, ratio, machine, moving, "G0 " if rapid else "")
 
 
-def _holds(axis: str, value: float, held: dict) -> bool:
+def _holds(axis: str, value: float, held: dict[str, float]) -> bool:
     return axis in held and abs(held[axis] - value) <= 1e-9
 
 
@@ -79,7 +81,7 @@ def check_thread(lead: float, speed: float, word: str) -> None:
                       f"above {MAX_FEED:g} (mm/min, about a rapid traverse)")
 
 
-def check_table_speed(gear_id, teeth: int, starts: int, hob_speed: float, machine: Machine) -> None:
+def check_table_speed(gear_id: int | None, teeth: int, starts: int, hob_speed: float, machine: Machine) -> None:
     """Before the program is made: the table turns at n0·z0/z2 (§B4); few teeth turn it fastest."""
     table_speed = hob_speed * starts / teeth
     if machine.table_speed_max is not None and table_speed > machine.table_speed_max:

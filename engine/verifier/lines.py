@@ -6,13 +6,14 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
+from typing import ClassVar, Literal
 
-from .blocks import read_block
+from .blocks import Block, read_block
 from .characters import check_characters
-from .grammar import ISO_COMMENT_TEXT, Dialect
+from .grammar import ISO_COMMENT_TEXT, Dialect, Header
 from .refusals import Refused
-from .shift_clamp import read_shift_line
-from .statements import STATEMENT, read_statement
+from .shift_clamp import ShiftLine, read_shift_line
+from .statements import STATEMENT, Statement, read_statement
 
 MAX_REMEMBERED = 20_000   # lines kept per dialect; the memory starts again when full
 ISO_LINE = re.compile(rf"([^()]*?) ?(?:\(({ISO_COMMENT_TEXT})\))?")
@@ -20,28 +21,29 @@ ISO_LINE = re.compile(rf"([^()]*?) ?(?:\(({ISO_COMMENT_TEXT})\))?")
 
 @dataclass(frozen=True, slots=True)
 class HeaderLine:
-    kind = "header"
+    kind: ClassVar[Literal["header"]] = "header"
     what: str
-    places: frozenset
+    places: frozenset[str]
     name: str | None = None        # the program name it gives (%_N_<name>_MPF, ISO O<n> (<name>))
     number: int | None = None      # the ISO program number
 
 
 @dataclass(frozen=True, slots=True)
 class CommentLine:
-    kind = "comment"
+    kind: ClassVar[Literal["comment"]] = "comment"
 
 
+Line = HeaderLine | CommentLine | ShiftLine | Statement | Block   # what a line reads as, by its kind
 COMMENT = CommentLine()
-_remembered: dict[str, dict] = {}    # dialect name -> line -> what it reads as
+_remembered: dict[str, dict[str, Line | Refused]] = {}    # dialect name -> line -> what it reads as
 
 
-def remembered_lines(dialect: Dialect) -> dict:
+def remembered_lines(dialect: Dialect) -> dict[str, Line | Refused]:
     """line -> what it reads as (or why it is refused), for the lines of `dialect` read so far."""
     return _remembered.setdefault(dialect.name, {})
 
 
-def read_line(dialect: Dialect, line: str):
+def read_line(dialect: Dialect, line: str) -> Line:
     """What `line` reads as, or Refused with the reason (both remembered)."""
     if type(line) is not str:
         raise Refused(f"a line must be text, not {type(line).__name__}")
@@ -57,14 +59,14 @@ def read_line(dialect: Dialect, line: str):
     return found
 
 
-def _read_fresh(dialect: Dialect, line: str):
+def _read_fresh(dialect: Dialect, line: str) -> Line | Refused:
     try:
         return _read(dialect, line)
     except Refused as refusal:
         return refusal
 
 
-def _read(dialect: Dialect, line: str):
+def _read(dialect: Dialect, line: str) -> Line:
     check_characters(line)
     for header in dialect.headers:
         match = header.pattern.fullmatch(line)
@@ -83,7 +85,7 @@ def _read(dialect: Dialect, line: str):
     return read_block(dialect, code)
 
 
-def _header(header, groups: dict) -> HeaderLine:
+def _header(header: Header, groups: dict[str, str | None]) -> HeaderLine:
     number = groups.get("number")
     return HeaderLine(header.what, header.places, groups.get("name"), int(number) if number else None)
 

@@ -30,8 +30,8 @@ Y_POSITION = "Y position"     # the event of a block (or the shift clamp) that p
 @dataclass(frozen=True)
 class Effect:
     """What one event does: facts it sets and facts it clears (a block's clears come first)."""
-    sets: frozenset = frozenset()
-    clears: frozenset = frozenset()
+    sets: frozenset[str] = frozenset()
+    clears: frozenset[str] = frozenset()
 
 
 def sets(*facts: str) -> Effect:
@@ -53,15 +53,15 @@ class Need:
 class Needs:
     """The needs of one motion or statement, in the order they are said, and as sets to test."""
 
-    def __init__(self, *needs: Need):
+    def __init__(self, *needs: Need) -> None:
         self.needs = needs
         self.required = frozenset(need.fact for need in needs if need.present)
         self.forbidden = frozenset(need.fact for need in needs if not need.present)
 
-    def __add__(self, other: "Needs") -> "Needs":
+    def __add__(self, other: Needs) -> Needs:
         return Needs(*self.needs, *other.needs)
 
-    def check(self, facts: set) -> None:
+    def check(self, facts: set[str]) -> None:
         if self.required <= facts and not self.forbidden & facts:
             return
         raise Refused(next(need.reason for need in self.needs if (need.fact in facts) != need.present))
@@ -69,11 +69,11 @@ class Needs:
 
 @dataclass(frozen=True)
 class StateRules:
-    effects: dict        # event -> Effect
-    needs: dict          # "G1" (a block moving with G1), "EGDEF" … -> Needs
+    effects: dict[str, Effect]   # event -> Effect
+    needs: dict[str, Needs]      # "G1" (a block moving with G1), "EGDEF" … -> Needs
 
 
-def stated(*codes: int) -> dict:
+def stated(*codes: int) -> dict[str, Effect]:
     """Modal G codes that, once a block gives them, hold for the rest of the program."""
     return {f"G{code}": sets(f"G{code}") for code in codes}
 
@@ -148,11 +148,11 @@ LATHE_ISO_STATE = StateRules(
 class State:
     """The facts that hold after the lines so far."""
 
-    def __init__(self, rules: StateRules):
+    def __init__(self, rules: StateRules) -> None:
         self.rules = rules
-        self.facts: set = set()
+        self.facts: set[str] = set()
 
-    def apply(self, events: frozenset) -> None:
+    def apply(self, events: frozenset[str]) -> None:
         effects = [self.rules.effects[event] for event in events if event in self.rules.effects]
         for effect in effects:
             self.facts -= effect.clears

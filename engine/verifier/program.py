@@ -15,6 +15,7 @@ engine.verifier.shift_clamp says; M30 last (ISO: then the closing %)."""
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING, Any
 
 from ..machines.records import Machine
 from ..names import NAME_RULES, is_safe
@@ -25,6 +26,14 @@ from .lines import read_line, remembered_lines
 from .machine_state import Y_POSITION, State
 from .refusals import LimitError, Refused, line_refused, shown_name
 from .shift_clamp import ShiftClamp
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
+
+    from .blocks import Block
+    from .lines import HeaderLine, Line
+    from .shift_clamp import ShiftLine
+    from .statements import Statement
 
 ARCS = (2, 3)
 RAPID = 0
@@ -42,7 +51,7 @@ def verify_program(lines: list[str], machine: Machine, program_name: str | None)
     try:
         for number, line in enumerate(lines, start=1):
             found = remembered.get(line) if type(line) is str else None
-            walk.take(number, read_line(dialect, line) if found is None or found.__class__ is Refused else found)
+            walk.take(number, read_line(dialect, line) if found is None or isinstance(found, Refused) else found)
         walk.finish()
     except Refused as refusal:
         raise line_refused(program_name or "the program", number, lines[number - 1] if number else "",
@@ -54,20 +63,23 @@ class ProgramReading:
     the working area and the bounds it leaves each axis, the position, the spindle speed, the
     feed, the table's coupling ratio and differential factors, the hob-shift clamp."""
 
-    def __init__(self, dialect: Dialect, machine: Machine, count: int, program_name: str | None):
+    def __init__(self, dialect: Dialect, machine: Machine, count: int, program_name: str | None) -> None:
         self.dialect, self.machine, self.count, self.program_name = dialect, machine, count, program_name
         self.state = State(dialect.state)
         self.required = {place: header for header in dialect.headers for place in header.required}
-        self.area = {"lower": {}, "upper": {}}
-        self.travel = {axis: (getattr(machine, f"{axis.lower()}_min"), getattr(machine, f"{axis.lower()}_max"))
-                       for axis in AXES}
+        self.area: dict[str, dict[str, float]] = {"lower": {}, "upper": {}}
+        self.travel: dict[str, tuple[float, float]] = {
+            axis: (getattr(machine, f"{axis.lower()}_min"), getattr(machine, f"{axis.lower()}_max")) for axis in AXES}
         self.bounds = self.travel                     # travel, narrowed by the working area once set
-        self.position: dict = {}
-        self.speed = self.feed = self.ratio = self.coupled_axes = None
-        self.differential: dict = {}
+        self.position: dict[str, float] = {}
+        self.speed: float | None = None
+        self.feed: float | None = None
+        self.ratio: float | None = None
+        self.coupled_axes: tuple[str, ...] | None = None
+        self.differential: dict[str, float] = {}
         self.clamp = ShiftClamp()
 
-    def take(self, number: int, line) -> None:
+    def take(self, number: int, line: Line) -> None:
         if number <= 2 or number == self.count or self.state.ended:
             self._check_place(number, line)
         if self.clamp.at and line.kind != "shift":
@@ -79,7 +91,7 @@ class ProgramReading:
         if not self.state.ended:
             raise Refused("the program does not end with M30")
 
-    def _check_place(self, number: int, line) -> None:
+    def _check_place(self, number: int, line: Line) -> None:
         """The header a place requires stands there; after M30 nothing but the closing header."""
         places = [place for place, here in (("first", number == 1), ("second", number == 2),
                                             ("last", number == self.count)) if here]
@@ -91,14 +103,14 @@ class ProgramReading:
             if header is not None and (line.kind != "header" or line.what != header.what):
                 raise Refused(f"the {place} line must be the {header.what}")
 
-    def _header(self, number: int, line) -> None:
+    def _header(self, number: int, line: HeaderLine) -> None:
         places = {"first": number == 1, "second": number == 2, "last": number == self.count}
         if not any(places[place] for place in line.places):
             raise Refused(f"the {line.what} belongs only in the {' or '.join(sorted(line.places))} line")
         if line.name is not None:
             self._check_name(line.name)
-        if line.number is not None and line.number not in self.dialect.program_numbers:
-            numbers = self.dialect.program_numbers
+        numbers = self.dialect.program_numbers
+        if line.number is not None and numbers is not None and line.number not in numbers:
             raise Refused(f"program number O{line.number:04d} is outside O{numbers[0]:04d} … O{numbers[-1]:04d} "
                           "(O9000 and above hold the machine builder's macros)")
 
@@ -113,10 +125,10 @@ class ProgramReading:
         if not is_safe("program", name):
             raise Refused(f"the program name {shown_name(name)} is not {NAME_RULES['program'].rule}")
 
-    def _comment(self, number: int, line) -> None:
+    def _comment(self, number: int, line: Line) -> None:
         return None
 
-    def _block(self, number: int, block) -> None:
+    def _block(self, number: int, block: Block) -> None:
         if block.modal:
             self.state.apply(block.modal)
         if block.feed is not None:
@@ -132,31 +144,33 @@ class ProgramReading:
         if block.speed is not None:
             self._set_speed(block.speed)
 
-    def _move(self, block) -> None:
+    def _move(self, block: Block) -> None:
+        assert block.needs is not None   # a block that moves, outside G25/G26, names its motion
         self.state.check(block.needs)
         self._check_motion(block.positions)
         if block.motion in ARCS:
             self._check_arc(block)
         if block.motion in self.dialect.thread_lead:
             address = self.dialect.thread_lead[block.motion]
+            assert self.speed is not None   # the thread's needs (engine.verifier.machine_state) hold an S
             check_thread(block.values[address], self.speed, address)
         if self.differential and self.ratio is not None:
-            self._check_differential(block.motion, block.positions)
+            self._check_differential(block.motion, block.positions, self.ratio)
         self.position.update(block.positions)
         if "Y" in block.positions:
             self.state.apply(frozenset({Y_POSITION}))
 
-    def _set_area(self, block) -> None:
+    def _set_area(self, block: Block) -> None:
         for axis, value in block.positions.items():
             low, high = self.travel[axis]
             if not low <= value <= high:
                 check_travel(axis, value, self.machine, "working-area limit ")
-        self.area[block.area] = dict(block.positions)
+        self.area[str(block.area)] = dict(block.positions)
         lower, upper = self.area["lower"], self.area["upper"]
         self.bounds = {axis: (max(low, lower.get(axis, -math.inf)), min(high, upper.get(axis, math.inf)))
                        for axis, (low, high) in self.travel.items()}
 
-    def _check_motion(self, positions: dict) -> None:
+    def _check_motion(self, positions: dict[str, float]) -> None:
         bounds = self.bounds
         for axis, value in positions.items():
             low, high = bounds[axis]
@@ -168,10 +182,11 @@ class ProgramReading:
         low, high = self.area["lower"].get(axis), self.area["upper"].get(axis)
         raise Refused(f"{axis}{value:g} lies outside the working area G25/G26 {axis} {low:g}…{high:g}")
 
-    def _check_arc(self, block) -> None:
+    def _check_arc(self, block: Block) -> None:
         if not {"X", "Z"} <= self.position.keys():
             raise Refused("an arc from an unknown start point: program X and Z before it")
         end = {**self.position, **block.positions}
+        assert self.dialect.arc_radius is not None   # a dialect with arcs names their radius word
         radius = block.values[self.dialect.arc_radius]
         check_radius(self.position["X"], self.position["Z"], end["X"], end["Z"], radius)
         box = arc_box(self.position["X"], self.position["Z"], end["X"], end["Z"], radius, block.motion == 3)
@@ -179,10 +194,10 @@ class ProgramReading:
             for extreme in extremes:
                 check_travel(axis, extreme, self.machine, "the arc reaches ")
 
-    def _check_differential(self, motion: int, positions: dict) -> None:
+    def _check_differential(self, motion: int | None, positions: dict[str, float], ratio: float) -> None:
         """A leading axis moving while coupled turns the table by its factor: at the block's
         feed, or for G0 at the machine's rapid rate (engine.verifier.limits)."""
-        check_coupled_move(motion == RAPID, self.feed, positions, (self.speed, self.ratio, self.differential),
+        check_coupled_move(motion == RAPID, self.feed, positions, (self.speed, ratio, self.differential),
                            self.machine, self.position)
 
     def _set_speed(self, speed: float) -> None:
@@ -194,40 +209,43 @@ class ProgramReading:
         if self.speed is not None and self.ratio is not None:
             check_table(self.speed, self.ratio, self.machine)
 
-    def _statement(self, number: int, statement) -> None:
+    def _statement(self, number: int, statement: Statement) -> None:
         self.state.check(statement.name)
         STATEMENT_TAKERS[statement.name](self, statement)
         self.state.apply(frozenset({statement.name}))
 
-    def _define_coupling(self, statement) -> None:
+    def _define_coupling(self, statement: Statement) -> None:
         self.coupled_axes = statement.leading
 
-    def _couple(self, statement) -> None:
+    def _couple(self, statement: Statement) -> None:
         if statement.leading != self.coupled_axes:
             raise Refused(f"EGON couples {','.join(statement.leading)} but EGDEF defined "
                           f"{','.join(self.coupled_axes or ()) or 'nothing'}")
         self.ratio, self.differential = statement.ratio, dict(statement.factors)
         self._check_table()
 
-    def _uncouple(self, statement) -> None:
+    def _uncouple(self, statement: Statement) -> None:
         self.ratio, self.differential = None, {}
 
-    def _delete_coupling(self, statement) -> None:
+    def _delete_coupling(self, statement: Statement) -> None:
         self.coupled_axes = self.ratio = None
         self.differential = {}
 
-    def _shift(self, number: int, line) -> None:
+    def _shift(self, number: int, line: ShiftLine) -> None:
         ends = self.clamp.take(line)
         if ends is not None:
             self.state.check(f"G{RAPID}")
             for value in ends:
                 self._check_motion({"Y": value})
             if self.differential and self.ratio is not None:
-                self._check_differential(RAPID, {"Y": ends[0]})
+                self._check_differential(RAPID, {"Y": ends[0]}, self.ratio)
             self.state.apply(frozenset({Y_POSITION}))
 
 
-TAKERS = {"header": ProgramReading._header, "comment": ProgramReading._comment, "block": ProgramReading._block,
-          "statement": ProgramReading._statement, "shift": ProgramReading._shift}
-STATEMENT_TAKERS = {"EGDEF": ProgramReading._define_coupling, "EGON": ProgramReading._couple,
-                    "EGOFS": ProgramReading._uncouple, "EGDEL": ProgramReading._delete_coupling}
+# each taker takes the kind of line it is named by
+TAKERS: dict[str, Callable[[ProgramReading, int, Any], None]] = {
+    "header": ProgramReading._header, "comment": ProgramReading._comment, "block": ProgramReading._block,
+    "statement": ProgramReading._statement, "shift": ProgramReading._shift}
+STATEMENT_TAKERS: dict[str, Callable[[ProgramReading, Statement], None]] = {
+    "EGDEF": ProgramReading._define_coupling, "EGON": ProgramReading._couple,
+    "EGOFS": ProgramReading._uncouple, "EGDEL": ProgramReading._delete_coupling}

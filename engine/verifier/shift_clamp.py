@@ -14,9 +14,13 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
+from typing import TYPE_CHECKING, ClassVar, Literal
 
 from .numbers import plain_decimal
 from .refusals import Refused
+
+if TYPE_CHECKING:
+    from collections.abc import Callable
 
 PARAMETER = "R11"
 UNSIGNED = r"(\d+(?:\.\d*)?|\.\d+)"
@@ -34,9 +38,9 @@ SHAPE = f"{PARAMETER}=R11+step, IF ({PARAMETER}<lo) OR ({PARAMETER}>hi), {PARAME
 
 @dataclass(frozen=True, slots=True)
 class ShiftLine:
-    kind = "shift"
+    kind: ClassVar[Literal["shift"]] = "shift"
     step: str
-    values: tuple
+    values: tuple[float, ...]
 
 
 def read_shift_line(code: str) -> ShiftLine | None:
@@ -56,7 +60,7 @@ class ShiftClamp:
     low: float = 0.0
     high: float = 0.0
 
-    def take(self, line: ShiftLine) -> tuple | None:
+    def take(self, line: ShiftLine) -> tuple[float, float] | None:
         """→ (lo, hi) at the move, the positions Y takes; Refused out of order or out of the interval."""
         if line.step != SEQUENCE[self.at]:
             raise Refused(f"the hob-shift clamp must read exactly {SHAPE}, in this order")
@@ -84,9 +88,11 @@ class ShiftClamp:
     def _end(self) -> None:
         return None
 
-    def _move(self) -> tuple:
+    def _move(self) -> tuple[float, float]:
         return self.low, self.high
 
 
-STEPS = {"step": ShiftClamp._step, "test": ShiftClamp._test, "reset": ShiftClamp._reset,
-         "end": ShiftClamp._end, "move": ShiftClamp._move}
+# each step takes the values its form captures
+STEPS: dict[str, Callable[..., tuple[float, float] | None]] = {
+    "step": ShiftClamp._step, "test": ShiftClamp._test, "reset": ShiftClamp._reset,
+    "end": ShiftClamp._end, "move": ShiftClamp._move}

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import re
 from dataclasses import dataclass
+from typing import ClassVar, Literal
 
 from .numbers import plain_decimal, whole_number
 from .refusals import Refused
@@ -26,30 +27,30 @@ MAX_DIFFERENTIAL = 360.0
 
 @dataclass(frozen=True, slots=True)
 class Statement:
-    kind = "statement"
+    kind: ClassVar[Literal["statement"]] = "statement"
     name: str
-    leading: tuple = ()              # leading axes, in order
+    leading: tuple[str, ...] = ()    # leading axes, in order
     ratio: float | None = None       # |z0/z2| of the hob spindle (EGON)
-    factors: tuple = ()              # (axis, |degrees of C per mm|) of Z and Y (EGON)
+    factors: tuple[tuple[str, float], ...] = ()   # (axis, |degrees of C per mm|) of Z and Y (EGON)
 
 
 def read_statement(name: str, arguments: str) -> Statement:
     return READERS[name](name, arguments.split(","))
 
 
-def _following(name: str, arguments: list) -> None:
+def _following(name: str, arguments: list[str]) -> None:
     if arguments[0] != FOLLOWING_AXIS:
         raise Refused(f"{name}: the following axis must be {FOLLOWING_AXIS} (the table), not {arguments[0]!r}")
 
 
-def _leading(name: str, axes: list) -> tuple:
+def _leading(name: str, axes: list[str]) -> tuple[str, ...]:
     if not axes or axes[0] != HOB_SPINDLE or len(set(axes)) != len(axes) or not set(axes) <= set(LEADING_AXES):
         raise Refused(f"{name}: the leading axes must be {HOB_SPINDLE} first, then Z and/or Y once each, "
                       f"not {','.join(axes)}")
     return tuple(axes)
 
 
-def _egdef(name: str, arguments: list) -> Statement:
+def _egdef(name: str, arguments: list[str]) -> Statement:
     _following(name, arguments)
     pairs = arguments[1:]
     if len(pairs) % 2 or any(kind not in COUPLING_TYPES for kind in pairs[1::2]):
@@ -57,7 +58,7 @@ def _egdef(name: str, arguments: list) -> Statement:
     return Statement(name, _leading(name, pairs[0::2]))
 
 
-def _egon(name: str, arguments: list) -> Statement:
+def _egon(name: str, arguments: list[str]) -> Statement:
     _following(name, arguments)
     if len(arguments) < 2 or arguments[1] not in EG_MODES:
         raise Refused(f"{name}: the block-change mode must be one of {', '.join(EG_MODES)}")
@@ -79,7 +80,7 @@ def _hob_ratio(name: str, numerator: str, denominator: str) -> float:
     return abs(starts / teeth)
 
 
-def _differential_factors(name: str, triples: list) -> tuple:
+def _differential_factors(name: str, triples: list[str]) -> tuple[tuple[str, float], ...]:
     """Z and Y factors (degrees of C per mm): plain decimals over a denominator that is not 0,
     at most MAX_DIFFERENTIAL in size."""
     factors = []
@@ -96,7 +97,7 @@ def _differential_factors(name: str, triples: list) -> tuple:
     return tuple(factors)
 
 
-def _off(name: str, arguments: list) -> Statement:
+def _off(name: str, arguments: list[str]) -> Statement:
     if arguments != [FOLLOWING_AXIS]:
         raise Refused(f"{name} takes the following axis only: {name}({FOLLOWING_AXIS})")
     return Statement(name)

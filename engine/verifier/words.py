@@ -5,8 +5,7 @@ The machine's own limits (travel, spindle maximum) are engine.verifier.limits.""
 from __future__ import annotations
 
 from ..nc.words import MAX_TOOL
-from .grammar import (ANGLE, CODE, FEED, OFFSET, PITCH, POSITION, RADIUS, SPEED, SPINDLE_POSITION, TOOL,
-                      TOOL_AND_OFFSET)
+from .grammar import ANGLE, CODE, FEED, OFFSET, PITCH, POSITION, RADIUS, SPEED, SPINDLE_POSITION, TOOL, TOOL_AND_OFFSET
 from .numbers import digits, plain_decimal
 from .refusals import Refused
 

@@ -1,5 +1,5 @@
 """Writes sample_shaft.dxf beside this file: the project's own sample turning drawing in the
-seed-000 convention (design notes §8), which `engine demo --turning` and the README import and
+seed-000 convention (design notes §8), which `engine demo --turning` and the guide import and
 users copy to start their own. Real CAD drawings carry no operation layers, so this one shows
 them all: run `python seed_templates/drawings/make_sample.py` after changing a table below and
 commit both files.

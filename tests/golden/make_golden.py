@@ -12,6 +12,7 @@ import os
 import sys
 import tempfile
 import uuid
+from functools import partial
 from pathlib import Path
 
 import psycopg
@@ -20,8 +21,7 @@ from psycopg.conninfo import conninfo_to_dict, make_conninfo
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))   # tests/: golden_cases and its makers
 
-from helpers.golden_cases import (hobbing_cases, hobbing_file, hobbing_text, turning_cases,  # noqa: E402
-                                  turning_file, turning_text)
+from helpers.golden_cases import hobbing_cases, hobbing_file, hobbing_text, turning_cases, turning_file, turning_text  # noqa: E402
 
 
 def seeded_database(admin_url: str) -> tuple[str, str]:
@@ -57,11 +57,11 @@ def main() -> int:
     try:
         for gear_id, choice_set in hobbing_cases():
             write(hobbing_file(gear_id, choice_set),
-                  rolled_back(url, lambda conn: hobbing_text(conn, gear_id, choice_set)))
+                  rolled_back(url, partial(hobbing_text, gear_id=gear_id, choice_set=choice_set)))
         with tempfile.TemporaryDirectory() as folder:
             for case, lathe in turning_cases():
                 write(turning_file(case, lathe),
-                      rolled_back(url, lambda conn: turning_text(conn, Path(folder), case, lathe)))
+                      rolled_back(url, partial(turning_text, folder=Path(folder), name=case, lathe=lathe)))
     finally:
         with psycopg.connect(args.database_url, autocommit=True) as admin:
             admin.execute(sql.SQL("DROP DATABASE IF EXISTS {} WITH (FORCE)").format(sql.Identifier(name)))

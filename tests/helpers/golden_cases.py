@@ -15,9 +15,9 @@ from pathlib import Path
 
 from engine.errors import EngineError
 from engine.hobbing.choices import Choices
+from engine.programs.dxf_import import import_dxf
 from engine.programs.instantiate import instantiate_gear
 from engine.programs.remake import instantiate_job
-from engine.programs.dxf_import import import_dxf
 from engine.turning.job_params import ProfileOptions
 
 GOLDEN = Path(__file__).resolve().parents[1] / "golden"

@@ -11,9 +11,26 @@ import re
 from dataclasses import dataclass
 
 from helpers.hobbing_envelope import hob_depths, known_xz, shift_limits
-from helpers.hobbing_reference import (Gear, Hob, Machine, Move, Nc, Unit, approach_needed, b_ratio, full_depth,
-                                       lead_angle, root_solid, roughing_feed_max, swivel, taper_depth, tip_radius_at,
-                                       unit_solid, y_factor, z_factor)
+from helpers.hobbing_reference import (
+    Gear,
+    Hob,
+    Machine,
+    Move,
+    Nc,
+    Unit,
+    approach_needed,
+    b_ratio,
+    full_depth,
+    lead_angle,
+    root_solid,
+    roughing_feed_max,
+    swivel,
+    taper_depth,
+    tip_radius_at,
+    unit_solid,
+    y_factor,
+    z_factor,
+)
 
 ROUND = 0.002        # mm or degrees: coordinates and angles are written with 3 decimals
 DEPTH = 0.01         # mm, last cut against (d_f2 + d_a0)/2 (Contract), and below the root at most
@@ -173,12 +190,12 @@ def coupling_problems(nc: Nc, case: Case) -> list[str]:
     if not egons:
         return ["no EGON"]
     lead = "Y" if case.tangential else "Z" if gear.beta and gear.gear_class != "worm_wheel" else None
-    for index, args in nc.calls("EGDEF"):
+    for _, args in nc.calls("EGDEF"):
         wanted = ("C", "B", "1") + ((lead, "1") if lead else ())
         if args != wanted:
             problems.append(f"EGDEF{args} expected EGDEF{wanted}")
     teeth = {u.z2 for u in gear.units}
-    for index, args in egons:
+    for _, args in egons:
         problems += _egon_problems(args, case, lead, teeth)
     coupled = {args[4] for _, args in egons if len(args) > 4}
     problems += [f"no EGON with denominator z2 = {z2} for unit z{z2}" for z2 in sorted(teeth) if str(z2) not in coupled]
@@ -278,7 +295,8 @@ def _taper_depth_problems(nc: Nc, last: Cut, case: Case) -> list[str]:
 
 def _root_problems(nc: Nc, all_cuts: list[Cut], case: Case) -> list[str]:
     pairs = [(move, cut.unit) for cut in all_cuts for move in passes(cut)]
-    depths = _deepest([(move, root_solid(case.gear, unit)) for move, unit in pairs], case, shift_limits(nc, case.machine))
+    depths = _deepest([(move, root_solid(case.gear, unit)) for move, unit in pairs], case,
+                      shift_limits(nc, case.machine))
     return [f"pass block {move.block}: the hob (3-D) reaches {depth:.3f} mm below unit z{unit.z2}'s root cone"
             for (move, unit), depth in zip(pairs, depths) if depth > DEPTH]
 

@@ -7,8 +7,16 @@ from __future__ import annotations
 import math
 import re
 
-from helpers.hobbing_checks import (Case, approach_problems, contract_problems, coupling_problems, depth_problems,
-                                    din_move, envelope_problems, feed_problems)
+from helpers.hobbing_checks import (
+    Case,
+    approach_problems,
+    contract_problems,
+    coupling_problems,
+    depth_problems,
+    din_move,
+    envelope_problems,
+    feed_problems,
+)
 from helpers.hobbing_envelope import Solid, hob_depths, known_xz, shift_limits
 from helpers.hobbing_reference import Nc, swivel
 

@@ -16,8 +16,16 @@ catch planted faults. Every number below was worked out by hand from the referen
 """
 from __future__ import annotations
 
-from helpers.hobbing_checks import (Case, Job, approach_problems, contract_problems, coupling_problems, depth_problems,
-                                    envelope_problems, feed_problems)
+from helpers.hobbing_checks import (
+                                    Case,
+                                    Job,
+                                    approach_problems,
+                                    contract_problems,
+                                    coupling_problems,
+                                    depth_problems,
+                                    envelope_problems,
+                                    feed_problems,
+)
 from helpers.hobbing_machine_checks import cycle_time_problems, obstacle_problems, table_speed_problems
 from helpers.hobbing_reference import Gear, Hob, Machine, Unit
 

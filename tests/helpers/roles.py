@@ -2,14 +2,14 @@
 superuser; SET ROLE drops to the role's privileges)."""
 from __future__ import annotations
 
-from contextlib import contextmanager
-
-from psycopg import sql
-from psycopg.pq import TransactionStatus
-from dataclasses import dataclass
-from psycopg.conninfo import conninfo_to_dict, make_conninfo
-import psycopg
 import uuid
+from contextlib import contextmanager
+from dataclasses import dataclass
+
+import psycopg
+from psycopg import sql
+from psycopg.conninfo import conninfo_to_dict, make_conninfo
+from psycopg.pq import TransactionStatus
 
 
 @contextmanager

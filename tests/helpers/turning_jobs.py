@@ -5,8 +5,8 @@ from __future__ import annotations
 import pytest
 
 from engine.errors import EngineError
-from engine.programs.remake import instantiate_job
 from engine.programs.dxf_import import import_dxf
+from engine.programs.remake import instantiate_job
 from helpers.drawings import seed_drawing
 
 

@@ -134,7 +134,16 @@ def _sql_round(value, digits=0):
     if isinstance(value, float) and not math.isfinite(value):
         return value
     exact = value if isinstance(value, Decimal) else Decimal(repr(value))
-    if exact.as_tuple().exponent >= -digits:
+    if _exponent(exact) >= -digits:
         return value  # nothing to round away
     rounded = exact.quantize(Decimal(1).scaleb(-digits), ROUND_HALF_UP, _ROUND_CONTEXT)
     return type(value)(rounded) if isinstance(value, (int, float)) else rounded
+
+
+def _exponent(number: Decimal) -> int:
+    """The exponent of a finite Decimal; NaN and infinity (whose exponent is a letter) are a
+    TypeError, as comparing that letter with a number was."""
+    exponent = number.as_tuple().exponent
+    if isinstance(exponent, str):
+        raise TypeError(f"ROUND needs a finite number, got {_describe(number)}")
+    return exponent

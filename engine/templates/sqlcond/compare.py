@@ -89,7 +89,7 @@ def _sql_between_symmetric(value, low, high):
 def _sql_in(value, *items):
     if value is None:
         return None
-    result = False
+    result: bool | None = False
     for item in items:
         equal = _sql_eq(value, item)
         if equal:

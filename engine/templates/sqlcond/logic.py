@@ -15,7 +15,7 @@ def _sql_truth(value):
 
 
 def _sql_and(*args):
-    result = True
+    result: bool | None = True
     for arg in args:
         value = _boolean(arg, "AND")
         if value is False:
@@ -26,7 +26,7 @@ def _sql_and(*args):
 
 
 def _sql_or(*args):
-    result = False
+    result: bool | None = False
     for arg in args:
         value = _boolean(arg, "OR")
         if value is True:

@@ -49,7 +49,7 @@ class _LikePattern:
 def _like_pattern(pattern, escape, flags):
     if len(escape) > 1:
         raise ValueError(f"invalid escape string {escape!r}: use one character or ''")
-    segments = [[]]  # each segment: regex parts, one per character matched
+    segments: list[list[str]] = [[]]  # each segment: regex parts, one per character matched
     chars = iter(pattern)
     for char in chars:
         if escape and char == escape:

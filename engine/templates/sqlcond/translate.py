@@ -11,6 +11,7 @@ from __future__ import annotations
 import ast
 import keyword
 from collections.abc import Callable
+from typing import NoReturn
 
 from sqlglot import exp
 
@@ -44,7 +45,7 @@ _CANNOT_RAISE = frozenset({
 
 def _is_direct(node):
     """A leaf, or a direct call (only ever made to a helper that cannot raise)."""
-    return not isinstance(node, ast.Call) or node.func.id != "_sql_defer"
+    return not (isinstance(node, ast.Call) and isinstance(node.func, ast.Name) and node.func.id == "_sql_defer")
 
 
 def _call(helper, args, lazy):
@@ -115,8 +116,9 @@ def _paren(node, lazy):
 
 def _neg(node, lazy):
     operand = _tr(node.this, lazy)
-    if isinstance(operand, ast.Constant) and type(operand.value) in (int, float):
-        return ast.Constant(-operand.value)
+    value = operand.value if isinstance(operand, ast.Constant) else None
+    if isinstance(value, (int, float)) and type(value) in (int, float):
+        return ast.Constant(-value)
     return _call("_sql_neg", [operand], lazy)
 
 
@@ -273,7 +275,7 @@ _HANDLERS: dict[type, tuple[Callable, frozenset]] = {
 }
 
 
-def _reject(node):
+def _reject(node) -> NoReturn:
     if isinstance(node, exp.Anonymous):
         name = node.name
     elif isinstance(node, exp.Cast):
