@@ -194,7 +194,7 @@ def empty_database_url(server_url, database_pool, _empty_databases) -> str:
     database_pool.give_back(name)
 
 
-# Variables of a developer's shell that would change what a command does (README, "Configuration").
+# Variables of a developer's shell that would change what a command does (docs/guide/configuration.md).
 NO_ENGINE_VARIABLES = {name: None for name in ("ENGINE_INSTANTIATE_MACHINE", "ENGINE_INSTANTIATE_OUT",
                                                "ENGINE_LINT_JSON", "ENGINE_DATABASE_URL", "DATABASE_URL")}
 

@@ -171,7 +171,7 @@ def test_numbers_are_written_as_they_are():
 
 @pytest.mark.parametrize("variable", ["ENGINE_INSTANTIATE_SKIP_BAD", "ENGINE_INSTANTIATE_WORKERS"])
 def test_a_batch_default_from_the_environment_does_not_refuse_one_gear(run, variable):
-    """A shop sets its batches' habit once (README: Configuration); `instantiate --gear 42`, on
+    """A shop sets its batches' habit once (docs/guide/configuration.md); `instantiate --gear 42`, on
     which the user gave no batch option, must still make the program."""
     value = "4" if variable.endswith("WORKERS") else "1"
     result = run("instantiate", "--gear", 42, env={variable: value})
@@ -180,7 +180,7 @@ def test_a_batch_default_from_the_environment_does_not_refuse_one_gear(run, vari
 
 
 def test_a_delete_is_confirmed_on_the_command_line_only(run):
-    """README: a delete without --yes says what it would delete and exits 1. An environment
+    """The guide (records): a delete without --yes says what it would delete and exits 1. An environment
     variable (or a config file's [gears.delete] yes = true) must not confirm every delete."""
     with psycopg.connect(run.url) as conn:
         conn.execute("INSERT INTO gear (id, gear_class, module, teeth, helix_angle, face_width) "

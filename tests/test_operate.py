@@ -251,7 +251,7 @@ def test_an_embedded_data_folder_that_cannot_be_used_is_one_line(own_engine):
 
 @pytest.mark.slow
 def test_demo_leaves_a_shop_database_on_the_embedded_server_untouched(own_engine):
-    """Without a URL the embedded server is the shop's database (README: Operating the embedded
+    """Without a URL the embedded server is the shop's database (guide, install-and-operate: the embedded
     server). `engine demo` must not seed the samples into it, nor store a job and a program (a
     record nobody deletes) for the shop's own gear 42."""
     for args in (("db", "migrate"), ("seed",)):
