@@ -246,7 +246,7 @@ def test_a_cut_comment_with_dollar_signs_is_drawn_as_written(conn, tmp_path):
     from dataclasses import replace
 
     from engine.pictures import save_atomically
-    from engine.simulation.recorded import record_program
+    from engine.simulation.hobbing.recorded import record_program
 
     program = instantiate_gear(conn, 42, choices=Choices())
     said = [line.replace("; CUT", "; CUT $\\frac$ costs 5 \\$", 1) for line in program.lines]

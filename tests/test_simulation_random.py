@@ -15,7 +15,7 @@ from engine.errors import EngineError
 from engine.hobbing.choices import Choices
 from engine.programs.instantiate import instantiate_gear
 from engine.simulation import simulate_stored_program
-from engine.simulation.envelope import HobBody, centres, nearest_radius
+from engine.simulation.hobbing.envelope import HobBody, centres, nearest_radius
 
 GEAR_ID = 900001
 INSERT_GEAR = """

@@ -4,7 +4,7 @@ generating zone L_gen = 2·h/tan α_n + π·m_n where it meets the gear (§B15),
 the program's Y positions bring to the zone (the shift range: the part of the hob the shifting
 uses), the hob centre's Y travel the working area G25/G26 allows, and a tangential pass's
 arrow. Y moves the hob along its own axis, so the zone stays at the gear and a different part of
-the hob reaches it (engine.simulation.envelope)."""
+the hob reaches it (engine.simulation.hobbing.envelope)."""
 from __future__ import annotations
 
 import math
@@ -12,7 +12,7 @@ import math
 from matplotlib.patches import Polygon
 
 from ..pictures import literal
-from ..simulation.rules import generating_length
+from ..simulation.hobbing.rules import generating_length
 from .plot_geometry import Pass, along_hob, cut_pass, full_depth_pose, hob_centre, hob_front_corners, unit_section
 from .side_view import BLANK_FILL, cut_colour, last_cut_of
 

@@ -1,7 +1,7 @@
 """The shapes of a hobbing picture, in the DIN frame the simulation works in (reference §A7: X from
 the work axis toward the hob, Z up along it, the gear's top face at Z = 0): a unit's section, the
 hob's outline seen along X or along Y, where a cut reaches full depth and which way its pass
-feeds. Pure functions of the simulation's recording (engine.simulation.recorded)."""
+feeds. Pure functions of the simulation's recording (engine.simulation.hobbing.recorded)."""
 from __future__ import annotations
 
 import math
@@ -40,7 +40,7 @@ def hob_side_outline(x: float, z: float, radius: float, half_length: float, swiv
 
 
 def hob_extent(radius: float, half_length: float, swivel: float) -> float:
-    """How far above and below its centre the swivelled hob reaches (engine.simulation.envelope)."""
+    """How far above and below its centre the swivelled hob reaches (engine.simulation.hobbing.envelope)."""
     a = math.radians(swivel)
     return radius * abs(math.cos(a)) + half_length * abs(math.sin(a))
 
@@ -61,7 +61,7 @@ def axis_direction(swivel: float) -> tuple[float, float]:
 
 
 def hob_centre(y: float, z: float, swivel: float) -> tuple[float, float]:
-    """Y moves the hob along its own axis (engine.simulation.envelope.centres)."""
+    """Y moves the hob along its own axis (engine.simulation.hobbing.envelope.centres)."""
     along = axis_direction(swivel)
     return y * along[0], z + y * along[1]
 

@@ -1,5 +1,5 @@
 """`engine plot --program ID`: a stored hobbing program drawn as the simulation reads it
-(engine.simulation.recorded): the side view (blank, units, fixture, tailstock, hob at approach and
+(engine.simulation.hobbing.recorded): the side view (blank, units, fixture, tailstock, hob at approach and
 at full depth, each pass with its direction, working area), the whole working area with every
 move, and the hob seen from its side with the shift range. The program's job supplies the gear,
 hob and machine, as `engine simulate --program ID` takes them. PNG or SVG, written whole or not
@@ -14,8 +14,8 @@ from ..errors import EngineError
 from ..gears.records import Gear, Hob, load_gear
 from ..machines.records import Machine, load_machine
 from ..pictures import literal, new_figure, picture_target, save_atomically
-from ..simulation.recorded import Recording, record_program
-from ..simulation.stored import load_hob
+from ..simulation.hobbing.recorded import Recording, record_program
+from ..simulation.hobbing.stored import load_hob
 from .hob_view import draw_hob_view
 from .side_view import draw_overview, draw_side_view
 

@@ -5,13 +5,13 @@ the blank, its units, the fixture and the tailstock; the coupling's teeth, hand 
 swivel against the gear; the depth per cut, the run-out, the table speed, the feed per workpiece
 revolution and the cycle time.
 
-One part per machine kind: today every module here serves the hobbing machine (the only kind
-whose programs are simulated; a lathe program's rapids are checked against the blank by
-engine.turning.material). A second kind gets its own subfolder. The simulation imports the
+One part per machine kind, each in its subfolder: hobbing/ (the only kind whose programs are
+simulated today; a lathe program's rapids are checked against the blank by
+engine.turning.material). A second kind gets a subfolder beside it. The simulation imports the
 verifier's reader, never the models that made the program (engine.hobbing, engine.turning):
 tests/test_house.py enforces it."""
-from .report import Finding, Report, SimulationError
-from .run import prove_program, simulate_program
-from .stored import simulate_stored_program
+from .hobbing.report import Finding, Report, SimulationError
+from .hobbing.run import prove_program, simulate_program
+from .hobbing.stored import simulate_stored_program
 
 __all__ = ["Finding", "Report", "SimulationError", "prove_program", "simulate_program", "simulate_stored_program"]

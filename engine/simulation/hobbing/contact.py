@@ -1,8 +1,8 @@
-"""Where a move's hob poses meet the solids (engine.simulation.solids), and whether that is
+"""Where a move's hob poses meet the solids (engine.simulation.hobbing.solids), and whether that is
 the intended cut. Intended: a G1 with the table coupled and the hob spindle turning, in a
 unit whose teeth the coupling generates, never below its intended root (less TOLERANCE). The
 gaps such cuts leave are free to the hob while the same coupling lasts (a coupled retract out
-of its own gaps), except on a rapid along Z (engine.simulation.walk). Anything else that enters
+of its own gaps), except on a rapid along Z (engine.simulation.hobbing.walk). Anything else that enters
 material is a collision."""
 from __future__ import annotations
 

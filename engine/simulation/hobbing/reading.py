@@ -1,17 +1,17 @@
 """A program read for the simulation with the verifier's own reader (engine.verifier:
 the machine's dialect, line by line), plus the two things the verifier reads but does not keep:
-the signed EGON terms (engine.simulation.coupling) and a block's G and M codes (M20/M21 clamp
+the signed EGON terms (engine.simulation.hobbing.coupling) and a block's G and M codes (M20/M21 clamp
 and release the tailstock, G4 dwells). A line the verifier refuses the simulation refuses too:
 it cannot follow what it cannot read (fail closed)."""
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..machines.records import Machine
-from ..verifier import grammar
-from ..verifier.blocks import TOKEN
-from ..verifier.lines import Line, read_line
-from ..verifier.refusals import Refused
+from ...machines.records import Machine
+from ...verifier import grammar
+from ...verifier.blocks import TOKEN
+from ...verifier.lines import Line, read_line
+from ...verifier.refusals import Refused
 from .report import SimulationError, where
 
 

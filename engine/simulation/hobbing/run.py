@@ -1,11 +1,11 @@
 """The simulation of one hobbing program against its gear, hob and machine (design notes §7,
-issue 14): read with the verifier's reader, followed block by block (engine.simulation.walk).
+issue 14): read with the verifier's reader, followed block by block (engine.simulation.hobbing.walk).
 A program with the hob-shift-per-part clamp (R11 lies in an interval) is followed once with
 the shift at each end of it."""
 from __future__ import annotations
 
-from ..gears.records import Gear, Hob
-from ..machines.records import Machine
+from ...gears.records import Gear, Hob
+from ...machines.records import Machine
 from .reading import read_program
 from .report import Report, SimulationError
 from .solids import setup_solids, unit_solids

@@ -5,8 +5,8 @@ from __future__ import annotations
 
 from dataclasses import asdict, dataclass, field
 
-from ..errors import EngineError
-from ..verifier.refusals import shown, shown_name
+from ...errors import EngineError
+from ...verifier.refusals import shown, shown_name
 
 
 class SimulationError(EngineError):

@@ -1,5 +1,5 @@
 """The moves the simulation follows, kept for a picture (`engine plot`, issue 17): the same
-reading and the same walk as `engine simulate` (engine.simulation.run), with every move's start
+reading and the same walk as `engine simulate` (engine.simulation.hobbing.run), with every move's start
 and end in the DIN frame, the swivel it ran at, whether it cut, the cuts as the walk closes them
 and the G25/G26 working area as the program sets it. A picture drawn from this shows what the
 simulation checked, not a second interpretation of the program text. A program with the
@@ -9,8 +9,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from ..gears.records import Gear, Hob
-from ..machines.records import Machine
+from ...gears.records import Gear, Hob
+from ...machines.records import Machine
 from .reading import read_program
 from .report import Report, SimulationError
 from .run import SHIFT_ENDS

@@ -1,5 +1,5 @@
 """The block-by-block walk: every axis (X, Y, Z, A; C through the coupling) followed in the DIN
-frame, each move's hob poses (engine.simulation.paths) checked against the solids, the coupling
+frame, each move's hob poses (engine.simulation.hobbing.paths) checked against the solids, the coupling
 and swivel checked where the hob cuts, cuts collected, the table speed and cycle time summed.
 
 M codes whose timing against the block's motion is the machine builder's choice are taken the
@@ -11,10 +11,10 @@ import math
 
 import numpy as np
 
-from ..gears.records import Gear, Hob
-from ..machines.records import Machine
-from ..verifier.refusals import Refused
-from ..verifier.shift_clamp import ShiftClamp
+from ...gears.records import Gear, Hob
+from ...machines.records import Machine
+from ...verifier.refusals import Refused
+from ...verifier.shift_clamp import ShiftClamp
 from .allowance import depth_problem, header_allowance
 from .contact import Motion, follow
 from .coupling import (

@@ -4,14 +4,14 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from ..errors import EngineError
-from ..gears.records import Hob, load_gear, load_hobs
-from ..machines.records import load_machine
+from ...errors import EngineError
+from ...gears.records import Hob, load_gear, load_hobs
+from ...machines.records import load_machine
 from .report import Report
 from .run import simulate_program
 
 if TYPE_CHECKING:
-    from ..db.connection import Connection
+    from ...db.connection import Connection
 
 PROGRAM_QUERY = """
 SELECT p.name, p.lines, j.gear_id, j.hob_id, j.machine

@@ -7,7 +7,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from ..machines.records import Machine
+from ...machines.records import Machine
 
 
 @dataclass(frozen=True, slots=True)

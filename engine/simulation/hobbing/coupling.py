@@ -15,7 +15,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from ..gears.records import Gear, Hob
+from ...gears.records import Gear, Hob
 from .frame import Senses
 
 ANGLE_TOLERANCE = 0.01       # degrees of swivel

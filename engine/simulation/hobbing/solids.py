@@ -14,8 +14,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..gears.records import Gear, Hob
-from ..machines.records import Machine
+from ...gears.records import Gear, Hob
+from ...machines.records import Machine
 
 if TYPE_CHECKING:
     from collections.abc import Callable

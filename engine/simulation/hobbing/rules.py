@@ -7,9 +7,9 @@ from __future__ import annotations
 import math
 import re
 
-from ..gears.cutting_data import feed_maximum
-from ..gears.records import Gear, Hob
-from ..machines.records import Machine
+from ...gears.cutting_data import feed_maximum
+from ...gears.records import Gear, Hob
+from ...machines.records import Machine
 
 TOOTH_DEPTH = 2.25        # h = 2.25·m_n (§B15)
 WORK_OFFSETS = (54, 55, 56, 57)
