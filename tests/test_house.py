@@ -349,5 +349,28 @@ def test_the_model_registry_fails_closed_while_empty(monkeypatch):
     from engine.errors import EngineError
     from engine.gears import models
     monkeypatch.setattr(models, "MODELS", {})
-    with pytest.raises(EngineError, match="no gear model is registered"):
+    with pytest.raises(EngineError, match="gear models not registered: cylindrical, duplex"):
         models.model_for_class(None, "cylindrical")
+
+
+def test_a_partly_filled_model_registry_is_refused_too():
+    """A library user who imports one model module only must not get an ancestor's model for a
+    class whose own model is missing (a taper gear planned as a cylindrical one): the registry
+    is refused until every model node has registered. Run in a fresh interpreter, where nothing
+    else has imported the models."""
+    import subprocess
+    import sys
+    code = ("from engine.hobbing import cylindrical\n"
+            "from engine.gears.models import registered_models\n"
+            "registered_models()\n")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert done.returncode == 1
+    assert "gear models not registered: duplex, taper, crowned, worm_wheel, turning" in done.stderr
+
+
+def test_every_model_node_is_registered_by_the_model_packages():
+    from engine.errors import EngineError
+    from engine.gears import models
+    assert sorted(models.registered_models()) == sorted(models.MODEL_NODES)
+    with pytest.raises(EngineError, match="'bevel' is not in MODEL_NODES"):
+        models.register_model("bevel")

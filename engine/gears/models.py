@@ -33,10 +33,18 @@ class HobbingModel(NamedModel, Protocol):
 # The model of a node of the group-technology tree serves it and every class below it that has
 # no model of its own. Filled by register_model as the model modules are imported.
 MODELS: dict[str, NamedModel] = {}
+# The nodes that have a model, as data (the gears section names no module above it). All must be
+# registered before any is used: with one missing, a class under it would silently get an
+# ancestor's model (a taper gear cut as a cylindrical one), so a partial registry is refused too.
+MODEL_NODES = ("cylindrical", "duplex", "taper", "crowned", "worm_wheel", "turning")
 
 
 def register_model(gear_class: str) -> Callable[[type], type]:
     """Class decorator: one instance of the model serves `gear_class` and the classes below it."""
+    if gear_class not in MODEL_NODES:
+        raise EngineError(f"internal error: model node {gear_class!r} is not in MODEL_NODES "
+                          "(engine.gears.models); add it there")
+
     def register(model_type: type) -> type:
         MODELS[gear_class] = model_type()
         return model_type
@@ -44,11 +52,13 @@ def register_model(gear_class: str) -> Callable[[type], type]:
 
 
 def registered_models() -> dict[str, NamedModel]:
-    """The registry, refused while empty: a caller that reached a model before engine.hobbing was
-    imported would otherwise see every class as having none (fail closed)."""
-    if not MODELS:
-        raise EngineError("internal error: no gear model is registered; import engine.hobbing.models and "
-                          "engine.turning before asking for one")
+    """The registry, refused unless every model node is registered: a caller that reached a model
+    before engine.hobbing.models and engine.turning were imported would otherwise see a class as
+    having none, or as having its ancestor's model (fail closed)."""
+    missing = [node for node in MODEL_NODES if node not in MODELS]
+    if missing:
+        raise EngineError(f"internal error: gear models not registered: {', '.join(missing)}; import "
+                          "engine.hobbing.models and engine.turning before asking for one")
     return MODELS
 
 
