@@ -12,7 +12,8 @@ import pytest
 from engine.errors import EngineError
 from engine.gears.cases import seed_cases
 from engine.gears.gear_geometry import DIAMETER_TOLERANCE, PROFILE_SHIFT_RANGE, TIP_SHORTENING_MAX
-from engine.gears.gear_import import import_gears, installed_classes, read_gears
+from engine.gears.gear_import import read_gears
+from engine.gears.gear_store import import_gears, installed_classes
 from engine.gears.hob_library import read_hobs
 from engine.gears.units import import_units
 from engine.library.nc_import import read_modules, read_params

@@ -9,7 +9,8 @@ import pytest
 
 from engine.errors import EngineError
 from engine.gears.classify import RULES, classify, classify_installed
-from engine.gears.gear_import import GearImportError, derived_diameters, import_gears, read_gears
+from engine.gears.gear_import import GearImportError, derived_diameters, read_gears
+from engine.gears.gear_store import import_gears
 
 HEADER = ("gear_id,gear_class,module,teeth,pressure_angle,helix_angle,hand,face_width,tip_diameter,root_diameter,"
           "cone_angle,crowning,material,hardness,quality_grade,quantity")

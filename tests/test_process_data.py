@@ -11,7 +11,8 @@ import pytest
 
 from engine.errors import EngineError
 from engine.gears.classify import classify
-from engine.gears.gear_import import GearImportError, import_gears
+from engine.gears.gear_import import GearImportError
+from engine.gears.gear_store import import_gears
 from engine.gears.records import load_gear
 from engine.hobbing.choices import Choices
 from engine.paths import SEED_DIR

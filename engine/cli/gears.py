@@ -30,7 +30,7 @@ def gears_import(ctx, csv_file, replace, as_json):
     unless --replace. The tip and root diameters of cylindrical gears must fit m_n, z, β and x.
 
     Example: engine gears import gears.csv --replace"""
-    from ..gears.gear_import import import_gears
+    from ..gears.gear_store import import_gears
 
     with connection(ctx) as conn:
         result = import_gears(conn, csv_file, replace=replace)

@@ -13,7 +13,8 @@ from psycopg import sql
 from psycopg.types.json import Jsonb
 
 from ..csv_reader import Column, CsvKind, parse_text, read_csv_file
-from ..gears.gear_import import GEAR_KIND, identical_gears, import_gears, installed_classes, read_gears
+from ..gears.gear_import import GEAR_KIND, read_gears
+from ..gears.gear_store import identical_gears, import_gears, installed_classes
 from ..gears.hob_library import HOB_COLUMNS
 from ..gears.units import UNIT_KIND, import_units
 from ..machines.records import Machine

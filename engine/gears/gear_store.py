@@ -1,0 +1,137 @@
+"""Storing gears read from CSV (engine.gears.gear_import reads and checks them first): every row
+in one COPY and one upsert, all or nothing; stored ids are refused unless --replace, which prints
+each change (old -> new). Also which classes a gear may be in, for the reader's checks."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from decimal import Decimal
+from pathlib import Path
+from typing import Any
+
+import psycopg
+from psycopg import sql
+
+from ..csv_reader import Problem
+from ..errors import EngineError
+from .gear_import import COLUMNS, Classes, GearImportError, read_gears
+
+INSTALLED = ("SELECT g.name, EXISTS (SELECT 1 FROM class_template(g.name)), "
+             "g.name IN (SELECT name FROM classes_and_below(ARRAY['cylindrical'])) FROM gear_class g")
+
+
+def installed_classes(conn: psycopg.Connection) -> Classes:
+    """The classes a gear can be in (leaves, and unit classes that others derive from, like spur),
+    and the cylindrical ones (whose diameters are checked)."""
+    rows = conn.execute(INSTALLED).fetchall()
+    return Classes({name: templated for name, templated, _ in rows},
+                   frozenset(name for name, _, cylindrical in rows if cylindrical))
+
+
+_COLUMN_LIST = sql.SQL(", ").join(sql.Identifier(column.column) for column in COLUMNS)
+_COPY = sql.SQL("COPY gear_import ({}) FROM STDIN").format(_COLUMN_LIST)
+_UPSERT = sql.SQL(
+    "INSERT INTO gear ({columns}) SELECT {columns} FROM gear_import "
+    "ON CONFLICT (id) DO UPDATE SET {updates}").format(
+    columns=_COLUMN_LIST,
+    updates=sql.SQL(", ").join(
+        sql.SQL("{0} = EXCLUDED.{0}").format(sql.Identifier(column.column))
+        for column in COLUMNS if column.column != "id"))
+_EXISTING = sql.SQL("SELECT {} FROM gear WHERE id = ANY(%s) ORDER BY id FOR UPDATE").format(_COLUMN_LIST)
+
+
+@dataclass(frozen=True)
+class GearChange:
+    """One field of a stored gear that an import with --replace changes: old → new."""
+
+    gear_id: int
+    field: str
+    old: Any
+    new: Any
+
+
+@dataclass(frozen=True)
+class GearImport:
+    """What an import did: how many gears it stored, which of them replaced stored gears, and what
+    changed in those (field by field)."""
+
+    imported: int
+    replaced: tuple[int, ...] = ()
+    changes: tuple[GearChange, ...] = ()
+
+    def change_lines(self) -> list[str]:
+        """One line per changed field (`gear 42: module 2 → 3`), and a line for a replaced gear the file
+        left as it was."""
+        changed = {change.gear_id for change in self.changes}
+        return ([f"gear {c.gear_id}: {c.field} {_said(c.old)} → {_said(c.new)}" for c in self.changes]
+                + [f"gear {gear_id}: unchanged" for gear_id in self.replaced if gear_id not in changed])
+
+    def as_json(self) -> dict[str, Any]:
+        return {"imported": self.imported, "replaced": list(self.replaced),
+                "changes": [{"gear_id": c.gear_id, "field": c.field, "old": _plain(c.old), "new": _plain(c.new)}
+                            for c in self.changes]}
+
+
+def _said(value: Any) -> str:
+    """A value as the change line shows it: numbers as written (2, not 2.000), nothing as (none)."""
+    return "(none)" if value is None else format(value.normalize(), "f") if isinstance(value, Decimal) \
+        else str(value)
+
+
+def _plain(value: Any) -> Any:
+    """A Decimal as the JSON number it is (whole numbers as int)."""
+    if not isinstance(value, Decimal):
+        return value
+    return int(value) if value == value.to_integral_value() else float(value)
+
+
+def _changes(stored: dict[int, tuple], gears: list[dict[str, Any]]) -> list[GearChange]:
+    """Per replaced gear, per field, the stored value and the file's, where they differ."""
+    return [GearChange(gear["gear_id"], column.name, old, gear[column.name])
+            for gear in gears if gear["gear_id"] in stored
+            for column, old in zip(COLUMNS, stored[gear["gear_id"]]) if old != gear[column.name]]
+
+
+def _refuse_existing(path: Path, stored: dict[int, tuple], gears: list[dict[str, Any]]) -> None:
+    """Without --replace, a gear_id already stored is refused: an import must not overwrite a gear
+    that jobs and programs were made for without saying so."""
+    problems = [Problem(gear["line"], "gear_id", f"gear {gear['gear_id']} already exists",
+                        "give a new gear_id, or import with --replace to overwrite it (the changes are printed)")
+                for gear in gears if gear["gear_id"] in stored]
+    if problems:
+        raise GearImportError(path, problems)
+
+
+def _store(conn: psycopg.Connection, path: Path, gears: list[dict[str, Any]], replace: bool) -> GearImport:
+    """All gears in one transaction: the stored ones read (and locked) first, refused unless `replace`;
+    then COPY into a temporary table and one INSERT … ON CONFLICT."""
+    try:
+        with conn.transaction():
+            rows = conn.execute(_EXISTING, ([gear["gear_id"] for gear in gears],)).fetchall()
+            stored = {row[0]: row for row in rows}
+            if not replace:
+                _refuse_existing(path, stored, gears)
+            conn.execute("CREATE TEMPORARY TABLE gear_import (LIKE gear) ON COMMIT DROP")
+            with conn.cursor().copy(_COPY) as copy:
+                for gear in gears:
+                    copy.write_row([gear[column.name] for column in COLUMNS])
+            conn.execute(_UPSERT)
+            conn.execute("DROP TABLE gear_import")
+    except (psycopg.errors.IntegrityError, psycopg.errors.DataError) as error:
+        message = error.diag.message_primary or str(error)
+        raise EngineError(f"{path}: the database refused the gears ({message}); "
+                          "nothing imported") from error
+    return GearImport(len(gears), tuple(sorted(stored)), tuple(_changes(stored, gears)))
+
+
+def import_gears(conn: psycopg.Connection, path: str | Path, *, replace: bool = False) -> GearImport:
+    """Import every gear of the CSV file at `path`, all or nothing. A gear_id already stored is
+    refused unless `replace`, which overwrites it and returns what changed."""
+    path = Path(path)
+    gears = read_gears(path, installed_classes(conn))
+    return _store(conn, path, gears, replace)
+
+
+def identical_gears(conn: psycopg.Connection, gears: list[dict[str, Any]]) -> set[int]:
+    """The ids of `gears` (as read_gears gives them) that are stored with every field as given."""
+    stored = {row[0]: row for row in conn.execute(_EXISTING, ([gear["gear_id"] for gear in gears],))}
+    return set(stored) - {change.gear_id for change in _changes(stored, gears)}
