@@ -48,8 +48,8 @@ def parse_range(text: str, option: str = "--gears") -> tuple[int, int]:
 @click.option("--out", type=click.Path(), help="Write the .MPF file here after the programs are committed: a "
               "batch always into this folder (made if missing), one program into it if it is a folder or ends with /.")
 @click.option("--force", is_flag=True, help="Replace files that exist in --out (else nothing is stored).")
-@click.option("--machine", help="Machine record (default hobber-840d; with --class: the config file's machine, "
-              "else required).")
+@click.option("--machine", help="Machine record (default: the config file's machine, else hobber-840d for a "
+              "gear; with --class one must be named).")
 @click.option("--cuts", type=click.IntRange(1, 2), help="1 = single cut, 2 = rough then finish (default by module).")
 @click.option("--coolant/--no-coolant", default=True, show_default=True, help="Coolant M8/M9.")
 @click.option("--shift-y", type=float, default=0.0, help="Hob shift position Y for this part, mm.")
