@@ -63,8 +63,8 @@ def help_command(tree: Path) -> list[str]:
 
 
 def source_tree_of(revision: str, into: Path) -> Path | None:
-    """The engine/ folder of `revision` (and engine/drawings/, which held the DXF reader before issue 25
-    moved it to engine/drawings/), unpacked into `into`; None when this checkout does not have the
+    """The engine/ folder of `revision` (and the top-level importers/ folder, which held the DXF reader
+    until issue 25 moved it to engine/drawings/), unpacked into `into`; None when this checkout does not have the
     commit (a shallow clone, an unpacked archive)."""
     had_importers = subprocess.run(["git", "-C", str(REPO), "cat-file", "-e", f"{revision}:importers"],
                                    capture_output=True).returncode == 0
