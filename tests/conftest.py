@@ -19,8 +19,7 @@ from helpers.database_pool import DatabasePool, create_database
 from psycopg.conninfo import conninfo_to_dict, make_conninfo
 from psycopg.pq import TransactionStatus
 
-import engine.hobbing.models  # noqa: F401  (the models register with engine.gears.models, as the commands
-import engine.turning  # noqa: F401   that use a model import these packages first)
+import engine.programs.all_models  # noqa: F401  (every model registers, as the commands that use one make it)
 
 pytest_plugins = ["helpers.turning_jobs"]   # fixtures shared by several test modules
 

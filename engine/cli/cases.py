@@ -30,9 +30,8 @@ def suggest(ctx, gear_id, top, machine, as_json):
     Prints the hob the library chooses, the nearest cases per cut kind with their distance,
     the proposal (n0, v, feeds in mm/min and mm per workpiece revolution) and plausibility notes.
     """
-    from .. import turning  # noqa: F401  (importing it registers the turning names model)
     from ..gears.cases import suggest_for_gear
-    from ..hobbing import models as hobbing_models  # noqa: F401  (importing it registers the hobbing models)
+    from ..programs import all_models  # noqa: F401  (registers every model)
 
     with connection(ctx) as conn:
         suggestion = suggest_for_gear(conn, gear_id, machine, top=top)

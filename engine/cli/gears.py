@@ -65,9 +65,8 @@ def gears_units(ctx, csv_file):
 def classify(ctx, gear_id):
     """Explain a gear's class: the group-technology decision path (face-width variation,
     generating line, units), the class stored, its hobbing model and the hob it gets."""
-    from .. import turning  # noqa: F401  (importing it registers the turning names model)
     from ..gears.classify import explain_gear
-    from ..hobbing import models as hobbing_models  # noqa: F401  (importing it registers the hobbing models)
+    from ..programs import all_models  # noqa: F401  (registers every model)
 
     with connection(ctx) as conn:
         report = explain_gear(conn, gear_id)

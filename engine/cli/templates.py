@@ -210,8 +210,7 @@ def template_restore(ctx, gear_class, version):
 @click.pass_context
 def lint(ctx, as_json):
     """Check every expression of every template: parses, is allowed, names known parameters."""
-    from .. import turning  # noqa: F401  (importing it registers the turning names model)
-    from ..hobbing import models as hobbing_models  # noqa: F401  (importing it registers the hobbing models)
+    from ..programs import all_models  # noqa: F401  (registers every model)
     from ..templates.lint import lint_all
 
     with connection(ctx) as conn:

@@ -21,10 +21,8 @@ import ast
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from .. import turning  # noqa: F401  (importing it registers the turning names model)
 from ..errors import EngineError
 from ..gears.models import model_for_class
-from ..hobbing import models as hobbing_models  # noqa: F401  (importing it registers the hobbing models)
 from ..library.nc_params import bindings, values
 from ..machines.records import Machine, load_machine
 from ..names import checked
@@ -36,6 +34,7 @@ from ..templates.rows import Template
 from ..templates.versions import runnable_template
 from ..turning.names import TurningModel
 from ..verifier.grammar import DIALECTS
+from . import all_models  # noqa: F401  (registers every model)
 from .batches import dry_program, read_only, refuse_out_in_dry_run
 from .instantiate import store_planned
 from .options import NO_FILE, NORMAL_RUN, Output, RunMode

@@ -10,14 +10,12 @@ from __future__ import annotations
 from dataclasses import replace
 from typing import TYPE_CHECKING
 
-from .. import turning  # noqa: F401  (importing it registers the turning names model)
 from ..errors import EngineError
 from ..gears.case_base import CUT_KINDS_BY_COUNT, CaseBase, job_cutting_record
 from ..gears.hob_matching import choose_hob
 from ..gears.models import model_for_class
 from ..gears.process_notes import hunting_tooth_notes
 from ..gears.records import Gear, load_gear, load_gears, load_hobs
-from ..hobbing import models as hobbing_models  # noqa: F401  (importing it registers the hobbing models)
 from ..hobbing.choices import Choices
 from ..machines.records import Machine, hobbing_machine
 from ..memory import no_cycle_collection
@@ -26,6 +24,7 @@ from ..templates.rows import Template
 from ..templates.versions import runnable_template
 from ..turning.names import TurningModel
 from ..verifier import LimitError, check_table_speed
+from . import all_models  # noqa: F401  (registers every model)
 from .batches import (
     Bad,
     batch_stage,

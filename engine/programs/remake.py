@@ -11,12 +11,10 @@ import re
 from dataclasses import replace
 from typing import TYPE_CHECKING
 
-from .. import turning  # noqa: F401  (importing it registers the turning names model)
 from ..errors import EngineError
 from ..gears.models import model_for_class
 from ..gears.process_notes import stored_feed_notes
 from ..gears.records import Hob, load_gear, load_hobs
-from ..hobbing import models as hobbing_models  # noqa: F401  (importing it registers the hobbing models)
 from ..hobbing.cylindrical import program_name
 from ..hobbing.machine_job import with_cycle_time
 from ..machines.records import Machine, load_machine
@@ -24,6 +22,7 @@ from ..memory import no_cycle_collection
 from ..nc.layout import NcLayout, class_layout
 from ..templates.rows import Template
 from ..templates.versions import runnable_template
+from . import all_models  # noqa: F401  (registers every model)
 from .batches import (
     batch_stage,
     checked,

@@ -15,10 +15,9 @@ from typing import TYPE_CHECKING
 from psycopg.errors import InsufficientPrivilege
 from psycopg.types.json import Jsonb
 
-from .. import turning  # noqa: F401  (importing it registers the turning names model)
 from ..db.connection import scalar
 from ..errors import EngineError
-from ..hobbing import models as hobbing_models  # noqa: F401  (importing it registers the hobbing models)
+from ..programs import all_models  # noqa: F401  (registers every model)
 from ..templates.analysis import class_findings
 from ..templates.lint import lint_class
 from ..templates.store import class_and_descendants

@@ -17,13 +17,12 @@ import json
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
 
-from .. import turning  # noqa: F401  (importing it registers the turning names model)
 from ..errors import EngineError
 from ..gears.models import model_for_class
-from ..hobbing import models as hobbing_models  # noqa: F401  (importing it registers the hobbing models)
 from ..machines.records import load_machine
 from ..nc.layout import ENDING_NAMES, NcLayout
 from ..nc.lineage import without_lineage
+from ..programs import all_models  # noqa: F401  (registers every model)
 from ..templates.decision_table import compiled_template
 from ..templates.history import layout_change
 from ..templates.rows import Template
