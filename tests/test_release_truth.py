@@ -65,7 +65,7 @@ def test_a_release_by_hand_of_a_refused_draft_is_not_shown_as_passed(run):
     line, release = released_v2(run)
     assert "gate passed" not in line
     assert "by hand from SQL" in line and "not through the engine's gate" in line
-    assert f"spur/{TEST_NAME}" in line and "fails now" in line
+    assert f"re-checked now: fails: golden test spur/{TEST_NAME}" in line
     assert release["released_via"] == "sql" and release["gate"] == "not run"
     assert not release["recheck"]["passed"]
     assert any(f"spur/{TEST_NAME}" in problem for problem in release["recheck"]["problems"])

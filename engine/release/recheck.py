@@ -26,7 +26,7 @@ if TYPE_CHECKING:
     from ..templates.rows import Template
 
 # released_via → how a screen names a release that is not the engine gate's (its own words)
-NOT_THE_GATE = {"seed": "released by engine seed (the shipped template), not through the engine's gate",
+NOT_THE_GATE = {"seed": "by engine seed, not through the engine's gate",
                 "sql": "released by hand from SQL by {login}, not through the engine's gate: the results it "
                        "states were not checked by the engine",
                 "unrecorded": "how it was released is not recorded (before migration 0026): not shown as the "
@@ -68,7 +68,7 @@ def _said(via: str, login: str, found: Recheck) -> tuple[str, str]:
     if via == "engine":
         if found.passed:
             return "passed", f"gate passed (re-checked now: {now})"
-        return "mismatch", f"MISMATCH: recorded as passed by the engine's gate, but {now}"
+        return "mismatch", f"MISMATCH: recorded as passed by the engine's gate; re-checked now: {now}"
     return "not run", f"{NOT_THE_GATE[via].format(login=login)}; re-checked now: {now}"
 
 
@@ -77,7 +77,7 @@ def _recheck_text(found: Recheck) -> str:
     if found.passed:
         return f"lint, {tests}, static analysis pass"
     more = f" (and {len(found.problems) - 1} more)" if len(found.problems) > 1 else ""
-    return f"{found.problems[0]}{more} fails now"
+    return f"fails: {found.problems[0]}{more}"
 
 
 def recheck(conn: Connection, gear_class: str, version: int, golden_tests: list[dict] | None) -> Recheck:
