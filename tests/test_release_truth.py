@@ -103,3 +103,17 @@ def test_a_release_through_the_engines_gate_shows_its_gate_passed(run):
         gated = conn.execute("SELECT count(*) FROM template_test t "
                              "JOIN classes_and_below(ARRAY['spur']) b ON b.name = t.gear_class").fetchone()[0]
     assert release["recheck"]["tests"] == gated > 1
+
+
+def test_a_release_recorded_before_migration_0026_is_re_checked_with_the_tests_of_today(run):
+    """A release stored before released_via and golden_tests existed (as the migration leaves it:
+    'unrecorded', no tests) is not shown as the gate's; the class's tests now are re-run."""
+    refused_draft(run)
+    committed(run.url, "INSERT INTO template_release (gear_class, version, hash, role, tests, released_via) "
+                       "SELECT g.name, g.template_version, template_rows_hash(r.rows), 'engine_releaser', %(tests)s, "
+                       "'unrecorded' FROM gear_class g CROSS JOIN assembled_rows_of(ARRAY[g.name]) r "
+                       "WHERE g.name = 'spur'", INVENTED)
+    line, release = released_v2(run)
+    assert "gate passed" not in line and "how it was released is not recorded" in line
+    assert f"golden test spur/{TEST_NAME}" in line
+    assert release["gate"] == "not run" and not release["recheck"]["recorded_tests"]
