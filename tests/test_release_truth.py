@@ -117,3 +117,16 @@ def test_a_release_recorded_before_migration_0026_is_re_checked_with_the_tests_o
     assert "gate passed" not in line and "how it was released is not recorded" in line
     assert f"golden test spur/{TEST_NAME}" in line
     assert release["gate"] == "not run" and not release["recheck"]["recorded_tests"]
+
+
+def test_a_retired_release_is_re_checked_against_its_own_rows_not_the_ones_released_now(run):
+    """v2 passed the gate; v3, broken, was then released by hand. v2's tests are re-run against
+    v2's stored rows: it still passed, and v3 does not."""
+    committed(run.url, GOLDEN_TEST, (TEST_NAME,))
+    committed(run.url, EDIT.format(sql.Identifier("o")), ('"M9 ; COOLANT OFF"', COOLANT_OFF_ROW))
+    assert run("template", "release", "--class", "spur", "--yes").exit_code == 0
+    committed(run.url, EDIT.format(sql.Identifier("o")), ('"M9"', COOLANT_ROW))
+    release_by_hand(run.url)
+    versions = json.loads(run("template", "history", "--class", "spur", "--json").stdout)["versions"]
+    gates = {v["version"]: (v["state"], v["release"]["gate"]) for v in versions if v["release"]}
+    assert gates[2] == ("retired", "passed") and gates[3] == ("released", "not run")
