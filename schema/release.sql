@@ -5,7 +5,9 @@
 
 -- One row per release of a class's version, with what the gate found (engine template release).
 -- tests: the golden tests the gate ran, [{"class", "name", "passed"}]; impact: the gate's summary
--- ({"jobs", "changed", ...}); checks: what else the gate checked (lint, static analysis).
+-- ({"jobs", "changed", ...}); checks: what else the gate checked (lint, static analysis). These
+-- three are what the caller of release_template states: a screen never shows them as the gate's
+-- result without re-running the recorded golden_tests (engine.release.recheck).
 CREATE TABLE template_release (
     id          bigserial PRIMARY KEY,
     gear_class  text NOT NULL,
@@ -18,6 +20,12 @@ CREATE TABLE template_release (
     impact      jsonb NOT NULL DEFAULT '{}',
     checks      jsonb NOT NULL DEFAULT '{}',
     note        text,
+    -- how the releasing login says it released: engine (after the gate), seed, sql (by hand),
+    -- unrecorded (before migration 0026); a claim, never a proof (docs/design.md §10)
+    released_via text NOT NULL DEFAULT 'sql' CHECK (released_via IN ('engine', 'seed', 'sql', 'unrecorded')),
+    -- the golden tests of the class and its descendants at the release, taken by the database
+    -- (golden_tests_of); NULL before migration 0026
+    golden_tests jsonb CHECK (golden_tests IS NULL OR jsonb_typeof(golden_tests) = 'array'),
     FOREIGN KEY (gear_class, version, hash) REFERENCES template_version_rows (gear_class, version, hash)
         ON DELETE CASCADE,
     UNIQUE (gear_class, version)
@@ -56,12 +64,16 @@ CROSS JOIN LATERAL jsonb_to_recordset(v.rows) AS x (id integer, t text, n intege
                                                      p_emit text)
 WHERE r.version = released_version(r.gear_class);
 
--- Release the class's current version (its draft): the gate's findings are recorded with it.
--- `expected_hash` is the hash of the rows the gate checked: if the draft changed since, nothing
--- is released. Returns the release's id.
+-- Release the class's current version (its draft): the gate's findings, as the caller states them,
+-- are recorded with it. `expected_hash` is the hash of the rows the gate checked: if the draft
+-- changed since, nothing is released. `via` is how the caller says it releases ('engine' after
+-- the engine's gate, 'seed' for the shipped templates; 'sql', the default, by hand): a claim of
+-- the releasing login, kept as such. The golden tests of the class and its descendants are taken
+-- by the database itself (from template_test, each with its class's version now), so a screen can
+-- re-run exactly what the gate ran. Returns the release's id.
 CREATE FUNCTION release_template(class_name text, expected_version integer, expected_hash text,
                                  tests jsonb DEFAULT '[]', impact jsonb DEFAULT '{}', checks jsonb DEFAULT '{}',
-                                 note text DEFAULT NULL)
+                                 note text DEFAULT NULL, via text DEFAULT 'sql')
 RETURNS bigint
 LANGUAGE plpgsql SECURITY DEFINER SET search_path = public, pg_temp
 AS $$
@@ -94,9 +106,10 @@ BEGIN
         RAISE EXCEPTION 'class % version % is released already; there is no draft to release', class_name, current
             USING ERRCODE = 'unique_violation';
     END IF;
-    INSERT INTO template_release (gear_class, version, hash, role, tests, impact, checks, note)
+    INSERT INTO template_release (gear_class, version, hash, role, tests, impact, checks, note, released_via,
+                                  golden_tests)
     VALUES (class_name, current, stored, template_editor(), coalesce(tests, '[]'), coalesce(impact, '{}'),
-            coalesce(checks, '{}'), note)
+            coalesce(checks, '{}'), note, coalesce(via, 'sql'), golden_tests_of(class_name))
     RETURNING id INTO made;
     RETURN made;
 END
@@ -170,3 +183,16 @@ CREATE TABLE template_test (
     UNIQUE (gear_class, name),
     CHECK ((gear_id IS NULL) <> (params IS NULL))
 );
+
+-- The golden tests of a class and its descendants as stored now, each with its class's current
+-- version: what the gate ran, recorded with a release by the database (not by its caller).
+CREATE FUNCTION golden_tests_of(class_name text) RETURNS jsonb
+LANGUAGE sql STABLE
+RETURN (SELECT coalesce(jsonb_agg(jsonb_build_object('id', t.id, 'class', t.gear_class, 'name', t.name,
+                                                     'gear_id', t.gear_id, 'params', t.params, 'choices', t.choices,
+                                                     'expect', to_jsonb(t.expect), 'description', t.description,
+                                                     'version', g.template_version)
+                                  ORDER BY t.gear_class, t.name), '[]')
+        FROM classes_and_below(ARRAY[class_name]) b
+        JOIN gear_class g ON g.name = b.name
+        JOIN template_test t ON t.gear_class = g.name);

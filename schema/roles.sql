@@ -70,6 +70,7 @@ GRANT USAGE ON SEQUENCE template_test_id_seq TO engine_editor;
 GRANT INSERT (pair_key, t, a, b, why), UPDATE (withdrawn_at) ON near_duplicate_intended TO engine_editor;
 GRANT USAGE ON SEQUENCE near_duplicate_intended_id_seq TO engine_editor;
 
--- Releasers release: release_template records the gate's findings with the release.
-REVOKE EXECUTE ON FUNCTION release_template(text, integer, text, jsonb, jsonb, jsonb, text) FROM PUBLIC;
-GRANT EXECUTE ON FUNCTION release_template(text, integer, text, jsonb, jsonb, jsonb, text) TO engine_releaser;
+-- Releasers release: release_template records the gate's findings, as its caller states them, with
+-- the release (and how the caller says it released; screens re-check it, docs/design.md §10).
+REVOKE EXECUTE ON FUNCTION release_template(text, integer, text, jsonb, jsonb, jsonb, text, text) FROM PUBLIC;
+GRANT EXECUTE ON FUNCTION release_template(text, integer, text, jsonb, jsonb, jsonb, text, text) TO engine_releaser;

@@ -97,31 +97,39 @@ def template_import(ctx, gear_class, parent, csv_file):
 @click.pass_context
 def template_history(ctx, gear_class, as_json):
     """Every stored version of the class, oldest first: when, who, rows, its state (released, retired,
-    draft, superseded), its release (who, when, golden tests run, programs changed of stored jobs)
-    and which rows changed.
+    draft, superseded), its release (who, when, how, programs changed of stored jobs) and which rows
+    changed. A release is re-checked as it is shown (lint, analysis and its recorded golden tests
+    against the released rows): "gate passed" only for one the engine's gate made that passes now.
 
     Example: engine template history --class spur
     """
+    from ..release.recheck import verdict
     from ..templates.history import history
 
     with connection(ctx) as conn:
         entries = history(conn, gear_class)
+        verdicts = {entry.version: verdict(conn, gear_class, entry.release) for entry in entries if entry.release}
     if as_json:
-        return emit_json({"class": gear_class, "versions": [_version_json(entry) for entry in entries]})
+        return emit_json({"class": gear_class,
+                          "versions": [_version_json(entry, verdicts.get(entry.version)) for entry in entries]})
     for number, entry in enumerate(entries):
         layout = _layout_text(entry.layout, entries[number - 1].layout if number else NcLayout())
         changes = _changes_text(entry.changes, first=number == 0, relaid=bool(layout))
         click.echo(f"v{entry.version:<4} {entry.state:10} {entry.created_at:%Y-%m-%d %H:%M:%S} by "
                    f"{entry.created_by:14} {entry.rows:3} rows  {changes}{layout}".rstrip())
         if entry.release is not None:
-            click.echo(f"      {_release_text(entry.release)}")
+            click.echo(f"      {_release_text(entry.release, verdicts[entry.version])}")
 
 
-def _release_text(release) -> str:
+def _release_text(release, verdict) -> str:
+    """Who released, and what is true of the gate (engine.release.recheck); what the releasing
+    session states (tests, impact) is said to be stated when the gate did not make the release."""
     impact = "" if release.jobs is None else f", {release.changed} of {release.jobs} stored program(s) changed"
+    stated = ("" if verdict.gate == "passed" or not release.tests
+              else f"; it states {release.tests} golden test(s) passed")
     note = f" ({release.note})" if release.note else ""
     return (f"released {release.released_at:%Y-%m-%d %H:%M:%S} by {release.released_by} as {release.role}: "
-            f"{release.tests} golden test(s){impact}{note}")
+            f"{verdict.said}{stated}{impact}{note}")
 
 
 def _layout_text(layout, before) -> str:
@@ -140,19 +148,21 @@ def _changes_text(changes, first: bool, relaid: bool = False) -> str:
     return ", ".join(f"{operation} x{operations.count(operation)}" for operation in dict.fromkeys(operations))
 
 
-def _version_json(entry) -> dict:
+def _version_json(entry, verdict) -> dict:
     return {"version": entry.version, "created_at": entry.created_at.isoformat(), "created_by": entry.created_by,
-            "rows": entry.rows, "state": entry.state, "release": _release_json(entry.release),
+            "rows": entry.rows, "state": entry.state, "release": _release_json(entry.release, verdict),
             "changes": [{"row_id": row_id, "operation": operation} for row_id, operation in entry.changes],
             "line_ending": ENDING_NAMES[entry.layout.line_ending], "final_newline": entry.layout.final_newline}
 
 
-def _release_json(release) -> dict | None:
+def _release_json(release, verdict) -> dict | None:
+    """`tests`, `changed`, `jobs`: what the releasing session stated; `gate`: passed only for the
+    engine's gate's release that passes its re-check now (`recheck`)."""
     if release is None:
         return None
     return {"released_at": release.released_at.isoformat(), "released_by": release.released_by,
-            "role": release.role, "tests": release.tests, "changed": release.changed, "jobs": release.jobs,
-            "note": release.note}
+            "role": release.role, "released_via": release.released_via, "tests": release.tests,
+            "changed": release.changed, "jobs": release.jobs, "note": release.note, **verdict.as_json()}
 
 
 @template.command("diff")

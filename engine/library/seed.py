@@ -100,7 +100,8 @@ def _seed_samples(conn: Connection, directory: Path, report: SeedReport) -> set[
     return samples_stored
 
 
-RELEASE_SEEDED = ("SELECT release_template(g.name, g.template_version, v.hash, note => %s) FROM gear_class g "
+RELEASE_SEEDED = ("SELECT release_template(g.name, g.template_version, v.hash, note => %s, via => 'seed') "
+                  "FROM gear_class g "
                   "JOIN template_version_rows v ON v.gear_class = g.name AND v.version = g.template_version "
                   "WHERE g.name = %s AND released_version(g.name) IS DISTINCT FROM g.template_version")
 

@@ -28,9 +28,9 @@ if TYPE_CHECKING:
     from ..db.connection import Connection
 
 RELEASER_ROLE = "engine_releaser"
-RELEASE = "SELECT release_template(%s, %s, %s, %s, %s, %s)"
+RELEASE = "SELECT release_template(%s, %s, %s, %s, %s, %s, via => 'engine')"   # after the gate (§10)
 MAY_RELEASE = ("SELECT current_user, has_function_privilege("
-               "'release_template(text, integer, text, jsonb, jsonb, jsonb, text)', 'EXECUTE')")
+               "'release_template(text, integer, text, jsonb, jsonb, jsonb, text, text)', 'EXECUTE')")
 
 
 class GateRefusal(EngineError):

@@ -34,14 +34,18 @@ class VersionEntry:
 
 @dataclass(frozen=True)
 class ReleaseEntry:
-    """Who released a version, when, and what the gate saw: tests run, programs changed of jobs."""
+    """Who released a version, when, how, and what the releasing session states the gate saw:
+    tests run, programs changed of jobs (claims: engine.release.recheck says what is true)."""
+    version: int
     released_at: datetime
     released_by: str
     role: str
-    tests: int
+    tests: int                       # golden tests the caller of release_template states it ran
     changed: int | None
     jobs: int | None
     note: str | None
+    released_via: str = "sql"        # engine, seed, sql (by hand), unrecorded: what the caller said
+    golden_tests: list | None = None  # the golden tests the database recorded with the release
 
 
 @dataclass(frozen=True)
@@ -77,7 +81,7 @@ ORDER BY v.version"""
 STATES = "SELECT version, state FROM template_version_state WHERE gear_class = %s"
 RELEASES = """
 SELECT version, released_at, released_by, role, jsonb_array_length(tests), (impact ->> 'changed')::int,
-       (impact ->> 'jobs')::int, note
+       (impact ->> 'jobs')::int, note, released_via, golden_tests
 FROM template_release WHERE gear_class = %s"""
 
 
@@ -86,7 +90,7 @@ def history(conn: Connection, gear_class: str) -> list[VersionEntry]:
     state (released, retired, draft, superseded) and its release."""
     _require_class(conn, gear_class)
     states: dict[int, str] = dict(conn.execute(STATES, (gear_class,)).fetchall())   # version -> state
-    releases = {row[0]: ReleaseEntry(*row[1:]) for row in conn.execute(RELEASES, (gear_class,))}
+    releases = {row[0]: ReleaseEntry(*row) for row in conn.execute(RELEASES, (gear_class,))}
     return [VersionEntry(version, created_at, created_by, row_count, tuple(zip(row_ids, operations)),
                          states.get(version, ""), releases.get(version), NcLayout(line_ending, final_newline))
             for version, created_at, created_by, row_count, line_ending, final_newline, row_ids, operations

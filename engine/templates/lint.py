@@ -15,17 +15,18 @@ from .translations import store_translations
 
 if TYPE_CHECKING:
     from ..db.connection import Connection
+    from .rows import Template
 
 
-def lint_class(conn: Connection, gear_class: str) -> list[LintProblem]:
-    """Every problem of one class's template, including unknown parameter names (its rows
-    compiled once, within the time of one compile)."""
+def lint_class(conn: Connection, gear_class: str, template: Template | None = None) -> list[LintProblem]:
+    """Every problem of one class's template (its current rows, or the stored version given: a
+    release re-checked), including unknown parameter names (its rows compiled once, within the
+    time of one compile)."""
     with rows_compiled_once():
-        return _class_problems(conn, gear_class)
+        return _class_problems(conn, gear_class, template or load_template(conn, gear_class))
 
 
-def _class_problems(conn: Connection, gear_class: str) -> list[LintProblem]:
-    template = load_template(conn, gear_class)
+def _class_problems(conn: Connection, gear_class: str, template: Template) -> list[LintProblem]:
     problems = structural_problems(gear_class, list(template.rows)) + _translation_problems(template)
     if problems:
         return problems

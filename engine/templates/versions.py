@@ -6,7 +6,11 @@ Every committed change of a template is a stored version (template_version_rows)
 current version is its draft until `engine template release` records it in template_release."""
 from __future__ import annotations
 
+from collections.abc import Iterator, Mapping
+from contextlib import contextmanager
+from contextvars import ContextVar
 from dataclasses import replace
+from types import MappingProxyType
 from typing import TYPE_CHECKING
 
 from ..db.connection import scalar
@@ -23,6 +27,10 @@ SELECT v.version, v.rows FROM template_release r
 JOIN template_version_rows v ON v.gear_class = r.gear_class AND v.version = r.version
 WHERE r.gear_class = %s ORDER BY r.id DESC LIMIT 1"""
 RELEASED_VERSION = "SELECT released_version(%s)"
+VERSION_ROWS = "SELECT rows FROM template_version_rows WHERE gear_class = %s AND version = %s"
+
+# Classes whose template is a given stored version while a release is re-checked (pinned_templates).
+_PINNED: ContextVar[Mapping[str, Template]] = ContextVar("pinned_templates", default=MappingProxyType({}))
 
 
 def released_template(conn: Connection, gear_class: str) -> Template:
@@ -47,8 +55,33 @@ def draft_template(conn: Connection, gear_class: str) -> Template:
 
 
 def runnable_template(conn: Connection, gear_class: str, draft: bool = False) -> Template:
-    """The template a job of the class is made with: the draft if asked for, else the released one."""
+    """The template a job of the class is made with: the draft if asked for, else the released one
+    (or, while a release is re-checked, the stored version pinned for the class)."""
+    pinned = _PINNED.get().get(gear_class)
+    if pinned is not None:
+        return pinned
     return draft_template(conn, gear_class) if draft else released_template(conn, gear_class)
+
+
+def stored_template(conn: Connection, gear_class: str, version: int) -> Template:
+    """The class's assembled rows as stored for `version` (template_version_rows)."""
+    found = conn.execute(VERSION_ROWS, (gear_class, version)).fetchone()
+    if found is None:
+        raise EngineError(f"class {gear_class!r} version {version} is not stored; see `engine template history "
+                          f"--class {gear_class}`")
+    rows = tuple(TemplateRow(**row) for row in found[0])
+    return Template(gear_class, version, rows, load_translations(conn, rows))
+
+
+@contextmanager
+def pinned_templates(templates: dict[str, Template]) -> Iterator[None]:
+    """Within the block, runnable_template gives these stored versions for their classes: the
+    golden tests of a release re-run against the rows it released, whatever is released now."""
+    token = _PINNED.set(MappingProxyType({**_PINNED.get(), **templates}))
+    try:
+        yield
+    finally:
+        _PINNED.reset(token)
 
 
 def released_version(conn: Connection, gear_class: str) -> int | None:
