@@ -254,3 +254,28 @@ def test_a_target_that_became_a_link_after_the_plan_is_not_written_through(run, 
     assert result.exit_code == 3 and "symbolic link" in result.stderr, result.output
     assert real.read_bytes() == b"; not the engine's\n" and (out / "GEAR43.MPF").is_symlink()
     assert [(out / f"{name}.MPF").read_bytes() for name in ("GEAR42", "GEAR44")] == [OLD["GEAR42"], OLD["GEAR44"]]
+
+
+def test_a_folder_swapped_while_the_files_are_named_is_said(run, tmp_path, after_plan, monkeypatch):
+    """Swapped after the first rename: the files still go into the folder opened at the start
+    (never through the new path), and the error says the folder moved and that they were written."""
+    out = tmp_path / "out"
+    old_files(out)
+
+    def swap_at_first_rename(files):
+        real = os.replace
+
+        def replace(*args, **kwargs):
+            if not (tmp_path / "moved").exists():
+                swap_for_a_folder(out, tmp_path / "elsewhere")
+            return real(*args, **kwargs)
+        monkeypatch.setattr(os, "replace", replace)
+    after_plan(swap_at_first_rename)
+    result = run("instantiate", "--gears", "42-44", "--out", out, "--force")
+    monkeypatch.undo()
+    assert result.exit_code == 3, result.output
+    assert "moved or swapped" in result.stderr and "and written" in result.stderr
+    assert everything_in(out) == []
+    for name in GEARS:
+        assert (tmp_path / "moved" / f"{name}.MPF").read_bytes() == latest_text(run.url, name)
+    assert everything_in(tmp_path / "moved") == ["GEAR42.MPF", "GEAR43.MPF", "GEAR44.MPF"]

@@ -13,8 +13,9 @@ stays until then. The files are written in two stages:
    with its process).
 2. Only then is each given its name: a new file linked to it (linkat, which never replaces), an
    old one replaced through a hidden temporary name (`.NAME.MPF.<hex>.tmp`, renamed at once
-   onto the target). A failure here (rare: the names are in a folder already checked) says
-   exactly which files were replaced and which not.
+   onto the target; a kill between the two leaves that hidden file beside the old one, which
+   is whole). A failure here (rare: the names are in a folder already checked) says exactly
+   which files were replaced and which not.
 
 The folder is opened once, at the start, and every step is relative to that descriptor, so the
 files go into the folder that was checked when the run was planned: a folder swapped for
@@ -31,7 +32,7 @@ import os
 import resource
 import secrets
 import stat
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 # errno of open(O_TMPFILE) where the kernel or the file system does not support it
@@ -73,7 +74,7 @@ class Staged:
     name: str
     descriptor: int | None = None
     temporary: str | None = None
-    replaces: bool = field(default=False)
+    replaces: bool = False
 
 
 def write_files(seen: FolderSeen, texts: dict[str, bytes], replace: bool) -> None:

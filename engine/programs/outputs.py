@@ -159,6 +159,9 @@ class StoredNotWritten(EngineError):
 def _not_written_message(error: NotWritten, missing: list[Path], written: list[Path], ids: list[int]) -> str:
     stored = f"program {ids[0]} is stored" if len(ids) == 1 else f"programs {_id_runs(ids)} are stored" if ids \
         else "the programs are stored"
+    if not missing:   # every file named, then the folder found moved or its names not synced
+        return (f"{stored} and written, but {error.path}: {error.cause}; check that the files are where the "
+                "machine reads them, or run the command again")
     kept = "every file there is as it was" if not written else \
         f"replaced or written: {', '.join(target.name for target in written)}"
     files = missing[0].name if len(missing) == 1 else f"{len(missing)} files (below)"
