@@ -117,7 +117,8 @@ def test_one_program_stored_not_written_is_exit_3_in_json_too(run, tmp_path, aft
     said = json.loads(result.stderr)
     program_id = stored(run.url, 1)["GEAR42"]
     assert said["exit"] == 3 and f"program {program_id} is stored" in said["error"]
-    assert "not written: GEAR42.MPF" in said["error"] and os.strerror(errno.ENOSPC) in said["error"]
+    assert f"not written: GEAR42.MPF (program {program_id})" in said["error"]
+    assert os.strerror(errno.ENOSPC) in said["error"]
     assert target.read_bytes() == OLD["GEAR42"] and everything_in(tmp_path) == ["GEAR42.MPF"]
 
 

@@ -153,10 +153,11 @@ class StoredNotWritten(EngineError):
         self.not_written = [str(target) for target in missing]
         self.problems = [f"not written: {target} (program {ids.get(target, '?')})" for target in missing] \
             if len(missing) > 1 else []
-        super().__init__(_not_written_message(error, missing, written, self.program_ids))
+        super().__init__(_not_written_message(error, missing, written, self.program_ids, ids))
 
 
-def _not_written_message(error: NotWritten, missing: list[Path], written: list[Path], ids: list[int]) -> str:
+def _not_written_message(error: NotWritten, missing: list[Path], written: list[Path], ids: list[int],
+                         by_file: dict[Path, int | None]) -> str:
     stored = f"program {ids[0]} is stored" if len(ids) == 1 else f"programs {_id_runs(ids)} are stored" if ids \
         else "the programs are stored"
     if not missing:   # every file named, then the folder found moved or its names not synced
@@ -164,7 +165,8 @@ def _not_written_message(error: NotWritten, missing: list[Path], written: list[P
                 "machine reads them, or run the command again")
     kept = "every file there is as it was" if not written else \
         f"replaced or written: {', '.join(target.name for target in written)}"
-    files = missing[0].name if len(missing) == 1 else f"{len(missing)} files (below)"
+    files = f"{missing[0].name} (program {by_file.get(missing[0], '?')})" if len(missing) == 1 \
+        else f"{len(missing)} files (below)"
     return (f"{stored}, but not written to files: {error.path}: {error.cause}; not written: {files}; {kept}. "
             "Fix the cause and run the command again (it stores new programs; --force replaces files); "
             "`engine programs show ID` shows a stored one")
