@@ -2,8 +2,10 @@
 command calls one library function (the command modules of engine.cli).
 
 Exit codes: 0 ok, 1 a handled error or bad input, option values included (one line on stderr;
-with --json one JSON object {"error": ..., "exit": 1}),
-2 unexpected (--traceback shows it).
+with --json one JSON object {"error": ..., "exit": 1}): nothing stored,
+2 unexpected (--traceback shows it),
+3 programs stored but their files not written (engine.programs.outputs.StoredNotWritten: the
+message names the programs and the files; "exit": 3 with --json).
 """
 from __future__ import annotations
 
@@ -119,7 +121,7 @@ class EngineGroup(click.Group):
         except EngineError as error:
             if ctx.meta.get("traceback"):
                 raise
-            fail(str(error), 1, getattr(error, "problems", ()))
+            fail(str(error), error.exit_code, getattr(error, "problems", ()))
         except BrokenPipeError:   # the reader left (engine … | head): it has what it wanted, no message
             _silence_stdout()
             ctx.exit(1)

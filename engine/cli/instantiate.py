@@ -47,7 +47,8 @@ def parse_range(text: str, option: str = "--gears") -> tuple[int, int]:
 @click.option("--all", "all_gears", is_flag=True, help="Batch: every gear.")
 @click.option("--out", type=click.Path(), help="Write the .MPF file here after the programs are committed: a "
               "batch always into this folder (made if missing), one program into it if it is a folder or ends with /.")
-@click.option("--force", is_flag=True, help="Replace files that exist in --out (else nothing is stored).")
+@click.option("--force", is_flag=True,
+              help="Replace files that exist in --out, each in one step (else nothing is stored).")
 @click.option("--machine", help="Machine record (default: the config file's machine, else hobber-840d for a "
               "gear; with --class one must be named).")
 @click.option("--cuts", type=click.IntRange(1, 2), help="1 = single cut, 2 = rough then finish (default by module).")
@@ -91,7 +92,9 @@ def instantiate(ctx, gear_id, job_id, gear_class, params_file, unverified, gear_
     one with its reason, with a progress bar on a terminal. Exit code 0: stored
     (with --skip-bad: the good ones, the bad ones listed on stderr); 1: bad
     input, or any bad gear or job without --skip-bad, or none good: nothing
-    stored; 2: a bug.
+    stored; 2: a bug; 3: stored, but the files not written (the error names the
+    programs and the files; the files there are as they were, or it says which
+    were replaced).
 
     --class C --params P.json makes a job of a class without a model (engine
     import-nc) on a lathe: its program is read by the machine's verifier, and

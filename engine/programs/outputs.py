@@ -5,15 +5,16 @@ database holds, byte for byte. Storing runs in a transaction of its own that com
 real (files_after_commit); psycopg makes `conn.transaction()` inside an open transaction a
 mere savepoint, so a connection already inside its caller's transaction is refused when
 files are asked for, rather than writing them before the caller's COMMIT. After the COMMIT
-each file is written unnamed (Linux O_TMPFILE) and given its name in one step (linkat), so
-a kill at any moment leaves each file complete or absent and no temporary file; --force
-removes the old file just before the new one is linked (a kill in between leaves no file).
-Where O_TMPFILE is not supported the file is written under a hidden temporary name first,
-which a kill at that moment can leave behind.
+the files are placed by engine.programs.file_writes (issue 26): all written in full first,
+then each given its name, an old file replaced in one step (rename), so a failure leaves
+every earlier file as it was and a kill leaves each file old or new, never missing.
 
 Files are refused before anything is stored: a name that is not an 840D program name, a
 name that would land outside --out, two programs of one run whose names differ only in case
-(the control does not tell case), and an existing file without --force.
+(the control does not tell case), an existing file without --force, and a target that is a
+symbolic link or not a regular file. What goes wrong after the COMMIT (a disk full, the folder
+swapped for a link) is StoredNotWritten: the CLI's exit code 3, "stored, not written", naming
+the stored programs and the files not written (exit 1 always means nothing stored).
 
 A file is written with the layout of its template version (issue 17: the class's line_ending and
 final_newline as that version records them, template_version_rows; LF with a final newline unless the
@@ -27,9 +28,8 @@ from __future__ import annotations
 
 import contextlib
 import contextvars
-import errno
 import os
-import secrets
+import stat
 from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -40,15 +40,15 @@ from psycopg.pq import TransactionStatus
 from ..errors import EngineError
 from ..names import checked
 from ..nc.layout import NcLayout, nc_text
+from ..nc.lineage import LINEAGE_SHAPE
+from .file_writes import FolderSeen, NotWritten, write_files
 from .options import Output
 
 if TYPE_CHECKING:
     from ..db.connection import Connection
 
 SUFFIX = ".MPF"
-# errno of open(O_TMPFILE) where the kernel or the file system does not support it
-NO_TMPFILE = (errno.EOPNOTSUPP, errno.EISDIR, errno.EINVAL, errno.ENOENT)
-PROC_FD = Path("/proc/self/fd")
+STORED_NOT_WRITTEN = 3   # the CLI's exit code when programs were committed but their files not written
 # machine name -> the line ending configured for its files, or None (its class's)
 CONFIGURED_ENDING: contextvars.ContextVar[Callable[[str], str | None] | None] = contextvars.ContextVar(
     "configured_ending", default=None)
@@ -67,6 +67,8 @@ class ProgramFiles:
         self.texts: dict[Path, bytes] = {}
         self.paths: dict[str, Path] = {}
         self.layouts: dict[str, NcLayout] = {}
+        self.ids: dict[Path, int | None] = {}   # the stored program of each file, from its lineage line
+        self.seen: FolderSeen | None = None
 
     def plan(self, programs: list[tuple[str, list[str]]],
              layouts: dict[str, NcLayout] | None = None) -> dict[str, str]:
@@ -81,6 +83,7 @@ class ProgramFiles:
         self.layouts = layouts or {}
         self.texts = {paths[name]: self._bytes(name, lines) for name, lines in programs}
         self.paths = paths
+        self.seen = FolderSeen.now(paths[programs[0][0]].parent)
         return {name: str(path) for name, path in paths.items()}
 
     def replace_texts(self, stored: dict[str, list[str]]) -> None:
@@ -88,6 +91,7 @@ class ProgramFiles:
         for name, lines in stored.items():
             if name in self.paths:
                 self.texts[self.paths[name]] = self._bytes(name, lines)
+                self.ids[self.paths[name]] = _program_id(lines)
 
     def _bytes(self, name: str, lines: list[str]) -> bytes:
         try:
@@ -118,25 +122,82 @@ class ProgramFiles:
                                   f"program as {target.name} (it does not tell upper from lower case): remove or "
                                   "rename it; nothing stored")
         existing = [target for target in targets if target.name in in_folder.get(target.name.upper(), ())]
+        _refuse_unreplaceable(existing)
         if existing and not self.force:
             more = f" (and {len(existing) - 1} more of this run's files)" if len(existing) > 1 else ""
             raise EngineError(f"{existing[0]} exists{more}; nothing stored: give --force to replace it, "
                               "or another --out")
 
     def write(self) -> None:
-        """After the COMMIT: every planned file, or (on an error) none of this run's files."""
-        written: list[Path] = []
+        """After the COMMIT: every planned file, or StoredNotWritten naming the programs stored and
+        the files not written (engine.programs.file_writes: none of them if it failed before any
+        was named)."""
+        if not self.texts or self.seen is None:
+            return
         try:
-            for target, data in self.texts.items():
-                target.parent.mkdir(parents=True, exist_ok=True)
-                _place(target, data, self.force)
-                written.append(target)
-        except OSError as error:
-            for path in written:
-                with contextlib.suppress(OSError):
-                    os.unlink(path)
-            raise EngineError(f"the program(s) are stored, but writing {error.filename or target} failed: "
-                              f"{error.strerror}; no file of this run was kept") from None
+            write_files(self.seen, {target.name: data for target, data in self.texts.items()}, self.force)
+        except NotWritten as error:
+            raise StoredNotWritten(error, self.texts, self.ids) from None
+
+
+class StoredNotWritten(EngineError):
+    """Programs committed, but (some of) their files not written: exit code 3, not 1 (which says
+    nothing was stored). The message names the stored program ids, the cause, the files written
+    and not written; `problems` lists the files not written when there are several."""
+    exit_code = STORED_NOT_WRITTEN
+
+    def __init__(self, error: NotWritten, texts: dict[Path, bytes], ids: dict[Path, int | None]):
+        missing = [target for target in texts if target.name not in error.written]
+        written = [target for target in texts if target.name in error.written]
+        self.program_ids = sorted(program_id for program_id in ids.values() if program_id is not None)
+        self.not_written = [str(target) for target in missing]
+        self.problems = [f"not written: {target} (program {ids.get(target, '?')})" for target in missing] \
+            if len(missing) > 1 else []
+        super().__init__(_not_written_message(error, missing, written, self.program_ids, ids))
+
+
+def _not_written_message(error: NotWritten, missing: list[Path], written: list[Path], ids: list[int],
+                         by_file: dict[Path, int | None]) -> str:
+    stored = f"program {ids[0]} is stored" if len(ids) == 1 else f"programs {_id_runs(ids)} are stored" if ids \
+        else "the programs are stored"
+    if not missing:   # every file named, then the folder found moved or its names not synced
+        return (f"{stored} and written, but {error.path}: {error.cause}; check that the files are where the "
+                "machine reads them, or run the command again")
+    kept = "every file there is as it was" if not written else \
+        f"replaced or written: {', '.join(target.name for target in written)}"
+    files = f"{missing[0].name} (program {by_file.get(missing[0], '?')})" if len(missing) == 1 \
+        else f"{len(missing)} files (below)"
+    return (f"{stored}, but not written to files: {error.path}: {error.cause}; not written: {files}; {kept}. "
+            "Fix the cause and run the command again (it stores new programs; --force replaces files); "
+            "`engine programs show ID` shows a stored one")
+
+
+def _id_runs(ids: list[int]) -> str:
+    """812, 815–900: the ids, consecutive runs joined (a batch draws them in a row)."""
+    runs: list[list[int]] = []
+    for program_id in ids:
+        if runs and program_id == runs[-1][-1] + 1:
+            runs[-1].append(program_id)
+        else:
+            runs.append([program_id])
+    return ", ".join(str(run[0]) if len(run) == 1 else f"{run[0]}–{run[-1]}" for run in runs)
+
+
+def _program_id(lines: list[str]) -> int | None:
+    """The program id on the stored program's lineage line (every stored program has one)."""
+    found = next((match for match in map(LINEAGE_SHAPE.search, lines) if match), None)
+    return int(found.group(1)) if found is not None and found.group(1).isdigit() else None
+
+
+def _refuse_unreplaceable(existing: list[Path]) -> None:
+    """--force replaces a program file, never a link (the file it points to would be left as it
+    was, or replaced elsewhere) nor a folder; checked before anything is stored."""
+    for target in existing:
+        mode = os.lstat(target).st_mode
+        if stat.S_ISLNK(mode) or not stat.S_ISREG(mode):
+            what = "a symbolic link" if stat.S_ISLNK(mode) else "not a regular file"
+            raise EngineError(f"{target} is {what}, which the engine never replaces: remove it or give another "
+                              "--out; nothing stored")
 
 
 @contextlib.contextmanager
@@ -225,68 +286,6 @@ def file_layouts(programs) -> dict[str, NcLayout]:
     configured = CONFIGURED_ENDING.get()
     return {item.name: item.layout.ending_from(configured(item.machine) if configured else None)
             for item in programs}
-
-
-def _place(target: Path, data: bytes, replace: bool) -> None:
-    """Write `data` unnamed, then name it `target` in one step (no half-written or temporary file)."""
-    folder = os.open(target.parent, os.O_RDONLY | os.O_DIRECTORY | os.O_CLOEXEC)
-    try:
-        unnamed = _unnamed_file(folder)
-        if unnamed is None:
-            return _place_through_temporary(target, data, replace)
-        try:
-            _write_all(unnamed, data)
-            _link(unnamed, folder, target.name, replace)
-        finally:
-            os.close(unnamed)
-    finally:
-        os.close(folder)
-
-
-def _unnamed_file(folder: int) -> int | None:
-    """A new file without a name in the folder (mode 0666 less the umask), or None where the
-    kernel, the file system or a missing /proc cannot give one."""
-    if not hasattr(os, "O_TMPFILE") or not PROC_FD.is_dir():
-        return None
-    try:
-        return os.open(".", os.O_TMPFILE | os.O_WRONLY | os.O_CLOEXEC, 0o666, dir_fd=folder)
-    except OSError as error:
-        if error.errno in NO_TMPFILE:
-            return None
-        raise
-
-
-def _link(unnamed: int, folder: int, name: str, replace: bool) -> None:
-    """Give the unnamed file its name; with `replace`, the old file goes just before."""
-    if replace:
-        with contextlib.suppress(FileNotFoundError):
-            os.unlink(name, dir_fd=folder)
-    # linkat(…, AT_SYMLINK_FOLLOW) through /proc: os.link uses linkat only with a dir_fd; link(2) does not follow
-    os.link(f"{PROC_FD}/{unnamed}", name, dst_dir_fd=folder, follow_symlinks=True)
-
-
-def _place_through_temporary(target: Path, data: bytes, replace: bool) -> None:
-    """Without O_TMPFILE: a hidden temporary file, renamed (--force) or linked (never over a file)."""
-    temporary = target.with_name(f".{target.name}.{secrets.token_hex(6)}.tmp")
-    descriptor = os.open(temporary, os.O_CREAT | os.O_EXCL | os.O_WRONLY | os.O_CLOEXEC, 0o666)
-    try:
-        try:
-            _write_all(descriptor, data)
-        finally:
-            os.close(descriptor)
-        if replace:
-            os.replace(temporary, target)
-        else:
-            os.link(temporary, target)
-    finally:
-        with contextlib.suppress(FileNotFoundError):
-            os.unlink(temporary)
-
-
-def _write_all(descriptor: int, data: bytes) -> None:
-    view = memoryview(data)
-    while view:
-        view = view[os.write(descriptor, view):]
 
 
 def commit_failure(error: psycopg.Error) -> EngineError:
