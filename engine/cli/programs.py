@@ -25,14 +25,25 @@ RECORD_FIELDS = (  # (label, the value of a ProgramRecord)
     ("gear", lambda record: record.gear_id if record.gear_id is not None else "-"),
     ("class", lambda record: record.gear_class),
     ("version", lambda record: f"v{record.template_version}" + (" (draft)" if record.draft else " (released)")),
-    ("verifier", lambda record: f"{UNVERIFIED}: no verifier read it, never written to a file" if record.unverified
-     else "read by the machine's verifier"),
+    ("verifier", lambda record: _verifier(record)),
+    ("rendering", lambda record: record.rendering.said if record.rendering else "not checked"),
     ("template hash", lambda record: record.template_hash),
     ("input hash", lambda record: record.input_hash or "-"),
     ("stored by", lambda record: record.stored_by or "-"),
     ("stored at", lambda record: record.created_at.isoformat(timespec="seconds")),
     ("layout", lambda record: record.layout.said),
 )
+
+
+def _verifier(record) -> str:
+    """Whether a verifier read the program: said only of one that is the rendering the engine
+    made and stored (a MISMATCH is lines no verifier read; an UNCHECKED one cannot be told)."""
+    if record.unverified:
+        return f"{UNVERIFIED}: no verifier read it, never written to a file"
+    if record.rendering is None or not record.rendering.matches:
+        status = record.rendering.status if record.rendering else "not checked"
+        return f"{status}: not known to be the program the machine's verifier read (see rendering)"
+    return "read by the machine's verifier"
 
 
 @click.group("programs")
@@ -70,11 +81,17 @@ def programs_list(ctx, gear_class, gear_id, job_id, draft, released, since, unti
 @click.option("--hash", "prefix", metavar="H",
               help="8 or more hex digits of the INPUT or TEMPLATE hash on a program's lineage line; lists every match.")
 @click.option("--json", "as_json", is_flag=True,
-              help="Print one JSON line: {programs: [{program_id, job_id, gear_id, class, ..., lines}]}.")
+              help="Print one JSON line: {programs: [{program_id, job_id, gear_id, class, ..., rendering: "
+                   "{status, reason}, lines}]}.")
 @click.pass_context
 def programs_show(ctx, program_id, prefix, as_json):
     """Show a stored program's record and its lines, by PROGRAM_ID or by --hash. The lines are
     printed with the class's line ending and final newline (an imported class: its file's).
+
+    Each program is first rendered again from its template version and its job's parameters
+    (milliseconds): `rendering:` says MATCH, MISMATCH (its stored lines are not what the
+    version makes: not the program the verifier read) or UNCHECKED (its job was edited since,
+    so it cannot be rendered again; make it again with `engine instantiate --job ID`).
 
     The lineage line of a file on the control, e.g.
     `; PROGRAM 812 TEMPLATE spur v4 1f3a9c07 INPUT 5be02d11`, leads to its record

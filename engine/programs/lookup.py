@@ -7,13 +7,14 @@ written with: a later change of the class's layout is a later version and leaves
 from __future__ import annotations
 
 import re
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from datetime import date, datetime
 from typing import TYPE_CHECKING
 
 from ..db.listing import day_range, records, require_class
 from ..errors import EngineError
 from ..nc.layout import ENDING_NAMES, NcLayout, nc_text
+from .rendering import Rendering, stored_rendering
 
 if TYPE_CHECKING:
     from ..db.connection import Connection
@@ -50,6 +51,7 @@ class ProgramRecord:
     name: str
     lines: list[str]
     layout: NcLayout = NcLayout()   # its template version's line ending and final newline
+    rendering: Rendering | None = None   # MATCH, MISMATCH or UNCHECKED (engine.programs.rendering); None: not checked
 
     @property
     def text(self) -> str:
@@ -61,13 +63,19 @@ class ProgramRecord:
         layout as the config file and a template CSV name it (line_ending "lf" or "crlf")."""
         fields = asdict(self)
         del fields["layout"]
+        fields["rendering"] = self.rendering.as_dict() if self.rendering else None
         return {"program_id": fields.pop("id"), "class": fields.pop("gear_class"), **fields,
                 "created_at": self.created_at.isoformat(), "line_ending": ENDING_NAMES[self.layout.line_ending],
                 "final_newline": self.layout.final_newline}
 
 
 def find_programs(conn: Connection, program_id: int | None = None, prefix: str | None = None) -> list[ProgramRecord]:
-    """The program with this id, or every program matching the hash prefix (one of the two)."""
+    """The program with this id, or every program matching the hash prefix (one of the two), each
+    checked against its rendering (engine.programs.rendering): what a screen shows it with."""
+    return [replace(record, rendering=stored_rendering(conn, record.id)) for record in _found(conn, program_id, prefix)]
+
+
+def _found(conn: Connection, program_id: int | None, prefix: str | None) -> list[ProgramRecord]:
     if (program_id is None) == (prefix is None):
         raise EngineError("give a program id or --hash H (8 or more hex digits of its lineage line), one of the two")
     if program_id is not None:

@@ -27,8 +27,13 @@ def plot_job(conn: Connection, job_id: int, out: str | Path) -> list[str]:
 
 
 def plot_program(conn: Connection, program_id: int, out: str | Path) -> list[str]:
-    """Draw the stored program to `out` as the simulation reads it; → one line per thing drawn."""
+    """Draw the stored program to `out` as the simulation reads it; → one line per thing drawn.
+    Refused unless the program is the rendering of the version and job it names
+    (engine.programs.rendering): a picture is evidence of what the program does."""
     from ..hobbing.program_plot import plot_stored_program
+    from .rendering import checked_program
+
+    checked_program(conn, program_id, "a picture")
 
     return plot_stored_program(conn, program_id, out)
 
