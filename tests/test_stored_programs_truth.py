@@ -8,7 +8,6 @@ import json
 
 import psycopg
 import pytest
-
 from helpers.roles import as_role
 
 GEAR = 42                    # the seeded spur gear: the paper's n0 = 246 r/min
@@ -123,3 +122,22 @@ def test_a_program_whose_job_was_edited_since_is_unchecked_and_not_evidence(run)
     assert "read by the machine's verifier" not in shown.stdout
     result = run("explain", "--program", genuine)
     assert result.exit_code == 1 and "UNCHECKED" in result.stderr and f"--job {job_id}" in result.stderr
+
+
+def listed(run, *args) -> dict:
+    result = run(*args, "--json")
+    assert result.exit_code == 0, result.output
+    return {record["program_id"]: record for record in json.loads(result.stdout)["programs"]}
+
+
+def test_lists_never_say_read_of_a_forged_program_and_check_it_when_asked(run, forgery):
+    job_id, genuine, forged_id = forgery
+    plain = listed(run, "programs", "list", "--job", job_id)
+    assert {plain[genuine]["rendering"], plain[forged_id]["rendering"]} == {"on show"}   # not rendered in a list
+    checked = listed(run, "programs", "list", "--job", job_id, "--check")
+    assert (checked[genuine]["rendering"], checked[genuine]["verifier"]) == ("MATCH", "read")
+    assert (checked[forged_id]["rendering"], checked[forged_id]["verifier"]) == ("MISMATCH", "-")
+    with psycopg.connect(run.url) as conn:
+        conn.execute("UPDATE job SET params = params || '{\"n0\": 240}' WHERE id = %s", (job_id,))
+    edited = json.loads(run("jobs", "show", job_id, "--json").stdout)["job"]["programs"]
+    assert {(p["rendering"], p["verifier"]) for p in edited} == {("UNCHECKED", "-")}

@@ -12,7 +12,7 @@ from .output import Column, day, day_options, emit_list, list_options, one_of
 PROGRAM_COLUMNS = (
     Column("program", "program_id"), Column("name", "name"), Column("job", "job_id"), Column("gear", "gear_id"),
     Column("class", "class"), Column("version", "template_version"), Column("draft", "draft"),
-    Column("verifier", "unverified", lambda unverified: UNVERIFIED if unverified else "read"),
+    Column("verifier", "verifier"), Column("rendering", "rendering"),
     Column("template", "template_hash", lambda digest: digest[:8]),
     Column("input", "input_hash", lambda digest: (digest or "-")[:8]),
     Column("lines", "line_count"), Column("stored", "created_at"),
@@ -57,13 +57,19 @@ def programs():
 @click.option("--job", "job_id", type=JOB_ID, help="Only programs made from this job.")
 @click.option("--draft", is_flag=True, help="Only programs made from a draft version (for trying).")
 @click.option("--released", is_flag=True, help="Only programs made from a released version.")
+@click.option("--check", is_flag=True, help="Render every program listed again (milliseconds each): MATCH or "
+              "MISMATCH in the rendering column instead of 'on show'.")
 @day_options("programs stored")
 @list_options("programs")
 @click.pass_context
-def programs_list(ctx, gear_class, gear_id, job_id, draft, released, since, until, output):
+def programs_list(ctx, gear_class, gear_id, job_id, draft, released, check, since, until, output):
     """The programs stored, one line each: name, job, gear, class, template version and hash,
-    draft or released, read by the verifier or UNVERIFIED, number of lines, when stored
-    (the text: `engine programs show ID`).
+    draft or released, read by the verifier or UNVERIFIED, whether its lines are the rendering
+    of its version and job, number of lines, when stored (the text: `engine programs show ID`).
+
+    The rendering column says UNCHECKED for a program whose job was edited since (it cannot be
+    rendered again: not evidence), else 'on show' (`engine programs show ID` renders it), or with
+    --check MATCH or MISMATCH. The verifier column never says read of a MISMATCH or UNCHECKED one.
 
     Example: engine programs list --gear 42 --released --since 2026-11-01
     """
@@ -72,7 +78,7 @@ def programs_list(ctx, gear_class, gear_id, job_id, draft, released, since, unti
     chosen = one_of(ctx, {"draft": draft, "released": released})
     kind = {"draft": True, "released": False}.get(chosen) if chosen is not None else None
     with connection(ctx) as conn:
-        found = list_programs(conn, gear_class, gear_id, job_id, kind, day(since), day(until))
+        found = list_programs(conn, gear_class, gear_id, job_id, kind, day(since), day(until), check)
     emit_list(output, "programs", PROGRAM_COLUMNS, found)
 
 

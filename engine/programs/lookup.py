@@ -14,7 +14,8 @@ from typing import TYPE_CHECKING
 from ..db.listing import day_range, records, require_class
 from ..errors import EngineError
 from ..nc.layout import ENDING_NAMES, NcLayout, nc_text
-from .rendering import Rendering, stored_rendering
+from ..nc.lineage import UNVERIFIED
+from .rendering import LISTED_RENDERING, MATCH, NOT_RENDERED, Renderer, Rendering, stored_rendering
 
 if TYPE_CHECKING:
     from ..db.connection import Connection
@@ -120,7 +121,8 @@ def checked_prefix(text: str) -> str:
 
 LIST_PROGRAMS = """
 SELECT p.id AS program_id, p.name, p.job_id, j.gear_id, p.gear_class AS class, p.template_version, p.draft,
-       p.unverified, p.template_hash, p.input_hash, cardinality(p.lines) AS line_count, p.stored_by, p.created_at
+       p.unverified, p.template_hash, p.input_hash, cardinality(p.lines) AS line_count, p.stored_by, p.created_at,
+       """ + LISTED_RENDERING + """ AS rendering
 FROM program p JOIN job j ON j.id = p.job_id
 WHERE (%(class)s::text IS NULL OR p.gear_class = %(class)s)
   AND (%(gear)s::int IS NULL OR j.gear_id = %(gear)s)
@@ -132,10 +134,29 @@ ORDER BY p.id"""
 
 
 def list_programs(conn: Connection, gear_class: str | None = None, gear_id: int | None = None,
-                  job_id: int | None = None,
-                  draft: bool | None = None, since: date | None = None, until: date | None = None) -> list[dict]:
+                  job_id: int | None = None, draft: bool | None = None, since: date | None = None,
+                  until: date | None = None, check: bool = False) -> list[dict]:
     """Every program matching all filters given (None: any), by id: its record without its lines.
-    draft True: made from a draft version (for trying only); False: from a released one."""
+    draft True: made from a draft version (for trying only); False: from a released one.
+    `rendering`: UNCHECKED for a program that cannot be rendered again (its job edited since), else
+    NOT_RENDERED, or with `check` MATCH or MISMATCH (engine.programs.rendering: milliseconds each, so
+    a list renders only when asked). `verifier`: UNVERIFIED, "read" (the record says a verifier
+    read it and the rendering does not contradict it) or "-"."""
     require_class(conn, gear_class)
     filters = {"class": gear_class, "gear": gear_id, "job": job_id, "draft": draft, **day_range(since, until)}
-    return records(conn.execute(LIST_PROGRAMS, filters))
+    renderer = Renderer(conn)
+    return [_listed(renderer, record, check) for record in records(conn.execute(LIST_PROGRAMS, filters))]
+
+
+def _listed(renderer: Renderer, record: dict, check: bool) -> dict:
+    if check and record["rendering"] == NOT_RENDERED:
+        record["rendering"] = renderer.rendering(record["program_id"]).status
+    return {**record, "verifier": listed_verifier(record["unverified"], record["rendering"])}
+
+
+def listed_verifier(unverified: bool, rendering: str) -> str:
+    """What a list says of the verifier: never "read" of a program that is not known to be the
+    one the verifier read."""
+    if unverified:
+        return UNVERIFIED
+    return "read" if rendering in (MATCH, NOT_RENDERED) else "-"

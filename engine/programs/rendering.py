@@ -30,14 +30,15 @@ import json
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+from ..db.connection import scalar
 from ..errors import EngineError
 from ..gears.models import model_for_class
 from ..hobbing.machine_job import with_cycle_time
-from ..machines.records import load_machine
+from ..machines.records import Machine, load_machine
 from ..names import shown
 from ..nc.lineage import lineage_line, lineage_words, with_lineage
 from ..templates.decision_table import compiled_template
-from ..templates.rows import Template, TemplateRow, rows_hash
+from ..templates.rows import Template, TemplateRow
 from ..templates.translations import load_translations
 from . import all_models  # noqa: F401  (registers every model)
 
@@ -45,13 +46,19 @@ if TYPE_CHECKING:
     from ..db.connection import Connection
 
 MATCH, MISMATCH, UNCHECKED = "MATCH", "MISMATCH", "UNCHECKED"
+NOT_RENDERED = "on show"   # a list's word for a program it did not render (`programs show` renders it)
+# What a list of programs says without rendering any (SQL over program p JOIN job j): UNCHECKED
+# for one that cannot be rendered again (its job edited since, or stored before input hashes).
+LISTED_RENDERING = ("CASE WHEN p.input_hash IS NOT NULL AND p.input_hash = job_input_hash(j.params, j.module_params) "
+                    "THEN 'on show' ELSE 'UNCHECKED' END")
 STORED = """
 SELECT p.id, p.name, p.gear_class, p.template_version, p.template_hash, p.input_hash, p.draft, p.unverified,
        p.lines, p.row_ids, p.trace, p.job_id, j.machine, j.params, j.module_params,
-       job_input_hash(j.params, j.module_params), v.rows, m.dialect
+       job_input_hash(j.params, j.module_params), v.version IS NOT NULL, m.dialect
 FROM program p JOIN job j ON j.id = p.job_id JOIN machine m ON m.name = j.machine
 LEFT JOIN template_version_rows v ON v.gear_class = p.gear_class AND v.version = p.template_version
 WHERE p.id = %s"""
+VERSION_ROWS = "SELECT rows FROM template_version_rows WHERE gear_class = %s AND version = %s"
 # The job locked as confirm_job_cases locks it (a program stored for it meanwhile waits: its foreign
 # key shares the row), then its last program: the one confirm_job_cases reads.
 LOCK_JOB = "SELECT 1 FROM job WHERE id = %s FOR UPDATE"
@@ -86,10 +93,7 @@ class Rendering:
 
 def stored_rendering(conn: Connection, program_id: int) -> Rendering:
     """The stored program compared with its rendering; EngineError if there is no such program."""
-    row = conn.execute(STORED, (program_id,)).fetchone()
-    if row is None:
-        raise EngineError(f"program {program_id} does not exist; see `engine programs list`")
-    return _compared(conn, StoredProgram(*row))
+    return Renderer(conn).rendering(program_id)
 
 
 def checked_program(conn: Connection, program_id: int, use: str) -> Rendering:
@@ -103,7 +107,7 @@ def checked_last_program(conn: Connection, job_id: int, use: str) -> Rendering |
     """The job's last program (what `cases confirm` takes as evidence) checked; None if it has none.
     Call it in the transaction that uses the program: the job stays locked until it ends."""
     conn.execute(LOCK_JOB, (job_id,))
-    found = conn.execute(LAST_PROGRAM, (job_id,)).fetchone()[0]
+    found = scalar(conn.execute(LAST_PROGRAM, (job_id,)))
     return None if found is None else checked_program(conn, found, use)
 
 
@@ -126,28 +130,86 @@ class StoredProgram:
     params: dict
     module_params: dict
     job_hash: str
-    version_rows: list | None
+    version_stored: bool
     dialect: str
 
 
-def _compared(conn: Connection, stored: StoredProgram) -> Rendering:
-    unchecked = _why_unchecked(stored)
-    if unchecked:
-        return Rendering(stored.id, UNCHECKED, unchecked)
-    template = _version_template(conn, stored)
-    if template.hash != stored.template_hash:
-        return Rendering(stored.id, MISMATCH, f"class {stored.gear_class} v{stored.version}'s stored rows have hash "
-                                              f"{template.hash}, the program records {stored.template_hash}")
-    try:
-        lines, row_ids, trace = _rendered(conn, stored, template)
-    except EngineError as error:   # the version no longer runs with the job: not the program stored
-        return Rendering(stored.id, MISMATCH, f"its version does not render its job now ({error})")
-    difference = _difference(stored, lines, row_ids, trace)
-    if difference:
-        return Rendering(stored.id, MISMATCH, f"{difference}; the stored lines are not the rendering of class "
-                                              f"{stored.gear_class} v{stored.version} with job {stored.job_id}")
-    return Rendering(stored.id, MATCH, f"its {len(lines)} lines are the rendering of class {stored.gear_class} "
-                                       f"v{stored.version} with job {stored.job_id}'s parameters")
+class Renderer:
+    """Renders stored programs again, reading each class's model, machine and template version once
+    (a list of a thousand programs renders with one query each: engine programs list --check)."""
+
+    def __init__(self, conn: Connection):
+        self.conn = conn
+        self._templates: dict[tuple[str, int], Template] = {}
+        self._models: dict[str, object] = {}
+        self._machines: dict[str, Machine] = {}
+
+    def rendering(self, program_id: int) -> Rendering:
+        row = self.conn.execute(STORED, (program_id,)).fetchone()
+        if row is None:
+            raise EngineError(f"program {program_id} does not exist; see `engine programs list`")
+        return self.compared(StoredProgram(*row))
+
+    def compared(self, stored: StoredProgram) -> Rendering:
+        unchecked = _why_unchecked(stored)
+        if unchecked:
+            return Rendering(stored.id, UNCHECKED, unchecked)
+        template = self.template(stored.gear_class, stored.version)
+        if template.hash != stored.template_hash:
+            return Rendering(stored.id, MISMATCH, f"class {stored.gear_class} v{stored.version}'s stored rows have "
+                                                  f"hash {template.hash}, the program records {stored.template_hash}")
+        try:
+            lines, row_ids, trace = self.rendered(stored, template)
+        except EngineError as error:   # the version does not render the job: not the program stored
+            return Rendering(stored.id, MISMATCH, f"its version does not render its job ({error})")
+        difference = _difference(stored, lines, row_ids, trace)
+        if difference:
+            return Rendering(stored.id, MISMATCH, f"{difference}; the stored lines are not the rendering of class "
+                                                  f"{stored.gear_class} v{stored.version} with job {stored.job_id}")
+        return Rendering(stored.id, MATCH, f"its {len(lines)} lines are the rendering of class {stored.gear_class} "
+                                           f"v{stored.version} with job {stored.job_id}'s parameters")
+
+    def template(self, gear_class: str, version: int) -> Template:
+        """The class's stored version (with the stored translations of its SQL conditions)."""
+        if (gear_class, version) not in self._templates:
+            found = scalar(self.conn.execute(VERSION_ROWS, (gear_class, version)))
+            rows = tuple(TemplateRow(**row) for row in found)
+            self._templates[gear_class, version] = Template(gear_class, version, rows,
+                                                            load_translations(self.conn, rows))
+        return self._templates[gear_class, version]
+
+    def rendered(self, stored: StoredProgram, template: Template) -> tuple[list, list, dict]:
+        """The lines (lineage line included), row ids and trace the engine makes for the job."""
+        params, module_params = self.inputs(stored)
+        result = compiled_template(template).run(params, module_params)
+        words = lineage_words(stored.id, stored.gear_class, stored.version, stored.template_hash,
+                              stored.input_hash or "", stored.draft, stored.unverified)
+        lines, row_ids = with_lineage(list(result.lines), list(result.row_ids), lineage_line(words, stored.dialect))
+        return lines, row_ids, json.loads(json.dumps(result.trace))   # as jsonb gives it back
+
+    def inputs(self, stored: StoredProgram) -> tuple[dict, dict]:
+        """The job's parameters as the engine gives them to the template (engine.programs.remake)."""
+        model, machine = self.model(stored.gear_class), self.machine(stored.machine)
+        params, module_params = stored.params, stored.module_params
+        if model is None:   # a job of an imported class: its rows alone
+            return params, module_params
+        if machine.kind == "lathe":   # a turning job: its passes computed from its parameters
+            from ..turning.model import template_module_params
+
+            return params, template_module_params(params, module_params)
+        if "cycle_time" in params:   # a hobbing job: the time follows its feeds
+            params = with_cycle_time(params, module_params, model.cut_shape, machine)
+        return params, module_params
+
+    def model(self, gear_class: str):
+        if gear_class not in self._models:
+            self._models[gear_class] = model_for_class(self.conn, gear_class)
+        return self._models[gear_class]
+
+    def machine(self, name: str) -> Machine:
+        if name not in self._machines:
+            self._machines[name] = load_machine(self.conn, name)
+        return self._machines[name]
 
 
 def _why_unchecked(stored: StoredProgram) -> str | None:
@@ -158,40 +220,9 @@ def _why_unchecked(stored: StoredProgram) -> str | None:
     if stored.job_hash != stored.input_hash:
         return (f"job {stored.job_id} was edited since (input hash now {stored.job_hash[:8]}, the program's "
                 f"{stored.input_hash[:8]}), so the parameters it was made from are gone; {remake}")
-    if stored.version_rows is None:
+    if not stored.version_stored:
         return f"class {stored.gear_class} v{stored.version} was never stored, so it cannot be rendered; {remake}"
     return None
-
-
-def _version_template(conn: Connection, stored: StoredProgram) -> Template:
-    rows = tuple(TemplateRow(**row) for row in stored.version_rows or ())
-    return Template(stored.gear_class, stored.version, rows, load_translations(conn, rows))
-
-
-def _rendered(conn: Connection, stored: StoredProgram, template: Template) -> tuple[list, list, dict]:
-    """The lines (lineage line included), row ids and trace the engine makes for the job."""
-    params, module_params = _inputs(conn, stored)
-    result = compiled_template(template).run(params, module_params)
-    words = lineage_words(stored.id, stored.gear_class, stored.version, stored.template_hash, stored.input_hash or "",
-                          stored.draft, stored.unverified)
-    lines, row_ids = with_lineage(list(result.lines), list(result.row_ids), lineage_line(words, stored.dialect))
-    return lines, row_ids, json.loads(json.dumps(result.trace))   # as jsonb gives it back
-
-
-def _inputs(conn: Connection, stored: StoredProgram) -> tuple[dict, dict]:
-    """The job's parameters as the engine gives them to the template (engine.programs.remake)."""
-    model = model_for_class(conn, stored.gear_class)
-    machine = load_machine(conn, stored.machine)
-    params, module_params = stored.params, stored.module_params
-    if model is None:   # a job of an imported class: its rows alone
-        return params, module_params
-    if machine.kind == "lathe":   # a turning job: its passes computed from its parameters
-        from ..turning.model import template_module_params
-
-        return params, template_module_params(params, module_params)
-    if "cycle_time" in params:   # a hobbing job: the time follows its feeds
-        params = with_cycle_time(params, module_params, model.cut_shape, machine)
-    return params, module_params
 
 
 def _difference(stored: StoredProgram, lines: list, row_ids: list, trace: dict) -> str | None:
