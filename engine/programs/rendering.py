@@ -16,7 +16,8 @@ Three outcomes (`Rendering.status`):
 * UNCHECKED: the program cannot be rendered again from the records, and is not evidence either:
   its job was edited after it was stored (the job's input hash is no longer the one its lineage
   line shows; the job has no history, so the parameters it was made from are gone), it was stored
-  before input hashes were kept, or its version's rows were never stored. Making it again
+  before input hashes were kept, its version's rows were never stored, or the version did not
+  render the job now (a run over its time budget on a busy machine). Making it again
   (`engine instantiate --job ID`) gives a program that can be checked.
 
 The rendering is made as the engine made it (engine.programs.remake): a hobbing job with its
@@ -160,8 +161,11 @@ class Renderer:
                                                   f"hash {template.hash}, the program records {stored.template_hash}")
         try:
             lines, row_ids, trace = self.rendered(stored, template)
-        except EngineError as error:   # the version does not render the job: not the program stored
-            return Rendering(stored.id, MISMATCH, f"its version does not render its job ({error})")
+        except EngineError as error:   # not rendered now (a run over its budget on a busy machine, or a job
+            # no version renders): nothing to compare, so no evidence either way
+            return Rendering(stored.id, UNCHECKED, f"class {stored.gear_class} v{stored.version} did not render job "
+                                                   f"{stored.job_id} now ({error}); try again, or "
+                                                   f"{REMAKE.format(job=stored.job_id)}")
         difference = _difference(stored, lines, row_ids, trace)
         if difference:
             return Rendering(stored.id, MISMATCH, f"{difference}; the stored lines are not the rendering of class "
