@@ -8,8 +8,11 @@ import json
 
 import psycopg
 import pytest
+from helpers.class_jobs import PAWN, import_emco, ok
 from helpers.roles import as_role
 
+LINUXCNC_LATHE = ("INSERT INTO machine (name, kind, dialect, x_min, x_max, z_min, z_max, spindle_max) "
+                  "VALUES ('lathe-linuxcnc', 'lathe', 'linuxcnc', 0, 400, -600, 200, 4000)")
 GEAR = 42                    # the seeded spur gear: the paper's n0 = 246 r/min
 GENUINE_SPINDLE = "M3 S246"
 FORGED_N0 = 900              # 4 × the job's n0, still below hobber-840d's hob spindle maximum
@@ -141,3 +144,22 @@ def test_lists_never_say_read_of_a_forged_program_and_check_it_when_asked(run, f
         conn.execute("UPDATE job SET params = params || '{\"n0\": 240}' WHERE id = %s", (job_id,))
     edited = json.loads(run("jobs", "show", job_id, "--json").stdout)["job"]["programs"]
     assert {(p["rendering"], p["verifier"]) for p in edited} == {("UNCHECKED", "-")}
+
+
+def test_every_kind_of_program_the_engine_makes_is_its_own_rendering(run, tmp_path):
+    """No false MISMATCH: hobbing programs of every seeded gear (a batch), a turning job's program
+    (import-dxf, then instantiate --job: its passes), a job of an imported class on an ISO lathe
+    (read by the verifier, from its draft) and one stored UNVERIFIED from a draft on a LinuxCNC lathe."""
+    ok(run("instantiate", "--all"))
+    import_emco(run, tmp_path)   # a turning job made and written, then imported as class emco_neg
+    ok(run("instantiate", "--class", "emco_neg", "--machine", "lathe-iso", "--draft"))
+    with psycopg.connect(run.url) as conn:
+        conn.execute(LINUXCNC_LATHE)
+    ok(run("import-nc", PAWN, "--class", "pawn"))
+    ok(run("instantiate", "--class", "pawn", "--machine", "lathe-linuxcnc", "--draft", "--unverified"))
+    programs = listed(run, "programs", "list", "--check")
+    kinds = {(p["class"], p["draft"], p["unverified"]) for p in programs.values()}
+    assert {("turning_iso", False, False), ("emco_neg", True, False), ("pawn", True, True)} <= kinds
+    assert {p["rendering"] for p in programs.values()} == {"MATCH"}, programs
+    assert {p["verifier"] for p in programs.values() if p["unverified"]} == {"UNVERIFIED"}
+    assert {p["verifier"] for p in programs.values() if not p["unverified"]} == {"read"}
