@@ -92,17 +92,19 @@ def test_a_genuine_program_shows_as_the_rendering_read_by_the_verifier(run, forg
 
 @pytest.mark.parametrize("command", [
     ("plot", "--program", "{id}", "-o", "{tmp}/forged.svg"),
+    ("plot", "--job", "{job}", "-o", "{tmp}/forged.svg"),   # a hobbing job is drawn by its newest program
     ("explain", "--program", "{id}"),
     ("simulate", "--program", "{id}"),
 ])
 def test_commands_that_use_a_stored_program_refuse_a_forged_one(run, forgery, tmp_path, command):
-    _, genuine, forged_id = forgery
+    job_id, genuine, forged_id = forgery
     before = counts(run.url)
-    args = [part.format(id=forged_id, tmp=tmp_path) for part in command]
+    args = [part.format(id=forged_id, job=job_id, tmp=tmp_path) for part in command]
     refused_in_one_line(run(*args), forged_id)
     assert counts(run.url) == before and not (tmp_path / "forged.svg").exists()
-    genuine_args = [part.format(id=genuine, tmp=tmp_path) for part in command]
-    assert run(*genuine_args).exit_code == 0
+    if "--program" in command:
+        genuine_args = [part.format(id=genuine, job=job_id, tmp=tmp_path) for part in command]
+        assert run(*genuine_args).exit_code == 0
 
 
 def test_cases_confirm_refuses_a_job_whose_last_program_is_forged_and_adds_no_case(run, forgery):
