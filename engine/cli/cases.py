@@ -100,9 +100,16 @@ def cases_list(ctx, output):
 @click.option("--job", "job_id", type=JOB_ID, required=True, help="Job whose stored cutting data proved good.")
 @click.pass_context
 def cases_confirm(ctx, job_id):
-    """Confirm a job: its stored cutting data become new cases (one per cut kind)."""
-    from ..gears.cases import confirm_job
+    """Confirm a job: its stored cutting data become new cases (one per cut kind).
 
-    with connection(ctx) as conn:
+    The job's last program vouches for the data: it must be the rendering of the template
+    version and job it names; a program that is not (MISMATCH), or cannot be rendered again
+    because the job was edited since (UNCHECKED), is refused and nothing is added.
+    """
+    from ..gears.cases import confirm_job
+    from ..programs.rendering import checked_last_program
+
+    with connection(ctx) as conn, conn.transaction():
+        checked_last_program(conn, job_id, "the cutting history; nothing confirmed")
         ids = confirm_job(conn, job_id)
     click.echo(f"job {job_id} confirmed: added case(s) {', '.join(f'#{i}' for i in ids)}")

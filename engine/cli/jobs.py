@@ -22,7 +22,8 @@ JOB_FIELDS = JOB_COLUMNS[:5] + (
     Column("cutting data", "cutting", lambda cutting: json.dumps(cutting, sort_keys=True)),
 )
 PROGRAM_COLUMNS = (Column("program", "program_id"), Column("name", "name"), Column("version", "template_version"),
-                   Column("draft", "draft"), Column("stored", "created_at"))
+                   Column("draft", "draft"), Column("verifier", "verifier"), Column("rendering", "rendering"),
+                   Column("stored", "created_at"))
 
 
 @click.group("jobs")

@@ -12,7 +12,7 @@ from .output import Column, day, day_options, emit_list, list_options, one_of
 PROGRAM_COLUMNS = (
     Column("program", "program_id"), Column("name", "name"), Column("job", "job_id"), Column("gear", "gear_id"),
     Column("class", "class"), Column("version", "template_version"), Column("draft", "draft"),
-    Column("verifier", "unverified", lambda unverified: UNVERIFIED if unverified else "read"),
+    Column("verifier", "verifier"), Column("rendering", "rendering"),
     Column("template", "template_hash", lambda digest: digest[:8]),
     Column("input", "input_hash", lambda digest: (digest or "-")[:8]),
     Column("lines", "line_count"), Column("stored", "created_at"),
@@ -25,14 +25,25 @@ RECORD_FIELDS = (  # (label, the value of a ProgramRecord)
     ("gear", lambda record: record.gear_id if record.gear_id is not None else "-"),
     ("class", lambda record: record.gear_class),
     ("version", lambda record: f"v{record.template_version}" + (" (draft)" if record.draft else " (released)")),
-    ("verifier", lambda record: f"{UNVERIFIED}: no verifier read it, never written to a file" if record.unverified
-     else "read by the machine's verifier"),
+    ("verifier", lambda record: _verifier(record)),
+    ("rendering", lambda record: record.rendering.said if record.rendering else "not checked"),
     ("template hash", lambda record: record.template_hash),
     ("input hash", lambda record: record.input_hash or "-"),
     ("stored by", lambda record: record.stored_by or "-"),
     ("stored at", lambda record: record.created_at.isoformat(timespec="seconds")),
     ("layout", lambda record: record.layout.said),
 )
+
+
+def _verifier(record) -> str:
+    """Whether a verifier read the program: said only of one that is the rendering the engine
+    made and stored (a MISMATCH is lines no verifier read; an UNCHECKED one cannot be told)."""
+    if record.unverified:
+        return f"{UNVERIFIED}: no verifier read it, never written to a file"
+    if record.rendering is None or not record.rendering.matches:
+        status = record.rendering.status if record.rendering else "not checked"
+        return f"{status}: not known to be the program the machine's verifier read (see rendering)"
+    return "read by the machine's verifier"
 
 
 @click.group("programs")
@@ -46,13 +57,19 @@ def programs():
 @click.option("--job", "job_id", type=JOB_ID, help="Only programs made from this job.")
 @click.option("--draft", is_flag=True, help="Only programs made from a draft version (for trying).")
 @click.option("--released", is_flag=True, help="Only programs made from a released version.")
+@click.option("--check", is_flag=True, help="Render every program listed again (milliseconds each): MATCH or "
+              "MISMATCH in the rendering column instead of 'on show'.")
 @day_options("programs stored")
 @list_options("programs")
 @click.pass_context
-def programs_list(ctx, gear_class, gear_id, job_id, draft, released, since, until, output):
+def programs_list(ctx, gear_class, gear_id, job_id, draft, released, check, since, until, output):
     """The programs stored, one line each: name, job, gear, class, template version and hash,
-    draft or released, read by the verifier or UNVERIFIED, number of lines, when stored
-    (the text: `engine programs show ID`).
+    draft or released, read by the verifier or UNVERIFIED, whether its lines are the rendering
+    of its version and job, number of lines, when stored (the text: `engine programs show ID`).
+
+    The rendering column says UNCHECKED for a program whose job was edited since (it cannot be
+    rendered again: not evidence), else 'on show' (`engine programs show ID` renders it), or with
+    --check MATCH or MISMATCH. The verifier column never says read of a MISMATCH or UNCHECKED one.
 
     Example: engine programs list --gear 42 --released --since 2026-11-01
     """
@@ -61,7 +78,7 @@ def programs_list(ctx, gear_class, gear_id, job_id, draft, released, since, unti
     chosen = one_of(ctx, {"draft": draft, "released": released})
     kind = {"draft": True, "released": False}.get(chosen) if chosen is not None else None
     with connection(ctx) as conn:
-        found = list_programs(conn, gear_class, gear_id, job_id, kind, day(since), day(until))
+        found = list_programs(conn, gear_class, gear_id, job_id, kind, day(since), day(until), check)
     emit_list(output, "programs", PROGRAM_COLUMNS, found)
 
 
@@ -70,11 +87,17 @@ def programs_list(ctx, gear_class, gear_id, job_id, draft, released, since, unti
 @click.option("--hash", "prefix", metavar="H",
               help="8 or more hex digits of the INPUT or TEMPLATE hash on a program's lineage line; lists every match.")
 @click.option("--json", "as_json", is_flag=True,
-              help="Print one JSON line: {programs: [{program_id, job_id, gear_id, class, ..., lines}]}.")
+              help="Print one JSON line: {programs: [{program_id, job_id, gear_id, class, ..., rendering: "
+                   "{status, reason}, lines}]}.")
 @click.pass_context
 def programs_show(ctx, program_id, prefix, as_json):
     """Show a stored program's record and its lines, by PROGRAM_ID or by --hash. The lines are
     printed with the class's line ending and final newline (an imported class: its file's).
+
+    Each program is first rendered again from its template version and its job's parameters
+    (milliseconds): `rendering:` says MATCH, MISMATCH (its stored lines are not what the
+    version makes: not the program the verifier read) or UNCHECKED (its job was edited since,
+    so it cannot be rendered again; make it again with `engine instantiate --job ID`).
 
     The lineage line of a file on the control, e.g.
     `; PROGRAM 812 TEMPLATE spur v4 1f3a9c07 INPUT 5be02d11`, leads to its record

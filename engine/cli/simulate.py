@@ -18,13 +18,17 @@ def simulate(ctx, program_id, as_json):
     coupling generates and the swivel, against the gear; depth, stock and run-out per cut; the
     table speed; the feed per workpiece revolution; the cycle time against the header.
 
-    One line per finding, then the summary. Exit 1 when the simulation refuses the program.
+    One line per finding, then the summary. Exit 1 when the simulation refuses the program, or
+    when its lines are not the rendering of the template version and job it names (MISMATCH),
+    or cannot be rendered again because its job was edited since (UNCHECKED).
 
     Example: engine simulate --program 7 --json
     """
+    from ..programs.rendering import checked_program
     from ..simulation import simulate_stored_program
 
     with connection(ctx) as conn:
+        checked_program(conn, program_id, "the simulation")   # a forged program proves nothing
         report = simulate_stored_program(conn, program_id)
     if as_json:
         emit_json({"program_id": program_id, **report.as_dict()})

@@ -63,10 +63,14 @@ def _values_read(entry: dict, values: dict) -> dict:
 
 
 def explain_program(conn: Connection, program_id: int, row: int | None = None) -> list[ExplainedRow]:
-    """The stored program's rows, explained from its stored trace."""
+    """The stored program's rows, explained from its stored trace; refused unless the program is
+    the rendering of the version and job it names (engine.programs.rendering)."""
+    from .rendering import checked_program
+
     found = conn.execute("SELECT lines, row_ids, trace FROM program WHERE id = %s", (program_id,)).fetchone()
     if found is None:
         raise EngineError(f"program {program_id} does not exist; see `SELECT id, name FROM program`")
+    checked_program(conn, program_id, "explain")   # its trace would narrate lines no template made
     lines, row_ids, trace = found
     if trace is None:
         raise EngineError(f"program {program_id} was stored before programs kept their trace; "

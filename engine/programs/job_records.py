@@ -8,6 +8,8 @@ from datetime import date
 from typing import TYPE_CHECKING
 
 from ..db.listing import Deletion, Reference, day_range, delete_row, one_record, records, require_class
+from .lookup import listed_verifier
+from .rendering import LISTED_RENDERING
 
 if TYPE_CHECKING:
     from ..db.connection import Connection
@@ -25,8 +27,9 @@ WHERE (%(class)s::text IS NULL OR j.gear_class = %(class)s)
 ORDER BY j.id"""
 ONE_JOB = JOB_COLUMNS + ", j.params, j.module_params, j.cutting FROM job j WHERE j.id = %s"
 JOB_PROGRAMS = """
-SELECT id AS program_id, name, template_version, draft, unverified, created_at
-FROM program WHERE job_id = %s ORDER BY id"""
+SELECT p.id AS program_id, p.name, p.template_version, p.draft, p.unverified, p.created_at,
+       """ + LISTED_RENDERING + """ AS rendering
+FROM program p JOIN job j ON j.id = p.job_id WHERE p.job_id = %s ORDER BY p.id"""
 
 JOB_DELETION = Deletion(
     kind="job",
@@ -52,7 +55,9 @@ def list_jobs(conn: Connection, gear_class: str | None = None, gear_id: int | No
 def job_details(conn: Connection, job_id: int) -> dict:
     """The job as stored (its parameters and cutting data included) and its programs."""
     job = one_record(conn.execute(ONE_JOB, (job_id,)), "job", job_id, "engine jobs list")
-    return {**job, "programs": records(conn.execute(JOB_PROGRAMS, (job_id,)))}
+    programs = [{**program, "verifier": listed_verifier(program["unverified"], program["rendering"])}
+                for program in records(conn.execute(JOB_PROGRAMS, (job_id,)))]
+    return {**job, "programs": programs}
 
 
 def delete_job(conn: Connection, job_id: int, yes: bool) -> str:

@@ -7,13 +7,15 @@ written with: a later change of the class's layout is a later version and leaves
 from __future__ import annotations
 
 import re
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from datetime import date, datetime
 from typing import TYPE_CHECKING
 
 from ..db.listing import day_range, records, require_class
 from ..errors import EngineError
 from ..nc.layout import ENDING_NAMES, NcLayout, nc_text
+from ..nc.lineage import UNVERIFIED
+from .rendering import LISTED_RENDERING, MATCH, NOT_RENDERED, Renderer, Rendering, stored_rendering
 
 if TYPE_CHECKING:
     from ..db.connection import Connection
@@ -50,6 +52,7 @@ class ProgramRecord:
     name: str
     lines: list[str]
     layout: NcLayout = NcLayout()   # its template version's line ending and final newline
+    rendering: Rendering | None = None   # MATCH, MISMATCH or UNCHECKED (engine.programs.rendering); None: not checked
 
     @property
     def text(self) -> str:
@@ -61,13 +64,19 @@ class ProgramRecord:
         layout as the config file and a template CSV name it (line_ending "lf" or "crlf")."""
         fields = asdict(self)
         del fields["layout"]
+        fields["rendering"] = self.rendering.as_dict() if self.rendering else None
         return {"program_id": fields.pop("id"), "class": fields.pop("gear_class"), **fields,
                 "created_at": self.created_at.isoformat(), "line_ending": ENDING_NAMES[self.layout.line_ending],
                 "final_newline": self.layout.final_newline}
 
 
 def find_programs(conn: Connection, program_id: int | None = None, prefix: str | None = None) -> list[ProgramRecord]:
-    """The program with this id, or every program matching the hash prefix (one of the two)."""
+    """The program with this id, or every program matching the hash prefix (one of the two), each
+    checked against its rendering (engine.programs.rendering): what a screen shows it with."""
+    return [replace(record, rendering=stored_rendering(conn, record.id)) for record in _found(conn, program_id, prefix)]
+
+
+def _found(conn: Connection, program_id: int | None, prefix: str | None) -> list[ProgramRecord]:
     if (program_id is None) == (prefix is None):
         raise EngineError("give a program id or --hash H (8 or more hex digits of its lineage line), one of the two")
     if program_id is not None:
@@ -112,7 +121,8 @@ def checked_prefix(text: str) -> str:
 
 LIST_PROGRAMS = """
 SELECT p.id AS program_id, p.name, p.job_id, j.gear_id, p.gear_class AS class, p.template_version, p.draft,
-       p.unverified, p.template_hash, p.input_hash, cardinality(p.lines) AS line_count, p.stored_by, p.created_at
+       p.unverified, p.template_hash, p.input_hash, cardinality(p.lines) AS line_count, p.stored_by, p.created_at,
+       """ + LISTED_RENDERING + """ AS rendering
 FROM program p JOIN job j ON j.id = p.job_id
 WHERE (%(class)s::text IS NULL OR p.gear_class = %(class)s)
   AND (%(gear)s::int IS NULL OR j.gear_id = %(gear)s)
@@ -124,10 +134,29 @@ ORDER BY p.id"""
 
 
 def list_programs(conn: Connection, gear_class: str | None = None, gear_id: int | None = None,
-                  job_id: int | None = None,
-                  draft: bool | None = None, since: date | None = None, until: date | None = None) -> list[dict]:
+                  job_id: int | None = None, draft: bool | None = None, since: date | None = None,
+                  until: date | None = None, check: bool = False) -> list[dict]:
     """Every program matching all filters given (None: any), by id: its record without its lines.
-    draft True: made from a draft version (for trying only); False: from a released one."""
+    draft True: made from a draft version (for trying only); False: from a released one.
+    `rendering`: UNCHECKED for a program that cannot be rendered again (its job edited since), else
+    NOT_RENDERED, or with `check` MATCH or MISMATCH (engine.programs.rendering: milliseconds each, so
+    a list renders only when asked). `verifier`: UNVERIFIED, "read" (the record says a verifier
+    read it and the rendering does not contradict it) or "-"."""
     require_class(conn, gear_class)
     filters = {"class": gear_class, "gear": gear_id, "job": job_id, "draft": draft, **day_range(since, until)}
-    return records(conn.execute(LIST_PROGRAMS, filters))
+    renderer = Renderer(conn)
+    return [_listed(renderer, record, check) for record in records(conn.execute(LIST_PROGRAMS, filters))]
+
+
+def _listed(renderer: Renderer, record: dict, check: bool) -> dict:
+    if check and record["rendering"] == NOT_RENDERED:
+        record["rendering"] = renderer.rendering(record["program_id"]).status
+    return {**record, "verifier": listed_verifier(record["unverified"], record["rendering"])}
+
+
+def listed_verifier(unverified: bool, rendering: str) -> str:
+    """What a list says of the verifier: never "read" of a program that is not known to be the
+    one the verifier read."""
+    if unverified:
+        return UNVERIFIED
+    return "read" if rendering in (MATCH, NOT_RENDERED) else "-"

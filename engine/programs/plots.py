@@ -1,7 +1,9 @@
 """Pictures of jobs and programs (issue 17): `engine plot --job ID` draws a turning job (the lathe's
 passes, X as a diameter) or a hobbing job (a side view of blank, units, hob and passes), picked
 by the kind of the job's machine; `engine plot --program ID` draws what a stored program does, by
-the simulation's reading of its lines. PNG or SVG by the file's suffix, written whole or not at all."""
+the simulation's reading of its lines. A stored program is drawn only if it is the rendering of
+the version and job it names (engine.programs.rendering). PNG or SVG by the file's suffix, written
+whole or not at all."""
 from __future__ import annotations
 
 from pathlib import Path
@@ -27,8 +29,13 @@ def plot_job(conn: Connection, job_id: int, out: str | Path) -> list[str]:
 
 
 def plot_program(conn: Connection, program_id: int, out: str | Path) -> list[str]:
-    """Draw the stored program to `out` as the simulation reads it; → one line per thing drawn."""
+    """Draw the stored program to `out` as the simulation reads it; → one line per thing drawn.
+    Refused unless the program is the rendering of the version and job it names
+    (engine.programs.rendering): a picture is evidence of what the program does."""
     from ..hobbing.program_plot import plot_stored_program
+    from .rendering import checked_program
+
+    checked_program(conn, program_id, "a picture")
 
     return plot_stored_program(conn, program_id, out)
 
@@ -41,8 +48,11 @@ def _turning(conn: Connection, job_id: int, out) -> list[str]:
 
 
 def _hobbing(conn: Connection, job_id: int, out) -> list[str]:
-    from ..hobbing.job_plot import plot_hobbing_job
+    """A hobbing job is drawn by the stored program that reaches the machine: checked first."""
+    from ..hobbing.job_plot import plot_hobbing_job, program_to_draw
+    from .rendering import checked_program
 
+    checked_program(conn, program_to_draw(conn, job_id)[0], f"a picture of job {job_id}")
     return plot_hobbing_job(conn, job_id, out)
 
 
