@@ -35,17 +35,19 @@ if TYPE_CHECKING:
 RECORD_PARAMETERS = ("gear_id", "gear_class", "machine", "hob_id", "mn", "z2", "alpha_n", "beta", "hand", "b",
                      "da2", "df2", "z0", "da0", "hob_hand", "swivel", "lead_angle", "coupling_b", "differential",
                      "tool_number")
+# A duplex gear's further unit (engine.hobbing.duplex, module sync:n): its number, teeth and width.
+UNIT_PARAMETERS = ("unit", "z2", "b")
 RELATIVE_TOLERANCE = 1e-9   # JSON numbers read back as they were stored; only float noise allowed
 NOTHING_STORED = "nothing stored"
 
 
 def check_hobbing_job(job_id: int, gear_class: str, model, gear: Gear, hob: Hob, machine: Machine,
-                      params: dict) -> None:
+                      params: dict, module_params: dict) -> None:
     """Refuse the stored job (EngineError, one line) unless its hob fits the gear, its record
     parameters equal the records and its hob speed is within a new job's bounds."""
     choices = job_choices(job_id, params)
     _check_hob(job_id, gear, hob, model.hob_purpose, model.shift_travel(choices))
-    _check_records(job_id, gear_class, model, gear, hob, machine, params, choices)
+    _check_records(job_id, gear_class, model, gear, hob, machine, params, module_params, choices)
     n0 = _number(job_id, params, "n0", "params.n0")
     _refused_as_new(job_id, "params.n0", lambda: _cutting_table(gear, hob, machine).with_overrides(hob_speed=n0))
     _refused_as_new(job_id, "params.n0", lambda: check_speeds(gear, hob.starts, n0, machine))
@@ -98,18 +100,22 @@ def _check_hob(job_id: int, gear: Gear, hob: Hob, purpose: str, shift_travel: fl
 
 
 def _check_records(job_id: int, gear_class: str, model, gear: Gear, hob: Hob, machine: Machine, params: dict,
-                   choices: Choices) -> None:
+                   module_params: dict, choices: Choices) -> None:
     """The record parameters re-derived by the class's model from the records, as the planner
     derives a new job's (the cutting data and cut count do not enter them). One the job lacks is
     left to the template, which names an unknown parameter it reads."""
     derived = _refused_as_new(job_id, f"gear {gear.id} with hob {hob.id}", lambda: model.job(
-        gear, gear_class, hob, machine, _cutting_table(gear, hob, machine), choices).params)
-    for name in RECORD_PARAMETERS:
-        if name in derived and name in params and not _same(params[name], derived[name]):
-            raise EngineError(f"job {job_id}: params.{name} = {params.get(name)!r} is not {derived[name]!r}, "
-                              f"the value of the records (gear {gear.id}, hob {hob.id}, machine {machine.name}); "
-                              f"correct job.params or make a new job with `engine instantiate --gear {gear.id}`; "
-                              f"{NOTHING_STORED}")
+        gear, gear_class, hob, machine, _cutting_table(gear, hob, machine), choices))
+    stated: list[tuple[str, object, str, object]] = [
+        (f"params.{name}", params, name, derived.params[name]) for name in RECORD_PARAMETERS if name in derived.params]
+    stated += [(f"module_params.{key}.{name}", module_params.get(key), name, unit[name])   # duplex units
+               for key, unit in derived.module_params.items() if key.startswith("sync:")
+               for name in UNIT_PARAMETERS if name in unit]
+    for where, values, name, value in stated:
+        if isinstance(values, dict) and name in values and not _same(values[name], value):
+            raise EngineError(f"job {job_id}: {where} = {values[name]!r} is not {value!r}, the value of the "
+                              f"records (gear {gear.id}, hob {hob.id}, machine {machine.name}); correct the job "
+                              f"or make a new job with `engine instantiate --gear {gear.id}`; {NOTHING_STORED}")
 
 
 def _cutting_table(gear: Gear, hob: Hob, machine: Machine):

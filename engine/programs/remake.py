@@ -84,7 +84,8 @@ class Remaker:
         stored = job_id is not None   # a stored job is checked as a new one; a golden test's case runs as given
         workpiece = self.workpiece(job_id, gear_id, hob_id, required=stored)
         if stored and workpiece:
-            check_hobbing_job(job_id, gear_class, model, workpiece.gear, workpiece.hob, machine, params)
+            check_hobbing_job(job_id, gear_class, model, workpiece.gear, workpiece.hob, machine, params,
+                              module_params)
             check_program_name(self.conn, job_id, gear_id, params)
             check_hobbing_feeds(job_id, workpiece.gear, workpiece.hob, machine, params, module_params, bounded=False)
         if "cycle_time" in params:   # the time follows feeds edited since
