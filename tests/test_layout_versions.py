@@ -8,6 +8,7 @@ from __future__ import annotations
 import csv
 import io
 import json
+import re
 
 import psycopg
 import pytest
@@ -61,12 +62,21 @@ def written(run, tmp_path, *options) -> tuple[dict, bytes]:
     return program, target.read_bytes()
 
 
+def printed_draft(run) -> tuple[dict, bytes]:
+    """The editor's draft program as printed (a draft is never written to a file, issue 26): its
+    record's id and version, and the bytes, in the class's layout as a file would have them."""
+    result = run("instantiate", "--gear", 42, "--draft")
+    assert result.exit_code == 0, result.output
+    program_id, version = re.search(r"program (\d+) \(job \d+, \d+ lines\) from spur v(\d+)", result.stderr).groups()
+    return {"program_id": int(program_id), "template_version": int(version)}, result.stdout_bytes
+
+
 def test_a_layout_change_is_a_draft_until_it_is_released(run, tmp_path):
     crlf_draft(run, tmp_path)
     runner, runners_file = written(run, tmp_path)
     assert runner["template_version"] == 1
     assert runners_file == joined(stored(run.url, runner["program_id"]), LF, True)
-    editor, editors_file = written(run, tmp_path, "--draft")
+    editor, editors_file = printed_draft(run)
     assert editor["template_version"] == 2
     assert editors_file == joined(stored(run.url, editor["program_id"]), CRLF, False)
     released = run("template", "release", "--class", "spur", "--yes")
@@ -98,7 +108,7 @@ def test_history_diff_and_restore_carry_the_layout(run, tmp_path):
     assert made(run("template", "diff", "--class", "spur", "--from", 1, "--to", 2, "--json"))["changes"] == []
     restored = run("template", "restore", "--class", "spur", "--version", 1)
     assert restored.exit_code == 0 and "restored version 1 as version 3" in restored.stdout, restored.output
-    editor, editors_file = written(run, tmp_path, "--draft")
+    editor, editors_file = printed_draft(run)
     assert editor["template_version"] == 3
     assert editors_file == joined(stored(run.url, editor["program_id"]), LF, True)
 

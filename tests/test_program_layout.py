@@ -168,10 +168,10 @@ def test_an_exported_template_carries_the_layout_into_another_class(run, tmp_pat
     assert class_layout_stored(run.url, "spur_copy") == (CRLF, False)
     with psycopg.connect(run.url) as conn:
         conn.execute("UPDATE gear SET gear_class = 'spur_copy' WHERE id = 42")
-    target = tmp_path / "GEAR42.MPF"
-    program = made(run("instantiate", "--gear", 42, "--draft", "--out", target, "--json"))
-    assert program["class"] == "spur_copy"
-    assert target.read_bytes() == joined(stored(run.url, program["program_id"]), CRLF, False)
+    printed = run("instantiate", "--gear", 42, "--draft")   # a draft is printed, never written (issue 26)
+    assert printed.exit_code == 0, printed.output
+    program_id = int(re.search(r"program (\d+) \(job \d+, \d+ lines\) from spur_copy v", printed.stderr).group(1))
+    assert printed.stdout_bytes == joined(stored(run.url, program_id), CRLF, False)
 
 
 def test_a_csv_without_the_layout_columns_leaves_the_class_layout(run, tmp_path):

@@ -268,7 +268,7 @@ def test_a_template_row_with_a_line_break_stores_and_writes_nothing(run, tmp_pat
                      (f'f"; GEAR {{gear_id}}{escape}G0 X9999 Z-9999"',))
     before = programs(run.url)
     for args in (("--gear", 42), ("--gears", "42-43"), ("--gears", "42-43", "--workers", "2")):
-        message = one_line_exit_1(run("instantiate", *args, "--draft", "--out", tmp_path))   # the editor tries it
+        message = one_line_exit_1(run("instantiate", *args, "--draft"))   # the editor tries it (a draft: no file)
         assert "line 3 '; GEAR 42" in message and named in message and "nothing stored" in message
         assert programs(run.url) == before and list(tmp_path.iterdir()) == []
 

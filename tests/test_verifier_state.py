@@ -66,7 +66,7 @@ def test_a_template_row_emitting_a_huge_hob_ratio_stores_nothing(run, tmp_path):
         conn.execute("UPDATE template_view SET o = %s WHERE gear_class = 'spur' AND id = 1500",
                      (repr(f'EGON(C,"FINE",B,-1,{HUGE})'),))
     before = programs(run.url)
-    message = one_line_exit_1(run("instantiate", "--gear", 42, "--draft", "--out", tmp_path))   # the editor tries it
+    message = one_line_exit_1(run("instantiate", "--gear", 42, "--draft"))   # the editor tries it (a draft: no file)
     assert "401 digits" in message and "nothing stored" in message
     assert programs(run.url) == before and list(tmp_path.iterdir()) == []
 
@@ -170,7 +170,7 @@ def test_a_spur_program_without_its_egon_and_m3_rows_stores_nothing(run, tmp_pat
     with psycopg.connect(run.url) as conn:
         conn.execute("UPDATE template_view SET p_emit = 'False' WHERE gear_class = 'spur' AND id IN (1500, 1700)")
     before = programs(run.url)
-    message = one_line_exit_1(run("instantiate", "--gear", 42, "--draft", "--out", tmp_path))   # the editor tries it
+    message = one_line_exit_1(run("instantiate", "--gear", 42, "--draft"))   # the editor tries it (a draft: no file)
     # gear 42's radial infeed: the paper's 36 mm/min scaled with its axial feed, 8.11 → 3.0 mm/rev (§C, §D)
     radial = round(36.0 * 3.0 / (105.0 / (246 / 19)), 1)
     assert f"G1 X51.500 F{radial}" in message and "spindle" in message
@@ -247,7 +247,7 @@ def test_a_template_row_naming_another_program_stores_nothing(run, tmp_path):
         conn.execute("UPDATE template_view SET o = %s WHERE gear_class = 'spur' AND id = 100",
                      (repr("%_N_GEAR43_MPF"),))
     before = programs(run.url)
-    message = one_line_exit_1(run("instantiate", "--gear", 42, "--draft", "--out", tmp_path))   # the editor tries it
+    message = one_line_exit_1(run("instantiate", "--gear", 42, "--draft"))   # the editor tries it (a draft: no file)
     assert "GEAR42 line 1 '%_N_GEAR43_MPF'" in message
     assert programs(run.url) == before and list(tmp_path.iterdir()) == []
 

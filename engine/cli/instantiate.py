@@ -32,7 +32,9 @@ def parse_range(text: str, option: str = "--gears") -> tuple[int, int]:
 
 @click.command()
 @click.option("--gear", "gear_id", type=GEAR_ID, help="Gear id: compute a new job and its program.")
-@click.option("--job", "job_id", type=JOB_ID, help="Stored job id: instantiate again with its (edited) parameters.")
+@click.option("--job", "job_id", type=JOB_ID, help="Stored job id: instantiate again with its (edited) parameters, "
+              "checked as a new job's: its hob must be one `engine hobs match` accepts, its gear, hob and machine "
+              "values those of the records, its speeds and feeds within a new job's bounds.")
 @click.option("--gears", "gear_range", help="Batch: gear ids FIRST-LAST (all stored, or none unless --skip-bad).")
 @click.option("--class", "gear_class", help="A class without a model (made by engine import-nc): a new job of it "
               "with --params, on --machine, its program read by the machine's verifier.")
@@ -70,7 +72,8 @@ def parse_range(text: str, option: str = "--gears") -> tuple[int, int]:
 @click.option("--explain", is_flag=True,
               help="Also say why each row emitted its line or not, with the values (on stderr; in --json: explain).")
 @click.option("--draft", is_flag=True, help="Use the class's draft (an editor trying a change), not its released "
-              "template; the program is recorded as a draft.")
+              "template; the program is recorded as a draft. Never written to a file: refused with --out or a "
+              "config output folder (print it, or try it with --dry-run).")
 @click.option("--dry-run", is_flag=True, help="Compute and check as a stored run does, store nothing: print the "
               "program (its lineage line says PROGRAM DRY-RUN), or a batch's count of what it would store. "
               "Not with --out.")

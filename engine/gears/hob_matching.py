@@ -173,19 +173,43 @@ def choose_hob(gear: Gear, hobs: list[Hob], *, purpose: str = "cylindrical",
     property checked and its values. Raises NoHobError naming the first unmet property."""
     need = need_of(gear, purpose, shift_travel)
     tests = [test for test in HOB_TESTS if purpose in test.purposes]
-    candidates = list(hobs)
+    candidates, position = _accepted(gear, list(hobs), need, tests)
+    if position is not None:
+        raise NoHobError(_refusal(gear, need, tests[position], tests[:position], candidates), tests[position].name)
+    candidates.sort(key=lambda hob: (hob.hand != need.hand, -_class_rank(hob.accuracy_class), hob.id))
+    best = candidates[0]
+    reason = f"{best.id}: " + ", ".join(test.said(gear, best, need) for test in tests)
+    return HobChoice(best, reason)
+
+
+def _accepted(gear: Gear, hobs: list[Hob], need: Need, tests: list[HobTest]) -> tuple[list[Hob], int | None]:
+    """The hobs that pass every required test, narrowed in the order of `tests`, and None; or,
+    when none is left, the hobs that reached the first test none passes, and that test's position.
+    The one acceptance of the engine: a new job's hob (choose_hob) and a stored job's (unmet_need)."""
+    candidates = hobs
     for position, test in enumerate(tests):
         fits = test.fits
         if fits is None:   # not required: a preference only orders the hobs
             continue
         passing = [hob for hob in candidates if fits(gear, hob, need)]
         if not passing:
-            raise NoHobError(_refusal(gear, need, test, tests[:position], candidates), test.name)
+            return candidates, position
         candidates = passing
-    candidates.sort(key=lambda hob: (hob.hand != need.hand, -_class_rank(hob.accuracy_class), hob.id))
-    best = candidates[0]
-    reason = f"{best.id}: " + ", ".join(test.said(gear, best, need) for test in tests)
-    return HobChoice(best, reason)
+    return candidates, None
+
+
+def unmet_need(gear: Gear, hob: Hob, *, purpose: str = "cylindrical", shift_travel: float = 0.0) -> str | None:
+    """What the gear needs that `hob` does not have ("module 2, the hob has module 2.5"), the first
+    property choose_hob would refuse it for; None if choose_hob accepts it for the gear (a stored
+    job naming its hob is held to the same tests as a new job, issue 26)."""
+    need = need_of(gear, purpose, shift_travel)
+    tests = [test for test in HOB_TESTS if purpose in test.purposes]
+    position = _accepted(gear, [hob], need, tests)[1]
+    if position is None:
+        return None
+    test = tests[position]
+    assert test.wanted is not None and test.offered is not None   # a required test says both
+    return f"{test.wanted(gear, need)}, the hob has {test.offered(hob)}"
 
 
 def _closest(gear: Gear, need: Need, test: HobTest, hobs: list[Hob], groups: int = 3) -> str:

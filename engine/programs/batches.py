@@ -108,11 +108,24 @@ def refuse_out_in_dry_run(output: Output, mode: RunMode) -> None:
                           "a batch's dry run reports what it would store)")
 
 
+def refuse_unfit_output(output: Output, mode: RunMode) -> None:
+    """No file for a dry run (refuse_out_in_dry_run), nor for a draft's program: a file in --out
+    or the machine's output folder is what an operator loads into the machine, and a draft is an
+    editor trying a change the release gate has not passed (issue 26); the only mark a draft's
+    program carries is ` DRAFT` at the end of its lineage comment."""
+    refuse_out_in_dry_run(output, mode)
+    if mode.draft and output.out is not None:
+        raise EngineError(f"--draft programs are never written to a file for the machine (--out or the config "
+                          f"file's output folder, here {output.out}): try the draft with --dry-run (printed, "
+                          "nothing stored), or release it (`engine template release --class C`) and instantiate "
+                          "the release; nothing stored")
+
+
 def batch_stage(conn, output: Output, mode: RunMode):
     """The one transaction of a batch: for a dry run READ ONLY and rolled back (its block gets
     None), else one that commits for real and then writes the files (its block gets ProgramFiles).
-    A dry run with --out is refused first."""
-    refuse_out_in_dry_run(output, mode)
+    A dry run or a draft with a file to write is refused first."""
+    refuse_unfit_output(output, mode)
     return read_only(conn) if mode.dry_run else files_after_commit(conn, output, batch=True)
 
 

@@ -35,7 +35,7 @@ from ..templates.versions import runnable_template
 from ..turning.names import TurningModel
 from ..verifier.grammar import DIALECTS
 from . import all_models  # noqa: F401  (registers every model)
-from .batches import dry_program, read_only, refuse_out_in_dry_run
+from .batches import dry_program, read_only, refuse_unfit_output
 from .instantiate import store_planned
 from .options import NO_FILE, NORMAL_RUN, Output, RunMode
 from .outputs import files_after_commit
@@ -69,7 +69,7 @@ def instantiate_class(conn: Connection, gear_class: str, given: dict, *, machine
     its program verified for `machine` (or, `unverified`, not read), stored with the job and written
     to `output` after the COMMIT. `mode.draft`: the class's draft; `mode.dry_run`: the same checks,
     nothing stored. The batch fields of `mode` do not apply."""
-    refuse_out_in_dry_run(output, mode)
+    refuse_unfit_output(output, mode)
     refuse_unverified_file(unverified, output.out)
     if mode.dry_run:
         with read_only(conn):

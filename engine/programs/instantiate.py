@@ -35,7 +35,7 @@ from .batches import (
     planned_or_bad,
     read_only,
     reason_of,
-    refuse_out_in_dry_run,
+    refuse_unfit_output,
 )
 from .options import NO_FILE, NORMAL_RUN, Output, RunMode
 from .outputs import ProgramFiles, file_layouts, files_after_commit
@@ -100,13 +100,13 @@ class Planner:
     def plan(self, gear: Gear) -> Planned:
         if gear.gear_class is None:
             raise EngineError(f"gear {gear.id} has no gear class; re-import it to classify it")
-        _check_machine_fits(gear, self.machine)
+        check_machine_fits(gear, self.machine)
         model = self.model(gear.gear_class)
         hob = choose_hob(gear, self.hobs, purpose=model.hob_purpose,
                          shift_travel=model.shift_travel(self.choices)).hob
         cutting, case_ids = self.cutting_data(gear, hob)
         job = model.job(gear, gear.gear_class, hob, self.machine, cutting, self.choices)
-        _check_table_speed(gear, hob.starts, cutting.hob_speed, self.machine)
+        check_speeds(gear, hob.starts, cutting.hob_speed, self.machine)
         template = self.template(gear.gear_class)
         result = run_template(template, job.params, job.module_params, self.machine, Workpiece(gear, hob))
         kinds = CUT_KINDS_BY_COUNT[self.choices.cut_count(gear.module)]
@@ -127,13 +127,15 @@ class Planner:
         return self._cutting[key]
 
 
-def _check_machine_fits(gear: Gear, machine: Machine) -> None:
+def check_machine_fits(gear: Gear, machine: Machine) -> None:
     if machine.module_max is not None and gear.module > machine.module_max:
         raise LimitError(f"gear {gear.id}: module {gear.module:g} exceeds {machine.name}'s maximum "
                          f"module {machine.module_max:g}; nothing stored")
 
 
-def _check_table_speed(gear: Gear, starts: int, hob_speed: float, machine: Machine) -> None:
+def check_speeds(gear: Gear, starts: int, hob_speed: float, machine: Machine) -> None:
+    """The hob speed within the machine's hob spindle and table speed limits (a new job's, and a
+    stored job's made again: engine.programs.job_checks)."""
     if hob_speed > machine.spindle_max:
         raise LimitError(f"gear {gear.id}: hob speed {hob_speed:g} r/min exceeds {machine.name}'s hob spindle "
                          f"maximum {machine.spindle_max:g} r/min; nothing stored")
@@ -146,7 +148,7 @@ def instantiate_gear(conn: Connection, gear_id: int, *, machine: str | None = No
     the COMMIT; an existing file only with `output.force`). With `mode.draft`, from the class's
     draft. With `mode.dry_run`, the same checks, nothing stored (engine.programs.batches): the
     program returned. The batch fields of `mode` do not apply."""
-    refuse_out_in_dry_run(output, mode)
+    refuse_unfit_output(output, mode)
     if mode.dry_run:
         with read_only(conn):
             planner = Planner(conn, machine, choices, overrides, mode.draft)

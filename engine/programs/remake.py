@@ -1,10 +1,13 @@
 """Stored jobs made again with their stored, possibly edited, parameters: one job (`engine
-instantiate --job ID`) or a range of them (`--jobs FIRST-LAST`), template rows only: no
-model, no hob choice, no cutting data. The programs are checked against the job's machine,
-stored with the template version they came from, and written after the database commit. A
-batch tries every job and names each bad one (engine.programs.batches). A job of a class without
-a model (engine.programs.class_jobs) is its class's rows run with its parameters, read by the
-verifier: one stored unverified is verified now, or refused."""
+instantiate --job ID`) or a range of them (`--jobs FIRST-LAST`), template rows only: no hob
+choice, no cutting data. A hobbing job is not trusted as stored (a runner may write jobs in SQL):
+its hob, its record parameters and its edited values are checked as a new job's are
+(engine.programs.job_checks), a turning job's parameters by the turning model. The programs are
+checked against the job's machine, stored with the template version they came from, and written
+after the database commit. A batch tries every job and names each bad one
+(engine.programs.batches). A job of a class without a model (engine.programs.class_jobs) is its
+class's rows run with its parameters, read by the verifier: one stored unverified is verified
+now, or refused."""
 from __future__ import annotations
 
 import re
@@ -13,7 +16,6 @@ from typing import TYPE_CHECKING
 
 from ..errors import EngineError
 from ..gears.models import model_for_class
-from ..gears.process_notes import stored_feed_notes
 from ..gears.records import Hob, load_gear, load_hobs
 from ..hobbing.cylindrical import program_name
 from ..hobbing.machine_job import with_cycle_time
@@ -22,6 +24,7 @@ from ..memory import no_cycle_collection
 from ..nc.layout import NcLayout, class_layout
 from ..templates.rows import Template
 from ..templates.versions import runnable_template
+from ..turning.names import TurningModel
 from . import all_models  # noqa: F401  (registers every model)
 from .batches import (
     batch_stage,
@@ -31,10 +34,11 @@ from .batches import (
     good_ones,
     planned_or_bad,
     read_only,
-    refuse_out_in_dry_run,
+    refuse_unfit_output,
 )
 from .class_jobs import class_job
 from .instantiate import store_planned
+from .job_checks import check_hobbing_feeds, check_hobbing_job
 from .options import NO_FILE, NORMAL_RUN, Output, RunMode
 from .outputs import file_layouts, files_after_commit
 from .records import Planned, Program
@@ -70,21 +74,36 @@ class Remaker:
         machine = self.machine(machine_name)
         if not self.modelled(gear_class):   # a job of an imported class (instantiate --class): its rows alone
             return class_job(self.template(gear_class), machine, params, module_params)
+        if job_id is not None:   # a stored job (a golden test's case names its machine itself)
+            check_machine_kind(job_id, gear_class, machine, self.turning(gear_class))
         if machine.kind == "lathe":   # a turning job: its passes are computed from its parameters
             from .turning_jobs import plan_turning_job  # the tool paths: only for turning jobs
 
             return plan_turning_job(self.conn, gear_class, machine, params, module_params, draft=self.draft)
-        template = self.template(gear_class)
-        if "cycle_time" in params:   # a hobbing job: the time follows feeds edited since
+        model = model_for_class(self.conn, gear_class)
+        stored = job_id is not None   # a stored job is checked as a new one; a golden test's case runs as given
+        workpiece = self.workpiece(job_id, gear_id, hob_id, required=stored)
+        if stored and workpiece:
+            check_hobbing_job(job_id, gear_class, model, workpiece.gear, workpiece.hob, machine, params,
+                              module_params)
             check_program_name(self.conn, job_id, gear_id, params)
-            params = with_cycle_time(params, module_params, model_for_class(self.conn, gear_class).cut_shape, machine)
-        result = run_template(template, params, module_params, machine, self.workpiece(gear_id, hob_id))
-        return Planned(gear_id, gear_class, machine_name, hob_id, params, module_params, template, result,
-                       notes=stored_feed_notes(job_id, params, module_params))
+            check_hobbing_feeds(job_id, workpiece.gear, workpiece.hob, machine, params, module_params, bounded=False)
+        if "cycle_time" in params:   # the time follows feeds edited since
+            params = with_cycle_time(params, module_params, model.cut_shape, machine)
+        result = run_template(self.template(gear_class), params, module_params, machine, workpiece)
+        if stored and workpiece:
+            check_hobbing_feeds(job_id, workpiece.gear, workpiece.hob, machine, params, module_params)
+        return Planned(gear_id, gear_class, machine_name, hob_id, params, module_params, self.template(gear_class),
+                       result)
 
-    def workpiece(self, gear_id: int | None, hob_id: str | None) -> Workpiece | None:
+    def workpiece(self, job_id: int | None, gear_id: int | None, hob_id: str | None,
+                  required: bool) -> Workpiece | None:
         """The job's gear and hob as stored now (the simulation proves against the records, not
-        against job.params, which may have been edited)."""
+        against job.params, which may have been edited). A stored hobbing job names both."""
+        if (gear_id is None or hob_id is None) and required:
+            raise EngineError(f"job {job_id} is a hobbing job without a {'gear' if gear_id is None else 'hob'}: "
+                              "its program cannot be proved against the records; make a new job with "
+                              "`engine instantiate --gear ID`; nothing stored")
         if gear_id is None or hob_id is None:
             return None
         if self._hobs is None:
@@ -93,6 +112,10 @@ class Remaker:
         if hob is None:
             raise EngineError(f"hob {hob_id!r} of the job does not exist; see `engine hobs list`")
         return Workpiece(load_gear(self.conn, gear_id), hob)
+
+    def turning(self, gear_class: str) -> bool:
+        """Whether the class's model is a turning one (its jobs run on a lathe)."""
+        return isinstance(model_for_class(self.conn, gear_class), TurningModel)
 
     def modelled(self, gear_class: str) -> bool:
         """Whether the class has a model (hobbing, turning) that its jobs were computed with."""
@@ -115,6 +138,15 @@ class Remaker:
         if gear_class not in self._templates:
             self._templates[gear_class] = runnable_template(self.conn, gear_class, self.draft)
         return self._templates[gear_class]
+
+
+def check_machine_kind(job_id: int, gear_class: str, machine: Machine, turning: bool) -> None:
+    """A turning class's job runs on a lathe, a hobbing class's on a hobbing machine: a job stored
+    with the other kind would run one model's template on the other machine."""
+    if turning != (machine.kind == "lathe"):
+        wanted = "a lathe" if turning else "a hobbing machine"
+        raise EngineError(f"job {job_id}: machine {machine.name} is a {machine.kind}, class {gear_class!r} runs on "
+                          f"{wanted}; correct job.machine; nothing stored")
 
 
 def check_program_name(conn: Connection, job_id: int, gear_id: int, params: dict) -> None:
@@ -140,7 +172,7 @@ def instantiate_job(conn: Connection, job_id: int, *, output: Output = NO_FILE, 
     """Instantiate a stored job again with its stored (possibly edited) parameters, its file
     written to `output`. With `mode.dry_run`, the same checks, nothing stored
     (engine.programs.batches): the program returned. The batch fields of `mode` do not apply."""
-    refuse_out_in_dry_run(output, mode)
+    refuse_unfit_output(output, mode)
     if mode.dry_run:
         with read_only(conn):
             return dry_program(conn, Remaker(conn, mode.draft).remade(_stored_job(conn, job_id)), job_id)
