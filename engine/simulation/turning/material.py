@@ -13,7 +13,8 @@ followed in order (shapely geometry):
   above the path is air afterwards (a plunge removes its own line), widened by AIR_TOLERANCE_MM
   so a rapid back up the line a plunge just fed runs in air — as design notes §8 model the chip.
 
-The tolerances cover the program's rounding (X to 0.001 mm on the diameter, arc ends and
+The section is drawn on both sides of the axis (work.whole), so a cut along the axis runs inside
+the part, not on its edge. The tolerances cover the program's rounding (X to 0.001 mm on the diameter, arc ends and
 radius to 0.001 mm, so a centre moves by a few µm), far below a tool's touch."""
 from __future__ import annotations
 
@@ -23,7 +24,7 @@ from shapely.ops import unary_union
 
 from .follow import RAPID, THREAD, Move
 from .report import TurningReport
-from .work import TurningRecords
+from .work import TurningRecords, whole
 
 AIR_TOLERANCE_MM = 0.01
 CUT_TOLERANCE_MM = 0.005
@@ -42,7 +43,7 @@ def column(move: Move) -> BaseGeometry:
         if abs(z1 - z0) > 1e-9:
             pieces.append(Polygon([(z0, r0), (z1, r1), (z1, ABOVE_EVERYTHING_MM), (z0, ABOVE_EVERYTHING_MM)]))
         pieces.append(LineString([(z0, min(r0, r1)), (z0, ABOVE_EVERYTHING_MM)]))
-    return unary_union(pieces).buffer(AIR_TOLERANCE_MM)
+    return whole(unary_union(pieces).buffer(AIR_TOLERANCE_MM))
 
 
 def thread_band(drawn: BaseGeometry, line: BaseGeometry) -> BaseGeometry:

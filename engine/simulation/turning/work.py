@@ -9,8 +9,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+from shapely.affinity import scale
 from shapely.geometry import Polygon, box
 from shapely.geometry.base import BaseGeometry
+from shapely.ops import unary_union
 
 from ...errors import EngineError
 
@@ -46,15 +48,15 @@ class TurningRecords:
     threads: dict[int, BaseGeometry] = field(default_factory=dict)
 
     def blank(self, feed_radius: float, facing_zs: list[float]) -> BaseGeometry:
-        """The material before the first cut. Without a stored stock (fail closed, as the importer
-        assumes it): the profile's Z extent stretched to every Z a FACE operation feeds along X
-        at, and the larger of the profile's top + ASSUMED_BLANK_MARGIN_MM and the largest
+        """The material before the first cut (both sides of the axis). Without a stored stock
+        (fail closed, as the importer assumes it): the profile's Z extent stretched to every Z a
+        FACE operation feeds along X at, and the larger of the profile's top + ASSUMED_BLANK_MARGIN_MM and the largest
         radius the program feeds at."""
         if self.stock is not None:
             z_front, z_back, radius = self.stock
-            return box(z_back, 0.0, z_front, radius)
+            return box(z_back, -radius, z_front, radius)
         radius = max(self.top + ASSUMED_BLANK_MARGIN_MM, feed_radius)
-        return box(min([self.z_back, *facing_zs]), 0.0, max([self.z_front, *facing_zs]), radius)
+        return box(min([self.z_back, *facing_zs]), -radius, max([self.z_front, *facing_zs]), radius)
 
 
 def turning_records(params: dict, module_params: dict) -> TurningRecords:
@@ -96,12 +98,19 @@ def thread_region(paths, n: int) -> BaseGeometry:
 
 
 def part_polygon(outline: list[Point]) -> BaseGeometry:
-    """The finished part: the half-profile closed along the axis (r = 0) when it does not close itself."""
+    """The finished part: the half-profile closed along the axis (r = 0) when it does not close
+    itself, with its mirror image below the axis (whole(): the axis lies inside the part)."""
     points = list(outline)
     if math.dist(points[0], points[-1]) > 1e-6:
         points = [(points[0][0], 0.0), *points, (points[-1][0], 0.0)]
     polygon = Polygon(points)
-    return polygon if polygon.is_valid else polygon.buffer(0)
+    return whole(polygon if polygon.is_valid else polygon.buffer(0))
+
+
+def whole(half: BaseGeometry) -> BaseGeometry:
+    """A half-plane region with its mirror below the axis: a solid of revolution's section, in
+    which a point on the axis lies inside (not on the boundary of) the material around it."""
+    return unary_union([half, scale(half, yfact=-1.0, origin=(0.0, 0.0))])
 
 
 def profile_points(items, where: str) -> list[Point]:
