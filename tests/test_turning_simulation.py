@@ -193,3 +193,15 @@ def test_the_real_drawings_that_become_jobs_still_do(conn, name):
         program = instantiate_job(conn, job_id)
         params, modules = conn.execute("SELECT params, module_params FROM job WHERE id = %s", (job_id,)).fetchone()
         assert not simulate_turning(program.lines, params, modules, load_machine(conn, machine)).refused
+
+
+# --- engine simulate ------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("machine", [ISO, S840D])
+def test_engine_simulate_follows_a_stored_lathe_program(run, machine):
+    assert run("import-dxf", SAMPLE, "--machine", machine).exit_code == 0
+    assert run("instantiate", "--job", 1).exit_code == 0
+    simulated = run("simulate", "--program", 1)
+    assert simulated.exit_code == 0, simulated.output
+    assert simulated.stdout.strip().endswith("clean")
+    assert "rapid(s)" in simulated.stdout and "cut(s)" in simulated.stdout
