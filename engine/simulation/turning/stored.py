@@ -20,7 +20,8 @@ WHERE p.id = %s"""
 
 def simulate_stored_turning(conn: Connection, program_id: int, name: str, lines: list[str],
                             machine: Machine) -> TurningReport:
-    params, module_params = conn.execute(JOB_QUERY, (program_id,)).fetchone()
+    row = conn.execute(JOB_QUERY, (program_id,)).fetchone()
+    params, module_params = row if row is not None else (None, None)
     if not isinstance(params, dict) or "profile" not in params:
         raise EngineError(f"program {program_id} is a lathe program without a drawing (its job has no "
                           "params.profile): the simulation has no part to follow it against")
