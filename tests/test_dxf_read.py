@@ -215,7 +215,7 @@ def test_seed_convention_operations_and_codes(tmp_path):
     seed_drawing(tmp_path / "part.dxf")
     operations = read_drawing(tmp_path / "part.dxf").operations
     assert [(op.layer, op.kind) for op in operations] == [("1", "ROUGH"), ("2", "SLOT"), ("3", "THREAD")]
-    assert operations[0].codes == {"spindle_rpm": 100, "feed": 1300, "tool": 1, "coolant": True}
+    assert operations[0].codes == {"spindle_rpm": 1000, "feed": 300, "tool": 1, "coolant": True}
     assert operations[1].codes == {"spindle_rpm": 80, "feed": 20, "tool": 2, "coolant": False}
     assert operations[2].codes == {"spindle_rpm": 700, "tool": 3, "thread_pitch": 1.5,
                                    "depth_per_pass": 0.4, "infeed_angle": 30}

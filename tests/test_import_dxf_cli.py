@@ -80,15 +80,15 @@ def test_a_feed_edited_in_sql_changes_exactly_that_operation_s_f_words(run, tmp_
     job_id = json.loads(run("import-dxf", tmp_path / "part.dxf", "--json").stdout)["job_id"]
     before = run("instantiate", "--job", job_id).stdout.splitlines()
     with psycopg.connect(run.url) as conn:
-        conn.execute("""UPDATE job SET module_params = jsonb_set(module_params, '{cutmotion:2,feed}', '35')
+        conn.execute("""UPDATE job SET module_params = jsonb_set(module_params, '{cutmotion:2,feed}', '25')
                         WHERE id = %s""", (job_id,))
     after = run("instantiate", "--job", job_id).stdout.splitlines()
     assert len(after) == len(before)
     changed = [(b, a) for b, a in zip(before, after) if b != a]
     lineage = [(b, a) for b, a in changed if b.lstrip("(; ").startswith("PROGRAM ")]   # a new program, new INPUT
     assert len(lineage) == 1 and lineage[0][0].split(" INPUT ")[1] != lineage[0][1].split(" INPUT ")[1]
-    assert [pair for pair in changed if pair not in lineage] == [("G98 F20.000", "G98 F35.000")]
-    assert {word for _, word in feed_words(after)} - {word for _, word in feed_words(before)} == {"F35.000"}
+    assert [pair for pair in changed if pair not in lineage] == [("G98 F20.000", "G98 F25.000")]
+    assert {word for _, word in feed_words(after)} - {word for _, word in feed_words(before)} == {"F25.000"}
 
 
 def test_plot_writes_a_picture_of_the_job(run, tmp_path):

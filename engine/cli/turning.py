@@ -7,6 +7,12 @@ from dataclasses import asdict
 import click
 
 from ..errors import EngineError
+from ..machines.turning_cutting import (
+    DEFAULT_TOOL_MATERIAL,
+    DEFAULT_WORKPIECE_MATERIAL,
+    TOOL_MATERIALS,
+    WORKPIECE_MATERIALS,
+)
 from ..turning.defaults import DEFAULT_LATHE, PROFILE_DEFAULTS, STOCK_MARGIN
 from .context import connection, emit_json, keyed
 
@@ -51,13 +57,19 @@ POSITIVE = FiniteFloatRange(min=0, min_open=True)
 @click.option("--profile-layer", metavar="NAME",
               help="Layer holding the part's profile (CAD drawings often use 'outline' or 'Sketch') "
                    "[default: 0; when layer 0 is empty, the one layer with one contour on the axis].")
+@click.option("--material", type=click.Choice(WORKPIECE_MATERIALS),
+              help=f"Workpiece material (ISO 513 group), for the cutting-data check "
+                   f"[default: {DEFAULT_WORKPIECE_MATERIAL}]; stored as params.workpiece_material.")
+@click.option("--tool-material", type=click.Choice(TOOL_MATERIALS),
+              help=f"Tool material of every operation, for the cutting-data check "
+                   f"[default: {DEFAULT_TOOL_MATERIAL}]; stored as module_params prep:n.tool_material.")
 @click.option("--draft", is_flag=True,
               help="Check the job's program with the turning class's draft, not its released template.")
 @click.option("--json", "as_json", is_flag=True,
               help="Print one JSON object: job_id, operations, repairs, notes, ...")
 @click.pass_context
 def import_dxf_command(ctx, dxf_file, machine, rough_depth, allowance, tool, speed, feed, stock_diameter,
-                       alternate, program_name, profile_layer, draft, as_json):
+                       alternate, program_name, profile_layer, material, tool_material, draft, as_json):
     """Make DXF_FILE a turning job: profile on layer 0 (or --profile-layer), operation n on layer n with its @-codes.
 
     A part drawn whole about a centre line (a side view) is turned as its upper half-profile.
@@ -74,7 +86,7 @@ def import_dxf_command(ctx, dxf_file, machine, rough_depth, allowance, tool, spe
     options = ProfileOptions(rough_depth, allowance, tool, speed, feed, stock_diameter)
     with connection(ctx) as conn:
         report = import_dxf(conn, dxf_file, machine, options, parse_pair(alternate), program_name, draft,
-                            profile_layer)
+                            profile_layer, (tool_material, material))
     if as_json:
         emit_json(keyed(asdict(report)))
         return

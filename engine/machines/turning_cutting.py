@@ -1,4 +1,4 @@
-"""Turning cutting data (docs/reference/hobbing.md §E6): the window of cutting speed vc (m/min)
+"""Turning cutting data (docs/reference/hobbing.md §E1): the window of cutting speed vc (m/min)
 and feed per revolution f (mm/rev) a tool maker or handbook gives for one operation, tool
 material and workpiece material group (ISO 513: P steel, K cast iron, N aluminium), and the
 check of a cut against it. Both the turning planner (an early warning) and the turning
@@ -11,10 +11,11 @@ f = F/n for a feed F in mm/min (G94). What is refused:
 * f outside the window: above it the edge or the insert breaks; below it the edge rubs, and
   a feed that far below is usually mm/rev written where mm/min is meant.
 vc below the window is not refused: at a constant spindle speed vc falls to zero towards the
-axis ("cutting speed declines to zero at the centre", Sandvik Coromant, parting and grooving
-guide), and a small part on a lathe whose spindle cannot reach the window runs below it; a low
-speed wears a tool sooner but overloads nothing. A thread's feed per revolution is its lead,
-so for THREAD only vc is bounded.
+axis ("cutting speed declines to zero at the centre", a tool maker's parting-and-grooving
+guide, scribd.com/document/230044235), and a small part on a lathe whose spindle cannot reach
+the window runs below it; a low speed wears a tool sooner but overloads nothing. A thread's
+feed per revolution is its lead, so for THREAD only vc is bounded. Callers pass vc at the
+largest diameter an operation (or a move) cuts at, where a constant spindle speed is fastest.
 """
 from __future__ import annotations
 
@@ -31,7 +32,7 @@ FPM = 0.3048                           # m/min per ft/min
 IPR = 25.4                             # mm/rev per in/rev
 RELATIVE_TOLERANCE = 1e-9              # F45 at S900 is 0.05 mm/rev, on the window's edge, not past it
 
-# The sources (hobbing.md §E6 gives each in full).
+# The sources (hobbing.md §E1 gives each in full).
 KORLOY = "Korloy ISO P turning table (hooguu.com, turning parameter calculator), P10-P50"
 MITSUBISHI = "Mitsubishi Materials catalogue 2020-2021 p. A014, mild steel, F and L cutting"
 KENNAMETAL = "Kennametal recommended starting speeds, turning (publications.dgisupply.com/view/344098998/5)"
@@ -61,8 +62,10 @@ _CARBIDE_STEEL_FINISH = _w(120, 500, 0.05, 0.013 * IPR, KORLOY, MITSUBISHI)
 # 1800 ft/min at .004 in/rev, feeds .004-.020 in/rev.
 _CARBIDE_IRON_TURN = _w(60, 1800 * FPM, 0.004 * IPR, 0.020 * IPR, EASYENG, KENNAMETAL)
 _CARBIDE_IRON_FINISH = _w(90, 1800 * FPM, 0.05, 0.020 * IPR, EASYENG, KENNAMETAL)
-# Carbide, aluminium (N): Kennametal N1-N3 400-6900 ft/min, feeds .004-.016 in/rev.
+# Carbide, aluminium (N): Kennametal N1-N3 400-6900 ft/min, feeds .004-.016 in/rev; finishing
+# down to easyengcalc's carbide finishing feed 0.05 mm/rev (its steel and cast-iron rows).
 _CARBIDE_AL_TURN = _w(400 * FPM, 6900 * FPM, 0.004 * IPR, 0.016 * IPR, KENNAMETAL)
+_CARBIDE_AL_FINISH = _w(400 * FPM, 6900 * FPM, 0.05, 0.016 * IPR, KENNAMETAL, EASYENG)
 # HSS (easyengcalc): steel rough 35-45, finish 50-70; cast iron 18-25, 30-35; aluminium
 # 150-200, 200-250 m/min; rough feed 0.2-0.3 mm/rev. Its finishing feed is "1/3 of the tool
 # width" (a broad tool): bounded here by 0.025 mm/rev (its finishing depth) and the rough 0.3.
@@ -71,7 +74,7 @@ _HSS = {"steel": (35, 45, 50, 70), "cast-iron": (18, 25, 30, 35), "aluminium": (
 
 def _carbide_rows() -> dict[tuple[str, str, str], Window]:
     turn = {"steel": _CARBIDE_STEEL_TURN, "cast-iron": _CARBIDE_IRON_TURN, "aluminium": _CARBIDE_AL_TURN}
-    finish = {"steel": _CARBIDE_STEEL_FINISH, "cast-iron": _CARBIDE_IRON_FINISH, "aluminium": _CARBIDE_AL_TURN}
+    finish = {"steel": _CARBIDE_STEEL_FINISH, "cast-iron": _CARBIDE_IRON_FINISH, "aluminium": _CARBIDE_AL_FINISH}
     groove = {"steel": _w(70, 220, 0.05, 0.35, KYOCERA), "cast-iron": _w(70, 200, 0.05, 0.45, KYOCERA),
               "aluminium": _w(200, 500, 0.05, 0.30, KYOCERA)}
     thread = {"steel": _w(25, 230, None, None, ISCAR), "cast-iron": _w(30, 190, None, None, ISCAR),

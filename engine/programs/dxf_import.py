@@ -43,10 +43,12 @@ class ImportReport:
 
 def import_dxf(conn: Connection, path: str | Path, machine_name: str | None = None,
                options: ProfileOptions = ProfileOptions(), alternate: list[int] | None = None,
-               program_name: str | None = None, draft: bool = False, profile_layer: str | None = None) -> ImportReport:
+               program_name: str | None = None, draft: bool = False, profile_layer: str | None = None,
+               materials: tuple[str | None, str | None] = (None, None)) -> ImportReport:
     """Read the drawing and store its job; EngineError (nothing stored) if it cannot become one.
     The program is named `program_name`, else after the drawing's file name (job_params.drawing_names);
-    the profile is read from layer `profile_layer` (None: layer 0, or the layer read_drawing chooses)."""
+    the profile is read from layer `profile_layer` (None: layer 0, or the layer read_drawing chooses);
+    `materials`: (tool material, workpiece material) for the cutting-data table, None = default."""
     # said before the drawing's own problems
     checked("drawing", Path(path).name, "drawing file name", "rename the file")
     if program_name is not None:
@@ -54,16 +56,19 @@ def import_dxf(conn: Connection, path: str | Path, machine_name: str | None = No
     machine = lathe(conn, machine_name)
     gear_class = turning_class(machine)
     with no_cycle_collection():   # a large drawing: the profile, its parameters and passes
-        return _import(conn, (path, profile_layer), machine, gear_class, options, alternate, program_name, draft)
+        return _import(conn, (path, profile_layer), machine, gear_class, options, (alternate, program_name, materials),
+                       draft)
 
 
-def _import(conn: Connection, source: tuple, machine, gear_class: str, options: ProfileOptions, alternate, program_name,
+def _import(conn: Connection, source: tuple, machine, gear_class: str, options: ProfileOptions, choices: tuple,
             draft: bool) -> ImportReport:
+    alternate, program_name, materials = choices
     drawing = read_drawing(*source)   # (path, profile layer)
     with conn.transaction():
         job_id = scalar(conn.execute("SELECT nextval('job_id_seq')"))
         program_number = (job_id - 1) % ISO_PROGRAM_NUMBERS + 1    # the job id, wrapped into O0001 … O8999
-        job = turning_job(drawing, machine.name, gear_class, program_number, options, alternate, program_name)
+        job = turning_job(drawing, machine.name, gear_class, program_number, options, alternate, program_name,
+                          materials)
         passes = job_passes(job.params, job.module_params)
         planned = plan_turning_job(conn, gear_class, machine, job.params, job.module_params, passes, draft)
         conn.execute(INSERT_TURNING_JOB, (job_id, gear_class, machine.name, Jsonb(job.params),

@@ -14,7 +14,3 @@ DEFAULT_INFEED_ANGLE = 0.0   # degrees, a thread layer without @A: radial infeed
 # Profile-only drawings: radial depth per rough pass (mm), allowance left by roughing (mm),
 # tool, spindle (r/min), feed (mm/min).
 PROFILE_DEFAULTS = {"rough_depth": 1.0, "allowance": 0.2, "tool": 1, "speed": DEFAULT_SPEED, "feed": DEFAULT_FEED}
-
-# Plausibility, a note and not a refusal: turning feeds beyond this per revolution (F/S) are
-# rare; a larger one is usually mm/rev written where mm/min is meant, or an inch value.
-FEED_PER_REV_NOTE = 2.0      # mm/rev

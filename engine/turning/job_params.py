@@ -12,6 +12,7 @@ from typing import Any
 from ..drawings.drawing import Drawing, Operation
 from ..drawings.profile import merged_bounds
 from ..errors import EngineError
+from ..machines.turning_cutting import DEFAULT_TOOL_MATERIAL, DEFAULT_WORKPIECE_MATERIAL, job_materials
 from ..names import NAME_RULES, checked, is_safe, shown
 from .defaults import (
     CLEARANCE,
@@ -19,7 +20,6 @@ from .defaults import (
     DEFAULT_INFEED_ANGLE,
     DEFAULT_SPEED,
     DEFAULT_THREAD_DEPTH_PER_PASS,
-    FEED_PER_REV_NOTE,
     PROFILE_DEFAULTS,
     STOCK_MARGIN,
     TOOL_CHANGE_DISTANCE,
@@ -61,7 +61,10 @@ class TurningJob:
 
 def turning_job(drawing: Drawing, machine: str, gear_class: str, program_number: int,
                 options: ProfileOptions = ProfileOptions(), alternate: list[int] | None = None,
-                program_name: str | None = None) -> TurningJob:
+                program_name: str | None = None, materials: tuple[str | None, str | None] = (None, None)
+                ) -> TurningJob:
+    """`materials`: (tool material of every operation, workpiece material), None = the default
+    (engine.machines.turning_cutting; reference §E1)."""
     job = TurningJob({}, {})
     if drawing.scale_to_mm != 1.0:
         job.notes.append(f"{drawing.units} drawing: lengths scaled ×{drawing.scale_to_mm:g} to mm; the @-codes "
@@ -83,7 +86,20 @@ def turning_job(drawing: Drawing, machine: str, gear_class: str, program_number:
         stock_diameter = blank_diameter(drawing, options)
     names = drawing_names(drawing.source.name, program_name)
     job.params = job_params(drawing, names, machine, gear_class, program_number, stock_diameter, alternate, job.notes)
+    add_materials(job, *materials)
     return job
+
+
+def add_materials(job: TurningJob, tool_material: str | None, workpiece_material: str | None) -> None:
+    """params.workpiece_material and each prep:n.tool_material, stored so SQL can change them (the
+    cutting-data windows of reference §E1 depend on them); unknown names refused here, at import."""
+    job.params["workpiece_material"] = workpiece_material or DEFAULT_WORKPIECE_MATERIAL
+    for name, values in job.module_params.items():
+        if name.startswith("prep:"):
+            values["tool_material"] = tool_material or DEFAULT_TOOL_MATERIAL
+    for name in job.module_params:
+        if name.startswith("prep:"):
+            job_materials(job.params, job.module_params, int(name.partition(":")[2]))
 
 
 def _layers(drawing: Drawing) -> str:
@@ -186,10 +202,6 @@ def add_operation(job: TurningJob, n: int, tool: int, speed: float, coolant: boo
     job.module_params[key("prep", n)] = {"tool": tool, "tool_offset": tool, "op_present": True}
     job.module_params[key("cutcond", n)] = {"spindle_rpm": speed, "coolant": coolant, "op_present": True}
     job.module_params[key("cutmotion", n)] = cutmotion
-    feed = cutmotion.get("feed")
-    if feed and speed and feed / speed > FEED_PER_REV_NOTE:
-        job.notes.append(f"operation {n} ({source}): F{feed:g} mm/min at S{speed:g} is {feed / speed:.3g} mm/rev, "
-                         f"more than {FEED_PER_REV_NOTE:g} mm/rev; check that @F is mm/min")
     job.operations.append({"operation": n, "kind": cutmotion["kind"], "source": source, "tool": tool,
                            "spindle_rpm": speed, "feed": cutmotion.get("feed"), "coolant": coolant,
                            "paths": len(cutmotion["paths"])})

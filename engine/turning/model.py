@@ -15,6 +15,7 @@ from ..names import NAME_RULES, is_safe, shown
 from ..nc.words import MAX_TOOL
 from . import toolpaths
 from .arc_split import with_short_arcs
+from .cutting_check import check_cutting_data
 from .material import check_job_rapids
 from .moves import Move, Pass
 from .names import MAX_OPERATIONS
@@ -68,6 +69,7 @@ def planned_passes(params: dict, module_params: dict) -> tuple[JobGeometry, dict
     check_turnable_from_outside(geometry.edges, f"drawing {params.get('drawing') or '(params.profile)'}")
     passes = {n: operation_passes(geometry, module_params[key("cutmotion", n)], f"module_params.cutmotion:{n}")
               for n in present}
+    check_cutting_data(params, module_params, passes)
     pair = alternated_pair(params, module_params, passes)
     if pair:
         first, second = pair

@@ -65,7 +65,7 @@ def nc_arc_words(name: str) -> list[str]:
 INCH = 25.4
 
 
-def seed_drawing(path: Path, *, rough_codes="@GROUGH @S100 @F1300 @T01 @M8", layer2_codes="@GSLOT\\P@S80 @F20 @T02 @M9",
+def seed_drawing(path: Path, *, rough_codes="@GROUGH @S1000 @F300 @T01 @M8", layer2_codes="@GSLOT\\P@S80 @F20 @T02 @M9",
                  fmt="asc") -> dict[str, str]:
     """A drawing in the seed-000 convention, in inches; returns handles of interest."""
     doc = ezdxf.new("R2010")
