@@ -18,6 +18,7 @@ from engine.machines.records import load_machine
 from engine.programs.dxf_import import import_dxf
 from engine.programs.remake import instantiate_job
 from engine.release.gate import release
+from engine.release.impact import impact
 from engine.simulation.turning.run import simulate_turning
 from engine.turning.job_params import ProfileOptions
 
@@ -90,6 +91,17 @@ def test_an_editor_row_rapid_through_the_stock_is_refused_by_instantiate_and_the
     rapid = "G00 X0.000 Z10.000" if machine == ISO else "G0 X0.000 Z10.000"
     conn.execute(INSERT, (CLASS[machine], AFTER_PATH, "cutmotion", 1, f'"{rapid}"', "op_present"))
     refused_everywhere(conn, machine, drawing, SHAFT_OPTIONS, "a rapid through material")
+
+
+@pytest.mark.parametrize("machine", [ISO, S840D])
+def test_the_impact_names_the_stored_turning_job_the_draft_would_send_through_its_stock(conn, tmp_path, machine):
+    job_id = import_dxf(conn, shaft_drawing(tmp_path / "shaft.dxf"), machine, SHAFT_OPTIONS).job_id
+    instantiate_job(conn, job_id)
+    rapid = "G00 X0.000 Z10.000" if machine == ISO else "G0 X0.000 Z10.000"
+    conn.execute(INSERT, (CLASS[machine], AFTER_PATH, "cutmotion", 1, f'"{rapid}"', "op_present"))
+    failures = impact(conn, CLASS[machine]).failures
+    assert [failure.job_id for failure in failures] == [job_id]
+    assert "a rapid through material" in failures[0].error
 
 
 # --- the other emitted-line forms, on the seeded sample drawing ------------------------------------
