@@ -57,9 +57,14 @@ def run_template(template: Template, params: dict, module_params: dict, machine:
     verify_program(result.lines, machine, name)
     if machine.kind == "hobber":
         prove(result.lines, machine, workpiece, name or "the program")
-    elif machine.kind == "lathe" and (workpiece is not None or template.gear_class in TURNING_CLASSES):
+    elif machine.kind == "lathe" and (workpiece is not None or from_drawing(template, params)):
         prove_lathe(result.lines, machine, workpiece, name or "the program")
     return result
+
+
+def from_drawing(template: Template, params) -> bool:
+    """A turning class's job, or any job whose parameters carry a drawing's profile."""
+    return template.gear_class in TURNING_CLASSES or (isinstance(params, dict) and "profile" in params)
 
 
 def prove_lathe(lines: list[str], machine: Machine, work: Workpiece | TurningWork | None, name: str) -> None:
