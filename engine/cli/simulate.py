@@ -1,5 +1,6 @@
 """`engine simulate --program ID`: follow a stored hobbing program against its gear, hob and
-machine and say what it proves (engine.simulation)."""
+machine, or a stored lathe program against its job's drawing and blank, and say what it proves
+(engine.simulation)."""
 from __future__ import annotations
 
 import click
@@ -13,10 +14,13 @@ from .ids import PROGRAM_ID
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object on one line.")
 @click.pass_context
 def simulate(ctx, program_id, as_json):
-    """Simulate a stored hobbing program: collisions of the hob (tip cylinder, length, swivel)
+    """Simulate a stored hobbing or turning program: collisions of the hob (tip cylinder, length, swivel)
     with the blank, its units, the fixture and the tailstock; the teeth, hand and lead the
     coupling generates and the swivel, against the gear; depth, stock and run-out per cut; the
-    table speed; the feed per workpiece revolution; the cycle time against the header.
+    table speed; the feed per workpiece revolution; the cycle time against the header. A lathe
+    program (a job from a drawing): rapids through the blank or the part, cuts into the part,
+    thread passes outside the drawn thread, tool changes away from the job's position, cuts with
+    the spindle stopped, and feed per revolution and cutting speed against the cutting-data table.
 
     One line per finding, then the summary. Exit 1 when the simulation refuses the program, or
     when its lines are not the rendering of the template version and job it names (MISMATCH),

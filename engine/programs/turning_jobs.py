@@ -1,5 +1,6 @@
 """A turning job's program in memory: template rows run with the job's parameters and the
-passes computed from them, then checked against the lathe. Nothing is stored here."""
+passes computed from them, then checked against the lathe and proved by the turning simulation
+against the job's stored parameters (engine.programs.verified_run). Nothing is stored here."""
 from __future__ import annotations
 
 from typing import TYPE_CHECKING
@@ -7,7 +8,7 @@ from typing import TYPE_CHECKING
 from ..errors import EngineError
 from ..machines.records import Machine, load_machine
 from ..programs.records import Planned
-from ..programs.verified_run import run_template
+from ..programs.verified_run import TurningWork, run_template
 from ..templates.versions import runnable_template
 from ..turning.defaults import DEFAULT_LATHE
 from ..turning.model import template_module_params
@@ -43,5 +44,5 @@ def plan_turning_job(conn: Connection, gear_class: str, machine: Machine, params
     draft, not its released template."""
     template = runnable_template(conn, gear_class, draft)
     extended = template_module_params(params, module_params, passes)
-    result = run_template(template, params, extended, machine)
+    result = run_template(template, params, extended, machine, TurningWork(params, module_params))
     return Planned(None, gear_class, machine.name, None, params, module_params, template, result)

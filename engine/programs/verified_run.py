@@ -2,7 +2,10 @@
 table of a program that may be stored is made (new gears, stored jobs made again, turning jobs
 from drawings), so no route stores lines the verifier has not read. On a hobber the program is
 also simulated against the gear and hob records (engine.simulation): nothing the simulation
-refuses is stored. The records come from the database, not from the job's parameters, which
+refuses is stored. A turning job's program (a drawing's job, classes turning_iso/turning_840d)
+is simulated against the job's stored records (engine.simulation.turning: its profile, blank,
+tool-change position and operations), read from its params and module_params as stored, not
+from the passes the planner computed. The records come from the database, not from the job's parameters, which
 a runner may have edited. The one exception is a class job stored with --unverified
 (engine.programs.class_jobs): its record and lineage line say UNVERIFIED, and it is never
 written to a file for the machine."""
@@ -15,6 +18,7 @@ from ..gears.records import Gear, Hob
 from ..machines.records import Machine
 from ..nc.lineage import refuse_lineage_shaped
 from ..simulation import SimulationError, simulate_program
+from ..simulation.turning.run import simulate_turning
 from ..templates.decision_table import Result, compiled_template
 from ..templates.rows import Template
 from ..verifier import verify_program
@@ -27,10 +31,25 @@ class Workpiece:
     hob: Hob
 
 
+@dataclass(frozen=True, slots=True)
+class TurningWork:
+    """What a lathe program is proved against: the job's parameters and module parameters as
+    stored (the drawing's profile, the blank, the tool-change position, the operations)."""
+    params: dict
+    module_params: dict
+
+
+# The classes whose jobs come from drawings (engine.programs.turning_jobs): their programs must be
+# proved by the turning simulation. A class job on a lathe (a class without a model) has no drawing
+# to be proved against: the verifier reads it alone.
+TURNING_CLASSES = frozenset({"turning_iso", "turning_840d"})
+
+
 def run_template(template: Template, params: dict, module_params: dict, machine: Machine,
-                 workpiece: Workpiece | None = None) -> Result:
+                 workpiece: Workpiece | TurningWork | None = None) -> Result:
     """Evaluate the decision table, verify the program for the machine (engine.verifier)
-    and, on a hobber, prove it by simulation against `workpiece`."""
+    and prove it by simulation: on a hobber against the gear and hob `workpiece`, on a lathe
+    (a turning class's job) against the job's records `workpiece`."""
     result = compiled_template(template).run(params, module_params)
     name = params.get("program_name") if isinstance(params, dict) else None
     name = name if isinstance(name, str) else None
@@ -38,12 +57,29 @@ def run_template(template: Template, params: dict, module_params: dict, machine:
     verify_program(result.lines, machine, name)
     if machine.kind == "hobber":
         prove(result.lines, machine, workpiece, name or "the program")
+    elif machine.kind == "lathe" and (workpiece is not None or from_drawing(template, params)):
+        prove_lathe(result.lines, machine, workpiece, name or "the program")
     return result
 
 
-def prove(lines: list[str], machine: Machine, workpiece: Workpiece | None, name: str) -> None:
+def from_drawing(template: Template, params) -> bool:
+    """A turning class's job, or any job whose parameters carry a drawing's profile."""
+    return template.gear_class in TURNING_CLASSES or (isinstance(params, dict) and "profile" in params)
+
+
+def prove_lathe(lines: list[str], machine: Machine, work: Workpiece | TurningWork | None, name: str) -> None:
+    """SimulationError (nothing stored) for a lathe program the turning simulation refuses."""
+    if not isinstance(work, TurningWork):
+        raise EngineError(f"{name}: a turning program needs its job's records (profile, blank, operations) to be "
+                          "proved by the simulation; nothing stored")
+    report = simulate_turning(lines, work.params, work.module_params, machine, name)
+    if report.refused:
+        raise SimulationError(f"{report.error()}; nothing stored")
+
+
+def prove(lines: list[str], machine: Machine, workpiece: Workpiece | TurningWork | None, name: str) -> None:
     """SimulationError (nothing stored) for a program the simulation refuses."""
-    if workpiece is None:
+    if not isinstance(workpiece, Workpiece):
         raise EngineError(f"{name}: a hobbing program needs its gear and hob to be proved by the simulation; "
                           "nothing stored")
     report = simulate_program(lines, workpiece.gear, workpiece.hob, machine, name)

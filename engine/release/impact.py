@@ -1,7 +1,9 @@
 """What a release would change on the shop floor (issue 15): every stored job of a class and of
 its descendants made again with the draft template and compared with its program from the
 released version. Template rows only (as engine.programs.remake makes a stored job again,
-without the verifier and the simulation, which the gate does not need to see a line change).
+without the verifier and the hobbing simulation, which the gate does not need to see a line
+change). A turning job's draft program is followed by the turning simulation (issue 26): a draft
+whose program for a stored job it refuses is named as failing for that job.
 
 The released program is the job's latest stored one (its lineage line left out) when it was made
 from the released version from the job's current parameters; otherwise the released template is
@@ -23,6 +25,7 @@ from ..machines.records import load_machine
 from ..nc.layout import ENDING_NAMES, NcLayout
 from ..nc.lineage import without_lineage
 from ..programs import all_models  # noqa: F401  (registers every model)
+from ..simulation.turning.run import simulate_turning
 from ..templates.decision_table import compiled_template
 from ..templates.history import layout_change
 from ..templates.rows import Template
@@ -187,7 +190,9 @@ class _Made:
     def draft_lines(self, key: tuple) -> list[str] | EngineError:
         if key not in self.drafts:
             try:
-                self.drafts[key] = compiled_template(self.pairs[key[0]][1]).run(*self.inputs.of(*key)).lines
+                lines = compiled_template(self.pairs[key[0]][1]).run(*self.inputs.of(*key)).lines
+                self.inputs.prove_turning(key, lines)
+                self.drafts[key] = lines
             except EngineError as error:
                 self.drafts[key] = error
         return self.drafts[key]
@@ -227,6 +232,19 @@ class _JobInputs:
 
             params = with_cycle_time(params, modules, self.cut_shape(gear_class), machine)
         return params, modules
+
+    def prove_turning(self, key: tuple, lines: list[str]) -> None:
+        """A turning job's draft program followed by the turning simulation against the job's stored
+        records, as engine.programs.verified_run proves it: SimulationError if it is refused."""
+        gear_class, machine_name, params_text, modules_text = key
+        machine = self.machine(machine_name)
+        params = json.loads(params_text)
+        if machine.kind != "lathe" or not isinstance(params, dict) or "profile" not in params:
+            return
+        report = simulate_turning(lines, params, json.loads(modules_text or "{}"), machine,
+                                  params.get("program_name") or "the program")
+        if report.refused:
+            raise report.error()
 
     def cut_shape(self, gear_class: str) -> str:
         if gear_class not in self.shapes:

@@ -5,9 +5,8 @@ the blank, its units, the fixture and the tailstock; the coupling's teeth, hand 
 swivel against the gear; the depth per cut, the run-out, the table speed, the feed per workpiece
 revolution and the cycle time.
 
-One part per machine kind, each in its subfolder: hobbing/ (the only kind whose programs are
-simulated today; a lathe program's rapids are checked against the blank by
-engine.turning.material). A second kind gets a subfolder beside it. The simulation imports the
+One part per machine kind, each in its subfolder: hobbing/, and turning/ (a lathe program
+against its job's drawing, blank and operations: engine.simulation.turning.run). The simulation imports the
 verifier's reader, never the models that made the program (engine.hobbing, engine.turning):
 tests/test_house.py enforces it."""
 from .hobbing.report import Finding, Report, SimulationError

@@ -1,5 +1,6 @@
 """A stored program simulated against the records of its job (`engine simulate --program ID`):
-its lines, the job's gear (with its units), hob and machine as the database holds them now."""
+its lines, the job's gear (with its units), hob and machine as the database holds them now; a
+lathe program is handed to the turning simulation (engine.simulation.turning.stored)."""
 from __future__ import annotations
 
 from typing import TYPE_CHECKING
@@ -25,6 +26,10 @@ def simulate_stored_program(conn: Connection, program_id: int) -> Report:
         raise EngineError(f"program {program_id} does not exist; see `SELECT id, name FROM program`")
     name, lines, gear_id, hob_id, machine_name = row
     machine = load_machine(conn, machine_name)
+    if machine.kind == "lathe":
+        from ..turning.stored import simulate_stored_turning  # the lathe's part of the simulation
+
+        return simulate_stored_turning(conn, program_id, name, list(lines), machine)
     if machine.kind != "hobber" or gear_id is None or hob_id is None:
         raise EngineError(f"program {program_id} is not a hobbing program (machine {machine_name}, "
                           f"gear {gear_id}, hob {hob_id}): the simulation follows hobbing programs only")

@@ -1,0 +1,142 @@
+"""The lathe program followed block by block as the control runs it: the tool's position (X a
+diameter, turned into the radius r = X/2 of the (z, r) half-plane), the spindle, the feed
+mode, the operation the block belongs to, and every tool change. What refuses here needs no
+geometry of the material: a tool change away from the job's tool-change position (the turret
+swings its tools out there: anywhere else one of them hits the part or the chuck), a cut with
+the spindle stopped or turning against the tool (the templates' outside tools cut with M03,
+design notes §8), a thread pass in an operation that is not a THREAD, an operation comment or
+a tool word that is not the job's. Each motion is handed on as a Move for the material walk."""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from ...verifier.arcs import arc_centre
+from .report import TurningReport
+from .work import Point, TurningRecords, arc_points
+
+RAPID, FEED, THREAD = "rapid", "feed", "thread"
+MOTIONS = {0: RAPID, 1: FEED, 2: FEED, 3: FEED, 32: THREAD, 33: THREAD}
+CUTTING_DIRECTION = 3        # M03: the direction the templates' outside turning tools cut in
+TOOL_CHANGE_TOLERANCE_MM = 0.01
+PER_MINUTE, PER_REVOLUTION = (94, 98), (95, 99)   # 840D G94/G95, ISO G98/G99
+
+
+@dataclass(frozen=True)
+class Move:
+    number: int
+    line: str
+    kind: str                 # rapid, feed or thread
+    points: list[Point]       # (z, r) along the move, start first
+    operation: int | None
+    speed: float | None       # S in r/min (G97), or m/min under G96
+    constant_speed: bool      # G96
+    feed: float | None        # F as written
+    per_minute: bool          # G94/G98
+    lead: float | None        # a thread's lead, mm/rev
+
+
+class ProgramState:
+    def __init__(self, records: TurningRecords, report: TurningReport, iso: bool):
+        self.records, self.report, self.iso = records, report, iso
+        x, z = records.tool_change
+        self.x, self.z = x, z            # a program starts where the last left the turret: at the change
+        self.spindle: int | None = None  # 3, 4 or None (stopped)
+        self.speed: float | None = None
+        self.constant_speed = False
+        self.feed: float | None = None
+        self.per_minute = True
+        self.motion: int | None = None
+        self.operation: int | None = None
+        self.moves: list[Move] = []
+
+    def take(self, step) -> None:
+        if step.operation is not None:
+            self._operation(step)
+        if step.block is None:
+            return
+        self._modes(step)
+        if "T" in step.block.values:
+            self._tool_change(step)
+        if step.block.motion is not None:
+            self.motion = step.block.motion
+        if step.block.moves and self.motion in MOTIONS:
+            self._move(step)
+
+    def _operation(self, step) -> None:
+        n, kind = step.operation
+        known = self.records.operations.get(n)
+        if known is None or known.kind != kind:
+            said = "no such operation" if known is None else f"operation {n} is {known.kind}"
+            self.report.add(step.number, step.line, f"the comment names operation {n} {kind}, but the job's "
+                            f"records say {said}: the simulation cannot tell what this part of the program cuts")
+            self.operation = None
+            return
+        self.operation = n
+
+    def _modes(self, step) -> None:
+        block, g, m = step.block, step.g_codes, step.m_codes
+        if block.speed is not None:
+            self.speed = block.speed
+        self.constant_speed = (self.constant_speed or 96 in g) and 97 not in g
+        if g & set(PER_MINUTE) or g & set(PER_REVOLUTION):
+            self.per_minute = bool(g & set(PER_MINUTE))
+        if block.feed is not None:
+            self.feed = block.feed
+        if m & {3, 4}:
+            self.spindle = 3 if 3 in m else 4
+        if 5 in m or 30 in m:
+            self.spindle = None
+
+    def _tool_change(self, step) -> None:
+        block = step.block
+        x, z = block.positions.get("X", self.x), block.positions.get("Z", self.z)
+        want_x, want_z = self.records.tool_change
+        if abs(x - want_x) > TOOL_CHANGE_TOLERANCE_MM or abs(z - want_z) > TOOL_CHANGE_TOLERANCE_MM:
+            self.report.add(step.number, step.line, f"a tool change at X{x:.3f} Z{z:.3f}, away from the job's "
+                            f"tool-change position X{want_x:.3f} Z{want_z:.3f} (params.tool_change_x/_z): "
+                            "the turret swings its tools there only")
+        tool = _tool_number(block.values["T"], self.iso)
+        op = self.records.operations.get(self.operation) if self.operation else None
+        if op is not None and op.tool is not None and tool != op.tool:
+            self.report.add(step.number, step.line, f"tool {tool} in operation {op.number}, whose tool is "
+                            f"{op.tool} (module_params.prep:{op.number}.tool)")
+
+    def _move(self, step) -> None:
+        block, motion = step.block, self.motion
+        assert motion is not None   # take() moves only with a motion in force
+        start = (self.z, self.x / 2.0)
+        self.x, self.z = block.positions.get("X", self.x), block.positions.get("Z", self.z)
+        end = (self.z, self.x / 2.0)
+        kind = MOTIONS[motion]
+        points = [start, end]
+        if motion in (2, 3):
+            radius = block.values.get("R", block.values.get("CR"))
+            if radius is not None and math.dist(start, end) > 0:
+                points = arc_points(start, end, arc_centre(start, end, radius, motion == 3), motion == 3)
+        lead = block.values.get("K", block.values.get("F")) if kind == THREAD else None
+        if kind != RAPID:
+            self._check_cut(step, kind)
+        self.moves.append(Move(step.number, step.line, kind, points, self.operation, self.speed,
+                               self.constant_speed, self.feed, self.per_minute, lead))
+
+    def _check_cut(self, step, kind: str) -> None:
+        what = "a thread pass" if kind == THREAD else "a cut"
+        if self.spindle is None:
+            self.report.add(step.number, step.line, f"{what} with the spindle stopped (no M03 since the start "
+                            "or the last M05): the tool is driven into a standing part")
+        elif self.spindle != CUTTING_DIRECTION:
+            self.report.add(step.number, step.line, f"{what} with the spindle turning M0{self.spindle}: the "
+                            f"job's outside turning tools cut with M0{CUTTING_DIRECTION}")
+        op = self.records.operations.get(self.operation) if self.operation else None
+        if op is None:
+            self.report.add(step.number, step.line, f"{what} outside any of the job's operations (no "
+                            "operation comment OP n KIND before it): the simulation cannot tell what it may cut")
+        elif kind == THREAD and op.kind != "THREAD":
+            self.report.add(step.number, step.line, f"{what} in operation {op.number} {op.kind}: threads are cut "
+                            "only in a THREAD operation, along the drawn thread")
+
+
+def _tool_number(value: float, iso: bool) -> int:
+    """ISO T0707: tool 7, offset 7 (reference §E); 840D T7 with its D word apart."""
+    return int(value) // 100 if iso else int(value)

@@ -1,0 +1,93 @@
+"""The material walk: the (z, r) half-plane (r ≥ 0) holds the blank minus what the tool has
+removed; the finished part (never to be cut) lies inside it. Every move of the program is
+followed in order (shapely geometry):
+
+* a rapid (G0/G00) must run through air: one that runs more than AIR_TOLERANCE_MM through the
+  material left or the part is refused (a rapid into material breaks the tool or the machine);
+* a cut (G1/G2/G3, a thread pass G32/G33) must not enter the finished part by more than
+  CUT_TOLERANCE_MM; a thread pass must touch the drawn thread (its THREAD operation's crest and
+  root lines) and may run inside the part only between the root's and the crest's radius, over
+  the drawn thread and its run-in from where the pass starts (a thread is cut from the part's
+  free end, design notes §8); the thread's groove is air for the rapid that pulls the tool out;
+* what a cut removes: an outside tool's body stands radially above its tip, so the column
+  above the path is air afterwards (a plunge removes its own line), widened by AIR_TOLERANCE_MM
+  so a rapid back up the line a plunge just fed runs in air — as design notes §8 model the chip.
+
+The section is drawn on both sides of the axis (work.whole), so a cut along the axis runs inside
+the part, not on its edge. The tolerances cover the program's rounding (X to 0.001 mm on the diameter, arc ends and
+radius to 0.001 mm, so a centre moves by a few µm), far below a tool's touch."""
+from __future__ import annotations
+
+from shapely.geometry import LineString, Point, Polygon, box
+from shapely.geometry.base import BaseGeometry
+from shapely.ops import unary_union
+
+from .follow import RAPID, THREAD, Move
+from .report import TurningReport
+from .work import TurningRecords, whole
+
+AIR_TOLERANCE_MM = 0.01
+CUT_TOLERANCE_MM = 0.005
+ABOVE_EVERYTHING_MM = 1.0e4     # the column a cut clears reaches past any lathe's travel
+
+
+def path(move: Move) -> BaseGeometry:
+    points = move.points
+    return Point(points[0]) if len(set(points)) == 1 else LineString(points)
+
+
+def column(move: Move) -> BaseGeometry:
+    """The material a cut leaves as air: everything radially above its path."""
+    pieces: list[BaseGeometry] = []
+    for (z0, r0), (z1, r1) in zip(move.points, move.points[1:]):
+        if abs(z1 - z0) > 1e-9:
+            pieces.append(Polygon([(z0, r0), (z1, r1), (z1, ABOVE_EVERYTHING_MM), (z0, ABOVE_EVERYTHING_MM)]))
+        pieces.append(LineString([(z0, min(r0, r1)), (z0, ABOVE_EVERYTHING_MM)]))
+    return whole(unary_union(pieces).buffer(AIR_TOLERANCE_MM))
+
+
+def thread_band(drawn: BaseGeometry, line: BaseGeometry) -> BaseGeometry:
+    """Between the drawn thread's root and crest radius, over its Z and the pass's."""
+    z0, r0, z1, r1 = drawn.bounds
+    p0, _, p1, _ = line.bounds
+    return box(min(z0, p0), r0, max(z1, p1), r1).buffer(CUT_TOLERANCE_MM)
+
+
+class MaterialWalk:
+    def __init__(self, records: TurningRecords, blank: BaseGeometry, report: TurningReport):
+        self.records, self.report = records, report
+        self.material = blank.difference(records.part)
+        self.inside_part = records.part.buffer(-CUT_TOLERANCE_MM)
+        self.solid_part = self.inside_part       # less the thread grooves cut so far
+        self.threads = {n: region.buffer(CUT_TOLERANCE_MM) for n, region in records.threads.items()}
+
+    def take(self, move: Move) -> None:
+        line = path(move)
+        if move.kind == RAPID:
+            self._rapid(move, line)
+            return
+        self.report.cut_moves += 1
+        self._cut(move, line)
+        self.material = self.material.difference(column(move))
+
+    def _rapid(self, move: Move, line: BaseGeometry) -> None:
+        self.report.rapids += 1
+        solid = self.material.buffer(-AIR_TOLERANCE_MM)
+        through = line.intersection(solid).length + line.intersection(self.solid_part).length
+        if through > 0:
+            self.report.add(move.number, move.line, f"a rapid through material for {through:.3f} mm "
+                            "(the blank not cut yet or the finished part): it breaks the tool")
+
+    def _cut(self, move: Move, line: BaseGeometry) -> None:
+        inside = line.intersection(self.inside_part)
+        if move.kind == THREAD and move.operation in self.threads:
+            drawn = self.threads[move.operation]
+            if line.intersection(drawn).is_empty:
+                self.report.add(move.number, move.line, f"a thread pass away from the drawn thread of operation "
+                                f"{move.operation} (its crest and root lines)")
+            groove = thread_band(drawn, line)
+            inside = inside.difference(groove)
+            self.solid_part = self.solid_part.difference(column(move).intersection(groove.buffer(AIR_TOLERANCE_MM)))
+        if inside.length > 0:
+            self.report.add(move.number, move.line, f"a cut into the finished part for {inside.length:.3f} mm "
+                            "of its path: the part's profile is spoiled")

@@ -1,0 +1,57 @@
+"""A lathe program read for the turning simulation with the verifier's own reader (the
+machine's dialect, line by line: engine.verifier), plus what the verifier reads but does not
+keep: a block's G and M codes and the operation comment each template slot writes before its
+tool change (`(OP n KIND Ttt)` in ISO, `; OP n KIND Tt` on the 840D). A line the verifier
+refuses the simulation refuses too: it cannot follow what it cannot read (fail closed)."""
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+from ...machines.records import Machine
+from ...verifier import grammar
+from ...verifier.blocks import TOKEN, Block
+from ...verifier.lines import read_line
+from ...verifier.refusals import Refused
+from ..hobbing.report import SimulationError, where
+
+OPERATION_COMMENT = re.compile(r"\s*(?:\(|;)\s*OP (\d+) ([A-Z]+)\b")
+ISO_COMMENT = re.compile(r"\([^()]*\)")
+
+
+@dataclass(frozen=True, slots=True)
+class Step:
+    number: int              # line number, from 1
+    line: str                # as emitted
+    block: Block | None      # None: a header or a comment
+    g_codes: frozenset = frozenset()
+    m_codes: frozenset = frozenset()
+    operation: tuple[int, str] | None = None   # (n, KIND) of an operation comment
+
+
+def read_lathe_program(lines: list[str], machine: Machine, name: str) -> list[Step]:
+    try:
+        dialect = grammar.dialect_for(machine)
+    except Refused as refusal:
+        raise SimulationError(f"machine {machine.name}: {refusal}; the simulation cannot read its programs") from None
+    return [_step(dialect, number, line, name) for number, line in enumerate(lines, start=1)]
+
+
+def _step(dialect, number: int, line: str, name: str) -> Step:
+    try:
+        item = read_line(dialect, line)
+    except Refused as refusal:
+        raise SimulationError(f"{where(name, number, line)}: the simulation cannot read it ({refusal}); "
+                              "a program it cannot follow is refused") from None
+    comment = OPERATION_COMMENT.match(line)
+    operation = (int(comment.group(1)), comment.group(2)) if comment else None
+    if not isinstance(item, Block):
+        return Step(number, line, None, operation=operation)
+    codes: dict[str, set[int]] = {"G": set(), "M": set()}
+    for token in ISO_COMMENT.sub(" ", line.partition(";")[0]).split():
+        word = TOKEN.fullmatch(token)
+        assert word is not None   # the verifier read the block word by word
+        address, equals, text = word.groups()
+        if address in codes and not equals:
+            codes[address].add(int(text))
+    return Step(number, line, item, frozenset(codes["G"]), frozenset(codes["M"]), operation)
