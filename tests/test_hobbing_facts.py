@@ -257,3 +257,11 @@ def test_a_duplex_units_header_is_held_to_its_unit_record(conn):
 def test_every_seeded_gears_genuine_program_states_only_true_facts(conn, gear_id):
     lines, hob_id = genuine(conn, gear_id)
     assert refusals(conn, lines, gear_id, hob_id) == {}
+
+
+@pytest.mark.parametrize("written", ["; n0 = 900 r/min", "; n0=246 r/min table=12.947 r/min  cuts=1 climb",
+                                     "; cut single climb", "; UNIT 2 z=20"])
+def test_a_header_fact_written_another_way_is_refused_not_left_unchecked(conn, written):
+    lines, hob_id = genuine(conn)
+    lines, number = inserted(lines, next(line for line in lines if line.startswith("; n0=")), written)
+    assert any("canonical whole-line form" in m for m in refusals(conn, lines, 42, hob_id)[number])

@@ -39,8 +39,8 @@ def header_n0(steps) -> tuple | None:
 
 
 def speed_facts(steps, gear: Gear, hob: Hob):
-    """Every S the program commands: within §C, and the header's n0."""
-    stated = header_n0(steps)
+    """Every S the program commands: within §C, and the n0 of every `; n0=` line."""
+    stated_lines = [(step, int(match.group(1))) for step in steps for match in [N0_LINE.fullmatch(step.line)] if match]
     for step in steps:
         speed = step.item.speed if step.kind == "block" and step.item.area is None else None
         if speed is None:
@@ -48,9 +48,10 @@ def speed_facts(steps, gear: Gear, hob: Hob):
         problem = speed_problem(speed, gear, hob)
         if problem:
             yield step, problem[0] + " (reference §B4, §C)", problem[1]
-        if stated is not None and speed != stated[1]:
-            yield step, (f"S{speed:g} commands the hob at {speed:g} r/min; the header states n0={stated[1]} "
-                         f"(line {stated[0].number})"), True
+        for stated, n0 in stated_lines:
+            if speed != n0:
+                yield step, (f"S{speed:g} commands the hob at {speed:g} r/min; the header states n0={n0} "
+                             f"(line {stated.number})"), True
 
 
 def tailstock_facts(steps):
