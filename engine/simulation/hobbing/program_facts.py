@@ -21,7 +21,8 @@ from .header_facts import N0_LINE
 
 CLAMP, RELEASE = 20, 21
 FEED = 1
-CUT_LINE = re.compile(r"; CUT (\S+) X=\S+ (\S+)")
+# `; CUT <name> X=<x> <word>`; an editor's words between the name and X= (a draft's TRIAL) are kept.
+CUT_LINE = re.compile(r"; CUT (\S+)(?: .*)? X=\S+ (\S+)")
 # The header's feed mode -> the word of the (rough, finish) cut; a single cut is the rough one
 # (engine.hobbing.choices: the paper's single rough cut).
 FEED_MODES = {"climb": ("CLIMB", "CLIMB"), "conventional": ("CONVENTIONAL", "CONVENTIONAL"),
