@@ -26,6 +26,7 @@ from .cutting_data import (
     hob_speed,
     per_minute,
 )
+from .speed_table import TOOLS, most_hob_speed, speed_range, tool_of
 
 if TYPE_CHECKING:
     from ..db.connection import Connection
@@ -121,12 +122,25 @@ class CaseBase:
         bounded = {cut: bounded_proposal(proposal, gear.module, hob.starts) for cut, (proposal, _) in found.items()}
         proposals = {cut: proposal for cut, (proposal, _) in bounded.items()}
         rough, finish = proposals["rough"], proposals["finish"]
-        cutting = CuttingData(rough.cutting_speed, hob_speed(rough.cutting_speed, hob.tip_diameter,
-                                                             machine.spindle_max),
-                              rough.axial_feed, finish.axial_feed, rough.radial_feed,
-                              "; ".join(p.source for p in proposals.values()), finish.radial_feed,
-                              tuple(note for _, note in bounded.values() if note))
+        speed, speed_note = bounded_hob_speed(gear, hob, rough.cutting_speed, machine.spindle_max)
+        notes = tuple(note for _, note in bounded.values() if note) + ((speed_note,) if speed_note else ())
+        v = rough.cutting_speed if speed_note is None else math.pi * hob.tip_diameter * speed / 1000
+        cutting = CuttingData(v, speed, rough.axial_feed, finish.axial_feed, rough.radial_feed,
+                              "; ".join(p.source for p in proposals.values()), finish.radial_feed, notes)
         return cutting, proposals, {cut: nearest for cut, (_, nearest) in found.items()}
+
+
+def bounded_hob_speed(gear, hob, cutting_speed: float, spindle_max: float) -> tuple[int, str | None]:
+    """n0 for the proposed v (§B4), at most the §C upper end for the gear's material and the hob's
+    material and coating (engine.gears.speed_table: the simulation refuses a faster hob), and the
+    one-line note when it was lowered. The note starts with "rough:" (a single cut is a rough cut)."""
+    speed = hob_speed(cutting_speed, hob.tip_diameter, spindle_max)
+    most = most_hob_speed(gear, hob)
+    if speed <= most:
+        return speed, None
+    return most, (f"rough: hob speed {speed} r/min (v {cutting_speed:.1f} m/min) bounded to {most} r/min, the upper "
+                  f"end of reference §C for {gear.material or 'an unlisted material'} with a "
+                  f"{TOOLS[tool_of(hob)]} hob ({speed_range(gear, hob)[1]:g} m/min)")
 
 
 def bounded_proposal(proposal: KindProposal, module: float, starts: int) -> tuple[KindProposal, str | None]:

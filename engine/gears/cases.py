@@ -37,6 +37,7 @@ from .cutting_data import CuttingData
 from .hob_matching import choose_hob
 from .models import model_for_class
 from .records import Gear, Hob, load_gear, load_hobs
+from .speed_table import SPEEDS, TOOLS, tool_of
 
 if TYPE_CHECKING:
     from ..db.connection import Connection
@@ -63,13 +64,6 @@ AXIAL_FEED_RANGE = pd.DataFrame([
     (1.0, 1.0, 2.0, 0.5, 1.0), (2.0, 1.5, 3.0, 0.8, 1.5), (3.0, 2.0, 3.5, 1.0, 2.0), (4.0, 2.0, 4.0, 1.0, 2.0),
 ], columns=["module", "rough_low", "rough_high", "finish_low", "finish_high"])
 
-# Typical cutting speed v [m/min] by workpiece material and hob (§C).
-SPEED_RANGE = {
-    "45": {"uncoated HSS": (30, 45), "coated HSS": (60, 120), "carbide": (150, 300)},
-    "C45": {"uncoated HSS": (30, 45), "coated HSS": (60, 120), "carbide": (150, 300)},
-    "20CrMnTi": {"uncoated HSS": (30, 40), "coated HSS": (60, 110), "carbide": (150, 280)},
-    "40Cr": {"uncoated HSS": (20, 35), "coated HSS": (50, 90), "carbide": (120, 220)},
-}
 CUTTING = {"rough": "roughing", "finish": "finishing"}
 
 
@@ -175,11 +169,11 @@ def _feed_note(gear: Gear, proposal: KindProposal) -> list[str]:
 
 
 def _speed_notes(gear: Gear, hob: Hob, proposals: dict) -> list[str]:
-    tool = "carbide" if "carbide" in hob.material.casefold() else "coated HSS" if hob.coating else "uncoated HSS"
-    ranges = SPEED_RANGE.get(gear.material or "")
+    tool = TOOLS[tool_of(hob)]
+    ranges = SPEEDS.get(gear.material or "")
     if ranges is None:
         return [f"no reference cutting speed range for material {gear.material or '(none)'}; check v by hand"]
-    low, high = ranges[tool]
+    low, high = ranges[tool_of(hob)]
     notes = [f"{p.cut}: cutting speed {p.cutting_speed:.1f} m/min is {'above' if p.cutting_speed > high else 'below'} "
              f"the typical {low}–{high} for {gear.material} with a {tool} hob (reference §C)"
              for p in proposals.values() if not low <= p.cutting_speed <= high]

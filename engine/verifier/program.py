@@ -165,6 +165,8 @@ class ProgramReading:
             low, high = self.travel[axis]
             if not low <= value <= high:
                 check_travel(axis, value, self.machine, "working-area limit ")
+        if block.positions:
+            area_once_problem(str(block.area), bool(self.area[str(block.area)]), bool(self.position))
         self.area[str(block.area)] = dict(block.positions)
         lower, upper = self.area["lower"], self.area["upper"]
         self.bounds = {axis: (max(low, lower.get(axis, -math.inf)), min(high, upper.get(axis, math.inf)))
@@ -249,3 +251,16 @@ TAKERS: dict[str, Callable[[ProgramReading, int, Any], None]] = {
 STATEMENT_TAKERS: dict[str, Callable[[ProgramReading, Statement], None]] = {
     "EGDEF": ProgramReading._define_coupling, "EGON": ProgramReading._couple,
     "EGOFS": ProgramReading._uncouple, "EGDEL": ProgramReading._delete_coupling}
+
+
+def area_once_problem(limit: str, already_set: bool, moved: bool) -> None:
+    """The working area (G25/G26 X… Y… Z…, reference §A4) is set once, before the first move: a
+    second G25/G26, or one after a move, would widen the area the rest of the program is held to
+    after the start was checked against it. (G25/G26 S… limit the spindle speed and are not this.)"""
+    word = "G25" if limit == "lower" else "G26"
+    if already_set:
+        raise Refused(f"{word} again: the working area is set once, before the first move (reference §A4); "
+                      "a second limit would widen it after the checked start")
+    if moved:
+        raise Refused(f"{word} after the first move: the working area is set once, before any motion "
+                      "(reference §A4)")

@@ -18,7 +18,11 @@ FOLLOWING_AXIS = "C"                 # the table follows
 HOB_SPINDLE = "B"                    # the hob spindle leads, always first
 LEADING_AXES = ("B", "Z", "Y")       # B; Z for the helical differential; Y for tangential feed
 COUPLING_TYPES = ("0", "1")          # 0 actual value, 1 setpoint
-EG_MODES = ('"NOC"', '"FINE"', '"COARSE"', '"IPOSTOP"')
+# The block-change modes of EGON (reference §A5): "NOC" changes block at once, "COARSE" at coarse
+# synchronism; the first cut would then start with the table not yet in step with the hob and cut
+# the teeth out of phase. Only "FINE" (block change at fine synchronism) is accepted.
+EG_MODES = ('"FINE"',)
+EG_MODES_KNOWN = ('"NOC"', '"FINE"', '"COARSE"', '"IPOSTOP"')
 RATIO_DIGITS = 4                     # teeth and starts: no gear has 10,000 teeth
 # Degrees of C per mm of Z or Y: 360/lead (reference §B9, §B10), 0.494 °/mm for m 2, z 30,
 # β 15°. A full table turn per mm of travel is a lead of 1 mm, which no hobbed gear has.
@@ -61,7 +65,10 @@ def _egdef(name: str, arguments: list[str]) -> Statement:
 def _egon(name: str, arguments: list[str]) -> Statement:
     _following(name, arguments)
     if len(arguments) < 2 or arguments[1] not in EG_MODES:
-        raise Refused(f"{name}: the block-change mode must be one of {', '.join(EG_MODES)}")
+        given = f", not {arguments[1]}, which goes on before the table is in step" \
+            if len(arguments) >= 2 and arguments[1] in EG_MODES_KNOWN else ""
+        raise Refused(f"{name}: the block-change mode must be \"FINE\" (wait for fine synchronism before the next "
+                      f"block, reference §A5){given}")
     triples = arguments[2:]
     if not triples or len(triples) % 3:
         raise Refused(f"{name}: after the mode come triples of a leading axis, numerator and denominator")

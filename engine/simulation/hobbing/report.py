@@ -15,7 +15,10 @@ class SimulationError(EngineError):
     the current spindle speed) above §C, a shift, swivel or T/D word while coupled, an offset other
     than D1, a unit re-cut by a new coupling, a generating zone off the hob, records other than the
     ones proved against, a header fact not in its canonical form, stated twice or after the first
-    motion, a wrong or missing cycle time, or a line it cannot read."""
+    motion, a wrong or missing cycle time, a hob that does not fit the gear, a hob speed above §C
+    or other than the header's n0, a cut with the tailstock released, a working area set again,
+    a header fact or cut word that is not the records' or the program's own, or a line it cannot
+    read (engine.simulation.hobbing.facts)."""
 
 
 def where(name: str, number: int, line: str) -> str:

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 from ...gears.records import Gear, Hob
 from ...machines.records import Machine
+from .facts import check_facts
 from .reading import read_program
 from .report import Report, SimulationError
 from .solids import setup_solids, unit_solids
@@ -27,6 +28,7 @@ def simulate_program(lines: list[str], gear: Gear, hob: Hob, machine: Machine, n
         for finding in other.findings:
             report.add(finding.number, finding.line, finding.message, finding.refuses)
         report.table_speed = max(report.table_speed, other.table_speed)
+    check_facts(steps, gear, hob, machine, report)
     return report
 
 
