@@ -43,8 +43,9 @@ def test_a_condition_the_sql_parser_fails_inside_is_refused_naming_its_row(run):
 
 @pytest.mark.parametrize("teeth", [5_000, 20_000, 100_000])
 def test_a_gear_whose_feed_would_be_written_f0_is_refused(run, tmp_path, teeth):
-    """§B5: v_f = f·n0·z0/z2; at 246 r/min, one start and 2 mm/rev, 5,000 teeth make 0.1 mm/min
-    at most (less than the one decimal of an F word can say, once the finishing feed is below 2)."""
+    """§B5: v_f = f·n2 with the table at n2 = n0·z0/z2: at n0 = 246 r/min and one start, 5,000
+    teeth turn the table at 0.05 r/min, and a radial feed of about 1 mm per table turn is
+    0.05 mm/min, below the 0.1 mm/min of an F word's one decimal (it was written F0)."""
     gears = tmp_path / "gears.csv"
     gears.write_text(f"{GEAR_COLUMNS}\n901,spur,2,{teeth},20,0,,20,,,,,40Cr,250,7,50,\n", encoding="utf-8")
     assert run("gears", "import", gears).exit_code == 0
