@@ -152,7 +152,7 @@ def test_result_table_view_lists_lines_with_their_template_rows(conn):
     assert rows[0][:2] == (1, 100)
 
 
-def test_the_wall_clock_budget_stops_a_runaway_instantiation(conn):
+def test_the_cpu_budget_stops_a_runaway_instantiation(conn):
     rows = [(i, "main", 1, None, "x = sqrt(2) * i", 'f"{x:.3f}"', None) for i in range(1, 200)]
     template = make_template(conn, "t_budget", rows)
     assert len(template.run({"i": 1}).lines) == 199

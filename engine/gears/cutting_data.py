@@ -111,8 +111,15 @@ def default_cutting_data(module: float, material: str | None, coated: bool,
 
 def programmed_feed(mm_per_minute: float) -> float:
     """The F word written, 0.1 mm/min below or at the feed: rounding half up could carry a feed
-    bounded to the §C maximum just past it (5.275 → 5.3 mm/min is 2.51 mm/rev against 2.50)."""
-    return math.floor(mm_per_minute * 10 + 1e-9) / 10
+    bounded to the §C maximum just past it (5.275 → 5.3 mm/min is 2.51 mm/rev against 2.50).
+    A feed below 0.1 mm/min would be written F0 (issue 26: a gear of 5,000 teeth turns its
+    table at n0·z0/z2 ≈ 0.05 r/min, §B5): refused, a program cannot cut at feed 0."""
+    feed = math.floor(mm_per_minute * 10 + 1e-9) / 10
+    if not feed > 0:
+        raise EngineError(f"the feed works out at {mm_per_minute:.3g} mm/min, below the 0.1 mm/min an F word "
+                          "can say (table speed n0·z0/z2, reference §B5): check the gear's teeth and the "
+                          "hob's starts and speed")
+    return feed
 
 
 def per_minute(feed_per_workpiece_rev: float, hob_speed_rpm: float, starts: int, teeth: int) -> float:

@@ -13,6 +13,8 @@ from __future__ import annotations
 
 import math
 
+from ..errors import EngineError
+
 
 class Clock:
     """Minutes of motion so far and the position the last block left."""
@@ -25,6 +27,9 @@ class Clock:
         self.position.update(axes)
 
     def feed(self, rate: float, **axes: float) -> None:
+        if not (isinstance(rate, (int, float)) and rate > 0):   # a runner's job may say F0 (issue 26)
+            raise EngineError(f"a cut's feed is {rate!r} mm/min: no cut moves at that; give the job's feeds "
+                              "(feed_axial, feed_radial, …) values above 0 mm/min, or plan the job anew")
         length = math.sqrt(sum((v - self.position.get(a, v)) ** 2 for a, v in axes.items()))
         self.minutes += length / rate
         self.position.update(axes)

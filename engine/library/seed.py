@@ -13,12 +13,14 @@ from psycopg import sql
 from psycopg.types.json import Jsonb
 
 from ..csv_reader import Column, CsvKind, parse_text, read_csv_file
+from ..errors import EngineError
 from ..gears.gear_import import GEAR_KIND, read_gears
 from ..gears.gear_store import identical_gears, import_gears, installed_classes
 from ..gears.hob_library import HOB_COLUMNS
 from ..gears.units import UNIT_KIND, import_units
 from ..machines.records import Machine
 from ..paths import SEED_DIR
+from ..templates.expectations import refuse_slow_patterns
 from ..templates.rows import read_csv
 from ..templates.store import ensure_class, replace_template
 
@@ -123,12 +125,21 @@ def _seed_template_tests(conn: Connection, directory: Path, report: SeedReport,
     for test in json.loads(path.read_text(encoding="utf-8")):
         if (test["class"], test["name"]) in stored or not _of_a_sample(test.get("gear_id"), samples_stored, report):
             continue
+        _refuse_slow_patterns(path, test)
         params = test.get("params")
         added += conn.execute(INSERT_TEST, (test["class"], test["name"], test.get("gear_id"),
                                             Jsonb(params) if params is not None else None,
                                             Jsonb(test.get("choices", {})), test["expect"],
                                             test.get("description", ""), test["class"])).fetchone() is not None
     report.count("template tests", added)
+
+
+def _refuse_slow_patterns(path: Path, test: dict) -> None:
+    """A pattern RE2 cannot run in linear time is refused where the test enters (issue 26)."""
+    try:
+        refuse_slow_patterns(test["expect"])
+    except EngineError as error:
+        raise EngineError(f"{path} test {test['class']}/{test['name']}: {error}") from None
 
 
 def _of_a_sample(gear_id: int | None, samples_stored: set[int] | None, report: SeedReport) -> bool:

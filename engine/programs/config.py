@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import os
 import re
+import stat
 import sys
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -43,6 +44,7 @@ else:   # Python 3.10
 APP = "nc-template-engine"
 LINE_ENDINGS = {name: ending for ending, name in ENDING_NAMES.items()}   # "lf": "\n", "crlf": "\r\n"
 SETTINGS = ("machine", "line_endings", "machines")   # top-level keys that are not command options
+MAX_CONFIG_BYTES = 1 << 20   # a settings file is a few hundred bytes; a bound, not a limit anyone meets
 MACHINE_SETTINGS = ("out", "line_endings")
 
 
@@ -81,8 +83,19 @@ def load_config(path: Path | None = None, named: bool | None = None) -> Config:
 
 
 def _read(path: Path) -> str:
+    """The file's text; only a regular file of at most MAX_CONFIG_BYTES (issue 26: /dev/zero was
+    read until memory ran out, a FIFO waited for a writer forever). It is opened without waiting
+    (O_NONBLOCK: a FIFO opens at once) and what was opened is checked before a byte is read."""
     try:
-        return path.read_text(encoding="utf-8")
+        with open(os.open(path, os.O_RDONLY | os.O_NONBLOCK), "rb") as file:
+            if not stat.S_ISREG(os.fstat(file.fileno()).st_mode):
+                raise EngineError(f"config file {path}: is not a regular file (a device, pipe or folder); "
+                                  "point ENGINE_CONFIG at a TOML file")
+            data = file.read(MAX_CONFIG_BYTES + 1)
+        if len(data) > MAX_CONFIG_BYTES:
+            raise EngineError(f"config file {path}: is larger than {MAX_CONFIG_BYTES >> 10} KiB, more than any "
+                              "settings need; point ENGINE_CONFIG at the TOML file of the settings")
+        return data.decode("utf-8")
     except (OSError, UnicodeDecodeError) as error:
         reason = getattr(error, "strerror", None) or str(error)
         raise EngineError(f"config file {path}: cannot be read ({reason}); fix it or set ENGINE_CONFIG") from None

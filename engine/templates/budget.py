@@ -1,6 +1,14 @@
-"""What one instantiation may spend: wall-clock time and the bytes of the values its expressions
-build (design notes §4). A shop runs thousands of gears unattended, so no template row, however
+"""What one instantiation may spend: CPU time and the bytes of the values its expressions build
+(design notes §4). A shop runs thousands of gears unattended, so no template row, however
 written, may hold a batch up or take the machine's memory.
+
+Time is the CPU time of the thread doing the work (issue 26): on a busy machine the same
+template must be accepted or refused, and wall-clock time would refuse a valid template, and
+blame one of its rows, whenever other work took the cores. It is the thread's time, not the
+process's: an import proves its rows in a thread while the importing thread spends its own CPU
+on the database (engine.library.nc_verify), and runners may share a process. There is no
+wall-clock backstop: an expression can call no function that blocks (the gate's whitelist,
+engine.templates.functions), so the only way a run can last is by computing, which this counts.
 
 Each guard (engine.templates.guards), f-string field, slice and nc_path block pays for the value
 it builds, temporaries included, as it builds it: the run is refused once it has built more than
@@ -15,7 +23,7 @@ import sys
 import threading
 import time
 
-MAX_SECONDS = 2.0            # wall-clock time of one instantiation
+MAX_SECONDS = 2.0            # CPU time (of its thread) of one instantiation
 SECONDS_PER_ROW = 50e-6      # and per row of its template: an imported program of 100,000 lines is
                              # 100,000 rows, about 20 us each to evaluate (asteval, trace, memo)
 MAX_BYTES = 64 << 20         # bytes of the values one instantiation's expressions build
@@ -34,11 +42,17 @@ def seconds_for(rows: int) -> float:
 
 
 class Budget:
-    """The time and bytes left to one instantiation."""
-    __slots__ = ("seconds", "deadline", "max_bytes", "bytes_left", "what")
+    """The CPU time and bytes left to one instantiation, spent by the thread that makes it.
+
+    `deadline` is in the thread's CPU time (time.thread_time). Reading that clock is a system
+    call (about ten times perf_counter's cost, and payments are many), so it is read only when
+    the wall clock says the deadline could have passed: a thread's CPU time never advances
+    faster than wall time, so until `wall_next` (perf_counter) at least `left` CPU seconds remain."""
+    __slots__ = ("seconds", "deadline", "wall_next", "max_bytes", "bytes_left", "what")
 
     def __init__(self, seconds: float = MAX_SECONDS, max_bytes: int = MAX_BYTES, what: str = "instantiation"):
-        self.seconds, self.deadline, self.what = seconds, time.perf_counter() + seconds, what
+        self.seconds, self.deadline, self.what = seconds, time.thread_time() + seconds, what
+        self.wall_next = time.perf_counter() + seconds
         self.max_bytes = self.bytes_left = max_bytes
 
     @classmethod
@@ -48,6 +62,7 @@ class Budget:
         budget = cls()
         if outer is not None and outer.deadline < budget.deadline:
             budget.seconds, budget.deadline, budget.what = outer.seconds, outer.deadline, outer.what
+            budget.wall_next = outer.wall_next
         return budget
 
     def pay(self, nbytes: int) -> None:
@@ -57,8 +72,12 @@ class Budget:
         self.check_time()
 
     def check_time(self) -> None:
-        if time.perf_counter() > self.deadline:
-            raise TimeoutError(f"{self.what} exceeded {self.seconds:.3g} s")
+        if time.perf_counter() < self.wall_next:
+            return   # less wall time has passed than CPU time was left: none can be spent yet
+        left = self.deadline - time.thread_time()
+        if left < 0:
+            raise TimeoutError(f"{self.what} exceeded {self.seconds:.3g} s of CPU time")
+        self.wall_next = time.perf_counter() + left
 
     @property
     def spent(self) -> int:

@@ -6,7 +6,7 @@ engine adds when it stores a program):
     no line: M8                 no line is exactly this
     line 3: G90 G71 G94         line 3 (1-based) is exactly this
     last line: M30              the last line is exactly this
-    match: ^EGON\\(C,"FINE",B   at least one line matches the regular expression (re.search)
+    match: ^EGON\\(C,"FINE",B   at least one line matches the regular expression (anywhere in it)
     no match: ^G1 .*F0\\b       no line matches it
     <property> = <expression> [± <tolerance>]     (`+-` for ±)
         the property read from the program (engine.templates.program_properties) equals the
@@ -26,13 +26,20 @@ engine adds when it stores a program):
 
 An expectation that cannot be read, a property no rule reads, or an expression that does not
 evaluate (an unknown name) fails the test with that reason: it never passes.
+
+Patterns are RE2's syntax and run by RE2 (google-re2), in time linear in the line (issue 26): a
+pattern Python's backtracking `re` would take minutes over (`^(.+)+!$`) cannot hold `engine test`
+or a release up. What RE2 cannot run in linear time (backreferences `\\1`, lookaround `(?=`,
+`(?<=`) is refused when a test is seeded (`refuse_slow_patterns`) and fails the test when it
+runs (a DBA may have written it in SQL). The expectation texts themselves are read by RE2 too.
 """
 from __future__ import annotations
 
 import math
-import re
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
+
+import re2  # type: ignore[import-untyped]   # google-re2 ships no stubs
 
 from ..errors import EngineError
 from .evaluator import evaluate
@@ -42,15 +49,19 @@ if TYPE_CHECKING:
     from collections.abc import Callable
 
 ABSOLUTE_TOLERANCE = 1e-6
-TEXT_KINDS = (   # (pattern, kind); the first that matches the expectation's text wins
-    (r"no line:\s?(.*)", "no line"),
-    (r"last line:\s?(.*)", "last line"),
-    (r"line (\d+):\s?(.*)", "line n"),
-    (r"line:\s?(.*)", "line"),
-    (r"no match:\s?(.*)", "no match"),
-    (r"match:\s?(.*)", "match"),
-)
-NUMERIC = re.compile(r"(?P<property>[^=]+?)\s*=\s*(?P<expression>.+?)(?:\s*(?:±|\+-)\s*(?P<tolerance>\S+))?\s*")
+RE2_OPTIONS = re2.Options()
+RE2_OPTIONS.log_errors = False   # a refused pattern is said in one line, not logged to stderr too
+TEXT_KINDS = tuple((re2.compile(pattern, RE2_OPTIONS), kind) for pattern, kind in (
+    # (pattern, kind); the first that matches the expectation's text wins
+    (r"(?s)no line:\s?(.*)", "no line"),
+    (r"(?s)last line:\s?(.*)", "last line"),
+    (r"(?s)line (\d+):\s?(.*)", "line n"),
+    (r"(?s)line:\s?(.*)", "line"),
+    (r"(?s)no match:\s?(.*)", "no match"),
+    (r"(?s)match:\s?(.*)", "match"),
+))
+NUMERIC = re2.compile(r"(?P<property>[^=]+?)\s*=\s*(?P<expression>.+?)(?:\s*(?:±|\+-)\s*(?P<tolerance>\S+))?\s*",
+                      RE2_OPTIONS)
 
 
 class ExpectationError(EngineError):
@@ -68,16 +79,24 @@ class Context:
 def check(expectation: str, context: Context) -> str | None:
     """None if the program meets the expectation, else the first difference in one line."""
     text = expectation.strip()
-    for pattern, kind in TEXT_KINDS:
-        match = re.fullmatch(pattern, text, re.DOTALL)
-        if match:
-            return TEXT_CHECKS[kind](*match.groups(), lines=context.lines)
+    kind, groups = _text_kind(text)
+    if kind is not None:
+        return TEXT_CHECKS[kind](*groups, lines=context.lines)
     numeric = NUMERIC.fullmatch(text)
     if numeric is None:
         raise ExpectationError(f"cannot read expectation {text!r}: write `line: …`, `no line: …`, `match: …`, "
                                "`no match: …` or `<property> = <expression> [± tolerance]`")
     return check_numeric(numeric.group("property"), numeric.group("expression"), numeric.group("tolerance"),
                          context)
+
+
+def _text_kind(text: str) -> tuple[str | None, tuple]:
+    """The kind of a text expectation and what it names, (None, ()) for a numeric one."""
+    for pattern, kind in TEXT_KINDS:
+        match = pattern.fullmatch(text)
+        if match:
+            return kind, match.groups()
+    return None, ()
 
 
 def _line_present(wanted: str, lines: list[str]) -> str | None:
@@ -104,10 +123,22 @@ def _last_line(wanted: str, lines: list[str]) -> str | None:
 
 
 def _pattern(text: str):
+    """The pattern compiled by RE2, or a one-line refusal saying what to write instead."""
     try:
-        return re.compile(text)
-    except re.error as error:
-        raise ExpectationError(f"pattern {text!r} is not a regular expression: {error}") from None
+        return re2.compile(text, RE2_OPTIONS)
+    except re2.error as error:
+        reason = error.args[0].decode(errors="replace") if error.args and isinstance(error.args[0], bytes) else error
+        raise ExpectationError(f"pattern {text!r} is not a regular expression RE2 runs ({reason}); patterns "
+                               "run in linear time, without backreferences or lookaround: rewrite it "
+                               "(docs/guide/release-and-golden-tests.md)") from None
+
+
+def refuse_slow_patterns(expectations) -> None:
+    """Every `match:`/`no match:` pattern of a test compiles in RE2, or ExpectationError naming it."""
+    for expectation in expectations:
+        kind, groups = _text_kind(expectation.strip())
+        if kind in ("match", "no match"):
+            _pattern(*groups)
 
 
 def _matches(pattern: str, lines: list[str]) -> str | None:

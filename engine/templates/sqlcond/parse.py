@@ -67,6 +67,11 @@ def parse(text):
         raise EngineError(f"{NOT_PARSED}: {_parse_error_message(error)}") from None
     except SqlglotError as error:
         raise EngineError(f"{NOT_PARSED}: {short(str(error), 80)}") from None
+    except Exception as error:  # noqa: BLE001 - sqlglot fails inside on some texts (issue 26:
+        # `(floor()[:]` raised AttributeError typing floor's missing argument): the editor's text
+        # is still what cannot be read, refused in one line, never a crash (exit 2)
+        raise EngineError(f"{NOT_PARSED}: the SQL parser cannot read it ({type(error).__name__}); "
+                          "check its brackets and each function's arguments") from None
 
 
 def reject_subqueries(tree):
