@@ -130,3 +130,16 @@ def test_a_retired_release_is_re_checked_against_its_own_rows_not_the_ones_relea
     versions = json.loads(run("template", "history", "--class", "spur", "--json").stdout)["versions"]
     gates = {v["version"]: (v["state"], v["release"]["gate"]) for v in versions if v["release"]}
     assert gates[2] == ("retired", "passed") and gates[3] == ("released", "not run")
+
+
+def test_a_forged_claim_that_passes_its_re_check_still_says_whose_word_the_impact_is(run):
+    """Adversary, issue 26: a releaser names the engine by hand for a draft whose checks pass, with
+    an invented impact (0 of 1 changed). The re-check cannot recompute the impact (it compared the
+    draft with the programs stored then) nor tell the login's call from the engine's: the line
+    says the gate passed as that login recorded it, and the impact is what the session stated."""
+    committed(run.url, EDIT.format(sql.Identifier("o")), ('"M9 ; COOLANT OFF"', COOLANT_OFF_ROW))
+    release_by_hand(run.url, FORGED)
+    line, release = released_v2(run)
+    assert release["released_via"] == "engine" and release["gate"] == "passed"
+    assert "gate passed (as " in line and " recorded it; re-checked now:" in line
+    assert "impact as the releasing session stated it (not re-checked): 0 of 1 stored program(s) changed" in line

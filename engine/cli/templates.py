@@ -123,8 +123,11 @@ def template_history(ctx, gear_class, as_json):
 
 def _release_text(release, verdict) -> str:
     """Who released, and what is true of the gate (engine.release.recheck); what the releasing
-    session states (tests, impact) is said to be stated when the gate did not make the release."""
-    impact = "" if release.jobs is None else f", {release.changed} of {release.jobs} stored program(s) changed"
+    session states is said to be stated: the tests when the gate did not make the release, the impact
+    always (the database cannot recompute it, and `via` is the releasing login's own claim)."""
+    impact = ("" if release.jobs is None else
+              f"; impact as the releasing session stated it (not re-checked): {release.changed} of {release.jobs} "
+              "stored program(s) changed")
     stated = ("" if verdict.gate == "passed" or not release.tests
               else f"; it states {release.tests} golden test(s) passed")
     note = f" ({release.note})" if release.note else ""

@@ -67,7 +67,7 @@ def _said(via: str, login: str, found: Recheck) -> tuple[str, str]:
     now = _recheck_text(found)
     if via == "engine":
         if found.passed:
-            return "passed", f"gate passed (re-checked now: {now})"
+            return "passed", f"gate passed (as {login} recorded it; re-checked now: {now})"
         return "mismatch", f"MISMATCH: recorded as passed by the engine's gate; re-checked now: {now}"
     return "not run", f"{NOT_THE_GATE[via].format(login=login)}; re-checked now: {now}"
 
