@@ -308,7 +308,7 @@ def test_release_on_the_command_line_and_history(run):
     history = run("template", "history", "--class", "spur").stdout
     states = [line.split()[1] for line in history.splitlines() if line.startswith("v")]
     assert states == ["retired", "superseded", "superseded", "released", "draft"]   # v2 broken, v3 mended
-    assert "1 of 1 stored program(s) changed" in history
+    assert "1 of 1 stored job(s) changed" in history
 
 
 class CliInput:

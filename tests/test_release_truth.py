@@ -142,4 +142,4 @@ def test_a_forged_claim_that_passes_its_re_check_still_says_whose_word_the_impac
     line, release = released_v2(run)
     assert release["released_via"] == "engine" and release["gate"] == "passed"
     assert "gate passed (as " in line and " recorded it; re-checked now:" in line
-    assert "impact as the releasing session stated it (not re-checked): 0 of 1 stored program(s) changed" in line
+    assert "impact as the releasing session stated it (not re-checked): 0 of 1 stored job(s) changed" in line

@@ -127,12 +127,17 @@ def _release_text(release, verdict) -> str:
     always (the database cannot recompute it, and `via` is the releasing login's own claim)."""
     impact = ("" if release.jobs is None else
               f"; impact as the releasing session stated it (not re-checked): {release.changed} of {release.jobs} "
-              "stored program(s) changed")
+              f"stored job(s) changed{_failed_text(release.failed)}")
     stated = ("" if verdict.gate == "passed" or not release.tests
               else f"; it states {release.tests} golden test(s) passed")
     note = f" ({release.note})" if release.note else ""
     return (f"released {release.released_at:%Y-%m-%d %H:%M:%S} by {release.released_by} as {release.role}: "
             f"{verdict.said}{stated}{impact}{note}")
+
+
+def _failed_text(failed: int | None) -> str:
+    """Stored jobs the released version made no program for (the impact's refusals)."""
+    return f", {failed} job(s) fail with it" if failed else ""
 
 
 def _layout_text(layout, before) -> str:
@@ -159,13 +164,15 @@ def _version_json(entry, verdict) -> dict:
 
 
 def _release_json(release, verdict) -> dict | None:
-    """`tests`, `changed`, `jobs`: what the releasing session stated; `gate`: passed only for the
+    """`tests`, `changed`, `jobs`, `failed`: what the releasing session stated (jobs whose program the
+    release changed, of the stored jobs, and those it made none for); `gate`: passed only for the
     engine's gate's release that passes its re-check now (`recheck`)."""
     if release is None:
         return None
     return {"released_at": release.released_at.isoformat(), "released_by": release.released_by,
             "role": release.role, "released_via": release.released_via, "tests": release.tests,
-            "changed": release.changed, "jobs": release.jobs, "note": release.note, **verdict.as_json()}
+            "changed": release.changed, "jobs": release.jobs, "failed": release.failed, "note": release.note,
+            **verdict.as_json()}
 
 
 @template.command("diff")

@@ -46,6 +46,7 @@ class ReleaseEntry:
     note: str | None
     released_via: str = "sql"        # engine, seed, sql (by hand), unrecorded: what the caller said
     golden_tests: list | None = None  # the golden tests the database recorded with the release
+    failed: int | None = None        # stored jobs the session states the released version failed for
 
 
 @dataclass(frozen=True)
@@ -81,7 +82,7 @@ ORDER BY v.version"""
 STATES = "SELECT version, state FROM template_version_state WHERE gear_class = %s"
 RELEASES = """
 SELECT version, released_at, released_by, role, jsonb_array_length(tests), (impact ->> 'changed')::int,
-       (impact ->> 'jobs')::int, note, released_via, golden_tests
+       (impact ->> 'jobs')::int, note, released_via, golden_tests, (impact ->> 'failed')::int
 FROM template_release WHERE gear_class = %s"""
 
 
