@@ -11,8 +11,11 @@ import math
 from ..errors import EngineError
 from ..machines.turning_cutting import job_materials, turning_cut_problem
 from .moves import Pass
-from .params import FIX
 
+# Where the value comes from: the drawing's @-codes on its layer (or import-dxf's options) before a
+# job exists, the job's module_params after.
+CUTTING_FIX = ("importing, change @S/@F on the drawing's layer {n} (or --speed, --feed, --material, --tool-material); "
+               "for a stored job, job.module_params in SQL, then instantiate the job again; nothing stored")
 CUTTING_KINDS = ("feed", "cw", "ccw", "thread")   # Move.kind of the moves that cut (a rapid does not)
 
 
@@ -34,4 +37,4 @@ def check_operation_cut(params: dict, module_params: dict, n: int, diameter: flo
     if problem:
         said = f"S{rpm:g} at Ø{diameter:.4g}" + ("" if kind == "THREAD" else f", F{cutmotion['feed']:g} mm/min")
         raise EngineError(f"operation {n} ({kind}, module_params.cutcond:{n} / cutmotion:{n}): {said}: "
-                          f"{problem}; {FIX}")
+                          f"{problem}; {CUTTING_FIX.format(n=n)}")
