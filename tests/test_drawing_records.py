@@ -151,3 +151,22 @@ def test_migration_0027_makes_a_record_for_each_job_made_from_a_drawing(empty_da
         assert conn.execute("SELECT count(*) FROM drawing").fetchone()[0] == 1
         made = conn.execute("INSERT INTO drawing (file_name, profile) VALUES ('new.dxf', '[]') RETURNING id")
         assert made.fetchone()[0] > turning_id   # the sequence continues after the ids the backfill took
+
+
+def test_the_proof_takes_the_records_facts_and_the_jobs_cutting_data():
+    """What the simulation is handed (engine.simulation.turning.drawing.proof_params): the part,
+    blank, tool-change position and materials of the record, the speeds and feeds of the job."""
+    from engine.simulation.turning.drawing import DRAWING_FACTS, DrawingRecord, proof_params
+
+    recorded = {"profile": [["line", 0.0, 0.0, 0.0, 8.0]], "stock_diameter": None, "stock_z_front": 0.0,
+                "stock_z_back": -10.0, "tool_change_x": 100.0, "tool_change_z": 50.0, "workpiece_material": "steel"}
+    assert set(recorded) == set(DRAWING_FACTS)
+    record = DrawingRecord(1, "a.dxf", recorded, {"1": "carbide"})
+    edited = {**recorded, "profile": [["line", 0.0, 0.0, 0.0, 7.0]], "stock_diameter": 30.0,
+              "workpiece_material": "aluminium", "clearance": 1.0}
+    modules = {"prep:1": {"tool": 1, "tool_material": "hss"}, "cutcond:1": {"spindle_rpm": 3999}}
+    params, module_params = proof_params(record, edited, modules)
+    assert params["profile"] == recorded["profile"] and params["workpiece_material"] == "steel"
+    assert "stock_diameter" not in params and params["clearance"] == 1.0   # NULL: the blank is assumed
+    assert module_params == {"prep:1": {"tool": 1, "tool_material": "carbide"}, "cutcond:1": {"spindle_rpm": 3999}}
+    assert modules["prep:1"]["tool_material"] == "hss"   # the job's own values are not changed
