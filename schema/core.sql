@@ -51,7 +51,7 @@ CREATE FUNCTION template_editor() RETURNS text LANGUAGE sql STABLE
 RETURN CASE WHEN current_setting('role') = 'none' THEN session_user::text ELSE current_setting('role') END;
 
 -- Records are appended, never changed: programs, the audit trail, stored template versions,
--- releases. Their tables' BEFORE UPDATE/DELETE/TRUNCATE triggers call this.
+-- releases, drawings. Their tables' BEFORE UPDATE/DELETE/TRUNCATE triggers call this.
 CREATE FUNCTION refuse_changing_a_record() RETURNS trigger
 LANGUAGE plpgsql
 AS $$
@@ -60,6 +60,7 @@ BEGIN
                     CASE TG_TABLE_NAME
                         WHEN 'program' THEN 'make a new program with engine instantiate'
                         WHEN 'template_audit' THEN 'the audit trail is append-only'
+                        WHEN 'drawing' THEN 'import the drawing again with engine import-dxf'
                         ELSE 'a new version is stored when a template changes' END
         USING ERRCODE = 'insufficient_privilege';
 END

@@ -94,6 +94,36 @@ CREATE TABLE gear (
     CONSTRAINT gear_crowning CHECK (crowning >= 0 AND crowning < 1)
 );
 
+-- A drawing as `engine import-dxf` read it (issue 26): what the turning proof takes the part, the
+-- blank, the tool-change position and the materials from, never from job.params (which a runner
+-- may edit in SQL). Written once with its job, never changed or deleted: importing the drawing
+-- again (e.g. with another --material) makes a new record and a new job. profile: the segments as
+-- job.params.profile holds them ([["line", z0, r0, z1, r1] | ["arc", z0, r0, z1, r1, zc, rc, ccw]],
+-- mm); stock_diameter NULL: the blank the importer assumes (docs/design.md §8); workpiece_material
+-- and tool_materials ({"n": material} per operation) NULL: the defaults. sha256 of the file's
+-- bytes; NULL for the records migration 0027 made from jobs imported before it (imported_by
+-- 'migration 0027').
+CREATE TABLE drawing (
+    id                 bigserial PRIMARY KEY,
+    file_name          text NOT NULL,
+    sha256             text CHECK (sha256 ~ '^[0-9a-f]{64}$'),
+    units              text,
+    profile            jsonb NOT NULL CHECK (jsonb_typeof(profile) = 'array'),
+    stock_diameter     double precision CHECK (stock_diameter > 0),
+    stock_z_front      double precision,
+    stock_z_back       double precision,
+    tool_change_x      double precision,
+    tool_change_z      double precision,
+    workpiece_material text,
+    tool_materials     jsonb CHECK (tool_materials IS NULL OR jsonb_typeof(tool_materials) = 'object'),
+    imported_by        text NOT NULL DEFAULT current_user,
+    imported_at        timestamptz NOT NULL DEFAULT now()
+);
+CREATE TRIGGER drawing_is_a_record BEFORE UPDATE OR DELETE ON drawing
+FOR EACH ROW EXECUTE FUNCTION refuse_changing_a_record();
+CREATE TRIGGER drawing_is_not_truncated BEFORE TRUNCATE ON drawing
+FOR EACH STATEMENT EXECUTE FUNCTION refuse_changing_a_record();
+
 -- A job: one workpiece on one machine with every parameter its template needs, as computed
 -- by the class's model (and possibly edited afterwards in SQL).
 -- params: {"name": value}; module_params: {"cutmotion:1": {"name": value}} (scope of module T,N).
@@ -109,6 +139,8 @@ CREATE TABLE job (
     -- the cutting data chosen for the job and where they came from; confirmed jobs become cases
     cutting       jsonb NOT NULL DEFAULT '{}' CHECK (jsonb_typeof(cutting) = 'object'),
     confirmed_at  timestamptz,
+    -- a turning job's drawing record (NULL: a hobbing job, or a class job without a drawing)
+    drawing_id    bigint REFERENCES drawing (id),
     CONSTRAINT job_safe_params CHECK (job_params_safe(params, module_params))
 );
 CREATE INDEX job_gear ON job (gear_id);

@@ -54,6 +54,9 @@ GRANT USAGE ON SEQUENCE job_id_seq, program_id_seq TO engine_runner;
 GRANT EXECUTE ON FUNCTION store_program(bigint, text, integer, text, text, text[], integer[], jsonb),
     confirm_job_cases(bigint) TO engine_runner;
 GRANT INSERT ON program_submission TO engine_runner;
+-- Runners import drawings (engine import-dxf): they insert drawing records, never change them.
+GRANT INSERT ON drawing TO engine_runner;
+GRANT USAGE ON SEQUENCE drawing_id_seq TO engine_runner;
 GRANT INSERT, UPDATE (last_seen) ON near_duplicate_seen TO engine_runner;
 
 -- Editors change templates through template_view (audited, versioned) and the engine's imports

@@ -127,33 +127,34 @@ def test_alternating_needs_one_tool(conn, tmp_path):
         import_dxf(conn, tmp_path / "wheel.dxf", alternate=[1, 2])
 
 
-def test_an_edited_segment_gives_the_new_program(conn, tmp_path):
+def test_an_edited_segment_is_refused_the_part_is_the_drawings(conn, tmp_path):
+    """Issue 26: the part is the drawing record's; a profile edited in SQL is named, nothing stored."""
     profile_only_drawing(tmp_path / "shaft.dxf")
     report = import_dxf(conn, tmp_path / "shaft.dxf", options=ProfileOptions(rough_depth=1.0))
-    before = instantiate_job(conn, report.job_id).lines
     # The shoulder at radius 8 (segment 1 of the profile, from Z 0 to Z −10) becomes radius 9.
     params = conn.execute("SELECT params FROM job WHERE id = %s", (report.job_id,)).fetchone()[0]
-    shoulder = params["profile"][1]
-    assert shoulder[:5] == ["line", 0, 8, -10, 8]
+    assert params["profile"][1][:5] == ["line", 0, 8, -10, 8]
     params["profile"][0][4] = params["profile"][1][2] = params["profile"][1][4] = params["profile"][2][2] = 9
     conn.execute("UPDATE job SET params = %s WHERE id = %s", (Jsonb(params), report.job_id))
-    after = instantiate_job(conn, report.job_id).lines
-    finish = [end for g, _, end in motions(operation_lines(after, 2)) if g == 1]
-    assert (0, 9) in finish and (-10, 9) in finish and before != after
+    with pytest.raises(EngineError, match=rf"job {report.job_id}: params\.profile\[0\] = \['line', 0\.0, 0\.0, "
+                                          r"0\.0, 9\] is not .*8\.0\].*import-dxf"):
+        instantiate_job(conn, report.job_id)
+    assert conn.execute("SELECT count(*) FROM program").fetchone()[0] == 0
 
 
 def test_program_beyond_the_lathe_is_not_stored(conn, seed_part):
-    report = import_dxf(conn, seed_part)
+    report = import_dxf(conn, seed_part, materials=(None, "aluminium"))
     count = conn.execute("SELECT count(*) FROM program").fetchone()[0]
     # S5000 is beyond lathe-iso's 4000 r/min yet inside the cutting-data table (reference §E1) only
     # for a thread in aluminium: π·25.4·5000/1000 = 399 m/min, within carbide's 40-480 (Iscar)
-    conn.execute("UPDATE job SET module_params = jsonb_set(module_params, '{cutcond:3,spindle_rpm}', '5000'), "
-                 "params = jsonb_set(params, '{workpiece_material}', '\"aluminium\"') WHERE id = %s", (report.job_id,))
+    conn.execute("UPDATE job SET module_params = jsonb_set(module_params, '{cutcond:3,spindle_rpm}', '5000') "
+                 "WHERE id = %s", (report.job_id,))
     with pytest.raises(LimitError, match=r"line \d+ 'G97 S5000 M03': spindle speed S5000 exceeds lathe-iso"):
         instantiate_job(conn, report.job_id)
+    # the tool-change position is the drawing record's (issue 26): an edit is named, not run
     conn.execute("UPDATE job SET params = jsonb_set(params, '{tool_change_x}', '900') WHERE id = %s",
                  (report.job_id,))
-    with pytest.raises(LimitError, match="X900 exceeds the travel of lathe-iso"):
+    with pytest.raises(EngineError, match=r"params\.tool_change_x = 900 is not"):
         instantiate_job(conn, report.job_id)
     assert conn.execute("SELECT count(*) FROM program").fetchone()[0] == count
 

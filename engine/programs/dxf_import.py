@@ -2,7 +2,9 @@
 
 The drawing is read, its numbers become job parameters, the program is computed and
 checked against the lathe (so a job that could never be instantiated is not stored), and
-the job is stored, all in one transaction: on any error nothing is stored. The program
+the job is stored with its drawing record (the part, blank, tool-change position and materials
+as read, with the file's sha256; engine.programs.drawing_records), all in one transaction: on
+any error nothing is stored. The program
 itself is stored by `engine instantiate --job ID`, like every instantiation.
 """
 from __future__ import annotations
@@ -19,14 +21,15 @@ from ..memory import no_cycle_collection
 from ..names import checked
 from ..turning.job_params import ProfileOptions, turning_job
 from ..turning.model import ISO_PROGRAM_NUMBERS, job_passes, key, present_operations
+from .drawing_records import file_sha256, store_drawing
 from .turning_jobs import lathe, plan_turning_job, turning_class
 
 if TYPE_CHECKING:
     from ..db.connection import Connection
 
 INSERT_TURNING_JOB = """
-INSERT INTO job (id, gear_id, gear_class, machine, hob_id, params, module_params)
-VALUES (%s, NULL, %s, %s, NULL, %s, %s)"""
+INSERT INTO job (id, gear_id, gear_class, machine, hob_id, params, module_params, drawing_id)
+VALUES (%s, NULL, %s, %s, NULL, %s, %s, %s)"""
 
 
 @dataclass
@@ -64,6 +67,7 @@ def _import(conn: Connection, source: tuple, machine, gear_class: str, options: 
             draft: bool) -> ImportReport:
     alternate, program_name, materials = choices
     drawing = read_drawing(*source)   # (path, profile layer)
+    sha256 = file_sha256(source[0])   # of the bytes just read: stored with the drawing record
     with conn.transaction():
         job_id = scalar(conn.execute("SELECT nextval('job_id_seq')"))
         program_number = (job_id - 1) % ISO_PROGRAM_NUMBERS + 1    # the job id, wrapped into O0001 … O8999
@@ -71,8 +75,9 @@ def _import(conn: Connection, source: tuple, machine, gear_class: str, options: 
                           materials)
         passes = job_passes(job.params, job.module_params)
         planned = plan_turning_job(conn, gear_class, machine, job.params, job.module_params, passes, draft)
+        drawing_id = store_drawing(conn, Path(source[0]).name, sha256, job.params, job.module_params)
         conn.execute(INSERT_TURNING_JOB, (job_id, gear_class, machine.name, Jsonb(job.params),
-                                          Jsonb(job.module_params)))
+                                          Jsonb(job.module_params), drawing_id))
     notes = job.notes + empty_operations(job, passes) + drawing.notes
     return ImportReport(job_id, str(drawing.source), machine.name, gear_class, len(planned.result.lines) + 1,
                         job.operations, drawing.repairs, notes)

@@ -2,7 +2,8 @@
 instantiate --job ID`) or a range of them (`--jobs FIRST-LAST`), template rows only: no hob
 choice, no cutting data. A hobbing job is not trusted as stored (a runner may write jobs in SQL):
 its hob, its record parameters and its edited values are checked as a new job's are
-(engine.programs.job_checks), a turning job's parameters by the turning model. The programs are
+(engine.programs.job_checks), a turning job's parameters by the turning model and against its
+drawing record (engine.programs.drawing_records). The programs are
 checked against the job's machine, stored with the template version they came from, and written
 after the database commit. A batch tries every job and names each bad one
 (engine.programs.batches). A job of a class without a model (engine.programs.class_jobs) is its
@@ -79,7 +80,8 @@ class Remaker:
         if machine.kind == "lathe":   # a turning job: its passes are computed from its parameters
             from .turning_jobs import plan_turning_job  # the tool paths: only for turning jobs
 
-            return plan_turning_job(self.conn, gear_class, machine, params, module_params, draft=self.draft)
+            return plan_turning_job(self.conn, gear_class, machine, params, module_params, draft=self.draft,
+                                    job_id=job_id)
         model = model_for_class(self.conn, gear_class)
         stored = job_id is not None   # a stored job is checked as a new one; a golden test's case runs as given
         workpiece = self.workpiece(job_id, gear_id, hob_id, required=stored)

@@ -3,9 +3,9 @@ table of a program that may be stored is made (new gears, stored jobs made again
 from drawings), so no route stores lines the verifier has not read. On a hobber the program is
 also simulated against the gear and hob records (engine.simulation): nothing the simulation
 refuses is stored. A turning job's program (a drawing's job, classes turning_iso/turning_840d)
-is simulated against the job's stored records (engine.simulation.turning: its profile, blank,
-tool-change position and operations), read from its params and module_params as stored, not
-from the passes the planner computed. The records come from the database, not from the job's parameters, which
+is simulated against the job's drawing record (engine.simulation.turning.drawing: its profile,
+blank, tool-change position and materials) and its stored operations (module_params), not
+against the passes the planner computed. The records come from the database, not from the job's parameters, which
 a runner may have edited. The one exception is a class job stored with --unverified
 (engine.programs.class_jobs): its record and lineage line say UNVERIFIED, and it is never
 written to a file for the machine."""
@@ -33,8 +33,9 @@ class Workpiece:
 
 @dataclass(frozen=True, slots=True)
 class TurningWork:
-    """What a lathe program is proved against: the job's parameters and module parameters as
-    stored (the drawing's profile, the blank, the tool-change position, the operations)."""
+    """What a lathe program is proved against: the job's parameters and module parameters with
+    the facts of its drawing record in place of the job's (the profile, the blank, the tool-change
+    position, the materials: engine.simulation.turning.drawing.proof_params), and its operations."""
     params: dict
     module_params: dict
 
