@@ -62,7 +62,8 @@ def test_a_runners_job_with_a_feed_of_0_is_refused(run, feed):
         conn.execute("UPDATE job SET module_params = jsonb_set(module_params, %s, '0') WHERE id = %s",
                      (["cutmotion:2", feed], job))
     before = stored(run.url)
-    refused_in_one_line(run("instantiate", "--job", job), "feed is 0 mm/min", "above 0")
+    refused_in_one_line(run("instantiate", "--job", job), f"cutmotion:2.{feed}: 0 mm/min must be above 0",
+                        "correct job.module_params")
     assert stored(run.url) == before
 
 

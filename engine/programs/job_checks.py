@@ -143,7 +143,8 @@ def _check_cut(job_id: int, key: str, cut: dict, table, teeth: float, module: fl
             where = f"module_params.{key}.{name}"
             value = _number(job_id, cut, name, where)
             if not value > 0:
-                raise EngineError(f"job {job_id}, {where}: {value:g} mm/min must be above 0; correct job.params; "
+                raise EngineError(f"job {job_id}, {where}: {value:g} mm/min must be above 0; correct "
+                                  f"job.{_column(where)}; "
                                   f"{NOTHING_STORED}")
             kind = CUT_KIND_BY_NAME.get(str(cut.get("cut_name")), "rough")
             override = {f"axial_feed_{kind}" if name == "feed_axial" else "radial_feed": value / one_mm_per_rev}
@@ -155,8 +156,14 @@ def _check_cut(job_id: int, key: str, cut: dict, table, teeth: float, module: fl
 def _number(job_id: int, values: dict, name: str, where: str, default: float | None = None) -> float:
     value = values.get(name, default)
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise EngineError(f"job {job_id}: {where} = {value!r} must be a number; correct job.params; {NOTHING_STORED}")
+        raise EngineError(f"job {job_id}: {where} = {value!r} must be a number; correct job.{_column(where)}; "
+                          f"{NOTHING_STORED}")
     return float(value)
+
+
+def _column(where: str) -> str:
+    """The job's column a parameter lives in: `module_params.cutmotion:2.feed_axial` → module_params."""
+    return where.split(".", 1)[0]
 
 
 def _refused_as_new(job_id: int, where: str, check):
