@@ -71,3 +71,15 @@ def test_an_840d_offset_called_in_a_block_of_its_own_is_checked_too(conn):
     tool = modules["prep:1"]["tool"]
     lines[first:first + 1] = [f"T{tool} D{modules['prep:1']['tool_offset']}", "D9"]
     assert any("tool offset 9" in f for f in refusals(lines, params, modules, lathe))
+
+
+@pytest.mark.parametrize("machine", [ISO, S840D])
+def test_a_thread_lead_other_than_the_drawn_pitch_is_refused(conn, machine):
+    """Every pass at lead 2.0 on the pitch-1.5 thread: the helix is not the drawing's."""
+    lines, params, modules, lathe = job(conn, machine)
+    pitch = next(v["thread_pitch"] for v in modules.values() if v.get("kind") == "THREAD")
+    written = "F1.5000" if machine == ISO else "K1.5"
+    assert pitch == 1.5 and any(written in line for line in lines)
+    edited = [line.replace(written, "F2.0000" if machine == ISO else "K2") for line in lines]
+    found = refusals(edited, params, modules, lathe)
+    assert any("thread lead 2.0000 mm" in f and "pitch 1.5000 mm" in f for f in found), found
