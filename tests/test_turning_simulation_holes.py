@@ -83,3 +83,41 @@ def test_a_thread_lead_other_than_the_drawn_pitch_is_refused(conn, machine):
     edited = [line.replace(written, "F2.0000" if machine == ISO else "K2") for line in lines]
     found = refusals(edited, params, modules, lathe)
     assert any("thread lead 2.0000 mm" in f and "pitch 1.5000 mm" in f for f in found), found
+
+
+@pytest.mark.parametrize("machine", [ISO, S840D])
+def test_a_thread_pass_run_on_into_the_shoulder_is_refused(conn, machine):
+    """The last pass to Z-30 instead of Z-23: past the Z-22…-26 groove, 4 mm into the Ø25 shoulder."""
+    lines, params, modules, lathe = job(conn, machine)
+    last = max(i for i, line in enumerate(lines) if line.startswith(("G32", "G33")))
+    assert "Z-23.000" in lines[last]
+    lines[last] = lines[last].replace("Z-23.000", "Z-30.000")
+    found = refusals(lines, params, modules, lathe)
+    assert any("a cut into the finished part" in f and "Z-30.000" in f for f in found), found
+
+
+def _before_last_op_leaves(lines: list[str], machine: str, inserted: list[str]) -> list[str]:
+    """`inserted` just before the last operation's rapid to X124 (the EMCO job's tool-change X)."""
+    leave = max(i for i, line in enumerate(lines) if line.startswith(f"{RAPID[machine]} X124.000 Z-"))
+    return [*lines[:leave], *inserted, *lines[leave:]]
+
+
+@pytest.mark.parametrize("machine", [ISO, S840D])
+def test_a_rapid_into_the_bar_behind_the_back_end_is_refused(conn, machine):
+    """10 mm behind the part's back end (Z-30) the bar runs on to the chuck at the stock's Ø24."""
+    lines, params, modules, lathe = job(conn, machine, EMCO, EMCO_OPTIONS)
+    assert params["stock_z_back"] == -30.0 and params["stock_diameter"] == 24.0
+    rapid = RAPID[machine]
+    edited = _before_last_op_leaves(lines, machine, [f"{rapid} X26.000 Z-40.000", f"{rapid} X4.000 Z-40.000"])
+    found = refusals(edited, params, modules, lathe)
+    assert any("X4.000 Z-40.000" in f and "a rapid through material" in f for f in found), found
+
+
+@pytest.mark.parametrize("machine", [ISO, S840D])
+def test_a_cut_behind_the_back_end_is_refused(conn, machine):
+    """`G01 X0 Z-40`: a cut behind the stock's back end goes into what holds the part."""
+    lines, params, modules, lathe = job(conn, machine, EMCO, EMCO_OPTIONS)
+    rapid, feed = RAPID[machine], FEED[machine]
+    inserted = [f"{rapid} X26.000 Z-40.000", f"{feed} X0.000 Z-40.000", f"{rapid} X26.000 Z-40.000"]
+    found = refusals(_before_last_op_leaves(lines, machine, inserted), params, modules, lathe)
+    assert any("X0.000 Z-40.000" in f and "behind the blank's back end" in f for f in found), found
