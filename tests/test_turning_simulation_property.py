@@ -3,8 +3,9 @@ random relative to the blank and the part; no program whose path enters material
 the finished profile is accepted, and none that keeps clear of both by a margin is refused for it.
 
 The truth is computed here on its own, without shapely and without the simulation's code: points
-sampled every SAMPLE_MM along each move are tested against the stepped shaft and the Ø36 blank
-(less the columns above earlier feeds: an outside tool's body stands radially above its tip, design
+sampled every SAMPLE_MM along each move are tested against the stepped shaft and the Ø36 blank,
+whose bar runs on behind its back end into the chuck (less the columns above earlier feeds: an
+outside tool's body stands radially above its tip, design
 notes §8) with a margin MARGIN_MM, so a point is "surely in material", "surely in air" or too
 close to an edge to say (then the move says nothing either way)."""
 from __future__ import annotations
@@ -19,7 +20,7 @@ from engine.simulation.turning.run import simulate_turning
 
 STEPS = [(0.0, -20.0, 10.0), (-20.0, -40.0, 15.0)]    # (z front, z back, radius) of the part, mm
 STOCK = {"stock_diameter": 36.0, "stock_z_front": 2.0, "stock_z_back": -42.0}
-BLANK_RADIUS, BLANK_FRONT, BLANK_BACK = 18.0, 2.0, -42.0
+BLANK_RADIUS, BLANK_FRONT = 18.0, 2.0      # the back end -42 does not bound it: the bar runs on
 CHANGE_X, CHANGE_Z = 80.0, 30.0
 MARGIN_MM = 0.05
 SAMPLE_MM = 0.02
@@ -27,7 +28,7 @@ GEOMETRY = ("a rapid through material", "a cut into the finished part")
 PARAMS = {
     "profile": [["line", 0.0, 0.0, 0.0, 10.0], ["line", 0.0, 10.0, -20.0, 10.0], ["line", -20.0, 10.0, -20.0, 15.0],
                 ["line", -20.0, 15.0, -40.0, 15.0], ["line", -40.0, 15.0, -40.0, 0.0]],
-    "tool_change_x": CHANGE_X, "tool_change_z": CHANGE_Z, **STOCK}
+    "tool_change_x": CHANGE_X, "tool_change_z": CHANGE_Z, "clearance": 2.0, **STOCK}
 MODULE_PARAMS = {"prep:1": {"tool": 1, "tool_offset": 1, "op_present": True},
                  "cutcond:1": {"spindle_rpm": 800.0, "coolant": False, "op_present": True},
                  "cutmotion:1": {"kind": "ROUGH", "feed": 160.0, "paths": [], "op_present": True}}
@@ -84,7 +85,7 @@ def surely_off_part(z: float, r: float) -> bool:
 def surely_in_material(z: float, r: float, feeds) -> bool:
     if surely_in_part(z, r):
         return True
-    if not (BLANK_BACK + MARGIN_MM < z < BLANK_FRONT - MARGIN_MM and r < BLANK_RADIUS - MARGIN_MM):
+    if not (z < BLANK_FRONT - MARGIN_MM and r < BLANK_RADIUS - MARGIN_MM):     # the bar runs on behind
         return False
     return all(found is None or found[0] > r + MARGIN_MM for found in (feed_radius_range(f, z) for f in feeds))
 
@@ -92,7 +93,7 @@ def surely_in_material(z: float, r: float, feeds) -> bool:
 def surely_in_air(z: float, r: float, feeds) -> bool:
     if not surely_off_part(z, r):
         return False
-    if not (BLANK_BACK - MARGIN_MM < z < BLANK_FRONT + MARGIN_MM and r < BLANK_RADIUS + MARGIN_MM):
+    if not (z < BLANK_FRONT + MARGIN_MM and r < BLANK_RADIUS + MARGIN_MM):
         return True
     return any(covers(f, z) and feed_radius_range(f, z)[1] < r - MARGIN_MM for f in feeds)
 

@@ -2,16 +2,21 @@
 (engine.machines.turning_cutting, by operation kind, tool material and workpiece material):
 the feed per revolution f = F/S under G94/G98 (mm/min), F under G95/G99, a thread's lead;
 the cutting speed vc = π·D·S/1000 m/min with D the largest diameter the cut reaches (G97), or
-S itself under G96 (constant cutting speed). One finding per operation and reason: a table
-value broken once is broken on every pass of the operation."""
+S itself under G96 (constant cutting speed). A thread pass's lead (ISO G32 F, 840D G33 K or F,
+mm/rev) must be the drawn pitch (module_params.cutmotion:n.thread_pitch) within
+LEAD_TOLERANCE_MM: another lead cuts another helix than the drawing's. One finding per operation
+and reason: a table value broken once is broken on every pass of the operation."""
 from __future__ import annotations
 
 import math
 
+from ...errors import EngineError
 from ...machines.turning_cutting import job_materials, turning_cut_problem
 from .follow import THREAD, Move
 from .report import TurningReport
-from .work import TurningRecords
+from .work import FIX, TurningRecords
+
+LEAD_TOLERANCE_MM = 1e-4     # the programs write the lead to 0.0001 mm (ISO F{pitch:.4f})
 
 
 def check_cutting(moves: list[Move], records: TurningRecords, params: dict, module_params: dict,
@@ -24,10 +29,29 @@ def check_cutting(moves: list[Move], records: TurningRecords, params: dict, modu
         vc, f = cutting_speed(move), feed_per_revolution(move)
         tool_material, workpiece_material = job_materials(params, module_params, op.number)
         problem = turning_cut_problem(op.kind, tool_material, workpiece_material, vc, f)
+        if move.kind == THREAD and op.kind == "THREAD":
+            problem = lead_problem(move, thread_pitch(module_params, op.number)) or problem
         if problem and (op.number, problem) not in said:
             said.add((op.number, problem))
             report.add(move.number, move.line, f"operation {op.number} {op.kind}: vc {vc:.0f} m/min, "
                        f"f {f:.3f} mm/rev: {problem}")
+
+
+def thread_pitch(module_params: dict, n: int) -> float:
+    """The drawn thread's pitch, mm (module_params.cutmotion:n.thread_pitch)."""
+    pitch = (module_params.get(f"cutmotion:{n}") or {}).get("thread_pitch")
+    if isinstance(pitch, bool) or not isinstance(pitch, (int, float)) or not 0 < pitch < math.inf:
+        raise EngineError(f"module_params.cutmotion:{n}.thread_pitch = {pitch!r} must be a positive number "
+                          f"(the THREAD operation's pitch, mm); {FIX}")
+    return float(pitch)
+
+
+def lead_problem(move: Move, pitch: float) -> str | None:
+    if move.lead is None:
+        return f"a thread pass without its lead (F or K), the drawn pitch is {pitch:.4f} mm"
+    if abs(move.lead - pitch) > LEAD_TOLERANCE_MM:
+        return f"thread lead {move.lead:.4f} mm, the drawn pitch {pitch:.4f} mm: it cuts another helix"
+    return None
 
 
 def cutting_speed(move: Move) -> float:

@@ -1,11 +1,12 @@
 """The lathe program followed block by block as the control runs it: the tool's position (X a
 diameter, turned into the radius r = X/2 of the (z, r) half-plane), the spindle, the feed
 mode, the operation the block belongs to, and every tool change. What refuses here needs no
-geometry of the material: a tool change away from the job's tool-change position (the turret
-swings its tools out there: anywhere else one of them hits the part or the chuck), a cut with
-the spindle stopped or turning against the tool (the templates' outside tools cut with M03,
-design notes §8), a thread pass in an operation that is not a THREAD, an operation comment or
-a tool word that is not the job's. Each motion is handed on as a Move for the material walk."""
+geometry of the material: a tool change away from the job's tool-change position or in a block
+that moves (the turret swings its tools out there: anywhere else one of them hits the part or
+the chuck), a cut with the spindle stopped or turning against the tool (the templates' outside
+tools cut with M03, design notes §8), a thread pass in an operation that is not a THREAD, an
+operation comment, a tool word or a tool offset (ISO T0101's last digits, 840D D) that is not
+the job's. Each motion is handed on as a Move for the material walk."""
 from __future__ import annotations
 
 import math
@@ -19,6 +20,7 @@ RAPID, FEED, THREAD = "rapid", "feed", "thread"
 MOTIONS = {0: RAPID, 1: FEED, 2: FEED, 3: FEED, 32: THREAD, 33: THREAD}
 CUTTING_DIRECTION = 3        # M03: the direction the templates' outside turning tools cut in
 TOOL_CHANGE_TOLERANCE_MM = 0.01
+DEFAULT_EDGE = 1            # 840D: D1 with a new tool unless the block says otherwise
 PER_MINUTE, PER_REVOLUTION = (94, 98), (95, 99)   # 840D G94/G95, ISO G98/G99
 
 
@@ -58,6 +60,8 @@ class ProgramState:
         self._modes(step)
         if "T" in step.block.values:
             self._tool_change(step)
+        elif not self.iso and "D" in step.block.values:
+            self._offset(step, _whole_word(step.block.values["D"]))
         if step.block.motion is not None:
             self.motion = step.block.motion
         if step.block.moves and self.motion in MOTIONS:
@@ -90,6 +94,9 @@ class ProgramState:
 
     def _tool_change(self, step) -> None:
         block = step.block
+        if block.moves:
+            self.report.add(step.number, step.line, "a tool change in a block that moves: the turret indexes "
+                            "on the way, not at the tool-change position; write T in its own block there")
         x, z = block.positions.get("X", self.x), block.positions.get("Z", self.z)
         want_x, want_z = self.records.tool_change
         if abs(x - want_x) > TOOL_CHANGE_TOLERANCE_MM or abs(z - want_z) > TOOL_CHANGE_TOLERANCE_MM:
@@ -97,10 +104,24 @@ class ProgramState:
                             f"tool-change position X{want_x:.3f} Z{want_z:.3f} (params.tool_change_x/_z): "
                             "the turret swings its tools there only")
         tool = _tool_number(block.values["T"], self.iso)
-        op = self.records.operations.get(self.operation) if self.operation else None
+        op = self._current()
         if op is not None and op.tool is not None and tool != op.tool:
             self.report.add(step.number, step.line, f"tool {tool} in operation {op.number}, whose tool is "
                             f"{op.tool} (module_params.prep:{op.number}.tool)")
+        self._offset(step, _offset_number(block.values, self.iso))
+
+    def _offset(self, step, offset: int) -> None:
+        """The tool offset the block activates against the operation's (module_params.prep:n.tool_offset):
+        another offset moves every cut of the operation by the difference of the two offsets' wear
+        and geometry values, which the program cannot show."""
+        op = self._current()
+        if op is not None and op.offset is not None and offset != op.offset:
+            word = "the T word's last two digits" if self.iso else "D"
+            self.report.add(step.number, step.line, f"tool offset {offset} ({word}) in operation {op.number}, "
+                            f"whose offset is {op.offset} (module_params.prep:{op.number}.tool_offset)")
+
+    def _current(self):
+        return self.records.operations.get(self.operation) if self.operation else None
 
     def _move(self, step) -> None:
         block, motion = step.block, self.motion
@@ -128,7 +149,7 @@ class ProgramState:
         elif self.spindle != CUTTING_DIRECTION:
             self.report.add(step.number, step.line, f"{what} with the spindle turning M0{self.spindle}: the "
                             f"job's outside turning tools cut with M0{CUTTING_DIRECTION}")
-        op = self.records.operations.get(self.operation) if self.operation else None
+        op = self._current()
         if op is None:
             self.report.add(step.number, step.line, f"{what} outside any of the job's operations (no "
                             "operation comment OP n KIND before it): the simulation cannot tell what it may cut")
@@ -140,3 +161,16 @@ class ProgramState:
 def _tool_number(value: float, iso: bool) -> int:
     """ISO T0707: tool 7, offset 7 (reference §E); 840D T7 with its D word apart."""
     return int(value) // 100 if iso else int(value)
+
+
+def _offset_number(values: dict[str, float], iso: bool) -> int:
+    """ISO T0709: offset 9, T0700 cancels it (0; reference §E). 840D `T7 D9`: D9; `T7` alone: the
+    edge the control activates with a new tool, D1 (Sinumerik MD20270 $MC_CUTTING_EDGE_DEFAULT = 1
+    as delivered)."""
+    if iso:
+        return int(values["T"]) % 100
+    return _whole_word(values.get("D", DEFAULT_EDGE))
+
+
+def _whole_word(value: float) -> int:
+    return int(value) if float(value).is_integer() else -1

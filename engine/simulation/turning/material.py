@@ -4,11 +4,17 @@ followed in order (shapely geometry):
 
 * a rapid (G0/G00) must run through air: one that runs more than AIR_TOLERANCE_MM through the
   material left or the part is refused (a rapid into material breaks the tool or the machine);
+  behind a stored blank's back end (params.stock_z_back) the bar runs on into the chuck at the
+  blank's radius (bar_behind): it is material too;
+* a cut behind a stored blank's back end by more than the job's run-out (params.clearance, the
+  overtravel the planner gives a pass at either end) is refused unless its operation is PART
+  (parting off at the back end): it would cut the bar that holds the part;
 * a cut (G1/G2/G3, a thread pass G32/G33) must not enter the finished part by more than
   CUT_TOLERANCE_MM; a thread pass must touch the drawn thread (its THREAD operation's crest and
   root lines) and may run inside the part only between the root's and the crest's radius, over
   the drawn thread and its run-in from where the pass starts (a thread is cut from the part's
-  free end, design notes §8); the thread's groove is air for the rapid that pulls the tool out;
+  free end, design notes §8), never on past the drawn thread's far end; the thread's groove
+  is air for the rapid that pulls the tool out;
 * what a cut removes: an outside tool's body stands radially above its tip, so the column
   above the path is air afterwards (a plunge removes its own line), widened by AIR_TOLERANCE_MM
   so a rapid back up the line a plunge just fed runs in air — as design notes §8 model the chip.
@@ -46,17 +52,28 @@ def column(move: Move) -> BaseGeometry:
     return whole(unary_union(pieces).buffer(AIR_TOLERANCE_MM))
 
 
-def thread_band(drawn: BaseGeometry, line: BaseGeometry) -> BaseGeometry:
-    """Between the drawn thread's root and crest radius, over its Z and the pass's."""
+def thread_band(drawn: BaseGeometry, move: Move) -> BaseGeometry:
+    """Between the drawn thread's root and crest radius, over its Z and the pass's run-in: from
+    where the pass starts (the free end it is cut from, design notes §8), never past the drawn
+    thread's far end (beyond it a relief groove is air anyway, a shoulder is the part)."""
     z0, r0, z1, r1 = drawn.bounds
-    p0, _, p1, _ = line.bounds
-    return box(min(z0, p0), r0, max(z1, p1), r1).buffer(CUT_TOLERANCE_MM)
+    start = move.points[0][0]
+    return box(min(z0, start), r0, max(z1, start), r1).buffer(CUT_TOLERANCE_MM)
+
+
+def bar_behind(blank: BaseGeometry) -> BaseGeometry:
+    """The bar behind the blank's back end, at the blank's radius, on into the chuck that holds it."""
+    z_back, low, _, high = blank.bounds
+    return box(z_back - ABOVE_EVERYTHING_MM, low, z_back, high)
 
 
 class MaterialWalk:
-    def __init__(self, records: TurningRecords, blank: BaseGeometry, report: TurningReport):
-        self.records, self.report = records, report
-        self.material = blank.difference(records.part)
+    def __init__(self, records: TurningRecords, blank: BaseGeometry, report: TurningReport, run_out: float):
+        """`run_out`: mm a cut may run on behind a stored blank's back end (params.clearance)."""
+        self.records, self.report, self.run_out = records, report, run_out
+        self.z_back = blank.bounds[0] if records.stock is not None else None
+        bar = [bar_behind(blank)] if self.z_back is not None else []
+        self.material = unary_union([blank, *bar]).difference(records.part)
         self.inside_part = records.part.buffer(-CUT_TOLERANCE_MM)
         self.solid_part = self.inside_part       # less the thread grooves cut so far
         self.threads = {n: region.buffer(CUT_TOLERANCE_MM) for n, region in records.threads.items()}
@@ -67,6 +84,7 @@ class MaterialWalk:
             self._rapid(move, line)
             return
         self.report.cut_moves += 1
+        self._behind(move, line)
         self._cut(move, line)
         self.material = self.material.difference(column(move))
 
@@ -78,6 +96,17 @@ class MaterialWalk:
             self.report.add(move.number, move.line, f"a rapid through material for {through:.3f} mm "
                             "(the blank not cut yet or the finished part): it breaks the tool")
 
+    def _behind(self, move: Move, line: BaseGeometry) -> None:
+        """Only a parting operation cuts at the back end (down to the axis); beyond the run-out
+        behind it any other cut goes into the bar the chuck holds, not into the blank the job turns."""
+        op = self.records.operations.get(move.operation) if move.operation else None
+        if self.z_back is None or (op is not None and op.kind == "PART"):
+            return       # an assumed blank: nothing is known of what lies behind it
+        behind = self.z_back - line.bounds[0]
+        if behind > self.run_out + CUT_TOLERANCE_MM:
+            self.report.add(move.number, move.line, f"a cut {behind:.3f} mm behind the blank's back end "
+                            f"Z{self.z_back:.3f}: it cuts the bar the chuck holds, not the blank")
+
     def _cut(self, move: Move, line: BaseGeometry) -> None:
         inside = line.intersection(self.inside_part)
         if move.kind == THREAD and move.operation in self.threads:
@@ -85,7 +114,7 @@ class MaterialWalk:
             if line.intersection(drawn).is_empty:
                 self.report.add(move.number, move.line, f"a thread pass away from the drawn thread of operation "
                                 f"{move.operation} (its crest and root lines)")
-            groove = thread_band(drawn, line)
+            groove = thread_band(drawn, move)
             inside = inside.difference(groove)
             self.solid_part = self.solid_part.difference(column(move).intersection(groove.buffer(AIR_TOLERANCE_MM)))
         if inside.length > 0:

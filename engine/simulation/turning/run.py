@@ -13,7 +13,7 @@ from .follow import FEED, Move, ProgramState
 from .material import MaterialWalk
 from .reading import read_lathe_program
 from .report import TurningReport
-from .work import turning_records
+from .work import number, turning_records
 
 
 def simulate_turning(lines: list[str], params: dict, module_params: dict, machine: Machine,
@@ -31,7 +31,7 @@ def simulate_turning(lines: list[str], params: dict, module_params: dict, machin
     blank = records.blank(_feed_radius(state.moves), _facing_zs(state.moves, records))
     z0, r0, z1, r1 = blank.bounds
     report.blank = f"Ø{2 * r1:.3f} Z{z0:.3f}…{z1:.3f}" + (" (assumed)" if records.stock is None else "")
-    walk = MaterialWalk(records, blank, report)
+    walk = MaterialWalk(records, blank, report, number(params, "clearance"))
     for move in state.moves:
         walk.take(move)
     check_cutting(state.moves, records, params, module_params, report)
