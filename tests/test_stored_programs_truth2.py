@@ -1,0 +1,154 @@
+"""A stored program is evidence only when it is proved now (issue 26, finding 9, second round).
+
+A runner can INSERT a job by hand and store, through program_submission, the very program the
+engine renders from it: the lines are the rendering (MATCH of old), but no verifier read them.
+The check proves the rendering as a new program is proved (the machine's verifier, the
+simulation) and says REFUSED when the proof refuses it; lists never say a verifier read a program
+they did not check; a job of a shape the engine never stores is refused in one line, never a
+crash; a program stored with no trace is not the rendering."""
+import json
+
+import psycopg
+import pytest
+from helpers.roles import as_role
+from psycopg.types.json import Jsonb
+
+from engine.nc.lineage import lineage_line, lineage_words
+from engine.programs.rendering import Renderer, StoredProgram
+
+GEAR = 42                  # the seeded spur gear, made on hobber-840d
+FAST_N0 = 1240             # r/min: over hobber-840d's hob spindle maximum (its machine record, read below)
+
+
+def made(run) -> tuple[int, int]:
+    result = run("instantiate", "--gear", GEAR, "--json")
+    assert result.exit_code == 0, result.output
+    found = json.loads(result.stdout)
+    return found["job_id"], found["program_id"]
+
+
+def hand_job(conn, job_id: int, params: dict | None = None, module_params: dict | None = None,
+             cutting: dict | None = None) -> int:
+    """A copy of the job INSERTed as a runner can, its params/module_params/cutting updated."""
+    gear_id, cls, machine, hob, p, m, c = conn.execute(
+        "SELECT gear_id, gear_class, machine, hob_id, params, module_params, cutting FROM job WHERE id = %s",
+        (job_id,)).fetchone()
+    return conn.execute(
+        "INSERT INTO job (gear_id, gear_class, machine, hob_id, params, module_params, cutting) "
+        "VALUES (%s, %s, %s, %s, %s, %s, %s) RETURNING id",
+        (gear_id, cls, machine, hob, Jsonb({**p, **(params or {})}), Jsonb({**m, **(module_params or {})}),
+         Jsonb({**(c or {}), **(cutting or {})}))).fetchone()[0]
+
+
+def hand_program(conn, job_id: int, trace: bool = True) -> int:
+    """The job's rendering by its class's released version, stored through program_submission as
+    verified (unverified false), as a runner can; `trace` False stores it without its trace."""
+    cls, machine, params, module_params, dialect, digest, version = conn.execute(
+        "SELECT j.gear_class, j.machine, j.params, j.module_params, m.dialect, job_input_hash(j.params, "
+        "j.module_params), (SELECT max(version) FROM template_version_rows v WHERE v.gear_class = j.gear_class) "
+        "FROM job j JOIN machine m ON m.name = j.machine WHERE j.id = %s", (job_id,)).fetchone()
+    program_id = conn.execute("SELECT nextval('program_id_seq')").fetchone()[0]
+    renderer = Renderer(conn)
+    template = renderer.template(cls, version)
+    stored = StoredProgram(program_id, "HAND", cls, version, template.hash, digest, False, False, [], [], None,
+                           job_id, machine, params, module_params, digest, True, dialect)
+    lines, row_ids, made_trace = renderer.rendered(stored, template)
+    conn.execute("INSERT INTO program_submission (id, job_id, gear_class, template_version, template_hash, name, "
+                 "lines, row_ids, trace, unverified) VALUES (%s, %s, %s, %s, %s, %s, %s, %s, %s, false)",
+                 (program_id, job_id, cls, version, template.hash, "HAND", lines, row_ids,
+                  Jsonb(made_trace) if trace else None))
+    return program_id
+
+
+@pytest.fixture
+def over_speed(run):
+    """(job, program): a hand job with n0 over the hob spindle maximum, and its rendering stored."""
+    job_id, _ = made(run)
+    with psycopg.connect(run.url) as conn, as_role(conn, "engine_runner"):
+        fast = hand_job(conn, job_id, params={"n0": FAST_N0}, cutting={"hob_speed": FAST_N0})
+        program_id = hand_program(conn, fast)
+    with psycopg.connect(run.url) as conn:
+        maximum = conn.execute("SELECT spindle_max FROM machine WHERE name = 'hobber-840d'").fetchone()[0]
+    assert FAST_N0 > maximum   # the case this test is about: a speed the verifier refuses
+    return fast, program_id
+
+
+def test_a_hand_stored_rendering_the_verifier_refuses_is_refused_not_match(run, over_speed, tmp_path):
+    job_id, program_id = over_speed
+    shown = run("programs", "show", program_id)
+    assert shown.exit_code == 0, shown.output
+    rendering = next(line for line in shown.stdout.splitlines() if line.startswith("rendering:"))
+    assert rendering.split()[1] == "REFUSED:" and "MATCH" not in rendering
+    assert "read by the machine's verifier" not in shown.stdout
+    checked = json.loads(run("programs", "list", "--job", job_id, "--check", "--json").stdout)["programs"]
+    assert [(p["rendering"], p["verifier"]) for p in checked] == [("REFUSED", "-")]
+    for command in (("simulate", "--program", program_id), ("explain", "--program", program_id),
+                    ("plot", "--program", program_id, "-o", tmp_path / "p.svg"),
+                    ("cases", "confirm", "--job", job_id)):
+        result = run(*command)
+        assert result.exit_code == 1, (command, result.output)
+        assert len(result.stderr.strip().splitlines()) == 1 and "REFUSED" in result.stderr, command
+    assert not (tmp_path / "p.svg").exists()
+
+
+def test_lists_say_a_program_not_checked_is_only_stored_as_verified(run):
+    job_id, program_id = made(run)
+    plain = json.loads(run("programs", "list", "--job", job_id, "--json").stdout)["programs"]
+    assert [(p["rendering"], p["verifier"]) for p in plain] == [("on show", "stored as verified, unchecked")]
+    job = json.loads(run("jobs", "show", job_id, "--json").stdout)["job"]["programs"]
+    assert [p["verifier"] for p in job] == ["stored as verified, unchecked"]
+    table = run("programs", "list", "--job", job_id)
+    assert table.exit_code == 0 and " read " not in f" {table.stdout} "
+    checked = json.loads(run("programs", "list", "--job", job_id, "--check", "--json").stdout)["programs"]
+    assert [(p["rendering"], p["verifier"]) for p in checked] == [("MATCH", "read")]
+
+
+def test_a_program_stored_without_its_trace_is_a_mismatch_and_explain_says_so(run):
+    job_id, _ = made(run)
+    with psycopg.connect(run.url) as conn, as_role(conn, "engine_runner"):
+        program_id = hand_program(conn, job_id, trace=False)
+    shown = json.loads(run("programs", "show", program_id, "--json").stdout)["programs"][0]
+    assert shown["rendering"]["status"] == "MISMATCH" and "trace" in shown["rendering"]["reason"]
+    explained = run("explain", "--program", program_id)
+    assert explained.exit_code == 1 and "before programs kept their trace" not in explained.stderr
+
+
+MALFORMED = [({"cutmotion:1": "x"}, {"cycle_time": 1}), ({"cutmotion:1": None}, {"cycle_time": 1}),
+             ({"cutmotion:1": {"feed_axial": "a"}}, {"cycle_time": 1}), ({"cutmotion:1": "x"}, {})]
+
+
+@pytest.mark.parametrize("module_params,params", MALFORMED)
+def test_a_hand_job_of_a_shape_the_engine_never_stores_is_refused_in_one_line(run, tmp_path, module_params,
+                                                                             params):
+    job_id, _ = made(run)
+    with psycopg.connect(run.url) as conn, as_role(conn, "engine_runner"):
+        bad = hand_job(conn, job_id, params=params, module_params=module_params)
+        program_id = junk_program(conn, bad)
+    for command in (("instantiate", "--job", bad), ("plot", "--job", bad, "-o", tmp_path / "j.svg"),
+                    ("cases", "confirm", "--job", bad),
+                    ("simulate", "--program", program_id), ("explain", "--program", program_id),
+                    ("instantiate", "--jobs", f"{bad}-{bad}")):
+        result = run(*command)
+        assert result.exit_code == 1, (command, result.output)
+        message = result.stderr.strip()
+        assert len(message.splitlines()) == 1 and f"job {bad}" in message, (command, message)
+        assert "module_params.cutmotion:1" in message, (command, message)
+    shown = json.loads(run("programs", "show", program_id, "--json").stdout)["programs"][0]["rendering"]
+    assert shown["status"] == "UNCHECKED" and "module_params.cutmotion:1" in shown["reason"]
+    listed = json.loads(run("programs", "list", "--job", bad, "--check", "--json").stdout)["programs"]
+    assert [(p["rendering"], p["verifier"]) for p in listed] == [("UNCHECKED", "-")]
+
+
+def junk_program(conn, job_id: int) -> int:
+    """A program stored by hand for the job: its lineage line and M30 (the database takes it)."""
+    cls, dialect, digest, version, template_hash, rows = conn.execute(
+        "SELECT j.gear_class, m.dialect, job_input_hash(j.params, j.module_params), v.version, v.hash, "
+        "v.rows FROM job j JOIN machine m ON m.name = j.machine JOIN template_version_rows v "
+        "ON v.gear_class = j.gear_class WHERE j.id = %s ORDER BY v.version DESC LIMIT 1", (job_id,)).fetchone()
+    program_id = conn.execute("SELECT nextval('program_id_seq')").fetchone()[0]
+    words = lineage_words(program_id, cls, version, template_hash, digest, False, False)
+    conn.execute("INSERT INTO program_submission (id, job_id, gear_class, template_version, template_hash, name, "
+                 "lines, row_ids, trace, unverified) VALUES (%s, %s, %s, %s, %s, %s, %s, %s, %s, false)",
+                 (program_id, job_id, cls, version, template_hash, "JUNK", [lineage_line(words, dialect), "M30"],
+                  [-1, rows[0]["id"]], Jsonb({})))
+    return program_id
