@@ -152,3 +152,21 @@ def junk_program(conn, job_id: int) -> int:
                  (program_id, job_id, cls, version, template_hash, "JUNK", [lineage_line(words, dialect), "M30"],
                   [-1, rows[0]["id"]], Jsonb({})))
     return program_id
+
+
+def program_count(url: str) -> int:
+    with psycopg.connect(url) as conn:
+        return conn.execute("SELECT count(*) FROM program").fetchone()[0]
+
+
+def test_an_out_path_the_system_refuses_is_one_line_and_nothing_stored(run, tmp_path):
+    (tmp_path / "loop").symlink_to(tmp_path / "loop")
+    (tmp_path / "file").write_text("")
+    long_name = tmp_path / ("a" * 300)   # over NAME_MAX (255) of every Linux file system
+    for out in (long_name, f"{long_name}/", f"{tmp_path / 'loop'}/x", f"{tmp_path / 'loop'}/"):
+        before = program_count(run.url)
+        result = run("instantiate", "--gear", GEAR, "--out", out)
+        assert result.exit_code == 1, (out, result.output)
+        message = result.stderr.strip()
+        assert len(message.splitlines()) == 1 and "nothing stored" in message and len(message) < 300, message
+        assert program_count(run.url) == before
