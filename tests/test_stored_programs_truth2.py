@@ -170,3 +170,28 @@ def test_an_out_path_the_system_refuses_is_one_line_and_nothing_stored(run, tmp_
         message = result.stderr.strip()
         assert len(message.splitlines()) == 1 and "nothing stored" in message and len(message) < 300, message
         assert program_count(run.url) == before
+
+
+def test_cases_confirm_refuses_feeds_in_job_cutting_the_program_never_ran(run):
+    """The runner's job: the engine's own parameters (its program MATCH and proved), job.cutting's
+    rough feeds set to 150 and 90 mm/min; the program cuts at the feeds of its module parameters."""
+    job_id, _ = made(run)
+    with psycopg.connect(run.url) as conn, as_role(conn, "engine_runner"):
+        forged = hand_job(conn, job_id, cutting={"rough": {"axial_feed": 150.0, "radial_feed": 90.0}})
+        hand_program(conn, forged)
+        ran = conn.execute("SELECT module_params->'cutmotion:2'->>'feed_axial' FROM job WHERE id = %s",
+                           (forged,)).fetchone()[0]
+    assert abs(float(ran) - 150.0) > 1
+    before = program_count(run.url), case_count(run.url)
+    result = run("cases", "confirm", "--job", forged)
+    assert result.exit_code == 1, result.output
+    message = result.stderr.strip()
+    assert len(message.splitlines()) == 1 and "axial_feed 150.0" in message and ran in message, message
+    assert (program_count(run.url), case_count(run.url)) == before
+    genuine = run("cases", "confirm", "--job", job_id)   # the engine's own job and cutting data: confirmed
+    assert genuine.exit_code == 0, genuine.output
+
+
+def case_count(url: str) -> int:
+    with psycopg.connect(url) as conn:
+        return conn.execute("SELECT count(*) FROM cutting_case").fetchone()[0]
