@@ -195,3 +195,35 @@ def test_cases_confirm_refuses_feeds_in_job_cutting_the_program_never_ran(run):
 def case_count(url: str) -> int:
     with psycopg.connect(url) as conn:
         return conn.execute("SELECT count(*) FROM cutting_case").fetchone()[0]
+
+
+COOLANT_OFF_ROW = 2900   # seed_templates/classes/spur.csv: `"M9"` when coolant; no golden test reads it
+COMMENTED = "M9 ; COOLANT OFF"
+
+
+def test_the_impact_of_a_draft_is_not_hidden_by_a_forged_stored_program(run):
+    """An editor's draft comments spur's coolant-off line; a runner stores for job 1 a program whose
+    lines are already the draft's (`M9 ; COOLANT OFF` where the released version makes `M9`: a
+    MISMATCH). The impact compares the draft with the released version rendered now, so job 1
+    still shows its change."""
+    job_id, genuine = made(run)
+    with psycopg.connect(run.url) as conn:
+        conn.execute("UPDATE template_view SET o = %s WHERE gear_class = 'spur' AND id = %s",
+                     (f'"{COMMENTED}"', COOLANT_OFF_ROW))
+    with psycopg.connect(run.url) as conn, as_role(conn, "engine_runner"):
+        lines, row_ids, trace, version, digest = conn.execute(
+            "SELECT lines, row_ids, trace, template_version, template_hash FROM program WHERE id = %s",
+            (genuine,)).fetchone()
+        assert "M9" in lines
+        forged_id = conn.execute("SELECT nextval('program_id_seq')").fetchone()[0]
+        kept = [(COMMENTED if line == "M9" else line.replace(f"PROGRAM {genuine} ", f"PROGRAM {forged_id} "), row)
+                for line, row in zip(lines, row_ids)]
+        conn.execute("INSERT INTO program_submission (id, job_id, gear_class, template_version, template_hash, name, "
+                     "lines, row_ids, trace) VALUES (%s, %s, 'spur', %s, %s, 'GEAR42', %s, %s, %s)",
+                     (forged_id, job_id, version, digest, [line for line, _ in kept], [row for _, row in kept],
+                      Jsonb(trace)))
+    dry = run("template", "release", "--class", "spur", "--dry-run", "--json")
+    assert dry.exit_code == 0, dry.output
+    impact = json.loads(dry.stdout)["impact"]
+    assert impact["changed"] == 1 and [diff["job_id"] for diff in impact["diffs"]] == [job_id], impact
+    assert f"+{COMMENTED}" in impact["diffs"][0]["diff"]
