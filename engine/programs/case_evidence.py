@@ -37,7 +37,10 @@ SELECT p.trace, j.cutting, j.module_params FROM program p JOIN job j ON j.id = p
 
 def check_case_evidence(conn: Connection, job_id: int, program_id: int) -> None:
     """EngineError (one line, nothing confirmed) for a value of job.cutting the program did not run."""
-    trace, cutting, module_params = conn.execute(PROGRAM_AND_CUTTING, (program_id,)).fetchone()
+    found = conn.execute(PROGRAM_AND_CUTTING, (program_id,)).fetchone()
+    if found is None:   # checked_last_program found it in this transaction, the job locked
+        raise EngineError(f"program {program_id} does not exist; nothing confirmed")
+    trace, cutting, module_params = found
     inputs = (trace or {}).get("inputs") or {}
     said = f"job {job_id}: job.cutting"
     ran = (inputs.get("job") or {}).get("n0")
@@ -75,7 +78,7 @@ def _first_cuts(inputs: dict, module_params: dict) -> dict[str, dict]:
     modules = [(key.removeprefix("module "), value) for key, value in inputs.items() if key.startswith("module ")]
     for key, cut in sorted(modules, key=lambda item: _number(item[0])):
         if key.startswith("cutmotion:") and isinstance(cut, dict) and cut.get("cut_on") is True:
-            kind = KIND_OF_CUT.get(cut.get("cut_name"))
+            kind = KIND_OF_CUT.get(str(cut.get("cut_name")))
             if kind:
                 stored = module_params.get(key)
                 found.setdefault(kind, {**(stored if isinstance(stored, dict) else {}), **cut})
