@@ -18,6 +18,9 @@ from engine.programs.rendering import Renderer, StoredProgram
 
 GEAR = 42                  # the seeded spur gear, made on hobber-840d
 FAST_N0 = 1240             # r/min: over hobber-840d's hob spindle maximum (its machine record, read below)
+# r/min: under it, but v = π·70·900/1000 ≈ 198 m/min, far above the hob's reference range: a new job's
+# bounds (engine.programs.job_checks, as `instantiate --job` holds a stored job) refuse it
+BOUNDED_N0 = 900
 
 
 def made(run) -> tuple[int, int]:
@@ -60,16 +63,17 @@ def hand_program(conn, job_id: int, trace: bool = True) -> int:
     return program_id
 
 
-@pytest.fixture
-def over_speed(run):
-    """(job, program): a hand job with n0 over the hob spindle maximum, and its rendering stored."""
+@pytest.fixture(params=[FAST_N0, BOUNDED_N0])
+def over_speed(run, request):
+    """(job, program): a hand job with n0 over the hob spindle maximum (or over a new job's
+    bounds), and its rendering stored."""
     job_id, _ = made(run)
     with psycopg.connect(run.url) as conn, as_role(conn, "engine_runner"):
-        fast = hand_job(conn, job_id, params={"n0": FAST_N0}, cutting={"hob_speed": FAST_N0})
+        fast = hand_job(conn, job_id, params={"n0": request.param}, cutting={"hob_speed": request.param})
         program_id = hand_program(conn, fast)
     with psycopg.connect(run.url) as conn:
         maximum = conn.execute("SELECT spindle_max FROM machine WHERE name = 'hobber-840d'").fetchone()[0]
-    assert FAST_N0 > maximum   # the case this test is about: a speed the verifier refuses
+    assert (request.param > maximum) == (request.param == FAST_N0)   # the verifier's case, and the bounds' one
     return fast, program_id
 
 

@@ -49,11 +49,10 @@ from ..templates.rows import Template, TemplateRow
 from ..templates.translations import load_translations
 from . import all_models  # noqa: F401  (registers every model)
 from .job_shape import check_job_shape, job_with_cycle_time
-from .rendering_proof import proof_refusal
-from .verified_run import Workpiece
 
 if TYPE_CHECKING:
     from ..db.connection import Connection
+    from .verified_run import Workpiece
 
 MATCH, MISMATCH, UNCHECKED, REFUSED = "MATCH", "MISMATCH", "UNCHECKED", "REFUSED"
 NOT_RENDERED = "on show"   # a list's word for a program it did not render (`programs show` renders it)
@@ -194,12 +193,25 @@ class Renderer:
 
     def refusal(self, stored: StoredProgram, template: Template, made: list) -> str | None:
         """Why the verifier or the simulation refuses the rendered lines now, or None."""
-        params, module_params = stored.params, stored.module_params
-        workpiece = self.workpiece(stored.gear_id, stored.hob_id) if self.model(stored.gear_class) else None
-        return proof_refusal(made, self.machine(stored.machine), template, params, module_params, workpiece)
+        # the proof's modules, imported only when a program is checked (a plain list stays quick)
+        from .job_checks import check_hobbing_feeds, check_hobbing_job
+        from .rendering_proof import proof_refusal
+
+        params, module_params, model = stored.params, stored.module_params, self.model(stored.gear_class)
+        workpiece = self.workpiece(stored.gear_id, stored.hob_id) if model else None
+        machine = self.machine(stored.machine)
+        checks = None
+        if workpiece is not None and machine.kind == "hobber":   # the job held to a new job's bounds too
+            def checks() -> None:
+                check_hobbing_job(stored.job_id, stored.gear_class, model, workpiece.gear, workpiece.hob, machine,
+                                  params, module_params)
+                check_hobbing_feeds(stored.job_id, workpiece.gear, workpiece.hob, machine, params, module_params)
+        return proof_refusal(made, machine, template, params, module_params, workpiece, checks)
 
     def workpiece(self, gear_id: int | None, hob_id: str | None) -> Workpiece | None:
         """The job's gear and hob as stored now (read once per list), None without both."""
+        from .verified_run import Workpiece
+
         if gear_id is None or hob_id is None:
             return None
         if self._hobs is None:

@@ -7,10 +7,14 @@ The lines match; no verifier ever read them. So the check (engine.programs.rende
 rendered lines now, as engine.programs.verified_run proves a program before it is stored: the
 machine's verifier (docs/reference/hobbing.md, machine limits), then on a hobber the simulation
 against the gear and hob records, on a lathe (a drawing's job) the turning simulation against the
-job's records. A rendering the proof refuses is REFUSED with the proof's one-line reason. A
+job's records; a hobbing job is also held to a new job's bounds (engine.programs.job_checks, as
+`instantiate --job` holds it: its hob, its record parameters, its hob speed and feeds). A
+rendering the proof refuses is REFUSED with the proof's one-line reason. A
 program stored UNVERIFIED (instantiate --class --unverified) is not proved: its record and its
 lineage line already say no verifier read it, and it is never written to a file."""
 from __future__ import annotations
+
+from collections.abc import Callable
 
 from ..errors import EngineError
 from ..machines.records import Machine
@@ -22,13 +26,17 @@ NOTHING_STORED = "; nothing stored"   # the proof's words for a new program; a s
 
 
 def proof_refusal(lines: list[str], machine: Machine, template: Template, params: dict, module_params: dict,
-                  workpiece: Workpiece | None) -> str | None:
+                  workpiece: Workpiece | None, job_checks: Callable[[], None] | None = None) -> str | None:
     """Why the proof refuses the rendered `lines` (template output, no lineage line), in one line,
     or None when it passes. `params`, `module_params`: the job's as stored; `workpiece`: its gear
-    and hob records (None for a job without both, or of an imported class: a hobber refuses it)."""
+    and hob records (None for a job without both, or of an imported class: a hobber refuses it);
+    `job_checks`: a stored hobbing job's checks as `instantiate --job` runs them (engine.programs.
+    job_checks: its hob, its record parameters, its hob speed and feeds within a new job's bounds)."""
     name = params.get("program_name") if isinstance(params, dict) else None
     name = name if isinstance(name, str) else None
     try:
+        if job_checks is not None:
+            job_checks()
         verify_program(lines, machine, name)
         if machine.kind == "hobber":
             prove(lines, machine, workpiece, name or "the program")
