@@ -231,3 +231,18 @@ def test_the_impact_of_a_draft_is_not_hidden_by_a_forged_stored_program(run):
     impact = json.loads(dry.stdout)["impact"]
     assert impact["changed"] == 1 and [diff["job_id"] for diff in impact["diffs"]] == [job_id], impact
     assert f"+{COMMENTED}" in impact["diffs"][0]["diff"]
+
+
+def test_an_out_folder_the_user_may_not_read_is_one_line_and_nothing_stored(run, tmp_path, monkeypatch):
+    """EACCES listing --out (the tests run as root, who reads every folder: the refusal is simulated)."""
+    import engine.programs.outputs as outputs
+
+    def refused(path):
+        raise PermissionError(13, "Permission denied", str(path))
+
+    monkeypatch.setattr(outputs.os, "listdir", refused)
+    before = program_count(run.url)
+    result = run("instantiate", "--gear", GEAR, "--out", f"{tmp_path}/")
+    assert result.exit_code == 1, result.output
+    assert "Permission denied" in result.stderr and len(result.stderr.strip().splitlines()) == 1
+    assert program_count(run.url) == before
