@@ -190,13 +190,13 @@ SELECT n.id, p.job_id, p.gear_class, p.template_version, p.template_hash, p.name
 FROM program p, (SELECT nextval('program_id_seq') AS id) n WHERE p.id = %s RETURNING id"""
 
 
-def test_a_program_stored_before_traces_says_so(run):
+def test_a_program_stored_without_a_trace_says_so_and_is_not_its_rendering(run):
     made = run("instantiate", "--gear", "42", "--json")
     program_id = __import__("json").loads(made.stdout)["program_id"]
     with psycopg.connect(run.url) as conn:   # programs are records: a copy stored without its trace
         program_id = conn.execute(COPY_WITHOUT_TRACE, (program_id,)).fetchone()[0]
     refused = run("explain", "--program", program_id)
-    assert refused.exit_code == 1 and "before programs kept their trace" in refused.stderr
+    assert refused.exit_code == 1 and "MISMATCH" in refused.stderr and "no trace stored" in refused.stderr
 
 
 def test_a_computed_text_with_a_nul_is_traced_not_fatal(conn):

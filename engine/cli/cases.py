@@ -104,12 +104,18 @@ def cases_confirm(ctx, job_id):
 
     The job's last program vouches for the data: it must be the rendering of the template
     version and job it names; a program that is not (MISMATCH), or cannot be rendered again
-    because the job was edited since (UNCHECKED), is refused and nothing is added.
+    because the job was edited since (UNCHECKED), or whose rendering the verifier or the
+    simulation refuses now (REFUSED), is refused and nothing is added. Every value a case takes
+    from job.cutting (the hob speed, each cut kind's axial and radial feed) must be what that
+    program ran (its trace): a difference is refused and nothing is added.
     """
     from ..gears.cases import confirm_job
+    from ..programs.case_evidence import check_case_evidence
     from ..programs.rendering import checked_last_program
 
     with connection(ctx) as conn, conn.transaction():
-        checked_last_program(conn, job_id, "the cutting history; nothing confirmed")
+        checked = checked_last_program(conn, job_id, "the cutting history; nothing confirmed")
+        if checked is not None:   # the database refuses a job without a program itself
+            check_case_evidence(conn, job_id, checked.program_id)
         ids = confirm_job(conn, job_id)
     click.echo(f"job {job_id} confirmed: added case(s) {', '.join(f'#{i}' for i in ids)}")

@@ -57,8 +57,8 @@ def programs():
 @click.option("--job", "job_id", type=JOB_ID, help="Only programs made from this job.")
 @click.option("--draft", is_flag=True, help="Only programs made from a draft version (for trying).")
 @click.option("--released", is_flag=True, help="Only programs made from a released version.")
-@click.option("--check", is_flag=True, help="Render every program listed again (milliseconds each): MATCH or "
-              "MISMATCH in the rendering column instead of 'on show'.")
+@click.option("--check", is_flag=True, help="Render and prove every program listed again (a verifier reading and a "
+              "simulation each): MATCH, MISMATCH or REFUSED in the rendering column instead of 'on show'.")
 @day_options("programs stored")
 @list_options("programs")
 @click.pass_context
@@ -69,7 +69,9 @@ def programs_list(ctx, gear_class, gear_id, job_id, draft, released, check, sinc
 
     The rendering column says UNCHECKED for a program whose job was edited since (it cannot be
     rendered again: not evidence), else 'on show' (`engine programs show ID` renders it), or with
-    --check MATCH or MISMATCH. The verifier column never says read of a MISMATCH or UNCHECKED one.
+    --check MATCH, MISMATCH or REFUSED (its lines are the rendering but the verifier or the
+    simulation refuses them now). The verifier column says read only of a program checked now
+    and MATCH; without --check, 'stored as verified, unchecked'.
 
     Example: engine programs list --gear 42 --released --since 2026-11-01
     """
@@ -95,8 +97,9 @@ def programs_show(ctx, program_id, prefix, as_json):
     printed with the class's line ending and final newline (an imported class: its file's).
 
     Each program is first rendered again from its template version and its job's parameters
-    (milliseconds): `rendering:` says MATCH, MISMATCH (its stored lines are not what the
-    version makes: not the program the verifier read) or UNCHECKED (its job was edited since,
+    and its rendering proved as a new program is: `rendering:` says MATCH, MISMATCH (its stored
+    lines are not what the version makes: not the program the verifier read), REFUSED (they are,
+    but the machine's verifier or the simulation refuses them now) or UNCHECKED (its job was edited since,
     so it cannot be rendered again; make it again with `engine instantiate --job ID`).
 
     The lineage line of a file on the control, e.g.

@@ -73,7 +73,7 @@ def explain_program(conn: Connection, program_id: int, row: int | None = None) -
     checked_program(conn, program_id, "explain")   # its trace would narrate lines no template made
     lines, row_ids, trace = found
     if trace is None:
-        raise EngineError(f"program {program_id} was stored before programs kept their trace; "
+        raise EngineError(f"program {program_id} has no trace stored (NULL); "
                           "make it again with `engine instantiate --job ID` to explain it")
     return explained_rows(trace, lines, row_ids, row)
 

@@ -139,9 +139,9 @@ def list_programs(conn: Connection, gear_class: str | None = None, gear_id: int 
     """Every program matching all filters given (None: any), by id: its record without its lines.
     draft True: made from a draft version (for trying only); False: from a released one.
     `rendering`: UNCHECKED for a program that cannot be rendered again (its job edited since), else
-    NOT_RENDERED, or with `check` MATCH or MISMATCH (engine.programs.rendering: milliseconds each, so
-    a list renders only when asked). `verifier`: UNVERIFIED, "read" (the record says a verifier
-    read it and the rendering does not contradict it) or "-"."""
+    NOT_RENDERED, or with `check` MATCH, MISMATCH or REFUSED (engine.programs.rendering: milliseconds each, so
+    a list renders only when asked). `verifier`: UNVERIFIED, "read" (checked now: MATCH),
+    "stored as verified, unchecked" (not rendered in this list) or "-" (MISMATCH, REFUSED, UNCHECKED)."""
     require_class(conn, gear_class)
     filters = {"class": gear_class, "gear": gear_id, "job": job_id, "draft": draft, **day_range(since, until)}
     renderer = Renderer(conn)
@@ -154,9 +154,14 @@ def _listed(renderer: Renderer, record: dict, check: bool) -> dict:
     return {**record, "verifier": listed_verifier(record["unverified"], record["rendering"])}
 
 
+STORED_UNCHECKED = "stored as verified, unchecked"   # the record's word alone: no rendering, no proof now
+
+
 def listed_verifier(unverified: bool, rendering: str) -> str:
-    """What a list says of the verifier: never "read" of a program that is not known to be the
-    one the verifier read."""
+    """What a list says of the verifier: "read" only of a program checked now (MATCH: its lines are
+    the rendering and pass the proof); of one not checked, what the record alone says."""
     if unverified:
         return UNVERIFIED
-    return "read" if rendering in (MATCH, NOT_RENDERED) else "-"
+    if rendering == MATCH:
+        return "read"
+    return STORED_UNCHECKED if rendering == NOT_RENDERED else "-"

@@ -77,13 +77,17 @@ class ProgramFiles:
         any file cannot be written."""
         if self.out is None or not programs:
             return {}
-        paths = self._targets([name for name, _ in programs])
-        self._refuse_existing(list(paths.values()))
-        _refuse_unwritable(paths[programs[0][0]].parent)
+        try:   # a path the system refuses to look at (too long, a symlink loop, a file as a folder, no access)
+            paths = self._targets([name for name, _ in programs])
+            self._refuse_existing(list(paths.values()))
+            _refuse_unwritable(paths[programs[0][0]].parent)
+            self.seen = FolderSeen.now(paths[programs[0][0]].parent)
+        except (OSError, RuntimeError) as error:   # RuntimeError: Path.resolve's symlink loop before 3.13
+            reason = getattr(error, "strerror", None) or str(error)
+            raise EngineError(f"--out {_short(self.out)}: cannot be used ({reason}); nothing stored") from None
         self.layouts = layouts or {}
         self.texts = {paths[name]: self._bytes(name, lines) for name, lines in programs}
         self.paths = paths
-        self.seen = FolderSeen.now(paths[programs[0][0]].parent)
         return {name: str(path) for name, path in paths.items()}
 
     def replace_texts(self, stored: dict[str, list[str]]) -> None:
@@ -228,6 +232,12 @@ def _committed(conn: Connection):
         transaction.__exit__(None, None, None)
     except psycopg.Error as error:
         raise commit_failure(error) from error
+
+
+def _short(path: Path | None) -> str:
+    """The path as given, cut to 80 characters (a name too long for the system is named, not printed whole)."""
+    text = str(path)
+    return text if len(text) <= 80 else text[:77] + "..."
 
 
 def _inside(folder: Path, name: str) -> Path:

@@ -19,7 +19,6 @@ from ..errors import EngineError
 from ..gears.models import model_for_class
 from ..gears.records import Hob, load_gear, load_hobs
 from ..hobbing.cylindrical import program_name
-from ..hobbing.machine_job import with_cycle_time
 from ..machines.records import Machine, load_machine
 from ..memory import no_cycle_collection
 from ..nc.layout import NcLayout, class_layout
@@ -40,6 +39,7 @@ from .batches import (
 from .class_jobs import class_job
 from .instantiate import store_planned
 from .job_checks import check_hobbing_feeds, check_hobbing_job
+from .job_shape import check_job_shape, job_with_cycle_time
 from .options import NO_FILE, NORMAL_RUN, Output, RunMode
 from .outputs import file_layouts, files_after_commit
 from .records import Planned, Program
@@ -83,6 +83,7 @@ class Remaker:
             return plan_turning_job(self.conn, gear_class, machine, params, module_params, draft=self.draft,
                                     job_id=job_id)
         model = model_for_class(self.conn, gear_class)
+        check_job_shape(job_id, params, module_params)   # a job written by hand: named, not a crash
         stored = job_id is not None   # a stored job is checked as a new one; a golden test's case runs as given
         workpiece = self.workpiece(job_id, gear_id, hob_id, required=stored)
         if stored and workpiece:
@@ -91,7 +92,7 @@ class Remaker:
             check_program_name(self.conn, job_id, gear_id, params)
             check_hobbing_feeds(job_id, workpiece.gear, workpiece.hob, machine, params, module_params, bounded=False)
         if "cycle_time" in params:   # the time follows feeds edited since
-            params = with_cycle_time(params, module_params, model.cut_shape, machine)
+            params = job_with_cycle_time(job_id, params, module_params, model.cut_shape, machine)
         result = run_template(self.template(gear_class), params, module_params, machine, workpiece)
         if stored and workpiece:
             check_hobbing_feeds(job_id, workpiece.gear, workpiece.hob, machine, params, module_params)

@@ -9,9 +9,14 @@ first renders it again here: the rows of the version it records (template_versio
 once per process), run with its job's parameters as stored, the engine's lineage line added,
 compared line by line, row by row and trace entry by trace entry with what is stored.
 
-Three outcomes (`Rendering.status`):
+Four outcomes (`Rendering.status`):
 
-* MATCH: the stored lines, row ids and trace are exactly the rendering.
+* MATCH: the stored lines, row ids and trace are exactly the rendering, and the rendered lines
+  pass now the proof a new program gets (engine.programs.rendering_proof: the machine's verifier,
+  the hobbing or turning simulation against the records); a program stored UNVERIFIED is not
+  proved (it says so itself).
+* REFUSED: they are the rendering, but the proof refuses it (a job stored by hand with a hob speed
+  over the machine's spindle maximum renders a program no verifier would pass). Not evidence.
 * MISMATCH: they are not; the first difference is named. Such a program is never evidence.
 * UNCHECKED: the program cannot be rendered again from the records, and is not evidence either:
   its job was edited after it was stored (the job's input hash is no longer the one its lineage
@@ -22,9 +27,10 @@ Three outcomes (`Rendering.status`):
 
 The rendering is made as the engine made it (engine.programs.remake): a hobbing job with its
 cycle time recomputed from its feeds, a turning job with its passes computed from its drawing's
-parameters, a job of an imported class with its rows alone. The machine's verifier and the
-simulation are not run here: they read the program the engine made, and a program that is that
-rendering passed them when it was stored (or is marked UNVERIFIED)."""
+parameters, a job of an imported class with its rows alone. A hobbing job whose module parameters
+are not the shape the engine stores (a job written by hand) is UNCHECKED, named, never a crash
+(engine.programs.job_shape). A stored trace must be the rendering's too: a
+program stored with none (NULL) since traces were kept is a MISMATCH."""
 from __future__ import annotations
 
 import json
@@ -34,7 +40,7 @@ from typing import TYPE_CHECKING
 from ..db.connection import scalar
 from ..errors import EngineError
 from ..gears.models import model_for_class
-from ..hobbing.machine_job import with_cycle_time
+from ..gears.records import Hob, load_gear, load_hobs
 from ..machines.records import Machine, load_machine
 from ..names import shown
 from ..nc.lineage import lineage_line, lineage_words, with_lineage
@@ -42,11 +48,13 @@ from ..templates.decision_table import compiled_template
 from ..templates.rows import Template, TemplateRow
 from ..templates.translations import load_translations
 from . import all_models  # noqa: F401  (registers every model)
+from .job_shape import check_job_shape, job_with_cycle_time
 
 if TYPE_CHECKING:
     from ..db.connection import Connection
+    from .verified_run import Workpiece
 
-MATCH, MISMATCH, UNCHECKED = "MATCH", "MISMATCH", "UNCHECKED"
+MATCH, MISMATCH, UNCHECKED, REFUSED = "MATCH", "MISMATCH", "UNCHECKED", "REFUSED"
 NOT_RENDERED = "on show"   # a list's word for a program it did not render (`programs show` renders it)
 # What a list of programs says without rendering any (SQL over program p JOIN job j): UNCHECKED
 # for one that cannot be rendered again (its job edited since, or stored before input hashes).
@@ -55,7 +63,7 @@ LISTED_RENDERING = ("CASE WHEN p.input_hash IS NOT NULL AND p.input_hash = job_i
 STORED = """
 SELECT p.id, p.name, p.gear_class, p.template_version, p.template_hash, p.input_hash, p.draft, p.unverified,
        p.lines, p.row_ids, p.trace, p.job_id, j.machine, j.params, j.module_params,
-       job_input_hash(j.params, j.module_params), v.version IS NOT NULL, m.dialect
+       job_input_hash(j.params, j.module_params), v.version IS NOT NULL, m.dialect, j.gear_id, j.hob_id
 FROM program p JOIN job j ON j.id = p.job_id JOIN machine m ON m.name = j.machine
 LEFT JOIN template_version_rows v ON v.gear_class = p.gear_class AND v.version = p.template_version
 WHERE p.id = %s"""
@@ -133,6 +141,8 @@ class StoredProgram:
     job_hash: str
     version_stored: bool
     dialect: str
+    gear_id: int | None = None   # the job's gear and hob, which the proof simulates against
+    hob_id: str | None = None
 
 
 class Renderer:
@@ -144,6 +154,8 @@ class Renderer:
         self._templates: dict[tuple[str, int], Template] = {}
         self._models: dict[str, object] = {}
         self._machines: dict[str, Machine] = {}
+        self._workpieces: dict[tuple[int, str], Workpiece] = {}
+        self._hobs: dict[str, Hob] | None = None
 
     def rendering(self, program_id: int) -> Rendering:
         row = self.conn.execute(STORED, (program_id,)).fetchone()
@@ -160,7 +172,7 @@ class Renderer:
             return Rendering(stored.id, MISMATCH, f"class {stored.gear_class} v{stored.version}'s stored rows have "
                                                   f"hash {template.hash}, the program records {stored.template_hash}")
         try:
-            lines, row_ids, trace = self.rendered(stored, template)
+            made, lines, row_ids, trace = self.made(stored, template)
         except EngineError as error:   # not rendered now (a run over its budget on a busy machine, or a job
             # no version renders): nothing to compare, so no evidence either way
             return Rendering(stored.id, UNCHECKED, f"class {stored.gear_class} v{stored.version} did not render job "
@@ -170,8 +182,45 @@ class Renderer:
         if difference:
             return Rendering(stored.id, MISMATCH, f"{difference}; the stored lines are not the rendering of class "
                                                   f"{stored.gear_class} v{stored.version} with job {stored.job_id}")
+        refusal = None if stored.unverified else self.refusal(stored, template, made)
+        if refusal:
+            return Rendering(stored.id, REFUSED, f"its lines are the rendering of class {stored.gear_class} "
+                                                 f"v{stored.version} with job {stored.job_id}, which the proof a new "
+                                                 f"program gets refuses now: {refusal}")
+        proved = "" if stored.unverified else ", proved now for the machine"
         return Rendering(stored.id, MATCH, f"its {len(lines)} lines are the rendering of class {stored.gear_class} "
-                                           f"v{stored.version} with job {stored.job_id}'s parameters")
+                                           f"v{stored.version} with job {stored.job_id}'s parameters{proved}")
+
+    def refusal(self, stored: StoredProgram, template: Template, made: list) -> str | None:
+        """Why the verifier or the simulation refuses the rendered lines now, or None."""
+        # the proof's modules, imported only when a program is checked (a plain list stays quick)
+        from .job_checks import check_hobbing_feeds, check_hobbing_job
+        from .rendering_proof import proof_refusal
+
+        params, module_params, model = stored.params, stored.module_params, self.model(stored.gear_class)
+        workpiece = self.workpiece(stored.gear_id, stored.hob_id) if model else None
+        machine = self.machine(stored.machine)
+        checks = None
+        if workpiece is not None and machine.kind == "hobber":   # the job held to a new job's bounds too
+            def checks() -> None:
+                check_hobbing_job(stored.job_id, stored.gear_class, model, workpiece.gear, workpiece.hob, machine,
+                                  params, module_params)
+                check_hobbing_feeds(stored.job_id, workpiece.gear, workpiece.hob, machine, params, module_params)
+        return proof_refusal(made, machine, template, params, module_params, workpiece, checks)
+
+    def workpiece(self, gear_id: int | None, hob_id: str | None) -> Workpiece | None:
+        """The job's gear and hob as stored now (read once per list), None without both."""
+        from .verified_run import Workpiece
+
+        if gear_id is None or hob_id is None:
+            return None
+        if self._hobs is None:
+            self._hobs = {hob.id: hob for hob in load_hobs(self.conn)}
+        if hob_id not in self._hobs:
+            return None
+        if (gear_id, hob_id) not in self._workpieces:
+            self._workpieces[gear_id, hob_id] = Workpiece(load_gear(self.conn, gear_id), self._hobs[hob_id])
+        return self._workpieces[gear_id, hob_id]
 
     def template(self, gear_class: str, version: int) -> Template:
         """The class's stored version (with the stored translations of its SQL conditions)."""
@@ -184,12 +233,16 @@ class Renderer:
 
     def rendered(self, stored: StoredProgram, template: Template) -> tuple[list, list, dict]:
         """The lines (lineage line included), row ids and trace the engine makes for the job."""
+        return self.made(stored, template)[1:]
+
+    def made(self, stored: StoredProgram, template: Template) -> tuple[list, list, list, dict]:
+        """The template's lines, then the lines with the lineage line, row ids and trace."""
         params, module_params = self.inputs(stored)
         result = compiled_template(template).run(params, module_params)
         words = lineage_words(stored.id, stored.gear_class, stored.version, stored.template_hash,
                               stored.input_hash or "", stored.draft, stored.unverified)
         lines, row_ids = with_lineage(list(result.lines), list(result.row_ids), lineage_line(words, stored.dialect))
-        return lines, row_ids, json.loads(json.dumps(result.trace))   # as jsonb gives it back
+        return list(result.lines), lines, row_ids, json.loads(json.dumps(result.trace))   # as jsonb gives it back
 
     def inputs(self, stored: StoredProgram) -> tuple[dict, dict]:
         """The job's parameters as the engine gives them to the template (engine.programs.remake)."""
@@ -201,8 +254,9 @@ class Renderer:
             from ..turning.model import template_module_params
 
             return params, template_module_params(params, module_params)
+        check_job_shape(stored.job_id, params, module_params)   # a job written by hand: named, not a crash
         if "cycle_time" in params:   # a hobbing job: the time follows its feeds
-            params = with_cycle_time(params, module_params, model.cut_shape, machine)
+            params = job_with_cycle_time(stored.job_id, params, module_params, model.cut_shape, machine)
         return params, module_params
 
     def model(self, gear_class: str):
@@ -240,7 +294,9 @@ def _difference(stored: StoredProgram, lines: list, row_ids: list, trace: dict) 
         number = next(n for n, (a, b) in enumerate(zip(stored.row_ids, row_ids), 1) if a != b)
         return f"line {number} is recorded as template row {stored.row_ids[number - 1]}, the rendering's row " \
                f"{row_ids[number - 1]}"
-    if stored.trace is not None and stored.trace != trace:
+    if stored.trace is None:   # every program stored since input hashes were kept has its trace
+        return "it has no trace stored (NULL), the rendering has one"
+    if stored.trace != trace:
         return f"its trace is not the rendering's ({_trace_difference(stored.trace, trace)})"
     return None
 

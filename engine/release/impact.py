@@ -5,9 +5,11 @@ without the verifier and the hobbing simulation, which the gate does not need to
 change). A turning job's draft program is followed by the turning simulation (issue 26): a draft
 whose program for a stored job it refuses is named as failing for that job.
 
-The released program is the job's latest stored one (its lineage line left out) when it was made
-from the released version from the job's current parameters; otherwise the released template is
-evaluated too. The draft is evaluated as if it had the released version number, so the
+The "before" side is the released version rendered now for the job, never the job's stored
+program: a stored program is a record a runner can write by hand (program_submission), and one that
+is not its rendering (a MISMATCH: lines equal to the draft's, say) would hide the job's change.
+Rendering the released version costs one more template run per distinct job input. The draft is
+evaluated as if it had the released version number, so the
 `; TEMPLATE class vN` line does not count as a change. A draft that only writes its lines with
 another layout (line ending, final newline: version_layout_change) changes no line, but the bytes of
 every stored program's file of the class: said on its own, with how many programs. Jobs with identical parameters are
@@ -23,8 +25,8 @@ from ..errors import EngineError
 from ..gears.models import model_for_class
 from ..machines.records import load_machine
 from ..nc.layout import ENDING_NAMES, NcLayout
-from ..nc.lineage import without_lineage
 from ..programs import all_models  # noqa: F401  (registers every model)
+from ..programs.job_shape import job_with_cycle_time
 from ..simulation.turning.run import simulate_turning
 from ..templates.decision_table import compiled_template
 from ..templates.history import layout_change
@@ -38,18 +40,12 @@ if TYPE_CHECKING:
 
 DIFFS_SHOWN = 5   # unified diffs the CLI prints (all of them with --json)
 
-# Every job of the classes with its latest program, and whether that program came from the
-# released version (class, version, hash) and the job's current parameters.
+# Every job of the classes, and whether it has a stored program (whose file a layout change changes).
 JOBS = """
-WITH released(gear_class, version, hash) AS (SELECT * FROM unnest(%s::text[], %s::int[], %s::text[]))
 SELECT j.id, j.gear_class, j.machine, j.params::text, j.module_params::text,
-       coalesce(p.template_version = r.version AND p.template_hash = r.hash
-                AND p.input_hash = job_input_hash(j.params, j.module_params), false),
-       p.lines, p.row_ids
+       EXISTS (SELECT 1 FROM program p WHERE p.job_id = j.id)
 FROM job j
-JOIN released r ON r.gear_class = j.gear_class
-LEFT JOIN (SELECT DISTINCT ON (job_id) job_id, template_version, template_hash, input_hash, lines, row_ids
-           FROM program ORDER BY job_id, id DESC) p ON p.job_id = j.id
+WHERE j.gear_class = ANY(%s::text[])
 ORDER BY j.id"""
 
 
@@ -115,11 +111,8 @@ def impact(conn: Connection, gear_class: str) -> Impact:
     report = Impact(gear_class, layouts=_layout_changes(conn, pairs))
     if not pairs:
         return report
-    classes = list(pairs)
-    versions = [pairs[name][0].version for name in classes]
-    hashes = [pairs[name][0].hash for name in classes]
     made = _Made(conn, pairs)
-    for job in conn.cursor(binary=True).execute(JOBS, (classes, versions, hashes)):
+    for job in conn.cursor(binary=True).execute(JOBS, (list(pairs),)):
         _compare(report, made, job)
     return report
 
@@ -149,18 +142,18 @@ def _layout_changes(conn: Connection, pairs: dict[str, tuple[Template, Template,
 
 
 def _compare(report: Impact, made: _Made, job) -> None:
-    job_id, gear_class, machine, params_text, modules_text, from_released, lines, row_ids = job
+    job_id, gear_class, machine, params_text, modules_text, has_program = job
     report.jobs += 1
-    if gear_class in report.layouts and lines is not None:
+    if gear_class in report.layouts and has_program:
         report.layouts[gear_class].programs += 1
     if not made.has_draft(gear_class):
         return   # no draft: nothing changes
     key = gear_class, machine, params_text, modules_text
-    new_lines = made.draft_lines(key)
+    new_lines = made.draft_lines(key, job_id)
     if isinstance(new_lines, EngineError):
         report.failures.append(JobFailure(job_id, gear_class, str(new_lines)))
         return
-    old_lines = without_lineage(lines, row_ids) if from_released else made.released_lines(key)
+    old_lines = made.released_lines(key, job_id)   # rendered now: a stored program may be a forgery
     if old_lines != new_lines:
         report.changed += 1
         report.diffs.append(JobDiff(job_id, gear_class, made.diff(gear_class, old_lines, new_lines)))
@@ -187,21 +180,21 @@ class _Made:
         return unified_diff(old, new, f"{gear_class} v{released.version} (released)",
                             f"{gear_class} v{draft_version} (draft)")
 
-    def draft_lines(self, key: tuple) -> list[str] | EngineError:
+    def draft_lines(self, key: tuple, job_id: int) -> list[str] | EngineError:
         if key not in self.drafts:
             try:
-                lines = compiled_template(self.pairs[key[0]][1]).run(*self.inputs.of(*key)).lines
+                lines = compiled_template(self.pairs[key[0]][1]).run(*self.inputs.of(job_id, *key)).lines
                 self.inputs.prove_turning(key, lines)
                 self.drafts[key] = lines
             except EngineError as error:
                 self.drafts[key] = error
         return self.drafts[key]
 
-    def released_lines(self, key: tuple) -> list[str]:
+    def released_lines(self, key: tuple, job_id: int) -> list[str]:
         """The released template's lines for the job (none if it fails: every draft line is a change)."""
         if key not in self.releases:
             try:
-                self.releases[key] = compiled_template(self.released(key[0])).run(*self.inputs.of(*key)).lines
+                self.releases[key] = compiled_template(self.released(key[0])).run(*self.inputs.of(job_id, *key)).lines
             except EngineError:
                 self.releases[key] = []
         return self.releases[key]
@@ -220,17 +213,16 @@ class _JobInputs:
         self.machines: dict[str, Machine] = {}
         self.shapes: dict[str, str] = {}   # class -> its model's cut shape
 
-    def of(self, gear_class: str, machine_name: str, params_text: str, modules_text: str) -> tuple[dict, dict]:
+    def of(self, job_id: int, gear_class: str, machine_name: str, params_text: str,
+           modules_text: str) -> tuple[dict, dict]:
         params, modules = json.loads(params_text), json.loads(modules_text or "{}")
         machine = self.machine(machine_name)
         if machine.kind == "lathe":
             from ..turning.model import template_module_params  # the tool paths: only for turning jobs
 
             return params, template_module_params(params, modules)
-        if "cycle_time" in params:
-            from ..hobbing.machine_job import with_cycle_time
-
-            params = with_cycle_time(params, modules, self.cut_shape(gear_class), machine)
+        if "cycle_time" in params:   # a job stored by hand of another shape is named, not a crash
+            params = job_with_cycle_time(job_id, params, modules, self.cut_shape(gear_class), machine)
         return params, modules
 
     def prove_turning(self, key: tuple, lines: list[str]) -> None:
