@@ -32,7 +32,7 @@ from engine.errors import EngineError  # noqa: E402
 from engine.gears.case_base import CUT_KINDS_BY_COUNT, job_cutting_record  # noqa: E402
 from engine.gears.hob_matching import choose_hob  # noqa: E402
 from engine.hobbing.choices import Choices  # noqa: E402
-from engine.programs.instantiate import Planner, _check_machine_fits, _check_table_speed  # noqa: E402
+from engine.programs.instantiate import Planner, check_machine_fits, check_speeds  # noqa: E402
 from engine.verifier import verify_program  # noqa: E402
 
 FIRST_ID = 100_000
@@ -178,13 +178,13 @@ class JinjaPipeline:
     def plan(self, planner: Planner, gear, templates: dict) -> tuple:
         """Planner.plan step for step (same calls, same order), rendering instead of run_template."""
         machine = planner.machine
-        _check_machine_fits(gear, machine)
+        check_machine_fits(gear, machine)
         model = planner.model(gear.gear_class)
         hob = choose_hob(gear, planner.hobs, purpose=model.hob_purpose,
                          shift_travel=model.shift_travel(planner.choices)).hob
         cutting, case_ids = planner.cutting_data(gear, hob)
         job = model.job(gear, gear.gear_class, hob, machine, cutting, planner.choices)
-        _check_table_speed(gear, hob.starts, cutting.hob_speed, machine)
+        check_speeds(gear, hob.starts, cutting.hob_speed, machine)
         jinja_template, version, template_hash = templates[gear.gear_class]
         params, module_params = job.params, job.module_params
         text = jinja_template.render({**params, "template_version": version, "module_params": module_params})
