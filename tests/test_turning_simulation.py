@@ -219,3 +219,35 @@ def test_engine_simulate_follows_a_stored_lathe_program(run, machine):
     assert simulated.exit_code == 0, simulated.output
     assert simulated.stdout.strip().endswith("clean")
     assert "rapid(s)" in simulated.stdout and "cut(s)" in simulated.stdout
+
+
+# --- the gate: a draft that stops a stored job the released version makes -----------------------
+
+SLOT_3_AFTER_PATH = 3075   # the sample's operation 3, which no seeded golden test of the lathe classes makes
+
+
+@pytest.mark.parametrize("machine", [ISO, S840D])
+def test_the_gate_refuses_a_draft_that_stops_a_stored_job_the_released_version_makes(conn, machine):
+    """A new user's finding: a rapid through the part in the sample's operation 3 passed every golden
+    test (they make operations 1 and 2) and the gate released it with '3 fail with the draft'."""
+    job_id = import_dxf(conn, SAMPLE, machine, ProfileOptions()).job_id
+    instantiate_job(conn, job_id)
+    rapid = "G00 X0.000 Z-30.000" if machine == ISO else "G0 X0.000 Z-30.000"
+    conn.execute(INSERT, (CLASS[machine], SLOT_3_AFTER_PATH, "cutmotion", 3, f'"{rapid}"', "op_present"))
+    with pytest.raises(EngineError) as gate:
+        release(conn, CLASS[machine], dry_run=True)
+    assert any(f"stored job {job_id} " in problem and "a rapid through material" in problem
+               for problem in gate.value.problems), gate.value.problems
+
+
+@pytest.mark.parametrize("machine", [ISO, S840D])
+def test_a_stored_job_the_released_version_fails_too_does_not_hold_up_a_release(conn, machine):
+    """A job a runner pushed beyond the cutting table fails with the released version as with the
+    draft: an older problem, listed by the impact, not the draft's doing."""
+    job_id = import_dxf(conn, SAMPLE, machine, ProfileOptions()).job_id
+    conn.execute("UPDATE job SET module_params = jsonb_set(module_params, '{cutcond:1,spindle_rpm}', '3999') "
+                 "WHERE id = %s", (job_id,))
+    comment = "(ROUGHING)" if machine == ISO else "; ROUGHING"
+    conn.execute(INSERT, (CLASS[machine], 1005, "prep", 1, f'"{comment}"', "op_present"))
+    report = release(conn, CLASS[machine], dry_run=True)
+    assert [(failure.job_id, failure.released_makes) for failure in report.impact.failures] == [(job_id, False)]

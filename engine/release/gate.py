@@ -69,9 +69,21 @@ def release(conn: Connection, gear_class: str, dry_run: bool = False, confirm=No
         tests, checks = gate(conn, gear_class, draft)
         report = ReleaseReport(gear_class, draft.version, draft.hash, dry_run, tests, impact(conn, gear_class),
                                checks, drafts_below=drafts_below(conn, gear_class))
+        refuse_broken_jobs(gear_class, draft.version, report.impact)
         if not dry_run and (confirm is None or confirm(report)):
             report.release_id = _record(conn, report)
     return report
+
+
+def refuse_broken_jobs(gear_class: str, version: int, found: Impact) -> None:
+    """A draft that makes no program for a stored job the released version makes one for (a turning
+    row emitting a rapid through the part, say) would stop that job at the machine: refused, each
+    job named. A job that fails with the released version too is an older problem: listed, not refused."""
+    broken = [failure for failure in found.failures if failure.released_makes]
+    if broken:
+        raise GateRefusal(gear_class, version, [f"stored job {failure.job_id} ({failure.gear_class}) gets a program "
+                                                f"from the released version but none from the draft: {failure.error}"
+                                                for failure in broken])
 
 
 def _require_releaser(conn: Connection) -> None:

@@ -61,6 +61,7 @@ class JobFailure:
     job_id: int
     gear_class: str
     error: str
+    released_makes: bool = False   # the released version makes this job a program that passes the same proof
 
 
 @dataclass
@@ -151,7 +152,7 @@ def _compare(report: Impact, made: _Made, job) -> None:
     key = gear_class, machine, params_text, modules_text
     new_lines = made.draft_lines(key, job_id)
     if isinstance(new_lines, EngineError):
-        report.failures.append(JobFailure(job_id, gear_class, str(new_lines)))
+        report.failures.append(JobFailure(job_id, gear_class, str(new_lines), made.released_proves(key, job_id)))
         return
     old_lines = made.released_lines(key, job_id)   # rendered now: a stored program may be a forgery
     if old_lines != new_lines:
@@ -189,6 +190,16 @@ class _Made:
             except EngineError as error:
                 self.drafts[key] = error
         return self.drafts[key]
+
+    def released_proves(self, key: tuple, job_id: int) -> bool:
+        """The released template makes the job a program the draft's proof accepts (asked only for a
+        job the draft fails for: a job that fails with both is an old problem, not the draft's)."""
+        try:
+            lines = compiled_template(self.released(key[0])).run(*self.inputs.of(job_id, *key)).lines
+            self.inputs.prove_turning(key, lines)
+        except EngineError:
+            return False
+        return True
 
     def released_lines(self, key: tuple, job_id: int) -> list[str]:
         """The released template's lines for the job (none if it fails: every draft line is a change)."""
