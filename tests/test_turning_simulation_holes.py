@@ -121,3 +121,14 @@ def test_a_cut_behind_the_back_end_is_refused(conn, machine):
     inserted = [f"{rapid} X26.000 Z-40.000", f"{feed} X0.000 Z-40.000", f"{rapid} X26.000 Z-40.000"]
     found = refusals(_before_last_op_leaves(lines, machine, inserted), params, modules, lathe)
     assert any("X0.000 Z-40.000" in f and "behind the blank's back end" in f for f in found), found
+
+
+@pytest.mark.parametrize("machine", [ISO, S840D])
+def test_a_runner_s_wide_clearance_does_not_widen_the_run_out_behind_the_back_end(conn, machine):
+    """Adversary: params.clearance is the runner's to edit; set to 31 mm it let a pass run 30 mm
+    into the bar the chuck holds. The run-out behind a stored back end stays the planner's 2 mm."""
+    lines, params, modules, lathe = job(conn, machine, EMCO, EMCO_OPTIONS)
+    rapid, feed = RAPID[machine], FEED[machine]
+    inserted = [f"{rapid} X26.000 Z-40.000", f"{feed} X20.000 Z-40.000", f"{rapid} X26.000 Z-40.000"]
+    found = refusals(_before_last_op_leaves(lines, machine, inserted), {**params, "clearance": 31.0}, modules, lathe)
+    assert any("X20.000 Z-40.000" in f and "behind the blank's back end" in f for f in found), found

@@ -6,9 +6,9 @@ followed in order (shapely geometry):
   material left or the part is refused (a rapid into material breaks the tool or the machine);
   behind a stored blank's back end (params.stock_z_back) the bar runs on into the chuck at the
   blank's radius (bar_behind): it is material too;
-* a cut behind a stored blank's back end by more than the job's run-out (params.clearance, the
-  overtravel the planner gives a pass at either end) is refused unless its operation is PART
-  (parting off at the back end): it would cut the bar that holds the part;
+* a cut behind a stored blank's back end by more than the run-out (the job's params.clearance, the
+  overtravel the planner gives a pass at either end, at most run.BEHIND_RUN_OUT_MM) is refused
+  unless its operation is PART (parting off at the back end): it would cut the bar that holds the part;
 * a cut (G1/G2/G3, a thread pass G32/G33) must not enter the finished part by more than
   CUT_TOLERANCE_MM; a thread pass must touch the drawn thread (its THREAD operation's crest and
   root lines) and may run inside the part only between the root's and the crest's radius, over
@@ -69,7 +69,7 @@ def bar_behind(blank: BaseGeometry) -> BaseGeometry:
 
 class MaterialWalk:
     def __init__(self, records: TurningRecords, blank: BaseGeometry, report: TurningReport, run_out: float):
-        """`run_out`: mm a cut may run on behind a stored blank's back end (params.clearance)."""
+        """`run_out`: mm a cut may run on behind a stored blank's back end (params.clearance, bounded)."""
         self.records, self.report, self.run_out = records, report, run_out
         self.z_back = blank.bounds[0] if records.stock is not None else None
         bar = [bar_behind(blank)] if self.z_back is not None else []

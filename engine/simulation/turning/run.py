@@ -15,6 +15,11 @@ from .reading import read_lathe_program
 from .report import TurningReport
 from .work import number, turning_records
 
+# The most a cut may run on behind a stored blank's back end (mm): the planner's overtravel,
+# engine.turning.defaults.CLEARANCE, as a fixed bound. The job's params.clearance is the runner's
+# to edit; taken alone, clearance=31 let a pass run 30 mm into the bar the chuck holds.
+BEHIND_RUN_OUT_MM = 2.0
+
 
 def simulate_turning(lines: list[str], params: dict, module_params: dict, machine: Machine,
                      name: str = "the program") -> TurningReport:
@@ -31,7 +36,7 @@ def simulate_turning(lines: list[str], params: dict, module_params: dict, machin
     blank = records.blank(_feed_radius(state.moves), _facing_zs(state.moves, records))
     z0, r0, z1, r1 = blank.bounds
     report.blank = f"Ø{2 * r1:.3f} Z{z0:.3f}…{z1:.3f}" + (" (assumed)" if records.stock is None else "")
-    walk = MaterialWalk(records, blank, report, number(params, "clearance"))
+    walk = MaterialWalk(records, blank, report, min(number(params, "clearance"), BEHIND_RUN_OUT_MM))
     for move in state.moves:
         walk.take(move)
     check_cutting(state.moves, records, params, module_params, report)
