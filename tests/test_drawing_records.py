@@ -170,3 +170,23 @@ def test_the_proof_takes_the_records_facts_and_the_jobs_cutting_data():
     assert "stock_diameter" not in params and params["clearance"] == 1.0   # NULL: the blank is assumed
     assert module_params == {"prep:1": {"tool": 1, "tool_material": "carbide"}, "cutcond:1": {"spindle_rpm": 3999}}
     assert modules["prep:1"]["tool_material"] == "hss"   # the job's own values are not changed
+
+
+def test_jobs_show_says_where_a_job_s_drawing_record_came_from(run):
+    """Third adversary: a runner may insert a drawing record by hand and a job that names it (the
+    import runs with a runner's rights). The record cannot be refused, but it says so: `jobs show`
+    gives a file import's hash, and 'no file hash' with the login for a record typed in SQL."""
+    imported = _sample_job(run)
+    digest = hashlib.sha256(SAMPLE_DRAWING.read_bytes()).hexdigest()
+    shown = json.loads(run("jobs", "show", imported, "--json").stdout)["job"]["drawing"]
+    assert SAMPLE_DRAWING.name in shown and f"file sha256 {digest[:16]}" in shown
+    with psycopg.connect(run.url) as conn, as_role(conn, "engine_runner"):
+        typed = conn.execute("INSERT INTO drawing (file_name, profile) SELECT file_name, profile FROM drawing "
+                             "WHERE id = (SELECT drawing_id FROM job WHERE id = %s) RETURNING id, imported_by",
+                             (imported,)).fetchone()
+        job_id = conn.execute("INSERT INTO job (gear_class, machine, params, module_params, drawing_id) "
+                              "SELECT gear_class, machine, params, module_params, %s FROM job WHERE id = %s "
+                              "RETURNING id", (typed[0], imported)).fetchone()[0]
+    shown = run("jobs", "show", job_id).stdout
+    assert f"drawing:           {typed[0]}: " in shown and "no file hash (typed in SQL" in shown
+    assert f"by {typed[1]} at" in shown

@@ -16,7 +16,7 @@ JOB_COLUMNS = (
     Column("confirmed", "confirmed_at"),
 )
 JOB_FIELDS = JOB_COLUMNS[:5] + (
-    Column("made", "created_at"), Column("confirmed", "confirmed_at"),
+    Column("made", "created_at"), Column("confirmed", "confirmed_at"), Column("drawing", "drawing"),
     Column("parameters", "params", lambda params: json.dumps(params, sort_keys=True)),
     Column("module parameters", "module_params", lambda params: json.dumps(params, sort_keys=True)),
     Column("cutting data", "cutting", lambda cutting: json.dumps(cutting, sort_keys=True)),

@@ -25,7 +25,16 @@ WHERE (%(class)s::text IS NULL OR j.gear_class = %(class)s)
   AND (%(since)s::date IS NULL OR j.created_at >= %(since)s::date)
   AND (%(until)s::date IS NULL OR j.created_at < %(until)s::date + 1)
 ORDER BY j.id"""
-ONE_JOB = JOB_COLUMNS + ", j.params, j.module_params, j.cutting FROM job j WHERE j.id = %s"
+# Where a turning job's drawing record came from: a file import states the file's hash; a record
+# without one was typed in SQL, or made by migration 0027 from a job's parameters. The record says
+# who made it: a runner can insert one by hand (design notes §8, the drawing record).
+DRAWING_SOURCE = """
+(SELECT format('%%s: %%s, %%s, by %%s at %%s', d.id, d.file_name,
+               CASE WHEN d.sha256 IS NOT NULL THEN 'file sha256 ' || left(d.sha256, 16) || '…'
+                    ELSE 'no file hash (typed in SQL or made by a migration)' END,
+               d.imported_by, to_char(d.imported_at, 'YYYY-MM-DD HH24:MI:SS'))
+ FROM drawing d WHERE d.id = j.drawing_id) AS drawing"""
+ONE_JOB = JOB_COLUMNS + ", j.params, j.module_params, j.cutting," + DRAWING_SOURCE + " FROM job j WHERE j.id = %s"
 JOB_PROGRAMS = """
 SELECT p.id AS program_id, p.name, p.template_version, p.draft, p.unverified, p.created_at,
        """ + LISTED_RENDERING + """ AS rendering
