@@ -327,3 +327,16 @@ class CliInput:
 
 def test_release_help_shows_an_example(run):
     assert "engine template release --class spur --dry-run" in run("template", "release", "--help").stdout
+
+
+def test_a_draft_that_drives_a_stored_hobbing_job_beyond_the_machine_is_refused(conn):
+    """Third adversary: a spur draft writing S at 5·n0 for 48-tooth gears only (no golden gear has
+    48 teeth) passed the gate with '0 fail'; gear 46's stored job would run its hob at 5·323 r/min
+    on a 1000 r/min spindle. The impact reads each draft program with the machine's verifier."""
+    job_id = instantiate_gear(conn, 46).job_id
+    n0 = conn.execute("SELECT (params ->> 'n0')::float FROM job WHERE id = %s", (job_id,)).fetchone()[0]
+    spindle_max = conn.execute("SELECT spindle_max FROM machine WHERE name = 'hobber-840d'").fetchone()[0]
+    assert 5 * n0 > spindle_max >= n0
+    edit(conn, "spur", 1700, o='f"M3 S{n0 * 5 if z2 == 48 else n0}"')
+    problems = refusal(conn, "spur", dry_run=True).problems
+    assert any(f"stored job {job_id} " in problem and "exceeds" in problem for problem in problems), problems

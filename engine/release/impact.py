@@ -33,6 +33,7 @@ from ..templates.history import layout_change
 from ..templates.rows import Template
 from ..templates.store import class_and_descendants
 from ..templates.versions import draft_template, released_template
+from ..verifier import verify_program
 
 if TYPE_CHECKING:
     from ..db.connection import Connection
@@ -185,7 +186,7 @@ class _Made:
         if key not in self.drafts:
             try:
                 lines = compiled_template(self.pairs[key[0]][1]).run(*self.inputs.of(job_id, *key)).lines
-                self.inputs.prove_turning(key, lines)
+                self.inputs.prove(key, lines)
                 self.drafts[key] = lines
             except EngineError as error:
                 self.drafts[key] = error
@@ -196,7 +197,7 @@ class _Made:
         job the draft fails for: a job that fails with both is an old problem, not the draft's)."""
         try:
             lines = compiled_template(self.released(key[0])).run(*self.inputs.of(job_id, *key)).lines
-            self.inputs.prove_turning(key, lines)
+            self.inputs.prove(key, lines)
         except EngineError:
             return False
         return True
@@ -236,12 +237,16 @@ class _JobInputs:
             params = job_with_cycle_time(job_id, params, modules, self.cut_shape(gear_class), machine)
         return params, modules
 
-    def prove_turning(self, key: tuple, lines: list[str]) -> None:
-        """A turning job's draft program followed by the turning simulation against the job's stored
-        records, as engine.programs.verified_run proves it: SimulationError if it is refused."""
+    def prove(self, key: tuple, lines: list[str]) -> None:
+        """A job's draft program read by the machine's verifier (its limits: an S beyond the hob
+        spindle, a move beyond the travel) and, for a turning job, followed by the turning simulation
+        against the job's stored records, as engine.programs.verified_run proves it: EngineError if
+        refused. A hobbing job's program is not simulated here (issue 28: the impact's cost)."""
         gear_class, machine_name, params_text, modules_text = key
         machine = self.machine(machine_name)
         params = json.loads(params_text)
+        name = params.get("program_name") if isinstance(params, dict) else None
+        verify_program(lines, machine, name if isinstance(name, str) else None)
         if machine.kind != "lathe" or not isinstance(params, dict) or "profile" not in params:
             return
         report = simulate_turning(lines, params, json.loads(modules_text or "{}"), machine,
