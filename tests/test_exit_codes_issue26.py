@@ -86,3 +86,18 @@ def test_a_config_that_is_no_regular_file_is_refused_without_reading_it(fresh_da
                           capture_output=True, text=True, env=environment, preexec_fn=_limited, timeout=HANG_GUARD)
     assert done.returncode == 1, done.stderr
     assert done.stderr.count("\n") == 1 and path in done.stderr and "not a regular file" in done.stderr, done.stderr
+
+
+def test_a_tab_inside_an_imported_nc_line_is_refused_when_stored_unverified(run, tmp_path):
+    """An imported program keeps its tabs (the file comes back byte for byte), but a stored NC line
+    holds no control character (check_program): `--unverified`, which skips the verifier that would
+    refuse the tab, ended in the database's CheckViolation and exit 2."""
+    source = (ROOT / "tests" / "data" / "nc" / "linuxcnc" / "lathe_pawn.ngc").read_text().splitlines()
+    source[3] = source[3].replace(" ", "\t", 1)
+    program = tmp_path / "tabbed.ngc"
+    program.write_text("\n".join(source) + "\n")
+    assert run("import-nc", program, "--class", "tabbed").exit_code == 0
+    before = stored(run.url)
+    refused_in_one_line(run("instantiate", "--class", "tabbed", "--draft", "--unverified", "--machine", "lathe-iso"),
+                        "line 4", "'\\t'", "no control character", "nothing stored")
+    assert stored(run.url) == before

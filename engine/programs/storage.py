@@ -12,6 +12,7 @@ refused with a message that names the program."""
 from __future__ import annotations
 
 import contextlib
+import re
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -146,11 +147,16 @@ def _deleted_message(named: list[str]) -> str:
     return f"{', '.join(named)} were deleted while their programs were made; nothing stored"
 
 
+# The characters check_program (schema/programs.sql) refuses in a stored line: every control
+# character, the TAB included (a line is one block of words separated by spaces).
+CONTROL = re.compile("[\x01-\x1f\x7f-\x9f\u2028\u2029]")
+
+
 def refuse_unsafe(name: str, lines: list[str]) -> None:
     """EngineError unless the program's name is an 840D program name and no line breaks."""
     checked("program", name, "program name", "set job.params.program_name in SQL; nothing stored")
     refuse_lineage_shaped(name, lines)
-    if line_breaking("".join(lines)) is None:
+    if CONTROL.search("".join(lines)) is None:
         return
     for number, line in enumerate(lines, 1):
         found = line_breaking(line)
@@ -158,6 +164,11 @@ def refuse_unsafe(name: str, lines: list[str]) -> None:
             raise EngineError(f"program {name} line {number} {shown(line)} holds {shown(found)}, which would start "
                               "another NC block: nothing stored; the job parameter or template row that made it "
                               "must not hold line breaks")
+        control = CONTROL.search(line)
+        if control is not None:
+            raise EngineError(f"program {name} line {number} {shown(line)} holds {shown(control.group())}: a stored "
+                              "NC line holds no control character; write spaces in the template row (or the "
+                              "imported program) that made it; nothing stored")
 
 
 def _copy_programs(conn: Connection, program_ids: list[int], job_ids: list[int], encoded: list[Encoded]) -> dict:
