@@ -190,3 +190,51 @@ def test_jobs_show_says_where_a_job_s_drawing_record_came_from(run):
     shown = run("jobs", "show", job_id).stdout
     assert f"drawing:           {typed[0]}: " in shown and "no file hash (typed in SQL" in shown
     assert f"by {typed[1]} at" in shown
+
+
+THREAD = "cutmotion:4"   # the sample's THREAD operation (layer 4, seed_templates/drawings/README.md)
+M20_PITCH = 1.5          # mm, M20×1.5: the drawing's @P
+M20_ROOT = 20 - 2 * (17 / 24) * math.sqrt(3) / 2 * M20_PITCH   # d3 = d − 2·h3, h3 = 0.61343·P (ISO 68-1): Ø18.16
+
+
+def _thread(url, job_id) -> dict:
+    with psycopg.connect(url) as conn:
+        return conn.execute("SELECT module_params->%s FROM job WHERE id = %s", (THREAD, job_id)).fetchone()[0]
+
+
+def test_a_runners_thread_pitch_edit_is_refused(run):
+    """A pitch of 2.0 on the drawn M20×1.5 rendered G32 … F2.0000 and was stored as MATCH."""
+    job_id = _sample_job(run)
+    assert _thread(run.url, job_id)["thread_pitch"] == M20_PITCH
+    _update(run.url, job_id, "module_params = jsonb_set(module_params, '{cutmotion:4,thread_pitch}', '2.0')")
+    before = counts(run.url)
+    refused = one_line_refusal(run("instantiate", "--job", job_id))
+    assert f"job {job_id}: module_params.cutmotion:4.thread_pitch = 2.0 is not 1.5" in refused
+    assert counts(run.url) == before
+
+
+def test_a_runners_root_line_edit_is_refused(run):
+    """The root line moved from r = d3/2 (Ø18.16) to r = 7.5 (Ø15) would cut the thread 1.6 mm too deep."""
+    job_id = _sample_job(run)
+    thread = _thread(run.url, job_id)
+    radii = sorted({value for path in thread["paths"] for segment in path for value in segment[2:5:2]})
+    assert math.isclose(radii[0], M20_ROOT / 2, abs_tol=0.01)   # the drawn root line
+    thread["paths"] = [[[*segment[:2], 7.5 if math.isclose(segment[2], radii[0]) else segment[2], segment[3],
+                         7.5 if math.isclose(segment[4], radii[0]) else segment[4], *segment[5:]]
+                        for segment in path] for path in thread["paths"]]
+    _update(run.url, job_id, "module_params = jsonb_set(module_params, '{cutmotion:4}', %s)", Jsonb(thread))
+    before = counts(run.url)
+    refused = one_line_refusal(run("instantiate", "--job", job_id))
+    assert f"job {job_id}: module_params.cutmotion:4.paths = " in refused and "7.5" in refused
+    assert counts(run.url) == before
+
+
+def test_the_sample_with_its_drawn_thread_is_made_again(run):
+    job_id = _sample_job(run)
+    with psycopg.connect(run.url) as conn:
+        threads = conn.execute("SELECT d.threads FROM job j JOIN drawing d ON d.id = j.drawing_id WHERE j.id = %s",
+                               (job_id,)).fetchone()[0]
+    drawn = _thread(run.url, job_id)
+    assert threads == {"4": {"thread_pitch": drawn["thread_pitch"], "paths": drawn["paths"]}}
+    made = run("instantiate", "--job", job_id)
+    assert made.exit_code == 0, made.output
