@@ -238,3 +238,50 @@ def test_the_sample_with_its_drawn_thread_is_made_again(run):
     assert threads == {"4": {"thread_pitch": drawn["thread_pitch"], "paths": drawn["paths"]}}
     made = run("instantiate", "--job", job_id)
     assert made.exit_code == 0, made.output
+
+
+def test_migration_0028_records_the_threads_of_the_job_stored_with_each_drawing(empty_database_url, tmp_path):
+    """A record a job names gets that job's THREAD operations ({} for none); one no job names stays
+    NULL (not recorded: the proof reads module_params, as before)."""
+    folder = tmp_path / "migrations"
+    shutil.copytree(MIGRATIONS_DIR, folder)
+    later = {path.name: path.read_text() for path in folder.glob("*.sql") if path.name >= "0028"}
+    for name in later:
+        (folder / name).unlink()
+    lines = [[["line", -2.0, 10.0, -20.0, 10.0]], [["line", -2.0, 9.08, -20.0, 9.08]]]
+    thread = {"kind": "THREAD", "paths": lines, "thread_pitch": 1.5, "depth_per_pass": 0.2}
+    params = {"drawing": "old.dxf", "profile": [["line", 0.0, 0.0, 0.0, 10.0]]}
+    with psycopg.connect(empty_database_url) as conn:
+        migrate(conn, folder)
+        conn.execute("INSERT INTO gear_class (name) VALUES ('turning_iso')")
+        conn.execute("INSERT INTO machine (name, kind, dialect, x_min, x_max, z_min, z_max, spindle_max) "
+                     "VALUES ('lathe-old', 'lathe', 'iso', 0, 300, -300, 300, 4000)")
+        drawings = [conn.execute("INSERT INTO drawing (file_name, profile) VALUES (%s, '[]') RETURNING id",
+                                 (name,)).fetchone()[0] for name in ("threaded.dxf", "plain.dxf", "unused.dxf")]
+        insert = ("INSERT INTO job (gear_class, machine, params, module_params, drawing_id) VALUES ('turning_iso', "
+                  "'lathe-old', %s, %s, %s)")
+        conn.execute(insert, (Jsonb(params), Jsonb({"cutmotion:4": thread, "cutmotion:1": {"kind": "ROUGH"}}),
+                              drawings[0]))
+        conn.execute(insert, (Jsonb(params), Jsonb({"cutmotion:1": {"kind": "ROUGH"}}), drawings[1]))
+        conn.commit()
+        for name, text in later.items():
+            (folder / name).write_text(text)
+        migrate(conn, folder)
+        recorded = dict(conn.execute("SELECT id, threads FROM drawing").fetchall())
+        with pytest.raises(errors.InsufficientPrivilege):   # the records are records again
+            conn.execute("UPDATE drawing SET threads = NULL")
+    assert recorded == {drawings[0]: {"4": {"thread_pitch": 1.5, "paths": lines}}, drawings[1]: {},
+                        drawings[2]: None}
+
+
+def test_the_proof_takes_the_records_thread_and_the_jobs_depth_per_pass():
+    from engine.simulation.turning.drawing import DrawingRecord, proof_params
+
+    lines = [[["line", -2.0, 10.0, -20.0, 10.0]], [["line", -2.0, 9.08, -20.0, 9.08]]]
+    record = DrawingRecord(1, "a.dxf", {}, None, {"4": {"thread_pitch": 1.5, "paths": lines}})
+    edited = {"cutmotion:4": {"kind": "THREAD", "thread_pitch": 2.0, "paths": [], "depth_per_pass": 0.1}}
+    _, module_params = proof_params(record, {}, edited)
+    assert module_params["cutmotion:4"] == {"kind": "THREAD", "thread_pitch": 1.5, "paths": lines,
+                                            "depth_per_pass": 0.1}
+    unrecorded = DrawingRecord(1, "a.dxf", {}, None, None)   # a record made before migration 0028
+    assert proof_params(unrecorded, {}, edited)[1] == edited
