@@ -2,8 +2,10 @@
 stored turning job before it is made again (`engine instantiate --job/--jobs`).
 
 A runner may edit job.params in SQL: the cutting data (speeds, feeds, depths) stay editable, but
-the finished part, the blank, the tool-change position and the materials are the drawing's
-(engine.simulation.turning.drawing.DRAWING_FACTS). A job whose params disagree with its drawing
+the finished part, the blank, the tool-change position, the materials and each THREAD
+operation's pitch and crest and root lines are the drawing's (engine.simulation.turning.drawing
+DRAWING_FACTS, THREAD_FACTS; a record with NULL threads, made before migration 0028 and named by
+no job then, holds the job to no thread data). A job whose params disagree with its drawing
 record on one of them is refused, one line naming the job, the parameter and both values; the
 proof itself reads the record (engine.programs.turning_jobs), so an edit could not pass it anyway,
 but the refusal says what to do instead of a simulation finding the runner cannot explain."""
