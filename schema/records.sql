@@ -102,7 +102,9 @@ CREATE TABLE gear (
 -- mm); stock_diameter NULL: the blank the importer assumes (docs/design.md §8); workpiece_material
 -- and tool_materials ({"n": material} per operation) NULL: the defaults. sha256 of the file's
 -- bytes; NULL for the records migration 0027 made from jobs imported before it (imported_by
--- 'migration 0027').
+-- 'migration 0027'). threads: each THREAD operation's pitch and crest and root lines as the job's
+-- module_params hold them ({"n": {"thread_pitch": p, "paths": [...]}}, {} for none; migration
+-- 0028), NULL when not recorded (records no job names at 0028: the proof reads module_params).
 CREATE TABLE drawing (
     id                 bigserial PRIMARY KEY,
     file_name          text NOT NULL,
@@ -117,7 +119,8 @@ CREATE TABLE drawing (
     workpiece_material text,
     tool_materials     jsonb CHECK (tool_materials IS NULL OR jsonb_typeof(tool_materials) = 'object'),
     imported_by        text NOT NULL DEFAULT current_user,
-    imported_at        timestamptz NOT NULL DEFAULT now()
+    imported_at        timestamptz NOT NULL DEFAULT now(),
+    threads            jsonb CHECK (threads IS NULL OR jsonb_typeof(threads) = 'object')
 );
 CREATE TRIGGER drawing_is_a_record BEFORE UPDATE OR DELETE ON drawing
 FOR EACH ROW EXECUTE FUNCTION refuse_changing_a_record();

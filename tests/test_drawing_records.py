@@ -190,3 +190,98 @@ def test_jobs_show_says_where_a_job_s_drawing_record_came_from(run):
     shown = run("jobs", "show", job_id).stdout
     assert f"drawing:           {typed[0]}: " in shown and "no file hash (typed in SQL" in shown
     assert f"by {typed[1]} at" in shown
+
+
+THREAD = "cutmotion:4"   # the sample's THREAD operation (layer 4, seed_templates/drawings/README.md)
+M20_PITCH = 1.5          # mm, M20×1.5: the drawing's @P
+M20_ROOT = 20 - 2 * (17 / 24) * math.sqrt(3) / 2 * M20_PITCH   # d3 = d − 2·h3, h3 = 0.61343·P (ISO 68-1): Ø18.16
+
+
+def _thread(url, job_id) -> dict:
+    with psycopg.connect(url) as conn:
+        return conn.execute("SELECT module_params->%s FROM job WHERE id = %s", (THREAD, job_id)).fetchone()[0]
+
+
+def test_a_runners_thread_pitch_edit_is_refused(run):
+    """A pitch of 2.0 on the drawn M20×1.5 rendered G32 … F2.0000 and was stored as MATCH."""
+    job_id = _sample_job(run)
+    assert _thread(run.url, job_id)["thread_pitch"] == M20_PITCH
+    _update(run.url, job_id, "module_params = jsonb_set(module_params, '{cutmotion:4,thread_pitch}', '2.0')")
+    before = counts(run.url)
+    refused = one_line_refusal(run("instantiate", "--job", job_id))
+    assert f"job {job_id}: module_params.cutmotion:4.thread_pitch = 2.0 is not 1.5" in refused
+    assert counts(run.url) == before
+
+
+def test_a_runners_root_line_edit_is_refused(run):
+    """The root line moved from r = d3/2 (Ø18.16) to r = 7.5 (Ø15) would cut the thread 1.6 mm too deep."""
+    job_id = _sample_job(run)
+    thread = _thread(run.url, job_id)
+    radii = sorted({value for path in thread["paths"] for segment in path for value in segment[2:5:2]})
+    assert math.isclose(radii[0], M20_ROOT / 2, abs_tol=0.01)   # the drawn root line
+    thread["paths"] = [[[*segment[:2], 7.5 if math.isclose(segment[2], radii[0]) else segment[2], segment[3],
+                         7.5 if math.isclose(segment[4], radii[0]) else segment[4], *segment[5:]]
+                        for segment in path] for path in thread["paths"]]
+    _update(run.url, job_id, "module_params = jsonb_set(module_params, '{cutmotion:4}', %s)", Jsonb(thread))
+    before = counts(run.url)
+    refused = one_line_refusal(run("instantiate", "--job", job_id))
+    assert f"job {job_id}: module_params.cutmotion:4.paths = " in refused and "7.5" in refused
+    assert counts(run.url) == before
+
+
+def test_the_sample_with_its_drawn_thread_is_made_again(run):
+    job_id = _sample_job(run)
+    with psycopg.connect(run.url) as conn:
+        threads = conn.execute("SELECT d.threads FROM job j JOIN drawing d ON d.id = j.drawing_id WHERE j.id = %s",
+                               (job_id,)).fetchone()[0]
+    drawn = _thread(run.url, job_id)
+    assert threads == {"4": {"thread_pitch": drawn["thread_pitch"], "paths": drawn["paths"]}}
+    made = run("instantiate", "--job", job_id)
+    assert made.exit_code == 0, made.output
+
+
+def test_migration_0028_records_the_threads_of_the_job_stored_with_each_drawing(empty_database_url, tmp_path):
+    """A record a job names gets that job's THREAD operations ({} for none); one no job names stays
+    NULL (not recorded: the proof reads module_params, as before)."""
+    folder = tmp_path / "migrations"
+    shutil.copytree(MIGRATIONS_DIR, folder)
+    later = {path.name: path.read_text() for path in folder.glob("*.sql") if path.name >= "0028"}
+    for name in later:
+        (folder / name).unlink()
+    lines = [[["line", -2.0, 10.0, -20.0, 10.0]], [["line", -2.0, 9.08, -20.0, 9.08]]]
+    thread = {"kind": "THREAD", "paths": lines, "thread_pitch": 1.5, "depth_per_pass": 0.2}
+    params = {"drawing": "old.dxf", "profile": [["line", 0.0, 0.0, 0.0, 10.0]]}
+    with psycopg.connect(empty_database_url) as conn:
+        migrate(conn, folder)
+        conn.execute("INSERT INTO gear_class (name) VALUES ('turning_iso')")
+        conn.execute("INSERT INTO machine (name, kind, dialect, x_min, x_max, z_min, z_max, spindle_max) "
+                     "VALUES ('lathe-old', 'lathe', 'iso', 0, 300, -300, 300, 4000)")
+        drawings = [conn.execute("INSERT INTO drawing (file_name, profile) VALUES (%s, '[]') RETURNING id",
+                                 (name,)).fetchone()[0] for name in ("threaded.dxf", "plain.dxf", "unused.dxf")]
+        insert = ("INSERT INTO job (gear_class, machine, params, module_params, drawing_id) VALUES ('turning_iso', "
+                  "'lathe-old', %s, %s, %s)")
+        conn.execute(insert, (Jsonb(params), Jsonb({"cutmotion:4": thread, "cutmotion:1": {"kind": "ROUGH"}}),
+                              drawings[0]))
+        conn.execute(insert, (Jsonb(params), Jsonb({"cutmotion:1": {"kind": "ROUGH"}}), drawings[1]))
+        conn.commit()
+        for name, text in later.items():
+            (folder / name).write_text(text)
+        migrate(conn, folder)
+        recorded = dict(conn.execute("SELECT id, threads FROM drawing").fetchall())
+        with pytest.raises(errors.InsufficientPrivilege):   # the records are records again
+            conn.execute("UPDATE drawing SET threads = NULL")
+    assert recorded == {drawings[0]: {"4": {"thread_pitch": 1.5, "paths": lines}}, drawings[1]: {},
+                        drawings[2]: None}
+
+
+def test_the_proof_takes_the_records_thread_and_the_jobs_depth_per_pass():
+    from engine.simulation.turning.drawing import DrawingRecord, proof_params
+
+    lines = [[["line", -2.0, 10.0, -20.0, 10.0]], [["line", -2.0, 9.08, -20.0, 9.08]]]
+    record = DrawingRecord(1, "a.dxf", {}, None, {"4": {"thread_pitch": 1.5, "paths": lines}})
+    edited = {"cutmotion:4": {"kind": "THREAD", "thread_pitch": 2.0, "paths": [], "depth_per_pass": 0.1}}
+    _, module_params = proof_params(record, {}, edited)
+    assert module_params["cutmotion:4"] == {"kind": "THREAD", "thread_pitch": 1.5, "paths": lines,
+                                            "depth_per_pass": 0.1}
+    unrecorded = DrawingRecord(1, "a.dxf", {}, None, None)   # a record made before migration 0028
+    assert proof_params(unrecorded, {}, edited)[1] == edited

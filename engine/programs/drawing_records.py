@@ -2,8 +2,10 @@
 stored turning job before it is made again (`engine instantiate --job/--jobs`).
 
 A runner may edit job.params in SQL: the cutting data (speeds, feeds, depths) stay editable, but
-the finished part, the blank, the tool-change position and the materials are the drawing's
-(engine.simulation.turning.drawing.DRAWING_FACTS). A job whose params disagree with its drawing
+the finished part, the blank, the tool-change position, the materials and each THREAD
+operation's pitch and crest and root lines are the drawing's (engine.simulation.turning.drawing
+DRAWING_FACTS, THREAD_FACTS; a record with NULL threads, made before migration 0028 and named by
+no job then, holds the job to no thread data). A job whose params disagree with its drawing
 record on one of them is refused, one line naming the job, the parameter and both values; the
 proof itself reads the record (engine.programs.turning_jobs), so an edit could not pass it anyway,
 but the refusal says what to do instead of a simulation finding the runner cannot explain."""
@@ -20,22 +22,22 @@ from ..db.connection import scalar
 from ..errors import EngineError
 from ..machines.turning_cutting import DEFAULT_TOOL_MATERIAL, DEFAULT_WORKPIECE_MATERIAL
 from ..names import shown
-from ..simulation.turning.drawing import DRAWING_FACTS, DrawingRecord, job_drawing
+from ..simulation.turning.drawing import DRAWING_FACTS, DrawingRecord, drawn_threads, job_drawing
 
 if TYPE_CHECKING:
     from ..db.connection import Connection
 
 INSERT_DRAWING = """
 INSERT INTO drawing (file_name, sha256, units, profile, stock_diameter, stock_z_front, stock_z_back, tool_change_x,
-                     tool_change_z, workpiece_material, tool_materials)
-VALUES (%s, %s, %s, %s, %s, %s, %s, %s, %s, %s, %s)
+                     tool_change_z, workpiece_material, tool_materials, threads)
+VALUES (%s, %s, %s, %s, %s, %s, %s, %s, %s, %s, %s, %s)
 RETURNING id"""
 # A fact missing from the params or the record stands for its default (jobs stored before the
 # materials were: engine.machines.turning_cutting.job_materials).
 DEFAULTS = {"workpiece_material": DEFAULT_WORKPIECE_MATERIAL, "tool_material": DEFAULT_TOOL_MATERIAL}
 RELATIVE_TOLERANCE = 1e-9   # JSON and double precision numbers read back as stored; only float noise allowed
-AGAIN = ("the part, blank, tool-change position and materials are the drawing's: import the drawing again with "
-         "`engine import-dxf` (--material for another material); nothing stored")
+AGAIN = ("the part, blank, tool-change position, materials and threads are the drawing's: import the drawing "
+         "again with `engine import-dxf` (--material for another material); nothing stored")
 
 
 def file_sha256(path: str | Path) -> str:
@@ -48,7 +50,8 @@ def store_drawing(conn: Connection, file_name: str, sha256: str, params: dict, m
     params); → its id, for job.drawing_id. Inside the import's transaction."""
     facts = [Jsonb(params["profile"]), *(params.get(name) for name in DRAWING_FACTS[1:])]
     return scalar(conn.execute(INSERT_DRAWING, (file_name, sha256, params.get("units"), *facts,
-                                                Jsonb(tool_materials(module_params)))))
+                                                Jsonb(tool_materials(module_params)),
+                                                Jsonb(drawn_threads(module_params)))))
 
 
 def tool_materials(module_params: dict) -> dict:
@@ -84,6 +87,8 @@ def disagreements(record: DrawingRecord, params: dict, module_params: dict):
             stated, recorded = values.get("tool_material"), record.tool_material(str(name).partition(":")[2])
             if not _same(stated, recorded, DEFAULTS["tool_material"]):
                 yield f"module_params.{name}.tool_material", stated, recorded
+    if record.threads is not None:   # None: a record made before threads were recorded (migration 0028)
+        yield from _threads(drawn_threads(module_params or {}), record.threads, module_params or {})
 
 
 def _same(stated, recorded, default) -> bool:
@@ -94,6 +99,28 @@ def _same(stated, recorded, default) -> bool:
             and not isinstance(recorded, bool):
         return math.isclose(stated, recorded, rel_tol=RELATIVE_TOLERANCE, abs_tol=RELATIVE_TOLERANCE)
     return stated == recorded
+
+
+def _threads(stated: dict, recorded: dict, module_params: dict):
+    """Each THREAD operation's pitch and crest and root lines against the record's; an operation
+    that is a THREAD in only one of them disagrees on its kind."""
+    for n in sorted(set(stated) | set(recorded)):
+        where = f"module_params.cutmotion:{n}"
+        if n not in stated or n not in recorded:
+            values = module_params.get(f"cutmotion:{n}")
+            yield f"{where}.kind", values.get("kind") if isinstance(values, dict) else None, \
+                "THREAD" if n in recorded else None
+        elif not _same(stated[n]["thread_pitch"], recorded[n].get("thread_pitch"), None):
+            yield f"{where}.thread_pitch", stated[n]["thread_pitch"], recorded[n].get("thread_pitch")
+        elif not _same_lines(stated[n]["paths"], recorded[n].get("paths")):
+            yield f"{where}.paths", stated[n]["paths"], recorded[n].get("paths")
+
+
+def _same_lines(stated, recorded) -> bool:
+    """The thread's paths (lists of segments) equal but for float noise."""
+    if isinstance(stated, list) and isinstance(recorded, list):
+        return len(stated) == len(recorded) and all(_same_lines(a, b) for a, b in zip(stated, recorded, strict=True))
+    return _same(stated, recorded, None)
 
 
 def _segments(stated: list, recorded: list):

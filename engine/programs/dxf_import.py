@@ -2,10 +2,10 @@
 
 The drawing is read, its numbers become job parameters, the program is computed and
 checked against the lathe (so a job that could never be instantiated is not stored), and
-the job is stored with its drawing record (the part, blank, tool-change position and materials
-as read, with the file's sha256; engine.programs.drawing_records), all in one transaction: on
-any error nothing is stored. The program
-itself is stored by `engine instantiate --job ID`, like every instantiation.
+the job is stored with its drawing record (the part, blank, tool-change position, materials and
+thread pitch and lines as read, with the file's sha256; engine.programs.drawing_records), all in
+one transaction: on any error nothing is stored. The program itself is stored by
+`engine instantiate --job ID`, like every instantiation.
 """
 from __future__ import annotations
 
