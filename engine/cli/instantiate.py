@@ -101,7 +101,9 @@ def instantiate(ctx, gear_id, job_id, gear_class, params_file, unverified, gear_
 
     --class C --params P.json makes a job of a class without a model (engine
     import-nc) on a lathe: its program is read by the machine's verifier, and
-    with its imported values it is the imported program again.
+    with its imported values it is the imported program again. Without a
+    drawing record the turning simulation cannot prove it: stored for review,
+    never written to a file (--out is refused).
 
     Example: engine instantiate --gear 42 --out /srv/nc/
     """

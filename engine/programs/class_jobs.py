@@ -71,6 +71,7 @@ def instantiate_class(conn: Connection, gear_class: str, given: dict, *, machine
     nothing stored. The batch fields of `mode` do not apply."""
     refuse_unfit_output(output, mode)
     refuse_unverified_file(unverified, output.out)
+    refuse_unsimulated_file(conn, gear_class, machine, output.out)
     if mode.dry_run:
         with read_only(conn):
             planned, taken = _planned(conn, gear_class, given, machine, source, mode.draft, unverified)
@@ -85,6 +86,20 @@ def refuse_unverified_file(unverified: bool, out) -> None:
     if unverified and out is not None:
         raise EngineError(f"--unverified with an output folder or --out {out}: {NEVER_WRITTEN}; leave out --out "
                           "(and the machine's out in the config file); nothing stored")
+
+
+def refuse_unsimulated_file(conn: Connection, gear_class: str, machine_name: str | None, out) -> None:
+    """A class job on a lathe has no drawing record (no part, no blank): the turning simulation
+    cannot prove its program, only the verifier reads it, so it never reaches a file for the
+    machine (issue 26: an adversary wrote a rapid through the part this way)."""
+    if out is None:
+        return
+    machine = class_machine(conn, machine_name)
+    if machine.kind == "lathe":
+        raise EngineError(f"class {gear_class} on lathe {machine.name}: a class job has no drawing record (part, "
+                          "blank), so the turning simulation cannot prove its program and it is never written to "
+                          f"a file ({out}); leave out --out (and the machine's out in the config file) to store it "
+                          "for review, or make the part's job with `engine import-dxf`; nothing stored")
 
 
 def _planned(conn: Connection, gear_class: str, given: dict, machine_name: str | None, source: str, draft: bool,
