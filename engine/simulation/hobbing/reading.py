@@ -33,20 +33,31 @@ def machine_dialect(machine: Machine):
     return grammar.dialect_for(machine)
 
 
-def read_program(lines: list[str], machine: Machine, name: str) -> list[Step]:
+def readable_dialect(machine: Machine):
+    """The machine's grammar, or SimulationError: a machine whose programs no grammar reads."""
     try:
-        dialect = machine_dialect(machine)
+        return machine_dialect(machine)
     except Refused as refusal:
         raise SimulationError(f"machine {machine.name}: {refusal}; the simulation cannot read its programs") from None
+
+
+def read_item(dialect, number: int, line: str, name: str):
+    """One line read as the verifier reads it, or SimulationError: a program the simulation cannot
+    follow is refused (shared by the hobbing and the turning simulation)."""
+    try:
+        return read_line(dialect, line)
+    except Refused as refusal:
+        raise SimulationError(f"{where(name, number, line)}: the simulation cannot read it ({refusal}); "
+                              "a program it cannot follow is refused") from None
+
+
+def read_program(lines: list[str], machine: Machine, name: str) -> list[Step]:
+    dialect = readable_dialect(machine)
     return [_step(dialect, number, line, name) for number, line in enumerate(lines, start=1)]
 
 
 def _step(dialect, number: int, line: str, name: str) -> Step:
-    try:
-        item = read_line(dialect, line)
-    except Refused as refusal:
-        raise SimulationError(f"{where(name, number, line)}: the simulation cannot read it ({refusal}); "
-                              "a program it cannot follow is refused") from None
+    item = read_item(dialect, number, line, name)
     if item.kind != "block":
         return Step(number, line, item)
     codes: dict[str, set[int]] = {"G": set(), "M": set()}

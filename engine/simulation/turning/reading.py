@@ -9,11 +9,8 @@ import re
 from dataclasses import dataclass
 
 from ...machines.records import Machine
-from ...verifier import grammar
 from ...verifier.blocks import TOKEN, Block
-from ...verifier.lines import read_line
-from ...verifier.refusals import Refused
-from ..hobbing.report import SimulationError, where
+from ..hobbing.reading import read_item, readable_dialect
 
 OPERATION_COMMENT = re.compile(r"\s*(?:\(|;)\s*OP (\d+) ([A-Z]+)\b")
 ISO_COMMENT = re.compile(r"\([^()]*\)")
@@ -30,19 +27,12 @@ class Step:
 
 
 def read_lathe_program(lines: list[str], machine: Machine, name: str) -> list[Step]:
-    try:
-        dialect = grammar.dialect_for(machine)
-    except Refused as refusal:
-        raise SimulationError(f"machine {machine.name}: {refusal}; the simulation cannot read its programs") from None
+    dialect = readable_dialect(machine)
     return [_step(dialect, number, line, name) for number, line in enumerate(lines, start=1)]
 
 
 def _step(dialect, number: int, line: str, name: str) -> Step:
-    try:
-        item = read_line(dialect, line)
-    except Refused as refusal:
-        raise SimulationError(f"{where(name, number, line)}: the simulation cannot read it ({refusal}); "
-                              "a program it cannot follow is refused") from None
+    item = read_item(dialect, number, line, name)
     comment = OPERATION_COMMENT.match(line)
     operation = (int(comment.group(1)), comment.group(2)) if comment else None
     if not isinstance(item, Block):
