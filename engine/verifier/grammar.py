@@ -75,6 +75,8 @@ class Dialect:
     thread_lead: dict[int, str] = field(default_factory=dict)   # thread G code -> the address of its lead (mm/rev)
     point_required: frozenset[str] = frozenset()      # addresses whose number must hold a decimal point
     program_numbers: range | None = None  # ISO O numbers a program may have
+    expander: str | None = None           # the bounded interpreter of engine.verifier.expansion that turns
+                                          # cycles, subprograms, parameters and jumps into plain lines
 
     def code_group(self, letter: str, code: int) -> str:
         codes = self.m_codes if letter == "M" else self.g_codes

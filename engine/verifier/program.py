@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING, Any
 from ..machines.records import Machine
 from ..names import NAME_RULES, is_safe
 from .arcs import arc_box, check_radius
+from .expansion import ExpansionRefused, PlainLine, expand
 from .grammar import AXES, Dialect, dialect_for
 from .limits import check_coupled_move, check_spindle, check_table, check_thread, check_travel
 from .lines import read_line, remembered_lines
@@ -46,6 +47,20 @@ def verify_program(lines: list[str], machine: Machine, program_name: str | None)
         dialect = dialect_for(machine)
     except Refused as refusal:
         raise LimitError(f"machine {machine.name}: {refusal}; nothing stored") from None
+    try:
+        plain = expand(dialect.expander, lines, machine)
+    except ExpansionRefused as refusal:
+        raise line_refused(program_name or "the program", refusal.number, refusal.source, str(refusal)) from None
+    except Refused as refusal:
+        raise LimitError(f"{shown_name(program_name or 'the program')}: {refusal}; nothing stored") from None
+    if plain is None:
+        _read_as_written(lines, dialect, machine, program_name)
+    else:
+        _read_expanded(plain, dialect, machine, program_name)
+
+
+def _read_as_written(lines: list[str], dialect: Dialect, machine: Machine, program_name: str | None) -> None:
+    """The engine's own dialects: every line is a plain line, read as it is (remembered per text)."""
     walk = ProgramReading(dialect, machine, len(lines), program_name)
     remembered, number = remembered_lines(dialect), 0
     try:
@@ -56,6 +71,20 @@ def verify_program(lines: list[str], machine: Machine, program_name: str | None)
     except Refused as refusal:
         raise line_refused(program_name or "the program", number, lines[number - 1] if number else "",
                            str(refusal)) from None
+
+
+def _read_expanded(plain: list[PlainLine], dialect: Dialect, machine: Machine, program_name: str | None) -> None:
+    """A dialect with an expander: its plain lines read in order (places counted in them), and a
+    refusal names the line of the program as written that the refused plain line comes from."""
+    walk = ProgramReading(dialect, machine, len(plain), program_name)
+    index = 0
+    try:
+        for index, line in enumerate(plain, start=1):
+            walk.take(index, read_line(dialect, line.text))
+        walk.finish()
+    except Refused as refusal:
+        where = plain[index - 1] if index else (plain[-1] if plain else PlainLine("", 0, ""))
+        raise line_refused(program_name or "the program", where.number, where.source, str(refusal)) from None
 
 
 class ProgramReading:

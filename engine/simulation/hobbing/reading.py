@@ -10,6 +10,7 @@ from dataclasses import dataclass
 from ...machines.records import Machine
 from ...verifier import grammar
 from ...verifier.blocks import TOKEN
+from ...verifier.expansion import ExpansionRefused, PlainLine, as_written, expand
 from ...verifier.lines import Line, read_line
 from ...verifier.refusals import Refused
 from .report import SimulationError, where
@@ -41,27 +42,42 @@ def readable_dialect(machine: Machine):
         raise SimulationError(f"machine {machine.name}: {refusal}; the simulation cannot read its programs") from None
 
 
-def read_item(dialect, number: int, line: str, name: str):
+def read_item(dialect, number: int, line: str, name: str, text: str | None = None):
     """One line read as the verifier reads it, or SimulationError: a program the simulation cannot
-    follow is refused (shared by the hobbing and the turning simulation)."""
+    follow is refused (shared by the hobbing and the turning simulation). `text` is the plain
+    line an expander made of `line` (engine.verifier.expansion); None: the line is plain."""
     try:
-        return read_line(dialect, line)
+        return read_line(dialect, line if text is None else text)
     except Refused as refusal:
         raise SimulationError(f"{where(name, number, line)}: the simulation cannot read it ({refusal}); "
                               "a program it cannot follow is refused") from None
 
 
+def plain_lines(dialect, lines: list[str], machine: Machine, name: str) -> list[PlainLine]:
+    """The lines the control runs, as the verifier expands them (cycles, subprograms, parameters
+    and jumps of a real program: engine.verifier.expansion), each with the line it comes from."""
+    try:
+        plain = expand(dialect.expander, lines, machine)
+    except ExpansionRefused as refusal:
+        raise SimulationError(f"{where(name, refusal.number, refusal.source)}: the simulation cannot follow it "
+                              f"({refusal}); a program it cannot follow is refused") from None
+    except Refused as refusal:
+        raise SimulationError(f"{name}: the simulation cannot follow it ({refusal})") from None
+    return as_written(lines) if plain is None else plain
+
+
 def read_program(lines: list[str], machine: Machine, name: str) -> list[Step]:
     dialect = readable_dialect(machine)
-    return [_step(dialect, number, line, name) for number, line in enumerate(lines, start=1)]
+    return [_step(dialect, plain, name) for plain in plain_lines(dialect, lines, machine, name)]
 
 
-def _step(dialect, number: int, line: str, name: str) -> Step:
-    item = read_item(dialect, number, line, name)
+def _step(dialect, plain: PlainLine, name: str) -> Step:
+    number, line = plain.number, plain.source
+    item = read_item(dialect, number, line, name, plain.text)
     if item.kind != "block":
         return Step(number, line, item)
     codes: dict[str, set[int]] = {"G": set(), "M": set()}
-    for token in line.partition(";")[0].split():
+    for token in plain.text.partition(";")[0].split():
         word = TOKEN.fullmatch(token)
         assert word is not None   # the verifier read the block word by word
         address, equals, text = word.groups()

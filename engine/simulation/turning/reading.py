@@ -10,7 +10,8 @@ from dataclasses import dataclass
 
 from ...machines.records import Machine
 from ...verifier.blocks import TOKEN, Block
-from ..hobbing.reading import read_item, readable_dialect
+from ...verifier.expansion import PlainLine
+from ..hobbing.reading import plain_lines, read_item, readable_dialect
 
 OPERATION_COMMENT = re.compile(r"\s*(?:\(|;)\s*OP (\d+) ([A-Z]+)\b")
 ISO_COMMENT = re.compile(r"\([^()]*\)")
@@ -27,18 +28,21 @@ class Step:
 
 
 def read_lathe_program(lines: list[str], machine: Machine, name: str) -> list[Step]:
+    """The steps of the lines the control runs (a real program's cycles, subprograms and
+    parameters expanded as the verifier expands them), each naming the line as written."""
     dialect = readable_dialect(machine)
-    return [_step(dialect, number, line, name) for number, line in enumerate(lines, start=1)]
+    return [_step(dialect, plain, name) for plain in plain_lines(dialect, lines, machine, name)]
 
 
-def _step(dialect, number: int, line: str, name: str) -> Step:
-    item = read_item(dialect, number, line, name)
-    comment = OPERATION_COMMENT.match(line)
+def _step(dialect, plain: PlainLine, name: str) -> Step:
+    number, line = plain.number, plain.source
+    item = read_item(dialect, number, line, name, plain.text)
+    comment = OPERATION_COMMENT.match(plain.text)
     operation = (int(comment.group(1)), comment.group(2)) if comment else None
     if not isinstance(item, Block):
         return Step(number, line, None, operation=operation)
     codes: dict[str, set[int]] = {"G": set(), "M": set()}
-    for token in ISO_COMMENT.sub(" ", line.partition(";")[0]).split():
+    for token in ISO_COMMENT.sub(" ", plain.text.partition(";")[0]).split():
         word = TOKEN.fullmatch(token)
         assert word is not None   # the verifier read the block word by word
         address, equals, text = word.groups()

@@ -1,0 +1,79 @@
+"""Real programs expanded into the plain lines their dialect's grammar reads (issue 27).
+
+A shop's own lathe program is not made of plain blocks alone: an ISO program calls canned cycles
+(G70–G76) and subprograms in the file (M98/M99), an 840D program computes with R-parameters and
+DEF variables and jumps (IF/GOTO/WHILE), a LinuxCNC program calls o-word subroutines with
+numbered and named parameters. The verifier and the simulation follow the moves the control
+makes, so a dialect that has such constructs names an expander: a bounded interpreter that turns
+the program as written into the plain lines the control really runs, each tagged with the line
+of the program it comes from. The verifier reads the plain lines with the dialect's grammar and
+names the line as written when it refuses one; the turning simulation follows the same lines.
+
+What an expander cannot turn into plain moves (a vendor cycle without a model, a subprogram not
+in the file, a loop past its step bound) it refuses naming the line and the construct: fail
+closed stays. A dialect without an expander is read line by line as written (the engine's own
+output, whose lines are plain already)."""
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from .refusals import Refused
+
+if TYPE_CHECKING:
+    from ..machines.records import Machine
+
+# The most plain lines one program may expand to, and the most lines an interpreter may step
+# through (a loop counts each pass): a program past either is refused, not followed for ever.
+MAX_PLAIN_LINES = 2_000_000
+MAX_STEPS = 5_000_000
+
+
+@dataclass(frozen=True, slots=True)
+class PlainLine:
+    """One line the dialect's grammar reads, and the line of the program it comes from."""
+    text: str       # a plain line: a header, a comment or a block of address words
+    number: int     # that program line's number, from 1
+    source: str     # that program line as written
+
+
+class ExpansionRefused(Refused):
+    """A program line the expander cannot turn into plain lines; `number` and `source` say which."""
+
+    def __init__(self, number: int, source: str, reason: str) -> None:
+        super().__init__(reason)
+        self.number, self.source = number, source
+
+
+Expander = Callable[[list[str], "Machine"], list[PlainLine]]
+EXPANDERS: dict[str, Expander] = {}    # expander name (Dialect.expander) -> the function
+
+
+def register_expander(name: str) -> Callable[[Expander], Expander]:
+    """Registers a dialect's expander under the name its Dialect row gives (Dialect.expander)."""
+    def register(function: Expander) -> Expander:
+        if name in EXPANDERS and EXPANDERS[name] is not function:
+            raise ValueError(f"two expanders named {name!r}")
+        EXPANDERS[name] = function
+        return function
+    return register
+
+
+def expand(name: str | None, lines: list[str], machine: Machine) -> list[PlainLine] | None:
+    """The plain lines of `lines` by the expander `name`; None for a dialect read as written.
+    A dialect that names an expander no module registered is refused (fail closed)."""
+    if name is None:
+        return None
+    expander = EXPANDERS.get(name)
+    if expander is None:
+        raise Refused(f"the {name} expander is not loaded (please report this)")
+    plain = expander(lines, machine)
+    if len(plain) > MAX_PLAIN_LINES:
+        raise Refused(f"the program expands to more than {MAX_PLAIN_LINES:,} blocks; split it")
+    return plain
+
+
+def as_written(lines: list[str]) -> list[PlainLine]:
+    """Every line as its own plain line (for a dialect whose expander passes a line on unchanged)."""
+    return [PlainLine(line, number, line) for number, line in enumerate(lines, start=1)]
