@@ -1,5 +1,6 @@
-"""The top-level data folders (design notes §3: migrations/, schema/, seed_templates/) ship
-inside the wheel as the package engine_data, which engine.paths finds with importlib.
+"""The packages engine/ and importers/ (design notes §3), and the top-level data folders
+(migrations/, schema/, seed_templates/), which ship inside the wheel as the package engine_data
+that engine.paths finds with importlib.
 Everything else about the project is in pyproject.toml."""
 from setuptools import find_packages, setup
 
@@ -8,7 +9,7 @@ DATA_FOLDERS = {"engine_data.migrations": "migrations", "engine_data.schema": "s
                 "engine_data.seed_templates.classes": "seed_templates/classes",
                 "engine_data.seed_templates.drawings": "seed_templates/drawings"}
 
-setup(packages=find_packages(include=["engine", "engine.*"]) + list(DATA_FOLDERS),
+setup(packages=find_packages(include=["engine", "engine.*", "importers", "importers.*"]) + list(DATA_FOLDERS),
       package_dir=DATA_FOLDERS,
       package_data={"engine": ["py.typed"], **{package: ["*.sql", "*.csv", "*.json", "*.md", "*.dxf"]
                                                for package in DATA_FOLDERS}})

@@ -124,7 +124,7 @@ def measure(path: Path, url: str, runs: int) -> tuple[list, list, list]:
     """Alternated runs of the three; each import stores one job (committed)."""
     import psycopg
 
-    from engine.programs.dxf_import import import_dxf
+    from importers.dxf import import_dxf
 
     plain, read, imported = [], [], []
     with psycopg.connect(url) as conn:

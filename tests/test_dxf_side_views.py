@@ -20,9 +20,9 @@ from helpers.lathe_programs import distance_to_chord, motions, operation_lines
 
 from engine.drawings.drawing import read_drawing
 from engine.drawings.read import DxfError
-from engine.programs.dxf_import import import_dxf
 from engine.programs.remake import instantiate_job
 from engine.turning.job_params import ProfileOptions
+from importers.dxf import import_dxf
 
 FLATTENING_MM = 0.0005
 ON_DRAWING_MM = 0.01       # a finish end point this close to a drawn line is on it

@@ -296,6 +296,48 @@ def test_every_folder_of_the_engine_has_its_layer():
     assert {folder for layer in LAYERS for folder in layer} - ENGINE_FOLDERS == {"top"}   # and no stale name
 
 
+# --- importers/ (design notes §3, Contract: a top-level folder of importers that create jobs) ---------
+# It stands between the engine's library and its command line: it imports the engine (drawings,
+# turning, programs), only engine.cli imports it, and it never imports engine.cli.
+IMPORTERS = "importers"
+
+
+def importer_problems(graph: dict[str, set[str]]) -> list[str]:
+    """`a -> b: why` for an engine module below the command line importing importers/, or an
+    importer importing the command line."""
+    def in_cli(module):
+        return module == CLI or module.startswith(CLI + ".") or module in CLI_ENTRY_POINTS
+    problems = []
+    for module, targets in sorted(graph.items()):
+        for target in sorted(targets):
+            if target.split(".")[0] == IMPORTERS and module.startswith("engine.") and not in_cli(module):
+                problems.append(f"{module} -> {target}: only the command line imports the importers")
+            if module.split(".")[0] == IMPORTERS and in_cli(target):
+                problems.append(f"{module} -> {target}: the importers stand below the command line")
+    return problems
+
+
+def engine_and_importers_graph():
+    root = Path(engine.__file__).parent.parent
+    return import_graph((Path(engine.__file__).parent, "engine"), (root / IMPORTERS, IMPORTERS))
+
+
+def test_the_importers_stand_between_the_library_and_the_command_line():
+    graph = engine_and_importers_graph()
+    assert "importers.dxf" in graph["engine.cli.turning"]              # the walk sees the CLI's import
+    assert any(target.startswith("engine.programs") for target in graph["importers.dxf"])
+    assert importer_problems(graph) == []
+    assert cycles(graph) == []
+
+
+def test_the_importer_check_finds_the_library_importing_an_importer():
+    graph = {"engine.programs.demo": {"importers.sample"}, "importers.sample": {"engine.cli.db"},
+             "engine.cli.db": {"importers.sample"}}
+    assert importer_problems(graph) == [
+        "engine.programs.demo -> importers.sample: only the command line imports the importers",
+        "importers.sample -> engine.cli.db: the importers stand below the command line"]
+
+
 FAKE_LAYERS = [("top",), ("db",), ("gears",), ("simulation",), ("hobbing", "turning"), ("cli",)]
 
 

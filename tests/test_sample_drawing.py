@@ -21,8 +21,8 @@ from helpers.lathe_programs import distance_to_drawn, drawn_polylines, motions, 
 from engine.cli.app import main
 from engine.machines.records import load_machine
 from engine.paths import SAMPLE_DRAWING, SEED_DIR, data_folder
-from engine.programs.demo import sample_turning_job
 from engine.verifier import verify_program
+from importers.sample import sample_turning_job
 
 ROOT = Path(__file__).resolve().parent.parent
 KINDS = ["ROUGH", "SLOT", "FINISH", "THREAD"]

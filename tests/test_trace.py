@@ -11,10 +11,10 @@ from helpers.drawings import seed_drawing
 
 from engine.hobbing.choices import Choices
 from engine.nc.lineage import LINEAGE_ROW_ID
-from engine.programs.dxf_import import import_dxf
 from engine.programs.instantiate import instantiate_gear, instantiate_gears
 from engine.programs.remake import instantiate_job
 from engine.templates.store import load_template
+from importers.dxf import import_dxf
 
 SEEDED_GEARS = {42: "spur", 43: "helical", 45: "spur", 50: "taper", 51: "crowned", 53: "worm_wheel", 54: "duplex"}
 CHOICES = (Choices(), Choices(cuts=2, coolant=False, tailstock=False, feed_mode="conventional-climb"),

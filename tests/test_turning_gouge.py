@@ -14,9 +14,9 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from engine.errors import EngineError
-from engine.programs.dxf_import import import_dxf
 from engine.turning.gouge import GOUGE_TOLERANCE_MM, PartIndex, check_no_gouge
 from engine.turning.moves import Move
+from importers.dxf import import_dxf
 
 # A shaft R10 from Z 0 to −60 with a collar R20 over Z −30 … −40, closed by the axis.
 CORNERS = [(0.0, 0.0), (0.0, 10.0), (-30.0, 10.0), (-30.0, 20.0), (-40.0, 20.0), (-40.0, 10.0),

@@ -17,11 +17,11 @@ from psycopg.types.json import Jsonb
 
 from engine.errors import EngineError
 from engine.library.refactor import refactor
-from engine.programs.dxf_import import import_dxf
 from engine.programs.remake import instantiate_job
 from engine.turning.job_params import ProfileOptions
 from engine.turning.names import MAX_OPERATIONS
 from engine.verifier import LimitError
+from importers.dxf import import_dxf
 
 # ISO F words carry their decimal point (a Fanuc-type control reads F300 by a parameter's unit).
 DIALECTS = {"lathe-iso": {"tools": ("T0101", "T0202"), "thread": "G32", "coolant": ("M08", "M09"),

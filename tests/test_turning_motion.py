@@ -17,9 +17,9 @@ import pytest
 from helpers.drawings import DXF, EMCO, seed_drawing
 from helpers.lathe_programs import drawn_polylines, motions, words
 
-from engine.programs.dxf_import import import_dxf
 from engine.programs.remake import instantiate_job
 from engine.turning.job_params import ProfileOptions
+from importers.dxf import import_dxf
 
 MACHINES = ("lathe-iso", "lathe-840d")
 SAMPLE_MM = 0.05

@@ -11,8 +11,8 @@ from helpers.turning_jobs import refused_after
 
 from engine.errors import EngineError
 from engine.machines.records import load_machine
-from engine.programs.dxf_import import import_dxf
 from engine.verifier import LimitError, verify_program
+from importers.dxf import import_dxf
 
 MODULE = "module_params = jsonb_set(module_params, '{%s}', '%s')"
 DROP = "module_params = module_params #- '{%s}'"

@@ -15,10 +15,10 @@ from helpers.drawings import DXF, INCH, seed_drawing
 from helpers.drawn_parts import two_rough_layers
 from helpers.lathe_programs import distance_to_drawn, drawn_polylines, operation_lines, words
 
-from engine.programs.dxf_import import import_dxf
 from engine.programs.remake import instantiate_job
 from engine.turning.job_params import ProfileOptions
 from engine.turning.job_plot import turning_job_figure
+from importers.dxf import import_dxf
 
 HEMISPHERE = "emco_lathe_testg02hemisphere_R14.dxf"
 PRINTED_MM = 0.0005   # the program states positions to 0.001 mm, rounded

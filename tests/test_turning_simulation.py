@@ -15,12 +15,12 @@ from psycopg.types.json import Jsonb
 
 from engine.errors import EngineError
 from engine.machines.records import load_machine
-from engine.programs.dxf_import import import_dxf
 from engine.programs.remake import instantiate_job
 from engine.release.gate import release
 from engine.release.impact import impact
 from engine.simulation.turning.run import simulate_turning
 from engine.turning.job_params import ProfileOptions
+from importers.dxf import import_dxf
 
 SAMPLE = Path(__file__).parent.parent / "seed_templates" / "drawings" / "sample_shaft.dxf"
 CLASS = {"lathe-iso": "turning_iso", "lathe-840d": "turning_840d"}

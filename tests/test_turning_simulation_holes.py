@@ -10,11 +10,11 @@ import pytest
 from helpers.drawings import DXF
 
 from engine.machines.records import load_machine
-from engine.programs.dxf_import import import_dxf
 from engine.programs.remake import instantiate_job
 from engine.simulation.turning.run import simulate_turning
 from engine.turning.job_params import ProfileOptions
 from engine.verifier import verify_program
+from importers.dxf import import_dxf
 
 SAMPLE = Path(__file__).parent.parent / "seed_templates" / "drawings" / "sample_shaft.dxf"
 EMCO = DXF / "emco_lathe_testNegDXF_R14.dxf"

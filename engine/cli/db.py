@@ -34,6 +34,8 @@ def demo(ctx, gear_id, turning, sample_path):
 
     Example: engine demo --turning
     """
+    from importers.sample import sample_turning_job
+
     from ..paths import SAMPLE_DRAWING
     from ..programs.demo import DEMO_DATABASE, run_demo
 
@@ -46,7 +48,7 @@ def demo(ctx, gear_id, turning, sample_path):
         click.echo("demo: --database-url/DATABASE_URL ignored: the demo writes sample data and runs only on "
                    "the embedded PostgreSQL; to load the samples into that database run `engine seed --samples`",
                    err=True)
-    result = run_demo(gear_id, turning)
+    result = run_demo(gear_id, sample_turning_job if turning else None)
     program = result.program
     click.echo(f"demo: in the database {DEMO_DATABASE} of the embedded PostgreSQL (data in {result.data_dir}); "
                f"migrations applied: {result.applied}; {result.report}", err=True)

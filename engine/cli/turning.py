@@ -80,7 +80,8 @@ def import_dxf_command(ctx, dxf_file, machine, rough_depth, allowance, tool, spe
     as a job parameter (edit it in SQL, then `engine instantiate --job ID`). Nothing is
     stored if the drawing cannot become a job or its program would exceed the lathe.
     """
-    from ..programs.dxf_import import import_dxf
+    from importers.dxf import import_dxf
+
     from ..turning.job_params import ProfileOptions
 
     options = ProfileOptions(rough_depth, allowance, tool, speed, feed, stock_diameter)

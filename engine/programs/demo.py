@@ -7,34 +7,34 @@ shop's database too when it runs without a URL. A shop that wants the samples in
 database says so: `engine seed --samples`.
 
 `engine demo --turning` makes a turning job of the project's sample drawing instead (issue 17:
-no real drawing carries operation layers, so users need one to copy): sample_turning_job
-imports it on the default lathe and instantiates it, on whatever connection it is given."""
+no real drawing carries operation layers, so users need one to copy): the command line hands
+run_demo the importer that makes it (importers.sample, design notes §3), which stands above this
+layer."""
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any, Protocol
 
 from ..db.embedded import embedded_data_dir, embedded_url
 from ..library.seed import SeedReport
-from ..paths import SAMPLE_DRAWING
 
 if TYPE_CHECKING:
     from ..db.connection import Connection
-    from .dxf_import import ImportReport
     from .records import Program
 
 DEMO_DATABASE = "engine_demo"
-# mm: the blank the sample drawing's roughing starts from (seed_templates/drawings/README.md);
-# the convention has no place for it in the drawing, so it is given as `--stock-diameter` would be.
-SAMPLE_STOCK_DIAMETER = 44.0
 
 
-@dataclass(frozen=True)
-class SampleJob:
-    drawing: Path           # the sample drawing, to copy as the start of one's own
-    job: ImportReport
-    program: Program
+class Sample(Protocol):
+    """What a sample importer returns (importers.sample.SampleJob): the drawing, its job, the program."""
+    @property
+    def drawing(self) -> Path: ...
+    @property
+    def job(self) -> Any: ...
+    @property
+    def program(self) -> Program: ...
 
 
 @dataclass(frozen=True)
@@ -43,12 +43,12 @@ class DemoResult:
     applied: int            # migrations applied by this run
     report: SeedReport
     program: Program
-    sample: SampleJob | None = None   # with --turning: the job the program was made for
+    sample: Sample | None = None   # with --turning: the job the program was made for
 
 
-def run_demo(gear_id: int = 42, turning: bool = False) -> DemoResult:
+def run_demo(gear_id: int = 42, sample_job: Callable[[Connection], Sample] | None = None) -> DemoResult:
     """Migrate and seed (samples included) the embedded server's database, then instantiate one
-    gear, or with `turning` the sample drawing's turning job."""
+    gear, or with `sample_job` (importers.sample.sample_turning_job) the sample drawing's job."""
     from ..db.connection import connect
     from ..db.migrate import migrate
     from ..library.seed import seed
@@ -57,20 +57,9 @@ def run_demo(gear_id: int = 42, turning: bool = False) -> DemoResult:
     with connect(embedded_url(DEMO_DATABASE)) as conn:
         applied = migrate(conn)
         report = seed(conn, samples=True)
-        sample = sample_turning_job(conn) if turning else None
+        sample = sample_job(conn) if sample_job else None
         program = sample.program if sample else instantiate_gear(conn, gear_id)
     return DemoResult(embedded_data_dir(), len(applied), report, program, sample)
-
-
-def sample_turning_job(conn: Connection, drawing: Path = SAMPLE_DRAWING) -> SampleJob:
-    """Import the sample drawing as a turning job on the default lathe (from the Ø44 blank) and
-    store its program, as `engine import-dxf` and `engine instantiate --job` do."""
-    from ..turning.job_params import ProfileOptions
-    from .dxf_import import import_dxf
-    from .remake import instantiate_job
-
-    job = import_dxf(conn, drawing, options=ProfileOptions(stock_diameter=SAMPLE_STOCK_DIAMETER))
-    return SampleJob(drawing, job, instantiate_job(conn, job.job_id))
 
 
 def operations_line(job) -> str:

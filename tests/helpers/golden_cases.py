@@ -15,10 +15,10 @@ from pathlib import Path
 
 from engine.errors import EngineError
 from engine.hobbing.choices import Choices
-from engine.programs.dxf_import import import_dxf
 from engine.programs.instantiate import instantiate_gear
 from engine.programs.remake import instantiate_job
 from engine.turning.job_params import ProfileOptions
+from importers.dxf import import_dxf
 
 GOLDEN = Path(__file__).resolve().parents[1] / "golden"
 

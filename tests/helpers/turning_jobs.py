@@ -5,9 +5,9 @@ from __future__ import annotations
 import pytest
 
 from engine.errors import EngineError
-from engine.programs.dxf_import import import_dxf
 from engine.programs.remake import instantiate_job
 from helpers.drawings import seed_drawing
+from importers.dxf import import_dxf
 
 
 @pytest.fixture

@@ -1,4 +1,4 @@
-"""`engine import-dxf`: a lathe drawing becomes one turning job (design notes §8).
+"""`engine import-dxf`: a lathe drawing becomes one turning job (design notes §3, §8).
 
 The drawing is read, its numbers become job parameters, the program is computed and
 checked against the lathe (so a job that could never be instantiated is not stored), and
@@ -15,17 +15,17 @@ from typing import TYPE_CHECKING
 
 from psycopg.types.json import Jsonb
 
-from ..db.connection import scalar
-from ..drawings.drawing import read_drawing
-from ..memory import no_cycle_collection
-from ..names import checked
-from ..turning.job_params import ProfileOptions, turning_job
-from ..turning.model import ISO_PROGRAM_NUMBERS, job_passes, key, present_operations
-from .drawing_records import file_sha256, store_drawing
-from .turning_jobs import lathe, plan_turning_job, turning_class
+from engine.db.connection import scalar
+from engine.drawings.drawing import read_drawing
+from engine.memory import no_cycle_collection
+from engine.names import checked
+from engine.programs.drawing_records import file_sha256, store_drawing
+from engine.programs.turning_jobs import lathe, plan_turning_job, turning_class
+from engine.turning.job_params import ProfileOptions, turning_job
+from engine.turning.model import ISO_PROGRAM_NUMBERS, job_passes, key, present_operations
 
 if TYPE_CHECKING:
-    from ..db.connection import Connection
+    from engine.db.connection import Connection
 
 INSERT_TURNING_JOB = """
 INSERT INTO job (id, gear_id, gear_class, machine, hob_id, params, module_params, drawing_id)
