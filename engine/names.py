@@ -6,7 +6,7 @@ machine names are printed inside the program's comments (`; HOB …`, ISO `(DRAW
 A newline in any of them would start a new NC block after the comment, and a `/` or `..`
 in a program name a file outside --out. So every name is checked where it enters (CSV
 imports, DXF import, options) and where it is used, against the patterns below; the
-database holds the same patterns (schema/core.sql, function safe_name) for
+database holds the same patterns (schema/schema.sql, function safe_name) for
 what is written in SQL. A name that does not fit is refused, never altered.
 """
 from __future__ import annotations

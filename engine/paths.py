@@ -13,7 +13,7 @@ SOURCE_ROOT = Path(__file__).resolve().parent.parent   # the checkout, or site-p
 
 def _is_checkout(root: Path) -> bool:
     """The project's own tree, not site-packages (which may hold some other `migrations/`)."""
-    return (root / "pyproject.toml").is_file() and (root / "schema" / "core.sql").is_file()
+    return (root / "pyproject.toml").is_file() and (root / "schema" / "schema.sql").is_file()
 
 
 def data_folder(name: str, root: Path = SOURCE_ROOT) -> Path:

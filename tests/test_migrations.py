@@ -11,10 +11,11 @@ from engine.db.migrate import discover, migrate, status
 from engine.errors import EngineError
 from engine.paths import MIGRATIONS_DIR, SCHEMA_DIR
 
-# The readable schema: every table, function, trigger and view once, in its final form, by
-# concern, loaded in this order (each file uses only objects of the files before it).
-SCHEMA_FILES = ("core.sql", "templates.sql", "versions.sql", "editing.sql", "records.sql", "programs.sql",
-                "release.sql", "roles.sql")
+# The readable schema (design notes §3, Contract): the whole current schema in one file, every
+# table, function, trigger and view once, in its final form, in sections by concern (each uses
+# only objects of the sections before it).
+SCHEMA_FILES = ("schema.sql",)
+SECTIONS = ("core", "templates", "versions", "editing", "records", "programs", "release", "roles")
 
 # Each query lists one kind of object as (key, definition) rows: the key names the object.
 ACL = "(SELECT array_agg(format('%s %s', CASE WHEN a.grantee = 0 THEN 'PUBLIC' ELSE a.grantee::regrole::text END, " \
@@ -76,8 +77,12 @@ def differences(from_schema, from_migrations) -> list[str]:
     return found
 
 
-def test_schema_folder_lists_its_files_in_load_order():
+def test_schema_folder_is_one_readable_file_in_its_sections():
     assert sorted(path.name for path in SCHEMA_DIR.glob("*.sql")) == sorted(SCHEMA_FILES)
+    text = (SCHEMA_DIR / "schema.sql").read_text(encoding="utf-8")
+    banners = [line.removeprefix("-- Section ").partition(":")[0] for line in text.splitlines()
+               if line.startswith("-- Section ")]
+    assert banners == list(SECTIONS)
 
 
 def test_migrations_produce_exactly_the_readable_schema(empty_database_url, database_url):

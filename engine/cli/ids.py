@@ -1,4 +1,4 @@
-"""The types of id options and arguments: the range of the column each names (schema/records.sql),
+"""The types of id options and arguments: the range of the column each names (schema/schema.sql),
 so an id beyond it (`--gear 99999999999`) is bad input said in one line, exit 1, like any other
 bad option, and never reaches the database as a number its column cannot hold."""
 from __future__ import annotations

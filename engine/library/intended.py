@@ -1,6 +1,6 @@
 """Near-duplicate pairs a person has judged (issue 16): the nightly refactor remembers which
 pairs it reported (new ones are listed first) and leaves out the pairs marked intended, whose
-marks say who, why and when (near_duplicate_intended, schema/templates.sql).
+marks say who, why and when (near_duplicate_intended, schema/schema.sql).
 
 A pair's identity is its module type and its two line texts, in either order. Not component
 ids: the refactor merges copies into the lowest id and deletes the rest, and an edit through

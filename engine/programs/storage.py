@@ -4,7 +4,7 @@ here: engine.programs.outputs writes them after the COMMIT of the caller's files
 Programs are records (design notes §10): no role may write the program table. The engine stores
 them through the database's own path, which checks each program against its job and the stored
 template version and records who stored it: the view program_submission, one INSERT or a
-batch through COPY (check_program, schema/programs.sql). Each program gets its lineage line here (engine.programs.
+batch through COPY (check_program, schema/schema.sql). Each program gets its lineage line here (engine.programs.
 lineage), checked by the database too (check_program_release). A program is stored only with a safe name
 (engine/names.py) and lines that are one NC line each: a line break inside a line would be a
 block that no check read. The database refuses both too (program_safe_name, check_program); here they are
@@ -147,7 +147,7 @@ def _deleted_message(named: list[str]) -> str:
     return f"{', '.join(named)} were deleted while their programs were made; nothing stored"
 
 
-# The characters check_program (schema/programs.sql) refuses in a stored line: every control
+# The characters check_program (schema/schema.sql) refuses in a stored line: every control
 # character, the TAB included (a line is one block of words separated by spaces).
 CONTROL = re.compile("[\x01-\x1f\x7f-\x9f\u2028\u2029]")
 
