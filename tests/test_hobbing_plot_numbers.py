@@ -229,4 +229,16 @@ def test_the_svg_and_the_report_carry_the_numbers(run, tmp_path):
     swivel_line = next(line for line in drawn if line.startswith("swivel A="))
     a_written = swivel_line.split()[1].rstrip("°")
     picture = svg.read_text(encoding="utf-8")
-    assert a_written in picture and "centre distance X" in picture and "hand check" in picture
+    assert a_written in picture and "numbers read from the program" in picture and "hand check" in picture
+    assert any(line.startswith("hand check: the hob's thread lies along the teeth") for line in drawn)
+
+
+def test_a_taper_states_the_centre_distance_from_one_end_of_its_pass_to_the_other(conn):
+    """§B12: one `G1 X… Z…` moves X with Z along the cone; the picture gives the centre distance
+    from least to most along the pass, as the program writes the pass's two ends."""
+    program, figure, _ = figure_of(conn, 50)
+    infeed = written(program.lines, r"^G1 X(\d+\.\d+) F")
+    slant = written(program.lines, r"^G1 X(\d+\.\d+) Z")
+    assert len(infeed) == len(slant) == 1
+    low, high = sorted((infeed[0], slant[0]))
+    assert f"centre distance X{low:.3f} … X{high:.3f} mm along the pass" in numbers_text(figure)

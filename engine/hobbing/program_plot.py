@@ -33,7 +33,7 @@ TITLE_WIDTH = 200          # characters of a title line at the figure's width
 TITLE_COLOURS = {False: "black", True: "red"}   # by whether the simulation refuses the program
 COLUMN_WIDTHS = (3, 2, 2)   # side view; overview over hob view; numbers over hand check (over worm view)
 RIGHT_ROWS = {False: (1.0, 1.1), True: (1.0, 0.9, 1.1)}   # by whether the gear is a worm wheel
-NUMBERS_WIDTH = 72         # characters of a line of the numbers' panel
+NUMBERS_WIDTH = 62         # characters of a line of the numbers' panel
 NUMBERS_ROWS = 22          # lines the panel has room for at least (more: closer together)
 NUMBERS_TITLE = "numbers read from the program (the simulation's reading)"
 DRAFT_WORDS = " · DRAFT: made from a template version not released, it never reaches the machine"
@@ -119,7 +119,7 @@ def draw_numbers(axes, scene: Scene) -> list[str]:
     step, row = 1.0 / max(NUMBERS_ROWS, sum(map(len, texts)) + len(texts)), 0.5
     for number, text in zip(numbers, texts):
         axes.text(0.0, 1.0 - row * step, literal("\n".join(text)), transform=axes.transAxes, va="top",
-                  fontsize="x-small", family="monospace", gid=number.gid)
+                  fontsize="small", family="monospace", gid=number.gid)
         row += len(text) + 1
     axes.set_title(NUMBERS_TITLE, fontsize="medium")
     axes.set_axis_off()

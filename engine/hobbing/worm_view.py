@@ -17,7 +17,7 @@ from .setup_numbers import moved_axes, span
 from .side_view import BLANK_FILL, cut_colour
 
 MOTIONS = (("X", "radial infeed"), ("Y", "tangential pass"))
-LABEL_STEP = 10          # points between the labels of cuts that start at one place (rough, finish)
+LABEL_STEP = 10          # points between labels of motions that start at one place (rough, finish, infeed)
 
 
 def draw_worm_view(axes, scene) -> list[str]:
@@ -32,10 +32,10 @@ def draw_worm_view(axes, scene) -> list[str]:
     for index, cut in enumerate(scene.recording.cuts):
         draw_hob(axes, scene, cut.moves[0].start, f"top hob {cut.label} start", "0.45", (0, (3, 2)))
         draw_hob(axes, scene, cut.moves[-1].end, f"top hob {cut.label} end", "black", "-")
-        for axis, name in MOTIONS:
+        for row, (axis, name) in enumerate(MOTIONS, start=len(MOTIONS) * index):
             moves = [move for move in cut.moves if moved_axes(move) == {axis}]
             if moves:
-                drawn.append(draw_motion(axes, cut, moves, axis, name, index, senses))
+                drawn.append(draw_motion(axes, cut, moves, (axis, name), (index, row), senses))
     finish(axes)
     return drawn or ["top view: no infeed or tangential pass"]
 
@@ -50,9 +50,10 @@ def draw_hob(axes, scene, pose: dict, gid: str, colour: str, style) -> None:
                              edgecolor=colour, linestyle=style, linewidth=1.0, gid=gid))
 
 
-def draw_motion(axes, cut, moves, axis: str, name: str, index: int, senses: Senses) -> str:
-    """The arrow of one motion, from where its first move starts to where its last ends."""
-    start, end, colour = moves[0].start, moves[-1].end, cut_colour(index)
+def draw_motion(axes, cut, moves, motion: tuple, place: tuple, senses: Senses) -> str:
+    """The arrow of one motion (axis, name), from where its first move starts to where its last
+    ends, in the cut's colour; its label on its own row (place: the cut's index, the label's row)."""
+    (axis, name), start, end, colour = motion, moves[0].start, moves[-1].end, cut_colour(place[0])
     if not ({"X", "Y"} <= start.keys() and {"X", "Y"} <= end.keys()):
         return f"{cut.label}: {name} where Y is not known"
     words = f"{cut.label}: {name} {span(moves, axis, senses)}"
@@ -60,7 +61,7 @@ def draw_motion(axes, cut, moves, axis: str, name: str, index: int, senses: Sens
                   arrowprops=dict(arrowstyle="-|>", color=colour, linewidth=1.8, mutation_scale=16))
     # A radial infeed before a tangential pass is a millimetre or so: named where it is, to be seen.
     short = " ".join(cut.label.split()[:2])
-    axes.annotate(literal(f"{short}: {name}"), xy=(start["X"], start["Y"]), xytext=(8, 4 + LABEL_STEP * index),
+    axes.annotate(literal(f"{short}: {name}"), xy=(start["X"], start["Y"]), xytext=(8, 4 + LABEL_STEP * place[1]),
                   textcoords="offset points", color=colour,
                   fontsize="x-small", gid=f"top label {name} {cut.label}")
     axes.plot([], [], color=colour, linewidth=1.8, label=literal(words))
@@ -74,4 +75,4 @@ def finish(axes) -> None:
     axes.set_ylabel("Y (mm)")
     axes.set_title("worm wheel from above: radial infeed (X) and tangential pass (Y)", fontsize="medium")
     axes.grid(True, linewidth=0.3)
-    axes.legend(loc="upper left", fontsize="x-small")
+    axes.legend(loc="best", fontsize="x-small")
