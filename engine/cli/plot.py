@@ -18,7 +18,9 @@ from .ids import JOB_ID, PROGRAM_ID
 @click.pass_context
 def plot_command(ctx, job_id, program_id, out, as_json):
     """Draw a job (turning: profile, blank, every pass, X as diameter; hobbing: side view of
-    blank, hob and passes) or a stored program, as PNG or SVG.
+    blank, hob and passes, the numbers read from the program — swivel A with its sign, centre
+    distance and depth per cut, feeds, shift range — and the gear's teeth beside the hob's
+    thread; a worm wheel also from above) or a stored program, as PNG or SVG.
 
     Example: engine plot --job 7 -o job7.svg
     """

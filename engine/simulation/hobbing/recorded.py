@@ -2,7 +2,9 @@
 reading and the same walk as `engine simulate` (engine.simulation.hobbing.run), with every move's start
 and end in the DIN frame, the swivel it ran at, whether it cut, the cuts as the walk closes them
 and the G25/G26 working area as the program sets it. A picture drawn from this shows what the
-simulation checked, not a second interpretation of the program text. A program with the
+simulation checked, not a second interpretation of the program text: the F in effect at each
+move, each A as the program writes it and each coupling are kept too (the numbers a picture
+states, issue 27). A program with the
 hob-shift-per-part clamp is followed at both ends of its R11 interval (the Y range it cuts at,
 the part of the hob the shifting uses); the moves are those at the low end."""
 from __future__ import annotations
@@ -27,6 +29,7 @@ class Move:
     end: dict
     swivel: float          # A in the DIN frame, degrees
     cutting: bool          # part of a cut the walk follows (coupled, spindle turning, G1)
+    feed: float | None = None   # the F in effect, as written (mm/min: the hobbing grammar has G94 only)
 
 
 @dataclass(frozen=True, slots=True)
@@ -52,6 +55,8 @@ class Recording:
     areas: dict = field(default_factory=dict)       # "lower"/"upper" -> {axis: DIN value}, as G25/G26 set them
     area_words: dict = field(default_factory=dict)  # "lower"/"upper" -> {axis: program value}
     cutting_y: tuple = (0.0, 0.0)                   # the lowest and highest Y (DIN) the hob cuts at
+    swivel_words: list = field(default_factory=list)  # (line, A as written) for every A the program writes
+    couplings: list = field(default_factory=list)     # every EGON as the walk read it (DIN Coupling)
 
     @property
     def final_swivel(self) -> float:
@@ -80,10 +85,17 @@ class RecordingSimulation(BlockSimulation):
         self.recording.areas[block.area] = {axis: self.senses.position(axis, value)
                                             for axis, value in block.positions.items()}
 
+    def _couple(self, step) -> None:
+        super()._couple(step)
+        self.recording.couplings.append(self.coupling)
+
     def _move(self, step, motion: int, program: dict, swivel: float | None = None) -> None:
         start = dict(self.position)
+        if swivel is not None:
+            self.recording.swivel_words.append((step.number, swivel))
         super()._move(step, motion, program, swivel)
-        move = Move(step.number, step.line, motion, start, dict(self.position), self.swivel, self.cut is not None)
+        move = Move(step.number, step.line, motion, start, dict(self.position), self.swivel, self.cut is not None,
+                    self.feed)
         self.recording.moves.append(move)
         if move.cutting:
             self.cut_moves.append(move)
