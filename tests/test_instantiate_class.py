@@ -262,16 +262,25 @@ def test_the_database_holds_the_unverified_word_to_the_record_and_refuses_it_for
 
 
 def test_a_lathe_class_job_made_again_is_proved_and_written_to_a_file(run, tmp_path):
-    """`instantiate --job` of a lathe class job: proved by the turning simulation again, and written."""
+    """`instantiate --job` of a lathe class job: proved by the turning simulation again, against
+    the blank its --params stated (Ø26 from Z0 to Z-40: the program's rapids at X28 and up stay
+    above it), and written; `engine simulate --program` says what it proved and what not."""
     import_emco(run, tmp_path)
     with psycopg.connect(run.url) as conn:
         release_draft(conn, "emco_neg")
-    made = json.loads(ok(run("instantiate", "--class", "emco_neg", "--machine", "lathe-iso", "--json")).stdout)
+    params = tmp_path / "blank.json"
+    params.write_text(json.dumps({"stock_diameter": 26, "stock_z_front": 0, "stock_z_back": -40}))
+    made = json.loads(ok(run("instantiate", "--class", "emco_neg", "--machine", "lathe-iso", "--params", params,
+                             "--json")).stdout)
+    assert any(f"the blank Ø{26:.3f} Z{-40:.3f}…{0:.3f}:" in note for note in made["notes"]), made["notes"]
     out = tmp_path / "AGAIN.NC"
     again = json.loads(ok(run("instantiate", "--job", made["job_id"], "--out", out, "--json")).stdout)
     with psycopg.connect(run.url) as conn:
         stored = conn.execute("SELECT lines FROM program WHERE id = %s", (again["program_id"],)).fetchone()[0]
     assert out.read_bytes() == ("\n".join(stored) + "\n").encode()
+    simulated = ok(run("simulate", "--program", again["program_id"])).stdout.splitlines()
+    assert simulated[-1].endswith(f"through the blank Ø{26:.3f} Z{-40:.3f}…{0:.3f}; clean")
+    assert any(line.startswith("not checked: a cut into the finished part") for line in simulated)
 
 
 def test_the_adversary_s_rapid_through_the_blank_in_an_imported_program_is_refused_naming_it(run, tmp_path):

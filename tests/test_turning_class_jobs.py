@@ -11,6 +11,7 @@ import math
 from dataclasses import replace
 
 import pytest
+from shapely.geometry import box
 
 from engine.errors import EngineError
 from engine.machines.records import Machine
@@ -19,6 +20,7 @@ from engine.simulation.turning.follow import ProgramState
 from engine.simulation.turning.reading import read_lathe_program
 from engine.simulation.turning.report import TurningReport
 from engine.simulation.turning.run import simulate_turning
+from engine.simulation.turning.undrawn import check_tool_changes
 from engine.simulation.turning.work import turning_records
 
 LATHE = Machine("lathe-iso", "lathe", "iso", 0.0, 400.0, 0.0, 0.0, -600.0, 200.0, 4000.0, None, None)
@@ -138,3 +140,19 @@ def test_a_class_job_s_blank_is_given_whole_or_not_at_all(given):
     params, _ = job_params("emco_neg", {"speed": 600}, {**given, "stock_z_front": 0, "stock_z_back": -60},
                            "P.json")
     assert params["stock_z_back"] == -60
+
+
+def test_a_tool_change_after_a_reference_return_is_clear_of_the_blank():
+    """A reference return (ISO G28; the grammar reads it once the dialect work widens it: the
+    reader's step is given G28 here) runs at rapid through its X/Z to the reference point, the
+    far corner of the travel: a tool change there is clear, as it is not where the tool stood."""
+    lines = inserted(CUT, "G00 X36.000 Z-40.000")
+    steps = read_lathe_program(inserted(CUT + 1, "T0202", lines), LATHE, "SHAFT")
+    back = [replace(step, g_codes=step.g_codes | {28}) if step.number == CUT + 2 else step for step in steps]
+    for given, refused in ((back, False), (steps, True)):
+        state = ProgramState(turning_records({}, {}), TurningReport("SHAFT"), "iso", (LATHE.x_max, LATHE.z_max))
+        for step in given:
+            state.take(step)
+        blank = box(-40.0, -22.0, 2.0, 22.0)
+        check_tool_changes(state.changes, blank, state.report)
+        assert bool(state.report.findings) == refused
