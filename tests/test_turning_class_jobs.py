@@ -156,3 +156,12 @@ def test_a_tool_change_after_a_reference_return_is_clear_of_the_blank():
         blank = box(-40.0, -22.0, 2.0, 22.0)
         check_tool_changes(state.changes, blank, state.report)
         assert bool(state.report.findings) == refused
+
+
+def test_a_cut_behind_a_stated_blank_s_back_end_is_refused_a_class_job_has_no_parting_operation():
+    """The blank Ø50 from Z2 to Z-30: the pass to Z-40 runs 10 mm behind its back end, into the bar
+    the chuck holds (more than the 2 mm run-out); stated to Z-45, the same program is clean."""
+    stock = {"stock_diameter": 50.0, "stock_z_front": 2.0, "stock_z_back": -30.0}
+    message = refusal(SHAFT, stock)
+    assert f"line {CUT + 1} 'G01 X36.000 Z-40.000'" in message and f"a cut {10.0:.3f} mm behind" in message
+    assert not report(SHAFT, {**stock, "stock_z_back": -45.0}).refused
