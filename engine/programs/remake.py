@@ -7,8 +7,9 @@ drawing record (engine.programs.drawing_records). The programs are
 checked against the job's machine, stored with the template version they came from, and written
 after the database commit. A batch tries every job and names each bad one
 (engine.programs.batches). A job of a class without a model (engine.programs.class_jobs) is its
-class's rows run with its parameters, read by the verifier: one stored unverified is verified
-now, or refused."""
+class's rows run with its parameters, read by the verifier and, on a lathe, proved by the turning
+simulation against its blank (no drawing record): one stored unverified is verified now, or
+refused."""
 from __future__ import annotations
 
 import re
