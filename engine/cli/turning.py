@@ -52,8 +52,9 @@ POSITIVE = FiniteFloatRange(min=0, min_open=True)
 @click.option("--alternate", metavar="A,B",
               help="Machine ROUGH operations A and B (one tool) pass by pass alternately, e.g. 1,2.")
 @click.option("--program-name", metavar="NAME",
-              help="The program's name (840D: letters, digits, _; two letters first; at most 24) "
-                   "[default: the file name in upper case, - . and spaces as _].")
+              help="The program's name (letters, digits, _; two letters first; at most 24) "
+                   "[default: the file name in upper case, - . and spaces as _; on an ISO lathe, "
+                   "when that is no such name, DXF_O and the program number].")
 @click.option("--profile-layer", metavar="NAME",
               help="Layer holding the part's profile (CAD drawings often use 'outline' or 'Sketch') "
                    "[default: 0; when layer 0 is empty, the one layer with one contour on the axis].")
