@@ -13,7 +13,7 @@ import math
 import ezdxf
 import pytest
 from helpers.drawings import DXF
-from helpers.drawn_parts import HALF_PROFILE
+from helpers.drawn_parts import HALF_PROFILE, outline_drawing
 from helpers.outcomes import job_count, made, one_line_refusal
 
 from engine.drawings.drawing import read_drawing
@@ -81,6 +81,7 @@ def test_a_vertical_half_profile_becomes_a_job(run, tmp_path):
 
 def test_an_outline_turning_about_another_vertical_line_is_refused_saying_so(tmp_path):
     doc = ezdxf.new("R2010")
+    doc.header["$INSUNITS"] = 4
     doc.modelspace().add_lwpolyline([(5, 20), (5, -20), (15, -20), (15, 10), (12, 20)], close=True)
     doc.saveas(tmp_path / "off.dxf")
     with pytest.raises(DxfError, match="the axis looks vertical: rotate the drawing") as caught:
@@ -149,3 +150,17 @@ def test_a_hex_bolt_is_refused_for_its_hexagon_not_for_a_bore(tmp_path):
     message = str(caught.value)
     assert "hexagon seen across its corners" in message and "bore" not in message
     assert f"±{0.433 * 25.4:.3f}" in message and f"±{0.866 * 25.4:.3f}" in message
+
+
+def test_a_drawing_either_axis_could_turn_is_read_seed_000_and_the_report_says_so(tmp_path):
+    """A rectangle from the origin right and up: a Ø100 disc 20 long about drawing Y 0, or a Ø40
+    bar 50 long about drawing X 0. The seed-000 reading stands; a note names the other."""
+    doc = ezdxf.new("R2010")
+    doc.header["$INSUNITS"] = 4
+    doc.modelspace().add_lwpolyline([(0, 0), (20, 0), (20, 50), (0, 50)], close=True)
+    doc.saveas(tmp_path / "either.dxf")
+    drawing = read_drawing(tmp_path / "either.dxf")
+    assert drawing.profile.bounds == pytest.approx((0, 20, 0, 50))
+    assert any("if that is its axis, rotate the drawing" in note for note in drawing.notes)
+    shaft = read_drawing(outline_drawing(tmp_path / "shaft.dxf"))   # drawn left of X 0: no doubt
+    assert not any("rotate the drawing" in note for note in shaft.notes)

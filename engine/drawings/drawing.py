@@ -36,6 +36,7 @@ from .outline import hatch_polygons, profile_of
 from .profile import Profile, chain_segments, scaled
 from .read import DxfError, ezdxf_warnings, load_drawing_file, summarised
 from .side_view import Marks
+from .vertical import vertical_doubt
 
 PROFILE_LAYER = "0"
 OR_NAME_IT = " or name its layer with --profile-layer"
@@ -134,7 +135,8 @@ def read_drawing(path: str | Path, profile_layer: str | None = None) -> Drawing:
                        "operation layers need it (the half-profile above the axis at drawing Y = 0): redraw it so")
     tool_change = None if side_view else tool_change_point(layer0.points, scale, profile.mirrored)
     notes = (chosen + outline_notes + reading_notes(units, assumed, collected, profile) + summarised(warnings)
-             + left_out_notes(profile_layer, layer0, chains, side_view))
+             + left_out_notes(profile_layer, layer0, chains, side_view)
+             + vertical_doubt(profile, profile_layer, side_view))
     return Drawing(drawing_file.path, units, scale, profile, [op for op in operations if op],
                    tool_change, drawing_file.repairs, notes)
 

@@ -43,11 +43,12 @@ def swapped(segment: Segment) -> Segment:
     return Arc(swap(segment.start), swap(segment.end), swap(segment.centre), not segment.ccw, segment.handle)
 
 
-def vertical_edge(segments: list[Segment], x: float, height: float) -> bool:
-    """A line along drawing X = x spanning most of the drawing's height."""
-    tolerance = END_MATCH_TOLERANCE_MM
-    return any(isinstance(s, Line) and abs(s.start[0] - x) <= tolerance and abs(s.end[0] - x) <= tolerance
-               and abs(s.end[1] - s.start[1]) >= AXIS_EDGE_SHARE * height for s in segments)
+def vertical_edge(segments: list[Segment], x: float, height: float, across: int = 1) -> bool:
+    """A line along coordinate 1 - across = x (drawing X, or Z in machine coordinates) spanning
+    most (AXIS_EDGE_SHARE) of the height along coordinate `across`."""
+    tolerance, along = END_MATCH_TOLERANCE_MM, 1 - across
+    return any(isinstance(s, Line) and abs(s.start[along] - x) <= tolerance and abs(s.end[along] - x) <= tolerance
+               and abs(s.end[across] - s.start[across]) >= AXIS_EDGE_SHARE * height for s in segments)
 
 
 def vertical_profile(segments: list[Segment], layer: str) -> VerticalReading | None:
@@ -72,3 +73,18 @@ def vertical_profile(segments: list[Segment], layer: str) -> VerticalReading | N
         f"layer {layer}: the axis is vertical (drawing X is the radius, the axis the line X 0, as OpenSCAD "
         "and FreeCAD revolve): the drawing was turned into the lathe's Z–X plane, its upper (+Y) end the "
         f"front (Z{profile.bounds[1]:g}); turn the drawing over if the other end is the front"])
+
+
+def vertical_doubt(profile: Profile, layer: str, other_reading: bool) -> list[str]:
+    """A note when a drawing read with its axis along drawing Y 0 could as well be a half-profile
+    about the vertical line X 0: it lies right of X 0 and an edge along X 0 spans its whole height
+    down to Y 0 (a revolve sketch of OpenSCAD or FreeCAD looks so). The seed-000 reading stands."""
+    z_min, _, r_min, r_max = profile.bounds
+    tolerance = END_MATCH_TOLERANCE_MM
+    if other_reading or profile.mirrored or abs(z_min) > tolerance or r_min > tolerance:
+        return []
+    if not vertical_edge(profile.segments + profile.closing_segments(), 0.0, r_max - r_min, across=1):
+        return []
+    return [f"layer {layer}: read with the axis along drawing Y 0 (radius = drawing Y); it lies right of "
+            "drawing X 0 with an edge along X 0 over its whole height, as a half-profile about a vertical "
+            "axis (OpenSCAD, FreeCAD) would: if that is its axis, rotate the drawing"]
