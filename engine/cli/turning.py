@@ -73,7 +73,9 @@ def import_dxf_command(ctx, dxf_file, machine, rough_depth, allowance, tool, spe
                        alternate, program_name, profile_layer, material, tool_material, draft, as_json):
     """Make DXF_FILE a turning job: profile on layer 0 (or --profile-layer), operation n on layer n with its @-codes.
 
-    A part drawn whole about a centre line (a side view) is turned as its upper half-profile.
+    A part drawn whole about a centre line (a side view) is turned as its upper half-profile;
+    a half-profile about a vertical axis at drawing X 0 (OpenSCAD, FreeCAD revolve) is turned
+    into the lathe's Z-X plane, its upper end the front (the report says so).
 
     A drawing with a profile only becomes a job when any of --rough-depth, --allowance,
     --tool, --speed, --feed, --stock-diameter is given: rough passes between blank and
