@@ -83,7 +83,7 @@ def vertical_doubt(profile: Profile, layer: str, other_reading: bool) -> list[st
     tolerance = END_MATCH_TOLERANCE_MM
     if other_reading or profile.mirrored or abs(z_min) > tolerance or r_min > tolerance:
         return []
-    if not vertical_edge(profile.segments + profile.closing_segments(), 0.0, r_max - r_min, across=1):
+    if not vertical_edge([*profile.segments, *profile.closing_segments()], 0.0, r_max - r_min, across=1):
         return []
     return [f"layer {layer}: read with the axis along drawing Y 0 (radius = drawing Y); it lies right of "
             "drawing X 0 with an edge along X 0 over its whole height, as a half-profile about a vertical "
