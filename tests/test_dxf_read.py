@@ -26,6 +26,7 @@ from helpers.drawings import (
     NOTHING_ON_0,
     REAL,
     SCATTERED,
+    VERTICAL,
     nc_arc_words,
     seed_drawing,
 )
@@ -101,11 +102,26 @@ def check_fact(name: str, category: str) -> None:
     elif category == CROSSES:
         ys = [v.y for v in paths[0].flattening(0.01)]
         assert len(paths) == 1 and min(ys) < 0 < max(ys)
+    elif category == VERTICAL:
+        check_vertical(name)
     elif category == FULL_VIEW:
         crossing = [p for p in paths if min(p.start.y, p.end.y) < 0 < max(p.start.y, p.end.y)]
         assert len(crossing) >= 2
     else:
         assert paths
+
+
+def check_vertical(name: str) -> None:
+    """Layer 0 empty; the outline right of drawing X 0 and crossing drawing Y 0, with a line along
+    its smallest X spanning its height: the edge OpenSCAD's rotate_extrude turns about."""
+    doc = ezdxf.readfile(DXF / name)
+    assert layer0_paths(name) == []
+    points = [v for entity in doc.modelspace().query("LWPOLYLINE")
+              for v in ezdxf.path.make_path(entity).flattening(0.01)]
+    xs, ys = [v.x for v in points], [v.y for v in points]
+    assert min(xs) >= 0 and min(ys) < 0 < max(ys)
+    along = [(a, b) for a, b in zip(points, points[1:]) if a.x == b.x == min(xs)]
+    assert max(abs(a.y - b.y) for a, b in along) == pytest.approx(max(ys) - min(ys))
 
 
 @pytest.mark.parametrize("name", sorted(REAL))
@@ -115,6 +131,9 @@ def test_every_real_drawing_reads_or_is_refused_with_its_reason(name):
     if refusal is None:
         drawing = read_drawing(DXF / name)
         assert drawing.profile.closed_by_axis == (category in (HALF_PROFILE, FULL_VIEW))
+        if category == VERTICAL:   # turned into Z–X: Z along drawing Y, the radius drawing X from 0
+            assert any("the axis is vertical" in note for note in drawing.notes)
+            assert drawing.profile.bounds[2] == 0.0
     else:
         with pytest.raises(DxfError, match=re.escape(refusal)) as caught:
             read_drawing(DXF / name)

@@ -143,14 +143,17 @@ def test_import_dxf_refuses_an_unsafe_program_name(run, tmp_path, name):
 @pytest.mark.parametrize("file_name, made", [("1part.dxf", "1PART"), ("a" * 25 + ".dxf", "A" * 25),
                                              ("p.dxf", "P"), ("part(1).dxf", None)])
 def test_a_program_name_made_from_a_file_name_is_refused_not_cut(run, tmp_path, file_name, made):
+    """On an 840D lathe the name is the program (on an ISO lathe it is only the comment after the
+    O number: tests/test_dxf_cad_conventions.py)."""
     seed_drawing(tmp_path / file_name)
     before = counts(run.url)
-    message = refused(run("import-dxf", tmp_path / file_name))
+    message = refused(run("import-dxf", tmp_path / file_name, "--machine", "lathe-840d"))
     assert (f"'{made}' made from its file name" in message and "--program-name" in message) if made else \
         "rename the file" in message
     assert counts(run.url) == before
     if made:
-        assert run("import-dxf", tmp_path / file_name, "--program-name", "PART_1").exit_code == 0
+        assert run("import-dxf", tmp_path / file_name, "--machine", "lathe-840d",
+                   "--program-name", "PART_1").exit_code == 0
 
 
 def test_a_turning_job_s_names_are_checked_where_they_are_used():

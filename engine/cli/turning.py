@@ -52,8 +52,9 @@ POSITIVE = FiniteFloatRange(min=0, min_open=True)
 @click.option("--alternate", metavar="A,B",
               help="Machine ROUGH operations A and B (one tool) pass by pass alternately, e.g. 1,2.")
 @click.option("--program-name", metavar="NAME",
-              help="The program's name (840D: letters, digits, _; two letters first; at most 24) "
-                   "[default: the file name in upper case, - . and spaces as _].")
+              help="The program's name (letters, digits, _; two letters first; at most 24) "
+                   "[default: the file name in upper case, - . and spaces as _; on an ISO lathe, "
+                   "when that is no such name, DXF_O and the program number].")
 @click.option("--profile-layer", metavar="NAME",
               help="Layer holding the part's profile (CAD drawings often use 'outline' or 'Sketch') "
                    "[default: 0; when layer 0 is empty, the one layer with one contour on the axis].")
@@ -72,7 +73,9 @@ def import_dxf_command(ctx, dxf_file, machine, rough_depth, allowance, tool, spe
                        alternate, program_name, profile_layer, material, tool_material, draft, as_json):
     """Make DXF_FILE a turning job: profile on layer 0 (or --profile-layer), operation n on layer n with its @-codes.
 
-    A part drawn whole about a centre line (a side view) is turned as its upper half-profile.
+    A part drawn whole about a centre line (a side view) is turned as its upper half-profile;
+    a half-profile about a vertical axis at drawing X 0 (OpenSCAD, FreeCAD revolve) is turned
+    into the lathe's Z-X plane, its upper end the front (the report says so).
 
     A drawing with a profile only becomes a job when any of --rough-depth, --allowance,
     --tool, --speed, --feed, --stock-diameter is given: rough passes between blank and

@@ -31,11 +31,12 @@ from .entities import (
     unit_scale,
 )
 from .geometry import Line, Segment
-from .layers import CENTRE, HIDDEN, chosen_profile_layer, layer_linetypes, line_role
+from .layers import CENTRE, HIDDEN, chosen_profile_layer, existing_layer, layer_linetypes, line_role
 from .outline import hatch_polygons, profile_of
 from .profile import Profile, chain_segments, scaled
 from .read import DxfError, ezdxf_warnings, load_drawing_file, summarised
 from .side_view import Marks
+from .vertical import vertical_doubt
 
 PROFILE_LAYER = "0"
 OR_NAME_IT = " or name its layer with --profile-layer"
@@ -125,16 +126,17 @@ def read_drawing(path: str | Path, profile_layer: str | None = None) -> Drawing:
         raise DxfError(no_geometry_message(collected))
     profile, outline_notes, chains = profile_of([scaled(s, scale) for s in layer0.segments],
                                                 scaled_marks(collected, scale), profile_layer)
-    side_view = bool(outline_notes)
+    side_view = bool(outline_notes)   # or a vertical axis: no tool-change POINT, no operation layers
     outline_notes += units_doubted(drawing_file, assumed)
     operations = [operation(name, number, collected.layers[name], scale, profile.mirrored)
                   for number, name in operation_layers(collected.layers)]
     if side_view and any(operations):
-        raise DxfError(f"layer {profile_layer} is a side view drawn whole; operation layers need the seed-000 "
-                       "convention (the half-profile above the axis at drawing Y = 0): redraw it so")
+        raise DxfError(f"layer {profile_layer} is not drawn in the seed-000 convention ({outline_notes[0]}); "
+                       "operation layers need it (the half-profile above the axis at drawing Y = 0): redraw it so")
     tool_change = None if side_view else tool_change_point(layer0.points, scale, profile.mirrored)
     notes = (chosen + outline_notes + reading_notes(units, assumed, collected, profile) + summarised(warnings)
-             + left_out_notes(profile_layer, layer0, chains, side_view))
+             + left_out_notes(profile_layer, layer0, chains, side_view)
+             + vertical_doubt(profile, profile_layer, side_view))
     return Drawing(drawing_file.path, units, scale, profile, [op for op in operations if op],
                    tool_change, drawing_file.repairs, notes)
 
@@ -142,8 +144,8 @@ def read_drawing(path: str | Path, profile_layer: str | None = None) -> Drawing:
 def left_out_notes(layer: str, content: LayerContent, chains: list, side_view: bool) -> list[str]:
     """What the profile layer holds besides the profile: other chains, or a side view's POINTs."""
     if side_view:
-        return [f"layer {layer}: {len(content.points)} POINT(s) left out (a side view has no tool-change "
-                "point)"] if content.points else []
+        return [f"layer {layer}: {len(content.points)} POINT(s) left out (only a half-profile on drawing "
+                "Y 0 has a tool-change point)"] if content.points else []
     if len(chains) <= 1:
         return []
     return [f"layer {layer}: {len(chains) - 1} other chain(s) are not part of the profile, left out"]
@@ -181,15 +183,6 @@ def choose_layer(collected: Collected, scale: float) -> list[str]:
             collected.other_layers[name] += content.entities
             del collected.layers[name]
     return [chosen[1]] if chosen else []
-
-
-def existing_layer(doc, name: str) -> str:
-    """The layer as the drawing spells it (DXF layer names ignore case); a name the drawing
-    does not have is refused with the names it has, so the user can pick the outline's."""
-    if name == PROFILE_LAYER or name in doc.layers:
-        return doc.layers.get(name).dxf.name if name in doc.layers else name
-    names = ", ".join(repr(layer.dxf.name) for layer in doc.layers)
-    raise DxfError(f"profile layer {name!r} is not in the drawing; its layers are {names}")
 
 
 def operation_number(layer: str) -> int | None:

@@ -65,18 +65,56 @@ def layer_linetypes(doc) -> dict[str, str]:
     return {layer.dxf.name.upper(): str(layer.dxf.get("linetype", "") or "") for layer in doc.layers}
 
 
+def drawing_layers(doc) -> list[str]:
+    """Every layer of the drawing: the LAYER table's, then those only entities name (of model
+    space and of the blocks it inserts). DXF lets an entity use a layer the table lacks (the
+    reader then takes the default layer properties), and some exporters write no table entry
+    for the layers they use: such a layer is the drawing's as much as any."""
+    names = {layer.dxf.name.upper(): layer.dxf.name for layer in doc.layers}
+    for entity in entities_with_blocks(doc):
+        names.setdefault(entity.dxf.layer.upper(), entity.dxf.layer)
+    return list(names.values())
+
+
+def entities_with_blocks(doc):
+    """Model space's entities and those of every block it inserts (the block's own, once)."""
+    modelspace = doc.modelspace()
+    yield from modelspace
+    inserted = {entity.dxf.name for entity in modelspace.query("INSERT")}
+    for name in sorted(inserted):
+        if name in doc.blocks:
+            yield from doc.blocks.get(name)
+
+
+def existing_layer(doc, name: str) -> str:
+    """The layer as the drawing spells it (DXF layer names ignore case), from the LAYER table or
+    from the entities that use it; a name the drawing does not have is refused with the names it
+    has, so the user can pick the outline's."""
+    layers = {layer.upper(): layer for layer in drawing_layers(doc)}
+    if name.upper() in layers:
+        return layers[name.upper()]
+    if name == "0":
+        return name
+    names = ", ".join(repr(layer) for layer in layers.values())
+    raise DxfError(f"profile layer {name!r} is not in the drawing; its layers are {names}")
+
+
 def axis_contours(segments, tolerance: float = END_MATCH_TOLERANCE_MM) -> int:
     """How many chains of a layer could be a turned part: a closed contour that touches or
-    straddles the axis (drawing Y = 0), or a half-contour with both ends on it."""
-    count = 0
-    for chain in chain_segments(segments):
-        _, _, r_min, r_max = chain.bounds
-        if chain.closed and r_min <= tolerance and r_max > tolerance:
-            count += 1
-        elif not chain.closed and abs(chain.start[1]) <= tolerance and abs(chain.end[1]) <= tolerance \
-                and max(abs(r_min), abs(r_max)) > tolerance:
-            count += 1
-    return count
+    straddles the axis (drawing Y = 0), or a half-contour with both ends on it; or the same
+    about a vertical axis (drawing X = 0, engine.drawings.vertical) right of it."""
+    return sum(1 for chain in chain_segments(segments) if on_axis(chain, 1, tolerance)
+               or (chain.bounds[0] >= -tolerance and on_axis(chain, 0, tolerance)))
+
+
+def on_axis(chain, across: int, tolerance: float) -> bool:
+    """The chain touches or straddles the axis along which coordinate `across` (1: drawing Y,
+    the radius; 0: drawing X) is 0: closed, or open with both ends on it."""
+    low, high = chain.bounds[2 * across], chain.bounds[2 * across + 1]
+    if chain.closed:
+        return low <= tolerance < high
+    return abs(chain.start[across]) <= tolerance and abs(chain.end[across]) <= tolerance \
+        and max(abs(low), abs(high)) > tolerance
 
 
 def chosen_profile_layer(segments_by_layer: dict[str, list]) -> tuple[str, str] | None:

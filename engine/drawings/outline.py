@@ -1,6 +1,6 @@
 """Which reading of the profile layer makes the part: a half-profile in the seed-000
-convention (profile), or a side view drawn whole (side_view), or neither, said
-by name (issue 17).
+convention (profile), or a side view drawn whole (side_view), or a half-profile with a
+vertical axis (vertical, issue 27), or neither, said by name (issue 17).
 
 A view a centre line runs through is a side view. Otherwise the layer is read as a
 half-profile as before; only when that fails is it tried as a side view symmetric about
@@ -13,6 +13,7 @@ from .geometry import Segment
 from .profile import END_MATCH_TOLERANCE_MM, Chain, Profile, chain_segments, find_profile, merged_bounds
 from .read import DxfError
 from .side_view import Marks, side_view, side_view_of, symmetry_axis
+from .vertical import vertical_profile
 
 HATCH_FLATTENING = 0.01   # drawing units: hatching only tells where material is, not its edge
 
@@ -25,7 +26,8 @@ def hatch_polygons(hatch) -> list[list[tuple[float, float]]]:
 
 
 def profile_of(segments: list[Segment], marks: Marks, layer: str) -> tuple[Profile, list[str], list[Chain]]:
-    """(profile, notes, chains of the layer): notes are non-empty exactly for a side view."""
+    """(profile, notes, chains of the layer): notes are non-empty exactly for a side view or a
+    vertical axis (a reading other than seed-000's half-profile on drawing Y 0)."""
     found = side_view_of(segments, marks, layer)
     if found is not None:
         return found.profile, found.notes, []
@@ -35,6 +37,9 @@ def profile_of(segments: list[Segment], marks: Marks, layer: str) -> tuple[Profi
     except DxfError as refusal:
         axis = symmetry_axis(segments)
         if axis is None:
+            vertical = None if plate_refusal(chains, layer) else vertical_profile(segments, layer)
+            if vertical is not None:
+                return vertical.profile, vertical.notes, []
             raise plate_refusal(chains, layer) or refusal from None
         found = side_view(axis, segments, marks, f"layer {layer}")
         return found.profile, found.notes, []

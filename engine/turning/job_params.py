@@ -6,14 +6,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any
 
 from ..drawings.drawing import Drawing, Operation
 from ..drawings.profile import merged_bounds
 from ..errors import EngineError
 from ..machines.turning_cutting import DEFAULT_TOOL_MATERIAL, DEFAULT_WORKPIECE_MATERIAL, job_materials
-from ..names import NAME_RULES, checked, is_safe, shown
 from .defaults import (
     CLEARANCE,
     DEFAULT_FEED,
@@ -26,6 +24,7 @@ from .defaults import (
 )
 from .model import key
 from .names import MAX_OPERATIONS, SLOT_DEFAULTS
+from .program_names import drawing_names
 from .segments import path_param
 
 
@@ -84,8 +83,10 @@ def turning_job(drawing: Drawing, machine: str, gear_class: str, program_number:
     else:
         add_profile_operations(job, options)
         stock_diameter = blank_diameter(drawing, options)
-    names = drawing_names(drawing.source.name, program_name)
-    job.params = job_params(drawing, names, machine, gear_class, program_number, stock_diameter, alternate, job.notes)
+    drawing_name, name, naming_notes = drawing_names(drawing.source.name, program_name, gear_class, program_number)
+    job.notes.extend(naming_notes)
+    job.params = job_params(drawing, (drawing_name, name), machine, gear_class, program_number, stock_diameter,
+                            alternate, job.notes)
     add_materials(job, *materials)
     return job
 
@@ -119,25 +120,6 @@ def job_params(drawing: Drawing, names: tuple[str, str], machine: str, gear_clas
         "tool_change_z": tool_change_z, "tool_change_x": tool_change_x, "clearance": CLEARANCE,
         "alternate": list(alternate) if alternate else None,
     }
-
-
-# A program name made from a drawing's file name: upper case (the NC does not tell case), with
-# the separators file names use where 840D names have _; nothing cut, nothing else replaced.
-FILE_NAME_SEPARATORS = str.maketrans({"-": "_", ".": "_", " ": "_"})
-
-
-def drawing_names(file_name: str, program_name: str | None = None) -> tuple[str, str]:
-    """(drawing, program name) of the job: the file name as it is (printed in the program's
-    comments) and the program name given, else made from the file name. Either refused
-    (EngineError) when it does not fit engine/names.py: never cut or altered to fit."""
-    drawing = checked("drawing", file_name, "drawing file name", "rename the file")
-    if program_name is not None:
-        return drawing, checked("program", program_name, "--program-name")
-    made = Path(file_name).stem.upper().translate(FILE_NAME_SEPARATORS)
-    if not is_safe("program", made):
-        raise EngineError(f"drawing {file_name}: the program name {shown(made)} made from its file name is not "
-                          f"an 840D program name ({NAME_RULES['program'].rule}); give one with --program-name NAME")
-    return drawing, made
 
 
 def tool_change(drawing: Drawing, stock_diameter: float | None, notes: list[str]) -> tuple[float, float]:

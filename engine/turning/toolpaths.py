@@ -90,7 +90,7 @@ def start_direction(segment: Segment) -> tuple[float, float]:
 def finish_passes(path: list[Segment], clearance: float) -> list[Pass]:
     """One pass along the path: rapid to clearance before its start — back along its first
     direction and out along its outward normal (the part lies left of a path drawn from the
-    front backwards), so in the air in front of the material — feed in, the path's own
+    front backwards), so in the air in front of the material, never below the axis — feed in, the path's own
     segments; the travel radius in and out is added by standalone()."""
     require_clearance(clearance)
     if not path:
@@ -98,8 +98,11 @@ def finish_passes(path: list[Segment], clearance: float) -> list[Pass]:
                           "or let the profile be finished")
     (start_z, start_r), (dz, dr) = path[0].start, start_direction(path[0])
     outward_z, outward_r = dr, -dz
-    moves = [rapid(start_z + clearance * (outward_z - dz), start_r + clearance * (outward_r - dr)),
-             feed(start_z, start_r)]
+    # A path starting on the axis (a dome, a ball end, a cone point) would put that point
+    # below the axis, through the part's other side: it comes in along the axis instead,
+    # from in front of the point (radius 0, diameter X0), where no material is.
+    approach_r = max(0.0, start_r + clearance * (outward_r - dr))
+    moves = [rapid(start_z + clearance * (outward_z - dz), approach_r), feed(start_z, start_r)]
     return [moves + [cutting_move(segment) for segment in path]]
 
 

@@ -23,6 +23,9 @@ FULL_VIEW = "full side view symmetric about the axis, lines meet in T-junctions"
 CROSSES = "one polyline crossing the axis"
 HALF_PROFILE = "half-profile"
 CLOSED = "closed outline on the axis"
+# OpenSCAD's revolve convention (rotate_extrude): layer 0 empty, one outline on layer 'Layer_1'
+# right of drawing X 0, closed by a line along its smallest X over the whole height (the axis).
+VERTICAL = "half-profile with a vertical axis"
 REAL = {
     "d2g_132_R14.dxf": (NOTHING_ON_0, None),   # layer 0 empty: layer '81' taken
     "d2g_132_R2000.dxf": (NOTHING_ON_0, None),
@@ -52,6 +55,10 @@ REAL = {
     "qcad_M4x25_DIN931_f_R2010.dxf": (NOTHING_ON_0, "not a turned surface"),   # hexagon head
     "qcad_flange_R2013.dxf": (SCATTERED, "needs internal turning"),
     "qcad_screw_R2007.dxf": (FULL_VIEW, None),
+    "scadchess_bishop_profile_R2007.dxf": (VERTICAL, "the axis looks vertical: rotate the drawing"),   # at X 0.545
+    "scadchess_king_profile_R2007.dxf": (VERTICAL, None),
+    "scadchess_pawn_profile_R2007.dxf": (VERTICAL, None),    # its ball top is the front: a dome on the axis
+    "scadchess_queen_profile_R2007.dxf": (VERTICAL, None),
 }
 
 
