@@ -13,12 +13,24 @@ k less the finish allowance, then the finish pass, infeeding along the flank (an
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 RAPID, FEED, CW, CCW, THREAD = 0, 1, 2, 3, 32
 ARC_STEP = math.radians(5.0)    # an arc of the contour is followed by chords of at most 5° for roughing
 EPS = 1e-9
 MAX_PASSES = 100_000            # a cycle making more passes than this is refused by its caller
+
+
+Swap = Callable[[float, float], tuple[float, float]]   # (x, z) <-> (level axis, cut axis)
+
+
+def _same(x: float, z: float) -> tuple[float, float]:
+    return x, z
+
+
+def _swapped(x: float, z: float) -> tuple[float, float]:
+    return z, x
 
 
 class CycleError(ValueError):
@@ -94,7 +106,7 @@ def rough(start: tuple[float, float], contour: list[Move], depth: float, retract
     if first is None:
         raise CycleError("the cycle's contour has no blocks")
     # work in (a, b): a the axis stepped by the depth, b the axis cut along
-    swap = (lambda x, z: (z, x)) if facing else (lambda x, z: (x, z))
+    swap = _swapped if facing else _same
     step, lift = (depth, retract) if facing else (2 * depth, 2 * retract)
     back = 2 * retract if facing else retract
     a0, b0 = swap(*start)
@@ -133,7 +145,7 @@ def _cut_end(points: list[tuple[float, float]], level: float, outward: float, b0
     return points[-1][1]
 
 
-def _pass(swap, cut: tuple[float, float, float], motion: int, lift: tuple[float, float]) -> list[Move]:
+def _pass(swap: Swap, cut: tuple[float, float, float], motion: int, lift: tuple[float, float]) -> list[Move]:
     level, b0, b_end = cut
     return [Move(motion, *swap(level, b0)), Move(FEED, *swap(level, b_end)),
             Move(FEED, *swap(level + lift[0], b_end + lift[1])), Move(RAPID, *swap(level + lift[0], b0))]
@@ -157,7 +169,7 @@ def peck(start: tuple[float, float], end: tuple[float, float], steps: tuple[floa
          grooving: bool) -> list[Move]:
     """G75 (grooving: pecks along X, stepping along Z) or G74 (pecks along Z, stepping along X):
     each peck Δ deep then back by the retract e, to the end, out at rapid, over by the step."""
-    swap = (lambda x, z: (x, z)) if grooving else (lambda x, z: (z, x))
+    swap = _same if grooving else _swapped
     (a0, b0), (a1, b1) = swap(*start), swap(*end)
     peck_step, over = (steps[0], steps[1]) if grooving else (steps[1], steps[0])
     if peck_step <= 0 or (abs(b1 - b0) > EPS and over <= 0):
@@ -174,9 +186,10 @@ def peck(start: tuple[float, float], end: tuple[float, float], steps: tuple[floa
     return moves
 
 
-def _pecks(swap, a0: float, a1: float, b: float, step: float, retract: float) -> list[Move]:
+def _pecks(swap: Swap, a0: float, a1: float, b: float, step: float, retract: float) -> list[Move]:
     sense = math.copysign(1.0, a1 - a0)
-    moves, a = [], a0
+    moves: list[Move] = []
+    a = a0
     for _ in range(MAX_PASSES):
         a = a1 if abs(a1 - a) <= step else a + sense * step
         moves.append(Move(FEED, *swap(a, b)))
