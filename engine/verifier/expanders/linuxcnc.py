@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING
 
 from ..expansion import MAX_PLAIN_LINES, MAX_STEPS, ExpansionRefused, PlainLine, register_expander
 from ..refusals import Refused
+from .linuxcnc_cycles import move_or_cycle
 from .linuxcnc_flow import FlowError, pair
 from .linuxcnc_lines import OWord, read
 from .linuxcnc_modes import Executor
@@ -43,7 +44,7 @@ class Interpreter:
             self.flow = pair(self.items)
         except FlowError as error:
             raise ExpansionRefused(error.index + 1, lines[error.index], str(error)) from None
-        self.executor = Executor()
+        self.executor = Executor(move_or_cycle)
         self.params = Parameters(self.executor.modes)
         self.plain: list[PlainLine] = []
         self.stopped = False

@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING
 from ..refusals import Refused
 from .cycles import MAX_PASSES, RAPID, THREAD
 from .linuxcnc_modes import number
-from .linuxcnc_motion import target
+from .linuxcnc_motion import move, target
 
 if TYPE_CHECKING:
     from .linuxcnc_modes import Executor
@@ -26,6 +26,17 @@ if TYPE_CHECKING:
 
 PROFILE_REASON = ("the LinuxCNC profile cycle G{code} (subroutine Q, distance D kept normal to the profile, "
                   "pockets and fillets) is not modelled; program its passes as G0/G1/G2/G3 moves")
+
+
+CYCLES = frozenset({"76", "70", "71", "71.1", "71.2", "72", "72.1", "72.2"})
+
+
+def move_or_cycle(executor: Executor, words: Words, motion: str) -> None:
+    """The motion of a line: a cycle here, any other motion by linuxcnc_motion.move."""
+    if motion in CYCLES:
+        cycle(executor, words, motion)
+    else:
+        move(executor, words, motion)
 
 
 def cycle(executor: Executor, words: Words, motion: str) -> None:

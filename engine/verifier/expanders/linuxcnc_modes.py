@@ -11,6 +11,7 @@ units and diameter mode are not reset by M2, so a length before G20/G21 and an X
 are refused: they are whatever the last program left."""
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 
 from ..refusals import Refused
@@ -68,9 +69,10 @@ class Modes:
 class Executor:
     """Turns each line's words into plain lines; `modes` is the interpreter's state."""
 
-    def __init__(self) -> None:
+    def __init__(self, mover: Callable[[Executor, Words, str], None]) -> None:
         self.modes = Modes()
         self.out: list[str] = []
+        self.mover = mover       # linuxcnc_motion.move, or a cycle (engine.verifier.expanders.linuxcnc)
 
     def run(self, words: Words) -> list[str]:
         self.out = []
@@ -182,12 +184,11 @@ class Executor:
             self.modes.arc_absolute = arcs == "90.1"
 
     def _motion(self, words: Words) -> None:
-        from .linuxcnc_motion import move  # the motion module reads Executor's modes
         motion = words.g(*MOTIONS)
         if motion is not None:
             self.modes.motion = motion
         if motion is not None or {"x", "z"} & words.values.keys():
-            move(self, words, self.modes.motion)
+            self.mover(self, words, self.modes.motion)
 
     def _stop(self, words: Words) -> None:
         for code in (2, 30):

@@ -6,7 +6,7 @@ turn), G33 with its lead K. X is written as a diameter, every length in mm.
 LinuxCNC refuses an arc whose centre is farther from the end than from the start by more than
 CENTER_ARC_RADIUS_TOLERANCE_MM = 2·0.01·√2 mm (src/emc/rs274ngc/interp_internal.hh); so does
 this reading. I is not scaled by G7 (rs274ngc read_x scales X only). The lathe cycles G70–G72 and
-G76 are expanded by engine.verifier.expanders.linuxcnc_cycles."""
+G76 are engine.verifier.expanders.linuxcnc_cycles'."""
 from __future__ import annotations
 
 import math
@@ -45,10 +45,6 @@ def _resolved(value: float, held: float | None, incremental: bool, axis: str) ->
 
 
 def move(executor: Executor, words: Words, motion: str) -> None:
-    if motion in CYCLES:
-        from .linuxcnc_cycles import cycle  # the cycles read the motion's helpers
-        cycle(executor, words, motion)
-        return
     x, z = target(executor, words)
     axes = _axes(words, x, z)
     if not axes:
@@ -120,5 +116,3 @@ def _signed(radius: float, start: tuple[float, float], end: tuple[float, float],
     sweep = (a1 - a0) % math.tau if ccw else (a0 - a1) % math.tau
     return -radius if sweep > math.pi else radius
 
-
-CYCLES = frozenset({"76", "70", "71", "71.1", "71.2", "72", "72.1", "72.2"})
