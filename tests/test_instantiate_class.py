@@ -56,27 +56,27 @@ def test_the_class_of_an_imported_program_gives_it_back_with_its_own_parameters(
         made.stderr.split("(not in --params): ")[1].splitlines()[0].split(", "))
 
 
-def test_new_values_change_exactly_the_words_bound_to_them_and_no_file_is_written(run, tmp_path):
-    """A lathe class job has no drawing record, so the turning simulation cannot prove it: it is
-    stored for review and never written to a file (issue 26), with the words bound changed."""
+def test_new_values_change_exactly_the_words_bound_to_them_and_the_file_is_the_stored_program(run, tmp_path):
+    """A lathe class job is proved by the turning simulation without a drawing record (issue 27):
+    proved, it is written to --out, and its notes say which checks did not run."""
     source, lines = import_emco(run, tmp_path)
     params = tmp_path / "new.json"
     params.write_text(json.dumps({"speed": 800, "feed": {"value": 120.5, "addresses": ["F"]}}))   # both forms
     out = tmp_path / "NEW.NC"
     with psycopg.connect(run.url) as conn:
         release_draft(conn, "emco_neg")   # a draft's program never reaches a file (issue 26)
-    before = stored_counts(run.url)
-    message = refused(run("instantiate", "--class", "emco_neg", "--machine", "lathe-iso", "--params", params,
-                          "--out", out))
-    assert "never written to a file" in message and "turning simulation" in message and not out.exists()
-    assert stored_counts(run.url) == before
     made = json.loads(ok(run("instantiate", "--class", "emco_neg", "--machine", "lathe-iso",
-                             "--params", params, "--json")).stdout)
+                             "--params", params, "--out", out, "--json")).stdout)
     new_words = {f"S{SPEED}": "S800", "F150.000": "F120.500"}
     expected = [" ".join(new_words.get(word, word) for word in line.split(" ")) for line in lines]
     template_lines, lineage, unverified = stored_program(run.url, made["program_id"])
     assert template_lines == expected and sum(a != b for a, b in zip(expected, lines)) == 4
     assert (made["given"], made["taken"], made["unverified"]) == (["speed", "feed"], ["program_name"], False)
+    with psycopg.connect(run.url) as conn:
+        stored = conn.execute("SELECT lines FROM program WHERE id = %s", (made["program_id"],)).fetchone()[0]
+    assert out.read_bytes() == ("\n".join(stored) + "\n").encode()   # through the writer, with the file's layout
+    assert any("(assumed)" in note for note in made["notes"])
+    assert any(note.startswith("not checked: a cut into the finished part") for note in made["notes"])
     again = json.loads(ok(run("instantiate", "--job", made["job_id"], "--draft", "--json")).stdout)
     assert stored_program(run.url, again["program_id"])[0] == expected   # the job made again, verified again
 
@@ -261,13 +261,43 @@ def test_the_database_holds_the_unverified_word_to_the_record_and_refuses_it_for
             resubmit(conn, hobbing, True, lambda line: line + " UNVERIFIED")
 
 
-def test_a_lathe_class_job_made_again_is_not_written_to_a_file_either(run, tmp_path):
-    """`instantiate --job` of a lathe class job: the same program without a drawing record, so the
-    same refusal of a file (issue 26), nothing stored."""
+def test_a_lathe_class_job_made_again_is_proved_and_written_to_a_file(run, tmp_path):
+    """`instantiate --job` of a lathe class job: proved by the turning simulation again, against
+    the blank its --params stated (Ø26 from Z0 to Z-40: the program's rapids at X28 and up stay
+    above it), and written; `engine simulate --program` says what it proved and what not."""
     import_emco(run, tmp_path)
     with psycopg.connect(run.url) as conn:
         release_draft(conn, "emco_neg")
-    made = json.loads(ok(run("instantiate", "--class", "emco_neg", "--machine", "lathe-iso", "--json")).stdout)
-    before, out = stored_counts(run.url), tmp_path / "AGAIN.NC"
-    message = refused(run("instantiate", "--job", made["job_id"], "--out", out))
-    assert "never written to a file" in message and not out.exists() and stored_counts(run.url) == before
+    params = tmp_path / "blank.json"
+    params.write_text(json.dumps({"stock_diameter": 26, "stock_z_front": 0, "stock_z_back": -40}))
+    made = json.loads(ok(run("instantiate", "--class", "emco_neg", "--machine", "lathe-iso", "--params", params,
+                             "--json")).stdout)
+    assert any(f"the blank Ø{26:.3f} Z{-40:.3f}…{0:.3f}:" in note for note in made["notes"]), made["notes"]
+    out = tmp_path / "AGAIN.NC"
+    again = json.loads(ok(run("instantiate", "--job", made["job_id"], "--out", out, "--json")).stdout)
+    with psycopg.connect(run.url) as conn:
+        stored = conn.execute("SELECT lines FROM program WHERE id = %s", (again["program_id"],)).fetchone()[0]
+    assert out.read_bytes() == ("\n".join(stored) + "\n").encode()
+    simulated = ok(run("simulate", "--program", again["program_id"])).stdout.splitlines()
+    assert simulated[-1].endswith(f"through the blank Ø{26:.3f} Z{-40:.3f}…{0:.3f}; clean")
+    assert any(line.startswith("not checked: a cut into the finished part") for line in simulated)
+
+
+def test_the_adversary_s_rapid_through_the_blank_in_an_imported_program_is_refused_naming_it(run, tmp_path):
+    """The second adversary of issue 26 wrote G00 X0.000 Z-15.000 into an imported lathe program:
+    the turning simulation follows it through the blank the program implies and refuses it, at
+    every exit (with --out, without, a dry run): exit 1, one line naming the line, nothing stored."""
+    source, lines = import_emco(run, tmp_path)
+    first_approach = lines.index("G00 X124.000 Z2.000")
+    evil = tmp_path / "evil.nc"
+    evil.write_text("\n".join([*lines[:first_approach + 1], "G00 X0.000 Z-15.000", *lines[first_approach + 1:]])
+                    + "\n")
+    ok(run("import-nc", evil, "--class", "evil_neg", "--params", tmp_path / "params.json"))   # as import_emco
+    with psycopg.connect(run.url) as conn:
+        release_draft(conn, "evil_neg")
+    before, out = stored_counts(run.url), tmp_path / "EVIL.NC"
+    for more in (["--out", out], [], ["--dry-run"]):
+        message = refused(run("instantiate", "--class", "evil_neg", "--machine", "lathe-iso", *more))
+        assert f"line {first_approach + 2} 'G00 X0.000 Z-15.000'" in message, message
+        assert "rapid through material" in message and "nothing stored" in message
+    assert stored_counts(run.url) == before and not out.exists()

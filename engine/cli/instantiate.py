@@ -101,9 +101,11 @@ def instantiate(ctx, gear_id, job_id, gear_class, params_file, unverified, gear_
 
     --class C --params P.json makes a job of a class without a model (engine
     import-nc) on a lathe: its program is read by the machine's verifier, and
-    with its imported values it is the imported program again. Without a
-    drawing record the turning simulation cannot prove it: stored for review,
-    never written to a file (--out is refused).
+    with its imported values it is the imported program again. The turning
+    simulation proves it without a drawing record, against the blank given in
+    --params (stock_diameter, stock_z_front, stock_z_back, mm, all three or
+    none) or else the one its program implies (assumed); proved, it is written
+    like any program, and its notes say what was not checked.
 
     Example: engine instantiate --gear 42 --out /srv/nc/
     """

@@ -21,6 +21,9 @@ def simulate(ctx, program_id, as_json):
     program (a job from a drawing): rapids through the blank or the part, cuts into the part,
     thread passes outside the drawn thread, tool changes away from the job's position, cuts with
     the spindle stopped, and feed per revolution and cutting speed against the cutting-data table.
+    A lathe class job's program (engine instantiate --class: no drawing) against its blank, stated
+    or assumed from its feeds: rapids through it, cuts with the spindle stopped, tool changes in a
+    moving block or inside the blank; the lines "not checked: ..." say what needs a drawing.
 
     One line per finding, then the summary. Exit 1 when the simulation refuses the program, or
     when its lines are not the rendering of the template version and job it names (MISMATCH),

@@ -8,12 +8,17 @@ the words bound to them change. A name the class was not imported with is refuse
 known ones: a typo must not silently leave a value as it was.
 
 The program is read by the machine's verifier (engine.programs.verified_run) before anything is
-stored. A hobbing program must be proved by the simulation against a gear and a hob, which such a
-job has not, so no hobber makes one. With `unverified` the program is stored without the
-verifier's reading, for a dialect the verifier does not know or a program it refuses: its record
-and its lineage line say UNVERIFIED (program.unverified), and it is never written to a file for the
-machine, because a program that reaches the machine must be one the verifier read. Made again
-(`instantiate --job`, engine.programs.remake) the job is verified then, or refused.
+stored. A lathe program is also proved by the turning simulation without a drawing record
+(engine.simulation.turning.undrawn): against the blank the job's parameters state
+(stock_diameter, stock_z_front, stock_z_back, given with --params like program_name, all three
+or none) or else the blank its program implies; what it cannot check without a drawing is in
+the program's notes. Proved, it is written to a file like any other. A hobbing program must be
+proved by the simulation against a gear and a hob, which such a job has not, so no hobber makes
+one. With `unverified` the program is stored without the verifier's reading, for a dialect the
+verifier does not know or a program it refuses: its record and its lineage line say UNVERIFIED
+(program.unverified), and it is never written to a file for the machine, because a program that
+reaches the machine must be one the verifier read. Made again (`instantiate --job`,
+engine.programs.remake) the job is verified then, or refused.
 """
 from __future__ import annotations
 
@@ -29,6 +34,7 @@ from ..names import checked
 from ..nc.layout import NcLayout, class_layout
 from ..nc.lineage import refuse_lineage_shaped
 from ..nc.tokens import NUMBER, tokenise
+from ..simulation.turning.work import BLANK_PARAMS
 from ..templates.decision_table import compiled_template
 from ..templates.rows import Template
 from ..templates.versions import runnable_template
@@ -40,7 +46,7 @@ from .instantiate import store_planned
 from .options import NO_FILE, NORMAL_RUN, Output, RunMode
 from .outputs import files_after_commit
 from .records import Planned, Program
-from .verified_run import run_template
+from .verified_run import class_work, run_template
 
 if TYPE_CHECKING:
     from ..db.connection import Connection
@@ -71,7 +77,6 @@ def instantiate_class(conn: Connection, gear_class: str, given: dict, *, machine
     nothing stored. The batch fields of `mode` do not apply."""
     refuse_unfit_output(output, mode)
     refuse_unverified_file(unverified, output.out)
-    refuse_unsimulated_file(conn, gear_class, machine, output.out)
     if mode.dry_run:
         with read_only(conn):
             planned, taken = _planned(conn, gear_class, given, machine, source, mode.draft, unverified)
@@ -86,20 +91,6 @@ def refuse_unverified_file(unverified: bool, out) -> None:
     if unverified and out is not None:
         raise EngineError(f"--unverified with an output folder or --out {out}: {NEVER_WRITTEN}; leave out --out "
                           "(and the machine's out in the config file); nothing stored")
-
-
-def refuse_unsimulated_file(conn: Connection, gear_class: str, machine_name: str | None, out) -> None:
-    """A class job on a lathe has no drawing record (no part, no blank): the turning simulation
-    cannot prove its program, only the verifier reads it, so it never reaches a file for the
-    machine (issue 26: an adversary wrote a rapid through the part this way)."""
-    if out is None:
-        return
-    machine = class_machine(conn, machine_name)
-    if machine.kind == "lathe":
-        raise EngineError(f"class {gear_class} on lathe {machine.name}: a class job has no drawing record (part, "
-                          "blank), so the turning simulation cannot prove its program and it is never written to "
-                          f"a file ({out}); leave out --out (and the machine's out in the config file) to store it "
-                          "for review, or make the part's job with `engine import-dxf`; nothing stored")
 
 
 def _planned(conn: Connection, gear_class: str, given: dict, machine_name: str | None, source: str, draft: bool,
@@ -162,17 +153,28 @@ def refuse_unread_dialect(machine: Machine) -> None:
 def job_params(gear_class: str, imported: dict, given: dict, source: str) -> tuple[dict, tuple[str, ...]]:
     """The job's parameters (the imported values, the given ones in their place, and a program
     name) and the names that took the imported value."""
-    unknown = sorted(set(given) - set(imported) - {PROGRAM_NAME})
+    unknown = sorted(set(given) - set(imported) - {PROGRAM_NAME, *BLANK_PARAMS})
     if unknown:
-        known = ", ".join(sorted(set(imported) | {PROGRAM_NAME}))
+        known = ", ".join(sorted(set(imported) | {PROGRAM_NAME, *BLANK_PARAMS}))
         raise EngineError(f"{source}: {', '.join(map(repr, unknown))} {'is' if len(unknown) == 1 else 'are'} not a "
                           f"parameter of class {gear_class} (its parameters: {known}); nothing stored")
     _refuse_other_kinds(gear_class, imported, given, source)
     params = {**imported, **given}
+    refuse_partial_blank(params, source)
     params.setdefault(PROGRAM_NAME, default_program_name(gear_class))
     checked("program", params[PROGRAM_NAME], "program_name",
             f"give {PROGRAM_NAME} in the parameters file; nothing stored")
     return params, tuple(name for name in imported if name not in given)
+
+
+def refuse_partial_blank(params: dict, source: str) -> None:
+    """The blank is stated whole (its diameter and both ends, mm) or not at all: a diameter
+    without its ends cannot be placed in Z, and ends alone say nothing of the material."""
+    stated = [name for name in BLANK_PARAMS if name in params]
+    if stated and len(stated) != len(BLANK_PARAMS):
+        missing = ", ".join(name for name in BLANK_PARAMS if name not in params)
+        raise EngineError(f"{source}: the blank needs {', '.join(BLANK_PARAMS)} together (mm; the diameter, the "
+                          f"front face's Z and the back end's Z); {missing} missing; nothing stored")
 
 
 def default_program_name(gear_class: str) -> str:
@@ -270,9 +272,10 @@ def class_job(template: Template, machine: Machine, params: dict, module_params:
     if machine.kind == "hobber":
         raise EngineError(f"class {template.gear_class} has no hobbing model: a program for hobbing machine "
                           f"{machine.name} must be proved by the simulation against a gear and a hob; nothing stored")
-    result = run_template(template, params, module_params, machine)
+    work = class_work(params) if machine.kind == "lathe" else None
+    result = run_template(template, params, module_params, machine, work)
     return Planned(None, template.gear_class, machine.name, None, params, module_params, template, result,
-                   layout=layout)
+                   notes=list(work.notes) if work else [], layout=layout)
 
 
 def _unverified_job(template: Template, machine: Machine, params: dict, layout: NcLayout) -> Planned:

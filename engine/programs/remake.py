@@ -7,8 +7,9 @@ drawing record (engine.programs.drawing_records). The programs are
 checked against the job's machine, stored with the template version they came from, and written
 after the database commit. A batch tries every job and names each bad one
 (engine.programs.batches). A job of a class without a model (engine.programs.class_jobs) is its
-class's rows run with its parameters, read by the verifier: one stored unverified is verified
-now, or refused."""
+class's rows run with its parameters, read by the verifier and, on a lathe, proved by the turning
+simulation against its blank (no drawing record): one stored unverified is verified now, or
+refused."""
 from __future__ import annotations
 
 import re
@@ -36,7 +37,7 @@ from .batches import (
     read_only,
     refuse_unfit_output,
 )
-from .class_jobs import class_job, refuse_unsimulated_file
+from .class_jobs import class_job
 from .instantiate import store_planned
 from .job_checks import check_hobbing_feeds, check_hobbing_job
 from .job_shape import check_job_shape, job_with_cycle_time
@@ -56,10 +57,9 @@ JOB_COLUMNS = "id, gear_id, gear_class, machine, hob_id, params, module_params"
 class Remaker:
     """Machines and templates read once for all the jobs made again in one run."""
 
-    def __init__(self, conn: Connection, draft: bool = False, to_file: bool = False):
+    def __init__(self, conn: Connection, draft: bool = False):
         self.conn = conn
         self.draft = draft   # the classes' drafts (an editor trying them), not their released versions
-        self.to_file = to_file   # the programs go to files for the machine (--out, the config's folder)
         self._machines: dict[str, Machine] = {}
         self._templates: dict[str, Template] = {}
         self._layouts: dict[str, NcLayout] = {}
@@ -75,8 +75,6 @@ class Remaker:
         job_id, gear_id, gear_class, machine_name, hob_id, params, module_params = job
         machine = self.machine(machine_name)
         if not self.modelled(gear_class):   # a job of an imported class (instantiate --class): its rows alone
-            if self.to_file:
-                refuse_unsimulated_file(self.conn, gear_class, machine_name, f"job {job_id}'s file")
             return class_job(self.template(gear_class), machine, params, module_params)
         if job_id is not None:   # a stored job (a golden test's case names its machine itself)
             check_machine_kind(job_id, gear_class, machine, self.turning(gear_class))
@@ -184,8 +182,7 @@ def instantiate_job(conn: Connection, job_id: int, *, output: Output = NO_FILE, 
             return dry_program(conn, Remaker(conn, mode.draft).remade(_stored_job(conn, job_id)), job_id)
     with files_after_commit(conn, output) as files:
         job = _stored_job(conn, job_id)
-        remaker = Remaker(conn, mode.draft, to_file=output.out is not None)
-        program = store_planned(conn, [remaker.remade(job)], files, existing_job=job_id)[0]
+        program = store_planned(conn, [Remaker(conn, mode.draft).remade(job)], files, existing_job=job_id)[0]
     return program
 
 
@@ -204,8 +201,7 @@ def instantiate_jobs(conn: Connection, first: int | None = None, last: int | Non
     `mode.dry_run`: what would be stored, nothing stored. `mode.progress(stage, done, total)` as
     the jobs are made (one process: `mode.workers` plans gears, not jobs)."""
     with batch_stage(conn, output, mode) as files, no_cycle_collection():   # making and storing build the batch
-        good, skipped = good_ones(_remade_jobs(conn, first, last, mode, output.out is not None), "job",
-                                  mode.skip_bad)
+        good, skipped = good_ones(_remade_jobs(conn, first, last, mode), "job", mode.skip_bad)
         if mode.dry_run:
             return dry_batch([item for _, item in good], skipped)
         files.plan([(item.name, item.lines) for _, item in good], file_layouts([item for _, item in good]))
@@ -213,14 +209,14 @@ def instantiate_jobs(conn: Connection, first: int | None = None, last: int | Non
     return replace(batch, skipped=skipped)
 
 
-def _remade_jobs(conn, first: int | None, last: int | None, mode: RunMode, to_file: bool = False) -> list:
+def _remade_jobs(conn, first: int | None, last: int | None, mode: RunMode) -> list:
     """(job id, its program encoded for storage), or Bad with its reason, for each stored job with
     first ≤ id ≤ last, in job order."""
     jobs = conn.execute(f"SELECT {JOB_COLUMNS} FROM job WHERE id BETWEEN %s AND %s ORDER BY id",
                         (first if first is not None else 0, last if last is not None else 2**62)).fetchall()
     if not jobs:
         raise EngineError(f"no jobs with ids in {first or 'the start'}…{last or 'the end'}")
-    remaker = Remaker(conn, mode.draft, to_file and not mode.dry_run)
+    remaker = Remaker(conn, mode.draft)
     return [_remade_in_batch(remaker, job, done, len(jobs), mode.progress) for done, job in enumerate(jobs, 1)]
 
 

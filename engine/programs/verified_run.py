@@ -6,12 +6,15 @@ refuses is stored. A turning job's program (a drawing's job, classes turning_iso
 is simulated against the job's drawing record (engine.simulation.turning.drawing: its profile,
 blank, tool-change position and materials) and its stored operations (module_params), not
 against the passes the planner computed. The records come from the database, not from the job's parameters, which
-a runner may have edited. The one exception is a class job stored with --unverified
-(engine.programs.class_jobs): its record and lineage line say UNVERIFIED, and it is never
-written to a file for the machine."""
+a runner may have edited. A class job's program on a lathe (a class without a model,
+engine.programs.class_jobs) has no drawing record: it is simulated against the blank its
+parameters state, or the one its program implies (engine.simulation.turning.undrawn), and the
+simulation's "not checked" list becomes the program's notes. The one exception is a class job
+stored with --unverified: its record and lineage line say UNVERIFIED, and it is never written
+to a file for the machine."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from ..errors import EngineError
 from ..gears.records import Gear, Hob
@@ -19,6 +22,7 @@ from ..machines.records import Machine
 from ..nc.lineage import refuse_lineage_shaped
 from ..simulation import SimulationError, simulate_program
 from ..simulation.turning.run import simulate_turning
+from ..simulation.turning.work import BLANK_PARAMS
 from ..templates.decision_table import Result, compiled_template
 from ..templates.rows import Template
 from ..verifier import verify_program
@@ -38,11 +42,18 @@ class TurningWork:
     position, the materials: engine.simulation.turning.drawing.proof_params), and its operations."""
     params: dict
     module_params: dict
+    notes: list = field(default_factory=list, compare=False)   # filled by the proof: what it did not check
+
+
+def class_work(params: dict) -> TurningWork:
+    """What a class job's lathe program is proved against: its params' blank, nothing else (no
+    profile, no operations: the simulation then proves it without a drawing record)."""
+    return TurningWork({name: params[name] for name in BLANK_PARAMS if name in params}, {})
 
 
 # The classes whose jobs come from drawings (engine.programs.turning_jobs): their programs must be
-# proved by the turning simulation. A class job on a lathe (a class without a model) has no drawing
-# to be proved against: the verifier reads it alone.
+# proved by the turning simulation against the drawing record. Every other lathe program (a class
+# job) is proved against a blank (class_work).
 TURNING_CLASSES = frozenset({"turning_iso", "turning_840d"})
 
 
@@ -58,7 +69,9 @@ def run_template(template: Template, params: dict, module_params: dict, machine:
     verify_program(result.lines, machine, name)
     if machine.kind == "hobber":
         prove(result.lines, machine, workpiece, name or "the program")
-    elif machine.kind == "lathe" and (workpiece is not None or from_drawing(template, params)):
+    elif machine.kind == "lathe":
+        if workpiece is None and not from_drawing(template, params):
+            workpiece = class_work(params)
         prove_lathe(result.lines, machine, workpiece, name or "the program")
     return result
 
@@ -76,6 +89,11 @@ def prove_lathe(lines: list[str], machine: Machine, work: Workpiece | TurningWor
     report = simulate_turning(lines, work.params, work.module_params, machine, name)
     if report.refused:
         raise SimulationError(f"{report.error()}; nothing stored")
+    if report.not_checked:
+        work.notes.append(f"turning simulation: followed {report.rapids} rapid(s) and {report.cut_moves} cut(s) "
+                          f"through the blank {report.blank}: no rapid through material, no cut with the spindle "
+                          "stopped, no tool change inside the blank")
+        work.notes.extend(f"not checked: {what}" for what in report.not_checked)
 
 
 def prove(lines: list[str], machine: Machine, workpiece: Workpiece | TurningWork | None, name: str) -> None:

@@ -27,6 +27,7 @@ from ..machines.records import load_machine
 from ..nc.layout import ENDING_NAMES, NcLayout
 from ..programs import all_models  # noqa: F401  (registers every model)
 from ..programs.job_shape import job_with_cycle_time
+from ..programs.verified_run import TurningWork, class_work
 from ..simulation.turning.run import simulate_turning
 from ..templates.decision_table import compiled_template
 from ..templates.history import layout_change
@@ -241,15 +242,17 @@ class _JobInputs:
         """A job's draft program read by the machine's verifier (its limits: an S beyond the hob
         spindle, a move beyond the travel) and, for a turning job, followed by the turning simulation
         against the job's stored records, as engine.programs.verified_run proves it: EngineError if
-        refused. A hobbing job's program is not simulated here (issue 28: the impact's cost)."""
+        refused. A class job's lathe program is simulated against its blank without a drawing record
+        (issue 27). A hobbing job's program is not simulated here (issue 28: the impact's cost)."""
         gear_class, machine_name, params_text, modules_text = key
         machine = self.machine(machine_name)
         params = json.loads(params_text)
         name = params.get("program_name") if isinstance(params, dict) else None
         verify_program(lines, machine, name if isinstance(name, str) else None)
-        if machine.kind != "lathe" or not isinstance(params, dict) or "profile" not in params:
+        if machine.kind != "lathe" or not isinstance(params, dict):
             return
-        report = simulate_turning(lines, params, json.loads(modules_text or "{}"), machine,
+        work = TurningWork(params, json.loads(modules_text or "{}")) if "profile" in params else class_work(params)
+        report = simulate_turning(lines, work.params, work.module_params, machine,
                                   params.get("program_name") or "the program")
         if report.refused:
             raise report.error()

@@ -6,7 +6,14 @@ that moves (the turret swings its tools out there: anywhere else one of them hit
 the chuck), a cut with the spindle stopped or turning against the tool (the templates' outside
 tools cut with M03, design notes §8), a thread pass in an operation that is not a THREAD, an
 operation comment, a tool word or a tool offset (ISO T0101's last digits, 840D D) that is not
-the job's. Each motion is handed on as a Move for the material walk."""
+the job's. Each motion is handed on as a Move for the material walk.
+
+A class job (records.drawn False: no drawing record) has no tool-change position, no operations
+and no tools: a program starts at the machine's reference point (`start`), each tool change is
+kept as a ToolChange for the check against the blank's envelope (engine.simulation.turning.
+undrawn), and a cut needs the spindle turning, M03 or M04 (which direction a tool cuts in is an
+operation record's). A reference return (ISO/LinuxCNC G28, G30; 840D G74, G75) runs at rapid to
+its intermediate point, if the block gives one, and on to the reference point."""
 from __future__ import annotations
 
 import math
@@ -22,6 +29,9 @@ CUTTING_DIRECTION = 3        # M03: the direction the templates' outside turning
 TOOL_CHANGE_TOLERANCE_MM = 0.01
 DEFAULT_EDGE = 1            # 840D: D1 with a new tool unless the block says otherwise
 PER_MINUTE, PER_REVOLUTION = (94, 98), (95, 99)   # 840D G94/G95, ISO G98/G99
+# The G codes that send the turret to the machine's reference point (or a fixed point beside it),
+# per dialect: ISO (Fanuc/Haas) and LinuxCNC G28/G30, Sinumerik 840D G74/G75.
+REFERENCE_RETURNS = {"iso": frozenset({28, 30}), "linuxcnc": frozenset({28, 30}), "840d": frozenset({74, 75})}
 
 
 @dataclass(frozen=True)
@@ -38,11 +48,25 @@ class Move:
     lead: float | None        # a thread's lead, mm/rev
 
 
+@dataclass(frozen=True)
+class ToolChange:
+    """A tool change of a class job, where the turret indexed: (z, r), and whether at the reference point."""
+    number: int
+    line: str
+    point: Point
+    at_reference: bool
+
+
 class ProgramState:
-    def __init__(self, records: TurningRecords, report: TurningReport, iso: bool):
-        self.records, self.report, self.iso = records, report, iso
-        x, z = records.tool_change
-        self.x, self.z = x, z            # a program starts where the last left the turret: at the change
+    def __init__(self, records: TurningRecords, report: TurningReport, dialect: str, start: tuple[float, float]):
+        """`start`: (x diameter, z) where the turret stands when the program starts: the job's
+        tool-change position (where the last program left it), or for a class job the reference point."""
+        self.records, self.report, self.iso = records, report, dialect == "iso"
+        self.returns = REFERENCE_RETURNS.get(dialect, frozenset())
+        self.reference = start
+        self.x, self.z = start
+        self.at_reference = not records.drawn   # a class job: the turret at the reference point
+        self.changes: list[ToolChange] = []
         self.spindle: int | None = None  # 3, 4 or None (stopped)
         self.speed: float | None = None
         self.constant_speed = False
@@ -58,6 +82,9 @@ class ProgramState:
         if step.block is None:
             return
         self._modes(step)
+        if step.g_codes & self.returns:
+            self._reference_return(step)
+            return
         if "T" in step.block.values:
             self._tool_change(step)
         elif not self.iso and "D" in step.block.values:
@@ -67,7 +94,20 @@ class ProgramState:
         if step.block.moves and self.motion in MOTIONS:
             self._move(step)
 
+    def _reference_return(self, step) -> None:
+        """At rapid through the block's X/Z (the intermediate point), then to the reference point."""
+        block = step.block
+        through = (block.positions.get("X", self.x), block.positions.get("Z", self.z))
+        for x, z in (through, self.reference):
+            start = (self.z, self.x / 2.0)
+            self.x, self.z = x, z
+            self.moves.append(Move(step.number, step.line, RAPID, [start, (z, x / 2.0)], self.operation, self.speed,
+                                   self.constant_speed, self.feed, self.per_minute, None))
+        self.at_reference = True
+
     def _operation(self, step) -> None:
+        if not self.records.drawn:
+            return   # a class job has no operation records to hold a comment against
         n, kind = step.operation
         known = self.records.operations.get(n)
         if known is None or known.kind != kind:
@@ -98,6 +138,9 @@ class ProgramState:
             self.report.add(step.number, step.line, "a tool change in a block that moves: the turret indexes "
                             "on the way, not at the tool-change position; write T in its own block there")
         x, z = block.positions.get("X", self.x), block.positions.get("Z", self.z)
+        if self.records.tool_change is None:   # a class job: checked against the blank once it is known
+            self.changes.append(ToolChange(step.number, step.line, (z, x / 2.0), self.at_reference and not block.moves))
+            return
         want_x, want_z = self.records.tool_change
         if abs(x - want_x) > TOOL_CHANGE_TOLERANCE_MM or abs(z - want_z) > TOOL_CHANGE_TOLERANCE_MM:
             self.report.add(step.number, step.line, f"a tool change at X{x:.3f} Z{z:.3f}, away from the job's "
@@ -129,6 +172,7 @@ class ProgramState:
         start = (self.z, self.x / 2.0)
         self.x, self.z = block.positions.get("X", self.x), block.positions.get("Z", self.z)
         end = (self.z, self.x / 2.0)
+        self.at_reference = self.at_reference and start == end
         kind = MOTIONS[motion]
         points = [start, end]
         if motion in (2, 3):
@@ -144,16 +188,16 @@ class ProgramState:
     def _check_cut(self, step, kind: str) -> None:
         what = "a thread pass" if kind == THREAD else "a cut"
         if self.spindle is None:
-            self.report.add(step.number, step.line, f"{what} with the spindle stopped (no M03 since the start "
-                            "or the last M05): the tool is driven into a standing part")
-        elif self.spindle != CUTTING_DIRECTION:
+            self.report.add(step.number, step.line, f"{what} with the spindle stopped (no M03 or M04 since the "
+                            "start or the last M05): the tool is driven into a standing part")
+        elif self.spindle != CUTTING_DIRECTION and self.records.drawn:
             self.report.add(step.number, step.line, f"{what} with the spindle turning M0{self.spindle}: the "
                             f"job's outside turning tools cut with M0{CUTTING_DIRECTION}")
         op = self._current()
-        if op is None:
+        if op is None and self.records.drawn:
             self.report.add(step.number, step.line, f"{what} outside any of the job's operations (no "
                             "operation comment OP n KIND before it): the simulation cannot tell what it may cut")
-        elif kind == THREAD and op.kind != "THREAD":
+        elif op is not None and kind == THREAD and op.kind != "THREAD":
             self.report.add(step.number, step.line, f"{what} in operation {op.number} {op.kind}: threads are cut "
                             "only in a THREAD operation, along the drawn thread")
 

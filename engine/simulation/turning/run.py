@@ -3,7 +3,9 @@
 turning.follow), then through the material (engine.simulation.turning.material) and against
 the cutting-data table (engine.simulation.turning.cutting). It reads only the program text,
 the job's stored params and module_params and the machine record — never the model that
-planned the passes (engine.turning)."""
+planned the passes (engine.turning). A class job's program (no drawing record: params without a
+profile, no operations) is proved against a blank only, and the report says what it could not
+check (engine.simulation.turning.undrawn)."""
 from __future__ import annotations
 
 from ...machines.records import Machine
@@ -13,7 +15,8 @@ from .follow import FEED, Move, ProgramState
 from .material import MaterialWalk
 from .reading import read_lathe_program
 from .report import TurningReport
-from .work import number, turning_records
+from .undrawn import NOT_CHECKED, check_tool_changes, program_blank, reference_point
+from .work import TurningRecords, number, turning_records
 
 # The most a cut may run on behind a stored blank's back end (mm): the planner's overtravel,
 # engine.turning.defaults.CLEARANCE, as a fixed bound. The job's params.clearance is the runner's
@@ -30,16 +33,21 @@ def simulate_turning(lines: list[str], params: dict, module_params: dict, machin
                               "lathe programs")
     records = turning_records(params, module_params)
     report = TurningReport(name)
-    state = ProgramState(records, report, machine.dialect == "iso")
+    start = records.tool_change or reference_point(machine)
+    state = ProgramState(records, report, machine.dialect, start)
     for step in read_lathe_program(lines, machine, name):
         state.take(step)
-    blank = records.blank(_feed_radius(state.moves), _facing_zs(state.moves, records))
+    blank, assumed = _blank(state.moves, records)
     z0, r0, z1, r1 = blank.bounds
-    report.blank = f"Ø{2 * r1:.3f} Z{z0:.3f}…{z1:.3f}" + (" (assumed)" if records.stock is None else "")
-    walk = MaterialWalk(records, blank, report, min(number(params, "clearance"), BEHIND_RUN_OUT_MM))
+    report.blank = f"Ø{2 * r1:.3f} Z{z0:.3f}…{z1:.3f}" + (" (assumed)" if assumed else "")
+    walk = MaterialWalk(records, blank, report, _run_out(params, records))
     for move in state.moves:
         walk.take(move)
-    check_cutting(state.moves, records, params, module_params, report)
+    if records.drawn:
+        check_cutting(state.moves, records, params, module_params, report)
+    else:
+        check_tool_changes(state.changes, blank, report)
+        report.not_checked = list(NOT_CHECKED)
     report.findings.sort(key=lambda finding: finding.number)
     return report
 
@@ -51,6 +59,20 @@ def prove_turning(lines: list[str], params: dict, module_params: dict, machine: 
     if report.refused:
         raise report.error()
     return report
+
+
+def _blank(moves: list[Move], records: TurningRecords):
+    """(the blank, whether assumed): a drawing job's (design notes §8) or a class job's (undrawn)."""
+    if not records.drawn:
+        return program_blank(moves, records.stock)
+    return records.blank(_feed_radius(moves), _facing_zs(moves, records)), records.stock is None
+
+
+def _run_out(params: dict, records: TurningRecords) -> float:
+    """A class job has no params.clearance (the planner's overtravel): the fixed bound alone."""
+    if not records.drawn and "clearance" not in params:
+        return BEHIND_RUN_OUT_MM
+    return min(number(params, "clearance"), BEHIND_RUN_OUT_MM)
 
 
 def _feed_radius(moves: list[Move]) -> float:

@@ -3,7 +3,10 @@ model that planned the passes): the finished part (params.profile, the drawing's
 (z, r)), the blank (params.stock_diameter, stock_z_front/back; without a stored diameter the
 blank the importer assumes, design notes §8), the tool-change position (params.tool_change_x
 as a diameter, tool_change_z), and per operation its kind, tool and offset, and for a THREAD
-operation the region between its drawn crest and root lines."""
+operation the region between its drawn crest and root lines. A class job (`engine instantiate
+--class`: no drawing, so no params.profile and no operations) has only a blank: the one its
+params state, or none, and then the simulation assumes one from the program
+(engine.simulation.turning.undrawn)."""
 from __future__ import annotations
 
 import math
@@ -21,6 +24,8 @@ from ...errors import EngineError
 ASSUMED_BLANK_MARGIN_MM = 1.0
 ARC_SAGITTA_MM = 1e-4       # chord error of an arc drawn as a polyline: far inside the tolerances
 MAX_ARC_PIECES = 4000
+# The blank a job's params state (mm): a class job's only records (engine.simulation.turning.undrawn).
+BLANK_PARAMS = ("stock_diameter", "stock_z_front", "stock_z_back")
 KINDS = ("ROUGH", "SLOT", "FINISH", "THREAD", "FACE", "PART")
 FIX = "fix the job's params in SQL and instantiate it again"
 
@@ -43,9 +48,10 @@ class TurningRecords:
     z_front: float
     z_back: float
     top: float                                    # the profile's largest radius
-    tool_change: tuple[float, float]              # (x diameter, z)
+    tool_change: tuple[float, float] | None       # (x diameter, z); None: no record (a class job)
     operations: dict[int, Operation] = field(default_factory=dict)
     threads: dict[int, BaseGeometry] = field(default_factory=dict)
+    drawn: bool = True                            # False: a class job, proved without a drawing record
 
     def blank(self, feed_radius: float, facing_zs: list[float]) -> BaseGeometry:
         """The material before the first cut (both sides of the axis). Without a stored stock
@@ -62,13 +68,12 @@ class TurningRecords:
 def turning_records(params: dict, module_params: dict) -> TurningRecords:
     if not isinstance(params, dict) or not isinstance(module_params, dict):
         raise EngineError(f"the job's params and module_params must be objects; {FIX}")
+    if params.get("profile") is None:
+        return undrawn_records(params, module_params)
     outline = profile_points(params.get("profile"), "params.profile")
     part = part_polygon(outline)
     zs, rs = [p[0] for p in outline], [p[1] for p in outline]
-    stock = None
-    if params.get("stock_diameter") is not None:
-        stock = (number(params, "stock_z_front"), number(params, "stock_z_back"),
-                 number(params, "stock_diameter") / 2.0)
+    stock = stored_stock(params)
     change = (number(params, "tool_change_x"), number(params, "tool_change_z"))
     records = TurningRecords(part, stock, max(zs), min(zs), max(rs), change)
     for n, kind in operation_kinds(module_params).items():
@@ -77,6 +82,32 @@ def turning_records(params: dict, module_params: dict) -> TurningRecords:
         if kind == "THREAD":
             records.threads[n] = thread_region(module_params[f"cutmotion:{n}"].get("paths"), n)
     return records
+
+
+def undrawn_records(params: dict, module_params: dict) -> TurningRecords:
+    """A class job's records: no part, no tool-change position, no operations; the blank its
+    params state, if they do. Operations without a drawing's profile are a drawing job whose
+    profile is gone, refused rather than proved as less than it is (fail closed)."""
+    if operation_kinds(module_params):
+        raise EngineError(f"the job has operations (module_params cutmotion:n) but no params.profile: a turning "
+                          f"job is proved against its drawing's profile; {FIX}")
+    stock = stored_stock(params)
+    empty = Polygon()
+    return TurningRecords(empty, stock, 0.0, 0.0, 0.0, None, drawn=False)
+
+
+def stored_stock(params: dict) -> tuple[float, float, float] | None:
+    """(z_front, z_back, radius) of the blank the params state (params.stock_diameter, mm, with
+    stock_z_front and stock_z_back), or None; a blank with no length or no diameter is refused."""
+    if params.get("stock_diameter") is None:
+        return None
+    z_front, z_back = number(params, "stock_z_front"), number(params, "stock_z_back")
+    diameter = number(params, "stock_diameter")
+    if not (diameter > 0 and z_front > z_back):
+        raise EngineError(f"the blank Ø{diameter:g} Z{z_front:g}…{z_back:g} (params.stock_diameter, stock_z_front, "
+                          "stock_z_back) must have a diameter > 0 and its front face in front of its back end "
+                          f"(stock_z_front > stock_z_back); {FIX}")
+    return z_front, z_back, diameter / 2.0
 
 
 def operation_kinds(module_params: dict) -> dict[int, str]:
