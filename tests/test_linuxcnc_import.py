@@ -31,8 +31,10 @@ def test_a_verified_linuxcnc_program_made_with_a_new_value_changes_only_its_boun
     lines = imported(run, tmp_path)
     assert refusal(lines) is None and MACRO_START in lines
     new = tmp_path / "new.json"
-    new.write_text(json.dumps({"start_diameter": 1.3}))   # the file's one decimal (writing a value's
-    # own digits, not the file's decimals, is i27-importnc's fix)
+    # the file's one decimal (writing a value's own digits, not the file's decimals, is i27-importnc's
+    # fix), and the bar the simulation proves the job against (test_linuxcnc_programs.BAR)
+    new.write_text(json.dumps({"start_diameter": 1.3, "stock_diameter": 30.48, "stock_z_front": 0,
+                               "stock_z_back": -100}))
     made = json.loads(ok(run("instantiate", "--class", "lc_turning", "--machine", "lathe-linuxcnc", "--draft",
                              "--params", new, "--json")).stdout)
     made_lines, _, unverified = stored_program(run.url, made["program_id"])

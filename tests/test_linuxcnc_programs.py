@@ -3,14 +3,15 @@ seeded LinuxCNC lathe, or refused naming the construct that is really there; a s
 is verified as its screen calls it (ngcgui, the lathe macros), and alone it is refused because
 nothing of it runs. The attack forms of issue 26 inserted into a real program are refused.
 
-(The turning simulation of a program without a drawing is i27-classsim's; until it lands these
-programs are verified, not simulated.)"""
+Each verified program is also followed by the turning simulation of a class job (i27-classsim,
+merged here) on the bar it is called on."""
 from __future__ import annotations
 
 import pytest
 from helpers.linuxcnc_programs import LATHE, PLASMA, PROGRAMS, file_lines, program_of, refusal
 
 import engine.verifier.expanders.linuxcnc as interpreter
+from engine.simulation.turning.run import simulate_turning
 
 VERIFIED = sorted(name for name, (_, construct) in PROGRAMS.items() if construct is None)
 
@@ -90,3 +91,31 @@ def test_a_loop_that_never_ends_is_refused_at_the_step_bound(monkeypatch):
     monkeypatch.setattr(interpreter, "MAX_STEPS", 5_000)
     message = refusal(turning_with("m3 ;Start Spindle", "m3", "o900 while [1]", "o900 endwhile"))
     assert message is not None and "more than 5,000 lines run" in message and "o900 endwhile" in message, message
+
+
+# --- the turning simulation of a program without a drawing (i27-classsim) ----------------------------------
+
+# The bar the macros are called on (params of a class job, mm): Ø1.2 in, its front face at Z0,
+# the tool starting 0.1 in in front of it (MACRO_START), so tool changes there are clear of it.
+BAR = {"stock_diameter": 1.2 * 25.4, "stock_z_front": 0.0, "stock_z_back": -100.0}
+SIMULATED = {
+    "lathe_macros/turning.ngc": None, "lathe_macros/chamfer.ngc": None, "lathe_macros/threading.ngc": None,
+    # a boring macro called on a solid bar: its first rapid enters material a drilled bore would not have
+    "lathe_macros/boring.ngc": "a rapid through material",
+    # the facing macro rapids out at the depth of the pass it just made, through the next step's stock
+    "lathe_macros/facing.ngc": "a rapid through material",
+}
+
+
+@pytest.mark.parametrize("name", VERIFIED)
+def test_each_verified_program_is_simulated_on_its_bar(name):
+    findings = [finding.message for finding in simulate_turning(program_of(name), BAR, {}, LATHE, name).findings]
+    expected = SIMULATED[name]
+    assert (findings == []) if expected is None else (findings and expected in findings[0]), findings
+
+
+def test_a_rapid_into_the_part_inserted_into_a_real_program_is_refused_by_the_simulation():
+    lines = turning_with("G1 Z #23 X[#14 + #24]", "G1 Z #23 X[#14 + #24]", "G0 X0")
+    assert refusal(lines) is None          # the verifier alone lets it pass: the travel holds X0
+    findings = simulate_turning(lines, BAR, {}, LATHE, "turning").findings
+    assert findings and "a rapid through material" in findings[0].message and findings[0].line == "G0 X0"
