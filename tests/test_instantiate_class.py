@@ -23,7 +23,7 @@ CAM = DATA / "nc" / "sinumerik" / "cam_840dsl" / "CAM_TEST.MPF"   # 840D sl CAM 
 EMCO_CNC = DATA / "nc" / "emco_from_dxf" / "testNegDXF.cnc"   # Emco fixed-column format
 # A LinuxCNC lathe as a shop would record it: a dialect the verifier has no grammar for.
 LINUXCNC_LATHE = ("INSERT INTO machine (name, kind, dialect, x_min, x_max, z_min, z_max, spindle_max) "
-                  "VALUES ('lathe-linuxcnc', 'lathe', 'linuxcnc', 0, 400, -600, 200, 4000)")
+                  "VALUES ('lathe-fagor', 'lathe', 'fagor', 0, 400, -600, 200, 4000)")
 SUBMIT = ("INSERT INTO program_submission (id, job_id, gear_class, template_version, template_hash, name, lines, "
           "row_ids, trace, unverified) VALUES (%s, %s, %s, %s, %s, %s, %s, %s, %s, %s)")
 
@@ -116,7 +116,7 @@ def test_a_class_imported_without_a_program_name_gets_an_840d_program_name_for_a
     with psycopg.connect(run.url) as conn:
         conn.execute(LINUXCNC_LATHE)
     ok(run("import-nc", PAWN, "--class", gear_class))
-    ok(run("instantiate", "--class", gear_class, "--machine", "lathe-linuxcnc", "--draft", "--unverified"))
+    ok(run("instantiate", "--class", gear_class, "--machine", "lathe-fagor", "--draft", "--unverified"))
     with psycopg.connect(run.url) as conn:
         name = conn.execute("SELECT name FROM program ORDER BY id DESC LIMIT 1").fetchone()[0]
     assert re.fullmatch(r"(?:[A-Z]{2}|_[A-Z])[A-Z0-9_]{0,22}", name), name   # §A1, in capitals like the class
@@ -143,8 +143,8 @@ def test_a_machine_whose_dialect_the_verifier_does_not_know_is_refused_and_nothi
         conn.execute(LINUXCNC_LATHE)
     ok(run("import-nc", PAWN, "--class", "pawn"))
     before = stored_counts(run.url)
-    message = refused(run("instantiate", "--class", "pawn", "--machine", "lathe-linuxcnc", "--draft"))
-    assert "'linuxcnc'" in message and "lathe/iso" in message and "lathe/840d" in message
+    message = refused(run("instantiate", "--class", "pawn", "--machine", "lathe-fagor", "--draft"))
+    assert "'fagor'" in message and "lathe/iso" in message and "lathe/840d" in message
     assert stored_counts(run.url) == before
 
 
@@ -176,7 +176,7 @@ def test_unknown_parameter_names_a_modelled_class_and_a_hobber_are_refused_namin
         ("--class", "spur", "--machine", "lathe-iso"): ["hobbing model", "--gear"],
         ("--class", "turning_iso", "--machine", "lathe-iso"): ["turning class", "import-dxf"],
         ("--class", "pawn", "--machine", "hobber-840d"): ["simulation", "gear and a hob"],
-        ("--class", "pawn"): ["--machine", "hobber-840d, lathe-840d, lathe-iso"],
+        ("--class", "pawn"): ["--machine", "hobber-840d, lathe-840d, lathe-iso, lathe-linuxcnc"],
         ("--class", "pawn", "--machine", "lathe-iso", "--cuts", "2"): ["--cuts", "--params"],
         ("--gear", "42", "--params", params): ["--params", "--class"],
         ("--gear", "42", "--unverified"): ["--unverified", "--class"],
@@ -193,7 +193,7 @@ def test_an_unverified_program_is_stored_and_shown_as_such_and_verified_when_mad
     with psycopg.connect(run.url) as conn:
         conn.execute(LINUXCNC_LATHE)
     ok(run("import-nc", PAWN, "--class", "pawn"))
-    made = ok(run("instantiate", "--class", "pawn", "--machine", "lathe-linuxcnc", "--draft", "--unverified"))
+    made = ok(run("instantiate", "--class", "pawn", "--machine", "lathe-fagor", "--draft", "--unverified"))
     assert "UNVERIFIED" in made.stderr.splitlines()[-1]
     with psycopg.connect(run.url) as conn:
         program_id, job_id = conn.execute("SELECT id, job_id FROM program ORDER BY id DESC LIMIT 1").fetchone()
@@ -209,7 +209,7 @@ def test_an_unverified_program_is_stored_and_shown_as_such_and_verified_when_mad
     assert json.loads(ok(run("programs", "show", program_id, "--json")).stdout)["programs"][0]["unverified"] is True
     before = stored_counts(run.url)
     remade = refused(run("instantiate", "--job", job_id, "--draft"))   # made again: read by the verifier
-    assert "'linuxcnc'" in remade and stored_counts(run.url) == before
+    assert "'fagor'" in remade and stored_counts(run.url) == before
 
 
 def test_an_unverified_program_is_never_written_to_a_file(run, tmp_path):
@@ -218,11 +218,11 @@ def test_an_unverified_program_is_never_written_to_a_file(run, tmp_path):
     ok(run("import-nc", PAWN, "--class", "pawn"))
     before = stored_counts(run.url)
     out = tmp_path / "PAWN.NGC"
-    message = refused(run("instantiate", "--class", "pawn", "--machine", "lathe-linuxcnc", "--draft", "--unverified",
+    message = refused(run("instantiate", "--class", "pawn", "--machine", "lathe-fagor", "--draft", "--unverified",
                           "--out", out))
     assert "never written to a file" in message and not out.exists()
     folder = tmp_path / "nc"
-    run.config.write_text(f'machine = "lathe-linuxcnc"\n\n[machines.lathe-linuxcnc]\nout = "{folder}"\n')
+    run.config.write_text(f'machine = "lathe-fagor"\n\n[machines.lathe-fagor]\nout = "{folder}"\n')
     message = refused(run("instantiate", "--class", "pawn", "--draft", "--unverified"))   # the config's machine
     assert "never written to a file" in message and not folder.exists()
     assert stored_counts(run.url) == before
@@ -249,7 +249,7 @@ def test_the_database_holds_the_unverified_word_to_the_record_and_refuses_it_for
     with psycopg.connect(run.url) as conn:
         conn.execute(LINUXCNC_LATHE)
     ok(run("import-nc", PAWN, "--class", "pawn"))
-    unverified = json.loads(ok(run("instantiate", "--class", "pawn", "--machine", "lathe-linuxcnc", "--draft",
+    unverified = json.loads(ok(run("instantiate", "--class", "pawn", "--machine", "lathe-fagor", "--draft",
                                    "--unverified", "--json")).stdout)["program_id"]
     hobbing = json.loads(ok(run("instantiate", "--gear", 42, "--json")).stdout)["program_id"]
     with psycopg.connect(run.url) as conn:

@@ -17,7 +17,7 @@ import re
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
 
-from .machine_state import HOBBING_STATE, LATHE_840D_STATE, LATHE_ISO_STATE, StateRules
+from .machine_state import HOBBING_STATE, LATHE_840D_STATE, LATHE_ISO_STATE, LINUXCNC_STATE, StateRules
 from .refusals import Refused
 
 if TYPE_CHECKING:
@@ -175,8 +175,32 @@ LATHE_ISO = Dialect(
     program_numbers=range(1, 9000),
 )
 
+# LinuxCNC lathe (docs/reference/linuxcnc-lathe.md): a program is read as the plain lines the
+# expander "linuxcnc" makes of it (engine.verifier.expanders.linuxcnc): in mm, absolute, X a
+# diameter, each move with its motion code, an arc with its radius R, G33 with its lead K, G96
+# with S the clamp D (the most the spindle turns), a tool change T M6 and its length offset G43.
+LINUXCNC_M_GROUPS = {2: "program end", 30: "program end", 3: "spindle", 4: "spindle", 5: "spindle",
+                     6: "tool change", 7: "coolant", 8: "coolant", 9: "coolant"}
+LATHE_LINUXCNC = Dialect(
+    name="LinuxCNC lathe",
+    headers=(),
+    comment="parentheses",
+    addresses={"X": POSITION, "Z": POSITION, "F": FEED, "S": SPEED, "T": TOOL, "R": RADIUS, "K": PITCH,
+               "G": CODE, "M": CODE},
+    g_codes={0: MOTION, 1: MOTION, 2: MOTION, 3: MOTION, 33: MOTION, 18: "plane", 21: "units",
+             40: "tool radius", 43: "tool length", 49: "tool length", 94: "feed type", 95: "feed type",
+             96: "spindle speed", 97: "spindle speed"},
+    m_codes=LINUXCNC_M_GROUPS,
+    state=LINUXCNC_STATE,
+    arc_radius="R",
+    needs_words={2: "R", 3: "R", 33: "K"},
+    thread_lead={33: "K"},
+    expander="linuxcnc",
+)
+
 # machine.kind, machine.dialect -> the grammar its programs are read with.
-DIALECTS = {("hobber", "840d"): HOBBING_840D, ("lathe", "840d"): LATHE_840D, ("lathe", "iso"): LATHE_ISO}
+DIALECTS = {("hobber", "840d"): HOBBING_840D, ("lathe", "840d"): LATHE_840D, ("lathe", "iso"): LATHE_ISO,
+            ("lathe", "linuxcnc"): LATHE_LINUXCNC}
 
 
 def dialect_for(machine: Machine) -> Dialect:

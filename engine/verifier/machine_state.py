@@ -144,6 +144,23 @@ LATHE_ISO_STATE = StateRules(
            "G32": LATHE_ISO_THREAD},
 )
 
+# LinuxCNC (docs/reference/linuxcnc-lathe.md §3): the expander writes every block in mm (G21 once
+# the program states its units), absolute, X a diameter, each feed block with its G94/G95; a tool
+# change M6 activates no offset until G43 applies the tool table's (G49 cancels it).
+LINUXCNC_OFFSET_NEEDS = Needs(Need(TOOL_OFFSET, "a cut with no tool length offset active (G43 after the tool "
+                                                "change M6, no G49 since): the position would be the spindle "
+                                                "nose's, not the tool tip's"))
+LINUXCNC_MOVE = needs_stated(21)
+LINUXCNC_CUT = LINUXCNC_MOVE + needs_stated(18) + SPINDLE_NEEDS + LINUXCNC_OFFSET_NEEDS
+LINUXCNC_STATE = StateRules(
+    effects={**stated(18, 21, 40), **SPINDLE, "M4": sets(SPINDLE_TURNING), **END, "M2": sets(ENDED), **OFFSETS,
+             "G43": sets(TOOL_OFFSET), "G49": clears(TOOL_OFFSET), "M6": Effect()},
+    needs={"G0": LINUXCNC_MOVE, "G1": LINUXCNC_CUT, "G2": LINUXCNC_CUT, "G3": LINUXCNC_CUT, "G33": LINUXCNC_CUT,
+           "M6": Needs(Need(SPINDLE_TURNING, "a tool change with the spindle turning (M3/M4 and no M5 since): "
+                                             "a tool change at the cut; stop the spindle (M5) and retract first",
+                            present=False))},
+)
+
 
 class State:
     """The facts that hold after the lines so far."""

@@ -1,0 +1,211 @@
+"""One LinuxCNC line's words carried out in LinuxCNC's order of execution (docs/reference/
+linuxcnc-lathe.md §3) into plain lines of the LinuxCNC lathe grammar: absolute positions in mm,
+X a diameter, one motion per block with its G code, a feed block with its feed mode and F.
+
+The modes the program states are followed: G20/G21 (a length in inches is × 25.4), G7/G8 (X a
+diameter or a radius), G90/G91 (an incremental X/Z is added to the position), G90.1/G91.1 (arc
+centres I/K absolute or from the start), G94/G95 (F per minute or per revolution), G96 with its
+clamp D (the plain S is the clamp: the speed the spindle reaches at the axis) and G97. The start
+is the state M2/M30 leaves (LinuxCNC M2/M30: G54, G17, G90, G94, G40, M5, M9, motion G1);
+units and diameter mode are not reset by M2, so a length before G20/G21 and an X before G7/G8
+are refused: they are whatever the last program left."""
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
+
+from ..refusals import Refused
+from .linuxcnc_words import Words
+
+INCH = 25.4
+# G codes refused, and why (a code not here and not carried out below is refused as unknown)
+REFUSED = {
+    **{code: "cutter radius compensation: the tool path under compensation is not the programmed one; "
+             "program the tool tip path (G40)" for code in ("41", "42", "41.1", "42.1")},
+    **{code: f"G{code} moves by way of a home position the machine record does not name"
+       for code in ("28", "28.1", "30", "30.1")},
+    "53": "G53 moves in machine coordinates, a frame the record's travel is not stated in",
+    **{code: f"G{code} selects a work offset the verifier cannot see (positions are read in G54)"
+       for code in ("55", "56", "57", "58", "59", "59.1", "59.2", "59.3")},
+    **{code: f"G{code} shifts every position by an offset the verifier cannot see"
+       for code in ("92", "92.1", "92.2", "92.3", "10", "52")},
+    "93": "G93 inverse-time feed: program F per minute (G94) or per revolution (G95)",
+    **{code: f"G{code} is a drilling cycle without a lathe model here; program its moves"
+       for code in ("73", "74", "81", "82", "83", "84", "85", "86", "87", "88", "89")},
+    **{code: f"G{code} is a probing move: where it stops is found on the machine"
+       for code in ("38.2", "38.3", "38.4", "38.5")},
+    "33.1": "G33.1 rigid tapping is not modelled; program the moves",
+    "43.1": "G43.1 dynamic tool offset: use G43 with the tool table",
+    "43.2": "G43.2 adds offsets the verifier cannot see",
+}
+IGNORED_G = frozenset({"54", "61", "61.1", "64", "80", "98", "99", "18"})   # no position changes
+MOTIONS = ("0", "1", "2", "3", "33", "76", "70", "71", "71.1", "71.2", "72", "72.1", "72.2")
+IGNORED_M = frozenset({0, 1, 48, 49, 50, 51, 52, 53, 60})      # pauses and override switches
+PLAIN_M = frozenset({3, 4, 5, 7, 8, 9})
+
+
+@dataclass
+class Modes:
+    """The modal state of the interpreter as LinuxCNC keeps it, lengths in mm and X a radius."""
+    inch: bool | None = None            # None: units not stated
+    diameter: bool | None = None        # None: G7/G8 not stated
+    incremental: bool = False
+    arc_absolute: bool = False          # G90.1; LinuxCNC's default is G91.1
+    per_rev: bool = False
+    plane: str = "17"
+    motion: str = "1"
+    feed: float | None = None           # mm/min or mm/rev
+    css_clamp: float | None = None      # G96 D, r/min
+    css: bool = False
+    tool: int | None = None             # selected by T, changed by M6
+    x: float | None = None              # radius, mm
+    z: float | None = None
+    extra: dict[str, float] = field(default_factory=dict)
+
+    def copy(self) -> Modes:
+        return replace(self, extra=dict(self.extra))
+
+
+class Executor:
+    """Turns each line's words into plain lines; `modes` is the interpreter's state."""
+
+    def __init__(self, mover: Callable[[Executor, Words, str], None]) -> None:
+        self.modes = Modes()
+        self.out: list[str] = []
+        self.mover = mover       # linuxcnc_motion.move, or a cycle (engine.verifier.expanders.linuxcnc)
+
+    def run(self, words: Words) -> list[str]:
+        self.out = []
+        self._check_codes(words)
+        for step in STEPS:
+            step(self, words)
+        return self.out
+
+    def length(self, value: float) -> float:
+        if self.modes.inch is None:
+            raise Refused("a length before G20/G21: the units are whatever the last program left")
+        return value * INCH if self.modes.inch else value
+
+    def _check_codes(self, words: Words) -> None:
+        for code in words.codes["g"]:
+            name = f"{code:g}"
+            if name in REFUSED:
+                raise Refused(f"G{name}: {REFUSED[name]}")
+            if name not in KNOWN_G:
+                raise Refused(f"G{name} is not a G code of the LinuxCNC lathe grammar")
+        for code in words.codes["m"]:
+            if 62 <= code <= 68:
+                raise Refused(f"M{code:g} switches a HAL output (a plasma torch, a probe, a machine's I/O): "
+                              "what it drives is not a lathe move the verifier can follow")
+            if code not in PLAIN_M | IGNORED_M | {2, 30, 6, 70, 71, 72, 73} or code != int(code):
+                raise Refused(f"M{code:g} is not an M code of the LinuxCNC lathe grammar (user M100-M199 "
+                              "and I/O codes run what the verifier cannot see)")
+
+    def _feed_mode(self, words: Words) -> None:
+        if words.g("93"):
+            raise Refused(REFUSED["93"])
+        mode = words.g("94", "95")
+        if mode is not None:
+            self.modes.per_rev = mode == "95"
+
+    def _feed(self, words: Words) -> None:
+        if "f" in words.values:
+            self.modes.feed = self.length(words.values["f"])
+
+    def _speed(self, words: Words) -> None:
+        mode = words.g("96", "97")
+        if mode == "96":
+            clamp = words.values.get("d")
+            if clamp is None or clamp <= 0:
+                raise Refused("G96 without a speed clamp D: the spindle would race as X nears the axis; "
+                              "write G96 D<max r/min> S…")
+            self.modes.css, self.modes.css_clamp = True, clamp
+        elif mode == "97":
+            self.modes.css = False
+        if "s" in words.values:
+            speed = words.values["s"]
+            if self.modes.css:
+                assert self.modes.css_clamp is not None
+                self.out.append(f"G96 S{_number(self.modes.css_clamp)}")
+            elif speed > 0:
+                self.out.append(f"G97 S{_number(speed)}")
+        elif mode == "96":
+            raise Refused("G96 without its S (surface speed)")
+
+    def _tool(self, words: Words) -> None:
+        if "t" in words.values:
+            tool = words.values["t"]
+            if tool != int(tool) or not 0 <= tool <= 99:
+                raise Refused(f"T{tool:g} is not a tool 0 … 99")
+            self.modes.tool = int(tool)
+        if words.has_m(6):
+            if not self.modes.tool:
+                raise Refused("M6 with no tool selected (T0 or no T): the spindle would be left empty")
+            self.out.append(f"T{self.modes.tool} M6")
+
+    def _spindle_and_coolant(self, words: Words) -> None:
+        codes = [int(code) for code in words.codes["m"] if code in PLAIN_M]
+        for group in ((3, 4, 5), (7, 8, 9)):
+            chosen = [code for code in codes if code in group]
+            if chosen:
+                self.out.append(" ".join(f"M{code}" for code in chosen))
+
+    def _lengths_and_planes(self, words: Words) -> None:
+        plane = words.g("17", "18", "19")
+        if plane is not None:
+            self.modes.plane = plane          # only G18 holds the lathe's arcs (linuxcnc_motion)
+            if plane == "18":
+                self.out.append("G18")
+        units = words.g("20", "21")
+        if units is not None:
+            self.modes.inch = units == "20"
+            self.out.append("G21")
+        diameter = words.g("7", "8")
+        if diameter is not None:
+            self.modes.diameter = diameter == "7"
+
+    def _offsets(self, words: Words) -> None:
+        if words.g("40"):
+            self.out.append("G40")
+        if words.g("43"):
+            holder = words.values.get("h")
+            if holder is not None and holder != self.modes.tool:
+                raise Refused(f"G43 H{holder:g} applies another tool's length than the one in the spindle")
+            self.out.append("G43")
+        if words.g("49"):
+            self.out.append("G49")
+
+    def _distance(self, words: Words) -> None:
+        distance = words.g("90", "91")
+        if distance is not None:
+            self.modes.incremental = distance == "91"
+        arcs = words.g("90.1", "91.1")
+        if arcs is not None:
+            self.modes.arc_absolute = arcs == "90.1"
+
+    def _motion(self, words: Words) -> None:
+        motion = words.g(*MOTIONS)
+        if motion is not None:
+            self.modes.motion = motion
+        if motion is not None or {"x", "z"} & words.values.keys():
+            self.mover(self, words, self.modes.motion)
+
+    def _stop(self, words: Words) -> None:
+        for code in (2, 30):
+            if words.has_m(code):
+                self.out.append(f"M{code}")
+
+
+def _number(value: float) -> str:
+    """A plain decimal with its point, to 0.1 µm (finer than any control's increment)."""
+    text = f"{value:.4f}".rstrip("0")
+    return "0." if text in ("-0.", "0.") else text
+
+
+number = _number
+
+
+KNOWN_G = frozenset({*MOTIONS, *IGNORED_G, "4", "17", "19", "7", "8", "20", "21", "40", "43", "49", "90", "91", "90.1",
+                     "91.1", "94", "95", "96", "97"})
+STEPS = (Executor._lengths_and_planes, Executor._feed_mode, Executor._feed, Executor._speed, Executor._tool,
+         Executor._spindle_and_coolant, Executor._offsets, Executor._distance, Executor._motion, Executor._stop)

@@ -1,0 +1,84 @@
+"""The real LinuxCNC lathe programs of tests/data/nc/linuxcnc and how each is run (issue 27): a
+program as it stands, or a subroutine file as the screen that calls it runs it (ngcgui: its
+preamble lathe_std.ngc, the file, the call with the form's defaults, m2; a lathe macro: the
+preamble, the operator's start position, the call with the MACRODEFAULTS values)."""
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+from engine.machines.records import Machine
+from engine.verifier import LimitError, verify_program
+from engine.verifier.expanders.linuxcnc_callers import as_called, macro_defaults, ngcgui_defaults
+
+ROOT = Path(__file__).resolve().parent.parent.parent
+FOLDER = ROOT / "tests" / "data" / "nc" / "linuxcnc"
+SEED = ROOT / "seed_templates" / "machines.csv"
+PREAMBLE = (FOLDER / "ngcgui_lathe" / "lathe_std.ngc").read_text().splitlines()   # g18 g20 g40 g49 g90 g94 g54
+# The lathe macros turn from where the tool stands (#<_x>, #<_z>): 1.2 in diameter, 0.1 in in front
+# of the face, outside the macros' default diameters (1.0 in finish, 1.0 in thread).
+MACRO_START = "g7 g0 x1.2 z0.1"
+NGCGUI, MACRO = "ngcgui", "macro"
+
+
+def seeded_lathe() -> Machine:
+    with SEED.open(newline="") as handle:
+        row = next(row for row in csv.DictReader(handle) if row["name"] == "lathe-linuxcnc")
+    numbers = [float(row[c]) if row[c] else None for c in ("x_min", "x_max", "y_min", "y_max", "z_min", "z_max",
+                                                             "spindle_max", "table_speed_max", "module_max")]
+    return Machine(row["name"], row["kind"], row["dialect"], *numbers)   # type: ignore[arg-type]
+
+
+LATHE = seeded_lathe()
+
+# file -> (how it runs, None for verified or the construct its refusal names)
+PROGRAMS = {
+    "lathe_g70_71_demo.ngc": (None, "profile cycle G71.1"),
+    "lathe_pawn.ngc": (None, "no tool length offset active"),
+    "lathe-g76.ngc": (None, "an X before G7/G8"),
+    "lathe_g7x_face_boring.ngc": (None, "profile cycle G72"),
+    "lathe_g7x_quadrants.ngc": (None, "profile cycle G70"),
+    "lathecomp.ngc": (None, "M6 with no tool selected"),
+    "lathe_macros/boring.ngc": (MACRO, None),
+    "lathe_macros/chamfer.ngc": (MACRO, None),
+    "lathe_macros/facing.ngc": (MACRO, None),
+    "lathe_macros/threading.ngc": (MACRO, None),
+    "lathe_macros/turning.ngc": (MACRO, None),
+    "lathe_macros/drill.ngc": (MACRO, "G83 is a drilling cycle"),
+    # its MACRODEFAULTS are in MACROCOMMAND's order (X, SFM, DOC, Z, Tool, Radius …) but the code
+    # reads the tool from #6: called with them, it selects T0.381
+    "lathe_macros/radius.ngc": (MACRO, "T0.381 is not a tool"),
+    "ngcgui_lathe/od.ngc": (NGCGUI, "G53 moves in machine coordinates"),
+    "ngcgui_lathe/id.ngc": (NGCGUI, "G53 moves in machine coordinates"),
+    "ngcgui_lathe/taper-od.ngc": (NGCGUI, "system parameter #5410"),
+    "ngcgui_lathe/g76diam.ngc": (NGCGUI, "the file g76base.ngc is not in this program"),
+    "ngcgui_lathe/g76base.ngc": (NGCGUI, "#<_vmajor> holds a value only the control has"),
+}
+PLASMA = {"plasmac_family/imperial_ramp_pierce.ngc": "M65 switches a HAL output",
+          "plasmac_family/metric_ramp_pierce.ngc": "M65 switches a HAL output",
+          "plasmac_family/imperial_wrench.ngc": "is a HAL pin or INI value",
+          "plasmac_family/metric_wrench.ngc": "is a HAL pin or INI value"}
+
+
+def file_lines(name: str) -> list[str]:
+    return (FOLDER / name).read_text().splitlines()
+
+
+def program_of(name: str, values: list[str] | None = None) -> list[str]:
+    """The program the control runs for `name`: the file, or the file as its screen calls it."""
+    how, _ = PROGRAMS[name]
+    lines = file_lines(name)
+    if how == NGCGUI:
+        return as_called(lines, values or ngcgui_defaults(lines), PREAMBLE)
+    if how == MACRO:
+        return as_called(lines, values or macro_defaults(lines), [*PREAMBLE, MACRO_START])
+    return lines
+
+
+def refusal(lines: list[str], machine: Machine = LATHE) -> str | None:
+    """None for a program the verifier reads whole, else its message."""
+    try:
+        verify_program(lines, machine, None)
+    except LimitError as error:
+        return str(error)
+    return None
