@@ -53,9 +53,30 @@ def import_nc_command(ctx, nc_file, gear_class, params_file, modules_file, paren
 
 
 def _binding_line(binding: dict) -> str:
-    """`  feed → F: 3 word(s) (F 3)`: a parameter, the addresses it binds, the words it bound."""
-    at = ", ".join(f"{address} {count}" for address, count in binding["at"].items())
-    return f"  {binding['parameter']} → {binding['binds']}: {binding['words']} word(s)" + (f" ({at})" if at else "")
+    """`  feed → F: 3 word(s) (F 3: lines 4, 9-10); left alone: U 1 (line 7)`: a parameter, the
+    addresses it binds, the words it bound and the equal words it left as written, per address."""
+    lines = binding.get("lines", {})
+    at = "; ".join(f"{address} {count}: {_lines(lines.get(address, []))}" for address, count in binding["at"].items())
+    left = "; ".join(f"{address} {entry['words']} ({_lines(entry['lines'])})"
+                     for address, entry in binding.get("left_alone", {}).items())
+    return (f"  {binding['parameter']} → {binding['binds']}: {binding['words']} word(s)" + (f" ({at})" if at else "")
+            + (f"; left alone: {left}" if left else ""))
+
+
+SHOWN_RANGES = 8   # line ranges printed per address; the rest counted (--json lists every line)
+
+
+def _lines(numbers: list[int]) -> str:
+    """`lines 4, 9-10` (`line 7`): line numbers as ranges, the first SHOWN_RANGES of them."""
+    ranges: list[list[int]] = []
+    for number in numbers:
+        if ranges and number <= ranges[-1][1] + 1:
+            ranges[-1][1] = max(ranges[-1][1], number)
+        else:
+            ranges.append([number, number])
+    shown = [f"{low}" if low == high else f"{low}-{high}" for low, high in ranges[:SHOWN_RANGES]]
+    more = f" … and {len(ranges) - SHOWN_RANGES} more range(s)" if len(ranges) > SHOWN_RANGES else ""
+    return ("line " if len(numbers) == 1 else "lines ") + ", ".join(shown) + more
 
 
 def _draft_note(report) -> str:
