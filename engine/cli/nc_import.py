@@ -15,8 +15,10 @@ from .context import connection, emit_json, keyed
               help="The job's parameters: JSON {name: value} or {name: {\"value\": v, \"addresses\": [\"F\"]}}, "
                    "or CSV name,value[,addresses]. A number equal to a value becomes a reference to it at the "
                    "addresses the parameter names (plain value: every address but G M N O T $, and never a number "
-                   "that names a block, program, tool edge or spindle); equal numbers elsewhere are left as "
-                   "written and listed with the reason. A bound form's value must be a number.")
+                   "that names a block, program, tool edge or spindle, nor a cycle's U W R); never a number "
+                   "inside [...] or a spindle clamp (G50 S). Equal numbers left as written are listed with "
+                   "their lines and the reason. A bound form's value must be a number; a bound word is "
+                   "written with the value's own digits, never rounded.")
 @click.option("--modules", "modules_file", type=click.Path(dir_okay=False),
               help="Corrections of the module assignment: CSV line_no,t (1-based program lines).")
 @click.option("--parent", help="Parent class in the tree, for a new class.")
@@ -27,6 +29,7 @@ def import_nc_command(ctx, nc_file, gear_class, params_file, modules_file, paren
     """Import NC_FILE as the class's template: one row per line, all or nothing.
 
     Instantiating the class with the same parameter values gives NC_FILE back line for line.
+    A tab in NC_FILE is refused, naming its line: replace tabs with spaces.
     """
     from ..library.nc_import import import_nc, read_modules, read_params
 
