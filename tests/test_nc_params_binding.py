@@ -109,8 +109,8 @@ def test_the_plain_form_binds_every_address_but_the_codes(conn, relative, parame
     rows = stored_rows(conn, "nc_plain")
     assert {line for line, o in rows.items() if binds(o, parameter)} == {line for line, *_ in quantities}
     assert {found for found in (word[1] for word in quantities)} >= {address}   # the demo's R0.3 is G71's retract
-    assert report.left_alone == [{"line": line, "word": word, "parameter": parameter}
-                                 for line, found, word, _ in equal if found in "NOT" or in_cycle(relative, line, found)]
+    assert [(left["line"], left["word"], left["parameter"]) for left in report.left_alone] == [
+        (line, word, parameter) for line, found, word, _ in equal if found in "NOT" or in_cycle(relative, line, found)]
     counts = {found: sum(1 for word in quantities if word[1] == found) for found in sorted({w[1] for w in quantities})}
     assert {key: report.bindings[0][key] for key in ("parameter", "addresses", "binds", "words", "at")} == {
         "parameter": parameter, "addresses": None, "binds": "every address but G M N O T $",
