@@ -175,3 +175,11 @@ def test_the_import_nc_command_refuses_a_tab_with_exit_1(run, tmp_path):
     assert result.exit_code == 1 and "line 2 column 3 holds a tab" in result.stderr, result.output
     listed = run("template", "export", "--class", "nc_tab")
     assert listed.exit_code != 0   # no class was made
+
+
+def test_a_format_spec_of_python_with_a_tilde_fill_is_still_python_s():
+    from engine.templates.evaluator import evaluate
+    from engine.templates.expressions import compile_expression
+
+    assert evaluate(compile_expression('f"{x:~>6}|{x:~#.00}|{x:~^7.2f}"'), {"x": 1.5}) == \
+        f"{1.5:~>6}|{own_digits(1.5, 2, False)}|{1.5:~^7.2f}"

@@ -183,8 +183,8 @@ def test_g_and_m_numbers_stay_literal_and_others_become_references(conn, tmp_pat
     path = write(tmp_path, "G01 X1 F250.\nM3 S1 $1\nG1 Z-.4 (1 mm)\n")
     report = import_nc(conn, path, "nc_snippet", {"x": 1, "feed": 250, "depth": -0.4})
     rows = load_template(conn, "nc_snippet").rows
-    assert rows[0].o == 'f"G01 X{nc_number(x, \'#\')} F{nc_number(feed, \'#.\')}"'
-    assert rows[1].o == 'f"M3 S{nc_number(x, \'#\')} $1"'   # M3 and $1 are codes; S1 is a value
+    assert rows[0].o == 'f"G01 X{x:~#} F{feed:~#.}"'
+    assert rows[1].o == 'f"M3 S{x:~#} $1"'   # M3 and $1 are codes; S1 is a value
     assert "G1 Z" in rows[2].o and "(1 mm)" in rows[2].o and "depth" in rows[2].o
     assert report.parameterised == 4 and report.ambiguous == {}
     assert instantiate(conn, "nc_snippet", {"x": 2, "feed": 300, "depth": -0.75}) == \
@@ -193,7 +193,7 @@ def test_g_and_m_numbers_stay_literal_and_others_become_references(conn, tmp_pat
 
 def test_a_value_two_parameters_share_uses_the_first_and_is_reported(conn, tmp_path):
     report = import_nc(conn, write(tmp_path, "G0 X5 Z5\n"), "nc_shared", {"x_start": 5, "z_start": 5})
-    field = "{nc_number(x_start, '#')}"
+    field = "{x_start:~#}"
     assert load_template(conn, "nc_shared").rows[0].o == f'f"G0 X{field} Z{field}"'
     assert report.ambiguous == {"5": ["x_start", "z_start"]}
 
@@ -228,7 +228,7 @@ def test_modules_of_an_840d_hobbing_program(conn, tmp_path):
     assert [(row.t, row.n) for row in rows] == [(t, n) for _, t, n in HOBBING]
     assert [row.id for row in rows] == list(range(10, 10 * len(HOBBING) + 1, 10))
     assert report.modules == {"main": 4, "prep": 7, "sync": 3, "shift": 1, "cutcond": 4, "cutmotion": 3}
-    assert rows[11].o == 'f"EGON(C,\\"FINE\\",B,-1,{nc_number(z2, \'#\')})"'
+    assert rows[11].o == """f'EGON(C,"FINE",B,-1,{z2:~#})'"""
 
 
 def test_the_engineer_corrects_modules_and_following_lines_follow(conn, tmp_path):
@@ -292,7 +292,7 @@ def test_import_nc_command_reports_json_and_export_gives_the_rows(run, tmp_path)
     assert report["modules"] == {"cutcond": 1, "cutmotion": 2}
     exported = run("template", "export", "--class", "nc_cli")
     assert exported.stdout.splitlines()[1:] == [
-        '10,cutmotion,1,,,"f""G01 X{nc_number(x, \'#\')}""",', '20,cutcond,1,,,"f""F{nc_number(feed, \'#.\')}""",',
+        '10,cutmotion,1,,,"f""G01 X{x:~#}""",', '20,cutcond,1,,,"f""F{feed:~#.}""",',
         '30,cutmotion,2,,,"""G1 Z-1""",']
 
 

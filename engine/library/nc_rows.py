@@ -14,7 +14,7 @@ from ..errors import EngineError
 from ..nc.tokens import NUMBER, WORD, facts
 from ..templates.evaluator import evaluate
 from ..templates.expressions import MAX_EXPRESSION_LENGTH, compile_expression
-from ..templates.nc_number import style_of
+from ..templates.nc_number import NC_NUMBER_SPEC, style_of
 from .nc_params import FUNCTION_ADDRESSES, Binding
 from .nc_references import CODE_NAMES, block_context, reference_at
 
@@ -74,7 +74,7 @@ def number_field(name: str, spelling: str) -> str:
     """The f-string replacement field that prints `name` exactly, in the style of `spelling`
     (engine.templates.nc_number: the value's own digits, at least the file's decimals, never
     rounded to them)."""
-    return f"{{nc_number({name}, '{style_of(spelling)}')}}"
+    return f"{{{name}:{NC_NUMBER_SPEC}{style_of(spelling)}}}"
 
 
 class Builder:

@@ -1,7 +1,10 @@
 """A number of an imported NC program written with the value given (issue 27): never rounded to
-the decimals the file happened to write. An imported row prints a bound word as
-`nc_number(feed, '0.010')`: the value's own digits (its shortest exact decimal: the float 0.025
-is 0.025, not 0.0250000000000000013…), in the style of the number as the file wrote it:
+the decimals the file happened to write. An imported row prints a bound word as the f-string
+field `{feed:~#.000}` (a format spec `~` and the style: the evaluator calls nc_number for it;
+`{nc_number(feed, '#.000')}` is the same as a call, for templates written by hand, but costs half
+as much again to compile, and an imported program compiles a row per line): the value's own
+digits (its shortest exact decimal: the float 0.025 is 0.025, not 0.0250000000000000013…), in the
+style of the number as the file wrote it:
 
 * the value the file had gives the file's spelling back exactly (`0.010` stays `0.010`), so the
   import comes back byte for byte;
@@ -42,6 +45,9 @@ def style_of(spelling: str) -> str:
     padded = len(integer) > 1 and integer.startswith("0")
     whole = "0" * len(sign + integer) if padded else ("#" if integer else "")   # width with the sign: a column
     return f"{'+' if sign == '+' else ''}{whole}{point}{'0' * len(fraction)}"
+
+
+NC_NUMBER_SPEC = "~"   # `{feed:~#.000}`: the f-string field of an imported word (engine.templates.evaluator)
 
 
 def nc_number(value, style: str) -> str:

@@ -66,11 +66,11 @@ PARAMS = {
 
 def binds(o: str, name: str) -> bool:
     """Whether a stored row `o` prints parameter `name` into a word (engine.templates.nc_number)."""
-    return f"nc_number({name}," in o
+    return "{" + name + ":~" in o
 
 
 def bound_count(o: str, name: str) -> int:
-    return o.count(f"nc_number({name},")
+    return o.count("{" + name + ":~")
 
 
 def real_files():
