@@ -88,16 +88,15 @@ def test_a_config_that_is_no_regular_file_is_refused_without_reading_it(fresh_da
     assert done.stderr.count("\n") == 1 and path in done.stderr and "not a regular file" in done.stderr, done.stderr
 
 
-def test_a_tab_inside_an_imported_nc_line_is_refused_when_stored_unverified(run, tmp_path):
-    """An imported program keeps its tabs (the file comes back byte for byte), but a stored NC line
-    holds no control character (check_program): `--unverified`, which skips the verifier that would
-    refuse the tab, ended in the database's CheckViolation and exit 2."""
+def test_a_tab_inside_an_imported_nc_line_is_refused_at_import_naming_the_line(run, tmp_path):
+    """A stored NC line holds no control character (check_program): a program with a tab was
+    imported, and then `--unverified`, which skips the verifier, ended in the database's
+    CheckViolation and exit 2 (issue 26); since issue 27 the import refuses the tab, naming its
+    line, and stores nothing."""
     source = (ROOT / "tests" / "data" / "nc" / "linuxcnc" / "lathe_pawn.ngc").read_text().splitlines()
     source[3] = source[3].replace(" ", "\t", 1)
     program = tmp_path / "tabbed.ngc"
     program.write_text("\n".join(source) + "\n")
-    assert run("import-nc", program, "--class", "tabbed").exit_code == 0
     before = stored(run.url)
-    refused_in_one_line(run("instantiate", "--class", "tabbed", "--draft", "--unverified", "--machine", "lathe-iso"),
-                        "line 4", "'\\t'", "no control character", "nothing stored")
+    refused_in_one_line(run("import-nc", program, "--class", "tabbed"), "line 4", "holds a tab", "nothing stored")
     assert stored(run.url) == before

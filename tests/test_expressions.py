@@ -114,7 +114,9 @@ def test_asteval_evaluation_agrees_with_python_on_ordinary_expressions(text):
 PLAIN_PIECES = st.one_of(
     st.text(alphabet=st.characters(blacklist_categories=("Cs",), blacklist_characters='"\\{}\n\r'), max_size=8),
     st.sampled_from(["{x}", "{x:.3f}", "{feed:+08.2f}", "{pi:.4f}", "{sin}", "{_x}", "{x!r}", "{x:9999}",
-                     "{x:>{w}}", "{x + 1}", "{x:{'5'}}", "{{", "}}", "{True}", "{min(x, 1)}"]),
+                     "{x:>{w}}", "{x + 1}", "{x:{'5'}}", "{{", "}}", "{True}", "{min(x, 1)}",
+                     "{nc_number(x, '0.010')}", "{nc_number(feed, '-.4')}", "{nc_number(x, 1)}", "{nc_number(pi, '2')}",
+                     "{nc_number(_x, '2')}", "{nc_number(x, '2'):>5}", "{nc_number(x)}", "{nc_number(sin, '1')}"]),
 )
 
 

@@ -14,7 +14,8 @@ from engine.templates.rows import export_csv
 from engine.templates.store import load_template
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "bench"))
-from import_nc import PARAMS, program  # noqa: E402   the benchmark's generated 840D program
+from import_nc import HOB_PARAMS as PARAMS  # noqa: E402   the benchmark's generated 840D program
+from import_nc import hob_program as program  # noqa: E402
 
 
 def stored(conn):

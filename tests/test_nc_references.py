@@ -10,7 +10,7 @@ import re
 
 import psycopg
 import pytest
-from helpers.nc_files import DATA, FAMILY, instantiated, stored_at, stored_rows
+from helpers.nc_files import DATA, FAMILY, binds, instantiated, stored_at, stored_rows
 from helpers.outcomes import one_line_error
 
 from engine.library.nc_import import import_nc
@@ -93,7 +93,7 @@ def test_plasma_io_channels_stay_and_the_values_they_carry_bind(conn):
     report = import_nc(conn, DATA / PIERCE, "nc_pierce", {"three": 3, "hundred": 100})
     assert sorted(left(report, "three")) == channels
     rows = stored_rows(conn, "nc_pierce")
-    assert all("{three" in rows[number] or "{hundred" in rows[number] for number, _ in carried)
+    assert all(binds(rows[number], "three") or binds(rows[number], "hundred") for number, _ in carried)
 
 
 # --- the command -------------------------------------------------------------------------------

@@ -15,15 +15,14 @@ import json
 import psycopg
 import pytest
 from helpers.class_jobs import PAWN, import_emco, ok, refused, stored_program
+from helpers.nc_files import DATA as NC
 from helpers.roles import as_role
-from helpers.shared_data import shared_data
 
 from engine.errors import EngineError
 from engine.library.nc_import import import_nc
 from engine.programs.class_jobs import instantiate_class
 from engine.release.gate import release
 
-NC = shared_data() / "nc"
 REAL_PROGRAMS = sorted(path for path in NC.rglob("*") if path.is_file() and path.name != "PROVENANCE.tsv")
 PAWN_PARAMS = {"spindle": 1000, "feed": 50.0}
 PASTE = ("INSERT INTO template_view (gear_class, id, t, n, o) "

@@ -15,8 +15,10 @@ from .context import connection, emit_json, keyed
               help="The job's parameters: JSON {name: value} or {name: {\"value\": v, \"addresses\": [\"F\"]}}, "
                    "or CSV name,value[,addresses]. A number equal to a value becomes a reference to it at the "
                    "addresses the parameter names (plain value: every address but G M N O T $, and never a number "
-                   "that names a block, program, tool edge or spindle); equal numbers elsewhere are left as "
-                   "written and listed with the reason. A bound form's value must be a number.")
+                   "that names a block, program, tool edge or spindle, nor a cycle's U W R); never a number "
+                   "inside [...] or a spindle clamp (G50 S). Equal numbers left as written are listed with "
+                   "their lines and the reason. A bound form's value must be a number; a bound word is "
+                   "written with the value's own digits, never rounded.")
 @click.option("--modules", "modules_file", type=click.Path(dir_okay=False),
               help="Corrections of the module assignment: CSV line_no,t (1-based program lines).")
 @click.option("--parent", help="Parent class in the tree, for a new class.")
@@ -27,6 +29,7 @@ def import_nc_command(ctx, nc_file, gear_class, params_file, modules_file, paren
     """Import NC_FILE as the class's template: one row per line, all or nothing.
 
     Instantiating the class with the same parameter values gives NC_FILE back line for line.
+    A tab in NC_FILE is refused, naming its line: replace tabs with spaces.
     """
     from ..library.nc_import import import_nc, read_modules, read_params
 
@@ -53,9 +56,30 @@ def import_nc_command(ctx, nc_file, gear_class, params_file, modules_file, paren
 
 
 def _binding_line(binding: dict) -> str:
-    """`  feed → F: 3 word(s) (F 3)`: a parameter, the addresses it binds, the words it bound."""
-    at = ", ".join(f"{address} {count}" for address, count in binding["at"].items())
-    return f"  {binding['parameter']} → {binding['binds']}: {binding['words']} word(s)" + (f" ({at})" if at else "")
+    """`  feed → F: 3 word(s) (F 3: lines 4, 9-10); left alone: U 1 (line 7)`: a parameter, the
+    addresses it binds, the words it bound and the equal words it left as written, per address."""
+    lines = binding.get("lines", {})
+    at = "; ".join(f"{address} {count}: {_lines(lines.get(address, []))}" for address, count in binding["at"].items())
+    left = "; ".join(f"{address} {entry['words']} ({_lines(entry['lines'])})"
+                     for address, entry in binding.get("left_alone", {}).items())
+    return (f"  {binding['parameter']} → {binding['binds']}: {binding['words']} word(s)" + (f" ({at})" if at else "")
+            + (f"; left alone: {left}" if left else ""))
+
+
+SHOWN_RANGES = 8   # line ranges printed per address; the rest counted (--json lists every line)
+
+
+def _lines(numbers: list[int]) -> str:
+    """`lines 4, 9-10` (`line 7`): line numbers as ranges, the first SHOWN_RANGES of them."""
+    ranges: list[list[int]] = []
+    for number in numbers:
+        if ranges and number <= ranges[-1][1] + 1:
+            ranges[-1][1] = max(ranges[-1][1], number)
+        else:
+            ranges.append([number, number])
+    shown = [f"{low}" if low == high else f"{low}-{high}" for low, high in ranges[:SHOWN_RANGES]]
+    more = f" … and {len(ranges) - SHOWN_RANGES} more range(s)" if len(ranges) > SHOWN_RANGES else ""
+    return ("line " if len(numbers) == 1 else "lines ") + ", ".join(shown) + more
 
 
 def _draft_note(report) -> str:

@@ -9,23 +9,20 @@ address its parameter does not bind is left as written and reported (`left_alone
 report lists every parameter with the words it bound. A line with no reference is a
 constant row (`o` = a plain string literal); a line with references is an f-string.
 
-Exact spelling: the field that replaces a number is a format recipe read off the
-number as written, so that the original value prints exactly as the original wrote it:
-* digits after the point → precision:             `0.0500` → `{p:.4f}`, `4` → `{p:.0f}`
-* a point with no digits after it → a literal `.`: `250.`   → `{p:.0f}.`
-* leading zeros → zero-padded width (sign incl.):  `-00500` → `{p:06.0f}`
-* an explicit `+` → the `+` flag:                  `+5`     → `{p:+.0f}`
-* no digit before the point (`.4`, `-.4`): written from the rounded magnitude, the integer
-  part only when it is not 0: `{'-' if p < 0 else ''}{round(abs(p) * 10) // 10 or ''}.`
-  `{round(abs(p) * 10) % 10:01d}`
-Other values of the parameter print in the same style (same decimals, same padding).
-Every field is evaluated with the original value before it is used; a number whose recipe
-would not give its spelling back (a float that cannot hold all its digits), and a
-negative zero (`J-0`: the sign is not in the value), stay literal. When several
-parameters that bind a number's address have its value, the first one given is used (reported).
+Exact values (issue 27): the field that replaces a number is `{nc_number(p, 'style')}`
+(engine.templates.nc_number), the style read off the number as written (`0.010` → `#.000`,
+`250.` → `#.`, `-00500` → `000000`, `+5` → `+#`, `.4` → `.0`). The imported value prints as the
+file wrote it; another value prints its own digits (the shortest exact decimal), with at least the
+file's decimals and the file's point, padding and sign: feed 0.025 in the style of `F0.010` is
+`F0.025`, 31.25 in the style of `F31.` is `F31.25`. It is never rounded: a value with more
+significant digits than an NC word holds is refused when the class is instantiated, with the reason.
+Every field is evaluated with the original value before it is used; a number it would not give
+back (a float that cannot hold all its digits, more digits than a word holds), and a negative
+zero (`J-0`: the sign is not in the value), stay literal. When several parameters that bind a
+number's address have its value, the first one given is used (reported).
 
 Literal text is quoted exactly: backslashes and the quote character are escaped, braces
-doubled inside f-strings, and control characters (tabs) written as escapes.
+doubled inside f-strings. A tab is refused with its line (refuse_tabs: no program line holds one).
 
 Modules: the rules of MODULE_RULES decide a line's module type from its tokens, in order;
 a line no rule decides keeps the module of the line before (the first line: main). The
@@ -129,7 +126,8 @@ def _import(conn: Connection, path, gear_class: str, params: dict | None, module
     counts = {t: sum(1 for row in rows if row.t == t) for t in MODULE_ORDER}
     return ImportReport(gear_class, str(path), len(rows), found.parameterised,
                         {t: c for t, c in counts.items() if c}, created, changed, template.version,
-                        found.ambiguous, released_version(conn, gear_class), binding_report(bound, found.bound),
+                        found.ambiguous, released_version(conn, gear_class),
+                        binding_report(bound, found.bound, found.bound_lines, found.left_lines),
                         [asdict(left) for left in found.left_alone])
 
 
@@ -205,7 +203,23 @@ def read_nc_file(path) -> tuple[list[str], NcLayout]:
                           "it is binary, not a text NC program")
     if not text.strip():
         raise EngineError(f"{path} is empty; give an NC program with at least one line")
+    refuse_tabs(path, text)
     return split_nc_text(path, text)
+
+
+def refuse_tabs(path, text: str) -> None:
+    """A tab is refused where the program enters, naming its line (issue 27): the program record
+    holds no control character in a line (check_program, migration 0010: every writer's program
+    is one block per line of printable text), and not every control reads a tab as a space (a
+    Fanuc's ISO code has no HT among its program characters). Accepted here, the class's every job
+    would fail when stored; refused, the user converts the file once and it comes back byte for byte."""
+    tab = text.find("\t")
+    if tab >= 0:
+        line = text.count("\n", 0, tab) + 1
+        column = tab - text.rfind("\n", 0, tab)
+        raise EngineError(f"{path} line {line} column {column} holds a tab: a stored NC line holds no control "
+                          "character and not every control reads a tab; replace each tab with a space "
+                          "(`expand -t 1 FILE`) and import the file again; nothing stored")
 
 
 RESERVED_NAMES = frozenset(FUNCTIONS) | frozenset(CONSTANTS) | {"template_version"}

@@ -113,14 +113,26 @@ declare(parse_addresses, "address letters", "write the addresses it binds, such 
 NO_ADDRESS = "no address"   # the key of the numbers after no address (EMCO columns, cycle arguments)
 
 
-def binding_report(bound: dict[str, Binding], words: Counter) -> list[dict]:
+def binding_report(bound: dict[str, Binding], words: Counter, lines: dict | None = None,
+                   left: dict | None = None) -> list[dict]:
     """Each parameter in the order given, for the import report: the addresses it binds (None:
     the plain form's, every address but the codes), the words it bound (`words`: (name, address)
-    → count) and how many at each address."""
+    → count) and how many at each address, with their line numbers (`lines`: (name, address) →
+    lines), and per address the equal words it left as written (`left`, the same form: count and lines)."""
+    lines, left = lines or {}, left or {}
     report = []
     for name, binding in bound.items():
         at = {address or NO_ADDRESS: count for (bound_name, address), count in sorted(
             words.items(), key=lambda item: item[0][1] or "") if bound_name == name}
         report.append({"parameter": name, "addresses": sorted(binding.addresses) if binding.addresses else None,
-                       "binds": binding.described(), "words": sum(at.values()), "at": at})
+                       "binds": binding.described(), "words": sum(at.values()), "at": at,
+                       "lines": _per_address(name, lines), "left_alone": {
+                           address: {"words": len(numbers), "lines": numbers}
+                           for address, numbers in _per_address(name, left).items()}})
     return report
+
+
+def _per_address(name: str, lines: dict) -> dict[str, list[int]]:
+    """address → the sorted line numbers of `name`'s entries in `lines` ((name, address) → lines)."""
+    return {address or NO_ADDRESS: sorted(numbers) for (owner, address), numbers in sorted(
+        lines.items(), key=lambda item: item[0][1] or "") if owner == name}

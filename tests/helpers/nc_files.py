@@ -2,6 +2,9 @@
 parameters, the class each becomes, and the rows and programs read back from the database."""
 from __future__ import annotations
 
+import atexit
+import shutil
+import tempfile
 from pathlib import Path
 
 import psycopg
@@ -11,7 +14,26 @@ from engine.templates.decision_table import compiled_template
 from engine.templates.store import load_template
 from helpers.shared_data import shared_data
 
-DATA = shared_data() / "nc"
+REAL = shared_data() / "nc"   # the files as their repositories have them
+
+
+def _as_imported(real: Path) -> Path:
+    """The real programs as a user imports them: a file with tabs is refused by import-nc, naming
+    the line (issue 27), and comes in once its tabs are spaces, as the refusal says. A copy of
+    tests/data/nc with each tab replaced by one space, made once per test process."""
+    copy = Path(tempfile.mkdtemp(prefix="real_nc_"))
+    atexit.register(shutil.rmtree, copy, True)
+    for path in real.rglob("*"):
+        if path.is_file():
+            target = copy / path.relative_to(real)
+            target.parent.mkdir(parents=True, exist_ok=True)
+            target.write_bytes(path.read_bytes().replace(b"\t", b" "))
+    return copy
+
+
+DATA = _as_imported(REAL)
+TABBED = sorted(str(path.relative_to(REAL)) for path in REAL.rglob("*")
+                if path.is_file() and path.suffix != ".tsv" and b"\t" in path.read_bytes())
 FAMILY = "linuxcnc/plasmac_family/"
 MACROS = "linuxcnc/lathe_macros/"
 
@@ -47,6 +69,15 @@ PARAMS = {
     "emco_from_dxf/testg02hemisphere.cnc": {"feed": 100, "z_clear": 3000},
     "emco_from_dxf/testg03hemisphere.cnc": {"feed": 100, "z_clear": 3000},
 }
+
+
+def binds(o: str, name: str) -> bool:
+    """Whether a stored row `o` prints parameter `name` into a word (engine.templates.nc_number)."""
+    return "{" + name + ":~" in o
+
+
+def bound_count(o: str, name: str) -> int:
+    return o.count("{" + name + ":~")
 
 
 def real_files():
