@@ -38,13 +38,14 @@ PROGRAMS = {
     "lathe-g76.ngc": (None, "an X before G7/G8"),
     "lathe_g7x_face_boring.ngc": (None, "profile cycle G72"),
     "lathe_g7x_quadrants.ngc": (None, "profile cycle G70"),
-    "lathecomp.ngc": (None, "M6 with no tool selected"),
+    # T0 M6 unloads the tool (accepted); the file states no G7/G8, which M2 does not reset
+    "lathecomp.ngc": (None, "an X before G7/G8"),
     "lathe_macros/boring.ngc": (MACRO, None),
     "lathe_macros/chamfer.ngc": (MACRO, None),
     "lathe_macros/facing.ngc": (MACRO, None),
     "lathe_macros/threading.ngc": (MACRO, None),
     "lathe_macros/turning.ngc": (MACRO, None),
-    "lathe_macros/drill.ngc": (MACRO, "G83 is a drilling cycle"),
+    "lathe_macros/drill.ngc": (MACRO, None),
     # its MACRODEFAULTS are in MACROCOMMAND's order (X, SFM, DOC, Z, Tool, Radius …) but the code
     # reads the tool from #6: called with them, it selects T0.381
     "lathe_macros/radius.ngc": (MACRO, "T0.381 is not a tool"),

@@ -63,6 +63,11 @@ def move(executor: Executor, words: Words, motion: str) -> None:
     executor.modes.x, executor.modes.z = x, z
 
 
+def feed_words(executor: Executor) -> str:
+    """The feed mode and F of a feed block (a canned cycle's feeds too)."""
+    return _feed(executor)
+
+
 def _axes(words: Words, x: float | None, z: float | None) -> str:
     shown = []
     if "x" in words.values and x is not None:
