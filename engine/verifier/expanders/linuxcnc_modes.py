@@ -24,7 +24,9 @@ REFUSED = {
              "program the tool tip path (G40)" for code in ("41", "42", "41.1", "42.1")},
     **{code: f"G{code} moves by way of a home position the machine record does not name"
        for code in ("28", "28.1", "30", "30.1")},
-    "53": "G53 moves in machine coordinates, a frame the record's travel is not stated in",
+    "53": "G53 moves in machine coordinates: the machine record does not give where the work "
+          "offset's zero lies in them (a G54 origin X/Z in machine coordinates would); program the "
+          "move in work coordinates",
     **{code: f"G{code} selects a work offset the verifier cannot see (positions are read in G54)"
        for code in ("55", "56", "57", "58", "59", "59.1", "59.2", "59.3")},
     **{code: f"G{code} shifts every position by an offset the verifier cannot see"
