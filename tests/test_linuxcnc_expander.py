@@ -115,7 +115,8 @@ def test_g76_makes_the_passes_of_linuxcnc_s_threading_cycle():
     (["o<shape> call"], "the file shape.ngc is not in this program"), (["o1 call"], "an o1 sub is not in"),
     (["o1 while [1]"], "without its o1 endwhile"), (["o2 endif"], "closes nothing"), (["/G0 X1"], "block delete"),
     (["o3 sub", "o3 endsub"], "never called"), (["M65 P1"], "HAL output"), (["G71 Q1 D1"], "profile cycle G71"),
-    (["G83 Z-1 R1 Q1"], "drilling cycle"), (["(unclosed"], "without its closing"),
+    (["G83 Z-1 R1 Q1"], "G83 outside G17"), (["G73 Z-1 R1 Q1"], "drilling cycle"),
+    (["(unclosed"], "without its closing"),
 ])
 def test_what_the_expander_cannot_follow_is_refused_naming_the_construct(body, reason):
     message = refusal(["G18", *body, "M2"])

@@ -27,8 +27,9 @@ def test_each_real_lathe_program_is_verified_or_refused_naming_its_construct(nam
         assert message.count("\n") == 0 and "nothing stored" in message
 
 
-def test_the_verified_programs_are_the_macros_that_turn_face_bore_chamfer_and_thread():
-    assert VERIFIED == ["lathe_macros/boring.ngc", "lathe_macros/chamfer.ngc", "lathe_macros/facing.ngc",
+def test_the_verified_programs_are_the_macros_that_turn_face_bore_chamfer_drill_and_thread():
+    assert VERIFIED == ["lathe_macros/boring.ngc", "lathe_macros/chamfer.ngc", "lathe_macros/drill.ngc",
+                        "lathe_macros/facing.ngc",
                         "lathe_macros/threading.ngc", "lathe_macros/turning.ngc"]
 
 
@@ -100,6 +101,7 @@ def test_a_loop_that_never_ends_is_refused_at_the_step_bound(monkeypatch):
 BAR = {"stock_diameter": 1.2 * 25.4, "stock_z_front": 0.0, "stock_z_back": -100.0}
 SIMULATED = {
     "lathe_macros/turning.ngc": None, "lathe_macros/chamfer.ngc": None, "lathe_macros/threading.ngc": None,
+    "lathe_macros/drill.ngc": None,       # G83 on the axis: pecks into the bar's solid centre
     # a boring macro called on a solid bar: its first rapid enters material a drilled bore would not have
     "lathe_macros/boring.ngc": "a rapid through material",
     # the facing macro rapids out at the depth of the pass it just made, through the next step's stock

@@ -35,22 +35,25 @@ LATHE = seeded_lathe()
 PROGRAMS = {
     "lathe_g70_71_demo.ngc": (None, "profile cycle G71.1"),
     "lathe_pawn.ngc": (None, "no tool length offset active"),
-    "lathe-g76.ngc": (None, "an X before G7/G8"),
+    # M2 does not reset G7/G8 and the INI's startup code runs once (docs/reference §3): not stated
+    "lathe-g76.ngc": (None, "an X before G7/G8: diameter or radius is whatever the last program left (M2/M30 keep it"),
     "lathe_g7x_face_boring.ngc": (None, "profile cycle G72"),
     "lathe_g7x_quadrants.ngc": (None, "profile cycle G70"),
-    "lathecomp.ngc": (None, "M6 with no tool selected"),
+    # T0 M6 unloads the tool (accepted); the file states no G7/G8, which M2 does not reset
+    "lathecomp.ngc": (None, "an X before G7/G8"),
     "lathe_macros/boring.ngc": (MACRO, None),
     "lathe_macros/chamfer.ngc": (MACRO, None),
     "lathe_macros/facing.ngc": (MACRO, None),
     "lathe_macros/threading.ngc": (MACRO, None),
     "lathe_macros/turning.ngc": (MACRO, None),
-    "lathe_macros/drill.ngc": (MACRO, "G83 is a drilling cycle"),
+    "lathe_macros/drill.ngc": (MACRO, None),
     # its MACRODEFAULTS are in MACROCOMMAND's order (X, SFM, DOC, Z, Tool, Radius …) but the code
     # reads the tool from #6: called with them, it selects T0.381
     "lathe_macros/radius.ngc": (MACRO, "T0.381 is not a tool"),
-    "ngcgui_lathe/od.ngc": (NGCGUI, "G53 moves in machine coordinates"),
-    "ngcgui_lathe/id.ngc": (NGCGUI, "G53 moves in machine coordinates"),
-    "ngcgui_lathe/taper-od.ngc": (NGCGUI, "system parameter #5410"),
+    "ngcgui_lathe/od.ngc": (NGCGUI, "G53 moves in machine coordinates: the machine record does not give"),
+    "ngcgui_lathe/id.ngc": (NGCGUI, "G53 moves in machine coordinates: the machine record does not give"),
+    "ngcgui_lathe/taper-od.ngc": (NGCGUI, "system parameter #5410 holds a value only the control has (the tool "
+                                          "table's diameter"),
     "ngcgui_lathe/g76diam.ngc": (NGCGUI, "the file g76base.ngc is not in this program"),
     "ngcgui_lathe/g76base.ngc": (NGCGUI, "#<_vmajor> holds a value only the control has"),
 }

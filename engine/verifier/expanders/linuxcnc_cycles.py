@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING
 
 from ..refusals import Refused
 from .cycles import MAX_PASSES, RAPID, THREAD
+from .linuxcnc_drilling import drilling
 from .linuxcnc_modes import number
 from .linuxcnc_motion import move, target
 
@@ -32,9 +33,17 @@ CYCLES = frozenset({"76", "70", "71", "71.1", "71.2", "72", "72.1", "72.2"})
 
 
 def move_or_cycle(executor: Executor, words: Words, motion: str) -> None:
-    """The motion of a line: a cycle here, any other motion by linuxcnc_motion.move."""
+    """The motion of a line: a cycle here, any other motion by linuxcnc_motion.move. A feed with
+    no tool in the spindle (T0 M6 unloaded it) is refused: no tool would cut where the program says."""
+    if motion not in ("0", "80") and executor.modes.extra.get("loaded") == 0:
+        raise Refused(f"G{motion} with no tool in the spindle (T0 M6 unloaded it): change to a tool first")
     if motion in CYCLES:
         cycle(executor, words, motion)
+    elif motion == "83":
+        drilling(executor, words)
+    elif motion == "80":
+        if {"x", "z"} & words.values.keys():
+            raise Refused("X or Z with G80 (no motion mode): LinuxCNC refuses axis words after G80")
     else:
         move(executor, words, motion)
 

@@ -24,22 +24,24 @@ REFUSED = {
              "program the tool tip path (G40)" for code in ("41", "42", "41.1", "42.1")},
     **{code: f"G{code} moves by way of a home position the machine record does not name"
        for code in ("28", "28.1", "30", "30.1")},
-    "53": "G53 moves in machine coordinates, a frame the record's travel is not stated in",
+    "53": "G53 moves in machine coordinates: the machine record does not give where the work "
+          "offset's zero lies in them (a G54 origin X/Z in machine coordinates would); program the "
+          "move in work coordinates",
     **{code: f"G{code} selects a work offset the verifier cannot see (positions are read in G54)"
        for code in ("55", "56", "57", "58", "59", "59.1", "59.2", "59.3")},
     **{code: f"G{code} shifts every position by an offset the verifier cannot see"
        for code in ("92", "92.1", "92.2", "92.3", "10", "52")},
     "93": "G93 inverse-time feed: program F per minute (G94) or per revolution (G95)",
     **{code: f"G{code} is a drilling cycle without a lathe model here; program its moves"
-       for code in ("73", "74", "81", "82", "83", "84", "85", "86", "87", "88", "89")},
+       for code in ("73", "74", "81", "82", "84", "85", "86", "87", "88", "89")},
     **{code: f"G{code} is a probing move: where it stops is found on the machine"
        for code in ("38.2", "38.3", "38.4", "38.5")},
     "33.1": "G33.1 rigid tapping is not modelled; program the moves",
     "43.1": "G43.1 dynamic tool offset: use G43 with the tool table",
     "43.2": "G43.2 adds offsets the verifier cannot see",
 }
-IGNORED_G = frozenset({"54", "61", "61.1", "64", "80", "98", "99", "18"})   # no position changes
-MOTIONS = ("0", "1", "2", "3", "33", "76", "70", "71", "71.1", "71.2", "72", "72.1", "72.2")
+IGNORED_G = frozenset({"54", "61", "61.1", "64", "18"})   # no position changes
+MOTIONS = ("0", "1", "2", "3", "33", "76", "80", "83", "70", "71", "71.1", "71.2", "72", "72.1", "72.2")
 IGNORED_M = frozenset({0, 1, 48, 49, 50, 51, 52, 53, 60})      # pauses and override switches
 PLAIN_M = frozenset({3, 4, 5, 7, 8, 9})
 
@@ -139,8 +141,9 @@ class Executor:
                 raise Refused(f"T{tool:g} is not a tool 0 … 99")
             self.modes.tool = int(tool)
         if words.has_m(6):
-            if not self.modes.tool:
-                raise Refused("M6 with no tool selected (T0 or no T): the spindle would be left empty")
+            if self.modes.tool is None:
+                raise Refused("M6 with no tool selected (no T before it)")
+            self.modes.extra["loaded"] = float(self.modes.tool)     # T0 M6 unloads (LinuxCNC: tool 0 = none)
             self.out.append(f"T{self.modes.tool} M6")
 
     def _spindle_and_coolant(self, words: Words) -> None:
@@ -179,6 +182,9 @@ class Executor:
         distance = words.g("90", "91")
         if distance is not None:
             self.modes.incremental = distance == "91"
+        retract = words.g("98", "99")
+        if retract is not None:              # a canned cycle's retract: initial level (G98) or R (G99)
+            self.modes.extra["retract"] = float(retract)
         arcs = words.g("90.1", "91.1")
         if arcs is not None:
             self.modes.arc_absolute = arcs == "90.1"
@@ -186,6 +192,8 @@ class Executor:
     def _motion(self, words: Words) -> None:
         motion = words.g(*MOTIONS)
         if motion is not None:
+            if motion != self.modes.motion:
+                self.modes.extra.pop("cycle_il", None)     # a new motion mode ends the cycle's initial level
             self.modes.motion = motion
         if motion is not None or {"x", "z"} & words.values.keys():
             self.mover(self, words, self.modes.motion)
@@ -205,7 +213,7 @@ def _number(value: float) -> str:
 number = _number
 
 
-KNOWN_G = frozenset({*MOTIONS, *IGNORED_G, "4", "17", "19", "7", "8", "20", "21", "40", "43", "49", "90", "91", "90.1",
-                     "91.1", "94", "95", "96", "97"})
+KNOWN_G = frozenset({*MOTIONS, *IGNORED_G, "98", "99", "4", "17", "19", "7", "8", "20", "21", "40", "43", "49", "90",
+                     "91", "90.1", "91.1", "94", "95", "96", "97"})
 STEPS = (Executor._lengths_and_planes, Executor._feed_mode, Executor._feed, Executor._speed, Executor._tool,
          Executor._spindle_and_coolant, Executor._offsets, Executor._distance, Executor._motion, Executor._stop)

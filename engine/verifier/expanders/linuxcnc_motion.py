@@ -28,7 +28,9 @@ def target(executor: Executor, words: Words) -> tuple[float | None, float | None
     x, z = modes.x, modes.z
     if "x" in words.values:
         if modes.diameter is None:
-            raise Refused("an X before G7/G8: diameter or radius is whatever the last program left")
+            raise Refused("an X before G7/G8: diameter or radius is whatever the last program left "
+                          "(M2/M30 keep it; the INI's startup G8 holds for the first program only); "
+                          "state G7 or G8 before the first X")
         value = executor.length(words.values["x"]) / (2.0 if modes.diameter else 1.0)
         x = _resolved(value, modes.x, modes.incremental, "X")
     if "z" in words.values:
@@ -61,6 +63,11 @@ def move(executor: Executor, words: Words, motion: str) -> None:
             raise Refused("G33 without its lead K (distance per revolution)")
         executor.out.append(f"G33 {axes} K{number(executor.length(lead))}")
     executor.modes.x, executor.modes.z = x, z
+
+
+def feed_words(executor: Executor) -> str:
+    """The feed mode and F of a feed block (a canned cycle's feeds too)."""
+    return _feed(executor)
 
 
 def _axes(words: Words, x: float | None, z: float | None) -> str:

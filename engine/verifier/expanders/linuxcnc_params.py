@@ -17,6 +17,9 @@ if TYPE_CHECKING:
 
 LOCALS = range(1, 31)
 SYSTEM = 5000
+# What a machine record would need to hold for a system parameter to be known (none holds it yet)
+SYSTEM_NEEDS = {5410: " (the tool table's diameter of the tool in the spindle: the machine record has no "
+                      "lathe tool table; program the diameter as a value)"}
 INCH = 25.4
 
 
@@ -47,7 +50,8 @@ class Parameters:
             if number in LOCALS:
                 return self.frame.numbered.get(number, 0.0)
             if number >= SYSTEM and number not in self.numbered:
-                raise Refused(f"system parameter #{number} holds a value only the control has")
+                raise Refused(f"system parameter #{number} holds a value only the control has"
+                              f"{SYSTEM_NEEDS.get(number, '')}")
             return self.numbered.get(number, 0.0)
         found = self._named(key)
         if found is None:
