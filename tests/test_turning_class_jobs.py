@@ -84,6 +84,17 @@ def test_the_adversary_s_rapid_through_the_blank_is_refused_naming_its_line():
     assert inside - 4 * AIR_TOLERANCE_MM < through <= inside + 0.001
 
 
+def test_a_refusal_against_an_assumed_blank_says_it_was_assumed_and_how_to_state_the_bar():
+    """The new user's proven program refused against a blank the engine guessed: the message names
+    that blank (Ø36 Z-40…2, as above) and the params that state the real bar; a stated blank's
+    refusal does not say so."""
+    message = refusal(inserted(APPROACH, "G00 X0.000 Z-15.000"))
+    assert f"the blank Ø{36.0:.3f} Z{-40.0:.3f}…{2.0:.3f} is assumed" in message
+    assert "stock_diameter, stock_z_front and stock_z_back" in message
+    stated = refusal(SHAFT, {"stock_diameter": 60.0, "stock_z_front": 5.0, "stock_z_back": -80.0})
+    assert "assumed" not in stated and "engine simulate" not in stated
+
+
 def test_a_stated_blank_is_the_one_proved_against():
     """The job states a blank Ø60 whose face is at Z5: the approach G00 X44 Z2 from (Z50, r62) enters
     it at Z5 (t = 45/48 of the way) and runs the rest, 3/48 of √(48² + 40²), through it."""

@@ -4,7 +4,12 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from ..hobbing.report import Report
+from ..hobbing.report import Report, SimulationError
+
+# What a user does about a blank the simulation assumed (a class job without stock_* params).
+STATE_THE_BLANK = ("the blank {blank} is assumed from the program's own cuts; if the bar is larger, "
+                   "state it with the params stock_diameter, stock_z_front and stock_z_back (mm, the program's "
+                   "frame) and instantiate again")
 
 
 @dataclass
@@ -13,6 +18,15 @@ class TurningReport(Report):
     cut_moves: int = 0       # feeds and thread passes followed
     blank: str = ""          # "Ø42.000 Z-70.000…0.000 (assumed)"
     not_checked: list[str] = field(default_factory=list)   # what it could not prove (a class job: no drawing)
+
+    def error(self) -> SimulationError:
+        """The first refusal, all of them counted (a refused program is not stored, so the count is
+        said here rather than left to `engine simulate`), and what to do about an assumed blank."""
+        first, more = self.refusals[0], len(self.refusals) - 1
+        extra = f" (and {more} more finding{'s' if more > 1 else ''})" if more else ""
+        hint = f"; {STATE_THE_BLANK.format(blank=self.blank.removesuffix(' (assumed)'))}" \
+            if self.blank.endswith("(assumed)") else ""
+        return SimulationError(f"the simulation refuses {first.sentence(self.name)}{extra}{hint}")
 
     def lines(self) -> list[str]:
         out = [("refused: " if f.refuses else "note: ") + f.sentence(self.name) for f in self.findings]
