@@ -1,0 +1,231 @@
+"""840D lathe programs as stored on the control (issue 27): the expander "840d-lathe" runs R-parameters,
+DEF variables and their arithmetic, jumps, loops and section repetitions into the plain blocks
+the 840D lathe grammar reads, and the verifier proves them on a lathe-840d record. What cannot be
+turned into plain moves is refused naming the line and the construct.
+
+Every expected number is computed here from the reference's rule (docs/reference §C), not copied
+from the expander: SIN in degrees, DIAMOF radii doubled, an arc's CR from its centre by Pythagoras,
+a G4 S dwell as turns × 60 / (r/min)."""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import pytest
+
+from engine.machines.records import Machine
+from engine.verifier import LimitError, expansion, verify_program
+from engine.verifier.expansion import expand
+
+DATA = Path(__file__).resolve().parent / "data" / "nc"
+GOLDEN = Path(__file__).resolve().parent / "golden" / "turning"
+# lathe-840d of seed_templates/machines.csv: X 0…400 (diameter), Z -600…200, 4000 r/min, G54
+LATHE = Machine("lathe-840d", "lathe", "840d", 0.0, 400.0, 0.0, 0.0, -600.0, 200.0, 4000.0, None, None)
+READY = ["G18 G71 G90 G40 DIAMON", "T1 D1", "G97 S800 M3", "G94 F150"]
+
+
+def plain(lines: list[str]) -> list[str]:
+    return [line.text for line in expand("840d-lathe", lines, LATHE)]
+
+
+def blocks(lines: list[str]) -> list[str]:
+    return [text for text in plain(lines) if not text.startswith(";")]
+
+
+def refused(lines: list[str], name: str | None = "TEST") -> str:
+    with pytest.raises(LimitError) as raised:
+        verify_program(lines, LATHE, name)
+    return str(raised.value)
+
+
+def words_of(text: str) -> dict[str, float]:
+    return {word[0]: float(word[1:]) for word in text.split() if word[0] in "XZF" and "=" not in word}
+
+
+# ------------------------------------------------------------------ the program as stored
+
+def test_a_program_without_the_header_is_verified():
+    verify_program([*READY, "G0 X50 Z2", "G1 Z-20", "M30"], LATHE, "TEST")
+
+
+def test_a_header_must_still_name_the_program_itself():
+    message = refused(["%_N_OTHER_MPF", ";$PATH=/_N_WKS_DIR/_N_SHAFT_WPD", *READY, "M30"])
+    assert "line 1" in message and "OTHER" in message and "TEST" in message
+
+
+def test_the_workpiece_path_line_is_read_in_the_second_line():
+    verify_program(["%_N_TEST_MPF", ";$PATH=/_N_WKS_DIR/_N_SHAFT_WPD", *READY, "M30"], LATHE, "TEST")
+
+
+def test_block_numbers_labels_and_comments_with_umlauts_are_read():
+    lines = ["N10 G18 G71 G90 G40 DIAMON ; Außendrehen", "; Schruppen – Stahl", "N20 T1 D1",
+             "N30 G97 S800 M3", "N40 G94 F150", "ANFANG: N50 G0 X50 Z2", "N60 G1 Z-20", "N70 M30"]
+    verify_program(lines, LATHE, "TEST")
+    assert "G1 Z-20" in blocks(lines)
+
+
+# ------------------------------------------------------------------ parameters and arithmetic
+
+def test_r_parameters_and_def_variables_are_evaluated_in_degrees():
+    lines = [*READY, "R1=25", "DEF REAL WINKEL=30, TIEFE", "TIEFE=R1*SIN(WINKEL)+SQRT(16)-ABS(-1)",
+             "G0 X=2*R1 Z=TIEFE", "G1 Z=-(R1+POT(2))/2", "M30"]
+    expected_z = 25 * math.sin(math.radians(30)) + 4 - 1
+    moves = [words_of(text) for text in blocks(lines) if text.startswith(("G0 X", "G1 Z"))]
+    assert moves[0]["X"] == 50 and moves[0]["Z"] == pytest.approx(expected_z, abs=1e-6)
+    assert moves[1]["Z"] == pytest.approx(-(25 + 4) / 2, abs=1e-6)
+    verify_program(lines, LATHE, "TEST")
+
+
+def test_an_int_variable_holds_a_whole_number():
+    lines = [*READY, "DEF INT N=7/2", "G0 X=N*10 Z2", "M30"]
+    assert "G0 X40 Z2" in blocks(lines)     # 3.5 rounds to 4 (reference §C2)
+
+
+def test_an_r_parameter_read_before_the_program_sets_it_is_refused():
+    message = refused([*READY, "G0 X=R7 Z2", "M30"])
+    assert "R7 is read before the program sets it" in message and "line 5" in message
+
+
+def test_a_system_variable_is_refused():
+    assert "system variable" in refused([*READY, "R1=$AA_IM[X]", "M30"]) + refused([*READY, "R1=$P_EP", "M30"])
+
+
+# ------------------------------------------------------------------ jumps and loops
+
+def test_if_gotof_skips_the_blocks_between():
+    lines = [*READY, "R1=1", "IF R1==1 GOTOF WEITER", "G0 X999 Z999", "WEITER:", "G0 X60 Z2", "M30"]
+    assert "G0 X999 Z999" not in blocks(lines) and "G0 X60 Z2" in blocks(lines)
+    verify_program(lines, LATHE, "TEST")
+
+
+def test_a_gotob_loop_cuts_each_pass():
+    """Three roughing passes from Ø48 down by 2 mm each: X 48, 46, 44."""
+    lines = [*READY, "R1=48", "G0 X50 Z2", "SCHLEIFE:", "G1 X=R1 Z2", "G1 Z-30", "G0 X50 Z2", "R1=R1-2",
+             "IF R1>=44 GOTOB SCHLEIFE", "M30"]
+    cuts = [words_of(text)["X"] for text in blocks(lines) if text.startswith("G1 X")]
+    assert cuts == [48, 46, 44]
+    verify_program(lines, LATHE, "TEST")
+
+
+def test_while_for_and_repeat_loops_run_their_passes():
+    lines = [*READY, "DEF INT I", "R2=0", "WHILE R2<3", "R2=R2+1", "G0 X=40+R2 Z2", "ENDWHILE",
+             "FOR I=1 TO 2", "G0 X=60+I Z2", "ENDFOR", "REPEAT", "R2=R2-1", "G0 X=80+R2 Z2", "UNTIL R2<=1", "M30"]
+    xs = [words_of(text)["X"] for text in blocks(lines) if text.startswith("G0 X")]
+    assert xs == [41, 42, 43, 61, 62, 82, 81]
+
+
+def test_a_section_of_the_file_repeats_as_a_subprogram_call():
+    lines = [*READY, "R1=50", "ANF: G0 X=R1 Z2", "R1=R1-4", "ENDE: G1 Z-10", "REPEAT ANF ENDE P=2", "M30"]
+    xs = [words_of(text)["X"] for text in blocks(lines) if text.startswith("G0 X")]
+    assert xs == [50, 46, 42]        # the section once as written, then P=2 more passes
+
+
+def test_if_else_endif_runs_one_branch():
+    lines = [*READY, "R1=0", "IF R1>0", "G0 X90 Z2", "ELSE", "G0 X70 Z2", "ENDIF", "M30"]
+    assert "G0 X70 Z2" in blocks(lines) and "G0 X90 Z2" not in blocks(lines)
+
+
+def test_a_loop_that_never_ends_is_refused_at_the_step_bound(monkeypatch):
+    monkeypatch.setattr(expansion, "MAX_STEPS", 5_000)
+    message = refused([*READY, "MARKE:", "G0 X50 Z2", "GOTOB MARKE", "M30"])
+    assert "more than 5,000 lines run" in message and "a loop that does not end" in message
+
+
+def test_a_jump_to_a_label_not_in_the_file_is_refused():
+    assert "not in the file" in refused([*READY, "GOTOF NIRGENDS", "M30"])
+
+
+# ------------------------------------------------------------------ what cannot be expanded
+
+@pytest.mark.parametrize("line, construct", [
+    ("L4000", "L4000 calls an external subprogram"),
+    ("L4000 P2", "L4000 calls an external subprogram"),
+    ("ABSTECHEN", "ABSTECHEN calls a subprogram that is not in the file"),
+    ('CYCLE95("KONTUR",2,0.2,0.1,,0.3,0.2,0.1,9)', "CYCLE95 is a vendor cycle without a model"),
+    ("CYCLE97(1.5,,0,-20,40,40,3,2,0.92,0.1,0,0,5,1,3,1)", "CYCLE97 is a vendor cycle without a model"),
+    ("G0 SUPA X200 Z100", "SUPA moves in the machine frame"),
+    ("G53 G0 X200", "G53 moves in the machine frame"),
+    ("G91 G0 X10", "incremental G91"),
+    ("G0 X=IC(10)", "incremental value"),
+    ("G42 G1 X40 Z0", "tool-nose radius compensation"),
+    ("G1 X40 Z0 RND=2", "RND= rounds the corner"),
+    ("CASE R1 OF 1 GOTOF A DEFAULT GOTOF B", "CASE"),
+    ("G55", "G55 is not the work offset of machine lathe-840d (G54)"),
+    ("G0 Y10", "Y is no axis of a lathe"),
+    ("/G0 X10 Z2", "skip switch"),
+])
+def test_a_construct_that_cannot_be_expanded_is_refused_naming_it(line, construct):
+    message = refused([*READY, line, "M30"])
+    assert "line 5" in message and construct in message, message
+
+
+def test_the_milling_program_of_the_sinumerik_data_is_no_lathe_program():
+    """CAM_TEST.MPF (840D sl CAM output, CYCLE800, Y and A axes) is refused at its milling plane G17."""
+    lines = (DATA / "sinumerik" / "cam_840dsl" / "CAM_TEST.MPF").read_text(encoding="utf-8").splitlines()
+    message = refused(lines, "CAM_TEST")
+    assert "line 6 'N60 G17 G710 G94 G90 FNORM'" in message and "milling program" in message
+
+
+# ------------------------------------------------------------------ the words of real lathe programs
+
+def test_g96_is_bounded_by_its_clamp_and_g95_feeds_per_turn():
+    lines = ["G18 G71 G90 G40 DIAMON", "T=\"SCHRUPP_80\" D1", "G96 S200 LIMS=3000 M4", "G95 F0.25", "G0 X50 Z2",
+             "G1 Z-20", "G96 S180", "G1 X40", "M30"]
+    verify_program(lines, LATHE, "TEST")
+    assert "G96 S180 LIMS=3000" in blocks(lines)      # the modal clamp written into the later G96
+
+
+def test_g96_without_a_clamp_is_refused():
+    lines = ["G18 G71 G90 G40 DIAMON", "T1 D1", "G96 S200 M4", "G95 F0.25", "G0 X50 Z2", "G1 Z-20", "M30"]
+    assert "LIMS" in refused(lines) and "line 6" in refused(lines)
+
+
+def test_a_clamp_above_the_spindle_maximum_is_refused():
+    message = refused(["G18 G71 G90 G40 DIAMON", "T1 D1", "G96 S200 LIMS=5000 M4", "M30"])
+    assert "LIMS=5000 exceeds lathe-840d's 4000 r/min" in message
+
+
+def test_diamof_radii_are_read_as_diameters():
+    lines = [*READY, "DIAMOF", "G0 X30 Z2", "DIAMON", "G0 X30 Z2", "M30"]
+    xs = [words_of(text)["X"] for text in blocks(lines) if text.startswith("G0 X")]
+    assert xs == [60, 30]
+
+
+def test_an_arc_by_its_centre_gets_the_radius_to_both_ends():
+    """G3 from Ø40 Z0 to Ø50 Z-5 around the centre 5 mm back in Z (K-5, I0 radial): a quarter circle."""
+    lines = [*READY, "G0 X40 Z0", "G3 X50 Z-5 I0 K-5", "G2 X60 Z-10 I=AC(50) K=AC(-10)", "M30"]
+    arcs = [text for text in blocks(lines) if text.startswith(("G3", "G2"))]
+    radius = math.hypot(0 - 0, 0 - (-5))          # start (Z0, r20) to centre (Z-5, r20)
+    assert arcs[0].endswith(f"CR={radius:g}")
+    # G2 from (Z-5, r25) to (Z-10, r30) around (Z-10, r25): clockwise from 0° to 90° is 270°, more than
+    # half a circle, so CR is negative (reference §C7)
+    assert arcs[1].endswith(f"CR={-math.hypot(-5 - (-10), 25 - 25):g}")
+    verify_program(lines, LATHE, "TEST")
+
+
+def test_a_centre_not_equally_far_from_both_ends_is_refused():
+    assert "no arc of one radius" in refused([*READY, "G0 X40 Z0", "G3 X50 Z-5 I0 K-7", "M30"])
+
+
+def test_a_dwell_in_spindle_turns_becomes_seconds():
+    lines = [*READY, "G0 X50 Z2", "G4 S10", "G4 F1.5", "M30"]
+    assert f"G4 F{10 * 60 / 800:g}" in blocks(lines)
+    verify_program(lines, LATHE, "TEST")
+
+
+def test_a_thread_is_cut_with_its_lead_k():
+    lines = [*READY, "G0 X24 Z5", "G33 Z-30 K1.5 SF=0", "G0 X26", "M30"]
+    assert "G33 Z-30 K1.5" in blocks(lines)
+    verify_program(lines, LATHE, "TEST")
+
+
+# ------------------------------------------------------------------ the engine's own programs
+
+@pytest.mark.parametrize("path", sorted(GOLDEN.glob("*_lathe-840d.NC")), ids=lambda path: path.stem)
+def test_the_engine_s_own_840d_lathe_programs_pass_unchanged(path):
+    lines = path.read_text(encoding="ascii").splitlines()
+    name = lines[0][len("%_N_"):-len("_MPF")]
+    verify_program(lines, LATHE, name)
+    moving = [text for text in plain(lines) if text.startswith(("G0", "G1", "G2", "G3", "G33"))]
+    written = [line for line in lines if line.startswith(("G0", "G1", "G2", "G3", "G33"))]
+    assert [words_of(text) for text in moving] == [words_of(line) for line in written]
