@@ -3,7 +3,7 @@ DEF variables and their arithmetic, jumps, loops and section repetitions into th
 the 840D lathe grammar reads, and the verifier proves them on a lathe-840d record. What cannot be
 turned into plain moves is refused naming the line and the construct.
 
-Every expected number is computed here from the reference's rule (docs/reference §C), not copied
+Every expected number is computed here from the reference's rule (docs/reference/sinumerik-lathe.md §S), not copied
 from the expander: SIN in degrees, DIAMOF radii doubled, an arc's CR from its centre by Pythagoras,
 a G4 S dwell as turns × 60 / (r/min)."""
 from __future__ import annotations
@@ -78,7 +78,7 @@ def test_r_parameters_and_def_variables_are_evaluated_in_degrees():
 
 def test_an_int_variable_holds_a_whole_number():
     lines = [*READY, "DEF INT N=7/2", "G0 X=N*10 Z2", "M30"]
-    assert "G0 X40 Z2" in blocks(lines)     # 3.5 rounds to 4 (reference §C2)
+    assert "G0 X40 Z2" in blocks(lines)     # 3.5 rounds to 4 (reference sinumerik-lathe §S2)
 
 
 def test_an_r_parameter_read_before_the_program_sets_it_is_refused():
@@ -118,6 +118,13 @@ def test_a_section_of_the_file_repeats_as_a_subprogram_call():
     lines = [*READY, "R1=50", "ANF: G0 X=R1 Z2", "R1=R1-4", "ENDE: G1 Z-10", "REPEAT ANF ENDE P=2", "M30"]
     xs = [words_of(text)["X"] for text in blocks(lines) if text.startswith("G0 X")]
     assert xs == [50, 46, 42]        # the section once as written, then P=2 more passes
+
+
+def test_repeat_with_one_label_runs_up_to_the_repeat_and_repeatb_one_block():
+    lines = [*READY, "R1=30", "ANF: G0 X=R1 Z2", "R1=R1+2", "REPEAT ANF P=1", "EINS: G0 X70 Z2", "REPEATB EINS P=2",
+             "M30"]
+    xs = [words_of(text)["X"] for text in blocks(lines) if text.startswith("G0 X")]
+    assert xs == [30, 32, 70, 70, 70]
 
 
 def test_if_else_endif_runs_one_branch():
@@ -198,7 +205,7 @@ def test_an_arc_by_its_centre_gets_the_radius_to_both_ends():
     radius = math.hypot(0 - 0, 0 - (-5))          # start (Z0, r20) to centre (Z-5, r20)
     assert arcs[0].endswith(f"CR={radius:g}")
     # G2 from (Z-5, r25) to (Z-10, r30) around (Z-10, r25): clockwise from 0° to 90° is 270°, more than
-    # half a circle, so CR is negative (reference §C7)
+    # half a circle, so CR is negative (reference sinumerik-lathe §S7)
     assert arcs[1].endswith(f"CR={-math.hypot(-5 - (-10), 25 - 25):g}")
     verify_program(lines, LATHE, "TEST")
 

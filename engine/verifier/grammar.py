@@ -27,7 +27,7 @@ if TYPE_CHECKING:
 POSITION, ANGLE, FEED, SPEED, CODE, TOOL, TOOL_AND_OFFSET, OFFSET, RADIUS, PITCH = (
     "position", "angle", "feed", "speed", "code", "tool", "tool and offset", "offset", "radius", "pitch")
 SPINDLE_POSITION = "spindle position"   # SPOS=<degrees>: orients the stopped spindle, moves no axis
-SPEED_LIMIT = "speed limit"     # LIMS=<r/min>: the clamp of constant cutting speed G96 (reference §C6)
+SPEED_LIMIT = "speed limit"     # LIMS=<r/min>: the clamp of constant cutting speed G96 (reference sinumerik-lathe §S6)
 TOOL_OR_NAME = "tool or name"   # 840D lathe: T1, or T="ROUGH" (a tool named in the tool list)
 MOTION = "motion"          # the modal group of G0, G1, G2, G3 and threading
 AXES = ("X", "Y", "Z")
@@ -121,7 +121,7 @@ DOOR_GROUP = "door"
 PROGRAM_HEADER_840D = Header("program header %_N_<NAME>_MPF", re.compile(rf"%_N_{NAME}_MPF"),
                              frozenset({"first"}), frozenset({"first"}))
 PATH_LINE_840D = Header("path line ;$PATH=/_N_MPF_DIR", re.compile(r";\$PATH=/_N_MPF_DIR"), frozenset({"second"}))
-# 840D lathe programs as stored on the control have no header (reference §C1): it is optional,
+# 840D lathe programs as stored on the control have no header (reference sinumerik-lathe §S1): it is optional,
 # and when it is there it must still name the program itself; the path line may name the
 # program folder or a workpiece folder.
 LATHE_HEADER_840D = replace(PROGRAM_HEADER_840D, required=frozenset())

@@ -28,7 +28,7 @@ def check_spindle(speed: float, machine: Machine) -> None:
 
 def check_speed_limit(limit: float, machine: Machine) -> None:
     """LIMS clamps the r/min of constant cutting speed G96: a clamp above the spindle's maximum
-    bounds nothing the machine can do (reference §C6)."""
+    bounds nothing the machine can do (reference sinumerik-lathe §S6)."""
     if limit > machine.spindle_max:
         raise Refused(f"spindle clamp LIMS={limit:g} exceeds {machine.name}'s {machine.spindle_max:g} r/min")
 

@@ -130,7 +130,7 @@ LATHE_840D_MOVE = Needs(Need("DIAMON", "motion before DIAMON: X would be a radiu
                                       "diameter")) + needs_stated(71, 90)
 LATHE_840D_THREAD = LATHE_840D_MOVE + needs_stated(18, 40, 97) + SPINDLE_NEEDS + OFFSET_NEEDS
 # A cut turns at r/min (G97 S…) or at a constant cutting speed G96 whose r/min rise as the
-# diameter falls, up to the clamp LIMS (reference §C6): G96 without LIMS is unbounded at the axis.
+# diameter falls, up to the clamp LIMS (reference sinumerik-lathe §S6): G96 without LIMS is unbounded at the axis.
 # The feed is per minute (G94) or per turn (G95); either, once stated.
 LATHE_840D_CUT = LATHE_840D_MOVE + needs_stated(18, 40) + Needs(
     Need(SPEED_BOUNDED, "a cut before the spindle speed is bounded: G97 S… in r/min, or G96 with its clamp "

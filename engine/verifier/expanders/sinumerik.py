@@ -129,7 +129,7 @@ class Interpreter:
         self._block(line, words(code))
 
     def _define(self, code: str) -> None:
-        """DEF REAL/INT/BOOL names, each 0 (FALSE) unless given a value (reference §C2)."""
+        """DEF REAL/INT/BOOL names, each 0 (FALSE) unless given a value (reference sinumerik-lathe §S2)."""
         match = DEFINITION.fullmatch(code)
         if match is None or match.group(1) not in VARIABLE_TYPES:
             raise Refused(f"{code[:40]}: only DEF REAL, INT and BOOL variables are evaluated")
@@ -177,7 +177,7 @@ def _read(number: int, text: str) -> SourceLine:
 
 
 def _typed(kind: type, value: float) -> float:
-    """INT rounds to a whole number, BOOL is 1 or 0 (reference §C2)."""
+    """INT rounds to a whole number, BOOL is 1 or 0 (reference sinumerik-lathe §S2)."""
     if kind is int:
         return float(round(value))
     if kind is bool:

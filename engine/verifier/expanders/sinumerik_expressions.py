@@ -1,7 +1,7 @@
 """The arithmetic of 840D programs (R-parameters, DEF variables, conditions), read by a bounded
 parser and evaluated over the values this program has set, never by Python's eval.
 
-Operators and their order are the control's (reference §C3: NOT; * / DIV MOD; + -; AND; XOR; OR;
+Operators and their order are the control's (reference sinumerik-lathe §S3: NOT; * / DIV MOD; + -; AND; XOR; OR;
 then the comparisons == <> > < >= <=, weakest), angles in degrees (SIN(30) is 0.5). A value the
 program has not set (an R-parameter it reads before assigning it, a system variable $…) is the
 control's and unknown here: it is refused, not taken as 0. Expressions are bounded in length and
@@ -40,7 +40,7 @@ def _round(value: float) -> float:
     return float(math.floor(abs(value) + 0.5)) * (1 if value >= 0 else -1)
 
 
-# name -> (number of arguments, function): the control's arithmetic functions (reference §C3)
+# name -> (number of arguments, function): the control's arithmetic functions (reference sinumerik-lathe §S3)
 FUNCTIONS: dict[str, tuple[int, Callable[..., float]]] = {
     "SIN": (1, _degrees(math.sin)), "COS": (1, _degrees(math.cos)), "TAN": (1, _degrees(math.tan)),
     "ASIN": (1, _inverse(math.asin)), "ACOS": (1, _inverse(math.acos)),
@@ -50,7 +50,7 @@ FUNCTIONS: dict[str, tuple[int, Callable[..., float]]] = {
     "EXP": (1, math.exp), "LN": (1, math.log),
 }
 CONSTANTS = {"TRUE": 1.0, "FALSE": 0.0}
-# binary operators from the weakest to the strongest (reference §C3)
+# binary operators from the weakest to the strongest (reference sinumerik-lathe §S3)
 LEVELS: tuple[dict[str, Callable[[float, float], float]], ...] = (
     {"==": lambda a, b: float(a == b), "<>": lambda a, b: float(a != b), ">": lambda a, b: float(a > b),
      "<": lambda a, b: float(a < b), ">=": lambda a, b: float(a >= b), "<=": lambda a, b: float(a <= b)},

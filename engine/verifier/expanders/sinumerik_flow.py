@@ -1,4 +1,4 @@
-"""Where an 840D program goes next (reference §C4, §C5): jumps to a label or block number
+"""Where an 840D program goes next (reference sinumerik-lathe §S4, §S5): jumps to a label or block number
 (GOTOF forward, GOTOB backward, GOTO either way, GOTOC without an alarm when missing),
 IF … GOTO…, the structured IF/ELSE/ENDIF, WHILE/ENDWHILE, REPEAT/UNTIL, FOR/ENDFOR, LOOP/ENDLOOP,
 and the section repetitions inside the file `REPEAT <label> [<label>] P=n` and `REPEATB <label>
@@ -158,7 +158,9 @@ class Flow:
         if match is None:
             raise Refused(f"{code}: REPEAT <label> [<label>] P=<n> repeats a section of the file")
         start = self.target(match.group(2))
-        end = self.target(match.group(3)) if match.group(3) else start
+        # REPEATB <label>: that one block; REPEAT <label>: from it to the line before the REPEAT;
+        # REPEAT <label> <label>: from the first to the second (reference sinumerik-lathe §S5)
+        end = self.target(match.group(3)) if match.group(3) else (start if match.group(1) == "REPEATB" else index - 1)
         if match.group(1) == "REPEAT" and start > index:
             raise Refused(f"REPEAT {match.group(2)}: the section must stand before the REPEAT (REPEATB searches back)")
         if end < start or len(self.sections) >= MAX_SECTIONS:
