@@ -13,7 +13,10 @@ from pathlib import Path
 
 import pytest
 
-from engine.machines.records import Machine
+from engine.machines.records import Machine, load_machine
+from engine.programs.dxf_import import import_dxf
+from engine.programs.remake import instantiate_job
+from engine.simulation.turning.run import simulate_turning
 from engine.verifier import LimitError, expansion, verify_program
 from engine.verifier.expansion import expand
 
@@ -236,3 +239,51 @@ def test_the_engine_s_own_840d_lathe_programs_pass_unchanged(path):
     moving = [text for text in plain(lines) if text.startswith(("G0", "G1", "G2", "G3", "G33"))]
     written = [line for line in lines if line.startswith(("G0", "G1", "G2", "G3", "G33"))]
     assert [words_of(text) for text in moving] == [words_of(line) for line in written]
+
+
+# ------------------------------------------------------------------ attack forms in the control's own words
+# The seeded sample drawing's 840D program (the engine's own), with an attack written the way a
+# program on the control writes it (R-parameters, a jump, a named tool): the expander turns it into
+# the plain moves, and the turning simulation follows them against the job's records.
+
+def _sample(conn):
+    sample = Path(__file__).resolve().parent.parent / "seed_templates" / "drawings" / "sample_shaft.dxf"
+    job_id = import_dxf(conn, sample, "lathe-840d").job_id
+    lines = instantiate_job(conn, job_id).lines
+    params, modules = conn.execute("SELECT params, module_params FROM job WHERE id = %s", (job_id,)).fetchone()
+    return lines, params, modules
+
+
+def _after_first_cut(lines: list[str], attack: list[str]) -> list[str]:
+    cut = next(index for index, line in enumerate(lines) if line.startswith("G1 "))
+    return [*lines[:cut + 1], *attack, *lines[cut + 1:]]
+
+
+@pytest.mark.parametrize("attack, reason", [
+    (["R5=0", "G0 X=R5 Z=R5-10"], "a rapid through material"),
+    (["DEF REAL TIEF=2*0", "G1 X=TIEF Z-10"], "a cut into the finished part"),
+    (['T="T2" D1'], "tool change"),
+    (["R7=1.5", "G33 Z-20 K=R7"], "a thread pass in operation 1 ROUGH"),
+])
+def test_an_attack_written_in_the_control_s_forms_is_refused_by_the_simulation(conn, attack, reason):
+    lines, params, modules = _sample(conn)
+    report = simulate_turning(lines, params, modules, load_machine(conn, "lathe-840d"))
+    assert not report.refused, report.lines()       # the program as made is clean
+    attacked = simulate_turning(_after_first_cut(lines, attack), params, modules, load_machine(conn, "lathe-840d"))
+    assert attacked.refused and any(reason in refusal.message for refusal in attacked.refusals), attacked.lines()
+
+
+@pytest.mark.parametrize("attack, reason", [
+    (["G97 S5000 M3"], "S5000 exceeds lathe-840d's 4000 r/min"),
+    (["G96 S200 M3", "G95 F0.2", "G1 X30 Z-5"], "G96 with its clamp LIMS"),
+    (["G1 X=2*R9 Z-5"], "R9 is read before the program sets it"),
+    (["R1=1", "SCHLEIFE:", "R1=R1+1", "GOTOB SCHLEIFE"], "more than 5,000 lines run"),
+    (["L4000"], "L4000 calls an external subprogram"),
+    (["G1 X500"], "X500 exceeds the travel of lathe-840d"),
+])
+def test_an_attack_in_the_engine_s_own_program_is_refused_by_the_verifier(conn, monkeypatch, attack, reason):
+    monkeypatch.setattr(expansion, "MAX_STEPS", 5_000)
+    lines, _, _ = _sample(conn)
+    name = lines[0][len("%_N_"):-len("_MPF")]
+    with pytest.raises(LimitError, match=reason):
+        verify_program(_after_first_cut(lines, attack), LATHE, name)

@@ -102,7 +102,8 @@ def _rendered(draw, address: str, value: float, is_840d: bool, kind: str):
         equals = "=" if is_840d else ""
         return [], f"{address}{equals}{part:.3f}+{rest:.3f}", float(f"{part:.3f}") + float(f"{rest:.3f}"), False
     if kind == "r-parameter":
-        return [f"R1={value:.3f}"], f"{address}=R1", float(f"{value:.3f}"), False
+        number = "XYZFS".index(address) + 1     # one parameter per address: X and Z in a block must not share R1
+        return [f"R{number}={value:.3f}"], f"{address}=R{number}", float(f"{value:.3f}"), False
     if kind == "exponent":
         text = draw(st.sampled_from([f"{value:.3e}", f"{value:.2E}"]))
         return [], f"{address}{text}", float(text), False

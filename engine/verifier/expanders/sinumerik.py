@@ -82,7 +82,16 @@ class Interpreter:
                 index = self.flow.after(index, self._run(index, line))
             except Refused as refusal:
                 raise ExpansionRefused(line.number, line.text, str(refusal)) from None
+        self._nothing_after(index)
         return self.plain
+
+    def _nothing_after(self, index: int) -> None:
+        """After the M30 (M2, M17) that ended the run the control reads nothing: a block written
+        there is refused, as in the engine's own programs (comments and labels may stand)."""
+        for line in self.lines[index:]:
+            if line.code and self.ended:
+                raise ExpansionRefused(line.number, line.text, "a line after M30: the program ends there, and the "
+                                       "control reads nothing after it")
 
     def _run(self, index: int, line: SourceLine) -> int | None:
         """Runs one line; the index of the line to run next, or None for the next one."""

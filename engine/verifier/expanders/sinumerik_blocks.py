@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 from ..arcs import ARC_TOLERANCE
+from ..numbers import plain_decimal
 from ..refusals import Refused
 from .sinumerik_expressions import evaluate
 from .sinumerik_lines import Word
@@ -146,7 +147,7 @@ def _unknown(word: Word) -> str:
 def value_of(word: Word, values: dict[str, float]) -> float:
     """A word's number: `X12.5`, or `X=<expression>` evaluated; AC(…) is absolute, IC(…) refused."""
     if word.form == "number":
-        return float(word.value)
+        return plain_decimal(word.name, word.value)      # at most MAX_DIGITS digits, never a crash
     text = word.value
     if text.startswith("IC(") or text.startswith("DC(") or text.startswith("CIC("):
         raise Refused(f"{word.name}={text}: an incremental value cannot be verified; program absolute positions")

@@ -14,6 +14,7 @@ from collections.abc import Callable
 from functools import lru_cache
 from typing import Any
 
+from ..numbers import plain_decimal
 from ..refusals import Refused
 
 MAX_LENGTH = 400        # characters of one expression: no real program's arithmetic is longer
@@ -143,7 +144,7 @@ class _Reader:
     def primary(self, depth: int) -> Tree:
         kind, value = self.take()
         if kind == "number":
-            return ("number", float(value))
+            return ("number", plain_decimal("", value))     # at most MAX_DIGITS digits
         if value == "(":
             inner = self.level(0, depth + 1)
             self.take(")")
