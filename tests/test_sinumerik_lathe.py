@@ -8,10 +8,12 @@ from the expander: SIN in degrees, DIAMOF radii doubled, an arc's CR from its ce
 a G4 S dwell as turns × 60 / (r/min)."""
 from __future__ import annotations
 
+import json
 import math
 from pathlib import Path
 
 import pytest
+from helpers.class_jobs import ok, stored_program
 
 from engine.machines.records import Machine, load_machine
 from engine.programs.dxf_import import import_dxf
@@ -287,3 +289,35 @@ def test_an_attack_in_the_engine_s_own_program_is_refused_by_the_verifier(conn, 
     name = lines[0][len("%_N_"):-len("_MPF")]
     with pytest.raises(LimitError, match=reason):
         verify_program(_after_first_cut(lines, attack), LATHE, name)
+
+
+# ------------------------------------------------------------------ import-nc and new values
+
+STORED_FORM = ["; WELLE D40 - Außendrehen, Schruppen in drei Schnitten", "N10 G18 G71 G90 G40 DIAMON",
+               'N20 T="SCHRUPP" D1', "N30 G96 S180 LIMS=2500 M4", "N40 G95 F0.25", "N50 R1=38",
+               "N60 G0 X42 Z2", "SCHNITT: N70 G1 X=R1 Z2", "N80 G1 Z-30", "N90 G0 X42 Z2", "N100 R1=R1-2",
+               "N110 IF R1>=34 GOTOB SCHNITT", "N120 G0 X100 Z100", "N130 M30"]
+
+
+def test_a_program_as_stored_is_imported_and_made_with_new_values_that_change_only_its_bound_words(run, tmp_path):
+    """import-nc of an 840D lathe program in the control's own form, then a class job with a new
+    surface speed and feed: verified on lathe-840d, and only S180 and F0.25 change, to the values given."""
+    source = tmp_path / "SHAFT.MPF"
+    source.write_text("\n".join(STORED_FORM) + "\n", encoding="utf-8")
+    verify_program(STORED_FORM, LATHE, "SHAFT")
+    params = tmp_path / "params.json"
+    params.write_text(json.dumps({"program_name": "SHAFT", "speed": 180, "feed": 0.25}))
+    ok(run("import-nc", source, "--class", "shaft", "--params", params))
+    new = tmp_path / "new.json"
+    new.write_text(json.dumps({"speed": 200, "feed": 0.2}))
+    made = json.loads(ok(run("instantiate", "--class", "shaft", "--machine", "lathe-840d", "--params", new,
+                             "--draft", "--json")).stdout)
+    lines, _, unverified = stored_program(run.url, made["program_id"])
+    assert not unverified
+    changed = [(old, line) for old, line in zip(STORED_FORM, lines) if old != line]
+    assert len(lines) == len(STORED_FORM) and [old for old, _ in changed] == [STORED_FORM[3], STORED_FORM[4]]
+    speed = next(word for word in changed[0][1].split() if word.startswith("S"))
+    feed = next(word for word in changed[1][1].split() if word.startswith("F"))
+    assert float(speed[1:]) == 200 and float(feed[1:]) == 0.2
+    assert changed[0][1].replace(speed, "S180") == STORED_FORM[3]
+    assert changed[1][1].replace(feed, "F0.25") == STORED_FORM[4]
