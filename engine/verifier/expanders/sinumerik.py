@@ -34,6 +34,10 @@ if TYPE_CHECKING:
 
 HEADER = re.compile(r"%_N_[A-Za-z0-9_]+_(?:MPF|SPF)|;\$PATH=/\S*")
 PRINTABLE = re.compile(r"[ -~]*")
+# A move already in plain form (the engine's own output, most CAM output): read by one pattern,
+# its numbers of at most twelve digits, so a long program is not taken apart word by word.
+_NUMBER = r"-?\d{1,6}(?:\.\d{0,6})?"
+PLAIN_MOVE = re.compile(rf"G([0-3]) X({_NUMBER}) Z({_NUMBER})(?: CR={_NUMBER})?(?: F{_NUMBER[2:]})?")
 VARIABLE_TYPES = {"REAL": float, "INT": int, "BOOL": bool}
 DEFINITION = re.compile(r"DEF (REAL|INT|BOOL|CHAR|STRING\[\d+\]|AXIS|FRAME|POS) (.+)")
 DEFINED_NAME = re.compile(r"([A-Z_][A-Z0-9_]*)(?:=(.+))?")
@@ -101,11 +105,21 @@ class Interpreter:
         if not line.code:
             self._comment(line)
             return None
+        plain_move = PLAIN_MOVE.fullmatch(line.text) if self.block.diameter else None
+        if plain_move is not None:
+            self._plain_move(line, plain_move)
+            return None
         jump = self.flow.control(index, line.code, self._condition, self._assign)
         if jump is not False:
             return jump
         self._statement(line)
         return None
+
+    def _plain_move(self, line: SourceLine, move: re.Match[str]) -> None:
+        """A move written as the grammar reads it: passed on as written, its motion and end kept."""
+        self.block.motion = int(move.group(1))
+        self.block.position.update(X=float(move.group(2)), Z=float(move.group(3)))
+        self._emit(line, line.text)
 
     def _condition(self, text: str) -> bool:
         return bool(evaluate(text, self.values))
@@ -178,6 +192,8 @@ class Interpreter:
 def _read(number: int, text: str) -> SourceLine:
     if not isinstance(text, str):
         raise ExpansionRefused(number, repr(text), f"a line must be text, not {type(text).__name__}")
+    if PLAIN_MOVE.fullmatch(text):
+        return SourceLine(number, text, None, None, text, False)
     try:
         check_line_characters(text)
         return read_source(number, text)
