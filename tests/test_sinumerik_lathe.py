@@ -321,3 +321,13 @@ def test_a_program_as_stored_is_imported_and_made_with_new_values_that_change_on
     assert float(speed[1:]) == 200 and float(feed[1:]) == 0.2
     assert changed[0][1].replace(speed, "S180") == STORED_FORM[3]
     assert changed[1][1].replace(feed, "F0.25") == STORED_FORM[4]
+
+
+def test_a_plain_move_reads_the_same_by_the_quick_pattern_and_word_by_word():
+    """The moves of the engine's own programs are passed on by one pattern; numbered (N…), the same
+    lines go word by word: both give the same motions and end points."""
+    lines = (GOLDEN / "shaft-profile_lathe-840d.NC").read_text(encoding="ascii").splitlines()
+    numbered = [line if line.startswith((";", "%")) else f"N{index} {line}" for index, line in enumerate(lines)]
+    quick = [words_of(text) for text in blocks(lines) if text.startswith(("G0", "G1", "G2", "G3"))]
+    word_by_word = [words_of(text) for text in blocks(numbered) if text.startswith(("G0", "G1", "G2", "G3"))]
+    assert quick == word_by_word and len(quick) > 50
