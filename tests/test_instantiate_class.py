@@ -148,15 +148,16 @@ def test_a_machine_whose_dialect_the_verifier_does_not_know_is_refused_and_nothi
     assert stored_counts(run.url) == before
 
 
-@pytest.mark.parametrize("path, machine", [(CAM, "lathe-840d"), (EMCO_CNC, "lathe-iso")],
+@pytest.mark.parametrize("path, machine, reason", [(CAM, "lathe-840d", "milling program"),
+                                                   (EMCO_CNC, "lathe-iso", "not a word")],
                          ids=["840D sl CAM program", "Emco program"])
-def test_a_real_program_the_verifier_refuses_is_refused_with_its_reason(run, path, machine):
+def test_a_real_program_the_verifier_refuses_is_refused_with_its_reason(run, path, machine, reason):
     ok(run("import-nc", path, "--class", "foreign"))
     before = stored_counts(run.url)
     message = refused(run("instantiate", "--class", "foreign", "--machine", machine, "--draft"))
     lines = path.read_text().splitlines()
     number = int(re.search(r"FOREIGN line (\d+) ", message)[1])
-    assert lines[number - 1].strip()[:20] in message and "not a word" in message, message
+    assert lines[number - 1].strip()[:20] in message and reason in message, message
     assert stored_counts(run.url) == before
     made = json.loads(ok(run("instantiate", "--class", "foreign", "--machine", machine, "--draft", "--unverified",
                              "--json")).stdout)

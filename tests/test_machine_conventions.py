@@ -266,6 +266,11 @@ def test_door_m_codes_are_the_machine_records_only(conn):
     assert accepted(conn, FLIPPED, hobbing_lines(["M60", "M61"]))
 
 
-def test_the_lathes_still_refuse_a_work_offset(conn):
-    lathe = ["%_N_TEST_MPF", ";$PATH=/_N_MPF_DIR", "; DRAWING part.dxf", "G18 G71 G90 G40 DIAMON", "G54", "M30"]
-    assert "work offset" in refusal(conn, "lathe-840d", lathe)
+def test_the_lathes_refuse_a_work_offset_other_than_the_record_s(conn):
+    """Issue 27: an 840D lathe program as stored on the control selects its work offset; the
+    record's (machine.work_offset, G54 as seeded) is the frame its travel is stated in, any
+    other is refused naming both."""
+    lathe = ["%_N_TEST_MPF", ";$PATH=/_N_MPF_DIR", "; DRAWING part.dxf", "G18 G71 G90 G40 DIAMON"]
+    assert accepted(conn, "lathe-840d", [*lathe, "G54", "M30"])
+    message = refusal(conn, "lathe-840d", [*lathe, "G55", "M30"])
+    assert "G55 is not the work offset of machine lathe-840d (G54)" in message

@@ -195,8 +195,22 @@ def test_a_control_or_non_ascii_character_is_refused_wherever_it_stands(conn, ch
                                                                         where, line):
     lines = list(PRELUDES[machine]) + (["G0 X55 Z10"] if machine == "hobber-840d" else [])
     lines[where:where + 1] = [line.format(c=character)]
+    if machine == "lathe-840d" and character.isprintable():
+        # 840D lathe comments hold any printable text (issue 27): "é" is text, not a block
+        assert accepted(conn, machine, [*lines, "M30"])
+        return
     message = refusal(conn, machine, lines)
     assert f"line {where + 1} " in message and named in message
+
+
+@pytest.mark.parametrize("comment", ["; DRAWING Läufer-Welle é ß", "G0 X40 Z2 ; Schrupp-Außen ÄÖÜ"])
+def test_a_non_ascii_comment_of_the_840d_lathe_is_read(conn, comment):
+    """Programs as stored on the control carry their writer's language in comments (issue 27):
+    an umlaut there is text, not a block; in the code it is still refused."""
+    assert accepted(conn, "lathe-840d", [*PRELUDES["lathe-840d"], "T1 D1", comment, "M30"])
+    code = comment.replace(";", "X", 1) if comment.startswith(";") else comment.replace(" ;", "", 1)
+    message = refusal(conn, "lathe-840d", [*PRELUDES["lathe-840d"], "T1 D1", code, "M30"])
+    assert "non-ASCII character" in message
 
 
 def test_an_iso_comment_cannot_close_early_and_hide_a_block(conn):

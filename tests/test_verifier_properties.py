@@ -72,10 +72,20 @@ def inside(machine: Machine, axis: str, value: float, hobbing: bool) -> bool:
 
 
 @st.composite
-def rendered(draw, address: str, value: float, is_840d: bool):
-    """(lines before the block, the word, its value as the control would evaluate it, plain?)."""
+def rendered(draw, address: str, value: float, is_840d: bool, evaluates: bool = False):
+    """(lines before the block, the word, its value as the control would evaluate it, plain?).
+    `evaluates`: the 840D lathe expander evaluates an expression after `=`, an R-parameter the
+    program set and AC(…) (issue 27); the plain block holds the value to six decimals."""
     kinds = [kind for kind in PLAIN + NOT_PLAIN if is_840d or kind not in ("equals", "r-parameter")]
     kind = draw(st.sampled_from(kinds))
+    lines, word, number, plain = draw(_rendered(address, value, is_840d, kind))
+    if evaluates and (kind in ("expression", "r-parameter") or word.startswith(f"{address}=AC(")):
+        return lines, word, round(number, 6), True
+    return lines, word, number, plain
+
+
+@st.composite
+def _rendered(draw, address: str, value: float, is_840d: bool, kind: str):
     if kind == "plain":
         return [], f"{address}{value:.3f}", float(f"{value:.3f}"), True
     if kind == "plain one decimal":
@@ -92,7 +102,8 @@ def rendered(draw, address: str, value: float, is_840d: bool):
         equals = "=" if is_840d else ""
         return [], f"{address}{equals}{part:.3f}+{rest:.3f}", float(f"{part:.3f}") + float(f"{rest:.3f}"), False
     if kind == "r-parameter":
-        return [f"R1={value:.3f}"], f"{address}=R1", float(f"{value:.3f}"), False
+        number = "XYZFS".index(address) + 1     # one parameter per address: X and Z in a block must not share R1
+        return [f"R{number}={value:.3f}"], f"{address}=R{number}", float(f"{value:.3f}"), False
     if kind == "exponent":
         text = draw(st.sampled_from([f"{value:.3e}", f"{value:.2E}"]))
         return [], f"{address}{text}", float(text), False
@@ -121,11 +132,14 @@ def control_or_not(draw, text: str):
 
 
 @st.composite
-def comment(draw, is_840d: bool):
+def comment(draw, is_840d: bool, any_printable: bool = False):
+    """A comment, perhaps with a control or non-ASCII character; `any_printable`: the 840D lathe
+    reads printable non-ASCII text in a comment (issue 27), so only a control character breaks it."""
     text = draw(st.text(alphabet="ABCXYZ0123456789 =.-", max_size=12))
     if not draw(st.booleans()):
         return "", False
     text, broken = draw(control_or_not(text))
+    broken = broken and not (any_printable and all(character.isprintable() for character in text))
     return (f" ; {text}" if is_840d else f" ({text})"), broken
 
 
@@ -135,21 +149,22 @@ def moves(draw):
     name = draw(st.sampled_from(sorted(DIALECTS)))
     prelude, axes, motions, is_840d, _ = DIALECTS[name]
     machine, hobbing = MACHINES[name], name.startswith("hobber")
+    evaluates = name == "lathe-840d"
     chosen = draw(st.lists(st.sampled_from(axes), min_size=1, max_size=len(axes), unique=True))
     before, words, fine = [], [draw(st.sampled_from(motions))], True
     for axis in chosen:
         low, high = (getattr(machine, f"{axis.lower()}_min"), getattr(machine, f"{axis.lower()}_max"))
-        lines, word, position, plain = draw(rendered(axis, draw(values_around(low, high)), is_840d))
+        lines, word, position, plain = draw(rendered(axis, draw(values_around(low, high)), is_840d, evaluates))
         plain = plain and (is_840d or "." in word)          # ISO: X114 is 0.114 mm without its point
         before, fine = before + lines, fine and plain and inside(machine, axis, position, hobbing)
         words.append(word)
     if words[0] in ("G1", "G01") and draw(st.booleans()):
-        lines, word, feed, plain = draw(rendered("F", draw(values_around(0.0, MAX_FEED)), is_840d))
+        lines, word, feed, plain = draw(rendered("F", draw(values_around(0.0, MAX_FEED)), is_840d, evaluates))
         plain = plain and (is_840d or "." in word)
         before, fine = before + lines, fine and plain and 0 < feed <= MAX_FEED
         words.append(word)
     block, broken = draw(control_or_not(" ".join(words)))
-    note, broken_note = draw(comment(is_840d))
+    note, broken_note = draw(comment(is_840d, evaluates))
     accepted = fine and not broken and not broken_note
     return machine, prelude + before + [block + note] + ENDINGS[name], accepted
 
@@ -159,7 +174,8 @@ def speeds(draw):
     name = draw(st.sampled_from(sorted(DIALECTS)))
     prelude, _, _, is_840d, form = DIALECTS[name]
     machine = MACHINES[name]
-    lines, word, speed, plain = draw(rendered("S", draw(values_around(0.0, machine.spindle_max)), is_840d))
+    lines, word, speed, plain = draw(rendered("S", draw(values_around(0.0, machine.spindle_max)), is_840d,
+                                              name == "lathe-840d"))
     block, broken = draw(control_or_not(form.format(word[1:])))
     return (machine, prelude + lines + [block] + ENDINGS[name],
             plain and not broken and 0 < speed <= machine.spindle_max)

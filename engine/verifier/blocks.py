@@ -23,8 +23,10 @@ from .grammar import (
     OFFSET,
     POINT_REASON,
     SPEED,
+    SPEED_LIMIT,
     TOOL,
     TOOL_AND_OFFSET,
+    TOOL_OR_NAME,
     WORD_NEEDS_CODE,
     WORKING_AREA,
     Dialect,
@@ -38,7 +40,8 @@ if TYPE_CHECKING:
     from collections.abc import Callable
 
 TOKEN = re.compile(r"([A-Z]+)(=?)(.*)")
-EQUALS_KINDS = frozenset({"position", "angle", "feed", "speed", "radius", "pitch", "spindle position"})
+EQUALS_KINDS = frozenset({"position", "angle", "feed", "speed", "radius", "pitch", "spindle position",
+                          SPEED_LIMIT, TOOL_OR_NAME})
 
 
 def _offset(number: float) -> str:
@@ -49,6 +52,7 @@ def _offset(number: float) -> str:
 # is the offset, D0 none; an ISO T<tool><offset> changes the tool and sets or cancels its offset.
 WORD_EVENTS: dict[str, Callable[[float], tuple[str, ...]]] = {
     SPEED: lambda value: ("S",), TOOL: lambda value: (TOOL_CHANGE,), OFFSET: lambda number: (_offset(number),),
+    SPEED_LIMIT: lambda value: ("LIMS",), TOOL_OR_NAME: lambda value: (TOOL_CHANGE,),
     TOOL_AND_OFFSET: lambda number: (TOOL_CHANGE, _offset(number % 100))}
 
 

@@ -22,6 +22,15 @@ def check_characters(line: object) -> None:
                   "or the control would read blocks nobody checked")
 
 
+def check_comment_characters(text: str, column_from: int = 1) -> None:
+    """A comment of a program as stored on the control may hold any printable text (umlauts: issue
+    27), never a control, format or line-separating character, which would break the line."""
+    for column, character in enumerate(text, start=column_from):
+        if not (character.isprintable() or character == " "):
+            raise Refused(f"{_named(character)} at column {column}: a line holds no control character, "
+                          "or the control would read blocks nobody checked")
+
+
 def _named(character: str) -> str:
     if character in CHARACTER_NAMES:
         return CHARACTER_NAMES[character]

@@ -27,6 +27,8 @@ if TYPE_CHECKING:
 POSITION, ANGLE, FEED, SPEED, CODE, TOOL, TOOL_AND_OFFSET, OFFSET, RADIUS, PITCH = (
     "position", "angle", "feed", "speed", "code", "tool", "tool and offset", "offset", "radius", "pitch")
 SPINDLE_POSITION = "spindle position"   # SPOS=<degrees>: orients the stopped spindle, moves no axis
+SPEED_LIMIT = "speed limit"     # LIMS=<r/min>: the clamp of constant cutting speed G96 (reference sinumerik-lathe §S6)
+TOOL_OR_NAME = "tool or name"   # 840D lathe: T1, or T="ROUGH" (a tool named in the tool list)
 MOTION = "motion"          # the modal group of G0, G1, G2, G3 and threading
 AXES = ("X", "Y", "Z")
 
@@ -112,13 +114,20 @@ DWELL = 4                   # its F is a time in seconds, not a feed
 # Words that mean something only together with one of these G codes in the same block.
 WORD_NEEDS_CODE = {"R": frozenset({2, 3}), "CR": frozenset({2, 3}), "K": frozenset({33})}
 # M codes by what they switch: two of one group in a block contradict each other (M3 M5).
-M_GROUPS = {3: "spindle", 5: "spindle", 8: "coolant", 9: "coolant", 20: "tailstock", 21: "tailstock",
+M_GROUPS = {3: "spindle", 4: "spindle", 5: "spindle", 8: "coolant", 9: "coolant", 20: "tailstock", 21: "tailstock",
             30: "program end"}
 WORK_OFFSETS = (54, 55, 56, 57)   # the settable work offsets a hobber's record may name (machine.work_offset)
 DOOR_GROUP = "door"
 PROGRAM_HEADER_840D = Header("program header %_N_<NAME>_MPF", re.compile(rf"%_N_{NAME}_MPF"),
                              frozenset({"first"}), frozenset({"first"}))
 PATH_LINE_840D = Header("path line ;$PATH=/_N_MPF_DIR", re.compile(r";\$PATH=/_N_MPF_DIR"), frozenset({"second"}))
+# 840D lathe programs as stored on the control have no header (reference sinumerik-lathe §S1): it is optional,
+# and when it is there it must still name the program itself; the path line may name the
+# program folder or a workpiece folder.
+LATHE_HEADER_840D = replace(PROGRAM_HEADER_840D, required=frozenset())
+LATHE_PATH_LINE_840D = Header("path line ;$PATH=/_N_MPF_DIR or /_N_WKS_DIR/_N_<NAME>_WPD",
+                              re.compile(r";\$PATH=/_N_(?:MPF_DIR|WKS_DIR/_N_[A-Za-z0-9_]+_WPD)"),
+                              frozenset({"second"}))
 
 HOBBING_840D = Dialect(
     name="840D hobbing",
@@ -137,21 +146,27 @@ HOBBING_840D = Dialect(
     equals_allowed=True,
 )
 
+# The plain lines the 840D lathe expander ("840d-lathe", engine.verifier.expanders.sinumerik)
+# makes of a program as stored on the control: G95 feed per turn, G96 constant cutting speed
+# with its clamp LIMS, G4 dwells, M4, the record's work offset and named tools are read here;
+# parameters, jumps and loops never reach the grammar.
 LATHE_840D = Dialect(
     name="840D lathe",
-    headers=HOBBING_840D.headers,
+    headers=(LATHE_HEADER_840D, LATHE_PATH_LINE_840D),
     comment="semicolon",
-    addresses={"X": POSITION, "Z": POSITION, "F": FEED, "S": SPEED, "T": TOOL, "D": OFFSET, "CR": RADIUS,
-               "K": PITCH, "G": CODE, "M": CODE},
-    g_codes={0: MOTION, 1: MOTION, 2: MOTION, 3: MOTION, 33: MOTION, 18: "plane", 40: "tool radius",
-             71: "units", 90: "distance", 94: "feed type", 97: "spindle speed"},
-    m_codes={code: M_GROUPS[code] for code in (3, 5, 8, 9, 30)},
+    addresses={"X": POSITION, "Z": POSITION, "F": FEED, "S": SPEED, "T": TOOL_OR_NAME, "D": OFFSET, "CR": RADIUS,
+               "K": PITCH, "LIMS": SPEED_LIMIT, "G": CODE, "M": CODE},
+    g_codes={0: MOTION, 1: MOTION, 2: MOTION, 3: MOTION, 33: MOTION, 4: "dwell", 18: "plane", 40: "tool radius",
+             71: "units", 90: "distance", 94: "feed type", 95: "feed type", 96: "spindle speed",
+             97: "spindle speed", **{code: "work offset" for code in WORK_OFFSETS}},
+    m_codes={code: M_GROUPS[code] for code in (3, 4, 5, 8, 9, 30)},
     state=LATHE_840D_STATE,
     keywords=frozenset({"DIAMON"}),
     equals_allowed=True,
     arc_radius="CR",
     needs_words={2: "CR", 3: "CR", 33: "K"},
     thread_lead={33: "K"},
+    expander="840d-lathe",
 )
 
 LATHE_ISO = Dialect(

@@ -26,6 +26,13 @@ def check_spindle(speed: float, machine: Machine) -> None:
         raise Refused(f"spindle speed S{speed:g} exceeds {machine.name}'s {machine.spindle_max:g} r/min")
 
 
+def check_speed_limit(limit: float, machine: Machine) -> None:
+    """LIMS clamps the r/min of constant cutting speed G96: a clamp above the spindle's maximum
+    bounds nothing the machine can do (reference sinumerik-lathe §S6)."""
+    if limit > machine.spindle_max:
+        raise Refused(f"spindle clamp LIMS={limit:g} exceeds {machine.name}'s {machine.spindle_max:g} r/min")
+
+
 def check_table(speed: float, ratio: float, machine: Machine, differential: tuple[tuple[str, float, float], ...] = (),
                 motion: str = "") -> None:
     """The table turns at n0·z0/z2 (reference §B4) plus, for each differential axis moving at v

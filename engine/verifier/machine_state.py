@@ -24,6 +24,7 @@ SPINDLE_SPEED, SPINDLE_TURNING, TOOL_OFFSET = "spindle speed", "spindle turning"
 COUPLING_DEFINED, COUPLED, ENDED = "coupling defined", "coupled", "ended"
 TOOL_CHANGE, OFFSET_ON, OFFSET_OFF = "tool change", "offset on", "offset off"
 WORK_OFFSET, Y_POSITIONED = "work offset", "Y positioned"
+SPEED_BOUNDED, FEED_TYPE = "spindle speed bounded", "feed type stated"
 Y_POSITION = "Y position"     # the event of a block (or the shift clamp) that positions Y
 
 
@@ -128,9 +129,20 @@ HOBBING_STATE = StateRules(
 LATHE_840D_MOVE = Needs(Need("DIAMON", "motion before DIAMON: X would be a radius, and the travel is checked as a "
                                       "diameter")) + needs_stated(71, 90)
 LATHE_840D_THREAD = LATHE_840D_MOVE + needs_stated(18, 40, 97) + SPINDLE_NEEDS + OFFSET_NEEDS
-LATHE_840D_CUT = LATHE_840D_THREAD + needs_stated(94)
+# A cut turns at r/min (G97 S…) or at a constant cutting speed G96 whose r/min rise as the
+# diameter falls, up to the clamp LIMS (reference sinumerik-lathe §S6): G96 without LIMS is unbounded at the axis.
+# The feed is per minute (G94) or per turn (G95); either, once stated.
+LATHE_840D_CUT = LATHE_840D_MOVE + needs_stated(18, 40) + Needs(
+    Need(SPEED_BOUNDED, "a cut before the spindle speed is bounded: G97 S… in r/min, or G96 with its clamp "
+                        "LIMS=… (without it the speed rises without limit toward the axis)")
+) + SPINDLE_NEEDS + OFFSET_NEEDS + Needs(
+    Need(FEED_TYPE, "motion before G94 or G95 (feed per minute or per turn) is stated: the control would keep "
+                    "whatever the last program left"))
+LATHE_840D_SPEEDS = {"G97": sets("G97", SPEED_BOUNDED), "G96": Effect(clears=frozenset({"G97", SPEED_BOUNDED})),
+                     "LIMS": sets(SPEED_BOUNDED), "G94": sets("G94", FEED_TYPE), "G95": sets(FEED_TYPE),
+                     "M4": sets(SPINDLE_TURNING)}
 LATHE_840D_STATE = StateRules(
-    effects={**stated(18, 40, 71, 90, 94, 97), "DIAMON": sets("DIAMON"), **SPINDLE, **END, **OFFSETS},
+    effects={**stated(18, 40, 71, 90), "DIAMON": sets("DIAMON"), **SPINDLE, **END, **OFFSETS, **LATHE_840D_SPEEDS},
     needs={"G0": LATHE_840D_MOVE, "G1": LATHE_840D_CUT, "G2": LATHE_840D_CUT, "G3": LATHE_840D_CUT,
            "G33": LATHE_840D_THREAD},
 )

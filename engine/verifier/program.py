@@ -22,7 +22,7 @@ from ..names import NAME_RULES, is_safe
 from .arcs import arc_box, check_radius
 from .expansion import ExpansionRefused, PlainLine, expand
 from .grammar import AXES, Dialect, dialect_for
-from .limits import check_coupled_move, check_spindle, check_table, check_thread, check_travel
+from .limits import check_coupled_move, check_speed_limit, check_spindle, check_table, check_thread, check_travel
 from .lines import read_line, remembered_lines
 from .machine_state import Y_POSITION, State
 from .refusals import LimitError, Refused, line_refused, shown_name
@@ -172,6 +172,8 @@ class ProgramReading:
             self.state.apply(block.events)
         if block.speed is not None:
             self._set_speed(block.speed)
+        if "LIMS" in block.values:
+            check_speed_limit(block.values["LIMS"], self.machine)
 
     def _move(self, block: Block) -> None:
         assert block.needs is not None   # a block that moves, outside G25/G26, names its motion

@@ -4,13 +4,30 @@ rapid traverse, tool and offset numbers in range, an arc radius not 0, a swivel 
 The machine's own limits (travel, spindle maximum) are engine.verifier.limits."""
 from __future__ import annotations
 
+import re
+
 from ..nc.words import MAX_TOOL
-from .grammar import ANGLE, CODE, FEED, OFFSET, PITCH, POSITION, RADIUS, SPEED, SPINDLE_POSITION, TOOL, TOOL_AND_OFFSET
+from .grammar import (
+    ANGLE,
+    CODE,
+    FEED,
+    OFFSET,
+    PITCH,
+    POSITION,
+    RADIUS,
+    SPEED,
+    SPEED_LIMIT,
+    SPINDLE_POSITION,
+    TOOL,
+    TOOL_AND_OFFSET,
+    TOOL_OR_NAME,
+)
 from .numbers import digits, plain_decimal
 from .refusals import Refused
 
 MAX_FEED = 20000.0    # mm/min: about a rapid traverse; a larger F is a unit slip or a typo
 MAX_ANGLE = 360.0     # degrees: a swivel beyond a whole turn is a unit slip
+TOOL_NAME = re.compile(r'"[A-Za-z0-9_.\-]{1,32}"')
 
 
 def _code(word: str, text: str) -> int:
@@ -63,10 +80,18 @@ def _tool_and_offset(word: str, text: str) -> int:
     return number
 
 
+def _tool_or_name(word: str, text: str) -> int:
+    """840D lathe: T<n>, or T="<name>" (the tool list's name; letters, digits, _ . -): a name is
+    tool 0 here, the change is what the verifier follows."""
+    if word == "T=" and TOOL_NAME.fullmatch(text):
+        return 0
+    return _tool(word, text)
+
+
 def _offset(word: str, text: str) -> int:
     return digits(word, text, range(1, 3), f"a tool offset 0 … {MAX_TOOL}")
 
 
 READERS = {CODE: _code, POSITION: _position, ANGLE: _angle, FEED: _feed, SPEED: _above_zero,
            PITCH: _above_zero, RADIUS: _radius, TOOL: _tool, TOOL_AND_OFFSET: _tool_and_offset,
-           OFFSET: _offset, SPINDLE_POSITION: _angle}
+           OFFSET: _offset, SPINDLE_POSITION: _angle, SPEED_LIMIT: _above_zero, TOOL_OR_NAME: _tool_or_name}
