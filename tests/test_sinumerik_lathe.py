@@ -16,11 +16,11 @@ import pytest
 from helpers.class_jobs import ok, stored_program
 
 from engine.machines.records import Machine, load_machine
-from engine.programs.dxf_import import import_dxf
 from engine.programs.remake import instantiate_job
 from engine.simulation.turning.run import simulate_turning
 from engine.verifier import LimitError, expansion, verify_program
 from engine.verifier.expansion import expand
+from importers.dxf import import_dxf
 
 DATA = Path(__file__).resolve().parent / "data" / "nc"
 GOLDEN = Path(__file__).resolve().parent / "golden" / "turning"
