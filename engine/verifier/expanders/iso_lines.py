@@ -18,6 +18,7 @@ from ..refusals import Refused
 HEADER = re.compile(r"O(?P<number>\d{1,5})\s*(?:\((?P<name>[^()%]*)\))?\s*;?")
 WORD = re.compile(r"\s*([A-Z])\s*([-+]?(?:\d+\.?\d*|\.\d+))")
 TAPE, HEADER_LINE, BLOCK, NOTHING = "tape", "header", "block", "nothing"
+COMMENT_REASON = "a comment is one (…) at the end of the block"
 
 
 @dataclass
@@ -70,14 +71,17 @@ def _read(number: int, line: str) -> Source:
 def _code(line: str) -> tuple[str, str | None]:
     """The line without its comments, and their text (inner parentheses left out); a `%` inside
     one would end the tape on a read-in."""
-    depth, kept, said = 0, [], []
+    depth, kept, said, closed = 0, [], [], False
     for char in line:
+        if depth == 0 and closed and not char.isspace() and char not in "(;":
+            raise Refused(f"{COMMENT_REASON}: the control would read what follows the ) as words")
         if char == "(":
             depth += 1
         elif char == ")":
             if depth == 0:
                 raise Refused("a ) without its ( : the control would read the rest as words")
             depth -= 1
+            closed = depth == 0
         elif depth:
             if char == "%":
                 raise Refused("a % inside a comment ends the program on a read-in")
