@@ -16,6 +16,7 @@ from ..numbers import why_not_plain
 from ..refusals import Refused
 
 HEADER = re.compile(r"O(?P<number>\d{1,5})\s*(?:\((?P<name>[^()%]*)\))?\s*;?")
+EXPONENT = re.compile(r"[eE][-+]?\d")
 WORD = re.compile(r"\s*([A-Z])\s*([-+]?(?:\d+\.?\d*|\.\d+))")
 TAPE, HEADER_LINE, BLOCK, NOTHING = "tape", "header", "block", "nothing"
 COMMENT_REASON = "a comment is one (…) at the end of the block"
@@ -107,9 +108,19 @@ def _words(code: str) -> list[tuple[str, str]]:
                 raise Refused(f"{token}: {why}")
             raise Refused(f"{token!r} is not a word of the ISO lathe grammar (one capital letter and "
                           "a plain number)")
+        _whole_token(code, match)
         words.append((match.group(1), match.group(2)))
         at = match.end()
     return words
+
+
+def _whole_token(code: str, match: re.Match[str]) -> None:
+    """A number that runs on into an exponent (F1e-05, X1.5E3) is refused as the whole token, not
+    read as a word and a stray rest."""
+    token = code[match.start():].split()[0] if code[match.start():].strip() else ""
+    if EXPONENT.match(code, match.end()):
+        why = why_not_plain(token.lstrip(), None)
+        raise Refused(f"{token.strip()}: {why or 'an exponent'}")
 
 
 def _whole(word: tuple[str, str], what: str) -> int:

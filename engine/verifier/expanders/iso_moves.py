@@ -241,13 +241,14 @@ def _spindle_words(source: Source, words: dict[str, str], modes: Modes, out: Emi
 
 def _tool(source: Source, text: str, modes: Modes) -> str:
     """T0101 and T101: tool 01, offset 01; T0100 cancels the offset. A turret indexing while the
-    tool stands within the box of the cuts so far swings the other tools through the part."""
+    tool stands within the box of the cuts so far, or on its edge (still at the cut), swings the
+    other tools through the part."""
     if not text.isdigit() or len(text) not in (3, 4):
         return f"T{text}"      # the grammar refuses it with its reason (T<tool><offset>, two digits each)
     tool = int(text) // 100
     box = modes.cut_box
     if tool != modes.tool and box is not None and modes.x is not None and modes.z is not None \
-            and modes.x < box[0] - 1e-6 and modes.z < box[1] - 1e-6:
+            and modes.x <= box[0] + 1e-6 and modes.z <= box[1] + 1e-6:
         raise source.refuse(f"T{text} changes the tool at X{modes.x:g} Z{modes.z:g}, within the cuts so far "
                             f"(up to X{box[0]:g} Z{box[1]:g}): index the turret clear of the part")
     modes.tool = tool
