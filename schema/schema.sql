@@ -1136,6 +1136,12 @@ CREATE TABLE machine (
     orient_before_coupling boolean NOT NULL DEFAULT false,                      -- SPOS before EGON
     door_close_m    smallint CHECK (door_close_m BETWEEN 0 AND 999),            -- guard door M functions
     door_open_m     smallint CHECK (door_open_m BETWEEN 0 AND 999),
+    -- ISO lathes (issue 27): the G28 reference point (X diameter, Z) in the travel's frame, NULL = not
+    -- stated; the G-code system: 'A' X/Z absolute and U/W incremental, G90 a cycle; 'B'/'C' (NULL) G90 absolute.
+    reference_x     numeric,
+    reference_z     numeric,
+    gcode_system    text CHECK (gcode_system IN ('A', 'B', 'C')),
+    CONSTRAINT machine_reference_point CHECK ((reference_x IS NULL) = (reference_z IS NULL)),
     CHECK (x_min < x_max AND y_min <= y_max AND z_min < z_max),
     CONSTRAINT machine_safe_name CHECK (safe_name('machine', name)),
     CONSTRAINT machine_load_position CHECK ((load_x IS NULL) = (load_z IS NULL))

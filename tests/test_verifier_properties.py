@@ -155,7 +155,8 @@ def moves(draw):
     for axis in chosen:
         low, high = (getattr(machine, f"{axis.lower()}_min"), getattr(machine, f"{axis.lower()}_max"))
         lines, word, position, plain = draw(rendered(axis, draw(values_around(low, high)), is_840d, evaluates))
-        plain = plain and (is_840d or "." in word)          # ISO: X114 is 0.114 mm without its point
+        # ISO: X114 is 0.114 mm without its point; a zero (X0, Z0) is the same either way
+        plain = plain and (is_840d or "." in word or position == 0)
         before, fine = before + lines, fine and plain and inside(machine, axis, position, hobbing)
         words.append(word)
     if words[0] in ("G1", "G01") and draw(st.booleans()):

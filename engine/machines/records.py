@@ -43,6 +43,11 @@ class Machine:
     orient_before_coupling: bool = False
     door_close_m: int | None = None
     door_open_m: int | None = None
+    # ISO lathes (issue 27, migration 0029): the G28 reference point in the travel's frame, and the
+    # G-code system ('A': X/Z absolute, U/W incremental, G90 a cycle; 'B'/'C'/None: G90 absolute).
+    reference_x: float | None = None
+    reference_z: float | None = None
+    gcode_system: str | None = None
 
 
 MACHINE_QUERY = f"SELECT {columns(Machine)} FROM machine"  # static, from the dataclass

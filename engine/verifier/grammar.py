@@ -77,6 +77,8 @@ class Dialect:
     thread_lead: dict[int, str] = field(default_factory=dict)   # thread G code -> the address of its lead (mm/rev)
     point_required: frozenset[str] = frozenset()      # addresses whose number must hold a decimal point
     program_numbers: range | None = None  # ISO O numbers a program may have
+    reserved_numbers: range | None = None  # … but these (the machine builder's macros)
+    framing_optional: bool = False        # ISO: the tape marks % may be left out; then the O line comes first
     expander: str | None = None           # the bounded interpreter of engine.verifier.expansion that turns
                                           # cycles, subprograms, parameters and jumps into plain lines
 
@@ -116,6 +118,13 @@ WORD_NEEDS_CODE = {"R": frozenset({2, 3}), "CR": frozenset({2, 3}), "K": frozens
 # M codes by what they switch: two of one group in a block contradict each other (M3 M5).
 M_GROUPS = {3: "spindle", 4: "spindle", 5: "spindle", 8: "coolant", 9: "coolant", 20: "tailstock", 21: "tailstock",
             30: "program end"}
+# The M codes real ISO lathe programs use (Fanuc/Haas, reference iso-lathe.md §M), as data: stops,
+# spindle, coolant, chuck, tailstock, thread chamfer, chip conveyor, gear range. M98/M99/M97 are
+# the expander's (subprograms); they never reach a plain line.
+ISO_M_GROUPS = {0: "stop", 1: "stop", 2: "program end", 30: "program end", 3: "spindle", 4: "spindle",
+                5: "spindle", 8: "coolant", 9: "coolant", 88: "coolant", 89: "coolant", 10: "chuck", 11: "chuck",
+                21: "tailstock", 22: "tailstock", 23: "thread chamfer", 24: "thread chamfer",
+                31: "chip conveyor", 33: "chip conveyor", 41: "gear range", 42: "gear range"}
 WORK_OFFSETS = (54, 55, 56, 57)   # the settable work offsets a hobber's record may name (machine.work_offset)
 DOOR_GROUP = "door"
 PROGRAM_HEADER_840D = Header("program header %_N_<NAME>_MPF", re.compile(rf"%_N_{NAME}_MPF"),
@@ -173,21 +182,24 @@ LATHE_ISO = Dialect(
     name="ISO lathe",
     headers=(Header("tape mark %", re.compile(r"%"), frozenset({"first", "last"}), frozenset({"first", "last"})),
              Header("program number O<nnnn> (NAME)",
-                    re.compile(rf"O(?P<number>\d{{4}}) \((?P<name>{ISO_COMMENT_TEXT})\)"),
-                    frozenset({"second"}), frozenset({"second"}))),
+                    re.compile(rf"O(?P<number>\d{{1,5}})(?: \((?P<name>{ISO_COMMENT_TEXT})\))?"),
+                    frozenset({"first", "second"}), frozenset({"second"}))),
     comment="parentheses",
     addresses={"X": POSITION, "Z": POSITION, "F": FEED, "S": SPEED, "T": TOOL_AND_OFFSET, "R": RADIUS,
                "G": CODE, "M": CODE},
-    g_codes={0: MOTION, 1: MOTION, 2: MOTION, 3: MOTION, 32: MOTION, 18: "plane", 21: "units",
+    g_codes={0: MOTION, 1: MOTION, 2: MOTION, 3: MOTION, 32: MOTION, 4: "dwell", 18: "plane", 21: "units",
              40: "tool radius", 90: "distance", 97: "spindle speed", 98: "feed type"},
-    m_codes={code: M_GROUPS[code] for code in (3, 5, 8, 9, 30)},
+    m_codes=ISO_M_GROUPS,
     state=LATHE_ISO_STATE,
     arc_radius="R",
     needs_words={2: "R", 3: "R", 32: "F"},
     thread_lead={32: "F"},
     point_required=frozenset({"X", "Z", "R", "F"}),
     # O9000 … O9999 hold the builder's macros on Fanuc-type controls: a program there replaces one.
-    program_numbers=range(1, 9000),
+    program_numbers=range(1, 100000),
+    reserved_numbers=range(9000, 10000),
+    framing_optional=True,
+    expander="iso",
 )
 
 # LinuxCNC lathe (docs/reference/linuxcnc-lathe.md): a program is read as the plain lines the

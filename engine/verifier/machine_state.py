@@ -151,7 +151,8 @@ LATHE_ISO_MOVE = needs_stated(21, 90)
 LATHE_ISO_THREAD = LATHE_ISO_MOVE + needs_stated(18, 40, 97) + SPINDLE_NEEDS + OFFSET_NEEDS
 LATHE_ISO_CUT = LATHE_ISO_THREAD + needs_stated(98)
 LATHE_ISO_STATE = StateRules(
-    effects={**stated(18, 21, 40, 90, 97, 98), **SPINDLE, **END, **OFFSETS},
+    effects={**stated(18, 21, 40, 90, 97, 98), **SPINDLE, **END, **OFFSETS,
+             "M4": sets(SPINDLE_TURNING), "M2": sets(ENDED)},
     needs={"G0": LATHE_ISO_MOVE, "G1": LATHE_ISO_CUT, "G2": LATHE_ISO_CUT, "G3": LATHE_ISO_CUT,
            "G32": LATHE_ISO_THREAD},
 )

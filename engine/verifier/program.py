@@ -23,7 +23,7 @@ from .arcs import arc_box, check_radius
 from .expansion import ExpansionRefused, PlainLine, expand
 from .grammar import AXES, Dialect, dialect_for
 from .limits import check_coupled_move, check_speed_limit, check_spindle, check_table, check_thread, check_travel
-from .lines import read_line, remembered_lines
+from .lines import HeaderLine, read_line, remembered_lines
 from .machine_state import Y_POSITION, State
 from .refusals import LimitError, Refused, line_refused, shown_name
 from .shift_clamp import ShiftClamp
@@ -32,7 +32,7 @@ if TYPE_CHECKING:
     from collections.abc import Callable
 
     from .blocks import Block
-    from .lines import HeaderLine, Line
+    from .lines import Line
     from .shift_clamp import ShiftLine
     from .statements import Statement
 
@@ -107,8 +107,12 @@ class ProgramReading:
         self.coupled_axes: tuple[str, ...] | None = None
         self.differential: dict[str, float] = {}
         self.clamp = ShiftClamp()
+        self.numbered = False
 
     def take(self, number: int, line: Line) -> None:
+        framed = isinstance(line, HeaderLine) and "last" in line.places
+        if number == 1 and self.dialect.framing_optional and not framed:
+            self._unframed()
         if number <= 2 or number == self.count or self.state.ended:
             self._check_place(number, line)
         if self.clamp.at and line.kind != "shift":
@@ -119,6 +123,12 @@ class ProgramReading:
         self.clamp.interrupted()
         if not self.state.ended:
             raise Refused("the program does not end with M30")
+
+    def _unframed(self) -> None:
+        """ISO without the tape marks (a program as stored in the control): the program number
+        line comes first, and no % is required at the end."""
+        number_line = self.required.get("second")
+        self.required = {"first": number_line} if number_line is not None else {}
 
     def _check_place(self, number: int, line: Line) -> None:
         """The header a place requires stands there; after M30 nothing but the closing header."""
@@ -138,10 +148,20 @@ class ProgramReading:
             raise Refused(f"the {line.what} belongs only in the {' or '.join(sorted(line.places))} line")
         if line.name is not None:
             self._check_name(line.name)
-        numbers = self.dialect.program_numbers
-        if line.number is not None and numbers is not None and line.number not in numbers:
-            raise Refused(f"program number O{line.number:04d} is outside O{numbers[0]:04d} … O{numbers[-1]:04d} "
-                          "(O9000 and above hold the machine builder's macros)")
+        if line.number is not None:
+            self._check_number(line.number)
+
+    def _check_number(self, number: int) -> None:
+        numbers, reserved = self.dialect.program_numbers, self.dialect.reserved_numbers
+        if self.numbered:
+            raise Refused(f"a second program number O{number:04d}: one program has one number")
+        self.numbered = True
+        if numbers is not None and (number not in numbers or (reserved is not None and number in reserved)):
+            ranges = f"O{numbers[0]:04d} … O{numbers[-1]:04d}"
+            if reserved is not None:
+                ranges = f"O{numbers[0]:04d} … O{reserved[0] - 1:04d} and O{reserved[-1] + 1:04d} … O{numbers[-1]:04d}"
+            raise Refused(f"program number O{number:04d} is outside {ranges} "
+                          "(O9000 … O9999 hold the machine builder's macros)")
 
     def _check_name(self, name: str) -> None:
         """The control stores the program under the header's name: it must be this program's

@@ -68,6 +68,9 @@ PARAMS = {
     "emco_from_dxf/testNegDXF.cnc": {"feed": 100, "z_clear": 3000, "arc_k": -500},
     "emco_from_dxf/testg02hemisphere.cnc": {"feed": 100, "z_clear": 3000},
     "emco_from_dxf/testg03hemisphere.cnc": {"feed": 100, "z_clear": 3000},
+    "fanuc/FANUC0T.nc": {"feed": 0.3},
+    "fanuc/0100.nc": {"feed": 0.35},
+    "fanuc/TOKARKA.NC": {"feed": 0.3},
 }
 
 

@@ -35,9 +35,11 @@ NOT_CHECKED = (
 
 
 def reference_point(machine: Machine) -> tuple[float, float]:
-    """(x diameter, z) of the lathe's reference point: the far corner of its travel, X max and
-    Z max, away from the chuck (where a reference return sends the turret), as the verifier's
-    travel limits give it in program coordinates."""
+    """(x diameter, z) of the lathe's reference point, where a reference return sends the turret:
+    the record's (reference_x, reference_z, in the travel's frame) when stated, else the far corner
+    of its travel, X max and Z max, away from the chuck, as the verifier's travel limits give it."""
+    if machine.reference_x is not None and machine.reference_z is not None:
+        return float(machine.reference_x), float(machine.reference_z)
     return machine.x_max, machine.z_max
 
 

@@ -1,0 +1,165 @@
+"""Real Fanuc/Haas lathe programs read by the ISO expander (issue 27), and the cycle geometry it
+expands G70–G76 with (engine/verifier/expanders/cycles.py).
+
+* Every real ISO lathe file under tests/data/nc/fanuc is either verified on the seeded
+  `lathe-iso` record or refused naming the construct that stops it (asserted per file).
+* The cycles make the moves the reference describes (docs/reference/iso-lathe.md): the expected
+  numbers are computed here from the reference formulas (G71: ceil((start X − finish X)/(2·Δd))
+  passes, retract e at 45°; G76: depth Δd·√n, at least Δdmin deeper each pass, flank infeed
+  depth·tan(a/2)), not copied from the code.
+* The attack forms of the issue, inserted after a real program's opening blocks, are refused
+  naming their reason."""
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import pytest
+from helpers.verifier_programs import LATHE_ISO, accepted, refusal
+
+from engine.verifier.expanders import cycles
+from engine.verifier.expanders.cycles import FEED, RAPID, THREAD, Move, Thread
+
+DATA = Path(__file__).resolve().parent / "data" / "nc" / "fanuc"
+
+# file -> (verified, the construct its refusal names). The files are as their authors wrote them.
+REAL = {
+    # Fanuc 0T: dimension words without a decimal point, read as 0.118 mm under input type I
+    "FANUC0T.nc": (False, "X118 needs a decimal point"),
+    # Fanuc macro program: ':' program number (ISO code form of O) and #50x variables
+    "0100.nc": (False, "':0100' is not a word of the ISO lathe grammar"),
+    # tape mark and program number on one line, as some DNC tools save them
+    "TOKARKA.NC": (False, "'%O1200' is not a word of the ISO lathe grammar"),
+}
+
+
+def real_lines(name: str) -> list[str]:
+    return (DATA / name).read_text(encoding="ascii").splitlines()
+
+
+def test_every_real_iso_lathe_file_is_in_the_table():
+    assert sorted(path.name for path in DATA.iterdir()) == sorted(REAL)
+
+
+@pytest.mark.parametrize("name", sorted(REAL))
+def test_a_real_iso_lathe_program_is_verified_or_refused_naming_the_construct(conn, name):
+    verified, construct = REAL[name]
+    if verified:
+        accepted(conn, "lathe-iso", real_lines(name))
+    else:
+        message = refusal(conn, "lathe-iso", real_lines(name))
+        assert construct in message, message
+
+
+# ---------------------------------------------------------------- attacks in a real program
+
+def opening() -> list[str]:
+    """FANUC0T.nc's first operation up to its approach (lines 4–9: spindle clamp G50 S600, tool
+    T0202, gear range, G96 S450 M03, rapid to X86. Z0.25) under the engine's own header lines
+    (the file itself relies on the control's power-on G21/G99, which the grammar wants stated)."""
+    return LATHE_ISO + ["G99"] + [line.strip() for line in real_lines("FANUC0T.nc")[3:9]]
+
+
+def with_body(body: list[str], start: list[str] | None = None) -> list[str]:
+    return (start or opening()) + body + ["G00 X200. Z150.", "M30", "%"]
+
+
+def test_the_real_opening_with_a_plain_cut_is_verified(conn):
+    accepted(conn, "lathe-iso", with_body(["G01 X80. F0.3", "Z-20.", "G00 X90."]))
+
+
+@pytest.mark.parametrize("body, reason", [
+    (["G00 X9999."], "X"),                                 # a rapid past the X travel (0 … 400)
+    (["G01 Z-700. F0.3"], "Z"),                            # a feed past the Z travel (−600 … 200)
+    (["G97 S9000"], "S9000"),                              # over spindle_max 4000 r/min
+    (["G01 X80. F0.3", "Z-20.", "T0303"], "changes the tool at"),   # the turret indexes at the cut
+    (["M98 P1234"], "not in this file"),                   # a subprogram the file does not hold
+    (["M99"], "starts it again for ever"),                 # M99 in the main program: an endless loop
+])
+def test_an_attack_inserted_into_a_real_program_is_refused_with_its_reason(conn, body, reason):
+    message = refusal(conn, "lathe-iso", with_body(body))
+    assert reason in message, message
+
+
+def test_g96_without_the_clamp_of_the_real_program_is_refused(conn):
+    start = [line for line in opening() if "G50" not in line]
+    message = refusal(conn, "lathe-iso", with_body(["G01 X80. F0.3"], start))
+    assert "G96 constant surface speed without a spindle clamp" in message, message
+
+
+# ---------------------------------------------------------------- cycle geometry
+
+def cut_passes(moves: list[Move], start_z: float) -> list[tuple[float, float]]:
+    """(level X, end Z) of each roughing pass: a feed along Z from the start Z at one diameter."""
+    return [(move.x, move.z) for before, move in zip(moves, moves[1:])
+            if move.motion == FEED and before.z == start_z and before.x == move.x and move.z != start_z]
+
+
+def test_g71_roughs_in_passes_of_twice_the_depth_on_the_diameter_down_to_the_allowance():
+    start, depth, retract, (u, w) = (60.0, 2.0), 2.0, 0.5, (0.4, 0.1)
+    contour = [Move(RAPID, 20.0, 2.0), Move(FEED, 20.0, -30.0), Move(FEED, 60.0, -30.0)]
+    moves = cycles.rough(start, contour, depth, retract, (u, w))
+    finish_x = 20.0 + u
+    count = math.ceil((start[0] - finish_x) / (2 * depth))
+    levels = [start[0] - 2 * depth * n for n in range(1, count)] + [finish_x]
+    *passes, contour_pass = cut_passes(moves, start[1])     # the last one follows the offset contour
+    assert contour_pass == pytest.approx((finish_x, -30.0 + w))
+    assert [x for x, _ in passes] == pytest.approx(levels)
+    assert all(z == pytest.approx(-30.0 + w) for _, z in passes)     # each pass ends at the shoulder + W
+    # after each pass the tool lifts by e (radius) at 45°: +2e on the diameter, +e along Z
+    ends = [i for i, m in enumerate(moves) if m.motion == FEED and (m.x, m.z) in passes]
+    lifts = [(moves[i + 1].x - moves[i].x, moves[i + 1].z - moves[i].z) for i in ends[:count]]
+    assert lifts == [pytest.approx((2 * retract, retract))] * count
+    # then one pass along the contour offset by U/W, and back to the start at rapid
+    assert moves[-3:] == [Move(FEED, 20.0 + u, -30.0 + w), Move(FEED, 60.0 + u, -30.0 + w), Move(RAPID, *start)]
+
+
+def test_g72_faces_in_passes_of_the_depth_along_z():
+    start, depth = (62.0, 2.0), 1.5
+    contour = [Move(RAPID, 62.0, -10.0), Move(FEED, 30.0, -10.0), Move(FEED, 30.0, 0.0)]
+    moves = cycles.rough(start, contour, depth, 0.5, (0.0, 0.0), facing=True)
+    count = math.ceil((start[1] - -10.0) / depth)
+    levels = [start[1] - depth * n for n in range(1, count)] + [-10.0]
+    cuts = [m.z for before, m in zip(moves, moves[1:])
+            if m.motion == FEED and before.x == start[0] and before.z == m.z and m.x != start[0]]
+    assert cuts[:-1] == pytest.approx(levels)      # then the pass along the contour at its Z
+    assert cuts[-1] == pytest.approx(-10.0)
+
+
+def test_g70_follows_the_contour_and_returns_to_the_start():
+    contour = [Move(RAPID, 20.0, 2.0), Move(FEED, 20.0, -30.0), Move(FEED, 60.0, -30.0)]
+    assert cycles.finish((62.0, 2.0), contour) == [*contour, Move(RAPID, 62.0, 2.0)]
+
+
+def reference_depths(first: float, height: float, minimum: float, allowance: float, finish: int) -> list[float]:
+    """Fanuc G76: pass n cuts to Δd·√n, at least Δdmin deeper than the pass before, while above
+    k − d; then k − d, then the finish passes at k."""
+    depths: list[float] = []
+    n = 1
+    while True:
+        depth = max(first * math.sqrt(n), (depths[-1] + minimum) if depths else 0.0)
+        if depth >= height - allowance:
+            return depths + [height - allowance] + [height] * finish
+        depths.append(depth)
+        n += 1
+
+
+def test_g76_cuts_each_pass_deeper_by_the_square_root_rule_along_the_flank():
+    # M20 × 2.5: root X17.4 (20 − 2·1.3), k 1.3, Δd 0.4, Δdmin 0.1, d 0.05, one finish pass, 60°
+    thread = Thread(17.4, -20.0, 1.3, 0.4, 2.5, minimum=0.1, allowance=0.05, finish_passes=1, angle=60.0)
+    start = (22.0, 3.0)
+    depths = reference_depths(0.4, 1.3, 0.1, 0.05, 1)
+    moves = cycles.threading(start, thread)
+    cuts = [(before, move) for before, move in zip(moves, moves[1:]) if move.motion == THREAD]
+    assert len(cuts) == len(depths)
+    for (before, cut), depth in zip(cuts, depths):
+        assert cut.x == pytest.approx(17.4 + 2 * (1.3 - depth))      # the diameter at that depth
+        assert cut.z == pytest.approx(-20.0)
+        # the infeed follows the flank: the start Z moves back by depth · tan(30°)
+        assert before.z == pytest.approx(start[1] + depth * math.tan(math.radians(30.0)))
+    assert all(b - a > 0 or b == a for a, b in zip(depths, depths[1:]))
+
+
+def test_g76_with_no_height_is_refused():
+    with pytest.raises(cycles.CycleError):
+        cycles.threading((22.0, 3.0), Thread(17.4, -20.0, 0.0, 0.4, 2.5))
