@@ -69,6 +69,7 @@ class Block:
     speed: float | None        # S
     feed: float | None         # F where it is a feed (not a G4 dwell's time)
     needs: str | None          # the motion whose needs the block must meet ("G1"), if it moves
+    g_codes: frozenset[int] = frozenset()   # every G code of the block, whatever the state rules keep
 
 
 def read_block(dialect: Dialect, code: str) -> Block:
@@ -98,7 +99,8 @@ def _block(dialect: Dialect, codes: dict[str, list[int]], groups: dict[int, str]
     kept = frozenset(effects & {*(f"M{code}" for code in codes["M"]), *events})
     feed = None if DWELL in codes["G"] else values.get("F")
     needs = f"G{motion}" if moves and area is None else None
-    return Block(values, motion, area, positions, moves, modal, kept, values.get("S"), feed, needs)
+    return Block(values, motion, area, positions, moves, modal, kept, values.get("S"), feed, needs,
+                 frozenset(codes["G"]))
 
 
 def _read_token(dialect: Dialect, token: str, codes: dict[str, list[int]], values: dict[str, float],

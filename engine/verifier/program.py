@@ -21,6 +21,7 @@ from ..machines.records import Machine
 from ..names import NAME_RULES, is_safe
 from .arcs import arc_box, check_radius
 from .expansion import ExpansionRefused, PlainLine, expand
+from .feed_mode import FeedMode
 from .grammar import AXES, Dialect, dialect_for
 from .limits import check_coupled_move, check_speed_limit, check_spindle, check_table, check_thread, check_travel
 from .lines import HeaderLine, read_line, remembered_lines
@@ -108,6 +109,7 @@ class ProgramReading:
         self.differential: dict[str, float] = {}
         self.clamp = ShiftClamp()
         self.numbered = False
+        self.feed_mode = FeedMode(machine)
 
     def take(self, number: int, line: Line) -> None:
         framed = isinstance(line, HeaderLine) and "last" in line.places
@@ -182,6 +184,10 @@ class ProgramReading:
             self.state.apply(block.modal)
         if block.feed is not None:
             self.feed = block.feed
+        self.feed_mode.take(block)
+        if block.speed is not None and block.moves:
+            self._set_speed(block.speed)       # the move runs at the S of its own block
+        self.feed_mode.check(block, self.feed, self.speed)
         if block.area:
             self._set_area(block)
         elif block.moves:
