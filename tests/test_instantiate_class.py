@@ -58,24 +58,34 @@ def test_the_class_of_an_imported_program_gives_it_back_with_its_own_parameters(
 
 def test_new_values_change_exactly_the_words_bound_to_them_and_the_file_is_the_stored_program(run, tmp_path):
     """A lathe class job is proved by the turning simulation without a drawing record (issue 27):
-    proved, it is written to --out, and its notes say which checks did not run."""
+    against a blank its params state (Ø26 from Z0 to Z-40), it is written to --out, and its notes
+    say which checks did not run. Against a blank assumed from its own cuts it is refused a file
+    (the adversary's rapid through bar the program never cuts would pass): nothing stored."""
     source, lines = import_emco(run, tmp_path)
     params = tmp_path / "new.json"
-    params.write_text(json.dumps({"speed": 800, "feed": {"value": 120.5, "addresses": ["F"]}}))   # both forms
+    new = {"speed": 800, "feed": {"value": 120.5, "addresses": ["F"]}}    # both forms
+    params.write_text(json.dumps(new))
     out = tmp_path / "NEW.NC"
     with psycopg.connect(run.url) as conn:
         release_draft(conn, "emco_neg")   # a draft's program never reaches a file (issue 26)
+    before = stored_counts(run.url)
+    message = refused(run("instantiate", "--class", "emco_neg", "--machine", "lathe-iso", "--params", params,
+                          "--out", out))
+    assert "assumed from its own cuts" in message and "stock_diameter, stock_z_front and stock_z_back" in message
+    assert stored_counts(run.url) == before and not out.exists()
+    params.write_text(json.dumps({**new, "stock_diameter": 26, "stock_z_front": 0, "stock_z_back": -40}))
     made = json.loads(ok(run("instantiate", "--class", "emco_neg", "--machine", "lathe-iso",
                              "--params", params, "--out", out, "--json")).stdout)
     new_words = {f"S{SPEED}": "S800", "F150.000": "F120.500"}
     expected = [" ".join(new_words.get(word, word) for word in line.split(" ")) for line in lines]
     template_lines, lineage, unverified = stored_program(run.url, made["program_id"])
     assert template_lines == expected and sum(a != b for a, b in zip(expected, lines)) == 4
-    assert (made["given"], made["taken"], made["unverified"]) == (["speed", "feed"], ["program_name"], False)
+    assert (made["given"], made["taken"], made["unverified"]) == (
+        ["speed", "feed", "stock_diameter", "stock_z_front", "stock_z_back"], ["program_name"], False)
     with psycopg.connect(run.url) as conn:
         stored = conn.execute("SELECT lines FROM program WHERE id = %s", (made["program_id"],)).fetchone()[0]
     assert out.read_bytes() == ("\n".join(stored) + "\n").encode()   # through the writer, with the file's layout
-    assert any("(assumed)" in note for note in made["notes"])
+    assert any(f"the blank Ø{26:.3f} Z{-40:.3f}…{0:.3f}:" in note for note in made["notes"]), made["notes"]
     assert any(note.startswith("not checked: a cut into the finished part") for note in made["notes"])
     again = json.loads(ok(run("instantiate", "--job", made["job_id"], "--draft", "--json")).stdout)
     assert stored_program(run.url, again["program_id"])[0] == expected   # the job made again, verified again

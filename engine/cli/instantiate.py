@@ -104,8 +104,9 @@ def instantiate(ctx, gear_id, job_id, gear_class, params_file, unverified, gear_
     with its imported values it is the imported program again. The turning
     simulation proves it without a drawing record, against the blank given in
     --params (stock_diameter, stock_z_front, stock_z_back, mm, all three or
-    none) or else the one its program implies (assumed); proved, it is written
-    like any program, and its notes say what was not checked.
+    none) or else the one its program implies (assumed: stored for review,
+    never written to a file); proved against a stated blank, it is written like
+    any program, and its notes say what was not checked.
 
     Example: engine instantiate --gear 42 --out /srv/nc/
     """

@@ -274,8 +274,10 @@ def class_job(template: Template, machine: Machine, params: dict, module_params:
                           f"{machine.name} must be proved by the simulation against a gear and a hob; nothing stored")
     work = class_work(params) if machine.kind == "lathe" else None
     result = run_template(template, params, module_params, machine, work)
+    assumed = machine.kind == "lathe" and not all(name in params for name in BLANK_PARAMS)
     return Planned(None, template.gear_class, machine.name, None, params, module_params, template, result,
-                   notes=list(work.notes) if work else [], layout=layout)
+                   notes=list(work.notes) if work else [], layout=layout, assumed_blank=assumed)
+
 
 
 def _unverified_job(template: Template, machine: Machine, params: dict, layout: NcLayout) -> Planned:

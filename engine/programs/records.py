@@ -28,6 +28,9 @@ class Planned:
     notes: list = field(default_factory=list)   # what the operator should know, one line each (bounded feeds, …)
     layout: NcLayout = NcLayout()    # the class's line ending and final newline (gear_class; issue 17)
     unverified: bool = False   # no verifier read it (engine.programs.class_jobs): stored so marked, never written
+    # A lathe class job proved against a blank assumed from its own cuts (no stock_* params): stored
+    # for review, never written to a file (engine.programs.class_jobs.ASSUMED_BLANK_FILE).
+    assumed_blank: bool = False
 
     @property
     def name(self) -> str:
@@ -44,7 +47,7 @@ class Planned:
             if with_job else (None, None, None))
         return Encoded(self.gear_id, self.gear_class, self.machine, self.hob_id, *job, self.template.version,
                        self.template.hash, self.name, self.result.lines, self.result.row_ids,
-                       json.dumps(self.result.trace), tuple(self.notes), self.layout)
+                       json.dumps(self.result.trace), tuple(self.notes), self.layout, self.assumed_blank)
 
 
 @dataclass(frozen=True, slots=True)
@@ -66,6 +69,7 @@ class Encoded:
     trace: str
     notes: tuple = ()
     layout: NcLayout = NcLayout()
+    assumed_blank: bool = False   # Planned.assumed_blank: never written to a file
 
 
 @dataclass(frozen=True)

@@ -44,7 +44,7 @@ from .job_shape import check_job_shape, job_with_cycle_time
 from .options import NO_FILE, NORMAL_RUN, Output, RunMode
 from .outputs import file_layouts, files_after_commit
 from .records import Planned, Program
-from .storage import Batch, store_programs
+from .storage import Batch, refuse_assumed_blank_file, store_programs
 from .verified_run import Workpiece, run_template
 from .workers import PLANNING
 
@@ -204,6 +204,8 @@ def instantiate_jobs(conn: Connection, first: int | None = None, last: int | Non
         good, skipped = good_ones(_remade_jobs(conn, first, last, mode), "job", mode.skip_bad)
         if mode.dry_run:
             return dry_batch([item for _, item in good], skipped)
+        for _, item in good:
+            refuse_assumed_blank_file(item.name, item.assumed_blank, output.out)
         files.plan([(item.name, item.lines) for _, item in good], file_layouts([item for _, item in good]))
         batch = store_programs(conn, [item for _, item in good], [job_id for job_id, _ in good], output.out, files)
     return replace(batch, skipped=skipped)

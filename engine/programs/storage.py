@@ -46,6 +46,21 @@ COPY_PROGRAM = ("COPY program_submission (id, job_id, gear_class, template_versi
 PROGRAM_TYPES = ("int8", "int8", "text", "int4", "text", "text", "text[]", "int4[]", "jsonb")
 
 
+# Why a lathe class job on an assumed blank never reaches a file: the blank the simulation proves it
+# against comes from the program's own cuts, so a rapid through bar the program never cuts (the
+# adversary's rapid to the axis 50 mm behind the face, a groove's run-in along the bar) cannot be
+# seen, and a bound value moved at instantiate moves the blank with it.
+ASSUMED_BLANK_FILE = ("is a lathe class job proved against a blank assumed from its own cuts, which cannot show a "
+                      "rapid through bar the program never cuts; it is never written to a file ({path}): state the "
+                      "bar with the params stock_diameter, stock_z_front and stock_z_back (mm, the program's frame) "
+                      "and instantiate again; nothing stored")
+
+
+def refuse_assumed_blank_file(name: str, assumed_blank: bool, path) -> None:
+    if assumed_blank and path is not None:
+        raise EngineError(f"program {name} " + ASSUMED_BLANK_FILE.format(path=path))
+
+
 def store_one(conn: Connection, planned: Planned, existing_job: int | None, path: str | None) -> Program:
     """The program (and its job, unless `existing_job`), its lineage line added. An unverified
     program (engine.programs.class_jobs) is stored only without a file for the machine."""
@@ -53,6 +68,7 @@ def store_one(conn: Connection, planned: Planned, existing_job: int | None, path
     if planned.unverified and path is not None:
         raise EngineError(f"program {planned.name} is unverified: it is never written to a file ({path}); "
                           "nothing stored")
+    refuse_assumed_blank_file(planned.name, planned.assumed_blank, path)
     with deleted_meanwhile(conn, gears=[planned.gear_id], hobs=[planned.hob_id], jobs=[existing_job]), \
             conn.transaction():
         return _stored_one(conn, planned, existing_job, path)
