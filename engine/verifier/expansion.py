@@ -26,8 +26,11 @@ if TYPE_CHECKING:
 
 # The most plain lines one program may expand to, and the most lines an interpreter may step
 # through (a loop counts each pass): a program past either is refused, not followed for ever.
-MAX_PLAIN_LINES = 2_000_000
-MAX_STEPS = 5_000_000
+# An interpreter steps at about 40 µs a line, so a million steps is under a minute of CPU for the
+# worst program (the adversary's 4.8 million-step loop ran past 5 minutes); a 100,000-line real
+# program with its loops and subprograms stays well inside.
+MAX_PLAIN_LINES = 1_000_000
+MAX_STEPS = 1_000_000
 
 
 @dataclass(frozen=True, slots=True)

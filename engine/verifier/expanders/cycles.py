@@ -19,7 +19,9 @@ from dataclasses import dataclass
 RAPID, FEED, CW, CCW, THREAD = 0, 1, 2, 3, 32
 ARC_STEP = math.radians(5.0)    # an arc of the contour is followed by chords of at most 5° for roughing
 EPS = 1e-9
-MAX_PASSES = 100_000            # a cycle making more passes than this is refused by its caller
+MAX_PASSES = 2_000              # a cycle making more passes than this is refused by its caller: a G71 of
+                                # 0.01 mm cuts over 20 mm of radius makes 2,000; more is a typo, and its moves
+                                # would cost minutes and memory to prove (the adversary's G76 H99999999)
 
 
 Swap = Callable[[float, float], tuple[float, float]]   # (x, z) <-> (level axis, cut axis)
@@ -154,8 +156,8 @@ def _pass(swap: Swap, cut: tuple[float, float, float], motion: int, lift: tuple[
 def pattern(start: tuple[float, float], contour: list[Move], relief: tuple[float, float], passes: int,
             allowance: tuple[float, float]) -> list[Move]:
     """G73: the contour repeated `passes` times, from the relief (i radius, k) in to the allowances."""
-    if passes < 1:
-        raise CycleError("the number of passes must be at least 1")
+    if passes < 1 or passes > MAX_PASSES:
+        raise CycleError(f"the number of passes must be 1 … {MAX_PASSES}")
     moves: list[Move] = []
     for n in range(passes):
         share = (passes - 1 - n) / (passes - 1) if passes > 1 else 0.0

@@ -109,6 +109,8 @@ def _depths(peak: float, first: float, last: float, degression: float, springs: 
             raise Refused(f"G76 makes more than {MAX_PASSES} passes")
         n += 1
         depth = peak + first * n ** (1.0 / degression)
+    if springs > MAX_PASSES:
+        raise Refused(f"G76 H{springs} asks for more than {MAX_PASSES} spring passes")
     return [*depths, *([last] * (max(springs, 0) + 1))]
 
 
