@@ -5,7 +5,7 @@ peck to the bottom Z, then the clear level: the initial Z in G98, R in G99)."""
 from __future__ import annotations
 
 import pytest
-from test_linuxcnc_expander import moves
+from helpers.linuxcnc_moves import moves
 
 from engine.verifier.expansion import ExpansionRefused
 

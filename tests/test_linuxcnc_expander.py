@@ -6,21 +6,13 @@ from __future__ import annotations
 import math
 
 import pytest
+from helpers.linuxcnc_moves import START, moves
 from helpers.linuxcnc_programs import LATHE, refusal
 
 from engine.verifier.expanders.linuxcnc import expand_linuxcnc
 from engine.verifier.expansion import ExpansionRefused
 
 INCH = 25.4
-START = ["G18 G21 G7 G90 G94", "T1 M6", "G43", "G97 S500 M3"]
-
-
-def moves(*body: str, start: list[str] = START) -> list[str]:
-    """The plain motion lines of START + body + M2."""
-    plain = expand_linuxcnc([*start, *body, "M2"], LATHE)
-    return [line.text for line in plain if line.text.split()[0] in ("G0", "G1", "G2", "G3")]
-
-
 def value(word: str, line: str) -> float:
     return float(next(token[len(word):] for token in line.split() if token.startswith(word)))
 
