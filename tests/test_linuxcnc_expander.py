@@ -131,3 +131,11 @@ def test_a_program_without_m2_is_refused():
 def test_lines_after_m2_and_after_the_closing_percent_are_not_run():
     assert moves("G0 X10 Z2", "M2", "G0 X999") == ["G0 X10. Z2."]
     assert refusal(["%", *START, "G0 X10 Z2", "M2", "%", "G0 X999"]) is None
+
+
+@pytest.mark.parametrize("speed", ["S0", "G96 D3000 S0 M3"])
+def test_a_cut_after_a_spindle_speed_of_0_is_refused(speed):
+    """S0 with M3 on stops the spindle (G96 S0: a surface speed of 0 m/min, 0 r/min at any X):
+    the feed after it would push the tool into a standing bar (adversary 27, finding 2)."""
+    message = refusal([*START, "G0 X60 Z5", "G1 X50 F100", speed, "G1 Z-30", "G0 X60", "M5", "M2"])
+    assert message is not None and "speed of 0" in message, message

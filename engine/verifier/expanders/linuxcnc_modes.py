@@ -126,10 +126,14 @@ class Executor:
             self.modes.css = False
         if "s" in words.values:
             speed = words.values["s"]
+            if speed <= 0:
+                raise Refused(f"S{speed:g}: a spindle speed of 0 (under G96 a surface speed of 0, 0 r/min at any X) "
+                              "stops the spindle while M3/M4 stays on, and a cut after it meets a standing bar; "
+                              "stop the spindle with M5 and state S above 0")
             if self.modes.css:
                 assert self.modes.css_clamp is not None
                 self.out.append(f"G96 S{_number(self.modes.css_clamp)}")
-            elif speed > 0:
+            else:
                 self.out.append(f"G97 S{_number(speed)}")
         elif mode == "96":
             raise Refused("G96 without its S (surface speed)")
