@@ -139,3 +139,15 @@ def test_a_cut_after_a_spindle_speed_of_0_is_refused(speed):
     the feed after it would push the tool into a standing bar (adversary 27, finding 2)."""
     message = refusal([*START, "G0 X60 Z5", "G1 X50 F100", speed, "G1 Z-30", "G0 X60", "M5", "M2"])
     assert message is not None and "speed of 0" in message, message
+
+
+@pytest.mark.parametrize("code", ["M70", "M72", "M73"])
+def test_saving_and_restoring_the_modal_state_is_refused(code):
+    """M73 in a sub saves the modes and M72 (or the sub's return after M73) restores them, the
+    spindle on/off, its S and the coolant with them: a spindle off at the save is off again after
+    the call, under a cut the verifier read as turning (adversary 27, finding 3)."""
+    body = ["o10 sub", "M73", "G97 S800 M3", "o10 endsub", "T1 M6 G43", "o10 call"]
+    if code != "M73":
+        body = ["G97 S800 M3", code]
+    message = refusal(["G18 G21 G7 G90 G94", *body, "G0 X60 Z5", "G1 X50 F100", "M5", "M2"])
+    assert message is not None and f"{code} restores the spindle state" in message, message

@@ -31,6 +31,9 @@ def seeded_lathe() -> Machine:
 
 LATHE = seeded_lathe()
 
+# The lathe macros save the modes with M73, restored (the spindle off with them) at their return:
+# refused (docs/reference/linuxcnc-lathe.md §5); `adapted` gives them without it (threading.ngc has none).
+M73 = "M73 restores the spindle state on return"
 # file -> (how it runs, None for verified or the construct its refusal names)
 PROGRAMS = {
     "lathe_g70_71_demo.ngc": (None, "profile cycle G71.1"),
@@ -41,15 +44,13 @@ PROGRAMS = {
     "lathe_g7x_quadrants.ngc": (None, "profile cycle G70"),
     # T0 M6 unloads the tool (accepted); the file states no G7/G8, which M2 does not reset
     "lathecomp.ngc": (None, "an X before G7/G8"),
-    "lathe_macros/boring.ngc": (MACRO, None),
-    "lathe_macros/chamfer.ngc": (MACRO, None),
-    "lathe_macros/facing.ngc": (MACRO, None),
+    "lathe_macros/boring.ngc": (MACRO, M73),
+    "lathe_macros/chamfer.ngc": (MACRO, M73),
+    "lathe_macros/facing.ngc": (MACRO, M73),
     "lathe_macros/threading.ngc": (MACRO, None),
-    "lathe_macros/turning.ngc": (MACRO, None),
-    "lathe_macros/drill.ngc": (MACRO, None),
-    # its MACRODEFAULTS are in MACROCOMMAND's order (X, SFM, DOC, Z, Tool, Radius …) but the code
-    # reads the tool from #6: called with them, it selects T0.381
-    "lathe_macros/radius.ngc": (MACRO, "T0.381 is not a tool"),
+    "lathe_macros/turning.ngc": (MACRO, M73),
+    "lathe_macros/drill.ngc": (MACRO, M73),
+    "lathe_macros/radius.ngc": (MACRO, M73),
     "ngcgui_lathe/od.ngc": (NGCGUI, "G53 moves in machine coordinates: the machine record does not give"),
     "ngcgui_lathe/id.ngc": (NGCGUI, "G53 moves in machine coordinates: the machine record does not give"),
     "ngcgui_lathe/taper-od.ngc": (NGCGUI, "system parameter #5410 holds a value only the control has (the tool "
@@ -76,6 +77,13 @@ def program_of(name: str, values: list[str] | None = None) -> list[str]:
     if how == MACRO:
         return as_called(lines, values or macro_defaults(lines), [*PREAMBLE, MACRO_START])
     return lines
+
+
+def adapted(name: str, values: list[str] | None = None) -> list[str]:
+    """A lathe macro as a user adapts it for the verifier: called as its screen calls it, without
+    the M73 that would restore the modes (and the spindle off) at its return; the m2 after the call
+    stops the spindle and coolant anyway."""
+    return [line for line in program_of(name, values) if line.split(";")[0].strip().upper() != "M73"]
 
 
 def refusal(lines: list[str], machine: Machine = LATHE) -> str | None:

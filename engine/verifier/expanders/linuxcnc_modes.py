@@ -42,6 +42,9 @@ REFUSED = {
 }
 IGNORED_G = frozenset({"54", "61", "61.1", "64", "18"})   # no position changes
 MOTIONS = ("0", "1", "2", "3", "33", "76", "80", "83", "70", "71", "71.1", "71.2", "72", "72.1", "72.2")
+# M70 saves the modal state that M72 restores, M73 saves it and restores it at the sub's return:
+# the spindle on/off and direction, S and the coolant with the modes (LinuxCNC M70-M73)
+SAVED = {70: " (M70 saves it for M72)", 72: " (saved by M70)", 73: " on return"}
 IGNORED_M = frozenset({0, 1, 48, 49, 50, 51, 52, 53, 60})      # pauses and override switches
 PLAIN_M = frozenset({3, 4, 5, 7, 8, 9})
 
@@ -99,7 +102,10 @@ class Executor:
             if 62 <= code <= 68:
                 raise Refused(f"M{code:g} switches a HAL output (a plasma torch, a probe, a machine's I/O): "
                               "what it drives is not a lathe move the verifier can follow")
-            if code not in PLAIN_M | IGNORED_M | {2, 30, 6, 70, 71, 72, 73} or code != int(code):
+            if code in (70, 72, 73):
+                raise Refused(f"M{code:g} restores the spindle state{SAVED[int(code)]}, which the verifier does "
+                              "not follow: state S and M3/M4/M5 after the call instead")
+            if code not in PLAIN_M | IGNORED_M | {2, 30, 6, 71} or code != int(code):
                 raise Refused(f"M{code:g} is not an M code of the LinuxCNC lathe grammar (user M100-M199 "
                               "and I/O codes run what the verifier cannot see)")
 

@@ -29,7 +29,6 @@ class Frame:
     back: int = -1                                      # the line after the call
     numbered: dict[int, float] = field(default_factory=dict)
     named: dict[str, float] = field(default_factory=dict)
-    saved: Modes | None = None                          # M73: the modes restored on return
     counts: dict[int, int] = field(default_factory=dict)   # repeat loop -> passes left
 
 
