@@ -151,3 +151,13 @@ def test_saving_and_restoring_the_modal_state_is_refused(code):
         body = ["G97 S800 M3", code]
     message = refusal(["G18 G21 G7 G90 G94", *body, "G0 X60 Z5", "G1 X50 F100", "M5", "M2"])
     assert message is not None and f"{code} restores the spindle state" in message, message
+
+
+@pytest.mark.parametrize("number", [31, 100, 4999])
+def test_a_numbered_global_read_before_the_file_sets_it_is_refused_naming_it(number):
+    """#31…#5000 are volatile globals the interpreter does not clear between runs: they hold what the
+    last program or MDI left, not 0 (adversary 27, finding 5). Set in the file first, they are read."""
+    with pytest.raises(ExpansionRefused, match=f"#{number} is read before the program sets it"):
+        parameter(f"[50 - #{number}]")
+    (line,) = moves("G8", f"#{number} = 4", f"G0 X[50 - #{number}]")
+    assert value("X", line) / 2 == 50 - 4
