@@ -161,3 +161,20 @@ def test_a_numbered_global_read_before_the_file_sets_it_is_refused_naming_it(num
         parameter(f"[50 - #{number}]")
     (line,) = moves("G8", f"#{number} = 4", f"G0 X[50 - #{number}]")
     assert value("X", line) / 2 == 50 - 4
+
+
+@pytest.mark.parametrize("mode, reason", [
+    ("G64", "G64 without P blends corners without a bound"),
+    ("G64 P0.02", "G64 P0.02 blends corners up to 0.02 mm"),
+    ("G20 G64 P0.001", f"blends corners up to {0.001 * INCH:g} mm"),
+])
+def test_blending_corners_beyond_a_hundredth_of_a_mm_is_refused(mode, reason):
+    """G64 rounds corners off the programmed path the verifier proves: bare G64 by as much as the
+    speed needs (adversary 27, finding 7), G64 P by up to P (0.001 in = 0.0254 mm)."""
+    message = refusal([*START, mode, "G21 G0 X60 Z5", "G1 X50 F100", "G1 Z-30", "G0 X60", "M5", "M2"])
+    assert message is not None and reason in message, message
+
+
+@pytest.mark.parametrize("mode", ["G61", "G61.1", "G64 P0.01", "G20 G64 P0.0003"])
+def test_exact_path_or_blending_within_a_hundredth_of_a_mm_is_accepted(mode):
+    assert refusal([*START, mode, "G21 G0 X60 Z5", "G1 X50 F100", "G1 Z-30", "G0 X60", "M5", "M2"]) is None

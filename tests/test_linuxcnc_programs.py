@@ -8,22 +8,29 @@ merged here) on the bar it is called on."""
 from __future__ import annotations
 
 import pytest
-from helpers.linuxcnc_programs import LATHE, M73, PLASMA, PROGRAMS, adapted, file_lines, program_of, refusal
+from helpers.linuxcnc_programs import (
+    LATHE,
+    M73,
+    PLASMA,
+    PREAMBLE_BLEND,
+    PROGRAMS,
+    adapted,
+    file_lines,
+    program_of,
+    refusal,
+)
 
 import engine.verifier.expanders.linuxcnc as interpreter
 from engine.simulation.turning.run import simulate_turning
 
-# The macros as adapted (without M73): verified, but radius.ngc, whose MACRODEFAULTS are in
-# MACROCOMMAND's order (X, SFM, DOC, Z, Tool, Radius …) while the code reads the tool from #6:
-# called with them, it selects T0.381.
-RADIUS = "lathe_macros/radius.ngc"
-VERIFIED = sorted(name for name, (_, construct) in PROGRAMS.items() if construct in (None, M73) and name != RADIUS)
+VERIFIED = sorted(name for name, (_, construct) in PROGRAMS.items() if construct is None)
+CALLED = sorted(name for name, (how, _) in PROGRAMS.items() if how)
 
 
 @pytest.mark.parametrize("name", sorted(PROGRAMS))
 def test_each_real_lathe_program_is_verified_or_refused_naming_its_construct(name):
-    _, construct = PROGRAMS[name]
-    message = refusal(program_of(name))
+    how, construct = PROGRAMS[name]
+    message = refusal(adapted(name) if how else program_of(name))
     if construct is None:
         assert message is None, message
     else:
@@ -31,14 +38,18 @@ def test_each_real_lathe_program_is_verified_or_refused_naming_its_construct(nam
         assert message.count("\n") == 0 and "nothing stored" in message
 
 
-@pytest.mark.parametrize("name", VERIFIED)
-def test_each_macro_without_an_m73_is_verified(name):
-    assert refusal(adapted(name)) is None
+@pytest.mark.parametrize("name", CALLED)
+def test_each_called_file_as_its_screen_calls_it_is_refused_for_the_preamble_s_blend(name):
+    message = refusal(program_of(name))
+    assert message is not None and PREAMBLE_BLEND in message, message
 
 
-def test_the_radius_macro_without_its_m73_is_refused_for_the_tool_its_defaults_select():
-    message = refusal(adapted(RADIUS))
-    assert message is not None and "T0.381 is not a tool" in message, message
+@pytest.mark.parametrize("name", sorted(set(CALLED) - {"lathe_macros/threading.ngc"} - {
+    name for name in CALLED if name.startswith("ngcgui")}))
+def test_a_macro_with_its_m73_is_refused_for_the_restore(name):
+    with_m73 = [line.replace("#<tol>  = 0.001", "#<tol>  = 0.0003") for line in program_of(name)]
+    message = refusal(with_m73)
+    assert message is not None and M73 in message, message
 
 
 def test_the_verified_programs_are_the_macros_that_turn_face_bore_chamfer_drill_and_thread():

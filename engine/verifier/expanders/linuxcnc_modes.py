@@ -40,7 +40,10 @@ REFUSED = {
     "43.1": "G43.1 dynamic tool offset: use G43 with the tool table",
     "43.2": "G43.2 adds offsets the verifier cannot see",
 }
-IGNORED_G = frozenset({"54", "61", "61.1", "64", "18"})   # no position changes
+IGNORED_G = frozenset({"54", "61", "61.1", "18"})   # no position changes (G61/G61.1: exact path)
+# G64 P<tolerance> blends corners, cutting each within P of the programmed path (g-code.adoc G64);
+# the verifier proves the programmed polyline, so only a blend within this (mm) is accepted
+BLEND_TOLERANCE = 0.01
 MOTIONS = ("0", "1", "2", "3", "33", "76", "80", "83", "70", "71", "71.1", "71.2", "72", "72.1", "72.2")
 # M70 saves the modal state that M72 restores, M73 saves it and restores it at the sub's return:
 # the spindle on/off and direction, S and the coolant with the modes (LinuxCNC M70-M73)
@@ -188,6 +191,17 @@ class Executor:
         if words.g("49"):
             self.out.append("G49")
 
+    def _path_mode(self, words: Words) -> None:
+        if not words.g("64"):
+            return
+        tolerance = words.values.get("p")
+        if tolerance is None:
+            raise Refused("G64 without P blends corners without a bound (as fast as possible, rapids too): "
+                          f"write G61, or G64 P<tolerance> of {BLEND_TOLERANCE:g} mm or less")
+        if self.length(tolerance) > BLEND_TOLERANCE:
+            raise Refused(f"G64 P{tolerance:g} blends corners up to {self.length(tolerance):g} mm off the path the "
+                          f"verifier proves: write G61, or G64 P of {BLEND_TOLERANCE:g} mm or less")
+
     def _distance(self, words: Words) -> None:
         distance = words.g("90", "91")
         if distance is not None:
@@ -223,7 +237,8 @@ def _number(value: float) -> str:
 number = _number
 
 
-KNOWN_G = frozenset({*MOTIONS, *IGNORED_G, "98", "99", "4", "17", "19", "7", "8", "20", "21", "40", "43", "49", "90",
-                     "91", "90.1", "91.1", "94", "95", "96", "97"})
+KNOWN_G = frozenset({*MOTIONS, *IGNORED_G, "64", "98", "99", "4", "17", "19", "7", "8", "20", "21", "40", "43", "49",
+                     "90", "91", "90.1", "91.1", "94", "95", "96", "97"})
 STEPS = (Executor._lengths_and_planes, Executor._feed_mode, Executor._feed, Executor._speed, Executor._tool,
-         Executor._spindle_and_coolant, Executor._offsets, Executor._distance, Executor._motion, Executor._stop)
+         Executor._spindle_and_coolant, Executor._offsets, Executor._path_mode, Executor._distance, Executor._motion,
+         Executor._stop)
