@@ -81,6 +81,14 @@ def test_an_attack_inserted_into_a_real_program_is_refused_with_its_reason(conn,
     assert reason in message, message
 
 
+@pytest.mark.parametrize("speed", ["G96 S0", "G97 S0"])
+def test_a_cut_after_a_spindle_speed_of_0_is_refused(conn, speed):
+    """The real opening turns at G96 S450 under the clamp G50 S600; S0 stops the spindle (a surface
+    speed of 0 is 0 r/min at any X), so the cut after it would meet a standing bar."""
+    message = refusal(conn, "lathe-iso", with_body([speed, "G01 X80. F0.3"]))
+    assert "S0" in message and "above 0" in message, message
+
+
 def test_g96_without_the_clamp_of_the_real_program_is_refused(conn):
     start = [line for line in opening() if "G50" not in line]
     message = refusal(conn, "lathe-iso", with_body(["G01 X80. F0.3"], start))

@@ -31,16 +31,23 @@ def seeded_lathe() -> Machine:
 
 LATHE = seeded_lathe()
 
-# file -> (how it runs, None for verified or the construct its refusal names)
+# The screens' preamble blends corners within 0.001 in (G64 P#<tol>: 0.0254 mm) and the lathe macros
+# but threading save the modes with M73: both are refused (docs/reference/linuxcnc-lathe.md §3, §6).
+# `adapted` gives a called file as a user adapts it for the verifier: #<tol> 0.0003 in, no M73 line.
+PREAMBLE_BLEND = "G64 P0.001 blends corners up to 0.0254 mm"
+M73 = "M73 restores the spindle state on return"
+TOLERANCE = "#<tol>  = 0.001"
+# file -> (how it runs, None for verified or the construct its refusal names; a called file adapted)
 PROGRAMS = {
     "lathe_g70_71_demo.ngc": (None, "profile cycle G71.1"),
-    "lathe_pawn.ngc": (None, "no tool length offset active"),
+    # bare G64 on line 2 (and no tool offset: CAM output with no T, M6 or G43)
+    "lathe_pawn.ngc": (None, "G64 without P blends corners without a bound"),
     # M2 does not reset G7/G8 and the INI's startup code runs once (docs/reference §3): not stated
-    "lathe-g76.ngc": (None, "an X before G7/G8: diameter or radius is whatever the last program left (M2/M30 keep it"),
+    "lathe-g76.ngc": (None, "G64 without P blends corners without a bound"),   # and an X before G7/G8
     "lathe_g7x_face_boring.ngc": (None, "profile cycle G72"),
     "lathe_g7x_quadrants.ngc": (None, "profile cycle G70"),
     # T0 M6 unloads the tool (accepted); the file states no G7/G8, which M2 does not reset
-    "lathecomp.ngc": (None, "an X before G7/G8"),
+    "lathecomp.ngc": (None, "G64 without P blends corners without a bound"),   # and an X before G7/G8
     "lathe_macros/boring.ngc": (MACRO, None),
     "lathe_macros/chamfer.ngc": (MACRO, None),
     "lathe_macros/facing.ngc": (MACRO, None),
@@ -57,10 +64,11 @@ PROGRAMS = {
     "ngcgui_lathe/g76diam.ngc": (NGCGUI, "the file g76base.ngc is not in this program"),
     "ngcgui_lathe/g76base.ngc": (NGCGUI, "#<_vmajor> holds a value only the control has"),
 }
-PLASMA = {"plasmac_family/imperial_ramp_pierce.ngc": "M65 switches a HAL output",
-          "plasmac_family/metric_ramp_pierce.ngc": "M65 switches a HAL output",
-          "plasmac_family/imperial_wrench.ngc": "is a HAL pin or INI value",
-          "plasmac_family/metric_wrench.ngc": "is a HAL pin or INI value"}
+# each blends corners (G64 P0.005 in, P0.125 mm) before it reads HAL/INI values or drives M65
+PLASMA = {"plasmac_family/imperial_ramp_pierce.ngc": "G64 P0.005 blends corners up to 0.127 mm",
+          "plasmac_family/metric_ramp_pierce.ngc": "M65 switches a HAL output",     # its G64 P0.254 after it
+          "plasmac_family/imperial_wrench.ngc": "G64 P0.005 blends corners up to 0.127 mm",
+          "plasmac_family/metric_wrench.ngc": "G64 P0.125 blends corners up to 0.125 mm"}
 
 
 def file_lines(name: str) -> list[str]:
@@ -76,6 +84,14 @@ def program_of(name: str, values: list[str] | None = None) -> list[str]:
     if how == MACRO:
         return as_called(lines, values or macro_defaults(lines), [*PREAMBLE, MACRO_START])
     return lines
+
+
+def adapted(name: str, values: list[str] | None = None) -> list[str]:
+    """A called file as a user adapts it for the verifier: called as its screen calls it, the
+    preamble's blend tolerance 0.0003 in (0.00762 mm), and without an M73 that would restore the
+    modes (and the spindle off) at its return; the m2 after the call stops spindle and coolant anyway."""
+    lines = [line for line in program_of(name, values) if line.split(";")[0].strip().upper() != "M73"]
+    return [line.replace(TOLERANCE, "#<tol>  = 0.0003") if line.startswith(TOLERANCE) else line for line in lines]
 
 
 def refusal(lines: list[str], machine: Machine = LATHE) -> str | None:

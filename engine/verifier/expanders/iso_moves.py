@@ -229,6 +229,9 @@ def _take_words(source: Source, words: dict[str, str], modes: Modes, out: Emitte
 
 def _spindle_words(source: Source, words: dict[str, str], modes: Modes, out: Emitted) -> None:
     if "S" in words:
+        if float(words["S"]) <= 0:
+            raise source.refuse(f"S{words['S']} must be above 0: a spindle speed of 0 (under G96 a surface speed "
+                                "of 0, 0 r/min at any X) stops the spindle and the cut after it meets a standing bar")
         if modes.css:
             assert modes.clamp is not None
             out.tokens.append(f"S{modes.clamp:.0f}")

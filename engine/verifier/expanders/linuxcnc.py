@@ -104,13 +104,6 @@ class Interpreter:
 
     def _words(self, index: int, code: str) -> None:
         words = read_words(code, self.params.lookup, self.params.defined)
-        modes = self.executor.modes
-        if words.has_m(73) or words.has_m(70):
-            self.params.frame.saved = modes.copy()
-        if words.has_m(72):
-            self._restore(self.params.frame.saved, "M72 without an M70 before it")
-        if words.has_m(71):
-            self.params.frame.saved = None
         for text in self.executor.run(words):
             self.plain.append(PlainLine(text, index + 1, self.lines[index]))
         if len(self.plain) > MAX_PLAIN_LINES:
@@ -118,19 +111,6 @@ class Interpreter:
         for key, value in words.settings:
             self.params.set(key, value)
         self.stopped = words.has_m(2) or words.has_m(30)
-
-    def _restore(self, saved: object, missing: str) -> None:
-        from .linuxcnc_modes import Modes
-        if not isinstance(saved, Modes):
-            raise Refused(missing)
-        modes = self.executor.modes
-        for name in ("inch", "diameter", "incremental", "arc_absolute", "per_rev", "plane", "motion", "feed",
-                     "css_clamp", "css"):
-            setattr(modes, name, getattr(saved, name))
-        if saved.inch is not None:
-            self.plain.append(PlainLine("G21", self._here, self.lines[self._here - 1]))
-
-    _here = 1
 
     def value(self, text: str) -> float:
         reader = Values(text, self.params.lookup, self.params.defined)
@@ -166,11 +146,7 @@ class Interpreter:
     def _return(self, index: int, item: OWord) -> int:
         if len(self.params.frames) == 1:
             raise Refused(f"o{item.label} {item.keyword} reached without a call")
-        frame = self.params.frames.pop()
-        if frame.saved is not None and self.executor.modes is not None:
-            self._here = index + 1
-            self._restore(frame.saved, "")
-        return frame.back
+        return self.params.frames.pop().back
 
     def _if(self, index: int, item: OWord) -> int:
         if self.value(item.rest):

@@ -40,8 +40,14 @@ REFUSED = {
     "43.1": "G43.1 dynamic tool offset: use G43 with the tool table",
     "43.2": "G43.2 adds offsets the verifier cannot see",
 }
-IGNORED_G = frozenset({"54", "61", "61.1", "64", "18"})   # no position changes
+IGNORED_G = frozenset({"54", "61", "61.1", "18"})   # no position changes (G61/G61.1: exact path)
+# G64 P<tolerance> blends corners, cutting each within P of the programmed path (g-code.adoc G64);
+# the verifier proves the programmed polyline, so only a blend within this (mm) is accepted
+BLEND_TOLERANCE = 0.01
 MOTIONS = ("0", "1", "2", "3", "33", "76", "80", "83", "70", "71", "71.1", "71.2", "72", "72.1", "72.2")
+# M70 saves the modal state that M72 restores, M73 saves it and restores it at the sub's return:
+# the spindle on/off and direction, S and the coolant with the modes (LinuxCNC M70-M73)
+SAVED = {70: " (M70 saves it for M72)", 72: " (saved by M70)", 73: " on return"}
 IGNORED_M = frozenset({0, 1, 48, 49, 50, 51, 52, 53, 60})      # pauses and override switches
 PLAIN_M = frozenset({3, 4, 5, 7, 8, 9})
 
@@ -99,7 +105,10 @@ class Executor:
             if 62 <= code <= 68:
                 raise Refused(f"M{code:g} switches a HAL output (a plasma torch, a probe, a machine's I/O): "
                               "what it drives is not a lathe move the verifier can follow")
-            if code not in PLAIN_M | IGNORED_M | {2, 30, 6, 70, 71, 72, 73} or code != int(code):
+            if code in (70, 72, 73):
+                raise Refused(f"M{code:g} restores the spindle state{SAVED[int(code)]}, which the verifier does "
+                              "not follow: state S and M3/M4/M5 after the call instead")
+            if code not in PLAIN_M | IGNORED_M | {2, 30, 6, 71} or code != int(code):
                 raise Refused(f"M{code:g} is not an M code of the LinuxCNC lathe grammar (user M100-M199 "
                               "and I/O codes run what the verifier cannot see)")
 
@@ -126,10 +135,14 @@ class Executor:
             self.modes.css = False
         if "s" in words.values:
             speed = words.values["s"]
+            if speed <= 0:
+                raise Refused(f"S{speed:g}: a spindle speed of 0 (under G96 a surface speed of 0, 0 r/min at any X) "
+                              "stops the spindle while M3/M4 stays on, and a cut after it meets a standing bar; "
+                              "stop the spindle with M5 and state S above 0")
             if self.modes.css:
                 assert self.modes.css_clamp is not None
                 self.out.append(f"G96 S{_number(self.modes.css_clamp)}")
-            elif speed > 0:
+            else:
                 self.out.append(f"G97 S{_number(speed)}")
         elif mode == "96":
             raise Refused("G96 without its S (surface speed)")
@@ -178,6 +191,17 @@ class Executor:
         if words.g("49"):
             self.out.append("G49")
 
+    def _path_mode(self, words: Words) -> None:
+        if not words.g("64"):
+            return
+        tolerance = words.values.get("p")
+        if tolerance is None:
+            raise Refused("G64 without P blends corners without a bound (as fast as possible, rapids too): "
+                          f"write G61, or G64 P<tolerance> of {BLEND_TOLERANCE:g} mm or less")
+        if self.length(tolerance) > BLEND_TOLERANCE:
+            raise Refused(f"G64 P{tolerance:g} blends corners up to {self.length(tolerance):g} mm off the path the "
+                          f"verifier proves: write G61, or G64 P of {BLEND_TOLERANCE:g} mm or less")
+
     def _distance(self, words: Words) -> None:
         distance = words.g("90", "91")
         if distance is not None:
@@ -213,7 +237,8 @@ def _number(value: float) -> str:
 number = _number
 
 
-KNOWN_G = frozenset({*MOTIONS, *IGNORED_G, "98", "99", "4", "17", "19", "7", "8", "20", "21", "40", "43", "49", "90",
-                     "91", "90.1", "91.1", "94", "95", "96", "97"})
+KNOWN_G = frozenset({*MOTIONS, *IGNORED_G, "64", "98", "99", "4", "17", "19", "7", "8", "20", "21", "40", "43", "49",
+                     "90", "91", "90.1", "91.1", "94", "95", "96", "97"})
 STEPS = (Executor._lengths_and_planes, Executor._feed_mode, Executor._feed, Executor._speed, Executor._tool,
-         Executor._spindle_and_coolant, Executor._offsets, Executor._distance, Executor._motion, Executor._stop)
+         Executor._spindle_and_coolant, Executor._offsets, Executor._path_mode, Executor._distance, Executor._motion,
+         Executor._stop)

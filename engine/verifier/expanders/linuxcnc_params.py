@@ -1,5 +1,6 @@
 """LinuxCNC parameters (docs/reference/linuxcnc-lathe.md §2): numbered `#1`…`#30` are a
-subroutine's own (its arguments), `#31`… are global and 0 until set; named `#<name>` belong to the
+subroutine's own (its arguments), `#31`… are global and hold what the last program left until the
+file sets them (a read before is refused); named `#<name>` belong to the
 subroutine (or main program) that sets them, `#<_name>` are global; reading a named parameter
 never set is an error on the control and is refused here. Of the interpreter's read-only
 parameters the position (#<_x>, #<_z>: X as a radius, program units) and the units (#<_imperial>,
@@ -29,7 +30,6 @@ class Frame:
     back: int = -1                                      # the line after the call
     numbered: dict[int, float] = field(default_factory=dict)
     named: dict[str, float] = field(default_factory=dict)
-    saved: Modes | None = None                          # M73: the modes restored on return
     counts: dict[int, int] = field(default_factory=dict)   # repeat loop -> passes left
 
 
@@ -52,7 +52,10 @@ class Parameters:
             if number >= SYSTEM and number not in self.numbered:
                 raise Refused(f"system parameter #{number} holds a value only the control has"
                               f"{SYSTEM_NEEDS.get(number, '')}")
-            return self.numbered.get(number, 0.0)
+            if number not in self.numbered:
+                raise Refused(f"#{number} is read before the program sets it: a global #31…#4999 keeps what "
+                              "the last program or MDI left (LinuxCNC does not clear them between runs); set it first")
+            return self.numbered[number]
         found = self._named(key)
         if found is None:
             raise Refused(f"#{key} is read before it is set (LinuxCNC stops there)")
