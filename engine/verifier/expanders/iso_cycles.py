@@ -7,7 +7,8 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import TYPE_CHECKING
 
-from . import cycles
+import engine.verifier.expanders.cycles as cycles
+
 from .cycles import CycleError, Move, Thread
 from .iso_modes import arc_radius
 

@@ -21,7 +21,8 @@ from __future__ import annotations
 import re
 from typing import TYPE_CHECKING
 
-from .. import expansion
+import engine.verifier.expansion as expansion  # read at call time: a test may lower MAX_STEPS
+
 from ..expansion import ExpansionRefused, PlainLine, register_expander
 from ..refusals import Refused
 from .sinumerik_blocks import BlockState, plain_block
