@@ -185,9 +185,8 @@ class ProgramReading:
         if block.feed is not None:
             self.feed = block.feed
         self.feed_mode.take(block)
-        if block.speed is not None and block.moves:
-            self._set_speed(block.speed)       # the move runs at the S of its own block
-        self.feed_mode.check(block, self.feed, self.speed)
+        # the move runs at the S of its own block; the speed itself is set (and checked) below
+        self.feed_mode.check(block, self.feed, self.speed if block.speed is None else block.speed)
         if block.area:
             self._set_area(block)
         elif block.moves:
