@@ -8,6 +8,8 @@ lathe macros of gmoccapy/axis run it by writing a program around it:
 * the lathe macros (`; MACRODEFAULTS=1.0,500.0,…`): the call with the defaults of the
   MACRODEFAULTS line (True/False as 1/0), from where the tool stands (the macro reads #<_x> and
   #<_z>), so the caller states the units, the diameter mode and that start position first.
+* gmoccapy's own lathe macros (configs/sim/gmoccapy/lathe_configs): one MDI line written by its
+  Cycles tab, after the INI's startup code; the data are in linuxcnc_gmoccapy.py.
 
 Nothing here evaluates anything: it writes text the expander then reads like any program."""
 from __future__ import annotations
@@ -49,10 +51,17 @@ def macro_defaults(lines: list[str]) -> list[str]:
 def as_called(lines: list[str], values: list[str], before: list[str]) -> list[str]:
     """`before` (a preamble, the caller's modes and position), the file up to its endsub (what
     follows, such as a macro file's M2, is never run by a call), its call, m2."""
+    call = f"o<{subroutine_name(lines)}> call " + "".join(f"[{value}]" for value in values)
+    return with_call(lines, call, before)
+
+
+def with_call(lines: list[str], call: str, before: list[str]) -> list[str]:
+    """As `as_called`, with the call line as the screen writes it; it must call the file's sub."""
     name = subroutine_name(lines)
+    if not re.match(rf"\s*o<{re.escape(name)}>\s*call\b", call, re.IGNORECASE):
+        raise Refused(f"the call {call.strip()!r} does not call o<{name}>, the file's subroutine")
     end = re.compile(rf"\s*o<{re.escape(name)}>\s*endsub\b", re.IGNORECASE)
     last = next((n for n, line in enumerate(lines) if end.match(line)), None)
     if last is None:
         raise Refused(f"o<{name}> sub without its o<{name}> endsub")
-    call = f"o<{name}> call " + "".join(f"[{value}]" for value in values)
     return [*before, *lines[:last + 1], call, "m2"]
