@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING
 from ..expansion import MAX_PLAIN_LINES, MAX_STEPS, ExpansionRefused, PlainLine, register_expander
 from ..refusals import Refused
 from .linuxcnc_cycles import move_or_cycle
-from .linuxcnc_flow import FlowError, pair
+from .linuxcnc_flow import FlowError, pair, repeat_count
 from .linuxcnc_lines import OWord, read
 from .linuxcnc_modes import Executor
 from .linuxcnc_params import Frame, Parameters
@@ -175,9 +175,9 @@ class Interpreter:
         return opener + 1 if counts[opener] > 0 else index + 1
 
     def _repeat(self, index: int, item: OWord) -> int:
-        count = self.value(item.rest)
-        self.params.frame.counts[index] = int(count)
-        return index + 1 if count >= 1 else self.flow.end[index] + 1
+        count = repeat_count(self.value(item.rest))
+        self.params.frame.counts[index] = count
+        return index + 1 if count > 0 else self.flow.end[index] + 1
 
     def _break(self, index: int, item: OWord) -> int:
         return self.flow.end[self.flow.loop[index]] + 1
