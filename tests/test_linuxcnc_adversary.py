@@ -1,11 +1,13 @@
 """LinuxCNC programs the verifier once accepted but LinuxCNC runs differently (issue 27, adversary
-27b; docs/reference/linuxcnc-lathe.md §6): a repeat count is rounded, not cut (H11)."""
+27b; docs/reference/linuxcnc-lathe.md §2, §6): a repeat count is rounded, not cut (H11); #1…#30
+of the main program hold what the last program left (H12)."""
 from __future__ import annotations
 
 import math
 
 import pytest
-from helpers.linuxcnc_moves import moves
+from helpers.linuxcnc_moves import START, moves
+from helpers.linuxcnc_programs import refusal
 
 
 def nearbyint(value: float) -> int:
@@ -23,4 +25,19 @@ def test_a_repeat_runs_its_body_the_count_rounded_as_linuxcnc_rounds_it(count):
     passes = max(0, nearbyint(count))
     lines = moves("#<n> = 0", f"o10 repeat [{count}]", "#<n> = [#<n> + 1]", "G0 X#<n> Z2", "o10 endrepeat")
     assert lines == [f"G0 X{n}. Z2." for n in range(1, passes + 1)]
+
+@pytest.mark.parametrize("number", [1, 30])
+def test_a_main_program_reading_a_numbered_parameter_below_31_before_setting_it_is_refused(number):
+    """Outside a call #1…#30 are not cleared between runs: X[#1 + 50] moves where the last
+    program's #1 says, not to X50."""
+    message = refusal([*START, f"G0 X[#{number} + 50] Z2", "G0 X100 Z50", "M5", "M2"])
+    assert message is not None and f"#{number} is read in the main program before the program sets it" in message, \
+        message
+
+
+def test_inside_a_call_an_argument_not_passed_is_0_and_the_main_program_s_value_returns_after():
+    """A call zeroes #1…#30 it is not given (interp_read.cc) and restores the caller's on return."""
+    lines = moves("o10 sub", "G0 X[#1 + 50] Z[#2 + 2]", "o10 endsub", "#1 = 7", "o10 call", "o10 call [4]",
+                  "G0 X#1 Z2")
+    assert lines == ["G0 X50. Z2.", "G0 X54. Z2.", "G0 X7. Z2."]
 
