@@ -2,7 +2,7 @@
 opening o-word (sub, if, while, do, repeat) paired with its closing one of the same label, the
 elseif/else of each if, and the loop each break/continue leaves. A program whose o-words do not
 pair is refused before anything runs, naming the line (the control refuses it too). Also the
-count of a `repeat`."""
+count of a `repeat` and the rule that a sub is defined before it is called."""
 from __future__ import annotations
 
 from dataclasses import dataclass, field
@@ -93,3 +93,14 @@ def repeat_count(value: float) -> int:
     Python's round() of a float is the same rule. The value is finite (Values refuses others)."""
     return round(value)
 
+
+def called_early(label: str, sub_line: int) -> str:
+    """The refusal of a call run before the interpreter has passed the sub's definition. o-code.adoc:
+    "Subroutines may only be called after they are defined". interp_o_word.cc `control_back_to`
+    does not find such a sub in its table of the subs read so far: it first opens a file named
+    after the label (cwd, PROGRAM_PREFIX, SUBROUTINE_PATH) and runs that, and only without one skips
+    forward in the file to the sub; what runs depends on files the verifier does not have."""
+    name = label.strip("<>")
+    return (f"o{label} call before its o{label} sub (line {sub_line}) is read: LinuxCNC calls a sub once it "
+            f"has read its definition; before that it runs a file {name}.ngc from its SUBROUTINE_PATH if there "
+            "is one (o-code.adoc: a sub is defined before it is called); define the sub before the call")
