@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING
 from ..expansion import MAX_PLAIN_LINES, MAX_STEPS, ExpansionRefused, PlainLine, register_expander
 from ..refusals import Refused
 from .linuxcnc_cycles import move_or_cycle
-from .linuxcnc_flow import FlowError, pair
+from .linuxcnc_flow import FlowError, called_early, pair, repeat_count
 from .linuxcnc_lines import OWord, read
 from .linuxcnc_modes import Executor
 from .linuxcnc_params import Frame, Parameters
@@ -49,6 +49,7 @@ class Interpreter:
         self.plain: list[PlainLine] = []
         self.stopped = False
         self.called: set[str] = set()
+        self.defined: set[str] = set()      # subs whose definition the run has passed (o-code.adoc)
 
     def _read_all(self, lines: list[str]) -> list[OWord | str | None]:
         items: list[OWord | str | None] = []
@@ -127,6 +128,7 @@ class Interpreter:
 
     # o-words: each returns the index of the next line to run
     def _sub(self, index: int, item: OWord) -> int:
+        self.defined.add(item.label)
         return self.flow.end[index] + 1          # a definition: skipped where it stands
 
     def _call(self, index: int, item: OWord) -> int:
@@ -136,6 +138,8 @@ class Interpreter:
             where = f"the file {named}.ngc" if item.label.startswith("<") else f"an o{item.label} sub"
             raise Refused(f"o{item.label} call: {where} is not in this program (an external subroutine "
                           "the control finds on its SUBROUTINE_PATH); put the sub into the file")
+        if item.label not in self.defined:
+            raise Refused(called_early(item.label, sub[0] + 1))
         if len(self.params.frames) > MAX_CALLS:
             raise Refused(f"more than {MAX_CALLS} nested calls: a recursion that does not end")
         self.called.add(item.label)
@@ -175,9 +179,9 @@ class Interpreter:
         return opener + 1 if counts[opener] > 0 else index + 1
 
     def _repeat(self, index: int, item: OWord) -> int:
-        count = self.value(item.rest)
-        self.params.frame.counts[index] = int(count)
-        return index + 1 if count >= 1 else self.flow.end[index] + 1
+        count = repeat_count(self.value(item.rest))
+        self.params.frame.counts[index] = count
+        return index + 1 if count > 0 else self.flow.end[index] + 1
 
     def _break(self, index: int, item: OWord) -> int:
         return self.flow.end[self.flow.loop[index]] + 1

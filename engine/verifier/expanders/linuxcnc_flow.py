@@ -1,7 +1,8 @@
 """Where the o-words of a LinuxCNC program lead (docs/reference/linuxcnc-lathe.md §6): each
 opening o-word (sub, if, while, do, repeat) paired with its closing one of the same label, the
 elseif/else of each if, and the loop each break/continue leaves. A program whose o-words do not
-pair is refused before anything runs, naming the line (the control refuses it too)."""
+pair is refused before anything runs, naming the line (the control refuses it too). Also the
+count of a `repeat` and the rule that a sub is defined before it is called."""
 from __future__ import annotations
 
 from dataclasses import dataclass, field
@@ -82,3 +83,24 @@ def _enclosing(stack: list[int], index: int, items: dict[int, OWord], kind: str 
                                                            and found.label == item.label):
             return opener
     raise FlowError(index, f"o{item.label} {item.keyword} outside {'a subroutine' if kind else 'its loop'}")
+
+
+def repeat_count(value: float) -> int:
+    """How often `oN repeat [value]` runs its body: interp_o_word.cc takes
+    `round_to_int(settings->test_value)`, which is `(int)std::nearbyint(x)` (interp_internal.hh):
+    rounding in the current mode, which nothing in src/ changes (no fesetround) from C's default: nearest
+    with ties to even (2.6 -> 3, 2.5 -> 2, 3.5 -> 4, 0.6 -> 1, 0.5 -> 0); 0 or less runs it never.
+    Python's round() of a float is the same rule. The value is finite (Values refuses others)."""
+    return round(value)
+
+
+def called_early(label: str, sub_line: int) -> str:
+    """The refusal of a call run before the interpreter has passed the sub's definition. o-code.adoc:
+    "Subroutines may only be called after they are defined". interp_o_word.cc `control_back_to`
+    does not find such a sub in its table of the subs read so far: it first opens a file named
+    after the label (cwd, PROGRAM_PREFIX, SUBROUTINE_PATH) and runs that, and only without one skips
+    forward in the file to the sub; what runs depends on files the verifier does not have."""
+    name = label.strip("<>")
+    return (f"o{label} call before its o{label} sub (line {sub_line}) is read: LinuxCNC calls a sub once it "
+            f"has read its definition; before that it runs a file {name}.ngc from its SUBROUTINE_PATH if there "
+            "is one (o-code.adoc: a sub is defined before it is called); define the sub before the call")

@@ -1,6 +1,6 @@
 """LinuxCNC parameters (docs/reference/linuxcnc-lathe.md §2): numbered `#1`…`#30` are a
-subroutine's own (its arguments), `#31`… are global and hold what the last program left until the
-file sets them (a read before is refused); named `#<name>` belong to the
+subroutine's own (its arguments); in the main program they, like the global `#31`…, hold what the
+last program left until the file sets them (a read before is refused); named `#<name>` belong to the
 subroutine (or main program) that sets them, `#<_name>` are global; reading a named parameter
 never set is an error on the control and is refused here. Of the interpreter's read-only
 parameters the position (#<_x>, #<_z>: X as a radius, program units) and the units (#<_imperial>,
@@ -48,7 +48,7 @@ class Parameters:
         if key.isdigit():
             number = int(key)
             if number in LOCALS:
-                return self.frame.numbered.get(number, 0.0)
+                return self._local(number)
             if number >= SYSTEM and number not in self.numbered:
                 raise Refused(f"system parameter #{number} holds a value only the control has"
                               f"{SYSTEM_NEEDS.get(number, '')}")
@@ -60,6 +60,15 @@ class Parameters:
         if found is None:
             raise Refused(f"#{key} is read before it is set (LinuxCNC stops there)")
         return found
+
+    def _local(self, number: int) -> float:
+        """Inside a call an argument not passed is 0 (interp_read.cc zeroes #N+1…#30 of the call); in
+        the main program #1…#30 are plain parameters holding what the last program or MDI left."""
+        if len(self.frames) > 1 or number in self.frame.numbered:
+            return self.frame.numbered.get(number, 0.0)
+        raise Refused(f"#{number} is read in the main program before the program sets it: outside a call "
+                      "#1…#30 keep what the last program or MDI left (LinuxCNC clears them only for a call's "
+                      "arguments); set it first")
 
     def defined(self, key: str) -> bool:
         if key.isdigit():
