@@ -63,7 +63,9 @@ PARAMS = {
         "lathe-g76.ngc", "lathe_g7x_quadrants.ngc", "lathe_g7x_face_boring.ngc", "lathecomp.ngc",
         "lathe_macros/chamfer.ngc", "lathe_macros/radius.ngc", "lathe_macros/drill.ngc",
         "ngcgui_lathe/taper-od.ngc", "ngcgui_lathe/g76diam.ngc", "ngcgui_lathe/g76base.ngc",
-        "ngcgui_lathe/lathe_std.ngc")},
+        "ngcgui_lathe/lathe_std.ngc", "lathe_macros/go_to_position.ngc", "lathe_macros/probe-hole.ngc",
+        *(f"gmoccapy_lathe/{macro}.ngc" for macro in (
+            "boring", "chamfer", "drilling", "facing", "grooving", "radius", "threading", "turning")))},
     "sinumerik/cam_840dsl/CAM_TEST.MPF": {"feed": 250, "clear_z": 60, "approach_z": 53, "spindle_speed": 1061},
     "emco_from_dxf/testNegDXF.cnc": {"feed": 100, "z_clear": 3000, "arc_k": -500},
     "emco_from_dxf/testg02hemisphere.cnc": {"feed": 100, "z_clear": 3000},
