@@ -31,8 +31,12 @@ def seeded_lathe() -> Machine:
 
 LATHE = seeded_lathe()
 
+# The preamble's blend (#<tol> 0.001 in: G64 P0.0254 mm) and the macros' M73 are followed
+# (docs/reference/linuxcnc-lathe.md §3, §6); PREAMBLE_BLEND is the refusal it had before that.
+PREAMBLE_BLEND = "G64 P0.001 blends corners up to 0.0254 mm"
+TOLERANCE = "#<tol>  = 0.001"
 # file -> (how it runs, None for verified or the construct its refusal names; a called file as its
-# screen calls it: the preamble's G64 P0.001 in and the macros' M73 are followed, docs/reference §3, §6)
+# screen calls it)
 PROGRAMS = {
     "lathe_g70_71_demo.ngc": (None, "profile cycle G71.1"),
     # bare G64 on line 2 (and no tool offset: CAM output with no T, M6 or G43)
