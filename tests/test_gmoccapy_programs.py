@@ -9,7 +9,7 @@ import math
 
 import pytest
 from helpers.gmoccapy_programs import AXIS_MACROS, GMOCCAPY, axis_macro, gmoccapy_lines, gmoccapy_program
-from helpers.linuxcnc_programs import LATHE, PREAMBLE_BLEND, refusal
+from helpers.linuxcnc_programs import LATHE, refusal
 
 from engine.verifier.expanders.linuxcnc_gmoccapy import mdi_call
 from engine.verifier.refusals import Refused
@@ -102,12 +102,3 @@ def test_a_cut_past_the_z_travel_inserted_into_a_verified_macro_is_refused(name)
 @pytest.mark.parametrize("name", sorted(AXIS_MACROS))
 def test_each_axis_lathe_macro_as_called_is_verified_or_refused_naming_its_construct(name):
     assert_outcome(axis_macro(name), AXIS_MACROS[name])
-
-
-@pytest.mark.parametrize("name", sorted(AXIS_MACROS))
-def test_an_axis_lathe_macro_with_the_preamble_s_tolerance_is_refused_today_for_it(name):
-    """The preamble's G64 P0.001 in (0.0254 mm) is refused at its g64 line, or, once the blend bound
-    accepts 0.0254 mm (another change of issue 27), the outcome is AXIS_MACROS's: nothing else."""
-    message = refusal(axis_macro(name, tolerance="0.001"))
-    blend = message is not None and PREAMBLE_BLEND in message and "g64 p#<tol>" in message
-    assert blend or message == refusal(axis_macro(name)), message

@@ -133,18 +133,6 @@ def test_a_cut_after_a_spindle_speed_of_0_is_refused(speed):
     assert message is not None and "speed of 0" in message, message
 
 
-@pytest.mark.parametrize("code", ["M70", "M72", "M73"])
-def test_saving_and_restoring_the_modal_state_is_refused(code):
-    """M73 in a sub saves the modes and M72 (or the sub's return after M73) restores them, the
-    spindle on/off, its S and the coolant with them: a spindle off at the save is off again after
-    the call, under a cut the verifier read as turning (adversary 27, finding 3)."""
-    body = ["o10 sub", "M73", "G97 S800 M3", "o10 endsub", "T1 M6 G43", "o10 call"]
-    if code != "M73":
-        body = ["G97 S800 M3", code]
-    message = refusal(["G18 G21 G7 G90 G94", *body, "G0 X60 Z5", "G1 X50 F100", "M5", "M2"])
-    assert message is not None and f"{code} restores the spindle state" in message, message
-
-
 @pytest.mark.parametrize("number", [31, 100, 4999])
 def test_a_numbered_global_read_before_the_file_sets_it_is_refused_naming_it(number):
     """#31…#5000 are volatile globals the interpreter does not clear between runs: they hold what the
@@ -157,16 +145,16 @@ def test_a_numbered_global_read_before_the_file_sets_it_is_refused_naming_it(num
 
 @pytest.mark.parametrize("mode, reason", [
     ("G64", "G64 without P blends corners without a bound"),
-    ("G64 P0.02", "G64 P0.02 blends corners up to 0.02 mm"),
-    ("G20 G64 P0.001", f"blends corners up to {0.001 * INCH:g} mm"),
+    ("G64 P0.03", "G64 P0.03 blends corners up to 0.03 mm"),
+    ("G20 G64 P0.002", f"blends corners up to {0.002 * INCH:g} mm"),
 ])
-def test_blending_corners_beyond_a_hundredth_of_a_mm_is_refused(mode, reason):
-    """G64 rounds corners off the programmed path the verifier proves: bare G64 by as much as the
-    speed needs (adversary 27, finding 7), G64 P by up to P (0.001 in = 0.0254 mm)."""
+def test_blending_corners_beyond_a_thousandth_of_an_inch_is_refused(mode, reason):
+    """G64 runs the tool off the programmed path: bare G64 by as much as the speed needs (adversary
+    27, finding 7), G64 P by up to P; the turning simulation allows for P up to 0.001 in (0.0254 mm)."""
     message = refusal([*START, mode, "G21 G0 X60 Z5", "G1 X50 F100", "G1 Z-30", "G0 X60", "M5", "M2"])
     assert message is not None and reason in message, message
 
 
-@pytest.mark.parametrize("mode", ["G61", "G61.1", "G64 P0.01", "G20 G64 P0.0003"])
-def test_exact_path_or_blending_within_a_hundredth_of_a_mm_is_accepted(mode):
+@pytest.mark.parametrize("mode", ["G61", "G61.1", "G64 P0.0254", "G20 G64 P0.001"])
+def test_exact_path_or_blending_within_a_thousandth_of_an_inch_is_accepted(mode):
     assert refusal([*START, mode, "G21 G0 X60 Z5", "G1 X50 F100", "G1 Z-30", "G0 X60", "M5", "M2"]) is None

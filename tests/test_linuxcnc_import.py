@@ -12,13 +12,13 @@ from __future__ import annotations
 import json
 
 from helpers.class_jobs import ok, refused, stored_program
-from helpers.linuxcnc_programs import LATHE, MACRO_START, adapted, refusal
+from helpers.linuxcnc_programs import LATHE, MACRO_START, program_of, refusal
 
 TURNING = "lathe_macros/turning.ngc"
 
 
 def imported(run, tmp_path):
-    lines = [line.expandtabs(4) for line in adapted(TURNING)]
+    lines = [line.expandtabs(4) for line in program_of(TURNING)]
     source = tmp_path / "turning_called.ngc"
     source.write_text("\n".join(lines) + "\n")
     params = tmp_path / "params.json"

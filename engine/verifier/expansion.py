@@ -39,6 +39,10 @@ class PlainLine:
     text: str       # a plain line: a header, a comment or a block of address words
     number: int     # that program line's number, from 1
     source: str     # that program line as written
+    # mm the control may run a move off its programmed path (LinuxCNC G64 P: blended corners,
+    # collinear feeds merged): the turning simulation lets the move be anywhere that close to it;
+    # 0 for every dialect that follows the programmed path exactly
+    blend: float = 0.0
 
 
 class ExpansionRefused(Refused):

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 from engine.verifier.expanders.linuxcnc_callers import as_called, macro_defaults
 from engine.verifier.expanders.linuxcnc_gmoccapy import SAVED, UI_VALUES, as_gmoccapy_runs
-from helpers.linuxcnc_programs import FOLDER, MACRO_START, PREAMBLE, TOLERANCE
+from helpers.linuxcnc_programs import FOLDER, MACRO_START, PREAMBLE
 
 TRAVEL_X = "exceeds the travel of lathe-linuxcnc (X 0"
 # macro file -> (its construct as the shipped sim calls it, with savestate.sav's values; the same
@@ -47,8 +47,8 @@ def gmoccapy_program(name: str, ui: bool = False) -> list[str]:
     return as_gmoccapy_runs(name, gmoccapy_lines(name), {**SAVED, **UI_VALUES} if ui else SAVED)
 
 
-def axis_macro(name: str, tolerance: str = "0.0003") -> list[str]:
-    """An axis lathe macro as called (helpers.linuxcnc_programs' MACRO), the preamble's #<tol> given."""
+def axis_macro(name: str) -> list[str]:
+    """An axis lathe macro as called (helpers.linuxcnc_programs' MACRO), the preamble as it stands
+    (its G64 P0.001 in, 0.0254 mm, is followed: docs/reference/linuxcnc-lathe.md §3)."""
     lines = (FOLDER / name).read_text().splitlines()
-    called = as_called(lines, macro_defaults(lines), [*PREAMBLE, MACRO_START])
-    return [f"#<tol>  = {tolerance}" if line.startswith(TOLERANCE) else line for line in called]
+    return as_called(lines, macro_defaults(lines), [*PREAMBLE, MACRO_START])

@@ -31,13 +31,10 @@ def seeded_lathe() -> Machine:
 
 LATHE = seeded_lathe()
 
-# The screens' preamble blends corners within 0.001 in (G64 P#<tol>: 0.0254 mm) and the lathe macros
-# but threading save the modes with M73: both are refused (docs/reference/linuxcnc-lathe.md §3, §6).
-# `adapted` gives a called file as a user adapts it for the verifier: #<tol> 0.0003 in, no M73 line.
-PREAMBLE_BLEND = "G64 P0.001 blends corners up to 0.0254 mm"
-M73 = "M73 restores the spindle state on return"
-TOLERANCE = "#<tol>  = 0.001"
-# file -> (how it runs, None for verified or the construct its refusal names; a called file adapted)
+# The preamble's blend (#<tol> 0.001 in: G64 P0.0254 mm) and the macros' M73 are followed
+# (docs/reference/linuxcnc-lathe.md §3, §6).
+# file -> (how it runs, None for verified or the construct its refusal names; a called file as its
+# screen calls it)
 PROGRAMS = {
     "lathe_g70_71_demo.ngc": (None, "profile cycle G71.1"),
     # bare G64 on line 2 (and no tool offset: CAM output with no T, M6 or G43)
@@ -84,14 +81,6 @@ def program_of(name: str, values: list[str] | None = None) -> list[str]:
     if how == MACRO:
         return as_called(lines, values or macro_defaults(lines), [*PREAMBLE, MACRO_START])
     return lines
-
-
-def adapted(name: str, values: list[str] | None = None) -> list[str]:
-    """A called file as a user adapts it for the verifier: called as its screen calls it, the
-    preamble's blend tolerance 0.0003 in (0.00762 mm), and without an M73 that would restore the
-    modes (and the spindle off) at its return; the m2 after the call stops spindle and coolant anyway."""
-    lines = [line for line in program_of(name, values) if line.split(";")[0].strip().upper() != "M73"]
-    return [line.replace(TOLERANCE, "#<tol>  = 0.0003") if line.startswith(TOLERANCE) else line for line in lines]
 
 
 def refusal(lines: list[str], machine: Machine = LATHE) -> str | None:

@@ -46,6 +46,7 @@ class Move:
     feed: float | None        # F as written
     per_minute: bool          # G94/G98
     lead: float | None        # a thread's lead, mm/rev
+    blend: float = 0.0        # mm the control may run it off its path (LinuxCNC G64 P; material walk)
 
 
 @dataclass(frozen=True)
@@ -102,7 +103,7 @@ class ProgramState:
             start = (self.z, self.x / 2.0)
             self.x, self.z = x, z
             self.moves.append(Move(step.number, step.line, RAPID, [start, (z, x / 2.0)], self.operation, self.speed,
-                                   self.constant_speed, self.feed, self.per_minute, None))
+                                   self.constant_speed, self.feed, self.per_minute, None, step.blend))
         self.at_reference = True
 
     def _operation(self, step) -> None:
@@ -183,7 +184,7 @@ class ProgramState:
         if kind != RAPID:
             self._check_cut(step, kind)
         self.moves.append(Move(step.number, step.line, kind, points, self.operation, self.speed,
-                               self.constant_speed, self.feed, self.per_minute, lead))
+                               self.constant_speed, self.feed, self.per_minute, lead, step.blend))
 
     def _check_cut(self, step, kind: str) -> None:
         what = "a thread pass" if kind == THREAD else "a cut"

@@ -28,6 +28,7 @@ from shapely.geometry import LineString, Point, Polygon, box
 from shapely.geometry.base import BaseGeometry
 from shapely.ops import unary_union
 
+from .blending import corner
 from .follow import RAPID, THREAD, Move
 from .report import TurningReport
 from .work import TurningRecords, whole
@@ -77,16 +78,35 @@ class MaterialWalk:
         self.inside_part = records.part.buffer(-CUT_TOLERANCE_MM)
         self.solid_part = self.inside_part       # less the thread grooves cut so far
         self.threads = {n: region.buffer(CUT_TOLERANCE_MM) for n, region in records.threads.items()}
+        self.last: Move | None = None
+        self.grown: dict[float, BaseGeometry] = {}    # inside_part grown by each blend tolerance
 
     def take(self, move: Move) -> None:
         line = path(move)
+        before, self.last = self.last, move
         if move.kind == RAPID:
             self._rapid(move, line)
+            self._corner(before, move)
             return
+        self._corner(before, move)
         self.report.cut_moves += 1
         self._behind(move, line)
         self._cut(move, line)
         self.material = self.material.difference(column(move))
+
+    def _corner(self, before: Move | None, move: Move) -> None:
+        """A blended junction (LinuxCNC G64 P, engine.simulation.turning.blending) runs inside the
+        angle of its two moves: next to a rapid it must be air, and it must never enter the part."""
+        if RAPID not in (move.kind, before.kind if before is not None else None):
+            return       # between two cuts the corner lies within the cuts' own blend (_cut)
+        region = corner(before, move, RAPID)
+        if region is None:
+            return
+        solid = self.material.buffer(-AIR_TOLERANCE_MM).union(self.solid_part)
+        if region.intersection(solid).area > 0:
+            self.report.add(move.number, move.line, f"the corner blended into this move at rapid (G64 P{move.blend:g} "
+                            "mm: the tool rounds it anywhere inside the angle, that far from the path) runs through "
+                            "material: keep the rapid that far clear of it, or write G61")
 
     def _rapid(self, move: Move, line: BaseGeometry) -> None:
         self.report.rapids += 1
@@ -107,8 +127,15 @@ class MaterialWalk:
             self.report.add(move.number, move.line, f"a cut {behind:.3f} mm behind the blank's back end "
                             f"Z{self.z_back:.3f}: it cuts the bar the chuck holds, not the blank")
 
+    def _within(self, blend: float) -> BaseGeometry:
+        """Where a cut's line may not run: the part (less the cut tolerance) grown by the blend
+        tolerance, since the tool may run anywhere within it of the line (blending.tube)."""
+        if blend not in self.grown:
+            self.grown[blend] = self.inside_part.buffer(blend) if blend > 0 else self.inside_part
+        return self.grown[blend]
+
     def _cut(self, move: Move, line: BaseGeometry) -> None:
-        inside = line.intersection(self.inside_part)
+        inside = line.intersection(self._within(move.blend))
         if move.kind == THREAD and move.operation in self.threads:
             drawn = self.threads[move.operation]
             if line.intersection(drawn).is_empty:
@@ -119,4 +146,12 @@ class MaterialWalk:
             self.solid_part = self.solid_part.difference(column(move).intersection(groove.buffer(AIR_TOLERANCE_MM)))
         if inside.length > 0:
             self.report.add(move.number, move.line, f"a cut into the finished part for {inside.length:.3f} mm "
-                            "of its path: the part's profile is spoiled")
+                            f"of its path{_blended(move)}: the part's profile is spoiled")
+
+
+def _blended(move: Move) -> str:
+    """A cut under G64 P may run anywhere within P of its path (engine.simulation.turning.blending)."""
+    if move.blend <= 0:
+        return ""
+    return (f" (its G64 P{move.blend:g} mm lets the tool run that far off the path: a finishing pass on the "
+            "part's profile is cut under G61 or a P within the cut tolerance)")

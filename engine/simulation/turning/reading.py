@@ -25,6 +25,7 @@ class Step:
     g_codes: frozenset = frozenset()
     m_codes: frozenset = frozenset()
     operation: tuple[int, str] | None = None   # (n, KIND) of an operation comment
+    blend: float = 0.0       # mm the control may run the move off its path (PlainLine.blend: LinuxCNC G64 P)
 
 
 def read_lathe_program(lines: list[str], machine: Machine, name: str) -> list[Step]:
@@ -48,4 +49,4 @@ def _step(dialect, plain: PlainLine, name: str) -> Step:
         address, equals, text = word.groups()
         if address in codes and not equals:
             codes[address].add(int(text))
-    return Step(number, line, item, frozenset(codes["G"]), frozenset(codes["M"]), operation)
+    return Step(number, line, item, frozenset(codes["G"]), frozenset(codes["M"]), operation, plain.blend)

@@ -5,7 +5,8 @@ of the LinuxCNC lathe grammar, each tagged with the line as written.
 It follows o-word subroutines defined in the file (`o100 sub … o100 endsub`, `o<name> call [a][b]`,
 `return`), loops (`while/endwhile`, `do/while`, `repeat/endrepeat`, `break`, `continue`) and
 `if/elseif/else/endif`, numbered and named parameters and expressions (linuxcnc_values), the
-modes (linuxcnc_modes), the motions (linuxcnc_motion) and G76 (linuxcnc_cycles). It stops at M2/
+modes (linuxcnc_modes) with their save and restore M70–M73 (linuxcnc_context), the motions
+(linuxcnc_motion) and G76 (linuxcnc_cycles). It stops at M2/
 M30 (the control reads nothing after) or at a second `%`. Bounded: more than MAX_STEPS lines run
 (a loop that never ends), more than MAX_PLAIN_LINES plain lines, or calls nested deeper than
 MAX_CALLS are refused. A call of a subroutine not in the file (an external `o<name>` file
@@ -17,6 +18,7 @@ from typing import TYPE_CHECKING
 
 from ..expansion import MAX_PLAIN_LINES, MAX_STEPS, ExpansionRefused, PlainLine, register_expander
 from ..refusals import Refused
+from .linuxcnc_context import Contexts
 from .linuxcnc_cycles import move_or_cycle
 from .linuxcnc_flow import FlowError, called_early, pair, repeat_count
 from .linuxcnc_lines import OWord, read
@@ -44,7 +46,8 @@ class Interpreter:
             self.flow = pair(self.items)
         except FlowError as error:
             raise ExpansionRefused(error.index + 1, lines[error.index], str(error)) from None
-        self.executor = Executor(move_or_cycle)
+        self.contexts = Contexts()
+        self.executor = Executor(move_or_cycle, self.contexts.carry_out)
         self.params = Parameters(self.executor.modes)
         self.plain: list[PlainLine] = []
         self.stopped = False
@@ -105,13 +108,17 @@ class Interpreter:
 
     def _words(self, index: int, code: str) -> None:
         words = read_words(code, self.params.lookup, self.params.defined)
-        for text in self.executor.run(words):
-            self.plain.append(PlainLine(text, index + 1, self.lines[index]))
+        self._emit(index, self.executor.run(words))
         if len(self.plain) > MAX_PLAIN_LINES:
             raise Refused(f"the program expands to more than {MAX_PLAIN_LINES:,} blocks; split it")
         for key, value in words.settings:
             self.params.set(key, value)
         self.stopped = words.has_m(2) or words.has_m(30)
+
+    def _emit(self, index: int, texts: list[str]) -> None:
+        """Each plain line with the blend tolerance in force (G64 P, mm: the turning simulation's)."""
+        blend = self.executor.modes.blend
+        self.plain.extend(PlainLine(text, index + 1, self.lines[index], blend) for text in texts)
 
     def value(self, text: str) -> float:
         reader = Values(text, self.params.lookup, self.params.defined)
@@ -145,11 +152,14 @@ class Interpreter:
         self.called.add(item.label)
         frame = Frame(back=index + 1, numbered=dict(enumerate(self.arguments(item.rest), start=1)))
         self.params.frames.append(frame)
+        self.contexts.enter()
         return sub[0] + 1
 
     def _return(self, index: int, item: OWord) -> int:
+        """Back to the caller; an M73 of the sub restores the modes it saved (linuxcnc_context)."""
         if len(self.params.frames) == 1:
             raise Refused(f"o{item.label} {item.keyword} reached without a call")
+        self._emit(index, self.contexts.leave(self.executor))
         return self.params.frames.pop().back
 
     def _if(self, index: int, item: OWord) -> int:

@@ -5,7 +5,9 @@ X a diameter, one motion per block with its G code, a feed block with its feed m
 The modes the program states are followed: G20/G21 (a length in inches is × 25.4), G7/G8 (X a
 diameter or a radius), G90/G91 (an incremental X/Z is added to the position), G90.1/G91.1 (arc
 centres I/K absolute or from the start), G94/G95 (F per minute or per revolution), G96 with its
-clamp D (the plain S is the clamp: the speed the spindle reaches at the axis) and G97. The start
+clamp D (the plain S is the clamp: the speed the spindle reaches at the axis) and G97, G61/G64 P
+(the blend tolerance each plain line carries), G43/G49, and the spindle, S and coolant that M70–M73
+save and restore (linuxcnc_context). The start
 is the state M2/M30 leaves (LinuxCNC M2/M30: G54, G17, G90, G94, G40, M5, M9, motion G1);
 units and diameter mode are not reset by M2, so a length before G20/G21 and an X before G7/G8
 are refused: they are whatever the last program left."""
@@ -40,15 +42,14 @@ REFUSED = {
     "43.1": "G43.1 dynamic tool offset: use G43 with the tool table",
     "43.2": "G43.2 adds offsets the verifier cannot see",
 }
-IGNORED_G = frozenset({"54", "61", "61.1", "18"})   # no position changes (G61/G61.1: exact path)
-# G64 P<tolerance> blends corners, cutting each within P of the programmed path (g-code.adoc G64);
-# the verifier proves the programmed polyline, so only a blend within this (mm) is accepted
-BLEND_TOLERANCE = 0.01
+IGNORED_G = frozenset({"54", "18"})   # no position changes
+# G64 P<tolerance> keeps the path within P of the programmed one (g-code.adoc G64): the tolerance in
+# effect travels with each plain line (PlainLine.blend, mm) to the turning simulation, which lets a
+# move be anywhere within it; accepted up to 0.001 in (0.0254 mm), the P LinuxCNC's lathe screens use
+BLEND_TOLERANCE = 0.0254
 MOTIONS = ("0", "1", "2", "3", "33", "76", "80", "83", "70", "71", "71.1", "71.2", "72", "72.1", "72.2")
-# M70 saves the modal state that M72 restores, M73 saves it and restores it at the sub's return:
-# the spindle on/off and direction, S and the coolant with the modes (LinuxCNC M70-M73)
-SAVED = {70: " (M70 saves it for M72)", 72: " (saved by M70)", 73: " on return"}
 IGNORED_M = frozenset({0, 1, 48, 49, 50, 51, 52, 53, 60})      # pauses and override switches
+CONTEXT_M = frozenset({70, 71, 72, 73})     # save, forget, restore the modes (linuxcnc_context)
 PLAIN_M = frozenset({3, 4, 5, 7, 8, 9})
 
 
@@ -66,6 +67,12 @@ class Modes:
     css_clamp: float | None = None      # G96 D, r/min
     css: bool = False
     tool: int | None = None             # selected by T, changed by M6
+    spindle: int = 5                    # M3, M4 or M5 (M2/M30 leave M5)
+    speed: float | None = None          # S as written (r/min, or the G96 surface speed); None: never set
+    mist: bool = False                  # M7 (M2/M30 leave M9)
+    flood: bool = False                 # M8
+    offset: bool | None = None          # G43 active (G49: False); None: not stated
+    blend: float = 0.0                  # G64 P in mm; 0 under G61/G61.1
     x: float | None = None              # radius, mm
     z: float | None = None
     extra: dict[str, float] = field(default_factory=dict)
@@ -77,10 +84,12 @@ class Modes:
 class Executor:
     """Turns each line's words into plain lines; `modes` is the interpreter's state."""
 
-    def __init__(self, mover: Callable[[Executor, Words, str], None]) -> None:
+    def __init__(self, mover: Callable[[Executor, Words, str], None],
+                 context: Callable[[Executor, int], None]) -> None:
         self.modes = Modes()
         self.out: list[str] = []
         self.mover = mover       # linuxcnc_motion.move, or a cycle (engine.verifier.expanders.linuxcnc)
+        self.context = context   # M70-M73 (engine.verifier.expanders.linuxcnc_context)
 
     def run(self, words: Words) -> list[str]:
         self.out = []
@@ -105,10 +114,7 @@ class Executor:
             if 62 <= code <= 68:
                 raise Refused(f"M{code:g} switches a HAL output (a plasma torch, a probe, a machine's I/O): "
                               "what it drives is not a lathe move the verifier can follow")
-            if code in (70, 72, 73):
-                raise Refused(f"M{code:g} restores the spindle state{SAVED[int(code)]}, which the verifier does "
-                              "not follow: state S and M3/M4/M5 after the call instead")
-            if code not in PLAIN_M | IGNORED_M | {2, 30, 6, 71} or code != int(code):
+            if code not in PLAIN_M | IGNORED_M | CONTEXT_M | {2, 30, 6} or code != int(code):
                 raise Refused(f"M{code:g} is not an M code of the LinuxCNC lathe grammar (user M100-M199 "
                               "and I/O codes run what the verifier cannot see)")
 
@@ -139,13 +145,18 @@ class Executor:
                 raise Refused(f"S{speed:g}: a spindle speed of 0 (under G96 a surface speed of 0, 0 r/min at any X) "
                               "stops the spindle while M3/M4 stays on, and a cut after it meets a standing bar; "
                               "stop the spindle with M5 and state S above 0")
-            if self.modes.css:
-                assert self.modes.css_clamp is not None
-                self.out.append(f"G96 S{_number(self.modes.css_clamp)}")
-            else:
-                self.out.append(f"G97 S{_number(speed)}")
+            self.modes.speed = speed
+            self.speed_line()
         elif mode == "96":
             raise Refused("G96 without its S (surface speed)")
+
+    def speed_line(self) -> None:
+        """The plain S line of the speed in force: under G96 the clamp, the speed reached at the axis."""
+        if self.modes.css:
+            assert self.modes.css_clamp is not None
+            self.out.append(f"G96 S{_number(self.modes.css_clamp)}")
+        else:
+            self.out.append(f"G97 S{_number(self.modes.speed or 0)}")
 
     def _tool(self, words: Words) -> None:
         if "t" in words.values:
@@ -159,12 +170,26 @@ class Executor:
             self.modes.extra["loaded"] = float(self.modes.tool)     # T0 M6 unloads (LinuxCNC: tool 0 = none)
             self.out.append(f"T{self.modes.tool} M6")
 
-    def _spindle_and_coolant(self, words: Words) -> None:
-        codes = [int(code) for code in words.codes["m"] if code in PLAIN_M]
-        for group in ((3, 4, 5), (7, 8, 9)):
-            chosen = [code for code in codes if code in group]
-            if chosen:
-                self.out.append(" ".join(f"M{code}" for code in chosen))
+    def _spindle(self, words: Words) -> None:
+        chosen = [int(code) for code in words.codes["m"] if code in (3, 4, 5)]
+        if chosen:
+            if self.modes.speed == 0 and chosen[-1] != 5:
+                raise Refused(f"M{chosen[-1]} with S0 in force (an M72/M73 restore set S0): the spindle stands "
+                              "while the program cuts; state S above 0 first")
+            self.modes.spindle = chosen[-1]
+            self.out.append(" ".join(f"M{code}" for code in chosen))
+
+    def _context(self, words: Words) -> None:
+        for code in sorted(CONTEXT_M):
+            if words.has_m(code):
+                self.context(self, code)
+
+    def _coolant(self, words: Words) -> None:
+        chosen = [int(code) for code in words.codes["m"] if code in (7, 8, 9)]
+        for code in chosen:
+            coolant(self.modes, code)
+        if chosen:
+            self.out.append(" ".join(f"M{code}" for code in chosen))
 
     def _lengths_and_planes(self, words: Words) -> None:
         plane = words.g("17", "18", "19")
@@ -187,20 +212,26 @@ class Executor:
             holder = words.values.get("h")
             if holder is not None and holder != self.modes.tool:
                 raise Refused(f"G43 H{holder:g} applies another tool's length than the one in the spindle")
+            self.modes.offset = True
             self.out.append("G43")
         if words.g("49"):
+            self.modes.offset = False
             self.out.append("G49")
 
     def _path_mode(self, words: Words) -> None:
+        if words.g("61", "61.1"):
+            self.modes.blend = 0.0
         if not words.g("64"):
             return
         tolerance = words.values.get("p")
         if tolerance is None:
             raise Refused("G64 without P blends corners without a bound (as fast as possible, rapids too): "
-                          f"write G61, or G64 P<tolerance> of {BLEND_TOLERANCE:g} mm or less")
-        if self.length(tolerance) > BLEND_TOLERANCE:
-            raise Refused(f"G64 P{tolerance:g} blends corners up to {self.length(tolerance):g} mm off the path the "
-                          f"verifier proves: write G61, or G64 P of {BLEND_TOLERANCE:g} mm or less")
+                          f"write G61, or G64 P<tolerance> of {BLEND_TOLERANCE:g} mm (0.001 in) or less")
+        if self.length(tolerance) > BLEND_TOLERANCE + 1e-9:     # 0.001 in × 25.4 in floating point
+            raise Refused(f"G64 P{tolerance:g} blends corners up to {self.length(tolerance):g} mm off the programmed "
+                          f"path, more than the {BLEND_TOLERANCE:g} mm (0.001 in) the proof allows for: write G61, "
+                          "or a smaller P")
+        self.modes.blend = self.length(tolerance)
 
     def _distance(self, words: Words) -> None:
         distance = words.g("90", "91")
@@ -237,8 +268,18 @@ def _number(value: float) -> str:
 number = _number
 
 
-KNOWN_G = frozenset({*MOTIONS, *IGNORED_G, "64", "98", "99", "4", "17", "19", "7", "8", "20", "21", "40", "43", "49",
-                     "90", "91", "90.1", "91.1", "94", "95", "96", "97"})
+# M7 turns mist on, M8 flood, M9 both off: (mist, flood) after it, None where it is left as it was
+COOLANT: dict[int, tuple[bool | None, bool | None]] = {7: (True, None), 8: (None, True), 9: (False, False)}
+
+
+def coolant(modes: Modes, code: int) -> None:
+    mist, flood = COOLANT[code]
+    modes.mist = modes.mist if mist is None else mist
+    modes.flood = modes.flood if flood is None else flood
+
+
+KNOWN_G = frozenset({*MOTIONS, *IGNORED_G, "61", "61.1", "64", "98", "99", "4", "17", "19", "7", "8", "20", "21",
+                     "40", "43", "49", "90", "91", "90.1", "91.1", "94", "95", "96", "97"})
 STEPS = (Executor._lengths_and_planes, Executor._feed_mode, Executor._feed, Executor._speed, Executor._tool,
-         Executor._spindle_and_coolant, Executor._offsets, Executor._path_mode, Executor._distance, Executor._motion,
-         Executor._stop)
+         Executor._spindle, Executor._context, Executor._coolant, Executor._offsets, Executor._path_mode,
+         Executor._distance, Executor._motion, Executor._stop)

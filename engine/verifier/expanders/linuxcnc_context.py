@@ -1,0 +1,119 @@
+"""M70–M73: the modal state saved and restored per call level, as LinuxCNC does it
+(docs/reference/linuxcnc-lathe.md §6; m-code.adoc M70–M73; src/emc/rs274ngc/interp_convert.cc
+`save_settings`, `restore_settings`, `gen_settings`, `gen_m_codes`; interp_o_word.cc
+`leave_context`).
+
+M70 saves the modes at the current call level, M73 too and marks them to be restored when the
+subroutine returns (`return` or `endsub`; at the main level it only saves), M72 restores them at
+the same level (refused without a save there), M71 forgets them. A call starts a level with
+nothing saved. The restore changes the expander's modes and writes the plain lines that make the
+machine state visible: units first (G20/G21), then F (written " F%.1f" in the restored units: a
+feed per turn of 0.004 in comes back as F0), S (" S%.0f"), feed mode, distance, plane, G96/G97,
+G90.1/G91.1, G7/G8, G98/G99, G43/G49, path mode, then M3/M4/M5 and the coolant where they differ.
+The motion mode, the tool and the position are not restored."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from ..refusals import Refused
+from .linuxcnc_modes import INCH, Modes, coolant
+
+if TYPE_CHECKING:
+    from .linuxcnc_modes import Executor
+
+# modes restored as they were saved, with no plain line of their own (each feed block carries its
+# feed mode, the plain lines are absolute mm with X a diameter, the blend travels on each line)
+RESTORED = ("per_rev", "incremental", "arc_absolute", "diameter", "plane", "blend")
+
+
+@dataclass
+class Saved:
+    modes: Modes
+    on_return: bool          # M73 in a subroutine: restored at its return
+
+
+class Contexts:
+    """The saved modes of each call level (LinuxCNC `sub_context[call_level]`), 0 the main program."""
+
+    def __init__(self) -> None:
+        self.level = 0
+        self.saved: dict[int, Saved] = {}
+
+    def carry_out(self, executor: Executor, code: int) -> None:
+        """M70–M73 in their place of a line's order of execution (after M3/M4/M5, before M7–M9)."""
+        if code in (70, 73):
+            self.saved[self.level] = Saved(executor.modes.copy(), code == 73 and self.level > 0)
+        elif code == 71:
+            self.saved.pop(self.level, None)
+        elif self.level not in self.saved:
+            raise Refused("M72 with no modes saved at this call level (no M70/M73, or M71 forgot them): "
+                          "LinuxCNC refuses it")
+        else:
+            restore(executor, self.saved[self.level].modes)
+
+    def enter(self) -> None:
+        self.level += 1
+        self.saved.pop(self.level, None)
+
+    def leave(self, executor: Executor) -> list[str]:
+        """The plain lines of a subroutine's return: the restore of an M73 made in it."""
+        executor.out = []
+        saved = self.saved.pop(self.level, None)
+        self.level -= 1
+        if saved is not None and saved.on_return:
+            restore(executor, saved.modes)
+        return executor.out
+
+
+def restore(executor: Executor, saved: Modes) -> None:
+    modes = executor.modes
+    if modes.inch != saved.inch:             # units first, so F is read in the restored units
+        modes.inch = saved.inch
+        executor.out.append("G21")
+    _feed_and_speed(executor, saved)
+    if saved.plane == "18" and modes.plane != "18":
+        executor.out.append("G18")
+    for name in RESTORED:
+        setattr(modes, name, getattr(saved, name))
+    if "retract" in saved.extra:
+        modes.extra["retract"] = saved.extra["retract"]
+    _spindle_and_coolant(executor, saved)
+    if saved.offset != modes.offset:
+        modes.offset = bool(saved.offset)    # an offset never stated comes back as none: fail closed
+        executor.out.append("G43" if modes.offset else "G49")
+
+
+def _feed_and_speed(executor: Executor, saved: Modes) -> None:
+    """F and S always (gen_settings: F%.1f, S%.0f), in the restored units; G96 comes back without D."""
+    modes = executor.modes
+    feed = float(f"{(saved.feed or 0.0) / (INCH if saved.inch else 1.0):.1f}")
+    modes.feed = executor.length(feed) if feed else None
+    if saved.css and not modes.css:
+        raise Refused("the restore turns G96 back on without its clamp D (LinuxCNC: the spindle speed is then "
+                      "not limited near the axis); state G96 D… S… after the call")
+    modes.css = saved.css
+    modes.speed = float(f"{saved.speed or 0.0:.0f}")
+    if saved.spindle != 5 and modes.speed == 0:
+        raise Refused(f"the restore turns the spindle on (M{saved.spindle}) at S0: it stands while the program "
+                      "cuts; state S above 0 before the M70/M73")
+    if modes.speed:
+        executor.speed_line()
+
+
+def _spindle_and_coolant(executor: Executor, saved: Modes) -> None:
+    """gen_m_codes: the spindle, then mist (M7, or M9 when neither is on) and flood (M8), each
+    where it differs from the state before the restore (an M9 there stops both)."""
+    modes = executor.modes
+    if saved.spindle != modes.spindle:
+        modes.spindle = saved.spindle
+        executor.out.append(f"M{saved.spindle}")
+    for now, then in zip(_coolant(modes), _coolant(saved)):
+        if then != now and then is not None:
+            coolant(modes, then)
+            executor.out.append(f"M{then}")
+
+
+def _coolant(modes: Modes) -> tuple[int | None, int | None]:
+    """interp_write.cc write_m_codes: mist 7, or 9 when neither is on (None under flood alone); flood 8 or None."""
+    return (7 if modes.mist else None if modes.flood else 9), (8 if modes.flood else None)
