@@ -29,6 +29,7 @@ BLOCK_DELETE = "block delete /: whether the line runs is the operator's switch"
 NO_Y = "Y0: the lathe has no Y axis"
 PROFILE_G72 = "the LinuxCNC profile cycle G72"
 G53 = "G53 moves in machine coordinates"
+TRAVEL_Z300 = "Z300 exceeds the travel of lathe-linuxcnc (Z -600…200)"
 
 # file (under tests/data/nc) -> (machine, None for verified or the construct its refusal names,
 # RIGHT or GAP, why)
@@ -59,6 +60,7 @@ CORPUS = {
         "lathe-linuxcnc", NO_Y, RIGHT,
         "a mill-turn (XYZ+C) demo: G10 L2 work offsets with Y, custom M429: not a two-axis lathe"),
     # peter-pan08/LatheEasyStep: programs its LinuxCNC conversational panel wrote, kept as test files
+    # (none states G43 after M6: behind the cycles LinuxCNC would apply no tool offset)
     "lathe_easystep/Test_Bohren.ngc": (
         "lathe-linuxcnc", PROFILE_G72, GAP,
         "facing with the LinuxCNC 2.9 profile cycle G72 Q<sub>: standard lathe work to expand"),
@@ -74,6 +76,22 @@ CORPUS = {
     "lathe_easystep/test.ngc": (
         "lathe-linuxcnc", G53, GAP,
         "tool change point X70 Z100 in machine coordinates (the record lacks the G54 origin); G72 next"),
+    # the same panel's example output of January 2026 (ngc/, removed from the repository later)
+    "lathe_easystep/ngc/Abdrehen.ngc": (
+        "lathe-linuxcnc", TRAVEL_Z300, RIGHT,
+        "tool-change point Z300 beyond the record's Z 200 mm; behind it cuts after M6 with no G43"),
+    "lathe_easystep/ngc/Bohren.ngc": (
+        "lathe-linuxcnc", G53, GAP,
+        "G53 tool-change point; behind it axial drilling G81 at X0, which the lathe model lacks too"),
+    "lathe_easystep/ngc/Einstich.ngc": (
+        "lathe-linuxcnc", G53, GAP,
+        "G53 tool-change point; behind it a groove cut after M6 with no G43 (no tool offset applied)"),
+    "lathe_easystep/ngc/Gewinde.ngc": (
+        "lathe-linuxcnc", G53, GAP,
+        "G53 tool-change point; behind it the G76 thread after M6 with no G43 (no tool offset)"),
+    "lathe_easystep/ngc/Planen.ngc": (
+        "lathe-linuxcnc", G53, GAP,
+        "G53 tool-change point; behind it facing with the profile cycle G72 on a contour subroutine"),
     # dubstar-04/LibLathe: the roughing path its profile operation wrote (FreeCAD's XYZ path model)
     "liblathe/profile.gcode": (
         "lathe-linuxcnc", NO_Y, RIGHT,

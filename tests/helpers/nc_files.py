@@ -78,7 +78,8 @@ PARAMS = {
         "linuxcnc_extra/threading.ngc", "linuxcnc_extra/bad_spirals_lathe.ngc", "linuxcnc_extra/g33_blend.ngc",
         "linuxcnc_extra/g33_simple.ngc", "linuxcnc_extra/millturn_example.ngc",
         "lathe_easystep/Test_Bohren.ngc", "lathe_easystep/Test_Gewinde.ngc", "lathe_easystep/Test_Gewinde_innen.ngc",
-        "lathe_easystep/Test_Innendrehen_mit_Gewinde.ngc", "lathe_easystep/test.ngc", "liblathe/profile.gcode")},
+        "lathe_easystep/Test_Innendrehen_mit_Gewinde.ngc", "lathe_easystep/test.ngc", "liblathe/profile.gcode",
+        *(f"lathe_easystep/ngc/{name}.ngc" for name in ("Abdrehen", "Bohren", "Einstich", "Gewinde", "Planen")))},
 }
 
 
