@@ -24,6 +24,7 @@ from engine.programs.class_jobs import instantiate_class
 from engine.release.gate import release
 
 REAL_PROGRAMS = sorted(path for path in NC.rglob("*") if path.is_file() and path.name != "PROVENANCE.tsv")
+TWINNED = NC / "liblathe" / "profile.gcode"   # LibLathe's path repeats each approach rapid
 PAWN_PARAMS = {"spindle": 1000, "feed": 50.0}
 PASTE = ("INSERT INTO template_view (gear_class, id, t, n, o) "
          "SELECT gear_class, id + 1, t, n, o FROM template_view WHERE gear_class = %s AND id = %s")
@@ -79,9 +80,10 @@ def test_the_engines_lathe_program_imported_is_released_and_runners_make_verifie
 def test_every_real_nc_program_imports_and_is_released(run):
     found = {path: repeats(program_lines(path)) for path in REAL_PROGRAMS}
     assert any(found[path][0] for path in REAL_PROGRAMS)        # lines repeated further on
-    assert not any(found[path][1] for path in REAL_PROGRAMS)    # none says a line twice in a row
+    # one says a line twice in a row: its release is refused (tests/test_real_lathe_corpus.py)
+    assert [path for path in REAL_PROGRAMS if found[path][1]] == [TWINNED]
     assert any(found[path][2] for path in REAL_PROGRAMS)        # blank lines in pairs
-    for number, path in enumerate(REAL_PROGRAMS):
+    for number, path in enumerate(path for path in REAL_PROGRAMS if path != TWINNED):
         gear_class = f"real_{number}"
         ok(run("import-nc", path, "--class", gear_class))
         released = run("template", "release", "--class", gear_class, "--yes")

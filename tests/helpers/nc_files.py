@@ -73,6 +73,15 @@ PARAMS = {
     "fanuc/FANUC0T.nc": {"feed": 0.3},
     "fanuc/0100.nc": {"feed": 0.35},
     "fanuc/TOKARKA.NC": {"feed": 0.3},
+    # issue 27's corpus of other people's lathe programs (tests/test_real_lathe_corpus.py): imported
+    # as they are, no value bound to a parameter
+    **{name: {} for name in (
+        "linuxcnc_extra/lathe-comp_test.ngc", "linuxcnc_extra/axis-lathe.ngc", "linuxcnc_extra/g76.ngc",
+        "linuxcnc_extra/threading.ngc", "linuxcnc_extra/bad_spirals_lathe.ngc", "linuxcnc_extra/g33_blend.ngc",
+        "linuxcnc_extra/g33_simple.ngc", "linuxcnc_extra/millturn_example.ngc",
+        "lathe_easystep/Test_Bohren.ngc", "lathe_easystep/Test_Gewinde.ngc", "lathe_easystep/Test_Gewinde_innen.ngc",
+        "lathe_easystep/Test_Innendrehen_mit_Gewinde.ngc", "lathe_easystep/test.ngc", "liblathe/profile.gcode",
+        *(f"lathe_easystep/ngc/{name}.ngc" for name in ("Abdrehen", "Bohren", "Einstich", "Gewinde", "Planen")))},
 }
 
 

@@ -1,0 +1,152 @@
+"""A corpus of lathe programs other people wrote (issue 27), run as they are through the verifier
+on the seeded machine of their dialect: verified, or refused naming the construct that stops it.
+
+The files sit byte for byte under tests/data/nc/<source>/ with their origin and open licence in
+tests/data/nc/PROVENANCE.tsv. Every lathe program of a chosen source is here, not only the ones
+that pass. Each row says whether the refusal is right (a true fault of the file, or a construct
+nothing in the file or the machine record can prove: failing closed is what a user relies on) or
+a gap (a construct a skilled programmer runs that the engine should learn to prove).
+
+The LinuxCNC files run on `lathe-linuxcnc`: X 0…400 mm, Z −600…200 mm, 4000 r/min."""
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pytest
+from helpers.nc_files import DATA as IMPORTABLE
+
+from engine.machines.records import load_machine
+from engine.verifier import LimitError, verify_program
+
+DATA = Path(__file__).resolve().parent / "data" / "nc"
+SOURCES = ("linuxcnc_extra", "lathe_easystep", "liblathe")
+RIGHT, GAP = "fail closed is right", "gap"
+
+# Constructs named by the refusals (substrings of the one-line message).
+BARE_G64 = "G64 without P blends corners without a bound"
+BLOCK_DELETE = "block delete /: whether the line runs is the operator's switch"
+NO_Y = "Y0: the lathe has no Y axis"
+PROFILE_G72 = "the LinuxCNC profile cycle G72"
+G53 = "G53 moves in machine coordinates"
+TRAVEL_Z300 = "Z300 exceeds the travel of lathe-linuxcnc (Z -600…200)"
+
+# file (under tests/data/nc) -> (machine, None for verified or the construct its refusal names,
+# RIGHT or GAP, why)
+CORPUS = {
+    # LinuxCNC/linuxcnc: lathe files not in tests/data/nc/linuxcnc
+    "linuxcnc_extra/lathe-comp_test.ngc": (
+        "lathe-linuxcnc", BARE_G64, RIGHT,
+        "the cutter-comp test: bare G64 has no path bound; behind it no G7/G8 and a cut with T0 unloaded"),
+    "linuxcnc_extra/axis-lathe.ngc": (
+        "lathe-linuxcnc", BLOCK_DELETE, RIGHT,
+        "AXIS's splash drawing: behind the / lines no G7/G8, no G18, no tool, no S: not a cutting program"),
+    "linuxcnc_extra/g76.ngc": (
+        "lathe-linuxcnc", BARE_G64, RIGHT,
+        "bare G64 has no path bound; behind it no G7/G8 and G92 Z0 shifts (computable from the position)"),
+    "linuxcnc_extra/threading.ngc": (
+        "lathe-linuxcnc", BARE_G64, RIGHT,
+        "bare G64; behind it no G7/G8, no G18 and no tool selected: it runs whatever tool is loaded"),
+    "linuxcnc_extra/bad_spirals_lathe.ngc": (
+        "lathe-linuxcnc", BLOCK_DELETE, RIGHT,
+        "a trajectory-planner fault case: its G3 centre is 12.7 mm from the start, 25.4 mm from the end"),
+    "linuxcnc_extra/g33_blend.ngc": (
+        "lathe-linuxcnc", BLOCK_DELETE, RIGHT,
+        "a planner test: behind the / line G64 P0.002 in (0.0508 mm) and cuts with no tool offset"),
+    "linuxcnc_extra/g33_simple.ngc": (
+        "lathe-linuxcnc", BARE_G64, RIGHT,
+        "bare G64; behind it no G7/G8, no G18, and G33 with no tool or tool offset"),
+    "linuxcnc_extra/millturn_example.ngc": (
+        "lathe-linuxcnc", NO_Y, RIGHT,
+        "a mill-turn (XYZ+C) demo: G10 L2 work offsets with Y, custom M429: not a two-axis lathe"),
+    # peter-pan08/LatheEasyStep: programs its LinuxCNC conversational panel wrote, kept as test files
+    # (none states G43 after M6: behind the cycles LinuxCNC would apply no tool offset)
+    "lathe_easystep/Test_Bohren.ngc": (
+        "lathe-linuxcnc", PROFILE_G72, GAP,
+        "facing with the LinuxCNC 2.9 profile cycle G72 Q<sub>: standard lathe work to expand"),
+    "lathe_easystep/Test_Gewinde.ngc": (
+        "lathe-linuxcnc", PROFILE_G72, GAP,
+        "facing G72 then roughing G71 on a contour subroutine, G76 thread: the profile cycles block it"),
+    "lathe_easystep/Test_Gewinde_innen.ngc": (
+        "lathe-linuxcnc", PROFILE_G72, GAP,
+        "bore and inner thread: G72 facing, G71 boring on a contour subroutine, G76"),
+    "lathe_easystep/Test_Innendrehen_mit_Gewinde.ngc": (
+        "lathe-linuxcnc", PROFILE_G72, GAP,
+        "the same part as Test_Gewinde_innen with other retract planes: G72/G71 block it"),
+    "lathe_easystep/test.ngc": (
+        "lathe-linuxcnc", G53, GAP,
+        "tool change point X70 Z100 in machine coordinates (the record lacks the G54 origin); G72 next"),
+    # the same panel's example output of January 2026 (ngc/, removed from the repository later)
+    "lathe_easystep/ngc/Abdrehen.ngc": (
+        "lathe-linuxcnc", TRAVEL_Z300, RIGHT,
+        "tool-change point Z300 beyond the record's Z 200 mm; behind it cuts after M6 with no G43"),
+    "lathe_easystep/ngc/Bohren.ngc": (
+        "lathe-linuxcnc", G53, GAP,
+        "G53 tool-change point; behind it axial drilling G81 at X0, which the lathe model lacks too"),
+    "lathe_easystep/ngc/Einstich.ngc": (
+        "lathe-linuxcnc", G53, GAP,
+        "G53 tool-change point; behind it a groove cut after M6 with no G43 (no tool offset applied)"),
+    "lathe_easystep/ngc/Gewinde.ngc": (
+        "lathe-linuxcnc", G53, GAP,
+        "G53 tool-change point; behind it the G76 thread after M6 with no G43 (no tool offset)"),
+    "lathe_easystep/ngc/Planen.ngc": (
+        "lathe-linuxcnc", G53, GAP,
+        "G53 tool-change point; behind it facing with the profile cycle G72 on a contour subroutine"),
+    # dubstar-04/LibLathe: the roughing path its profile operation wrote (FreeCAD's XYZ path model)
+    "liblathe/profile.gcode": (
+        "lathe-linuxcnc", NO_Y, RIGHT,
+        "Y0 in every block and F on G0, no units, no spindle, no tool: a path dump, not a program"),
+}
+
+
+def lines_of(name: str) -> list[str]:
+    return (DATA / name).read_text(encoding="utf-8").splitlines()
+
+
+def outcome(conn, machine: str, lines: list[str]) -> str | None:
+    """None for a program the verifier reads whole on the seeded `machine`, else its message."""
+    try:
+        verify_program(lines, load_machine(conn, machine), None)
+    except LimitError as error:
+        return str(error)
+    return None
+
+
+def test_every_file_of_the_corpus_sources_is_in_the_table():
+    present = sorted(str(path.relative_to(DATA)) for source in SOURCES for path in (DATA / source).rglob("*")
+                     if path.is_file())
+    assert present == sorted(CORPUS)
+
+
+@pytest.mark.parametrize("name", sorted(CORPUS))
+def test_a_real_lathe_program_is_verified_or_refused_naming_its_construct(conn, name):
+    machine, construct, _, _ = CORPUS[name]
+    message = outcome(conn, machine, lines_of(name))
+    if construct is None:
+        assert message is None, message
+    else:
+        assert message is not None and construct in message, message
+        assert "\n" not in message and message.endswith("nothing stored")
+
+
+def test_each_row_says_whether_failing_closed_is_right_or_a_gap():
+    assert {kind for _, _, kind, _ in CORPUS.values()} <= {RIGHT, GAP}
+    assert all(why and len(why) <= 110 for _, _, _, why in CORPUS.values())
+
+
+def test_a_cam_path_that_repeats_a_block_imports_but_its_release_is_refused(run):
+    """LibLathe wrote each approach rapid twice in a row ('G0 X-20 Y0 Z5 F10' on lines 3 and 4): the
+    author's own twin, but the release gate's duplicate-row rule reads each as a row pasted twice.
+    A gap of the gate (a verbatim twin from the imported file is not an editor's paste)."""
+    lines = lines_of("liblathe/profile.gcode")
+    twins = {number + 1 for number in range(1, len(lines))
+             if lines[number].strip() and lines[number] == lines[number - 1]}
+    imported = run("import-nc", IMPORTABLE / "liblathe" / "profile.gcode", "--class", "liblathe_profile")
+    assert imported.exit_code == 0, imported.output
+    released = run("template", "release", "--class", "liblathe_profile", "--yes")
+    assert released.exit_code == 1 and "released class" not in released.output
+    # import-nc stores line n as row 10·n: the gate names exactly the file's twin lines, the
+    # approach rapid of each of its 21 passes (X -20 … 0 in steps of 1)
+    named = {int(row) // 10 for row in re.findall(r"row (\d+) column o: repeats row \d+ exactly .{0,60}"
+                                                 r"a row pasted twice \(duplicate-row\)", released.output)}
+    assert named == twins and len(twins) == 21, released.output
