@@ -12,24 +12,32 @@ expands G70–G76 with (engine/verifier/expanders/cycles.py).
 from __future__ import annotations
 
 import math
+import re
 from pathlib import Path
 
 import pytest
 from helpers.verifier_programs import LATHE_ISO, accepted, refusal
 
+from engine.machines.records import load_machine
+from engine.verifier import LimitError, verify_program
 from engine.verifier.expanders import cycles
 from engine.verifier.expanders.cycles import FEED, RAPID, THREAD, Move, Thread
 
 DATA = Path(__file__).resolve().parent / "data" / "nc" / "fanuc"
 
-# file -> (verified, the construct its refusal names). The files are as their authors wrote them.
+# file -> (the seeded record it runs on, verified, the construct its refusal names). The files are
+# as their authors wrote them.
 REAL = {
-    # Fanuc 0T: dimension words without a decimal point, read as 0.118 mm under input type I
-    "FANUC0T.nc": (False, "X118 needs a decimal point"),
-    # Fanuc macro program: ':' program number (ISO code form of O) and #50x variables
-    "0100.nc": (False, "':0100' is not a word of the ISO lathe grammar"),
-    # tape mark and program number on one line, as some DNC tools save them
-    "TOKARKA.NC": (False, "'%O1200' is not a word of the ISO lathe grammar"),
+    # Fanuc 0T, written for pocket-calculator decimal input (X86. beside X118 and Z-45) and the
+    # control's power-on G18 G21 G40 G97 G99: both are facts of the lathe-fanuc-0t record
+    "FANUC0T.nc": ("lathe-fanuc-0t", True, None),
+    # ':0100' program number and custom macro B (#501 … #509, X[#504+6.]) are followed; then G96
+    # S250 with no spindle clamp G50 S before it: the spindle speeds up without bound as X nears 0
+    "0100.nc": ("lathe-fanuc-0t", False, "G96 constant surface speed without a spindle clamp"),
+    # '%O1200' on one line, G-code system B (G90 G95 G92 S500 G33) is followed; it relies on the
+    # power-on plane G18, which lathe-iso's record does not state (and past that, its tool calls
+    # are comments "(T0101)": a cut with no tool offset, test below)
+    "TOKARKA.NC": ("lathe-iso", False, "motion before G18 (the ZX plane of the arcs) is stated"),
 }
 
 
@@ -41,14 +49,36 @@ def test_every_real_iso_lathe_file_is_in_the_table():
     assert sorted(path.name for path in DATA.iterdir()) == sorted(REAL)
 
 
+def stored_name(lines: list[str]) -> str:
+    """The name the header gives (O1200 (TOKARKA)), the program's name in the shop; TEST if none."""
+    named = re.search(r"[O:]\d+\s*\((\w+)\)", "".join(lines[:2]))
+    return named.group(1) if named else "TEST"
+
+
+def verdict(conn, machine: str, lines: list[str]) -> str | None:
+    """None if the program is verified, else the refusal (one line)."""
+    try:
+        verify_program(lines, load_machine(conn, machine), stored_name(lines))
+    except LimitError as refused:
+        assert "\n" not in str(refused) and str(refused).endswith("nothing stored")
+        return str(refused)
+    return None
+
+
 @pytest.mark.parametrize("name", sorted(REAL))
 def test_a_real_iso_lathe_program_is_verified_or_refused_naming_the_construct(conn, name):
-    verified, construct = REAL[name]
+    machine, verified, construct = REAL[name]
+    message = verdict(conn, machine, real_lines(name))
     if verified:
-        accepted(conn, "lathe-iso", real_lines(name))
+        assert message is None, message
     else:
-        message = refusal(conn, "lathe-iso", real_lines(name))
-        assert construct in message, message
+        assert message is not None and construct in message, message
+
+
+def test_tokarka_with_its_plane_stated_is_refused_for_its_commented_out_tool_calls(conn):
+    lines = real_lines("TOKARKA.NC")
+    message = verdict(conn, "lathe-iso", lines[:1] + ["G18"] + lines[1:])
+    assert message is not None and "line 13" in message and "no tool offset active" in message, message
 
 
 # ---------------------------------------------------------------- attacks in a real program
