@@ -13,15 +13,18 @@ from __future__ import annotations
 
 import math
 import re
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
 from helpers.verifier_programs import LATHE_ISO, accepted, refusal
 
-from engine.machines.records import load_machine
+from engine.machines.records import Machine, load_machine
 from engine.verifier import LimitError, verify_program
 from engine.verifier.expanders import cycles
 from engine.verifier.expanders.cycles import FEED, RAPID, THREAD, Move, Thread
+from engine.verifier.expanders.iso import expand_iso
+from engine.verifier.expansion import ExpansionRefused
 
 DATA = Path(__file__).resolve().parent / "data" / "nc" / "fanuc"
 
@@ -79,6 +82,91 @@ def test_tokarka_with_its_plane_stated_is_refused_for_its_commented_out_tool_cal
     lines = real_lines("TOKARKA.NC")
     message = verdict(conn, "lathe-iso", lines[:1] + ["G18"] + lines[1:])
     assert message is not None and "line 13" in message and "no tool offset active" in message, message
+
+
+# ---------------------------------------------------------------- decimal point input, headers
+
+FANUC_0T = "lathe-fanuc-0t"      # pocket-calculator input, power-on G18 G21 G40 G97 G99, system A
+
+
+def plain_moves(machine: Machine, lines: list[str]) -> list[tuple[float, float]]:
+    """(X, Z) of every feed move G1 the expander writes, as absolute mm."""
+    moves = []
+    for line in expand_iso(lines, machine):
+        words = dict(re.findall(r"([XZ])(-?[\d.]+)", line.text))
+        if line.text.startswith("G1 ") and "X" in words and "Z" in words:
+            moves.append((float(words["X"]), float(words["Z"])))
+    return moves
+
+
+def cut(body: list[str]) -> list[str]:
+    return ["%", "O0002", "G50 S2000", "T0101", "G97 S800 M03", "G00 X122. Z2."] + body + \
+        ["G00 X200. Z150.", "M30", "%"]
+
+
+def test_x118_is_118_mm_under_calculator_input_and_refused_under_increment_input(conn):
+    calculator = load_machine(conn, FANUC_0T)
+    assert calculator.decimal_point_input == "calculator"
+    moves = plain_moves(calculator, cut(["G01 X118 Z-45 F0.3"]))
+    assert moves == [pytest.approx((118.0, -45.0))]        # X118 = X118. mm, not 0.118 mm
+    increment = replace(calculator, decimal_point_input="increment")
+    with pytest.raises(ExpansionRefused, match="X118 needs a decimal point"):
+        expand_iso(cut(["G01 X118 Z-45 F0.3"]), increment)
+
+
+@pytest.mark.parametrize("header", ["%O1200(TOKARKA)", "%O1200 (TOKARKA)"])
+def test_the_tape_mark_and_the_program_number_on_one_first_line_are_accepted(conn, header):
+    assert verdict(conn, FANUC_0T, [header] + cut(["G01 X118. F0.3"])[2:]) is None
+
+
+def test_a_tape_mark_and_program_number_after_the_first_line_is_refused(conn):
+    message = verdict(conn, FANUC_0T, cut(["%O1201", "G01 X118. F0.3"]))
+    assert message is not None and "%O1201" in message, message
+
+
+# ---------------------------------------------------------------- custom macro B
+
+MACRO_PASSES = [
+    "#1=120.", "#2=2.5", "#3=#2*4+#2*[3-1]*2+80.",      # 10 + 10 + 80 = 100 mm, the finished diameter
+    "WHILE [#1 GT #3] DO 1",
+    "#1=#1-#2*2",                                      # 2·depth on the diameter
+    "IF [#1 LT #3] THEN #1=#3",
+    "G01 X#1 Z-[#3/4] F0.25",                          # each pass to Z−25
+    "G00 U2. Z2.",
+    "END 1",
+    "IF [#3 EQ 100] GOTO 100",
+    "G00 X9999.",                                      # skipped by the GOTO: past the X travel
+    "N100 G00 X[SQRT[#3*#3]+50.] Z[ROUND[2.5]+0.5]",    # X150 Z3.5
+]
+
+
+def test_macro_b_loops_and_jumps_evaluate_to_plain_passes(conn):
+    finish, depth = 10 + 10 + 80.0, 2.5
+    levels, diameter = [], 120.0
+    while diameter > finish:
+        diameter = max(diameter - 2 * depth, finish)
+        levels.append(diameter)
+    moves = plain_moves(load_machine(conn, FANUC_0T), cut(MACRO_PASSES))
+    assert moves == [pytest.approx((x, -finish / 4)) for x in levels]
+    assert verdict(conn, FANUC_0T, cut(MACRO_PASSES)) is None
+
+
+@pytest.mark.parametrize("body, reason", [
+    (["G00 X#5021"], "#5021 is a system variable: it holds positions and work offsets"),
+    (["#1=#2001"], "#2001 is a system variable: it holds tool compensation values"),
+    (["#3000=1"], "#3000 is a system variable: setting it changes the alarm"),
+    (["G00 X[#7+1.]"], "#7 is read before this program sets it: it is vacant"),
+    (["G00 X#510"], "#510 is read before this program sets it: it is a value an earlier program left"),
+    (["#1=ATAN[1]/[1]"], "ATAN: its result depends on parameter 6004#0"),
+    (["#1=0", "#2=5/#1"], "5/0: a division by zero"),
+    (["GOTO 77"], "GOTO 77: there is no block N77"),
+    (["WHILE [1 EQ 2] DO 2", "G00 X100."], "DO 2 without its END 2"),
+    (["G65 P9100 A1."], "G65 calls a macro program"),
+    (["#1=3.5", "G#1 X100."], "G3.5: a G code from an expression must be whole"),
+])
+def test_a_macro_construct_that_cannot_be_followed_is_refused_naming_it(conn, body, reason):
+    message = verdict(conn, FANUC_0T, cut(body))
+    assert message is not None and reason in message, message
 
 
 # ---------------------------------------------------------------- attacks in a real program
