@@ -41,6 +41,9 @@ REAL = {
     # power-on plane G18, which lathe-iso's record does not state (and past that, its tool calls
     # are comments "(T0101)": a cut with no tool offset, test below)
     "TOKARKA.NC": ("lathe-iso", False, "motion before G18 (the ZX plane of the arcs) is stated"),
+    # a lathe program of another control, Philips System 3000 (%PM tape start, G13 N1=8001 N2=8011
+    # repeats, G15/G17 contour words A B, G68): not ISO; refused on its first line
+    "PHILIPS.nc": ("lathe-iso", False, "'%PM' is not a word of the ISO lathe grammar"),
 }
 
 
