@@ -19,6 +19,7 @@ from pathlib import Path
 import pytest
 from helpers.verifier_programs import LATHE_ISO, accepted, refusal
 
+import engine.verifier.expansion as expansion
 from engine.machines.records import Machine, load_machine
 from engine.verifier import LimitError, verify_program
 from engine.verifier.expanders import cycles
@@ -170,6 +171,16 @@ def test_macro_b_loops_and_jumps_evaluate_to_plain_passes(conn):
 def test_a_macro_construct_that_cannot_be_followed_is_refused_naming_it(conn, body, reason):
     message = verdict(conn, FANUC_0T, cut(body))
     assert message is not None and reason in message, message
+
+
+def test_a_macro_loop_that_never_ends_is_refused_at_the_step_bound(conn, monkeypatch):
+    """The bound is engine.verifier.expansion.MAX_STEPS (a million lines; lowered here so the test
+    runs in a moment): the loop's WHILE line is the one named."""
+    monkeypatch.setattr(expansion, "MAX_STEPS", 5_000)
+    body = ["#1=0", "WHILE [#1 GE 0] DO 1", "#1=#1+1", "END 1"]
+    message = verdict(conn, FANUC_0T, cut(body))
+    assert message is not None and "more than 5,000 blocks" in message, message
+    assert "line 8 'WHILE [#1 GE 0] DO 1'" in message, message
 
 
 # ---------------------------------------------------------------- attacks in a real program

@@ -11,8 +11,10 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+import engine.verifier.expansion as expansion  # read at call time: a test may lower MAX_STEPS
+
 from ...names import is_safe
-from ..expansion import MAX_STEPS, ExpansionRefused, PlainLine, register_expander
+from ..expansion import ExpansionRefused, PlainLine, register_expander
 from .iso_lines import BLOCK, HEADER_LINE, MACRO, TAPE, Source, read_sources
 from .iso_macro_flow import MacroRun
 from .iso_modes import Modes
@@ -83,9 +85,9 @@ class Run:
         steps = 0
         while not self.modes.ended:
             steps += 1
-            if steps > MAX_STEPS:
+            if steps > expansion.MAX_STEPS:
                 raise self.sources[min(index, len(self.sources) - 1)].refuse(
-                    f"the program runs more than {MAX_STEPS:,} blocks (a loop that never ends?)")
+                    f"the program runs more than {expansion.MAX_STEPS:,} blocks (a loop that never ends?)")
             if index >= len(self.sources):
                 last = self.sources[-1] if self.sources else Source(0, "", "nothing")
                 raise last.refuse("the program does not end with M30 (or M02)")
