@@ -155,6 +155,17 @@ def test_macro_b_loops_and_jumps_evaluate_to_plain_passes(conn):
     assert verdict(conn, FANUC_0T, cut(MACRO_PASSES)) is None
 
 
+def test_a_value_from_an_expression_is_rounded_as_the_control_rounds_it(conn):
+    """A dimension to the least input increment, 0.001 mm; an S value to a whole r/min, a half
+    away from zero (Fanuc: S[1000.5] is S1001)."""
+    body = ["#1=2.", "G97 S[#1*400.25] M03", "G01 X[100./3.] Z-10. F0.2"]
+    texts = [line.text for line in expand_iso(cut(body), load_machine(conn, FANUC_0T))]
+    speed = math.floor(2 * 400.25 + 0.5)
+    assert any(f"S{speed}" in text.split() for text in texts), texts
+    moves = plain_moves(load_machine(conn, FANUC_0T), cut(body))
+    assert moves == [pytest.approx((round(100 / 3, 3), -10.0), abs=1e-9)]
+
+
 @pytest.mark.parametrize("body, reason", [
     (["G00 X#5021"], "#5021 is a system variable: it holds positions and work offsets"),
     (["#1=#2001"], "#2001 is a system variable: it holds tool compensation values"),
@@ -167,6 +178,7 @@ def test_macro_b_loops_and_jumps_evaluate_to_plain_passes(conn):
     (["WHILE [1 EQ 2] DO 2", "G00 X100."], "DO 2 without its END 2"),
     (["G65 P9100 A1."], "G65 calls a macro program"),
     (["#1=3.5", "G#1 X100."], "G3.5: a G code from an expression must be whole"),
+    (["G00 X#0"], "#0 is always vacant"),
 ])
 def test_a_macro_construct_that_cannot_be_followed_is_refused_naming_it(conn, body, reason):
     message = verdict(conn, FANUC_0T, cut(body))

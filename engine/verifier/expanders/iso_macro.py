@@ -102,7 +102,9 @@ def variable_number(value: float) -> int:
 
 
 def read_variable(variables: dict[int, float], number: int) -> float:
-    if number >= 1000 or number < 0:
+    if number == 0:
+        raise MacroError("#0 is always vacant (the null variable): a value the verifier cannot follow")
+    if number >= 1000:
         raise MacroError(f"#{number} is a system variable: it holds {_system(number)}, a value only the control has")
     if not any(number in span for span in WRITABLE):
         raise MacroError(f"#{number} is not a variable of custom macro B (#1–#33, #100–#199, #500–#999)")
@@ -114,7 +116,7 @@ def read_variable(variables: dict[int, float], number: int) -> float:
 
 
 def write_variable(variables: dict[int, float], number: int, value: float) -> None:
-    if number >= 1000 or number < 0:
+    if number >= 1000:
         raise MacroError(f"#{number} is a system variable: setting it changes {_system(number)}, which the "
                          "verifier does not follow")
     if not any(number in span for span in WRITABLE):

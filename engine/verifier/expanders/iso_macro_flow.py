@@ -1,10 +1,10 @@
 """Custom macro B statements of an ISO lathe program followed (issue 27): assignments `#i=…`, the
 jumps `GOTO n` and `IF [cond] GOTO n`, `IF [cond] THEN #i=…`, the loops `WHILE [cond] DO m` …
 `END m`, and NC blocks whose words hold variables or expressions (`X[#504+6.]`, `Z-#1`), which
-become plain words: a dimension rounded to the least input increment (0.001 mm, 0.0001 in), a
-value in an M, S, T, P … word rounded to a whole number, a G code that must be whole. Every
-statement is one step of the expander's walk, so a loop is bounded by MAX_STEPS like every other
-(engine.verifier.expansion). The arithmetic is engine.verifier.expanders.iso_macro."""
+become plain words: a dimension rounded to the least input increment (0.001 mm, 0.0001 in), F
+as computed, a value in an M, S, T, P … word rounded to a whole number, a G code that must be
+whole. Every statement is one step of the expander's walk, so a loop is bounded by MAX_STEPS like
+every other (engine.verifier.expansion). The arithmetic is engine.verifier.expanders.iso_macro."""
 from __future__ import annotations
 
 import re
@@ -180,5 +180,7 @@ def _written(letter: str, value: float, decimals: int) -> str:
         return str(int(value))
     if letter in WHOLE or letter not in DIMENSIONS:
         return str(int(macro.round_half_away(value)))
+    if letter == "F":      # a feed keeps its digits (0.0005 mm/rev is not 0)
+        return f"{value:.6f}".rstrip("0")
     text = f"{round(value, decimals):.{decimals}f}"
     return "0." if float(text) == 0 else text
