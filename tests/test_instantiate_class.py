@@ -187,7 +187,7 @@ def test_unknown_parameter_names_a_modelled_class_and_a_hobber_are_refused_namin
         ("--class", "spur", "--machine", "lathe-iso"): ["hobbing model", "--gear"],
         ("--class", "turning_iso", "--machine", "lathe-iso"): ["turning class", "import-dxf"],
         ("--class", "pawn", "--machine", "hobber-840d"): ["simulation", "gear and a hob"],
-        ("--class", "pawn"): ["--machine", "hobber-840d, lathe-840d, lathe-iso, lathe-linuxcnc"],
+        ("--class", "pawn"): ["--machine", "hobber-840d, lathe-840d, lathe-fanuc-0t, lathe-iso, lathe-linuxcnc"],
         ("--class", "pawn", "--machine", "lathe-iso", "--cuts", "2"): ["--cuts", "--params"],
         ("--gear", "42", "--params", params): ["--params", "--class"],
         ("--gear", "42", "--unverified"): ["--unverified", "--class"],

@@ -12,24 +12,39 @@ expands G70–G76 with (engine/verifier/expanders/cycles.py).
 from __future__ import annotations
 
 import math
+import re
+from dataclasses import replace
 from pathlib import Path
 
 import pytest
 from helpers.verifier_programs import LATHE_ISO, accepted, refusal
 
+import engine.verifier.expansion as expansion
+from engine.machines.records import Machine, load_machine
+from engine.verifier import LimitError, verify_program
 from engine.verifier.expanders import cycles
 from engine.verifier.expanders.cycles import FEED, RAPID, THREAD, Move, Thread
+from engine.verifier.expanders.iso import expand_iso
+from engine.verifier.expansion import ExpansionRefused
 
 DATA = Path(__file__).resolve().parent / "data" / "nc" / "fanuc"
 
-# file -> (verified, the construct its refusal names). The files are as their authors wrote them.
+# file -> (the seeded record it runs on, verified, the construct its refusal names). The files are
+# as their authors wrote them.
 REAL = {
-    # Fanuc 0T: dimension words without a decimal point, read as 0.118 mm under input type I
-    "FANUC0T.nc": (False, "X118 needs a decimal point"),
-    # Fanuc macro program: ':' program number (ISO code form of O) and #50x variables
-    "0100.nc": (False, "':0100' is not a word of the ISO lathe grammar"),
-    # tape mark and program number on one line, as some DNC tools save them
-    "TOKARKA.NC": (False, "'%O1200' is not a word of the ISO lathe grammar"),
+    # Fanuc 0T, written for pocket-calculator decimal input (X86. beside X118 and Z-45) and the
+    # control's power-on G18 G21 G40 G97 G99: both are facts of the lathe-fanuc-0t record
+    "FANUC0T.nc": ("lathe-fanuc-0t", True, None),
+    # ':0100' program number and custom macro B (#501 … #509, X[#504+6.]) are followed; then G96
+    # S250 with no spindle clamp G50 S before it: the spindle speeds up without bound as X nears 0
+    "0100.nc": ("lathe-fanuc-0t", False, "G96 constant surface speed without a spindle clamp"),
+    # '%O1200' on one line, G-code system B (G90 G95 G92 S500 G33) is followed; it relies on the
+    # power-on plane G18, which lathe-iso's record does not state (and past that, its tool calls
+    # are comments "(T0101)": a cut with no tool offset, test below)
+    "TOKARKA.NC": ("lathe-iso", False, "motion before G18 (the ZX plane of the arcs) is stated"),
+    # a lathe program of another control, Philips System 3000 (%PM tape start, G13 N1=8001 N2=8011
+    # repeats, G15/G17 contour words A B, G68): not ISO; refused on its first line
+    "PHILIPS.nc": ("lathe-iso", False, "'%PM' is not a word of the ISO lathe grammar"),
 }
 
 
@@ -41,14 +56,143 @@ def test_every_real_iso_lathe_file_is_in_the_table():
     assert sorted(path.name for path in DATA.iterdir()) == sorted(REAL)
 
 
+def stored_name(lines: list[str]) -> str:
+    """The name the header gives (O1200 (TOKARKA)), the program's name in the shop; TEST if none."""
+    named = re.search(r"[O:]\d+\s*\((\w+)\)", "".join(lines[:2]))
+    return named.group(1) if named else "TEST"
+
+
+def verdict(conn, machine: str, lines: list[str]) -> str | None:
+    """None if the program is verified, else the refusal (one line)."""
+    try:
+        verify_program(lines, load_machine(conn, machine), stored_name(lines))
+    except LimitError as refused:
+        assert "\n" not in str(refused) and str(refused).endswith("nothing stored")
+        return str(refused)
+    return None
+
+
 @pytest.mark.parametrize("name", sorted(REAL))
 def test_a_real_iso_lathe_program_is_verified_or_refused_naming_the_construct(conn, name):
-    verified, construct = REAL[name]
+    machine, verified, construct = REAL[name]
+    message = verdict(conn, machine, real_lines(name))
     if verified:
-        accepted(conn, "lathe-iso", real_lines(name))
+        assert message is None, message
     else:
-        message = refusal(conn, "lathe-iso", real_lines(name))
-        assert construct in message, message
+        assert message is not None and construct in message, message
+
+
+def test_tokarka_with_its_plane_stated_is_refused_for_its_commented_out_tool_calls(conn):
+    lines = real_lines("TOKARKA.NC")
+    message = verdict(conn, "lathe-iso", lines[:1] + ["G18"] + lines[1:])
+    assert message is not None and "line 13" in message and "no tool offset active" in message, message
+
+
+# ---------------------------------------------------------------- decimal point input, headers
+
+FANUC_0T = "lathe-fanuc-0t"      # pocket-calculator input, power-on G18 G21 G40 G97 G99, system A
+
+
+def plain_moves(machine: Machine, lines: list[str]) -> list[tuple[float, float]]:
+    """(X, Z) of every feed move G1 the expander writes, as absolute mm."""
+    moves = []
+    for line in expand_iso(lines, machine):
+        words = dict(re.findall(r"([XZ])(-?[\d.]+)", line.text))
+        if line.text.startswith("G1 ") and "X" in words and "Z" in words:
+            moves.append((float(words["X"]), float(words["Z"])))
+    return moves
+
+
+def cut(body: list[str]) -> list[str]:
+    return ["%", "O0002", "G50 S2000", "T0101", "G97 S800 M03", "G00 X122. Z2."] + body + \
+        ["G00 X200. Z150.", "M30", "%"]
+
+
+def test_x118_is_118_mm_under_calculator_input_and_refused_under_increment_input(conn):
+    calculator = load_machine(conn, FANUC_0T)
+    assert calculator.decimal_point_input == "calculator"
+    moves = plain_moves(calculator, cut(["G01 X118 Z-45 F0.3"]))
+    assert moves == [pytest.approx((118.0, -45.0))]        # X118 = X118. mm, not 0.118 mm
+    increment = replace(calculator, decimal_point_input="increment")
+    with pytest.raises(ExpansionRefused, match="X118 needs a decimal point"):
+        expand_iso(cut(["G01 X118 Z-45 F0.3"]), increment)
+
+
+@pytest.mark.parametrize("header", ["%O1200(TOKARKA)", "%O1200 (TOKARKA)"])
+def test_the_tape_mark_and_the_program_number_on_one_first_line_are_accepted(conn, header):
+    assert verdict(conn, FANUC_0T, [header] + cut(["G01 X118. F0.3"])[2:]) is None
+
+
+def test_a_tape_mark_and_program_number_after_the_first_line_is_refused(conn):
+    message = verdict(conn, FANUC_0T, cut(["%O1201", "G01 X118. F0.3"]))
+    assert message is not None and "%O1201" in message, message
+
+
+# ---------------------------------------------------------------- custom macro B
+
+MACRO_PASSES = [
+    "#1=120.", "#2=2.5", "#3=#2*4+#2*[3-1]*2+80.",      # 10 + 10 + 80 = 100 mm, the finished diameter
+    "WHILE [#1 GT #3] DO 1",
+    "#1=#1-#2*2",                                      # 2·depth on the diameter
+    "IF [#1 LT #3] THEN #1=#3",
+    "G01 X#1 Z-[#3/4] F0.25",                          # each pass to Z−25
+    "G00 U2. Z2.",
+    "END 1",
+    "IF [#3 EQ 100] GOTO 100",
+    "G00 X9999.",                                      # skipped by the GOTO: past the X travel
+    "N100 G00 X[SQRT[#3*#3]+50.] Z[ROUND[2.5]+0.5]",    # X150 Z3.5
+]
+
+
+def test_macro_b_loops_and_jumps_evaluate_to_plain_passes(conn):
+    finish, depth = 10 + 10 + 80.0, 2.5
+    levels, diameter = [], 120.0
+    while diameter > finish:
+        diameter = max(diameter - 2 * depth, finish)
+        levels.append(diameter)
+    moves = plain_moves(load_machine(conn, FANUC_0T), cut(MACRO_PASSES))
+    assert moves == [pytest.approx((x, -finish / 4)) for x in levels]
+    assert verdict(conn, FANUC_0T, cut(MACRO_PASSES)) is None
+
+
+def test_a_value_from_an_expression_is_rounded_as_the_control_rounds_it(conn):
+    """A dimension to the least input increment, 0.001 mm; an S value to a whole r/min, a half
+    away from zero (Fanuc: S[1000.5] is S1001)."""
+    body = ["#1=2.", "G97 S[#1*400.25] M03", "G01 X[100./3.] Z-10. F0.2"]
+    texts = [line.text for line in expand_iso(cut(body), load_machine(conn, FANUC_0T))]
+    speed = math.floor(2 * 400.25 + 0.5)
+    assert any(f"S{speed}" in text.split() for text in texts), texts
+    moves = plain_moves(load_machine(conn, FANUC_0T), cut(body))
+    assert moves == [pytest.approx((round(100 / 3, 3), -10.0), abs=1e-9)]
+
+
+@pytest.mark.parametrize("body, reason", [
+    (["G00 X#5021"], "#5021 is a system variable: it holds positions and work offsets"),
+    (["#1=#2001"], "#2001 is a system variable: it holds tool compensation values"),
+    (["#3000=1"], "#3000 is a system variable: setting it changes the alarm"),
+    (["G00 X[#7+1.]"], "#7 is read before this program sets it: it is vacant"),
+    (["G00 X#510"], "#510 is read before this program sets it: it is a value an earlier program left"),
+    (["#1=ATAN[1]/[1]"], "ATAN: its result depends on parameter 6004#0"),
+    (["#1=0", "#2=5/#1"], "5/0: a division by zero"),
+    (["GOTO 77"], "GOTO 77: there is no block N77"),
+    (["WHILE [1 EQ 2] DO 2", "G00 X100."], "DO 2 without its END 2"),
+    (["G65 P9100 A1."], "G65 calls a macro program"),
+    (["#1=3.5", "G#1 X100."], "G3.5: a G code from an expression must be whole"),
+    (["G00 X#0"], "#0 is always vacant"),
+])
+def test_a_macro_construct_that_cannot_be_followed_is_refused_naming_it(conn, body, reason):
+    message = verdict(conn, FANUC_0T, cut(body))
+    assert message is not None and reason in message, message
+
+
+def test_a_macro_loop_that_never_ends_is_refused_at_the_step_bound(conn, monkeypatch):
+    """The bound is engine.verifier.expansion.MAX_STEPS (a million lines; lowered here so the test
+    runs in a moment): the loop's WHILE line is the one named."""
+    monkeypatch.setattr(expansion, "MAX_STEPS", 5_000)
+    body = ["#1=0", "WHILE [#1 GE 0] DO 1", "#1=#1+1", "END 1"]
+    message = verdict(conn, FANUC_0T, cut(body))
+    assert message is not None and "more than 5,000 blocks" in message, message
+    assert "line 8 'WHILE [#1 GE 0] DO 1'" in message, message
 
 
 # ---------------------------------------------------------------- attacks in a real program

@@ -48,6 +48,12 @@ class Machine:
     reference_x: float | None = None
     reference_z: float | None = None
     gcode_system: str | None = None
+    # How the control reads a dimension word without a decimal point (migration 0030): 'increment'
+    # (X118 = 0.118 mm, refused) or 'calculator' (X118 = 118 mm; Fanuc parameter 3401#0 DPI = 1).
+    decimal_point_input: str = "increment"
+    # The modal G codes the control is in at power-on and reset ('G18 G21 G40 G97 G99'), which a
+    # program that does not state them runs under; None: not stated (such a program is refused).
+    power_on: str | None = None
 
 
 MACHINE_QUERY = f"SELECT {columns(Machine)} FROM machine"  # static, from the dataclass

@@ -11,8 +11,12 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-from ..expansion import MAX_STEPS, ExpansionRefused, PlainLine, register_expander
-from .iso_lines import BLOCK, HEADER_LINE, TAPE, Source, read_sources
+import engine.verifier.expansion as expansion  # read at call time: a test may lower MAX_STEPS
+
+from ...names import is_safe
+from ..expansion import ExpansionRefused, PlainLine, register_expander
+from .iso_lines import BLOCK, HEADER_LINE, MACRO, TAPE, Source, read_sources
+from .iso_macro_flow import MacroRun
 from .iso_modes import Modes
 from .iso_moves import take_block
 
@@ -42,9 +46,11 @@ class Run:
                 self.labels.setdefault(source.label, index)
             if source.kind == HEADER_LINE and source.program is not None:
                 self.programs.setdefault(source.program, index)
+        self.macro = MacroRun(sources, self.labels)
 
     def run(self) -> list[PlainLine]:
         start = self._start()
+        self._power_on(start)
         self._walk(start)
         closing = next((s for s in reversed(self.sources) if s.kind != "nothing"), None)
         if closing is not None and closing.kind == TAPE and self.modes.ended:
@@ -55,21 +61,33 @@ class Run:
         """The lines before the first block: `%` and the program number line pass on as they are."""
         for index, source in enumerate(self.sources):
             if source.kind == TAPE or source.kind == HEADER_LINE:
-                self.plain.append(PlainLine(_header_text(source), source.number, source.text))
+                if source.tape:
+                    self.plain.append(PlainLine("%", source.number, source.text))
+                self.plain.extend(PlainLine(text, source.number, source.text) for text in _header_texts(source))
                 if source.kind == HEADER_LINE:
                     return index + 1
-            elif source.kind == BLOCK:
+            elif source.kind in (BLOCK, MACRO):
                 return index
         return len(self.sources)
+
+    def _power_on(self, start: int) -> None:
+        """The modes the record says the control is in at power-on (machine.power_on), stated as a
+        plain block before the program's first, as if the program had written them."""
+        codes = (getattr(self.machine, "power_on", None) or "").split()
+        first = next((s for s in self.sources[start:] if s.kind in (BLOCK, MACRO)), None)
+        if codes and first is not None:
+            words = [("G", code[1:]) for code in codes]
+            take_block(Source(first.number, first.text, BLOCK, words), self.modes, self.sources, self.labels,
+                       self.plain)
 
     def _walk(self, index: int) -> None:
         stack: list[tuple[int, int, int]] = []     # (return index, start index, passes left)
         steps = 0
         while not self.modes.ended:
             steps += 1
-            if steps > MAX_STEPS:
+            if steps > expansion.MAX_STEPS:
                 raise self.sources[min(index, len(self.sources) - 1)].refuse(
-                    f"the program runs more than {MAX_STEPS:,} blocks (a loop that never ends?)")
+                    f"the program runs more than {expansion.MAX_STEPS:,} blocks (a loop that never ends?)")
             if index >= len(self.sources):
                 last = self.sources[-1] if self.sources else Source(0, "", "nothing")
                 raise last.refuse("the program does not end with M30 (or M02)")
@@ -84,7 +102,7 @@ class Run:
         for source in self.sources[index:]:
             if source.kind == HEADER_LINE:
                 return
-            if source.kind == BLOCK:
+            if source.kind in (BLOCK, MACRO):
                 raise source.refuse("a line after M30: the program ends there, and the control reads nothing "
                                     "after it")
 
@@ -94,6 +112,11 @@ class Run:
                                 "read-in)")
         if source.kind == HEADER_LINE:
             raise source.refuse(f"a second program number O{source.program} before M30: the main program has no end")
+        if source.kind == MACRO:
+            taken = self.macro.take(source, index, 3 if self.modes.scale == 1.0 else 4)
+            if isinstance(taken, int):
+                return taken
+            source = taken
         if source.kind != BLOCK:
             if source.comment is not None:
                 self.plain.append(PlainLine(f"({source.comment})", source.number, source.text))
@@ -139,10 +162,19 @@ class Run:
         return back
 
 
-def _header_text(source: Source) -> str:
+def _header_texts(source: Source) -> list[str]:
+    """`%`, or the program number with its name. On a Fanuc control the text after the O number is
+    a comment the program list shows (the program is stored under its number): a text that is not
+    a program name (`( FANUC 0T )`) is passed on as a comment line of its own, not as the name."""
     if source.kind == TAPE:
-        return "%"
-    return f"O{source.program:04d}" + (f" ({source.name})" if source.name is not None else "")
+        return ["%"]
+    number = f"O{source.program:04d}"
+    name = source.name.strip() if source.name is not None else None
+    if name is None:
+        return [number]
+    if is_safe("program", name):
+        return [f"{number} ({name})"]
+    return [number, f"({name})"]
 
 
 def _int(source: Source, text: str) -> int:

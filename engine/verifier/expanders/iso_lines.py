@@ -3,8 +3,10 @@ them: blank lines and `%`, the program number line `O<n>` with or without `(NAME
 number N, the optional block skip `/`, comments in parentheses (nested parentheses inside a
 comment are part of it, as Haas reads them; an unbalanced one is refused), `;` as the end of the
 block as printed in manuals, and words of one capital letter and a plain number (X.15, Z-1.,
-T0101). Anything else on a line (a `,C` chamfer word, a `#` macro variable, a lowercase word) is
-refused naming it: the expander does not guess what a control would make of it."""
+T0101). A line with a `#` variable, a bracketed expression or a macro statement (IF, GOTO,
+WHILE … DO, END) is kept as written for engine.verifier.expanders.iso_macro_flow. Anything else on
+a line (a `,C` chamfer word, a lowercase word) is refused naming it: the expander does not guess
+what a control would make of it."""
 from __future__ import annotations
 
 import re
@@ -15,10 +17,13 @@ from ..expansion import ExpansionRefused
 from ..numbers import why_not_plain
 from ..refusals import Refused
 
-HEADER = re.compile(r"O(?P<number>\d{1,5})\s*(?:\((?P<name>[^()%]*)\))?\s*;?")
+HEADER = re.compile(r"(?P<tape>%)?[O:](?P<number>\d{1,5})\s*(?:\((?P<name>[^()%]*)\))?\s*;?")
 EXPONENT = re.compile(r"[eE][-+]?\d")
 WORD = re.compile(r"\s*([A-Z])\s*([-+]?(?:\d+\.?\d*|\.\d+))")
-TAPE, HEADER_LINE, BLOCK, NOTHING = "tape", "header", "block", "nothing"
+TAPE, HEADER_LINE, BLOCK, NOTHING, MACRO = "tape", "header", "block", "nothing", "macro"
+LABEL = re.compile(r"N\s*(?P<number>\d+)\s*")
+# a custom macro B line: a variable, an expression, or a statement (engine.verifier.expanders.iso_macro_flow)
+MACRO_LINE = re.compile(r"[^(]*[#\[]|\s*(?:IF|WHILE|GOTO|END\s*\d|DO\s*\d)")
 COMMENT_REASON = "a comment is one (…) at the end of the block"
 
 
@@ -33,6 +38,8 @@ class Source:
     program: int | None = None        # the O number of a header line
     name: str | None = None           # the (NAME) of a header line
     comment: str | None = None        # its comments' text, passed on (the simulation reads "(OP n …)")
+    tape: bool = False                # a header line `%O1200` that also holds the tape mark
+    macro: str | None = None          # a custom macro B line's code, evaluated as the program runs
 
     def refuse(self, reason: str) -> ExpansionRefused:
         return ExpansionRefused(self.number, self.text, reason)
@@ -55,18 +62,29 @@ def _read(number: int, line: str) -> Source:
     if stripped == "%":
         return Source(number, line, TAPE)
     header = HEADER.fullmatch(stripped)
-    if header:
-        return Source(number, line, HEADER_LINE, program=int(header["number"]), name=header["name"])
+    if header and (number == 1 or not header["tape"]):
+        return Source(number, line, HEADER_LINE, program=int(header["number"]), name=header["name"],
+                      tape=bool(header["tape"]))
     code, comment = _code(stripped)
     if code.startswith("/"):
         code = code[1:]     # optional block skip: read as run (the switch off, its state at power-on)
     if code.endswith(";"):
         code = code[:-1]
+    if MACRO_LINE.match(code):
+        return _macro(number, line, code, comment)
     words = _words(code)
     label = None
     if words and words[0][0] == "N":
         label = _whole(words.pop(0), "a sequence number")
     return Source(number, line, BLOCK if words else NOTHING, words, label, comment=comment)
+
+
+def _macro(number: int, line: str, code: str, comment: str | None) -> Source:
+    label = LABEL.match(code)
+    if label is not None:
+        code = code[label.end():]
+    return Source(number, line, MACRO, label=int(label["number"]) if label else None, comment=comment,
+                  macro=code.strip())
 
 
 def _code(line: str) -> tuple[str, str | None]:

@@ -19,12 +19,20 @@ INCH = 25.4
 POINT_WORDS = frozenset({"X", "Z", "U", "W", "R", "I", "K", "F"})
 
 
-
-def check_points(words: list[tuple[str, str]]) -> None:
-    """ValueError for a dimension word without its decimal point (but a zero)."""
+def check_points(words: list[tuple[str, str]], decimal_point_input: str = "increment") -> list[tuple[str, str]]:
+    """The words as the control reads them: under pocket-calculator input (machine record
+    decimal_point_input 'calculator', Fanuc parameter 3401#0 DPI = 1) X118 is 118 mm, written X118.;
+    under increment input (type I) ValueError for such a word (but a zero): it would be 0.118 mm."""
+    if decimal_point_input == "calculator":
+        return [(letter, _pointed(text) if letter in POINT_WORDS else text) for letter, text in words]
     for letter, text in words:
         if letter in POINT_WORDS and "." not in text and float(text) != 0:
             raise ValueError(f"{letter}{text} {POINT_REASON}; write {letter}{text}.")
+    return words
+
+
+def _pointed(text: str) -> str:
+    return text if "." in text else text + "."
 
 
 def arc_radius(centre: tuple[float, float], start: tuple[float, float], end: tuple[float, float],

@@ -4,6 +4,7 @@ motion in the block, and the plain line the grammar reads emitted. The cycles G7
 engine.verifier.expanders.iso_cycles."""
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import TYPE_CHECKING
 
 from ..expansion import ExpansionRefused, PlainLine
@@ -24,8 +25,10 @@ REFUSED = {
     41: "G41 tool-nose radius compensation moves the path by the insert's radius, which the verifier cannot see",
     42: "G42 tool-nose radius compensation moves the path by the insert's radius, which the verifier cannot see",
     53: "G53 moves in machine coordinates, which the record's travel is not stated in",
-    92: "G92 (threading cycle) is not expanded; program the thread with G76 or G32",
-    94: "G94 (facing cycle) is not expanded; program the passes or use G72",
+    92: "G92 (threading cycle, G-code system A) is not expanded; program the thread with G76 or G32",
+    94: "G94 (facing cycle, G-code system A) is not expanded; program the passes or use G72",
+    65: "G65 calls a macro program with arguments, which the expander does not follow",
+    66: "G66 calls a macro program after every move, which the expander does not follow",
     90: "G90 with X/Z is the turning cycle (G-code system A), which is not expanded; use G71",
 }
 OTHER_WORDS = frozenset({"X", "Z", "U", "W", "R", "I", "K", "F", "S", "T", "M", "G", "P", "Q", "L", "D", "A", "E"})
@@ -34,6 +37,10 @@ OTHER_WORDS = frozenset({"X", "Z", "U", "W", "R", "I", "K", "F", "S", "T", "M", 
 def take_block(source: Source, modes: Modes, sources: list[Source], labels: dict[int, int],
                plain: list[PlainLine]) -> int | None:
     """Follows the block; returns the index to go on at if the block jumps (a cycle's P…Q)."""
+    try:
+        source = replace(source, words=check_points(source.words, modes.machine.decimal_point_input))
+    except ValueError as error:
+        raise source.refuse(str(error)) from None
     g_codes = [_code(source, text) for letter, text in source.words if letter == "G"]
     words: dict[str, str] = {}
     for letter, text in source.words:
@@ -41,10 +48,6 @@ def take_block(source: Source, modes: Modes, sources: list[Source], labels: dict
             if letter in words:
                 raise source.refuse(f"{letter} twice in one block")
             words[letter] = text
-    try:
-        check_points(source.words)
-    except ValueError as error:
-        raise source.refuse(str(error)) from None
     cycle = next((code for code in g_codes if code in CYCLE_CODES), None)
     if cycle is not None:
         return take_cycle(cycle, source, words, modes, sources, labels, plain)
@@ -83,6 +86,8 @@ def _take_code(code: int, source: Source, words: dict[str, str], modes: Modes, o
     axes = {"X", "Z", "U", "W"} & words.keys()
     if code in MOTIONS:
         modes.motion = code
+    elif code == 33 and _system_b(modes):
+        modes.motion = 32          # G-code systems B and C write thread cutting G33 (system A's G32)
     elif code in PASSED:
         out.tokens.append(PASSED[code])
     elif code == 90 and not axes:
@@ -91,12 +96,12 @@ def _take_code(code: int, source: Source, words: dict[str, str], modes: Modes, o
     elif code in (20, 21):
         modes.scale = INCH if code == 20 else 1.0
         out.tokens.append("G21")
-    elif code in (98, 99):
-        modes.per_rev = code == 99
+    elif code in (98, 99) or (code in (94, 95) and _system_b(modes)):
+        modes.per_rev = code in (99, 95)
         out.tokens.append("G98")
     elif code in (96, 97):
         _spindle_mode(code, source, modes, out)
-    elif code == 50:
+    elif code == 50 or (code == 92 and _system_b(modes)):
         _g50(source, words, modes)
     elif code in WORK_OFFSET_CODES:
         if f"G{code}" != modes.machine.work_offset:
@@ -108,6 +113,12 @@ def _take_code(code: int, source: Source, words: dict[str, str], modes: Modes, o
         _dwell(source, words, modes, out)
     elif code not in IGNORED:
         raise source.refuse(REFUSED.get(code, f"G{code} is not a G code the ISO lathe expander follows"))
+
+
+def _system_b(modes: Modes) -> bool:
+    """G-code system B or C (machine.gcode_system, NULL read as B): G94/G95 are the feed per minute
+    and per revolution, G92 the coordinate setting and spindle clamp (system A's G98/G99 and G50)."""
+    return getattr(modes.machine, "gcode_system", None) != "A"
 
 
 def _spindle_mode(code: int, source: Source, modes: Modes, out: Emitted) -> None:
