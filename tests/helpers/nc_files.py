@@ -32,8 +32,9 @@ def _as_imported(real: Path) -> Path:
 
 
 DATA = _as_imported(REAL)
+NOT_PROGRAMS = (".tsv", ".expected")   # the provenance table; LinuxCNC's expected interpreter output
 TABBED = sorted(str(path.relative_to(REAL)) for path in REAL.rglob("*")
-                if path.is_file() and path.suffix != ".tsv" and b"\t" in path.read_bytes())
+                if path.is_file() and path.suffix not in NOT_PROGRAMS and b"\t" in path.read_bytes())
 FAMILY = "linuxcnc/plasmac_family/"
 MACROS = "linuxcnc/lathe_macros/"
 
@@ -64,6 +65,10 @@ PARAMS = {
         "lathe_macros/chamfer.ngc", "lathe_macros/radius.ngc", "lathe_macros/drill.ngc",
         "ngcgui_lathe/taper-od.ngc", "ngcgui_lathe/g76diam.ngc", "ngcgui_lathe/g76base.ngc",
         "ngcgui_lathe/lathe_std.ngc")},
+    # LinuxCNC's own interpreter tests of G70-G72 and G76 (tests/interp), as they are
+    **{f"linuxcnc/interp_tests/{name}.ngc": {} for name in (
+        "g71-with-g70", "g72-iterations-present", "g72-iterations-missing", "g71-endless-loop",
+        "g71-endless-loop2", "g71-endless-loop_2", "g76only")},
     "sinumerik/cam_840dsl/CAM_TEST.MPF": {"feed": 250, "clear_z": 60, "approach_z": 53, "spindle_speed": 1061},
     "emco_from_dxf/testNegDXF.cnc": {"feed": 100, "z_clear": 3000, "arc_k": -500},
     "emco_from_dxf/testg02hemisphere.cnc": {"feed": 100, "z_clear": 3000},
@@ -85,7 +90,7 @@ def bound_count(o: str, name: str) -> int:
 
 def real_files():
     assert DATA.is_dir(), f"the real NC files are missing: {DATA} (tests/data/README.md)"
-    found = sorted(str(p.relative_to(DATA)) for p in DATA.rglob("*") if p.is_file() and p.suffix != ".tsv")
+    found = sorted(str(p.relative_to(DATA)) for p in DATA.rglob("*") if p.is_file() and p.suffix not in NOT_PROGRAMS)
     assert set(found) == set(PARAMS), "a real file without parameters in PARAMS (or one gone)"
     return found
 
