@@ -24,9 +24,10 @@ import re
 from collections.abc import Callable
 
 import pytest
-from helpers.linuxcnc_programs import FOLDER, refusal
+from helpers.linuxcnc_programs import FOLDER, LATHE, refusal
 
 import engine.verifier.expanders.cycles as iso_cycles
+from engine.simulation.turning.run import simulate_turning
 from engine.verifier.expanders.linuxcnc import Interpreter
 
 START_X, START_Z, DEPTH, RETRACT = 20.0, 2.0, 2.0, 0.5          # radius, mm
@@ -98,8 +99,15 @@ def test_g70_makes_p_passes_from_d_down_to_e_each_from_the_start():
     assert [move[3] for move in found if move[0] == "G3"] == [pytest.approx(0.5)]
 
 
-def test_the_cycles_program_is_verified_on_the_seeded_lathe():
-    assert refusal([*HEAD, ROUGH, FINISH, *TAIL]) is None
+def test_the_cycles_program_is_verified_and_the_turning_simulation_follows_every_move():
+    """On a Ø40 bar (the start X): each level cuts the bar, each retract and return stays in air."""
+    program = [*HEAD, ROUGH, FINISH, *TAIL]
+    assert refusal(program) is None
+    bar = {"stock_diameter": 2 * START_X, "stock_z_front": 0.0, "stock_z_back": -100.0}
+    report = simulate_turning(program, bar, {}, LATHE, "g7x")
+    made = moves(program)
+    assert report.findings == []
+    assert (report.rapids, report.cut_moves) == (sum(m[0] == "G0" for m in made), sum(m[0] != "G0" for m in made))
 
 
 def back_in_z(code: str) -> list[str]:
@@ -209,3 +217,30 @@ def test_a_profile_in_another_quadrant_is_cut_as_its_mirror_image(z_sense, x_sen
     lines, image = mirrored(z_sense, x_sense)
     expected = [image(move) for move in original]
     assert close(moves(lines), expected, tolerance=1e-6)
+
+
+# --- types: pockets cut (G71), left (G71.1), only they (G71.2) -----------------------------------------------
+
+POCKET = ["o300 sub", "G1 X32 Z0", "G1 Z-10", "G1 X20", "G1 Z-20", "G1 X32", "G1 Z-30", "o300 endsub"]
+TOP, FLOOR = 16.0, 10.0          # radius: the pocket between Z-10 and Z-20 goes down from X16 to X10
+
+
+def levels(code: str) -> tuple[list[float], list[float]]:
+    """(the radii of the cuts along Z over the whole length to the Z-30 closing line, the radii of the
+    feeds along the pocket from Z-10 to its wall at Z-20 below its top X16)."""
+    made = moves([*HEAD[:5], *POCKET, "G0 X40 Z2", f"{code} Q300 X40 Z2 D0 I2 R0.5", *TAIL])
+    along = [(a[2], b[2], b[1] / 2) for a, b in zip(made, made[1:]) if b[0] == "G1" and a[1] == b[1] and a[2] != b[2]]
+    return ([x for z0, z1, x in along if z1 == -30 and x > TOP],
+            [x for z0, z1, x in along if (z0, z1) == (-10, -20) and x < TOP - 1e-9])
+
+
+@pytest.mark.parametrize("code, roughs, cuts_pocket", [("G71", True, True), ("G71.1", True, False),
+                                                      ("G71.2", False, True)])
+def test_type_1_leaves_the_pocket_and_type_2_cuts_only_it(code, roughs, cuts_pocket):
+    """adoc: "The G7x.1 cycles do not cut pockets. The G7x.2 cycles only cut after the first pocket";
+    cc 743-750 (type 2 skips the first roughing), 756-761 (type 1 follows the profile, climb_only)."""
+    over, pocket = levels(code)
+    above = [START_X - n * DEPTH for n in range(10) if START_X - n * DEPTH > TOP + 1e-9]           # 20, 18
+    inside = [START_X - n * DEPTH for n in range(10) if FLOOR < START_X - n * DEPTH < TOP - 1e-9] + [FLOOR]  # 14 12 10
+    assert over == (above if roughs else [])
+    assert pocket == (inside if cuts_pocket else [])
