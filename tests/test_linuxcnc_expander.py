@@ -106,7 +106,8 @@ def test_g76_makes_the_passes_of_linuxcnc_s_threading_cycle():
     (["G55"], "work offset"), (["G53 G0 Z0"], "machine coordinates"), (["A1"], "no A axis"),
     (["o<shape> call"], "the file shape.ngc is not in this program"), (["o1 call"], "an o1 sub is not in"),
     (["o1 while [1]"], "without its o1 endwhile"), (["o2 endif"], "closes nothing"), (["/G0 X1"], "block delete"),
-    (["o3 sub", "o3 endsub"], "never called"), (["M65 P1"], "HAL output"), (["G71 Q1 D1"], "profile cycle G71"),
+    (["o3 sub", "o3 endsub"], "never called"), (["M65 P1"], "HAL output"),
+    (["G71 Q1 D1"], "G71 from a position not yet programmed"),
     (["G83 Z-1 R1 Q1"], "G83 outside G17"), (["G73 Z-1 R1 Q1"], "drilling cycle"),
     (["(unclosed"], "without its closing"),
 ])

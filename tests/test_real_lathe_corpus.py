@@ -27,7 +27,9 @@ RIGHT, GAP = "fail closed is right", "gap"
 BARE_G64 = "G64 without P blends corners without a bound"
 BLOCK_DELETE = "block delete /: whether the line runs is the operator's switch"
 NO_Y = "Y0: the lathe has no Y axis"
-PROFILE_G72 = "the LinuxCNC profile cycle G72"
+G83_RETRACT = "G83 before G98/G99: the retract level is whatever the last program left"
+NOSE_COMP = "cutter radius compensation: the tool path under compensation is not the programmed one"
+NO_OFFSET = "a cut with no tool length offset active"
 G53 = "G53 moves in machine coordinates"
 TRAVEL_Z300 = "Z300 exceeds the travel of lathe-linuxcnc (Z -600…200)"
 
@@ -62,17 +64,17 @@ CORPUS = {
     # peter-pan08/LatheEasyStep: programs its LinuxCNC conversational panel wrote, kept as test files
     # (none states G43 after M6: behind the cycles LinuxCNC would apply no tool offset)
     "lathe_easystep/Test_Bohren.ngc": (
-        "lathe-linuxcnc", PROFILE_G72, GAP,
-        "facing with the LinuxCNC 2.9 profile cycle G72 Q<sub>: standard lathe work to expand"),
+        "lathe-linuxcnc", G83_RETRACT, RIGHT,
+        "its G72 facing expands; then a peck drill G83 with no G98/G99 stated (M2 does not reset it)"),
     "lathe_easystep/Test_Gewinde.ngc": (
-        "lathe-linuxcnc", PROFILE_G72, GAP,
-        "facing G72 then roughing G71 on a contour subroutine, G76 thread: the profile cycles block it"),
+        "lathe-linuxcnc", NOSE_COMP, GAP,
+        "G72 facing expands; then G42.1 D0.8 L2, tool nose radius compensation, which is not modelled"),
     "lathe_easystep/Test_Gewinde_innen.ngc": (
-        "lathe-linuxcnc", PROFILE_G72, GAP,
-        "bore and inner thread: G72 facing, G71 boring on a contour subroutine, G76"),
+        "lathe-linuxcnc", NO_OFFSET, GAP,
+        "its G72 cuts after T01 M6 with no G43 (its panel's M6 remap applies it; the record cannot say so)"),
     "lathe_easystep/Test_Innendrehen_mit_Gewinde.ngc": (
-        "lathe-linuxcnc", PROFILE_G72, GAP,
-        "the same part as Test_Gewinde_innen with other retract planes: G72/G71 block it"),
+        "lathe-linuxcnc", NOSE_COMP, GAP,
+        "the same part as Test_Gewinde_innen with other retract planes: G41.1 nose compensation"),
     "lathe_easystep/test.ngc": (
         "lathe-linuxcnc", G53, GAP,
         "tool change point X70 Z100 in machine coordinates (the record lacks the G54 origin); G72 next"),

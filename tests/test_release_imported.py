@@ -23,7 +23,9 @@ from engine.library.nc_import import import_nc
 from engine.programs.class_jobs import instantiate_class
 from engine.release.gate import release
 
-REAL_PROGRAMS = sorted(path for path in NC.rglob("*") if path.is_file() and path.name != "PROVENANCE.tsv")
+# LinuxCNC's expected interpreter output (interp_tests/*.expected) is a record of moves, not a program
+REAL_PROGRAMS = sorted(path for path in NC.rglob("*") if path.is_file() and path.name != "PROVENANCE.tsv"
+                       and path.suffix != ".expected")
 TWINNED = NC / "liblathe" / "profile.gcode"   # LibLathe's path repeats each approach rapid
 PAWN_PARAMS = {"spindle": 1000, "feed": 50.0}
 PASTE = ("INSERT INTO template_view (gear_class, id, t, n, o) "

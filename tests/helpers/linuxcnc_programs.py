@@ -33,16 +33,20 @@ LATHE = seeded_lathe()
 
 # The preamble's blend (#<tol> 0.001 in: G64 P0.0254 mm) and the macros' M73 are followed
 # (docs/reference/linuxcnc-lathe.md §3, §6).
+# The G70-G72 programs are written in radius mode, as rs274 (LinuxCNC's interpreter run alone, whose
+# expected output their tests hold) starts, but none states G8: M2 does not reset G7/G8, so their
+# first X (the cycle's own) is refused. With G8 and a tool they expand (tests/test_linuxcnc_g7x.py).
+X_BEFORE_G7_G8 = "an X before G7/G8: diameter or radius is whatever the last program left"
 # file -> (how it runs, None for verified or the construct its refusal names; a called file as its
 # screen calls it)
 PROGRAMS = {
-    "lathe_g70_71_demo.ngc": (None, "profile cycle G71.1"),
+    "lathe_g70_71_demo.ngc": (None, X_BEFORE_G7_G8),          # on G71.1 X15; with G8, its G42.1 after
     # bare G64 on line 2 (and no tool offset: CAM output with no T, M6 or G43)
     "lathe_pawn.ngc": (None, "G64 without P blends corners without a bound"),
     # M2 does not reset G7/G8 and the INI's startup code runs once (docs/reference §3): not stated
     "lathe-g76.ngc": (None, "G64 without P blends corners without a bound"),   # and an X before G7/G8
-    "lathe_g7x_face_boring.ngc": (None, "profile cycle G72"),
-    "lathe_g7x_quadrants.ngc": (None, "profile cycle G70"),
+    "lathe_g7x_face_boring.ngc": (None, X_BEFORE_G7_G8),      # on G72 X1 in o101; with G8, no S before the cut
+    "lathe_g7x_quadrants.ngc": (None, X_BEFORE_G7_G8),        # on G70 X15; with G8, no S before the cut
     # T0 M6 unloads the tool (accepted); the file states no G7/G8, which M2 does not reset
     "lathecomp.ngc": (None, "G64 without P blends corners without a bound"),   # and an X before G7/G8
     "lathe_macros/boring.ngc": (MACRO, None),
@@ -60,6 +64,18 @@ PROGRAMS = {
                                           "table's diameter"),
     "ngcgui_lathe/g76diam.ngc": (NGCGUI, "the file g76base.ngc is not in this program"),
     "ngcgui_lathe/g76base.ngc": (NGCGUI, "#<_vmajor> holds a value only the control has"),
+    # LinuxCNC's interpreter tests (tests/interp): its expected output is made in radius mode
+    "interp_tests/g71-with-g70.ngc": (None, X_BEFORE_G7_G8),       # on G71.1 X15 (the demo's profile)
+    "interp_tests/g72-iterations-present.ngc": (None, X_BEFORE_G7_G8),   # on G72 X50
+    "interp_tests/g72-iterations-missing.ngc": (None, X_BEFORE_G7_G8),   # on G72 X50
+    # G92.1 on line 3 clears the G92 offsets: refused like every G92 code (an offset the verifier
+    # does not follow); LinuxCNC ends it (168 lines of expected output, the loop of issue #2939 fixed)
+    "interp_tests/g71-endless-loop.ngc": (None, "G92.1 shifts every position by an offset"),
+    # no G20/G21 (the F.24 of its G71 line is a length), no G7/G8; LinuxCNC ends it (issue #2844)
+    "interp_tests/g71-endless-loop2.ngc": (None, "a length before G20/G21"),
+    # G52 shifts Z before its G71 (then g42 before its G70)
+    "interp_tests/g71-endless-loop_2.ngc": (None, "G52 shifts every position by an offset"),
+    "interp_tests/g76only.ngc": (None, "G64 without P blends corners without a bound"),   # g20 g64 g18
 }
 # each blends corners (G64 P0.005 in, P0.125 mm) before it reads HAL/INI values or drives M65
 PLASMA = {"plasmac_family/imperial_ramp_pierce.ngc": "G64 P0.005 blends corners up to 0.127 mm",

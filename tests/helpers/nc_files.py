@@ -32,8 +32,9 @@ def _as_imported(real: Path) -> Path:
 
 
 DATA = _as_imported(REAL)
+NOT_PROGRAMS = (".tsv", ".expected")   # the provenance table; LinuxCNC's expected interpreter output
 TABBED = sorted(str(path.relative_to(REAL)) for path in REAL.rglob("*")
-                if path.is_file() and path.suffix != ".tsv" and b"\t" in path.read_bytes())
+                if path.is_file() and path.suffix not in NOT_PROGRAMS and b"\t" in path.read_bytes())
 FAMILY = "linuxcnc/plasmac_family/"
 MACROS = "linuxcnc/lathe_macros/"
 
@@ -66,6 +67,10 @@ PARAMS = {
         "ngcgui_lathe/lathe_std.ngc", "lathe_macros/go_to_position.ngc", "lathe_macros/probe-hole.ngc",
         *(f"gmoccapy_lathe/{macro}.ngc" for macro in (
             "boring", "chamfer", "drilling", "facing", "grooving", "radius", "threading", "turning")))},
+    # LinuxCNC's own interpreter tests of G70-G72 and G76 (tests/interp), as they are
+    **{f"linuxcnc/interp_tests/{name}.ngc": {} for name in (
+        "g71-with-g70", "g72-iterations-present", "g72-iterations-missing", "g71-endless-loop",
+        "g71-endless-loop2", "g71-endless-loop_2", "g76only")},
     "sinumerik/cam_840dsl/CAM_TEST.MPF": {"feed": 250, "clear_z": 60, "approach_z": 53, "spindle_speed": 1061},
     "emco_from_dxf/testNegDXF.cnc": {"feed": 100, "z_clear": 3000, "arc_k": -500},
     "emco_from_dxf/testg02hemisphere.cnc": {"feed": 100, "z_clear": 3000},
@@ -73,6 +78,7 @@ PARAMS = {
     "fanuc/FANUC0T.nc": {"feed": 0.3},
     "fanuc/0100.nc": {"feed": 0.35},
     "fanuc/TOKARKA.NC": {"feed": 0.3},
+    "fanuc/PHILIPS.nc": {},
     # issue 27's corpus of other people's lathe programs (tests/test_real_lathe_corpus.py): imported
     # as they are, no value bound to a parameter
     **{name: {} for name in (
@@ -96,7 +102,7 @@ def bound_count(o: str, name: str) -> int:
 
 def real_files():
     assert DATA.is_dir(), f"the real NC files are missing: {DATA} (tests/data/README.md)"
-    found = sorted(str(p.relative_to(DATA)) for p in DATA.rglob("*") if p.is_file() and p.suffix != ".tsv")
+    found = sorted(str(p.relative_to(DATA)) for p in DATA.rglob("*") if p.is_file() and p.suffix not in NOT_PROGRAMS)
     assert set(found) == set(PARAMS), "a real file without parameters in PARAMS (or one gone)"
     return found
 

@@ -6,7 +6,8 @@ It follows o-word subroutines defined in the file (`o100 sub … o100 endsub`, `
 `return`), loops (`while/endwhile`, `do/while`, `repeat/endrepeat`, `break`, `continue`) and
 `if/elseif/else/endif`, numbered and named parameters and expressions (linuxcnc_values), the
 modes (linuxcnc_modes) with their save and restore M70–M73 (linuxcnc_context), the motions
-(linuxcnc_motion) and G76 (linuxcnc_cycles). It stops at M2/
+(linuxcnc_motion), G76 (linuxcnc_cycles) and G70-G72, whose profile subroutine it reads line by
+line for linuxcnc_g7x (`profile`). It stops at M2/
 M30 (the control reads nothing after) or at a second `%`. Bounded: more than MAX_STEPS lines run
 (a loop that never ends), more than MAX_PLAIN_LINES plain lines, or calls nested deeper than
 MAX_CALLS are refused. A call of a subroutine not in the file (an external `o<name>` file
@@ -14,6 +15,7 @@ searched in the control's SUBROUTINE_PATH) is refused naming the file: the verif
 the program it is given."""
 from __future__ import annotations
 
+from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 from ..expansion import MAX_PLAIN_LINES, MAX_STEPS, ExpansionRefused, PlainLine, register_expander
@@ -25,7 +27,7 @@ from .linuxcnc_lines import OWord, read
 from .linuxcnc_modes import Executor
 from .linuxcnc_params import Frame, Parameters
 from .linuxcnc_values import Values
-from .linuxcnc_words import read_words
+from .linuxcnc_words import Words, read_words
 
 if TYPE_CHECKING:
     from ...machines.records import Machine
@@ -48,6 +50,7 @@ class Interpreter:
             raise ExpansionRefused(error.index + 1, lines[error.index], str(error)) from None
         self.contexts = Contexts()
         self.executor = Executor(move_or_cycle, self.contexts.carry_out)
+        self.executor.profile = self.profile
         self.params = Parameters(self.executor.modes)
         self.plain: list[PlainLine] = []
         self.stopped = False
@@ -119,6 +122,38 @@ class Interpreter:
         """Each plain line with the blend tolerance in force (G64 P, mm: the turning simulation's)."""
         blend = self.executor.modes.blend
         self.plain.extend(PlainLine(text, index + 1, self.lines[index], blend) for text in texts)
+    def profile(self, label: str, line: Callable[[Words], None]) -> None:
+        """The sub `label` read as a G70-G72 reads its profile (LinuxCNC interp_g7x.cc convert_g7x):
+        its o-words and parameter settings carried out, each other line's words given to `line`
+        and not run; the call's line is the cycle's, so a refusal here names the profile's line."""
+        sub = self.flow.subs.get(label)
+        if sub is None:
+            raise Refused(f"Q{label}: no o{label} sub in this program (the profile a G70-G72 follows)")
+        level, index, steps = len(self.params.frames), sub[0] + 1, 0
+        self.called.add(label)
+        self.params.frames.append(Frame(back=-1))
+        self.contexts.enter()       # its endsub leaves a call level, as a call's does
+        while len(self.params.frames) > level:
+            steps += 1
+            if steps > MAX_STEPS:
+                raise Refused(f"the profile o{label} runs more than {MAX_STEPS:,} lines: a loop that does not end")
+            try:
+                index = self._profile_step(index, line)
+            except ExpansionRefused:
+                raise
+            except Refused as refusal:
+                raise ExpansionRefused(index + 1, self.lines[index], str(refusal)) from None
+
+    def _profile_step(self, index: int, line: Callable[[Words], None]) -> int:
+        item = self.items[index]
+        if isinstance(item, OWord):
+            return OWORDS[item.keyword](self, index, item)
+        if item:
+            words = read_words(item, self.params.lookup, self.params.defined, profile=True)
+            for key, value in words.settings:
+                self.params.set(key, value)
+            line(words)
+        return index + 1
 
     def value(self, text: str) -> float:
         reader = Values(text, self.params.lookup, self.params.defined)

@@ -57,13 +57,15 @@ class Contexts:
         self.saved.pop(self.level, None)
 
     def leave(self, executor: Executor) -> list[str]:
-        """The plain lines of a subroutine's return: the restore of an M73 made in it."""
-        executor.out = []
+        """The plain lines of a subroutine's return: the restore of an M73 made in it. The lines a
+        block is still writing (a G70-G72 reading its profile sub) are kept as they were."""
+        pending, executor.out = executor.out, []
         saved = self.saved.pop(self.level, None)
         self.level -= 1
         if saved is not None and saved.on_return:
             restore(executor, saved.modes)
-        return executor.out
+        restored, executor.out = executor.out, pending
+        return restored
 
 
 def restore(executor: Executor, saved: Modes) -> None:

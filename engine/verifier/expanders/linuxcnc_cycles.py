@@ -8,8 +8,9 @@ per spring pass H; the tool ends at the block's X and Z. In G7 I, J and K are di
 E/L is refused (not modelled).
 
 G70/G71/G72 (profile cycles over a subroutine Q, with a distance D kept normal to the profile,
-pockets and fillets) are refused: engine.verifier.expanders.cycles offsets a contour by the
-Fanuc allowances U/W, which is not LinuxCNC's D, so the moves would not be the control's."""
+pockets and fillets) are engine.verifier.expanders.linuxcnc_g7x's, ported from LinuxCNC's own
+interp_g7x.cc: engine.verifier.expanders.cycles offsets a contour by the Fanuc allowances U/W,
+which is not LinuxCNC's D, so its moves would not be the control's."""
 from __future__ import annotations
 
 import math
@@ -18,16 +19,13 @@ from typing import TYPE_CHECKING
 from ..refusals import Refused
 from .cycles import MAX_PASSES, RAPID, THREAD
 from .linuxcnc_drilling import drilling
+from .linuxcnc_g7x import profile_cycle
 from .linuxcnc_modes import number
 from .linuxcnc_motion import move, target
 
 if TYPE_CHECKING:
     from .linuxcnc_modes import Executor
     from .linuxcnc_words import Words
-
-PROFILE_REASON = ("the LinuxCNC profile cycle G{code} (subroutine Q, distance D kept normal to the profile, "
-                  "pockets and fillets) is not modelled; program its passes as G0/G1/G2/G3 moves")
-
 
 CYCLES = frozenset({"76", "70", "71", "71.1", "71.2", "72", "72.1", "72.2"})
 
@@ -50,7 +48,8 @@ def move_or_cycle(executor: Executor, words: Words, motion: str) -> None:
 
 def cycle(executor: Executor, words: Words, motion: str) -> None:
     if motion != "76":
-        raise Refused(PROFILE_REASON.format(code=motion))
+        profile_cycle(executor, words, motion)
+        return
     moves, pitch = threading(executor, words)
     executor.out.extend(_plain(moves, pitch))
 

@@ -90,6 +90,8 @@ class Executor:
         self.out: list[str] = []
         self.mover = mover       # linuxcnc_motion.move, or a cycle (engine.verifier.expanders.linuxcnc)
         self.context = context   # M70-M73 (engine.verifier.expanders.linuxcnc_context)
+        # the interpreter's reader of a G70-G72 profile: the sub's label, what to do with each line's words
+        self.profile: Callable[[str, Callable[[Words], None]], None] | None = None
 
     def run(self, words: Words) -> list[str]:
         self.out = []

@@ -6,7 +6,7 @@ turn), G33 with its lead K. X is written as a diameter, every length in mm.
 LinuxCNC refuses an arc whose centre is farther from the end than from the start by more than
 CENTER_ARC_RADIUS_TOLERANCE_MM = 2·0.01·√2 mm (src/emc/rs274ngc/interp_internal.hh); so does
 this reading. I is not scaled by G7 (rs274ngc read_x scales X only). The lathe cycles G70–G72 and
-G76 are engine.verifier.expanders.linuxcnc_cycles'."""
+G76 are engine.verifier.expanders.linuxcnc_cycles' (G70–G72: linuxcnc_g7x)."""
 from __future__ import annotations
 
 import math
@@ -104,7 +104,7 @@ def _arc_radius(executor: Executor, words: Words, motion: str, x: float | None, 
                       "(LinuxCNC allows 0.028 mm)")
     if math.isclose(modes.x, x, abs_tol=1e-9) and math.isclose(modes.z, z, abs_tol=1e-9):
         raise Refused("a full circle: a lathe tool cannot turn one")
-    return _signed((start + end) / 2.0, (modes.z, modes.x), (z, x), (centre[1], centre[0]), motion == "3")
+    return signed_radius((start + end) / 2.0, (modes.z, modes.x), (z, x), (centre[1], centre[0]), motion == "3")
 
 
 def _centre(executor: Executor, words: Words, x: float, z: float) -> tuple[float, float]:
@@ -116,7 +116,7 @@ def _centre(executor: Executor, words: Words, x: float, z: float) -> tuple[float
     return (x + i, z + k)
 
 
-def _signed(radius: float, start: tuple[float, float], end: tuple[float, float], centre: tuple[float, float],
+def signed_radius(radius: float, start: tuple[float, float], end: tuple[float, float], centre: tuple[float, float],
             ccw: bool) -> float:
     """R < 0 for an arc of more than half a turn (the convention of engine.verifier.arcs, in (z, r))."""
     a0, a1 = (math.atan2(p[1] - centre[1], p[0] - centre[0]) for p in (start, end))

@@ -1,7 +1,9 @@
 """The words and parameter settings of one LinuxCNC line, their values read with the parameters
 as they stand before the line (LinuxCNC: a setting takes effect after every value of its line
 is read, docs/reference/linuxcnc-lathe.md §2). G and M may stand several times, once per modal
-group; every other letter once. Letters of axes the lathe does not have are refused."""
+group; every other letter once. Letters of axes the lathe does not have are refused, but for the
+words of a G70-G72 (g-code.adoc G71: U/W on the cycle's line; U/W incremental X/Z and A/C a
+fillet/chamfer in its profile's lines, read with `profile`)."""
 from __future__ import annotations
 
 from collections.abc import Callable
@@ -12,6 +14,8 @@ from .linuxcnc_values import Values
 
 LETTERS = frozenset("dfghiijkklmpqrstxze")          # the words a LinuxCNC lathe program uses
 OTHER_AXES = frozenset("abcuvwy")                    # axes a two-axis lathe does not have
+PROFILE_WORDS = frozenset("acuw")                    # G70-G72's own meaning of these letters
+G7X = ("70", "71", "71.1", "71.2", "72", "72.1", "72.2")
 
 
 @dataclass
@@ -29,7 +33,8 @@ class Words:
         return float(code) in self.codes["m"]
 
 
-def read_words(code: str, lookup: Callable[[str], float], defined: Callable[[str], bool]) -> Words:
+def read_words(code: str, lookup: Callable[[str], float], defined: Callable[[str], bool],
+               profile: bool = False) -> Words:
     reader, words = Values(code, lookup, defined), Words()
     while reader.at < len(code):
         letter = reader.peek()
@@ -40,6 +45,10 @@ def read_words(code: str, lookup: Callable[[str], float], defined: Callable[[str
             continue
         reader.at += 1
         _word(letter, reader.value(), words)
+    allowed = PROFILE_WORDS if profile else frozenset("uw") if words.g(*G7X) else frozenset()
+    for letter in sorted(PROFILE_WORDS & words.values.keys() - allowed):
+        name = letter.upper()
+        raise Refused(f"{name}{words.values[letter]:g}: the lathe has no {name} axis (X and Z only)")
     return words
 
 
@@ -48,9 +57,9 @@ def _word(letter: str, value: float, words: Words) -> None:
         if round(value * 10) != value * 10 or value < 0:
             raise Refused(f"{letter.upper()}{value:g} is not a {letter.upper()} code")
         words.codes[letter].append(value)
-    elif letter in OTHER_AXES:
+    elif letter in OTHER_AXES - PROFILE_WORDS:
         raise Refused(f"{letter.upper()}{value:g}: the lathe has no {letter.upper()} axis (X and Z only)")
-    elif letter not in LETTERS:
+    elif letter not in LETTERS | PROFILE_WORDS:
         raise Refused(f"{letter.upper()} is not a word of a LinuxCNC lathe program")
     elif letter in words.values:
         raise Refused(f"{letter.upper()} twice in one line")
