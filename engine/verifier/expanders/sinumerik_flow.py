@@ -1,5 +1,6 @@
 """Where an 840D program goes next (reference sinumerik-lathe §S4, §S5): jumps to a label or block number
-(GOTOF forward, GOTOB backward, GOTO either way, GOTOC without an alarm when missing),
+(GOTOF forward, GOTOB backward, each to the nearest target in its direction; GOTO either way and
+GOTOC without an alarm when missing, both refused for a target that stands twice),
 IF … GOTO…, the structured IF/ELSE/ENDIF, WHILE/ENDWHILE, REPEAT/UNTIL, FOR/ENDFOR, LOOP/ENDLOOP,
 and the section repetitions inside the file `REPEAT <label> [<label>] P=n` and `REPEATB <label>
 P=n`. The pairs are matched once, before the program runs; a statement without its partner is
