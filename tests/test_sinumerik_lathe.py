@@ -91,11 +91,11 @@ def test_an_r_parameter_read_before_the_program_sets_it_is_refused():
     assert "R7 is read before the program sets it" in message and "line 5" in message
 
 
-@pytest.mark.parametrize("speed", ["S0", "G96 S0 LIMS=3000", "R1=0 S=R1"])
+@pytest.mark.parametrize("speed", [["S0"], ["G96 S0 LIMS=3000"], ["R1=0", "S=R1"]], ids=" ".join)
 def test_a_cut_after_a_spindle_speed_of_0_is_refused(speed):
     """S0 (or a cutting speed of 0 m/min under G96) stops the spindle: the cut after it would meet a
     standing bar."""
-    message = refused([*READY, "G0 X50 Z2", speed, "G1 Z-20", "M30"])
+    message = refused([*READY, "G0 X50 Z2", *speed, "G1 Z-20", "M30"])
     assert "S0" in message and "above 0" in message, message
 
 

@@ -26,7 +26,7 @@ import engine.verifier.expansion as expansion  # read at call time: a test may l
 from ..expansion import ExpansionRefused, PlainLine, register_expander
 from ..refusals import Refused
 from .sinumerik_blocks import BlockState, plain_block
-from .sinumerik_expressions import evaluate
+from .sinumerik_expressions import evaluate, names_read, round_half_up
 from .sinumerik_flow import Flow
 from .sinumerik_lines import SourceLine, Word, check_line_characters, read_source, words
 
@@ -166,6 +166,7 @@ class Interpreter:
             self.values[name.group(1)] = _typed(kind, evaluate(name.group(2), self.values) if name.group(2) else 0.0)
 
     def _block(self, line: SourceLine, found: list[Word]) -> None:
+        self._one_reading(found)
         address_words = []
         for word in found:
             if word.form == "equals" and self._assignable(word.name):
@@ -180,6 +181,22 @@ class Interpreter:
         self.ended = plain.ends
         if plain.text():
             self._emit(line, plain.text())
+
+    def _one_reading(self, found: list[Word]) -> None:
+        """A block that assigns a variable and reads it in another word (`G0 X=R1 R1=100`), or assigns
+        it twice, is refused: whether the control assigns before it evaluates the other words, or in
+        the written order, is not confirmed (reference sinumerik-lathe §S2). `R1=R1+1` reads the old value."""
+        assigned = [word.name for word in found if word.form == "equals" and self._assignable(word.name)]
+        for word in found:
+            if word.form != "equals" or word.value.startswith('"'):
+                continue
+            others = set(assigned) - ({word.name} if assigned.count(word.name) == 1 else set())
+            read = names_read(word.value) & others
+            if read or (word.name in assigned and assigned.count(word.name) > 1):
+                name = sorted(read)[0] if read else word.name
+                raise Refused(f"{name} is assigned in this block and read or assigned again in it ({word.name}="
+                              f"{word.value}): the order the control takes them in is not confirmed; assign "
+                              "in a block of its own")
 
     def _assignable(self, name: str) -> bool:
         return name in self.types or bool(R_PARAMETER.fullmatch(name))
@@ -203,9 +220,10 @@ def _read(number: int, text: str) -> SourceLine:
 
 
 def _typed(kind: type, value: float) -> float:
-    """INT rounds to a whole number, BOOL is 1 or 0 (reference sinumerik-lathe §S2)."""
+    """INT rounds to a whole number the control's way (half up, as ROUND), BOOL is 1 or 0 (reference
+    sinumerik-lathe §S2)."""
     if kind is int:
-        return float(round(value))
+        return round_half_up(value)
     if kind is bool:
         return float(bool(value))
     return value

@@ -24,6 +24,7 @@ if TYPE_CHECKING:
     from ...machines.records import Machine
 
 MOTIONS = (0, 1, 2, 3, 33)
+CUTTING_MOTIONS = (1, 2, 3, 33)     # moves whose feed or lead depends on the spindle's r/min
 # G codes kept in the plain block as written, and G codes written as another one
 KEPT_G = frozenset({4, 18, 40, 71, 90, 94, 95, 96, 97})
 SAME_AS = {710: 71}     # G710: metric, feeds included
@@ -83,6 +84,7 @@ class BlockState:
     clamp: float | None = None       # LIMS, r/min
     rpm: float | None = None         # S under G97, r/min (a G4 S… dwell counts its turns at it)
     css: bool = False                # G96: S is a cutting speed in m/min, the r/min vary
+    frozen: bool = False             # G97 without S after G96: the r/min G96 last reached, unknown here
     position: dict[str, float] = field(default_factory=dict)   # X (diameter) and Z, mm
 
 
@@ -112,10 +114,26 @@ def plain_block(found: list[Word], state: BlockState, values: dict[str, float]) 
     """The plain block of a block's address words (assignments and control words taken out)."""
     plain = Plain()
     arc_centre: dict[str, float] = {}
+    was_css = state.css
     for word in found:
         _take(word, plain, state, values, arc_centre)
     _finish_motion(plain, state, arc_centre)
+    _frozen_speed(plain, state, was_css)
     return plain
+
+
+def _frozen_speed(plain: Plain, state: BlockState, was_css: bool) -> None:
+    """G97 without S after G96 keeps "the last speed set by G96" ([PGF-2004] §7.13): the r/min at the
+    diameter where G96 last set it, which the verifier does not follow. A cut (G1 G2 G3 G33) before an
+    S states the speed again is refused; a rapid G0 does not depend on it (reference sinumerik-lathe §S6)."""
+    if 97 in plain.g and was_css and "S" not in plain.words:
+        state.frozen = True
+    elif "S" in plain.words or 96 in plain.g:
+        state.frozen = False
+    motion = next((code for code in plain.g if code in MOTIONS), None)
+    if state.frozen and motion in CUTTING_MOTIONS and {"X", "Z"} & plain.words.keys():
+        raise Refused("a cut after G97 without S after G96: the spindle keeps the speed G96 last reached, "
+                      "which the verifier cannot know; state the speed with G97 (G97 S…)")
 
 
 def _take(word: Word, plain: Plain, state: BlockState, values: dict[str, float],

@@ -37,7 +37,13 @@ def _sqrt(value: float) -> float:
     return math.sqrt(value)
 
 
-def _round(value: float) -> float:
+def round_half_up(value: float) -> float:
+    """ROUND, and a REAL assigned to an INT: "a fraction >= 0.5 is rounded up, otherwise rounded down"
+    ([PGA-2000] §1.9, reference sinumerik-lathe §S2), so 2.5 is 3, not Python's half-to-even 2. For a
+    negative value with a fraction of exactly 0.5 "up" may mean -2 or -3: the manual does not say, refused."""
+    if value < 0 and value - math.floor(value) == 0.5:
+        raise Refused(f"rounding {value:g} to a whole number: the manual rounds a fraction of 0.5 up, and does "
+                      "not say whether a negative half goes to the larger or the smaller whole number")
     return float(math.floor(abs(value) + 0.5)) * (1 if value >= 0 else -1)
 
 
@@ -47,7 +53,7 @@ FUNCTIONS: dict[str, tuple[int, Callable[..., float]]] = {
     "ASIN": (1, _inverse(math.asin)), "ACOS": (1, _inverse(math.acos)),
     "ATAN2": (2, lambda y, x: math.degrees(math.atan2(y, x))), "SQRT": (1, _sqrt), "ABS": (1, abs),
     "POT": (1, lambda value: value * value), "TRUNC": (1, lambda value: float(math.trunc(value))),
-    "ROUND": (1, _round), "MINVAL": (2, min), "MAXVAL": (2, max),
+    "ROUND": (1, round_half_up), "MINVAL": (2, min), "MAXVAL": (2, max),
     "EXP": (1, math.exp), "LN": (1, math.log),
 }
 CONSTANTS = {"TRUE": 1.0, "FALSE": 0.0}
@@ -60,9 +66,21 @@ LEVELS: tuple[dict[str, Callable[[float, float], float]], ...] = (
     {"AND": lambda a, b: float(bool(a) and bool(b))},
     {"+": lambda a, b: a + b, "-": lambda a, b: a - b},
     {"*": lambda a, b: a * b, "/": lambda a, b: _divide(a, b),
-     "DIV": lambda a, b: float(math.trunc(_divide(a, b))), "MOD": lambda a, b: a - b * math.trunc(_divide(a, b))},
+     "DIV": lambda a, b: float(_whole_quotient("DIV", a, b)[0]),
+     "MOD": lambda a, b: float(_whole_quotient("MOD", a, b)[1])},
 )
 Tree = tuple[Any, ...]   # ("number", v) | ("name", n) | ("call", n, args) | ("not", t) | ("neg", t) | (op, left, right)
+
+
+def _whole_quotient(operator: str, a: float, b: float) -> tuple[int, int]:
+    """DIV and MOD: the whole quotient and the remainder of a division of whole numbers [PGA-JP].
+    For whole numbers of which none is negative every reading agrees (7 DIV 2 = 3, 7 MOD 3 = 1);
+    the manuals read here give no rule for a negative or fractional operand (truncated or floored,
+    the remainder's sign), so such an operand is refused (reference sinumerik-lathe §S3)."""
+    if a < 0 or b <= 0 or a != math.floor(a) or b != math.floor(b):
+        raise Refused(f"{a:g} {operator} {b:g}: {operator} is evaluated for whole numbers, none negative, "
+                      "and a divisor above 0; the rule for other operands is not confirmed")
+    return divmod(int(a), int(b))
 
 
 def _divide(a: float, b: float) -> float:
@@ -89,6 +107,25 @@ def parse(text: str) -> Tree:
     if reader.position != len(reader.tokens):
         raise Refused(f"{text}: not an expression the control reads ({reader.rest()} left over)")
     return tree
+
+
+def names_read(text: str) -> frozenset[str]:
+    """The names an expression reads (R1, a DEF variable); none for text that is no expression
+    (a string, a call's arguments), which is refused where it is evaluated."""
+    try:
+        tree = parse(text)
+    except Refused:
+        return frozenset()
+    return frozenset(_names_in(tree))
+
+
+def _names_in(tree: Tree) -> list[str]:
+    if tree[0] == "name":
+        return [tree[1]]
+    if tree[0] == "number":
+        return []
+    branches = tree[2] if tree[0] == "call" else tree[1:]
+    return [name for branch in branches for name in _names_in(branch)]
 
 
 def _tokens(text: str) -> list[tuple[str, str]]:

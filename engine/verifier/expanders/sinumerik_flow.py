@@ -1,5 +1,6 @@
 """Where an 840D program goes next (reference sinumerik-lathe §S4, §S5): jumps to a label or block number
-(GOTOF forward, GOTOB backward, GOTO either way, GOTOC without an alarm when missing),
+(GOTOF forward, GOTOB backward, each to the nearest target in its direction; GOTO either way and
+GOTOC without an alarm when missing, both refused for a target that stands twice),
 IF … GOTO…, the structured IF/ELSE/ENDIF, WHILE/ENDWHILE, REPEAT/UNTIL, FOR/ENDFOR, LOOP/ENDLOOP,
 and the section repetitions inside the file `REPEAT <label> [<label>] P=n` and `REPEATB <label>
 P=n`. The pairs are matched once, before the program runs; a statement without its partner is
@@ -25,6 +26,9 @@ CLOSERS = {closer: opener for opener, closers in PAIRS.items() for closer in clo
 Condition = Callable[[str], bool]      # evaluates a condition with the program's values
 Assign = Callable[[str, str], float]   # assigns a variable the value of an expression ("" only evaluates)
 MAX_SECTIONS = 11          # section repetitions nested in one another (the control's call depth)
+# where a directed jump searches its target, from the jump's line (reference sinumerik-lathe §S4)
+SEARCHES: dict[str, Callable[[int, int], bool]] = {"GOTOF": lambda place, jump: place > jump,
+                                                   "GOTOB": lambda place, jump: place <= jump}
 
 
 @dataclass
@@ -42,11 +46,11 @@ def _keyword(line: SourceLine) -> str:
 class Flow:
     def __init__(self, lines: list[SourceLine]) -> None:
         self.lines = lines
-        self.targets: dict[str, int] = {}
+        self.targets: dict[str, list[int]] = {}       # every line a label or block number stands on
         for index, line in enumerate(lines):
             for target in (line.label, line.block_number):
-                if target and target not in self.targets:
-                    self.targets[target] = index
+                if target:
+                    self.targets.setdefault(target, []).append(index)
         self.partner: dict[int, int] = {}
         self.opener: dict[int, int] = {}
         self._match_pairs()
@@ -81,11 +85,32 @@ class Flow:
         else:
             stack.pop()
 
-    def target(self, name: str) -> int:
+    def places(self, name: str) -> list[int]:
         key = name if not name.isdigit() else f"N{name}"
         if key not in self.targets:
             raise Refused(f"a jump to {name}, which is not in the file")
         return self.targets[key]
+
+    def target(self, name: str) -> int:
+        """The one line of a label or block number; one that stands more than once is refused, since
+        which of them the control takes is not confirmed (reference sinumerik-lathe §S4)."""
+        places = self.places(name)
+        if len(places) > 1:
+            lines = ", ".join(str(self.lines[place].number) for place in places)
+            raise Refused(f"{name} stands on lines {lines}: which one the control takes here is not confirmed; "
+                          "give each block its own number or label")
+        return places[0]
+
+    def search(self, jump: str, name: str, index: int) -> int:
+        """The line a jump from line `index` reaches: GOTOF searches forward from the jump, GOTOB
+        backward (its own block included), GOTO/GOTOC need a target that stands once in the file."""
+        if jump not in SEARCHES:
+            return self.target(name)
+        found = [place for place in self.places(name) if SEARCHES[jump](place, index)]
+        if not found:
+            direction = "forward" if jump == "GOTOF" else "backward"
+            raise Refused(f"{jump} {name}: the label is not {direction} of the jump")
+        return found[0] if jump == "GOTOF" else found[-1]
 
     def control(self, index: int, code: str, condition: Condition,
                 assign: Assign) -> int | None | bool:
@@ -104,11 +129,7 @@ class Flow:
         match = JUMP.fullmatch(code)
         if match is None:
             raise Refused(f"{code}: a jump names one label or block number")
-        goal = self.target(match.group(2))
-        if (match.group(1) == "GOTOF" and goal <= index) or (match.group(1) == "GOTOB" and goal > index):
-            direction = "forward" if match.group(1) == "GOTOF" else "backward"
-            raise Refused(f"{match.group(1)} {match.group(2)}: the label is not {direction} of the jump")
-        return goal
+        return self.search(match.group(1), match.group(2), index)
 
     def _if(self, index: int, code: str, condition: Condition) -> int | None:
         match = CONDITIONAL_JUMP.fullmatch(code)

@@ -22,6 +22,10 @@ CLOSING = re.compile(r"\s+\)")
 NAME = re.compile(r"\$?[A-Z_][A-Z0-9_]*")
 ADDRESS_NUMBER = re.compile(r"([A-Z]+)(\d*)")
 NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)")
+# An operator spelt as a word stands between blanks (`R1=R2 DIV 2`, the manual's spelling): the
+# expression runs on across those blanks (reference sinumerik-lathe §S3).
+WORD_OPERATORS = ("DIV", "MOD", "AND", "OR", "XOR")
+WORD_OPERATOR = re.compile(rf" +(?:{'|'.join(WORD_OPERATORS)}) +(?=[^ ])")
 
 
 @dataclass(frozen=True, slots=True)
@@ -124,6 +128,8 @@ def _address_word(code: str, name: str, end: int) -> tuple[Word, int]:
     number = NUMBER.match(code, end) if not digits else re.compile(r"\.?\d*").match(code, end)
     rest = number.group(0) if number else ""
     if not digits and not rest:
+        if name in WORD_OPERATORS:
+            raise Refused(f"{name} is an operator between two values (R1=R2 {name} 2), not a word of its own")
         return Word(name, "", "keyword"), end
     return Word(letters, digits + rest, "number"), end + len(rest)
 
@@ -140,7 +146,11 @@ def _until_blank(code: str, position: int) -> tuple[str, int]:
         elif not quoted and character in ")]":
             depth -= 1
         elif character == " " and depth <= 0 and not quoted:
-            break
+            operator = WORD_OPERATOR.match(code, index)
+            if operator is None:
+                break
+            index = operator.end()
+            continue
         index += 1
     if quoted or depth > 0:
         raise Refused(f"{code[position:index]!r}: an unclosed string or parenthesis")
