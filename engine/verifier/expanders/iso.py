@@ -11,6 +11,9 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+import engine.verifier.expanders.iso_labels as iso_labels
+import engine.verifier.expanders.iso_rules as iso_rules
+
 from ..expansion import MAX_STEPS, ExpansionRefused, PlainLine, register_expander
 from .iso_lines import BLOCK, HEADER_LINE, TAPE, Source, read_sources
 from .iso_modes import Modes
@@ -35,11 +38,9 @@ class Run:
         self.sources, self.machine = sources, machine
         self.modes = Modes(machine)
         self.plain: list[PlainLine] = []
-        self.labels: dict[int, int] = {}
+        self.labels = iso_labels.Labels(sources)      # N numbers, program by program
         self.programs: dict[int, int] = {}
         for index, source in enumerate(sources):
-            if source.label is not None:
-                self.labels.setdefault(source.label, index)
             if source.kind == HEADER_LINE and source.program is not None:
                 self.programs.setdefault(source.program, index)
 
@@ -101,10 +102,12 @@ class Run:
         codes = {letter for letter, _ in source.words}
         m_codes = [_int(source, text) for letter, text in source.words if letter == "M"]
         if 98 in m_codes or 97 in m_codes:
+            iso_rules.check_call(source, 97 if 97 in m_codes else 98)
             return self._call(source, index, stack, local=97 in m_codes)
         if 99 in m_codes:
+            iso_rules.check_call(source, 99)
             return self._return(source, stack)
-        jump = take_block(source, self.modes, self.sources, self.labels, self.plain)
+        jump = take_block(source, self.modes, self.sources, self.labels.within(index, source), self.plain)
         if codes & {"M"} and any(code in END_CODES for code in m_codes):
             self.modes.ended = True
         return jump if jump is not None else index + 1
@@ -116,7 +119,7 @@ class Run:
         number, repeats = _int(source, words["P"]), _int(source, words.get("L", "1"))
         if not local and len(words["P"]) > 4 and "L" not in words:
             repeats, number = divmod(number, 10000)     # Fanuc P<repeats><4-digit program>
-        target = self.labels.get(number) if local else self.programs.get(number)
+        target = self.labels.within(index, source).get(number) if local else self.programs.get(number)
         if target is None:
             what = f"label N{number}" if local else f"subprogram O{number:04d}"
             raise source.refuse(f"M9{'7' if local else '8'} P{words['P']} calls {what}, which is not in this file: "

@@ -8,6 +8,7 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 import engine.verifier.expanders.cycles as cycles
+import engine.verifier.expanders.iso_rules as iso_rules
 
 from .cycles import CycleError, Move, Thread
 from .iso_modes import arc_radius
@@ -21,7 +22,9 @@ Where = tuple[list["Source"], dict[int, int]]          # the program's lines and
 Result = tuple[list[Move], "int | None", float]         # the moves, where to go on, the feed (or lead)
 Reader = Callable[["Source", dict[str, str], "Modes", tuple[float, float], Where], Result]
 CYCLE_CODES = frozenset({70, 71, 72, 73, 74, 75, 76})
-CONTOUR_WORDS = frozenset({"X", "Z", "U", "W", "R", "I", "K", "F", "S", "T"})
+# F in the contour is ignored by G71–G73 and effective in G70 (iso_rules.check_finish_feed); S and T
+# are refused in it (adversary 27b H3): G70 would change the speed or index the turret mid-contour.
+CONTOUR_WORDS = frozenset({"X", "Z", "U", "W", "R", "I", "K", "F"})
 
 
 def take_cycle(code: int, source: Source, words: dict[str, str], modes: Modes, sources: list[Source],
@@ -56,7 +59,7 @@ def _contour(source: Source, words: dict[str, str], modes: Modes, where: Where) 
     sources, labels = where
     first, last = (int(_word(source, words, letter)) for letter in ("P", "Q"))
     if first not in labels or last not in labels or labels[last] < labels[first]:
-        raise source.refuse(f"the contour N{first} … N{last} is not in the file (in that order)")
+        raise source.refuse(f"the contour N{first} … N{last} is not in this program (in that order)")
     x, z, motion = modes.x, modes.z, modes.motion
     assert x is not None and z is not None
     moves: list[Move] = []
@@ -80,7 +83,8 @@ def _contour_move(block: Source, modes: Modes, at: tuple[float, float], motion: 
             elif code != 40:
                 raise block.refuse(f"G{code} inside a cycle's contour is not followed (only G0–G3 and G40)")
         elif letter == "M" or letter not in CONTOUR_WORDS:
-            raise block.refuse(f"{letter}{text} inside a cycle's contour is not followed")
+            raise block.refuse(f"{letter}{text} inside a cycle's contour is not followed (G70 executes it, "
+                               "G71–G73 ignore it): state it before the cycle")
         else:
             words[letter] = text
     x, z = at
@@ -95,14 +99,18 @@ def _contour_move(block: Source, modes: Modes, at: tuple[float, float], motion: 
     if motion is None:
         raise block.refuse("a contour move before any G0/G1/G2/G3")
     radius = None
-    if motion in (2, 3):
-        radius = modes.length(words["R"]) if "R" in words else arc_radius(
-            (modes.length(words.get("I", "0")), modes.length(words.get("K", "0"))), at, (x, z), motion == 2)
+    if motion in (2, 3) and "R" in words:
+        radius = modes.length(words["R"])
+    elif motion in (2, 3):
+        centre = (modes.length(words.get("I", "0")), modes.length(words.get("K", "0")))
+        iso_rules.check_centre(block, centre, at, (x, z))
+        radius = arc_radius(centre, at, (x, z), motion == 2)
     return x, z, motion, Move(motion, x, z, radius)
 
 
 def _g70(source: Source, words: dict[str, str], modes: Modes, start: tuple[float, float], where: Where) -> Result:
     contour, _ = _contour(source, words, modes, where)
+    iso_rules.check_finish_feed(where[0], where[1], words)
     return cycles.finish(start, contour), None, _word(source, words, "F", modes.feed or 0.0)
 
 
@@ -114,6 +122,7 @@ def _rough(code: int) -> Reader:
             modes.cycle[f"{code}retract"] = modes.length(words.get("R", "0"))
             return [], None, 0.0
         contour, after = _contour(source, words, modes, where)
+        iso_rules.check_type_one(source, code, where, contour)
         depth = modes.length(words["D"]) if "D" in words else modes.cycle.get(f"{code}depth", 0.0)
         retract = modes.cycle.get(f"{code}retract", depth / 2)
         allowance = (modes.length(words.get("U", "0")), modes.length(words.get("W", "0")))
