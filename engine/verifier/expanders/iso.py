@@ -38,11 +38,14 @@ class Run:
         self.sources, self.machine = sources, machine
         self.modes = Modes(machine)
         self.plain: list[PlainLine] = []
-        self.labels = iso_labels.Labels(sources)      # N numbers, program by program
+        self.labels: dict[int, int] = {}
         self.programs: dict[int, int] = {}
         for index, source in enumerate(sources):
+            if source.label is not None:
+                self.labels.setdefault(source.label, index)
             if source.kind == HEADER_LINE and source.program is not None:
                 self.programs.setdefault(source.program, index)
+        self.in_program = iso_labels.Labels(sources)     # N numbers program by program: G70–G73 P/Q, M97 P
 
     def run(self) -> list[PlainLine]:
         start = self._start()
@@ -107,7 +110,7 @@ class Run:
         if 99 in m_codes:
             iso_rules.check_call(source, 99)
             return self._return(source, stack)
-        jump = take_block(source, self.modes, self.sources, self.labels.within(index, source), self.plain)
+        jump = take_block(source, self.modes, self.sources, self.in_program.within(index, source), self.plain)
         if codes & {"M"} and any(code in END_CODES for code in m_codes):
             self.modes.ended = True
         return jump if jump is not None else index + 1
@@ -119,7 +122,7 @@ class Run:
         number, repeats = _int(source, words["P"]), _int(source, words.get("L", "1"))
         if not local and len(words["P"]) > 4 and "L" not in words:
             repeats, number = divmod(number, 10000)     # Fanuc P<repeats><4-digit program>
-        target = self.labels.within(index, source).get(number) if local else self.programs.get(number)
+        target = self.in_program.within(index, source).get(number) if local else self.programs.get(number)
         if target is None:
             what = f"label N{number}" if local else f"subprogram O{number:04d}"
             raise source.refuse(f"M9{'7' if local else '8'} P{words['P']} calls {what}, which is not in this file: "
