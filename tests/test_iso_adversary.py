@@ -196,3 +196,30 @@ def test_an_arc_whose_end_is_not_on_the_circle_of_its_centre_is_refused(conn):
 def test_an_arc_whose_end_is_on_the_circle_of_its_centre_is_verified(conn):
     body = ["G0 X0. Z2.", "G1 Z0. F100.", "G3 X20. Z-10. I0. K-10.", "G0 X100. Z50."]
     assert accepted(conn, "lathe-iso", program("lathe-iso", body))
+
+
+# ---------------------------------------------------------------- what the rules leave alone
+
+@pytest.mark.parametrize("body", [
+    # G71 type I with an arc in its contour, then G70 (no F, S or T in the contour)
+    ["G0 X50. Z2.", "G71 U2. R1.", "G71 P10 Q40 U0.5 W0.1 F100.", "N10 G0 X20.", "N20 G1 Z-10.",
+     "N30 G2 X40. Z-20. R10.", "N40 G1 X48.", "G70 P10 Q40", "G0 X100. Z50."],
+    # Haas one-block G71 with D written with its point
+    ["G0 X50. Z2.", "G71 P10 Q40 U0.5 W0.1 D1. F100.", "N10 G0 X20.", "N20 G1 Z-10.", "N30 X40. Z-20.",
+     "N40 X48.", "G0 X100. Z50."],
+    # G72 type I: the first contour block moves in Z alone
+    ["G0 X52. Z2.", "G72 W2. R1.", "G72 P10 Q40 U0.5 W0.1 F100.", "N10 G0 Z-20.", "N20 G1 X40.", "N30 Z-10.",
+     "N40 X20. Z0.", "G70 P10 Q40", "G0 X100. Z50."],
+    # Fanuc two-block G76 and G75 with the bottom relief R0
+    ["G0 X30. Z5.", "G76 P010060 Q100 R0.05", "G76 X18.16 Z-20. P920 Q300 F1.5", "G0 X100. Z50."],
+    ["G0 X50. Z-10.", "G75 R1.", "G75 X30. Z-20. P2000 Q3000 R0 F50.", "G0 X100. Z50."],
+    # a tool change on its own block clear of the part, and a plain call and return
+    ["G0 X50. Z2.", "G1 X30. Z-20. F100.", "G0 X200. Z100.", "T0202", "G0 X60. Z5."],
+])
+def test_the_ordinary_forms_of_cycles_and_tool_changes_are_still_verified(conn, body):
+    assert accepted(conn, "lathe-iso", program("lathe-iso", body))
+
+
+def test_a_plain_m98_and_m99_are_still_verified(conn):
+    assert accepted(conn, "lathe-iso", with_subprogram(["G0 X50. Z2.", "M98 P1000 L2", "G0 X100. Z50."],
+                                                       ["G0 X60. Z5."]))
