@@ -103,6 +103,14 @@ def test_an_f_in_a_contour_only_g71_runs_is_ignored_as_the_control_does(conn):
     assert accepted(conn, "lathe-iso", program("lathe-iso", [*ROUGH, *contour, "G0 X100. Z50."]))
 
 
+
+def test_a_contour_block_without_its_decimal_point_is_refused(conn):
+    """Found while fixing H3: the contour blocks are read by the cycle, not by the block walk, and
+    their X20 was read as 20 mm where a Fanuc under input type I moves to X0.020."""
+    contour = ["N10 G0 X20" if line.startswith("N10") else line for line in CONTOUR]
+    message = refusal(conn, "lathe-iso", program("lathe-iso", [*ROUGH, *contour, "G0 X100. Z50."]))
+    assert "'N10 G0 X20'" in message and "X20 needs a decimal point" in message, message
+
 # ---------------------------------------------------------------- H6: sequence numbers per program
 
 def test_g70_in_a_subprogram_finishes_the_subprograms_own_contour(conn):

@@ -8,6 +8,7 @@ import math
 from typing import TYPE_CHECKING
 
 import engine.verifier.expanders.cycles as cycles
+import engine.verifier.expanders.iso_modes as iso_modes
 
 from ..arcs import ARC_TOLERANCE
 
@@ -155,3 +156,12 @@ def check_centre(block: Source, centre: tuple[float, float], start: tuple[float,
     if abs(radii[0] - radii[1]) > ARC_TOLERANCE or radii[0] == 0:
         raise block.refuse(f"the arc centre is {radii[0]:.3f} mm from the start and {radii[1]:.3f} mm from the end: "
                            "no arc of one radius joins them")
+
+
+def check_contour_points(block: Source) -> None:
+    """A contour block N<P>…N<Q> is read by the cycle, never by the block walk: its dimension
+    words need their decimal point all the same (X20 is 0.020 mm under input type I)."""
+    try:
+        iso_modes.check_points(block.words)
+    except ValueError as error:
+        raise block.refuse(f"{error} (a block of a cycle's contour)") from None
