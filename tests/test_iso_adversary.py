@@ -89,13 +89,40 @@ def test_g99_on_the_g70_block_is_refused(conn):
 @pytest.mark.parametrize("block, construct", [
     ("N10 G0 X20. S9000", "S9000 inside a cycle's contour"),
     ("N20 G1 Z-20. T0303", "T0303 inside a cycle's contour"),
-    ("N20 G1 Z-20. F90000.", "F90000. in the contour G70 runs"),
 ])
-def test_f_s_t_in_a_contour_g70_runs_are_refused(conn, block, construct):
+def test_s_and_t_in_a_contour_are_refused(conn, block, construct):
     contour = [block if line.split()[0] == block.split()[0] else line for line in CONTOUR]
     body = [*ROUGH, *contour, "G70 P10 Q40", "G0 X100. Z50."]
     message = refusal(conn, "lathe-iso", program("lathe-iso", body))
     assert construct in message, message
+
+
+def finish_with_feed(after: list[str]) -> list[str]:
+    """G71 and G70 over CONTOUR with F50. stated in its N30 block, then `after`."""
+    contour = [line + (" F50." if line.startswith("N30") else "") for line in CONTOUR]
+    return program("lathe-iso", [*ROUGH, *contour, "G70 P10 Q40", *after, "G0 X100. Z50."])
+
+
+def test_g70_finishes_at_the_feed_its_contour_states_from_that_block_on(conn):
+    lines = finish_with_feed([])
+    g70 = lines.index("G70 P10 Q40") + 1
+    made = [line.text for line in expand_iso(lines, load_machine(conn, "lathe-iso")) if line.number == g70]
+    modal, stated = 100.0, 50.0      # G98 F100. of the opening (mm/min); F50. from N30 on
+    assert made == ["G0 X20.0000 Z2.0000", f"G1 X20.0000 Z-20.0000 F{modal:.4f}",
+                    f"G1 X40.0000 Z-20.0000 F{stated:.4f}", f"G1 X40.0000 Z-30.0000 F{stated:.4f}",
+                    "G0 X50.0000 Z2.0000"], made
+
+
+def test_a_feed_above_the_bound_in_a_g70_contour_is_refused(conn):
+    contour = [line + (" F90000." if line.startswith("N20") else "") for line in CONTOUR]
+    message = refusal(conn, "lathe-iso", program("lathe-iso", [*ROUGH, *contour, "G70 P10 Q40", "G0 X100. Z50."]))
+    assert "'G70 P10 Q40'" in message and "F90000" in message, message
+
+
+def test_a_cut_after_a_g70_whose_contour_states_f_must_state_its_own(conn):
+    message = refusal(conn, "lathe-iso", finish_with_feed(["G1 X60."]))
+    assert "'G1 X60.'" in message and "after a G70 whose contour states F" in message, message
+    assert accepted(conn, "lathe-iso", finish_with_feed(["G1 X60. F80."]))
 
 
 def test_an_f_in_a_contour_only_g71_runs_is_ignored_as_the_control_does(conn):

@@ -302,7 +302,8 @@ def _feed(source: Source, modes: Modes) -> str:
     if modes.feed is None and modes.per_rev is None:
         return ""      # the grammar refuses the cut: no G98/G99 stated
     if modes.feed is None:
-        raise source.refuse("a cut before any feed F")
+        raise source.refuse("a cut before any feed F (after a G70 whose contour states F, which F the control "
+                            "keeps is not known: state F)")
     if modes.per_rev is None:
         return f"F{modes.feed * modes.scale:.4f}"    # the grammar refuses the cut: no G98/G99 stated
     value = modes.feed_per_minute(modes.feed)

@@ -116,17 +116,6 @@ def _check_cycle_numbers(source: Source, code: int, form: str, words: dict[str, 
 
 
 
-def check_finish_feed(sources: list[Source], labels: dict[int, int], words: dict[str, str]) -> None:
-    """H3: G70 finishes at the F written in its contour (G71–G73 ignore it there), feed by feed
-    as the blocks set it; the expander finishes at one feed, so an F in the contour is refused."""
-    first, last = labels[int(float(words["P"]))], labels[int(float(words["Q"]))]
-    for block in sources[first:last + 1]:
-        for letter, text in block.words if block.kind == "block" else []:
-            if letter == "F":
-                raise block.refuse(f"F{text} in the contour G70 runs: the control finishes at that feed, which the "
-                                   "expander does not follow; state the finishing feed before the G70")
-
-
 def check_type_one(source: Source, code: int, where: tuple[list[Source], dict[int, int]], contour: list[Move]) -> None:
     """H14: G71/G72 are followed as Fanuc type I only: the first contour block moves across the
     passes alone (G71: X/U, no Z/W; a Z there makes it type II, which roughs pockets), and the
