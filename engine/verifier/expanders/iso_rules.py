@@ -1,7 +1,8 @@
 """Constructs of an ISO lathe block whose effect the expander does not follow exactly, refused
-naming the block and the construct (issue 27, adversary 27b H1, H2, H4, H5, H8, H13, H16, H17,
-L1). Each rule is the control's behaviour the plain lines would otherwise miss; the facts and
-their sources are in docs/reference/iso-lathe.md ("Refused: a control would run it otherwise")."""
+naming the block and the construct (issue 27, adversary 27b H1, H2, H4, H5, H8, H13, H14, H16,
+H17, L1, L2, and the decimal point of a cycle's contour blocks). Each rule is the control's
+behaviour the plain lines would otherwise miss; the facts and their sources are in
+docs/reference/iso-lathe.md ("Refused: a control would run it otherwise")."""
 from __future__ import annotations
 
 import math
