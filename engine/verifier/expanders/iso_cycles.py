@@ -82,7 +82,7 @@ def _contour(source: Source, words: dict[str, str], modes: Modes, where: Where,
 def _contour_move(block: Source, modes: Modes, at: tuple[float, float], motion: int | None
                   ) -> tuple[float, float, int | None, Move | None]:
     words = {}
-    iso_rules.check_contour_points(block)
+    iso_rules.check_contour_points(block, modes)
     for letter, text in block.words:
         if letter == "G":
             code = int(float(text))

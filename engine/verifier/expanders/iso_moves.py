@@ -49,7 +49,7 @@ def take_block(source: Source, modes: Modes, sources: list[Source], labels: dict
         raise source.refuse(str(error)) from None
     cycle = next((code for code in g_codes if code in CYCLE_CODES), None)
     if cycle is not None:
-        iso_rules.check_cycle(source, cycle, g_codes, words)
+        iso_rules.check_cycle(source, cycle, g_codes, words, modes)
         return take_cycle(cycle, source, words, modes, sources, labels, plain)
     iso_rules.check_block(source, g_codes, words, modes)
     out = Emitted(source, plain)

@@ -89,7 +89,7 @@ def cycle_form(code: int, words: dict[str, str]) -> str:
     return str(code) if AXES & words.keys() else f"{code} first"
 
 
-def check_cycle(source: Source, code: int, g_codes: list[int], words: dict[str, str]) -> None:
+def check_cycle(source: Source, code: int, g_codes: list[int], words: dict[str, str], modes: Modes) -> None:
     """H2, H13, L1: a cycle block carries only the words its form is read with."""
     others = [g for g in g_codes if g != code]
     if others:
@@ -100,14 +100,14 @@ def check_cycle(source: Source, code: int, g_codes: list[int], words: dict[str, 
         if letter == "M" or (letter != "G" and letter not in CYCLE_FORMS[form]):
             raise source.refuse(f"{letter}{text} on the G{code} cycle block is not followed (the control applies "
                                 "it with the cycle): write it on a block of its own before the cycle")
-    _check_cycle_numbers(source, code, form, words)
+    _check_cycle_numbers(source, code, form, words, increment_input(modes))
 
 
-def _check_cycle_numbers(source: Source, code: int, form: str, words: dict[str, str]) -> None:
+def _check_cycle_numbers(source: Source, code: int, form: str, words: dict[str, str], increment: bool) -> None:
     if form in ("74", "75") and float(words.get("R", "0")) != 0:
         raise source.refuse(f"R{words['R']} on the second G{code} block is the relief at the bottom of each cut, "
                             "which the expander does not follow: leave it out (or R0)")
-    if form in D_LENGTH and "D" in words and "." not in words["D"] and float(words["D"]) != 0:
+    if increment and form in D_LENGTH and "D" in words and "." not in words["D"] and float(words["D"]) != 0:
         raise source.refuse(f"D{words['D']} on the G{code} block needs a decimal point: a Fanuc 10/11-format control "
                             f"reads it in the least input increment; write D{words['D']}.")
     for letter in ("P", "Q"):
@@ -148,10 +148,19 @@ def check_centre(block: Source, centre: tuple[float, float], start: tuple[float,
                            "no arc of one radius joins them")
 
 
-def check_contour_points(block: Source) -> None:
+def check_contour_points(block: Source, modes: Modes) -> None:
     """A contour block N<P>…N<Q> is read by the cycle, never by the block walk: its dimension
     words need their decimal point all the same (X20 is 0.020 mm under input type I)."""
+    if not increment_input(modes):
+        return
     try:
         iso_modes.check_points(block.words)
     except ValueError as error:
         raise block.refuse(f"{error} (a block of a cycle's contour)") from None
+
+
+def increment_input(modes: Modes) -> bool:
+    """Whether a number without a point is read in the least input increment (Fanuc input type I,
+    the default). Under pocket-calculator input (a record's decimal_point_input 'calculator') it is
+    mm, as the expander reads it, so the point rules above do not apply."""
+    return getattr(modes.machine, "decimal_point_input", "increment") != "calculator"
