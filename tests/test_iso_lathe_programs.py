@@ -35,9 +35,11 @@ REAL = {
     # Fanuc 0T, written for pocket-calculator decimal input (X86. beside X118 and Z-45) and the
     # control's power-on G18 G21 G40 G97 G99: both are facts of the lathe-fanuc-0t record
     "FANUC0T.nc": ("lathe-fanuc-0t", True, None),
-    # ':0100' program number and custom macro B (#501 … #509, X[#504+6.]) are followed; then G96
-    # S250 with no spindle clamp G50 S before it: the spindle speeds up without bound as X nears 0
-    "0100.nc": ("lathe-fanuc-0t", False, "G96 constant surface speed without a spindle clamp"),
+    # ':0100' program number and custom macro B (#501 … #509, X[#504+6.]) are followed; then
+    # N1G0X380.Z300.T0101M16 indexes the turret in a block that moves (whether it indexes during
+    # or after the move is the builder's parameter), and past that G96 S250 has no spindle clamp
+    # G50 S before it: the spindle speeds up without bound as X nears 0
+    "0100.nc": ("lathe-fanuc-0t", False, "T0101 with a move in the same block"),
     # '%O1200' on one line, G-code system B (G90 G95 G92 S500 G33) is followed; it relies on the
     # power-on plane G18, which lathe-iso's record does not state (and past that, its tool calls
     # are comments "(T0101)": a cut with no tool offset, test below)

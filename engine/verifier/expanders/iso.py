@@ -11,6 +11,8 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
+import engine.verifier.expanders.iso_labels as iso_labels
+import engine.verifier.expanders.iso_rules as iso_rules
 import engine.verifier.expansion as expansion  # read at call time: a test may lower MAX_STEPS
 
 from ...names import is_safe
@@ -47,6 +49,7 @@ class Run:
             if source.kind == HEADER_LINE and source.program is not None:
                 self.programs.setdefault(source.program, index)
         self.macro = MacroRun(sources, self.labels)
+        self.in_program = iso_labels.Labels(sources)     # N numbers program by program: G70–G73 P/Q, M97 P
 
     def run(self) -> list[PlainLine]:
         start = self._start()
@@ -124,10 +127,12 @@ class Run:
         codes = {letter for letter, _ in source.words}
         m_codes = [_int(source, text) for letter, text in source.words if letter == "M"]
         if 98 in m_codes or 97 in m_codes:
+            iso_rules.check_call(source, 97 if 97 in m_codes else 98)
             return self._call(source, index, stack, local=97 in m_codes)
         if 99 in m_codes:
+            iso_rules.check_call(source, 99)
             return self._return(source, stack)
-        jump = take_block(source, self.modes, self.sources, self.labels, self.plain)
+        jump = take_block(source, self.modes, self.sources, self.in_program.within(index, source), self.plain)
         if codes & {"M"} and any(code in END_CODES for code in m_codes):
             self.modes.ended = True
         return jump if jump is not None else index + 1
@@ -139,7 +144,7 @@ class Run:
         number, repeats = _int(source, words["P"]), _int(source, words.get("L", "1"))
         if not local and len(words["P"]) > 4 and "L" not in words:
             repeats, number = divmod(number, 10000)     # Fanuc P<repeats><4-digit program>
-        target = self.labels.get(number) if local else self.programs.get(number)
+        target = self.in_program.within(index, source).get(number) if local else self.programs.get(number)
         if target is None:
             what = f"label N{number}" if local else f"subprogram O{number:04d}"
             raise source.refuse(f"M9{'7' if local else '8'} P{words['P']} calls {what}, which is not in this file: "

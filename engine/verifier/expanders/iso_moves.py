@@ -7,6 +7,8 @@ from __future__ import annotations
 from dataclasses import replace
 from typing import TYPE_CHECKING
 
+import engine.verifier.expanders.iso_rules as iso_rules
+
 from ..expansion import ExpansionRefused, PlainLine
 from ..grammar import REFUSED_G_CODES
 from .iso_cycles import CYCLE_CODES, take_cycle
@@ -50,7 +52,9 @@ def take_block(source: Source, modes: Modes, sources: list[Source], labels: dict
             words[letter] = text
     cycle = next((code for code in g_codes if code in CYCLE_CODES), None)
     if cycle is not None:
+        iso_rules.check_cycle(source, cycle, g_codes, words, modes)
         return take_cycle(cycle, source, words, modes, sources, labels, plain)
+    iso_rules.check_block(source, g_codes, words, modes)
     out = Emitted(source, plain)
     for code in g_codes:
         _take_code(code, source, words, modes, out)
@@ -131,7 +135,7 @@ def _spindle_mode(code: int, source: Source, modes: Modes, out: Emitted) -> None
 
 def _g50(source: Source, words: dict[str, str], modes: Modes) -> None:
     """G50 S: the spindle clamp (r/min), never a speed; G50 X/Z: the present position is given these
-    coordinates, so the frame shifts (the position must be known: after G28)."""
+    coordinates, so the frame shifts (the position must be known: after G28); G50 U/W: by increments."""
     if "S" in words:
         modes.clamp = float(words.pop("S"))
     if "X" in words or "Z" in words:
@@ -143,6 +147,15 @@ def _g50(source: Source, words: dict[str, str], modes: Modes) -> None:
                 here = modes.x if axis == "X" else modes.z
                 shift = here - float(words.pop(axis)) * modes.scale
                 setattr(modes, f"shift_{axis.lower()}", shift)
+    _g50_increment(words, modes)
+
+
+def _g50_increment(words: dict[str, str], modes: Modes) -> None:
+    """G50 U/W: the present position's coordinates grow by U (diameter) / W, nothing moves; a later
+    X/Z therefore lands U / W lower in the travel's frame (adversary 27b H7)."""
+    for axis, word in (("x", "U"), ("z", "W")):
+        if word in words:
+            setattr(modes, f"shift_{axis}", getattr(modes, f"shift_{axis}") - modes.length(words.pop(word)))
 
 
 def _reference_return(source: Source, words: dict[str, str], modes: Modes, out: Emitted) -> None:
@@ -300,7 +313,8 @@ def _feed(source: Source, modes: Modes) -> str:
     if modes.feed is None and modes.per_rev is None:
         return ""      # the grammar refuses the cut: no G98/G99 stated
     if modes.feed is None:
-        raise source.refuse("a cut before any feed F")
+        raise source.refuse("a cut before any feed F (after a G70 whose contour states F, which F the control "
+                            "keeps is not known: state F)")
     if modes.per_rev is None:
         return f"F{modes.feed * modes.scale:.4f}"    # the grammar refuses the cut: no G98/G99 stated
     value = modes.feed_per_minute(modes.feed)
@@ -318,6 +332,7 @@ def _radius(source: Source, words: dict[str, str], modes: Modes, end: tuple[floa
     if modes.x is None or modes.z is None or end[0] is None or end[1] is None:
         raise source.refuse("an arc from an unknown start point: program X and Z before it")
     centre = (modes.length(words.get("I", "0")), modes.length(words.get("K", "0")))
+    iso_rules.check_centre(source, centre, (modes.x, modes.z), (end[0], end[1]))
     return arc_radius(centre, (modes.x, modes.z), (end[0], end[1]), modes.motion == 2)
 
 
