@@ -1,6 +1,7 @@
 """The real lathe programs the verifier accepts (issue 27), followed by the turning simulation on
 the stock each is written for, and each one the simulation passes made again from its imported
-class with a new value: only the bound word changes, to exactly the value given.
+class with a new value: only the bound word changes, to exactly the value given. One the
+simulation refuses is refused when made from its class too, naming its block, nothing stored.
 
 The programs: the LinuxCNC axis lathe macros as their screen calls them (tests/helpers/
 linuxcnc_programs.py; go_to_position of tests/helpers/gmoccapy_programs.py), gmoccapy's macros
@@ -20,8 +21,9 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 
+import psycopg
 import pytest
-from helpers.class_jobs import ok, stored_program
+from helpers.class_jobs import ok, refused, stored_program
 from helpers.gmoccapy_programs import axis_macro, gmoccapy_program
 from helpers.linuxcnc_programs import program_of
 
@@ -65,7 +67,7 @@ class Real:
     machine: str
     stock: dict
     refused: tuple[str, str] | None     # the simulation's first finding and its line; None: it passes
-    bound: tuple[str, float, float] | None = None     # (address, the file's value, a new value)
+    bound: tuple[str, float, float]     # a start (or feed) word: (address, the file's value, a new value)
 
 
 REAL = {
@@ -87,14 +89,14 @@ REAL = {
     # above the cut, so the retract runs through the core. (As called from Ø1.2 in, above its Ø1.0
     # finish, its roughing loop WHILE [#14 LT [#1 - #3]] never runs: a boring call starts inside.)
     "lathe_macros/boring.ngc": Real(lambda: program_of("lathe_macros/boring.ngc"), "lathe-linuxcnc",
-                                    MACRO_BAR, (RAPID_THROUGH, "G0 Z #13")),
+                                    MACRO_BAR, (RAPID_THROUGH, "G0 Z #13"), ("X", 1.2, 1.25)),
     # Not a fault of the stock, nor a crash of the real macro: each pass feeds in to the face
     # diameter #1 at Z#13 (its DOC #3 taken along Z), then G0 Z[#13+#3] back out at #1, along the
     # shoulder it leaves. A real facing tool removes the slab #13…#13+#3 with its edge; the walk
     # clears only a radial feed's own line (an outside tool's body radially above its tip), so the
     # slab stays and the rapid runs through it. Any bar the macro faces (over Ø1.0 in) shows it.
     "lathe_macros/facing.ngc": Real(lambda: program_of("lathe_macros/facing.ngc"), "lathe-linuxcnc",
-                                    MACRO_BAR, (RAPID_THROUGH, "G0 Z[#13+#3]")),
+                                    MACRO_BAR, (RAPID_THROUGH, "G0 Z[#13+#3]"), ("X", 1.2, 1.25)),
     "gmoccapy/grooving": Real(lambda: gmoccapy_program("grooving"), "lathe-linuxcnc", GROOVING_BAR, None,
                               ("X", 10.0, 9.5)),        # G8: the start radius, Ø20 to Ø19
     "gmoccapy/radius": Real(lambda: gmoccapy_program("radius"), "lathe-linuxcnc", RADIUS_BAR, None,
@@ -103,11 +105,11 @@ REAL = {
     # Z0, so each G76 pass enters the bar at its start, mid-bar, where only the truncation pass's
     # plunge line is cut: its first pass rapids 0.5 mm deep (j1 on the diameter) into the bar.
     "gmoccapy/threading": Real(lambda: gmoccapy_program("threading"), "lathe-linuxcnc", THREAD_BAR,
-                                (RAPID_THROUGH, "g76 p#4 z#5 i-1 j1 k#3 h3 r1.5 q29.5 e0 l0")),
+                                (RAPID_THROUGH, "g76 p#4 z#5 i-1 j1 k#3 h3 r1.5 q29.5 e0 l0"), ("X", 4.263, 4.5)),
     # The stock's fault (no bore in a class job's params): G01Z-51.4 at X96., X95.6, then G00Z0.45
     # back out inside the bore it cut, through the solid core of the bar a class job states.
     "FANUC0T.nc": Real(lambda: FANUC0T.read_text().splitlines(), "lathe-fanuc-0t", FANUC_BLANK,
-                       (RAPID_THROUGH, "G00Z0.45")),
+                       (RAPID_THROUGH, "G00Z0.45"), ("F", 0.3, 0.25)),      # F0.3 and F.3
 }
 MADE = sorted(name for name, real in REAL.items() if real.refused is None)
 
@@ -161,15 +163,21 @@ def written(lines: list[str], tmp_path: Path) -> Path:
     return source
 
 
-def made(run, tmp_path: Path, real: Real) -> tuple[list[str], list[str], bool]:
-    """(the lines imported, the lines made with the new value, the program's unverified)."""
-    address, old, new = real.bound or ("", 0.0, 0.0)
+def imported(run, tmp_path: Path, real: Real) -> tuple[list[str], Path]:
+    """(the lines imported as class real_made with the start bound, the params file of the new value)."""
+    address, old, new = real.bound
     lines = [line.expandtabs(4) for line in real.lines()]
     params = tmp_path / "params.json"
     params.write_text(json.dumps({"start": {"value": old, "addresses": [address]}}))
     ok(run("import-nc", written(lines, tmp_path), "--class", "real_made", "--params", params))
     values = tmp_path / "new.json"
     values.write_text(json.dumps({"start": new, **real.stock}))
+    return lines, values
+
+
+def made(run, tmp_path: Path, real: Real) -> tuple[list[str], list[str], bool]:
+    """(the lines imported, the lines made with the new value, the program's unverified)."""
+    lines, values = imported(run, tmp_path, real)
     job = json.loads(ok(run("instantiate", "--class", "real_made", "--machine", real.machine, "--draft",
                             "--params", values, "--json")).stdout)
     made_lines, _, unverified = stored_program(run.url, job["program_id"])
@@ -179,7 +187,6 @@ def made(run, tmp_path: Path, real: Real) -> tuple[list[str], list[str], bool]:
 @pytest.mark.parametrize("name", MADE)
 def test_each_simulated_real_program_made_with_a_new_value_changes_only_its_bound_word(run, tmp_path, name):
     real = REAL[name]
-    assert real.bound is not None
     address, old, new = real.bound
     lines, made_lines, unverified = made(run, tmp_path, real)
     assert not unverified and len(made_lines) == len(lines)
@@ -201,3 +208,27 @@ def test_the_made_programs_are_the_ones_the_simulation_passes():
                     "lathe_macros/go_to_position.ngc", "lathe_macros/threading.ngc", "lathe_macros/turning.ngc"]
 
 
+
+
+
+def programs(url: str) -> int:
+    with psycopg.connect(url) as conn:
+        row = conn.execute("SELECT count(*) FROM program").fetchone()
+    assert row is not None
+    return row[0]
+
+
+@pytest.mark.parametrize("name", sorted(set(REAL) - set(MADE)))
+def test_a_real_program_the_simulation_refuses_is_refused_when_made_and_nothing_is_stored(run, tmp_path, name):
+    """Imported as a class (the file as the control runs it), it is made on the same stock: the
+    simulation names its block and the finding, one line, and no program is stored."""
+    real = REAL[name]
+    assert real.refused is not None
+    _, values = imported(run, tmp_path, real)
+    before = programs(run.url)
+    message = refused(run("instantiate", "--class", "real_made", "--machine", real.machine, "--draft",
+                          "--params", values))
+    reason, line = real.refused
+    assert reason in message and re.search(rf"line \d+ '\s*{re.escape(line)}\s*'", message), message
+    assert message.endswith("nothing stored"), message
+    assert programs(run.url) == before
