@@ -55,7 +55,7 @@ RADIUS_BAR = stock(44.0, 0.0, -100.0)
 THREAD_BAR = stock(6.0, 0.0, -100.0)
 # FANUC0T rapids to X86. Z0.25 and faces from there out to X118 (its first cut, so the face stands
 # at Z0.25), then bores from Ø96 out to Ø107.4 down to Z-51.4: a Ø118 blank, its face at Z0.25, with
-# a bore under Ø86 that a class job's params cannot state: the solid bar of that diameter.
+# a bore under Ø96 (its first boring pass) that a class job's params cannot state: the solid bar.
 FANUC_BLANK = stock(118.0, 0.25, -100.0)
 
 RAPID_THROUGH = "a rapid through material"
