@@ -131,9 +131,13 @@ BAR = {"stock_diameter": 1.2 * 25.4, "stock_z_front": 0.0, "stock_z_back": -100.
 SIMULATED = {
     "lathe_macros/turning.ngc": None, "lathe_macros/chamfer.ngc": None, "lathe_macros/threading.ngc": None,
     "lathe_macros/drill.ngc": None,       # G83 on the axis: pecks into the bar's solid centre
-    # a boring macro called on a solid bar: its first rapid enters material a drilled bore would not have
+    # the stock's fault: after its finish pass the macro backs off inward (X[#1 - #3]) and rapids out
+    # along Z (G0 Z #13), right in a bored blank; a class job's blank is solid (its params hold no
+    # bore) and the walk clears only the column above a cut, so the retract runs through the core
     "lathe_macros/boring.ngc": "a rapid through material",
-    # the facing macro rapids out at the depth of the pass it just made, through the next step's stock
+    # the walk's chip, not the stock: each pass feeds in to #1 at Z#13, then G0 Z[#13+#3] along the
+    # shoulder; a facing tool removes the slab #13…#13+#3, the walk only the radial feed's own line
+    # (tests/test_real_programs_made.py holds each program's outcome on the stock it is written for)
     "lathe_macros/facing.ngc": "a rapid through material",
 }
 

@@ -24,7 +24,9 @@ GMOCCAPY = {
     # the .ui's groove.tool 9 is not in lathe.tbl: no start position, and LinuxCNC refuses the M6
     "grooving": (None, "T9 is not in the sim's tool table lathe.tbl"),
     "radius": (None, None),
-    # the .ui's thread.x 0: the truncation pass goes to X[0 - 0.108·pitch]
+    # the .ui's thread.x 0: the truncation pass goes to X[0 - 0.108·pitch]. Saved, it is verified but
+    # the turning simulation refuses it on its Ø6 bar: the thread runs from the start Z-22.2399 toward
+    # Z0, so G76's first pass rapids into the bar mid-length (tests/test_real_programs_made.py)
     "threading": (None, TRAVEL_X),
     # saved turn.z 120 from the start Z15 at 4°: the taper ends past the axis
     "turning": (TRAVEL_X, None),
