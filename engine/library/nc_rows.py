@@ -69,8 +69,7 @@ class Found:
         """Take in what one line gave (engine.library.nc_import reads each distinct text once), as
         if it had been read at `line`: the same references and reports, with that line's number."""
         self.parameterised += line_found.parameterised
-        for value, names in line_found.ambiguous.items():
-            self.ambiguous.setdefault(value, names)
+        self.ambiguous.update(line_found.ambiguous)   # as _part sets them: the last line read wins
         self.bound.update(line_found.bound)
         self.left_alone.extend(replace(left, line=line) for left in line_found.left_alone)
         for mine, theirs in ((self.bound_lines, line_found.bound_lines), (self.left_lines, line_found.left_lines)):
