@@ -158,22 +158,38 @@ def timed_import(server_url: str, seeded: str, path: Path, gear_class: str, para
     return seconds
 
 
+PROOF_PROFILES: list = []   # the profile of the proof's thread (check, compile, run), which cProfile
+                           # of the importing thread does not see
+
+
 def _profiler():
     import cProfile
 
+    from engine.library.nc_verify import Proof
+
+    if not PROOF_PROFILES:
+        unprofiled = Proof.run
+
+        def run(proof) -> None:
+            PROOF_PROFILES.append(cProfile.Profile())
+            PROOF_PROFILES[-1].runcall(unprofiled, proof)
+        Proof.run = run   # type: ignore[method-assign, assignment]   # this process, for the profiled import (the last)
+        PROOF_PROFILES.append(cProfile.Profile())
     profiler = cProfile.Profile()
     profiler.enable()
     return profiler
 
 
 def _report_profile(profiler) -> None:
-    """The cProfile top lines of one import (this process only: the fork reading the second half
-    is not profiled), by cumulative and by own time."""
+    """The cProfile top lines of one import, by cumulative and by own time: the importing thread
+    (the fork reading the second half of a long program is not profiled), then the proof's thread."""
     import pstats
 
     profiler.disable()
-    for order in ("cumulative", "tottime"):
-        pstats.Stats(profiler).sort_stats(order).print_stats(18)
+    for title, stats in (("importing thread", profiler), ("proof thread", PROOF_PROFILES[-1])):
+        for order in ("cumulative", "tottime"):
+            print(f"--- {title}, by {order} time")
+            pstats.Stats(stats).sort_stats(order).print_stats(18)
 
 
 def main(argv=None) -> int:
@@ -217,12 +233,15 @@ def _report(args, sizes: dict, times: dict, cpu: dict) -> None:
     print(f"import-nc: {args.program} programs of {', '.join(str(count) for count in sizes.values())} lines, "
           f"{args.reps} alternated runs")
     for scale in sizes:
-        print(f"  {sizes[scale]:7d} lines: median {median(times[scale]):6.2f} s ({per_line[scale] * 1e6:5.1f} us per "
-              f"line, {per_line[scale] / per_line[smallest]:.2f}x that of {sizes[smallest]}); runs "
+        own, backend = (median(values) for values in zip(*cpu[scale]))
+        print(f"  {sizes[scale]:7d} lines: median {median(times[scale]):6.2f} s wall ({per_line[scale] * 1e6:5.1f} us "
+              f"per line, {per_line[scale] / per_line[smallest]:.2f}x that of {sizes[smallest]}), CPU {own:6.2f} s "
+              f"here + {backend:6.2f} s server = {own + backend:6.2f} s; runs "
               + ", ".join(f"{t:.2f}" for t in times[scale]))
     print(f"the largest import (medians): {client:.2f} s of CPU in this process and its fork, "
-          f"{server:.2f} s in the database server; "
-          f"load average now {', '.join(f'{load:.2f}' for load in os.getloadavg())} on {os.cpu_count()} cores")
+          f"{server:.2f} s in the database server (its backend process: /proc, so only for a server on this "
+          f"machine, else nan); load average now {', '.join(f'{load:.2f}' for load in os.getloadavg())} "
+          f"on {os.cpu_count()} cores")
     ratio = per_line[largest] / per_line[smallest]
     print(f"per-line time at {sizes[largest]} against {sizes[smallest]} lines: {ratio:.2f} "
           f"(linear <= {LINEAR}): {verdict(ratio <= LINEAR)}")

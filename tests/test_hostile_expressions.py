@@ -17,7 +17,8 @@ import psycopg
 import pytest
 
 from engine.templates.budget import MAX_BYTES
-from engine.templates.decision_table import CompiledTemplate, TemplateError
+from engine.templates.checks import structural_problems
+from engine.templates.decision_table import CompiledTemplate, TemplateError, compile_row, rows_compiled_once
 from engine.templates.expressions import MAX_EXPRESSION_LENGTH
 from engine.templates.rows import Template, TemplateRow
 from engine.templates.trace import MAX_TRACE_BYTES
@@ -233,3 +234,19 @@ def test_the_trace_keeps_integers_up_to_64_bits_and_summarises_longer_ones():
     rows = (TemplateRow(10, "main", 1, None, "small = (1 << 64) - 1; large = 1 << 64; truth = z2 > 0", "'x'", None),)
     computed = CompiledTemplate(Template("ints", 1, rows)).run({"z2": 1}).trace["rows"][0]["computed"]
     assert computed == {"small": 2 ** 64 - 1, "large": "<integer of 65 bits>", "truth": True}
+
+
+def test_rows_sharing_a_text_are_each_checked_with_all_their_columns():
+    """A body is compiled once however many rows hold it (issue 27: a long program repeats its
+    lines): a row whose `o` an earlier row had is still refused for its own p_emit, and each row
+    holding a refused text is named, not only the first."""
+    rows = [TemplateRow(10, "main", 1, None, None, '"G0 X1."', None),
+            TemplateRow(20, "main", 1, None, None, '"G0 X1."', "__import__('os')"),
+            TemplateRow(30, "main", 1, None, None, "open('x')", None),
+            TemplateRow(40, "main", 1, None, None, "open('x')", None),
+            TemplateRow(50, "main", 1, None, None, '"G0 X1."', None)]
+    with rows_compiled_once():
+        problems = structural_problems("spur", rows)
+        compiled = [compile_row("spur", row) for row in (rows[0], rows[4])]
+    assert [(problem.row_id, problem.column) for problem in problems] == [(20, "p_emit"), (30, "o"), (40, "o")]
+    assert [row.row.id for row in compiled] == [10, 50]

@@ -2,6 +2,7 @@
 a thread while they are written (issue 13, item 9). Neither may change what is stored or what is
 refused: the class is the one a single process makes, byte for byte, and a bad line in either
 half, or a row that would not give its line back, stores nothing."""
+import re
 import sys
 from pathlib import Path
 
@@ -16,6 +17,7 @@ from engine.templates.store import load_template
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "bench"))
 from import_nc import HOB_PARAMS as PARAMS  # noqa: E402   the benchmark's generated 840D program
 from import_nc import hob_program as program  # noqa: E402
+from import_nc import lathe_program  # noqa: E402   the benchmark's generated lathe program (issue 27)
 
 
 def stored(conn):
@@ -67,3 +69,26 @@ def test_rows_that_do_not_give_the_file_back_are_not_stored(conn, long_program, 
     with pytest.raises(EngineError, match="line 1501: the imported template gives"):
         import_nc(conn, long_program, "nc_wrong", PARAMS)
     assert stored(conn) == before
+
+
+def test_a_line_repeated_through_the_program_is_reported_at_every_line_holding_it(conn, tmp_path, monkeypatch):
+    """Each distinct text is read once (issue 27); the report still names every line: the roughing
+    cycle `G71 U1.5 R0.5` of each operation binds its depth of cut at U and leaves R0.5 (the
+    retract, equal to the finishing allowance parameter that binds only W) alone, line by line."""
+    path = tmp_path / "SHAFTS.NC"
+    lines = lathe_program(3_000)
+    path.write_text("\n".join(lines) + "\n")
+    cycle = [number for number, line in enumerate(lines, start=1) if line == "G71 U1.5 R0.5"]
+    speed = [number for number, line in enumerate(lines, start=1) if re.search(r"\bS200\b", line)]
+    assert len(cycle) > 50 and len(speed) > 100   # operations of about 30 lines, each twice G96
+    params = {"depth": {"value": 1.5, "addresses": ["U"]}, "allowance": {"value": 0.5, "addresses": ["W"]},
+              "surface_speed": 200}
+    for reads_in_two in (False, True):
+        monkeypatch.setattr(nc_halves, "TWO_PROCESSES_FROM", 100 if reads_in_two else 10**9)
+        report = import_nc(conn, path, f"nc_repeated_{int(reads_in_two)}", params)
+        by_name = {binding["parameter"]: binding for binding in report.bindings}
+        assert by_name["depth"]["lines"] == {"U": cycle}
+        assert by_name["surface_speed"]["lines"] == {"S": speed}
+        assert [(left["line"], left["word"]) for left in report.left_alone if left["parameter"] == "allowance"] == [
+            (number, "R0.5") for number in cycle]
+        assert report.parameterised == len(cycle) + len(speed)

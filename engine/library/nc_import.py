@@ -56,7 +56,7 @@ from ..memory import no_cycle_collection
 from ..names import shown
 from ..nc.layout import NcLayout, split_nc_text, store_layout
 from ..nc.lineage import ENGINES_LINE, first_lineage_shaped
-from ..nc.tokens import LABEL, SYMBOL, LineFacts, facts, tokenise
+from ..nc.tokens import LABEL, SYMBOL, LineFacts
 from ..templates.functions import CONSTANTS, FUNCTIONS
 from ..templates.rows import MODULE_ORDER, TemplateRow
 from ..templates.store import ensure_class, load_template, replace_template
@@ -133,13 +133,21 @@ def _import(conn: Connection, path, gear_class: str, params: dict | None, module
 
 def _read_lines(lines: list[str], built: Builder, start: int, end: int) -> tuple:
     """Lines start…end: the facts of each (for its module), its row's `o`, and what they gave
-    (references, ambiguous values, words bound, numbers left alone)."""
+    (references, ambiguous values, words bound, numbers left alone). Each distinct text is read
+    once (its tokens, facts and `o` are those of its text; a long program repeats `T0101` and
+    `G96 S200 M03` in every operation, half of the lines of the bench's lathe program); what it
+    gave is counted again at every line that holds it, with that line's number."""
     built.found = Found()
     line_facts, texts = [], []
+    read: dict[str, tuple] = {}   # text -> (facts, o, what it gave: None for nothing)
     for number in range(start, end):
-        tokens = tokenise(lines[number])
-        line_facts.append(facts(tokens))
-        texts.append(built.o(number + 1, lines[number], tokens))
+        known = read.get(lines[number])
+        if known is None:
+            known = read[lines[number]] = built.read(number + 1, lines[number])
+        line_facts.append(known[0])
+        texts.append(known[1])
+        if known[2] is not None:
+            built.found.add_line(known[2], number + 1)
     return line_facts, texts, built.found
 
 

@@ -7,11 +7,11 @@ from __future__ import annotations
 
 import math
 from collections import Counter
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from decimal import Decimal, InvalidOperation
 
 from ..errors import EngineError
-from ..nc.tokens import NUMBER, WORD, facts
+from ..nc.tokens import NUMBER, WORD, LineFacts, facts, tokenise
 from ..templates.evaluator import evaluate
 from ..templates.expressions import MAX_EXPRESSION_LENGTH, compile_expression
 from ..templates.nc_number import NC_NUMBER_SPEC, style_of
@@ -65,9 +65,23 @@ class Found:
             for key, lines in theirs.items():
                 mine.setdefault(key, []).extend(lines)
 
+    def add_line(self, line_found: Found, line: int) -> None:
+        """Take in what one line gave (engine.library.nc_import reads each distinct text once), as
+        if it had been read at `line`: the same references and reports, with that line's number."""
+        self.parameterised += line_found.parameterised
+        self.ambiguous.update(line_found.ambiguous)   # as _part sets them: the last line read wins
+        self.bound.update(line_found.bound)
+        self.left_alone.extend(replace(left, line=line) for left in line_found.left_alone)
+        for mine, theirs in ((self.bound_lines, line_found.bound_lines), (self.left_lines, line_found.left_lines)):
+            for key, lines in theirs.items():
+                mine.setdefault(key, []).extend([line] * len(lines))
+
     def was_bound(self, name: str, address: str | None, line: int) -> None:
         self.bound[(name, address)] += 1
         self.bound_lines.setdefault((name, address), []).append(line)
+
+
+EMPTY = Found()   # what a line with no number equal to a parameter gives
 
 
 def number_field(name: str, spelling: str) -> str:
@@ -86,10 +100,23 @@ class Builder:
         self.spelled: dict[tuple, bool] = {}   # (field, name, number) -> the field gives the number back
         # the codes and words of the line being read, once a number needs them
         self.context: frozenset[str] | None = None
+        self.line_facts: LineFacts | None = None   # the facts of the line being read, if known
 
-    def o(self, line_number: int, line: str, tokens) -> str:
+    def read(self, line_number: int, line: str) -> tuple:
+        """(facts, o, what the line gave: None for nothing) of one line, read as line
+        `line_number`; `found` is left as it was."""
+        found, self.found = self.found, Found()
+        try:
+            tokens = tokenise(line)
+            line_facts = facts(tokens)
+            o = self.o(line_number, line, tokens, line_facts)
+            return line_facts, o, None if self.found == EMPTY else self.found
+        finally:
+            self.found = found
+
+    def o(self, line_number: int, line: str, tokens, line_facts: LineFacts | None = None) -> str:
         """The row's `o`: the line written out, or an f-string with its references."""
-        self.context = None
+        self.context, self.line_facts = None, line_facts
         parts = [self._part(line_number, tokens, index) for index in range(len(tokens))]
         fields = "".join(text for is_field, text in parts if is_field)
         literal = "".join(text for is_field, text in parts if not is_field)
@@ -142,7 +169,7 @@ class Builder:
 
     def _reference(self, tokens, index: int):
         if self.context is None:
-            self.context = block_context(facts(tokens))
+            self.context = block_context(self.line_facts or facts(tokens))
         return reference_at(tokens, index, self.context)
 
     def _spelled(self, source: str, binding: Binding, spelling: str) -> bool:

@@ -34,10 +34,11 @@ def structural_problems(gear_class: str, rows: list[TemplateRow]) -> list[LintPr
     """Every row's structure, and its expressions compiled within the time of one compile: the
     row at which that time ran out is a problem, and the rows after it are not compiled."""
     problems, out_of_time = [], False
+    lineage: dict = {}   # o -> writes a lineage line: parsed once per text (a long program repeats lines)
     with compiling(len(rows)):
         for row in rows:
             problems += [LintProblem(gear_class, row.id, column, message)
-                         for column, message in _row_structure(row)]
+                         for column, message in _row_structure(row, lineage)]
             if row.t in MODULE_ORDER and row.id >= 0 and not out_of_time:
                 try:
                     compile_row(gear_class, row)
@@ -55,14 +56,16 @@ def _out_of_time() -> bool:
     return False
 
 
-def _row_structure(row: TemplateRow):
+def _row_structure(row: TemplateRow, lineage: dict):
     if row.t not in MODULE_ORDER:
         yield "t", f"unknown module type {row.t!r}; use one of {', '.join(MODULE_ORDER)}"
     if row.id < 0 or row.n < 0:
         yield "id", "id and n must not be negative"
     if row.o is None and row.s is None:
         yield "o", "row has neither o nor s: it does nothing"
-    if writes_lineage(row.o):
+    if row.o not in lineage:
+        lineage[row.o] = writes_lineage(row.o)
+    if lineage[row.o]:
         yield "o", ("writes a line that reads as a lineage line, which only the engine writes (one per "
                     "program); remove the row")
     if row.p_calc is not None and row.s is None:

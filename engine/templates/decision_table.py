@@ -249,13 +249,18 @@ _ONCE = threading.local()
 
 class rows_compiled_once:
     """`with rows_compiled_once():` each row compiled in the block is compiled once, however often
-    it is checked and run (an import checks its rows before storing them, then instantiates them)."""
+    it is checked and run (an import checks its rows before storing them, then instantiates them),
+    and each body (p_calc, s, o, p_emit) once however many rows hold it: the gate's verdict and
+    the guarded trees depend on the texts alone, and a long program repeats its lines (a
+    100,000-line lathe program has 49,000 distinct ones: `T0101`, `G96 S200 M03` in every
+    operation). A body that is refused is not kept: each row holding it is refused again."""
 
     def __enter__(self):
-        self.outer, _ONCE.rows = getattr(_ONCE, "rows", None), {}
+        self.outer = getattr(_ONCE, "rows", None), getattr(_ONCE, "bodies", None)
+        _ONCE.rows, _ONCE.bodies = {}, {}
 
     def __exit__(self, *exc) -> None:
-        _ONCE.rows = self.outer
+        _ONCE.rows, _ONCE.bodies = self.outer
 
 
 def compile_row(gear_class: str, row: TemplateRow, translations=None) -> CompiledRow:
@@ -271,8 +276,18 @@ def compile_row(gear_class: str, row: TemplateRow, translations=None) -> Compile
         return _compile_row(gear_class, row, translations)
     key = gear_class, row
     if key not in remembered:
-        remembered[key] = _compile_row(gear_class, row, translations)
+        remembered[key] = _compiled_body(gear_class, row)
     return remembered[key]
+
+
+def _compiled_body(gear_class: str, row: TemplateRow) -> CompiledRow:
+    """The row with the compiled expressions of the first row of its body (rows_compiled_once)."""
+    body = row.p_calc, row.s, row.o, row.p_emit
+    known = _ONCE.bodies.get(body)
+    if known is None:
+        compiled = _ONCE.bodies[body] = _compile_row(gear_class, row)
+        return compiled
+    return CompiledRow(row, known.o, known.p_calc, known.s, known.p_emit, known.inputs)
 
 
 def _compile_row(gear_class: str, row: TemplateRow, translations=None) -> CompiledRow:
