@@ -4,7 +4,9 @@ set, never by Python's eval.
 
 Order of operations (Fanuc operator's manual, "Custom macro", "Arithmetic and logic operation"):
 functions and brackets first; then * / AND MOD; then + - OR XOR; then the comparisons EQ NE GT GE
-LT LE, weakest. Angles are in degrees (SIN[30] is 0.5). Variables: #1–#33 local, #100–#199 and
+LT LE, weakest; a comparison's TRUE/FALSE is not a number (stored, or used in arithmetic or as a
+condition alone, it is an alarm), brackets nest five deep (alarm 118). FIX goes towards zero, FUP
+away from zero. Angles are in degrees (SIN[30] is 0.5). Variables: #1–#33 local, #100–#199 and
 #500–#999 common. A variable the program reads before setting it is vacant (or, #500–#999, holds
 what an earlier program left on the control): refused naming it, never taken as 0. The system
 variables #1000 and above (interface signals, clocks, tool offsets, positions, modal states) hold

@@ -3,8 +3,10 @@ jumps `GOTO n` and `IF [cond] GOTO n`, `IF [cond] THEN #i=…`, the loops `WHILE
 `END m`, and NC blocks whose words hold variables or expressions (`X[#504+6.]`, `Z-#1`), which
 become plain words: a dimension rounded to the least input increment (0.001 mm, 0.0001 in), F
 as computed, a value in an M, S, T, P … word rounded to a whole number, a G code that must be
-whole. Every statement is one step of the expander's walk, so a loop is bounded by MAX_STEPS like
-every other (engine.verifier.expansion). The arithmetic is engine.verifier.expanders.iso_macro."""
+whole; ROUND inside a word is refused (the control rounds it to the address's least input
+increment there). The loops are paired first (engine.verifier.expanders.iso_loops). Every
+statement is one step of the expander's walk, so a loop is bounded by MAX_STEPS like every other
+(engine.verifier.expansion). The arithmetic is engine.verifier.expanders.iso_macro."""
 from __future__ import annotations
 
 import re
