@@ -1144,8 +1144,9 @@ CREATE TABLE machine (
     -- a dimension word without a decimal point (migration 0030): 'increment' X118 = 0.118 mm (refused),
     -- 'calculator' X118 = 118 mm (Fanuc parameter 3401#0 DPI)
     decimal_point_input text NOT NULL DEFAULT 'increment' CHECK (decimal_point_input IN ('increment', 'calculator')),
-    -- the modal G codes at power-on and reset (migration 0030), e.g. 'G18 G21 G40 G97 G99'; NULL = not stated
-    power_on        text CHECK (power_on ~ '^G(18|2[01]|40|9[0457-9])( G(18|2[01]|40|9[0457-9]))*$'),
+    -- the modal G codes at power-on and reset (migration 0030), e.g. 'G18 G40 G97 G99'; NULL = not stated;
+    -- never G20/G21 (migration 0031: a Fanuc keeps the units the last program set, across reset and M30)
+    power_on        text CHECK (power_on ~ '^G(18|40|9[0457-9])( G(18|40|9[0457-9]))*$'),
     CONSTRAINT machine_reference_point CHECK ((reference_x IS NULL) = (reference_z IS NULL)),
     CHECK (x_min < x_max AND y_min <= y_max AND z_min < z_max),
     CONSTRAINT machine_safe_name CHECK (safe_name('machine', name)),

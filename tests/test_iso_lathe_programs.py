@@ -32,9 +32,12 @@ DATA = Path(__file__).resolve().parent / "data" / "nc" / "fanuc"
 # file -> (the seeded record it runs on, verified, the construct its refusal names). The files are
 # as their authors wrote them.
 REAL = {
-    # Fanuc 0T, written for pocket-calculator decimal input (X86. beside X118 and Z-45) and the
-    # control's power-on G18 G21 G40 G97 G99: both are facts of the lathe-fanuc-0t record
-    "FANUC0T.nc": ("lathe-fanuc-0t", True, None),
+    # Fanuc 0T, written for pocket-calculator decimal input (X86. beside X118 and Z-45, a fact of
+    # the lathe-fanuc-0t record) and the control's power-on G18 G40 G97 G99; it states no G20/G21:
+    # a Fanuc keeps the units the program before it left (reset and M30 do not clear them), so its
+    # X86. is 86 mm only if that program ran in G21 (adversary 27c; migration 0031 took G21 out of
+    # the record's power_on). Verified until then; with G21 stated it is (test_real_programs_made)
+    "FANUC0T.nc": ("lathe-fanuc-0t", False, "motion before G21 (mm) is stated"),
     # ':0100' program number and custom macro B (#501 … #509, X[#504+6.]) are followed; then
     # N1G0X380.Z300.T0101M16 indexes the turret in a block that moves (whether it indexes during
     # or after the move is the builder's parameter), and past that G96 S250 has no spindle clamp
@@ -92,7 +95,7 @@ def test_tokarka_with_its_plane_stated_is_refused_for_its_commented_out_tool_cal
 
 # ---------------------------------------------------------------- decimal point input, headers
 
-FANUC_0T = "lathe-fanuc-0t"      # pocket-calculator input, power-on G18 G21 G40 G97 G99, system A
+FANUC_0T = "lathe-fanuc-0t"      # pocket-calculator input, power-on G18 G40 G97 G99, system A
 
 
 def plain_moves(machine: Machine, lines: list[str]) -> list[tuple[float, float]]:
@@ -106,7 +109,7 @@ def plain_moves(machine: Machine, lines: list[str]) -> list[tuple[float, float]]
 
 
 def cut(body: list[str]) -> list[str]:
-    return ["%", "O0002", "G50 S2000", "T0101", "G97 S800 M03", "G00 X122. Z2."] + body + \
+    return ["%", "O0002", "G21", "G50 S2000", "T0101", "G97 S800 M03", "G00 X122. Z2."] + body + \
         ["G00 X200. Z150.", "M30", "%"]
 
 
@@ -140,9 +143,10 @@ MACRO_PASSES = [
     "G01 X#1 Z-[#3/4] F0.25",                          # each pass to Z−25
     "G00 U2. Z2.",
     "END 1",
+    "#4=ROUND[2.5]",                                   # 3: ROUND in an assignment rounds to a whole number
     "IF [#3 EQ 100] GOTO 100",
     "G00 X9999.",                                      # skipped by the GOTO: past the X travel
-    "N100 G00 X[SQRT[#3*#3]+50.] Z[ROUND[2.5]+0.5]",    # X150 Z3.5
+    "N100 G00 X[SQRT[#3*#3]+50.] Z[#4+0.5]",           # X150 Z3.5
 ]
 
 
@@ -190,11 +194,12 @@ def test_a_macro_construct_that_cannot_be_followed_is_refused_naming_it(conn, bo
 def test_a_macro_loop_that_never_ends_is_refused_at_the_step_bound(conn, monkeypatch):
     """The bound is engine.verifier.expansion.MAX_STEPS (a million lines; lowered here so the test
     runs in a moment): the loop's WHILE line is the one named."""
-    monkeypatch.setattr(expansion, "MAX_STEPS", 5_000)
+    # 6 blocks before the loop, then WHILE, #1=…, END: the 5,005th block is a WHILE (7 + 3·4,999)
+    monkeypatch.setattr(expansion, "MAX_STEPS", 5_004)
     body = ["#1=0", "WHILE [#1 GE 0] DO 1", "#1=#1+1", "END 1"]
     message = verdict(conn, FANUC_0T, cut(body))
-    assert message is not None and "more than 5,000 blocks" in message, message
-    assert "line 8 'WHILE [#1 GE 0] DO 1'" in message, message
+    assert message is not None and "more than 5,004 blocks" in message, message
+    assert "line 9 'WHILE [#1 GE 0] DO 1'" in message, message
 
 
 # ---------------------------------------------------------------- attacks in a real program

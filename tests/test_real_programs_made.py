@@ -34,6 +34,12 @@ INCH = 25.4
 FANUC0T = Path(__file__).resolve().parent / "data" / "nc" / "fanuc" / "FANUC0T.nc"
 
 
+def fanuc0t_in_mm() -> list[str]:
+    """FANUC0T.nc with the G21 its author relied on the control to be in stated after its O line."""
+    lines = FANUC0T.read_text().splitlines()
+    return lines[:2] + ["G21"] + lines[2:]
+
+
 def stock(diameter: float, front: float, back: float) -> dict:
     """A class job's blank (mm): a solid bar, its front face at Z `front`, its back end at `back`."""
     return {"stock_diameter": diameter, "stock_z_front": front, "stock_z_back": back}
@@ -108,7 +114,9 @@ REAL = {
                                 (RAPID_THROUGH, "g76 p#4 z#5 i-1 j1 k#3 h3 r1.5 q29.5 e0 l0"), ("X", 4.263, 4.5)),
     # The stock's fault (no bore in a class job's params): G01Z-51.4 at X96., X95.6, then G00Z0.45
     # back out inside the bore it cut, through the solid core of the bar a class job states.
-    "FANUC0T.nc": Real(lambda: FANUC0T.read_text().splitlines(), "lathe-fanuc-0t", FANUC_BLANK,
+    # The file states no G20/G21 (it relies on the units the program before it left: refused as it
+    # stands, test_iso_lathe_programs.REAL): followed here with G21 stated after its program number.
+    "FANUC0T.nc": Real(lambda: fanuc0t_in_mm(), "lathe-fanuc-0t", FANUC_BLANK,
                        (RAPID_THROUGH, "G00Z0.45"), ("F", 0.3, 0.25)),      # F0.3 and F.3
 }
 MADE = sorted(name for name, real in REAL.items() if real.refused is None)

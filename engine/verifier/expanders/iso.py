@@ -79,6 +79,9 @@ class Run:
         codes = (getattr(self.machine, "power_on", None) or "").split()
         first = next((s for s in self.sources[start:] if s.kind in (BLOCK, MACRO)), None)
         if codes and first is not None:
+            fault = iso_rules.power_on_fault(codes, getattr(self.machine, "gcode_system", None))
+            if fault is not None:
+                raise first.refuse(fault)
             words = [("G", code[1:]) for code in codes]
             take_block(Source(first.number, first.text, BLOCK, words), self.modes, self.sources, self.labels,
                        self.plain)

@@ -4,7 +4,9 @@ set, never by Python's eval.
 
 Order of operations (Fanuc operator's manual, "Custom macro", "Arithmetic and logic operation"):
 functions and brackets first; then * / AND MOD; then + - OR XOR; then the comparisons EQ NE GT GE
-LT LE, weakest. Angles are in degrees (SIN[30] is 0.5). Variables: #1–#33 local, #100–#199 and
+LT LE, weakest; a comparison's TRUE/FALSE is not a number (stored, or used in arithmetic or as a
+condition alone, it is an alarm), brackets nest five deep (alarm 118). FIX goes towards zero, FUP
+away from zero. Angles are in degrees (SIN[30] is 0.5). Variables: #1–#33 local, #100–#199 and
 #500–#999 common. A variable the program reads before setting it is vacant (or, #500–#999, holds
 what an earlier program left on the control): refused naming it, never taken as 0. The system
 variables #1000 and above (interface signals, clocks, tool offsets, positions, modal states) hold
@@ -57,9 +59,11 @@ def round_half_away(value: float) -> float:
 # name -> function of one bracketed argument (Fanuc "Arithmetic and logic operation")
 FUNCTIONS: dict[str, Callable[[float], float]] = {
     "SIN": _degrees(math.sin), "COS": _degrees(math.cos), "TAN": _degrees(math.tan), "SQRT": _sqrt,
-    "ABS": abs, "ROUND": round_half_away, "FIX": lambda v: float(math.floor(v)),
-    "FUP": lambda v: float(math.ceil(v)), "LN": _ln, "EXP": math.exp,
+    "ABS": abs, "ROUND": round_half_away, "FIX": lambda v: float(math.trunc(v)),
+    "FUP": lambda v: math.copysign(math.ceil(abs(v)), v), "LN": _ln, "EXP": math.exp,
 }
+# FIX drops the fraction (towards zero: FIX[-1.2] is -1), FUP rounds away from zero (FUP[-1.2] is -2):
+# Fanuc operator's manual, custom macro, "Rounding up and down to an integer"; docs/reference/iso-lathe.md.
 # functions whose result a parameter of the control chooses (ATAN/ASIN/ACOS ranges: parameter 6004#0 NAT)
 UNKNOWN_FUNCTIONS = {"ATAN": "parameter 6004#0", "ASIN": "parameter 6004#0", "ACOS": "parameter 6004#0",
                      "BIN": "BCD conversion", "BCD": "BCD conversion", "POPEN": "the reader", "BPRNT": "the printer",
@@ -84,6 +88,43 @@ def _mod(a: float, b: float) -> float:
     if round_half_away(b) == 0:
         raise MacroError(f"{a:g} MOD 0: a division by zero (alarm on the control)")
     return float(math.fmod(round_half_away(a), round_half_away(b)))
+
+
+class Truth(float):
+    """The TRUE (1) or FALSE (0) of a comparison: Fanuc keeps it apart from numbers (it cannot be
+    stored in a variable, used in arithmetic, or stand for a number in a word)."""
+
+
+COMPARISONS = frozenset({"EQ", "NE", "GT", "GE", "LT", "LE"})
+LOGIC = frozenset({"AND", "OR", "XOR"})
+MAX_BRACKETS = 5        # Fanuc: brackets nest five deep, function brackets included (alarm 118)
+
+
+def apply(name: str, operator: Callable[[float, float], float], a: float, b: float) -> float:
+    """One binary operation with Fanuc's types: a comparison of two numbers gives TRUE/FALSE;
+    AND/OR/XOR join two comparisons or two numbers; arithmetic takes numbers only."""
+    truths = isinstance(a, Truth), isinstance(b, Truth)
+    if name in LOGIC and truths[0] == truths[1]:
+        return Truth(operator(a, b)) if truths[0] else operator(a, b)
+    if any(truths):
+        raise MacroError(f"{name} with the TRUE/FALSE of a comparison as a number (an alarm on the control)")
+    return Truth(operator(a, b)) if name in COMPARISONS else operator(a, b)
+
+
+def number(value: float, where: str) -> float:
+    if isinstance(value, Truth):
+        raise MacroError(f"{where}: the TRUE/FALSE of a comparison is not a number (an alarm on the control)")
+    return value
+
+
+def check_brackets(code: str) -> None:
+    """Fanuc alarm 118: brackets nested more than five deep in one statement or block."""
+    depth = deepest = 0
+    for char in code:
+        depth += {"[": 1, "]": -1}.get(char, 0)
+        deepest = max(deepest, depth)
+    if deepest > MAX_BRACKETS:
+        raise MacroError(f"brackets nested {deepest} deep: Fanuc allows {MAX_BRACKETS} (alarm 118)")
 
 
 # binary operators from the weakest to the strongest
@@ -174,15 +215,15 @@ class Expression:
         else:
             left = self._level(level + 1)
             while self._peek() in LEVELS[level]:
-                operator = LEVELS[level][self._next("an operator")]
-                left = operator(left, self._level(level + 1))
+                name = self._next("an operator")
+                left = apply(name, LEVELS[level][name], left, self._level(level + 1))
         self.depth -= 1
         return left
 
     def _unary(self) -> float:
         if self._peek() in ("-", "+"):
             sign = -1.0 if self._next("a sign") == "-" else 1.0
-            return sign * self._unary()
+            return sign * number(self._unary(), "a sign")
         return self._primary()
 
     def _primary(self) -> float:
@@ -194,7 +235,7 @@ class Expression:
         if token in FUNCTIONS:
             if self._next("its [") != "[":
                 raise MacroError(f"{token} without its bracketed argument")
-            return FUNCTIONS[token](self._bracket())
+            return FUNCTIONS[token](number(self._bracket(), token))
         if token in UNKNOWN_FUNCTIONS:
             raise MacroError(f"{token}: its result depends on {UNKNOWN_FUNCTIONS[token]} of the control")
         if token[0].isdigit() or token[0] == ".":
@@ -211,11 +252,22 @@ class Expression:
         """The number after #: written (#501) or computed (#[#1+500])."""
         token = self._next("a variable number")
         if token == "[":
-            return variable_number(self._bracket())
+            return variable_number(number(self._bracket(), "#[...]"))
         if not token.isdigit():
             raise MacroError(f"#{token} is not a variable (# and its number)")
         return int(token)
 
 
 def evaluate(text: str, variables: dict[int, float]) -> float:
-    return Expression(text, variables).value()
+    """An arithmetic expression's value (a number: `#1=[1 LT 2]` is refused)."""
+    return number(Expression(text, variables).value(), repr(text.strip()))
+
+
+def condition(text: str, variables: dict[int, float]) -> bool:
+    """The condition of IF/WHILE: a comparison (EQ NE GT GE LT LE, or comparisons joined by AND OR
+    XOR); a bare number (`IF [#1] GOTO 10`) is refused, as Fanuc alarms on it."""
+    value = Expression(text, variables).value()
+    if not isinstance(value, Truth):
+        raise MacroError(f"[{text.strip()}] is not a comparison: IF and WHILE need EQ NE GT GE LT or LE "
+                         "(an alarm on the control)")
+    return float(value) != 0.0

@@ -3,14 +3,17 @@ jumps `GOTO n` and `IF [cond] GOTO n`, `IF [cond] THEN #i=…`, the loops `WHILE
 `END m`, and NC blocks whose words hold variables or expressions (`X[#504+6.]`, `Z-#1`), which
 become plain words: a dimension rounded to the least input increment (0.001 mm, 0.0001 in), F
 as computed, a value in an M, S, T, P … word rounded to a whole number, a G code that must be
-whole. Every statement is one step of the expander's walk, so a loop is bounded by MAX_STEPS like
-every other (engine.verifier.expansion). The arithmetic is engine.verifier.expanders.iso_macro."""
+whole; ROUND inside a word is refused (the control rounds it to the address's least input
+increment there). The loops are paired first (engine.verifier.expanders.iso_loops). Every
+statement is one step of the expander's walk, so a loop is bounded by MAX_STEPS like every other
+(engine.verifier.expansion). The arithmetic is engine.verifier.expanders.iso_macro."""
 from __future__ import annotations
 
 import re
 from dataclasses import replace
 from typing import TYPE_CHECKING
 
+import engine.verifier.expanders.iso_loops as iso_loops
 import engine.verifier.expanders.iso_macro as macro
 from engine.verifier.expanders.iso_macro import MacroError
 
@@ -21,7 +24,6 @@ ASSIGNMENT = re.compile(r"#\s*(?P<number>\d+|\[.*?\])\s*=(?P<value>.+)", re.DOTA
 GOTO = re.compile(r"GOTO(?P<target>.+)")
 LOOP_END = re.compile(r"END\s*(?P<id>\d+)")
 LOOP_DO = re.compile(r"DO\s*(?P<id>\d+)")
-LOOP_DO_AT_END = re.compile(r"DO\s*(?P<id>\d+)\s*$")
 LOOP_IDS = (1, 2, 3)
 # words whose value is a length (rounded to the least input increment) and those read as whole numbers
 DIMENSIONS = frozenset({"X", "Z", "U", "W", "R", "I", "K", "F", "C"})
@@ -34,6 +36,7 @@ class MacroRun:
     def __init__(self, sources: list[Source], labels: dict[int, int]) -> None:
         self.sources, self.labels = sources, labels
         self.variables: dict[int, float] = {}
+        self.loops = iso_loops.Loops(sources)      # paired before the run: a Fanuc alarms on a bad structure
 
     def take(self, source: Source, index: int, decimals: int) -> int | Source:
         """The index to go on at after a statement, or the block with its words evaluated."""
@@ -43,18 +46,19 @@ class MacroRun:
             raise source.refuse(str(error)) from None
 
     def _take(self, code: str, index: int, source: Source, decimals: int) -> int | Source:
+        macro.check_brackets(code)
         if code.startswith("#"):
             self._assign(code)
             return index + 1
         if code.startswith("IF"):
             return self._if(code[2:].strip(), index)
         if code.startswith("GOTO"):
-            return self._goto(code)
+            return self._goto(code, index)
         if code.startswith("WHILE"):
             return self._while(code[5:].strip(), index)
         end = LOOP_END.fullmatch(code)
         if end:
-            return self._loop_start(index, int(end["id"]))
+            return self.loops.pairs[index]
         if LOOP_DO.fullmatch(code):
             raise MacroError(f"{code}: DO without WHILE loops for ever")
         return replace(source, kind="block", words=block_words(code, self.variables, decimals))
@@ -71,20 +75,21 @@ class MacroRun:
         condition, rest = bracketed(code)
         rest = rest.strip()
         if rest.startswith("THEN"):
-            if _true(condition, self.variables):
+            if macro.condition(condition, self.variables):
                 self._assign(rest[4:].strip())
             return index + 1
         if not rest.startswith("GOTO"):
             raise MacroError("IF [...] is followed by GOTO n or THEN #i=…")
-        return self._goto(rest) if _true(condition, self.variables) else index + 1
+        return self._goto(rest, index) if macro.condition(condition, self.variables) else index + 1
 
-    def _goto(self, code: str) -> int:
+    def _goto(self, code: str, index: int) -> int:
         match = GOTO.fullmatch(code)
         if match is None:
             raise MacroError(f"{code!r}: GOTO without its sequence number")
         label = int(macro.round_half_away(macro.evaluate(match["target"], self.variables)))
         if label not in self.labels:
             raise MacroError(f"GOTO {label}: there is no block N{label} in this file")
+        self.loops.check_jump(index, self.labels[label], label)
         return self.labels[label]
 
     def _while(self, code: str, index: int) -> int:
@@ -92,32 +97,9 @@ class MacroRun:
         loop = LOOP_DO.fullmatch(rest.strip())
         if loop is None or int(loop["id"]) not in LOOP_IDS:
             raise MacroError("WHILE [...] is followed by DO 1, DO 2 or DO 3")
-        if _true(condition, self.variables):
+        if macro.condition(condition, self.variables):
             return index + 1
-        return self._loop_end(index, int(loop["id"])) + 1
-
-    def _loop_end(self, index: int, loop_id: int) -> int:
-        for at in range(index + 1, len(self.sources)):
-            if LOOP_END.fullmatch(self.sources[at].macro or "") and int(_loop_id(self.sources[at])) == loop_id:
-                return at
-        raise MacroError(f"DO {loop_id} without its END {loop_id}")
-
-    def _loop_start(self, index: int, loop_id: int) -> int:
-        for at in range(index - 1, -1, -1):
-            code = self.sources[at].macro or ""
-            loop = LOOP_DO_AT_END.search(code) if code.startswith("WHILE") else None
-            if loop is not None and int(loop["id"]) == loop_id:
-                return at
-        raise MacroError(f"END {loop_id} without its WHILE [...] DO {loop_id} before it")
-
-
-def _loop_id(source: Source) -> str:
-    match = LOOP_END.fullmatch(source.macro or "")
-    return match["id"] if match else ""
-
-
-def _true(condition: str, variables: dict[int, float]) -> bool:
-    return macro.evaluate(condition, variables) != 0
+        return self.loops.pairs[index] + 1
 
 
 def bracketed(code: str) -> tuple[str, str]:
@@ -146,9 +128,21 @@ def block_words(code: str, variables: dict[int, float], decimals: int) -> list[t
         letter = code[at]
         if not ("A" <= letter <= "Z"):
             raise MacroError(f"{code[at:].split()[0]!r} is not a word (one capital letter and its value)")
+        if code[at + 1:].lstrip()[:1] in ("#", "[", "-", "+") and "ROUND" in _word_text(code, at):
+            raise MacroError(f"ROUND inside the {letter} word: there it rounds to the least input increment "
+                             "of the address (Fanuc), not to a whole number; round in an assignment #i=ROUND[...]")
         value, at = _value(code, at + 1, variables)
         words.append((letter, value if isinstance(value, str) else _written(letter, value, decimals)))
     return words
+
+
+def _word_text(code: str, at: int) -> str:
+    """The text from a word's letter up to the next letter outside brackets (its value)."""
+    depth, end = 0, at + 1
+    while end < len(code) and (depth or not ("A" <= code[end] <= "Z")):
+        depth += {"[": 1, "]": -1}.get(code[end], 0)
+        end += 1
+    return code[at:end]
 
 
 def _value(code: str, at: int, variables: dict[int, float]) -> tuple[str | float, int]:

@@ -164,3 +164,25 @@ def increment_input(modes: Modes) -> bool:
     the default). Under pocket-calculator input (a record's decimal_point_input 'calculator') it is
     mm, as the expander reads it, so the point rules above do not apply."""
     return getattr(modes.machine, "decimal_point_input", "increment") != "calculator"
+
+
+# Codes of one modal group: a record that lists two of them does not say which the control is in.
+POWER_ON_GROUPS = (("G20", "G21"), ("G94", "G95", "G98", "G99"), ("G96", "G97"))
+
+
+def power_on_fault(codes: list[str], gcode_system: str | None) -> str | None:
+    """Why the record's power_on cannot be taken as the state a program starts in, or None.
+    G20/G21: a Fanuc keeps the units the program before set, across reset and M30 (the clear state
+    leaves them), so only the program may state them. G90 on G-code system A is the turning cycle,
+    not a mode (system A has no G90/G91 distance mode)."""
+    units = [code for code in codes if code in ("G20", "G21")]
+    if units:
+        return (f"the machine record's power_on lists {' and '.join(units)}: a Fanuc keeps the units the "
+                "program before it set (reset and M30 leave them): only the program may state them")
+    if gcode_system == "A" and "G90" in codes:
+        return "the machine record's power_on lists G90, which on G-code system A is the turning cycle, not a mode"
+    for group in POWER_ON_GROUPS:
+        listed = [code for code in codes if code in group]
+        if len(listed) > 1:
+            return f"the machine record's power_on lists {' and '.join(listed)}, one modal group: which holds?"
+    return None
