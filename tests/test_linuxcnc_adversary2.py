@@ -163,3 +163,27 @@ def test_the_g71_rise_in_mm_is_still_refused_as_not_monotonic():
     message = refusal([*head(), "o100 sub", *profile, "o100 endsub", "G0 X40 Z2", "G71 Q100 X40 Z2 D0 I1 R0.5",
                        "G0 X50 Z5", "M5", "M2"])
     assert message is not None and "Not monotonic" in message, message
+
+
+def test_g94_or_g95_on_a_line_of_its_own_sets_the_feed_to_0():
+    """convert_feed_mode sets feed_rate 0 with every G94/G95 (interp_convert.cc 2855-2870), and
+    a G1 at feed 0 stops LinuxCNC ("Cannot do G1 with zero feed rate")."""
+    message = refusal([*head(), "G0 X40 Z2", "G94", *CUTS[1:]])
+    assert message is not None and "'G1 X30 Z0'" in message and "G94/G95 (it sets the feed to 0)" in message, \
+        message
+
+
+def test_f_on_the_g95_line_is_set_after_the_feed_mode():
+    lines = plain([*head(), "G0 X40 Z2", "G95 F0.1", "G1 X30 Z0", "M5", "M2"])
+    assert lines[-1][0].endswith("G95 F0.1")
+
+
+def test_a_units_change_under_g95_voids_the_feed_until_f_is_stated_again():
+    """emccanon.cc SET_FEED_RATE keeps a per-revolution rate as written; after G21 the interpreter
+    reads it back unchanged (GET_EXTERNAL_FEED_RATE) and each traverse re-sends it in mm: 0.004 in/rev
+    becomes 0.004 mm/rev. A feed move before a new F is refused; with F stated it is that F."""
+    start = ["G7 G18 G20 G90 G95 G40 G61", "T1 M6", "G43", "S500 M3", "F0.004", "G0 X1.6 Z0.1"]
+    message = refusal([*start, "G21", "G0 X40 Z2", "G1 X30 Z0", "G0 X40", "M5", "M2"])
+    assert message is not None and "'G1 X30 Z0'" in message and "a G20/G21 under G95" in message, message
+    lines = plain([*start, "G21", "G0 X40 Z2", "G1 X30 Z0 F0.1", "M5", "M2"])
+    assert lines[-1][0].endswith("G95 F0.1")

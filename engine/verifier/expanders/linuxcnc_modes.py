@@ -124,8 +124,8 @@ class Executor:
         if words.g("93"):
             raise Refused(REFUSED["93"])
         mode = words.g("94", "95")
-        if mode is not None:
-            self.modes.per_rev = mode == "95"
+        if mode is not None:         # interp_convert.cc convert_feed_mode: G94/G95 also set the feed to 0
+            self.modes.per_rev, self.modes.feed = mode == "95", None
 
     def _feed(self, words: Words) -> None:
         if "f" in words.values:
@@ -201,6 +201,10 @@ class Executor:
                 self.out.append("G18")
         units = words.g("20", "21")
         if units is not None:
+            if self.modes.per_rev and self.modes.inch != (units == "20"):
+                # emccanon.cc keeps a G95 rate as written (SET_FEED_RATE) and re-sends it after each
+                # traverse in the units then in force (START_SPEED_FEED_SYNCH): no F until stated again
+                self.modes.feed = None
             self.modes.inch = units == "20"
             self.out.append("G21")
         diameter = words.g("7", "8")
