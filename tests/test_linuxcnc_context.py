@@ -63,7 +63,7 @@ def test_the_feed_comes_back_to_a_tenth_of_a_unit_as_linuxcnc_writes_it():
     """restore_settings writes " F%.1f" in the restored units: F0.004 in/rev comes back as F0.0, and
     the next feed move without its own F is refused; F123.456 mm/min comes back as F123.5."""
     sub = ["o10 sub", "M73", "F0.008", "o10 endsub"]
-    with pytest.raises(ExpansionRefused, match="a feed move before any F"):
+    with pytest.raises(ExpansionRefused, match="a feed move with no F in force"):
         moves("G20 G95 F0.004", *sub, "o10 call", "G1 X1 Z0")
     (line,) = moves("G21 G94 F123.456", *sub, "o10 call", "G1 X50")
     assert line.endswith(f"G94 F{float(f'{123.456:.1f}'):g}")

@@ -148,9 +148,10 @@ def test_linuxcnc_s_errors_are_refusals(line, reason):
 # --- LinuxCNC's own tests: the moves of their expected output -------------------------------------------
 
 CANON = re.compile(r"\s*N\.+\s+(STRAIGHT_TRAVERSE|STRAIGHT_FEED|ARC_FEED)\((.*)\)")
-# test program -> the lines stated before it (rs274's start: G8, mm) and a line it drops
-GOLDEN = {"g71-with-g70": (["G8"], None), "g72-iterations-present": (["G8"], None),
-          "g72-iterations-missing": (["G8"], None), "g71-endless-loop2": (["G21 G8"], None),
+# test program -> the lines stated before it (rs274's start: G8, mm) and a line it drops; the
+# g72 programs open with `G54 G18 G21 F400`, whose F LinuxCNC reads in the units before the G21
+GOLDEN = {"g71-with-g70": (["G8"], None), "g72-iterations-present": (["G21 G8"], None),
+          "g72-iterations-missing": (["G21 G8"], None), "g71-endless-loop2": (["G21 G8"], None),
           # G92.1 clears offsets nothing set; the verifier refuses every G92 code, so it is left out here
           "g71-endless-loop": ([], "G90 G92.1 (G90 abs dist mode, G92.1 Reset coord sys offset)")}
 

@@ -37,9 +37,11 @@ TRAVEL_Z300 = "Z300 exceeds the travel of lathe-linuxcnc (Z -600…200)"
 # RIGHT or GAP, why)
 CORPUS = {
     # LinuxCNC/linuxcnc: lathe files not in tests/data/nc/linuxcnc
+    # line 1 `g20 g64 g18 f30`: LinuxCNC reads F before the line's G20 (order of execution), in the
+    # units the last program left (issue 27 lcfix3; before it, the bare G64 of the same line)
     "linuxcnc_extra/lathe-comp_test.ngc": (
-        "lathe-linuxcnc", BARE_G64, RIGHT,
-        "the cutter-comp test: bare G64 has no path bound; behind it no G7/G8 and a cut with T0 unloaded"),
+        "lathe-linuxcnc", "a length before G20/G21", RIGHT,
+        "the cutter-comp test: F30 read in the last program's units; bare G64, no G7/G8, a cut with T0"),
     "linuxcnc_extra/axis-lathe.ngc": (
         "lathe-linuxcnc", BLOCK_DELETE, RIGHT,
         "AXIS's splash drawing: behind the / lines no G7/G8, no G18, no tool, no S: not a cutting program"),

@@ -48,7 +48,9 @@ PROGRAMS = {
     "lathe_g7x_face_boring.ngc": (None, X_BEFORE_G7_G8),      # on G72 X1 in o101; with G8, no S before the cut
     "lathe_g7x_quadrants.ngc": (None, X_BEFORE_G7_G8),        # on G70 X15; with G8, no S before the cut
     # T0 M6 unloads the tool (accepted); the file states no G7/G8, which M2 does not reset
-    "lathecomp.ngc": (None, "G64 without P blends corners without a bound"),   # and an X before G7/G8
+    # line 1 `g20 g64 g18 f30`: LinuxCNC reads F before the line's G20 (order of execution), in
+    # the units the last program left (issue 27 lcfix3; before it, the bare G64 of the same line)
+    "lathecomp.ngc": (None, "a length before G20/G21"),   # and G64 without P, and an X before G7/G8
     "lathe_macros/boring.ngc": (MACRO, None),
     "lathe_macros/chamfer.ngc": (MACRO, None),
     "lathe_macros/facing.ngc": (MACRO, None),
@@ -66,8 +68,10 @@ PROGRAMS = {
     "ngcgui_lathe/g76base.ngc": (NGCGUI, "#<_vmajor> holds a value only the control has"),
     # LinuxCNC's interpreter tests (tests/interp): its expected output is made in radius mode
     "interp_tests/g71-with-g70.ngc": (None, X_BEFORE_G7_G8),       # on G71.1 X15 (the demo's profile)
-    "interp_tests/g72-iterations-present.ngc": (None, X_BEFORE_G7_G8),   # on G72 X50
-    "interp_tests/g72-iterations-missing.ngc": (None, X_BEFORE_G7_G8),   # on G72 X50
+    # line 1 `G54 G18 G21 F400`: F is read before the line's G21, in the last program's units
+    # (issue 27 lcfix3; before it, the X of G72 X50 before G7/G8, still there after)
+    "interp_tests/g72-iterations-present.ngc": (None, "a length before G20/G21"),
+    "interp_tests/g72-iterations-missing.ngc": (None, "a length before G20/G21"),
     # G92.1 on line 3 clears the G92 offsets: refused like every G92 code (an offset the verifier
     # does not follow); LinuxCNC ends it (168 lines of expected output, the loop of issue #2939 fixed)
     "interp_tests/g71-endless-loop.ngc": (None, "G92.1 shifts every position by an offset"),

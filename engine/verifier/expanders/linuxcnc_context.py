@@ -13,7 +13,6 @@ G90.1/G91.1, G7/G8, G98/G99, G43/G49, path mode, then M3/M4/M5 and the coolant w
 The motion mode, the tool and the position are not restored."""
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from ..refusals import Refused
@@ -27,43 +26,48 @@ if TYPE_CHECKING:
 RESTORED = ("per_rev", "incremental", "arc_absolute", "diameter", "plane", "blend")
 
 
-@dataclass
-class Saved:
-    modes: Modes
-    on_return: bool          # M73 in a subroutine: restored at its return
-
-
 class Contexts:
-    """The saved modes of each call level (LinuxCNC `sub_context[call_level]`), 0 the main program."""
+    """The saved modes of each call level (LinuxCNC `sub_context[call_level]`), 0 the main program.
+    `saved` holds a level's modes while CONTEXT_VALID is set; `on_return` the levels whose
+    CONTEXT_RESTORE_ON_RETURN is set: M73 in a subroutine sets it and only a new call clears it
+    (interp_convert.cc convert_m M70-M73; interp_o_word.cc, `context_status = 0` at the call), so
+    an M70 after M73, or M71 then M70, saves anew and the return still restores."""
 
     def __init__(self) -> None:
         self.level = 0
-        self.saved: dict[int, Saved] = {}
+        self.saved: dict[int, Modes] = {}
+        self.on_return: set[int] = set()
 
     def carry_out(self, executor: Executor, code: int) -> None:
         """M70–M73 in their place of a line's order of execution (after M3/M4/M5, before M7–M9)."""
         if code in (70, 73):
-            self.saved[self.level] = Saved(executor.modes.copy(), code == 73 and self.level > 0)
+            self.saved[self.level] = executor.modes.copy()
+            if code == 73 and self.level > 0:
+                self.on_return.add(self.level)
         elif code == 71:
-            self.saved.pop(self.level, None)
+            self.saved.pop(self.level, None)     # clears VALID only: the restore-on-return flag stays
         elif self.level not in self.saved:
             raise Refused("M72 with no modes saved at this call level (no M70/M73, or M71 forgot them): "
                           "LinuxCNC refuses it")
         else:
-            restore(executor, self.saved[self.level].modes)
+            restore(executor, self.saved[self.level])
 
     def enter(self) -> None:
         self.level += 1
         self.saved.pop(self.level, None)
+        self.on_return.discard(self.level)
 
     def leave(self, executor: Executor) -> list[str]:
-        """The plain lines of a subroutine's return: the restore of an M73 made in it. The lines a
-        block is still writing (a G70-G72 reading its profile sub) are kept as they were."""
+        """The plain lines of a subroutine's return: the restore when both flags are set
+        (interp_o_word.cc leave_context). The lines a block is still writing (a G70-G72 reading
+        its profile sub) are kept as they were."""
         pending, executor.out = executor.out, []
         saved = self.saved.pop(self.level, None)
+        armed = self.level in self.on_return
+        self.on_return.discard(self.level)
         self.level -= 1
-        if saved is not None and saved.on_return:
-            restore(executor, saved.modes)
+        if saved is not None and armed:
+            restore(executor, saved)
         restored, executor.out = executor.out, pending
         return restored
 
@@ -76,14 +80,29 @@ def restore(executor: Executor, saved: Modes) -> None:
     _feed_and_speed(executor, saved)
     if saved.plane == "18" and modes.plane != "18":
         executor.out.append("G18")
+    blend = _restored_blend(modes, saved)
     for name in RESTORED:
         setattr(modes, name, getattr(saved, name))
+    modes.blend = blend
     if "retract" in saved.extra:
         modes.extra["retract"] = saved.extra["retract"]
     _spindle_and_coolant(executor, saved)
     if saved.offset != modes.offset:
         modes.offset = bool(saved.offset)    # an offset never stated comes back as none: fail closed
         executor.out.append("G43" if modes.offset else "G49")
+
+
+def _restored_blend(modes: Modes, saved: Modes) -> float:
+    """gen_settings writes a changed G64 tolerance as " G64 P%f" in the restored units: six
+    decimals, so a P under 0.0000005 comes back as P0.000000, which LinuxCNC reads as no bound."""
+    if saved.blend <= 0 or saved.blend == modes.blend:
+        return saved.blend
+    unit = INCH if saved.inch else 1.0
+    printed = float(f"{saved.blend / unit:f}")
+    if printed <= 0:
+        raise Refused(f"the restore writes the saved G64 P{saved.blend / unit:g} as G64 P{printed:f}: LinuxCNC reads a "
+                      "zero tolerance as none, corners blend without a bound; save a P of 0.000001 or more")
+    return printed * unit
 
 
 def _feed_and_speed(executor: Executor, saved: Modes) -> None:

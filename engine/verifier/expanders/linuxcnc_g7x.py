@@ -10,7 +10,11 @@ are carried out, each G0/G1/G2/G3 (G0 as G1) adds a segment from the last point,
 1184). D, E, I, R, U, W are lengths not halved by G7 (a radius); defaults D0 E0 I1 R0.5 P1
 (cc 1188). The moves (engine.verifier.expanders.linuxcnc_g7x_path) are G0 for LinuxCNC's
 straight_rapid, G1 at the modal F for straight_move, G2/G3 for circular_move (cc 921-968); the
-motion mode left is that of the last move. Every G7X error of LinuxCNC is a refusal naming it."""
+motion mode left is that of the last move. Every G7X error of LinuxCNC is a refusal naming it.
+
+interp_g7x.cc works in program units, its tolerances too (1e-6, monotonic 1e-3, a connecting arc
+over a 1e-2 gap, cc 43, 65, 867): the cycle is computed here in the program's units (inches under
+G20) and its moves converted to mm only when written as plain lines."""
 from __future__ import annotations
 
 import math
@@ -19,7 +23,7 @@ from typing import TYPE_CHECKING
 from ..refusals import Refused
 from .linuxcnc_g7x_path import MAX_PASSES, Profile
 from .linuxcnc_g7x_segments import Chamfer, Fillet, G7xError, Round, Segment, Straight
-from .linuxcnc_modes import MOTIONS, number
+from .linuxcnc_modes import INCH, MOTIONS, number
 from .linuxcnc_motion import ARC_TOLERANCE_MM, feed_words, signed_radius, target
 
 if TYPE_CHECKING:
@@ -45,27 +49,28 @@ def profile_cycle(executor: Executor, words: Words, motion: str) -> None:
         raise Refused(f"G{motion} from a position not yet programmed: the cycle starts where the tool stands")
     executor.out.append(f"G0 X{number(2 * x)} Z{number(z)}")
     modes.x, modes.z = x, z
-    reader = ProfileReader(executor, complex(z, x))
+    unit = INCH if modes.inch else 1.0       # target() above refused a length before G20/G21
+    reader = ProfileReader(executor, complex(z, x) / unit, unit)
     executor.profile(str(int(words.values["q"])), reader.line)
     if len(reader.path) <= 1:
         raise Refused(f"G{motion} Q{words.values['q']:g}: the profile has fewer than 2 moves; LinuxCNC then cuts "
                       "nothing and holds the profile's end as the position while the tool stands at the start")
-    moves = Moves(complex(z, x))
+    moves = Moves(complex(z, x) / unit)
     try:
         _cut(executor, words, motion, reader, moves)
     except G7xError as error:
         meaning = MEANINGS.get(str(error), "")
         raise Refused(f"G{motion}: LinuxCNC stops with \"G7X error: {error}\"{': ' if meaning else ''}{meaning}") \
             from None
-    executor.out.extend(moves.plain(executor))
-    modes.x, modes.z, modes.motion = moves.at.imag, moves.at.real, moves.last
+    executor.out.extend(moves.plain(executor, unit))
+    modes.x, modes.z, modes.motion = moves.at.imag * unit, moves.at.real * unit, moves.last
 
 
 def _cut(executor: Executor, words: Words, motion: str, reader: ProfileReader, moves: Moves) -> None:
     """cc 1188-1232: the words and the cycle; a profile ending short of X (G71) or Z (G72) closes
-    back to it."""
+    back to it. D, E, I, R, U, W as written: program units, as the profile."""
     cycle, subcycle = motion.partition(".")[0], int(motion.partition(".")[2] or 0)
-    d, e, i, r, u, w = (executor.length(words.values.get(letter, default))
+    d, e, i, r, u, w = (words.values.get(letter, default)
                         for letter, default in (("d", 0.0), ("e", 0.0), ("i", 1.0), ("r", 0.5), ("u", 0.0),
                                                 ("w", 0.0)))
     passes = int(words.values.get("p", 1))
@@ -88,8 +93,9 @@ def _cut(executor: Executor, words: Words, motion: str, reader: ProfileReader, m
 class ProfileReader:
     """The profile as convert_g7x builds it from the subroutine's lines (cc 1056-1184)."""
 
-    def __init__(self, executor: Executor, start: complex) -> None:
+    def __init__(self, executor: Executor, start: complex, unit: float) -> None:
         self.executor, self.at, self.motion = executor, start, "0"     # the cycle's G0 set the mode (cc 1046)
+        self.unit = unit             # mm per program unit: the profile is kept in program units
         self.path = Profile()
 
     def line(self, words: Words) -> None:
@@ -106,7 +112,7 @@ class ProfileReader:
         if self.motion in ("0", "1", "2", "3"):
             self.path.extend(self._corner(words, end))
         self.at = end
-        modes.x, modes.z = end.imag, end.real      # #<_x>, #<_z> read the profile's point (cc 1179)
+        modes.x, modes.z = end.imag * self.unit, end.real * self.unit    # #<_x>, #<_z>: the profile's point (cc 1179)
 
     def _end(self, words: Words) -> complex:
         """X/Z as a move reads them, U (halved in G7)/W added in absolute mode only (cc 1072-1103)."""
@@ -122,12 +128,13 @@ class ProfileReader:
             x += self.executor.length(values["u"]) / (2.0 if modes.diameter else 1.0)
         if "w" in values:
             z += self.executor.length(values["w"])
-        return complex(z, x)
+        return complex(z, x) / self.unit
 
     def _center(self, words: Words, end: complex) -> complex:
         """cc 1117-1156: from R (the centre on the side G2/G3 turns), or I/K from the start
         (G91.1) or absolute (G90.1); LinuxCNC checks the I/K arc as any arc."""
-        values, length, start = words.values, self.executor.length, self.at
+        values, length = words.values, self.executor.length
+        start, end = self.at * self.unit, end * self.unit          # the centre found in mm
         if "r" in values:
             if "i" in values or "k" in values:
                 raise Refused("LinuxCNC: G7X error: both R and I or K flag used for arc")
@@ -135,7 +142,7 @@ class ProfileReader:
             if r * r < chord / 4:
                 raise Refused(f"an arc R{values['r']:g} shorter than half its chord in the profile")
             side = 1j * math.sqrt((r * r - chord / 4) / chord) * (end - start)
-            return (start + end) / 2.0 + (side if self.motion == "3" else -side)
+            return ((start + end) / 2.0 + (side if self.motion == "3" else -side)) / self.unit
         if "i" not in values and "k" not in values:
             raise Refused("LinuxCNC: G7X error: either I or K must be present for arc")
         center = complex(length(values.get("k", 0.0)), length(values.get("i", 0.0)))
@@ -143,21 +150,21 @@ class ProfileReader:
         if abs(abs(start - center) - abs(end - center)) > ARC_TOLERANCE_MM:
             raise Refused(f"the profile's arc has its centre {abs(start - center):.4f} mm from its start but "
                           f"{abs(end - center):.4f} mm from its end (LinuxCNC allows 0.028 mm)")
-        return center
+        return center / self.unit
 
     def _corner(self, words: Words, end: complex) -> list[Segment]:
         values = words.values
         if "a" in values and "c" in values:
             raise Refused("LinuxCNC: G7X error: Both A and C parameters on a corner")
         if "a" in values:
-            return [Fillet(self.executor.length(values["a"]), end)]
+            return [Fillet(values["a"], end)]
         if "c" in values:
-            return [Chamfer(self.executor.length(values["c"]), end)]
+            return [Chamfer(values["c"], end)]
         return []
 
 
 class Moves:
-    """motion_machine (cc 921): the moves in program coordinates, X a radius; an arc ending where
+    """motion_machine (cc 921): the moves in program coordinates and units, X a radius; an arc ending where
     the tool stands is not made (cc 960)."""
 
     def __init__(self, at: complex) -> None:
@@ -178,8 +185,10 @@ class Moves:
         self.made.append((motion, self.at, end, center))
         self.at, self.last = end, motion
 
-    def plain(self, executor: Executor) -> list[str]:
-        return [_plain(executor, *move) for move in self.made]
+    def plain(self, executor: Executor, unit: float) -> list[str]:
+        """The moves as plain lines in mm (`unit` mm per program unit)."""
+        return [_plain(executor, motion, start * unit, end * unit, None if center is None else center * unit)
+                for motion, start, end, center in self.made]
 
 
 def _plain(executor: Executor, motion: str, start: complex, end: complex, center: complex | None) -> str:

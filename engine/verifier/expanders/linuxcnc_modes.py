@@ -124,8 +124,8 @@ class Executor:
         if words.g("93"):
             raise Refused(REFUSED["93"])
         mode = words.g("94", "95")
-        if mode is not None:
-            self.modes.per_rev = mode == "95"
+        if mode is not None:         # interp_convert.cc convert_feed_mode: G94/G95 also set the feed to 0
+            self.modes.per_rev, self.modes.feed = mode == "95", None
 
     def _feed(self, words: Words) -> None:
         if "f" in words.values:
@@ -201,11 +201,24 @@ class Executor:
                 self.out.append("G18")
         units = words.g("20", "21")
         if units is not None:
+            if self.modes.per_rev and self.modes.inch != (units == "20"):
+                # emccanon.cc keeps a G95 rate as written (SET_FEED_RATE) and re-sends it after each
+                # traverse in the units then in force (START_SPEED_FEED_SYNCH): no F until stated again
+                self.modes.feed = None
             self.modes.inch = units == "20"
             self.out.append("G21")
         diameter = words.g("7", "8")
         if diameter is not None:
+            if (diameter == "7") != self.modes.diameter and self._motion_to_be(words) == "76":
+                raise Refused(f"G{diameter} on a G76 line that switches the diameter mode: LinuxCNC rescales I, J, "
+                              "K once more (interp_convert.cc convert_lathe_diameter_mode, G76 ×2 or ÷2 again): "
+                              "the thread's depth is not the one written; state G7/G8 on a line of its own")
             self.modes.diameter = diameter == "7"
+
+    def _motion_to_be(self, words: Words) -> str | None:
+        """LinuxCNC's block->motion_to_be: the line's motion code, or the modal one when axes are written."""
+        motion = words.g(*MOTIONS)
+        return motion if motion is not None or not {"x", "z"} & words.values.keys() else self.modes.motion
 
     def _offsets(self, words: Words) -> None:
         if words.g("40"):
@@ -229,6 +242,10 @@ class Executor:
         if tolerance is None:
             raise Refused("G64 without P blends corners without a bound (as fast as possible, rapids too): "
                           f"write G61, or G64 P<tolerance> of {BLEND_TOLERANCE:g} mm (0.001 in) or less")
+        if tolerance <= 0:      # interp_convert.cc convert_control_mode: P < 0 is the default tolerance, 0
+            raise Refused(f"G64 P{tolerance:g}: LinuxCNC reads a zero or negative tolerance as none (tc.c "
+                          "tcFindBlendTolerance: a quarter of each move), corners blend without a bound: write "
+                          f"G61, or G64 P<tolerance> above 0 and up to {BLEND_TOLERANCE:g} mm (0.001 in)")
         if self.length(tolerance) > BLEND_TOLERANCE + 1e-9:     # 0.001 in × 25.4 in floating point
             raise Refused(f"G64 P{tolerance:g} blends corners up to {self.length(tolerance):g} mm off the programmed "
                           f"path, more than the {BLEND_TOLERANCE:g} mm (0.001 in) the proof allows for: write G61, "
@@ -282,6 +299,9 @@ def coolant(modes: Modes, code: int) -> None:
 
 KNOWN_G = frozenset({*MOTIONS, *IGNORED_G, "61", "61.1", "64", "98", "99", "4", "17", "19", "7", "8", "20", "21",
                      "40", "43", "49", "90", "91", "90.1", "91.1", "94", "95", "96", "97"})
-STEPS = (Executor._lengths_and_planes, Executor._feed_mode, Executor._feed, Executor._speed, Executor._tool,
-         Executor._spindle, Executor._context, Executor._coolant, Executor._offsets, Executor._path_mode,
-         Executor._distance, Executor._motion, Executor._stop)
+# LinuxCNC's order of execution of a line's items (overview.adoc "G-code Order of Execution";
+# interp_execute.cc execute_block: spindle mode, feed mode, F, S, T, convert_m, convert_g, stop):
+# F is read in the units before the line's G20/G21, M70/M73 save and M72 restores before its G7/G8
+STEPS = (Executor._feed_mode, Executor._feed, Executor._speed, Executor._tool, Executor._spindle,
+         Executor._context, Executor._coolant, Executor._lengths_and_planes, Executor._offsets,
+         Executor._path_mode, Executor._distance, Executor._motion, Executor._stop)

@@ -82,7 +82,9 @@ def _axes(words: Words, x: float | None, z: float | None) -> str:
 def _feed(executor: Executor) -> str:
     modes = executor.modes
     if modes.feed is None or modes.feed <= 0:
-        raise Refused("a feed move before any F: LinuxCNC would refuse it, or use the last program's")
+        raise Refused("a feed move with no F in force: none yet (LinuxCNC would refuse it, or use the last "
+                      "program's), or none since a G94/G95 (it sets the feed to 0) or a G20/G21 under G95 "
+                      "(LinuxCNC then feeds the old number in the new units); state F")
     return f" G{'95' if modes.per_rev else '94'} F{number(modes.feed)}"
 
 
