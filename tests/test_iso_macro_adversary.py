@@ -9,7 +9,7 @@ from dataclasses import replace
 
 import psycopg
 import pytest
-from test_iso_lathe_programs import FANUC_0T, cut, plain_moves, verdict
+from helpers.iso_real_programs import FANUC_0T, cut, plain_moves, verdict
 
 from engine.machines.records import load_machine
 from engine.verifier.expanders.iso import expand_iso

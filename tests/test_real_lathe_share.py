@@ -4,8 +4,8 @@ turning simulation follows, it finds nothing on the stock they are written for.
 
 Each file is in exactly one table: the per-dialect outcome tables the other tests assert file by
 file (LinuxCNC: tests/helpers/linuxcnc_programs.PROGRAMS, gmoccapy_programs.GMOCCAPY and
-AXIS_MACROS; the other people's repositories: test_real_lathe_corpus.CORPUS; Fanuc/ISO:
-test_iso_lathe_programs.REAL; the simulation and the remake: test_real_programs_made.REAL), the
+AXIS_MACROS; the other people's repositories: helpers.real_lathe_corpus.CORPUS; Fanuc/ISO:
+helpers.iso_real_programs.REAL; the simulation and the remake: helpers.real_programs_made.REAL), the
 Emco fixed-column files below, or NOT_LATHE_PROGRAMS. A new file is not counted until it is
 classified. The share is far below the issue's three quarters: the refusals are the programs'
 (faults of their own, or modes they leave to whatever ran before them, which LinuxCNC's own
@@ -16,11 +16,11 @@ from __future__ import annotations
 from pathlib import Path
 
 from helpers.gmoccapy_programs import AXIS_MACROS, GMOCCAPY
+from helpers.iso_real_programs import REAL as ISO_REAL
 from helpers.linuxcnc_programs import PROGRAMS
+from helpers.real_lathe_corpus import CORPUS
+from helpers.real_programs_made import REAL as MADE
 from helpers.verifier_programs import refusal
-from test_iso_lathe_programs import REAL as ISO_REAL
-from test_real_lathe_corpus import CORPUS
-from test_real_programs_made import REAL as MADE
 
 NC = Path(__file__).resolve().parent / "data" / "nc"
 NOT_PROGRAMS = (".tsv", ".expected")     # provenance; LinuxCNC's expected interpreter output
@@ -65,7 +65,7 @@ def outcomes() -> dict[str, bool]:
 
 
 def made_key(name: str) -> str:
-    """test_real_programs_made's key of a file: LinuxCNC's paths under linuxcnc/, a gmoccapy macro by name."""
+    """helpers.real_programs_made's key of a file: LinuxCNC's paths under linuxcnc/, a gmoccapy macro by name."""
     short = name.removeprefix("linuxcnc/")
     if short.startswith("gmoccapy_lathe/"):
         return "gmoccapy/" + Path(short).stem
