@@ -22,6 +22,7 @@ from pathlib import Path
 import psycopg
 import pytest
 from helpers.class_jobs import ok, refused, stored_program
+from helpers.linuxcnc_programs import program_of
 from helpers.real_programs_made import MADE, REAL, Real
 
 from engine.machines.records import load_machine
@@ -146,3 +147,17 @@ def test_a_real_program_the_simulation_refuses_is_refused_when_made_and_nothing_
     assert reason in message and re.search(rf"line \d+ '\s*{re.escape(line)}\s*'", message), message
     assert message.endswith("nothing stored"), message
     assert programs(run.url) == before
+
+
+@pytest.mark.parametrize("blank", ["stock_diameter", "stock_z_front", "stock_z_back"])
+def test_a_blank_parameter_given_to_import_nc_is_refused_and_no_class_is_stored(run, tmp_path, blank):
+    """The threading macro's G76 ends `e0 l0`: stock_z_front 0 bound at import would make the taper E a
+    reference, and a job on another blank would cut another thread. The blank belongs to instantiate."""
+    lines = program_of("lathe_macros/threading.ngc")
+    source = written(lines, tmp_path)
+    params = tmp_path / "params.json"
+    params.write_text(json.dumps({blank: 0, "start_x": {"value": 1.2, "addresses": ["X"]}}))
+    message = refused(run("import-nc", source, "--class", "lm_blank", "--params", params))
+    assert f"parameter {blank} is the blank of a class job" in message and "instantiate --params" in message
+    with psycopg.connect(run.url) as conn:
+        assert conn.execute("SELECT count(*) FROM gear_class WHERE name = 'lm_blank'").fetchone() == (0,)

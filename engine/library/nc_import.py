@@ -62,7 +62,7 @@ from ..templates.rows import MODULE_ORDER, TemplateRow
 from ..templates.store import ensure_class, load_template, replace_template
 from ..templates.versions import released_version
 from .nc_halves import in_halves
-from .nc_params import binding_report, bindings, parse_addresses, values
+from .nc_params import binding_report, bindings, parse_addresses, refuse_blank_params, values
 from .nc_rows import Builder, Found
 from .nc_verify import Proof
 
@@ -102,6 +102,7 @@ def _import(conn: Connection, path, gear_class: str, params: dict | None, module
         raise EngineError(f"class name {gear_class!r}: use lower-case letters, digits and _, "
                           "starting with a letter")
     check_param_names(params or {})
+    refuse_blank_params(params or {})
     bound = bindings(params or {})
     params = values(params or {})
     lines, layout = read_nc_file(path)

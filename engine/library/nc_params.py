@@ -136,3 +136,16 @@ def _per_address(name: str, lines: dict) -> dict[str, list[int]]:
     """address → the sorted line numbers of `name`'s entries in `lines` ((name, address) → lines)."""
     return {address or NO_ADDRESS: sorted(numbers) for (owner, address), numbers in sorted(
         lines.items(), key=lambda item: item[0][1] or "") if owner == name}
+
+
+def refuse_blank_params(params: dict) -> None:
+    """The blank of a class job (stock_diameter, stock_z_front, stock_z_back, mm) is what the turning
+    simulation proves the program against, given at instantiate: bound at import it would also be a
+    value of the program, and a new blank would rewrite every word that held its value (a G76 E0
+    taper with stock_z_front 0)."""
+    from ..simulation.turning.work import BLANK_PARAMS  # the simulation's names; not needed at start-up
+
+    stated = [name for name in BLANK_PARAMS if name in params]
+    if stated:
+        raise EngineError(f"parameter {stated[0]} is the blank of a class job, not a value of the program: "
+                          "leave it out of import-nc's params and give it to instantiate --params")
