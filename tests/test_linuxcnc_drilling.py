@@ -42,6 +42,14 @@ def test_g83_takes_the_peck_clearance_d_of_the_block():
     assert z_moves(lines[1:]) == reference_g83(10.0, 1.0, -5.0, 3.0, 0.5, 10.0)
 
 
+def test_an_x0_in_the_g83_block_with_the_tool_on_the_axis_drills_as_without_it():
+    """A new user's G83 X0.000 after G0 X0: it moves nothing, so the pecks are those of the block
+    without its X (reference_g83 of the peck rule); an X off where the tool stands is refused."""
+    assert moves(*DRILL, "G98 G83 X0.000 Z-5 R1 Q3", "G80") == moves(*DRILL, "G98 G83 Z-5 R1 Q3", "G80")
+    with pytest.raises(ExpansionRefused, match="G83 with an X the tool is not at"):
+        moves("G17 G95 F0.1", "G0 X0 Z10", "G98 G83 X4 Z-5 R1 Q3")
+
+
 @pytest.mark.parametrize("body, reason", [
     (["G17 G95 F0.1", "G0 X10 Z10", "G98 G83 Z-5 R1 Q3"], "off the lathe's axis"),
     (["G95 F0.1", "G0 X0 Z10", "G98 G83 Z-5 R1 Q3"], "outside G17"),

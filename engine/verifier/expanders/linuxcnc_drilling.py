@@ -68,8 +68,10 @@ def _check(executor: Executor, words: Words) -> None:
         raise Refused("G83 with Y or a repeat L is not modelled")
     if "retract" not in modes.extra:
         raise Refused("G83 before G98/G99: the retract level is whatever the last program left")
-    if "x" in words.values:
-        raise Refused("G83 with an X: drill from the axis, G0 X0 before the cycle")
+    if "x" in words.values and not (words.values["x"] == 0 and modes.x == 0):
+        # an X0 where the tool already stands on the axis moves nothing; any other X is the cycle's
+        # first rapid, at the current Z, which the verifier does not follow
+        raise Refused("G83 with an X the tool is not at: drill from the axis, G0 X0 before the cycle")
     if modes.x is None or modes.z is None or abs(modes.x) > 1e-9:
         raise Refused("G83 off the lathe's axis (X not 0): the part turns, a drill off the axis cuts a ring; "
                       "G0 X0 before the cycle")
