@@ -30,6 +30,7 @@ from .golden import test_command
 from .hobs import hobs
 from .instantiate import instantiate
 from .jobs import jobs
+from .machines import machines
 from .nc_import import import_nc_command
 from .plot import plot_command
 from .programs import programs
@@ -207,8 +208,8 @@ def main(ctx, database_url, traceback):
         logging.getLogger("psycopg").addHandler(logging.NullHandler())
 
 
-COMMANDS = (demo, db, seed_command, gears, classify, instantiate, explain, template, lint, hobs, suggest, cases,
-            import_nc_command, refactor_command, import_dxf_command, plot_command, simulate, programs,
+COMMANDS = (demo, db, seed_command, gears, classify, instantiate, explain, template, lint, hobs, machines, suggest,
+            cases, import_nc_command, refactor_command, import_dxf_command, plot_command, simulate, programs,
             test_command, jobs, config)
 
 

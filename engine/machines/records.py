@@ -77,3 +77,8 @@ def load_machine(conn: Connection, name: str) -> Machine:
         known = ", ".join(r[0] for r in conn.execute("SELECT name FROM machine ORDER BY name"))
         raise EngineError(f"machine {name!r} does not exist; known machines: {known or 'none (run engine seed)'}")
     return as_float(Machine, row, "machine")
+
+
+def all_machines(conn: Connection) -> list[Machine]:
+    """Every machine record, by name: what `--machine` accepts."""
+    return [as_float(Machine, row, "machine") for row in conn.execute(MACHINE_QUERY + " ORDER BY name")]
