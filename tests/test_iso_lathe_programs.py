@@ -21,6 +21,7 @@ from helpers.verifier_programs import LATHE_ISO, accepted, refusal
 
 import engine.verifier.expansion as expansion
 from engine.machines.records import load_machine
+from engine.verifier import LimitError, verify_program
 from engine.verifier.expanders import cycles
 from engine.verifier.expanders.cycles import FEED, RAPID, THREAD, Move, Thread
 from engine.verifier.expanders.iso import expand_iso
@@ -265,3 +266,13 @@ def test_g76_cuts_each_pass_deeper_by_the_square_root_rule_along_the_flank():
 def test_g76_with_no_height_is_refused():
     with pytest.raises(cycles.CycleError):
         cycles.threading((22.0, 3.0), Thread(17.4, -20.0, 0.0, 0.4, 2.5))
+
+
+def test_a_program_whose_header_names_another_program_is_refused_saying_what_to_give(conn):
+    """A new user imported TOKARKA.NC as class y2 and made it as _Y2: its header %O1200(TOKARKA)
+    would store it on the control as TOKARKA; the refusal names both and the param that settles it."""
+    with pytest.raises(LimitError) as raised:
+        verify_program(real_lines("TOKARKA.NC"), load_machine(conn, "lathe-iso"), "_Y2")
+    message = str(raised.value)
+    assert "names program TOKARKA, but this program is _Y2" in message
+    assert "give program_name TOKARKA in the job's params" in message

@@ -172,7 +172,8 @@ class ProgramReading:
             raise Refused(f"the header names program {shown_name(name)}, but the job names none (params.program_name)")
         if name != self.program_name:
             raise Refused(f"the header names program {shown_name(name)}, but this program is "
-                          f"{shown_name(self.program_name)}: a read-in would store it as the other")
+                          f"{shown_name(self.program_name)}: a read-in would store it as the other; "
+                          f"give program_name {shown_name(name)} in the job's params")
         if not is_safe("program", name):
             raise Refused(f"the program name {shown_name(name)} is not {NAME_RULES['program'].rule}")
 
