@@ -20,7 +20,10 @@ MACHINE_COLUMNS = (
 
 @click.group("machines")
 def machines():
-    """Machine records: which machines exist, the dialect each runs and its limits."""
+    """Machine records: which machines exist, the dialect each runs and its limits.
+
+    Example: engine machines list
+    """
 
 
 @machines.command("list")
