@@ -18,7 +18,7 @@ Every expression is compiled and evaluated through the expression gate
 (engine.templates.expressions, engine.templates.evaluator), never Python's eval."""
 from __future__ import annotations
 
-from dataclasses import astuple, dataclass
+from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from .decision_table import CompiledRow, compile_row
@@ -111,7 +111,7 @@ def duplicates(rows: list[CompiledRow], known_names):
 
 
 def _body(row: CompiledRow) -> tuple:
-    return astuple(row.row)[1:]
+    return row.row.values()[1:]
 
 
 def _mistake(row: CompiledRow, adjacent: bool) -> str | None:

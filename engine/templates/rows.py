@@ -19,7 +19,7 @@ import io
 import json
 import re
 from collections.abc import Mapping
-from dataclasses import astuple, dataclass, field
+from dataclasses import dataclass, field
 from functools import cached_property
 from pathlib import Path
 
@@ -82,6 +82,12 @@ class TemplateRow:
     o: str | None
     p_emit: str | None
 
+    def values(self) -> tuple:
+        """(id, t, n, p_calc, s, o, p_emit): what dataclasses.astuple gives for these plain fields,
+        without its deep copy of every value (11 s of the 14 s that exporting every class of a library
+        with a 29,000-line program took)."""
+        return (self.id, self.t, self.n, self.p_calc, self.s, self.o, self.p_emit)
+
 
 @dataclass(frozen=True)
 class Template:
@@ -105,7 +111,7 @@ class Template:
 
 
 def rows_hash(rows) -> str:
-    payload = json.dumps([astuple(row) for row in rows], separators=(",", ":"))
+    payload = json.dumps([row.values() for row in rows], separators=(",", ":"))
     return hashlib.sha256(payload.encode()).hexdigest()[:16]
 
 
@@ -124,7 +130,7 @@ def export_csv(template: Template, layout: NcLayout = NcLayout()) -> str:
     given = layout_cells(layout) if layout != NcLayout() else []
     writer.writerow(CSV_COLUMNS + LAYOUT_COLUMNS if given else CSV_COLUMNS)
     for row in template.rows:
-        writer.writerow(["" if value is None else value for value in astuple(row)] + given)
+        writer.writerow(["" if value is None else value for value in row.values()] + given)
     return buffer.getvalue()
 
 
