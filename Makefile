@@ -4,7 +4,8 @@
 # files take DATABASE_URL (admin URL), else the server on 127.0.0.1:5432.
 VENV ?= .venv
 PYTHON ?= $(VENV)/bin/python
-PYTEST = $(PYTHON) -m pytest -q -p no:cacheprovider
+PYTEST = $(PYTHON) -m pytest -q -p no:cacheprovider $(WORKERS)
+WORKERS ?= -n 2 --dist worksteal   # pytest-xdist, as .ci/run; `make test WORKERS=` for one process
 BENCHMARKS = $(filter-out bench/_common.py bench/smoke.py,$(sort $(wildcard bench/*.py)))
 
 .PHONY: test test-fast lint typecheck golden docs bench bench-smoke
