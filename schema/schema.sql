@@ -1061,8 +1061,12 @@ BEGIN
               FROM assembly a JOIN component c ON c.id = a.component_id WHERE a.gear_class = class_name) THEN
         RETURN false;
     END IF;
+    -- Only a row that breaks one of template_row_check's rules is checked (for its message), in the
+    -- same order: a call per row took 1.3 s of a 100,000-line import-nc.
     PERFORM template_row_check(class_name, x.id, x.t, x.n, x.p_calc, x.s, x.o)
-    FROM jsonb_to_recordset(own) AS x (id integer, t text, n integer, p_calc text, s text, o text);
+    FROM jsonb_to_recordset(own) AS x (id integer, t text, n integer, p_calc text, s text, o text)
+    WHERE x.id IS NULL OR x.id < 0 OR x.n IS NULL OR x.n < 0 OR (x.o IS NULL AND x.s IS NULL)
+       OR (x.p_calc IS NOT NULL AND x.s IS NULL) OR NOT EXISTS (SELECT 1 FROM module_type m WHERE m.code = x.t);
     before := class_rows_json(class_name);
     WITH gone AS (DELETE FROM assembly WHERE gear_class = class_name RETURNING component_id)
     SELECT array_agg(component_id) INTO old_components FROM gone;

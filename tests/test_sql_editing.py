@@ -8,6 +8,7 @@ import pytest
 from helpers.releases import release_draft
 from helpers.roles import as_role
 from psycopg import errors, sql
+from psycopg.types.json import Jsonb
 
 from engine.library.refactor import refactor
 from engine.programs.instantiate import instantiate_gear
@@ -268,6 +269,32 @@ def test_a_statement_with_one_bad_row_changes_no_row(conn):
                      "WHERE gear_class = 'spur' AND id IN (800, 900, 1000, 1100)")
     assert state(conn) == before
 
+
+
+# The same rules where the engine's imports write a class (replace_class_template, issue 28: it
+# checks one by one only the rows that break a rule): each bad row is refused with the words of
+# template_view, the first bad row in order is the one named, and nothing changes.
+GOOD_ROW = {"id": 10, "t": "main", "n": 1, "p_calc": None, "s": None, "o": '"G90"', "p_emit": None}
+BAD_ROWS = [({"id": -5}, errors.CheckViolation, "class imported row -5 column id: id must not be negative"),
+            ({"n": -1}, errors.CheckViolation, "class imported row 30 column n: n must be a whole number >= 0, got -1"),
+            ({"t": "mian"}, errors.CheckViolation,
+             "class imported row 30 column t: unknown module type 'mian'; use one of main, prep, sync, shift, "
+             "cutcond, cutmotion"),
+            ({"o": None}, errors.CheckViolation, "class imported row 30 column o: row has neither o nor s: it does nothing"),
+            ({"p_calc": "x > 1"}, errors.CheckViolation,
+             "class imported row 30 column p_calc: p_calc has no effect without s (use p_emit to decide output)")]
+
+
+@pytest.mark.parametrize("change, error, message", BAD_ROWS, ids=[next(iter(case[0])) for case in BAD_ROWS])
+def test_an_imported_row_breaking_a_rule_is_refused_naming_the_first_and_nothing_changes(conn, change, error, message):
+    conn.execute("INSERT INTO gear_class (name) VALUES ('imported')")
+    rows = [{**GOOD_ROW, "id": row_id} for row_id in (10, 20)]
+    rows += [{**GOOD_ROW, "id": 30, **change}, {**GOOD_ROW, "id": 40, "n": -2}, {**GOOD_ROW, "id": 50}]
+    before = state(conn)
+    with pytest.raises(error) as refused, conn.transaction():
+        conn.execute("SELECT replace_class_template('imported', %s)", (Jsonb(rows),))
+    assert refused.value.diag.message_primary == message
+    assert state(conn) == before
 
 # --- audit ------------------------------------------------------------------------------------
 
