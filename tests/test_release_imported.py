@@ -44,8 +44,11 @@ def repeats(lines: list[str]) -> tuple[list[str], list[str], list[int]]:
     """(non-blank lines repeated further on, non-blank lines right after their twin, blank lines right
     after a blank line), each by its line number."""
     after_twin = [index for index in range(1, len(lines)) if lines[index] == lines[index - 1]]
-    further_on = [index for index in range(len(lines)) if lines[index].strip() and index not in after_twin
-                  and lines[index] in lines[:index]]
+    twins, seen, further_on = set(after_twin), set(), []
+    for index, line in enumerate(lines):   # one pass: `line in lines[:index]` took 8 s on TOKARKA.NC's 28,904 lines
+        if line.strip() and index not in twins and line in seen:
+            further_on.append(index)
+        seen.add(line)
     return (further_on, [index for index in after_twin if lines[index].strip()],
             [index for index in after_twin if not lines[index].strip()])
 
