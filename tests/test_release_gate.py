@@ -340,3 +340,20 @@ def test_a_draft_that_drives_a_stored_hobbing_job_beyond_the_machine_is_refused(
     edit(conn, "spur", 1700, o='f"M3 S{n0 * 5 if z2 == 48 else n0}"')
     problems = refusal(conn, "spur", dry_run=True).problems
     assert any(f"stored job {job_id} " in problem and "exceeds" in problem for problem in problems), problems
+
+
+def test_a_draft_whose_program_the_hobbing_simulation_refuses_for_a_stored_job_is_refused(conn):
+    """Issue 28: impact proves every program it changes. A spur draft that makes the axial cut a
+    rapid for 48-tooth gears only (no golden gear has 48 teeth, and the move is inside the travel, so
+    the verifier reads it) would drive gear 46's stored job through its blank at rapid. The impact
+    follows each changed program with the hobbing simulation against the job's gear and hob."""
+    job_id = instantiate_gear(conn, 46).job_id
+    other = instantiate_gear(conn, 42).job_id
+    teeth = dict(conn.execute("SELECT id, teeth FROM gear WHERE id IN (42, 46)").fetchall())
+    assert teeth[46] == 48 != teeth[42]
+    edit(conn, "spur", 2700, o='f"G{0 if z2 == 48 else 1} Z{z_to:.3f} F{feed_axial:.1f}"')   # the last cut
+    report = impact(conn, "spur")
+    assert [failure.job_id for failure in report.failures] == [job_id] and report.failures[0].released_makes
+    assert "gear 46" in report.failures[0].error and other not in {diff.job_id for diff in report.diffs}
+    problems = refusal(conn, "spur", dry_run=True).problems
+    assert any(f"stored job {job_id} " in problem and "gear 46" in problem for problem in problems), problems

@@ -1,9 +1,12 @@
 """What a release would change on the shop floor (issue 15): every stored job of a class and of
 its descendants made again with the draft template and compared with its program from the
-released version. Template rows only (as engine.programs.remake makes a stored job again,
-without the verifier and the hobbing simulation, which the gate does not need to see a line
-change). A turning job's draft program is followed by the turning simulation (issue 26): a draft
-whose program for a stored job it refuses is named as failing for that job.
+released version. Each program the draft changes is proved as a program that is stored is
+(engine.programs.verified_run): read by the machine's verifier, and followed by the simulation
+against the job's records: a hobbing job's by the hobbing simulation against its gear and hob as
+stored (issue 28), a turning job's by the turning simulation (issue 26). A draft whose program for
+a stored job fails the proof is named as failing for that job; the gate refuses it where the
+released version makes that job a program that passes. A program the draft leaves as it is, is
+not proved again: releasing the draft does not change it.
 
 The "before" side is the released version rendered now for the job, never the job's stored
 program: a stored program is a record a runner can write by hand (program_submission), and one that
@@ -23,11 +26,13 @@ from typing import TYPE_CHECKING
 
 from ..errors import EngineError
 from ..gears.models import model_for_class
+from ..gears.records import Gear, Hob, load_gear, load_hobs
 from ..machines.records import load_machine
 from ..nc.layout import ENDING_NAMES, NcLayout
 from ..programs import all_models  # noqa: F401  (registers every model)
 from ..programs.job_shape import job_with_cycle_time
 from ..programs.verified_run import TurningWork, class_work
+from ..simulation import SimulationError, simulate_program
 from ..simulation.turning.run import simulate_turning
 from ..templates.decision_table import compiled_template
 from ..templates.history import layout_change
@@ -45,7 +50,7 @@ DIFFS_SHOWN = 5   # unified diffs the CLI prints (all of them with --json)
 # Every job of the classes, and whether it has a stored program (whose file a layout change changes).
 JOBS = """
 SELECT j.id, j.gear_class, j.machine, j.params::text, j.module_params::text,
-       EXISTS (SELECT 1 FROM program p WHERE p.job_id = j.id)
+       EXISTS (SELECT 1 FROM program p WHERE p.job_id = j.id), j.gear_id, j.hob_id
 FROM job j
 WHERE j.gear_class = ANY(%s::text[])
 ORDER BY j.id"""
@@ -145,21 +150,26 @@ def _layout_changes(conn: Connection, pairs: dict[str, tuple[Template, Template,
 
 
 def _compare(report: Impact, made: _Made, job) -> None:
-    job_id, gear_class, machine, params_text, modules_text, has_program = job
+    job_id, gear_class, machine, params_text, modules_text, has_program, gear_id, hob_id = job
     report.jobs += 1
     if gear_class in report.layouts and has_program:
         report.layouts[gear_class].programs += 1
     if not made.has_draft(gear_class):
         return   # no draft: nothing changes
-    key = gear_class, machine, params_text, modules_text
+    key = gear_class, machine, params_text, modules_text, gear_id, hob_id
     new_lines = made.draft_lines(key, job_id)
     if isinstance(new_lines, EngineError):
         report.failures.append(JobFailure(job_id, gear_class, str(new_lines), made.released_proves(key, job_id)))
         return
     old_lines = made.released_lines(key, job_id)   # rendered now: a stored program may be a forgery
-    if old_lines != new_lines:
-        report.changed += 1
-        report.diffs.append(JobDiff(job_id, gear_class, made.diff(gear_class, old_lines, new_lines)))
+    if old_lines == new_lines:
+        return   # the release does not change this job's program: not proved again
+    failure = made.draft_failure(key, job_id)
+    if failure is not None:
+        report.failures.append(JobFailure(job_id, gear_class, str(failure), made.released_proves(key, job_id)))
+        return
+    report.changed += 1
+    report.diffs.append(JobDiff(job_id, gear_class, made.diff(gear_class, old_lines, new_lines)))
 
 
 class _Made:
@@ -170,6 +180,7 @@ class _Made:
         self.pairs, self.inputs = pairs, _JobInputs(conn)
         self.drafts: dict[tuple, list[str] | EngineError] = {}
         self.releases: dict[tuple, list[str]] = {}
+        self.proofs: dict[tuple, EngineError | None] = {}
 
     def has_draft(self, gear_class: str) -> bool:
         released, draft, _ = self.pairs[gear_class]
@@ -184,21 +195,32 @@ class _Made:
                             f"{gear_class} v{draft_version} (draft)")
 
     def draft_lines(self, key: tuple, job_id: int) -> list[str] | EngineError:
+        """The draft's lines for the job, or why the draft makes none (its rows fail to run)."""
         if key not in self.drafts:
             try:
-                lines = compiled_template(self.pairs[key[0]][1]).run(*self.inputs.of(job_id, *key)).lines
-                self.inputs.prove(key, lines)
-                self.drafts[key] = lines
+                self.drafts[key] = compiled_template(self.pairs[key[0]][1]).run(*self.inputs.of(job_id, *key)).lines
             except EngineError as error:
                 self.drafts[key] = error
         return self.drafts[key]
+
+    def draft_failure(self, key: tuple, job_id: int) -> EngineError | None:
+        """Why the draft's changed program for the job fails its proof (verifier, simulation), or None."""
+        if key not in self.proofs:
+            lines = self.drafts[key]
+            assert not isinstance(lines, EngineError)
+            try:
+                self.inputs.prove(key, lines, job_id)
+                self.proofs[key] = None
+            except EngineError as error:
+                self.proofs[key] = error
+        return self.proofs[key]
 
     def released_proves(self, key: tuple, job_id: int) -> bool:
         """The released template makes the job a program the draft's proof accepts (asked only for a
         job the draft fails for: a job that fails with both is an old problem, not the draft's)."""
         try:
             lines = compiled_template(self.released(key[0])).run(*self.inputs.of(job_id, *key)).lines
-            self.inputs.prove(key, lines)
+            self.inputs.prove(key, lines, job_id)
         except EngineError:
             return False
         return True
@@ -225,9 +247,11 @@ class _JobInputs:
         self.conn = conn
         self.machines: dict[str, Machine] = {}
         self.shapes: dict[str, str] = {}   # class -> its model's cut shape
+        self.gears: dict[int, Gear] = {}
+        self.hobs: dict[str, Hob] | None = None
 
     def of(self, job_id: int, gear_class: str, machine_name: str, params_text: str,
-           modules_text: str) -> tuple[dict, dict]:
+           modules_text: str, *_records) -> tuple[dict, dict]:
         params, modules = json.loads(params_text), json.loads(modules_text or "{}")
         machine = self.machine(machine_name)
         if machine.kind == "lathe":
@@ -238,17 +262,19 @@ class _JobInputs:
             params = job_with_cycle_time(job_id, params, modules, self.cut_shape(gear_class), machine)
         return params, modules
 
-    def prove(self, key: tuple, lines: list[str]) -> None:
-        """A job's draft program read by the machine's verifier (its limits: an S beyond the hob
-        spindle, a move beyond the travel) and, for a turning job, followed by the turning simulation
-        against the job's stored records, as engine.programs.verified_run proves it: EngineError if
-        refused. A class job's lathe program is simulated against its blank without a drawing record
-        (issue 27). A hobbing job's program is not simulated here (issue 28: the impact's cost)."""
-        gear_class, machine_name, params_text, modules_text = key
+    def prove(self, key: tuple, lines: list[str], job_id: int) -> None:
+        """A job's program read by the machine's verifier (its limits: an S beyond the hob spindle, a
+        move beyond the travel) and followed by the simulation against the job's stored records, as
+        engine.programs.verified_run proves it: EngineError if refused. A hobbing job's against its
+        gear and hob as stored (issue 28); a turning job's against its drawing's records, a class
+        job's lathe program against its blank without a drawing record (issue 27)."""
+        gear_class, machine_name, params_text, modules_text, gear_id, hob_id = key
         machine = self.machine(machine_name)
         params = json.loads(params_text)
         name = params.get("program_name") if isinstance(params, dict) else None
         verify_program(lines, machine, name if isinstance(name, str) else None)
+        if machine.kind == "hobber":
+            self.prove_hobbing(lines, machine, job_id, gear_id, hob_id, name if isinstance(name, str) else None)
         if machine.kind != "lathe" or not isinstance(params, dict):
             return
         work = TurningWork(params, json.loads(modules_text or "{}")) if "profile" in params else class_work(params)
@@ -256,6 +282,23 @@ class _JobInputs:
                                   params.get("program_name") or "the program")
         if report.refused:
             raise report.error()
+
+    def prove_hobbing(self, lines: list[str], machine: Machine, job_id: int, gear_id: int | None,
+                      hob_id: str | None, name: str | None) -> None:
+        """The hobbing simulation of a job's program against its gear and hob records (a stored
+        hobbing job names both; one that does not cannot be proved, as engine.programs.remake says)."""
+        if gear_id is None or hob_id is None:
+            raise EngineError(f"job {job_id} is a hobbing job without a {'gear' if gear_id is None else 'hob'}: "
+                              "its program cannot be proved against the records")
+        if self.hobs is None:
+            self.hobs = {hob.id: hob for hob in load_hobs(self.conn)}
+        if hob_id not in self.hobs:
+            raise EngineError(f"hob {hob_id!r} of job {job_id} does not exist; see `engine hobs list`")
+        if gear_id not in self.gears:
+            self.gears[gear_id] = load_gear(self.conn, gear_id)
+        report = simulate_program(lines, self.gears[gear_id], self.hobs[hob_id], machine, name or "the program")
+        if report.refused:
+            raise SimulationError(f"gear {gear_id}: {report.error()}")
 
     def cut_shape(self, gear_class: str) -> str:
         if gear_class not in self.shapes:
