@@ -342,18 +342,33 @@ def test_a_draft_that_drives_a_stored_hobbing_job_beyond_the_machine_is_refused(
     assert any(f"stored job {job_id} " in problem and "exceeds" in problem for problem in problems), problems
 
 
-def test_a_draft_whose_program_the_hobbing_simulation_refuses_for_a_stored_job_is_refused(conn):
+@pytest.mark.parametrize("workers", [1, 2])
+def test_a_draft_whose_program_the_hobbing_simulation_refuses_for_a_stored_job_is_refused(conn, workers):
     """Issue 28: impact proves every program it changes. A spur draft that makes the axial cut a
     rapid for 48-tooth gears only (no golden gear has 48 teeth, and the move is inside the travel, so
     the verifier reads it) would drive gear 46's stored job through its blank at rapid. The impact
-    follows each changed program with the hobbing simulation against the job's gear and hob."""
+    follows each changed program with the hobbing simulation against the job's gear and hob, in one
+    process or forked workers alike."""
     job_id = instantiate_gear(conn, 46).job_id
     other = instantiate_gear(conn, 42).job_id
     teeth = dict(conn.execute("SELECT id, teeth FROM gear WHERE id IN (42, 46)").fetchall())
     assert teeth[46] == 48 != teeth[42]
     edit(conn, "spur", 2700, o='f"G{0 if z2 == 48 else 1} Z{z_to:.3f} F{feed_axial:.1f}"')   # the last cut
-    report = impact(conn, "spur")
+    report = impact(conn, "spur", workers)
     assert [failure.job_id for failure in report.failures] == [job_id] and report.failures[0].released_makes
     assert "gear 46" in report.failures[0].error and other not in {diff.job_id for diff in report.diffs}
-    problems = refusal(conn, "spur", dry_run=True).problems
+    problems = refusal(conn, "spur", dry_run=True, workers=workers).problems
     assert any(f"stored job {job_id} " in problem and "gear 46" in problem for problem in problems), problems
+
+
+def test_the_impact_proved_in_two_workers_is_the_impact_proved_here(conn):
+    """The changed programs of several stored jobs proved in forked workers: the same changes, the
+    same failures with the same reasons, in job order; the connection the workers inherit is not
+    theirs to use, and it still works after them."""
+    for gear in (42, 45, 46, 54):
+        instantiate_gear(conn, gear)
+    edit(conn, "spur", COOLANT_ROW, p_emit="coolant AND z2 >= 30")
+    edit(conn, "spur", 2700, o='f"G{0 if z2 == 48 else 1} Z{z_to:.3f} F{feed_axial:.1f}"')
+    here, two = impact(conn, "spur"), impact(conn, "spur", workers=2)
+    assert here == two and len(here.failures) == 1 and here.changed >= 2
+    assert conn.execute("SELECT count(*) FROM job").fetchone()[0] >= 4

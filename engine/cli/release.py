@@ -13,12 +13,15 @@ SHOWN_FAILURES = 5   # jobs the draft fails for, listed by the text output (all 
 @click.option("--dry-run", is_flag=True, help="Run the gate and show the impact; release nothing.")
 @click.option("--yes", is_flag=True, help="Release without asking (after the gate and the impact).")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object, every diff included.")
+@click.option("--workers", type=click.IntRange(1, 64), default=1, show_default=True,
+              help="Prove the stored jobs' changed programs (verifier and simulation) in this many processes.")
 @click.pass_context
-def template_release(ctx, gear_class, dry_run, yes, as_json):
+def template_release(ctx, gear_class, dry_run, yes, as_json, workers):
     """Release the class's draft to the shop floor: refused, naming every row, column and test that
     failed, unless engine lint, the golden tests of the class and its descendants and the static
-    analysis pass. Shows how many stored programs the release changes and the first diffs, then
-    asks (unless --yes). Needs the role engine_releaser.
+    analysis pass. Shows how many stored programs the release changes and the first diffs, each
+    changed program proved by the verifier and the simulation, then asks (unless --yes). Needs the
+    role engine_releaser.
 
     Example: engine template release --class spur --dry-run
     """
@@ -33,7 +36,7 @@ def template_release(ctx, gear_class, dry_run, yes, as_json):
         return click.confirm(f"release class {report.gear_class} v{report.version}?", err=True)
 
     with connection(ctx) as conn:
-        report = release(conn, gear_class, dry_run=dry_run, confirm=confirm)
+        report = release(conn, gear_class, dry_run=dry_run, confirm=confirm, workers=workers)
     if as_json:
         return emit_json(_as_json(report))
     if dry_run or yes:

@@ -74,3 +74,31 @@ def _plan_slice(bounds: tuple[int, int]) -> list:
     """In a worker: plan a slice of the gears (plan_one encodes them, here, in parallel)."""
     planner, gears, plan_one = _BATCH
     return [plan_one(planner, gear) for gear in gears[bounds[0]:bounds[1]]]
+
+
+_MAPPED: list = []   # (work, the worker's set-up) of the map being run, inherited by the forked workers
+
+
+def map_in_workers(work, items: list, workers: int, in_worker=None) -> list:
+    """[work(item) for item in items], in `workers` forked processes, in order. What `work` returns
+    comes back pickled; `in_worker()` runs first in each worker (to take away what it must not
+    touch: the database connection it inherits). One worker, or a single item, runs here."""
+    if workers <= 1 or len(items) < 2:
+        return [work(item) for item in items]
+    size = max(1, len(items) // (workers * SLICES_PER_WORKER))
+    slices = [items[start:start + size] for start in range(0, len(items), size)]
+    _MAPPED[:] = [work, in_worker]
+    try:
+        with multiprocessing.get_context("fork").Pool(workers, initializer=_mapping_worker) as pool:
+            return [result for done in pool.imap(_map_slice, slices) for result in done]
+    finally:
+        _MAPPED.clear()
+
+
+def _mapping_worker() -> None:
+    if _MAPPED[1] is not None:
+        _MAPPED[1]()
+
+
+def _map_slice(items: list) -> list:
+    return [_MAPPED[0](item) for item in items]

@@ -55,10 +55,10 @@ class ReleaseReport:
     drafts_below: list[str] = field(default_factory=list)   # descendants whose drafts need their own release
 
 
-def release(conn: Connection, gear_class: str, dry_run: bool = False, confirm=None) -> ReleaseReport:
+def release(conn: Connection, gear_class: str, dry_run: bool = False, confirm=None, workers: int = 1) -> ReleaseReport:
     """Gate, impact and (not a dry run) the release of the class's draft, in one transaction.
     `confirm(report)`, if given, is asked after the impact and before recording; False releases
-    nothing."""
+    nothing. The impact proves the programs the draft changes in `workers` processes."""
     with conn.transaction():
         draft = draft_template(conn, gear_class)
         if not draft.draft:
@@ -67,7 +67,7 @@ def release(conn: Connection, gear_class: str, dry_run: bool = False, confirm=No
         if not dry_run:
             _require_releaser(conn)
         tests, checks = gate(conn, gear_class, draft)
-        report = ReleaseReport(gear_class, draft.version, draft.hash, dry_run, tests, impact(conn, gear_class),
+        report = ReleaseReport(gear_class, draft.version, draft.hash, dry_run, tests, impact(conn, gear_class, workers),
                                checks, drafts_below=drafts_below(conn, gear_class))
         refuse_broken_jobs(gear_class, draft.version, report.impact)
         if not dry_run and (confirm is None or confirm(report)):

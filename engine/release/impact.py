@@ -32,6 +32,7 @@ from ..nc.layout import ENDING_NAMES, NcLayout
 from ..programs import all_models  # noqa: F401  (registers every model)
 from ..programs.job_shape import job_with_cycle_time
 from ..programs.verified_run import TurningWork, class_work
+from ..programs.workers import map_in_workers
 from ..simulation import SimulationError, simulate_program
 from ..simulation.turning.run import simulate_turning
 from ..templates.decision_table import compiled_template
@@ -112,15 +113,17 @@ class Impact:
                 "layout": [change.as_json() for change in self.layouts.values()]}
 
 
-def impact(conn: Connection, gear_class: str) -> Impact:
+def impact(conn: Connection, gear_class: str, workers: int = 1) -> Impact:
     """Every stored job of the class and its descendants made with the draft, compared with the
-    released program."""
+    released program; the changed programs proved in `workers` processes."""
     pairs = _template_pairs(conn, class_and_descendants(conn, gear_class))
     report = Impact(gear_class, layouts=_layout_changes(conn, pairs))
     if not pairs:
         return report
     made = _Made(conn, pairs)
-    for job in conn.cursor(binary=True).execute(JOBS, (list(pairs),)):
+    jobs = conn.cursor(binary=True).execute(JOBS, (list(pairs),)).fetchall()
+    made.prove_changed(jobs, workers)
+    for job in jobs:
         _compare(report, made, job)
     return report
 
@@ -203,6 +206,30 @@ class _Made:
                 self.drafts[key] = error
         return self.drafts[key]
 
+    def prove_changed(self, jobs: list, workers: int) -> None:
+        """Prove ahead, in `workers` processes, the draft's program of every distinct job input it
+        changes (the simulation is most of an impact's time); the records they are proved against are
+        read here first, the workers read no database."""
+        pending: dict[tuple, int] = {}
+        for job_id, gear_class, machine, params_text, modules_text, _, gear_id, hob_id in jobs:
+            key = gear_class, machine, params_text, modules_text, gear_id, hob_id
+            if key in pending or not self.has_draft(gear_class):
+                continue
+            lines = self.draft_lines(key, job_id)
+            if not isinstance(lines, EngineError) and lines != self.released_lines(key, job_id):
+                pending[key] = job_id
+        self.inputs.read_records(list(pending))
+        proofs = map_in_workers(self._proof_of, list(pending.items()), workers, self.inputs.without_database)
+        self.proofs.update(zip(pending, proofs))
+
+    def _proof_of(self, pending: tuple) -> EngineError | None:
+        key, job_id = pending
+        try:
+            self.inputs.prove(key, self.drafts[key], job_id)   # type: ignore[arg-type]   # lines: pending only
+        except EngineError as error:
+            return EngineError(str(error))   # as its message: what a worker sends back is pickled
+        return None
+
     def draft_failure(self, key: tuple, job_id: int) -> EngineError | None:
         """Why the draft's changed program for the job fails its proof (verifier, simulation), or None."""
         if key not in self.proofs:
@@ -249,6 +276,24 @@ class _JobInputs:
         self.shapes: dict[str, str] = {}   # class -> its model's cut shape
         self.gears: dict[int, Gear] = {}
         self.hobs: dict[str, Hob] | None = None
+
+    def read_records(self, keys: list[tuple]) -> None:
+        """The machines, gears and hobs the proofs of these job inputs read, read now."""
+        for _, machine_name, _, _, gear_id, hob_id in keys:
+            machine = self.machine(machine_name)
+            if machine.kind != "hobber" or gear_id is None or hob_id is None:
+                continue
+            if self.hobs is None:
+                self.hobs = {hob.id: hob for hob in load_hobs(self.conn)}
+            if gear_id not in self.gears:
+                try:
+                    self.gears[gear_id] = load_gear(self.conn, gear_id)
+                except EngineError:
+                    pass   # the proof names the job's missing gear
+
+    def without_database(self) -> None:
+        """In a worker: the connection it inherits shares the parent's socket, so it is taken away."""
+        self.conn = None   # type: ignore[assignment]
 
     def of(self, job_id: int, gear_class: str, machine_name: str, params_text: str,
            modules_text: str, *_records) -> tuple[dict, dict]:
