@@ -3,7 +3,9 @@ the intended cut. Intended: a G1 with the table coupled and the hob spindle turn
 unit whose teeth the coupling generates, never below its intended root (less TOLERANCE). The
 gaps such cuts leave are free to the hob while the same coupling lasts (a coupled retract out
 of its own gaps), except on a rapid along Z (engine.simulation.hobbing.walk). Anything else that enters
-material is a collision. Plain floats, pose by pose and height by height (issue 28: no numpy)."""
+material is a collision. Followed pose by pose and height by height in plain floats; the envelope
+is computed with numpy only after a process's first MATH_SECTIONS sections (issue 28: one gear's
+command never imports numpy)."""
 from __future__ import annotations
 
 from bisect import bisect_left, bisect_right
@@ -15,8 +17,8 @@ from .solids import Solid
 TOLERANCE = 0.01      # mm: below the root, or into material, before it counts
 # Sections (one pose at one height) a process follows in plain floats before it imports numpy for
 # the rest (engine.simulation.hobbing.envelope_arrays): one gear takes a few thousand (gear 42 of
-# the samples 4,300), a batch hundreds of thousands; in plain floats each costs about 5 µs more, so
-# this many cost about what importing numpy does (0.1 s)
+# the samples 4,300), a batch hundreds of thousands; in plain floats each costs about 5–10 µs more,
+# so this many cost about what importing numpy does (0.1–0.2 s)
 MATH_SECTIONS = 20_000
 _followed = [0]       # sections followed by this process so far
 

@@ -8,9 +8,9 @@ axis than the solid's radius. `nearest_radius` gives that closest distance at on
 horizontal slice of the (convex) cylinder is convex and the distance from the work axis is a
 convex function, so along the slice's one free coordinate (dy, the slice's Y from the centre)
 the minimum is where the derivative changes sign, found by Newton's method kept inside a
-bracket that halves when a step leaves it. Plain floats (math): the simulation needs no numpy,
-so proving one gear starts without importing it (issue 28). Exact to well below a micrometre,
-not sampled.
+bracket that halves when a step leaves it. Plain floats (math): proving one gear needs no numpy
+and starts without importing it (issue 28); a batch's later sections go to the same search with
+numpy (engine.simulation.hobbing.envelope_arrays). Exact to well below a micrometre, not sampled.
 
 The shift axis Y rides on the swivel head: Y moves the hob along its own axis, so the
 generating zone stays where X and Z put it and a different part of the hob reaches it."""

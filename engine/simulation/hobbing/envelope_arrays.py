@@ -1,7 +1,7 @@
 """The hob envelope of engine.simulation.hobbing.envelope for many poses and heights at once,
 with numpy: the same least distance from the work axis per height, by golden-section search
 along the section's free coordinate, for every pose and height together. A batch of gears
-follows hundreds of thousands of sections, about ten times faster so than one by one in plain
+follows hundreds of thousands of sections, several times faster so than one by one in plain
 floats, but importing numpy takes about 0.1 s: a process follows its first sections in plain
 floats (engine.simulation.hobbing.contact.MATH_SECTIONS) and imports this module only after
 them, so one gear's command never loads numpy (issue 28). The two agree to about a micrometre
