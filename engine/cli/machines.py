@@ -1,14 +1,16 @@
 """`engine machines list`: the machine records, each with its kind, its NC dialect (the grammar the
 verifier reads its programs in), its travel and spindle limit and, for ISO lathes, the control's
-facts the record states (G-code system, decimal point input, power-on modes)."""
+facts the record states (G-code system, decimal point input, power-on modes); `--csv` every column
+of the record, as `engine machines import` reads it. `engine machines import`: new machine records
+from such a file (engine.machines.importing)."""
 from __future__ import annotations
 
-from dataclasses import asdict
+from dataclasses import asdict, fields
 
 import click
 
-from .context import connection
-from .output import Column, emit_list, list_options
+from .context import connection, emit_json
+from .output import Column, csv_text, emit_list, list_options
 
 MACHINE_COLUMNS = (
     Column("machine", "name"), Column("kind", "kind"), Column("dialect", "dialect"),
@@ -16,6 +18,13 @@ MACHINE_COLUMNS = (
     Column("spindle max", "spindle_max"), Column("G-code system", "gcode_system"),
     Column("decimal point", "decimal_point_input"), Column("power-on", "power_on"),
 )
+
+
+def every_column() -> tuple[Column, ...]:
+    """The record's every field, as --csv writes it and `engine machines import` reads it."""
+    from ..machines.records import Machine
+
+    return tuple(Column(spec.name, spec.name) for spec in fields(Machine))
 
 
 @click.group("machines")
@@ -31,13 +40,37 @@ def machines():
 @click.pass_context
 def machines_list(ctx, output):
     """Every machine record, one line each (kind, dialect, travel in mm, spindle r/min, ISO facts).
-    --json gives every field of the record. Add or change a record in SQL (docs/guide/
-    machines-and-simulation.md).
+    --json and --csv give every field of the record (the CSV as `engine machines import` reads it).
+    Change a record in SQL (docs/guide/machines-and-simulation.md).
 
-    Example: engine machines list --csv
+    Example: engine machines list --csv > machines.csv
     """
     from ..machines.records import all_machines
 
     with connection(ctx) as conn:
         records = [asdict(machine) for machine in all_machines(conn)]
+    if output == "csv":
+        click.echo(csv_text(every_column(), records), nl=False)
+        return
     emit_list(output, "machines", MACHINE_COLUMNS, records)
+
+
+@machines.command("import")
+@click.argument("csv_file", type=click.Path(dir_okay=False))
+@click.option("--json", "as_json", is_flag=True, help="Print one JSON object: {added: [names]}.")
+@click.pass_context
+def machines_import(ctx, csv_file, as_json):
+    """Add the machines of CSV_FILE (the columns `engine machines list --csv` writes; name, kind and
+    dialect required, an empty cell the column's default). Only new machines: one that exists is
+    refused (change it in SQL); any bad row stops the whole file, nothing stored.
+
+    Example: engine machines import my_lathes.csv
+    """
+    from ..machines.importing import import_machines
+    from ..verifier.grammar import DIALECTS
+
+    with connection(ctx) as conn:
+        added = import_machines(conn, csv_file, set(DIALECTS))
+    if as_json:
+        return emit_json({"added": added})
+    click.echo(f"{csv_file}: added {len(added)} machine(s): {', '.join(added)}")

@@ -5,7 +5,7 @@ from __future__ import annotations
 import csv
 import json
 import tempfile
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -18,7 +18,7 @@ from ..gears.gear_import import GEAR_KIND, read_gears
 from ..gears.gear_store import identical_gears, import_gears, installed_classes
 from ..gears.hob_library import HOB_COLUMNS
 from ..gears.units import UNIT_KIND, import_units
-from ..machines.records import Machine
+from ..machines.importing import MACHINE_KIND
 from ..paths import SEED_DIR
 from ..templates.expectations import refuse_slow_patterns
 from ..templates.rows import read_csv
@@ -30,8 +30,6 @@ if TYPE_CHECKING:
 # The seed tables' CSV kinds: every cell goes as text, and the database parses it into its column's type.
 CLASS_KIND = CsvKind("gear class", (Column("name", parse_text, required=True), Column("parent", parse_text),
                                     Column("description", parse_text)))
-MACHINE_KIND = CsvKind("machine", tuple(Column(spec.name, parse_text, required=spec.name in ("name", "kind", "dialect"))
-                                        for spec in fields(Machine)))   # the columns of the machine table
 SEED_HOB_KIND = CsvKind("hob", tuple(Column(column.name, parse_text, column.required) for column in HOB_COLUMNS))
 
 # table, CSV file, key column, its kind; loaded in this order.
