@@ -298,7 +298,8 @@ def test_release_on_the_command_line_and_history(run):
     committed_edit(run.url, COOLANT_OFF_ROW, o=COMMENTED)
     dry = run("template", "release", "--class", "spur", "--dry-run", "--json")
     payload = json.loads(dry.stdout)
-    assert dry.stdout.count("\n") == 1 and payload["impact"]["changed"] == 1 and not payload["released"]
+    assert dry.stdout.count("\n") == 1 and not payload["released"]
+    assert payload["impact"]["changed"] == payload["impact"]["proved"] == 1
     assert "+M9 ; COOLANT OFF" in payload["impact"]["diffs"][0]["diff"]
     declined = CliInput(run, "n\n")("template", "release", "--class", "spur")
     assert "1 program(s) change" in declined.stdout and "nothing released" in declined.stdout
@@ -357,6 +358,7 @@ def test_a_draft_whose_program_the_hobbing_simulation_refuses_for_a_stored_job_i
     report = impact(conn, "spur", workers)
     assert [failure.job_id for failure in report.failures] == [job_id] and report.failures[0].released_makes
     assert "gear 46" in report.failures[0].error and other not in {diff.job_id for diff in report.diffs}
+    assert report.proved == 1   # gear 42's program is unchanged: not proved again
     problems = refusal(conn, "spur", dry_run=True, workers=workers).problems
     assert any(f"stored job {job_id} " in problem and "gear 46" in problem for problem in problems), problems
 
@@ -372,3 +374,32 @@ def test_the_impact_proved_in_two_workers_is_the_impact_proved_here(conn):
     here, two = impact(conn, "spur"), impact(conn, "spur", workers=2)
     assert here == two and len(here.failures) == 1 and here.changed >= 2
     assert conn.execute("SELECT count(*) FROM job").fetchone()[0] >= 4
+
+
+def test_a_draft_that_sends_a_stored_lathe_class_job_through_its_blank_is_refused(run, tmp_path):
+    """New-user review of issue 28: a class job (instantiate --class --params, a shop's own lathe
+    program imported) was made again by the impact as if it were a drawing's turning job, failed
+    for want of a tool-change position with both versions, was listed as an older problem, and the
+    draft that rapids into the part was released. The impact makes a class job from its rows alone
+    and proves it against its stated blank, as engine.programs.remake does."""
+    from helpers.class_jobs import import_emco, ok
+    from helpers.releases import release_draft
+
+    _, lines = import_emco(run, tmp_path)
+    with psycopg.connect(run.url) as conn:
+        release_draft(conn, "emco_neg")
+    params = tmp_path / "blank.json"
+    params.write_text(json.dumps({"stock_diameter": 26, "stock_z_front": 0, "stock_z_back": -40}))
+    job_id = json.loads(ok(run("instantiate", "--class", "emco_neg", "--machine", "lathe-iso", "--params", params,
+                               "--json")).stdout)["job_id"]
+    approach = lines.index("G00 X124.000 Z2.000")
+    with psycopg.connect(run.url) as conn:
+        row = conn.execute("SELECT id FROM template_view WHERE gear_class = 'emco_neg' ORDER BY id OFFSET %s LIMIT 1",
+                           (approach,)).fetchone()[0]
+        edit(conn, "emco_neg", row, o='"G00 X0.000 Z-15.000"')
+        conn.commit()
+        report = impact(conn, "emco_neg")
+        assert [(failure.job_id, failure.released_makes) for failure in report.failures] == [(job_id, True)]
+        assert "rapid through material" in report.failures[0].error, report.failures[0].error
+    refusal = run("template", "release", "--class", "emco_neg", "--dry-run")
+    assert refusal.exit_code == 1 and f"stored job {job_id} " in refusal.stderr, refusal.output

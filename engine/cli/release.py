@@ -49,7 +49,8 @@ def _show(report, diffs_shown: int) -> None:
     click.echo(f"class {report.gear_class} v{report.version} ({report.hash[:8]}): gate passed: lint, "
                f"{len(report.tests)} golden test(s), static analysis")
     click.echo(f"impact: {impact.jobs} stored job(s) of {report.gear_class} and its descendants, "
-               f"{impact.changed} program(s) change, {len(impact.failures)} fail with the draft")
+               f"{impact.changed} program(s) change, {len(impact.failures)} fail with the draft; "
+               f"{impact.proved} changed program(s) proved (machine verifier and simulation)")
     for change in impact.layouts.values():
         click.echo(change.said())
     for failure in impact.failures[:SHOWN_FAILURES]:
@@ -74,7 +75,7 @@ def _as_json(report) -> dict:
     return {"class": report.gear_class, "version": report.version, "hash": report.hash,
             "dry_run": report.dry_run, "released": report.release_id is not None, "release_id": report.release_id,
             "tests": report.tests, "checks": report.checks, "drafts_below": report.drafts_below,
-            "impact": {"jobs": impact.jobs, "changed": impact.changed,
+            "impact": {"jobs": impact.jobs, "changed": impact.changed, "proved": impact.proved,
                        "failures": [{"job_id": f.job_id, "class": f.gear_class, "error": f.error}
                                     for f in impact.failures],
                        "diffs": [{"job_id": d.job_id, "class": d.gear_class, "diff": d.diff}

@@ -104,6 +104,7 @@ class Impact:
     failures: list[JobFailure] = field(default_factory=list)
     diffs: list[JobDiff] = field(default_factory=list)
     layouts: dict[str, LayoutChange] = field(default_factory=dict)   # class → its draft's other layout
+    proved: int = 0   # distinct changed programs read by the verifier and followed by the simulation
 
     def summary(self) -> dict:
         """What a release records: the counts, the changed and failing job ids, the layout changes."""
@@ -122,7 +123,7 @@ def impact(conn: Connection, gear_class: str, workers: int = 1) -> Impact:
         return report
     made = _Made(conn, pairs)
     jobs = conn.cursor(binary=True).execute(JOBS, (list(pairs),)).fetchall()
-    made.prove_changed(jobs, workers)
+    report.proved = made.prove_changed(jobs, workers)
     for job in jobs:
         _compare(report, made, job)
     return report
@@ -206,10 +207,10 @@ class _Made:
                 self.drafts[key] = error
         return self.drafts[key]
 
-    def prove_changed(self, jobs: list, workers: int) -> None:
+    def prove_changed(self, jobs: list, workers: int) -> int:
         """Prove ahead, in `workers` processes, the draft's program of every distinct job input it
         changes (the simulation is most of an impact's time); the records they are proved against are
-        read here first, the workers read no database."""
+        read here first, the workers read no database. Returns how many were proved."""
         pending: dict[tuple, int] = {}
         for job_id, gear_class, machine, params_text, modules_text, _, gear_id, hob_id in jobs:
             key = gear_class, machine, params_text, modules_text, gear_id, hob_id
@@ -221,6 +222,7 @@ class _Made:
         self.inputs.read_records(list(pending))
         proofs = map_in_workers(self._proof_of, list(pending.items()), workers, self.inputs.without_database)
         self.proofs.update(zip(pending, proofs))
+        return len(pending)
 
     def _proof_of(self, pending: tuple) -> EngineError | None:
         key, job_id = pending
@@ -274,6 +276,7 @@ class _JobInputs:
         self.conn = conn
         self.machines: dict[str, Machine] = {}
         self.shapes: dict[str, str] = {}   # class -> its model's cut shape
+        self.models: dict[str, bool] = {}  # class -> whether it has a model (else its jobs are class jobs)
         self.gears: dict[int, Gear] = {}
         self.hobs: dict[str, Hob] | None = None
 
@@ -298,6 +301,8 @@ class _JobInputs:
     def of(self, job_id: int, gear_class: str, machine_name: str, params_text: str,
            modules_text: str, *_records) -> tuple[dict, dict]:
         params, modules = json.loads(params_text), json.loads(modules_text or "{}")
+        if not self.modelled(gear_class):   # a class job (instantiate --class): its rows alone, as
+            return params, modules          # engine.programs.remake makes it again
         machine = self.machine(machine_name)
         if machine.kind == "lathe":
             from ..turning.model import template_module_params  # the tool paths: only for turning jobs
@@ -322,7 +327,8 @@ class _JobInputs:
             self.prove_hobbing(lines, machine, job_id, gear_id, hob_id, name if isinstance(name, str) else None)
         if machine.kind != "lathe" or not isinstance(params, dict):
             return
-        work = TurningWork(params, json.loads(modules_text or "{}")) if "profile" in params else class_work(params)
+        drawn = self.modelled(gear_class) and "profile" in params   # a class job: against its blank alone
+        work = TurningWork(params, json.loads(modules_text or "{}")) if drawn else class_work(params)
         report = simulate_turning(lines, work.params, work.module_params, machine,
                                   params.get("program_name") or "the program")
         if report.refused:
@@ -349,6 +355,12 @@ class _JobInputs:
         if gear_class not in self.shapes:
             self.shapes[gear_class] = model_for_class(self.conn, gear_class).cut_shape
         return self.shapes[gear_class]
+
+    def modelled(self, gear_class: str) -> bool:
+        """Whether the class has a model (hobbing, turning); read before the workers start."""
+        if gear_class not in self.models:
+            self.models[gear_class] = model_for_class(self.conn, gear_class) is not None
+        return self.models[gear_class]
 
     def machine(self, name: str):
         if name not in self.machines:
