@@ -28,7 +28,7 @@ def exported(run) -> list[dict]:
 def written(tmp_path, rows: list[dict]) -> str:
     path = tmp_path / "machines.csv"
     with path.open("w", newline="") as handle:
-        writer = csv.DictWriter(handle, fieldnames=list(rows[0]))
+        writer = csv.DictWriter(handle, fieldnames=list(dict.fromkeys(key for row in rows for key in row)), restval="")
         writer.writeheader()
         writer.writerows(rows)
     return str(path)
@@ -57,12 +57,23 @@ def test_a_lathe_given_by_its_required_columns_takes_the_defaults(run, tmp_path)
 LATHE = {"name": "new-lathe", "kind": "lathe", "dialect": "iso", "x_min": "0", "x_max": "300", "z_min": "-500",
          "z_max": "200", "spindle_max": "4000"}
 REFUSED = [
-    ("exists", [{**LATHE, "name": "lathe-fanuc-0t"}], "machine 'lathe-fanuc-0t' exists"),
+    ("exists", [{**LATHE, "name": "lathe-fanuc-0t"}], "machine(s) lathe-fanuc-0t exist already"),
+    ("exists in another case", [{**LATHE, "name": "Lathe-Fanuc-0T"}], "machine(s) lathe-fanuc-0t exist already"),
     ("no grammar", [{**LATHE, "dialect": "haas"}], "dialect 'haas', which no grammar of the verifier reads"),
     ("twice", [LATHE, LATHE], "machine 'new-lathe' is given twice"),
-    ("refused value", [{**LATHE, "spindle_max": "-1"}], "the database refused machine 'new-lathe' ("),
-    ("not a number", [{**LATHE, "x_max": "lots"}], "the database refused machine 'new-lathe' ("),
+    ("twice in two cases", [LATHE, {**LATHE, "name": "NEW-lathe"}], "is given twice (names that differ only in case"),
+    ("refused value", [{**LATHE, "spindle_max": "-1"}], "machine 'new-lathe': spindle_max must be above 0 (r/min)"),
+    ("a choice misspelt", [{**LATHE, "decimal_point_input": "calculater"}],
+     "machine 'new-lathe': decimal_point_input must be increment or calculator"),
+    ("travel backwards", [{**LATHE, "x_min": "400"}], "machine 'new-lathe': x_min must be below x_max"),
+    ("not a number", [{**LATHE, "x_max": "350,5"}], "line 3 column x_max: '350,5' is not a number"),
     ("no kind", [{**LATHE, "kind": ""}], "line 3 gives no kind"),
+    ("no travel", [{**LATHE, "z_min": ""}], "line 3 gives no z_min"),
+    ("power-on G90 on system A", [{**LATHE, "gcode_system": "A", "power_on": "G18 G40 G90 G97 G99"}],
+     "power_on lists G90, which on G-code system A is the turning cycle"),
+    ("power-on one group twice", [{**LATHE, "power_on": "G18 G98 G99"}], "power_on lists G98 and G99, one modal group"),
+    ("reference outside the travel", [{**LATHE, "reference_x": "420", "reference_z": "100"}],
+     "reference_x 420 lies outside its travel (X 0…300)"),
 ]
 
 
@@ -72,3 +83,19 @@ def test_a_bad_file_is_refused_in_one_line_and_nothing_is_stored(run, tmp_path, 
     message = refused(run("machines", "import", written(tmp_path, [{**LATHE, "name": "good-lathe"}, *rows])))
     assert words in message and "machines.csv" in message, message
     assert machines(run.url) == before
+
+
+def test_every_check_of_the_machine_table_is_said_in_the_words_of_its_columns(conn):
+    """A value the table refuses is named by what its check asks (engine.machines.importing.CHECKS),
+    not by the constraint's name: a check added to the table without its words fails here."""
+    from engine.machines.importing import CHECKS
+
+    names = {name for (name,) in conn.execute(
+        "SELECT conname FROM pg_constraint WHERE conrelid = 'machine'::regclass AND contype = 'c'")}
+    assert names == set(CHECKS)
+
+
+def test_a_header_without_rows_is_refused(run, tmp_path):
+    path = tmp_path / "machines.csv"
+    path.write_text(",".join(LATHE) + "\n")
+    assert "holds no machine" in refused(run("machines", "import", path))

@@ -70,7 +70,17 @@ def machines_import(ctx, csv_file, as_json):
     from ..verifier.grammar import DIALECTS
 
     with connection(ctx) as conn:
-        added = import_machines(conn, csv_file, set(DIALECTS))
+        added = import_machines(conn, csv_file, set(DIALECTS), record_fault)
     if as_json:
         return emit_json({"added": added})
     click.echo(f"{csv_file}: added {len(added)} machine(s): {', '.join(added)}")
+
+
+def record_fault(machine: dict) -> str | None:
+    """Why the verifier could never take an ISO lathe's record as it is (a power-on state its
+    control cannot be in: G90 on G-code system A, two codes of one modal group), or None."""
+    if machine["dialect"] != "iso" or not machine.get("power_on"):
+        return None
+    from ..verifier.expanders.iso_rules import power_on_fault
+
+    return power_on_fault(machine["power_on"].split(), machine.get("gcode_system"))

@@ -10,6 +10,7 @@ grammar for is refused where it enters, naming the ones it has: such a machine c
 given a program. All or nothing: any bad row stops the file, nothing stored."""
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import fields
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -25,32 +26,77 @@ from .records import Machine
 if TYPE_CHECKING:
     from ..db.connection import Connection
 
-REQUIRED = ("name", "kind", "dialect")
+# The columns a machine cannot do without (NOT NULL, no default): the rest take their default.
+REQUIRED = ("name", "kind", "dialect", "x_min", "x_max", "z_min", "z_max", "spindle_max")
 # The columns of the machine table (the record's fields), as text the database converts.
 MACHINE_KIND = CsvKind("machine", tuple(Column(spec.name, parse_text, required=spec.name in REQUIRED)
                                         for spec in fields(Machine)))
+NUMBERS = tuple(spec.name for spec in fields(Machine) if str(spec.type).split(" ")[0] in ("float", "int"))
+# What each of the table's checks asks, in the words of the record's columns (schema/schema.sql).
+CHECKS = {
+    "machine_kind_check": "kind must be hobber or lathe",
+    "machine_check": "x_min must be below x_max, y_min at most y_max and z_min below z_max (mm)",
+    "machine_spindle_max_check": "spindle_max must be above 0 (r/min)",
+    "machine_work_offset_check": "work_offset must be one of G54, G55, G56, G57",
+    "machine_gcode_system_check": "gcode_system must be A, B or C (empty: none stated)",
+    "machine_decimal_point_input_check": "decimal_point_input must be increment or calculator",
+    "machine_power_on_check": "power_on lists modal codes among G18 G40 G90 G94 G95 G97 G98 G99, one space "
+                              "apart (never G20/G21: the program states its units)",
+    "machine_reference_point": "reference_x and reference_z are given together or not at all",
+    "machine_load_position": "load_x and load_z are given together or not at all",
+    "machine_safe_name": "a machine name is letters, digits, - and _ (it is printed in programs' comments)",
+    "machine_rapid_rate_check": "rapid_rate must be above 0 (mm/min)",
+    **{f"machine_{axis}_direction_check": f"{axis}_direction must be 1 or -1 (its sense against DIN 66217)"
+       for axis in "abcyz"},
+    **{f"machine_{column}_check": f"{column} must be 0 or more (mm)"
+       for column in ("fixture_diameter", "fixture_gap", "tailstock_diameter", "tailstock_gap")},
+    **{f"machine_door_{which}_m_check": f"door_{which}_m must be an M number from 0 to 999"
+       for which in ("close", "open")},
+}
 
 
 def read_machines(path: str | Path) -> list[dict[str, Any]]:
     """The rows of a machines CSV as {column: text}, an empty cell None (the column's default);
-    a row without a name, kind or dialect is refused, naming its line."""
-    machines = []
-    for line, row in read_csv_file(path, MACHINE_KIND).rows():
-        machine = {key: (value if value != "" else None) for key, value in row.items()}
-        missing = [column for column in REQUIRED if machine[column] is None]
-        if missing:
-            raise EngineError(f"{path}: line {line} gives no {missing[0]}; every machine needs its name, kind "
-                              "(hobber or lathe) and dialect; nothing imported")
-        machines.append(machine)
+    a row without one of the REQUIRED columns, or with text where a number goes, is refused,
+    naming its line and the column."""
+    machines = [_machine(path, line, row) for line, row in read_csv_file(path, MACHINE_KIND).rows()]
+    if not machines:
+        raise EngineError(f"{path} holds no machine, only its header; add a row per machine; nothing imported")
     return machines
 
 
-def import_machines(conn: Connection, path: str | Path, grammars: set[tuple[str, str]]) -> list[str]:
+def _machine(path, line: int, row: dict[str, str]) -> dict[str, Any]:
+    machine = {key: (value if value != "" else None) for key, value in row.items()}
+    missing = [column for column in REQUIRED if machine[column] is None]
+    if missing:
+        raise EngineError(f"{path}: line {line} gives no {missing[0]}; every machine needs "
+                          f"{', '.join(REQUIRED)}; nothing imported")
+    for column in NUMBERS:
+        text = machine.get(column)
+        if text is not None and not _is_number(text):
+            raise EngineError(f"{path}: line {line} column {column}: {shown(text)} is not a number "
+                              "(write 350.5 with a point, no unit); nothing imported")
+    return machine
+
+
+def _is_number(text: str) -> bool:
+    try:
+        return abs(float(text)) < float("inf")
+    except ValueError:
+        return False
+
+
+def import_machines(conn: Connection, path: str | Path, grammars: set[tuple[str, str]],
+                    fault: Callable[[dict], str | None] = lambda machine: None) -> list[str]:
     """Add every machine of the CSV file at `path`, all or nothing; `grammars`: the (kind, dialect)
-    pairs the verifier reads. Returns the names added."""
+    pairs the verifier reads; `fault(machine)`: why the verifier could never take the record as it
+    is (a power-on state its control cannot be in), or None. Returns the names added."""
     machines = read_machines(path)
     for machine in machines:
         _refuse_unknown_grammar(path, machine, grammars)
+        _refuse_reference_outside(path, machine)
+        if (why := fault(machine)) is not None:
+            raise EngineError(f"{path}: machine {shown(machine['name'])}: {why}; correct the row; nothing imported")
     names = [machine["name"] for machine in machines]
     _refuse_repeated(path, names)
     _refuse_existing(conn, path, names)
@@ -68,29 +114,46 @@ def _refuse_unknown_grammar(path, machine: dict, grammars: set[tuple[str, str]])
                           f"{known}; nothing imported")
 
 
+def _refuse_reference_outside(path, machine: dict) -> None:
+    """The reference point (G28's, an ISO lathe's) lies within the machine's own travel: a point
+    outside it would refuse every program that returns there, as a move beyond the travel."""
+    for axis in ("x", "z"):
+        point = machine.get(f"reference_{axis}")
+        low, high = float(machine[f"{axis}_min"]), float(machine[f"{axis}_max"])
+        if point is not None and not low <= float(point) <= high:
+            raise EngineError(f"{path}: machine {shown(machine['name'])}: reference_{axis} {point} lies outside its "
+                              f"travel ({axis.upper()} {machine[f'{axis}_min']}…{machine[f'{axis}_max']}); "
+                              "give the point the control's parameters hold; nothing imported")
+
+
 def _refuse_repeated(path, names: list[str]) -> None:
-    repeated = sorted({name for name in names if names.count(name) > 1})
+    """A name given twice, also in another case: `--machine` finds a machine by its name as typed,
+    and two names an operator cannot tell apart would pick the wrong record."""
+    folded = [name.casefold() for name in names]
+    repeated = sorted({name for name, fold in zip(names, folded) if folded.count(fold) > 1})
     if repeated:
-        raise EngineError(f"{path}: machine {shown(repeated[0])} is given twice; give each machine once; "
-                          "nothing imported")
+        raise EngineError(f"{path}: machine {shown(repeated[0])} is given twice (names that differ only in case "
+                          "are one machine); give each machine once; nothing imported")
 
 
 def _refuse_existing(conn: Connection, path, names: list[str]) -> None:
-    found = conn.execute("SELECT name FROM machine WHERE name = ANY(%s) ORDER BY name", (names,)).fetchone()
+    found = [name for (name,) in conn.execute(
+        "SELECT name FROM machine WHERE lower(name) = ANY(%s) ORDER BY name", ([name.lower() for name in names],))]
     if found:
-        raise EngineError(f"{path}: machine {shown(found[0])} exists; its stored programs were proved against its "
-                          "record, so change it in SQL (UPDATE machine …) or give the new machine another name; "
-                          "nothing imported")
+        raise EngineError(f"{path}: machine(s) {', '.join(found)} exist already (names that differ only in case "
+                          "are one machine): an import adds new machines only; remove their rows from the file, "
+                          "give a new machine another name, or change an existing record in SQL (UPDATE machine "
+                          "…): its stored programs were proved against it; nothing imported")
 
 
 def _insert(conn: Connection, path, machine: dict) -> None:
-    """One record; a value the table's checks refuse (a negative spindle limit, text for a number)
-    names the machine, inside the file's transaction (nothing of the file is stored)."""
+    """One record; a value the table's checks refuse (a negative spindle limit) names the machine
+    and what the check asks, inside the file's transaction (nothing of the file is stored)."""
     given = {column: value for column, value in machine.items() if value is not None}   # empty: the default
     try:
         conn.execute(sql.SQL("INSERT INTO machine ({}) VALUES ({})").format(
             sql.SQL(", ").join(map(sql.Identifier, given)), sql.SQL(", ").join(sql.Placeholder() * len(given))),
             list(given.values()))
     except (psycopg.errors.IntegrityError, psycopg.errors.DataError) as error:
-        raise EngineError(f"{path}: the database refused machine {shown(machine['name'])} "
-                          f"({error.diag.message_primary or error}); nothing imported") from error
+        asks = CHECKS.get(error.diag.constraint_name or "", error.diag.message_primary or str(error))
+        raise EngineError(f"{path}: machine {shown(machine['name'])}: {asks}; nothing imported") from error
