@@ -29,7 +29,6 @@ def teeth(conn, gear_id) -> int:
 
 # --- a line the machine's matcher reads as a second lineage --------------------------------------
 
-@pytest.mark.xfail(strict=True, reason="FOUND: impact's proof skips refuse_lineage_shaped (verified_run runs it)")
 def test_a_lineage_shaped_line_for_48_teeth_only_is_refused(conn):
     """Every program that is stored passes refuse_lineage_shaped (engine.programs.verified_run): a
     draft writing `; PROGRAM 1 TEMPLATE ...` for gear 46's 48 teeth only (no golden gear has 48)
@@ -50,8 +49,7 @@ def _gear_without_diameters(conn, gear_id):
     conn.execute("UPDATE gear SET teeth = 2, tip_diameter = NULL, root_diameter = NULL WHERE id = %s", (gear_id,))
 
 
-@pytest.mark.parametrize("workers", [1, pytest.param(2, marks=pytest.mark.xfail(
-    strict=True, raises=AttributeError, reason="FOUND: a worker re-reads the gear with no connection"))])
+@pytest.mark.parametrize("workers", [1, 2])
 def test_a_gear_record_that_no_longer_loads_is_named_in_workers_as_in_one_process(conn, workers):
     """read_records swallows load_gear's EngineError ('the proof names it'); the proof then calls
     load_gear again, which in a forked worker has no connection."""

@@ -29,6 +29,7 @@ from ..gears.models import model_for_class
 from ..gears.records import Gear, Hob, load_gear, load_hobs
 from ..machines.records import load_machine
 from ..nc.layout import ENDING_NAMES, NcLayout
+from ..nc.lineage import refuse_lineage_shaped
 from ..programs import all_models  # noqa: F401  (registers every model)
 from ..programs.job_shape import job_with_cycle_time
 from ..programs.verified_run import TurningWork, class_work
@@ -277,7 +278,7 @@ class _JobInputs:
         self.machines: dict[str, Machine] = {}
         self.shapes: dict[str, str] = {}   # class -> its model's cut shape
         self.models: dict[str, bool] = {}  # class -> whether it has a model (else its jobs are class jobs)
-        self.gears: dict[int, Gear] = {}
+        self.gears: dict[int, Gear | EngineError] = {}   # a gear that no longer loads: why, for its proof
         self.hobs: dict[str, Hob] | None = None
 
     def read_records(self, keys: list[tuple]) -> None:
@@ -289,10 +290,7 @@ class _JobInputs:
             if self.hobs is None:
                 self.hobs = {hob.id: hob for hob in load_hobs(self.conn)}
             if gear_id not in self.gears:
-                try:
-                    self.gears[gear_id] = load_gear(self.conn, gear_id)
-                except EngineError:
-                    pass   # the proof names the job's missing gear
+                self.gears[gear_id] = self.gear(gear_id)
 
     def without_database(self) -> None:
         """In a worker: the connection it inherits shares the parent's socket, so it is taken away."""
@@ -322,6 +320,7 @@ class _JobInputs:
         machine = self.machine(machine_name)
         params = json.loads(params_text)
         name = params.get("program_name") if isinstance(params, dict) else None
+        refuse_lineage_shaped(name if isinstance(name, str) else "the program", lines)   # as verified_run does
         verify_program(lines, machine, name if isinstance(name, str) else None)
         if machine.kind == "hobber":
             self.prove_hobbing(lines, machine, job_id, gear_id, hob_id, name if isinstance(name, str) else None)
@@ -346,10 +345,21 @@ class _JobInputs:
         if hob_id not in self.hobs:
             raise EngineError(f"hob {hob_id!r} of job {job_id} does not exist; see `engine hobs list`")
         if gear_id not in self.gears:
-            self.gears[gear_id] = load_gear(self.conn, gear_id)
-        report = simulate_program(lines, self.gears[gear_id], self.hobs[hob_id], machine, name or "the program")
+            self.gears[gear_id] = self.gear(gear_id)
+        gear = self.gears[gear_id]
+        if isinstance(gear, EngineError):   # raised here, in a worker too: it has no connection to read it again
+            raise EngineError(str(gear))
+        report = simulate_program(lines, gear, self.hobs[hob_id], machine, name or "the program")
         if report.refused:
             raise SimulationError(f"gear {gear_id}: {report.error()}")
+
+    def gear(self, gear_id: int) -> Gear | EngineError:
+        """The job's gear as stored now, or why it no longer loads (a record edited since: the proof
+        names the job)."""
+        try:
+            return load_gear(self.conn, gear_id)
+        except EngineError as error:
+            return error
 
     def cut_shape(self, gear_class: str) -> str:
         if gear_class not in self.shapes:
