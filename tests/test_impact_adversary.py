@@ -4,11 +4,17 @@ import pytest
 from psycopg import sql
 
 from engine.errors import EngineError
+from engine.library.nc_import import import_nc
+from engine.programs.class_jobs import instantiate_class
 from engine.programs.instantiate import instantiate_gear
 from engine.release.gate import release
 from engine.release.impact import impact
 
 SPEED_ROW, LAST_CUT_ROW, COOLANT_ROW, COOLANT_OFF_ROW = 1700, 2700, 1800, 2900   # seed_templates/classes/spur.csv
+# A shop's own ISO lathe program (tests/test_turning_class_jobs.py): one rough pass at Ø36 from Z2 to Z-40.
+SHAFT = ["%", "O0001 (SHAFT)", "G21 G18 G40 G90", "G00 X124.000 Z50.000", "T0101", "G97 S600 M03", "G98 F150.000",
+         "G00 X44.000 Z2.000", "G01 X36.000 Z2.000", "G01 X36.000 Z-40.000", "G00 X44.000 Z-40.000",
+         "G00 X44.000 Z2.000", "G00 X124.000 Z50.000", "M05", "M30", "%"]
 EDIT = sql.SQL("UPDATE template_view SET {} = %s WHERE gear_class = %s AND id = %s")
 
 
@@ -99,3 +105,25 @@ def test_a_draft_that_raises_a_python_error_for_48_teeth_only_is_refused_not_cra
     edit(conn, "spur", COOLANT_ROW, o=f'"M8" if z2 != 48 else f"M8 ; {{{expression}}}"')
     problems = refused_problems(conn, "spur")
     assert any(f"stored job {job_id} " in problem for problem in problems), problems
+
+
+# --- a class job on a lathe (a class without a model: import-nc, instantiate --class) --------------
+
+def test_a_draft_rapid_through_the_blank_of_a_stored_lathe_class_job_is_refused(conn, tmp_path):
+    """The class job's program is made with its rows alone (engine.programs.class_jobs.class_job) and
+    proved against the blank it implies. A draft rapid from the approach point (Ø44, Z2) to X0 Z-15
+    crosses the Ø36 Z-40…2 blank the cut implies: every remake of the job after the release is refused
+    by the turning simulation, so the gate must refuse the draft."""
+    path = tmp_path / "SHAFT.NC"
+    path.write_text("\n".join(SHAFT) + "\n")
+    import_nc(conn, path, "shaft", {"speed": 600, "feed": 150.0})
+    release(conn, "shaft")
+    job_id = instantiate_class(conn, "shaft", {}, machine="lathe-iso").program.job_id
+    approach = conn.execute("SELECT id FROM template_view WHERE gear_class = 'shaft' AND o = %s",
+                            ('"G00 X44.000 Z2.000"',)).fetchone()[0]
+    conn.execute("INSERT INTO template_view (gear_class, id, t, n, o) SELECT gear_class, %s, t, n, %s "
+                 "FROM template_view WHERE gear_class = 'shaft' AND id = %s",
+                 (approach + 5, '"G00 X0.000 Z-15.000"', approach))
+    problems = refused_problems(conn, "shaft")
+    assert any(f"stored job {job_id} " in problem and "rapid through material" in problem
+               for problem in problems), problems
