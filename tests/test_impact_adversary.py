@@ -127,3 +127,18 @@ def test_a_draft_rapid_through_the_blank_of_a_stored_lathe_class_job_is_refused(
     problems = refused_problems(conn, "shaft")
     assert any(f"stored job {job_id} " in problem and "rapid through material" in problem
                for problem in problems), problems
+
+
+# --- the draft's own version number ---------------------------------------------------------------
+
+@pytest.mark.xfail(strict=True, reason="FOUND: the impact runs the draft with the released version number")
+def test_a_draft_that_reads_its_own_version_number_is_proved_as_it_will_run(conn):
+    """Rows may read template_version (turning_840d's `; TEMPLATE` line does). The impact evaluates the
+    draft as if it had the released version number, so a row that misbehaves only from the draft's
+    number on (and for 48 teeth only: no golden gear) shows no change; released, the draft runs
+    with its own number and gear 46's stored job's hob turns at 5·n0."""
+    job_id = instantiate_gear(conn, 46).job_id
+    released = conn.execute("SELECT released_version('spur')").fetchone()[0]
+    edit(conn, "spur", SPEED_ROW, o=f'f"M3 S{{n0 * 5 if z2 == 48 and template_version > {released} else n0}}"')
+    problems = refused_problems(conn, "spur")
+    assert any(f"stored job {job_id} " in problem and "exceeds" in problem for problem in problems), problems
