@@ -131,7 +131,6 @@ def test_a_draft_rapid_through_the_blank_of_a_stored_lathe_class_job_is_refused(
 
 # --- the draft's own version number ---------------------------------------------------------------
 
-@pytest.mark.xfail(strict=True, reason="FOUND: the impact runs the draft with the released version number")
 def test_a_draft_that_reads_its_own_version_number_is_proved_as_it_will_run(conn):
     """Rows may read template_version (turning_840d's `; TEMPLATE` line does). The impact evaluates the
     draft as if it had the released version number, so a row that misbehaves only from the draft's

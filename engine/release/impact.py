@@ -12,8 +12,9 @@ The "before" side is the released version rendered now for the job, never the jo
 program: a stored program is a record a runner can write by hand (program_submission), and one that
 is not its rendering (a MISMATCH: lines equal to the draft's, say) would hide the job's change.
 Rendering the released version costs one more template run per distinct job input. The draft is
-evaluated as if it had the released version number, so the
-`; TEMPLATE class vN` line does not count as a change. A draft that only writes its lines with
+evaluated with its own version number, as it runs once released (rows may read template_version);
+its `; TEMPLATE class vN` line, differing in the number alone, is not a change
+(engine.release.version_lines). A draft that only writes its lines with
 another layout (line ending, final newline: version_layout_change) changes no line, but the bytes of
 every stored program's file of the class: said on its own, with how many programs. Jobs with identical parameters are
 evaluated once: 10,000 stored jobs of a class take seconds (bench/impact.py)."""
@@ -42,6 +43,7 @@ from ..templates.rows import Template
 from ..templates.store import class_and_descendants
 from ..templates.versions import draft_template, released_template
 from ..verifier import verify_program
+from .version_lines import same_program
 
 if TYPE_CHECKING:
     from ..db.connection import Connection
@@ -131,8 +133,8 @@ def impact(conn: Connection, gear_class: str, workers: int = 1) -> Impact:
 
 
 def _template_pairs(conn: Connection, classes: list[str]) -> dict[str, tuple[Template, Template, int]]:
-    """(released, draft evaluated as the released version, the draft's own version) of each class
-    that has a released template; the draft is the released one for a class without a draft."""
+    """(released, draft, the draft's own version) of each class that has a released template; the
+    draft is the released one for a class without a draft."""
     pairs = {}
     for name in classes:
         try:
@@ -140,7 +142,7 @@ def _template_pairs(conn: Connection, classes: list[str]) -> dict[str, tuple[Tem
         except EngineError:
             continue   # a class without rows (an inner node of the tree) has no jobs of its own
         draft = draft_template(conn, name)
-        pairs[name] = released, replace(draft, version=released.version, draft=False), draft.version
+        pairs[name] = released, replace(draft, draft=False), draft.version
     return pairs
 
 
@@ -167,7 +169,7 @@ def _compare(report: Impact, made: _Made, job) -> None:
         report.failures.append(JobFailure(job_id, gear_class, str(new_lines), made.released_proves(key, job_id)))
         return
     old_lines = made.released_lines(key, job_id)   # rendered now: a stored program may be a forgery
-    if old_lines == new_lines:
+    if same_program(old_lines, new_lines):
         return   # the release does not change this job's program: not proved again
     failure = made.draft_failure(key, job_id)
     if failure is not None:
@@ -218,7 +220,7 @@ class _Made:
             if key in pending or not self.has_draft(gear_class):
                 continue
             lines = self.draft_lines(key, job_id)
-            if not isinstance(lines, EngineError) and lines != self.released_lines(key, job_id):
+            if not isinstance(lines, EngineError) and not same_program(self.released_lines(key, job_id), lines):
                 pending[key] = job_id
         self.inputs.read_records(list(pending))
         proofs = map_in_workers(self._proof_of, list(pending.items()), workers, self.inputs.without_database)
