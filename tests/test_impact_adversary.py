@@ -9,6 +9,7 @@ from engine.programs.class_jobs import instantiate_class
 from engine.programs.instantiate import instantiate_gear
 from engine.release.gate import release
 from engine.release.impact import impact
+from engine.release.version_lines import same_program
 
 SPEED_ROW, LAST_CUT_ROW, COOLANT_ROW, COOLANT_OFF_ROW = 1700, 2700, 1800, 2900   # seed_templates/classes/spur.csv
 # A shop's own ISO lathe program (tests/test_turning_class_jobs.py): one rough pass at Ø36 from Z2 to Z-40.
@@ -141,3 +142,14 @@ def test_a_draft_that_reads_its_own_version_number_is_proved_as_it_will_run(conn
     edit(conn, "spur", SPEED_ROW, o=f'f"M3 S{{n0 * 5 if z2 == 48 and template_version > {released} else n0}}"')
     problems = refused_problems(conn, "spur")
     assert any(f"stored job {job_id} " in problem and "exceeds" in problem for problem in problems), problems
+
+
+@pytest.mark.parametrize(("old", "new", "same"), [
+    ("; TEMPLATE spur v3", "; TEMPLATE spur v5", True),                 # the number alone: no change
+    ("(TEMPLATE spur v3)", "(TEMPLATE spur v5)", True),
+    ("(TEMPLATE spur v3) G00 X3.", "(TEMPLATE spur v5) G00 X5.", False),  # ISO runs the block after it
+    ("; TEMPLATE spur v3", "; TEMPLATE spur v5 S1615", False),
+    ("M3 S323 ; TEMPLATE v3", "M3 S1615 ; TEMPLATE v5", False),
+])
+def test_only_a_template_comment_differing_in_its_version_number_is_no_change(old, new, same):
+    assert same_program(["G90", old], ["G90", new]) is same
