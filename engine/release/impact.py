@@ -12,8 +12,9 @@ The "before" side is the released version rendered now for the job, never the jo
 program: a stored program is a record a runner can write by hand (program_submission), and one that
 is not its rendering (a MISMATCH: lines equal to the draft's, say) would hide the job's change.
 Rendering the released version costs one more template run per distinct job input. The draft is
-evaluated as if it had the released version number, so the
-`; TEMPLATE class vN` line does not count as a change. A draft that only writes its lines with
+evaluated with its own version number, as it runs once released (rows may read template_version);
+its `; TEMPLATE class vN` line, differing in the number alone, is not a change
+(engine.release.version_lines). A draft that only writes its lines with
 another layout (line ending, final newline: version_layout_change) changes no line, but the bytes of
 every stored program's file of the class: said on its own, with how many programs. Jobs with identical parameters are
 evaluated once: 10,000 stored jobs of a class take seconds (bench/impact.py)."""
@@ -29,6 +30,7 @@ from ..gears.models import model_for_class
 from ..gears.records import Gear, Hob, load_gear, load_hobs
 from ..machines.records import load_machine
 from ..nc.layout import ENDING_NAMES, NcLayout
+from ..nc.lineage import refuse_lineage_shaped
 from ..programs import all_models  # noqa: F401  (registers every model)
 from ..programs.job_shape import job_with_cycle_time
 from ..programs.verified_run import TurningWork, class_work
@@ -41,6 +43,7 @@ from ..templates.rows import Template
 from ..templates.store import class_and_descendants
 from ..templates.versions import draft_template, released_template
 from ..verifier import verify_program
+from .version_lines import same_program
 
 if TYPE_CHECKING:
     from ..db.connection import Connection
@@ -130,8 +133,8 @@ def impact(conn: Connection, gear_class: str, workers: int = 1) -> Impact:
 
 
 def _template_pairs(conn: Connection, classes: list[str]) -> dict[str, tuple[Template, Template, int]]:
-    """(released, draft evaluated as the released version, the draft's own version) of each class
-    that has a released template; the draft is the released one for a class without a draft."""
+    """(released, draft, the draft's own version) of each class that has a released template; the
+    draft is the released one for a class without a draft."""
     pairs = {}
     for name in classes:
         try:
@@ -139,7 +142,7 @@ def _template_pairs(conn: Connection, classes: list[str]) -> dict[str, tuple[Tem
         except EngineError:
             continue   # a class without rows (an inner node of the tree) has no jobs of its own
         draft = draft_template(conn, name)
-        pairs[name] = released, replace(draft, version=released.version, draft=False), draft.version
+        pairs[name] = released, replace(draft, draft=False), draft.version
     return pairs
 
 
@@ -166,7 +169,7 @@ def _compare(report: Impact, made: _Made, job) -> None:
         report.failures.append(JobFailure(job_id, gear_class, str(new_lines), made.released_proves(key, job_id)))
         return
     old_lines = made.released_lines(key, job_id)   # rendered now: a stored program may be a forgery
-    if old_lines == new_lines:
+    if same_program(old_lines, new_lines):
         return   # the release does not change this job's program: not proved again
     failure = made.draft_failure(key, job_id)
     if failure is not None:
@@ -217,7 +220,7 @@ class _Made:
             if key in pending or not self.has_draft(gear_class):
                 continue
             lines = self.draft_lines(key, job_id)
-            if not isinstance(lines, EngineError) and lines != self.released_lines(key, job_id):
+            if not isinstance(lines, EngineError) and not same_program(self.released_lines(key, job_id), lines):
                 pending[key] = job_id
         self.inputs.read_records(list(pending))
         proofs = map_in_workers(self._proof_of, list(pending.items()), workers, self.inputs.without_database)
@@ -277,7 +280,7 @@ class _JobInputs:
         self.machines: dict[str, Machine] = {}
         self.shapes: dict[str, str] = {}   # class -> its model's cut shape
         self.models: dict[str, bool] = {}  # class -> whether it has a model (else its jobs are class jobs)
-        self.gears: dict[int, Gear] = {}
+        self.gears: dict[int, Gear | EngineError] = {}   # a gear that no longer loads: why, for its proof
         self.hobs: dict[str, Hob] | None = None
 
     def read_records(self, keys: list[tuple]) -> None:
@@ -289,10 +292,7 @@ class _JobInputs:
             if self.hobs is None:
                 self.hobs = {hob.id: hob for hob in load_hobs(self.conn)}
             if gear_id not in self.gears:
-                try:
-                    self.gears[gear_id] = load_gear(self.conn, gear_id)
-                except EngineError:
-                    pass   # the proof names the job's missing gear
+                self.gears[gear_id] = self.gear(gear_id)
 
     def without_database(self) -> None:
         """In a worker: the connection it inherits shares the parent's socket, so it is taken away."""
@@ -322,6 +322,7 @@ class _JobInputs:
         machine = self.machine(machine_name)
         params = json.loads(params_text)
         name = params.get("program_name") if isinstance(params, dict) else None
+        refuse_lineage_shaped(name if isinstance(name, str) else "the program", lines)   # as verified_run does
         verify_program(lines, machine, name if isinstance(name, str) else None)
         if machine.kind == "hobber":
             self.prove_hobbing(lines, machine, job_id, gear_id, hob_id, name if isinstance(name, str) else None)
@@ -346,10 +347,21 @@ class _JobInputs:
         if hob_id not in self.hobs:
             raise EngineError(f"hob {hob_id!r} of job {job_id} does not exist; see `engine hobs list`")
         if gear_id not in self.gears:
-            self.gears[gear_id] = load_gear(self.conn, gear_id)
-        report = simulate_program(lines, self.gears[gear_id], self.hobs[hob_id], machine, name or "the program")
+            self.gears[gear_id] = self.gear(gear_id)
+        gear = self.gears[gear_id]
+        if isinstance(gear, EngineError):   # raised here, in a worker too: it has no connection to read it again
+            raise EngineError(str(gear))
+        report = simulate_program(lines, gear, self.hobs[hob_id], machine, name or "the program")
         if report.refused:
             raise SimulationError(f"gear {gear_id}: {report.error()}")
+
+    def gear(self, gear_id: int) -> Gear | EngineError:
+        """The job's gear as stored now, or why it no longer loads (a record edited since: the proof
+        names the job)."""
+        try:
+            return load_gear(self.conn, gear_id)
+        except EngineError as error:
+            return error
 
     def cut_shape(self, gear_class: str) -> str:
         if gear_class not in self.shapes:
