@@ -276,11 +276,13 @@ def test_a_statement_with_one_bad_row_changes_no_row(conn):
 # template_view, the first bad row in order is the one named, and nothing changes.
 GOOD_ROW = {"id": 10, "t": "main", "n": 1, "p_calc": None, "s": None, "o": '"G90"', "p_emit": None}
 BAD_ROWS = [({"id": -5}, errors.CheckViolation, "class imported row -5 column id: id must not be negative"),
-            ({"n": -1}, errors.CheckViolation, "class imported row 30 column n: n must be a whole number >= 0, got -1"),
+            ({"n": -1}, errors.CheckViolation,
+             "class imported row 30 column n: n must be a whole number >= 0, got -1"),
             ({"t": "mian"}, errors.CheckViolation,
              "class imported row 30 column t: unknown module type 'mian'; use one of main, prep, sync, shift, "
              "cutcond, cutmotion"),
-            ({"o": None}, errors.CheckViolation, "class imported row 30 column o: row has neither o nor s: it does nothing"),
+            ({"o": None}, errors.CheckViolation,
+             "class imported row 30 column o: row has neither o nor s: it does nothing"),
             ({"p_calc": "x > 1"}, errors.CheckViolation,
              "class imported row 30 column p_calc: p_calc has no effect without s (use p_emit to decide output)")]
 
