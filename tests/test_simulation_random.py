@@ -1,7 +1,7 @@
 """Random valid gears of every class, instantiated through the library on the test database:
 every program is stored proved by the simulation or refused with an EngineError (one line),
 never anything else. The hob envelope agrees with the hob's
-points sampled densely."""
+points sampled densely, in plain floats (one gear's proof, issue 28) and with numpy (a batch's)."""
 from __future__ import annotations
 
 import math
@@ -15,7 +15,8 @@ from engine.errors import EngineError
 from engine.hobbing.choices import Choices
 from engine.programs.instantiate import instantiate_gear
 from engine.simulation import simulate_stored_program
-from engine.simulation.hobbing.envelope import HobBody, centres, nearest_radius
+from engine.simulation.hobbing import envelope_arrays
+from engine.simulation.hobbing.envelope import HobBody, centres, nearest_radii
 
 GEAR_ID = 900001
 INSERT_GEAR = """
@@ -88,14 +89,26 @@ def hob_points(body: HobBody, swivel: float, centre, count: int = 200) -> np.nda
     return np.concatenate([p.reshape(-1, 3) for p in surface]) + np.asarray(centre)
 
 
+def in_plain_floats(body: HobBody, swivel: float, cx, cy, cz, heights) -> np.ndarray:
+    """engine.simulation.hobbing.envelope.nearest_radii pose by pose, shaped as the numpy version's."""
+    rows = np.broadcast_to(heights, (len(cx), heights.shape[1])).tolist()
+    return np.array([nearest_radii(body, swivel, float(x), float(y), float(z), row)
+                     for x, y, z, row in zip(cx[:, 0], cy[:, 0], cz[:, 0], rows)])
+
+
+ENVELOPES = {"plain floats": in_plain_floats, "numpy": envelope_arrays.nearest_radius}
+
+
 @pytest.mark.slow
+@pytest.mark.parametrize("envelope", ENVELOPES)
 @settings(max_examples=40, deadline=None)
 @given(radius=st.floats(20, 50), length=st.floats(60, 160), swivel=st.floats(-35, 35), x=st.floats(25, 120),
        y=st.floats(-40, 40))
-def test_the_envelope_is_the_nearest_point_of_the_hob_at_each_height(radius, length, swivel, x, y):
+def test_the_envelope_is_the_nearest_point_of_the_hob_at_each_height(envelope, radius, length, swivel, x, y):
+    nearest_radius = ENVELOPES[envelope]
     body = HobBody(radius, length / 2)
     x = max(x, radius + 1.0)
-    cx, cy, cz = centres(np.array([x]), np.array([y]), np.array([0.0]), swivel)
+    cx, cy, cz = (np.array([value]) for value in centres(x, y, 0.0, swivel))
     points = hob_points(body, swivel, (cx[0], cy[0], cz[0]))
     distance = np.hypot(points[:, 0], points[:, 1])
     at_heights = nearest_radius(body, swivel, cx[:, None], cy[:, None], cz[:, None], points[None, :, 2])[0]
@@ -106,3 +119,19 @@ def test_the_envelope_is_the_nearest_point_of_the_hob_at_each_height(radius, len
     step_along, step_round = length / 199, 2 * math.pi / 199          # the sampling grid of hob_points
     resolution = step_along / 2 + radius * step_round ** 2 / 8 + 0.01
     assert nearest >= distance.min() - resolution          # and as near as the hob comes, to the sampling
+
+
+@settings(max_examples=60, deadline=None)
+@given(radius=st.floats(20, 50), length=st.floats(60, 160), swivel=st.floats(-35, 35), x=st.floats(0, 120),
+       y=st.floats(-40, 40), z=st.floats(-60, 60))
+def test_the_envelope_in_plain_floats_and_with_numpy_agree(radius, length, swivel, x, y, z):
+    """A process follows its first sections in plain floats and the rest with numpy
+    (engine.simulation.hobbing.contact.MATH_SECTIONS): the two give one distance, to a micrometre."""
+    body = HobBody(radius, length / 2)
+    cx, cy, cz = (np.array([[value]]) for value in centres(x, y, z, swivel))
+    heights = np.linspace(z - 100, z + 100, 401)[None, :]
+    plain, arrays = in_plain_floats(body, swivel, cx, cy, cz, heights), envelope_arrays.nearest_radius(
+        body, swivel, cx, cy, cz, heights)
+    assert (np.isinf(plain) == np.isinf(arrays)).all()
+    finite = np.isfinite(plain)
+    assert np.abs(plain[finite] - arrays[finite]).max(initial=0.0) < 0.001   # mm: a micrometre

@@ -115,7 +115,6 @@ def instantiate(ctx, gear_id, job_id, gear_class, params_file, unverified, gear_
     from ..programs.instantiate import instantiate_gear
     from ..programs.options import RunMode
     from ..programs.outputs import line_endings
-    from ..programs.remake import instantiate_job
 
     _refuse_all_but_one_job(gear_id, job_id, gear_class, gear_range, job_range, all_gears)
     _refuse_options_of_other_jobs(ctx, gear_class is not None)
@@ -140,6 +139,7 @@ def instantiate(ctx, gear_id, job_id, gear_class, params_file, unverified, gear_
             program = instantiate_gear(conn, gear_id, machine=machine, choices=choices, overrides=overrides,
                                        output=output, mode=mode)
         elif job_id is not None:
+            from ..programs.remake import instantiate_job  # a stored job's path only (issue 28: start-up)
             program = instantiate_job(conn, job_id, output=output, mode=mode)
         elif gear_class is not None:
             job = _class_job(conn, gear_class, params_file, machine, output, mode, unverified)

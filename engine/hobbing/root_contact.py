@@ -4,18 +4,21 @@ swivelled hob's points off the Y = 0 plane lie at other heights than its centre 
 tangency of its section in that plane is not enough: every point of the tip cylinder must stay
 outside the root r(z). For one point at (x', y, z) from the centre, the centre distance X
 keeps it outside when √((X + x')² + y²) ≥ r(z); the centre's X is the largest such bound over
-the cylinder (sampled, then sampled again finely around the worst point)."""
+the cylinder (sampled, then sampled again finely around the worst point). The sampling is numpy's,
+imported by the first taper or crowned gear: a spur or helical gear's command never loads it (issue 28)."""
 from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from typing import TYPE_CHECKING
 
-import numpy as np
+if TYPE_CHECKING:
+    import numpy as np
 
 COARSE = (121, 361)        # samples along the hob axis and around it
 REFINE_SPAN = 3            # coarse steps either side of the worst sample, sampled again finely
 
-RootRadius = Callable[[np.ndarray], np.ndarray]   # intended root radius at heights z (DIN, mm)
+RootRadius = Callable[["np.ndarray"], "np.ndarray"]   # intended root radius at heights z (DIN, mm)
 
 
 def centre_on_root_cone(root_radius: float, cone_angle: float, hob_radius: float, hob_length: float,
@@ -36,6 +39,7 @@ def contact_on_root(root: RootRadius, z_centre: float, hob_radius: float, hob_le
                     swivel: float) -> tuple[float, float]:
     """(X of the centre, Z of the contact point less z_centre): a swivelled hob touches the root
     off its centre's height, so a pass must carry the centre that much beyond a face."""
+    import numpy as np
     eta, half = math.radians(swivel), hob_length / 2
     along, around = np.linspace(-half, half, COARSE[0]), np.linspace(0, 2 * math.pi, COARSE[1])
     coarse = _needed(root, z_centre, hob_radius, eta, along, around)
@@ -50,6 +54,7 @@ def contact_on_root(root: RootRadius, z_centre: float, hob_radius: float, hob_le
 
 
 def _needed(root, z_centre, hob_radius, eta, along, around) -> tuple[float, float, tuple[int, int]]:
+    import numpy as np
     t, phi = np.meshgrid(along, around, indexing="ij")
     x = hob_radius * np.cos(phi)
     y = t * math.cos(eta) - hob_radius * np.sin(phi) * math.sin(eta)

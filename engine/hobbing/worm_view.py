@@ -26,7 +26,7 @@ def draw_worm_view(axes, scene) -> list[str]:
     axes.add_patch(Circle((0.0, 0.0), unit.radius_at_top, facecolor=BLANK_FILL, edgecolor="0.3", linewidth=0.8,
                           gid="top wheel tip", label="wheel tip circle"))
     if unit.intended_root is not None:
-        axes.add_patch(Circle((0.0, 0.0), float(unit.intended_root.min()), fill=False, edgecolor="0.3",
+        axes.add_patch(Circle((0.0, 0.0), min(unit.intended_root), fill=False, edgecolor="0.3",
                               linestyle=":", linewidth=0.7, gid="top wheel root", label="intended root"))
     senses, drawn = Senses.of(scene.machine), []
     for index, cut in enumerate(scene.recording.cuts):

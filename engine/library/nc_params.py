@@ -143,7 +143,7 @@ def refuse_blank_params(params: dict) -> None:
     simulation proves the program against, given at instantiate: bound at import it would also be a
     value of the program, and a new blank would rewrite every word that held its value (a G76 E0
     taper with stock_z_front 0)."""
-    from ..simulation.turning.work import BLANK_PARAMS  # the simulation's names; not needed at start-up
+    from ..simulation.turning import BLANK_PARAMS  # the simulation's names; not needed at start-up
 
     stated = [name for name in BLANK_PARAMS if name in params]
     if stated:

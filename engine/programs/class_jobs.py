@@ -34,7 +34,7 @@ from ..names import checked
 from ..nc.layout import NcLayout, class_layout
 from ..nc.lineage import refuse_lineage_shaped
 from ..nc.tokens import NUMBER, tokenise
-from ..simulation.turning.work import BLANK_PARAMS
+from ..simulation.turning import BLANK_PARAMS
 from ..templates.decision_table import compiled_template
 from ..templates.rows import Template
 from ..templates.versions import runnable_template

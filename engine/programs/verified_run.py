@@ -21,8 +21,7 @@ from ..gears.records import Gear, Hob
 from ..machines.records import Machine
 from ..nc.lineage import refuse_lineage_shaped
 from ..simulation import SimulationError, simulate_program
-from ..simulation.turning.run import simulate_turning
-from ..simulation.turning.work import BLANK_PARAMS
+from ..simulation.turning import BLANK_PARAMS
 from ..templates.decision_table import Result, compiled_template
 from ..templates.rows import Template
 from ..verifier import verify_program
@@ -82,7 +81,10 @@ def from_drawing(template: Template, params) -> bool:
 
 
 def prove_lathe(lines: list[str], machine: Machine, work: Workpiece | TurningWork | None, name: str) -> None:
-    """SimulationError (nothing stored) for a lathe program the turning simulation refuses."""
+    """SimulationError (nothing stored) for a lathe program the turning simulation refuses. The
+    turning simulation (shapely) is imported here, by lathe programs only: a hobbing command never
+    loads it (issue 28)."""
+    from ..simulation.turning.run import simulate_turning
     if not isinstance(work, TurningWork):
         raise EngineError(f"{name}: a turning program needs its job's records (profile, blank, operations) to be "
                           "proved by the simulation; nothing stored")

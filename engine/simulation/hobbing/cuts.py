@@ -6,9 +6,8 @@ tangential worm-wheel pass, the hob's trailing end beyond the wheel's centre pla
 feeds per workpiece revolution (radial infeed and pass)."""
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
-
-import numpy as np
 
 from .report import CutSummary
 from .solids import Solid
@@ -60,9 +59,9 @@ def radial_feed(cut: Cut) -> float | None:
 
 def summary(cut: Cut, unit: Solid, half_length: float) -> CutSummary:
     centre = min(end["X"] for _, end, _ in cut.moves)
-    reached = np.isfinite(unit.reach)
-    depth = float((unit.radius[reached] - unit.reach[reached]).max()) if reached.any() else 0.0
-    stock = float(unit.stock().max()) if reached.all() else float("inf")
+    depths = [radius - reach for radius, reach in zip(unit.radius, unit.reach) if reach != math.inf]
+    depth = max(depths) if depths else 0.0
+    stock = max(unit.stock()) if len(depths) == len(unit.reach) else math.inf
     pass_axes = ("Z",) if cut.pass_moves("Z") else ("Y",)
     return CutSummary(cut.number, unit.name, centre, depth, stock, run_out(cut, unit, half_length),
                       radial_feed(cut), feed_per_revolution(cut, pass_axes))

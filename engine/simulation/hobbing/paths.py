@@ -6,21 +6,19 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-
 POSE_STEP = 0.5          # mm
 AXES = ("X", "Y", "Z")
 
 
 def move_poses(start: dict, end: dict, rapid: bool) -> tuple:
-    """(x, y, z) arrays of DIN positions from start to end (an axis whose start is unknown
+    """(x, y, z) lists of DIN positions from start to end (an axis whose start is unknown
     jumps: only the end is followed)."""
     begin = {axis: start.get(axis, end[axis]) for axis in end} if {"X", "Z"} <= start.keys() else dict(end)
     pieces = [_line(begin, end)]
     leg = _dog_leg(begin, end) if rapid else []
     if len(leg) > 2:   # with one arrival (one axis moving, or all by the same) the leg is the line itself
         pieces += [_line(a, b) for a, b in zip(leg[:-1], leg[1:])]
-    return tuple(np.concatenate([piece[i] for piece in pieces]) for i in range(3))
+    return tuple([value for piece in pieces for value in piece[i]] for i in range(3))
 
 
 def _dog_leg(begin: dict, end: dict) -> list[dict]:
@@ -38,5 +36,11 @@ def _dog_leg(begin: dict, end: dict) -> list[dict]:
 
 def _line(a: dict, b: dict) -> tuple:
     length = math.dist([a.get(axis, 0.0) for axis in AXES], [b.get(axis, 0.0) for axis in AXES])
-    share = np.linspace(0.0, 1.0, max(2, int(math.ceil(length / POSE_STEP)) + 1))
-    return tuple(a.get(axis, 0.0) + share * (b.get(axis, 0.0) - a.get(axis, 0.0)) for axis in AXES)
+    count = max(2, int(math.ceil(length / POSE_STEP)) + 1)
+    shares = [i / (count - 1) for i in range(count)]
+    return tuple(_along(a.get(axis, 0.0), b.get(axis, 0.0), shares) for axis in AXES)
+
+
+def _along(start: float, end: float, shares: list[float]) -> list[float]:
+    travel = end - start
+    return [start + share * travel for share in shares]

@@ -5,14 +5,13 @@ notes §7). A unit also knows its intended root (reference §B3, §B11, §B12; a
 throat is the hob's own tip circle about the mid-plane, §B10) and keeps, per height, how close
 to the axis the hob has cut so far (`reach`), over the whole program and within the present
 coupling (`session_reach`): the gaps a coupled hob has cut are free to it while the coupling
-lasts, not after a new EGON, whose phase is not the old one."""
+lasts, not after a new EGON, whose phase is not the old one. Per height as plain lists of floats
+(issue 28: the simulation starts without numpy)."""
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
-
-import numpy as np
 
 from ...gears.records import Gear, Hob
 from ...machines.records import Machine
@@ -34,37 +33,43 @@ class Solid:
     slope: float = 0.0            # dR/dz (a taper's tan δ)
     teeth: int | None = None      # a toothed unit: the teeth the coupling must generate to cut it
     clamped_only: bool = False    # the tailstock: there only between M20 and M21
-    root: Callable[[np.ndarray], np.ndarray] | None = None   # heights -> intended root radius (units)
-    heights: np.ndarray = field(init=False)
-    radius: np.ndarray = field(init=False)
-    reach: np.ndarray = field(init=False)
-    session_reach: np.ndarray = field(init=False)
+    root: Callable[[float], float] | None = None   # height -> intended root radius (units), mm
+    heights: list[float] = field(init=False)       # ascending, HEIGHT_STEP apart at most, both faces
+    radius: list[float] = field(init=False)
+    reach: list[float] = field(init=False)
+    session_reach: list[float] = field(init=False)
+    intended_root: list[float] | None = field(init=False)
     session: int = -1
     cut_sessions: set = field(default_factory=set)   # the couplings whose cuts entered its material
 
     def __post_init__(self):
         count = max(2, int(math.ceil((self.z_high - self.z_low) / HEIGHT_STEP)) + 1)
-        self.heights = np.linspace(self.z_low, self.z_high, count)
-        self.radius = self.radius_at(self.heights)
-        self.reach = np.full(count, np.inf)
-        self.session_reach = np.full(count, np.inf)
-        self.intended_root = self.root(self.heights) if self.root is not None else None
+        step = (self.z_high - self.z_low) / (count - 1)
+        self.heights = [self.z_low + i * step for i in range(count - 1)] + [self.z_high]
+        self.radius = [self.radius_at(height) for height in self.heights]
+        self._largest = max(self.radius)
+        self.reach = [math.inf] * count
+        self.session_reach = [math.inf] * count
+        root = self.root
+        self.intended_root = [root(height) for height in self.heights] if root is not None else None
 
-    def radius_at(self, heights):
-        return self.radius_at_top + self.slope * heights
+    def radius_at(self, height: float) -> float:
+        return self.radius_at_top + self.slope * height
 
     @property
     def largest_radius(self) -> float:
-        return float(self.radius.max())
+        return self._largest
 
     def start_session(self, session: int) -> None:
         if self.session != session:
             self.session = session
-            self.session_reach = np.full(len(self.heights), np.inf)
+            self.session_reach = [math.inf] * len(self.heights)
 
-    def stock(self) -> np.ndarray:
-        """How far above its intended root the hob has left each height of the unit."""
-        return self.reach - self.intended_root
+    def stock(self) -> list[float]:
+        """How far above its intended root the hob has left each height of the unit (mm; inf
+        where it never reached)."""
+        assert self.intended_root is not None   # a unit, not the fixture or the tailstock
+        return [reach - root for reach, root in zip(self.reach, self.intended_root)]
 
 
 def unit_solids(gear: Gear, hob: Hob, worm_wheel: bool) -> list[Solid]:
@@ -106,7 +111,7 @@ def _throat(gear, hob, root_radius, top, width, slope):
     (d_f2 + d_a0)/2 − √(r0² − (z − z_m)²)."""
     r0, middle = hob.tip_diameter / 2, top - width / 2
     centre = root_radius + r0
-    return lambda z: centre - np.sqrt(np.maximum(r0 ** 2 - (z - middle) ** 2, 0.0))
+    return lambda z: centre - math.sqrt(max(r0 ** 2 - (z - middle) ** 2, 0.0))
 
 
 ROOTS = {"cone": _cone, "crowned": _crowned, "throat": _throat}

@@ -9,8 +9,6 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
-
 from ...gears.records import Gear, Hob
 from ...machines.records import Machine
 from ...verifier.refusals import Refused
@@ -303,7 +301,7 @@ class BlockSimulation:
         if self.cut is None or self.cut.teeth != teeth:
             self._end_cut()
             table = abs(self._coupled.k_b) * self.speed
-            before = {id(unit): unit.reach.copy() for unit in self.units if unit.teeth == teeth}
+            before = {id(unit): list(unit.reach) for unit in self.units if unit.teeth == teeth}
             self.cut = Cut(step.number, step.line, teeth, table, before)
         self.cut.add(start, end, velocities)
         table = abs(self._coupled.k_b) * self.speed        # the spindle speed now, not the cut's first
@@ -317,7 +315,8 @@ class BlockSimulation:
             return
         cut, self.cut = self.cut, None
         for unit in self.units:
-            if id(unit) in cut.reach_before and (unit.reach < cut.reach_before[id(unit)]).any():
+            before = cut.reach_before.get(id(unit))
+            if before is not None and any(now < then for now, then in zip(unit.reach, before)):
                 self.last_cut_of[id(unit)] = cut
                 self.report.cuts.append(summary(cut, unit, self.body.half_length))
                 self._check_run_out(cut, self.report.cuts[-1])
@@ -351,14 +350,14 @@ class BlockSimulation:
             self.report.add(*last, f"{unit.name} is never cut")
             return
         stock = unit.stock()
-        worst = int(np.argmax(stock))
+        worst = max(range(len(stock)), key=stock.__getitem__)      # the first of equal heights, low to high
         z = unit.heights[worst] * self.senses.z
-        if np.isinf(stock[worst]):
+        if stock[worst] == math.inf:
             self.report.add(cut.number, cut.line, f"the cuts of {unit.name} never reach Z{z:.3f}: part of its face "
                                                   "is not cut")
         else:
-            for at in (worst, int(np.argmin(stock))):
-                problem = depth_problem(float(stock[at]), self.allowance)
+            for at in (worst, min(range(len(stock)), key=stock.__getitem__)):
+                problem = depth_problem(stock[at], self.allowance)
                 if problem:
                     z = unit.heights[at] * self.senses.z
                     self.report.add(cut.number, cut.line, f"the last cut of {unit.name} {problem} at Z{z:.3f}")

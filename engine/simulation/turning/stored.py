@@ -10,10 +10,10 @@ from typing import TYPE_CHECKING
 
 from ...errors import EngineError
 from ...machines.records import Machine
+from . import BLANK_PARAMS
 from .drawing import job_drawing, proof_params
 from .report import TurningReport
 from .run import simulate_turning
-from .work import BLANK_PARAMS
 
 if TYPE_CHECKING:
     from ...db.connection import Connection

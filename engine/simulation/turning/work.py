@@ -25,7 +25,6 @@ ASSUMED_BLANK_MARGIN_MM = 1.0
 ARC_SAGITTA_MM = 1e-4       # chord error of an arc drawn as a polyline: far inside the tolerances
 MAX_ARC_PIECES = 4000
 # The blank a job's params state (mm): a class job's only records (engine.simulation.turning.undrawn).
-BLANK_PARAMS = ("stock_diameter", "stock_z_front", "stock_z_back")
 KINDS = ("ROUGH", "SLOT", "FINISH", "THREAD", "FACE", "PART")
 FIX = "fix the job's params in SQL and instantiate it again"
 
