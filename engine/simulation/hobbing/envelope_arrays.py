@@ -5,7 +5,7 @@ and height together. A batch of gears follows hundreds of thousands of sections,
 faster so than one by one in plain floats, but importing numpy takes about 0.1 s: a process
 follows its first sections in plain floats (engine.simulation.hobbing.contact.MATH_SECTIONS)
 and imports this module only after them, so one gear's command never loads numpy (issue 28).
-The two agree to 1e-9 mm (tests/test_simulation_random.py, tests/test_hobbing_envelope_exact.py)."""
+The two agree to 1e-9 mm (tests/test_simulation_random.py, tests/test_simulation_envelope.py)."""
 from __future__ import annotations
 
 import numpy as np
