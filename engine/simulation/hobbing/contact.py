@@ -3,7 +3,9 @@ the intended cut. Intended: a G1 with the table coupled and the hob spindle turn
 unit whose teeth the coupling generates, never below its intended root (less TOLERANCE). The
 gaps such cuts leave are free to the hob while the same coupling lasts (a coupled retract out
 of its own gaps), except on a rapid along Z (engine.simulation.hobbing.walk). Anything else that enters
-material is a collision. Plain floats, pose by pose and height by height (issue 28: no numpy)."""
+material is a collision. Plain floats, pose by pose and height by height, for a process's first
+MATH_SECTIONS sections (one gear's proof imports no numpy); engine.simulation.hobbing.contact_arrays
+follows the rest by the same rules (issue 28)."""
 from __future__ import annotations
 
 import math

@@ -124,7 +124,7 @@ def _cut(solid: Solid, motion: Motion, index, radius, least) -> Contact | None:
     """contact._cut: the least distance per height over the poses (`least`) into both reaches."""
     solid.start_session(motion.session)
     assert solid.intended_root is not None   # a unit the hob cuts has its intended root
-    blank, root = np.asarray(solid.radius), np.asarray(solid.intended_root)
+    blank, root = _blank(solid), np.asarray(solid.intended_root)
     if (least < blank - TOLERANCE).any():
         solid.cut_sessions.add(motion.session)
     for i in np.flatnonzero(np.isfinite(least)).tolist():
