@@ -17,16 +17,6 @@ SLACK = 1e-6           # mm a bound must clear a distance by to rule a slice out
                        # distance is exact to ~1e-9 mm, not to the last bit, while a bound can be exact
 
 
-def span_radii(hob: HobBody, swivel: float, spans: list, heights: list[float]) -> list[list[float]]:
-    """Per span (cx, cy, cz, first, last: a pose and the indices of `heights` it reaches), the
-    least distance at each of heights[first:last], inf where the hob has no point there."""
-    cx, cy, cz = (np.array([span[i] for span in spans], float)[:, None] for i in range(3))
-    first, last = (np.array([span[i] for span in spans]) for i in (3, 4))
-    index = np.minimum(first[:, None] + np.arange(int((last - first).max()))[None, :], len(heights) - 1)
-    radius = nearest_radius(hob, swivel, cx, cy, cz, np.asarray(heights, float)[index])
-    return [row[:end - start].tolist() for row, start, end in zip(radius, first, last)]
-
-
 def nearest_radius(hob: HobBody, swivel: float, cx, cy, cz, heights):
     """Per pose (cx, cy, cz: arrays of shape (P, 1)) and height (shape (P, W)): the least
     distance from the work axis of the hob's points at that height, inf where it has none."""

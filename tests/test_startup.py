@@ -1,0 +1,66 @@
+"""Start-up (issue 28): a command imports what it uses and nothing else, so `engine instantiate
+--gear 42` starts about as fast as a bare connect-and-query (bench/latency.py times it; no test
+here is timed). Each check runs a fresh interpreter, where nothing else has imported anything,
+and reads its sys.modules after the work."""
+from __future__ import annotations
+
+import subprocess
+import sys
+
+import pytest
+
+from engine.verifier.expansion import EXPANDER_MODULES, expander_named
+from engine.verifier.grammar import DIALECTS
+
+# libraries an 840D hobbing command does not need: numpy (about 0.1 s of a start), the plots'
+# matplotlib, the case base's pandas, the SQL translation's sqlglot, the drawings' ezdxf and the
+# turning simulation's shapely
+HEAVY = {"numpy", "matplotlib", "pandas", "sqlglot", "ezdxf", "shapely"}
+LATHE_EXPANDERS = {"engine.verifier.expanders.iso", "engine.verifier.expanders.linuxcnc",
+                   "engine.verifier.expanders.sinumerik"}
+
+
+def modules_after(code: str, *arguments: str) -> set[str]:
+    """The modules loaded once `code` has run in a fresh interpreter (its last stdout line)."""
+    done = subprocess.run([sys.executable, "-c", f"{code}\nimport sys\nprint(' '.join(sorted(sys.modules)))",
+                           *arguments], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    return set(done.stdout.splitlines()[-1].split())
+
+
+def top_level(modules: set[str]) -> set[str]:
+    return {name.partition(".")[0] for name in modules}
+
+
+def test_proving_and_checking_gear_42_loads_no_library_it_does_not_use(database_url):
+    """The whole command, the simulation of the program included (a dry run: stored or not, the
+    same checks run)."""
+    code = ("import sys\nfrom engine.cli import main\n"
+            "try:\n    main(['--database-url', sys.argv[1], 'instantiate', '--gear', '42', '--dry-run'])\n"
+            "except SystemExit as done:\n    assert not done.code, done.code")
+    loaded = modules_after(code, database_url)
+    assert "engine.simulation.hobbing.walk" in loaded          # the program was proved
+    assert top_level(loaded) & HEAVY == set()
+    assert loaded & LATHE_EXPANDERS == set()
+    assert not any(name.startswith("engine.simulation.turning.") for name in loaded)
+
+
+def test_importing_the_command_line_loads_no_heavy_library():
+    loaded = modules_after("import engine.cli.app, engine.programs.instantiate, engine.programs.all_models")
+    assert top_level(loaded) & HEAVY == set()
+    assert loaded & LATHE_EXPANDERS == set()
+
+
+@pytest.mark.parametrize("name", sorted(EXPANDER_MODULES))
+def test_a_dialect_s_expander_is_imported_with_its_first_use_and_alone(name):
+    code = ("import sys\nfrom engine.verifier.expansion import EXPANDERS, expander_named\n"
+            "assert sys.argv[1] not in EXPANDERS\nexpander_named(sys.argv[1])\nassert sys.argv[1] in EXPANDERS")
+    loaded = modules_after(code, name)
+    assert loaded & LATHE_EXPANDERS == {EXPANDER_MODULES[name]}
+
+
+def test_every_dialect_that_names_an_expander_finds_it():
+    named = {dialect.expander for dialect in DIALECTS.values() if dialect.expander is not None}
+    assert named == set(EXPANDER_MODULES)
+    for name in named:
+        assert callable(expander_named(name))
