@@ -5,12 +5,22 @@ in this process only. Repetitions alternate; stored jobs/programs are deleted be
 The Jinja2 pipeline of bench/batch.py does not simulate: this ratio says how much of the gap
 between the two is the proof.
 
-    python bench/simulation.py [--count 1000] [--reps 3] [--profile] [--database-url URL]
+Then the simulation alone against an earlier tree (issue 28): every program the batch proved
+is simulated again by this tree and by `--against` (default 7bb4197, main before issue 28:
+the golden-section search), each in a subprocess of its own (the same interpreter, its source
+tree first on sys.path), runs alternated; printed per program and as a ratio, with how many
+of the two trees' reports (Report.lines(): findings, cuts, times) differ.
+
+    python bench/simulation.py [--count 1000] [--reps 3] [--against REV] [--profile] [--database-url URL]
 """
 from __future__ import annotations
 
 import argparse
+import json
+import pickle
+import subprocess
 import sys
+import tempfile
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
@@ -18,10 +28,31 @@ sys.path.insert(0, str(HERE))
 
 from _common import add_database_argument, bench_database, median, parse_arguments  # noqa: E402
 from batch import FIRST_ID, clear_jobs, generate_gears, insert_gears, run_ours  # noqa: E402
+from latency import source_tree_of  # noqa: E402
 
 from engine.programs import verified_run  # noqa: E402
 
 WARMUP_GEARS = 100
+AGAINST = "7bb4197"      # main before issue 28: the golden-section search, every section with numpy
+WARMUP_PROGRAMS = 50     # simulated untimed first in each subprocess (imports, the switch to numpy)
+
+# Runs in the subprocess: the tree's own simulation follows every program; prints seconds and reports.
+TIMER = r"""
+import json, pickle, sys, time
+tree, data = sys.argv[1], sys.argv[2]
+sys.path.insert(0, tree)
+from engine.simulation.hobbing.run import simulate_program
+import engine.simulation.hobbing.run as run
+assert run.__file__.startswith(tree), run.__file__
+with open(data, "rb") as file:
+    programs, warmup = pickle.load(file)
+for lines, gear, hob, machine, name in programs[:warmup]:
+    simulate_program(lines, gear, hob, machine, name)
+start = time.perf_counter()
+reports = [simulate_program(lines, gear, hob, machine, name) for lines, gear, hob, machine, name in programs]
+seconds = time.perf_counter() - start
+print(json.dumps({"seconds": seconds, "reports": [report.lines() for report in reports]}))
+"""
 
 
 def no_proof(lines, machine, workpiece, name) -> None:
@@ -36,6 +67,57 @@ def run(conn, first: int, last: int, proved: bool) -> float:
     finally:
         verified_run.prove = real
     return seconds
+
+
+def proved_programs(conn, first: int, last: int) -> list:
+    """(lines, gear, hob, machine, name) of every program the batch proves, recorded from one run."""
+    real, recorded = verified_run.prove, []
+
+    def recording(lines, machine, workpiece, name) -> None:
+        recorded.append((list(lines), workpiece.gear, workpiece.hob, machine, name))
+        real(lines, machine, workpiece, name)
+
+    verified_run.prove = recording
+    try:
+        clear_jobs(conn)
+        run_ours(conn, first, last)
+    finally:
+        verified_run.prove = real
+    return recorded
+
+
+def timed_tree(tree: Path, data: Path) -> dict:
+    done = subprocess.run([sys.executable, "-c", TIMER, str(tree), str(data)], capture_output=True, text=True)
+    if done.returncode != 0:
+        raise RuntimeError(f"simulation run in {tree} failed: {done.stderr.strip()[-800:]}")
+    return json.loads(done.stdout.strip().splitlines()[-1])
+
+
+def compare_trees(programs: list, against: str, reps: int) -> None:
+    """The same programs simulated by this tree and by `against`, alternated; ratio and report differences."""
+    with tempfile.TemporaryDirectory() as folder:
+        (Path(folder) / "before").mkdir()
+        before = source_tree_of(against, Path(folder) / "before")
+        if before is None:
+            print(f"\nsimulation alone: this checkout has no commit {against}; give --against REV")
+            return
+        data = Path(folder) / "programs.pickle"
+        data.write_bytes(pickle.dumps((programs, min(WARMUP_PROGRAMS, len(programs)))))
+        trees = {"this tree": HERE.parent, against: before}
+        runs: dict = {name: [] for name in trees}
+        for repetition in range(reps):
+            for name in (list(trees) if repetition % 2 == 0 else list(trees)[::-1]):
+                runs[name].append(timed_tree(trees[name], data))
+    times = {name: [found["seconds"] for found in runs[name]] for name in trees}
+    seconds = {name: median(times[name]) for name in trees}
+    ours, theirs = runs["this tree"][0]["reports"], runs[against][0]["reports"]
+    differing = sum(mine != other for mine, other in zip(ours, theirs))
+    print(f"\nsimulation alone: {len(programs)} proved programs, {reps} alternated runs per tree (subprocesses)")
+    for name in trees:
+        print(f"  {name:12s}: median {seconds[name] / len(programs) * 1e3:6.2f} ms per program "
+              f"({', '.join(f'{value:.2f}' for value in times[name])} s)")
+    print(f"  ratio {against}/this tree = {seconds[against] / seconds['this tree']:.2f}x faster (target >= 3); "
+          f"reports differing: {differing} of {len(programs)}")
 
 
 def profile(conn, first: int, last: int, top: int) -> None:
@@ -60,6 +142,8 @@ def main(argv=None) -> int:
     parser.add_argument("--reps", type=int, default=3, help="alternated repetitions (default 3)")
     parser.add_argument("--profile", action="store_true", help="also print cProfile hotspots of a simulated run")
     parser.add_argument("--top", type=int, default=30)
+    parser.add_argument("--against", default=AGAINST, metavar="REV",
+                        help=f"the tree the simulation alone is compared with (default {AGAINST})")
     args = parse_arguments(parser, argv, smoke={"count": 20, "reps": 1})
 
     import psycopg
@@ -75,6 +159,7 @@ def main(argv=None) -> int:
             for proved in ((True, False) if repetition % 2 == 0 else (False, True)):
                 clear_jobs(conn)
                 times[proved].append(run(conn, first, last, proved))
+        programs = proved_programs(conn, first, last)
         if args.profile:
             profile(conn, first, last, args.top)
 
@@ -86,6 +171,7 @@ def main(argv=None) -> int:
     print(f"  ratio with/without = {with_sim / without:.2f}x time; the simulation costs "
           f"{(with_sim - without) / args.count * 1e3:.2f} ms per program "
           f"({(with_sim - without) / with_sim:.0%} of the batch)")
+    compare_trees(programs, args.against, args.reps)
     return 0
 
 

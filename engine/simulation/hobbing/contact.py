@@ -3,58 +3,70 @@ the intended cut. Intended: a G1 with the table coupled and the hob spindle turn
 unit whose teeth the coupling generates, never below its intended root (less TOLERANCE). The
 gaps such cuts leave are free to the hob while the same coupling lasts (a coupled retract out
 of its own gaps), except on a rapid along Z (engine.simulation.hobbing.walk). Anything else that enters
-material is a collision. Followed pose by pose and height by height in plain floats; the envelope
-is computed with numpy only after a process's first MATH_SECTIONS sections (issue 28: one gear's
-command never imports numpy)."""
+material is a collision. Plain floats, pose by pose and height by height, for a process's first
+MATH_SECTIONS sections (one gear's proof imports no numpy); engine.simulation.hobbing.contact_arrays
+follows the rest by the same rules (issue 28)."""
 from __future__ import annotations
 
+import math
 from bisect import bisect_left, bisect_right
 from dataclasses import dataclass
 
+from .contact_records import TOLERANCE, Contact, Motion, contact_at
 from .envelope import HobBody, centres, nearest_radii
+from .paths import corners, pieces_poses
 from .solids import Solid
 
-TOLERANCE = 0.01      # mm: below the root, or into material, before it counts
+__all__ = ["TOLERANCE", "Contact", "Motion", "follow"]
+
+MARGIN = 1e-6         # mm a move's bounding box is widened by against rounding (its poses are interpolated)
 # Sections (one pose at one height) a process follows in plain floats before it imports numpy for
-# the rest (engine.simulation.hobbing.envelope_arrays): one gear takes a few thousand (gear 42 of
-# the samples 4,300), a batch hundreds of thousands; in plain floats each costs about 5–10 µs more,
-# so this many cost about what importing numpy does (0.1–0.2 s)
+# the rest (engine.simulation.hobbing.contact_arrays, envelope_arrays): one gear takes a few thousand (gear 42 of
+# the samples 4,300), a batch hundreds of thousands; in plain floats each costs about 5 µs more, so
+# this many cost about what importing numpy does (0.1 s)
 MATH_SECTIONS = 20_000
 _followed = [0]       # sections followed by this process so far
 
 
-@dataclass(frozen=True, slots=True)
-class Motion:
-    """What the hob is doing on a move: which teeth it cuts (None: not an intended cut), whether
-    the coupling is on with the spindle turning (its own gaps are free), in which coupling
-    session, with the tailstock clamped or not, and why it is not a cut (for the message)."""
-    cutting_teeth: int | None
-    coupled_running: bool
-    session: int
-    tailstock: bool
-    reason: str
+def follow(solids: list[Solid], hob: HobBody, swivel: float, pieces: list, motion: Motion) -> list[Contact]:
+    """Every solid the hob meets on the move's straight pieces (engine.simulation.hobbing.paths:
+    machine positions, DIN) against the rules above; the intended cuts recorded in the units'
+    reach. A solid the move's bounding box keeps clear of the hob is passed over before any pose
+    is worked out (most are: the fixture and the tailstock on nearly every move, the blank on
+    the approach)."""
+    x, y, z = corners(pieces)
+    box = Box.of(x, y, z, hob, swivel)
+    near = [solid for solid in solids if (motion.tailstock or not solid.clamped_only) and box.reaches(solid)]
+    if not near:
+        return []
+    if _followed[0] > MATH_SECTIONS:
+        from .contact_arrays import meet_all
+        return meet_all(near, hob, swivel, pieces, motion)
+    poses = [centres(px, py, pz, swivel) for px, py, pz in zip(*pieces_poses(pieces))]
+    return [found for found in (_meet(solid, hob, swivel, poses, motion) for solid in near) if found is not None]
 
 
 @dataclass(frozen=True, slots=True)
-class Contact:
-    solid: Solid
-    depth: float          # mm
-    height: float         # DIN Z where it is deepest
-    below_root: bool      # an intended cut below the root (else a collision)
+class Box:
+    """The least hob centre X of a move's poses and the heights its hob spans (mm, DIN): the poses
+    lie on straight pieces between the given positions, so their least and greatest values bound
+    them; the centre's Z is Z + Y·sin A, bounded by the extremes of each term."""
+    x_low: float
+    z_low: float
+    z_high: float
+    radius: float
 
+    @classmethod
+    def of(cls, x, y, z, hob: HobBody, swivel: float) -> Box:
+        sine = math.sin(math.radians(swivel))
+        shifts = (min(y) * sine, max(y) * sine)
+        extent = hob.extent(swivel)
+        return cls(min(x), min(z) + min(shifts) - extent, max(z) + max(shifts) + extent, hob.radius)
 
-def follow(solids: list[Solid], hob: HobBody, swivel: float, x, y, z, motion: Motion) -> list[Contact]:
-    """Every solid the poses (sequences x, y, z: machine positions, DIN) meet against the rules
-    above; the intended cuts recorded in the units' reach."""
-    poses = [centres(float(px), float(py), float(pz), swivel) for px, py, pz in zip(x, y, z)]
-    contacts = []
-    for solid in solids:
-        if solid.clamped_only and not motion.tailstock:
-            continue
-        found = _meet(solid, hob, swivel, poses, motion)
-        if found is not None:
-            contacts.append(found)
-    return contacts
+    def reaches(self, solid: Solid) -> bool:
+        """The tests of _spans, for the whole move at once (with a micrometre's margin for rounding)."""
+        return (self.x_low - self.radius < solid.largest_radius + TOLERANCE and self.z_high + MARGIN >= solid.z_low
+                and self.z_low - MARGIN <= solid.z_high)
 
 
 def _meet(solid: Solid, hob: HobBody, swivel: float, poses: list, motion: Motion) -> Contact | None:
@@ -62,7 +74,9 @@ def _meet(solid: Solid, hob: HobBody, swivel: float, poses: list, motion: Motion
     spans = list(_spans(solid, hob.extent(swivel), hob.radius, poses))
     if not spans:
         return None
-    radii = [(span[3], found) for span, found in zip(spans, _span_radii(solid, hob, swivel, spans))]
+    _followed[0] += sum(last - first for *_, first, last in spans)
+    radii = [(first, nearest_radii(hob, swivel, cx, cy, cz, solid.heights[first:last]))
+             for cx, cy, cz, first, last in spans]
     if motion.cutting_teeth is not None and solid.teeth == motion.cutting_teeth:
         return _cut(solid, motion, radii)
     return _collision(solid, motion, radii)
@@ -77,16 +91,6 @@ def _spans(solid: Solid, extent: float, radius: float, poses: list):
             first, last = bisect_left(solid.heights, cz - extent), bisect_right(solid.heights, cz + extent)
             if last > first:
                 yield cx, cy, cz, first, last
-
-
-def _span_radii(solid: Solid, hob: HobBody, swivel: float, spans: list) -> list[list[float]]:
-    """The least distance of the hob from the work axis at each height of each span: in plain
-    floats for a process's first MATH_SECTIONS sections, then with numpy."""
-    _followed[0] += sum(last - first for *_, first, last in spans)
-    if _followed[0] > MATH_SECTIONS:
-        from .envelope_arrays import span_radii
-        return span_radii(hob, swivel, spans, solid.heights)
-    return [nearest_radii(hob, swivel, cx, cy, cz, solid.heights[first:last]) for cx, cy, cz, first, last in spans]
 
 
 def _cut(solid: Solid, motion: Motion, radii: list) -> Contact | None:
@@ -108,7 +112,7 @@ def _cut(solid: Solid, motion: Motion, radii: list) -> Contact | None:
             index += 1
     if entered:
         solid.cut_sessions.add(motion.session)
-    return _contact(solid, deepest, at, True)
+    return contact_at(solid, deepest, at, True)
 
 
 def _collision(solid: Solid, motion: Motion, radii: list) -> Contact | None:
@@ -121,11 +125,4 @@ def _collision(solid: Solid, motion: Motion, radii: list) -> Contact | None:
             if blank[index] - radius > deepest and not (own_gaps and radius >= session_reach[index] - TOLERANCE):
                 deepest, at = blank[index] - radius, index
             index += 1
-    return _contact(solid, deepest, at, False)
-
-
-def _contact(solid: Solid, depth: float, at: int, below_root: bool) -> Contact | None:
-    """The deepest point (the first pose and lowest height of equal depths), or None (at -1)."""
-    if at < 0:
-        return None
-    return Contact(solid, depth, solid.heights[at], below_root)
+    return contact_at(solid, deepest, at, False)

@@ -1,16 +1,36 @@
-"""The hob as the simulation sees it: its tip cylinder (radius d_a0/2, length L, end faces
+"""The hob as the simulation sees it: its tip cylinder (radius R = d_a0/2, length L, end faces
 included), the axis in the Y–Z plane swivelled by A about X (reference §A6, §B7). Every hob
 point lies within that solid, so what the cylinder does not touch, the hob does not touch.
 
 The blank, its units, the fixture and the tailstock are all solids of revolution about the
 work axis, so a hob pose meets them where, at some height z, the hob comes closer to the work
-axis than the solid's radius. `nearest_radius` gives that closest distance at one height: the
-horizontal slice of the (convex) cylinder is convex and the distance from the work axis is a
-convex function, so along the slice's one free coordinate (dy, the slice's Y from the centre)
-the minimum is where the derivative changes sign, found by Newton's method kept inside a
-bracket that halves when a step leaves it. Plain floats (math): proving one gear needs no numpy
-and starts without importing it (issue 28); a batch's later sections go to the same search with
-numpy (engine.simulation.hobbing.envelope_arrays). Exact to well below a micrometre, not sampled.
+axis than the solid's radius. `nearest_radius` gives that closest distance at one height,
+exactly (issue 28), not searched:
+
+* The hob. Centre C = (cx, cy, cz), axis u = (0, c, s) with s, c = sin A, cos A (mm, DIN).
+  A point p lies in the hob where |(p − C)·u| ≤ L/2 (between the end faces) and its distance
+  from the axis is at most R.
+* Its horizontal slice at height z, dz = z − cz. Write p − C = (ξ, dy, dz). The radial
+  directions are X and e = (0, −s, c); along e the point lies −q, q = s·dy − c·dz (mm), so the
+  mantle holds ξ² + q² ≤ R²: in the (ξ, dy) plane an ellipse about (0, dy₀), dy₀ = c·dz/s,
+  with semi-axes a = R along X and b = R/|s| along Y (for s = 0, the strip |dz| ≤ R). The end
+  faces, |c·dy + s·dz| ≤ L/2, cut it between two lines of constant dy.
+* The nearest point to the work axis (x = y = 0). At dy the slice spans X = cx ± w,
+  w = √(R² − q²), so the squared distance is g(dy) = (cx − w)₊² + (cy + dy)² (mm²), convex in
+  dy (the slice is convex). Without the end faces its least value is at dy* = −cy where the
+  axis passes through the ellipse (distance 0 there), else at the foot of the normal from the
+  axis's point P = (−cx, −cy − dy₀) (from the ellipse's centre): the foot is
+  (a²Pξ/(t + a²), b²Py/(t + b²)), t (mm²) the root of
+      F(t) = (a·Pξ/(t + a²))² + (b·Py/(t + b²))² − 1,
+  which falls and is convex for t > 0, so Newton's steps from a t where F ≥ 0, such as
+  t₀ = max(0, a|Pξ| − a², b|Py| − b²) (each term alone is 1 there), rise to the root and never
+  pass it. dy* = −cy − Py·t/(t + b²) (the difference written out: b is large for a nearly level
+  hob, and dy₀ with it).
+* The end faces. g is convex, so over the band between them its least value lies at dy*
+  clamped into the band; the distance is √g there (mm), to about 1e-10 mm.
+
+Plain floats (math): the simulation needs no numpy, so proving one gear starts without importing
+it; engine.simulation.hobbing.envelope_arrays computes the same for a batch's many sections.
 
 The shift axis Y rides on the swivel head: Y moves the hob along its own axis, so the
 generating zone stays where X and Z put it and a different part of the hob reaches it."""
@@ -19,11 +39,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-FREE_STEPS = 8             # Newton's steps from the last height's dy before the safe way is taken
-STEP_LIMIT = 60            # Newton or halving steps in the bracket (it halves at least every other one)
-DY_TOLERANCE = 1e-7        # mm: the free coordinate is found this closely (the distance to ~1e-12 mm)
-THIN = 1e-12               # mm: a slice this thin (a tangent plane) has no interior to step in
-UPRIGHT = 1e-12            # the sine of a swivel this small is taken as 0 (as the numpy version does)
+UPRIGHT = 1e-12            # the sine of a swivel this small is taken as 0: the slice is a strip
+ROOT_TOLERANCE = 1e-9      # F(t) within this of 0: dy* is off by ~1e-9·cx, the distance by far less
+STEP_LIMIT = 60            # Halley's or Newton's steps at most (one to three suffice: the start is near)
 
 
 @dataclass(frozen=True, slots=True)
@@ -43,6 +61,13 @@ def centres(x: float, y: float, z: float, swivel: float) -> tuple[float, float, 
     return x, y * math.cos(a), z + y * math.sin(a)
 
 
+def sine_cosine(swivel: float) -> tuple[float, float]:
+    """sin A and cos A of the swivel (degrees), the sine of a level hob exactly 0."""
+    a = math.radians(swivel)
+    s = math.sin(a)
+    return (s if abs(s) > UPRIGHT else 0.0), math.cos(a)
+
+
 def nearest_radius(hob: HobBody, swivel: float, cx: float, cy: float, cz: float, height: float) -> float:
     """The least distance from the work axis (mm) of the hob's points at `height` with its centre
     at (cx, cy, cz); inf where the hob has no point at that height."""
@@ -50,105 +75,84 @@ def nearest_radius(hob: HobBody, swivel: float, cx: float, cy: float, cz: float,
 
 
 def nearest_radii(hob: HobBody, swivel: float, cx: float, cy: float, cz: float, heights) -> list[float]:
-    """nearest_radius at each of `heights` for one pose. The hob's section by the plane dz above
-    its centre: a point of it at dy (along Y from the centre) lies q = s·dy − c·dz across the
-    cylinder (s, c: sine and cosine of the swivel), so it spans X = cx ± w, w = √(R² − q²), and the
-    end faces bound dy to |c·dy + s·dz| ≤ L/2. Its squared distance from the work axis,
-    (cx − w)₊² + (cy + dy)², is convex in dy. Each height takes Newton's steps from the last
-    height's dy while they stay inside (two or three: the distance is nearly a parabola in dy),
-    else the safe way (Slice.bracketed). Written out in one loop: this is the simulation's inner
-    loop (several thousand sections a program)."""
-    a = math.radians(swivel)
-    section = Slice(math.sin(a), math.cos(a), hob.radius, cx, cy)
-    s, c, r2 = section.s, section.c, section.r2
-    found, guess = [], -cy
+    """nearest_radius at each of `heights` for one pose (the module's formulation)."""
+    s, c = sine_cosine(swivel)
+    r, half = hob.radius, hob.half_length
+    found = []
     for height in heights:
         dz = height - cz
-        low, high = section.span(dz, hob.half_length)
+        low, high = band(s, c, r, half, dz)
         if low > high:
             found.append(math.inf)
             continue
-        dy, done = (low if guess < low else high if guess > high else guess), False
-        for _ in range(FREE_STEPS):
-            q = s * dy - c * dz
-            w2 = r2 - q * q
-            if w2 <= THIN:
-                break
-            w = math.sqrt(w2)
-            gap = cx - w
-            if gap > 0:
-                sq = s * q
-                step = dy - (gap * sq / w + cy + dy) / (1.0 + sq * sq / w2 + gap * s * s * r2 / (w2 * w))
-            else:
-                step = -cy
-            if not low < step < high:
-                break
-            if -DY_TOLERANCE < step - dy < DY_TOLERANCE:
-                dy, done = step, True
-                break
-            dy = step
-        guess = dy if done else section.bracketed(dz, low, high)
-        q = s * guess - c * dz
-        found.append(math.sqrt(max(cx - math.sqrt(max(r2 - q * q, 0.0)), 0.0) ** 2 + (cy + guess) ** 2))
+        dy = min(max(unbounded_dy(s, c, r, cx, cy, dz), low), high)
+        q = s * dy - c * dz
+        gap = max(cx - math.sqrt(max(r * r - q * q, 0.0)), 0.0)
+        found.append(math.sqrt(gap * gap + (cy + dy) ** 2))
     return found
 
 
-class Slice:
-    """One pose's sections: the swivel's sine and cosine, the hob's radius, the centre's X and Y."""
+def band(s: float, c: float, r: float, half: float, dz: float) -> tuple[float, float]:
+    """(low, high) of dy in the slice at dz: between the end faces and within the ellipse's
+    (or the strip's) reach; low > high where the hob has no point there."""
+    low, high = (-half - s * dz) / c, (half - s * dz) / c
+    if s:
+        first, second = (c * dz - r) / s, (c * dz + r) / s
+        return max(low, min(first, second)), min(high, max(first, second))
+    return (low, high) if abs(dz) <= r else (high, low - 1.0)
 
-    __slots__ = ("s", "c", "r", "r2", "cx", "cy")
 
-    def __init__(self, s: float, c: float, r: float, cx: float, cy: float) -> None:
-        s = s if abs(s) > UPRIGHT else 0.0    # an upright hob: the section's width does not vary along dy
-        self.s, self.c, self.r, self.r2, self.cx, self.cy = s, c, r, r * r, cx, cy
+def unbounded_dy(s: float, c: float, r: float, cx: float, cy: float, dz: float) -> float:
+    """dy of the slice's nearest point to the work axis, the end faces left out: −cy where the
+    axis passes through the ellipse (or the strip), else the foot of the normal from it."""
+    if not s or cx <= 0.0:
+        return -cy
+    b = r / abs(s)
+    px, py = cx, -cy - c * dz / s                 # |Pξ| and Py
+    if (px / r) ** 2 + (py / b) ** 2 <= 1.0:
+        return -cy
+    t = ellipse_root(r, b, px, abs(py))
+    return -cy - py * t / (t + b * b)
 
-    def span(self, dz: float, half_length: float) -> tuple[float, float]:
-        """(low, high) of dy at dz; low > high where the hob has no point there."""
-        s, c = self.s, self.c
-        low, high = (-half_length - s * dz) / c, (half_length - s * dz) / c
-        if s:
-            first, second = (c * dz - self.r) / s, (c * dz + self.r) / s
-            return max(low, min(first, second)), min(high, max(first, second))
-        return (low, high) if abs(dz) <= self.r else (high, low - 1.0)
 
-    def squared(self, dz: float, dy: float) -> float:
-        q = self.s * dy - self.c * dz
-        half = math.sqrt(max(self.r2 - q * q, 0.0))
-        return max(self.cx - half, 0.0) ** 2 + (self.cy + dy) ** 2
+def ellipse_root(a: float, b: float, px: float, py: float) -> float:
+    """The root t (mm²) of F above, for a point (px, py ≥ 0) outside the ellipse of semi-axes a, b:
+    Halley's steps (step) from _start's bound, never below t₀ (F ≥ 0 there), until |F| is
+    within ROOT_TOLERANCE: one to three from that start."""
+    a2, b2 = a * a, b * b
+    ap, bp = a * px, b * py
+    floor = max(ap - a2, bp - b2, 0.0)
+    t = _start(a2, b2, ap, bp, floor)
+    for _ in range(STEP_LIMIT):
+        ta, tb = t + a2, t + b2
+        u2, v2 = (ap / ta) ** 2, (bp / tb) ** 2
+        f = u2 + v2 - 1.0
+        if -ROOT_TOLERANCE <= f <= ROOT_TOLERANCE:
+            return t
+        t = max(t + step(f, u2 / ta + v2 / tb, u2 / (ta * ta) + v2 / (tb * tb)), floor)
+    return t
 
-    def bracketed(self, dz: float, low: float, high: float) -> float:
-        """An end whose slope points out of the interval, else the root of the slope: Newton's steps
-        inside the bracket where the slope changes sign, halving it when a step would leave it."""
-        if high - low <= THIN or self.derivatives(dz, low)[0] >= 0:
-            return low
-        if self.derivatives(dz, high)[0] <= 0:
-            return high
-        dy = (low + high) / 2
-        for _ in range(STEP_LIMIT):
-            slope, curvature = self.derivatives(dz, dy)
-            if slope > 0:
-                high = dy
-            else:
-                low = dy
-            step = dy - slope / curvature if 0 < curvature < math.inf else math.nan
-            step = step if low < step < high else (low + high) / 2
-            if abs(step - dy) < DY_TOLERANCE:
-                return step
-            dy = step
-        return dy
 
-    def derivatives(self, dz: float, dy: float) -> tuple[float, float]:
-        """Half the first and second derivative of the squared distance along dy: cy + dy +
-        (cx − w)·s·q/w and 1 + s²q²/w² + (cx − w)·s²R²/w³ where the hob's side faces the axis
-        (the first is ±inf at the section's rim, pointing inwards)."""
-        s = self.s
-        q = s * dy - self.c * dz
-        w2 = self.r2 - q * q
-        w = math.sqrt(max(w2, 0.0))
-        gap = self.cx - w
-        if gap <= 0:
-            return self.cy + dy, 1.0
-        if w <= THIN:
-            return (math.copysign(math.inf, s * q) if s * q else self.cy + dy), math.inf
-        sq = s * q
-        return gap * sq / w + self.cy + dy, 1.0 + sq * sq / w2 + gap * s * s * self.r2 / (w2 * w)
+def step(f: float, slope: float, bend: float) -> float:
+    """How far t moves: Halley's step for F (slope = −F′/2, bend = F″/6), t − 2FF′/(2F′² − FF″),
+    where it is at most twice Newton's step f/(2·slope), else Newton's (far from the root,
+    where Halley's could run off)."""
+    denominator = 4.0 * slope * slope - 3.0 * f * bend
+    if denominator >= 2.0 * slope * slope:
+        return 2.0 * f * slope / denominator
+    return f / (2.0 * slope)
+
+
+def _start(a2: float, b2: float, ap: float, bp: float, floor: float) -> float:
+    """A lower bound of the root close to it. t₀ = floor (where F ≥ 0) bounds it below. Holding
+    the smaller term of F at its value at t₀ and solving for the larger gives t₁ ≥ root (the
+    held term only falls as t rises); one Newton's step back from t₁ lands at or below the root
+    (F is convex), and close: the held term hardly changes on a long ellipse (b ≫ a: a nearly
+    level hob). The larger of that and t₀."""
+    u, v = ap / (floor + a2), bp / (floor + b2)
+    if (v < 1.0) if u >= v else (u < 1.0):
+        high = ap / math.sqrt(1.0 - v * v) - a2 if u >= v else bp / math.sqrt(1.0 - u * u) - b2
+        u, v = ap / (high + a2), bp / (high + b2)
+        back = high + (u * u + v * v - 1.0) / (2.0 * (u * u / (high + a2) + v * v / (high + b2)))
+        return max(back, floor)
+    return floor

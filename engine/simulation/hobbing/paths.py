@@ -13,12 +13,36 @@ AXES = ("X", "Y", "Z")
 def move_poses(start: dict, end: dict, rapid: bool) -> tuple:
     """(x, y, z) lists of DIN positions from start to end (an axis whose start is unknown
     jumps: only the end is followed)."""
+    return pieces_poses(move_pieces(start, end, rapid))
+
+
+def move_pieces(start: dict, end: dict, rapid: bool) -> list[tuple[dict, dict]]:
+    """The straight pieces (from, to) the hob follows: the line, and for a rapid the dog-leg."""
     begin = {axis: start.get(axis, end[axis]) for axis in end} if {"X", "Z"} <= start.keys() else dict(end)
-    pieces = [_line(begin, end)]
+    pieces = [(begin, end)]
     leg = _dog_leg(begin, end) if rapid else []
     if len(leg) > 2:   # with one arrival (one axis moving, or all by the same) the leg is the line itself
-        pieces += [_line(a, b) for a, b in zip(leg[:-1], leg[1:])]
-    return tuple([value for piece in pieces for value in piece[i]] for i in range(3))
+        pieces += list(zip(leg[:-1], leg[1:]))
+    return pieces
+
+
+def pieces_poses(pieces: list[tuple[dict, dict]]) -> tuple:
+    """(x, y, z) lists of the poses along the pieces, POSE_STEP apart at most."""
+    lines = [_line(a, b) for a, b in pieces]
+    return tuple([value for line in lines for value in line[i]] for i in range(3))
+
+
+def corners(pieces: list[tuple[dict, dict]]) -> tuple[list[float], list[float], list[float]]:
+    """(x, y, z) lists of the pieces' ends: every pose lies between their least and greatest."""
+    ends = [point for piece in pieces for point in piece]
+    x, y, z = ([point.get(axis, 0.0) for point in ends] for axis in AXES)
+    return x, y, z
+
+
+def pose_count(a: dict, b: dict) -> int:
+    """Poses on the piece from a to b, both ends included."""
+    length = math.dist([a.get(axis, 0.0) for axis in AXES], [b.get(axis, 0.0) for axis in AXES])
+    return max(2, int(math.ceil(length / POSE_STEP)) + 1)
 
 
 def _dog_leg(begin: dict, end: dict) -> list[dict]:
@@ -35,8 +59,7 @@ def _dog_leg(begin: dict, end: dict) -> list[dict]:
 
 
 def _line(a: dict, b: dict) -> tuple:
-    length = math.dist([a.get(axis, 0.0) for axis in AXES], [b.get(axis, 0.0) for axis in AXES])
-    count = max(2, int(math.ceil(length / POSE_STEP)) + 1)
+    count = pose_count(a, b)
     shares = [i / (count - 1) for i in range(count)]
     return tuple(_along(a.get(axis, 0.0), b.get(axis, 0.0), shares) for axis in AXES)
 

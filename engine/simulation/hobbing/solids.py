@@ -11,7 +11,8 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING
+from functools import lru_cache
+from typing import TYPE_CHECKING, Any
 
 from ...gears.records import Gear, Hob
 from ...machines.records import Machine
@@ -41,12 +42,14 @@ class Solid:
     intended_root: list[float] | None = field(init=False)
     session: int = -1
     cut_sessions: set = field(default_factory=set)   # the couplings whose cuts entered its material
+    height_array: Any = None      # heights and radius as numpy arrays, for a batch's sections (contact_arrays)
+    radius_array: Any = None
 
     def __post_init__(self):
-        count = max(2, int(math.ceil((self.z_high - self.z_low) / HEIGHT_STEP)) + 1)
-        step = (self.z_high - self.z_low) / (count - 1)
-        self.heights = [self.z_low + i * step for i in range(count - 1)] + [self.z_high]
-        self.radius = [self.radius_at(height) for height in self.heights]
+        self.heights = heights_between(self.z_low, self.z_high)
+        count = len(self.heights)
+        top, slope = self.radius_at_top, self.slope
+        self.radius = [top + slope * height for height in self.heights] if slope else [top] * count
         self._largest = max(self.radius)
         self.reach = [math.inf] * count
         self.session_reach = [math.inf] * count
@@ -70,6 +73,16 @@ class Solid:
         where it never reached)."""
         assert self.intended_root is not None   # a unit, not the fixture or the tailstock
         return [reach - root for reach, root in zip(self.reach, self.intended_root)]
+
+
+@lru_cache(maxsize=256)
+def heights_between(z_low: float, z_high: float) -> list[float]:
+    """The heights a solid from z_low to z_high is followed at: both faces, HEIGHT_STEP apart at
+    most. Remembered: a batch's fixtures and tailstocks (thousands of heights each) recur from
+    gear to gear; the list is shared, never changed."""
+    count = max(2, int(math.ceil((z_high - z_low) / HEIGHT_STEP)) + 1)
+    step = (z_high - z_low) / (count - 1)
+    return [z_low + i * step for i in range(count - 1)] + [z_high]
 
 
 def unit_solids(gear: Gear, hob: Hob, worm_wheel: bool) -> list[Solid]:

@@ -30,7 +30,7 @@ from .cuts import Cut, summary
 from .envelope import HobBody
 from .frame import Senses
 from .headers import comment_problem, header_place_problem
-from .paths import move_poses
+from .paths import move_pieces
 from .report import Report, SimulationError, where
 from .rules import (
     block_record_problem,
@@ -265,11 +265,11 @@ class BlockSimulation:
             self.report.add(step.number, step.line, f"the swivel A {self.swivel:g}° sets the hob axis within "
                                                     f"{90 - MAX_SWIVEL:g}° of the work axis: not a hobbing set-up")
             return
-        x, y, z = move_poses(start, end, motion == 0)
+        pieces = move_pieces(start, end, motion == 0)
         teeth = self._cut_teeth() if cutting else None
         reason = self._reason(motion)
         running = self.coupling is not None and self.spindle and not _rapid_along_z(motion, start, end)
-        for contact in follow(self.solids, self.body, swivel, x, y, z,
+        for contact in follow(self.solids, self.body, swivel, pieces,
                               Motion(teeth, running, self.session, self.tailstock, reason)):
             self.report.add(step.number, step.line, self._contact_message(contact, reason, teeth))
         for unit in self.units:
