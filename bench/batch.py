@@ -17,6 +17,7 @@ from __future__ import annotations
 import argparse
 import json
 import random
+import shutil
 import subprocess
 import sys
 import time
@@ -366,9 +367,19 @@ def profile_ours(conn, first: int, last: int, top: int) -> None:
         pstats.Stats(profiler, stream=sys.stdout).strip_dirs().sort_stats(order).print_stats(top)
 
 
-def run_cli_once(url: str, first: int, last: int) -> tuple[float, int]:
-    from latency import engine_command
+def engine_command() -> str:
+    """The console script installed next to this interpreter (the venv's `engine`)."""
+    beside = Path(sys.executable).parent / "engine"
+    if beside.exists():
+        return str(beside)
+    found = shutil.which("engine")
+    if found is None:
+        sys.exit("bench/batch.py: no `engine` console script next to this Python nor on PATH; "
+                 "install the project (pip install -e .)")
+    return found
 
+
+def run_cli_once(url: str, first: int, last: int) -> tuple[float, int]:
     command = [engine_command(), "--database-url", url, "instantiate", "--gears", f"{first}-{last}", "--json"]
     start = time.perf_counter()
     completed = subprocess.run(command, capture_output=True, text=True)
