@@ -111,6 +111,36 @@ def test_the_nearest_point_agrees_with_dense_sampling_of_the_cylinder(seed):
                 assert abs(together - expected) <= AGREE, (case, height, together, expected)
 
 
+def turned_and_mirrored(case: dict) -> list[dict]:
+    """The case swivelled half a turn either way and beyond 90° (a cylinder has no direction: the
+    same body, its centre where the case has it), and with its centre across the work axis."""
+    cx, cy, cz = case["centre"]
+    return [{**case, "swivel": case["swivel"] + 180.0}, {**case, "swivel": case["swivel"] - 180.0},
+            {**case, "swivel": 90.0 + abs(case["swivel"]) + 1.0}, {**case, "centre": (-cx, cy, cz)}]
+
+
+@pytest.mark.parametrize("seed", [4, 5])
+def test_a_hob_swivelled_beyond_90_degrees_or_across_the_axis_agrees_with_sampling(seed):
+    """Adversary of issue 28: with cos A < 0 the band between the end faces came out empty, so a
+    hob swivelled beyond ±90° met nothing; and the gap in X assumed the centre on the +X side."""
+    rng = np.random.default_rng(seed + 100)
+    for original in random_cases(seed, 12):
+        for case in turned_and_mirrored(original):
+            body = HobBody(case["radius"], case["length"] / 2)
+            cx, cy, cz = case["centre"]
+            heights = heights_of(case, rng)
+            arrays = envelope_arrays.nearest_radius(body, case["swivel"], np.array([[cx]]), np.array([[cy]]),
+                                                    np.array([[cz]]), np.array([heights]))[0]
+            for height, together in zip(heights, arrays):
+                expected = reference(case, height)
+                plain = nearest_radius(body, case["swivel"], cx, cy, cz, height)
+                if math.isinf(expected):
+                    assert math.isinf(plain) and math.isinf(together), (case, height)
+                else:
+                    assert abs(plain - expected) <= AGREE, (case, height, plain, expected)
+                    assert abs(together - expected) <= AGREE, (case, height, together, expected)
+
+
 def test_the_reference_finds_a_cap_and_the_axis_inside():
     """The reference itself on two cases worked out by hand: a level hob (A = 0) R 40, L 100 at
     X 100, Y 80 (its end face at Y 30): at its centre height the nearest point is the cap's

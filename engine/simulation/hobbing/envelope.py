@@ -62,10 +62,15 @@ def centres(x: float, y: float, z: float, swivel: float) -> tuple[float, float, 
 
 
 def sine_cosine(swivel: float) -> tuple[float, float]:
-    """sin A and cos A of the swivel (degrees), the sine of a level hob exactly 0."""
+    """sin A and cos A of the hob's body at swivel A (degrees), the sine of a level hob exactly 0.
+    A cylinder has no direction: swivelled beyond ±90° it is the cylinder at A ∓ 180°, so the pair
+    is taken with cos A ≥ 0 (the band between the end faces divides by it; with cos A < 0 every
+    slice read as empty, and the hob met nothing)."""
     a = math.radians(swivel)
-    s = math.sin(a)
-    return (s if abs(s) > UPRIGHT else 0.0), math.cos(a)
+    s, c = math.sin(a), math.cos(a)
+    if c < 0:
+        s, c = -s, -c
+    return (s if abs(s) > UPRIGHT else 0.0), c
 
 
 def nearest_radius(hob: HobBody, swivel: float, cx: float, cy: float, cz: float, height: float) -> float:
@@ -75,8 +80,11 @@ def nearest_radius(hob: HobBody, swivel: float, cx: float, cy: float, cz: float,
 
 
 def nearest_radii(hob: HobBody, swivel: float, cx: float, cy: float, cz: float, heights) -> list[float]:
-    """nearest_radius at each of `heights` for one pose (the module's formulation)."""
+    """nearest_radius at each of `heights` for one pose (the module's formulation). The solids
+    are of revolution about the work axis, so a centre at −cx (across the axis) is as far as one
+    at cx: the formulation is written for cx ≥ 0."""
     s, c = sine_cosine(swivel)
+    cx = abs(cx)
     r, half = hob.radius, hob.half_length
     found = []
     for height in heights:

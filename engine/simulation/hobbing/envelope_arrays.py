@@ -37,7 +37,7 @@ class Sections:
             empty = low > high
         else:
             empty = np.abs(dz) > r
-        self.s, self.c, self.r, self.cx, self.dz = s, c, r, cx, dz
+        self.s, self.c, self.r, self.cx, self.dz = s, c, r, np.abs(cx), dz   # across the axis: as far (cx ≥ 0)
         self.low, self.high, self.empty = low, np.where(empty, low, high), empty
 
     def nearest(self, cy, where=None):
