@@ -201,11 +201,16 @@ class _Made:
         return unified_diff(old, new, f"{gear_class} v{released.version} (released)",
                             f"{gear_class} v{draft_version} (draft)")
 
+    def job_inputs(self, key: tuple, job_id: int) -> tuple[dict, dict]:
+        """The job's parameters and module parameters as its template reads them (key: class,
+        machine, params, module params, gear, hob)."""
+        return self.inputs.of(job_id, *key[:4])
+
     def draft_lines(self, key: tuple, job_id: int) -> list[str] | EngineError:
         """The draft's lines for the job, or why the draft makes none (its rows fail to run)."""
         if key not in self.drafts:
             try:
-                self.drafts[key] = compiled_template(self.pairs[key[0]][1]).run(*self.inputs.of(job_id, *key)).lines
+                self.drafts[key] = compiled_template(self.pairs[key[0]][1]).run(*self.job_inputs(key, job_id)).lines
             except EngineError as error:
                 self.drafts[key] = error
         return self.drafts[key]
@@ -236,22 +241,17 @@ class _Made:
         return None
 
     def draft_failure(self, key: tuple, job_id: int) -> EngineError | None:
-        """Why the draft's changed program for the job fails its proof (verifier, simulation), or None."""
+        """Why the draft's changed program for the job fails its proof (verifier, simulation), or None
+        (proved ahead by prove_changed; here if it was not)."""
         if key not in self.proofs:
-            lines = self.drafts[key]
-            assert not isinstance(lines, EngineError)
-            try:
-                self.inputs.prove(key, lines, job_id)
-                self.proofs[key] = None
-            except EngineError as error:
-                self.proofs[key] = error
+            self.proofs[key] = self._proof_of((key, job_id))
         return self.proofs[key]
 
     def released_proves(self, key: tuple, job_id: int) -> bool:
         """The released template makes the job a program the draft's proof accepts (asked only for a
         job the draft fails for: a job that fails with both is an old problem, not the draft's)."""
         try:
-            lines = compiled_template(self.released(key[0])).run(*self.inputs.of(job_id, *key)).lines
+            lines = compiled_template(self.released(key[0])).run(*self.job_inputs(key, job_id)).lines
             self.inputs.prove(key, lines, job_id)
         except EngineError:
             return False
@@ -261,7 +261,7 @@ class _Made:
         """The released template's lines for the job (none if it fails: every draft line is a change)."""
         if key not in self.releases:
             try:
-                self.releases[key] = compiled_template(self.released(key[0])).run(*self.inputs.of(job_id, *key)).lines
+                self.releases[key] = compiled_template(self.released(key[0])).run(*self.job_inputs(key, job_id)).lines
             except EngineError:
                 self.releases[key] = []
         return self.releases[key]
@@ -284,22 +284,21 @@ class _JobInputs:
         self.hobs: dict[str, Hob] | None = None
 
     def read_records(self, keys: list[tuple]) -> None:
-        """The machines, gears and hobs the proofs of these job inputs read, read now."""
+        """The machines, gears and hobs the proofs of these job inputs read, read now (a record that
+        is missing is named by the job's proof, from what was read here)."""
         for _, machine_name, _, _, gear_id, hob_id in keys:
-            machine = self.machine(machine_name)
-            if machine.kind != "hobber" or gear_id is None or hob_id is None:
-                continue
-            if self.hobs is None:
-                self.hobs = {hob.id: hob for hob in load_hobs(self.conn)}
-            if gear_id not in self.gears:
-                self.gears[gear_id] = self.gear(gear_id)
+            if self.machine(machine_name).kind == "hobber" and gear_id is not None and hob_id is not None:
+                try:
+                    self.workpiece(0, gear_id, hob_id)
+                except EngineError:
+                    pass
 
     def without_database(self) -> None:
         """In a worker: the connection it inherits shares the parent's socket, so it is taken away."""
         self.conn = None   # type: ignore[assignment]
 
     def of(self, job_id: int, gear_class: str, machine_name: str, params_text: str,
-           modules_text: str, *_records) -> tuple[dict, dict]:
+           modules_text: str) -> tuple[dict, dict]:
         params, modules = json.loads(params_text), json.loads(modules_text or "{}")
         if not self.modelled(gear_class):   # a class job (instantiate --class): its rows alone, as
             return params, modules          # engine.programs.remake makes it again
@@ -342,26 +341,27 @@ class _JobInputs:
         if gear_id is None or hob_id is None:
             raise EngineError(f"job {job_id} is a hobbing job without a {'gear' if gear_id is None else 'hob'}: "
                               "its program cannot be proved against the records")
+        gear, hob = self.workpiece(job_id, gear_id, hob_id)
+        report = simulate_program(lines, gear, hob, machine, name or "the program")
+        if report.refused:
+            raise SimulationError(f"gear {gear_id}: {report.error()}")
+
+    def workpiece(self, job_id: int, gear_id: int, hob_id: str) -> tuple[Gear, Hob]:
+        """The job's gear and hob as stored now, each read once: in a worker from what was read before
+        it started. A gear that no longer loads (a record edited since) is kept as its reason."""
         if self.hobs is None:
             self.hobs = {hob.id: hob for hob in load_hobs(self.conn)}
         if hob_id not in self.hobs:
             raise EngineError(f"hob {hob_id!r} of job {job_id} does not exist; see `engine hobs list`")
         if gear_id not in self.gears:
-            self.gears[gear_id] = self.gear(gear_id)
+            try:
+                self.gears[gear_id] = load_gear(self.conn, gear_id)
+            except EngineError as error:
+                self.gears[gear_id] = error
         gear = self.gears[gear_id]
-        if isinstance(gear, EngineError):   # raised here, in a worker too: it has no connection to read it again
+        if isinstance(gear, EngineError):
             raise EngineError(str(gear))
-        report = simulate_program(lines, gear, self.hobs[hob_id], machine, name or "the program")
-        if report.refused:
-            raise SimulationError(f"gear {gear_id}: {report.error()}")
-
-    def gear(self, gear_id: int) -> Gear | EngineError:
-        """The job's gear as stored now, or why it no longer loads (a record edited since: the proof
-        names the job)."""
-        try:
-            return load_gear(self.conn, gear_id)
-        except EngineError as error:
-            return error
+        return gear, self.hobs[hob_id]
 
     def cut_shape(self, gear_class: str) -> str:
         if gear_class not in self.shapes:
