@@ -96,19 +96,24 @@ def heights_of(case: dict, rng) -> list[float]:
 def test_the_nearest_point_agrees_with_dense_sampling_of_the_cylinder(seed):
     rng = np.random.default_rng(seed + 100)
     for case in random_cases(seed, 40):
-        body = HobBody(case["radius"], case["length"] / 2)
-        cx, cy, cz = case["centre"]
-        heights = heights_of(case, rng)
-        arrays = envelope_arrays.nearest_radius(body, case["swivel"], np.array([[cx]]), np.array([[cy]]),
-                                                np.array([[cz]]), np.array([heights]))[0]
-        for height, together in zip(heights, arrays):
-            expected = reference(case, height)
-            plain = nearest_radius(body, case["swivel"], cx, cy, cz, height)
-            if math.isinf(expected):
-                assert math.isinf(plain) and math.isinf(together), (case, height)
-            else:
-                assert abs(plain - expected) <= AGREE, (case, height, plain, expected)
-                assert abs(together - expected) <= AGREE, (case, height, together, expected)
+        assert_agrees_with_sampling(case, heights_of(case, rng))
+
+
+def assert_agrees_with_sampling(case: dict, heights: list[float]) -> None:
+    """The plain floats and the numpy path, at each height, against the reference (both inf where
+    the hob has no point there)."""
+    body = HobBody(case["radius"], case["length"] / 2)
+    cx, cy, cz = case["centre"]
+    arrays = envelope_arrays.nearest_radius(body, case["swivel"], np.array([[cx]]), np.array([[cy]]),
+                                            np.array([[cz]]), np.array([heights]))[0]
+    for height, together in zip(heights, arrays):
+        expected = reference(case, height)
+        plain = nearest_radius(body, case["swivel"], cx, cy, cz, height)
+        if math.isinf(expected):
+            assert math.isinf(plain) and math.isinf(together), (case, height)
+        else:
+            assert abs(plain - expected) <= AGREE, (case, height, plain, expected)
+            assert abs(together - expected) <= AGREE, (case, height, together, expected)
 
 
 def turned_and_mirrored(case: dict) -> list[dict]:
@@ -126,19 +131,7 @@ def test_a_hob_swivelled_beyond_90_degrees_or_across_the_axis_agrees_with_sampli
     rng = np.random.default_rng(seed + 100)
     for original in random_cases(seed, 12):
         for case in turned_and_mirrored(original):
-            body = HobBody(case["radius"], case["length"] / 2)
-            cx, cy, cz = case["centre"]
-            heights = heights_of(case, rng)
-            arrays = envelope_arrays.nearest_radius(body, case["swivel"], np.array([[cx]]), np.array([[cy]]),
-                                                    np.array([[cz]]), np.array([heights]))[0]
-            for height, together in zip(heights, arrays):
-                expected = reference(case, height)
-                plain = nearest_radius(body, case["swivel"], cx, cy, cz, height)
-                if math.isinf(expected):
-                    assert math.isinf(plain) and math.isinf(together), (case, height)
-                else:
-                    assert abs(plain - expected) <= AGREE, (case, height, plain, expected)
-                    assert abs(together - expected) <= AGREE, (case, height, together, expected)
+            assert_agrees_with_sampling(case, heights_of(case, rng))
 
 
 def test_the_reference_finds_a_cap_and_the_axis_inside():
