@@ -14,6 +14,7 @@ from engine.errors import EngineError
 from engine.gears.records import GearUnit, load_gear, load_hobs
 from engine.machines.records import load_machine
 from engine.simulation import SimulationError, prove_program, simulate_program
+from engine.simulation.hobbing import contact
 
 MACHINE = "hobber-840d"
 
@@ -97,6 +98,24 @@ def test_the_run_out_into_a_fixture_larger_than_the_root_is_refused(records, spu
     report = simulate_program(lines, spur.gear, spur.hob, machine, "TEST")
     assert any("into the fixture" in m for m in refusal(report, number_of(lines, f"G1 Z{spur.z_end:.3f} F38.0")))
     assert not simulate_program(lines, spur.gear, spur.hob, replace(machine, fixture_gap=20.0)).refused
+
+
+@pytest.mark.parametrize("sections", [10 ** 12, -1], ids=["plain floats", "numpy"])
+@pytest.mark.parametrize(("into", "refused"), [(0.0, False), (0.003, True), (0.005, True)])
+def test_a_run_out_a_few_micrometres_into_the_fixture_is_refused(records, spur, monkeypatch, sections, into, refused):
+    """The fixture is hardened steel, not stock: the run-out beyond the bottom face, at full depth,
+    holds the hob tip at d_f/2 (§B3: a = (d_f2 + d_a0)/2), so a fixture of Ø d_f + 2·into right
+    under the face (no gap) is touched (into 0) or entered by `into` mm. The program is written to
+    0.001 mm: entering it by 0.003 mm is a collision, not the 0.01 mm depth tolerance of a cut
+    (a crowned run-out once passed 0.005 mm into a Ø20 fixture). Both paths of the contacts: one
+    gear's plain floats and a batch's numpy (engine.simulation.hobbing.contact.MATH_SECTIONS)."""
+    monkeypatch.setattr(contact, "MATH_SECTIONS", sections)
+    machine = replace(records["machine"], fixture_diameter=spur.gear.root_diameter + 2 * into, fixture_gap=0.0)
+    lines = spur.lines()
+    found = refusal(simulate_program(lines, spur.gear, spur.hob, machine, "TEST"),
+                    number_of(lines, f"G1 Z{spur.z_end:.3f} F38.0"))
+    assert bool([m for m in found if "into the fixture" in m]) == refused, found
+    assert not refused or any(f"{into:.3f} mm into the fixture" in m for m in found), found
 
 
 def test_the_infeed_into_a_clamped_tailstock_is_refused_and_without_m20_it_is_not(records, spur):

@@ -10,7 +10,7 @@ import math
 
 import numpy as np
 
-from .contact_records import TOLERANCE, Contact, Motion, contact_at
+from .contact_records import TOLERANCE, Contact, Motion, collision_threshold, contact_at
 from .envelope import HobBody
 from .envelope_arrays import SLACK, Sections
 from .paths import AXES, pose_count
@@ -41,7 +41,7 @@ def _meet(solid: Solid, hob: HobBody, swivel: float, cx, cy, cz, motion: Motion)
         return None
     cx, cy, cz, first, last = near
     cutting = motion.cutting_teeth is not None and solid.teeth == motion.cutting_teeth
-    limit = None if cutting else _open_below(solid, motion)
+    limit = None if cutting else _open_below(solid, motion, collision_threshold(hob.radius))
     if limit is not None and (cx - hob.radius >= limit[first.min():last.max()].max() + SLACK).all():
         return None   # every pose keeps out of the material in X alone: _collision finds nothing
     count = len(solid.heights)
@@ -53,7 +53,7 @@ def _meet(solid: Solid, hob: HobBody, swivel: float, cx, cy, cz, motion: Motion)
         return _cut(solid, motion, index, radius, _per_height_least(radius, raw, count))
     if sections.farther_than(cy, np.where(valid, limit[index], -np.inf)):
         return None   # no section can come into the material: _collision finds nothing
-    return _collision(solid, motion, index, np.where(valid, sections.nearest(cy), np.inf))
+    return _collision(solid, motion, index, np.where(valid, sections.nearest(cy), np.inf), limit)
 
 
 def _near_poses(solid: Solid, extent: float, radius: float, cx, cy, cz):
@@ -111,10 +111,10 @@ def _per_height_least(values, raw, count: int):
     return table[:, :count].min(axis=0)
 
 
-def _open_below(solid: Solid, motion: Motion):
+def _open_below(solid: Solid, motion: Motion, threshold: float):
     """Per height, the distance (mm) below which a section would be a collision: inside the
-    material by TOLERANCE, and in its own gaps (_collision) also nearer than the coupling cut."""
-    limit = _blank(solid) - TOLERANCE
+    material by `threshold`, and in its own gaps (_collision) also nearer than the coupling cut."""
+    limit = _blank(solid) - threshold
     if motion.coupled_running and solid.session == motion.session:
         limit = np.minimum(limit, np.asarray(solid.session_reach, float) - TOLERANCE)
     return limit
@@ -135,13 +135,10 @@ def _cut(solid: Solid, motion: Motion, index, radius, least) -> Contact | None:
     return _deepest(solid, index, below, below > TOLERANCE, True)
 
 
-def _collision(solid: Solid, motion: Motion, index, radius) -> Contact | None:
-    """contact._collision: inside the material, except in the gaps this coupling cut."""
-    into = _blank(solid)[index] - radius
-    hit = into > TOLERANCE
-    if motion.coupled_running and solid.session == motion.session:
-        hit &= ~(radius >= np.asarray(solid.session_reach)[index] - TOLERANCE)
-    return _deepest(solid, index, into, hit, False)
+def _collision(solid: Solid, motion: Motion, index, radius, limit) -> Contact | None:
+    """contact._collision: nearer than `limit` (_open_below: inside the material by the collision
+    threshold, except in the gaps this coupling cut)."""
+    return _deepest(solid, index, _blank(solid)[index] - radius, radius < limit[index], False)
 
 
 def _deepest(solid: Solid, index, depth, hit, below_root: bool) -> Contact | None:

@@ -5,9 +5,22 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from .solids import Solid
+from .solids import HEIGHT_STEP, Solid
 
-TOLERANCE = 0.01      # mm: below the root, or into material, before it counts
+TOLERANCE = 0.01      # mm: below the intended root, or into the blank it cuts, before it counts
+# mm into a solid the hob must not touch (the fixture, the tailstock, a unit outside its cut)
+# before it counts: the resolution the program is written in (X/Z with 3 decimals; an approach
+# computed to touch may land that much nearer once rounded). A fixture is hardened steel: the
+# depth tolerance of a cut (0.01 mm) let a crowned run-out pass 0.005 mm into a Ø20 fixture.
+COLLISION_TOLERANCE = 0.002
+
+
+def collision_threshold(hob_radius: float) -> float:
+    """The depth (mm) a solid's sampled heights may show before it counts as a collision: the
+    heights lie HEIGHT_STEP apart, and between two of them the hob may come nearer than at
+    either by up to step²/(8·r0) (the clearance is convex in height), so the threshold is that
+    much below COLLISION_TOLERANCE: what passes is at most COLLISION_TOLERANCE deep anywhere."""
+    return max(0.0, COLLISION_TOLERANCE - HEIGHT_STEP ** 2 / (8 * hob_radius))
 
 
 @dataclass(frozen=True, slots=True)
