@@ -6,6 +6,7 @@ VENV ?= .venv
 PYTHON ?= $(VENV)/bin/python
 PYTEST = $(PYTHON) -m pytest -q -p no:cacheprovider $(WORKERS)
 WORKERS ?= -n 2 --dist worksteal   # pytest-xdist, as .ci/run; `make test WORKERS=` for one process
+unexport PYTHONDONTWRITEBYTECODE   # the suite's workers reuse the compiled engine and rewritten tests (.ci/run)
 BENCHMARKS = $(filter-out bench/_common.py bench/smoke.py,$(sort $(wildcard bench/*.py)))
 
 .PHONY: test test-fast lint typecheck golden docs bench bench-smoke

@@ -5,7 +5,8 @@ under test can reach a developer's database through it. Each session gets its ow
 migrated and seeded database; tests that commit get a clone of it.
 
 Markers (pyproject.toml): `db` and `cli` are put on a test here, by the fixtures it uses; `slow`
-is written on the slowest tests, so that `pytest -m "not slow"` is a fast subset."""
+is written on the slowest tests, and put here on the sets of a big matrix left out of the sample
+(tests/helpers/matrix_sample.py), so that `pytest -m "not slow"` is a fast subset."""
 from __future__ import annotations
 
 import os
@@ -16,6 +17,7 @@ from urllib.parse import urlsplit, urlunsplit
 import psycopg
 import pytest
 from helpers.database_pool import DatabasePool, create_database
+from helpers.matrix_sample import mark_matrices
 from psycopg.conninfo import conninfo_to_dict, make_conninfo
 from psycopg.pq import TransactionStatus
 
@@ -81,8 +83,11 @@ def pytest_report_header(config) -> str:
     return f"test server: {name}, PostgreSQL {version}"
 
 
+@pytest.hookimpl(tryfirst=True)    # before `-m` deselects by the markers put on here
 def pytest_collection_modifyitems(items) -> None:
-    """`db` on every test using a database of the server, `cli` on every test using the CLI."""
+    """`db` on every test using a database of the server, `cli` on every test using the CLI;
+    `slow` on the sets of a big matrix left out of the fast subset (tests/helpers/matrix_sample.py)."""
+    mark_matrices(items)
     for item in items:
         used = set(getattr(item, "fixturenames", ()))
         if used & DATABASE_FIXTURES:

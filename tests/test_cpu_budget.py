@@ -80,6 +80,7 @@ def test_a_run_under_its_cpu_budget_is_accepted_on_a_busy_machine(template, busy
         template.run({"i": next(jobs)}, deadline_seconds=0.3 * run)
 
 
+@pytest.mark.slow   # keeps both cores busy for seconds
 def test_a_compile_under_its_cpu_budget_is_accepted_on_a_busy_machine(busy_machine, monkeypatch):
     compile_time = cpu_seconds(lambda: CompiledTemplate(Template("busy", 1, rows())))
     monkeypatch.setattr(budget, "seconds_for", lambda count: 2 * compile_time)

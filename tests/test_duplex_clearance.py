@@ -114,6 +114,7 @@ def check_program_cuts(gear: Gear, hob: Hob, params: dict, module_params: dict) 
     return least
 
 
+@pytest.mark.slow   # 150 random layouts, a program each
 @settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(layouts())
 def test_every_duplex_layout_gets_a_clear_program_or_a_one_line_refusal(layout):

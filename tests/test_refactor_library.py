@@ -58,6 +58,7 @@ def assembly_mapping(conn) -> dict[tuple[str, int], int]:
             in conn.execute("SELECT gear_class, id, component_id FROM assembly")}
 
 
+@pytest.mark.slow   # imports every real program (about 40 s)
 def test_real_programs_and_seeded_classes_refactor_losslessly_and_idempotently(conn):
     imported = import_every_real_file(conn)
     before = exports(conn)
@@ -76,6 +77,7 @@ def test_real_programs_and_seeded_classes_refactor_losslessly_and_idempotently(c
         assert text.encode() == (DATA / relative).read_bytes(), name
 
 
+@pytest.mark.slow   # imports every real program (about 25 s)
 def test_copies_left_by_sql_edits_are_merged_across_real_and_seeded_classes(conn):
     import_every_real_file(conn)
     imperial, metric = class_name(FAMILY + "imperial_ramp_pierce.ngc"), class_name(FAMILY + "metric_ramp_pierce.ngc")

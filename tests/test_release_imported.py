@@ -82,6 +82,7 @@ def test_the_engines_lathe_program_imported_is_released_and_runners_make_verifie
 
 # --- every real program of tests/data/nc ----------------------------------------------------------------
 
+@pytest.mark.slow   # imports and releases every real program (about 25 s)
 def test_every_real_nc_program_imports_and_is_released(run):
     found = {path: repeats(program_lines(path)) for path in REAL_PROGRAMS}
     assert any(found[path][0] for path in REAL_PROGRAMS)        # lines repeated further on
