@@ -153,3 +153,25 @@ def test_a_draft_that_reads_its_own_version_number_is_proved_as_it_will_run(conn
 ])
 def test_only_a_template_comment_differing_in_its_version_number_is_no_change(old, new, same):
     assert same_program(["G90", old], ["G90", new]) is same
+
+
+# --- a turning job drawn from a DXF: proved against its drawing record, not its params ----------
+
+@pytest.mark.parametrize("workers", [1, 2])
+def test_a_drawn_job_whose_params_left_its_drawing_record_is_named_not_proved(conn, seed_job, workers):
+    """A runner's SQL can change a turning job's params after import; `engine instantiate --job`
+    then refuses it, naming the drawing record it no longer agrees with, because the program is
+    proved against the drawing as recorded (engine.programs.drawing_records). The impact proves a
+    draft's program for the job the same way: a tool change position 1 mm off the drawing's is not
+    proved as the job's own, and the job is named, as an old problem of the job (the released
+    version fails it too), in one process and in workers."""
+    gear_class = conn.execute("SELECT gear_class FROM job WHERE id = %s", (seed_job,)).fetchone()[0]
+    recorded = conn.execute("SELECT (params->>'tool_change_x')::float FROM job WHERE id = %s", (seed_job,)).fetchone()[0]
+    conn.execute("UPDATE job SET params = jsonb_set(params, '{tool_change_x}', to_jsonb(%s::float)) WHERE id = %s",
+                 (recorded + 1.0, seed_job))
+    edit(conn, gear_class, 150, o='"G21 G18 G40 G90 "')    # a draft that changes every program of the class
+    report = impact(conn, gear_class, workers=workers)
+    failures = [failure for failure in report.failures if failure.job_id == seed_job]
+    assert len(failures) == 1, report.failures
+    assert f"params.tool_change_x = {recorded + 1.0:g}" in failures[0].error, failures[0].error
+    assert "drawing record" in failures[0].error and not failures[0].released_makes
