@@ -391,6 +391,7 @@ def test_the_model_registry_fails_closed_while_empty(monkeypatch):
     from engine.errors import EngineError
     from engine.gears import models
     monkeypatch.setattr(models, "MODELS", {})
+    monkeypatch.setattr(models, "DEFERRED", {})   # nor any model's module waiting to be imported
     with pytest.raises(EngineError, match="gear models not registered: cylindrical, duplex"):
         models.model_for_class(None, "cylindrical")
 
