@@ -45,6 +45,8 @@ MACHINE_SETTINGS = ("out", "line_endings")
 
 @dataclass(frozen=True)
 class Config:
+    """The settings of the config file: option defaults by command, the default machine, line endings and output
+    folders."""
     path: Path | None = None
     commands: dict = field(default_factory=dict)   # everything that is not a setting: option defaults
     machine: str | None = None
