@@ -12,7 +12,6 @@ from typing import TYPE_CHECKING
 from psycopg.types.json import Jsonb
 
 from ..db.connection import scalar
-from ..db.listing import records
 from ..errors import EngineError
 from ..names import checked
 from .checks import check_rows
@@ -52,6 +51,8 @@ def load_template(conn: Connection, gear_class: str) -> Template:
 
 def class_records(conn: Connection) -> list[dict]:
     """Every class by name: its parent, template version, row count (own and inherited), description."""
+    from ..db.listing import records  # the listings' module: `engine template list` (issue 28: start-up)
+
     return records(conn.execute("""
         SELECT g.name AS class, g.parent, g.template_version, count(r.id)::int AS rows, g.description
         FROM gear_class g LEFT JOIN assembled_row r ON r.gear_class = g.name
