@@ -52,7 +52,7 @@ ROWS_PER_TYPE = {"main": 0.15, "prep": 0.10, "sync": 0.05, "shift": 0.07, "cutco
 
 def seed_bodies() -> dict[str, list[tuple]]:
     """Distinct bodies (t, o, p_calc, s, p_emit) of the seeded standard code, per module type."""
-    from engine.templates.rows import read_csv
+    from engine.templates.template_csv import read_csv
 
     bodies: dict[str, set] = defaultdict(set)
     for path in sorted(SEED_CLASSES.glob("*.csv")):

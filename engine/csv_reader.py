@@ -25,15 +25,11 @@ from typing import Any
 
 from .errors import EngineError
 from .names import shown
+from .quantities import MAX_MAGNITUDE  # the records read from the database refuse the same
 
 SEPARATORS = (",", ";")
 DECIMAL_COMMA = re.compile(r"[+-]?(\d+,\d*|,\d+)([eE][+-]?\d{1,3})?")
 SPLIT_DECIMAL = re.compile(r"\d,\d")
-# No dimension of a gear, hob or machine reaches a kilometre (mm), no speed a million (r/min):
-# a larger number is a slip of the keyboard, and 1e999, a valid numeric in PostgreSQL, is no
-# float at all (the models would compute with infinities). The records read from the database
-# (engine.gears.records) refuse the same.
-MAX_MAGNITUDE = 1e6
 MAX_BYTES = 32 << 20   # a template of 100,000 NC lines exports to about 10 MB; no gear list comes near
 
 

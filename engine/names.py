@@ -19,6 +19,7 @@ from .errors import EngineError
 
 @dataclass(frozen=True)
 class NameRule:
+    """A kind of name the engine stores (program, class, machine): the pattern it fits and the rule said to the user."""
     pattern: str     # a regular expression both Python and PostgreSQL read the same way (no anchors)
     rule: str        # what a name must be, said to the user
 

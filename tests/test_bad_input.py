@@ -17,7 +17,7 @@ from psycopg.conninfo import conninfo_to_dict
 
 from engine.drawings.entities import MAX_COORDINATE_MM
 from engine.gears.records import load_gear
-from engine.templates import rows as template_rows
+from engine.templates import template_csv
 
 ROOT = Path(__file__).resolve().parents[1]
 HEADER = ("gear_id,gear_class,module,teeth,pressure_angle,helix_angle,hand,face_width,tip_diameter,"
@@ -134,7 +134,7 @@ def test_an_oversized_cell_names_the_line(run, tmp_path):
 
 def test_an_oversized_template_file_is_refused_before_it_is_read(run, tmp_path, monkeypatch):
     text = exported_spur(run)
-    monkeypatch.setattr(template_rows, "MAX_CSV_BYTES", len(text.encode()) - 1)
+    monkeypatch.setattr(template_csv, "MAX_CSV_BYTES", len(text.encode()) - 1)
     (tmp_path / "spur.csv").write_text(text)
     import_refused(run, tmp_path / "spur.csv", "more than a template CSV may hold")
 

@@ -17,7 +17,7 @@ from engine.gears.gear_store import import_gears, installed_classes
 from engine.gears.hob_library import read_hobs
 from engine.gears.units import import_units
 from engine.library.nc_import import read_modules, read_params
-from engine.templates.rows import read_csv
+from engine.templates.template_csv import read_csv
 
 GEARS_COMMA = ("gear_id,gear_class,module,teeth,helix_angle,hand,face_width,tip_diameter,material\n"
                "90201,spur,2.5,40,0,,30,106.2,40Cr\n"

@@ -13,7 +13,7 @@ import engine
 
 # engine/'s folders, bottom to top: a folder may import only folders of a lower entry, never one in
 # its own entry nor above. "top" is engine's loose modules (errors, names, paths, memory,
-# csv_reader, pictures) and its __init__: they import nothing of the engine but each other.
+# csv_reader, quantities, pictures) and its __init__: they import nothing of the engine but each other.
 LAYERS = [
     ("top",),
     ("db",),                                  # connection, embedded server, migrations, records
@@ -158,7 +158,8 @@ def test_engine_is_laid_out_as_the_design_s_sections():
     folder = Path(engine.__file__).parent
     assert missing_design_folders(folder) == []
     # below every section
-    assert loose_modules(folder) == ["csv_reader.py", "errors.py", "memory.py", "names.py", "paths.py", "pictures.py"]
+    assert loose_modules(folder) == ["csv_reader.py", "errors.py", "memory.py", "names.py", "paths.py", "pictures.py",
+                                     "quantities.py"]
 
 
 def test_every_module_says_what_it_is_in_its_first_line():
@@ -391,6 +392,7 @@ def test_the_model_registry_fails_closed_while_empty(monkeypatch):
     from engine.errors import EngineError
     from engine.gears import models
     monkeypatch.setattr(models, "MODELS", {})
+    monkeypatch.setattr(models, "DEFERRED", {})   # nor any model's module waiting to be imported
     with pytest.raises(EngineError, match="gear models not registered: cylindrical, duplex"):
         models.model_for_class(None, "cylindrical")
 

@@ -11,8 +11,8 @@ import pytest
 from engine.errors import EngineError
 from engine.library import nc_halves, nc_verify
 from engine.library.nc_import import import_nc
-from engine.templates.rows import export_csv
 from engine.templates.store import load_template
+from engine.templates.template_csv import export_csv
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "bench"))
 from import_nc import HOB_PARAMS as PARAMS  # noqa: E402   the benchmark's generated 840D program

@@ -22,8 +22,8 @@ from engine.library.nc_rows import number_field
 from engine.nc.tokens import detokenise, tokenise
 from engine.templates.evaluator import evaluate
 from engine.templates.expressions import compile_expression
-from engine.templates.rows import export_csv, parse_csv
 from engine.templates.store import ensure_class, load_template, replace_template
+from engine.templates.template_csv import export_csv, parse_csv
 
 # --- tokens ------------------------------------------------------------------------------
 

@@ -26,8 +26,9 @@ from engine.programs.records import Planned
 from engine.programs.storage import store_one
 from engine.templates.decision_table import CompiledTemplate
 from engine.templates.history import restore
-from engine.templates.rows import Template, TemplateRow, export_csv, rows_hash
+from engine.templates.rows import Template, TemplateRow, rows_hash
 from engine.templates.store import load_template, replace_template
+from engine.templates.template_csv import export_csv
 from engine.templates.versions import draft_template
 
 

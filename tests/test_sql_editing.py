@@ -13,8 +13,9 @@ from psycopg.types.json import Jsonb
 from engine.library.refactor import refactor
 from engine.programs.instantiate import instantiate_gear
 from engine.programs.options import RunMode
-from engine.templates.rows import TemplateRow, export_csv
+from engine.templates.rows import TemplateRow
 from engine.templates.store import load_template, replace_template
+from engine.templates.template_csv import export_csv
 
 ROW_COLUMNS = ("id", "t", "n", "p_calc", "s", "o", "p_emit")
 

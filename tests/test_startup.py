@@ -18,6 +18,21 @@ from engine.verifier.grammar import DIALECTS
 HEAVY = {"numpy", "matplotlib", "pandas", "sqlglot", "ezdxf", "shapely"}
 LATHE_EXPANDERS = {"engine.verifier.expanders.iso", "engine.verifier.expanders.linuxcnc",
                    "engine.verifier.expanders.sinumerik"}
+# what `engine instantiate --gear 42` used to import and does not use: the other commands' modules
+# (engine.cli.commands imports a command on its first lookup), the other hobbing models and the
+# turning package's own (engine.programs.all_models defers each to its first use), the batch
+# workers' multiprocessing, the embedded server's module (a URL is given), the explanation of
+# rows (no --explain), the TOML reader (no config file: ENGINE_CONFIG="", tests/conftest.py), the
+# CSV reader and a template's CSV form (engine.quantities holds the bound the records share with it),
+# the listings' helpers (engine template list), the checks of rows before they are written
+CLI_MODULES_OF_INSTANTIATE = {"engine.cli", "engine.cli.app", "engine.cli.commands", "engine.cli.context",
+                              "engine.cli.conventions", "engine.cli.examples", "engine.cli.ids",
+                              "engine.cli.instantiate", "engine.cli.progress"}
+OTHER_MODELS = {"engine.hobbing.duplex", "engine.hobbing.taper", "engine.hobbing.crowned",
+                "engine.hobbing.worm_wheel", "engine.hobbing.models"}
+UNUSED_BY_ONE_GEAR = {"multiprocessing", "engine.programs.workers", "engine.db.embedded", "engine.programs.explain",
+                      "tomllib", "engine.csv_reader", "engine.templates.template_csv", "engine.db.listing",
+                      "engine.templates.checks"}
 
 
 def modules_after(code: str, *arguments: str) -> set[str]:
@@ -43,6 +58,41 @@ def test_proving_and_checking_gear_42_loads_no_library_it_does_not_use(database_
     assert top_level(loaded) & HEAVY == set()
     assert loaded & LATHE_EXPANDERS == set()
     assert not any(name.startswith("engine.simulation.turning.") for name in loaded)
+    assert {name for name in loaded if name.startswith("engine.cli")} == CLI_MODULES_OF_INSTANTIATE
+    assert "engine.hobbing.cylindrical" in loaded                # gear 42's class is served by it
+    assert loaded & OTHER_MODELS == set()
+    assert loaded & UNUSED_BY_ONE_GEAR == set()
+
+
+def test_the_command_line_imports_no_command_until_it_is_looked_up():
+    code = ("from engine.cli.app import main\nassert main.commands.imported() == set(), main.commands.imported()\n"
+            "assert 'hobs' in main.commands and 'nosuch' not in main.commands\n"
+            "assert main.commands.imported() == set()\nmain.commands['hobs']")
+    loaded = modules_after(code)
+    assert {name for name in loaded if name.startswith("engine.cli.")} - CLI_MODULES_OF_INSTANTIATE == {
+        "engine.cli.hobs", "engine.cli.output"}
+
+
+def test_each_command_module_is_named_with_the_command_it_holds():
+    """engine.cli.commands names each command's module: looked up, it is a command of that name
+    (a wrong entry would answer `engine NAME` with another command, or none)."""
+    from engine.cli.app import main
+    from engine.cli.commands import COMMAND_MODULES
+
+    assert len(main.commands) == len(COMMAND_MODULES) == 22
+    for name in COMMAND_MODULES:
+        assert main.commands[name].name == name
+
+
+def test_the_models_a_command_does_not_plan_with_are_imported_when_the_registry_is_read_whole():
+    """Deferred is not missing: reading the whole registry (engine lint, engine classify) imports
+    every model's module, and each model node has its model."""
+    code = ("import sys\nimport engine.programs.all_models\n"
+            "assert 'engine.hobbing.taper' not in sys.modules\n"
+            "from engine.gears.models import MODEL_NODES, registered_models\n"
+            "assert sorted(registered_models()) == sorted(MODEL_NODES)")
+    loaded = modules_after(code)
+    assert OTHER_MODELS - {"engine.hobbing.models"} <= loaded
 
 
 def test_importing_the_command_line_loads_no_heavy_library():

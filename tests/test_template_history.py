@@ -11,8 +11,8 @@ from engine.db.migrate import migrate
 from engine.errors import EngineError
 from engine.paths import MIGRATIONS_DIR
 from engine.templates.history import diff, history, restore
-from engine.templates.rows import export_csv
 from engine.templates.store import load_template
+from engine.templates.template_csv import export_csv
 
 
 def exported(conn, gear_class):

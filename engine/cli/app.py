@@ -20,25 +20,9 @@ import unicodedata
 import click
 
 from ..errors import EngineError
-from .cases import cases, suggest
+from .commands import COMMAND_MODULES, LazyCommands
 from .context import CONFIG
-from .conventions import JSON_SEEN, apply_conventions, default_map, json_from_defaults
-from .db import db, demo, seed_command
-from .explain import explain
-from .gears import classify, gears
-from .golden import test_command
-from .hobs import hobs
-from .instantiate import instantiate
-from .jobs import jobs
-from .machines import machines
-from .nc_import import import_nc_command
-from .plot import plot_command
-from .programs import programs
-from .refactor import refactor_command
-from .settings import config
-from .simulate import simulate
-from .templates import lint, template
-from .turning import import_dxf_command
+from .conventions import JSON_SEEN, apply_conventions, apply_to_one, default_map, json_from_defaults
 
 JSON_ARGS = "engine.json_args"   # ctx.meta: --json among the invocation's arguments
 
@@ -208,15 +192,11 @@ def main(ctx, database_url, traceback):
         logging.getLogger("psycopg").addHandler(logging.NullHandler())
 
 
-COMMANDS = (demo, db, seed_command, gears, classify, instantiate, explain, template, lint, hobs, machines, suggest,
-            cases, import_nc_command, refactor_command, import_dxf_command, plot_command, simulate, programs,
-            test_command, jobs, config)
+def _given_conventions(name: str, command: click.Command) -> None:
+    apply_conventions(command, f"engine {name}")
 
 
-def _register(group: click.Group, commands) -> None:
-    for command in commands:
-        group.add_command(command)
-
-
-_register(main, COMMANDS)
-apply_conventions(main)   # environment variables, examples in --help, --json errors (engine.cli.conventions)
+# each command imported as it is first looked up (engine.cli.commands), with the conventions
+# (environment variables, examples in --help, --json errors: engine.cli.conventions)
+main.commands = LazyCommands(COMMAND_MODULES, _given_conventions)
+apply_to_one("engine", main)

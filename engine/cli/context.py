@@ -17,10 +17,12 @@ def connection(ctx, migrated: bool = True):
     from ..db.connection import connect
     from ..db.migrate import require_current
 
-    with connect(ctx.obj["database_url"]) as conn:
+    # the check's reads run in autocommit, each its own statement: no BEGIN and COMMIT round trips
+    # for them (issue 28: start-up); the command then starts idle, in transactions as always
+    with connect(ctx.obj["database_url"], autocommit=migrated) as conn:
         if migrated:
             require_current(conn)
-            conn.commit()   # the check's read ends here: the command starts idle
+            conn.autocommit = False
         yield conn
 
 

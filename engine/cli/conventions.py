@@ -9,8 +9,9 @@
 * an `Example:` line at the end of its --help (engine.cli.examples, or its own docstring's);
 * --json remembered, so that an error of a --json invocation is reported as JSON.
 
-Applied once to the whole command tree when engine.cli.app is imported, so a command added
-to any group gets them too.
+Applied to `engine` itself when engine.cli.app is imported, and to each of its commands (with
+every command below it) as the command is imported (engine.cli.commands), so a command added to
+any group gets them too.
 """
 from __future__ import annotations
 
@@ -68,12 +69,19 @@ def envvar_name(path: str, option: click.Option) -> str:
     return "_".join(words).upper().replace("-", "_")
 
 
-def apply_conventions(group: click.Group) -> None:
-    for path, command in walk(group):
-        _add_example(path, command)
-        for option in options(command):
-            _add_envvar(path, option)
-            _remember_json(option)
+def apply_conventions(command: click.Command, path: str = "engine") -> None:
+    """The conventions given to `command` (at `path`) and every command below it."""
+    for path_below, below in walk(command, path):
+        apply_to_one(path_below, below)
+
+
+def apply_to_one(path: str, command: click.Command) -> None:
+    """The conventions given to `command` alone, not to the commands of a group (engine's own
+    are given as each is imported: engine.cli.commands)."""
+    _add_example(path, command)
+    for option in options(command):
+        _add_envvar(path, option)
+        _remember_json(option)
 
 
 def command_line_only(path: str, option: click.Option) -> str | None:

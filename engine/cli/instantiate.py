@@ -256,9 +256,7 @@ def _report_class_job(job, as_json: bool, explain: bool) -> None:
 
 
 def _report_program(program, as_json: bool, explain: bool, more: dict | None = None) -> None:
-    from ..programs.explain import explained_rows
-
-    rows = explained_rows(program.trace, program.lines, program.row_ids) if explain else []
+    rows = _explained(program) if explain else []
     dry_run = program.program_id is None
     if as_json:
         emit_json({"program_id": program.program_id, "job_id": program.job_id, "name": program.name,
@@ -275,6 +273,12 @@ def _report_program(program, as_json: bool, explain: bool, more: dict | None = N
     if program.path is None:
         click.echo(program.text, nl=False)
     click.echo(_program_summary(program) + (f" written to {program.path}" if program.path else ""), err=True)
+
+
+def _explained(program) -> list:
+    from ..programs.explain import explained_rows  # with --explain only (issue 28: start-up)
+
+    return explained_rows(program.trace, program.lines, program.row_ids)
 
 
 def _program_summary(program) -> str:

@@ -52,8 +52,8 @@ def template_export(ctx, gear_class, out):
     LF with a final newline (imported from such a file) gives that on every row (line_ending
     lf|crlf, final_newline yes|no), so an import elsewhere writes the same bytes."""
     from ..nc.layout import class_layout
-    from ..templates.rows import export_csv
     from ..templates.store import load_template
+    from ..templates.template_csv import export_csv
 
     with connection(ctx) as conn:
         text = export_csv(load_template(conn, gear_class), class_layout(conn, gear_class))
@@ -75,8 +75,8 @@ def template_import(ctx, gear_class, parent, csv_file):
     of it is a new draft version, as a change of rows is, until `engine template release`); a CSV
     without them leaves it as it is."""
     from ..nc.layout import class_layout, store_layout
-    from ..templates.rows import read_template_csv
     from ..templates.store import ensure_class, replace_template
+    from ..templates.template_csv import read_template_csv
 
     read = read_template_csv(csv_file)
     with connection(ctx) as conn:

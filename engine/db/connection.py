@@ -5,7 +5,6 @@ import os
 from typing import TYPE_CHECKING, Any
 
 from ..errors import EngineError
-from .embedded import embedded_data_dir, embedded_url
 
 if TYPE_CHECKING:
     from collections.abc import Sequence
@@ -31,6 +30,8 @@ def resolve_url(database_url: str | None = None) -> str:
         return os.environ["DATABASE_URL"]
     if any(os.environ.get(name) for name in LIBPQ_VARIABLES):
         return ""  # libpq reads the PG* variables itself
+    from .embedded import embedded_url  # the server of its own only when none is named (issue 28: start-up)
+
     return embedded_url()
 
 
@@ -42,6 +43,8 @@ def url_in_use(database_url: str | None = None) -> tuple[str, str]:
         return url, "DATABASE_URL" if url == os.environ.get("DATABASE_URL") else "--database-url"
     if not url:
         return _libpq_conninfo(), "the PG* variables"
+    from .embedded import embedded_data_dir
+
     return url, f"the embedded PostgreSQL, data in {embedded_data_dir()}"
 
 

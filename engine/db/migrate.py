@@ -32,6 +32,7 @@ CREATE TABLE IF NOT EXISTS schema_migration (
 
 @dataclass(frozen=True)
 class Migration:
+    """A migration file NNNN.slug.sql of this installation."""
     version: str
     name: str
     path: Path
@@ -47,6 +48,7 @@ class Migration:
 
 @dataclass(frozen=True)
 class MigrationState:
+    """A migration and whether (and when) the database applied it, and whether its file changed since."""
     migration: Migration
     applied_at: object | None  # datetime when applied
     changed: bool              # applied, but the file differs from what was applied

@@ -7,8 +7,8 @@ from dataclasses import fields
 from decimal import Decimal
 from typing import TYPE_CHECKING, Any, TypeVar
 
-from ..csv_reader import MAX_MAGNITUDE  # the CSV readers refuse larger numbers; so do the records
 from ..errors import EngineError
+from ..quantities import MAX_MAGNITUDE  # the CSV readers refuse larger numbers; so do the records
 
 if TYPE_CHECKING:
     from _typeshed import DataclassInstance

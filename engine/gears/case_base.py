@@ -56,6 +56,7 @@ LOAD_CASES = f"SELECT {', '.join(CASE_COLUMNS)} FROM cutting_case ORDER BY id"  
 
 @dataclass(frozen=True)
 class KindProposal:
+    """The cutting speed and feeds proposed for one cut kind (rough, finish), and the cases they came from."""
     cut: str
     cutting_speed: float     # m/min
     axial_feed: float        # mm per workpiece revolution
@@ -161,6 +162,7 @@ def bounded_proposal(proposal: KindProposal, module: float, starts: int) -> tupl
 
 @dataclass(frozen=True)
 class _Case:
+    """A cutting case of the history as the nearest-neighbour search reads it: its features and per-revolution feeds."""
     position: int            # in CaseBase.records
     id: int
     features: tuple          # in DISTANCE_FEATURES order: floats, casefolded text, None when missing

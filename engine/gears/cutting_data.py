@@ -39,6 +39,7 @@ MULTI_START_EXPONENT = 0.5
 
 @dataclass(frozen=True)
 class CuttingData:
+    """Speeds and feeds of a job: the case base's suggestion, bounded, with the overrides given."""
     cutting_speed: float          # m/min
     hob_speed: int                # n0, r/min of B
     axial_feed_rough: float       # mm per workpiece revolution

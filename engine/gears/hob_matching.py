@@ -30,6 +30,7 @@ ADD_A_HOB = "add one with `engine hobs add …` or `engine hobs import FILE.csv`
 
 @dataclass(frozen=True)
 class HobChoice:
+    """The hob chosen for a gear and why (engine hobs match says it)."""
     hob: Hob
     reason: str
 

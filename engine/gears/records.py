@@ -20,6 +20,7 @@ TOOTH_DEPTH = Decimal("2.25")  # full tooth depth in modules: root = tip − 2·
 
 @dataclass(frozen=True)
 class Gear:
+    """A workpiece record (table gear, with its units): what the hobbing models and the simulation read."""
     id: int
     gear_class: str | None
     module: float
@@ -61,6 +62,8 @@ class GearUnit:
 
 @dataclass(frozen=True)
 class Hob:
+    """A hob of the library (table hob): its size, starts and hand, which engine.gears.hob_matching checks against a
+    gear."""
     id: str
     module: float
     pressure_angle: float

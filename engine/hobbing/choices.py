@@ -23,6 +23,7 @@ WORM_FEEDS = ("radial", "tangential")
 
 @dataclass(frozen=True)
 class Choices:
+    """What the user chose for a new hobbing job (the options of engine instantiate); None leaves it to the model."""
     cuts: int | None = None            # 1 = finish only, 2 = rough then finish; None = by module
     finish_stock: float | None = None  # radial stock left by the rough cut, mm
     coolant: bool = True

@@ -40,6 +40,7 @@ class GearShape(Protocol):
 
 @dataclass(frozen=True)
 class JobParameters:
+    """A job's parameters, and those of its modules, as the template reads them."""
     params: dict
     module_params: dict
 

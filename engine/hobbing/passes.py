@@ -23,6 +23,7 @@ class Reach:
 
 @dataclass(frozen=True)
 class Cut:
+    """One cut of a job (rough or finish): its centre distance and pass direction."""
     number: int               # 1 = rough, 2 = finish (a single cut is number 2, named SINGLE)
     name: str
     centre_distance: float

@@ -21,8 +21,8 @@ from ..gears.units import UNIT_KIND, import_units
 from ..machines.importing import MACHINE_KIND
 from ..paths import SEED_DIR
 from ..templates.expectations import refuse_slow_patterns
-from ..templates.rows import read_csv
 from ..templates.store import ensure_class, replace_template
+from ..templates.template_csv import read_csv
 
 if TYPE_CHECKING:
     from ..db.connection import Connection

@@ -14,6 +14,8 @@ if TYPE_CHECKING:
 
 @dataclass(frozen=True)
 class Machine:
+    """A machine record (table machine): its kind and dialect, axis travels (mm), speed limits (r/min) and fixture
+    sizes."""
     name: str
     kind: str
     dialect: str

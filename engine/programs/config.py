@@ -36,11 +36,6 @@ from ..errors import EngineError
 from ..machines.records import DEFAULT_HOBBING_MACHINE
 from ..nc.layout import ENDING_NAMES
 
-if sys.version_info >= (3, 11):
-    import tomllib
-else:   # Python 3.10
-    import tomli as tomllib
-
 APP = "nc-template-engine"
 LINE_ENDINGS = {name: ending for ending, name in ENDING_NAMES.items()}   # "lf": "\n", "crlf": "\r\n"
 SETTINGS = ("machine", "line_endings", "machines")   # top-level keys that are not command options
@@ -50,6 +45,8 @@ MACHINE_SETTINGS = ("out", "line_endings")
 
 @dataclass(frozen=True)
 class Config:
+    """The settings of the config file: option defaults by command, the default machine, line endings and output
+    folders."""
     path: Path | None = None
     commands: dict = field(default_factory=dict)   # everything that is not a setting: option defaults
     machine: str | None = None
@@ -75,11 +72,21 @@ def load_config(path: Path | None = None, named: bool | None = None) -> Config:
     if path is None or (not path.exists() and not named):
         return Config()
     text = _read(path)
+    tomllib = _toml_reader()
     try:
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as error:
         raise EngineError(f"config file {path}: {error}; fix that line") from None
     return _settings(path, text, data)
+
+
+def _toml_reader():
+    """The TOML reader, imported only when there is a file to read (issue 28: start-up)."""
+    if sys.version_info >= (3, 11):
+        import tomllib
+    else:   # Python 3.10
+        import tomli as tomllib
+    return tomllib
 
 
 def _read(path: Path) -> str:

@@ -37,12 +37,11 @@ from .batches import (
     reason_of,
     refuse_unfit_output,
 )
-from .options import NO_FILE, NORMAL_RUN, Output, RunMode
+from .options import NO_FILE, NORMAL_RUN, PLANNING, Output, RunMode
 from .outputs import ProgramFiles, file_layouts, files_after_commit
 from .records import Planned, Program
 from .storage import Batch, store_many, store_one
 from .verified_run import Workpiece, run_template
-from .workers import PLANNING, plan_in_workers
 
 if TYPE_CHECKING:
     from ..db.connection import Connection
@@ -187,6 +186,8 @@ def _planned_gears(planner: Planner, first, last, mode: RunMode) -> list:
     if not gears and not refused:
         raise EngineError(f"no gears with ids in {first or 'the start'}…{last or 'the end'}")
     if mode.workers > 1 and len(gears) > 1:
+        from .workers import plan_in_workers  # a batch across cores only: multiprocessing (issue 28: start-up)
+
         planned = plan_in_workers(planner, gears, _plan_in_batch, mode)
     else:
         planned = [_counted(_plan_in_batch(planner, gear), done, len(gears), mode.progress)

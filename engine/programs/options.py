@@ -14,6 +14,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 Progress = Callable[[str, int, int], None]   # progress(stage, done, total) as a batch's items are planned
+PLANNING = "planning"   # the stage a batch's progress callback is told while its gears are planned
 
 
 @dataclass(frozen=True, slots=True)

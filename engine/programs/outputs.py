@@ -41,11 +41,11 @@ from ..errors import EngineError
 from ..names import checked
 from ..nc.layout import NcLayout, nc_text
 from ..nc.lineage import LINEAGE_SHAPE
-from .file_writes import FolderSeen, NotWritten, write_files
 from .options import Output
 
 if TYPE_CHECKING:
     from ..db.connection import Connection
+    from .file_writes import FolderSeen, NotWritten
 
 SUFFIX = ".MPF"
 STORED_NOT_WRITTEN = 3   # the CLI's exit code when programs were committed but their files not written
@@ -77,6 +77,8 @@ class ProgramFiles:
         any file cannot be written."""
         if self.out is None or not programs:
             return {}
+        from .file_writes import FolderSeen  # only where files are written (issue 28: start-up)
+
         try:   # a path the system refuses to look at (too long, a symlink loop, a file as a folder, no access)
             paths = self._targets([name for name, _ in programs])
             self._refuse_existing(list(paths.values()))
@@ -138,6 +140,8 @@ class ProgramFiles:
         was named)."""
         if not self.texts or self.seen is None:
             return
+        from .file_writes import NotWritten, write_files
+
         try:
             write_files(self.seen, {target.name: data for target, data in self.texts.items()}, self.force)
         except NotWritten as error:

@@ -74,6 +74,7 @@ class Encoded:
 
 @dataclass(frozen=True)
 class Program:
+    """A program made: stored (its ids) or a dry run's (ids None), with its lines, trace, notes and file path."""
     program_id: int | None   # None: a dry run (engine.programs.batches), nothing stored
     job_id: int | None       # None: a dry run of a new job
     name: str

@@ -41,12 +41,11 @@ from .class_jobs import class_job
 from .instantiate import store_planned
 from .job_checks import check_hobbing_feeds, check_hobbing_job
 from .job_shape import check_job_shape, job_with_cycle_time
-from .options import NO_FILE, NORMAL_RUN, Output, RunMode
+from .options import NO_FILE, NORMAL_RUN, PLANNING, Output, RunMode
 from .outputs import file_layouts, files_after_commit
 from .records import Planned, Program
 from .storage import Batch, refuse_assumed_blank_file, store_programs
 from .verified_run import Workpiece, run_template
-from .workers import PLANNING
 
 if TYPE_CHECKING:
     from ..db.connection import Connection

@@ -13,11 +13,10 @@ import multiprocessing
 
 from ..errors import EngineError
 from ..templates.decision_table import compiled_template
-from .options import RunMode
+from .options import PLANNING, RunMode
 
 SLICES_PER_WORKER = 8   # small enough to balance the workers, large enough to amortise sending jobs
 
-PLANNING = "planning"   # the stage a batch's progress callback is told while its gears are planned
 _BATCH: list = []   # (planner, gears, plan function) of the batch being planned, inherited by the forked workers
 
 

@@ -13,6 +13,7 @@ from .rows import MODULE_ORDER, TemplateRow, writes_lineage
 
 @dataclass(frozen=True)
 class LintProblem:
+    """A fault of a template row found before it runs (engine lint, the release gate): the class, row and column."""
     gear_class: str
     row_id: int | None
     column: str

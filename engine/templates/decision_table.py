@@ -42,6 +42,7 @@ class TemplateError(EngineError):
 
 @dataclass(frozen=True)
 class CompiledRow:
+    """A template row with its expressions parsed and checked, ready to run for a job."""
     row: TemplateRow
     o: Compiled | None
     p_calc: Compiled | None

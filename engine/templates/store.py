@@ -12,10 +12,8 @@ from typing import TYPE_CHECKING
 from psycopg.types.json import Jsonb
 
 from ..db.connection import scalar
-from ..db.listing import records
 from ..errors import EngineError
 from ..names import checked
-from .checks import check_rows
 from .rows import Template, TemplateRow
 from .translations import load_translations, store_translations
 
@@ -52,6 +50,8 @@ def load_template(conn: Connection, gear_class: str) -> Template:
 
 def class_records(conn: Connection) -> list[dict]:
     """Every class by name: its parent, template version, row count (own and inherited), description."""
+    from ..db.listing import records  # the listings' module: `engine template list` (issue 28: start-up)
+
     return records(conn.execute("""
         SELECT g.name AS class, g.parent, g.template_version, count(r.id)::int AS rows, g.description
         FROM gear_class g LEFT JOIN assembled_row r ON r.gear_class = g.name
@@ -86,7 +86,7 @@ def _class_exists(conn: Connection, name: str) -> bool:
     return conn.execute("SELECT 1 FROM gear_class WHERE name = %s", (name,)).fetchone() is not None
 
 
-def replace_template(conn: Connection, gear_class: str, rows: list[TemplateRow], check=check_rows) -> bool:
+def replace_template(conn: Connection, gear_class: str, rows: list[TemplateRow], check=None) -> bool:
     """Make `rows` the class's template, reusing identical component bodies.
 
     A derived class (one whose ancestors have rows) stores only the rows that differ from
@@ -94,9 +94,12 @@ def replace_template(conn: Connection, gear_class: str, rows: list[TemplateRow],
     anything changed; the class's version and its descendants' versions are then bumped and
     template_audit records each changed row of the class. The database does the writing
     (replace_class_template, SECURITY DEFINER), so an editor needs no rights on the library tables.
-    `check(gear_class, rows)` refuses rows that could never run, before they are written; a caller
-    that passes a check running in the background (engine import-nc) waits for its verdict before
-    it commits."""
+    `check(gear_class, rows)` refuses rows that could never run, before they are written (by
+    default engine.templates.checks.check_rows, imported here: reading a template does not need
+    it, issue 28); a caller that passes a check running in the background (engine import-nc)
+    waits for its verdict before it commits."""
+    if check is None:
+        from .checks import check_rows as check
     with conn.transaction():
         inherited = inherited_rows(conn, gear_class)
         check(gear_class, merge_rows(inherited, rows))

@@ -58,6 +58,7 @@ WORD_EVENTS: dict[str, Callable[[float], tuple[str, ...]]] = {
 
 @dataclass(frozen=True, slots=True)
 class Block:
+    """An NC block as read: its address values, motion, positions and modal codes."""
     kind: ClassVar[Literal["block"]] = "block"
     values: dict[str, float]   # address -> value (G and M codes apart)
     motion: int | None         # the block's G0/G1/G2/G3/thread code

@@ -61,6 +61,7 @@ class Header:
 
 @dataclass(frozen=True)
 class Dialect:
+    """What the verifier reads a machine's programs as: headers, comments, addresses, G and M codes, state rules."""
     name: str
     headers: tuple[Header, ...]
     comment: str                          # "semicolon": `; text` to the end; "parentheses": `(text)`

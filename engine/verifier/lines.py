@@ -21,6 +21,7 @@ ISO_LINE = re.compile(rf"([^()]*?) ?(?:\(({ISO_COMMENT_TEXT})\))?")
 
 @dataclass(frozen=True, slots=True)
 class HeaderLine:
+    """A program's header line as read: the program name (or ISO number) it gives."""
     kind: ClassVar[Literal["header"]] = "header"
     what: str
     places: frozenset[str]
@@ -30,6 +31,7 @@ class HeaderLine:
 
 @dataclass(frozen=True, slots=True)
 class CommentLine:
+    """A line that is only a comment."""
     kind: ClassVar[Literal["comment"]] = "comment"
 
 

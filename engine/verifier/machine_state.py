@@ -70,6 +70,7 @@ class Needs:
 
 @dataclass(frozen=True)
 class StateRules:
+    """A dialect's machine-state rules: what each event sets or clears, and what each motion or statement needs."""
     effects: dict[str, Effect]   # event -> Effect
     needs: dict[str, Needs]      # "G1" (a block moving with G1), "EGDEF" … -> Needs
 

@@ -38,6 +38,7 @@ SHAPE = f"{PARAMETER}=R11+step, IF ({PARAMETER}<lo) OR ({PARAMETER}>hi), {PARAME
 
 @dataclass(frozen=True, slots=True)
 class ShiftLine:
+    """One of the hob-shift lines of SHAPE as read: which (step) and the numbers it gives."""
     kind: ClassVar[Literal["shift"]] = "shift"
     step: str
     values: tuple[float, ...]

@@ -31,6 +31,7 @@ MAX_DIFFERENTIAL = 360.0
 
 @dataclass(frozen=True, slots=True)
 class Statement:
+    """A coupling statement (EGDEF, EGON, EGOFS, EGDEL) as read: its leading axes, ratio and factors."""
     kind: ClassVar[Literal["statement"]] = "statement"
     name: str
     leading: tuple[str, ...] = ()    # leading axes, in order

@@ -2,8 +2,8 @@
 bodies stored, and the reference longest-common-subsequence similarity of design notes §5."""
 from __future__ import annotations
 
-from engine.templates.rows import export_csv
 from engine.templates.store import load_template
+from engine.templates.template_csv import export_csv
 
 
 def exports(conn) -> dict[str, str]:

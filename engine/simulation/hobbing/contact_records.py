@@ -37,6 +37,7 @@ class Motion:
 
 @dataclass(frozen=True, slots=True)
 class Contact:
+    """The hob's deepest reach into a solid during one move: a cut below the root, or a collision."""
     solid: Solid
     depth: float          # mm
     height: float         # DIN Z where it is deepest

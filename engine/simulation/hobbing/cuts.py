@@ -15,6 +15,7 @@ from .solids import Solid
 
 @dataclass
 class Cut:
+    """One cut followed: from a coupling's start to its end, with its moves and each unit's reach before it."""
     number: int
     line: str
     teeth: int

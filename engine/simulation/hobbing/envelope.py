@@ -46,6 +46,7 @@ STEP_LIMIT = 60            # Halley's or Newton's steps at most (one to three su
 
 @dataclass(frozen=True, slots=True)
 class HobBody:
+    """The hob as the simulation sees it: a cylinder of its tip radius and length (mm)."""
     radius: float          # d_a0/2
     half_length: float     # L/2
 

@@ -20,6 +20,7 @@ from .report import Report
 
 @dataclass(frozen=True)
 class Records:
+    """What the fact rules check the program's reading against: the gear, hob and machine records."""
     steps: list
     gear: Gear
     hob: Hob
@@ -63,6 +64,7 @@ def _units(records: Records) -> int:
 
 @dataclass(frozen=True)
 class FactRule:
+    """A rule of the reference the program's values must agree with the records by, and its section."""
     name: str
     section: str
     check: Callable[[Records], Iterable[tuple]]

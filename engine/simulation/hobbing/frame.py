@@ -12,6 +12,7 @@ from ...machines.records import Machine
 
 @dataclass(frozen=True, slots=True)
 class Senses:
+    """The machine's axis senses (+1 or −1 each) of A, B, C, Y and Z, from its record."""
     a: int
     b: int
     c: int

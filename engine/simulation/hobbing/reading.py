@@ -18,6 +18,7 @@ from .report import SimulationError, where
 
 @dataclass(frozen=True, slots=True)
 class Step:
+    """One line of the program as the simulation follows it, with the G and M codes it gives."""
     number: int        # line number, from 1
     line: str          # as emitted
     item: Line         # what the verifier read it as (kind: header, comment, block, statement, shift)

@@ -27,6 +27,7 @@ def where(name: str, number: int, line: str) -> str:
 
 @dataclass(frozen=True)
 class Finding:
+    """What the simulation found at one line: a refusal (refuses) or a note."""
     number: int
     line: str
     message: str
@@ -38,6 +39,7 @@ class Finding:
 
 @dataclass
 class CutSummary:
+    """One cut as simulated: its centre distance, depth, stock left and feeds (mm, mm per workpiece revolution)."""
     number: int          # the cut's first line
     unit: str
     centre_distance: float
@@ -50,6 +52,7 @@ class CutSummary:
 
 @dataclass
 class Report:
+    """The simulation's report of one program: its findings, couplings, cuts, table speed and cycle time."""
     name: str
     findings: list[Finding] = field(default_factory=list)
     teeth: list[str] = field(default_factory=list)       # per coupling: "19 (unit 1)"

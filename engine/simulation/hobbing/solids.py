@@ -27,6 +27,7 @@ BEYOND_TRAVEL = 50.0    # mm: a fixture or tailstock is followed this far past t
 
 @dataclass(eq=False)
 class Solid:
+    """A solid of revolution about the work axis (a gear unit, the fixture, the tailstock) between two heights."""
     name: str
     z_low: float
     z_high: float
