@@ -166,7 +166,8 @@ def test_a_drawn_job_whose_params_left_its_drawing_record_is_named_not_proved(co
     proved as the job's own, and the job is named, as an old problem of the job (the released
     version fails it too), in one process and in workers."""
     gear_class = conn.execute("SELECT gear_class FROM job WHERE id = %s", (seed_job,)).fetchone()[0]
-    recorded = conn.execute("SELECT (params->>'tool_change_x')::float FROM job WHERE id = %s", (seed_job,)).fetchone()[0]
+    recorded = conn.execute("SELECT (params->>'tool_change_x')::float FROM job WHERE id = %s",
+                            (seed_job,)).fetchone()[0]
     conn.execute("UPDATE job SET params = jsonb_set(params, '{tool_change_x}', to_jsonb(%s::float)) WHERE id = %s",
                  (recorded + 1.0, seed_job))
     edit(conn, gear_class, 150, o='"G21 G18 G40 G90 "')    # a draft that changes every program of the class
