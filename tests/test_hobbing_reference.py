@@ -177,9 +177,9 @@ class Bench:
 
 
 @pytest.fixture(scope="module")
-def bench(server_url, database_url):
+def bench(server_url, database_url, database_pool):
     """On its own copy of the seeded database: a connection left open on the session's database
-    would stop other tests from copying it."""
+    would stop other tests from copying it. Dropped by the pool, behind the tests that follow."""
     base = conninfo_to_dict(database_url)["dbname"]
     name = f"{base}_ref{uuid.uuid4().hex[:6]}"
     with psycopg.connect(server_url, autocommit=True) as admin:
@@ -189,8 +189,7 @@ def bench(server_url, database_url):
             with connection.transaction(force_rollback=True):
                 yield Bench(connection)
     finally:
-        with psycopg.connect(server_url, autocommit=True) as admin:
-            admin.execute(sql.SQL("DROP DATABASE IF EXISTS {} WITH (FORCE)").format(sql.Identifier(name)))
+        database_pool.give_back(name)
 
 
 def program_of(bench, case_id):

@@ -15,9 +15,12 @@ itself could lose the last commits, and no test crashes the server or reads what
 """
 from __future__ import annotations
 
+import subprocess
+import sys
 import threading
 import uuid
 from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
 
 import psycopg
 from psycopg import sql
@@ -39,6 +42,27 @@ def drop_database(server_url: str, name: str) -> None:
     """DROP DATABASE `name`, ending any connection a test left open to it."""
     with psycopg.connect(server_url, autocommit=True) as admin:
         admin.execute(sql.SQL("DROP DATABASE IF EXISTS {} WITH (FORCE)").format(sql.Identifier(name)))
+
+
+# Run by drop_later in a process of its own: drops the databases named on its command line.
+DROPPER = """
+import sys
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+sys.path.insert(0, sys.argv[1])
+from helpers.database_pool import DROPS_AT_ONCE, drop_database
+with ThreadPoolExecutor(max_workers=DROPS_AT_ONCE) as drops:
+    list(drops.map(lambda name: drop_database(sys.argv[2], name), sys.argv[3:]))
+"""
+
+
+def drop_later(server_url: str, names: list[str]) -> None:
+    """DROP DATABASE each of `names` in a detached process (its own session: it outlives pytest).
+    Against the embedded server, which stops when the session ends and whose folder is deleted
+    with everything in it, the dropper finds no server and ends: nothing is left either way."""
+    subprocess.Popen([sys.executable, "-c", DROPPER, str(Path(__file__).resolve().parent.parent), server_url,
+                      *names], stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                     start_new_session=True)
 
 
 class Kind:
@@ -96,14 +120,18 @@ class DatabasePool:
             self.changed.notify_all()
 
     def close(self) -> None:
-        """Stop making, then drop what is still ready or used (every database made here)."""
+        """Stop making, then have what is still ready or used (every database made here) dropped by
+        a process of its own, which the session does not wait for: each DROP DATABASE waits for a
+        checkpoint, and at the end of a worker's session a dozen of them took 10-25 s on a busy
+        server (issue 28), time in which no test ran."""
         with self.changed:
             self.closing = True
             self.changed.notify_all()
         for thread in self.threads:
             thread.join()
         leftovers = self.used + [name for kind in self.kinds for name in kind.ready]
-        self._drop_all(leftovers)
+        if leftovers:
+            drop_later(self.server_url, leftovers)
         self._raise_error()
 
     # --- the threads ------------------------------------------------------------------------------
