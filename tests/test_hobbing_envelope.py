@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 from helpers.hobbing_checks import Case, depth_problems
-from helpers.hobbing_envelope import Solid, Sweep, intrusion
+from helpers.hobbing_envelope import TOLERANCE, Solid, Sweep, intrusion
 from helpers.hobbing_reference import Gear, Hob, Unit, read
 
 
@@ -76,3 +76,66 @@ def test_taper_pass_touching_the_root_cone_passes_and_one_deeper_is_found(deeper
     text = TAPER_PASS.replace("X54.208", f"X{54.208 - deeper:.3f}").replace("X49.313", f"X{49.313 - deeper:.3f}")
     problems = [p for p in depth_problems(read(text), case) if "root cone" in p]
     assert bool(problems) == found, problems
+
+
+def grid_depth(sweep: Sweep, solid: Solid, r0: float, length: float, counts=(17, 81, 721)) -> tuple[float, float]:
+    """(deepest, net): the deepest of a grid of hob points swept along the move — the fraction f, the
+    place τ ∈ [0, 1] along the shifted body, the angle θ across it (w = r0·sin θ) and, for each, the
+    point of the chord |v| ≤ r0·cos θ nearest the work axis (the deepest: depth falls with ρ) — and
+    the grid's net radius (mm): every hob point lies within it of a grid point, the depth is 1-Lipschitz
+    (mm per mm), so the deepest hob point is at most `net` deeper than the grid's."""
+    n_f, n_tau, n_theta = counts if (sweep.x0, sweep.z0) != (sweep.x1, sweep.z1) else (1, *counts[1:])
+    f = np.linspace(0, 1, n_f)[:, None, None]
+    tau = np.linspace(0, 1, n_tau)[None, :, None]
+    theta = np.linspace(-math.pi / 2, math.pi / 2, n_theta)[None, None, :]
+    t_low = sweep.y_start[0] + f * (sweep.y_end[0] - sweep.y_start[0]) - length / 2
+    t_high = sweep.y_start[1] + f * (sweep.y_end[1] - sweep.y_start[1]) + length / 2
+    t, w = t_low + tau * (t_high - t_low), r0 * np.sin(theta)
+    centre_x = sweep.x0 + f * (sweep.x1 - sweep.x0)
+    x = centre_x - np.clip(centre_x, -r0 * np.cos(theta), r0 * np.cos(theta))
+    eta = math.radians(sweep.eta)
+    y = t * math.cos(eta) - w * math.sin(eta)
+    z = sweep.z0 + f * (sweep.z1 - sweep.z0) + t * math.sin(eta) + w * math.cos(eta)
+    wall = (solid.radius + solid.slope * (z - solid.z_ref) - np.hypot(x, y)) / math.hypot(1, solid.slope)
+    deepest = float(np.minimum(wall, np.minimum(z - solid.bottom, solid.top - z)).max())
+    shift = max(abs(sweep.y_end[0] - sweep.y_start[0]), abs(sweep.y_end[1] - sweep.y_start[1]))
+    travel = math.hypot(sweep.x1 - sweep.x0, sweep.z1 - sweep.z0) + shift
+    widest = max(sweep.y_start[1] - sweep.y_start[0], sweep.y_end[1] - sweep.y_end[0]) + length
+    net = travel / max(n_f - 1, 1) / 2 + widest / (n_tau - 1) / 2 + math.sqrt(2) * r0 * math.pi / (n_theta - 1) / 2
+    return deepest, net
+
+
+def random_sweep(rng: np.random.Generator) -> tuple[Sweep, Solid, float, float]:
+    """A hob (r0, L) near a blank, cone or cylinder, standing still or moving axially, radially or
+    slantwise, its shift fixed, a range, or moving: about half of them touching or intruding."""
+    r0, length = rng.uniform(10, 45), rng.uniform(20, 150)
+    top = rng.uniform(-20, 10)
+    solid = Solid(rng.uniform(15, 80), top - rng.uniform(5, 50), top, math.tan(math.radians(rng.uniform(-10, 10)))
+                  * (rng.random() < 0.5), top)
+    x0 = solid.radius + r0 + rng.uniform(-8, 3)
+    z0 = rng.uniform(solid.bottom - r0, solid.top + r0)
+    kind = rng.integers(4)
+    x1 = x0 + (rng.uniform(-10, 10) if kind in (2, 3) else 0.0)
+    z1 = z0 + (rng.uniform(-40, 40) if kind in (1, 3) else 0.0)
+    y0 = sorted(rng.uniform(-20, 20, 2)) if rng.random() < 0.3 else [rng.uniform(-20, 20)] * 2
+    y1 = sorted(rng.uniform(-20, 20, 2)) if rng.random() < 0.2 else y0
+    return Sweep(x0, z0, x1, z1, rng.uniform(-30, 30), tuple(y0), tuple(y1)), solid, r0, length
+
+
+def test_envelope_agrees_with_a_dense_grid_of_hob_points_on_random_sweeps():
+    """Seeded random sweeps and solids: the proven intrusion is never shallower than any grid point
+    by more than its TOLERANCE (1e-6 mm), nor deeper than the grid's deepest by more than its net radius
+    (pairs clear by their bounding box: no grid point inside the solid)."""
+    rng = np.random.default_rng(28)
+    searched = touching = 0
+    for _ in range(40):
+        sweep, solid, r0, length = random_sweep(rng)
+        exact = intrusion(sweep, solid, r0, length)
+        deepest, net = grid_depth(sweep, solid, r0, length)
+        if exact == -math.inf:      # clear by its bounding box: only "no intrusion" is claimed
+            assert deepest <= 0, (sweep, solid, r0, length, deepest)
+            continue
+        assert deepest <= exact + TOLERANCE, (sweep, solid, r0, length, exact, deepest)
+        assert exact <= deepest + net, (sweep, solid, r0, length, exact, deepest, net)
+        searched, touching = searched + 1, touching + (deepest > -0.5)
+    assert searched >= 25 and touching >= 10, (searched, touching)
