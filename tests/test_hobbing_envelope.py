@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 from helpers.hobbing_checks import Case, depth_problems
-from helpers.hobbing_envelope import Solid, Sweep, intrusion
+from helpers.hobbing_envelope import TOLERANCE, Solid, Sweep, intrusion
 from helpers.hobbing_reference import Gear, Hob, Unit, read
 
 
@@ -76,3 +76,86 @@ def test_taper_pass_touching_the_root_cone_passes_and_one_deeper_is_found(deeper
     text = TAPER_PASS.replace("X54.208", f"X{54.208 - deeper:.3f}").replace("X49.313", f"X{49.313 - deeper:.3f}")
     problems = [p for p in depth_problems(read(text), case) if "root cone" in p]
     assert bool(problems) == found, problems
+
+
+def depth_at(sweep: Sweep, solid: Solid, r0: float, length: float, cell: np.ndarray) -> np.ndarray:
+    """Depth in the solid of the hob points at cell = (f, τ, θ) rows: the centre at fraction f of the
+    move, the place τ ∈ [0, 1] along the body between its ends (shift range and L), the angle θ across
+    it (w = r0·sin θ) and there the point of the chord |v| ≤ r0·cos θ nearest the work axis (the
+    deepest: depth falls with ρ)."""
+    f, tau, theta = cell.T
+    t_low = sweep.y_start[0] + f * (sweep.y_end[0] - sweep.y_start[0]) - length / 2
+    t_high = sweep.y_start[1] + f * (sweep.y_end[1] - sweep.y_start[1]) + length / 2
+    t, w = t_low + tau * (t_high - t_low), r0 * np.sin(theta)
+    centre_x = sweep.x0 + f * (sweep.x1 - sweep.x0)
+    x = centre_x - np.clip(centre_x, -r0 * np.cos(theta), r0 * np.cos(theta))
+    eta = math.radians(sweep.eta)
+    y = t * math.cos(eta) - w * math.sin(eta)
+    z = sweep.z0 + f * (sweep.z1 - sweep.z0) + t * math.sin(eta) + w * math.cos(eta)
+    wall = (solid.radius + solid.slope * (z - solid.z_ref) - np.hypot(x, y)) / math.hypot(1, solid.slope)
+    return np.minimum(wall, np.minimum(z - solid.bottom, solid.top - z))
+
+
+def bracketed_depth(sweep: Sweep, solid: Solid, r0: float, length: float, target: float = 0.01,
+                    cap: int = 1_000_000) -> tuple[float, float]:
+    """(lower, upper) of the deepest hob point, by cells of (f, τ, θ) alone (branch and bound). A cell's
+    centre is a hob point (lower bound); every hob point of the cell lies within its net radius of it
+    — half-widths times mm per unit: f moves the centre and the shift range (|ΔC| + the largest shift
+    change), τ spans the body (its longest), θ moves the chord's end by r0 per radian along X and
+    across (√2·r0) — and the depth is 1-Lipschitz (mm per mm), so centre + net bounds the cell. Cells
+    bounded below the best centre are dropped, the others halved each way, down to `target` mm or
+    `cap` cells."""
+    still = (sweep.x0, sweep.z0, sweep.y_start) == (sweep.x1, sweep.z1, sweep.y_end)
+    half = np.array([0.0 if still else 1 / 16, 1 / 32, math.pi / 128])
+    shift = max(abs(sweep.y_end[0] - sweep.y_start[0]), abs(sweep.y_end[1] - sweep.y_start[1]))
+    rates = np.array([math.hypot(sweep.x1 - sweep.x0, sweep.z1 - sweep.z0) + shift,
+                      max(sweep.y_start[1] - sweep.y_start[0], sweep.y_end[1] - sweep.y_end[0]) + length,
+                      math.sqrt(2) * r0])
+    axes = [np.zeros(1) if still else (np.arange(8) + 0.5) / 8, (np.arange(16) + 0.5) / 16,
+            (np.arange(64) + 0.5) / 64 * math.pi - math.pi / 2]
+    cells = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
+    best = -math.inf
+    while True:
+        value, net = depth_at(sweep, solid, r0, length, cells), float(half @ rates)
+        best = max(best, float(value.max()))
+        kept = cells[value + net >= best]
+        if net <= target or len(kept) * 8 > cap:
+            return best, max(best, float(value.max()) + net)
+        signs = np.array([[a, b, c] for a in (-1, 1) for b in (-1, 1) for c in (-1, 1)], float) * half / 2
+        cells, half = (kept[:, None, :] + np.unique(signs, axis=0)[None]).reshape(-1, 3), half / 2
+
+
+def random_sweep(rng: np.random.Generator) -> tuple[Sweep, Solid, float, float]:
+    """A hob (r0, L) near a blank, cone or cylinder, standing still or moving axially, radially or
+    slantwise, its shift fixed, a range, or moving: about half of them touching or intruding."""
+    r0, length = rng.uniform(10, 45), rng.uniform(20, 150)
+    top = rng.uniform(-20, 10)
+    solid = Solid(rng.uniform(15, 80), top - rng.uniform(5, 50), top, math.tan(math.radians(rng.uniform(-10, 10)))
+                  * (rng.random() < 0.5), top)
+    x0 = solid.radius + r0 + rng.uniform(-8, 3)
+    z0 = rng.uniform(solid.bottom - r0, solid.top + r0)
+    kind = rng.integers(4)
+    x1 = x0 + (rng.uniform(-10, 10) if kind in (2, 3) else 0.0)
+    z1 = z0 + (rng.uniform(-40, 40) if kind in (1, 3) else 0.0)
+    y0 = sorted(rng.uniform(-20, 20, 2)) if rng.random() < 0.3 else [rng.uniform(-20, 20)] * 2
+    y1 = sorted(rng.uniform(-20, 20, 2)) if rng.random() < 0.2 else y0
+    return Sweep(x0, z0, x1, z1, rng.uniform(-30, 30), tuple(y0), tuple(y1)), solid, r0, length
+
+
+def test_envelope_agrees_with_a_branch_and_bound_over_hob_points_on_random_sweeps():
+    """Seeded random sweeps and solids: the proven intrusion is never shallower than a hob point the
+    cells found by more than its TOLERANCE (1e-6 mm), never deeper than the cells' upper bound, and
+    that bracket is narrow (pairs clear by their bounding box: no hob point inside the solid)."""
+    rng = np.random.default_rng(28)
+    searched = touching = narrow = 0
+    for _ in range(40):
+        sweep, solid, r0, length = random_sweep(rng)
+        exact = intrusion(sweep, solid, r0, length)
+        deepest, upper = bracketed_depth(sweep, solid, r0, length)
+        if exact == -math.inf:      # clear by its bounding box: only "no intrusion" is claimed
+            assert deepest <= 0, (sweep, solid, r0, length, deepest)
+            continue
+        assert deepest <= exact + TOLERANCE and exact <= upper, (sweep, solid, r0, length, exact, deepest, upper)
+        assert upper - deepest < 0.5, (sweep, solid, r0, length, deepest, upper)
+        searched, touching, narrow = searched + 1, touching + (deepest > -0.5), narrow + (upper - deepest < 0.01)
+    assert searched >= 25 and touching >= 10 and narrow >= 20, (searched, touching, narrow)

@@ -4,16 +4,31 @@ work axis (blank units, root cone, fixture, tailstock), for the reference checks
 Frame: DIN 66217 (reference §A7). The swivel η turns the hob axis about X: u = (0, cos η, sin η); the
 shift Y slides the hob along that axis (§A6), so the body occupies t ∈ [Y − L/2, Y + L/2] along u
 from the centre (X, 0, Z), and within r0 of it: a point is centre + t·u + v·e_x + w·n with
-n = (0, −sin η, cos η), v² + w² ≤ r0².
+n = (0, −sin η, cos η), v² + w² ≤ r0² (mm, degrees).
 
 Intrusion = the largest depth by which any point of the hob lies inside the solid (depth = distance to
-the solid's boundary: min of the cone/cylinder wall along its normal and both faces). Why it is found
-exactly, not sampled: for fixed (t, w) the point nearest the work axis has |x| = max(0, |X| − √(r0² − w²)),
-convex in (X, w); ρ = √(x² + y²) is then convex and the depth concave in (move fraction, t, w). A
-concave function's maximum over a convex domain has no false local maxima, so golden-section over the
-move fraction and over w, with the exact maximum over t (endpoints, the wall's own maximum, and where
-the wall meets a face: a quadratic), finds it to 1e-4 mm. A move that also swivels is checked at
-steps of at most 0.25° of η.
+the solid's boundary: min of the cone/cylinder wall along its normal and both faces), over the whole
+move: the centre at fraction f ∈ [0, 1] of it, the shift range moving linearly with f.
+
+Why the answer is proven, not sampled (issue 28):
+* Concave. For fixed (f, t, w) the point nearest the work axis has |x| = max(0, |X(f)| − √(r0² − w²)),
+  convex in (f, w); ρ = √(x² + y²) is then convex and the depth (a minimum of the wall, c·(R + k·z − ρ),
+  and the faces, all concave) is concave in (f, t, w) over a convex domain (t between bounds linear in f).
+  Its maximum over t (f, w fixed) is exact: at an end of t's range, the wall's own maximum or where the
+  wall meets a face (a quadratic). ψ(f, w) = that maximum is concave, and so is φ(f) = max_w ψ(f, w).
+* Bounded from above by values alone. For a concave g sampled at x_{i−1} < x_i < x_{i+1} < x_{i+2}, on
+  [x_i, x_{i+1}] g lies below the secant through x_{i−1}, x_i extended forward and below the secant
+  through x_{i+1}, x_{i+2} extended back (slopes of a concave function fall): the larger of the lower
+  of the two lines over the cell bounds g there (at the ends of the range the one line left does).
+  Values known only to ±ε (g ≤ ĝ + ε, g ≥ ĝ) move that bound by at most 2ε within one cell.
+* Grid section (_grid_max): each round samples a bracket at GRID + 1 points, bounds every cell so, and
+  keeps the cells whose bound reaches the best value seen (a cell bounded below it cannot hold the
+  maximum, the best value being that of a real point); the bracket shrinks to those cells (about two
+  of GRID at a sharp maximum; at a flat one the bound meets the value). It stops when the largest
+  bound is within TOLERANCE/4 (over w) or TOLERANCE (over f, the inner gap counted) of the best value.
+  The intrusion returned is that best value: the depth of a point of the hob (never deeper than the
+  truth) and at most TOLERANCE mm shallower. A hob standing still needs no f; a move that also
+  swivels is checked at steps of at most 0.25° of η (move_sweeps).
 """
 from __future__ import annotations
 
@@ -22,8 +37,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-GOLDEN = (math.sqrt(5) - 1) / 2
-RESOLUTION = 5e-4       # mm of bracket left by the golden-section searches (depth is 1-Lipschitz)
+TOLERANCE = 1e-6        # mm: the intrusion is proven within this below the truth, never above it
+GRID = 16               # cells per round of the grid section (a sharp maximum's bracket shrinks ~8×)
+ROUNDS = 60             # rounds at most; a search not within TOLERANCE by then is an error, not a guess
 _FOUND: dict = {}       # (sweep, solid, r0, length) → intrusion: the same DIN moves recur across machines
 
 
@@ -98,46 +114,70 @@ def _near(p: dict, r0: float, length: float) -> np.ndarray:
     return ~(x_clear | (z_low >= p["top"]) | (z_high <= p["bottom"]))
 
 
-def _golden_max(f, low: np.ndarray, high: np.ndarray, scale: float = 1.0) -> np.ndarray:
-    """Maximum of concave functions (vectorised) on [low, high], to RESOLUTION mm (`scale` mm per unit
-    of the argument)."""
-    width = float(np.max(high - low)) * scale if low.size else 0.0
-    steps = max(1, math.ceil(math.log(max(width, RESOLUTION) / RESOLUTION) / -math.log(GOLDEN)))
-    a, b = low.copy(), high.copy()
-    x1, x2 = b - GOLDEN * (b - a), a + GOLDEN * (b - a)
-    f1, f2 = f(x1), f(x2)
-    for _ in range(steps):
-        right = f1 < f2
-        a = np.where(right, x1, a)
-        b = np.where(right, b, x2)
-        x1, x2, f1, f2 = (np.where(right, x2, b - GOLDEN * (b - a)), np.where(right, a + GOLDEN * (b - a), x1),
-                          np.where(right, f2, np.nan), np.where(right, np.nan, f1))
-        fresh = f(np.where(right, x2, x1))
-        f1, f2 = np.where(right, f1, fresh), np.where(right, fresh, f2)
-    return np.maximum.reduce([f1, f2, f(low), f(high)])
+def _grid_max(f, low: np.ndarray, high: np.ndarray, tolerance: float) -> tuple[np.ndarray, np.ndarray]:
+    """(best, gap): the largest value of concave functions on [low, high] (one row each), the best
+    value of a point evaluated and the proven bound on how far the maximum lies above it. `f` maps
+    arguments (rows × points) to (values, their error ε ≥ 0, per row)."""
+    low, high = low.astype(float), high.astype(float)
+    best = np.full(low.shape, -np.inf)
+    steps = np.linspace(0.0, 1.0, GRID + 1)
+    for _ in range(ROUNDS):
+        value, error = f(low[:, None] + (high - low)[:, None] * steps)
+        best = np.maximum(best, value.max(axis=1))
+        bound = _cell_bounds(value) + 2 * error[:, None]
+        gap = np.maximum(bound.max(axis=1) - best, 0.0)
+        if (gap <= tolerance).all():
+            return best, gap
+        kept = bound >= best[:, None] - 1e-12
+        first, last = kept.argmax(axis=1), GRID - 1 - kept[:, ::-1].argmax(axis=1)
+        low, high = low + (high - low) * first / GRID, low + (high - low) * (last + 1) / GRID
+    raise AssertionError(f"hob envelope: the grid section did not close to {tolerance} mm (gap {gap.max()})")
+
+
+def _cell_bounds(g: np.ndarray) -> np.ndarray:
+    """Upper bound of a concave function on each cell between neighbouring samples (rows × GRID), in
+    units of the cell: below the secant from the left, g_i + (g_i − g_{i−1})·s, and below the one from
+    the right, g_{i+1} + (g_{i+1} − g_{i+2})·(1 − s), s ∈ [0, 1] across the cell."""
+    inf = np.full(g[:, :1].shape, np.inf)
+    left_slope = np.concatenate([inf * np.nan, g[:, 1:-1] - g[:, :-2]], axis=1)        # per cell i
+    right_slope = np.concatenate([g[:, 1:-1] - g[:, 2:], inf * np.nan], axis=1)
+    a, b = g[:, :-1], g[:, 1:]
+    left = lambda s: np.where(np.isnan(left_slope), np.inf, a + left_slope * s)        # noqa: E731
+    right = lambda s: np.where(np.isnan(right_slope), np.inf, b + right_slope * (1 - s))   # noqa: E731
+    with np.errstate(divide="ignore", invalid="ignore"):
+        cross = np.clip((b + right_slope - a) / (left_slope + right_slope), 0.0, 1.0)
+    bound = np.maximum(np.minimum(left(0.0), right(0.0)), np.minimum(left(1.0), right(1.0)))
+    meet = np.minimum(left(cross), right(cross))
+    bound = np.maximum(bound, np.where(np.isfinite(meet), meet, -np.inf))
+    return np.maximum(bound, np.maximum(a, b))
 
 
 def _search(p: dict, r0: float, length: float, still: bool) -> np.ndarray:
-    eta = np.radians(p["eta"])
+    """φ's maximum over the move fraction (still: at f = 0), each φ(f) by a grid section over w."""
+    count = p["x0"].shape[0]
+    if still:
+        return _over_w(p, np.zeros((count, 1)), r0, length)[0][:, 0]
+    over_f = lambda fraction: _over_w(p, fraction, r0, length)   # noqa: E731
+    return _grid_max(over_f, np.zeros(count), np.ones(count), TOLERANCE)[0]
+
+
+def _over_w(p: dict, fraction: np.ndarray, r0: float, length: float) -> tuple[np.ndarray, np.ndarray]:
+    """φ(f) for each row's fractions (rows × points): (values, the largest gap of a row)."""
+    rows, points = fraction.shape
+    q = {k: np.repeat(v, points)[:, None] for k, v in p.items()}
+    f = fraction.reshape(-1, 1)
+    x = q["x0"] + f * (q["x1"] - q["x0"])
+    zc = q["z0"] + f * (q["z1"] - q["z0"])
+    t_low = q["ylo0"] + f * (q["ylo1"] - q["ylo0"]) - length / 2
+    t_high = q["yhi0"] + f * (q["yhi1"] - q["yhi0"]) + length / 2
+    eta = np.radians(q["eta"])
     ce, se = np.cos(eta), np.sin(eta)
 
-    def over_w(fraction: np.ndarray) -> np.ndarray:
-        x = p["x0"] + fraction * (p["x1"] - p["x0"])
-        zc = p["z0"] + fraction * (p["z1"] - p["z0"])
-        t_low = p["ylo0"] + fraction * (p["ylo1"] - p["ylo0"]) - length / 2
-        t_high = p["yhi0"] + fraction * (p["yhi1"] - p["yhi0"]) + length / 2
-
-        def at_w(w: np.ndarray) -> np.ndarray:
-            nearest_x = np.maximum(0.0, np.abs(x) - np.sqrt(np.maximum(r0 * r0 - w * w, 0.0)))
-            return _best_along_t(nearest_x, zc + w * ce, -w * se, t_low, t_high, ce, se, p)
-        return _golden_max(at_w, np.full(x.shape, -r0), np.full(x.shape, r0))
-
-    count = p["x0"].shape
-    if still:
-        return over_w(np.zeros(count))
-    travel = np.hypot(p["x1"] - p["x0"], p["z1"] - p["z0"]) + np.maximum(np.abs(p["ylo1"] - p["ylo0"]),
-                                                                         np.abs(p["yhi1"] - p["yhi0"]))
-    return _golden_max(over_w, np.zeros(count), np.ones(count), max(float(np.max(travel)), 1.0))
+    def at_w(w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        nearest_x = np.maximum(0.0, np.abs(x) - np.sqrt(np.maximum(r0 * r0 - w * w, 0.0)))
+        return _best_along_t(nearest_x, zc + w * ce, -w * se, t_low, t_high, ce, se, q), np.zeros(len(w))
+    best, gap = _grid_max(at_w, np.full(rows * points, -r0), np.full(rows * points, r0), TOLERANCE / 4)
+    return best.reshape(rows, points), gap.reshape(rows, points).max(axis=1)
 
 
 def _depth(x, y, z, p: dict) -> np.ndarray:
