@@ -89,6 +89,7 @@ class DatabasePool:
         self.server_url = server_url
         self.kinds: list[Kind] = []
         self.used: list[str] = []
+        self.dropping: list[str] = []   # the batch the drop thread is dropping (dropped again at close: IF EXISTS)
         self.error: BaseException | None = None
         self.closing = False
         self.changed = threading.Condition()
@@ -127,9 +128,10 @@ class DatabasePool:
         with self.changed:
             self.closing = True
             self.changed.notify_all()
-        for thread in self.threads:
+        for thread in self.threads[:MAKERS]:   # not the dropper: it may be waiting for a checkpoint
             thread.join()
-        leftovers = self.used + [name for kind in self.kinds for name in kind.ready]
+        with self.changed:
+            leftovers = self.used + self.dropping + [name for kind in self.kinds for name in kind.ready]
         if leftovers:
             drop_later(self.server_url, leftovers)
         self._raise_error()
@@ -179,8 +181,8 @@ class DatabasePool:
             self.changed.wait_for(lambda: self.closing or self.used)
             if self.closing:
                 return []
-            batch, self.used = self.used, []
-            return batch
+            self.dropping, self.used = self.used, []
+            return self.dropping
 
     def _drop_all(self, names: list[str]) -> None:
         with ThreadPoolExecutor(max_workers=DROPS_AT_ONCE) as drops:
