@@ -160,6 +160,7 @@ def test_every_test_the_doc_names_exists(doc):
     assert not wrong, f"docs/architecture.md names tests that do not exist: {wrong}"
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_every_database_object_the_doc_names_exists(doc, conn):
     wrong = [name for name in doc_names(SQL_OBJECT, doc) if not in_database(conn, name)]
     assert not wrong, f"docs/architecture.md names database objects the migrations do not make: {wrong}"

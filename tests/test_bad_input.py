@@ -178,6 +178,7 @@ def test_a_drawing_with_coordinates_that_are_no_number_stores_no_job(run, tmp_pa
 
 # --- the server lost -----------------------------------------------------------------------------
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_a_server_lost_mid_batch_is_exit_1_and_says_nothing_was_stored(fresh_database_url):
     with psycopg.connect(fresh_database_url) as conn:
         conn.execute("INSERT INTO gear (id, gear_class, module, teeth, face_width, material, hardness, quality_grade) "

@@ -265,6 +265,7 @@ def stderr_of(url: str, *args: str, terminal: bool) -> str:
     return written.decode(errors="replace")
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_a_batch_shows_a_progress_bar_on_a_terminal_only(run):
     on_terminal = stderr_of(run.url, "instantiate", "--gears", "42-54", "--dry-run", terminal=True)
     assert "planning" in on_terminal and "100%" in on_terminal

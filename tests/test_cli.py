@@ -163,6 +163,7 @@ def test_demo_runs_on_the_embedded_server_from_nothing(tmp_path):
                         str(tmp_path / "pgdata")], capture_output=True, timeout=60)
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_libpq_variables_choose_the_server_when_no_url_is_given(fresh_database_url):
     from psycopg.conninfo import conninfo_to_dict
 

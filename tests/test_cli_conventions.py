@@ -51,6 +51,7 @@ def first_level_keys(payload: dict) -> set[str]:
     return set(payload) | set(inner)
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_json_is_one_line_with_the_same_key_names_on_every_command(run, tmp_path):
     made = one_json_line(run("instantiate", "--gear", 42, "--json"))
     assert {"program_id", "job_id", "class"} <= made.keys()

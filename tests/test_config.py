@@ -41,6 +41,7 @@ def test_command_line_beats_environment_beats_config_file(run):
     assert "'from-the-table'" in run("instantiate", "--gear", 42).stderr
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_database_url_keeps_working_and_engine_database_url_too(run):
     run.config.write_text("")
     for variable in ("DATABASE_URL", "ENGINE_DATABASE_URL"):

@@ -71,6 +71,7 @@ def template():
     return CompiledTemplate(Template("busy", 1, rows()))
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_a_run_under_its_cpu_budget_is_accepted_on_a_busy_machine(template, busy_machine):
     jobs = iter(range(1, 1000))   # a new job each run: no row's outcome comes from the memo
     run = cpu_seconds(lambda: template.run({"i": next(jobs)}, deadline_seconds=600))

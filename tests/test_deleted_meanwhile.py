@@ -10,6 +10,7 @@ import time
 from pathlib import Path
 
 import psycopg
+import pytest
 
 GEAR = ("INSERT INTO gear (id, gear_class, module, teeth, helix_angle, face_width, material, hardness, quality_grade, "
         "quantity) VALUES (%s, 'spur', 2, %s, 0, 20, '40Cr', 250, 7, 50)")
@@ -46,6 +47,7 @@ def engine_while_deleting(url: str, delete: str, *args) -> subprocess.CompletedP
     return subprocess.CompletedProcess(args, making.returncode, stdout, stderr)
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_a_job_deleted_while_it_is_made_again_is_said_in_one_line(run):
     url = run.url
     add_gears(url, 91511)
@@ -62,6 +64,7 @@ def test_a_job_deleted_while_it_is_made_again_is_said_in_one_line(run):
     assert counts(url) == (before[0] - 1, before[1])   # the deleted job, nothing stored
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_a_gear_of_a_batch_deleted_meanwhile_is_named_and_nothing_is_stored(fresh_database_url):
     url = fresh_database_url
     add_gears(url, 91521, 91522, 91523)

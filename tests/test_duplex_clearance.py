@@ -180,6 +180,7 @@ def segment(move) -> list[tuple[float, float]]:
     return list(zip(np.linspace(x0, x1, steps), np.linspace(z0, z1, steps)))
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_a_narrower_unit_1_gets_a_shortened_run_out_that_clears_unit_2(conn):
     """Unit 1 20 mm wide: the run-out toward unit 2 is shortened so the hob stays clear, and the
     hob centre still passes unit 1's bottom face; every move of the program keeps clear."""

@@ -32,6 +32,7 @@ def job_passes_every_check(run, *args) -> dict:
     return job
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 @pytest.mark.parametrize(("name", "speed"), [("scadchess_pawn_profile_R2007.dxf", "800"),
                                              ("scadchess_queen_profile_R2007.dxf", "500")])
 def test_openscad_chess_pieces_become_jobs_that_pass_every_check(run, name, speed):

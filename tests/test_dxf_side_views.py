@@ -98,6 +98,7 @@ def check_program_against_the_drawing(lines: list[str], polylines, z_span) -> No
                     assert r >= outline_radius(z, polylines) - GOUGE_MM, (number, g, start, end, z, r)
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_the_qcad_screw_becomes_its_upper_half_and_a_checked_job(conn):
     name = "qcad_screw_R2007.dxf"
     axis_y = centre_line_y(name)

@@ -43,6 +43,7 @@ def failure_of(done: subprocess.CompletedProcess, name: str) -> str:
     return failing[0]
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_a_catastrophic_pattern_is_matched_in_linear_time(fresh_database_url):
     add_test(fresh_database_url, "catastrophic", CATASTROPHIC)
     done = engine_test(fresh_database_url)   # on main: TimeoutExpired (re backtracks 2^n)
@@ -50,6 +51,7 @@ def test_a_catastrophic_pattern_is_matched_in_linear_time(fresh_database_url):
     assert "no line matches" in failure_of(done, "catastrophic")
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_a_backreference_fails_its_test_in_one_line_naming_it(fresh_database_url):
     add_test(fresh_database_url, "backreference", BACKREFERENCE)
     done = engine_test(fresh_database_url)

@@ -142,6 +142,7 @@ def verdict(text):
     return ast.dump(compiled.tree, include_attributes=True), compiled.names, compiled.ordered_names, compiled.calls
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 @settings(max_examples=300, deadline=None)
 @given(st.lists(PLAIN_PIECES, max_size=12).map("".join), st.booleans())
 def test_plain_lines_get_the_full_gate_s_verdict(body, f_string):

@@ -93,6 +93,7 @@ def test_file_with_byte_order_mark_imports(conn, tmp_path):
     assert stored(conn, 90001)["gear_class"] == "spur"
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_ten_thousand_rows_import(conn, tmp_path):
     rows = [f"{100000 + n},,2,{17 + n % 80},,{15 if n % 2 else ''},{'L' if n % 2 else ''},20,,,,,,,,"
             for n in range(10_000)]

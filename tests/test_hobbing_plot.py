@@ -182,6 +182,7 @@ def job_with_program(url: str, gear_id: int = 42) -> int:
                             (gear_id,)).fetchone()[0]
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_plot_writes_png_and_svg_for_a_job_and_a_program(run, tmp_path):
     assert run("instantiate", "--gear", 54).exit_code == 0
     job_id = job_with_program(run.url, 54)
@@ -240,6 +241,7 @@ def test_a_picture_that_cannot_be_written_is_refused_in_one_line_naming_the_file
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_a_cut_comment_with_dollar_signs_is_drawn_as_written(conn, tmp_path):
     """The legend names each pass by its `; CUT …` comment; matplotlib reads text between two `$`
     as TeX. The picture shows the shop's words as written (the SVG carries each text it draws)."""
@@ -264,6 +266,7 @@ def draft_of_spur(run, tmp_path) -> None:
     assert run("template", "import", "--class", "spur", tmp_path / "spur.csv").exit_code == 0
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_the_picture_of_a_job_is_of_its_released_program_not_a_draft_tried_on_it(run, tmp_path):
     """The operator's picture of a job shows the program that reaches the machine; a draft is
     drawn only for a job that has nothing else, and then the picture and the report say draft."""
@@ -298,6 +301,7 @@ def test_the_picture_of_a_program_the_simulation_refuses_says_so_in_red(conn):
     assert same_color(figure._suptitle.get_color(), "red")
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_a_picture_with_a_long_file_name_is_not_a_bug(run, tmp_path):
     """A name of 249 characters is a valid file name (Linux allows 255); the picture is written
     beside it under `.NAME.<random>.png` first, which is too long: OSError, exit 2."""
@@ -309,6 +313,7 @@ def test_a_picture_with_a_long_file_name_is_not_a_bug(run, tmp_path):
     assert [path.name for path in tmp_path.iterdir() if path.suffix == ".png"] in ([], [target.name])
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_a_cut_comment_with_dollar_signs_is_drawn_not_a_bug(run, tmp_path):
     """The picture's legend takes a cut's label from the program's `; CUT …` comment; matplotlib
     reads text between two $ as TeX, so a draft whose comment says `$\\frac$` stores a program
@@ -324,6 +329,7 @@ def test_a_cut_comment_with_dollar_signs_is_drawn_not_a_bug(run, tmp_path):
     assert result.exit_code == 0 and target.is_file(), result.output
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_the_picture_of_a_job_is_of_the_program_that_reaches_the_machine(run, tmp_path):
     """`engine plot --job ID` draws the job's newest program. After an editor tries a draft on
     the job (`instantiate --job ID --draft`), that is the draft's program: the operator's picture

@@ -220,6 +220,7 @@ def test_a_cylindrical_gear_has_no_view_from_above(conn):
     assert not [axes for axes in figure.axes if axes.get_title().startswith(TOP)]
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_the_svg_and_the_report_carry_the_numbers(run, tmp_path):
     """The picture is passed around as a file: its text holds the A written, and the command's
     report the same lines."""

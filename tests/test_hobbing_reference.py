@@ -353,6 +353,7 @@ def random_case(draw, kind: str):
     return gear, hob, choice, crowning, draw(st.sampled_from((STOCK, PAPER_STOCK, ("20CrMnTi", 180, 7))))
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 @pytest.mark.parametrize("kind", [pytest.param(kind, marks=() if kind == "spur" else pytest.mark.slow)
                                   for kind in CLASSES])    # 30 random gears each: spur alone in the fast subset
 @settings(max_examples=30, deadline=None, database=None, phases=(Phase.explicit, Phase.generate),

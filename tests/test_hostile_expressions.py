@@ -103,6 +103,7 @@ def test_a_hostile_row_in_the_template_view_is_refused_in_one_line(fresh_databas
         assert counts(conn) == before
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_lint_names_every_row_the_gate_refuses_and_goes_on(fresh_database_url):
     seen = [columns for columns, _, gate_sees in HOSTILE if gate_sees]
     with psycopg.connect(fresh_database_url) as conn:
@@ -117,6 +118,7 @@ def test_lint_names_every_row_the_gate_refuses_and_goes_on(fresh_database_url):
     assert "class duplex" in linted.stdout   # duplex inherits spur's rows: lint went on past spur
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_rows_cheap_alone_stop_at_the_budget_of_the_whole_run(fresh_database_url):
     """Each row prints one line of 256 KiB; 300 of them are more than one run may build."""
     line = f"'\U0001F600' * {WIDE}"
@@ -145,6 +147,7 @@ def run_traced(rows, params, seconds=2.0):
         tracemalloc.stop()
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_tool_paths_are_paid_block_by_block():
     """nc_path prints up to 200,000 blocks of 512 characters: two calls on a path of 65,000
     copies of one move would build 70 MB; the second stops when the run's bytes run out."""
@@ -180,6 +183,7 @@ def hundreds_of_large_integers(rows):
     return "; ".join(assignments), rows
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_hundreds_of_large_integers_keep_a_bounded_trace_or_are_refused(fresh_database_url, tmp_path):
     """Either the program is stored with a trace within its bound (the integers summarised, the
     rows past the bound counted), or the compile runs out of time and is refused in one line."""
@@ -205,6 +209,7 @@ def test_hundreds_of_large_integers_keep_a_bounded_trace_or_are_refused(fresh_da
     assert kept and kept[0]["computed"]["a7"] == f"<integer of {(1 << 4000).bit_length()} bits>"
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_lint_of_hundreds_of_large_integers_finishes(fresh_database_url):
     """Every name the rows read they assign first: lint passes them, or names the row at which
     the compile ran out of time, and goes on to the next class."""

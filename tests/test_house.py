@@ -126,12 +126,14 @@ def engine_graph():
     return import_graph((Path(engine.__file__).parent, "engine"))
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_no_import_cycle_in_the_package():
     graph = engine_graph()
     assert len(graph) > 80          # the walk read the whole package
     assert cycles(graph) == []
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_nothing_below_the_command_line_imports_it():
     graph = engine_graph()
     assert any(target.startswith(CLI + ".") for target in graph["engine.cli.app"])   # the walk sees CLI imports
@@ -273,16 +275,19 @@ def folders_missing_from_layers(folders=ENGINE_FOLDERS, layers=LAYERS) -> list[s
     return sorted(set(folders) - {folder for layer in layers for folder in layer})
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_every_folder_imports_only_folders_below_it():
     graph = engine_graph()
     assert "engine.machines.records" in graph["engine.gears.cases"]   # the walk sees imports between folders
     assert layer_problems(graph) == []
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_no_two_folders_import_each_other():
     assert two_way_folder_pairs(engine_graph()) == []
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_the_simulation_never_imports_the_models():
     graph = engine_graph()
     found = [f"{module} -> {target}" for module, targets in graph.items() if module.startswith("engine.simulation")

@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 
 import psycopg
+import pytest
 from helpers.drawings import DXF, EMCO, REAL, seed_drawing
 from helpers.outcomes import job_count, one_line_refusal
 
@@ -29,6 +30,7 @@ NOT_TURNED_FROM_OUTSIDE = {"d2g_132_R14.dxf": "internal turning is not supported
                            "ezdxf_AC1003_LINE_Example.dxf": "internal turning is not supported"}
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_every_real_drawing_becomes_a_job_or_is_refused_with_its_reason(run):
     assert {name for name, (_, refusal) in REAL.items() if refusal is None} == PROFILE_ONLY
     for name, (_, refusal) in sorted(REAL.items()):
@@ -98,6 +100,7 @@ def test_a_feed_edited_in_sql_changes_exactly_that_operation_s_f_words(run, tmp_
     assert {word for _, word in feed_words(after)} - {word for _, word in feed_words(before)} == {"F25.000"}
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_plot_writes_a_picture_of_the_job(run, tmp_path):
     job_id = json.loads(run("import-dxf", DXF / EMCO[1], "--rough-depth", "1", "--program-name", "EMCO_G02",
                             "--json").stdout)["job_id"]

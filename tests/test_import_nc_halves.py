@@ -32,6 +32,7 @@ def long_program(tmp_path) -> Path:
     return path
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_a_program_read_in_two_processes_is_stored_as_one_process_stores_it(conn, long_program, monkeypatch):
     monkeypatch.setattr(nc_halves, "TWO_PROCESSES_FROM", 10**9)
     alone = import_nc(conn, long_program, "nc_alone", PARAMS)
@@ -55,6 +56,7 @@ def test_a_bad_line_in_either_half_is_named_and_nothing_is_stored(conn, long_pro
     assert stored(conn) == before
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_rows_that_do_not_give_the_file_back_are_not_stored(conn, long_program, monkeypatch):
     """The proof compares what the rows give with the file: a wrong line makes it refuse."""
     original = nc_verify.CompiledTemplate.run
@@ -71,6 +73,7 @@ def test_rows_that_do_not_give_the_file_back_are_not_stored(conn, long_program, 
     assert stored(conn) == before
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_a_line_repeated_through_the_program_is_reported_at_every_line_holding_it(conn, tmp_path, monkeypatch):
     """Each distinct text is read once (issue 27); the report still names every line: the roughing
     cycle `G71 U1.5 R0.5` of each operation binds its depth of cut at U and leaves R0.5 (the

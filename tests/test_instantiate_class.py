@@ -35,6 +35,7 @@ def stored_counts(url) -> tuple[int, int]:
 
 # --- verified: the imported program again, and new values --------------------------------------------
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_the_class_of_an_imported_program_gives_it_back_with_its_own_parameters(run, tmp_path):
     source, lines = import_emco(run, tmp_path)
     before = stored_counts(run.url)
@@ -56,6 +57,7 @@ def test_the_class_of_an_imported_program_gives_it_back_with_its_own_parameters(
         made.stderr.split("(not in --params): ")[1].splitlines()[0].split(", "))
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_new_values_change_exactly_the_words_bound_to_them_and_the_file_is_the_stored_program(run, tmp_path):
     """A lathe class job is proved by the turning simulation without a drawing record (issue 27):
     against a blank its params state (Ø26 from Z0 to Z-40), it is written to --out, and its notes
@@ -107,6 +109,7 @@ def test_a_bound_form_naming_addresses_the_class_does_not_bind_is_refused_naming
     assert stored_counts(run.url) == before
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_a_bound_form_naming_the_class_s_address_in_lower_case_is_the_class_s_binding(run, tmp_path):
     source, lines = import_emco(run, tmp_path)
     params = tmp_path / "lower.json"
@@ -133,6 +136,7 @@ def test_a_class_imported_without_a_program_name_gets_an_840d_program_name_for_a
     assert name.lstrip("_") == gear_class.upper()[:len(name.lstrip("_"))]
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_a_dry_run_of_a_class_job_with_csv_parameters_prints_the_program_and_stores_nothing(run, tmp_path):
     source, lines = import_emco(run, tmp_path)
     params = tmp_path / "new.csv"
@@ -272,6 +276,7 @@ def test_the_database_holds_the_unverified_word_to_the_record_and_refuses_it_for
             resubmit(conn, hobbing, True, lambda line: line + " UNVERIFIED")
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_a_lathe_class_job_made_again_is_proved_and_written_to_a_file(run, tmp_path):
     """`instantiate --job` of a lathe class job: proved by the turning simulation again, against
     the blank its --params stated (Ø26 from Z0 to Z-40: the program's rapids at X28 and up stay
@@ -294,6 +299,7 @@ def test_a_lathe_class_job_made_again_is_proved_and_written_to_a_file(run, tmp_p
     assert any(line.startswith("not checked: a cut into the finished part") for line in simulated)
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_the_adversary_s_rapid_through_the_blank_in_an_imported_program_is_refused_naming_it(run, tmp_path):
     """The second adversary of issue 26 wrote G00 X0.000 Z-15.000 into an imported lathe program:
     the turning simulation follows it through the blank the program implies and refuses it, at

@@ -49,6 +49,7 @@ def test_a_real_iso_lathe_program_is_verified_or_refused_naming_the_construct(co
         assert message is not None and construct in message, message
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_tokarka_with_its_plane_stated_is_refused_for_its_commented_out_tool_calls(conn):
     lines = real_lines("TOKARKA.NC")
     message = verdict(conn, "lathe-iso", lines[:1] + ["G18"] + lines[1:])
@@ -268,6 +269,7 @@ def test_g76_with_no_height_is_refused():
         cycles.threading((22.0, 3.0), Thread(17.4, -20.0, 0.0, 0.4, 2.5))
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_a_program_whose_header_names_another_program_is_refused_saying_what_to_give(conn):
     """A new user imported TOKARKA.NC as class y2 and made it as _Y2: its header %O1200(TOKARKA)
     would store it on the control as TOKARKA; the refusal names both and the param that settles it."""

@@ -167,6 +167,7 @@ def test_a_release_that_changes_only_the_layout_says_every_program_file_of_the_c
                                  "to": {"line_ending": "crlf", "final_newline": False}, "programs": programs}]
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_a_release_of_rows_alone_names_no_layout_change(run, tmp_path):
     written(run, tmp_path)
     edited = tmp_path / "spur.csv"

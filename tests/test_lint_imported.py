@@ -57,6 +57,7 @@ def test_a_changed_row_naming_an_unknown_parameter_is_the_one_problem(conn):
     assert str(problems[0]) == f"class nc_cam row {changed.id} column o: unknown parameter 'nonexistent'"
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_names_computed_by_earlier_rows_are_known(conn):
     real_files()
     import_nc(conn, DATA / CAM, "nc_cam", PARAMS[CAM])

@@ -51,6 +51,7 @@ def test_rows_whose_inputs_repeat_are_not_evaluated_again(monkeypatch):
     assert evaluated == []
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_the_seeded_classes_give_the_same_programs_with_and_without_the_memo(conn, monkeypatch):
     from engine.hobbing.choices import Choices
     from engine.programs.instantiate import instantiate_gear

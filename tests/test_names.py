@@ -252,6 +252,7 @@ def injected_anywhere(url, folder) -> list[str]:
     return [text for text in texts if "X9999" in text]
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_no_route_puts_a_block_into_a_program(run, tmp_path):
     out = tmp_path / "out"
     assert run("instantiate", "--gears", "42-43", "--out", out).exit_code == 0

@@ -76,6 +76,7 @@ FRAGMENT = st.one_of(
 )
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 @settings(max_examples=400, deadline=None)
 @given(st.lists(FRAGMENT, max_size=25).map("".join))
 def test_nc_like_lines_tokenise_back(line):
@@ -91,6 +92,7 @@ def test_any_text_tokenises_back(line):
     assert detokenise(tokenise(line)) == line
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 @settings(max_examples=400, deadline=None)
 @given(NUMBER)
 def test_a_number_field_prints_the_original_value_as_written(spelling):

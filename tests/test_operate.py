@@ -174,6 +174,7 @@ def test_psql_missing_everywhere_says_the_command_to_run(tmp_path, monkeypatch):
     assert result.stderr.rstrip().endswith("run: psql --dbname postgresql://shop@db.example/engine -c 'SELECT 1'")
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_seed_loads_what_a_shop_needs_and_the_samples_only_when_asked(empty_database_url):
     def engine_on_it(*args):
         result = CliRunner().invoke(main, ["--database-url", empty_database_url, *args])

@@ -307,6 +307,7 @@ def store_nc_program(conn, gear_class):
     return store_one(conn, planned, job, None).program_id
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_every_route_of_an_edit_keeps_each_programs_version_equal_to_its_rows(fresh_database_url, tmp_path):
     url, made = fresh_database_url, []
     nc_file = tmp_path / "part.nc"
@@ -376,6 +377,7 @@ rows = st.lists(st.builds(TemplateRow, st.integers(0, 2**31 - 1), st.sampled_fro
                           st.integers(0, 1000), texts, texts, texts, texts), max_size=6)
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 @settings(max_examples=200, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(rows=rows)
 def test_the_databases_template_hash_is_the_engines(conn, rows):

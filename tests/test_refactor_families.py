@@ -97,6 +97,7 @@ def renumbered(tmp_path, old: str, new: str):
     return path
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_a_family_keeps_its_key_when_a_member_joins_and_marked_intended_is_not_listed(conn, tmp_path):
     import_nc(conn, CAM, "cam")
     first = family_of(refactor(conn), RETRACT)
@@ -146,6 +147,7 @@ def marked_before_issue_17(conn, t: str, a: str, b: str, why: str) -> str:
     return key
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_marks_and_seen_pairs_stored_before_block_numbers_left_the_keys_still_hold(conn):
     """A shop marked two retracts (one family now) and two arcs (one pair of families now)
     intended, under the keys of their full texts; the report still leaves both out and counts

@@ -144,6 +144,7 @@ def test_lines_the_wrench_pair_shares_are_stored_once(conn):
     assert all(count >= 2 for (count,) in shared_by)
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_instantiation_during_a_refactor_sees_the_old_library_and_writers_wait(fresh_database_url):
     url = fresh_database_url
     with psycopg.connect(url) as setup:
@@ -218,6 +219,7 @@ def test_instantiation_during_a_refactor_sees_the_old_library_and_writers_wait(f
         writer.close()
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_a_refactor_that_deadlocks_with_a_hand_made_sql_edit_retries_and_commits(fresh_database_url):
     """A DBA's edit that changes assembly first and component second, while the refactor
     waits for its lock on both: PostgreSQL aborts one of them; the refactor runs again."""

@@ -289,6 +289,7 @@ def committed_edit(url, row_id=COOLANT_ROW, **columns):
         edit(conn, "spur", row_id, **columns)
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_release_on_the_command_line_and_history(run):
     assert run("instantiate", "--gear", 42).exit_code == 0
     committed_edit(run.url, o="M8 ; COOLANT ON")
@@ -376,6 +377,7 @@ def test_the_impact_proved_in_two_workers_is_the_impact_proved_here(conn):
     assert conn.execute("SELECT count(*) FROM job").fetchone()[0] >= 4
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_a_draft_that_sends_a_stored_lathe_class_job_through_its_blank_is_refused(run, tmp_path):
     """New-user review of issue 28: a class job (instantiate --class --params, a shop's own lathe
     program imported) was made again by the impact as if it were a drawing's turning job, failed

@@ -61,6 +61,7 @@ def refusal(conn, gear_class: str) -> EngineError:
 
 # --- the engine's own program, end to end, verified -------------------------------------------------------
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_the_engines_lathe_program_imported_is_released_and_runners_make_verified_jobs_of_it(run, tmp_path):
     source, lines = import_emco(run, tmp_path)
     further_on, after_twin, _ = repeats(lines)

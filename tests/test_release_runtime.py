@@ -185,6 +185,7 @@ def check_lineage(run, program_id: int, path: Path) -> None:
     assert program_id in [record["program_id"] for record in json.loads(found.stdout)["programs"]]
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_every_seeded_gears_program_carries_its_lineage(run, tmp_path):
     for gear_id in SEEDED_GEARS:
         made = run("instantiate", "--gear", gear_id, "--out", tmp_path / f"G{gear_id}.MPF", "--json")
@@ -217,6 +218,7 @@ def batch_programs(run, folder: Path, *args) -> list[tuple[int, Path]]:
     return [(program_id, folder / f"{name}.MPF") for program_id, name in named]
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_batches_and_remade_jobs_carry_their_lineage(run, tmp_path):
     batch = batch_programs(run, tmp_path / "batch", "--gears", "42-54")
     with psycopg.connect(run.url) as conn:
@@ -312,6 +314,7 @@ def test_programs_show_gives_the_record_and_refuses_in_one_line(run):
         assert refused.exit_code == 1 and refused.stderr.count("\n") == 1 and words in refused.stderr, refused.stderr
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_a_role_without_the_right_gets_one_line_and_exit_1(fresh_database_url):
     """An editor alone (no engine_runner) trying a draft, or a reader instantiating: the database
     refuses; the user reads which roles may do it, exit 1, and nothing is stored."""

@@ -7,6 +7,7 @@ release` still shows its gate passed (design notes §10, threat model)."""
 import json
 
 import psycopg
+import pytest
 from helpers.roles import as_role
 from psycopg import sql
 from psycopg.types.json import Jsonb
@@ -91,6 +92,7 @@ def test_the_recorded_tests_are_the_databases_not_the_callers(run):
     assert f"spur/{TEST_NAME}" in line and not release["recheck"]["passed"]
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_a_release_through_the_engines_gate_shows_its_gate_passed(run):
     committed(run.url, GOLDEN_TEST, (TEST_NAME,))
     committed(run.url, EDIT.format(sql.Identifier("o")), ('"M9 ; COOLANT OFF"', COOLANT_OFF_ROW))
@@ -119,6 +121,7 @@ def test_a_release_recorded_before_migration_0026_is_re_checked_with_the_tests_o
     assert release["gate"] == "not run" and not release["recheck"]["recorded_tests"]
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_a_retired_release_is_re_checked_against_its_own_rows_not_the_ones_released_now(run):
     """v2 passed the gate; v3, broken, was then released by hand. v2's tests are re-run against
     v2's stored rows: it still passed, and v3 does not."""
@@ -132,6 +135,7 @@ def test_a_retired_release_is_re_checked_against_its_own_rows_not_the_ones_relea
     assert gates[2] == ("retired", "passed") and gates[3] == ("released", "not run")
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_a_forged_claim_that_passes_its_re_check_still_says_whose_word_the_impact_is(run):
     """Adversary, issue 26: a releaser names the engine by hand for a draft whose checks pass, with
     an invented impact (0 of 1 changed). The re-check cannot recompute the impact (it compared the

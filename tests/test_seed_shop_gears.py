@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 
 import psycopg
+import pytest
 from click.testing import CliRunner
 
 from engine.cli.app import main
@@ -31,6 +32,7 @@ def sample_tests_of(gear_id: int) -> int:
     return sum(test.get("gear_id") == gear_id for test in tests)
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_the_samples_leave_a_shops_own_gears_without_their_tests_and_units(empty_database_url):
     url = empty_database_url
     engine_on(url, "db", "migrate")
@@ -53,6 +55,7 @@ def test_a_second_seed_of_the_samples_changes_nothing_and_says_nothing_skipped(f
     assert seeded == "seed: everything was already there; nothing changed\n"
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_the_samples_do_not_hang_golden_tests_on_a_shops_own_gear(empty_database_url):
     """A shop's own gear 42 (m3 z33), then `engine seed --samples`: the sample golden tests of
     gear 42 (m2 z19) must not be attached to the shop's gear (which then can never be deleted)."""

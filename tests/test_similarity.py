@@ -22,6 +22,7 @@ unit_lists = st.lists(st.lists(st.sampled_from(["G1", "X", "Z", "F", "{x}", "{z:
                                min_size=0, max_size=9).map(tuple), min_size=0, max_size=25, unique=True)
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 @settings(max_examples=300, deadline=None)
 @given(lines=unit_lists, threshold=st.sampled_from([0.5, 0.6, 2 / 3, 0.75, 0.8, 0.9, 1.0]))
 def test_the_pair_search_finds_what_comparing_every_pair_finds(lines, threshold):

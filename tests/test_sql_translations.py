@@ -27,6 +27,7 @@ def instantiated_in_a_new_process(url: str, gear: int, *options: str) -> dict:
     return json.loads(done.stderr.strip().splitlines()[-1])
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_seeded_classes_run_from_their_kept_translations_without_sqlglot(fresh_database_url):
     for gear in (42, 53):     # spur: `shift_per_part = 0`; worm wheel: `cut_on AND NOT tangential` …
         assert instantiated_in_a_new_process(fresh_database_url, gear) == {"exit": 0, "sqlglot": False}
@@ -60,6 +61,7 @@ def test_lint_names_a_translation_that_is_not_sqlglot_s(run):
         in linted.stdout
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_a_condition_edited_in_sql_runs_and_lint_keeps_its_translation(run):
     with psycopg.connect(run.url) as conn:
         conn.execute("UPDATE template_view SET p_emit = 'coolant AND 1 = 1' WHERE gear_class = 'spur' AND id = 1800")

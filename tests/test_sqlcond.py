@@ -403,6 +403,7 @@ def test_malformed_inputs_are_rejected(text):
     assert "\n" not in message
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_deep_nesting_is_an_engine_error():
     with pytest.raises(EngineError):
         translate("(" * 3000 + "1" + ")" * 3000)

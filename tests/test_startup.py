@@ -47,6 +47,7 @@ def top_level(modules: set[str]) -> set[str]:
     return {name.partition(".")[0] for name in modules}
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_proving_and_checking_gear_42_loads_no_library_it_does_not_use(database_url):
     """The whole command, the simulation of the program included (a dry run: stored or not, the
     same checks run)."""
@@ -95,6 +96,7 @@ def test_the_models_a_command_does_not_plan_with_are_imported_when_the_registry_
     assert OTHER_MODELS - {"engine.hobbing.models"} <= loaded
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_importing_the_command_line_loads_no_heavy_library():
     loaded = modules_after("import engine.cli.app, engine.programs.instantiate, engine.programs.all_models")
     assert top_level(loaded) & HEAVY == set()

@@ -146,6 +146,7 @@ def test_lists_never_say_read_of_a_forged_program_and_check_it_when_asked(run, f
     assert {(p["rendering"], p["verifier"]) for p in edited} == {("UNCHECKED", "-")}
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_every_kind_of_program_the_engine_makes_is_its_own_rendering(run, tmp_path):
     """No false MISMATCH: hobbing programs of every seeded gear (a batch), a turning job's program
     (import-dxf, then instantiate --job: its passes), a job of an imported class on an ISO lathe

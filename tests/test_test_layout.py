@@ -7,6 +7,8 @@ from __future__ import annotations
 import ast
 from pathlib import Path
 
+import pytest
+
 TESTS = Path(__file__).resolve().parent
 TOP_LEVEL_ALLOWED = {"conftest.py"}   # besides test_*.py
 
@@ -39,6 +41,7 @@ def stray_modules(folder: Path) -> list[str]:
                   if not path.name.startswith("test_") and path.name not in TOP_LEVEL_ALLOWED)
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_no_module_of_the_tests_imports_a_test_module():
     assert imports_of_test_modules(TESTS) == []
 

@@ -133,6 +133,7 @@ def drawings(tmp_path: Path):
         yield DXF / name, ProfileOptions(rough_depth=1.0)
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 @pytest.mark.parametrize("machine", MACHINES)
 def test_no_rapid_enters_the_part_or_the_blank(conn, tmp_path, machine):
     for path, options in drawings(tmp_path):

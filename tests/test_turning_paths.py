@@ -291,6 +291,7 @@ def step(z, low, high, kind, size):
             Arc((z, high - size), (z - size, high), (z - size, high - size), ccw=True)]
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 @settings(max_examples=40, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(profile=stepped_profiles(), extra=st.floats(0.5, 6.0), per_pass=st.floats(0.5, 3.0),
        allowance=st.floats(0.0, 1.0), front_stock=st.sampled_from([0.0, 0.5, 2.0]))

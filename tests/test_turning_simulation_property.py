@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import math
 
+import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -128,6 +129,7 @@ z_grid = st.integers(-100, 20).map(lambda i: i * 0.5)        # Z -50 … 10 mm
 move = st.tuples(st.sampled_from(["rapid", "feed"]), grid, z_grid)
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 @settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(dialect=st.sampled_from(sorted(DIALECTS)), moves=st.lists(move, min_size=1, max_size=6))
 def test_no_program_through_material_or_into_the_part_is_accepted(dialect, moves):

@@ -20,6 +20,7 @@ import csv
 import math
 from pathlib import Path
 
+import pytest
 from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
@@ -190,6 +191,7 @@ def verdict(machine: Machine, lines: list[str]) -> bool:
     return True
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 @settings(max_examples=600, deadline=None)
 @given(moves())
 def test_a_move_is_accepted_exactly_when_it_is_plain_and_inside_the_machine(case):
@@ -197,6 +199,7 @@ def test_a_move_is_accepted_exactly_when_it_is_plain_and_inside_the_machine(case
     assert verdict(machine, lines) == accepted, lines
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 @settings(max_examples=300, deadline=None)
 @given(speeds())
 def test_a_spindle_speed_is_accepted_exactly_when_it_is_plain_above_0_and_within_the_spindle(case):
@@ -204,6 +207,7 @@ def test_a_spindle_speed_is_accepted_exactly_when_it_is_plain_above_0_and_within
     assert verdict(machine, lines) == accepted, lines
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 @settings(max_examples=300, deadline=None)
 @given(step=st.floats(0, 2), low=values_around(-80, 0), high=values_around(0, 80), reset=values_around(-80, 80))
 def test_the_hob_shift_clamp_is_accepted_exactly_when_its_whole_interval_lies_inside(step, low, high, reset):
@@ -243,6 +247,7 @@ TOOL_EVENTS = {   # block -> the offset it leaves: None if the block does not to
 }
 
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 @settings(max_examples=300, deadline=None)
 @given(data=st.data())
 def test_a_lathe_cut_is_accepted_exactly_when_a_tool_offset_is_active(data):
@@ -276,6 +281,7 @@ def test_the_table_is_accepted_exactly_when_its_speed_with_the_z_term_is_within_
 
 # ---------------------------------------------------------------- arcs
 
+@pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 @settings(max_examples=400, deadline=None)
 @given(start_x=st.floats(150, 250), start_z=st.floats(-300, -100), end_x=st.floats(150, 250),
        end_z=st.floats(-300, -100), radius=st.floats(0.01, 30), longer=st.booleans(), ccw=st.booleans())
