@@ -184,3 +184,40 @@ def test_a_move_past_the_fixture_dips_between_two_poses(records, monkeypatch, se
     depth = deepest_along(35.0, 100.0, a_written, (*start, z), (*end, z), 10.0, -math.inf, -spur.gear.face_width)
     assert depth == pytest.approx(0.0036, abs=0.0002)
     assert any("into the fixture" in m for m in messages(report)), (depth, messages(report))
+
+
+@PATHS
+def test_the_hob_end_beside_the_tailstock_dips_between_two_heights(records, monkeypatch, sections):
+    """The first test's geometry above the work: the seeded Ø20 tailstock (clamped by M20 from the
+    top face, Z 0, up; its heights multiples of 0.5 mm), the hob parked at X20 Y60.885 Z100.078
+    before M21. At the tailstock's heights the hob is 0.0001 mm inside it; 30 mm above their
+    centre and 100 mm above the top face, between two of them, 0.0061 mm."""
+    monkeypatch.setattr(contact, "MATH_SECTIONS", sections)
+    spur = Hand(records["gear"](42), records["hobs"]["H-M2-AA-R1"])
+    machine = records["machine"]
+    assert (machine.tailstock_diameter, machine.tailstock_gap) == (20.0, 0.0)
+    park = (20.0, 60.885, 100.078)
+    extra = [f"G0 Z{park[2]:.3f}", f"G0 Y{park[1]:.3f}", f"G0 X{park[0]:.3f}",
+             f"G0 X{spur.x_retract:.3f}", "G0 Y0.000"]
+    lines = after_coupling(spur, extra)
+    assert lines.index("M20") < lines.index(extra[2]) < lines.index("M21")
+    report = simulate_program(lines, spur.gear, spur.hob, machine, "TEST")
+    a_written = round(swivel(spur.gear, spur.hob), 3)
+    depth = true_depth(35.0, 100.0, a_written, park, 10.0, 0.0, math.inf)
+    assert depth == pytest.approx(0.0061, abs=0.0002)
+    assert any("into the tailstock" in m for m in messages(report)), (depth, messages(report))
+
+
+@pytest.mark.parametrize(("park", "solid"), [((20.0, 60.880, -99.948), "the fixture"),
+                                             ((20.0, 60.880, 100.078), "the tailstock")])
+def test_the_same_park_5_micrometres_nearer_is_refused(records, park, solid):
+    """The control of the end-face tests: the same rapids with Y 0.005 mm less put the hob about
+    0.005 mm inside at the solid's own heights too (the end face moves 0.005·cos A toward the
+    axis), and the simulation names the solid, so what those tests ask of it can be had."""
+    spur = Hand(records["gear"](42), records["hobs"]["H-M2-AA-R1"])
+    extra = [f"G0 Z{park[2]:.3f}", f"G0 Y{park[1]:.3f}", f"G0 X{park[0]:.3f}",
+             f"G0 X{spur.x_retract:.3f}", "G0 Y0.000"]
+    lines = after_coupling(spur, extra)
+    report = simulate_program(lines, spur.gear, spur.hob, records["machine"], "TEST")
+    found = [f.message for f in report.refusals if f.number == lines.index(extra[2]) + 1]
+    assert any(f"into {solid}" in m for m in found), messages(report)
