@@ -221,3 +221,58 @@ def test_the_same_park_5_micrometres_nearer_is_refused(records, park, solid):
     report = simulate_program(lines, spur.gear, spur.hob, records["machine"], "TEST")
     found = [f.message for f in report.refusals if f.number == lines.index(extra[2]) + 1]
     assert any(f"into {solid}" in m for m in found), messages(report)
+
+
+def duplex_program(gear, hob, extra: list[str]) -> list[str]:
+    """Gear 54 (unit 1: z30, d_a 64, d_f 55, Z 0 … −20; unit 2: z19, d_a 42, d_f 33, Z −75 … −90)
+    hobbed by one spur hob in two couplings (§A5, §B3: full depth a = (d_f + d_a0)/2; §B7's run-in,
+    3 mm run-out; the feeds per table revolution of the Hand's z19 program), then `extra` after
+    the spindle stops, before M21."""
+    unit = gear.units[0]
+    a_value = round(swivel(gear, hob), 3)
+    lines = ["%_N_TEST_MPF", ";$PATH=/_N_MPF_DIR", "G90 G71 G94", "G25 X20.000 Y-80.000 Z-350.000",
+             "G26 X320.000 Y80.000 Z150.000", "WALIMON", "M20"]
+    for teeth, tip, root, top, width in [(gear.teeth, gear.tip_diameter, gear.root_diameter, 0.0, gear.face_width),
+                                          (unit.teeth, unit.tip_diameter, unit.root_diameter, unit.z_top,
+                                           unit.face_width)]:
+        retract = (tip + hob.tip_diameter) / 2 + 5.0
+        h = (tip - root) / 2
+        lean = math.tan(math.radians(a_value)) * math.sqrt(h * (tip - h))
+        run_in = math.sqrt(h * (hob.tip_diameter - h)) + 2.0 + lean
+        lines += [f"G0 Z{top + run_in:.3f}", f"G0 X{retract:.3f}", f"G0 A={a_value:.3f}", "G0 Y0.000", "EGDEF(C,B,1)",
+                  f'EGON(C,"FINE",B,-1,{teeth})', "M3 S246",
+                  f"G1 X{(root + hob.tip_diameter) / 2:.3f} F{36.0 * 19 / teeth:.1f}",
+                  f"G1 Z{top - width - 3.0:.3f} F{38.0 * 19 / teeth:.1f}",
+                  f"G0 X{retract:.3f}", "EGOFS(C)", "EGDEL(C)"]
+    lines += ["M5", *extra, "M21", "M30"]
+    return lines[:2] + [f"; CYCLE TIME {program_minutes(lines, RAPID_RATE, LOAD):.1f} MIN"] + lines[2:]
+
+
+@PATHS
+def test_the_hob_end_beside_the_other_unit_dips_between_two_heights(records, monkeypatch, sections):
+    """The end-face dip against a neighbouring unit: the duplex gear 54 hobbed whole, then the hob
+    parked at X20 Y71.895 Z−109.928, its end face beside unit 2 (Ø42, Z −75 … −90, finished
+    work) 5 mm below its top face. At the unit's heights (0.5 mm apart) it is 0.0003 mm inside
+    the tip cylinder; between two of them 0.0037 mm."""
+    monkeypatch.setattr(contact, "MATH_SECTIONS", sections)
+    gear, hob = records["gear"](54), records["hobs"]["H-M2-AA-R1"]
+    assert not simulate_program(duplex_program(gear, hob, []), gear, hob, records["machine"], "TEST").refused
+    park = (20.0, 71.895, -109.928)
+    retract = (gear.tip_diameter + hob.tip_diameter) / 2 + 5.0
+    extra = [f"G0 X{retract:.3f}", f"G0 Z{park[2]:.3f}", f"G0 Y{park[1]:.3f}", f"G0 X{park[0]:.3f}",
+             f"G0 X{retract:.3f}", "G0 Y0.000"]
+    report = simulate_program(duplex_program(gear, hob, extra), gear, hob, records["machine"], "TEST")
+    unit = gear.units[0]
+    depth = true_depth(35.0, 100.0, round(swivel(gear, hob), 3), park, unit.tip_diameter / 2,
+                       unit.z_top - unit.face_width, unit.z_top)
+    assert depth == pytest.approx(0.0037, abs=0.0002)
+    assert any("into unit 2" in m for m in messages(report)), (depth, messages(report))
+
+
+def test_the_duplex_park_5_micrometres_nearer_is_refused(records):
+    """The control of the other-unit test: Y 0.005 mm less, and unit 2 is named."""
+    gear, hob = records["gear"](54), records["hobs"]["H-M2-AA-R1"]
+    retract = (gear.tip_diameter + hob.tip_diameter) / 2 + 5.0
+    extra = [f"G0 X{retract:.3f}", "G0 Z-109.928", "G0 Y71.890", "G0 X20.000", f"G0 X{retract:.3f}", "G0 Y0.000"]
+    report = simulate_program(duplex_program(gear, hob, extra), gear, hob, records["machine"], "TEST")
+    assert any("into unit 2" in f.message and f.line == "G0 X20.000" for f in report.refusals), messages(report)
