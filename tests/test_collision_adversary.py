@@ -109,8 +109,8 @@ def test_the_hob_end_beside_the_fixture_dips_between_two_heights(records, monkey
     dx/dz = √(r0² − X²)/X ≈ 1.44: the least distance from the axis goes as
     √(f₀² + (1.44·δz)²) ≈ f₀ + 1.04·δz²/f₀, a curvature of about 0.2/mm against the 1/r0 =
     0.029/mm the threshold allows for. At the fixture's heights (multiples of 0.5 mm) the hob
-    is at most 0.0009 mm inside (below the 0.0011 mm threshold for r0 35); 0.25 mm from the
-    nearest of them it is 0.006 mm inside, 50 mm below the fixture's top face."""
+    is at most 0.0009 mm inside (below the 0.0011 mm threshold for r0 35); between two of them
+    it is 0.006 mm inside, 50 mm below the fixture's top face."""
     monkeypatch.setattr(contact, "MATH_SECTIONS", sections)
     spur = Hand(records["gear"](42), records["hobs"]["H-M2-AA-R1"])
     machine = records["machine"]
