@@ -10,7 +10,7 @@ import math
 
 import numpy as np
 
-from .contact_bounds import exact_collision
+from .contact_bounds_arrays import exact_collision
 from .contact_records import COLLISION_TOLERANCE, TOLERANCE, Contact, Motion, contact_at, exact
 from .envelope import HobBody
 from .envelope_arrays import SLACK, Sections
@@ -24,7 +24,7 @@ def meet_all(solids: list[Solid], hob: HobBody, swivel: float, pieces: list, mot
     a = math.radians(swivel)
     cx, cy, cz = x, y * math.cos(a), z + y * math.sin(a)
     found = (_meet(solid, hob, swivel, cx, cy, cz, motion) if not exact(solid, motion)
-             else exact_collision(solid, hob, swivel, pieces, [0]) for solid in solids)
+             else exact_collision(solid, hob, swivel, pieces, _heights(solid), _blank(solid)) for solid in solids)
     return [contact for contact in found if contact is not None]
 
 

@@ -214,7 +214,8 @@ def _pose_samples(solid: Solid, hob: HobBody, swivel: float, pose: tuple, extent
     first, last = bisect_left(heights, cz - extent), bisect_right(heights, cz + extent)
     reach = (max(solid.z_low, cz - extent), min(solid.z_high, cz + extent))
     if last <= first:
-        return -math.inf, math.inf
+        return -math.inf, solid.largest_radius - (abs(cx) - hob.radius)
     counted[0] += last - first
     found = nearest_radii(hob, swivel, cx, cy, cz, heights[first:last])
-    return pose_bound(heights, solid.radius, first, found, found, reach)
+    deepest, bound = pose_bound(heights, solid.radius, first, found, found, reach)
+    return deepest, min(bound, solid.largest_radius - (abs(cx) - hob.radius))   # or X alone
