@@ -1,10 +1,9 @@
 """engine.simulation.hobbing.contact_bounds for a batch, with numpy: the same bounds of a
-collision's depth between the sampled heights and poses of a move's straight pieces, every
-pose and height at once, first from envelope_arrays' cheap bounds of each section's distance
-(a lower and an upper bound stand in for the value: the far sample's lower bound of the depth,
-the near one's upper bound), then, where those reach the tolerance, from the exact distances;
-a piece still not settled is searched by contact_bounds.deepest_on_piece (plain floats, so
-both paths report the same depth and height)."""
+collision's depth between the sampled heights and poses of a move's straight pieces, from the
+exact distances (envelope_arrays) of every wanted pose at every height at once (envelope_arrays'
+cheap bounds of a section's distance were tried in their place: near the blank, where a pose is
+wanted, they are millimetres apart and settled nothing); a piece not settled is searched by
+contact_bounds.deepest_on_piece (plain floats, so both paths report the same depth and height)."""
 from __future__ import annotations
 
 import math
@@ -46,7 +45,7 @@ class Poses:
         self.cx, self.cy, self.cz = x, y * math.cos(angle), z + y * math.sin(angle)
 
     def unsettled(self, solid: Solid, hob: HobBody, swivel: float, heights, radius) -> list[int]:
-        """The pieces whose bounds (cheap, then exact) leave the hob possibly deeper than LIMIT."""
+        """The pieces whose bounds leave the hob possibly deeper than LIMIT (contact_bounds.piece_reaches)."""
         same = self.piece[:-1] == self.piece[1:]
         x_alone = _x_alone(self.cx, hob.radius, solid.largest_radius)
         if not (same & (x_alone > LIMIT)).any():
@@ -58,14 +57,10 @@ class Poses:
             return []
         rows = Rows(self, wanted, solid, extent, heights, radius)
         base_upper = np.where(side == 0, solid.largest_radius - (np.abs(self.cx) - hob.radius), -np.inf)
-        flags = None
-        for exact in (False, True):
-            low, high = rows.pose_bounds(hob, swivel, self.cy[wanted], exact)
-            lower, upper = np.full(len(self.cx), -np.inf), base_upper.copy()
-            lower[wanted], upper[wanted] = low, np.minimum(high, base_upper[wanted])
-            flags = same & (_interval_bounds(lower, upper, x_alone, side, self.piece) > LIMIT)
-            if not flags.any():
-                return []
+        low, high = rows.pose_bounds(hob, swivel, self.cy[wanted])
+        lower, upper = np.full(len(self.cx), -np.inf), base_upper.copy()
+        lower[wanted], upper[wanted] = low, np.minimum(high, base_upper[wanted])
+        flags = same & (_interval_bounds(lower, upper, x_alone, side, self.piece) > LIMIT)
         return sorted(set(self.piece[:-1][flags].tolist()))
 
 
@@ -122,52 +117,38 @@ class Rows:
         self.high = np.minimum(solid.z_high, cz + extent)
         self.cx, self.cz = poses.cx[wanted][:, None], cz[:, None]
 
-    def pose_bounds(self, hob: HobBody, swivel: float, cy, exact: bool):
-        """(L, U) per pose (contact_bounds.pose_bound), from envelope_arrays' bounds of each
-        section's distance or, with `exact`, from the distances themselves."""
-        sections = Sections(hob, swivel, self.cx, self.cz, self.heights)
-        if exact:
-            lower = upper = sections.nearest(cy[:, None])
-        else:
-            lower, upper = sections.bounds(cy[:, None])
-        valid = self.inside & ~sections.empty & np.isfinite(upper) & np.isfinite(lower)
-        low = np.where(valid, self.radius - upper, -np.inf)
-        high = np.where(valid, self.radius - lower, -np.inf)
-        return low.max(axis=1), height_bounds(self.heights, valid, low, high, (self.low, self.high))
+    def pose_bounds(self, hob: HobBody, swivel: float, cy):
+        """(L, U) per pose (contact_bounds.pose_bound) from the exact distances."""
+        distance = Sections(hob, swivel, self.cx, self.cz, self.heights).nearest(cy[:, None])
+        valid = self.inside & np.isfinite(distance)
+        depth = np.where(valid, self.radius - distance, -np.inf)
+        return depth.max(axis=1), height_bounds(self.heights, valid, depth, depth, (self.low, self.high))
 
 
 def height_bounds(h, valid, low, high, reach):
-    """contact_bounds.height_bound per row (h, valid, low, high of shape (P, W); a row's valid
-    samples contiguous), inf for a row with none."""
+    """contact_bounds.height_bound per row (h, valid, low, high of shape (P, W), low and high
+    −inf where not valid; a row's valid samples contiguous), inf for a row with none. Per
+    sample j, the line through j and j − 1 carried up to j + 1, and through j and j + 1 carried
+    down to j − 1; the stretch to the reach beyond the first (last) valid sample by the latter
+    (former) carried that far."""
     rows, width = h.shape
-    pad = np.full((rows, 1), -np.inf)
-    low_p, high_p = np.hstack([pad, low, pad, pad]), np.hstack([pad, high, pad, pad])
-    h_p = np.hstack([h[:, :1] - 1.0, h, h[:, -1:] + 1.0, h[:, -1:] + 2.0])
-    valid_p = np.hstack([np.zeros((rows, 1), bool), valid, np.zeros((rows, 2), bool)])
-    j = np.arange(1, width + 1)          # the padded columns of the samples
-    step = h_p[:, j + 1] - h_p[:, j]
-    left = np.where(valid_p[:, j - 1], _line(high_p[:, j], low_p[:, j - 1], step, h_p[:, j] - h_p[:, j - 1]), np.inf)
-    right = np.where(valid_p[:, j + 2], _line(high_p[:, j + 1], low_p[:, j + 2], step,
-                                              h_p[:, j + 2] - h_p[:, j + 1]), np.inf)
-    between = np.where(valid_p[:, j] & valid_p[:, j + 1], np.minimum(left, right), -np.inf).max(axis=1)
-    ends = np.maximum(_end(h, valid, low, high, reach[0], 1), _end(h, valid, low, high, reach[1], -1))
-    return np.maximum(np.maximum(high.max(axis=1), between), ends)
-
-
-def _end(h, valid, low, high, reach, sense: int):
-    """The bound over the stretch from a row's first (sense 1) or last (−1) valid sample to the
-    reach beyond it: the line through it and its inner neighbour; inf without one."""
-    rows, width = h.shape
-    order = np.arange(width) if sense == 1 else np.arange(width)[::-1]
-    at = order[np.argmax(valid[:, order], axis=1)]
-    inner = np.clip(at + sense, 0, width - 1)
-    row = np.arange(rows)
-    beyond = (h[row, at] - reach) * sense
-    has_inner = valid[row, inner] & (inner != at)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        line = _line(high[row, at], low[row, inner], np.maximum(beyond, 0.0), (h[row, inner] - h[row, at]) * sense)
-    found = np.where(has_inner, line, np.inf)
-    return np.where(valid.any(axis=1), np.where(beyond > 0.0, found, -np.inf), np.inf)
+    low_p, high_p, h_p = (np.empty((rows, width + 2)) for _ in range(3))
+    for padded, values, edge in ((low_p, low, -np.inf), (high_p, high, -np.inf), (h_p, h, None)):
+        padded[:, 1:-1] = values
+        padded[:, 0], padded[:, -1] = (edge, edge) if edge is not None else (h[:, 0] - 1.0, h[:, -1] + 1.0)
+    below, above = h - h_p[:, :-2], h_p[:, 2:] - h       # spacing to the sample below and above
+    up = _line(high, low_p[:, :-2], above, below)
+    down = _line(high, low_p[:, 2:], below, above)
+    pair = valid[:, :-1] & valid[:, 1:]
+    between = np.where(pair, np.minimum(up[:, :-1], down[:, 1:]), -np.inf).max(axis=1, initial=-np.inf)
+    before = np.concatenate([np.zeros((rows, 1), bool), valid[:, :-1]], axis=1)
+    after = np.concatenate([valid[:, 1:], np.zeros((rows, 1), bool)], axis=1)
+    bottom, top = h - reach[0][:, None], reach[1][:, None] - h
+    ends = np.maximum(
+        np.where(valid & ~before & (bottom > 0.0), _line(high, low_p[:, 2:], bottom, above), -np.inf),
+        np.where(valid & ~after & (top > 0.0), _line(high, low_p[:, :-2], top, below), -np.inf)).max(axis=1)
+    bound = np.maximum(np.maximum(high.max(axis=1), between), ends)
+    return np.where(valid.any(axis=1), bound, np.inf)
 
 
 def _line(near, far, beyond, spacing):
