@@ -26,7 +26,7 @@ import math
 from bisect import bisect_left, bisect_right
 
 from .contact_records import COLLISION_TOLERANCE, Contact
-from .envelope import HobBody, centres, nearest_radii, nearest_radius
+from .envelope import HobBody, centres, nearest_radii, nearest_radius, sine_cosine
 from .paths import AXES, pieces_poses
 from .solids import Solid
 
@@ -99,11 +99,28 @@ def _pose_line(near: float, far: float) -> float:
     return _line(near, far, 1.0, 1.0)
 
 
-def x_alone_bounds(xs: list[float], r0: float, largest: float) -> list[float]:
-    """Per interval between consecutive poses, R_max − (least |x| − r0) (mm): every hob point
-    lies at least |x| − r0 from the work axis, |x| linear along the interval unless x
-    changes sign on it (then 0)."""
-    return [largest - ((min(abs(a), abs(b)) if a * b > 0.0 else 0.0) - r0) for a, b in zip(xs, xs[1:])]
+def x_reach(hob: HobBody, swivel: float, solid: Solid) -> tuple:
+    """What x_alone needs of the hob and the solid: r0, the solid's largest radius, the hob's
+    extent along Z, the half-height band (L/2)·|sin A| of its X-most generator, cos A, and the
+    solid's faces (mm)."""
+    s, c = sine_cosine(swivel)
+    return hob.radius, solid.largest_radius, hob.extent(swivel), hob.half_length * abs(s), c, solid.z_low, solid.z_high
+
+
+def x_alone(one: tuple, two: tuple, reach: tuple) -> float:
+    """A bound of the depth (mm) at every pose between the hob centres `one` and `two` (DIN, mm)
+    from X alone. At height dz from the centre the hob's points lie at most w(dz) from it along
+    X: its points there have q = (t·sin A − dz)/cos A for some t within ±L/2, so
+    w = √(r0² − q²) with |q| at least the distance of dz from the band ±(L/2)|sin A|, over
+    cos A. Over the heights both poses meet the solid at, the widest w; every point lies at
+    least |x| − w from the work axis, |x| linear between the poses (0 if x changes sign)."""
+    r0, largest, extent, band, c, z_low, z_high = reach
+    near = min(abs(one[0]), abs(two[0])) if one[0] * two[0] > 0.0 else 0.0
+    low = max(z_low - max(one[2], two[2]), -extent)
+    high = min(z_high - min(one[2], two[2]), extent)
+    gap = max(0.0, low - band, -band - high)
+    width = math.sqrt(max(r0 * r0 - (gap / c) ** 2, 0.0)) if c > 0.0 else r0
+    return largest - (near - width)
 
 
 def deepest_on_piece(solid: Solid, hob: HobBody, swivel: float, start: tuple, end: tuple) -> tuple[float, float]:
@@ -194,28 +211,29 @@ def piece_reaches(solid: Solid, hob: HobBody, swivel: float, poses: list, counte
     """Whether the bounds of the module leave the hob possibly deeper than the tolerance less
     SLACK somewhere on one piece (poses: hob centres, DIN, mm, evenly spaced): exact samples at
     the solid's heights for the poses within two of an interval X alone does not settle."""
-    extent, r0, largest = hob.extent(swivel), hob.radius, solid.largest_radius
-    x_alone = x_alone_bounds([cx for cx, _, _ in poses], r0, largest)
-    if max(x_alone) <= LIMIT:
+    extent, reach = hob.extent(swivel), x_reach(hob, swivel, solid)
+    across = [x_alone(one, two, reach) for one, two in zip(poses, poses[1:])]
+    if max(across) <= LIMIT:
         return False
     side = [overlap_side(cz, extent, solid) for _, _, cz in poses]
-    wanted = {j for i, bound in enumerate(x_alone) if bound > LIMIT for j in range(i - 1, i + 3)}
-    found = [_pose_samples(solid, hob, swivel, pose, extent, counted) if i in wanted and not side[i]
-             else (-math.inf, largest - (abs(pose[0]) - r0) if not side[i] else -math.inf)
+    wanted = {j for i, bound in enumerate(across) if bound > LIMIT for j in range(i - 1, i + 3)}
+    found = [_pose_samples(solid, hob, swivel, pose, extent, reach) if i in wanted and not side[i]
+             else (-math.inf, x_alone(pose, pose, reach) if not side[i] else -math.inf, 0)
              for i, pose in enumerate(poses)]
-    return max(interval_bounds(found, x_alone, side)) > LIMIT
+    counted[0] += sum(count for _, _, count in found)
+    return max(interval_bounds([bounds[:2] for bounds in found], across, side)) > LIMIT
 
 
 def _pose_samples(solid: Solid, hob: HobBody, swivel: float, pose: tuple, extent: float,
-                  counted: list[int]) -> tuple[float, float]:
-    """(L, U) of one pose from its exact distances at the solid's heights within its reach."""
+                  reach: tuple) -> tuple[float, float, int]:
+    """(L, U, sections worked out) of one pose from its exact distances at the solid's heights
+    within its reach (U no more than X alone allows)."""
     cx, cy, cz = pose
-    heights = solid.heights
+    heights, by_x = solid.heights, x_alone(pose, pose, reach)
     first, last = bisect_left(heights, cz - extent), bisect_right(heights, cz + extent)
-    reach = (max(solid.z_low, cz - extent), min(solid.z_high, cz + extent))
     if last <= first:
-        return -math.inf, solid.largest_radius - (abs(cx) - hob.radius)
-    counted[0] += last - first
+        return -math.inf, by_x, 0
     found = nearest_radii(hob, swivel, cx, cy, cz, heights[first:last])
-    deepest, bound = pose_bound(heights, solid.radius, first, found, found, reach)
-    return deepest, min(bound, solid.largest_radius - (abs(cx) - hob.radius))   # or X alone
+    deepest, bound = pose_bound(heights, solid.radius, first, found, found,
+                                (max(solid.z_low, cz - extent), min(solid.z_high, cz + extent)))
+    return deepest, min(bound, by_x), last - first
