@@ -123,11 +123,12 @@ def x_alone(one: tuple, two: tuple, reach: tuple) -> float:
     return largest - (near - width)
 
 
-def deepest_on_piece(solid: Solid, hob: HobBody, swivel: float, start: tuple, end: tuple) -> tuple[float, float]:
+def deepest_on_piece(solid: Solid, hob: HobBody, swivel: float, start: tuple[float, float, float],
+                     end: tuple[float, float, float]) -> tuple[float, float]:
     """The deepest the hob comes into the solid on the straight piece start → end (machine X, Y,
     Z, mm) and at which height: golden sections over the share s of the piece (where the hob's
     heights meet the solid's), each s's deepest height by golden sections (M(s) is concave)."""
-    a, b = centres(start[0], start[1], start[2], swivel), centres(end[0], end[1], end[2], swivel)
+    a, b = centres(*start, swivel), centres(*end, swivel)
     extent = hob.extent(swivel)
     span = _overlap(a[2], b[2], solid.z_low - extent, solid.z_high + extent)
     if span is None:
@@ -198,13 +199,25 @@ def exact_collision(solid: Solid, hob: HobBody, swivel: float, pieces: list, cou
     where deeper than COLLISION_TOLERANCE: each piece a bound settles is passed over, the rest
     searched exactly (deepest_on_piece). counted[0] grows by the sections worked out."""
     best = (-math.inf, solid.z_high)
-    for a, b in pieces:
+    for a, b in open_pieces(solid, hob, swivel, pieces):
         xs, ys, zs = pieces_poses([(a, b)])
         poses = [centres(x, y, z, swivel) for x, y, z in zip(xs, ys, zs)]
         if piece_reaches(solid, hob, swivel, poses, counted):
-            start, end = (tuple(point.get(axis, 0.0) for axis in AXES) for point in (a, b))
-            best = max(best, deepest_on_piece(solid, hob, swivel, start, end))
+            best = max(best, deepest_on_piece(solid, hob, swivel, *ends(a, b)))
     return Contact(solid, best[0], best[1], False) if best[0] > COLLISION_TOLERANCE else None
+
+
+def open_pieces(solid: Solid, hob: HobBody, swivel: float, pieces: list) -> list:
+    """The pieces X alone does not settle from their two ends (x_alone holds between them)."""
+    reach = x_reach(hob, swivel, solid)
+    centred = [tuple(centres(*point, swivel) for point in ends(a, b)) for a, b in pieces]
+    return [piece for piece, (one, two) in zip(pieces, centred) if x_alone(one, two, reach) > LIMIT]
+
+
+def ends(a: dict, b: dict) -> tuple[tuple[float, float, float], tuple[float, float, float]]:
+    """A piece's ends as machine (X, Y, Z) (mm; an axis not given at 0, as paths does)."""
+    one, two = (tuple(point.get(axis, 0.0) for axis in AXES) for point in (a, b))
+    return (one[0], one[1], one[2]), (two[0], two[1], two[2])
 
 
 def piece_reaches(solid: Solid, hob: HobBody, swivel: float, poses: list, counted: list[int]) -> bool:

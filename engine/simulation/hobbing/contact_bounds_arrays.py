@@ -10,7 +10,7 @@ import math
 
 import numpy as np
 
-from .contact_bounds import LIMIT, deepest_on_piece, x_reach
+from .contact_bounds import LIMIT, deepest_on_piece, ends, open_pieces, x_reach
 from .contact_records import COLLISION_TOLERANCE, Contact
 from .envelope import HobBody
 from .envelope_arrays import Sections
@@ -25,13 +25,12 @@ STRIDES = (4, 1)
 
 def exact_collision(solid: Solid, hob: HobBody, swivel: float, pieces: list, heights, radius) -> Contact | None:
     """contact_bounds.exact_collision (heights and radius: the solid's as arrays)."""
-    moves = Poses(pieces, swivel)
-    flagged = moves.unsettled(solid, hob, swivel, heights, radius)
+    pieces = open_pieces(solid, hob, swivel, pieces)
+    if not pieces:
+        return None
     best = (-math.inf, solid.z_high)
-    for index in flagged:
-        a, b = pieces[index]
-        start, end = (tuple(point.get(axis, 0.0) for axis in AXES) for point in (a, b))
-        best = max(best, deepest_on_piece(solid, hob, swivel, start, end))
+    for index in Poses(pieces, swivel).unsettled(solid, hob, swivel, heights, radius):
+        best = max(best, deepest_on_piece(solid, hob, swivel, *ends(*pieces[index])))
     return Contact(solid, best[0], best[1], False) if best[0] > COLLISION_TOLERANCE else None
 
 
