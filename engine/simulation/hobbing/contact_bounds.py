@@ -13,8 +13,8 @@ line through two of its values outside their chord, so between exact samples:
 * In s, the same per pose, with bounds in place of values: the line through the far pose's
   lower bound L (its deepest sample) and the near pose's upper bound U (the height bound) stays
   above M beyond the near pose ((U − M)(1 + t) + (M_far − L)·t ≥ 0 for t ≥ 0 steps past it).
-  A pose out of reach in X alone bounds M by R_max − (|cx| − r0), on an interval too (|x|
-  is linear there unless it changes sign).
+  X alone bounds M too, on a whole interval (x_alone: the hob's width along X at the heights
+  it meets the solid at), and settles most poses and pieces before any section is worked out.
 
 Where a bound reaches COLLISION_TOLERANCE less SLACK, `deepest_on_piece` finds the true deepest
 point of the piece: golden sections over s, each point's deepest height by golden sections
