@@ -2,17 +2,21 @@
 the intended cut. Intended: a G1 with the table coupled and the hob spindle turning, in a
 unit whose teeth the coupling generates, never below its intended root (less TOLERANCE). The
 gaps such cuts leave are free to the hob while the same coupling lasts (a coupled retract out
-of its own gaps), except on a rapid along Z (engine.simulation.hobbing.walk). Anything else that enters
-material is a collision. Plain floats, pose by pose and height by height, for a process's first
-MATH_SECTIONS sections (one gear's proof imports no numpy); engine.simulation.hobbing.contact_arrays
-follows the rest by the same rules (issue 28)."""
+of its own gaps), except on a rapid along Z (engine.simulation.hobbing.walk). Anything else
+that enters material is a collision, held to COLLISION_TOLERANCE between the sampled heights
+and poses too (engine.simulation.hobbing.contact_bounds: convexity on a straight piece), except
+in those own gaps and on a move that swivels the hob, where the samples are all that is
+checked. Plain floats, pose by pose and height by height, for a process's first MATH_SECTIONS
+sections (one gear's proof imports no numpy); engine.simulation.hobbing.contact_arrays follows
+the rest by the same rules (issue 28)."""
 from __future__ import annotations
 
 import math
 from bisect import bisect_left, bisect_right
 from dataclasses import dataclass
 
-from .contact_records import TOLERANCE, Contact, Motion, collision_threshold, contact_at
+from .contact_bounds import exact_collision
+from .contact_records import COLLISION_TOLERANCE, TOLERANCE, Contact, Motion, contact_at, exact
 from .envelope import HobBody, centres, nearest_radii
 from .paths import corners, pieces_poses
 from .solids import Solid
@@ -42,8 +46,11 @@ def follow(solids: list[Solid], hob: HobBody, swivel: float, pieces: list, motio
     if _followed[0] > MATH_SECTIONS:
         from .contact_arrays import meet_all
         return meet_all(near, hob, swivel, pieces, motion)
-    poses = [centres(px, py, pz, swivel) for px, py, pz in zip(*pieces_poses(pieces))]
-    return [found for found in (_meet(solid, hob, swivel, poses, motion) for solid in near) if found is not None]
+    sampled = [solid for solid in near if not exact(solid, motion)]
+    poses = [centres(px, py, pz, swivel) for px, py, pz in zip(*pieces_poses(pieces))] if sampled else []
+    found = (_meet(solid, hob, swivel, poses, motion) if solid in sampled
+             else exact_collision(solid, hob, swivel, pieces, _followed) for solid in near)
+    return [contact for contact in found if contact is not None]
 
 
 @dataclass(frozen=True, slots=True)
@@ -79,7 +86,7 @@ def _meet(solid: Solid, hob: HobBody, swivel: float, poses: list, motion: Motion
              for cx, cy, cz, first, last in spans]
     if motion.cutting_teeth is not None and solid.teeth == motion.cutting_teeth:
         return _cut(solid, motion, radii)
-    return _collision(solid, motion, radii, collision_threshold(hob.radius))
+    return _collision(solid, motion, radii, COLLISION_TOLERANCE)
 
 
 def _spans(solid: Solid, extent: float, radius: float, poses: list):

@@ -10,7 +10,8 @@ import math
 
 import numpy as np
 
-from .contact_records import TOLERANCE, Contact, Motion, collision_threshold, contact_at
+from .contact_bounds_arrays import exact_collision
+from .contact_records import COLLISION_TOLERANCE, TOLERANCE, Contact, Motion, contact_at, exact
 from .envelope import HobBody
 from .envelope_arrays import SLACK, Sections
 from .paths import AXES, pose_count
@@ -22,7 +23,8 @@ def meet_all(solids: list[Solid], hob: HobBody, swivel: float, pieces: list, mot
     x, y, z = _poses(pieces)
     a = math.radians(swivel)
     cx, cy, cz = x, y * math.cos(a), z + y * math.sin(a)
-    found = (_meet(solid, hob, swivel, cx, cy, cz, motion) for solid in solids)
+    found = (_meet(solid, hob, swivel, cx, cy, cz, motion) if not exact(solid, motion)
+             else exact_collision(solid, hob, swivel, pieces, _heights(solid), _blank(solid)) for solid in solids)
     return [contact for contact in found if contact is not None]
 
 
@@ -41,7 +43,7 @@ def _meet(solid: Solid, hob: HobBody, swivel: float, cx, cy, cz, motion: Motion)
         return None
     cx, cy, cz, first, last = near
     cutting = motion.cutting_teeth is not None and solid.teeth == motion.cutting_teeth
-    limit = None if cutting else _open_below(solid, motion, collision_threshold(hob.radius))
+    limit = None if cutting else _open_below(solid, motion, COLLISION_TOLERANCE)
     if limit is not None and (cx - hob.radius >= limit[first.min():last.max()].max() + SLACK).all():
         return None   # every pose keeps out of the material in X alone: _collision finds nothing
     count = len(solid.heights)

@@ -20,8 +20,10 @@ from ...machines.records import Machine
 if TYPE_CHECKING:
     from collections.abc import Callable
 
-HEIGHT_STEP = 0.5       # mm between the heights a solid is followed at (its faces included; the
-                        # clearance is convex in height, so between two it errs by < step²/(8·r0))
+HEIGHT_STEP = 0.5       # mm between the heights a solid is followed at (its faces included). The
+                        # clearance is convex in height but may bend sharply (near the end face's
+                        # rim far more than the tip circle's 1/r0): no step allowance bounds what
+                        # lies between two heights; contact_bounds bounds it by convexity instead
 BEYOND_TRAVEL = 50.0    # mm: a fixture or tailstock is followed this far past the Z travel and the hob
 
 

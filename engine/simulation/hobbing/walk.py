@@ -170,6 +170,8 @@ class BlockSimulation:
     def _move(self, step, motion: int, program: dict, swivel: float | None = None) -> None:
         if self.coupling is not None:
             self._check_coupled_axes(step, program, swivel)
+        swivelling = swivel is not None and (not self.swivel_known or
+                                             moves({"A": self.swivel}, "A", self.senses.swivel(swivel)))
         if swivel is not None:
             self.swivel, self.swivel_known = self.senses.swivel(swivel), True
         target = {axis: self.senses.position(axis, value) for axis, value in program.items()}
@@ -185,7 +187,7 @@ class BlockSimulation:
         else:
             self._end_cut()
         if {"X", "Z"} <= end.keys():
-            self._contacts(step, motion, cutting, start, end)
+            self._contacts(step, motion, cutting, start, end, swivelling)
         self.position = end
 
     def _check_coupled_axes(self, step, program: dict, swivel: float | None) -> None:
@@ -259,7 +261,10 @@ class BlockSimulation:
         teeth = self._coupled.teeth(self.hob.starts)
         return int(round(teeth)) if abs(teeth - round(teeth)) < 1e-9 else None
 
-    def _contacts(self, step, motion: int, cutting: bool, start: dict, end: dict) -> None:
+    def _contacts(self, step, motion: int, cutting: bool, start: dict, end: dict, swivelling: bool) -> None:
+        """The hob's contacts on the move, at the swivel it ends with. A move that swivels the hob
+        is followed at its new A throughout and only at the sampled poses and heights (not a
+        translation: engine.simulation.hobbing.contact_bounds' convexity does not hold on it)."""
         swivel = (self.swivel + 90.0) % 180.0 - 90.0       # a cylinder turned by 180° is the same cylinder
         if abs(swivel) > MAX_SWIVEL:
             self.report.add(step.number, step.line, f"the swivel A {self.swivel:g}° sets the hob axis within "
@@ -270,7 +275,7 @@ class BlockSimulation:
         reason = self._reason(motion)
         running = self.coupling is not None and self.spindle and not _rapid_along_z(motion, start, end)
         for contact in follow(self.solids, self.body, swivel, pieces,
-                              Motion(teeth, running, self.session, self.tailstock, reason)):
+                              Motion(teeth, running, self.session, self.tailstock, reason, swivelling)):
             self.report.add(step.number, step.line, self._contact_message(contact, reason, teeth))
         for unit in self.units:
             if len(unit.cut_sessions) > 1 and ("recut", unit.name) not in self.said:
