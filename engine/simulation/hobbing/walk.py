@@ -270,6 +270,8 @@ class BlockSimulation:
             self.report.add(step.number, step.line, f"the swivel A {self.swivel:g}° sets the hob axis within "
                                                     f"{90 - MAX_SWIVEL:g}° of the work axis: not a hobbing set-up")
             return
+        if round((self.swivel - swivel) / 180.0) % 2:   # the head turned half a turn: the same cylinder,
+            start, end = _along_flipped_axis(start), _along_flipped_axis(end)   # its shift the other way
         pieces = move_pieces(start, end, motion == 0)
         teeth = self._cut_teeth() if cutting else None
         reason = self._reason(motion)
@@ -379,3 +381,9 @@ def _rapid_along_z(motion: int, start: dict, end: dict) -> bool:
     (the rapid between two cuts of a taper, inside the large end of its tip cone, ran through them)."""
     return motion == 0 and start.get("Z", end.get("Z")) != end.get("Z")
 
+
+def _along_flipped_axis(position: dict) -> dict:
+    """The position with the hob's shift along the cylinder's axis as the reduced swivel points it:
+    Y rides on the swivel head (reference §A6: centre (X, Y·cos A, Z + Y·sin A)), so at A and at
+    A − 180° the same shift lies on opposite sides of the pivot."""
+    return {**position, "Y": -position["Y"]} if "Y" in position else position
