@@ -47,6 +47,7 @@ from .rules import (
     zone_problem,
 )
 from .solids import Solid
+from .swivel_sweep import sweep_problem
 from .timing import feed_minutes, header_minutes, header_problem, rapid_minutes
 
 AXES = ("X", "Y", "Z")
@@ -172,6 +173,7 @@ class BlockSimulation:
             self._check_coupled_axes(step, program, swivel)
         swivelling = swivel is not None and (not self.swivel_known or
                                              moves({"A": self.swivel}, "A", self.senses.swivel(swivel)))
+        swivel_from = self.swivel if self.swivel_known else None
         if swivel is not None:
             self.swivel, self.swivel_known = self.senses.swivel(swivel), True
         target = {axis: self.senses.position(axis, value) for axis, value in program.items()}
@@ -187,8 +189,15 @@ class BlockSimulation:
         else:
             self._end_cut()
         if {"X", "Z"} <= end.keys():
+            if swivelling:
+                self._swivel_sweep(step, start, end, swivel_from)
             self._contacts(step, motion, cutting, start, end, swivelling)
         self.position = end
+
+    def _swivel_sweep(self, step, start: dict, end: dict, swivel_from: float | None) -> None:
+        problem = sweep_problem(self.solids, self.body, self.tailstock, start, end, swivel_from, self.swivel)
+        if problem:
+            self.report.add(step.number, step.line, problem)
 
     def _check_coupled_axes(self, step, program: dict, swivel: float | None) -> None:
         """Y (unless a leading axis) and A may not move while the table is coupled (§B15)."""

@@ -1,0 +1,63 @@
+"""A move that turns the swivel A (engine.simulation.hobbing.walk). The hob is not translated on
+it, so the convexity the contacts' bounds rest on (engine.simulation.hobbing.contact_bounds) does
+not hold, and its poses are followed at the final A only. The move is proved clear where no swivel
+between its two ends can bring the hob near a solid, from two bounds that hold for every A:
+
+* every point of the hob lies at X − r0 or farther from the work axis: the tip cylinder's points
+  are centre + t·u + v·e_x + w·n with u and n in the Y-Z plane and v² + w² ≤ r0² (DIN, the
+  swivel turns the hob about X), so their X is the centre's X ± r0 whatever A;
+* and between Zc − e(A) and Zc + e(A) in height, Zc = Z + Y·sin A (the shift Y runs along the hob's
+  axis, reference §A6), e(A) = r0·|cos A| + (L/2)·|sin A|: evaluated every STEP degrees between the
+  two swivels and widened by the most it can change between two of them.
+
+A swivel that leaves both bounds open for some solid is refused (fail closed): an adversary turned
+A from 1.763° to 80° with the hob 4 mm off the gear's tip in X and 36 mm above its face, and the
+hob swept 3.24 mm into the finished gear while both ends were clear. Units mm and degrees."""
+from __future__ import annotations
+
+import math
+
+from .contact_records import COLLISION_TOLERANCE
+from .envelope import HobBody
+from .solids import Solid
+
+STEP = 0.1                 # degrees between the swivels the reach in Z is evaluated at
+UNKNOWN = (-90.0, 90.0)    # the swivels an A not yet written may be at (a cylinder: modulo 180°)
+
+
+def sweep_problem(solids: list[Solid], body: HobBody, tailstock: bool, start: dict, end: dict,
+                  swivel_from: float | None, swivel_to: float) -> str | None:
+    """Why the swivel from `swivel_from` (None: not known yet) to `swivel_to` over the move from
+    `start` to `end` (DIN positions) cannot be proved clear, or None."""
+    ends = [position for position in (start, end) if {"X", "Z"} <= position.keys()]
+    x_tip = min(position["X"] for position in ends) - body.radius
+    heights = [position["Z"] for position in ends]
+    shift = max((abs(position.get("Y", 0.0)) for position in ends), default=0.0)
+    reach = z_reach(body, shift, swivel_from, swivel_to)
+    for solid in solids:
+        if (solid.clamped_only and not tailstock) or x_tip >= solid.largest_radius + COLLISION_TOLERANCE:
+            continue
+        if max(heights) + reach >= solid.z_low and min(heights) - reach <= solid.z_high:
+            return _refusal(solid, x_tip, swivel_from, swivel_to)
+    return None
+
+
+def z_reach(body: HobBody, shift: float, swivel_from: float | None, swivel_to: float) -> float:
+    """The most the hob reaches above or below its position's Z (mm) at any swivel between the two."""
+    low, high = UNKNOWN if swivel_from is None else sorted((swivel_from, swivel_to))
+    steps = max(1, math.ceil((high - low) / STEP))
+    worst = max(_reach_at(body, shift, math.radians(low + (high - low) * k / steps)) for k in range(steps + 1))
+    slope = shift + body.half_length + body.radius     # mm per radian: the most the reach changes
+    return worst + slope * math.radians((high - low) / steps) / 2
+
+
+def _reach_at(body: HobBody, shift: float, angle: float) -> float:
+    sine, cosine = abs(math.sin(angle)), abs(math.cos(angle))
+    return shift * sine + body.radius * cosine + body.half_length * sine
+
+
+def _refusal(solid: Solid, x_tip: float, swivel_from: float | None, swivel_to: float) -> str:
+    came = "an A not written before" if swivel_from is None else f"A{swivel_from:g}°"
+    return (f"the hob swivels from {came} to A{swivel_to:g}° with its tip cylinder {x_tip:.3f} mm from the "
+            f"work axis, within reach of {solid.name} (radius {solid.largest_radius:.3f} mm): a swivel is "
+            "proved only where the hob clears the work in X or in Z throughout; swivel it farther out")
