@@ -13,8 +13,8 @@ from __future__ import annotations
 import math
 
 import pytest
+from helpers.collision_truth import after_coupling, messages, true_depth
 from helpers.simulation_programs import Hand, swivel
-from test_collision_adversary import after_coupling, messages, true_depth
 
 from engine.gears.records import load_gear, load_hobs
 from engine.machines.records import load_machine
