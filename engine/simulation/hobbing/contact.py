@@ -86,7 +86,7 @@ def _meet(solid: Solid, hob: HobBody, swivel: float, poses: list, motion: Motion
              for cx, cy, cz, first, last in spans]
     if motion.cutting_teeth is not None and solid.teeth == motion.cutting_teeth:
         return _cut(solid, motion, radii)
-    return _collision(solid, motion, radii, COLLISION_TOLERANCE)
+    return _collision(solid, motion, radii)
 
 
 def _spans(solid: Solid, extent: float, radius: float, poses: list):
@@ -122,12 +122,12 @@ def _cut(solid: Solid, motion: Motion, radii: list) -> Contact | None:
     return contact_at(solid, deepest, at, True)
 
 
-def _collision(solid: Solid, motion: Motion, radii: list, threshold: float) -> Contact | None:
-    """The deepest point inside the solid deeper than `threshold` (mm), where it is not a gap this
-    coupling cut."""
+def _collision(solid: Solid, motion: Motion, radii: list) -> Contact | None:
+    """The deepest point inside the solid deeper than COLLISION_TOLERANCE (mm), where it is not a
+    gap this coupling cut."""
     own_gaps = motion.coupled_running and solid.session == motion.session
     blank, session_reach = solid.radius, solid.session_reach
-    deepest, at = threshold, -1
+    deepest, at = COLLISION_TOLERANCE, -1
     for index, found in radii:
         for radius in found:
             if blank[index] - radius > deepest and not (own_gaps and radius >= session_reach[index] - TOLERANCE):

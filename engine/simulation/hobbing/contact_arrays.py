@@ -43,7 +43,7 @@ def _meet(solid: Solid, hob: HobBody, swivel: float, cx, cy, cz, motion: Motion)
         return None
     cx, cy, cz, first, last = near
     cutting = motion.cutting_teeth is not None and solid.teeth == motion.cutting_teeth
-    limit = None if cutting else _open_below(solid, motion, COLLISION_TOLERANCE)
+    limit = None if cutting else _open_below(solid, motion)
     if limit is not None and (cx - hob.radius >= limit[first.min():last.max()].max() + SLACK).all():
         return None   # every pose keeps out of the material in X alone: _collision finds nothing
     count = len(solid.heights)
@@ -113,10 +113,10 @@ def _per_height_least(values, raw, count: int):
     return table[:, :count].min(axis=0)
 
 
-def _open_below(solid: Solid, motion: Motion, threshold: float):
+def _open_below(solid: Solid, motion: Motion):
     """Per height, the distance (mm) below which a section would be a collision: inside the
-    material by `threshold`, and in its own gaps (_collision) also nearer than the coupling cut."""
-    limit = _blank(solid) - threshold
+    material by COLLISION_TOLERANCE, and in its own gaps (_collision) also nearer than the coupling cut."""
+    limit = _blank(solid) - COLLISION_TOLERANCE
     if motion.coupled_running and solid.session == motion.session:
         limit = np.minimum(limit, np.asarray(solid.session_reach, float) - TOLERANCE)
     return limit
