@@ -13,22 +13,16 @@ from __future__ import annotations
 import math
 
 import pytest
-from helpers.collision_truth import after_coupling, messages, true_depth
+from helpers.collision_truth import PATHS, after_coupling, messages, seeded_records, true_depth
 from helpers.simulation_programs import Hand, swivel
 
-from engine.gears.records import load_gear, load_hobs
-from engine.machines.records import load_machine
 from engine.simulation import simulate_program
 from engine.simulation.hobbing import contact
-
-ALLOWED = 0.002          # mm: the claim's depth
-PATHS = pytest.mark.parametrize("sections", [10 ** 12, -1], ids=["plain floats", "numpy"])
 
 
 @pytest.fixture
 def records(conn):
-    return {"machine": load_machine(conn, "hobber-840d"), "hobs": {hob.id: hob for hob in load_hobs(conn)},
-            "gear": lambda gear_id: load_gear(conn, gear_id)}
+    return seeded_records(conn)
 
 
 @PATHS

@@ -9,8 +9,21 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import pytest
 
+from engine.gears.records import load_gear, load_hobs
+from engine.machines.records import load_machine
 from helpers.simulation_programs import LOAD, RAPID_RATE, Hand, program_minutes
+
+ALLOWED = 0.002          # mm: the claim's depth (contact_records.COLLISION_TOLERANCE)
+# both paths of the contacts: one gear's plain floats and a batch's numpy (contact.MATH_SECTIONS)
+PATHS = pytest.mark.parametrize("sections", [10 ** 12, -1], ids=["plain floats", "numpy"])
+
+
+def seeded_records(conn) -> dict:
+    """The seeded hobber-840d, the hobs by id and a reader of gears, from the test's connection."""
+    return {"machine": load_machine(conn, "hobber-840d"), "hobs": {hob.id: hob for hob in load_hobs(conn)},
+            "gear": lambda gear_id: load_gear(conn, gear_id)}
 
 
 def _frame(swivel_deg: float):
