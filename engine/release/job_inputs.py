@@ -56,8 +56,8 @@ class JobInputs:
         kind = self.machine(machine_name).kind
         if kind == "hobber" and gear_id is not None and hob_id is not None:
             self.workpiece(job_id, gear_id, hob_id)
-        elif kind == "lathe" and self.drawn(gear_class, json.loads(params_text)):
-            self.drawing(job_id, json.loads(params_text), json.loads(modules_text or "{}"))
+        elif kind == "lathe" and self.drawn(gear_class, params := json.loads(params_text)):
+            self.drawing(job_id, params, json.loads(modules_text or "{}"))
 
     def without_database(self) -> None:
         """In a worker: the connection it inherits shares the parent's socket, so it is taken away."""
