@@ -174,6 +174,8 @@ class DatabasePool:
     def _drop_behind(self) -> None:
         while batch := self._next_drops():
             self._drop_all(batch)
+            with self.changed:
+                self.dropping = []   # dropped: not handed to the dropper at close again
 
     def _next_drops(self) -> list[str]:
         """Every used database not yet dropped; [] when closing."""
