@@ -272,8 +272,9 @@ class BlockSimulation:
 
     def _contacts(self, step, motion: int, cutting: bool, start: dict, end: dict, swivelling: bool) -> None:
         """The hob's contacts on the move, at the swivel it ends with. A move that swivels the hob
-        is followed at its new A throughout and only at the sampled poses and heights (not a
-        translation: engine.simulation.hobbing.contact_bounds' convexity does not hold on it)."""
+        is followed at its new A at the sampled poses and heights only (not a translation:
+        contact_bounds' convexity does not hold on it); the swivel between its ends is proved by
+        _swivel_sweep (engine.simulation.hobbing.swivel_sweep), or refused."""
         swivel = (self.swivel + 90.0) % 180.0 - 90.0       # a cylinder turned by 180° is the same cylinder
         if abs(swivel) > MAX_SWIVEL:
             self.report.add(step.number, step.line, f"the swivel A {self.swivel:g}° sets the hob axis within "
