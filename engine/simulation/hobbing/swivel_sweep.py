@@ -7,8 +7,11 @@ between its two ends can bring the hob near a solid, from two bounds that hold f
   are centre + t·u + v·e_x + w·n with u and n in the Y-Z plane and v² + w² ≤ r0² (DIN, the
   swivel turns the hob about X), so their X is the centre's X ± r0 whatever A;
 * and between Zc − e(A) and Zc + e(A) in height, Zc = Z + Y·sin A (the shift Y runs along the hob's
-  axis, reference §A6), e(A) = r0·|cos A| + (L/2)·|sin A|: evaluated every STEP degrees between the
-  two swivels and widened by the most it can change between two of them.
+  axis, reference §A6), e(A) = r0·|cos A| + (L/2)·|sin A|. With a = |Y| + L/2 and b = r0, the
+  reach a·|sin A| + b·|cos A| has period 180°; on 0…90° it is √(a² + b²)·sin(A + atan(b/a)),
+  rising to its peak √(a² + b²) at A* = atan(a/b) and falling after; on 90…180° it is its mirror.
+  So its largest value between two swivels is exact: the peak where ±A* + k·180° lies between
+  them, else the larger of its values at the two ends.
 
 A swivel that leaves both bounds open for some solid is refused (fail closed): an adversary turned
 A from 1.763° to 80° with the hob 4 mm off the gear's tip in X and 36 mm above its face, and the
@@ -21,7 +24,6 @@ from .contact_records import COLLISION_TOLERANCE
 from .envelope import HobBody
 from .solids import Solid
 
-STEP = 0.1                 # degrees between the swivels the reach in Z is evaluated at
 UNKNOWN = (-90.0, 90.0)    # the swivels an A not yet written may be at (a cylinder: modulo 180°)
 
 
@@ -45,10 +47,15 @@ def sweep_problem(solids: list[Solid], body: HobBody, tailstock: bool, start: di
 def z_reach(body: HobBody, shift: float, swivel_from: float | None, swivel_to: float) -> float:
     """The most the hob reaches above or below its position's Z (mm) at any swivel between the two."""
     low, high = UNKNOWN if swivel_from is None else sorted((swivel_from, swivel_to))
-    steps = max(1, math.ceil((high - low) / STEP))
-    worst = max(_reach_at(body, shift, math.radians(low + (high - low) * k / steps)) for k in range(steps + 1))
-    slope = shift + body.half_length + body.radius     # mm per radian: the most the reach changes
-    return worst + slope * math.radians((high - low) / steps) / 2
+    along, across = shift + body.half_length, body.radius
+    if _peak_between(math.degrees(math.atan2(along, across)), low, high):
+        return math.hypot(along, across)
+    return max(_reach_at(body, shift, math.radians(low)), _reach_at(body, shift, math.radians(high)))
+
+
+def _peak_between(peak: float, low: float, high: float) -> bool:
+    """Whether ±peak + k·180° (degrees) lies between low and high for some whole k."""
+    return any(math.floor((high - centre) / 180.0) >= math.ceil((low - centre) / 180.0) for centre in (peak, -peak))
 
 
 def _reach_at(body: HobBody, shift: float, angle: float) -> float:
