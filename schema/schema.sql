@@ -1172,7 +1172,11 @@ CREATE TABLE hob (
     -- A worm-wheel hob is made for its worm; it never cuts cylindrical gears, nor the reverse.
     purpose        text NOT NULL DEFAULT 'cylindrical' CHECK (purpose IN ('cylindrical', 'worm_wheel')),
     tool_number    integer NOT NULL DEFAULT 1 CHECK (tool_number BETWEEN 1 AND 32000),  -- T<n> D1
-    CONSTRAINT hob_safe_id CHECK (safe_name('hob', id))
+    -- The module the record gives: normal, or (worm-wheel hobs, as catalogued: DIN 3975) the
+    -- worm's axial module m_x; the engine converts it on load to m_n = m_x·cos γ0.
+    module_kind    text NOT NULL DEFAULT 'normal' CHECK (module_kind IN ('normal', 'axial')),
+    CONSTRAINT hob_safe_id CHECK (safe_name('hob', id)),
+    CONSTRAINT hob_axial_module_of_worm_wheel_hobs CHECK (module_kind = 'normal' OR purpose = 'worm_wheel')
 );
 -- One hob per id whatever its case: H-M2-AA-R1 and h-m2-aa-r1 are one hob.
 CREATE UNIQUE INDEX hob_id_ignoring_case ON hob (upper(id));

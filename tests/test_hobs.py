@@ -174,10 +174,10 @@ def test_list_shows_every_seeded_hob(run):
     result = run("hobs", "list")
     assert result.exit_code == 0, result.output
     lines = result.stdout.splitlines()
-    assert lines[0].split()[:3] == ["id", "module", "α"]
+    assert lines[0].split()[:4] == ["id", "module", "kind", "α"]
     assert sorted(line.split()[0] for line in lines[1:]) == sorted(seeded_hob_ids())
     worm = next(line.split() for line in lines if line.startswith("H-WW-M3-R1 "))
-    assert worm[1:] == ["3", "20", "1", "50", "90", "R", "A", "HSS", "TiN", "worm_wheel", "1"]
+    assert worm[1:] == ["3", "normal", "20", "1", "50", "90", "R", "A", "HSS", "TiN", "worm_wheel", "1"]
 
 
 def test_add_then_list_shows_the_new_hob(run):
@@ -188,7 +188,7 @@ def test_add_then_list_shows_the_new_hob(run):
     added = next(h for h in listed if h["hob_id"] == "H-M5-B-L1")
     assert added == {"hob_id": "H-M5-B-L1", "module": 5, "pressure_angle": 20, "starts": 1, "tip_diameter": 110,
                      "length": 160, "hand": "L", "accuracy_class": "B", "material": "HSS",
-                     "coating": "TiAlN", "purpose": "cylindrical", "tool_number": 1}
+                     "coating": "TiAlN", "purpose": "cylindrical", "tool_number": 1, "module_kind": "normal"}
     assert len(listed) == len(seeded_hob_ids()) + 1
 
 
@@ -214,10 +214,11 @@ def test_a_bad_or_duplicate_hob_is_refused_and_nothing_changes(run, options, wor
     assert hob_rows(run.url) == before
 
 
-GOOD_CSV = """id,module,pressure_angle,starts,tip_diameter,length,hand,accuracy_class,material,coating,purpose
-H-M2-AA-R1,2,20,1,70,150,R,AA,HSS,TiAlN,cylindrical
-H-M6-B-R1,6,20,1,125,200,R,B,,,
-H-WW-M4-L1,4,20,2,60,110,L,A,PM-HSS,TiN,worm_wheel
+GOOD_CSV = """id,module,pressure_angle,starts,tip_diameter,length,hand,accuracy_class,material,coating,purpose,\
+module_kind
+H-M2-AA-R1,2,20,1,70,150,R,AA,HSS,TiAlN,cylindrical,
+H-M6-B-R1,6,20,1,125,200,R,B,,,,
+H-WW-M4-L1,4,20,2,60,110,L,A,PM-HSS,TiN,worm_wheel,axial
 """
 
 
@@ -233,8 +234,26 @@ def test_import_adds_new_hobs_and_updates_existing_ones(run, tmp_path):
     assert (listed["H-M6-B-R1"]["material"], listed["H-M6-B-R1"]["coating"],
             listed["H-M6-B-R1"]["purpose"]) == ("HSS", "", "cylindrical")
     assert (listed["H-WW-M4-L1"]["starts"], listed["H-WW-M4-L1"]["purpose"]) == (2, "worm_wheel")
+    assert (listed["H-WW-M4-L1"]["module"], listed["H-WW-M4-L1"]["module_kind"]) == (4, "axial")   # as catalogued
     again = run("hobs", "import", path)
     assert again.exit_code == 0 and "added 0 hob(s), updated 3" in again.stdout
+
+
+@pytest.mark.parametrize("row, words", [
+    ("H-WW-X,3,20,1,50,90,R,A,worm_wheel,", "column module_kind: is missing: a worm-wheel hob's record must say"),
+    ("H-CYL-X,3,20,1,80,120,R,A,cylindrical,axial", "column module_kind: axial is for worm-wheel hobs"),
+    ("H-WW-Y,3,20,1,50,90,R,A,worm_wheel,transverse", "column module_kind: 'transverse' must be normal or axial"),
+])
+def test_a_hob_whose_module_is_not_said_plainly_is_refused(run, tmp_path, row, words):
+    """A catalogue worm-wheel hob gives its worm's axial module (DIN 3975): read as normal, its
+    tangential feed would be coupled to the wrong pitch, so its record must say which it gives."""
+    before = hob_rows(run.url)
+    path = tmp_path / "hobs.csv"
+    path.write_text("id,module,pressure_angle,starts,tip_diameter,length,hand,accuracy_class,purpose,module_kind\n"
+                    f"{row}\n", encoding="utf-8")
+    result = run("hobs", "import", path)
+    assert result.exit_code == 1 and words in result.stderr, result.output
+    assert hob_rows(run.url) == before
 
 
 def test_import_without_the_optional_columns(run, tmp_path):

@@ -10,13 +10,14 @@ from .ids import GEAR_ID
 from .output import Column, emit_list, emit_record, list_options
 
 HOB_COLUMNS = (
-    Column("id", "hob_id"), Column("module", "module"), Column("α", "pressure_angle"), Column("starts", "starts"),
-    Column("da0", "tip_diameter"), Column("length", "length"), Column("hand", "hand"),
+    Column("id", "hob_id"), Column("module", "module"), Column("kind", "module_kind"), Column("α", "pressure_angle"),
+    Column("starts", "starts"), Column("da0", "tip_diameter"), Column("length", "length"), Column("hand", "hand"),
     Column("class", "accuracy_class"), Column("material", "material"), Column("coating", "coating"),
     Column("purpose", "purpose"), Column("T", "tool_number"),
 )
 HOB_FIELDS = (
-    Column("hob", "hob_id"), Column("module", "module"), Column("pressure angle", "pressure_angle"),
+    Column("hob", "hob_id"), Column("module", "module"), Column("module kind", "module_kind"),
+    Column("pressure angle", "pressure_angle"),
     Column("starts", "starts"), Column("tip diameter", "tip_diameter"), Column("length", "length"),
     Column("hand", "hand"), Column("accuracy class", "accuracy_class"), Column("material", "material"),
     Column("coating", "coating"), Column("purpose", "purpose"), Column("tool number", "tool_number"),
@@ -79,7 +80,8 @@ def hobs_delete(ctx, hob_id, yes):
 
 @hobs.command("add")
 @click.option("--id", "hob_id", required=True, help="Hob id (unique), e.g. H-M2-AA-R1.")
-@click.option("--module", type=float, required=True, help="Normal module m_n, mm.")
+@click.option("--module", type=float, required=True,
+              help="Module, mm: the normal module m_n, or with --module-kind axial the worm's axial module m_x.")
 @click.option("--pressure-angle", type=float, default=20.0, show_default=True, help="Pressure angle α_n, degrees.")
 @click.option("--starts", type=int, default=1, show_default=True, help="Number of starts z0.")
 @click.option("--tip-diameter", type=float, required=True, help="Tip (outside) diameter da0, mm.")
@@ -91,15 +93,18 @@ def hobs_delete(ctx, hob_id, yes):
 @click.option("--purpose", default="cylindrical", show_default=True, help="cylindrical or worm_wheel.")
 @click.option("--tool-number", type=int, default=1, show_default=True,
               help="The hob's place in the machine's tool list: the program calls T<n> D1.")
+@click.option("--module-kind", type=click.Choice(["normal", "axial"]), default=None,
+              help="Which module --module is: normal (default for cylindrical hobs) or axial (a worm-wheel hob "
+                   "catalogued by its worm's axial module, DIN 3975). A worm-wheel hob must say.")
 @click.pass_context
 def hobs_add(ctx, hob_id, module, pressure_angle, starts, tip_diameter, length, hand, accuracy_class,
-             material, coating, purpose, tool_number):
+             material, coating, purpose, tool_number, module_kind):
     """Add one hob to the library; a bad value or an existing id stores nothing."""
     from ..gears.hob_library import add_hob
     from ..gears.records import Hob
 
     hob = Hob(hob_id, module, pressure_angle, starts, tip_diameter, length, hand, accuracy_class,
-              material, coating, purpose, tool_number)
+              material, coating, purpose, tool_number, module_kind or "")
     with connection(ctx) as conn:
         add_hob(conn, hob)
     click.echo(f"added hob {hob_id}")

@@ -30,7 +30,7 @@ from ..csv_reader import (
 from ..db.connection import scalar
 from ..errors import EngineError
 from ..names import NAME_RULES, is_safe, said
-from .gear_import import POSITIVE, parse_hand
+from .gear_import import POSITIVE, parse_hand, parse_module_kind
 from .hob_matching import ACCURACY_CLASSES, PURPOSES, HobChoice, choose_hob
 from .models import ancestry
 from .records import TOOTH_DEPTH, Hob, load_gear, load_hobs
@@ -84,6 +84,7 @@ HOB_COLUMNS: tuple[Column, ...] = (
     Column("coating", parse_text),
     Column("purpose", parse_purpose),
     Column("tool_number", parse_positive_whole, check=lambda v: v <= 32000, rule="is above 32000"),
+    Column("module_kind", parse_module_kind),
 )
 COLUMN_NAMES = tuple(column.name for column in HOB_COLUMNS)
 HOB_KIND = CsvKind("hob", HOB_COLUMNS)
@@ -112,6 +113,22 @@ def _check_tip_diameter(hob: dict[str, Any], line: int | None) -> Problem | None
     return None
 
 
+def _check_module_kind(hob: dict[str, Any], line: int | None) -> Problem | None:
+    """A worm-wheel hob says which module its record gives: catalogues give the worm's axial
+    module m_x (DIN 3975), and read as a normal module it couples the tangential feed to the wrong
+    pitch (2 % at a lead angle of 11.6°). A cylindrical hob's module is normal (left empty: normal)."""
+    kind, purpose = hob["module_kind"], hob["purpose"]
+    if kind is None and purpose == "worm_wheel":
+        return Problem(line, "module_kind", "is missing: a worm-wheel hob's record must say which module it gives",
+                       "write axial (the worm's axial module m_x, as worm-wheel hobs are catalogued) or normal")
+    if kind == "axial" and purpose != "worm_wheel":
+        return Problem(line, "module_kind", "axial is for worm-wheel hobs (the module of the worm they copy)",
+                       "write normal, or purpose worm_wheel")
+    if kind is None:
+        hob["module_kind"] = "normal"
+    return None
+
+
 def parse_hob(cells: dict[str, str], line: int | None = None,
               separator: str = ",") -> tuple[dict[str, Any], list[Problem]]:
     """The hob of named cells (every column; missing cells are empty) and its problems."""
@@ -121,8 +138,8 @@ def parse_hob(cells: dict[str, str], line: int | None = None,
         hob[column.name], problem = _parse_cell(column, cells.get(column.name, "").strip(), line, separator)
         if problem:
             problems.append(problem)
-    tip_problem = _check_tip_diameter(hob, line)
-    return hob, problems + ([tip_problem] if tip_problem else [])
+    crossed = [problem for problem in (_check_tip_diameter(hob, line), _check_module_kind(hob, line)) if problem]
+    return hob, problems + crossed
 
 
 # --- the library -------------------------------------------------------------------------

@@ -7,6 +7,7 @@ coarsest sufficient class (fine hobs are kept for fine gears), then the id.
 """
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -75,6 +76,26 @@ def _lead(hob: Hob) -> float:
     return lead_angle(hob.module, hob.starts, hob.tip_diameter)
 
 
+def _module_distance(gear: Gear, hob: Hob) -> float:
+    """How far the hob's module is from the gear's, in the frame the hob's record gives it (mm). A
+    worm-wheel hob catalogued by its worm's axial module (DIN 3975) matches the wheel's axial module
+    m_n/cos γ (γ the wheel's helix, its worm's lead): the hob's axial pitch is the wheel's transverse
+    pitch, though an oversize hob's lead differs a little (LEAD_ANGLE_TOLERANCE)."""
+    if hob.module_kind == "axial":
+        return abs(hob.stated_module - gear.module / math.cos(math.radians(gear.helix_angle)))
+    return abs(hob.module - gear.module)
+
+
+def _module_said(hob: Hob) -> str:
+    return f"axial module {hob.stated_module:g}" if hob.module_kind == "axial" else f"module {hob.module:g}"
+
+
+def _module_wanted(gear: Gear) -> str:
+    if gear.module_kind == "axial":
+        return f"module {gear.module:g} (axial {gear.stated_module:g})"
+    return f"module {gear.module:g}"
+
+
 @dataclass(frozen=True)
 class HobTest:
     """One property of a hob, for the gears of `purposes`. A required test narrows the
@@ -117,11 +138,11 @@ HOB_TESTS: tuple[HobTest, ...] = (
             offered=lambda hob: f"purpose {hob.purpose}",
             distance=lambda gear, hob, need: 0.0),
     HobTest("module", BOTH,
-            said=lambda gear, hob, need: f"module {hob.module:g}",
-            fits=lambda gear, hob, need: abs(hob.module - gear.module) < MODULE_TOLERANCE,
-            wanted=lambda gear, need: f"module {gear.module:g}",
-            offered=lambda hob: f"module {hob.module:g}",
-            distance=lambda gear, hob, need: abs(hob.module - gear.module)),
+            said=lambda gear, hob, need: _module_said(hob),
+            fits=lambda gear, hob, need: _module_distance(gear, hob) < MODULE_TOLERANCE,
+            wanted=lambda gear, need: _module_wanted(gear),
+            offered=_module_said,
+            distance=lambda gear, hob, need: _module_distance(gear, hob)),
     HobTest("pressure angle", BOTH,
             said=lambda gear, hob, need: f"pressure angle {hob.pressure_angle:g}°",
             fits=lambda gear, hob, need: abs(hob.pressure_angle - gear.pressure_angle) < ANGLE_TOLERANCE,

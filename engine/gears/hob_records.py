@@ -14,7 +14,7 @@ if TYPE_CHECKING:
 
 ONE_HOB = """
 SELECT id AS hob_id, module, pressure_angle, starts, tip_diameter, length, hand, accuracy_class, material,
-       coating, purpose, tool_number
+       coating, purpose, tool_number, module_kind
 FROM hob WHERE upper(id) = upper(%s)"""
 HOB_JOBS = """
 SELECT j.id AS job_id, j.gear_id, j.gear_class AS class, j.machine, j.created_at
@@ -33,10 +33,12 @@ HOB_DELETION = Deletion(
 
 def hob_records(conn: Connection) -> list[dict]:
     """Every hob of the library by id, its id under the common key hob_id."""
-    return [_record(asdict(hob)) for hob in load_hobs(conn)]
+    return [_record(hob) for hob in load_hobs(conn)]
 
 
-def _record(fields: dict) -> dict:
+def _record(hob) -> dict:
+    """The hob as its record gives it (the module in its own kind: what `hobs import` reads back)."""
+    fields = {**asdict(hob), "module": hob.stated_module}
     return {"hob_id": fields.pop("id"), **fields}
 
 

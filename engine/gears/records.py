@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING, Any
 
 from ..db.records import as_float, columns
 from ..errors import EngineError
+from .hob_geometry import hob_axial_module, normal_from_axial
 
 if TYPE_CHECKING:
     from collections.abc import Sequence
@@ -76,6 +77,16 @@ class Hob:
     coating: str
     purpose: str
     tool_number: int = 1
+    # The module the record gives: 'normal', or 'axial' (a worm-wheel hob catalogued by its worm's
+    # axial module, DIN 3975: converted on load, so `module` is always the normal module m_n).
+    module_kind: str = "normal"
+
+    @property
+    def stated_module(self) -> float:
+        """The module as the record gives it (the axial module m_x of an axial-stated hob)."""
+        if self.module_kind == "axial":   # to 1e-9 mm: the record's value back, not its last bit
+            return round(hob_axial_module(self.module, self.starts, self.tip_diameter), 9)
+        return self.module
 
 
 def normal_module(module: Any, module_kind: str | None, helix_angle: Any) -> Any:
@@ -183,4 +194,11 @@ def _with_units(gear: Gear, units: dict) -> Gear:
 
 
 def load_hobs(conn: Connection) -> list[Hob]:
-    return [_as_float(Hob, row) for row in conn.execute(HOB_QUERY + " ORDER BY id")]
+    return [_normal(_as_float(Hob, row)) for row in conn.execute(HOB_QUERY + " ORDER BY id")]
+
+
+def _normal(hob: Hob) -> Hob:
+    """The hob with its normal module: an axial module converted once, here (hob_geometry)."""
+    if hob.module_kind != "axial":
+        return hob
+    return replace(hob, module=normal_from_axial(hob.module, hob.starts, hob.tip_diameter))

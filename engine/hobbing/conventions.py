@@ -57,7 +57,8 @@ def differential(module: float, teeth: int, helix_angle: float, gear_hand: str |
 
 
 def tangential_factor(module: float, teeth: int, lead: float) -> float:
-    """k_Y = +360·cos γ/(π·m_n·z2) degrees of C per mm of Y for either hob hand (§A7): the hob
+    """k_Y = +360·cos γ0/(π·m_n0·z2) degrees of C per mm of Y, the hob's normal module m_n0 and lead γ0
+    (its axial module m_x0 = m_n0/cos γ0: §B10), for either hob hand (§A7): the hob
     turned +360° equals a move of −lead (right hand) or +lead (left hand), and k_B already
     carries that hand, so the Y term does not."""
     return 360 * math.cos(math.radians(lead)) / (math.pi * module * teeth)

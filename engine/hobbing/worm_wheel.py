@@ -5,7 +5,9 @@ helix, and the small difference otherwise (an oversize or resharpened hob, withi
 match's tolerance), so the hob's thread lies along the teeth. Radial: X plunges to the full-depth
 centre distance and dwells while the table turns.
 Tangential: the centre distance is set in air, the hob feeds along its own axis (Y) through
-the wheel, and the table gets the extra rotation 360·cos γ/(π·m_n·z2) degrees per mm of Y."""
+the wheel, and the table gets the extra rotation 360·cos γ0/(π·m_n0·z2) = 360/(π·m_x0·z2) degrees
+per mm of Y: the hob's own axial pitch π·m_x0 is one wheel tooth (§B10). A hob catalogued by its
+worm's axial module has it as its record's module (engine.gears.records.Hob.module_kind)."""
 from __future__ import annotations
 
 import math
@@ -50,7 +52,7 @@ class WormWheelModel(CylindricalModel):
                   "shift_on": False, "shift_y": 0.0, "shift_per_part": 0.0, "shift_min": 0.0, "shift_max": 0.0,
                   "z_mid": round(-gear.face_width / 2, 3), "tangential": tangential,
                   "y_start": y_clear, "y_end": -y_clear,
-                  "tangential_factor": round(conventions.tangential_factor(gear.module, gear.teeth, setup.lead), 6)}
+                  "tangential_factor": round(conventions.tangential_factor(hob.module, gear.teeth, setup.lead), 6)}
         xs = [setup.x_retract] + [cut["cut_x"] for cut in module_params.values() if cut["cut_on"]]
         params.update(working_area(xs, [0.0, y_clear, -y_clear], [params["z_mid"]]))
         return self.for_machine(params, module_params, machine, hob)

@@ -80,7 +80,10 @@ def expected_k_z(gear: Gear, teeth: int) -> float:
 
 
 def expected_k_y(gear: Gear, hob: Hob, teeth: int) -> float:
-    return 360 * math.cos(math.radians(lead_angle(hob))) / (math.pi * gear.module * teeth)
+    """k_Y = 360/(π·m_x0·z2) degrees of C per mm of Y (§B10): moved along its own axis by one axial
+    pitch π·m_x0 = π·m_n0/cos γ0, the hob's thread stands as it stood one wheel tooth on. The hob's
+    pitch, not the wheel's: the two are one pitch when the hob fits (engine.gears.hob_matching)."""
+    return 360 * math.cos(math.radians(lead_angle(hob))) / (math.pi * hob.module * teeth)
 
 
 def factor_agrees(found: float, wanted: float, resolution: float) -> bool:
@@ -136,7 +139,7 @@ def _factor_problem(axis: str, found: float, wanted: float, gear: Gear, teeth: i
         return (f"the Z term {found:+.6f}°/mm (DIN) generates {made}; the gear needs {wanted:+.6f}°/mm "
                 f"(−h_gear·360·sinβ/(π·m_n·z2), {hand_name(gear.hand) if gear.helix_angle else 'spur'})")
     return (f"the Y term {found:+.6f}°/mm (DIN) is not the {wanted:+.6f}°/mm the hob's feed along Y needs "
-            "(+360·cosγ/(π·m_n·z2), 0 where Y does not feed while coupled)")
+            "(+360·cos γ0/(π·m_n0·z2) = 360/(π·m_x0·z2), the hob's axial pitch; 0 where Y does not feed while coupled)")
 
 
 def swivel_problem(swivel_din: float, gear: Gear, hob: Hob) -> str | None:

@@ -1,0 +1,112 @@
+"""Worm wheels cut with catalogue worm-wheel hobs (issue 29). Worm-gear drawings and hob catalogues
+give the worm's axial module m_x (DIN 3975); the hob record says so (module_kind axial) and the
+engine matches it to the wheel's axial module. Every program here is made by `instantiate_gear`,
+which stores only what the verifier and the hobbing simulation prove.
+
+Expected numbers come from the reference (docs/reference/hobbing.md §B1, §B10), computed here:
+* the hob's lead angle γ0 from tan γ0 = z0·m_x/d_m0, d_m0 = d_a0 − 2.5·m_x·cos γ0, solved by
+  bisection (the engine iterates; the two must agree);
+* the tangential coupling k_Y = 360/(π·m_x·z2) degrees of C per mm of Y, for either hand (§A7);
+* the radial plunge to the full-depth centre distance (d_f2 + d_a0)/2, the swivel h·(γ0 − γ).
+
+The wheels: m_x 3, z2 40, worm diameter quotient q = 10 (d1 = 30 mm), so the wheel's helix is the
+worm's lead, tan γ = z1/q: 5.711° for one start, 11.310° for two; tip 126 and root 112.5 mm
+(d2 = m_x·z2 = 120, addendum m_x, dedendum 1.25·m_x). The hobs copy the worm: d_a0 = 37.5 mm."""
+from __future__ import annotations
+
+import math
+
+import pytest
+from helpers.nc_reader import read_program
+
+from engine.errors import EngineError
+from engine.gears.hob_geometry import hob_axial_module, lead_angle, normal_from_axial
+from engine.gears.hob_library import import_hobs
+from engine.hobbing.choices import Choices
+from engine.programs.instantiate import instantiate_gear
+
+M_X, Z2, Q, HOB_TIP = 3.0, 40, 10.0, 37.5
+TIP, ROOT = M_X * Z2 + 2 * M_X, M_X * Z2 - 2.5 * M_X
+HOBS = """id,module,pressure_angle,starts,tip_diameter,length,hand,accuracy_class,purpose,module_kind
+CAT-WW-MX3-R1,3,20,1,37.5,90,R,A,worm_wheel,axial
+CAT-WW-MX3-L1,3,20,1,37.5,90,L,A,worm_wheel,axial
+CAT-WW-MX3-R2,3,20,2,37.5,90,R,A,worm_wheel,axial
+CAT-WW-MX3-L2,3,20,2,37.5,90,L,A,worm_wheel,axial
+"""
+WHEELS = {(hand, starts): 900 + 10 * starts + (hand == "L") for hand in "RL" for starts in (1, 2)}
+
+
+def worm_lead(starts: int) -> float:
+    return math.degrees(math.atan(starts / Q))
+
+
+def hob_lead(starts: int) -> float:
+    """γ0 of the catalogue hob (§B1, §B10): the root of tan γ = z0·m_x/(d_a0 − 2.5·m_x·cos γ), by bisection."""
+    low, high = 0.0, math.pi / 4
+    for _ in range(100):
+        middle = (low + high) / 2
+        if math.tan(middle) * (HOB_TIP - 2.5 * M_X * math.cos(middle)) < starts * M_X:
+            low = middle
+        else:
+            high = middle
+    return math.degrees((low + high) / 2)
+
+
+@pytest.fixture
+def wheels(conn, tmp_path):
+    path = tmp_path / "catalogue.csv"
+    path.write_text(HOBS, encoding="utf-8")
+    import_hobs(conn, path)
+    for (hand, starts), gear_id in WHEELS.items():
+        conn.execute("INSERT INTO gear (id, gear_class, module, module_kind, teeth, helix_angle, hand, face_width, "
+                     "tip_diameter, root_diameter, material, hardness, quality_grade, quantity) "
+                     "VALUES (%s, 'worm_wheel', %s, 'axial', %s, %s, %s, 25, %s, %s, 'CuSn12', 90, 8, 20)",
+                     (gear_id, M_X, Z2, round(worm_lead(starts), 6), hand, TIP, ROOT))
+    return conn
+
+
+def made(conn, gear_id: int, feed: str):
+    program = instantiate_gear(conn, gear_id, choices=Choices(worm_feed=feed))
+    hob = next(line.split()[2] for line in program.lines if line.startswith("; HOB "))
+    return hob, read_program(program.text)
+
+
+def test_the_conversion_gives_the_catalogue_module_and_lead_back():
+    for starts in (1, 2, 3):
+        normal = normal_from_axial(M_X, starts, HOB_TIP)
+        assert normal == pytest.approx(M_X * math.cos(math.radians(hob_lead(starts))), abs=1e-12)
+        assert lead_angle(normal, starts, HOB_TIP) == pytest.approx(hob_lead(starts), abs=1e-9)
+        assert hob_axial_module(normal, starts, HOB_TIP) == pytest.approx(M_X, abs=1e-12)
+
+
+@pytest.mark.parametrize("hand", ["R", "L"])
+@pytest.mark.parametrize("starts", [1, 2])
+def test_a_catalogue_hob_feeds_tangentially_with_the_worms_pitch(wheels, hand, starts):
+    hob, nc = made(wheels, WHEELS[hand, starts], "tangential")
+    assert hob == f"CAT-WW-MX3-{hand}{starts}"
+    egon = nc.block_with("EGON").call("EGON").args
+    k_y = 360 / (math.pi * M_X * Z2)        # §B10, degrees of C per mm of Y, either hand (§A7)
+    assert egon[5] == "Y" and float(egon[6]) == pytest.approx(k_y, abs=1e-6), egon
+    assert egon[3] == str(-starts if hand == "R" else starts) and egon[4] == str(Z2)   # B:C = z0:z2, hob's hand
+
+
+@pytest.mark.parametrize("hand", ["R", "L"])
+@pytest.mark.parametrize("starts", [1, 2])
+def test_a_catalogue_hob_plunges_radially_to_the_full_depth(wheels, hand, starts):
+    hob, nc = made(wheels, WHEELS[hand, starts], "radial")
+    assert hob == f"CAT-WW-MX3-{hand}{starts}"
+    plunge = [move for move in nc.moves_in("G1") if move.changed == {"X"}]
+    assert plunge[-1].end["X"] == pytest.approx((ROOT + HOB_TIP) / 2, abs=0.001)
+    sign = 1 if hand == "R" else -1          # §A7: A = h_hob·γ0 − h_gear·γ, the same hand
+    assert nc.block_with("A").words["A"] == pytest.approx(sign * (hob_lead(starts) - worm_lead(starts)), abs=0.001)
+    assert len(nc.block_with("EGON").call("EGON").args) == 5, "a radial plunge couples no Y"
+
+
+def test_a_catalogue_hob_entered_as_normal_does_not_fit_the_wheel(wheels):
+    """The old reading of a catalogue hob: its m_x 3 taken as a normal module. Its axial pitch would
+    then be π·3/cos γ0, not the wheel's π·3: refused, naming the axial module the wheel needs."""
+    wheels.execute("DELETE FROM hob WHERE id LIKE 'CAT-WW-MX3-%'")
+    wheels.execute("INSERT INTO hob (id, module, starts, tip_diameter, length, hand, accuracy_class, purpose, "
+                   "module_kind) VALUES ('CAT-AS-NORMAL', 3, 1, 37.5, 90, 'R', 'A', 'worm_wheel', 'normal')")
+    with pytest.raises(EngineError, match=r"axial 3\b"):
+        instantiate_gear(wheels, WHEELS["R", 1], choices=Choices(worm_feed="tangential"))
