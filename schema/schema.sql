@@ -1151,6 +1151,17 @@ CREATE TABLE machine (
     -- the modal G codes at power-on and reset (migration 0030), e.g. 'G18 G40 G97 G99'; NULL = not stated;
     -- never G20/G21 (migration 0031: a Fanuc keeps the units the last program set, across reset and M30)
     power_on        text CHECK (power_on ~ '^G(18|40|9[0457-9])( G(18|40|9[0457-9]))*$'),
+    -- What a hobbing program does besides cutting, for its floor-to-floor time (NULL: not stated):
+    -- degrees per second of the swivel head; seconds of a spindle start (M3/M4), of a coupling's
+    -- synchronisation (EGON), of the tailstock's clamp or release (each), of the door's close or
+    -- open (each), of a tool call (T), and of loading and unloading one part.
+    swivel_speed     numeric CHECK (swivel_speed > 0),
+    spindle_runup    numeric CHECK (spindle_runup >= 0),
+    coupling_sync    numeric CHECK (coupling_sync >= 0),
+    tailstock_time   numeric CHECK (tailstock_time >= 0),
+    door_time        numeric CHECK (door_time >= 0),
+    tool_change_time numeric CHECK (tool_change_time >= 0),
+    load_unload_time numeric CHECK (load_unload_time >= 0),
     CONSTRAINT machine_reference_point CHECK ((reference_x IS NULL) = (reference_z IS NULL)),
     CHECK (x_min < x_max AND y_min <= y_max AND z_min < z_max),
     CONSTRAINT machine_safe_name CHECK (safe_name('machine', name)),

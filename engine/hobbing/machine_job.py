@@ -1,17 +1,19 @@
 """A job's parameters made ready for its machine: the signed values in the machine's senses
 (engine.hobbing.conventions), the machine's setup (work offset, tool call, door and load
 blocks, spindle orientation), the working area widened to the load position, and the cycle
-time of the program the template will write (engine.hobbing.cycle_time)."""
+time of the program the template will write (engine.hobbing.cycle_time) and its floor-to-floor
+time (engine.hobbing.floor_time)."""
 from __future__ import annotations
 
 from ..gears.records import Hob
 from ..machines.records import Machine
 from . import conventions
 from .cycle_time import cycle_time
+from .floor_time import floor_to_floor
 from .passes import LIMIT_MARGIN
 
 SETUP_PARAMETERS = frozenset({"work_offset", "tool_number", "door_close_m", "door_open_m", "load_position",
-                              "load_x", "load_z", "orient_before_coupling", "cycle_time"})
+                              "load_x", "load_z", "orient_before_coupling", "cycle_time", "floor_to_floor"})
 
 
 def machine_setup(machine: Machine, hob: Hob) -> dict:
@@ -38,12 +40,14 @@ def machine_job(params: dict, module_params: dict, machine: Machine, hob: Hob, s
 
 
 def with_cycle_time(job: dict, modules: dict, shape: str, machine: Machine) -> dict:
-    """The job with the cycle time of its program (program values in, as stored): a stored job
+    """The job with the cycle and floor-to-floor times of its program (program values in, as stored): a stored job
     whose feeds were edited is made again with the time its program now takes, so the header
     never tells the operator a time the simulation does not find."""
     cuts = [modules[key] for key in sorted(modules, key=_module_order)
             if key.startswith("cutmotion:") and modules[key]["cut_on"]]
-    return {**job, "cycle_time": round(cycle_time(job, cuts, shape, machine.rapid_rate), 4)}   # printed to 0.1 once
+    minutes = cycle_time(job, cuts, shape, machine.rapid_rate)
+    return {**job, "cycle_time": round(minutes, 4),   # printed to 0.1 once
+            "floor_to_floor": round(floor_to_floor(job, modules, machine, minutes), 4)}
 
 
 def _module_order(key: str) -> tuple:

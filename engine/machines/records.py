@@ -56,6 +56,17 @@ class Machine:
     # The modal G codes the control is in at power-on and reset ('G18 G21 G40 G97 G99'), which a
     # program that does not state them runs under; None: not stated (such a program is refused).
     power_on: str | None = None
+    # What a hobbing program does besides cutting (migration 0034; None: not stated), for its
+    # floor-to-floor time (engine.hobbing.floor_time): degrees per second of the swivel head, and
+    # seconds of a spindle start, a coupling's synchronisation, a tailstock clamp or release, a door
+    # close or open, a tool call, and loading and unloading one part.
+    swivel_speed: float | None = None
+    spindle_runup: float | None = None
+    coupling_sync: float | None = None
+    tailstock_time: float | None = None
+    door_time: float | None = None
+    tool_change_time: float | None = None
+    load_unload_time: float | None = None
 
 
 MACHINE_QUERY = f"SELECT {columns(Machine)} FROM machine"  # static, from the dataclass

@@ -2,7 +2,8 @@
 hob, machine), never from the job or the model that made it (issue 26; design notes §7). One
 row per rule, with the reference section it rests on; each yields (step, message, refuses) and
 each message goes to the report with its line. The collisions, coupling, swivel, depth, feeds,
-run-out, records named and cycle time are the walk's (engine.simulation.hobbing.walk, rules)."""
+run-out, records named and cycle time are the walk's; the floor-to-floor time is
+engine.simulation.hobbing.floor_facts' (engine.simulation.hobbing.walk, rules)."""
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable
@@ -11,6 +12,7 @@ from dataclasses import dataclass
 from ...gears.records import Gear, Hob
 from ...machines.records import Machine
 from .cutting_speed import material_note
+from .floor_facts import floor_facts
 from .frame import Senses
 from .header_facts import gear_line_problem, hob_line_problem, table_problem, template_class, unit_line_problem
 from .hob_fit import hob_fit_problem
@@ -83,6 +85,8 @@ FACT_RULES = (
              lambda r: cut_word_facts(r.steps, r.machine)),
     FactRule("the header's cuts and feed mode are the cuts'", "§B13, §B14",
              lambda r: cut_count_facts(r.steps, r.machine, r.report, _units(r))),
+    FactRule("the header's floor-to-floor time is the program's at the machine's times", "§B16",
+             lambda r: floor_facts(r.steps, r.machine, r.report)),
 )
 
 

@@ -7,9 +7,10 @@ from __future__ import annotations
 
 import re
 
-CLAIM = re.compile(r"\b(GEAR|HOB|MACHINE|CYCLE|ALLOWANCE)|\b(CUT|UNIT|n0)\b", re.IGNORECASE)
+CLAIM = re.compile(r"\b(GEAR|HOB|MACHINE|CYCLE|FLOOR|ALLOWANCE)|\b(CUT|UNIT|n0)\b", re.IGNORECASE)
 CANONICAL = (re.compile(r"; GEAR \S+( .*)?"), re.compile(r"; HOB \S+( .*)?"), re.compile(r"; MACHINE \S+"),
-             re.compile(r"; CYCLE TIME [0-9]+(\.[0-9]+)? MIN"), re.compile(r"; ALLOWANCE [0-9]+(\.[0-9]+)? MM( .*)?"),
+             re.compile(r"; CYCLE TIME [0-9]+(\.[0-9]+)? MIN"), re.compile(r"; FLOOR TO FLOOR [0-9]+(\.[0-9]+)? MIN"),
+             re.compile(r"; ALLOWANCE [0-9]+(\.[0-9]+)? MM( .*)?"),
              # the facts engine.simulation.hobbing.header_facts and program_facts hold (issue 26)
              re.compile(r"; n0=[0-9]+ r/min table=[0-9]+(\.[0-9]+)? r/min cuts=[0-9]+ \S+"),
              re.compile(r"; CUT \S+( .*)? X=\S+ \S+"), re.compile(r"; UNIT [0-9]+ z=\S+ b=\S+ Z\S+"))
@@ -28,8 +29,9 @@ def comment_problem(step) -> str | None:
         return None
     if step.kind == "comment" and not code.strip() and any(form.fullmatch(step.line) for form in CANONICAL):
         return None
-    return ("a comment that names a header fact (gear, hob, machine, cycle time, allowance, n0, cut, unit) is not "
-            "its canonical whole-line form `; GEAR <id>`, `; HOB <id>`, `; MACHINE <name>`, `; CYCLE TIME <m> MIN`, "
+    return ("a comment that names a header fact (gear, hob, machine, cycle or floor-to-floor time, allowance, n0, "
+            "cut, unit) is not its canonical whole-line form `; GEAR <id>`, `; HOB <id>`, `; MACHINE <name>`, "
+            "`; CYCLE TIME <m> MIN`, `; FLOOR TO FLOOR <m> MIN`, "
             "`; ALLOWANCE <mm> MM`, `; n0=<n> r/min table=<n2> r/min cuts=<c> <mode>`, `; CUT <name> … X=<x> <word>`, "
             "`; UNIT <n> z=<z> b=<b> Z<top>`: it would go unchecked")
 
