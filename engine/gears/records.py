@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 from decimal import Decimal
 from typing import TYPE_CHECKING, Any
@@ -154,16 +155,22 @@ def load_gears(conn: Connection, first: int | None = None, last: int | None = No
     if not gears:
         return gears
     units = _load_units(conn, gears[0].id, gears[-1].id)
-    return [_with_units(gear, units) for gear in gears]
+    whole = (_or_refused(lambda gear=gear: _with_units(gear, units), gear.id, refused) for gear in gears)
+    return [gear for gear in whole if gear]
 
 
 def _completed_or_refused(gear: Gear, refused: dict | None) -> Gear | None:
+    return _or_refused(lambda: _completed(gear), gear.id, refused)
+
+
+def _or_refused(complete: Callable[[], Gear], gear_id: int, refused: dict | None) -> Gear | None:
+    """complete(), or with `refused` None and its message kept by the gear's id (a batch names every bad gear)."""
     if refused is None:
-        return _completed(gear)
+        return complete()
     try:
-        return _completed(gear)
+        return complete()
     except EngineError as error:
-        refused[gear.id] = str(error)
+        refused[gear_id] = str(error)
         return None
 
 
@@ -190,7 +197,23 @@ def _load_units(conn: Connection, first: int, last: int) -> dict[int, tuple]:
 
 
 def _with_units(gear: Gear, units: dict) -> Gear:
-    return replace(gear, units=units.get(gear.id, ())) if gear.id in units else gear
+    """The gear with its further units, each completed as the gear is (_completed_unit)."""
+    if gear.id not in units:
+        return gear
+    return replace(gear, units=tuple(_completed_unit(gear, unit) for unit in units[gear.id]))
+
+
+def _completed_unit(gear: Gear, unit: GearUnit) -> GearUnit:
+    """A unit written in SQL without its diameters gets them as `engine gears import` computes a
+    unit's: spur teeth of the gear's module (engine.gears.units). Before, the simulation met
+    the missing root as a bug (exit 2) in the middle of a batch."""
+    if unit.tip_diameter is not None and unit.root_diameter is not None:
+        return unit
+    tip, root = derived_diameters(gear.module, unit.teeth, 0, unit.tip_diameter, unit.root_diameter)
+    if not 0 < root < tip:
+        raise EngineError(f"gear {gear.id} unit {unit.unit}: its computed root diameter {root:g} is not between 0 "
+                          f"and the tip diameter {tip:g}; give the unit's tip_diameter and root_diameter")
+    return replace(unit, tip_diameter=tip, root_diameter=root)
 
 
 def load_hobs(conn: Connection) -> list[Hob]:
