@@ -155,7 +155,7 @@ def test_worm_wheel_plunges_radially_without_z(conn):
     program, nc = program_of(conn, 53)
     g, hob = gear(conn, 53), hob_of(conn, program)
     coupled = [m for m in nc.moves if m.block < nc.index("EGOFS")]   # then it leaves for the load position
-    z_values = {m.end["Z"] for m in coupled}
+    z_values = {m.end["Z"] for m in coupled if m.end["Z"] is not None}   # from the load position X first
     assert z_values == {-g["b"] / 2}, "the hob stays in the wheel's mid-plane"
     assert all("Z" not in m.changed for m in coupled if m.start["Z"] is not None)
     plunge = [m for m in cutting_moves(nc) if m.changed == {"X"}]
@@ -212,6 +212,19 @@ def test_duplex_cuts_both_units_with_their_own_parameters(conn):
     assert egon_blocks[1] > first.block and egon_blocks[1] < second.block
 
 
+def test_a_unit_written_in_sql_without_its_diameters_gets_them_as_an_import_would(conn):
+    """A unit inserted by a DBA without tip and root: spur teeth of the gear's module, tip
+    m·(z + 2), root tip − 2·2.25·m (as `engine gears import` computes them). Before, the
+    simulation met the missing root as a bug (exit 2) in the middle of a batch."""
+    conn.execute("UPDATE gear_unit SET tip_diameter = NULL, root_diameter = NULL WHERE gear_id = 54")
+    program, nc = program_of(conn, 54)
+    g, hob = gear(conn, 54), hob_of(conn, program)
+    teeth2 = conn.execute("SELECT teeth FROM gear_unit WHERE gear_id = 54").fetchone()[0]
+    root2 = g["mn"] * (teeth2 + 2) - 2 * 2.25 * g["mn"]
+    second = [m for m in cutting_moves(nc) if m.changed == {"Z"}][1]
+    assert abs(second.start["X"] - (root2 + hob["da0"]) / 2) < 0.01
+
+
 def test_duplex_refuses_units_too_close_for_the_hob(conn):
     conn.execute("UPDATE gear_unit SET z_top = -30 WHERE gear_id = 54")
     with pytest.raises(EngineError, match="wider gap"):
@@ -224,8 +237,8 @@ def test_duplex_inherits_spur_rows_and_stores_only_its_own(conn):
     assembled = conn.execute("SELECT count(*), count(*) FILTER (WHERE inherited_from = 'spur') "
                              "FROM template_view WHERE gear_class = 'duplex'").fetchone()
     assert assembled == (own + spur, spur) and own < spur
-    conn.execute("""UPDATE template_view SET o = 'f"G0 X{x_retract:.3f} Z{z_start:.3f} ; SPUR"'
-                    WHERE gear_class = 'spur' AND id = 1250""")
+    conn.execute("""UPDATE template_view SET o = 'f"G0 Z{z_start:.3f} ; SPUR"'
+                    WHERE gear_class = 'spur' AND id = 1252""")
     program = instantiate_gear(conn, 54, mode=RunMode(draft=True))
     assert sum(line.endswith("; SPUR") for line in program.lines) == 1, "spur's edit reaches duplex's draft"
 

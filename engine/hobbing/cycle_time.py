@@ -94,10 +94,16 @@ def cycle_time(job: dict, cuts: list[dict], shape: str, rapid_rate: float) -> fl
     position. `job` and `cuts` in program values (engine.hobbing.conventions)."""
     load = {"X": job["load_x"], "Z": job["load_z"]} if job["load_position"] else {}
     clock = Clock(rapid_rate, load)
-    clock.rapid(X=job["x_retract"], Z=job["z_mid"] if shape == "worm" else job["z_start"])
+    start_z = job["z_mid"] if shape == "worm" else job["z_start"]
+    if load:   # out in X above the work, then down: one rapid in both would sweep the hob over the gear
+        clock.rapid(X=job["x_retract"])
+        clock.rapid(Z=start_z)
+    else:
+        clock.rapid(X=job["x_retract"], Z=start_z)
     clock.rapid(Y=job["y_start"] if shape == "worm" else job["shift_y"])
     for cut in cuts:
         PASSES[shape](clock, job, cut)
-    if load:
-        clock.rapid(**load)
+    if load:   # up at the retract X, then in: the same the other way round
+        clock.rapid(Z=load["Z"])
+        clock.rapid(X=load["X"])
     return clock.minutes
