@@ -41,7 +41,7 @@ class Attempt:
     """One choice of the search: the hob and the job's choices (feed mode and cuts resolved)."""
     hob: Hob
     choices: Choices
-    given: frozenset = frozenset()   # the names of the choices the user gave ("feed_mode", "cuts")
+    given: frozenset[str] = frozenset()   # the names of the choices the user gave ("feed_mode", "cuts")
 
     def cut_count(self, module: float) -> int:
         return self.choices.cut_count(module)
@@ -63,18 +63,27 @@ class Attempt:
 def attempts(hobs: list[Hob], choices: Choices, module: float) -> list[Attempt]:
     """The first choice, then the alternatives of SEARCH_ORDER (the same job once)."""
     given = frozenset(name for name in ("feed_mode", "cuts") if getattr(choices, name) is not None)
-    modes = [choices.feed_mode] if choices.feed_mode is not None else \
-        [DEFAULT_FEED_MODE] + [mode for mode in FEED_MODES if mode != DEFAULT_FEED_MODE]
-    first_count = choices.cut_count(module)
-    counts = [first_count] if choices.cuts is not None or first_count == 2 else [first_count, 2]
     found: dict[tuple, Attempt] = {}
-    for count in counts:
+    for cuts in _cut_choices(choices, module):
         for hob in hobs[:MAX_HOBS]:
-            for mode in modes:
-                cuts = choices.cuts if count == first_count else count
+            for mode in _feed_modes(choices):
                 attempt = Attempt(hob, replace(choices, feed_mode=mode, cuts=cuts), given)
                 found.setdefault(attempt.key(module), attempt)
     return list(found.values())
+
+
+def _feed_modes(choices: Choices) -> list[str]:
+    """The mode given, or the model's first and then the others (FEED_MODES order)."""
+    if choices.feed_mode is not None:
+        return [choices.feed_mode]
+    return [DEFAULT_FEED_MODE] + [mode for mode in FEED_MODES if mode != DEFAULT_FEED_MODE]
+
+
+def _cut_choices(choices: Choices, module: float) -> list[int | None]:
+    """The cuts given, or the model's (None: by module), then two where the model says one."""
+    if choices.cuts is not None or choices.cut_count(module) == 2:
+        return [choices.cuts]
+    return [None, 2]
 
 
 @dataclass(frozen=True)
