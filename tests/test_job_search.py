@@ -200,3 +200,24 @@ def test_a_job_the_search_made_is_made_again_as_it_was(conn):
         return [line for line in lines if not line.startswith("; PROGRAM ")]
 
     assert body(again.lines) == body(program.lines)
+
+
+def test_a_refusal_keeps_its_type_and_one_choice_keeps_its_words():
+    """Nothing fits: the refusal is of the first refusal's type (a verifier's LimitError stays one);
+    a search of one choice only (everything given, one hob) refuses with the words of that refusal."""
+    from engine.gears.records import Hob
+    from engine.programs.job_search import attempts, first_that_fits
+    from engine.verifier import LimitError
+
+    hobs = [Hob(f"H{n}", 2.0, 20.0, 1, 70.0, 100.0, "R", "A", "HSS", "TiN", "cylindrical") for n in (1, 2)]
+
+    def too_fast(attempt):
+        raise LimitError(f"gear 7: the table turns too fast with {attempt.hob.id}; nothing stored")
+
+    with pytest.raises(LimitError) as refused:
+        first_that_fits(7, 2.0, attempts(hobs, Choices(), 2.0), too_fast)
+    assert str(refused.value).startswith("gear 7: no choice fits, tried: [climb, hob H1, 1 cut] (the first choice) "
+                                         "the table turns too fast with H1; [conventional, hob H1, 1 cut] the table")
+    with pytest.raises(LimitError) as alone:
+        first_that_fits(7, 2.0, attempts(hobs[:1], Choices(feed_mode="climb", cuts=1), 2.0), too_fast)
+    assert str(alone.value) == "gear 7: the table turns too fast with H1; nothing stored"
