@@ -58,8 +58,9 @@ def parse_range(text: str, option: str = "--gears") -> tuple[int, int]:
 @click.option("--shift-y", type=float, default=0.0, help="Hob shift position Y for this part, mm.")
 @click.option("--shift-per-part", type=float, default=0.0,
               help="Shift the hob by this many mm every part (R11 counts), wrapping within the hob's usable length.")
-@click.option("--feed-mode", type=click.Choice(["climb", "conventional", "conventional-climb"]), default="climb",
-              show_default=True, help="Axial pass direction; conventional-climb: rough conventional, finish climb.")
+@click.option("--feed-mode", type=click.Choice(["climb", "conventional", "conventional-climb"]),
+              help="Axial pass direction; conventional-climb: rough conventional, finish climb. Default: the "
+                   "engine's choice, climb first, another direction where climb does not fit (the note says why).")
 @click.option("--tailstock/--no-tailstock", default=True, show_default=True, help="Tailstock clamp M20/M21.")
 @click.option("--worm-feed", type=click.Choice(["radial", "tangential"]), default="radial", show_default=True,
               help="Worm wheels: radial plunge, or tangential feed along Y.")

@@ -193,15 +193,23 @@ def choose_hob(gear: Gear, hobs: list[Hob], *, purpose: str = "cylindrical",
                shift_travel: float = 0.0) -> HobChoice:
     """The best fitting hob for `gear` (see the module notes), with the reason: every
     property checked and its values. Raises NoHobError naming the first unmet property."""
+    return matching_hobs(gear, hobs, purpose=purpose, shift_travel=shift_travel)[0]
+
+
+def matching_hobs(gear: Gear, hobs: list[Hob], *, purpose: str = "cylindrical",
+                  shift_travel: float = 0.0) -> list[HobChoice]:
+    """Every hob that passes the required tests, best first (choose_hob's order: the gear's hand,
+    the coarsest sufficient class, the id), each with its reason: the search before a refusal
+    (engine.programs.job_search) tries the others when the best does not fit the job. Raises
+    NoHobError naming the first property no hob has."""
     need = need_of(gear, purpose, shift_travel)
     tests = [test for test in HOB_TESTS if purpose in test.purposes]
     candidates, position = _accepted(gear, list(hobs), need, tests)
     if position is not None:
         raise NoHobError(_refusal(gear, need, tests[position], tests[:position], candidates), tests[position].name)
     candidates.sort(key=lambda hob: (hob.hand != need.hand, -_class_rank(hob.accuracy_class), hob.id))
-    best = candidates[0]
-    reason = f"{best.id}: " + ", ".join(test.said(gear, best, need) for test in tests)
-    return HobChoice(best, reason)
+    return [HobChoice(hob, f"{hob.id}: " + ", ".join(test.said(gear, hob, need) for test in tests))
+            for hob in candidates]
 
 
 def _accepted(gear: Gear, hobs: list[Hob], need: Need, tests: list[HobTest]) -> tuple[list[Hob], int | None]:

@@ -18,6 +18,10 @@ FEED_MODES = {
     "conventional": (False, False),
     "conventional-climb": (False, True),
 }
+# The model's first feed mode when the user gives none (Choices.feed_mode None): climb, the
+# engine's habit before issue 29. The search (engine.programs.job_search) may take another one
+# when the first does not fit; a mode the user gave is never changed.
+DEFAULT_FEED_MODE = "climb"
 WORM_FEEDS = ("radial", "tangential")
 
 
@@ -27,7 +31,7 @@ class Choices:
     cuts: int | None = None            # 1 = finish only, 2 = rough then finish; None = by module
     finish_stock: float | None = None  # radial stock left by the rough cut, mm
     coolant: bool = True
-    feed_mode: str = "climb"
+    feed_mode: str | None = None       # None = the model's choice (DEFAULT_FEED_MODE first)
     shift_y: float = 0.0               # hob shift position for this part, mm (0 = no shift)
     shift_per_part: float = 0.0        # shift step per part, mm (0 = no shifting from part to part)
     tailstock: bool = True             # clamp the workpiece with the tailstock (the paper's example)
@@ -35,7 +39,7 @@ class Choices:
     allowance: float = 0.0             # radial process allowance left at the final cut for shaving/grinding, mm (§B14)
 
     def __post_init__(self):
-        if self.feed_mode not in FEED_MODES:
+        if self.feed_mode is not None and self.feed_mode not in FEED_MODES:
             raise EngineError(f"feed mode {self.feed_mode!r} is not one of {', '.join(FEED_MODES)}")
         if self.worm_feed not in WORM_FEEDS:
             raise EngineError(f"worm feed {self.worm_feed!r} is not one of {', '.join(WORM_FEEDS)}")
@@ -59,10 +63,15 @@ class Choices:
             return self.finish_stock
         return min(1.0, max(0.3, 0.15 * module))
 
+    @property
+    def mode(self) -> str:
+        """The feed mode the job is cut with: the one given, else the model's first choice."""
+        return self.feed_mode if self.feed_mode is not None else DEFAULT_FEED_MODE
+
     def climb(self, cut_number: int, cut_count: int) -> bool:
         """Whether cut `cut_number` (1 = rough, 2 = finish) runs climb; a single cut takes the
         roughing direction (the paper's single rough cut, conventional-climb mode)."""
-        rough, finish = FEED_MODES[self.feed_mode]
+        rough, finish = FEED_MODES[self.mode]
         return rough if cut_number == 1 or cut_count == 1 else finish
 
     @property

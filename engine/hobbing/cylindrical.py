@@ -122,7 +122,7 @@ class CylindricalModel:
             "hand": gear.hand or "", "b": gear.face_width, "da2": gear.tip_diameter, "df2": gear.root_diameter,
             "hob_id": hob.id, "z0": hob.starts, "da0": hob.tip_diameter, "hob_hand": hob.hand,
             "machine": machine.name, "n0": cutting.hob_speed, "cuts": choices.cut_count(gear.module),
-            "coolant": choices.coolant, "tailstock": choices.tailstock, "feed_mode": choices.feed_mode,
+            "coolant": choices.coolant, "tailstock": choices.tailstock, "feed_mode": choices.mode,
             "swivel": round(setup.swivel, 6), "lead_angle": round(setup.lead, 4),
             "coupling_b": conventions.coupling_numerator(hob.starts, hob.hand),
             "differential": round(conventions.differential(gear.module, gear.teeth, gear.helix_angle, gear.hand), 6),

@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 
 from ..errors import EngineError
 from ..gears.case_base import CUT_KINDS_BY_COUNT, CaseBase, job_cutting_record
-from ..gears.hob_matching import choose_hob
+from ..gears.hob_matching import matching_hobs
 from ..gears.models import model_for_class
 from ..gears.process_notes import hunting_tooth_notes
 from ..gears.records import Gear, load_gear, load_gears, load_hobs
@@ -37,6 +37,7 @@ from .batches import (
     reason_of,
     refuse_unfit_output,
 )
+from .job_search import attempts, first_that_fits
 from .options import NO_FILE, NORMAL_RUN, PLANNING, Output, RunMode
 from .outputs import ProgramFiles, file_layouts, files_after_commit
 from .records import Planned, Program
@@ -97,18 +98,31 @@ class Planner:
         return model
 
     def plan(self, gear: Gear) -> Planned:
+        """The gear's job with the first choice that fits, planned and proved (engine.programs.job_search:
+        the model's first choice, then the alternatives a skilled programmer would try)."""
         if gear.gear_class is None:
             raise EngineError(f"gear {gear.id} has no gear class; re-import it to classify it")
         check_machine_fits(gear, self.machine)
         model = self.model(gear.gear_class)
-        hob = choose_hob(gear, self.hobs, purpose=model.hob_purpose,
-                         shift_travel=model.shift_travel(self.choices)).hob
+        self.template(gear.gear_class)   # a class refused is not a choice that does not fit: refused before the search
+        hobs = [choice.hob for choice in matching_hobs(gear, self.hobs, purpose=model.hob_purpose,
+                                                       shift_travel=model.shift_travel(self.choices))]
+        found = first_that_fits(gear.id, gear.module, attempts(hobs, self.choices, gear.module),
+                                lambda attempt: self._planned(gear, model, attempt.hob, attempt.choices))
+        found.planned.notes[:0] = found.notes
+        if found.notes:   # the job keeps why its hob, feed mode and cut count are not the first choice
+            found.planned.cutting = {**(found.planned.cutting or {}), "choice": found.notes[0]}
+        return found.planned
+
+    def _planned(self, gear: Gear, model, hob, choices: Choices) -> Planned:
+        """The job of one choice (hob, choices), its program verified and proved, or its refusal."""
+        assert gear.gear_class is not None   # plan refused a gear without one
         cutting, case_ids = self.cutting_data(gear, hob)
-        job = model.job(gear, gear.gear_class, hob, self.machine, cutting, self.choices)
+        job = model.job(gear, gear.gear_class, hob, self.machine, cutting, choices)
         check_speeds(gear, hob.starts, cutting.hob_speed, self.machine)
         template = self.template(gear.gear_class)
         result = run_template(template, job.params, job.module_params, self.machine, Workpiece(gear, hob))
-        kinds = CUT_KINDS_BY_COUNT[self.choices.cut_count(gear.module)]
+        kinds = CUT_KINDS_BY_COUNT[choices.cut_count(gear.module)]
         cutting = cutting.of_cuts(kinds)
         record = job_cutting_record(cutting, gear, hob, kinds, case_ids)
         notes = [f"gear {gear.id}: {note}" for note in cutting.notes] + hunting_tooth_notes(gear, hob)

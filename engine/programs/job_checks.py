@@ -81,10 +81,11 @@ def _unit_teeth(job_id: int, module_params: dict, key: str, teeth: int) -> float
 
 def job_choices(job_id: int, params: dict) -> Choices:
     """The choices the stored job was made with, as a new job's are checked (allowance, feed mode,
-    shift)."""
+    shift, and its cut count: a new job's search may have taken two cuts where the module says one)."""
     worm_feed = "tangential" if params.get("tangential") is True else "radial"
+    cuts = params.get("cuts") if params.get("cuts") in (1, 2) else None
     return _refused_as_new(job_id, "params", lambda: Choices(
-        cuts=None, coolant=bool(params.get("coolant", True)), feed_mode=params.get("feed_mode", "climb"),
+        cuts=cuts, coolant=bool(params.get("coolant", True)), feed_mode=params.get("feed_mode", "climb"),
         shift_y=_number(job_id, params, "shift_y", "params.shift_y", 0.0),
         shift_per_part=_number(job_id, params, "shift_per_part", "params.shift_per_part", 0.0),
         tailstock=bool(params.get("tailstock", True)), worm_feed=worm_feed,

@@ -1,0 +1,144 @@
+"""The search before a refusal (issue 29): a gear the first choice does not fit is tried with the
+alternatives a skilled programmer would try, and refused only when none fits.
+
+The first choice is the model's: climb, the best hob of engine.gears.hob_matching.choose_hob,
+the cuts by module (Choices.cut_count). When it is refused for a fit reason (the model's
+refusal, e.g. the hob reaching a duplex gear's other unit; a speed limit; the verifier's or the
+simulation's refusal of the made program), the alternatives of SEARCH_ORDER are tried in order,
+each one planned, verified and proved exactly as the first (engine.programs.verified_run): the
+first that is proved is taken, and a note says which choice was taken and why. A choice the user
+gave (--feed-mode, --cuts) is never varied. Nothing of an attempt that is refused is kept, so no
+unproved program is ever stored or printed.
+"""
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING, Any
+
+from ..errors import EngineError
+from ..hobbing.choices import DEFAULT_FEED_MODE, FEED_MODES, Choices
+
+if TYPE_CHECKING:
+    from ..gears.records import Hob
+
+MAX_HOBS = 3        # hobs tried at most: the best and the next two that pass every test of choose_hob
+NOTHING_STORED = "; nothing stored"
+
+# What the search varies, in this order (issue 29). The attempts are the product of the rows with
+# the first row varying fastest: a change that keeps the hob and the cuts (the pass direction: only
+# the pass ends move) is tried before another hob (a tool change on the machine), and both before a
+# second cut (a longer cycle). A row whose choice the user gave has that value only.
+SEARCH_ORDER: tuple[tuple[str, str], ...] = (
+    ("feed direction", "climb, then conventional, then conventional-climb (rough conventional, finish climb)"),
+    ("hob", f"the best hob, then the others choose_hob accepts, in its order (hand, class, id); {MAX_HOBS} at most"),
+    ("cuts", "the model's count (one up to m 3, §B14), then two cuts (rough, then finish)"),
+)
+
+
+@dataclass(frozen=True)
+class Attempt:
+    """One choice of the search: the hob and the job's choices (feed mode and cuts resolved)."""
+    hob: Hob
+    choices: Choices
+    given: frozenset[str] = frozenset()   # the names of the choices the user gave ("feed_mode", "cuts")
+
+    def cut_count(self, module: float) -> int:
+        return self.choices.cut_count(module)
+
+    def said(self, module: float) -> str:
+        """'conventional, hob H-M2-A-L1, 1 cut' (a choice the user gave marked so)."""
+        count = self.cut_count(module)
+        mode = self.choices.mode + (" (given)" if "feed_mode" in self.given else "")
+        cuts = f"{count} cut{'s' if count > 1 else ''}" + (" (given)" if "cuts" in self.given else "")
+        return f"{mode}, hob {self.hob.id}, {cuts}"
+
+    def key(self, module: float) -> tuple:
+        """What makes two attempts the same job: a single cut runs the roughing direction only, so
+        conventional and conventional-climb are one job then."""
+        count = self.cut_count(module)
+        return self.hob.id, count, tuple(self.choices.climb(number, count) for number in (1, 2)[2 - count:])
+
+
+def attempts(hobs: list[Hob], choices: Choices, module: float) -> list[Attempt]:
+    """The first choice, then the alternatives of SEARCH_ORDER (the same job once)."""
+    given = frozenset(name for name in ("feed_mode", "cuts") if getattr(choices, name) is not None)
+    found: dict[tuple, Attempt] = {}
+    for cuts in _cut_choices(choices, module):
+        for hob in hobs[:MAX_HOBS]:
+            for mode in _feed_modes(choices):
+                attempt = Attempt(hob, replace(choices, feed_mode=mode, cuts=cuts), given)
+                found.setdefault(attempt.key(module), attempt)
+    return list(found.values())
+
+
+def _feed_modes(choices: Choices) -> list[str]:
+    """The mode given, or the model's first and then the others (FEED_MODES order)."""
+    if choices.feed_mode is not None:
+        return [choices.feed_mode]
+    return [DEFAULT_FEED_MODE] + [mode for mode in FEED_MODES if mode != DEFAULT_FEED_MODE]
+
+
+def _cut_choices(choices: Choices, module: float) -> list[int | None]:
+    """The cuts given, or the model's (None: by module), then two where the model says one."""
+    if choices.cuts is not None or choices.cut_count(module) == 2:
+        return [choices.cuts]
+    return [None, 2]
+
+
+@dataclass(frozen=True)
+class Found:
+    """What the search took: the planned job, the attempt, and the notes saying why."""
+    planned: Any
+    attempt: Attempt
+    notes: list
+
+
+def first_that_fits(gear_id: int, module: float, tried: list[Attempt], plan: Callable[[Attempt], object]) -> Found:
+    """plan(attempt) for each attempt in order until one is planned and proved; the refusals of the
+    ones before it named in the note. None fits: the first attempt's refusal (its type kept), with
+    every alternative tried and its reason, in one line."""
+    refused: list[tuple[Attempt, EngineError]] = []
+    for attempt in tried:
+        try:
+            planned = plan(attempt)
+        except EngineError as error:
+            refused.append((attempt, error))
+            continue
+        return Found(planned, attempt, [_note(gear_id, module, attempt, refused)] if refused else [])
+    raise _refusal(gear_id, module, refused) from None
+
+
+def reason(gear_id: int, error: EngineError) -> str:
+    """The refusal without the gear's name and the trailing 'nothing stored' (said once around it)."""
+    text = str(error)
+    text = text.removeprefix(f"gear {gear_id}: ")
+    return text.removesuffix(NOTHING_STORED)
+
+
+def _note(gear_id: int, module: float, taken: Attempt, refused: list[tuple[Attempt, EngineError]]) -> str:
+    """'gear 54: cut with [conventional, …], not the first choice: [climb, …] does not fit: <reason>'."""
+    before = "; ".join(f"[{attempt.said(module)}] does not fit: {reason(gear_id, error)}" for attempt, error in refused)
+    return f"gear {gear_id}: cut with [{taken.said(module)}], not the first choice: {before}"
+
+
+def _refusal(gear_id: int, module: float, refused: list[tuple[Attempt, EngineError]]) -> EngineError:
+    """The refusal when nothing fits, of the first attempt's type (a LimitError stays one), naming
+    every choice tried: the same reason for all (not a matter of the choices: e.g. a crowning too
+    steep for its face) is the first refusal followed by the choices tried; else each choice with
+    its reason, the first choice first. A single attempt's refusal is unchanged."""
+    first_attempt, first = refused[0]
+    if len(refused) == 1:
+        return first
+    tried = [f"[{attempt.said(module)}]" + (" (the first choice)" if attempt is first_attempt else "")
+             for attempt, _ in refused]
+    reasons = [reason(gear_id, error) for _, error in refused]
+    if len(set(reasons)) == 1:
+        message = f"{str(first).removesuffix(NOTHING_STORED)}; the same with every choice tried: {', '.join(tried)}"
+    else:
+        message = f"gear {gear_id}: no choice fits, tried: " + "; ".join(
+            f"{said} {why}" for said, why in zip(tried, reasons))
+    error = type(first).__new__(type(first))   # its type and attributes, the new line
+    error.__dict__.update(first.__dict__)
+    error.args = (message + NOTHING_STORED,)
+    return error
