@@ -5,6 +5,7 @@ import math
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 from decimal import Decimal
+from functools import partial
 from typing import TYPE_CHECKING, Any
 
 from ..db.records import as_float, columns
@@ -155,7 +156,7 @@ def load_gears(conn: Connection, first: int | None = None, last: int | None = No
     if not gears:
         return gears
     units = _load_units(conn, gears[0].id, gears[-1].id)
-    whole = (_or_refused(lambda gear=gear: _with_units(gear, units), gear.id, refused) for gear in gears)
+    whole = (_or_refused(partial(_with_units, gear, units), gear.id, refused) for gear in gears)
     return [gear for gear in whole if gear]
 
 
