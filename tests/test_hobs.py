@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import json
+import math
 from pathlib import Path
 
 import psycopg
@@ -19,6 +20,13 @@ SEED_HOBS = Path(__file__).resolve().parent.parent / "seed_templates" / "hobs.cs
 GENERATING_M2 = 31.010
 # Worm-wheel hob m 3, 1 start, da0 50: d_m0 = 50 − 2·1.25·3 = 42.5; γ = asin(3/42.5) = 4.048°.
 WORM_HOB_LEAD = 4.048
+# Its axial module m_n0/cos γ (§B10): a wheel of helix β fits its pitch with normal module m_x·cos β.
+WORM_HOB_AXIAL = 3.0 / math.sqrt(1 - (3.0 / 42.5) ** 2)
+
+
+def wheel_module(helix: float) -> float:
+    """The normal module of a wheel of this helix whose transverse pitch is the hob's axial pitch."""
+    return WORM_HOB_AXIAL * math.cos(math.radians(helix))
 
 
 def hob(hob_id, module=2.0, hand="R", accuracy_class="AA", length=100.0, pressure_angle=20.0,
@@ -57,10 +65,11 @@ def refusal(gear_, library=LIBRARY, **options) -> str:
     (gear(grade=7), {"shift_travel": 60}, "length", "length ≥ 101.0 mm", "length 100 (H-M2-AA-R1)"),
     (gear(module=3.0, hand="L", helix=WORM_HOB_LEAD, grade=8), {"purpose": "worm_wheel"}, "hand", "hand L",
      "hand R (H-WW-M3-R1)"),
-    (gear(module=3.0, hand="R", helix=5.0, grade=8), {"purpose": "worm_wheel"}, "lead angle",
+    (gear(module=wheel_module(5.0), hand="R", helix=5.0, grade=8), {"purpose": "worm_wheel"}, "lead angle",
      "lead angle 5° ± 0.5°", "lead angle 4.05° (H-WW-M3-R1)"),
-    (gear(module=2.0, hand="R", helix=4.0, grade=8), {"purpose": "worm_wheel"}, "module", "module 2",
-     "module 3 (H-WW-M3-R1)"),
+    # a worm wheel is held by axial module m_n/cos β (§B10): 2/cos 4° = 2.004878; the hob's 3/cos 4.048°
+    (gear(module=2.0, hand="R", helix=4.0, grade=8), {"purpose": "worm_wheel"}, "module", "axial module 2.00488",
+     "axial module 3.0075 (normal 3) (H-WW-M3-R1)"),
 ])
 def test_a_refusal_names_the_gear_the_first_missing_property_and_the_closest_hobs(
         gear_, options, first_missing, needed, closest):
@@ -112,7 +121,7 @@ def test_the_coarsest_sufficient_class_is_kept_for_the_gear():
 
 @pytest.mark.parametrize("helix, fits", [(WORM_HOB_LEAD, True), (4.5, True), (3.6, True), (4.6, False), (3.5, False)])
 def test_a_worm_wheel_needs_the_hob_lead_angle_within_half_a_degree_of_its_helix(helix, fits):
-    wheel = gear(module=3.0, hand="R", helix=helix, grade=8)
+    wheel = gear(module=wheel_module(helix), hand="R", helix=helix, grade=8)
     if fits:
         assert choose_hob(wheel, LIBRARY, purpose="worm_wheel").hob.id == "H-WW-M3-R1"
     else:

@@ -12,7 +12,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 from ..errors import EngineError
-from .hob_geometry import generating_length, lead_angle
+from .hob_geometry import generating_length, hob_axial_module, lead_angle
 from .records import Gear, Hob
 
 # Hob accuracy classes from best to coarsest (DIN 3968 / GB/T 6084).
@@ -23,6 +23,10 @@ DEFAULT_GRADE = 8
 PURPOSES = ("cylindrical", "worm_wheel")
 ANGLE_TOLERANCE = 1e-6
 MODULE_TOLERANCE = 1e-6
+# A worm-wheel hob's axial module against the wheel's (mm): 0.001 mm of module is π µm of pitch,
+# within the single axial pitch tolerance of a class AA hob (DIN 3968, a few µm) [K]; it absorbs a
+# helix angle rounded to 0.01° (7e-6 mm at m 3, γ 4°), not a hob of another worm.
+AXIAL_MODULE_TOLERANCE = 0.001
 # A worm-wheel hob copies its worm: its lead angle must be the wheel's helix angle.
 LEAD_ANGLE_TOLERANCE = 0.5   # degrees
 SHIFT_MARGIN = 5.0           # mm kept unused at each end of the hob (§B15 "margins")
@@ -77,22 +81,34 @@ def _lead(hob: Hob) -> float:
 
 
 def _module_distance(gear: Gear, hob: Hob) -> float:
-    """How far the hob's module is from the gear's, in the frame the hob's record gives it (mm). A
-    worm-wheel hob catalogued by its worm's axial module (DIN 3975) matches the wheel's axial module
-    m_n/cos γ (γ the wheel's helix, its worm's lead): the hob's axial pitch is the wheel's transverse
-    pitch, though an oversize hob's lead differs a little (LEAD_ANGLE_TOLERANCE)."""
-    if hob.module_kind == "axial":
-        return abs(hob.stated_module - gear.module / math.cos(math.radians(gear.helix_angle)))
+    """How far the hob's module is from the gear's (mm). A worm-wheel hob, however its record
+    states its module, is held to the wheel by axial module: its axial pitch π·m_n0/cos γ0 must be
+    the wheel's transverse pitch π·m_n/cos γ (γ the wheel's helix, its worm's lead; DIN 3975),
+    though an oversize hob's lead may differ a little (LEAD_ANGLE_TOLERANCE). A hob matched by
+    normal module within that lead tolerance could cut a 4-start wheel's teeth 0.33 % too far apart
+    (adversary 29). A cylindrical hob matches by normal module."""
+    if hob.purpose == "worm_wheel":
+        return abs(hob_axial_module(hob.module, hob.starts, hob.tip_diameter)
+                   - gear.module / math.cos(math.radians(gear.helix_angle)))
     return abs(hob.module - gear.module)
 
 
+def _module_fits(gear: Gear, hob: Hob) -> bool:
+    tolerance = AXIAL_MODULE_TOLERANCE if hob.purpose == "worm_wheel" else MODULE_TOLERANCE
+    return _module_distance(gear, hob) < tolerance
+
+
 def _module_said(hob: Hob) -> str:
-    return f"axial module {hob.stated_module:g}" if hob.module_kind == "axial" else f"module {hob.module:g}"
+    """A worm-wheel hob by the axial module it is held to (and its record's kind), else by module."""
+    if hob.purpose != "worm_wheel":
+        return f"module {hob.module:g}"
+    axial = round(hob_axial_module(hob.module, hob.starts, hob.tip_diameter), 6)
+    return f"axial module {axial:g}" + ("" if hob.module_kind == "axial" else f" (normal {hob.module:g})")
 
 
-def _module_wanted(gear: Gear) -> str:
-    if gear.module_kind == "axial":
-        return f"module {gear.module:g} (axial {gear.stated_module:g})"
+def _module_wanted(gear: Gear, purpose: str) -> str:
+    if purpose == "worm_wheel":
+        return f"axial module {round(gear.module / math.cos(math.radians(gear.helix_angle)), 6):g}"
     return f"module {gear.module:g}"
 
 
@@ -139,8 +155,8 @@ HOB_TESTS: tuple[HobTest, ...] = (
             distance=lambda gear, hob, need: 0.0),
     HobTest("module", BOTH,
             said=lambda gear, hob, need: _module_said(hob),
-            fits=lambda gear, hob, need: _module_distance(gear, hob) < MODULE_TOLERANCE,
-            wanted=lambda gear, need: _module_wanted(gear),
+            fits=lambda gear, hob, need: _module_fits(gear, hob),
+            wanted=lambda gear, need: _module_wanted(gear, need.purpose),
             offered=_module_said,
             distance=lambda gear, hob, need: _module_distance(gear, hob)),
     HobTest("pressure angle", BOTH,
