@@ -78,7 +78,7 @@ def cutting_speed(tip_diameter: float, n0: float) -> float:
 def choosing(monkeypatch, conn, hob_id: str) -> None:
     """The planner takes `hob_id` whatever the gear (as a runner's job naming it would)."""
     hob = next(h for h in load_hobs(conn) if h.id == hob_id)
-    monkeypatch.setattr(instantiating, "choose_hob", lambda *args, **kwargs: HobChoice(hob, "a runner's choice"))
+    monkeypatch.setattr(instantiating, "matching_hobs", lambda *args, **kwargs: [HobChoice(hob, "a runner's choice")])
 
 
 @pytest.mark.parametrize("hob_id, module", [("H-M2.5-AA-R1", 2.5), ("H-M3-AA-R1", 3)])

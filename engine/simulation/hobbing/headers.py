@@ -7,7 +7,10 @@ from __future__ import annotations
 
 import re
 
-CLAIM = re.compile(r"\b(GEAR|HOB|MACHINE|CYCLE|FLOOR|ALLOWANCE)|\b(CUT|UNIT|n0)\b", re.IGNORECASE)
+# The words of a header fact, and any time in minutes (a misspelt `; FL00R TO FL00R 9.9 MIN` is
+# still read as the program's time by whoever reads it: adversary 29).
+CLAIM = re.compile(r"\b(GEAR|HOB|MACHINE|CYCLE|FLOOR|ALLOWANCE)|\b(CUT|UNIT|n0)\b|[0-9]\s*MIN(UTES?)?\b",
+                   re.IGNORECASE)
 CANONICAL = (re.compile(r"; GEAR \S+( .*)?"), re.compile(r"; HOB \S+( .*)?"), re.compile(r"; MACHINE \S+"),
              re.compile(r"; CYCLE TIME [0-9]+(\.[0-9]+)? MIN"), re.compile(r"; FLOOR TO FLOOR [0-9]+(\.[0-9]+)? MIN"),
              re.compile(r"; ALLOWANCE [0-9]+(\.[0-9]+)? MM( .*)?"),
