@@ -1,4 +1,5 @@
-"""A move that turns the swivel A (engine.simulation.hobbing.walk). The hob is not translated on
+"""A move that turns the swivel A, or that runs before A (or, swivelled, Y) is written
+(engine.simulation.hobbing.walk). The hob is not translated on
 it, so the convexity the contacts' bounds rest on (engine.simulation.hobbing.contact_bounds) does
 not hold, and its poses are followed at the final A only. The move is proved clear where no swivel
 between its two ends can bring the hob near a solid, from two bounds that hold for every A:
@@ -28,20 +29,29 @@ UNKNOWN = (-90.0, 90.0)    # the swivels an A not yet written may be at (a cylin
 
 
 def sweep_problem(solids: list[Solid], body: HobBody, tailstock: bool, start: dict, end: dict,
-                  swivel_from: float | None, swivel_to: float) -> str | None:
+                  swivel_from: float | None, swivel_to: float, shift_travel: float) -> str | None:
     """Why the swivel from `swivel_from` (None: not known yet) to `swivel_to` over the move from
-    `start` to `end` (DIN positions) cannot be proved clear, or None."""
+    `start` to `end` (DIN positions) cannot be proved clear, or None. A Y not yet written stands
+    anywhere the last program left it: up to `shift_travel` (the machine's largest |Y|) either way."""
     ends = [position for position in (start, end) if {"X", "Z"} <= position.keys()]
     x_tip = min(position["X"] for position in ends) - body.radius
     heights = [position["Z"] for position in ends]
-    shift = max((abs(position.get("Y", 0.0)) for position in ends), default=0.0)
+    shift = max((abs(position["Y"]) if "Y" in position else shift_travel for position in ends), default=0.0)
     reach = z_reach(body, shift, swivel_from, swivel_to)
     for solid in solids:
         if (solid.clamped_only and not tailstock) or x_tip >= solid.largest_radius + COLLISION_TOLERANCE:
             continue
         if max(heights) + reach >= solid.z_low and min(heights) - reach <= solid.z_high:
-            return _refusal(solid, x_tip, swivel_from, swivel_to)
+            return _refusal(solid, x_tip, swivel_from, swivel_to, "Y" not in end)
     return None
+
+
+def unknown_pose(swivelling: bool, swivel_known: bool, swivel: float, end: dict) -> bool:
+    """Whether a move must be proved for every swivel or shift the head may stand at: it turns A,
+    or A is not written yet (the head stands where the last program left it; followed at 0 it
+    passed a hob 1.94 mm inside the gear after a 20° helical's program: adversary 29), or Y is not
+    written yet and the hob is swivelled (its centre then stands Y·sin A off in Z, reference §A6)."""
+    return swivelling or not swivel_known or ("Y" not in end and swivel != 0.0)
 
 
 def z_reach(body: HobBody, shift: float, swivel_from: float | None, swivel_to: float) -> float:
@@ -63,8 +73,14 @@ def _reach_at(body: HobBody, shift: float, angle: float) -> float:
     return shift * sine + body.radius * cosine + body.half_length * sine
 
 
-def _refusal(solid: Solid, x_tip: float, swivel_from: float | None, swivel_to: float) -> str:
-    came = "an A not written before" if swivel_from is None else f"A{swivel_from:g}°"
-    return (f"the hob swivels from {came} to A{swivel_to:g}° with its tip cylinder {x_tip:.3f} mm from the "
-            f"work axis, within reach of {solid.name} (radius {solid.largest_radius:.3f} mm): a swivel is "
-            "proved only where the hob clears the work in X or in Z throughout; swivel it farther out")
+def _refusal(solid: Solid, x_tip: float, swivel_from: float | None, swivel_to: float, y_unknown: bool) -> str:
+    if swivel_from is None:
+        what = "the hob moves before A is written (the head may stand at any swivel the last program left)"
+    elif swivel_from != swivel_to:
+        what = f"the hob swivels from A{swivel_from:g}° to A{swivel_to:g}°"
+    else:
+        what = f"the hob moves at A{swivel_to:g}°"
+    shift = " with Y not yet written (any shift the last program left)" if y_unknown else ""
+    return (f"{what}{shift} with its tip cylinder {x_tip:.3f} mm from the work axis, within reach of {solid.name} "
+            f"(radius {solid.largest_radius:.3f} mm): such a move is proved only where the hob clears the work in "
+            "X or in Z for every swivel and shift it may have; write A and Y with the hob farther out")

@@ -47,7 +47,7 @@ from .rules import (
     zone_problem,
 )
 from .solids import Solid
-from .swivel_sweep import sweep_problem
+from .swivel_sweep import sweep_problem, unknown_pose
 from .timing import feed_minutes, header_minutes, header_problem, rapid_minutes
 
 AXES = ("X", "Y", "Z")
@@ -189,15 +189,14 @@ class BlockSimulation:
         else:
             self._end_cut()
         if {"X", "Z"} <= end.keys():
-            if swivelling:
+            if unknown_pose(swivelling, self.swivel_known, self.swivel, end):
                 self._swivel_sweep(step, start, end, swivel_from)
             self._contacts(step, motion, cutting, start, end, swivelling)
         self.position = end
 
     def _swivel_sweep(self, step, start: dict, end: dict, swivel_from: float | None) -> None:
-        problem = sweep_problem(self.solids, self.body, self.tailstock, start, end, swivel_from, self.swivel)
-        if problem:
-            self.report.add(step.number, step.line, problem)
+        self._refuse(step, sweep_problem(self.solids, self.body, self.tailstock, start, end, swivel_from,
+                                         self.swivel, max(abs(self.machine.y_min), abs(self.machine.y_max))))
 
     def _check_coupled_axes(self, step, program: dict, swivel: float | None) -> None:
         """Y (unless a leading axis) and A may not move while the table is coupled (§B15)."""
