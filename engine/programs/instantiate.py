@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING
 
 from ..errors import EngineError
 from ..gears.case_base import CUT_KINDS_BY_COUNT, CaseBase, job_cutting_record
+from ..gears.feed_marks import bounded_for_marks
 from ..gears.hob_matching import choose_hob
 from ..gears.models import model_for_class
 from ..gears.process_notes import hunting_tooth_notes
@@ -104,6 +105,9 @@ class Planner:
         hob = choose_hob(gear, self.hobs, purpose=model.hob_purpose,
                          shift_travel=model.shift_travel(self.choices)).hob
         cutting, case_ids = self.cutting_data(gear, hob)
+        if model.hob_purpose != "worm_wheel":     # a worm wheel's plunge or tangential feed has no axial pass
+            cutting = bounded_for_marks(cutting, gear, hob, self.choices.cut_count(gear.module), self.choices.allowance,
+                                        frozenset(name for name, value in self.overrides.items() if value is not None))
         job = model.job(gear, gear.gear_class, hob, self.machine, cutting, self.choices)
         check_speeds(gear, hob.starts, cutting.hob_speed, self.machine)
         template = self.template(gear.gear_class)
