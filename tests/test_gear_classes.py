@@ -334,7 +334,8 @@ def test_suggest_for_the_papers_gear_proposes_its_published_data(run):
     proposal = json.loads(out.stdout)
     text = json.dumps(proposal)
     assert '"hob_speed": 246' in text
-    assert (proposal["rough"]["axial_feed"], proposal["rough"]["radial_feed"]) == (PAPER_AXIAL_BOUNDED,
+    # the suggestion is per cut kind, bounded by §C alone: the feed-mark bound of the last cut is the job's
+    assert (proposal["rough"]["axial_feed"], proposal["rough"]["radial_feed"]) == (round(3.0 * 246 / 19, 1),
                                                                                    PAPER_RADIAL_BOUNDED)
     assert any(f"axial feed {PAPER_FEED_PER_REV:.2f} mm per workpiece rev" in note and "bounded to 3.00" in note
                for note in proposal["notes"])
