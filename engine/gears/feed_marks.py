@@ -3,9 +3,11 @@
 Every workpiece revolution the hob moves on by the axial feed f_a; its tip circle (d_a0) leaves
 a scallop between two positions, δ ≈ f_a²·sin α_n/(4·d_a0) deep on the flank [K]. The marks run
 across the face width, so they are a waviness of the flank line: they count against the helix
-form tolerance f_fβ of ISO 1328-1:2013, formula (11) [S] (DIN 3962-2 and GB/T 10095 grade the
-same way). The marks may take a share of it, the rest is left for the hob's, the machine's and
-the set-up's errors: that share is a rule of thumb [K], the engine's choice, to calibrate.
+form tolerance f_fβ of ISO 1328-1:2013, formula (11) [S, as public gear-tolerance calculators
+quote it; the standard's own text was not retrieved] (DIN 3962-2 and GB/T 10095 grade the same
+deviation with the same √2 step [K]; the standard's classes run 1–11, grade 12 takes the next
+step). The marks may take a share of it, the rest is left for the hob's, the machine's and the
+set-up's errors: that share is a rule of thumb [K], the engine's choice, to calibrate.
 
 The engine bounds the axial feed of a job's last cut by it (engine.programs.instantiate); the
 simulation (engine.simulation.hobbing.mark_facts) refuses a program whose last cut is deeper.
