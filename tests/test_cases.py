@@ -7,6 +7,7 @@ import math
 from dataclasses import replace
 
 import pytest
+from helpers import feed_mark_reference
 from psycopg import sql
 
 from engine.errors import EngineError
@@ -26,6 +27,10 @@ M2_ROUGH_MAX = 3.0
 PAPER_FEED_PER_REV = PAPER_AXIAL / (PAPER_N0 / 19)
 BOUNDED_AXIAL = round(M2_ROUGH_MAX * PAPER_N0 / 19, 1)                                     # 38.8 mm/min
 BOUNDED_RADIAL = round(PAPER_RADIAL * M2_ROUGH_MAX / PAPER_FEED_PER_REV, 1)                # scaled alike
+# The job's single cut is its last: its feed marks at 3.0 mm/rev (§B6) are deeper than grade 7 allows on
+# m2 z19 b20 with d_a0 70, so the job cuts at the bound (the suggestion, per cut kind, does not know the
+# job's cut count and is bounded by §C alone).
+JOB_AXIAL = round(min(M2_ROUGH_MAX, feed_mark_reference.bound(7, 2, 19, 0, 20, 20, 70)) * PAPER_N0 / 19, 1)
 # A case within the §C range even for a 2-start hob (3.0/√2 = 2.12): 25 mm/min is 1.93 mm/rev.
 USUAL_AXIAL, USUAL_RADIAL = 25.0, 8.0
 CASE_COLUMNS = ("module", "teeth", "material", "hardness", "quality_grade", "hob_material", "hob_coating",
@@ -203,12 +208,13 @@ def test_a_confirmed_job_becomes_one_case_per_cut_and_only_once(conn, machine):
     assert record["rough"] == {"axial_feed": BOUNDED_AXIAL, "radial_feed": BOUNDED_RADIAL} and "finish" not in record
     job_id = instantiate_gear(conn, gear.id).job_id   # a job becomes a case only once the engine made its program
     stored = stored_cutting(conn, job_id)
-    assert (stored["hob_speed"], stored["rough"], "finish" in stored) == (PAPER_N0, record["rough"], False)
+    assert (stored["hob_speed"], stored["rough"], "finish" in stored) == (
+        PAPER_N0, {"axial_feed": JOB_AXIAL, "radial_feed": BOUNDED_RADIAL}, False)
     before = len(list_cases(conn))
     (case_id,) = confirm_job(conn, job_id)
     case = list_cases(conn).set_index("id").loc[case_id]
     assert (case.module, case.teeth, case.material, case.cut, case.hob_tip_diameter) == (2, 19, "40Cr", "rough", 70)
-    assert (case.hob_speed, case.axial_feed, case.radial_feed) == (PAPER_N0, BOUNDED_AXIAL, BOUNDED_RADIAL)
+    assert (case.hob_speed, case.axial_feed, case.radial_feed) == (PAPER_N0, JOB_AXIAL, BOUNDED_RADIAL)
     assert case.source == f"job {job_id}" and case.job_id == job_id
     with pytest.raises(EngineError, match=f"job {job_id} was already confirmed at"):
         confirm_job(conn, job_id)

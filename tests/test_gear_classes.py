@@ -12,6 +12,7 @@ import math
 
 import psycopg
 import pytest
+from helpers import feed_mark_reference
 from helpers.nc_reader import read_program
 
 from engine.errors import EngineError
@@ -80,13 +81,15 @@ def test_taper_feed_along_the_slant_keeps_the_axial_feed(conn):
     program, nc = program_of(conn, 50)
     slanted = [m for m in cutting_moves(nc) if {"X", "Z"} <= m.changed][-1]
     axial = slanted.feed * math.cos(math.radians(gear(conn, 50)["cone"]))
-    assert abs(axial - PAPER_AXIAL_BOUNDED) < 0.1   # the paper's case, bounded to m2's roughing maximum
+    assert abs(axial - PAPER_AXIAL_BOUNDED) < 0.1   # the paper's case, bounded by its grade's feed marks
 
 
 # The paper's case (§D): 246 r/min, 105 axial and 36 radial mm/min, i.e. 105/(246/19) = 8.11 mm per
 # workpiece rev, 2.7× the roughing maximum 3.0 for m2 (§C): bounded to 3.0 mm/rev, radial scaled alike.
+# Its single cut is the last one: at 3.0 mm/rev its feed marks (§B6) would be deeper than grade 7
+# allows on m2 z19 b20 (d_a0 70, cone 6.5°), so the axial feed is bounded further, the radial not.
 PAPER_FEED_PER_REV = 105.0 / (246 / 19)
-PAPER_AXIAL_BOUNDED = round(3.0 * 246 / 19, 1)
+PAPER_AXIAL_BOUNDED = round(min(3.0, feed_mark_reference.bound(7, 2, 19, 0, 20, 20, 70, 6.5)) * 246 / 19, 1)
 PAPER_RADIAL_BOUNDED = round(36.0 * 3.0 / PAPER_FEED_PER_REV, 1)
 
 
@@ -344,7 +347,8 @@ def test_suggest_for_the_papers_gear_proposes_its_published_data(run):
     proposal = json.loads(out.stdout)
     text = json.dumps(proposal)
     assert '"hob_speed": 246' in text
-    assert (proposal["rough"]["axial_feed"], proposal["rough"]["radial_feed"]) == (PAPER_AXIAL_BOUNDED,
+    # the suggestion is per cut kind, bounded by §C alone: the feed-mark bound of the last cut is the job's
+    assert (proposal["rough"]["axial_feed"], proposal["rough"]["radial_feed"]) == (round(3.0 * 246 / 19, 1),
                                                                                    PAPER_RADIAL_BOUNDED)
     assert any(f"axial feed {PAPER_FEED_PER_REV:.2f} mm per workpiece rev" in note and "bounded to 3.00" in note
                for note in proposal["notes"])

@@ -164,7 +164,10 @@ def test_hob_starts_prime_to_the_teeth_do_not_warn(conn):
 def test_cli_instantiate_says_the_bounded_feed_and_the_hunting_tooth_in_one_line_each(run):
     paper = run("instantiate", "--gear", 42)    # the paper's case: 8.11 mm/rev at m2, bounded to 3.0 (§C)
     bounded = [line for line in paper.stderr.splitlines() if line.startswith("note: ") and "bounded" in line]
-    assert paper.exit_code == 0 and len(bounded) == 1 and "8.11" in bounded[0] and "3.00" in bounded[0]
+    # then, its single cut being its last, bounded again by its grade's feed marks (§B6)
+    table, marks = bounded[0], bounded[1:]
+    assert paper.exit_code == 0 and "8.11" in table and "3.00" in table
+    assert len(marks) == 1 and "feed marks" in marks[0] and "grade 7" in marks[0]
     batch = run("instantiate", "--gears", "46-46", "--json")
     assert any("common factor 2" in note for note in json.loads(batch.stdout)["notes"])
 

@@ -103,15 +103,17 @@ def test_a_finish_feed_edited_beyond_the_table_is_refused(run):
 
 
 def test_a_legitimate_edit_still_makes_its_program(run):
-    """A lower hob speed and a feed within the table, edited in SQL, are the shop's to choose."""
+    """A lower hob speed and a feed within the table, edited in SQL, are the shop's to choose. 20 mm/min
+    at n0 200 is 20/(200/19) = 1.9 mm per workpiece rev: within §C and within the feed marks grade 7
+    allows gear 42 (§B6: 1.9²·sin 20°/280 = 4.4 µm of 6.4)."""
     job = made_job(run)
     module_params = one_value(run, "SELECT module_params FROM job WHERE id = %s", job)
     single = next(key for key, cut in module_params.items() if cut["cut_on"])
     copy = runners_copy(run, job, params={"n0": 200}, module_params={single: {**module_params[single],
-                                                                                "feed_axial": 25.0}})
+                                                                                "feed_axial": 20.0}})
     made = run("instantiate", "--job", copy)
     assert made.exit_code == 0, made.output
-    assert "M3 S200" in made.stdout and "F25.0" in made.stdout
+    assert "M3 S200" in made.stdout and "F20.0" in made.stdout
 
 
 @pytest.mark.parametrize("target", [("--gear", "42"), ("--job", None), ("--jobs", None)])

@@ -18,7 +18,7 @@ from ..gears.cutting_data import per_minute, programmed_feed
 from ..gears.models import register_model
 from . import conventions
 from .cylindrical import RAPID_SHORT_OF_CUT, CylindricalModel, JobParameters
-from .passes import APPROACH_SAFETY, feeds, plan_cuts, working_area
+from .passes import APPROACH_SAFETY, plan_cuts, working_area
 
 DWELL_TABLE_TURNS = 2.0   # table revolutions at full depth after a radial plunge (enveloping cuts)
 
@@ -44,9 +44,7 @@ class WormWheelModel(CylindricalModel):
             "cut_name": cut.name, "cut_x": round(cut.centre_distance, 3), "cut_on": cut.on,
             "x_air": round(air_position(gear, hob, tangential, cut.centre_distance), 3),
             "dwell": round(DWELL_TABLE_TURNS * 60 / table_speed, 1),
-            "feed_radial": feeds(cut, cutting, hob.starts, gear.teeth)["feed_radial"],
-            "feed_tangential": programmed_feed(per_minute(cutting.axial_feed_rough, cutting.hob_speed, hob.starts,
-                                                          gear.teeth))} for cut in cuts}
+            **cut_feeds(cut, cutting, hob.starts, gear.teeth)} for cut in cuts}
         y_clear = round(tangential_clearance(gear, hob, setup.full_depth), 3) if tangential else 0.0
         params = {**self.base_params(gear, gear_class, hob, machine, cutting, choices, setup),
                   "shift_on": False, "shift_y": 0.0, "shift_per_part": 0.0, "shift_min": 0.0, "shift_max": 0.0,
@@ -56,6 +54,18 @@ class WormWheelModel(CylindricalModel):
         xs = [setup.x_retract] + [cut["cut_x"] for cut in module_params.values() if cut["cut_on"]]
         params.update(working_area(xs, [0.0, y_clear, -y_clear], [params["z_mid"]]))
         return self.for_machine(params, module_params, machine, hob)
+
+
+def cut_feeds(cut, cutting, starts: int, teeth: int) -> dict:
+    """Feeds of one cut in mm/min (G94). A radial cut's plunge is the cut itself (§B10: X plunges
+    while the table turns), so the finishing plunge runs at the finishing radial feed, not the
+    roughing one a cylindrical gear's infeed in air takes (issue 29); the tangential feed of a
+    cut at its kind's axial feed (a tangential wheel is one cut, a rough one)."""
+    finish = cut.name == "FINISH"
+    radial = cutting.finish_radial_feed if finish else cutting.radial_feed
+    axial = cutting.axial_feed_finish if finish else cutting.axial_feed_rough
+    return {"feed_radial": programmed_feed(per_minute(radial, cutting.hob_speed, starts, teeth)),
+            "feed_tangential": programmed_feed(per_minute(axial, cutting.hob_speed, starts, teeth))}
 
 
 def check_module_stated(gear) -> None:

@@ -13,10 +13,11 @@ holds the feed per minute rounded to 0.1, the F word its value rounded down to 0
 feed the trace does not record (a taper cut reads feed_slant, not feed_axial) is taken from the
 job's module parameters, which the MATCH check proved are what the program was rendered from.
 
-The radial feed of a finish cut is not compared: the program cuts FINISH at the roughing radial
-feed (engine.hobbing.passes.feeds reads cutting.radial_feed), while job.cutting stores the finish
-cases' radial feed, so the two differ for every two-cut job the engine makes; that value is not
-vouched for by any program (docs/design.md, the rendering check)."""
+The radial feed of a finish cut is not compared: a cylindrical program cuts FINISH at the roughing
+radial feed (its infeed is in air; engine.hobbing.passes.feeds reads cutting.radial_feed), while
+job.cutting stores the finish cases' radial feed, so the two differ for every two-cut cylindrical
+job the engine makes; that value is not vouched for by any program (docs/design.md, the rendering
+check). A worm wheel's finishing plunge runs at it (issue 29, engine.hobbing.worm_wheel.cut_feeds)."""
 from __future__ import annotations
 
 from typing import TYPE_CHECKING

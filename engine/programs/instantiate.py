@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING
 
 from ..errors import EngineError
 from ..gears.case_base import CUT_KINDS_BY_COUNT, CaseBase, job_cutting_record
+from ..gears.feed_marks import bounded_for_marks
 from ..gears.hob_matching import matching_hobs
 from ..gears.models import model_for_class
 from ..gears.process_notes import hunting_tooth_notes
@@ -118,6 +119,9 @@ class Planner:
         """The job of one choice (hob, choices), its program verified and proved, or its refusal."""
         assert gear.gear_class is not None   # plan refused a gear without one
         cutting, case_ids = self.cutting_data(gear, hob)
+        if model.hob_purpose != "worm_wheel":     # a worm wheel's plunge or tangential feed has no axial pass
+            cutting = bounded_for_marks(cutting, gear, hob, choices.cut_count(gear.module), choices.allowance,
+                                        frozenset(name for name, value in self.overrides.items() if value is not None))
         job = model.job(gear, gear.gear_class, hob, self.machine, cutting, choices)
         check_speeds(gear, hob.starts, cutting.hob_speed, self.machine)
         template = self.template(gear.gear_class)

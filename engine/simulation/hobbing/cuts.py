@@ -3,7 +3,8 @@ spindle turning) between a rapid or an uncoupling. What it reports per cut (refe
 §B5, §B7, §B8): the centre distance and depth reached, the stock it leaves above the intended
 root, the run-out (how far the pass carries the hob centre beyond the face it leaves; for a
 tangential worm-wheel pass, the hob's trailing end beyond the wheel's centre plane), and the
-feeds per workpiece revolution (radial infeed and pass)."""
+feeds per workpiece revolution (radial infeed and pass, and along an axial pass's path: the
+spacing of its feed marks)."""
 from __future__ import annotations
 
 import math
@@ -53,6 +54,17 @@ def feed_per_revolution(cut: Cut, axes: tuple) -> float | None:
     return max(speeds) / cut.table_speed
 
 
+def mark_feed(cut: Cut) -> float | None:
+    """The largest path feed of the cut's axial pass moves (Z moving), per workpiece revolution:
+    the spacing of the feed marks (§B6). A taper's or a crowning's G1 X Z moves the hob along
+    the slant, so X counts with Z; None for a cut without an axial pass (a worm wheel's)."""
+    speeds = [math.hypot(velocities.get("X", 0.0), velocities["Z"]) for _, _, velocities in cut.moves
+              if velocities.get("Z")]
+    if not speeds or cut.table_speed <= 0:
+        return None
+    return max(speeds) / cut.table_speed
+
+
 def radial_feed(cut: Cut) -> float | None:
     radial = [move for move in cut.moves if set(move[2]) == {"X"}]
     return feed_per_revolution(Cut(cut.number, cut.line, cut.teeth, cut.table_speed, moves=radial), ("X",))
@@ -65,4 +77,4 @@ def summary(cut: Cut, unit: Solid, half_length: float) -> CutSummary:
     stock = max(unit.stock()) if len(depths) == len(unit.reach) else math.inf
     pass_axes = ("Z",) if cut.pass_moves("Z") else ("Y",)
     return CutSummary(cut.number, unit.name, centre, depth, stock, run_out(cut, unit, half_length),
-                      radial_feed(cut), feed_per_revolution(cut, pass_axes))
+                      radial_feed(cut), feed_per_revolution(cut, pass_axes), mark_feed(cut))

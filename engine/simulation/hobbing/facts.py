@@ -2,8 +2,8 @@
 hob, machine), never from the job or the model that made it (issue 26; design notes §7). One
 row per rule, with the reference section it rests on; each yields (step, message, refuses) and
 each message goes to the report with its line. The collisions, coupling, swivel, depth, feeds,
-run-out, records named and cycle time are the walk's; the floor-to-floor time is
-engine.simulation.hobbing.floor_facts' (engine.simulation.hobbing.walk, rules)."""
+run-out, records named and cycle time are the walk's (engine.simulation.hobbing.walk, rules); the
+feed marks are engine.simulation.hobbing.mark_facts', the floor-to-floor time floor_facts'."""
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable
@@ -16,6 +16,7 @@ from .floor_facts import floor_facts
 from .frame import Senses
 from .header_facts import gear_line_problem, hob_line_problem, table_problem, template_class, unit_line_problem
 from .hob_fit import hob_fit_problem
+from .mark_facts import mark_facts
 from .program_facts import area_facts, cut_count_facts, cut_word_facts, speed_facts, tailstock_facts
 from .report import Report
 
@@ -87,6 +88,8 @@ FACT_RULES = (
              lambda r: cut_count_facts(r.steps, r.machine, r.report, _units(r))),
     FactRule("the header's floor-to-floor time is the program's at the machine's times", "§B16",
              lambda r: floor_facts(r.steps, r.machine, r.report)),
+    FactRule("the last cut's feed marks within the depth the gear's grade allows", "§B6",
+             lambda r: mark_facts(r.steps, r.gear, r.hob, r.report)),
 )
 
 

@@ -48,6 +48,7 @@ class CutSummary:
     run_out: float | None          # mm the hob centre passes the face it leaves (None: no axial/tangential pass)
     radial_feed: float | None      # mm per workpiece revolution
     pass_feed: float | None        # axial (or tangential) mm per workpiece revolution
+    mark_feed: float | None = None  # mm per workpiece revolution along an axial pass's path (§B6 feed marks)
 
 
 @dataclass
