@@ -3,7 +3,7 @@
 proves, and every refusal names a physical reason and what was tried").
 
 A population drawn with a fixed seed from the reference ranges: module 1–8 on a hobber rated for
-it (the seeded hobber-840d's record, widened to m 8 and 500 mm of X), 12–120 teeth, every hobbing
+it (the seeded hobber-840d's record, widened to m 8 and 500 mm of X, loading at Z300), 12–120 teeth, every hobbing
 class (spur, helical of both hands, taper, crowned, cluster, worm wheels with catalogue hobs by
 axial module); a hob library sized roughly per DIN 8002 (tip diameter and length by module,
 both hands, 1–3 starts, classes AA and A) and catalogue worm-wheel hobs for the worms drawn.
@@ -117,7 +117,10 @@ def populate(conn, count: int, seed_value: int) -> None:
     _insert(conn, "hob", HOB_COLUMNS, sorted(hobs))
     _insert(conn, "gear", GEAR_COLUMNS, gears)
     _insert(conn, "gear_unit", UNIT_COLUMNS, units)
-    conn.execute("UPDATE machine SET module_max = 8, x_max = 500 WHERE name = 'hobber-840d'")
+    # loaded high enough that a hob at the load position clears the largest gear at any swivel and
+    # shift the last program may have left (engine.simulation.hobbing.swivel_sweep.unknown_pose)
+    conn.execute("UPDATE machine SET module_max = 8, x_max = 500, z_max = 350, load_z = 300 "
+                 "WHERE name = 'hobber-840d'")
     conn.commit()
 
 

@@ -2,7 +2,11 @@
 at X300 Z100; a gear whose tip radius reaches past X300 − r0 lies under that point, and one G0 in X
 and Z together (on a line, or as a dog-leg where the control does not interpolate rapids) sweeps
 the hob down through its top face. A programmer leaves the load position out in X above the work,
-then goes down at the retract X; and at the end goes up first, then in. The population of
+then goes down at the retract X; and at the end goes up first, then in. Here the hobber loads at
+X300 Z250: before the program writes A and Y the head may stand at any swivel and shift the last
+program left, so the hob there reaches √((L/2 + |Y|max)² + r0²) = √(165² + 62.5²) = 176 mm below
+its centre (swivel_sweep), and only a load position that high is clear of this gear's top face
+whatever the head's swivel (at Z100 nothing could be proved). The population of
 scripts/hob_population.py (300 gears, seed 29) had 25 refused so; now none."""
 from __future__ import annotations
 
@@ -20,7 +24,8 @@ HOB = ("H-M8-A-R1-T", 8, 1, 125, 170, "R", "A")
 
 @pytest.fixture
 def big_gear(conn):
-    conn.execute("UPDATE machine SET x_max = 500, module_max = 8 WHERE name = 'hobber-840d'")
+    conn.execute("UPDATE machine SET x_max = 500, z_max = 300, load_z = 250, module_max = 8 "
+                 "WHERE name = 'hobber-840d'")
     conn.execute("INSERT INTO hob (id, module, starts, tip_diameter, length, hand, accuracy_class) "
                  "VALUES (%s, %s, %s, %s, %s, %s, %s)", HOB)
     conn.execute("INSERT INTO gear (id, gear_class, module, teeth, face_width, material, hardness, quality_grade, "
@@ -34,7 +39,7 @@ def test_a_gear_under_the_load_position_is_reached_one_axis_at_a_time(big_gear):
     x_retract = (656 + 125) / 2 + 5                  # tip and hob radii and the retract clearance
     assert rapids[0].changed == {"X"} and rapids[0].end["X"] == pytest.approx(x_retract, abs=0.001)
     assert rapids[1].changed == {"Z"}
-    assert rapids[-2].changed == {"Z"} and rapids[-2].end["Z"] == pytest.approx(100.0)
+    assert rapids[-2].changed == {"Z"} and rapids[-2].end["Z"] == pytest.approx(250.0)
     assert rapids[-1].changed == {"X"} and rapids[-1].end["X"] == pytest.approx(300.0)
 
 
@@ -43,5 +48,5 @@ def test_one_rapid_in_both_axes_from_the_load_position_is_refused(big_gear):
     big_gear.execute("""UPDATE template_view SET o = 'f"G0 X{x_retract:.3f} Z{z_start:.3f}"', p_emit = NULL
                         WHERE gear_class = 'spur' AND id = 1250""")
     big_gear.execute("UPDATE template_view SET p_emit = 'False' WHERE gear_class = 'spur' AND id IN (1251, 1252)")
-    with pytest.raises(EngineError, match=r"into unit 1"):
+    with pytest.raises(EngineError, match=r"within reach of unit 1"):
         instantiate_gear(big_gear, GEAR, mode=RunMode(draft=True))
