@@ -99,16 +99,18 @@ def read_holdings(path: str | Path) -> list[dict[str, Any]]:
     if not file.records:
         raise EngineError(f"{path}: no work-holding rows; give one work-holding per line under the header")
     holdings, problems = [], []
-    first_line: dict[str, int] = {}   # id in upper case -> the line it is first on
+    first_line: dict[str, tuple[int, str]] = {}   # id in upper case -> (line, id) where it is first
     for line, cells in file.rows():
         holding, row_problems = parse_holding(cells, line, file.separator)
         folded = holding["id"].upper() if holding["id"] is not None else None
         if folded in first_line:
-            row_problems.append(Problem(line, "id", f"{holding['id']} is already on line {first_line[folded]} "
-                                        "(ids that differ only in case name one work-holding)",
+            earlier, earlier_id = first_line[folded]
+            case = f" as {earlier_id} (ids that differ only in case name one work-holding)" \
+                if earlier_id != holding["id"] else ""
+            row_problems.append(Problem(line, "id", f"{holding['id']} is already on line {earlier}{case}",
                                         "give each work-holding once"))
         elif folded is not None:
-            first_line[folded] = line
+            first_line[folded] = (line, holding["id"])
         problems += row_problems
         holdings.append(holding)
     if problems:
