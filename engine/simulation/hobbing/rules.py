@@ -136,8 +136,8 @@ def setup_advice(solid_name: str) -> str:
         return ("; clamp without the tailstock (--no-tailstock) or use a smaller tailstock/fixture in the "
                 "machine record")
     if solid_name == "the fixture":
-        return ("; clamp the gear on a work-holding sized for it (`engine fixtures match --gear ID`, "
-                "`engine instantiate --fixture ID`) or use a larger fixture_gap (a spacer) in the machine record")
+        return ("; use a smaller fixture (a work-holding sized for the gear: `engine fixtures match --gear ID`, "
+                "`engine instantiate --fixture ID`) or a larger fixture_gap (a spacer) in the machine record")
     if solid_name.startswith("the ") and solid_name.split()[1] in WORK_HOLDING_KINDS:
         return "; choose a work-holding that clears the root (`engine fixtures match --gear ID`)"
     return ""
