@@ -20,7 +20,10 @@ MACHINE_OWN = "none (the machine's own fixture and tailstock)"
 
 @click.group("fixtures")
 def fixtures():
-    """Work-holding library: arbors, mandrels, collets and centres a gear is clamped on (list, import, match)."""
+    """Work-holding library: arbors, mandrels, collets and centres a gear is clamped on (list, import, match).
+
+    Example: engine fixtures match --gear 42
+    """
 
 
 @fixtures.command("list")
@@ -45,7 +48,10 @@ def fixtures_list(ctx, output):
 @click.pass_context
 def fixtures_import(ctx, csv_file, as_json):
     """Add or update (by id) the work-holdings of CSV_FILE (columns of seed_templates/work_holdings.csv:
-    id,kind,diameter,height,tailstock_diameter,machine); any bad row stops the whole file (nothing stored)."""
+    id,kind,diameter,height,tailstock_diameter,machine); any bad row stops the whole file (nothing stored).
+
+    Example: engine fixtures import holdings.csv
+    """
     from ..machines.holding_library import import_holdings
 
     with connection(ctx) as conn:
@@ -63,7 +69,10 @@ def fixtures_import(ctx, csv_file, as_json):
 @click.pass_context
 def fixtures_match(ctx, gear_id, machine, as_json):
     """The work-holding `engine instantiate --gear` would clamp the gear on, and why: the machine's own
-    fixture and tailstock when they clear the root, else the largest of the library that does."""
+    fixture and tailstock when they clear the root, else the largest of the library that does.
+
+    Example: engine fixtures match --gear 42
+    """
     from ..gears.holding_matching import match_holding
 
     with connection(ctx) as conn:
