@@ -1192,6 +1192,23 @@ CREATE TABLE hob (
 -- One hob per id whatever its case: H-M2-AA-R1 and h-m2-aa-r1 are one hob.
 CREATE UNIQUE INDEX hob_id_ignoring_case ON hob (upper(id));
 
+-- Work-holding library (issue 29): arbors, mandrels, collets and centres a job may be clamped on
+-- instead of the machine record's fixture and tailstock; its id is printed in the program.
+CREATE TABLE work_holding (
+    id                 text PRIMARY KEY,
+    kind               text NOT NULL CHECK (kind IN ('arbor', 'mandrel', 'collet', 'centres')),
+    -- the part under the gear the hob must clear: its diameter and height (mm), its top face the
+    -- machine record's fixture_gap below the gear's bottom face; the machine's fixture below it
+    diameter           numeric NOT NULL CHECK (diameter > 0 AND diameter < 'Infinity'),
+    height             numeric NOT NULL CHECK (height > 0 AND height < 'Infinity'),
+    -- the centre (or tailstock) above the top face, mm; 0 = none
+    tailstock_diameter numeric NOT NULL DEFAULT 0 CHECK (tailstock_diameter >= 0 AND tailstock_diameter < 'Infinity'),
+    machine            text REFERENCES machine (name),   -- the machine it fits; NULL = any hobber
+    CONSTRAINT work_holding_safe_id CHECK (id ~ '^[A-Za-z0-9][A-Za-z0-9_.-]{0,31}$')
+);
+-- One work-holding per id whatever its case (a setter reading `; FIXTURE …` cannot tell them apart).
+CREATE UNIQUE INDEX work_holding_id_ignoring_case ON work_holding (upper(id));
+
 -- Workpieces (design notes §9 columns).
 CREATE TABLE gear (
     id             integer PRIMARY KEY CHECK (id > 0),
@@ -1276,6 +1293,8 @@ CREATE TABLE job (
     confirmed_at  timestamptz,
     -- a turning job's drawing record (NULL: a hobbing job, or a class job without a drawing)
     drawing_id    bigint REFERENCES drawing (id),
+    -- the work-holding the job is clamped on (NULL: the machine record's fixture and tailstock)
+    work_holding_id text REFERENCES work_holding (id),
     CONSTRAINT job_safe_params CHECK (job_params_safe(params, module_params))
 );
 CREATE INDEX job_gear ON job (gear_id);

@@ -80,7 +80,7 @@ def test_each_command_module_is_named_with_the_command_it_holds():
     from engine.cli.app import main
     from engine.cli.commands import COMMAND_MODULES
 
-    assert len(main.commands) == len(COMMAND_MODULES) == 22
+    assert len(main.commands) == len(COMMAND_MODULES) == 23   # issue 29: engine fixtures
     for name in COMMAND_MODULES:
         assert main.commands[name].name == name
 

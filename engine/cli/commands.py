@@ -24,7 +24,7 @@ COMMAND_MODULES = {
     "import-nc": ("nc_import", "import_nc_command"), "refactor": ("refactor", "refactor_command"),
     "import-dxf": ("turning", "import_dxf_command"), "plot": ("plot", "plot_command"),
     "simulate": ("simulate", "simulate"), "programs": ("programs", "programs"), "test": ("golden", "test_command"),
-    "jobs": ("jobs", "jobs"), "config": ("settings", "config"),
+    "jobs": ("jobs", "jobs"), "config": ("settings", "config"), "fixtures": ("fixtures", "fixtures"),
 }
 
 

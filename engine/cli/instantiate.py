@@ -62,6 +62,9 @@ def parse_range(text: str, option: str = "--gears") -> tuple[int, int]:
               help="Axial pass direction; conventional-climb: rough conventional, finish climb. Default: the "
                    "engine's choice, climb first, another direction where climb does not fit (the note says why).")
 @click.option("--tailstock/--no-tailstock", default=True, show_default=True, help="Tailstock clamp M20/M21.")
+@click.option("--fixture", "fixture", help="Work-holding id of the library (`engine fixtures list`) to clamp the gear "
+              "on; refused if it does not fit and clear the gear (default: the machine's own fixture and tailstock "
+              "when they clear the root, else the largest work-holding that does, as `engine fixtures match`).")
 @click.option("--worm-feed", type=click.Choice(["radial", "tangential"]), default="radial", show_default=True,
               help="Worm wheels: radial plunge, or tangential feed along Y.")
 @click.option("--allowance", type=float, default=0.0, show_default=True,
@@ -83,8 +86,8 @@ def parse_range(text: str, option: str = "--gears") -> tuple[int, int]:
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object (program_id, path, lines, ...).")
 @click.pass_context
 def instantiate(ctx, gear_id, job_id, gear_class, params_file, unverified, gear_range, job_range, all_gears, out,
-                force, machine, cuts, coolant, shift_y, shift_per_part, feed_mode, tailstock, worm_feed, allowance,
-                hob_speed, workers, explain, draft, dry_run, skip_bad, as_json):
+                force, machine, cuts, coolant, shift_y, shift_per_part, feed_mode, tailstock, fixture, worm_feed,
+                allowance, hob_speed, workers, explain, draft, dry_run, skip_bad, as_json):
     """Produce the NC program of a gear (or a stored job, a job of an imported class, or a batch of gears).
 
     The program is checked against the machine's limits and proved by the
@@ -128,7 +131,7 @@ def instantiate(ctx, gear_id, job_id, gear_class, params_file, unverified, gear_
     _refuse_new_job_choices_for_stored_jobs(ctx, job_id is not None or bool(job_range))
     choices = Choices(cuts=cuts, coolant=coolant, shift_y=shift_y, shift_per_part=shift_per_part,
                       feed_mode=feed_mode, tailstock=tailstock, worm_feed=worm_feed,
-                      allowance=allowance)
+                      allowance=allowance, fixture=fixture)
     overrides = {"hob_speed": hob_speed}
     config = settings(ctx)   # the config file: the machine's output folder and line endings (over the class's)
     output = _output(config, machine, out, force, new_job_written=not (dry_run or job_id is not None or job_range))
@@ -201,7 +204,7 @@ def where_it_applies(ctx, name: str, value, applies: bool, refusal: str):
 
 
 NEW_JOB_CHOICES = ("machine", "cuts", "coolant", "shift_y", "shift_per_part", "feed_mode", "tailstock",
-                   "worm_feed", "allowance", "hob_speed")
+                   "worm_feed", "allowance", "hob_speed", "fixture")
 
 
 HOBBING_CHOICES = NEW_JOB_CHOICES[1:]   # all but --machine: what a hobbing model computes a job with

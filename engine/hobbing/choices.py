@@ -37,6 +37,7 @@ class Choices:
     tailstock: bool = True             # clamp the workpiece with the tailstock (the paper's example)
     worm_feed: str = "radial"          # worm wheels: radial plunge or tangential feed along Y
     allowance: float = 0.0             # radial process allowance left at the final cut for shaving/grinding, mm (§B14)
+    fixture: str | None = None         # the work-holding's id (--fixture); None: chosen (issue 29)
 
     def __post_init__(self):
         if self.feed_mode is not None and self.feed_mode not in FEED_MODES:

@@ -50,7 +50,7 @@ JOB_PARAMETERS = frozenset({
     "hob_id", "z0", "da0", "hob_hand", "machine", "n0", "cuts", "coolant", "tailstock", "feed_mode",
     "swivel", "lead_angle", "x_retract", "z_start", "z_end", "x_lower", "x_upper", "y_lower", "y_upper",
     "z_lower", "z_upper", "shift_on", "shift_y", "shift_per_part", "shift_min", "shift_max",
-    "template_version", "coupling_b", "differential", "allowance",
+    "template_version", "coupling_b", "differential", "allowance", "fixture_id",
 }) | SETUP_PARAMETERS
 CUT_PARAMETERS = frozenset({"cut_name", "cut_x", "feed_radial", "feed_axial", "cut_on", "climb",
                             "z_from", "z_to", "x_air"})
@@ -130,6 +130,7 @@ class CylindricalModel:
             "z_start": round(setup.reach.approach, 3),
             "z_end": round(-gear.face_width - setup.reach.overrun, 3),
             "allowance": choices.allowance,   # mm radial, left at the final cut (passes.plan_cuts)
+            "fixture_id": "",   # the job's work-holding, set by the planner (engine.gears.holding_matching)
         }
 
     def class_params(self, gear: Gear, hob: Hob, setup: Setup, choices: Choices) -> dict:

@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING
 from ..errors import EngineError
 from ..gears.records import Gear, Hob, load_gear
 from ..machines.records import Machine, load_machine
+from ..machines.work_holding import job_work_holding
 from ..pictures import literal, new_figure, picture_target, save_atomically
 from ..simulation.hobbing.recorded import Recording, record_program
 from ..simulation.hobbing.stored import load_hob
@@ -80,7 +81,7 @@ def load_scene(conn: Connection, program_id: int) -> Scene:
         raise EngineError(f"program {program_id} runs on {machine_name}, a {machine.kind}, not a hobbing program; "
                           f"draw its job with `engine plot --job {job_id} -o FILE.png`")
     gear, hob = load_gear(conn, gear_id), load_hob(conn, hob_id)
-    recording = record_program(list(lines), gear, hob, machine, name)
+    recording = record_program(list(lines), gear, hob, machine, name, job_work_holding(conn, job_id))
     return Scene(program_id, job_id, name, draft, gear_class, gear, hob, machine, recording)
 
 

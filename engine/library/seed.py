@@ -18,6 +18,7 @@ from ..gears.gear_import import GEAR_KIND, read_gears
 from ..gears.gear_store import identical_gears, import_gears, installed_classes
 from ..gears.hob_library import HOB_COLUMNS
 from ..gears.units import UNIT_KIND, import_units
+from ..machines.holding_library import HOLDING_COLUMNS
 from ..machines.importing import MACHINE_KIND
 from ..paths import SEED_DIR
 from ..templates.expectations import refuse_slow_patterns
@@ -31,13 +32,16 @@ if TYPE_CHECKING:
 CLASS_KIND = CsvKind("gear class", (Column("name", parse_text, required=True), Column("parent", parse_text),
                                     Column("description", parse_text)))
 SEED_HOB_KIND = CsvKind("hob", tuple(Column(column.name, parse_text, column.required) for column in HOB_COLUMNS))
+SEED_HOLDING_KIND = CsvKind("work-holding", tuple(Column(column.name, parse_text, column.required)
+                                                  for column in HOLDING_COLUMNS))
 
 # table, CSV file, key column, its kind; loaded in this order.
 SEED_TABLES = (
     ("machine", "machines.csv", "name", MACHINE_KIND),
     ("hob", "hobs.csv", "id", SEED_HOB_KIND),
+    ("work_holding", "work_holdings.csv", "id", SEED_HOLDING_KIND),
 )
-SHOP_TABLES = SEED_TABLES[:1]   # the machines; the hobs are samples
+SHOP_TABLES = SEED_TABLES[:1]   # the machines; the hobs and work-holdings are samples
 
 
 @dataclass
@@ -82,7 +86,8 @@ def seed(conn: Connection, directory: Path = SEED_DIR, *, samples: bool = True) 
     with conn.transaction():
         _seed_classes(conn, directory, report)
         for table, file_name, key, kind in SEED_TABLES if samples else SHOP_TABLES:
-            report.count(table + "s", _insert_missing(conn, table, key, _read(directory / file_name, kind)))
+            rows = _read(directory / file_name, kind)
+            report.count(table.replace("_", "-") + "s", _insert_missing(conn, table, key, rows))
         seeded = _seed_templates(conn, directory, report)
         samples_stored = _seed_samples(conn, directory, report) if samples else None
         _seed_template_tests(conn, directory, report, samples_stored)

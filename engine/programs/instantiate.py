@@ -14,11 +14,13 @@ from ..errors import EngineError
 from ..gears.case_base import CUT_KINDS_BY_COUNT, CaseBase, job_cutting_record
 from ..gears.feed_marks import bounded_for_marks
 from ..gears.hob_matching import matching_hobs
+from ..gears.holding_matching import choose_holding
 from ..gears.models import model_for_class
 from ..gears.process_notes import hunting_tooth_notes
 from ..gears.records import Gear, load_gear, load_gears, load_hobs
 from ..hobbing.choices import Choices
 from ..machines.records import Machine, hobbing_machine
+from ..machines.work_holding import load_work_holdings
 from ..memory import no_cycle_collection
 from ..nc.layout import NcLayout, class_layout
 from ..templates.rows import Template
@@ -58,6 +60,7 @@ class Planner:
         self.draft = draft   # the classes' drafts (an editor trying them), not their released versions
         self.machine = hobbing_machine(conn, machine)
         self.hobs = load_hobs(conn)
+        self.holdings = load_work_holdings(conn)
         self.case_base = CaseBase.load(conn)
         self._cutting: dict[tuple, tuple] = {}
         self.choices = choices
@@ -118,20 +121,23 @@ class Planner:
     def _planned(self, gear: Gear, model, hob, choices: Choices) -> Planned:
         """The job of one choice (hob, choices), its program verified and proved, or its refusal."""
         assert gear.gear_class is not None   # plan refused a gear without one
+        holding = choose_holding(gear, hob, self.machine, self.holdings, choices.fixture).holding
         cutting, case_ids = self.cutting_data(gear, hob)
         if model.hob_purpose != "worm_wheel":     # a worm wheel's plunge or tangential feed has no axial pass
             cutting = bounded_for_marks(cutting, gear, hob, choices.cut_count(gear.module), choices.allowance,
                                         frozenset(name for name, value in self.overrides.items() if value is not None))
         job = model.job(gear, gear.gear_class, hob, self.machine, cutting, choices)
+        params = {**job.params, "fixture_id": holding.id if holding else ""}   # `; FIXTURE <id>` (issue 29)
         check_speeds(gear, hob.starts, cutting.hob_speed, self.machine)
         template = self.template(gear.gear_class)
-        result = run_template(template, job.params, job.module_params, self.machine, Workpiece(gear, hob))
+        result = run_template(template, params, job.module_params, self.machine, Workpiece(gear, hob, holding))
         kinds = CUT_KINDS_BY_COUNT[choices.cut_count(gear.module)]
         cutting = cutting.of_cuts(kinds)
         record = job_cutting_record(cutting, gear, hob, kinds, case_ids)
         notes = [f"gear {gear.id}: {note}" for note in cutting.notes] + hunting_tooth_notes(gear, hob)
-        return Planned(gear.id, gear.gear_class, self.machine.name, hob.id, job.params,
-                       job.module_params, template, result, record, notes, self._layouts[gear.gear_class])
+        return Planned(gear.id, gear.gear_class, self.machine.name, hob.id, params, job.module_params, template,
+                       result, record, notes, self._layouts[gear.gear_class],
+                       work_holding_id=holding.id if holding else None)
 
     def cutting_data(self, gear: Gear, hob) -> tuple:
         """Cutting data from the nearest cases of the machining history (overrides applied),

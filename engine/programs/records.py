@@ -31,6 +31,7 @@ class Planned:
     # A lathe class job proved against a blank assumed from its own cuts (no stock_* params): stored
     # for review, never written to a file (engine.programs.class_jobs.ASSUMED_BLANK_FILE).
     assumed_blank: bool = False
+    work_holding_id: str | None = None   # job.work_holding_id: None, the machine record's fixture (issue 29)
 
     @property
     def name(self) -> str:
@@ -47,7 +48,8 @@ class Planned:
             if with_job else (None, None, None))
         return Encoded(self.gear_id, self.gear_class, self.machine, self.hob_id, *job, self.template.version,
                        self.template.hash, self.name, self.result.lines, self.result.row_ids,
-                       json.dumps(self.result.trace), tuple(self.notes), self.layout, self.assumed_blank)
+                       json.dumps(self.result.trace), tuple(self.notes), self.layout, self.assumed_blank,
+                       self.work_holding_id)
 
 
 @dataclass(frozen=True, slots=True)
@@ -70,6 +72,7 @@ class Encoded:
     notes: tuple = ()
     layout: NcLayout = NcLayout()
     assumed_blank: bool = False   # Planned.assumed_blank: never written to a file
+    work_holding_id: str | None = None   # Planned.work_holding_id
 
 
 @dataclass(frozen=True)

@@ -17,10 +17,12 @@ from dataclasses import replace
 from typing import TYPE_CHECKING
 
 from ..errors import EngineError
+from ..gears.holding_matching import choose_holding
 from ..gears.models import model_for_class
 from ..gears.records import Hob, load_gear, load_hobs
 from ..hobbing.cylindrical import program_name
 from ..machines.records import Machine, load_machine
+from ..machines.work_holding import job_work_holding
 from ..memory import no_cycle_collection
 from ..nc.layout import NcLayout, class_layout
 from ..templates.rows import Template
@@ -90,6 +92,7 @@ class Remaker:
             check_hobbing_job(job_id, gear_class, model, workpiece.gear, workpiece.hob, machine, params,
                               module_params)
             check_program_name(self.conn, job_id, gear_id, params)
+            check_work_holding(job_id, workpiece, machine)
             check_hobbing_feeds(job_id, workpiece.gear, workpiece.hob, machine, params, module_params, bounded=False)
         if "cycle_time" in params:   # the time follows feeds edited since
             params = job_with_cycle_time(job_id, params, module_params, model.cut_shape, machine)
@@ -114,7 +117,7 @@ class Remaker:
         hob = self._hobs.get(hob_id)
         if hob is None:
             raise EngineError(f"hob {hob_id!r} of the job does not exist; see `engine hobs list`")
-        return Workpiece(load_gear(self.conn, gear_id), hob)
+        return Workpiece(load_gear(self.conn, gear_id), hob, job_work_holding(self.conn, job_id))
 
     def turning(self, gear_class: str) -> bool:
         """Whether the class's model is a turning one (its jobs run on a lathe)."""
@@ -150,6 +153,17 @@ def check_machine_kind(job_id: int, gear_class: str, machine: Machine, turning: 
         wanted = "a lathe" if turning else "a hobbing machine"
         raise EngineError(f"job {job_id}: machine {machine.name} is a {machine.kind}, class {gear_class!r} runs on "
                           f"{wanted}; correct job.machine; nothing stored")
+
+
+def check_work_holding(job_id: int, workpiece: Workpiece, machine: Machine) -> None:
+    """A stored job's work-holding is held to a new job's tests (engine.gears.holding_matching):
+    one too large for the gear's root is refused by name before the simulation."""
+    holding = workpiece.holding
+    if holding is not None:
+        try:
+            choose_holding(workpiece.gear, workpiece.hob, machine, [holding], holding.id)
+        except EngineError as refusal:
+            raise EngineError(f"job {job_id}: {refusal}; nothing stored") from None
 
 
 def check_program_name(conn: Connection, job_id: int, gear_id: int, params: dict) -> None:

@@ -34,7 +34,7 @@ program stored with none (NULL) since traces were kept is a MISMATCH."""
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
 from ..db.connection import scalar
@@ -42,6 +42,7 @@ from ..errors import EngineError
 from ..gears.models import model_for_class
 from ..gears.records import Hob, load_gear, load_hobs
 from ..machines.records import Machine, load_machine
+from ..machines.work_holding import job_work_holding
 from ..names import shown
 from ..nc.lineage import lineage_line, lineage_words, with_lineage
 from ..templates.decision_table import compiled_template
@@ -199,6 +200,8 @@ class Renderer:
 
         params, module_params, model = stored.params, stored.module_params, self.model(stored.gear_class)
         workpiece = self.workpiece(stored.gear_id, stored.hob_id) if model else None
+        if workpiece is not None:   # the job's work-holding, which its program states and is proved against
+            workpiece = replace(workpiece, holding=job_work_holding(self.conn, stored.job_id))
         machine = self.machine(stored.machine)
         checks = None
         if workpiece is not None and machine.kind == "hobber":   # the job held to a new job's bounds too

@@ -36,11 +36,12 @@ DRAFTS = ("SELECT c, v, NOT EXISTS (SELECT 1 FROM template_release r WHERE r.gea
           "FROM unnest(%s::text[], %s::int[]) AS x (c, v)")
 
 INSERT_JOB = """
-INSERT INTO job (gear_id, gear_class, machine, hob_id, params, module_params, cutting)
-VALUES (%s, %s, %s, %s, %s, %s, %s) RETURNING id"""
+INSERT INTO job (gear_id, gear_class, machine, hob_id, params, module_params, cutting, work_holding_id)
+VALUES (%s, %s, %s, %s, %s, %s, %s, %s) RETURNING id"""
 INSERT_PROGRAM = ("INSERT INTO program_submission (id, job_id, gear_class, template_version, template_hash, name, "
                   "lines, row_ids, trace, unverified) VALUES (%s, %s, %s, %s, %s, %s, %s, %s, %s, %s) RETURNING id")
-COPY_JOB = "COPY job (id, gear_id, gear_class, machine, hob_id, params, module_params, cutting) FROM STDIN"
+COPY_JOB = ("COPY job (id, gear_id, gear_class, machine, hob_id, params, module_params, cutting, work_holding_id) "
+            "FROM STDIN")
 COPY_PROGRAM = ("COPY program_submission (id, job_id, gear_class, template_version, template_hash, name, lines, "
                 "row_ids, trace) FROM STDIN (FORMAT BINARY)")
 PROGRAM_TYPES = ("int8", "int8", "text", "int4", "text", "text", "text[]", "int4[]", "jsonb")
@@ -79,7 +80,7 @@ def _stored_one(conn: Connection, planned: Planned, existing_job: int | None, pa
     if job_id is None:
         job_id = scalar(conn.execute(INSERT_JOB, (planned.gear_id, planned.gear_class, planned.machine,
                                                   planned.hob_id, Jsonb(planned.params), Jsonb(planned.module_params),
-                                                  Jsonb(planned.cutting or {}))))
+                                                  Jsonb(planned.cutting or {}), planned.work_holding_id)))
     program_id = _next_ids(conn, "program_id_seq", 1)[0]
     template = planned.template
     lines, row_ids = Lineage(conn, [planned.machine], [(template.gear_class, template.version)], [job_id]).added(
@@ -118,7 +119,8 @@ def store_many(conn: Connection, encoded: list[Encoded], out=None, files=None) -
         with conn.cursor().copy(COPY_JOB) as copy:
             for job_id, item in zip(job_ids, encoded):
                 copy.write_row((job_id, item.gear_id, item.gear_class, item.machine, item.hob_id,
-                                _json(item.params), _json(item.module_params), _json(item.cutting)))
+                                _json(item.params), _json(item.module_params), _json(item.cutting),
+                                item.work_holding_id))
         _stored_texts(files, _copy_programs(conn, program_ids, job_ids, encoded))
     return Batch(len(encoded), sum(len(item.lines) + 1 for item in encoded),
                  min(program_ids), max(program_ids), out,

@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 from ..errors import EngineError
 from ..gears.records import Gear, Hob
 from ..machines.records import Machine
+from ..machines.work_holding import WorkHolding
 from ..nc.lineage import refuse_lineage_shaped
 from ..simulation import SimulationError, simulate_program
 from ..simulation.turning import BLANK_PARAMS
@@ -29,9 +30,11 @@ from ..verifier import verify_program
 
 @dataclass(frozen=True, slots=True)
 class Workpiece:
-    """What a hobbing program is proved against: the gear (with its units) and the hob, as stored."""
+    """What a hobbing program is proved against: the gear (with its units) and the hob, as stored,
+    and the job's work-holding (None: the machine record's fixture and tailstock, issue 29)."""
     gear: Gear
     hob: Hob
+    holding: WorkHolding | None = None
 
 
 @dataclass(frozen=True, slots=True)
@@ -103,6 +106,6 @@ def prove(lines: list[str], machine: Machine, workpiece: Workpiece | TurningWork
     if not isinstance(workpiece, Workpiece):
         raise EngineError(f"{name}: a hobbing program needs its gear and hob to be proved by the simulation; "
                           "nothing stored")
-    report = simulate_program(lines, workpiece.gear, workpiece.hob, machine, name)
+    report = simulate_program(lines, workpiece.gear, workpiece.hob, machine, name, workpiece.holding)
     if report.refused:   # named by the gear: the id the user gave (a batch names each bad gear)
         raise SimulationError(f"gear {workpiece.gear.id}: {report.error()}; nothing stored")

@@ -14,6 +14,7 @@ from ..errors import EngineError
 from ..gears.models import model_for_class
 from ..gears.records import Gear, Hob, load_gear, load_hobs
 from ..machines.records import load_machine
+from ..machines.work_holding import WorkHolding, job_work_holding
 from ..nc.lineage import refuse_lineage_shaped
 from ..programs.drawing_records import turning_job_drawing
 from ..programs.job_shape import job_with_cycle_time
@@ -40,6 +41,7 @@ class JobInputs:
         self.gears: dict[int, Gear | EngineError] = {}   # a gear that no longer loads: why, for its proof
         self.hobs: dict[str, Hob] | None = None
         self.drawings: dict[int, DrawingRecord | EngineError] = {}   # job -> its record, or why it has none fit
+        self.holdings: dict[int, WorkHolding | None] = {}   # job -> its work-holding (None: the machine's own)
 
     def read_records(self, pending: dict[tuple, int]) -> None:
         """The machines, gears, hobs and drawing records the proofs of these job inputs (each with a
@@ -56,6 +58,7 @@ class JobInputs:
         kind = self.machine(machine_name).kind
         if kind == "hobber" and gear_id is not None and hob_id is not None:
             self.workpiece(job_id, gear_id, hob_id)
+            self.holding(job_id)
         elif kind == "lathe" and self.drawn(gear_class, params := json.loads(params_text)):
             self.drawing(job_id, params, json.loads(modules_text or "{}"))
 
@@ -110,7 +113,7 @@ class JobInputs:
             raise EngineError(f"job {job_id} is a hobbing job without a {'gear' if gear_id is None else 'hob'}: "
                               "its program cannot be proved against the records")
         gear, hob = self.workpiece(job_id, gear_id, hob_id)
-        report = simulate_program(lines, gear, hob, machine, name or "the program")
+        report = simulate_program(lines, gear, hob, machine, name or "the program", self.holding(job_id))
         if report.refused:
             raise SimulationError(f"gear {gear_id}: {report.error()}")
 
@@ -148,6 +151,12 @@ class JobInputs:
         if isinstance(gear, EngineError):
             raise EngineError(str(gear))
         return gear, self.hobs[hob_id]
+
+    def holding(self, job_id: int) -> WorkHolding | None:
+        """The job's work-holding, which its program states and is proved against (issue 29), read once."""
+        if job_id not in self.holdings:
+            self.holdings[job_id] = job_work_holding(self.conn, job_id)
+        return self.holdings[job_id]
 
     def cut_shape(self, gear_class: str) -> str:
         if gear_class not in self.shapes:

@@ -11,11 +11,13 @@ from dataclasses import dataclass
 
 from ...gears.records import Gear, Hob
 from ...machines.records import Machine
+from ...machines.work_holding import WorkHolding
 from .cutting_speed import material_note
 from .floor_facts import floor_facts
 from .frame import Senses
 from .header_facts import gear_line_problem, hob_line_problem, table_problem, template_class, unit_line_problem
 from .hob_fit import hob_fit_problem
+from .holding_facts import holding_facts
 from .mark_facts import mark_facts
 from .program_facts import area_facts, cut_count_facts, cut_word_facts, speed_facts, tailstock_facts
 from .report import Report
@@ -23,12 +25,14 @@ from .report import Report
 
 @dataclass(frozen=True)
 class Records:
-    """What the fact rules check the program's reading against: the gear, hob and machine records."""
+    """What the fact rules check the program's reading against: the gear, hob and machine records
+    and the job's work-holding."""
     steps: list
     gear: Gear
     hob: Hob
     machine: Machine
     report: Report      # the walk's, for the cuts it found
+    holding: WorkHolding | None = None   # the job's work-holding (None: the machine record's fixture)
 
 
 def _hob_fits(records: Records):
@@ -82,6 +86,8 @@ FACT_RULES = (
              lambda r: tailstock_facts(r.steps)),
     FactRule("the working area set once, before the first move", "§A4", lambda r: area_facts(r.steps)),
     FactRule("GEAR, HOB, UNIT and table speed of the header are the records'", "§B4", _header_lines),
+    FactRule("the header's FIXTURE is the work-holding the program is proved against", "issue 29",
+             lambda r: holding_facts(r.steps, r.holding, r.machine.name)),
     FactRule("each cut's CLIMB/CONVENTIONAL/RADIAL/TANGENTIAL is its direction", "§B13, §B10",
              lambda r: cut_word_facts(r.steps, r.machine)),
     FactRule("the header's cuts and feed mode are the cuts'", "§B13, §B14",
@@ -93,11 +99,12 @@ FACT_RULES = (
 )
 
 
-def check_facts(steps, gear: Gear, hob: Hob, machine: Machine, report: Report) -> None:
+def check_facts(steps, gear: Gear, hob: Hob, machine: Machine, report: Report,
+                holding: WorkHolding | None = None) -> None:
     """Every FACT_RULES finding into the report."""
     if not steps:
         return
-    records = Records(steps, gear, hob, machine, report)
+    records = Records(steps, gear, hob, machine, report, holding)
     for rule in FACT_RULES:
         for step, message, refuses in rule.check(records):
             report.add(step.number, step.line, message, refuses)

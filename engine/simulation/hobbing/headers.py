@@ -1,6 +1,6 @@
 """The header comments a hobbing program states facts in (`; GEAR n`, `; HOB id`, `; MACHINE
-name`, `; CYCLE TIME m MIN`, `; ALLOWANCE a MM`): the simulation holds each to the records, the
-simulated time and the last cut's depth. A comment that looks like one of them but is written
+name`, `; FIXTURE id`, `; CYCLE TIME m MIN`, `; ALLOWANCE a MM`): the simulation holds each to the
+records, the simulated time and the last cut's depth. A comment that looks like one of them but is written
 another way (other case, `GEAR=44`, a trailing comment on a block) would go unchecked while a
 reader takes it as the program's claim, so it fails closed: refused unless it is the canonical form."""
 from __future__ import annotations
@@ -9,9 +9,10 @@ import re
 
 # The words of a header fact, and any time in minutes (a misspelt `; FL00R TO FL00R 9.9 MIN` is
 # still read as the program's time by whoever reads it: adversary 29).
-CLAIM = re.compile(r"\b(GEAR|HOB|MACHINE|CYCLE|FLOOR|ALLOWANCE)|\b(CUT|UNIT|n0)\b|[0-9]\s*MIN(UTES?)?\b",
+CLAIM = re.compile(r"\b(GEAR|HOB|MACHINE|FIXTURE|CYCLE|FLOOR|ALLOWANCE)|\b(CUT|UNIT|n0)\b|[0-9]\s*MIN(UTES?)?\b",
                    re.IGNORECASE)
 CANONICAL = (re.compile(r"; GEAR \S+( .*)?"), re.compile(r"; HOB \S+( .*)?"), re.compile(r"; MACHINE \S+"),
+             re.compile(r"; FIXTURE \S+"),   # the job's work-holding (engine.simulation.hobbing.holding_facts)
              re.compile(r"; CYCLE TIME [0-9]+(\.[0-9]+)? MIN"), re.compile(r"; FLOOR TO FLOOR [0-9]+(\.[0-9]+)? MIN"),
              re.compile(r"; ALLOWANCE [0-9]+(\.[0-9]+)? MM( .*)?"),
              # the facts engine.simulation.hobbing.header_facts and program_facts hold (issue 26)
@@ -32,9 +33,9 @@ def comment_problem(step) -> str | None:
         return None
     if step.kind == "comment" and not code.strip() and any(form.fullmatch(step.line) for form in CANONICAL):
         return None
-    return ("a comment that names a header fact (gear, hob, machine, cycle or floor-to-floor time, allowance, n0, "
-            "cut, unit) is not its canonical whole-line form `; GEAR <id>`, `; HOB <id>`, `; MACHINE <name>`, "
-            "`; CYCLE TIME <m> MIN`, `; FLOOR TO FLOOR <m> MIN`, "
+    return ("a comment that names a header fact (gear, hob, machine, fixture, cycle or floor-to-floor time, "
+            "allowance, n0, cut, unit) is not its canonical whole-line form `; GEAR <id>`, `; HOB <id>`, "
+            "`; MACHINE <name>`, `; FIXTURE <id>`, `; CYCLE TIME <m> MIN`, `; FLOOR TO FLOOR <m> MIN`, "
             "`; ALLOWANCE <mm> MM`, `; n0=<n> r/min table=<n2> r/min cuts=<c> <mode>`, `; CUT <name> … X=<x> <word>`, "
             "`; UNIT <n> z=<z> b=<b> Z<top>`: it would go unchecked")
 

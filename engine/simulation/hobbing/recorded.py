@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 
 from ...gears.records import Gear, Hob
 from ...machines.records import Machine
+from ...machines.work_holding import WorkHolding
 from .reading import read_program
 from .report import Report, SimulationError
 from .run import SHIFT_ENDS
@@ -111,14 +112,15 @@ class RecordingSimulation(BlockSimulation):
             self.cut_moves = []
 
 
-def record_program(lines: list[str], gear: Gear, hob: Hob, machine: Machine, name: str = "the program") -> Recording:
+def record_program(lines: list[str], gear: Gear, hob: Hob, machine: Machine, name: str = "the program",
+                   holding: WorkHolding | None = None) -> Recording:
     """The recording of `lines` (a hobbing program for `gear`, `hob`, `machine`); SimulationError
     for a program or machine the simulation cannot read."""
     if machine.kind != "hobber":
         raise SimulationError(f"machine {machine.name} is a {machine.kind}: the simulation follows hobbing programs")
     steps = read_program(lines, machine, name)
     ends = SHIFT_ENDS if any(step.kind == "shift" for step in steps) else SHIFT_ENDS[:1]
-    recordings = [_follow(steps, lines, gear, hob, machine, name, end) for end in ends]
+    recordings = [_follow(steps, lines, gear, hob, machine, name, end, holding) for end in ends]
     held = [pose["Y"] for recording in recordings for move in recording.moves if move.cutting
             for pose in (move.start, move.end) if "Y" in pose]
     recording = recordings[0]
@@ -126,10 +128,11 @@ def record_program(lines: list[str], gear: Gear, hob: Hob, machine: Machine, nam
     return recording
 
 
-def _follow(steps, lines, gear: Gear, hob: Hob, machine: Machine, name: str, shift_end: int) -> Recording:
+def _follow(steps, lines, gear: Gear, hob: Hob, machine: Machine, name: str, shift_end: int,
+            holding: WorkHolding | None = None) -> Recording:
     worm_wheel = hob.purpose == "worm_wheel"
     units = unit_solids(gear, hob, worm_wheel)
-    setup = setup_solids(machine, units, hob)
+    setup = setup_solids(machine, units, hob, holding)
     recording = Recording(Report(name), units, setup)
     walk = RecordingSimulation(recording, recording.report, gear, hob, machine, units, setup, worm_wheel, shift_end)
     for step in steps:

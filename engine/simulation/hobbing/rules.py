@@ -10,6 +10,7 @@ import re
 from ...gears.cutting_data import feed_maximum
 from ...gears.records import Gear, Hob
 from ...machines.records import Machine
+from ...machines.work_holding import KINDS as WORK_HOLDING_KINDS
 
 TOOTH_DEPTH = 2.25        # h = 2.25·m_n (§B15)
 WORK_OFFSETS = (54, 55, 56, 57)
@@ -135,5 +136,8 @@ def setup_advice(solid_name: str) -> str:
         return ("; clamp without the tailstock (--no-tailstock) or use a smaller tailstock/fixture in the "
                 "machine record")
     if solid_name == "the fixture":
-        return "; use a smaller fixture or a larger fixture_gap (a spacer) in the machine record"
+        return ("; use a smaller fixture (a work-holding sized for the gear: `engine fixtures match --gear ID`, "
+                "`engine instantiate --fixture ID`) or a larger fixture_gap (a spacer) in the machine record")
+    if solid_name.startswith("the ") and solid_name.split()[1] in WORK_HOLDING_KINDS:
+        return "; choose a work-holding that clears the root (`engine fixtures match --gear ID`)"
     return ""

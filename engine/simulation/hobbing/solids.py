@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING, Any
 
 from ...gears.records import Gear, Hob
 from ...machines.records import Machine
+from ...machines.work_holding import WorkHolding
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -133,18 +134,23 @@ def _throat(gear, hob, root_radius, top, width, slope):
 ROOTS = {"cone": _cone, "crowned": _crowned, "throat": _throat}
 
 
-def setup_solids(machine: Machine, units: list[Solid], hob: Hob) -> list[Solid]:
+def setup_solids(machine: Machine, units: list[Solid], hob: Hob, holding: WorkHolding | None = None) -> list[Solid]:
     """The fixture below the lowest unit's bottom face and the tailstock above the top face,
-    each followed from its face to past the travel (a diameter of 0: none)."""
+    each followed from its face to past the travel (a diameter of 0: none). A job's work-holding
+    (issue 29) puts its own part under the gear, `height` mm tall, on the machine's fixture, and its
+    centre in place of the machine's tailstock."""
     reach = hob.tip_diameter / 2 + hob.length
     bottom = min(unit.z_low for unit in units) - machine.fixture_gap
     top = max(unit.z_high for unit in units) + machine.tailstock_gap
     z_far_low = min(machine.z_min, -machine.z_max) - reach - BEYOND_TRAVEL
     z_far_high = max(machine.z_max, -machine.z_min) + reach + BEYOND_TRAVEL
     solids = []
+    if holding is not None:
+        solids.append(Solid(f"the {holding.kind} {holding.id}", bottom - holding.height, bottom, holding.diameter / 2))
+        bottom -= holding.height
     if machine.fixture_diameter > 0:
         solids.append(Solid("the fixture", min(z_far_low, bottom - 1.0), bottom, machine.fixture_diameter / 2))
-    if machine.tailstock_diameter > 0:
-        solids.append(Solid("the tailstock", top, max(z_far_high, top + 1.0), machine.tailstock_diameter / 2,
-                            clamped_only=True))
+    tailstock = machine.tailstock_diameter if holding is None else holding.tailstock_diameter
+    if tailstock > 0:
+        solids.append(Solid("the tailstock", top, max(z_far_high, top + 1.0), tailstock / 2, clamped_only=True))
     return solids
