@@ -110,3 +110,19 @@ def test_a_catalogue_hob_entered_as_normal_does_not_fit_the_wheel(wheels):
                    "module_kind) VALUES ('CAT-AS-NORMAL', 3, 1, 37.5, 90, 'R', 'A', 'worm_wheel', 'normal')")
     with pytest.raises(EngineError, match=r"no hob has axial module 3 among"):
         instantiate_gear(wheels, WHEELS["R", 1], choices=Choices(worm_feed="tangential"))
+
+
+def test_a_tangential_wheel_over_module_3_is_cut_once_and_says_so(wheels):
+    """A tangential pass feeds the hob through the wheel at full depth once (§B10). The header said
+    the module's two cuts (m_x 4 > 3) and the simulation, following one, refused every such wheel;
+    two cuts asked for are refused in one line."""
+    wheels.execute("UPDATE gear SET module = 4, tip_diameter = 4 * 42, root_diameter = 4 * 37.5 WHERE id = %s",
+                   (WHEELS["R", 1],))
+    wheels.execute("UPDATE hob SET module = 4, tip_diameter = 50 WHERE id = 'CAT-WW-MX3-R1'")
+    wheels.execute("UPDATE machine SET y_min = -150, y_max = 150 WHERE name = 'hobber-840d'")   # the stroke
+    _, nc = made(wheels, WHEELS["R", 1], "tangential")
+    header = next(line for line in nc.lines if line.startswith("; n0="))
+    assert " cuts=1 " in header
+    assert len([move for move in nc.moves_in("G1") if move.changed == {"Y"}]) == 1
+    with pytest.raises(EngineError, match="two cuts with a tangential feed"):
+        instantiate_gear(wheels, WHEELS["R", 1], choices=Choices(worm_feed="tangential", cuts=2))

@@ -38,7 +38,9 @@ class WormWheelModel(CylindricalModel):
         check_module_stated(gear)
         setup = self.setup(gear, hob)
         tangential = choices.worm_feed == "tangential"
-        cuts = plan_cuts(gear.module, setup.full_depth, replace(choices, cuts=1) if tangential else choices)
+        if tangential:
+            choices = one_tangential_cut(gear, choices)
+        cuts = plan_cuts(gear.module, setup.full_depth, choices)
         table_speed = cutting.hob_speed * hob.starts / gear.teeth
         module_params = {f"cutmotion:{cut.number}": {
             "cut_name": cut.name, "cut_x": round(cut.centre_distance, 3), "cut_on": cut.on,
@@ -66,6 +68,16 @@ def cut_feeds(cut, cutting, starts: int, teeth: int) -> dict:
     axial = cutting.axial_feed_finish if finish else cutting.axial_feed_rough
     return {"feed_radial": programmed_feed(per_minute(radial, cutting.hob_speed, starts, teeth)),
             "feed_tangential": programmed_feed(per_minute(axial, cutting.hob_speed, starts, teeth))}
+
+
+def one_tangential_cut(gear, choices):
+    """A tangential pass feeds the hob through the wheel at full depth once (§B10): one cut, and
+    the header says so (it said the module's two, and the simulation, following one, refused every
+    tangential wheel over m 3: new-user review 29). Two cuts asked for are refused, not dropped."""
+    if choices.cuts == 2:
+        raise EngineError(f"gear {gear.id}: two cuts with a tangential feed: a tangential pass cuts the full depth "
+                          "once; give --cuts 1, or --worm-feed radial for a rough and a finishing plunge")
+    return replace(choices, cuts=1)
 
 
 def check_module_stated(gear) -> None:
