@@ -383,3 +383,17 @@ def test_match_takes_a_worm_wheel_hob_for_a_worm_wheel_class(run):
 def test_match_of_a_missing_gear_is_refused(run):
     result = run("hobs", "match", "--gear", 999)
     assert result.exit_code == 1 and "gear 999 does not exist" in result.stderr
+
+
+def test_the_list_as_csv_is_a_file_import_reads_back_unchanged(run, tmp_path):
+    """sqlite-utils' rule: every list exports what its import reads (adversary and new-user review 29:
+    the header said hob_id, the import wants id)."""
+    listed = run("hobs", "list", "--csv")
+    assert listed.exit_code == 0 and listed.stdout.splitlines()[0].startswith("id,module,module_kind,")
+    path = tmp_path / "hobs.csv"
+    path.write_text(listed.stdout, encoding="utf-8")
+    before = hob_rows(run.url)
+    again = run("hobs", "import", path, "--json")
+    assert again.exit_code == 0, again.output
+    assert json.loads(again.stdout) == {"added": 0, "updated": len(before)}
+    assert hob_rows(run.url) == before

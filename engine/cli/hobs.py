@@ -43,7 +43,11 @@ def hobs_list(ctx, output):
 
     with connection(ctx) as conn:
         library = hob_records(conn)
-    emit_list(output, "hobs", HOB_COLUMNS, library)
+    if output == "csv":   # the columns `hobs import` reads: its id column is `id`
+        library, columns = [{"id": hob["hob_id"], **hob} for hob in library], (Column("id", "id"), *HOB_COLUMNS[1:])
+        emit_list(output, "hobs", columns, library)
+    else:
+        emit_list(output, "hobs", HOB_COLUMNS, library)
 
 
 @hobs.command("show")
