@@ -166,7 +166,8 @@ def add_hob(conn: psycopg.Connection, hob: Hob) -> None:
     """Store one new hob; refuse a bad one (every problem named) or an id already there."""
     values, problems = parse_hob({name: _cell(getattr(hob, name)) for name in COLUMN_NAMES})
     if problems:
-        told = "; ".join(f"{problem.column} {problem.what}" for problem in problems)
+        told = "; ".join(f"{problem.column} {problem.what} ({problem.todo})" if problem.todo else
+                         f"{problem.column} {problem.what}" for problem in problems)
         raise EngineError(f"hob {said('hob', hob.id) if hob.id else '(no id)'}: {told}; nothing stored")
     exists = f"hob {values['id']} already exists; choose another id, or change it with `engine hobs import FILE.csv`"
     found = conn.execute("SELECT id FROM hob WHERE upper(id) = upper(%s)", (values["id"],)).fetchone()
