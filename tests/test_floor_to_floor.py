@@ -89,3 +89,12 @@ def test_a_machine_that_does_not_state_its_times_gets_no_line_and_refuses_one(co
     claimed = program.lines[:2] + ["; FLOOR TO FLOOR 3.0 MIN"] + program.lines[2:]
     assert any("does not state load_unload_time" in message for message in refusals(simulate_program(
         claimed, *records(conn, 42, hob_id))))
+
+
+def test_a_machine_that_states_some_of_its_times_is_told_which_are_missing(conn):
+    """New-user review 29: a machine stating some times and not others got no line and no word."""
+    conn.execute("UPDATE machine SET door_time = NULL, load_unload_time = NULL WHERE name = 'hobber-840d'")
+    program = instantiate_gear(conn, 42)
+    assert not any(FLOOR.fullmatch(line) for line in program.lines)
+    assert any("no floor-to-floor time: machine hobber-840d does not state door_time, load_unload_time" in note
+               for note in program.notes), program.notes

@@ -32,3 +32,13 @@ def floor_to_floor(job: dict, modules: dict, machine: Machine, cycle: float) -> 
     seconds = (abs(job["swivel"]) / swivel + couplings * (runup + sync) + 2 * job["tailstock"] * tailstock
                + doors * door + tool + load)
     return cycle + seconds / 60
+
+
+def floor_time_notes(machine: Machine) -> list[str]:
+    """Why a program for a machine that states some of its times but not all has no floor-to-floor
+    line (new-user review 29: nothing said so); nothing where it states all or none."""
+    missing = [name for name in TIMES if getattr(machine, name) is None]
+    if not missing or len(missing) == len(TIMES):
+        return []
+    return [f"no floor-to-floor time: machine {machine.name} does not state {', '.join(missing)}; "
+            "state them on its record (docs/guide/machines-and-simulation.md)"]

@@ -19,6 +19,7 @@ from ..gears.models import model_for_class
 from ..gears.process_notes import hunting_tooth_notes
 from ..gears.records import Gear, load_gear, load_gears, load_hobs
 from ..hobbing.choices import Choices
+from ..hobbing.floor_time import floor_time_notes
 from ..machines.records import Machine, hobbing_machine
 from ..machines.work_holding import load_work_holdings
 from ..memory import no_cycle_collection
@@ -134,7 +135,8 @@ class Planner:
         kinds = CUT_KINDS_BY_COUNT[choices.cut_count(gear.module)]
         cutting = cutting.of_cuts(kinds)
         record = job_cutting_record(cutting, gear, hob, kinds, case_ids)
-        notes = [f"gear {gear.id}: {note}" for note in cutting.notes] + hunting_tooth_notes(gear, hob)
+        notes = ([f"gear {gear.id}: {note}" for note in cutting.notes] + hunting_tooth_notes(gear, hob)
+                 + floor_time_notes(self.machine))
         return Planned(gear.id, gear.gear_class, self.machine.name, hob.id, params, job.module_params, template,
                        result, record, notes, self._layouts[gear.gear_class],
                        work_holding_id=holding.id if holding else None)
