@@ -47,6 +47,7 @@ from helpers.hobbing_reference_gears import (
     make_gear,
     make_hob,
     only_hob,
+    read_holding,
     read_machine,
 )
 from helpers.hobbing_reference_programs import HAND_WRITTEN
@@ -377,7 +378,8 @@ def test_random_valid_gears_make_a_correct_program_or_a_one_line_refusal(conn, k
     shift = {5.0: 5.0}.get(choice.get("shift_y"), "per part" if choice.get("shift_per_part") else 0.0)
     case = Case(gear, hob, read_machine(conn, DIN.name), Job(choice.get("coolant", True), shift,
                                                              choice.get("worm_feed", "radial"),
-                                                             choice.get("tailstock", True)))
+                                                             choice.get("tailstock", True)),
+                read_holding(conn, program.text))
     problems = all_problems(read(program.text), case)
     assert not problems, f"{gear} {hob} {choice}:\n  " + "\n  ".join(problems) + "\n" + program.text
 

@@ -203,7 +203,7 @@ def test_hobs_show_and_csv(run):
     assert (hob["hob_id"], hob["module"], hob["starts"], hob["hand"], hob["tool_number"]) == \
         ("H-LIST-1", 4.5, 2, "L", 7)
     assert [job["job_id"] for job in hob["jobs"]] == [job_id]
-    rows = {row["hob_id"]: row for row in csv.DictReader(io.StringIO(run("hobs", "list", "--csv").stdout))}
+    rows = {row["id"]: row for row in csv.DictReader(io.StringIO(run("hobs", "list", "--csv").stdout))}
     assert (rows["H-LIST-1"]["module"], rows["H-LIST-1"]["accuracy_class"]) == ("4.5", "B")
 
 

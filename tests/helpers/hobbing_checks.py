@@ -46,11 +46,21 @@ class Job:
 
 
 @dataclass(frozen=True)
+class Holding:
+    """A job's work-holding as the shop's record declares it (table work_holding, issue 29): its
+    part under the gear (diameter, height, on the machine's fixture) and its centre above (Ø, 0 = none)."""
+    diameter: float
+    height: float
+    tailstock_diameter: float
+
+
+@dataclass(frozen=True)
 class Case:
     gear: Gear
     hob: Hob
     machine: Machine = Machine()
     job: Job = Job()
+    holding: Holding | None = None    # the program's `; FIXTURE <id>`; None: the machine's own
 
     @property
     def tangential(self) -> bool:

@@ -26,14 +26,21 @@ REACH = 1000.0      # mm: the fixture and tailstock are long cylinders along the
 
 def obstacles(case: Case) -> list[tuple[str, float, Solid]]:
     """Fixture below the lowest unit, tailstock above the top face (when the job clamps with it),
-    as (name, diameter, cylinder) in the DIN frame, from the machine record."""
+    as (name, diameter, cylinder) in the DIN frame, from the machine record; with a job's
+    work-holding, its part under the gear and its centre (the work_holding record)."""
     found = []
     bottom = min(u.bottom for u in case.gear.units)
     top = max(u.z_top for u in case.gear.units)
     diameter, gap = case.machine.fixture
+    if case.holding is not None:    # the job's work-holding under the gear, on the machine's fixture
+        found.append(("work-holding", case.holding.diameter,
+                      Solid(case.holding.diameter / 2, bottom - gap - case.holding.height, bottom - gap)))
+        bottom -= case.holding.height
     if diameter > 0:
         found.append(("fixture", diameter, Solid(diameter / 2, bottom - gap - REACH, bottom - gap)))
     diameter, gap = case.machine.tailstock
+    if case.holding is not None:    # its centre in place of the machine's tailstock
+        diameter = case.holding.tailstock_diameter
     if diameter > 0 and case.job.tailstock:
         found.append(("tailstock", diameter, Solid(diameter / 2, top + gap, top + gap + REACH)))
     return found

@@ -5,7 +5,9 @@ Diameters follow the reference: d = mn·z/cosβ, d_a = d + 2mn(1 + x), d_f = d_a
 from __future__ import annotations
 
 import math
+import re
 
+from helpers.hobbing_checks import Holding
 from helpers.hobbing_reference import Gear, Hob, Machine, Unit, lead_angle
 
 DIN = Machine()
@@ -98,3 +100,14 @@ def read_machine(conn, name: str) -> Machine:
     return Machine(name, a, b, c, y, z, offset, float(table) if table else math.inf, float(rapid),
                    (number(fix_d), number(fix_gap)), (number(tail_d), number(tail_gap)),
                    (None if load_x is None else float(load_x), None if load_z is None else float(load_z)))
+
+
+def read_holding(conn, program_text: str):
+    """The work-holding the program states (`; FIXTURE <id>`), as its record declares it; None
+    where the program states none (the machine's own fixture and tailstock)."""
+    stated = re.search(r"^; FIXTURE (\S+)$", program_text, re.MULTILINE)
+    if stated is None:
+        return None
+    row = conn.execute("SELECT diameter, height, tailstock_diameter FROM work_holding WHERE id = %s",
+                       (stated.group(1),)).fetchone()
+    return Holding(*(float(value) for value in row))
