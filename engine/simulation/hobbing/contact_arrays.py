@@ -57,10 +57,9 @@ def _meet(solid: Solid, hob: HobBody, swivel: float, cx, cy, cz, motion: Motion)
         return None   # every pose keeps out of the material in X alone: _collision finds nothing
     count = len(solid.heights)
     raw = first[:, None] + np.arange(int((last - first).max()))[None, :]
-    valid, index = raw < last[:, None], np.minimum(raw, count - 1)
     if limit is None:
-        return _cut(solid, motion, *least_sections(hob, swivel, (cx, cy, cz), _heights(solid), index, valid,
-                                                          (first, last)))
+        return _cut(solid, motion, *least_sections(hob, swivel, (cx, cy, cz), _heights(solid), raw, last))
+    valid, index = raw < last[:, None], np.minimum(raw, count - 1)
     sections = Sections(hob, swivel, cx, cz, _heights(solid)[index])
     if sections.farther_than(cy, np.where(valid, limit[index], -np.inf)):
         return None   # no section can come into the material: _collision finds nothing
