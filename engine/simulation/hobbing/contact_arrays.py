@@ -2,8 +2,9 @@
 heights each one spans as arrays, every section's least distance at once
 (engine.simulation.hobbing.envelope_arrays), and the same rules as contact's plain floats: the
 intended cut recorded in the unit's reach (the least distance per height over the move's
-poses), the deepest point below the root or inside the material, the first pose and lowest
-height of equal depths. Imported after a process's first contact.MATH_SECTIONS sections."""
+poses: engine.simulation.hobbing.least_arrays), the deepest point below the root or inside the
+material, the first pose and lowest height of equal depths. Imported after a process's first
+contact.MATH_SECTIONS sections."""
 from __future__ import annotations
 
 import math

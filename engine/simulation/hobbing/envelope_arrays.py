@@ -83,12 +83,6 @@ class Sections:
         gap = np.maximum(gap, 0.0)
         return lower, np.where(self.empty, np.inf, np.sqrt(gap * gap + across ** 2))
 
-    def upper(self, cy):
-        """bounds' upper alone (mm): the distance of the slice's point (cx − w₀, d₀)."""
-        _, _, gap, across = self._point(cy)
-        gap = np.maximum(gap, 0.0)
-        return np.where(self.empty, np.inf, np.sqrt(gap * gap + across ** 2))
-
     def _point(self, cy) -> tuple:
         """At d₀ (−cy clamped into the band): q₀, w₀ (the slice's half-width there), cx − w₀ and cy + d₀ (mm)."""
         d0 = np.minimum(np.maximum(-cy, self.low), self.high)
