@@ -2,8 +2,9 @@
 heights each one spans as arrays, every section's least distance at once
 (engine.simulation.hobbing.envelope_arrays), and the same rules as contact's plain floats: the
 intended cut recorded in the unit's reach (the least distance per height over the move's
-poses), the deepest point below the root or inside the material, the first pose and lowest
-height of equal depths. Imported after a process's first contact.MATH_SECTIONS sections."""
+poses: engine.simulation.hobbing.least_arrays), the deepest point below the root or inside the
+material, the first pose and lowest height of equal depths. Imported after a process's first
+contact.MATH_SECTIONS sections."""
 from __future__ import annotations
 
 import math
@@ -14,6 +15,7 @@ from .contact_bounds_arrays import exact_collision
 from .contact_records import COLLISION_TOLERANCE, TOLERANCE, Contact, Motion, contact_at, exact
 from .envelope import HobBody
 from .envelope_arrays import SLACK, Sections
+from .least_arrays import least_sections
 from .paths import AXES, pose_count
 from .solids import Solid
 
@@ -28,11 +30,19 @@ def meet_all(solids: list[Solid], hob: HobBody, swivel: float, pieces: list, mot
     return [contact for contact in found if contact is not None]
 
 
-def _poses(pieces: list) -> tuple:
-    """paths.pieces_poses as arrays, the same values (the same shares i/(n − 1) of each piece)."""
-    shares = [np.arange(count) / (count - 1) for count in (pose_count(a, b) for a, b in pieces)]
-    return tuple(np.concatenate([a.get(axis, 0.0) + share * (b.get(axis, 0.0) - a.get(axis, 0.0))
-                                 for (a, b), share in zip(pieces, shares)]) for axis in AXES)
+def _poses(pieces: list):
+    """paths.pieces_poses as arrays (rows X, Y, Z), the same values (the same shares i/(n − 1)
+    of each piece)."""
+    rows = [_piece_poses(a, b) for a, b in pieces]
+    return rows[0] if len(rows) == 1 else np.concatenate(rows, axis=1)
+
+
+def _piece_poses(a: dict, b: dict):
+    """The poses of one piece (rows X, Y, Z, mm): its start plus each share of its travel."""
+    count = pose_count(a, b)
+    start = np.array([[a.get(axis, 0.0)] for axis in AXES])
+    travel = np.array([[b.get(axis, 0.0) - a.get(axis, 0.0)] for axis in AXES])
+    return start + (np.arange(count) / (count - 1)) * travel
 
 
 def _meet(solid: Solid, hob: HobBody, swivel: float, cx, cy, cz, motion: Motion) -> Contact | None:
@@ -48,11 +58,10 @@ def _meet(solid: Solid, hob: HobBody, swivel: float, cx, cy, cz, motion: Motion)
         return None   # every pose keeps out of the material in X alone: _collision finds nothing
     count = len(solid.heights)
     raw = first[:, None] + np.arange(int((last - first).max()))[None, :]
+    if limit is None:
+        return _cut(solid, motion, *least_sections(hob, swivel, (cx, cy, cz), _heights(solid), raw, last))
     valid, index = raw < last[:, None], np.minimum(raw, count - 1)
     sections = Sections(hob, swivel, cx, cz, _heights(solid)[index])
-    if limit is None:
-        radius = _least_per_height(sections, cy, raw, valid, count)
-        return _cut(solid, motion, index, radius, _per_height_least(radius, raw, count))
     if sections.farther_than(cy, np.where(valid, limit[index], -np.inf)):
         return None   # no section can come into the material: _collision finds nothing
     return _collision(solid, motion, index, np.where(valid, sections.nearest(cy), np.inf), limit)
@@ -61,17 +70,19 @@ def _meet(solid: Solid, hob: HobBody, swivel: float, cx, cy, cz, motion: Motion)
 def _near_poses(solid: Solid, extent: float, radius: float, cx, cy, cz):
     """(cx, cy, cz, first, last) of the poses within reach of the solid (contact._spans' tests),
     the first three of shape (P, 1); None for none."""
-    near = (cx - radius < solid.largest_radius + TOLERANCE) & (cz + extent >= solid.z_low) & \
-           (cz - extent <= solid.z_high)
-    if not near.any():
+    near = np.flatnonzero((cx - radius < solid.largest_radius + TOLERANCE) & (cz + extent >= solid.z_low) &
+                          (cz - extent <= solid.z_high))
+    if not near.size:
         return None
-    heights = _heights(solid)
-    first = np.searchsorted(heights, cz[near] - extent)
-    last = np.searchsorted(heights, cz[near] + extent, side="right")
+    heights, at = _heights(solid), cz[near]
+    first = np.searchsorted(heights, at - extent)
+    last = np.searchsorted(heights, at + extent, side="right")
     keep = last > first
-    if not keep.any():
-        return None
-    return cx[near][keep][:, None], cy[near][keep][:, None], cz[near][keep][:, None], first[keep], last[keep]
+    if not keep.all():
+        if not keep.any():
+            return None
+        near, first, last = near[keep], first[keep], last[keep]
+    return cx[near][:, None], cy[near][:, None], cz[near][:, None], first, last
 
 
 def _heights(solid: Solid):
@@ -86,31 +97,6 @@ def _blank(solid: Solid):
     if solid.radius_array is None:
         solid.radius_array = np.asarray(solid.radius, float)
     return solid.radius_array
-
-
-def _least_per_height(sections: Sections, cy, raw, valid, count: int):
-    """The sections' distances where one may be the least at its height over the move's poses,
-    inf elsewhere. A cut needs no more (_cut: the reach per height is that least, the unit is
-    entered and the root passed where it is, and no other section is the deepest). A section
-    whose lower bound is above the least upper bound at its height (by SLACK) is farther than
-    the least and left out (most are: the hob passes a height with most of its poses well above
-    or below it)."""
-    lower, upper = sections.bounds(cy)
-    lower = np.where(valid, lower, np.inf)
-    least_upper = _per_height_least(np.where(valid, upper, np.inf), raw, count)
-    keep = valid & (lower <= least_upper[np.minimum(raw, count - 1)] + SLACK)
-    radius = np.full(lower.shape, np.inf)
-    radius[keep] = sections.nearest(cy, keep)
-    return radius
-
-
-def _per_height_least(values, raw, count: int):
-    """The least of `values` (shape (P, W), inf where not valid) at each of `count` heights:
-    raw[p, j] is the height of values[p, j], increasing along a row (past count − 1 where
-    the row is padded), so each lands in a cell of its own in a table of P rows."""
-    table = np.full((raw.shape[0], count + raw.shape[1]), np.inf)
-    table[np.arange(raw.shape[0])[:, None], raw] = values
-    return table[:, :count].min(axis=0)
 
 
 def _open_below(solid: Solid, motion: Motion):
@@ -129,10 +115,13 @@ def _cut(solid: Solid, motion: Motion, index, radius, least) -> Contact | None:
     blank, root = _blank(solid), np.asarray(solid.intended_root)
     if (least < blank - TOLERANCE).any():
         solid.cut_sessions.add(motion.session)
-    for i in np.flatnonzero(np.isfinite(least)).tolist():
-        found = float(least[i])
-        solid.reach[i] = min(solid.reach[i], found)
-        solid.session_reach[i] = min(solid.session_reach[i], found)
+    reach, session_reach = solid.reach, solid.session_reach
+    at = np.flatnonzero(np.isfinite(least))
+    for i, found in zip(at.tolist(), least[at].tolist()):
+        if found < reach[i]:
+            reach[i] = found
+        if found < session_reach[i]:
+            session_reach[i] = found
     below = root[index] - radius
     return _deepest(solid, index, below, below > TOLERANCE, True)
 

@@ -30,14 +30,17 @@ class Sections:
         s, c = sine_cosine(swivel)
         r = hob.radius
         dz = heights - cz
-        low, high = (-hob.half_length - s * dz) / c, (hob.half_length - s * dz) / c
+        sdz, cdz = s * dz, c * dz
+        low, high = (-hob.half_length - sdz) / c, (hob.half_length - sdz) / c
         if s:
-            first, second = (c * dz - r) / s, (c * dz + r) / s
-            low, high = np.maximum(low, np.minimum(first, second)), np.minimum(high, np.maximum(first, second))
+            first, second = (cdz - r) / s, (cdz + r) / s       # first < second where s > 0
+            near, far = (first, second) if s > 0 else (second, first)
+            low, high = np.maximum(low, near), np.minimum(high, far)
             empty = low > high
         else:
             empty = np.abs(dz) > r
         self.s, self.c, self.r, self.cx, self.dz = s, c, r, np.abs(cx), dz   # across the axis: as far (cx ≥ 0)
+        self.cdz = cdz
         self.low, self.high, self.empty = low, np.where(empty, low, high), empty
 
     def nearest(self, cy, where=None):
@@ -46,13 +49,13 @@ class Sections:
         s, c, r = self.s, self.c, self.r
         if where is None:
             cx, cy = self.cx + 0.0 * self.dz, cy + 0.0 * self.dz
-            dz, low, high, empty = self.dz, self.low, self.high, self.empty
+            dz, cdz, low, high, empty = self.dz, self.cdz, self.low, self.high, self.empty
         else:
-            rows = np.nonzero(where)[0]
-            cx, cy = self.cx[rows, 0], cy[rows, 0]
-            dz, low, high, empty = self.dz[where], self.low[where], self.high[where], self.empty[where]
-        dy = np.clip(unbounded_dy(s, c, r, cx, cy, dz), low, high)
-        q = s * dy - c * dz
+            cx, cy = _picked(self.cx, where), _picked(cy, where)
+            dz, cdz, low, high, empty = (self.dz[where], self.cdz[where], self.low[where], self.high[where],
+                                         self.empty[where])
+        dy = np.minimum(np.maximum(unbounded_dy(s, c, r, cx, cy, dz), low), high)
+        q = s * dy - cdz
         gap = np.maximum(cx - np.sqrt(np.maximum(r * r - q * q, 0.0)), 0.0)
         return np.where(empty, np.inf, np.sqrt(gap * gap + (cy + dy) ** 2))
 
@@ -66,27 +69,36 @@ class Sections:
           k = w′(d₀) = −s·q₀/w₀, and the axis is (cx − w₀ + k·(cy + d₀))/√(1 + k²) from that
           line's far side.
         The upper is the distance of one of its points: (cx − w₀, d₀)."""
-        s, c, r, dz, cx = self.s, self.c, self.r, self.dz, self.cx
-        q_low, q_high = s * self.low - c * dz, s * self.high - c * dz
+        s, r, cdz, cx = self.s, self.r, self.cdz, self.cx
+        q_low, q_high = s * self.low - cdz, s * self.high - cdz
         if s < 0:
             q_low, q_high = q_high, q_low
         least = np.maximum(np.maximum(q_low, -q_high), 0.0)      # 0 where q changes sign in the band
         in_x = cx - np.sqrt(np.maximum(r * r - least * least, 0.0))
-        d0 = np.clip(-cy, self.low, self.high)
-        q0 = s * d0 - c * dz
-        w0 = np.sqrt(np.maximum(r * r - q0 * q0, 0.0))
-        gap = cx - w0
-        with np.errstate(divide="ignore", invalid="ignore"):
-            k = -s * q0 / w0
-            tangent = np.where(w0 > TANGENT_WIDTH, (gap + k * (cy + d0)) / np.sqrt(1.0 + k * k), 0.0)
+        q0, w0, gap, across = self._point(cy)
+        wide = w0 > TANGENT_WIDTH
+        k = np.divide(-s * q0, w0, out=np.zeros(w0.shape), where=wide)
+        tangent = np.where(wide, (gap + k * across) / np.sqrt(1.0 + k * k), 0.0)
         lower = np.maximum(in_x, tangent)          # an empty slice's does not matter: its distance is inf
         gap = np.maximum(gap, 0.0)
-        return lower, np.where(self.empty, np.inf, np.sqrt(gap * gap + (cy + d0) ** 2))
+        return lower, np.where(self.empty, np.inf, np.sqrt(gap * gap + across ** 2))
+
+    def _point(self, cy) -> tuple:
+        """At d₀ (−cy clamped into the band): q₀, w₀ (the slice's half-width there), cx − w₀ and cy + d₀ (mm)."""
+        d0 = np.minimum(np.maximum(-cy, self.low), self.high)
+        q0 = self.s * d0 - self.cdz
+        w0 = np.sqrt(np.maximum(self.r * self.r - q0 * q0, 0.0))
+        return q0, w0, self.cx - w0, cy + d0
 
     def farther_than(self, cy, radius) -> bool:
         """Whether every slice lies at least `radius` (mm, per slice) from the work axis, by
         the lower of bounds, by SLACK. Where one may not, the nearest points are worked out."""
         return bool((self.bounds(cy)[0] >= radius + SLACK).all())
+
+
+def _picked(values, where):
+    """`values` (one per slice, or one per pose: shape (P, 1)) at the slices `where` marks, flat."""
+    return values[where] if values.shape == where.shape else values[np.nonzero(where)[0], 0]
 
 
 def unbounded_dy(s: float, c: float, r: float, cx, cy, dz):
@@ -105,23 +117,21 @@ def unbounded_dy(s: float, c: float, r: float, cx, cy, dz):
 
 def ellipse_root(a: float, b: float, px, py):
     """envelope.ellipse_root elementwise (flat arrays of points outside the ellipse): the same
-    start and steps, each on the points whose |F| is still above ROOT_TOLERANCE."""
+    start and steps on every point, each one's t held from the first step its |F| is within
+    ROOT_TOLERANCE (the points are not picked out step by step: a cut's few dozen cost more
+    in picking than in stepping)."""
     a2, b2 = a * a, b * b
     ap, bp = a * px, b * py
     floor = np.maximum(np.maximum(ap - a2, bp - b2), 0.0)
     t = _start(a2, b2, ap, bp, floor)
-    live = np.arange(t.size)
     for _ in range(STEP_LIMIT):
-        at = t[live]
-        ta, tb = at + a2, at + b2
-        u2, v2 = (ap[live] / ta) ** 2, (bp[live] / tb) ** 2
+        ta, tb = t + a2, t + b2
+        u2, v2 = (ap / ta) ** 2, (bp / tb) ** 2
         f = u2 + v2 - 1.0
         going = np.abs(f) > ROOT_TOLERANCE
-        if not going.all():
-            live, at, ta, tb, u2, v2, f = (x[going] for x in (live, at, ta, tb, u2, v2, f))
-            if not live.size:
-                break
-        t[live] = np.maximum(at + step(f, u2 / ta + v2 / tb, u2 / (ta * ta) + v2 / (tb * tb)), floor[live])
+        if not going.any():
+            break
+        t = np.where(going, np.maximum(t + step(f, u2 / ta + v2 / tb, u2 / (ta * ta) + v2 / (tb * tb)), floor), t)
     return t
 
 
@@ -137,6 +147,8 @@ def _start(a2: float, b2: float, ap, bp, floor):
     with np.errstate(divide="ignore", invalid="ignore"):
         high = np.where(u >= v, ap / np.sqrt(1.0 - np.minimum(v * v, 1.0)) - a2,
                         bp / np.sqrt(1.0 - np.minimum(u * u, 1.0)) - b2)
-        u, v = ap / (high + a2), bp / (high + b2)
-        back = high + (u * u + v * v - 1.0) / (2.0 * (u * u / (high + a2) + v * v / (high + b2)))
+        ha, hb = high + a2, high + b2
+        u, v = ap / ha, bp / hb
+        uu, vv = u * u, v * v
+        back = high + (uu + vv - 1.0) / (2.0 * (uu / ha + vv / hb))
     return np.where(np.isfinite(back), np.maximum(back, floor), floor)

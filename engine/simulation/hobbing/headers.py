@@ -6,6 +6,7 @@ reader takes it as the program's claim, so it fails closed: refused unless it is
 from __future__ import annotations
 
 import re
+from functools import lru_cache
 
 # The words of a header fact, and any time in minutes (a misspelt `; FL00R TO FL00R 9.9 MIN` is
 # still read as the program's time by whoever reads it: adversary 29).
@@ -28,10 +29,17 @@ CLASS_LINES = (re.compile(r"; TEMPLATE \S+ v[0-9]+"),
 
 def comment_problem(step) -> str | None:
     """A comment naming a header fact must be that header's canonical whole line."""
-    code, semicolon, comment = step.line.partition(";")
-    if not semicolon or comment.strip() in REMARKS or not CLAIM.search(comment) or _names_a_class(step.line):
+    return line_comment_problem(step.line, step.kind)
+
+
+@lru_cache(maxsize=4096)
+def line_comment_problem(line: str, kind: str) -> str | None:
+    """comment_problem of a line read as `kind`. Remembered: a batch's programs share most of
+    their comment lines."""
+    code, semicolon, comment = line.partition(";")
+    if not semicolon or comment.strip() in REMARKS or not CLAIM.search(comment) or _names_a_class(line):
         return None
-    if step.kind == "comment" and not code.strip() and any(form.fullmatch(step.line) for form in CANONICAL):
+    if kind == "comment" and not code.strip() and any(form.fullmatch(line) for form in CANONICAL):
         return None
     return ("a comment that names a header fact (gear, hob, machine, fixture, cycle or floor-to-floor time, "
             "allowance, n0, cut, unit) is not its canonical whole-line form `; GEAR <id>`, `; HOB <id>`, "

@@ -6,6 +6,7 @@ it cannot follow what it cannot read (fail closed)."""
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 from ...machines.records import Machine
 from ...verifier import grammar
@@ -77,11 +78,18 @@ def _step(dialect, plain: PlainLine, name: str) -> Step:
     item = read_item(dialect, number, line, name, plain.text)
     if item.kind != "block":
         return Step(number, line, item)
+    return Step(number, line, item, *block_codes(plain.text.partition(";")[0]))
+
+
+@lru_cache(maxsize=4096)
+def block_codes(code: str) -> tuple[frozenset, frozenset]:
+    """The G and the M codes of a block's words (its text before the comment). Remembered: a
+    batch's programs repeat most of their blocks (the approach, the retract, the M codes)."""
     codes: dict[str, set[int]] = {"G": set(), "M": set()}
-    for token in plain.text.partition(";")[0].split():
+    for token in code.split():
         word = TOKEN.fullmatch(token)
         assert word is not None   # the verifier read the block word by word
         address, equals, text = word.groups()
         if address in codes and not equals:
             codes[address].add(int(text))
-    return Step(number, line, item, frozenset(codes["G"]), frozenset(codes["M"]))
+    return frozenset(codes["G"]), frozenset(codes["M"])
