@@ -221,3 +221,14 @@ def test_a_refusal_keeps_its_type_and_one_choice_keeps_its_words():
     with pytest.raises(LimitError) as alone:
         first_that_fits(7, 2.0, attempts(hobs[:1], Choices(feed_mode="climb", cuts=1), 2.0), too_fast)
     assert str(alone.value) == "gear 7: the table turns too fast with H1; nothing stored"
+
+
+def test_a_row_that_fails_to_run_is_not_searched_around(conn):
+    """A template row that fails to evaluate fails for every choice: the search stops at it, names the
+    row once and tries nothing else (a hostile row's refusal ran past 700 characters, repeated per choice)."""
+    conn.execute("INSERT INTO template_view (gear_class, id, t, n, s) VALUES ('spur', 750, 'main', 1, %s)",
+                 ("broken = 1 / (z2 - z2)",))
+    with pytest.raises(EngineError) as refused:
+        instantiate_gear(conn, 42, mode=RunMode(draft=True))
+    message = str(refused.value)
+    assert "row 750" in message and "tried" not in message and message.count("row 750") == 1

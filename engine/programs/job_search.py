@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING, Any
 
 from ..errors import EngineError
 from ..hobbing.choices import DEFAULT_FEED_MODE, FEED_MODES, Choices
+from ..templates.decision_table import TemplateError
 
 if TYPE_CHECKING:
     from ..gears.records import Hob
@@ -102,6 +103,8 @@ def first_that_fits(gear_id: int, module: float, tried: list[Attempt], plan: Cal
     for attempt in tried:
         try:
             planned = plan(attempt)
+        except TemplateError:
+            raise   # the class's rows fail to run: no other choice is a way out, the template is to mend
         except EngineError as error:
             refused.append((attempt, error))
             continue
