@@ -31,7 +31,9 @@ from _common import add_database_argument, bench_database, delete_programs, medi
 
 from engine.errors import EngineError  # noqa: E402
 from engine.gears.case_base import CUT_KINDS_BY_COUNT, job_cutting_record  # noqa: E402
+from engine.gears.feed_marks import bounded_for_marks  # noqa: E402
 from engine.gears.hob_matching import choose_hob  # noqa: E402
+from engine.gears.holding_matching import choose_holding  # noqa: E402
 from engine.hobbing.choices import Choices  # noqa: E402
 from engine.programs.instantiate import Planner, check_machine_fits, check_speeds  # noqa: E402
 from engine.verifier import verify_program  # noqa: E402
@@ -65,16 +67,18 @@ GEAR_COLUMNS = ("id", "gear_class", "module", "teeth", "pressure_angle", "helix_
 # Which template row emits each line of the standard code (seed_templates/classes/*.csv, same
 # ids in both classes) and the p_emit condition that decides it: the Jinja2 pipeline stores
 # row_ids like the decision table does (program.row_ids is NOT NULL).
-ROW_IDS = ((100, None), (200, None), (300, None), (400, None), (500, None), (600, None), (650, None), (700, None),
+ROW_IDS = ((100, None), (200, None), (300, None), (400, None), (500, None), (510, "fixture"), (600, None),
+           (650, None), (660, "floor"), (700, None),
            (705, "allowance"), (800, None), (810, None), (900, None), (1000, None), (1100, None),
-           (1120, "door_close"), (1150, None), (1200, "tailstock"), (1250, None), (1300, None),
+           (1120, "door_close"), (1150, None), (1200, "tailstock"), (1250, "no_load_position"),
+           (1251, "load_position"), (1252, "load_position"), (1300, None),
            (1310, "shift_fixed"), (1320, "shift_per_part"), (1330, "shift_per_part"), (1340, "shift_per_part"),
            (1350, "shift_per_part"), (1360, "shift_per_part"), (1370, "orient"), (1400, None), (1500, None),
            (1700, None), (1800, "coolant"),
            (1900, "cut1"), (2000, "cut1"), (2050, "cut1"), (2100, "cut1"), (2200, "cut1"), (2300, "cut1"),
            (2400, "cut2"), (2500, "cut2"), (2550, "cut2"), (2600, "cut2"), (2700, "cut2"), (2800, "cut2"),
            (2900, "coolant"), (3000, None), (3050, None), (3100, None), (3140, "load_position"),
-           (3150, "tailstock"), (3170, "door_open"), (3200, None))
+           (3145, "load_position"), (3150, "tailstock"), (3170, "door_open"), (3200, None))
 
 # Same id allocation as engine.programs.storage; the COPY statements are engine.programs.storage's own.
 NEXT_IDS = "SELECT nextval(%s::regclass) FROM generate_series(1, %s)"
@@ -167,7 +171,8 @@ class JinjaPipeline:
                  "shift_fixed": params["shift_per_part"] == 0, "shift_per_part": params["shift_per_part"] > 0,
                  "coolant": bool(params["coolant"]), "orient": bool(params["orient_before_coupling"]),
                  "door_close": params["door_close_m"] > 0, "door_open": params["door_open_m"] > 0,
-                 "load_position": bool(params["load_position"]),
+                 "load_position": bool(params["load_position"]), "no_load_position": not params["load_position"],
+                 "fixture": params["fixture_id"] != "", "floor": params["floor_to_floor"] > 0,
                  "cut1": bool(module_params["cutmotion:1"]["cut_on"]),
                  "cut2": bool(module_params["cutmotion:2"]["cut_on"])}
         key = tuple(flags.values())
@@ -183,11 +188,14 @@ class JinjaPipeline:
         model = planner.model(gear.gear_class)
         hob = choose_hob(gear, planner.hobs, purpose=model.hob_purpose,
                          shift_travel=model.shift_travel(planner.choices)).hob
+        holding = choose_holding(gear, hob, machine, planner.holdings, planner.choices.fixture).holding
         cutting, case_ids = planner.cutting_data(gear, hob)
+        cutting = bounded_for_marks(cutting, gear, hob, planner.choices.cut_count(gear.module),
+                                    planner.choices.allowance, frozenset())
         job = model.job(gear, gear.gear_class, hob, machine, cutting, planner.choices)
         check_speeds(gear, hob.starts, cutting.hob_speed, machine)
         jinja_template, version, template_hash = templates[gear.gear_class]
-        params, module_params = job.params, job.module_params
+        params, module_params = {**job.params, "fixture_id": holding.id if holding else ""}, job.module_params
         text = jinja_template.render({**params, "template_version": version, "module_params": module_params})
         lines = text.splitlines()
         name = str(params.get("program_name", f"JOB_{gear.id}"))
@@ -232,7 +240,7 @@ def store(conn, planned: list[tuple]) -> None:
             for job_id, item in zip(job_ids, planned):
                 gear_id, gear_class, machine, hob_id, params, module_params = item[:6]
                 copy.write_row((job_id, gear_id, gear_class, machine, hob_id, Jsonb(params), Jsonb(module_params),
-                                Jsonb(item[11] or {})))
+                                Jsonb(item[11] or {}), params["fixture_id"] or None))
         # Every stored program carries its lineage line (engine.nc.lineage), as store_many adds it.
         lineage = storage.Lineage(conn, [item[2] for item in planned], [(item[1], item[6]) for item in planned],
                                   job_ids)

@@ -46,7 +46,8 @@ def planned_programs(conn) -> list:
     with conn.cursor().copy(storage.COPY_JOB) as copy:
         for job_id, item in zip(job_ids, encoded):
             copy.write_row((job_id, item.gear_id, item.gear_class, item.machine, item.hob_id,
-                            storage._json(item.params), storage._json(item.module_params), storage._json(item.cutting)))
+                            storage._json(item.params), storage._json(item.module_params), storage._json(item.cutting),
+                            item.work_holding_id))
     conn.commit()
     return list(zip(job_ids, encoded))
 
