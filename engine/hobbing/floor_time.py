@@ -12,10 +12,7 @@ added to the cycle time in minutes. A machine that does not state all of them ge
 line (0.0 here: the templates emit the line where it is above 0)."""
 from __future__ import annotations
 
-from ..machines.records import Machine
-
-TIMES = ("swivel_speed", "spindle_runup", "coupling_sync", "tailstock_time", "door_time", "tool_change_time",
-         "load_unload_time")
+from ..machines.records import FLOOR_TIMES, Machine, unstated_floor_times
 
 
 def floor_to_floor(job: dict, modules: dict, machine: Machine, cycle: float) -> float:
@@ -23,10 +20,9 @@ def floor_to_floor(job: dict, modules: dict, machine: Machine, cycle: float) -> 
     them: its one swivel A, one tool call, a coupling and a spindle start per unit (a cluster gear's
     next unit stops the spindle, couples, starts it again), the tailstock
     clamped and released when the job clamps it, the door's blocks where the machine has them)."""
-    stated = [getattr(machine, name) for name in TIMES]
-    if any(time is None for time in stated):
+    if unstated_floor_times(machine):
         return 0.0
-    swivel, runup, sync, tailstock, door, tool, load = (float(time) for time in stated)
+    swivel, runup, sync, tailstock, door, tool, load = (float(getattr(machine, name)) for name in FLOOR_TIMES)
     couplings = 1 + sum(1 for key, values in modules.items() if key.startswith("sync:") and "unit" in values)
     doors = (job["door_close_m"] > 0) + (job["door_open_m"] > 0)
     seconds = (abs(job["swivel"]) / swivel + couplings * (runup + sync) + 2 * job["tailstock"] * tailstock
@@ -37,8 +33,8 @@ def floor_to_floor(job: dict, modules: dict, machine: Machine, cycle: float) -> 
 def floor_time_notes(machine: Machine) -> list[str]:
     """Why a program for a machine that states some of its times but not all has no floor-to-floor
     line (new-user review 29: nothing said so); nothing where it states all or none."""
-    missing = [name for name in TIMES if getattr(machine, name) is None]
-    if not missing or len(missing) == len(TIMES):
+    missing = unstated_floor_times(machine)
+    if not missing or len(missing) == len(FLOOR_TIMES):
         return []
     return [f"no floor-to-floor time: machine {machine.name} does not state {', '.join(missing)}; "
             "state them on its record (docs/guide/machines-and-simulation.md)"]

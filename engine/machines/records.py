@@ -69,6 +69,16 @@ class Machine:
     load_unload_time: float | None = None
 
 
+# The times a hobber's record states for the floor-to-floor time, in this order (migration 0034).
+FLOOR_TIMES = ("swivel_speed", "spindle_runup", "coupling_sync", "tailstock_time", "door_time", "tool_change_time",
+               "load_unload_time")
+
+
+def unstated_floor_times(machine: Machine) -> list[str]:
+    """The FLOOR_TIMES the record leaves NULL (all stated: none; a floor-to-floor time needs all)."""
+    return [name for name in FLOOR_TIMES if getattr(machine, name) is None]
+
+
 MACHINE_QUERY = f"SELECT {columns(Machine)} FROM machine"  # static, from the dataclass
 
 

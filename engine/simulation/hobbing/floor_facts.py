@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import re
 
-from ...machines.records import Machine
+from ...machines.records import FLOOR_TIMES, Machine, unstated_floor_times
 from .headers import header_place_problem
 from .report import Report
 
@@ -19,8 +19,6 @@ HEADER = re.compile(r"; FLOOR TO FLOOR ([0-9]+(?:\.[0-9]+)?) MIN")
 # on both sides: the cycle time's 2 % + 0.1 min let an uncounted spindle start and tailstock clamp
 # (5 s) through (adversary 29).
 TOLERANCE = 0.06
-TIMES = ("swivel_speed", "spindle_runup", "coupling_sync", "tailstock_time", "door_time", "tool_change_time",
-         "load_unload_time")
 SPINDLE_STARTS, TAILSTOCK = frozenset({3, 4}), frozenset({20, 21})
 
 
@@ -36,7 +34,7 @@ def floor_facts(steps: list, machine: Machine, report: Report):
     first_motion = next((s.number for s in steps if s.kind == "block" and s.item.moves), None)
     if first_motion is not None and step.number > first_motion:
         yield step, header_place_problem("FLOOR TO FLOOR", False, True), True
-    missing = [name for name in TIMES if getattr(machine, name) is None]
+    missing = unstated_floor_times(machine)
     if missing:
         yield step, (f"machine {machine.name} does not state {', '.join(missing)}: a floor-to-floor time cannot "
                      "be proved for it; state them on the machine record or leave the line out"), True
@@ -64,6 +62,6 @@ def handling_seconds(steps: list, machine: Machine) -> float:
         counts["tailstock"] += len(step.m_codes & TAILSTOCK)
         counts["door"] += len(step.m_codes & doors)
         counts["tool"] += "T" in step.item.values
-    speed, runup, sync, tailstock, door, tool, load = (float(getattr(machine, name) or 0.0) for name in TIMES)
+    speed, runup, sync, tailstock, door, tool, load = (float(getattr(machine, name) or 0.0) for name in FLOOR_TIMES)
     return (swivel / speed + counts["spindle"] * runup + counts["sync"] * sync + counts["tailstock"] * tailstock
             + counts["door"] * door + counts["tool"] * tool + load)
