@@ -59,9 +59,11 @@ def test_a_duplex_gear_synchronises_once_per_unit(conn):
     assert sum(line.startswith("EGON(") for line in lines) == 2
 
 
-def records(conn, gear_id: int, hob_id: str):
+def simulated(conn, lines: list[str], made: list[str]):
+    """The simulation's report of `lines` for gear 42 with the hob the engine's program `made` names."""
+    hob_id = next(line.split()[2] for line in made if line.startswith("; HOB "))
     hob = next(hob for hob in load_hobs(conn) if hob.id == hob_id)
-    return load_gear(conn, gear_id), hob, load_machine(conn, "hobber-840d")
+    return simulate_program(lines, load_gear(conn, 42), hob, load_machine(conn, "hobber-840d"))
 
 
 def refusals(report) -> list[str]:
@@ -70,25 +72,21 @@ def refusals(report) -> list[str]:
 
 def test_a_header_that_says_another_time_is_refused(conn):
     program = instantiate_gear(conn, 42)
-    hob_id = next(line.split()[2] for line in program.lines if line.startswith("; HOB "))
-    assert not refusals(simulate_program(program.lines, *records(conn, 42, hob_id)))
+    assert not refusals(simulated(conn, program.lines, program.lines))
     minutes = stated(program.lines)
     edited = [f"; FLOOR TO FLOOR {minutes + 0.6:.1f} MIN" if FLOOR.fullmatch(line) else line for line in program.lines]
-    assert any("floor-to-floor time of" in message for message in refusals(simulate_program(
-        edited, *records(conn, 42, hob_id))))
+    assert any("floor-to-floor time of" in message for message in refusals(simulated(conn, edited, program.lines)))
     loose = [line.replace("; FLOOR TO FLOOR", "; floor to floor") for line in program.lines]
-    assert any("canonical whole-line form" in message for message in refusals(simulate_program(
-        loose, *records(conn, 42, hob_id))))
+    assert any("canonical whole-line form" in message for message in refusals(simulated(conn, loose, program.lines)))
 
 
 def test_a_machine_that_does_not_state_its_times_gets_no_line_and_refuses_one(conn):
     conn.execute("UPDATE machine SET load_unload_time = NULL WHERE name = 'hobber-840d'")
     program = instantiate_gear(conn, 42)
     assert not any(FLOOR.fullmatch(line) for line in program.lines)
-    hob_id = next(line.split()[2] for line in program.lines if line.startswith("; HOB "))
     claimed = program.lines[:2] + ["; FLOOR TO FLOOR 3.0 MIN"] + program.lines[2:]
-    assert any("does not state load_unload_time" in message for message in refusals(simulate_program(
-        claimed, *records(conn, 42, hob_id))))
+    assert any("does not state load_unload_time" in message
+               for message in refusals(simulated(conn, claimed, program.lines)))
 
 
 def test_a_machine_that_states_some_of_its_times_is_told_which_are_missing(conn):
