@@ -3,10 +3,13 @@ and producing exactly the readable schema in schema/."""
 import re
 import shutil
 import threading
+import uuid
 
 import psycopg
 import pytest
+from psycopg import conninfo, sql
 
+from engine.db import migrate as migrate_module
 from engine.db.migrate import discover, migrate, status
 from engine.errors import EngineError
 from engine.paths import MIGRATIONS_DIR, SCHEMA_DIR
@@ -229,6 +232,72 @@ def test_concurrent_migrate_runs_apply_each_migration_once(empty_database_url):
         thread.join()
     assert errors == []
     assert sorted(applied) == sorted(m.version for m in discover())
+
+
+def test_two_databases_migrating_at_once_on_a_fresh_server_both_get_the_roles(
+        empty_database_url, server_url, tmp_path, monkeypatch):
+    """Roles are the cluster's: on a fresh server (every embedded one, a new CI machine) two
+    databases migrating at once raced to create them, and the loser of 0015 failed with 'role
+    "engine_releaser" does not exist' (its failed lookup stays cached for the transaction).
+    Migrations 0001-0015 with roles of their own (a fresh server's absent roles, without
+    touching the server's real ones), run on two databases at once, with pauses that make the
+    race happen every time: between "no such role yet" and CREATE ROLE (both see it missing),
+    and after the role's block (the first one's creation stays uncommitted meanwhile)."""
+    suffix = uuid.uuid4().hex[:6]
+    roles = {role: f"{role}_{suffix}" for role in migrate_module.CLUSTER_ROLES}
+    folder = tmp_path / "migrations"
+    folder.mkdir()
+    for migration in discover()[:15]:
+        text = migration.text
+        for role, renamed in roles.items():
+            text = re.sub(rf"\b{role}\b", renamed, text)
+        (folder / migration.path.name).write_text(with_pauses(text))
+    monkeypatch.setattr(migrate_module, "CLUSTER_ROLES", tuple(roles.values()))
+    names = [f"engine_test_{uuid.uuid4().hex[:10]}" for _ in range(2)]
+    try:
+        with psycopg.connect(server_url, autocommit=True) as admin:
+            for name in names:
+                admin.execute(sql.SQL("CREATE DATABASE {}").format(sql.Identifier(name)))
+        assert migrate_at_once([conninfo.make_conninfo(server_url, dbname=name) for name in names], folder) == []
+    finally:
+        with psycopg.connect(server_url, autocommit=True) as admin:
+            for name in names:
+                admin.execute(sql.SQL("DROP DATABASE IF EXISTS {} WITH (FORCE)").format(sql.Identifier(name)))
+            for role in roles.values():
+                admin.execute(sql.SQL("DROP ROLE IF EXISTS {}").format(sql.Identifier(role)))
+
+
+ROLE_CHECK = re.compile(r"(IF NOT EXISTS \(SELECT 1 FROM pg_roles WHERE rolname = [^)]*\) THEN)")
+BLOCK_END = re.compile(r"^END\s*\$\$;$", re.MULTILINE)
+
+
+def with_pauses(text: str) -> str:
+    """A migration that creates roles, paused 0.2 s before each CREATE ROLE and 0.6 s after its
+    block (in the same transaction)."""
+    if not ROLE_CHECK.search(text):
+        return text
+    text = ROLE_CHECK.sub(r"\1 PERFORM pg_sleep(0.2);", text)
+    block = BLOCK_END.search(text, text.index("CREATE ROLE"))
+    assert block is not None, "the role's DO block ends with END $$;"
+    return text[:block.end()] + "\nSELECT pg_sleep(0.6);" + text[block.end():]
+
+
+def migrate_at_once(urls, folder) -> list[Exception]:
+    errors: list[Exception] = []
+
+    def run(url):
+        try:
+            with psycopg.connect(url) as conn:
+                migrate(conn, folder)
+        except Exception as error:  # collected and returned
+            errors.append(error)
+
+    threads = [threading.Thread(target=run, args=(url,)) for url in urls]
+    for thread in threads:
+        thread.start()
+    for thread in threads:
+        thread.join()
+    return errors
 
 
 def test_hob_ids_differing_only_in_case_stop_migration_0011_with_their_names(empty_database_url, tmp_path):

@@ -21,6 +21,14 @@ MIGRATION_FILE = re.compile(r"^(\d{4})\.([a-z0-9_-]+)\.sql$")
 # Any constant works: all engines on one database agree on it.
 MIGRATION_LOCK_KEY = 0x4E43_5445_4D50  # "NCTEMP"
 
+# The roles the migrations grant to (0005, 0015). Roles are cluster-wide: two databases migrating at
+# once on a fresh server race to create them, and the loser's CREATE ROLE waits for the winner,
+# fails as a duplicate, and its next GRANT in the same transaction still finds no role (PostgreSQL
+# keeps the failed lookup cached until the transaction ends). Created first, each committed on its
+# own, the migrations' own "IF NOT EXISTS" then finds them.
+CLUSTER_ROLES = ("engine_reader", "engine_runner", "engine_editor", "engine_releaser")
+ROLE_EXISTS = "SELECT 1 FROM pg_roles WHERE rolname = %s"
+
 CREATE_LEDGER = """
 CREATE TABLE IF NOT EXISTS schema_migration (
     version    text PRIMARY KEY,
@@ -119,12 +127,28 @@ def _apply_pending(conn: Connection, directory: Path | None) -> list[Migration]:
             f"applied migration {changed[0]} was edited since it ran (checksum differs); "
             "restore the file and put the change in a new migration"
         )
-    done = []
+    done: list[Migration] = []
+    if any(state.applied_at is None for state in states):
+        _create_cluster_roles(conn)
     for state in states:
         if state.applied_at is None:
             _apply(conn, state.migration)
             done.append(state.migration)
     return done
+
+
+def _create_cluster_roles(conn: Connection) -> None:
+    """Each missing role of CLUSTER_ROLES created and committed alone (the connection is in
+    autocommit); one created meanwhile by another database's migration is left as it is."""
+    import psycopg
+
+    for role in CLUSTER_ROLES:
+        if conn.execute(ROLE_EXISTS, (role,)).fetchone() is not None:
+            continue
+        try:
+            conn.execute(sql.SQL("CREATE ROLE {} NOLOGIN").format(sql.Identifier(role)))
+        except (psycopg.errors.DuplicateObject, psycopg.errors.UniqueViolation):
+            pass   # created meanwhile: the other database's commit is what we waited for
 
 
 def _apply(conn: Connection, migration: Migration) -> None:
