@@ -106,6 +106,7 @@ def deepest_along(r0, length, swivel_deg, start, end, radius, z_low, z_high) -> 
     return at((low + high) / 2)
 
 
+@pytest.mark.slow   # a golden-section truth over random moves: 0.6 s a set
 @PATHS
 def test_a_move_past_the_fixture_dips_between_two_poses(records, monkeypatch, sections):
     """The poses along a move lie at most 0.5 mm apart (paths.POSE_STEP) and nothing is allowed

@@ -93,6 +93,7 @@ def reference_deepest(hob: HobBody, swivel: float, start: tuple, end: tuple, z_l
     return best
 
 
+@pytest.mark.slow   # a random search against a fine grid: 1.4 s a set
 @PATHS
 def test_random_moves_past_a_fixture_report_what_a_fine_grid_finds(monkeypatch, sections):
     """Hobs (r0 10…60, L 40…200) swivelled −45°…45°, straight moves of 5…40 mm in X, Y and Z

@@ -164,6 +164,7 @@ def test_every_program_of_a_grade_6_batch_is_within_its_limit(conn):
 POPULATION_HOBS = {1: 50, 1.5: 63, 2: 70, 2.5: 75, 3: 80, 4: 90}
 
 
+@pytest.mark.slow   # a random population made and read: 1.4 s
 def test_a_random_grade_6_population_keeps_every_last_cut_within_its_limit(conn):
     """60 spur and helical gears, m1–4 (the seeded machine's range), 12–120 teeth, b 6–12·m, grade
     6: before issue 29 about two in three single cuts left deeper marks than the grade allows (the

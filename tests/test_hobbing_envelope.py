@@ -142,6 +142,7 @@ def random_sweep(rng: np.random.Generator) -> tuple[Sweep, Solid, float, float]:
     return Sweep(x0, z0, x1, z1, rng.uniform(-30, 30), tuple(y0), tuple(y1)), solid, r0, length
 
 
+@pytest.mark.slow   # a branch and bound over random sweeps: 1.4 s
 def test_envelope_agrees_with_a_branch_and_bound_over_hob_points_on_random_sweeps():
     """Seeded random sweeps and solids: the proven intrusion is never shallower than a hob point the
     cells found by more than its TOLERANCE (1e-6 mm), never deeper than the cells' upper bound, and

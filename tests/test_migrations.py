@@ -234,8 +234,8 @@ def test_concurrent_migrate_runs_apply_each_migration_once(empty_database_url):
     assert sorted(applied) == sorted(m.version for m in discover())
 
 
-def test_two_databases_migrating_at_once_on_a_fresh_server_both_get_the_roles(
-        empty_database_url, server_url, tmp_path, monkeypatch):
+@pytest.mark.slow   # two migrations with 1.6 s of pauses each; 5-30 s beside the other worker's tests
+def test_two_databases_migrating_at_once_on_a_fresh_server_both_get_the_roles(server_url, tmp_path, monkeypatch):
     """Roles are the cluster's: on a fresh server (every embedded one, a new CI machine) two
     databases migrating at once raced to create them, and the loser of 0015 failed with 'role
     "engine_releaser" does not exist' (its failed lookup stays cached for the transaction).
