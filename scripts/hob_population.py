@@ -44,6 +44,19 @@ HOB_TIP = {1.0: 50, 1.25: 50, 1.5: 56, 2.0: 63, 2.5: 70, 3.0: 80, 4.0: 90, 5.0: 
 CLASSES = ("spur", "spur", "helical", "helical", "taper", "crowned", "duplex", "worm_wheel")
 MATERIALS = ("45", "C45", "20CrMnTi", "40Cr")
 WORM_QUOTIENTS = (10.0, 12.5)    # q = d1/m_x of the worms drawn (DIN 3976 values)
+# The shop's arbors between centres for small bores, beside the seeded library: (diameter under
+# the gear, height from the table to the gear, centre diameter above it), mm. A gear of m 1-1.5
+# with 12-14 teeth has a root of about Ø14-19: it is hobbed on a thin arbor tall enough that the
+# hob (Ø50-63) runs out below the gear without reaching the table.
+WORK_HOLDINGS = [(f"POP-A-D{d}-H{h}", "arbor", d, h, round(0.6 * d)) for d in (8, 10, 12) for h in (80, 100)]
+# A cluster gear is a hobbing job only when a hob of the library fits between its units: cutting
+# one unit at full depth, the hob's tip circle (centre distance r_f + r_a0) meets the other unit's
+# tip cylinder over a half-chord sqrt(r_a0² − (a − r_a,other)²) along Z; the gap must hold that,
+# a clearance and the hob centre carried past the face it leaves (both 1 mm). Narrower gaps are a
+# gear shaper's job, whatever the engine says: they are counted apart. The hob's swivel and length
+# are left out, so the bound is the most generous to "hobbable".
+GAP_CLEARANCE = 1.0
+GAP_OVERRUN = 1.0
 
 
 def hob_rows() -> list[tuple]:
@@ -107,6 +120,32 @@ MACHINE = """INSERT INTO machine SELECT * FROM machine WHERE name = 'hobber-840d
              ON CONFLICT DO NOTHING"""
 
 
+def hobbable_gap(module: float, units: list[tuple[int, float]], hob_tip: float) -> float:
+    """The least gap (mm) between two spur units (teeth, face) of a cluster gear that a hob of
+    tip diameter `hob_tip` can cut, each unit next to the other (see GAP_CLEARANCE)."""
+    r_a0 = hob_tip / 2
+    need = 0.0
+    for (teeth, _), (other_teeth, _) in ((units[0], units[1]), (units[1], units[0])):
+        root, other_tip = module * (teeth - 2.5) / 2, module * (other_teeth + 2) / 2
+        centre_above = root + r_a0 - other_tip     # hob centre's distance outside the other's tip
+        if centre_above < r_a0:                    # the tip circle dips under the other unit's tip
+            need = max(need, math.sqrt(r_a0 ** 2 - max(centre_above, 0.0) ** 2))
+    return need + GAP_CLEARANCE + GAP_OVERRUN
+
+
+def shaper_jobs(conn) -> set[int]:
+    """The cluster gears whose gap no hob of the library for their module fits (worm-wheel hobs, copies
+    of a worm, are not for spur units)."""
+    rows = conn.execute("""SELECT g.id, g.module, g.teeth, g.face_width, u.teeth, u.face_width,
+                                  -g.face_width - u.z_top,
+                                  (SELECT min(tip_diameter) FROM hob h
+                                   WHERE h.module = g.module AND h.purpose <> 'worm_wheel')
+                           FROM gear g JOIN gear_unit u ON u.gear_id = g.id
+                           WHERE g.gear_class = 'duplex' AND g.id >= %s""", (FIRST,)).fetchall()
+    return {gear_id for gear_id, module, z1, b1, z2, b2, gap, tip in rows
+            if tip is None or float(gap) < hobbable_gap(float(module), [(z1, b1), (z2, b2)], float(tip))}
+
+
 def populate(conn, count: int, seed_value: int) -> None:
     rng, hobs = random.Random(seed_value), set(hob_rows())
     gears, units = [], []
@@ -117,6 +156,7 @@ def populate(conn, count: int, seed_value: int) -> None:
     _insert(conn, "hob", HOB_COLUMNS, sorted(hobs))
     _insert(conn, "gear", GEAR_COLUMNS, gears)
     _insert(conn, "gear_unit", UNIT_COLUMNS, units)
+    _insert(conn, "work_holding", ("id", "kind", "diameter", "height", "tailstock_diameter"), WORK_HOLDINGS)
     # loaded high enough that a hob at the load position clears the largest gear at any swivel and
     # shift the last program may have left (engine.simulation.hobbing.swivel_sweep.unknown_pose)
     conn.execute("UPDATE machine SET module_max = 8, x_max = 500, z_max = 350, load_z = 300 "
@@ -144,9 +184,15 @@ def report(conn, count: int, workers: int, examples: int = 0) -> None:
     batch = instantiate_gears(conn, FIRST, FIRST + count - 1, mode=RunMode(dry_run=True, skip_bad=True,
                                                                           workers=workers))
     refused = {gear_id: message for gear_id, message in _skipped(batch)}
-    print(f"population: {count} gears, {count - len(refused)} proved ({100 * (count - len(refused)) / count:.1f} %)")
+    shaped = shaper_jobs(conn)
+    work = count - len(shaped)
+    made = work - len(set(refused) - shaped)
+    print(f"population: {count} gears, {count - len(refused)} proved ({100 * (count - len(refused)) / count:.1f} %); "
+          f"of the {work} a hob of the library fits, {made} proved ({100 * made / work:.1f} %); "
+          f"{len(shaped)} cluster gears too narrow for any hob (a shaper's job), {len(shaped & set(refused))} "
+          "of them refused")
     for gear_class in sorted(set(classes.values())):
-        ids = [gear_id for gear_id, name in classes.items() if name == gear_class]
+        ids = [gear_id for gear_id, name in classes.items() if name == gear_class and gear_id not in shaped]
         bad = [gear_id for gear_id in ids if gear_id in refused]
         print(f"  {gear_class:10s} {len(ids) - len(bad):4d} of {len(ids):4d} proved")
         for text, number in Counter(reason(refused[gear_id]) for gear_id in bad).most_common(6):
