@@ -22,7 +22,7 @@ from hypothesis import strategies as st
 
 from engine.errors import EngineError
 from engine.gears.records import Gear, GearUnit, Hob
-from engine.hobbing.choices import FEED_MODES, Choices
+from engine.hobbing.choices import FEED_MODES, UNIT_FEED_MODES, Choices
 from engine.hobbing.duplex import DuplexModel
 from engine.programs.instantiate import instantiate_gear
 
@@ -80,7 +80,8 @@ def layouts(draw):
     gear = Gear(9001, "duplex", module, teeth[0], 20.0, 0.0, None, widths[0], tips[0],
                 round(tips[0] - 4.5 * module, 3), None, None, None, None, None, None,
                 units=(GearUnit(2, teeth[1], widths[1], tips[1], None, -widths[0] - gap),))
-    choices = Choices(cuts=draw(st.sampled_from([None, 1, 2])), feed_mode=draw(st.sampled_from(sorted(FEED_MODES))),
+    modes = sorted(FEED_MODES) + list(UNIT_FEED_MODES)
+    choices = Choices(cuts=draw(st.sampled_from([None, 1, 2])), feed_mode=draw(st.sampled_from(modes)),
                       shift_y=draw(st.sampled_from([0.0, 0.0, 6.0, -10.0])))
     return gear, hob, choices
 

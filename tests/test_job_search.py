@@ -134,10 +134,13 @@ def test_a_feed_mode_the_user_gave_is_named_in_the_refusal(conn):
 def expected_choices(conn) -> list[str]:
     """Every choice of the search for gear 54 (m2: one cut by module, §B14): one cut climb and
     conventional (a single cut runs the roughing direction: conventional-climb is conventional),
-    two cuts in all three modes; with every hob of the library that matches."""
+    two cuts in all three modes, each then with the units fed each their own way (a cluster
+    gear: unit 1's/unit 2's); with every hob of the library that matches."""
     hobs = [hob for hob, _ in library(conn)]
-    one = [f"[{mode}, hob {hob}, 1 cut]" for hob in hobs for mode in ("climb", "conventional")]
-    two = [f"[{mode}, hob {hob}, 2 cuts]" for hob in hobs for mode in ("climb", "conventional", "conventional-climb")]
+    per_unit = ("climb/conventional", "conventional/climb")
+    one = [f"[{mode}, hob {hob}, 1 cut]" for hob in hobs for mode in ("climb", "conventional", *per_unit)]
+    two = [f"[{mode}, hob {hob}, 2 cuts]" for hob in hobs
+           for mode in ("climb", "conventional", "conventional-climb", *per_unit)]
     return one + two
 
 

@@ -58,9 +58,11 @@ def parse_range(text: str, option: str = "--gears") -> tuple[int, int]:
 @click.option("--shift-y", type=float, default=0.0, help="Hob shift position Y for this part, mm.")
 @click.option("--shift-per-part", type=float, default=0.0,
               help="Shift the hob by this many mm every part (R11 counts), wrapping within the hob's usable length.")
-@click.option("--feed-mode", type=click.Choice(["climb", "conventional", "conventional-climb"]),
-              help="Axial pass direction; conventional-climb: rough conventional, finish climb. Default: the "
-                   "engine's choice, climb first, another direction where climb does not fit (the note says why).")
+@click.option("--feed-mode", metavar="MODE",
+              help="Axial pass direction: climb, conventional or conventional-climb (rough conventional, finish "
+                   "climb); a cluster gear's units each their own, unit 1's/unit 2's (climb/conventional). "
+                   "Default: the engine's choice, climb first, another direction where climb does not fit (the "
+                   "note says why).")
 @click.option("--tailstock/--no-tailstock", default=True, show_default=True, help="Tailstock clamp M20/M21.")
 @click.option("--fixture", "fixture", help="Work-holding id of the library (`engine fixtures list`) to clamp the gear "
               "on; refused if it does not fit and clear the gear (default: the machine's own fixture and tailstock "

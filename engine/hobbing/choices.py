@@ -1,7 +1,7 @@
 """Process choices of a hobbing job: what the engineer decides, switched on in template rows."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from ..errors import EngineError
 
@@ -22,6 +22,12 @@ FEED_MODES = {
 # engine's habit before issue 29. The search (engine.programs.job_search) may take another one
 # when the first does not fit; a mode the user gave is never changed.
 DEFAULT_FEED_MODE = "climb"
+# A cluster gear may feed each unit its own way: "climb/conventional" is unit 1 climb, unit 2
+# conventional. Fed toward each other, both passes leave their unit into the gap between the
+# units, where only the short run-out of the face they leave is needed, not a full run-in
+# (engine.hobbing.duplex: the gap holds the hob's reach into the other unit and that run-out).
+UNIT_SEPARATOR = "/"
+UNIT_FEED_MODES = ("climb/conventional", "conventional/climb")
 WORM_FEEDS = ("radial", "tangential")
 
 
@@ -40,8 +46,9 @@ class Choices:
     fixture: str | None = None         # the work-holding's id (--fixture); None: chosen (issue 29)
 
     def __post_init__(self):
-        if self.feed_mode is not None and self.feed_mode not in FEED_MODES:
-            raise EngineError(f"feed mode {self.feed_mode!r} is not one of {', '.join(FEED_MODES)}")
+        if self.feed_mode is not None and not _known_mode(self.feed_mode):
+            raise EngineError(f"feed mode {self.feed_mode!r} is not one of {', '.join(FEED_MODES)}, nor one "
+                              f"per unit of a cluster gear (unit 1's/unit 2's, e.g. {UNIT_FEED_MODES[0]})")
         if self.worm_feed not in WORM_FEEDS:
             raise EngineError(f"worm feed {self.worm_feed!r} is not one of {', '.join(WORM_FEEDS)}")
         if self.shift_per_part < 0:
@@ -71,10 +78,35 @@ class Choices:
 
     def climb(self, cut_number: int, cut_count: int) -> bool:
         """Whether cut `cut_number` (1 = rough, 2 = finish) runs climb; a single cut takes the
-        roughing direction (the paper's single rough cut, conventional-climb mode)."""
+        roughing direction (the paper's single rough cut, conventional-climb mode). A mode per
+        unit is read through for_unit first."""
         rough, finish = FEED_MODES[self.mode]
         return rough if cut_number == 1 or cut_count == 1 else finish
+
+    def for_unit(self, number: int, units: int, gear_id: int) -> Choices:
+        """The choices unit `number` of a gear of `units` units is cut with: its own feed mode where
+        the mode names one per unit, else these. A mode per unit on a gear of another number of
+        units is refused."""
+        modes = self.mode.split(UNIT_SEPARATOR)
+        if len(modes) == 1:
+            return self
+        if len(modes) != units:
+            raise EngineError(f"gear {gear_id}: feed mode {self.mode} names one for each of {len(modes)} units; "
+                              f"the gear has {units}: give one of {', '.join(FEED_MODES)}")
+        return replace(self, feed_mode=modes[number - 1])
+
+    def directions(self, cut_count: int, units: int) -> tuple:
+        """The pass directions (climb or not) of every cut of every unit: what makes two modes the
+        same job (a single cut runs the roughing direction only)."""
+        return tuple(self.for_unit(unit, units, 0).climb(number, cut_count)
+                     for unit in range(1, units + 1) for number in (1, 2)[2 - cut_count:])
 
     @property
     def shifting(self) -> bool:
         return self.shift_y != 0 or self.shift_per_part > 0
+
+
+def _known_mode(mode: str) -> bool:
+    """A mode of FEED_MODES, or two of them (unit 1's and unit 2's) joined by UNIT_SEPARATOR."""
+    modes = mode.split(UNIT_SEPARATOR)
+    return len(modes) <= 2 and all(one in FEED_MODES for one in modes)

@@ -99,6 +99,7 @@ class CylindricalModel:
 
     def job(self, gear: Gear, gear_class: str, hob: Hob, machine: Machine,
             cutting: CuttingData, choices: Choices) -> JobParameters:
+        choices = choices.for_unit(1, 1, gear.id)   # a mode per unit is a cluster gear's
         setup = self.setup(gear, hob)
         cuts = plan_cuts(gear.module, setup.full_depth, choices)
         module_params = {f"cutmotion:{cut.number}": self.cut_params(cut, gear, hob, cutting, setup)

@@ -56,7 +56,8 @@ class DuplexModel(CylindricalModel):
 
     def _unit_cuts(self, number, unit, hob, cutting, choices, setup) -> dict:
         cuts = {}
-        for cut, module_number in zip(plan_cuts(unit.module, setup.full_depth, choices), UNIT_MODULES[number]):
+        unit_choices = choices.for_unit(number, len(UNIT_MODULES), unit.id)
+        for cut, module_number in zip(plan_cuts(unit.module, setup.full_depth, unit_choices), UNIT_MODULES[number]):
             params = self.cut_params(cut, unit, hob, cutting, setup)
             params["z_from"] = round(params["z_from"] + unit.z_top, 3)
             params["z_to"] = round(params["z_to"] + unit.z_top, 3)

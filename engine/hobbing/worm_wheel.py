@@ -36,6 +36,7 @@ class WormWheelModel(CylindricalModel):
 
     def job(self, gear, gear_class, hob, machine, cutting, choices) -> JobParameters:
         check_module_stated(gear)
+        choices = choices.for_unit(1, 1, gear.id)   # a mode per unit is a cluster gear's
         setup = self.setup(gear, hob)
         tangential = choices.worm_feed == "tangential"
         if tangential:

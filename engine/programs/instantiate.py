@@ -112,7 +112,7 @@ class Planner:
         self.template(gear.gear_class)   # a class refused is not a choice that does not fit: refused before the search
         hobs = [choice.hob for choice in matching_hobs(gear, self.hobs, purpose=model.hob_purpose,
                                                        shift_travel=model.shift_travel(self.choices))]
-        found = first_that_fits(gear.id, gear.module, attempts(hobs, self.choices, gear.module),
+        found = first_that_fits(gear.id, gear.module, attempts(hobs, self.choices, gear.module, 1 + len(gear.units)),
                                 lambda attempt: self._planned(gear, model, attempt.hob, attempt.choices))
         found.planned.notes[:0] = found.notes
         if found.notes:   # the job keeps why its hob, feed mode and cut count are not the first choice

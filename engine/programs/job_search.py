@@ -17,7 +17,7 @@ from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
 from ..errors import EngineError
-from ..hobbing.choices import DEFAULT_FEED_MODE, FEED_MODES, Choices
+from ..hobbing.choices import DEFAULT_FEED_MODE, FEED_MODES, UNIT_FEED_MODES, UNIT_SEPARATOR, Choices
 from ..templates.decision_table import TemplateError
 
 if TYPE_CHECKING:
@@ -31,7 +31,8 @@ NOTHING_STORED = "; nothing stored"
 # the pass ends move) is tried before another hob (a tool change on the machine), and both before a
 # second cut (a longer cycle). A row whose choice the user gave has that value only.
 SEARCH_ORDER: tuple[tuple[str, str], ...] = (
-    ("feed direction", "climb, then conventional, then conventional-climb (rough conventional, finish climb)"),
+    ("feed direction", "climb, then conventional, then conventional-climb (rough conventional, finish climb); "
+                       "a cluster gear then each unit its own way (climb/conventional, conventional/climb)"),
     ("hob", f"the best hob, then the others choose_hob accepts, in its order (hand, class, id); {MAX_HOBS} at most"),
     ("cuts", "the model's count (one up to m 3, §B14), then two cuts (rough, then finish)"),
 )
@@ -58,26 +59,34 @@ class Attempt:
         """What makes two attempts the same job: a single cut runs the roughing direction only, so
         conventional and conventional-climb are one job then."""
         count = self.cut_count(module)
-        return self.hob.id, count, tuple(self.choices.climb(number, count) for number in (1, 2)[2 - count:])
+        return self.hob.id, count, self.choices.directions(count, self.units)
+
+    @property
+    def units(self) -> int:
+        """The units the mode names a direction for (a cluster gear's two, or one for all)."""
+        return len(self.choices.mode.split(UNIT_SEPARATOR))
 
 
-def attempts(hobs: list[Hob], choices: Choices, module: float) -> list[Attempt]:
-    """The first choice, then the alternatives of SEARCH_ORDER (the same job once)."""
+def attempts(hobs: list[Hob], choices: Choices, module: float, units: int = 1) -> list[Attempt]:
+    """The first choice, then the alternatives of SEARCH_ORDER (the same job once); a gear of two
+    units (a cluster gear) also tries each unit fed its own way (UNIT_FEED_MODES)."""
     given = frozenset(name for name in ("feed_mode", "cuts") if getattr(choices, name) is not None)
     found: dict[tuple, Attempt] = {}
     for cuts in _cut_choices(choices, module):
         for hob in hobs[:MAX_HOBS]:
-            for mode in _feed_modes(choices):
+            for mode in _feed_modes(choices, units):
                 attempt = Attempt(hob, replace(choices, feed_mode=mode, cuts=cuts), given)
                 found.setdefault(attempt.key(module), attempt)
     return list(found.values())
 
 
-def _feed_modes(choices: Choices) -> list[str]:
-    """The mode given, or the model's first and then the others (FEED_MODES order)."""
+def _feed_modes(choices: Choices, units: int) -> list[str]:
+    """The mode given, or the model's first and then the others (FEED_MODES order), then for a
+    cluster gear those feeding each unit its own way."""
     if choices.feed_mode is not None:
         return [choices.feed_mode]
-    return [DEFAULT_FEED_MODE] + [mode for mode in FEED_MODES if mode != DEFAULT_FEED_MODE]
+    per_unit = list(UNIT_FEED_MODES) if units == 2 else []
+    return [DEFAULT_FEED_MODE] + [mode for mode in FEED_MODES if mode != DEFAULT_FEED_MODE] + per_unit
 
 
 def _cut_choices(choices: Choices, module: float) -> list[int | None]:

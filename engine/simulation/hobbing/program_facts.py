@@ -28,6 +28,7 @@ CUT_LINE = re.compile(r"; CUT (\S+)(?: .*)? X=\S+ (\S+)")
 FEED_MODES = {"climb": ("CLIMB", "CLIMB"), "conventional": ("CONVENTIONAL", "CONVENTIONAL"),
               "conventional-climb": ("CONVENTIONAL", "CLIMB")}
 CUT_NAMES = {1: ("SINGLE",), 2: ("ROUGH", "FINISH")}
+UNIT_SEPARATOR = "/"   # a cluster gear's mode per unit, unit 1's/unit 2's (the header says it so)
 
 
 def header_n0(steps) -> tuple | None:
@@ -152,8 +153,21 @@ def cut_count_facts(steps, machine: Machine, report, units: int):
     elif cuts and [cut[1] for cut in cuts] != list(names) * units:
         yield step, (f"the header states cuts={count}; the program's `; CUT` comments name "
                      f"{' '.join(cut[1] for cut in cuts)} over {units} unit(s)"), True
-    words = FEED_MODES.get(mode)
     axial = [cut for cut in cuts if cut[2] in ("CLIMB", "CONVENTIONAL")]
-    if axial and (words is None or any(cut[2] != words[0 if cut[1] != "FINISH" else 1] for cut in axial)):
+    if axial and not _feed_mode_kept(mode, cuts, count, units):
         yield step, (f"the header states feed mode {mode}; the cuts are "
                      f"{' '.join(cut[1] + ' ' + cut[2] for cut in axial)}"), True
+
+
+def _feed_mode_kept(mode: str, cuts: list, count: int, units: int) -> bool:
+    """Every axial cut's word is the one the header's mode gives its unit and its place (rough or
+    finish): one mode for all units, or one per unit ("climb/conventional": unit 1's/unit 2's,
+    the cuts of unit 1 coming first)."""
+    modes = mode.split(UNIT_SEPARATOR)
+    if len(modes) not in (1, units) or any(one not in FEED_MODES for one in modes):
+        return False
+    for index, cut in enumerate(cuts):
+        words = FEED_MODES[modes[min(index // max(count, 1), len(modes) - 1)]]
+        if cut[2] in ("CLIMB", "CONVENTIONAL") and cut[2] != words[0 if cut[1] != "FINISH" else 1]:
+            return False
+    return True
