@@ -44,6 +44,7 @@ class Gear:
     # converted on load, so `module` is always the normal module the models compute with), or None
     # (not stated: normal for cylindrical gears; the worm-wheel model refuses it).
     module_kind: str | None = None
+    profile_shift: float | None = None   # x [modules] as the drawing gives it (None: not given)
     units: tuple = ()          # further toothed units of a multi-unit gear (GearUnit), unit 2 first
 
     @property
