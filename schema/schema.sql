@@ -1186,6 +1186,13 @@ CREATE TABLE hob (
     -- The module the record gives: normal, or (worm-wheel hobs, as catalogued: DIN 3975) the
     -- worm's axial module m_x; the engine converts it on load to m_n = m_x·cos γ0.
     module_kind    text NOT NULL DEFAULT 'normal' CHECK (module_kind IN ('normal', 'axial')),
+    -- Gashes (flutes): i = gashes/starts edges share a workpiece revolution's feed, which bounds
+    -- it by the chip thickness (Hoffmeister, docs/reference/hobbing.md §C1); 12 = the usual solid
+    -- HSS catalogue hob of m1–m4 (DIN 3968).
+    gashes         integer NOT NULL DEFAULT 12 CHECK (gashes > 0),
+    -- The tooth profile: the basic rack's, a protuberance (undercuts the root ahead of shaving or
+    -- grinding), or topping (the hob's root also cuts the gear's tip).
+    profile        text NOT NULL DEFAULT 'standard' CHECK (profile IN ('standard', 'protuberance', 'topping')),
     CONSTRAINT hob_safe_id CHECK (safe_name('hob', id)),
     CONSTRAINT hob_axial_module_of_worm_wheel_hobs CHECK (module_kind = 'normal' OR purpose = 'worm_wheel')
 );

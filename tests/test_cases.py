@@ -7,7 +7,7 @@ import math
 from dataclasses import replace
 
 import pytest
-from helpers import feed_mark_reference
+from helpers import chip_reference, feed_mark_reference
 from psycopg import sql
 
 from engine.errors import EngineError
@@ -93,15 +93,17 @@ def test_the_papers_example_comes_back_with_its_feed_bounded_to_the_m2_roughing_
     assert len(feed_note) == 1 and "bounded to 3.00" in feed_note[0] and "m2" in feed_note[0]
 
 
-@pytest.mark.parametrize("module, teeth, starts, cut, maximum", [
+@pytest.mark.parametrize("module, teeth, starts, cut, table", [
     (1.0, 20, 1, "rough", 2.0), (1.5, 20, 1, "rough", 2.5), (2.5, 30, 1, "rough", 3.25), (4.0, 25, 1, "rough", 4.0),
     (3.0, 41, 1, "finish", 2.0), (1.5, 20, 1, "finish", 1.25), (0.8, 20, 1, "rough", 2.0),
-    (2.0, 30, 2, "rough", 3.0 / math.sqrt(2)), (2.0, 30, 4, "finish", 1.5 / 2)])
-def test_a_case_feed_above_the_table_is_bounded_per_module_and_starts(empty_history, machine, module, teeth,
-                                                                      starts, cut, maximum):
+    (2.0, 30, 2, "rough", 3.0), (2.0, 30, 4, "finish", 1.5), (2.0, 30, 3, "rough", 3.0)])
+def test_a_case_feed_above_the_table_is_bounded_per_module_and_chip(empty_history, machine, module, teeth,
+                                                                    starts, cut, table):
     """§C table interpolated between modules (m1 2.0/1.0, m2 3.0/1.5, m3 3.5/2.0, m4 4.0/2.0), the end rows
-    beyond; a z0-start hob takes the single-start maximum / √z0. A case of 6 mm/rev is above all of them."""
+    beyond; and at most the feed whose Hoffmeister chip stays within 0.20 mm (§C1: the seeded hob's d_a0 70
+    and 12 gashes, z0 as given). A case of 6 mm/rev is above all of them."""
     conn = empty_history
+    maximum = min(table, chip_reference.feed_at_bound(module, teeth, 0.0, 0.0, 70.0, 12, starts))
     insert_case(conn, module=module, teeth=teeth, hob_starts=starts, cut=cut,
                 axial_feed=6.0 * PAPER_N0 * starts / teeth, radial_feed=2.0 * PAPER_N0 * starts / teeth)
     conn.execute("INSERT INTO gear (id, gear_class, module, teeth, face_width, material, hardness, quality_grade) "
@@ -125,9 +127,12 @@ def test_an_override_of_the_feed_beyond_the_table_is_refused(empty_history, mach
     from engine.gears.cutting_data import default_cutting_data
 
     cutting = default_cutting_data(2.0, "40Cr", True, 70, 1000)
-    assert cutting.with_overrides(2.0, 1, axial_feed_rough=M2_ROUGH_MAX).axial_feed_rough == M2_ROUGH_MAX
-    with pytest.raises(EngineError, match="axial feed rough 3.1 mm per workpiece rev exceeds the 3.00 maximum for m2"):
-        cutting.with_overrides(2.0, 1, axial_feed_rough=3.1)
+    gear = insert_paper_gear(empty_history)
+    given = cutting.with_overrides(gear, hob(empty_history), axial_feed_rough=M2_ROUGH_MAX)
+    assert given.axial_feed_rough == M2_ROUGH_MAX
+    with pytest.raises(EngineError, match="axial feed rough 3.1 mm per workpiece rev exceeds the 3.00 mm/rev "
+                                          "roughing maximum for m2"):
+        cutting.with_overrides(gear, hob(empty_history), axial_feed_rough=3.1)
 
 
 def test_the_nearest_case_ranks_first_and_weighs_most(empty_history, machine):

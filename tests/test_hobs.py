@@ -186,18 +186,21 @@ def test_list_shows_every_seeded_hob(run):
     assert lines[0].split()[:4] == ["id", "module", "kind", "α"]
     assert sorted(line.split()[0] for line in lines[1:]) == sorted(seeded_hob_ids())
     worm = next(line.split() for line in lines if line.startswith("H-WW-M3-R1 "))
-    assert worm[1:] == ["3", "normal", "20", "1", "50", "90", "R", "A", "HSS", "TiN", "worm_wheel", "1"]
+    assert worm[1:] == ["3", "normal", "20", "1", "50", "90", "R", "A", "HSS", "TiN", "worm_wheel", "1", "12",
+                        "standard"]
 
 
 def test_add_then_list_shows_the_new_hob(run):
     result = run("hobs", "add", "--id", "H-M5-B-L1", "--module", 5, "--tip-diameter", 110, "--length", 160,
-                 "--hand", "l", "--accuracy-class", "b", "--coating", "TiAlN")
+                 "--hand", "l", "--accuracy-class", "b", "--coating", "TiAlN", "--gashes", 14,
+                 "--profile", "protuberance")
     assert result.exit_code == 0, result.output
     listed = json.loads(run("hobs", "list", "--json").stdout)["hobs"]
     added = next(h for h in listed if h["hob_id"] == "H-M5-B-L1")
     assert added == {"hob_id": "H-M5-B-L1", "module": 5, "pressure_angle": 20, "starts": 1, "tip_diameter": 110,
                      "length": 160, "hand": "L", "accuracy_class": "B", "material": "HSS",
-                     "coating": "TiAlN", "purpose": "cylindrical", "tool_number": 1, "module_kind": "normal"}
+                     "coating": "TiAlN", "purpose": "cylindrical", "tool_number": 1, "module_kind": "normal",
+                     "gashes": 14, "profile": "protuberance"}
     assert len(listed) == len(seeded_hob_ids()) + 1
 
 

@@ -98,7 +98,8 @@ def test_a_finish_feed_edited_beyond_the_table_is_refused(run):
     feed = round(2.0 * table_speed, 1)                          # mm/min for 2.0 mm/rev
     copy = runners_copy(run, job, module_params={finish: {**module_params[finish], "feed_axial": feed}})
     before = program_count(run)
-    refused(run("instantiate", "--job", copy), f"job {copy}, module_params.{finish}.feed_axial", "1.50 maximum")
+    refused(run("instantiate", "--job", copy), f"job {copy}, module_params.{finish}.feed_axial",
+            "1.50 mm/rev finishing maximum")
     assert program_count(run) == before
 
 

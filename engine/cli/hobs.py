@@ -13,7 +13,8 @@ HOB_COLUMNS = (
     Column("id", "hob_id"), Column("module", "module"), Column("kind", "module_kind"), Column("α", "pressure_angle"),
     Column("starts", "starts"), Column("da0", "tip_diameter"), Column("length", "length"), Column("hand", "hand"),
     Column("class", "accuracy_class"), Column("material", "material"), Column("coating", "coating"),
-    Column("purpose", "purpose"), Column("T", "tool_number"),
+    Column("purpose", "purpose"), Column("T", "tool_number"), Column("gashes", "gashes"),
+    Column("profile", "profile"),
 )
 HOB_FIELDS = (
     Column("hob", "hob_id"), Column("module", "module"), Column("module kind", "module_kind"),
@@ -21,6 +22,7 @@ HOB_FIELDS = (
     Column("starts", "starts"), Column("tip diameter", "tip_diameter"), Column("length", "length"),
     Column("hand", "hand"), Column("accuracy class", "accuracy_class"), Column("material", "material"),
     Column("coating", "coating"), Column("purpose", "purpose"), Column("tool number", "tool_number"),
+    Column("gashes", "gashes"), Column("profile", "profile"),
 )
 JOB_COLUMNS = (Column("job", "job_id"), Column("gear", "gear_id"), Column("class", "class"),
                Column("machine", "machine"), Column("made", "created_at"))
@@ -100,15 +102,19 @@ def hobs_delete(ctx, hob_id, yes):
 @click.option("--module-kind", type=click.Choice(["normal", "axial"]), default=None,
               help="Which module --module is: normal (default for cylindrical hobs) or axial (a worm-wheel hob "
                    "catalogued by its worm's axial module, DIN 3975). A worm-wheel hob must say.")
+@click.option("--gashes", type=int, default=12, show_default=True,
+              help="Gashes (flutes) of the hob; with the starts they bound the feed by the chip thickness.")
+@click.option("--profile", type=click.Choice(["standard", "protuberance", "topping"]), default="standard",
+              show_default=True, help="Tooth profile: the basic rack's, with a tip protuberance, or topping.")
 @click.pass_context
 def hobs_add(ctx, hob_id, module, pressure_angle, starts, tip_diameter, length, hand, accuracy_class,
-             material, coating, purpose, tool_number, module_kind):
+             material, coating, purpose, tool_number, module_kind, gashes, profile):
     """Add one hob to the library; a bad value or an existing id stores nothing."""
     from ..gears.hob_library import add_hob
     from ..gears.records import Hob
 
     hob = Hob(hob_id, module, pressure_angle, starts, tip_diameter, length, hand, accuracy_class,
-              material, coating, purpose, tool_number, module_kind or "")
+              material, coating, purpose, tool_number, module_kind or "", gashes, profile)
     with connection(ctx) as conn:
         add_hob(conn, hob)
     click.echo(f"added hob {hob_id}")

@@ -22,7 +22,7 @@ from .cutting_data import (
     RADIAL_TO_AXIAL,
     CuttingData,
     default_cutting_data,
-    feed_maximum,
+    feed_limit,
     hob_speed,
     per_minute,
 )
@@ -120,7 +120,7 @@ class CaseBase:
         defaults = default_cutting_data(gear.module, gear.material, bool(hob.coating), hob.tip_diameter,
                                         machine.spindle_max)
         found = {cut: self.propose(query_of(gear, hob, cut), top, defaults) for cut in CUT_KINDS}
-        bounded = {cut: bounded_proposal(proposal, gear.module, hob.starts) for cut, (proposal, _) in found.items()}
+        bounded = {cut: bounded_proposal(proposal, gear, hob) for cut, (proposal, _) in found.items()}
         proposals = {cut: proposal for cut, (proposal, _) in bounded.items()}
         rough, finish = proposals["rough"], proposals["finish"]
         speed, speed_note = bounded_hob_speed(gear, hob, rough.cutting_speed, machine.spindle_max)
@@ -144,20 +144,20 @@ def bounded_hob_speed(gear, hob, cutting_speed: float, spindle_max: float) -> tu
                   f"{TOOLS[tool_of(hob)]} hob ({speed_range(gear, hob)[1]:g} m/min)")
 
 
-def bounded_proposal(proposal: KindProposal, module: float, starts: int) -> tuple[KindProposal, str | None]:
-    """The proposal with its axial feed at most the maximum for the module and hob starts
-    (cutting_data.FEED_MAXIMUM, reference §C), and the one-line note when it was lowered. The
-    radial feed is scaled by the same factor: it came from the same cases, and a feed whose
-    definition is suspect (the paper's, §D) is suspect on both axes."""
-    limit = feed_maximum(module, proposal.cut, starts)
+def bounded_proposal(proposal: KindProposal, gear, hob) -> tuple[KindProposal, str | None]:
+    """The proposal with its axial feed at most the maximum for the gear and hob (the §C table
+    for the module, and the chip-thickness bound of Hoffmeister's formula, §C1:
+    cutting_data.feed_limit), and the one-line note when it was lowered. The radial feed is
+    scaled by the same factor: it came from the same cases, and a feed whose definition is
+    suspect (the paper's, §D) is suspect on both axes."""
+    limit, why = feed_limit(gear, hob, proposal.cut)
     if proposal.axial_feed <= limit + FEED_EPSILON:
         return proposal, None
     factor = limit / proposal.axial_feed
     lowered = KindProposal(proposal.cut, proposal.cutting_speed, limit, proposal.radial_feed * factor,
                            f"{proposal.source}, feed bounded", proposal.case_ids)
     return lowered, (f"{proposal.cut}: axial feed {proposal.axial_feed:.2f} mm per workpiece rev ({proposal.source}) "
-                     f"bounded to {limit:.2f}, the {proposal.cut}ing maximum for m{module:g} with a {starts}-start "
-                     f"hob (reference §C); radial feed scaled alike to {lowered.radial_feed:.2f}")
+                     f"bounded to {limit:.2f}, the {why}; radial feed scaled alike to {lowered.radial_feed:.2f}")
 
 
 @dataclass(frozen=True)

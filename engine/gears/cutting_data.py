@@ -9,6 +9,7 @@ import math
 from dataclasses import dataclass, replace
 
 from ..errors import EngineError
+from .chip_thickness import ALLOWED_CHIP_THICKNESS, chip_feed_bound
 
 # Cutting speed v [m/min] by material, for uncoated and coated HSS hobs, wet (§C, mid-range).
 CUTTING_SPEED = {
@@ -31,9 +32,10 @@ RADIAL_TO_AXIAL = 0.35   # radial infeed (in air) per workpiece revolution, rela
 # 8.11 mm/rev at m2, §D), so every transferred feed is bounded by this table.
 FEED_MAXIMUM = ((1.0, 2.0, 1.0), (2.0, 3.0, 1.5), (3.0, 3.5, 2.0), (4.0, 4.0, 2.0))
 FEED_MAXIMUM_COLUMN = {"rough": 1, "finish": 2}
-# Multi-start hobs: "lower f_a to keep chip thickness in range" (§C). At the same f_a each gash of a
-# z0-start hob takes z0 times the generating increment; the bound is the single-start one / √z0
-# (half at z0 = 4). The exponent is our choice [K][?], not from a source: calibrate it.
+# Multi-start hobs: "lower f_a to keep chip thickness in range" (§C). A cylindrical gear's feed is
+# bounded by the chip thickness of Hoffmeister's formula (engine.gears.chip_thickness, §C1), for
+# single- and multi-start hobs alike. A worm wheel is cut by radial or tangential feed, outside that
+# formula's validity: its bound stays the single-start one / √z0, an exponent of our choice [K][?].
 MULTI_START_EXPONENT = 0.5
 
 
@@ -57,33 +59,50 @@ class CuttingData:
         """The same data with only the notes of these cut kinds (a single-cut job has no finish)."""
         return replace(self, notes=tuple(note for note in self.notes if note.split(":")[0] in cut_kinds))
 
-    def with_overrides(self, module: float = 0.0, starts: int = 1, **overrides) -> CuttingData:
+    def with_overrides(self, gear=None, hob=None, **overrides) -> CuttingData:
         """A speed or feed of 0 or below stops the hob or the feed: refused as it is given. An
-        axial feed (mm per workpiece revolution) above the maximum for the module is refused too:
-        the table's maximum is already the upper end of practice; a shop that proved more
-        calibrates FEED_MAXIMUM, it does not pass one job beyond it unnoticed."""
+        axial feed (mm per workpiece revolution) above the maximum for the gear and hob is refused
+        too (feed_limit): the table's maximum is already the upper end of practice, and the chip
+        bound is the hob's; a shop that proved more calibrates them, it does not pass one job
+        beyond them unnoticed. An axial feed is given with the gear and hob it is for."""
         given = {name: value for name, value in overrides.items() if value is not None}
         for name, value in given.items():
             if not value > 0:
                 raise EngineError(f"{name.replace('_', ' ')} {value:g} must be above 0 (r/min or mm/min)")
         for name, cut in (("axial_feed_rough", "rough"), ("axial_feed_finish", "finish")):
-            if name in given and given[name] > feed_maximum(module, cut, starts) + FEED_EPSILON:
-                raise EngineError(f"{name.replace('_', ' ')} {given[name]:g} mm per workpiece rev exceeds the "
-                                  f"{feed_maximum(module, cut, starts):.2f} maximum for m{module:g} with a "
-                                  f"{starts}-start hob (reference §C); give a feed within it")
+            if name in given:
+                most, why = feed_limit(gear, hob, cut)
+                if given[name] > most + FEED_EPSILON:
+                    raise EngineError(f"{name.replace('_', ' ')} {given[name]:g} mm per workpiece rev exceeds "
+                                      f"the {most:.2f} mm/rev {why}; give a feed within it")
         return replace(self, **given, source=self.source + " + overrides") if given else self
 
 
 FEED_EPSILON = 1e-9
 
 
-def feed_maximum(module: float, cut: str, starts: int = 1) -> float:
-    """The most f_a [mm per workpiece revolution] for the module and cut kind (FEED_MAXIMUM,
-    interpolated), lowered for multi-start hobs by √z0."""
+def table_maximum(module: float, cut: str) -> float:
+    """The most f_a [mm per workpiece revolution] of the §C table for the module and cut kind
+    (FEED_MAXIMUM, interpolated): a single-start hob in steel."""
     column = FEED_MAXIMUM_COLUMN[cut]
-    rows = [(row[0], row[column]) for row in FEED_MAXIMUM]
-    single_start = _interpolated(rows, module)
-    return single_start / max(1, starts) ** MULTI_START_EXPONENT
+    return _interpolated([(row[0], row[column]) for row in FEED_MAXIMUM], module)
+
+
+def feed_limit(gear, hob, cut: str) -> tuple[float, str]:
+    """(the most f_a [mm per workpiece revolution], what it is, read after "the <f> mm/rev"): the
+    §C table's maximum for the module, and for a cylindrical gear at most the feed whose chips stay
+    within the allowed thickness (Hoffmeister, §C1); a worm-wheel hob's is the table's / √z0
+    (radial or tangential feed, outside the formula's validity)."""
+    table = table_maximum(gear.module, cut)
+    if hob.purpose == "worm_wheel":
+        return (table / max(1, hob.starts) ** MULTI_START_EXPONENT,
+                f"{cut}ing maximum for m{gear.module:g} with a {hob.starts}-start worm-wheel hob (reference §C)")
+    chip = chip_feed_bound(gear, hob)
+    if chip < table:
+        return chip, (f"chip-thickness bound for m{gear.module:g} z{gear.teeth} with hob {hob.id} ({hob.starts} "
+                      f"start(s), {hob.gashes} gashes): Hoffmeister's h_max within {ALLOWED_CHIP_THICKNESS:g} mm "
+                      "(reference §C1)")
+    return table, f"{cut}ing maximum for m{gear.module:g} (reference §C)"
 
 
 def _interpolated(rows: list[tuple[float, float]], x: float) -> float:

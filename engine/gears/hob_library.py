@@ -35,6 +35,9 @@ from .hob_matching import ACCURACY_CLASSES, PURPOSES, HobChoice, choose_hob
 from .models import ancestry
 from .records import TOOTH_DEPTH, Hob, load_gear, load_hobs
 
+# The hob's tooth profile (table hob's CHECK, reference §C1): the basic rack's, a tip protuberance,
+# or a topping hob that also cuts the gear's tip.
+PROFILES = ("standard", "protuberance", "topping")
 HobImportError = CsvError   # a file of bad rows: `problems` holds one line per problem, in file order
 
 
@@ -59,6 +62,12 @@ def parse_hob_id(cell: str) -> str:
     return cell
 
 
+def parse_profile(cell: str) -> str:
+    if cell.lower() not in PROFILES:
+        raise CellError(f"is not one of {', '.join(PROFILES)}")
+    return cell.lower()
+
+
 def parse_purpose(cell: str) -> str:
     if cell.lower() not in PURPOSES:
         raise CellError(f"is not one of {', '.join(PURPOSES)}")
@@ -68,6 +77,7 @@ def parse_purpose(cell: str) -> str:
 declare(parse_accuracy_class, "accuracy class", f"write one of {', '.join(ACCURACY_CLASSES)}")
 declare(parse_hob_id, "hob id", "write an id like H-M2-AA-R1")
 declare(parse_purpose, "purpose", f"write one of {', '.join(PURPOSES)}")
+declare(parse_profile, "profile", f"write one of {', '.join(PROFILES)}")
 
 # In the order of the fields of records.Hob (and of seed_templates/hobs.csv).
 HOB_COLUMNS: tuple[Column, ...] = (
@@ -85,10 +95,13 @@ HOB_COLUMNS: tuple[Column, ...] = (
     Column("purpose", parse_purpose),
     Column("tool_number", parse_positive_whole, check=lambda v: v <= 32000, rule="is above 32000"),
     Column("module_kind", parse_module_kind),
+    Column("gashes", parse_positive_whole),
+    Column("profile", parse_profile),
 )
 COLUMN_NAMES = tuple(column.name for column in HOB_COLUMNS)
 HOB_KIND = CsvKind("hob", HOB_COLUMNS)
-DEFAULTS = {"material": "HSS", "coating": "", "purpose": "cylindrical", "tool_number": 1}
+DEFAULTS = {"material": "HSS", "coating": "", "purpose": "cylindrical", "tool_number": 1, "gashes": 12,
+            "profile": "standard"}
 assert COLUMN_NAMES == tuple(field.name for field in fields(Hob)), "HOB_COLUMNS must follow records.Hob"
 
 

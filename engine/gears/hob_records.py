@@ -14,7 +14,7 @@ if TYPE_CHECKING:
 
 ONE_HOB = """
 SELECT id AS hob_id, module, pressure_angle, starts, tip_diameter, length, hand, accuracy_class, material,
-       coating, purpose, tool_number, module_kind
+       coating, purpose, tool_number, module_kind, gashes, profile
 FROM hob WHERE upper(id) = upper(%s)"""
 HOB_JOBS = """
 SELECT j.id AS job_id, j.gear_id, j.gear_class AS class, j.machine, j.created_at

@@ -44,6 +44,7 @@ class Gear:
     # converted on load, so `module` is always the normal module the models compute with), or None
     # (not stated: normal for cylindrical gears; the worm-wheel model refuses it).
     module_kind: str | None = None
+    profile_shift: float | None = None   # x [modules] as the drawing gives it (None: not given)
     units: tuple = ()          # further toothed units of a multi-unit gear (GearUnit), unit 2 first
 
     @property
@@ -82,6 +83,14 @@ class Hob:
     # The module the record gives: 'normal', or 'axial' (a worm-wheel hob catalogued by its worm's
     # axial module, DIN 3975: converted on load, so `module` is always the normal module m_n).
     module_kind: str = "normal"
+    # Gashes (flutes) of the hob: with the starts they set how many cutting edges share one
+    # workpiece revolution's feed (Hoffmeister's i = gashes/starts, reference §C1). The migration's
+    # default, 12, is the usual count of solid HSS catalogue hobs of m1–m4 [K].
+    gashes: int = 12
+    # The hob's tooth profile (reference §C1): standard (the basic rack profile, DIN 3972),
+    # protuberance (a tip protuberance undercutting the root ahead of shaving or grinding) or
+    # topping (the hob's root also cuts the gear's tip diameter).
+    profile: str = "standard"
 
     @property
     def stated_module(self) -> float:

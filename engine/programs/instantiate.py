@@ -144,11 +144,12 @@ class Planner:
     def cutting_data(self, gear: Gear, hob) -> tuple:
         """Cutting data from the nearest cases of the machining history (overrides applied),
         and the ids of the cases they came from; gears alike share one suggestion."""
-        key = (gear.module, gear.teeth, gear.material, gear.hardness, gear.quality_grade, hob.id)
+        key = (gear.module, gear.teeth, gear.material, gear.hardness, gear.quality_grade, hob.id,
+               gear.helix_angle, gear.profile_shift, tuple(unit.teeth for unit in gear.units))   # the chip bound's
         if key not in self._cutting:
             cutting, proposals, _ = self.case_base.cutting_data(gear, hob, self.machine)
             case_ids = [case_id for proposal in proposals.values() for case_id in proposal.case_ids]
-            self._cutting[key] = (cutting.with_overrides(gear.module, hob.starts, **self.overrides), case_ids)
+            self._cutting[key] = (cutting.with_overrides(gear, hob, **self.overrides), case_ids)
         return self._cutting[key]
 
 

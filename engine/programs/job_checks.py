@@ -64,7 +64,7 @@ def check_hobbing_feeds(job_id: int, gear: Gear, hob: Hob, machine: Machine, par
     for key, cut in sorted(module_params.items()):
         if key.startswith("cutmotion:") and isinstance(cut, dict) and cut.get("cut_on") is not False:
             teeth = _unit_teeth(job_id, module_params, key, gear.teeth)
-            _check_cut(job_id, key, cut, table if bounded else None, teeth, gear.module, hob.starts, n0)
+            _check_cut(job_id, key, cut, table if bounded else None, teeth, gear, hob, n0)
 
 
 def _unit_teeth(job_id: int, module_params: dict, key: str, teeth: int) -> float:
@@ -133,12 +133,11 @@ def _same(stored, derived) -> bool:
     return stored == derived
 
 
-def _check_cut(job_id: int, key: str, cut: dict, table, teeth: float, module: float, starts: int,
-               n0: float) -> None:
+def _check_cut(job_id: int, key: str, cut: dict, table, teeth: float, gear: Gear, hob: Hob, n0: float) -> None:
     """Each feed of the cut above 0 and, with the §C `table`, the axial one per workpiece
     revolution (of the unit's `teeth`) within the maximum for its kind (rough or finish), the
-    module and the hob's starts."""
-    one_mm_per_rev = per_minute(1.0, n0, starts, int(teeth))   # mm/min per mm/rev (§B5)
+    gear and the hob (the §C table and the chip bound of §C1)."""
+    one_mm_per_rev = per_minute(1.0, n0, hob.starts, int(teeth))   # mm/min per mm/rev (§B5)
     for name in ("feed_axial", "feed_radial", "feed_tangential"):
         if name in cut:
             where = f"module_params.{key}.{name}"
@@ -151,7 +150,7 @@ def _check_cut(job_id: int, key: str, cut: dict, table, teeth: float, module: fl
             override = {f"axial_feed_{kind}" if name == "feed_axial" else "radial_feed": value / one_mm_per_rev}
             if table is not None:
                 _refused_as_new(job_id, f"{where} = {value:g} mm/min",
-                                lambda override=override: table.with_overrides(module, starts, **override))
+                                lambda override=override: table.with_overrides(gear, hob, **override))
 
 
 def _number(job_id: int, values: dict, name: str, where: str, default: float | None = None) -> float:

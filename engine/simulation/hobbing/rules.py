@@ -7,7 +7,7 @@ from __future__ import annotations
 import math
 import re
 
-from ...gears.cutting_data import feed_maximum
+from ...gears.cutting_data import feed_limit
 from ...gears.records import Gear, Hob
 from ...machines.records import Machine
 from ...machines.work_holding import KINDS as WORK_HOLDING_KINDS
@@ -76,14 +76,15 @@ def run_out_problem(run_out: float | None, least: float, unit: str) -> str | Non
 
 
 def feed_problem(feed: float | None, gear: Gear, hob: Hob, motion: str = "pass") -> str | None:
-    """§C: the roughing maximum f_a for the module bounds every pass, rough or finish."""
+    """§C, §C1: the roughing maximum f_a for the gear and hob bounds every pass, rough or finish:
+    the table's for the module, and the feed whose chips (Hoffmeister's h_max at the whole tooth
+    depth) stay within the allowed thickness."""
     if feed is None:
         return None
-    most = feed_maximum(gear.module, "rough", hob.starts)
+    most, why = feed_limit(gear, hob, "rough")
     if feed <= most * (1 + FEED_TOLERANCE):
         return None
-    return (f"the {motion} feeds {feed:.3f} mm per workpiece revolution, above the {most:g} mm/rev roughing maximum "
-            f"for m{gear.module:g} with a {hob.starts}-start hob (§C)")
+    return f"the {motion} feeds {feed:.3f} mm per workpiece revolution, above the {most:.3g} mm/rev {why}"
 
 
 HEADERS = {"GEAR": re.compile(r";\s*GEAR\s+(\S+)"), "HOB": re.compile(r";\s*HOB\s+(\S+)"),
