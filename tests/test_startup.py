@@ -24,15 +24,16 @@ LATHE_EXPANDERS = {"engine.verifier.expanders.iso", "engine.verifier.expanders.l
 # workers' multiprocessing, the embedded server's module (a URL is given), the explanation of
 # rows (no --explain), the TOML reader (no config file: ENGINE_CONFIG="", tests/conftest.py), the
 # CSV reader and a template's CSV form (engine.quantities holds the bound the records share with it),
-# the listings' helpers (engine template list), the checks of rows before they are written
+# the listings' helpers (engine template list), the checks of rows before they are written, a
+# lathe's arcs (a hobbing program has none); the batch's progress bar is not among the CLI's modules
 CLI_MODULES_OF_INSTANTIATE = {"engine.cli", "engine.cli.app", "engine.cli.commands", "engine.cli.context",
                               "engine.cli.conventions", "engine.cli.examples", "engine.cli.ids",
-                              "engine.cli.instantiate", "engine.cli.progress"}
+                              "engine.cli.instantiate"}
 OTHER_MODELS = {"engine.hobbing.duplex", "engine.hobbing.taper", "engine.hobbing.crowned",
                 "engine.hobbing.worm_wheel", "engine.hobbing.models"}
 UNUSED_BY_ONE_GEAR = {"multiprocessing", "engine.programs.workers", "engine.db.embedded", "engine.programs.explain",
                       "tomllib", "engine.csv_reader", "engine.templates.template_csv", "engine.db.listing",
-                      "engine.templates.checks"}
+                      "engine.templates.checks", "engine.verifier.arcs"}
 
 
 def modules_after(code: str, *arguments: str) -> set[str]:
