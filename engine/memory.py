@@ -1,7 +1,8 @@
-"""Pausing Python's cycle collector while a large structure is built.
+"""Python's cycle collector: paused while a large structure is built, and spared the walks a
+command's start and exit would make over objects that live as long as the process.
 
-Building one allocates objects faster than they die, so the collector runs again and again
-over everything built so far, and its cost grows with the square of the size. The
+Building a large structure allocates objects faster than they die, so the collector runs again
+and again over everything built so far, and its cost grows with the square of the size. The
 structures built under the pause (a batch of planned programs, an ezdxf document) are
 freed by reference counting or collected once, after the pause."""
 from __future__ import annotations
@@ -26,8 +27,9 @@ def no_cycle_collection():
 # start of a command allocates some 60,000 that live until it ends (modules, classes, functions,
 # tables), so the collector ran about 90 times over them and found nothing (8 ms of the 0.2 s of
 # `engine instantiate --gear 42`, issue 28). Every 100,000 it still runs during long work, each
-# collection over as many objects, so the total stays the same; what it leaves for the next one
-# is at most that many objects.
+# collection over as many objects, so the total stays the same; young garbage waits for at most
+# that many allocations, and what outlived a young collection for an older one, ten young ones
+# later as before.
 COMMAND_YOUNG_COLLECTION = 100_000
 _exit_without_collection = False
 
