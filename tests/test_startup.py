@@ -24,15 +24,16 @@ LATHE_EXPANDERS = {"engine.verifier.expanders.iso", "engine.verifier.expanders.l
 # workers' multiprocessing, the embedded server's module (a URL is given), the explanation of
 # rows (no --explain), the TOML reader (no config file: ENGINE_CONFIG="", tests/conftest.py), the
 # CSV reader and a template's CSV form (engine.quantities holds the bound the records share with it),
-# the listings' helpers (engine template list), the checks of rows before they are written
+# the listings' helpers (engine template list), the checks of rows before they are written, a
+# lathe's arcs (a hobbing program has none); the batch's progress bar is not among the CLI's modules
 CLI_MODULES_OF_INSTANTIATE = {"engine.cli", "engine.cli.app", "engine.cli.commands", "engine.cli.context",
                               "engine.cli.conventions", "engine.cli.examples", "engine.cli.ids",
-                              "engine.cli.instantiate", "engine.cli.progress"}
+                              "engine.cli.instantiate"}
 OTHER_MODELS = {"engine.hobbing.duplex", "engine.hobbing.taper", "engine.hobbing.crowned",
                 "engine.hobbing.worm_wheel", "engine.hobbing.models"}
 UNUSED_BY_ONE_GEAR = {"multiprocessing", "engine.programs.workers", "engine.db.embedded", "engine.programs.explain",
                       "tomllib", "engine.csv_reader", "engine.templates.template_csv", "engine.db.listing",
-                      "engine.templates.checks"}
+                      "engine.templates.checks", "engine.verifier.arcs"}
 
 
 def modules_after(code: str, *arguments: str) -> set[str]:
@@ -116,3 +117,36 @@ def test_every_dialect_that_names_an_expander_finds_it():
     assert named == set(EXPANDER_MODULES)
     for name in named:
         assert callable(expander_named(name))
+
+
+def test_a_command_leaves_what_is_alive_at_its_exit_to_the_system():
+    """engine.memory.command_collection: the command's exit handler freezes everything alive, so
+    Python's last collection at exit walks none of it. A handler registered before the command
+    runs after it (last in, first out) and finds it frozen; the command's output is whole."""
+    code = ("import atexit, gc, sys\n"
+            "atexit.register(lambda: sys.stderr.write(f'frozen {gc.get_freeze_count()}\\n'))\n"
+            "from engine.cli import main\n"
+            "try:\n    main(['--help'])\nexcept SystemExit as done:\n    assert not done.code, done.code")
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    assert "Usage: " in done.stdout and "instantiate" in done.stdout
+    frozen = int(done.stderr.split("frozen ")[-1])
+    assert frozen > 10_000   # the modules, classes and functions loaded: tens of thousands of objects
+
+
+def test_a_command_collects_young_objects_rarely_and_restores_the_collector_after_it():
+    """While a command runs, a young collection waits for COMMAND_YOUNG_COLLECTION objects (its
+    start allocates fewer); after it, the process collects as it did (a test runner, a caller)."""
+    import gc
+
+    from click.testing import CliRunner
+
+    from engine.cli import main
+    from engine.memory import COMMAND_YOUNG_COLLECTION, command_collection
+
+    before = gc.get_threshold()
+    with command_collection():
+        assert gc.get_threshold() == (max(COMMAND_YOUNG_COLLECTION, before[0]), *before[1:])
+    assert gc.get_threshold() == before
+    assert CliRunner().invoke(main, ["--help"]).exit_code == 0
+    assert gc.get_threshold() == before

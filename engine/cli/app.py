@@ -20,6 +20,7 @@ import unicodedata
 import click
 
 from ..errors import EngineError
+from ..memory import command_collection
 from .commands import COMMAND_MODULES, LazyCommands
 from .context import CONFIG
 from .conventions import JSON_SEEN, apply_conventions, apply_to_one, default_map, json_from_defaults
@@ -74,6 +75,11 @@ def wants_json(args: list[str]) -> bool:
 
 class EngineGroup(click.Group):
     """Reads the config file, turns errors into one-line messages (JSON with --json) and exit codes."""
+
+    def main(self, *args, **extra):
+        """The command, with the cycle collector as a command wants it (engine.memory.command_collection)."""
+        with command_collection():
+            return super().main(*args, **extra)
 
     def make_context(self, info_name, args, parent=None, **extra):
         """The config file's option defaults (engine.programs.config) are the context's default_map."""

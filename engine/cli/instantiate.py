@@ -11,7 +11,6 @@ import click
 from ..errors import EngineError
 from .context import connection, emit_json, settings
 from .ids import GEAR_ID, JOB_ID
-from .progress import progress_bar
 
 if TYPE_CHECKING:
     from ..db.connection import Connection
@@ -183,6 +182,7 @@ def _batch(conn: Connection, job_range, gear_range, machine, choices, overrides,
     bar on a terminal."""
     from ..programs.instantiate import instantiate_gears
     from ..programs.remake import instantiate_jobs
+    from .progress import progress_bar  # a batch's bar only (issue 28: start-up)
 
     with progress_bar("instantiate") as progress:
         mode = replace(mode, progress=progress)

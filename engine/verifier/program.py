@@ -19,7 +19,6 @@ from typing import TYPE_CHECKING, Any
 
 from ..machines.records import Machine
 from ..names import NAME_RULES, is_safe
-from .arcs import arc_box, check_radius
 from .expansion import ExpansionRefused, PlainLine, expand
 from .feed_mode import FeedMode
 from .grammar import AXES, Dialect, dialect_for
@@ -242,6 +241,8 @@ class ProgramReading:
         raise Refused(f"{axis}{value:g} lies outside the working area G25/G26 {axis} {low:g}…{high:g}")
 
     def _check_arc(self, block: Block) -> None:
+        from .arcs import arc_box, check_radius  # a lathe's arcs: a hobbing program has none (issue 28: start-up)
+
         if not {"X", "Z"} <= self.position.keys():
             raise Refused("an arc from an unknown start point: program X and Z before it")
         end = {**self.position, **block.positions}
