@@ -14,6 +14,7 @@ has a dedendum of 1.4·m_n (ISO 53 profile D), T = 2.4·m_n, not the standard 2.
 from __future__ import annotations
 
 import json
+import math
 import re
 
 import psycopg
@@ -156,3 +157,53 @@ def test_a_stored_feed_mode_not_a_word_is_refused_in_one_line(run, stored):
     result = run("instantiate", "--job", job_id, "--dry-run")
     assert result.exit_code == 1, result.output
     assert result.stderr.count("\n") == 1 and "feed mode" in result.stderr, result.stderr
+
+
+# Hoffmeister (reference §C1), written out here with the depth of cut as a parameter.
+def h_max(module, teeth, tip_of_hob, gashes, starts, feed, depth) -> float:
+    return (4.9 * module * teeth ** -0.542 * (tip_of_hob / 2 / module) ** -0.225 * (gashes / starts) ** -0.877
+            * (feed / module) ** 0.511 * (depth / module) ** 0.319)
+
+
+GRIND = 45                     # m4 z25 spur, d_a 108, hob H-M4-A-R1 (d_a0 90, 12 gashes, 1 start)
+GRIND_ROOT = 108 - 2 * (4 + 1.4 * 4)     # dedendum 1.4·m_n (ISO 53 profile D): d_f 88.8
+GRIND_DEPTH = (108 - GRIND_ROOT) / 2     # T = 9.6 mm = 2.4·m_n
+
+
+def axial_feeds(lines: list[str], teeth: int, starts: int) -> list[float]:
+    """f_a [mm per workpiece revolution] of every G1 Z pass: F over the table speed n0·z0/z2."""
+    n0 = next(int(line.split("=")[1].split()[0]) for line in lines if line.startswith("; n0="))
+    table, feed, found = n0 * starts / teeth, 0.0, []
+    for line in lines:
+        word = F_WORD.search(line) if line.startswith("G1") else None
+        feed = float(word.group(1)) if word else feed
+        if line.startswith("G1") and Z_WORD.search(line):
+            found.append(feed / table)
+    return found
+
+
+def test_a_gear_cut_deeper_than_2_25_modules_keeps_its_chips_within_the_bound(conn):
+    """The bound took T = 2.25·m_n whatever the record: gear 45 with d_f 88.8 (T 9.6 mm) roughed at
+    1.92 mm/rev, chips of 0.204 mm."""
+    conn.execute("UPDATE gear SET root_diameter = %s WHERE id = %s", (GRIND_ROOT, GRIND))
+    lines = instantiate_gear(conn, GRIND, choices=Choices(cuts=2)).lines
+    chips = [h_max(4, 25, 90, 12, 1, feed, GRIND_DEPTH) for feed in axial_feeds(lines, 25, 1)]
+    assert chips and max(chips) <= 0.20 * (1 + 1e-6), chips
+
+
+def test_the_simulation_refuses_a_pass_above_the_bound_of_the_records_depth(conn):
+    """The simulation reads the F word and the records: a rough pass at the feed the standard depth
+    would allow (F21.7 at 11.32 r/min of the table: 1.917 mm/rev, chips of 0.204 mm at T 9.6 mm)
+    is above the bound of this gear."""
+    conn.execute("UPDATE gear SET root_diameter = %s WHERE id = %s", (GRIND_ROOT, GRIND))
+    lines = instantiate_gear(conn, GRIND, choices=Choices(cuts=2)).lines
+    n0 = next(int(line.split("=")[1].split()[0]) for line in lines if line.startswith("; n0="))
+    table = n0 / 25
+    standard_bound = 4 * (0.20 / h_max(4, 25, 90, 12, 1, 4, 9.0)) ** (1 / 0.511)   # T = 2.25·m_n
+    fast = math.floor(standard_bound * table * 10) / 10
+    assert h_max(4, 25, 90, 12, 1, fast / table, GRIND_DEPTH) > 0.20
+    rough = next(index for index, line in enumerate(lines) if line.startswith("G1") and Z_WORD.search(line))
+    forged = list(lines)
+    forged[rough] = F_WORD.sub(f"F{fast:.1f}", lines[rough])
+    found = messages(simulated(conn, GRIND, forged))
+    assert any("Hoffmeister" in message for message in found), found
