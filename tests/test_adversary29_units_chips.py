@@ -207,3 +207,19 @@ def test_the_simulation_refuses_a_pass_above_the_bound_of_the_records_depth(conn
     forged[rough] = F_WORD.sub(f"F{fast:.1f}", lines[rough])
     found = messages(simulated(conn, GRIND, forged))
     assert any("Hoffmeister" in message for message in found), found
+
+
+def test_a_slip_in_the_planners_chip_bound_is_not_proved(conn, monkeypatch):
+    """The simulation held passes to the planner's own chip bound (engine.gears.cutting_data's
+    chip_feed_bound): a planner whose bound were twice the formula's would rough gear 45 at the
+    history's 3.5 mm/rev, chips of 0.27 mm, and the simulation proved it. It works h_max out itself."""
+    import engine.gears.cutting_data as cutting_data
+    from engine.errors import EngineError
+
+    true_bound = 4 * (0.20 / h_max(4, 25, 90, 12, 1, 4, 9.0)) ** (1 / 0.511)
+    assert h_max(4, 25, 90, 12, 1, 3.5, 9.0) > 0.25 and true_bound < 3.5
+    real = cutting_data.chip_feed_bound
+    monkeypatch.setattr(cutting_data, "chip_feed_bound", lambda gear, hob: 2 * real(gear, hob))
+    with pytest.raises(EngineError) as refused:
+        instantiate_gear(conn, GRIND, choices=Choices(cuts=2, feed_mode="climb"))
+    assert "Hoffmeister" in str(refused.value) and "\n" not in str(refused.value), str(refused.value)
