@@ -223,3 +223,22 @@ def test_a_slip_in_the_planners_chip_bound_is_not_proved(conn, monkeypatch):
     with pytest.raises(EngineError) as refused:
         instantiate_gear(conn, GRIND, choices=Choices(cuts=2, feed_mode="climb"))
     assert "Hoffmeister" in str(refused.value) and "\n" not in str(refused.value), str(refused.value)
+
+
+def test_a_tangential_pass_above_the_feed_bound_is_refused(run):
+    """A tangential worm wheel's pass feeds along Y at its kind's axial feed, at most the §C
+    roughing maximum for m3, 3.5 mm per workpiece revolution (one start). Neither the stored job's
+    check nor the simulation bounded it: feed_tangential edited to 1.5× that was proved."""
+    made = run("instantiate", "--gear", 53, "--worm-feed", "tangential", "--json")
+    assert made.exit_code == 0, made.output
+    job_id = json.loads(made.stdout)["job_id"]
+    with psycopg.connect(run.url) as conn:
+        n0, starts, teeth = conn.execute(
+            "SELECT (j.params->>'n0')::float, h.starts, g.teeth FROM job j JOIN hob h ON h.id = j.hob_id "
+            "JOIN gear g ON g.id = j.gear_id WHERE j.id = %s", (job_id,)).fetchone()
+        fast = round(1.5 * 3.5 * n0 * starts / teeth, 1)   # mm/min: 1.5 × 3.5 mm/rev at n0·z0/z2
+        conn.execute("UPDATE job SET module_params = jsonb_set(module_params, '{cutmotion:2,feed_tangential}', "
+                     "%s::jsonb) WHERE id = %s", (json.dumps(fast), job_id))
+    result = run("instantiate", "--job", job_id, "--dry-run")
+    assert result.exit_code == 1, result.output
+    assert result.stderr.count("\n") == 1 and "tangential" in result.stderr, result.stderr
