@@ -22,7 +22,7 @@ from dataclasses import dataclass
 # one value for every hob until a shop calibrates it (carbide hobs are usually run thinner [K][?]).
 ALLOWED_CHIP_THICKNESS = 0.20
 FEED_EXPONENT = 0.511          # of f_a/m_n in Hoffmeister's formula
-TOOTH_DEPTH = 2.25             # T = 2.25·m_n: the whole tooth depth, the deepest any cut goes (§B15)
+TOOTH_DEPTH = 2.25             # T = 2.25·m_n: the standard whole tooth depth (§B15), the least T taken
 
 
 @dataclass(frozen=True)
@@ -55,13 +55,23 @@ def feed_for_chip_thickness(case: ChipCase, thickness: float = ALLOWED_CHIP_THIC
 
 
 def chip_cases(gear, hob) -> list[ChipCase]:
-    """One case per toothing of the gear (unit 1 and a duplex's further units), each at the
-    whole tooth depth T = 2.25·m_n: h_max grows with T, so a feed within the bound there is
-    within it for every pass, however deep."""
-    teeth = [gear.teeth] + [unit.teeth for unit in gear.units]
+    """One case per toothing of the gear (unit 1 and a duplex's further units), each at its whole
+    tooth depth: h_max grows with T, so a feed within the bound there is within it for every pass,
+    however deep. The depth is the record's (d_a − d_f)/2 where deeper than 2.25·m_n: a gear
+    ground after hobbing (dedendum 1.4·m_n, ISO 53 profile D) is cut 2.4·m_n deep (adversary 29)."""
+    toothings = [(gear.teeth, gear.tip_diameter, gear.root_diameter)]
+    toothings += [(unit.teeth, unit.tip_diameter, unit.root_diameter) for unit in gear.units]
     shift = float(gear.profile_shift) if getattr(gear, "profile_shift", None) is not None else 0.0
     return [ChipCase(gear.module, z2, gear.helix_angle, shift, hob.tip_diameter / 2, hob.gashes, hob.starts,
-                     TOOTH_DEPTH * gear.module) for z2 in teeth]
+                     tooth_depth(gear.module, tip, root)) for z2, tip, root in toothings]
+
+
+def tooth_depth(module: float, tip_diameter, root_diameter) -> float:
+    """T [mm]: (d_a − d_f)/2 of the record, at least the standard 2.25·m_n (also when not given)."""
+    standard = TOOTH_DEPTH * module
+    if tip_diameter is None or root_diameter is None:
+        return standard
+    return max(standard, (float(tip_diameter) - float(root_diameter)) / 2)
 
 
 def chip_feed_bound(gear, hob) -> float:

@@ -107,6 +107,9 @@ class Choices:
 
 
 def _known_mode(mode: str) -> bool:
-    """A mode of FEED_MODES, or two of them (unit 1's and unit 2's) joined by UNIT_SEPARATOR."""
+    """A mode of FEED_MODES, or two of them (unit 1's and unit 2's) joined by UNIT_SEPARATOR; a
+    stored job's params.feed_mode may be any JSON value (a number is no mode)."""
+    if not isinstance(mode, str):
+        return False
     modes = mode.split(UNIT_SEPARATOR)
     return len(modes) <= 2 and all(one in FEED_MODES for one in modes)

@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING
 
 from ..errors import EngineError
 from ..gears.case_base import CUT_KINDS_BY_COUNT, CaseBase, job_cutting_record
+from ..gears.chip_thickness import chip_cases
 from ..gears.feed_marks import bounded_for_marks
 from ..gears.hob_matching import matching_hobs
 from ..gears.holding_matching import choose_holding
@@ -145,7 +146,7 @@ class Planner:
         """Cutting data from the nearest cases of the machining history (overrides applied),
         and the ids of the cases they came from; gears alike share one suggestion."""
         key = (gear.module, gear.teeth, gear.material, gear.hardness, gear.quality_grade, hob.id,
-               gear.helix_angle, gear.profile_shift, tuple(unit.teeth for unit in gear.units))   # the chip bound's
+               tuple(chip_cases(gear, hob)))   # all the chip bound reads: helix, x, each toothing's teeth and depth
         if key not in self._cutting:
             cutting, proposals, _ = self.case_base.cutting_data(gear, hob, self.machine)
             case_ids = [case_id for proposal in proposals.values() for case_id in proposal.case_ids]

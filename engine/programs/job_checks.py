@@ -147,7 +147,8 @@ def _check_cut(job_id: int, key: str, cut: dict, table, teeth: float, gear: Gear
                                   f"job.{_column(where)}; "
                                   f"{NOTHING_STORED}")
             kind = CUT_KIND_BY_NAME.get(str(cut.get("cut_name")), "rough")
-            override = {f"axial_feed_{kind}" if name == "feed_axial" else "radial_feed": value / one_mm_per_rev}
+            along = name in ("feed_axial", "feed_tangential")   # a tangential pass runs at its kind's axial feed
+            override = {f"axial_feed_{kind}" if along else "radial_feed": value / one_mm_per_rev}
             if table is not None:
                 _refused_as_new(job_id, f"{where} = {value:g} mm/min",
                                 lambda override=override: table.with_overrides(gear, hob, **override))

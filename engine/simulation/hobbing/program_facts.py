@@ -92,16 +92,19 @@ def area_facts(steps):
             moved = True
 
 
-def cut_directions(steps, machine: Machine):
-    """(comment step, name, word, Z direction in the DIN frame (−1 down, +1 up, 0 none), moves Y)
-    for each `; CUT` comment: the first feed move after it that changes Z gives the direction."""
+def cut_directions(steps, machine: Machine, starts: frozenset = frozenset()):
+    """(comment step, name, word, Z direction in the DIN frame (−1 down, +1 up, 0 none, BOTH), moves Y)
+    for each `; CUT` comment: every feed move after it (to the next) that changes Z gives the
+    direction; moves both ways are BOTH (adversary 29: a 1 µm move down before a pass fed up made
+    the pass CLIMB). With `starts` (the walk's cuts' first lines), a stretch also begins at each
+    of those lines, named and said None."""
     z_sense = -1 if int(machine.z_direction) < 0 else 1
     found: list[list] = []
     position: dict[str, float] = {}
     for step in steps:
         match = CUT_LINE.fullmatch(step.line)
-        if match:
-            found.append([step, match.group(1), match.group(2), 0, False])
+        if match or step.number in starts:
+            found.append([step, *(match.groups() if match else (None, None)), 0, False])
         if step.kind != "block" or not step.item.moves or step.item.area is not None:
             continue
         positions = step.item.positions
@@ -111,63 +114,98 @@ def cut_directions(steps, machine: Machine):
     return found
 
 
+BOTH = 2   # a cut feeding both down and up along Z: neither climb nor conventional
+
+
 def _direction(cut: list, positions: dict, position: dict, z_sense: int) -> None:
     if "Y" in positions and positions["Y"] != position.get("Y", positions["Y"]):
         cut[4] = True
-    if cut[3] == 0 and "Z" in positions and "Z" in position and positions["Z"] != position["Z"]:
-        cut[3] = z_sense * (1 if positions["Z"] > position["Z"] else -1)
+    if "Z" in positions and "Z" in position and positions["Z"] != position["Z"]:
+        sense = z_sense * (1 if positions["Z"] > position["Z"] else -1)
+        cut[3] = sense if cut[3] in (0, sense) else BOTH
 
 
 def cut_word_facts(steps, machine: Machine):
     """§B13 (Phillips): climb hobbing turns the hob against its feed at the contact. The hob
     turns in its cutting direction under M3, which the engine's DIN frame takes as the teeth
     moving up (+Z) where they meet the work: climb feeds down (−Z), conventional up; a worm
-    wheel's RADIAL cut has no axial or tangential pass, its TANGENTIAL cut feeds along Y."""
+    wheel's RADIAL cut has no axial or tangential pass, its TANGENTIAL cut feeds along Y and not
+    along Z (a Z pass said TANGENTIAL would escape the header's feed mode)."""
     for step, _, word, z, along_y in cut_directions(steps, machine):
-        wanted = {"CLIMB": z < 0, "CONVENTIONAL": z > 0, "RADIAL": z == 0 and not along_y,
-                  "TANGENTIAL": along_y}.get(word)
+        wanted = {"CLIMB": z == -1, "CONVENTIONAL": z == 1, "RADIAL": z == 0 and not along_y,
+                  "TANGENTIAL": along_y and z == 0}.get(word)
         if wanted is None:
             yield step, f"the cut is said {word}: not CLIMB, CONVENTIONAL, RADIAL or TANGENTIAL", True
         elif not wanted:
-            made = ("feeds down (−Z, DIN)" if z < 0 else "feeds up (+Z, DIN)" if z > 0 else
-                    "feeds along Y" if along_y else "has no axial pass")
+            made = ("feeds both down and up along Z" if z == BOTH else "feeds down (−Z, DIN)" if z < 0 else
+                    "feeds up (+Z, DIN)" if z > 0 else "feeds along Y" if along_y else "has no axial pass")
             yield step, f"the cut is said {word} but {made}: it is {_actual(z, along_y)} (reference §B13)", True
 
 
 def _actual(z: int, along_y: bool) -> str:
+    if z == BOTH:
+        return "neither CLIMB nor CONVENTIONAL"
     return "CLIMB" if z < 0 else "CONVENTIONAL" if z > 0 else "TANGENTIAL" if along_y else "RADIAL"
 
 
 def cut_count_facts(steps, machine: Machine, report, units: int):
     """The header's cuts are the cuts the walk follows, per unit, and the `; CUT` comments' names
-    (SINGLE, or ROUGH then FINISH, per unit); its feed mode the comments' words."""
+    (SINGLE, or ROUGH then FINISH, per unit; a program without them states a feed mode nothing
+    holds it to); its feed mode the comments' words, each cut's unit the one the walk found it cut."""
     stated = header_n0(steps)
     cuts = cut_directions(steps, machine)
     if stated is None:
         return
     step, _, count, mode = stated
     names = CUT_NAMES.get(count, ())
+    if not cuts and names:   # no `; CUT` comments: the header's mode is held to the walk's passes
+        cuts = walked_cuts(steps, machine, report, names)
     if len(report.cuts) != count * units:
         yield step, (f"the header states cuts={count}; the simulation follows {len(report.cuts)} cut(s) over "
                      f"{units} unit(s)"), True
-    elif cuts and [cut[1] for cut in cuts] != list(names) * units:
+    elif any(cut[0].kind == "comment" for cut in cuts) and [cut[1] for cut in cuts] != list(names) * units:
         yield step, (f"the header states cuts={count}; the program's `; CUT` comments name "
-                     f"{' '.join(cut[1] for cut in cuts)} over {units} unit(s)"), True
-    axial = [cut for cut in cuts if cut[2] in ("CLIMB", "CONVENTIONAL")]
-    if axial and not _feed_mode_kept(mode, cuts, count, units):
-        yield step, (f"the header states feed mode {mode}; the cuts are "
-                     f"{' '.join(cut[1] + ' ' + cut[2] for cut in axial)}"), True
+                     f"{' '.join(cut[1] for cut in cuts) or 'none'} over {units} unit(s)"), True
+    axial = [cut for cut in cuts if cut[2] not in NOT_AXIAL]
+    cut_units = _cut_units(cuts, report, count)
+    if axial and not _feed_mode_kept(mode, cuts, cut_units, units):
+        said = [(f"unit {unit} " if units > 1 else "") + f"{cut[1]} {cut[2]}"
+                for cut, unit in zip(cuts, cut_units) if cut[2] not in NOT_AXIAL]
+        yield step, f"the header states feed mode {mode}; the cuts are {', '.join(said)}", True
 
 
-def _feed_mode_kept(mode: str, cuts: list, count: int, units: int) -> bool:
+NOT_AXIAL = ("RADIAL", "TANGENTIAL")   # a worm wheel's cuts: no axial pass, no feed mode
+
+
+def walked_cuts(steps, machine: Machine, report, names: tuple) -> list[list]:
+    """The walk's cuts as `; CUT` comments would say them: named by their place in their unit's
+    coupling (a unit is roughed and finished in one), said by their direction (BOTH: both ways)."""
+    passes = cut_directions(steps, machine, frozenset(done.number for done in report.cuts))
+    for index, cut in enumerate(passes):
+        cut[1] = names[index % len(names)]
+        cut[2] = "CLIMB+CONVENTIONAL" if cut[3] == BOTH else _actual(cut[3], cut[4])
+    return passes
+
+
+def _cut_units(cuts: list, report, count: int) -> list[int]:
+    """The unit number each `; CUT` comment's cut entered: the walk's first cut starting after the
+    comment (its unit "unit <n> (...)"), else by place (count comments per unit, unit 1's first)."""
+    found = []
+    for index, cut in enumerate(cuts):
+        entered = next((done.unit for done in report.cuts if done.number >= cut[0].number), "")
+        words = entered.split()
+        found.append(int(words[1]) if len(words) > 1 and words[1].isdecimal() else 1 + index // max(count, 1))
+    return found
+
+
+def _feed_mode_kept(mode: str, cuts: list, cut_units: list[int], units: int) -> bool:
     """Every axial cut's word is the one the header's mode gives its unit and its place (rough or
-    finish): one mode for all units, or one per unit ("climb/conventional": unit 1's/unit 2's,
-    the cuts of unit 1 coming first)."""
+    finish): one mode for all units, or one per unit ("climb/conventional": unit 1's/unit 2's)."""
     modes = mode.split(UNIT_SEPARATOR)
     if len(modes) not in (1, units) or any(one not in FEED_MODES for one in modes):
         return False
-    for index, cut in enumerate(cuts):
-        words = FEED_MODES[modes[min(index // max(count, 1), len(modes) - 1)]]
-        if cut[2] in ("CLIMB", "CONVENTIONAL") and cut[2] != words[0 if cut[1] != "FINISH" else 1]:
+    for cut, unit in zip(cuts, cut_units):
+        words = FEED_MODES[modes[min(unit - 1, len(modes) - 1)]]
+        if cut[2] not in NOT_AXIAL and cut[2] != words[0 if cut[1] != "FINISH" else 1]:
             return False
     return True

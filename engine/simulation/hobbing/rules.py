@@ -7,10 +7,11 @@ from __future__ import annotations
 import math
 import re
 
-from ...gears.cutting_data import feed_limit
+from ...gears.cutting_data import feed_limit, table_maximum
 from ...gears.records import Gear, Hob
 from ...machines.records import Machine
 from ...machines.work_holding import KINDS as WORK_HOLDING_KINDS
+from .chips import chip_problem
 
 TOOTH_DEPTH = 2.25        # h = 2.25·m_n (§B15)
 WORK_OFFSETS = (54, 55, 56, 57)
@@ -77,14 +78,18 @@ def run_out_problem(run_out: float | None, least: float, unit: str) -> str | Non
 
 def feed_problem(feed: float | None, gear: Gear, hob: Hob, motion: str = "pass") -> str | None:
     """§C, §C1: the roughing maximum f_a for the gear and hob bounds every pass, rough or finish:
-    the table's for the module, and the feed whose chips (Hoffmeister's h_max at the whole tooth
-    depth) stay within the allowed thickness."""
+    the table's for the module, and for a cylindrical gear the feed whose chips (Hoffmeister's
+    h_max at the whole tooth depth) stay within the allowed thickness, worked out here from the
+    feed (engine.simulation.hobbing.chips), not the planner's bound."""
     if feed is None:
         return None
-    most, why = feed_limit(gear, hob, "rough")
-    if feed <= most * (1 + FEED_TOLERANCE):
-        return None
-    return f"the {motion} feeds {feed:.3f} mm per workpiece revolution, above the {most:.3g} mm/rev {why}"
+    if hob.purpose == "worm_wheel":
+        most, why = feed_limit(gear, hob, "rough")
+    else:
+        most, why = table_maximum(gear.module, "rough"), f"roughing maximum for m{gear.module:g} (reference §C)"
+    if feed > most * (1 + FEED_TOLERANCE):
+        return f"the {motion} feeds {feed:.3f} mm per workpiece revolution, above the {most:.3g} mm/rev {why}"
+    return None if hob.purpose == "worm_wheel" else chip_problem(feed, gear, hob, motion)
 
 
 HEADERS = {"GEAR": re.compile(r";\s*GEAR\s+(\S+)"), "HOB": re.compile(r";\s*HOB\s+(\S+)"),

@@ -321,8 +321,9 @@ class BlockSimulation:
             self.cut = Cut(step.number, step.line, teeth, table, before)
         self.cut.add(start, end, velocities)
         table = abs(self._coupled.k_b) * self.speed        # the spindle speed now, not the cut's first
-        if not self.worm_wheel and table > 0 and velocities.get("Z"):
-            self._refuse(step, feed_problem(abs(velocities["Z"]) / table, self.gear, self.hob))
+        along, motion = ("Y", "tangential pass") if self.worm_wheel else ("Z", "pass")   # §C bounds both passes
+        if table > 0 and velocities.get(along):
+            self._refuse(step, feed_problem(abs(velocities[along]) / table, self.gear, self.hob, motion))
         if table > 0 and velocities.keys() == {"X"}:          # the radial infeed is bounded by §C too
             self._refuse(step, feed_problem(abs(velocities["X"]) / table, self.gear, self.hob, "radial infeed"))
 
