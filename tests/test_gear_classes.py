@@ -61,17 +61,25 @@ def test_taper_x_follows_z_along_the_cone(conn):
     slope = math.tan(math.radians(g["cone"]))
     slanted = [m for m in cutting_moves(nc) if {"X", "Z"} <= m.changed]
     assert slanted, "the taper pass must move X and Z together (G1 X… Z…)"
+    # a spur gear's hob is swivelled by γ only: its polyline (issue 29) runs along the cone
     for move in slanted:
         dz = move.end["Z"] - move.start["Z"]
         assert abs((move.end["X"] - move.start["X"]) / dz - slope) < 2 * ROUND / abs(dz)
-        # the pass crosses both faces: from above Z = 0 to below Z = -b (climb)
-        assert move.start["Z"] > 0 and move.end["Z"] < -g["b"]
+    # each pass crosses both faces: from above Z = 0 to below Z = -b (climb), without a gap
+    passes = [[]]
+    for move in slanted:
+        if passes[-1] and move.start != passes[-1][-1].end:
+            passes.append([])
+        passes[-1].append(move)
+    for moves in passes:
+        assert moves[0].start["Z"] > 0 and moves[-1].end["Z"] < -g["b"]
     # at the top face (Z = 0) the last cut reaches the root cone: the hob's tip section (an
     # ellipse r0 × r0/cos η for the swivel η = γ of a spur gear, §B2) touches the root line
     # x = d_f2/2 + z·tan δ, so its centre lies the ellipse's support distance off that line
     # (for δ = 0 this is (d_f2 + d_a0)/2, §B3)
-    last = slanted[-1]
-    x_at_top = last.start["X"] + (0 - last.start["Z"]) * slope
+    last = next(m for m in passes[-1] if m.end["Z"] <= 0 <= m.start["Z"])
+    x_at_top = last.start["X"] + (0 - last.start["Z"]) * (last.end["X"] - last.start["X"]) / (
+        last.end["Z"] - last.start["Z"])
     delta, eta, r0 = math.radians(g["cone"]), math.radians(lead_angle(hob)), hob["da0"] / 2
     support = r0 * math.sqrt(math.cos(delta) ** 2 + (math.sin(delta) / math.cos(eta)) ** 2)
     assert abs(x_at_top - (g["df2"] / 2 + support / math.cos(delta))) < 0.01

@@ -1,4 +1,4 @@
-"""Taper gears (issue 14 item 5): the infeed `G1 X{cut_x + z_from·tan δ}` at the approach Z
+"""Taper gears (issue 14 item 5): the infeed `G1 X{taper_x_0}` (the pass's first vertex) at the approach Z
 leaves the hob clear of the conical blank, for both cone signs, climb and conventional, one
 cut and two, swivel included; the pass still carries the hob centre beyond both faces.
 
@@ -63,11 +63,10 @@ def hob_clearance(surface: np.ndarray, centre: tuple, corners: list) -> float:
 
 
 def infeed_clearance(gear: Gear, hob: Hob, cut: dict, x_retract: float) -> float:
-    """The hob along the infeed at the approach Z: X from the retract position to the cone line."""
-    slope = math.tan(math.radians(gear.cone_angle))
+    """The hob along the infeed at the approach Z: X from the retract position to the pass's first vertex."""
     surface = hob_surface(hob.tip_diameter / 2, hob.length / 2, swivel(gear.helix_angle, gear.hand, hob))
     corners = blank_corners(gear.tip_diameter, gear.cone_angle, gear.face_width)
-    x_in = cut["cut_x"] + cut["z_from"] * slope
+    x_in = cut["taper_x_0"]
     return min(hob_clearance(surface, (x, cut["z_from"]), corners) for x in np.linspace(x_in, x_retract, 4))
 
 

@@ -48,13 +48,17 @@ def axial_pass(clock: Clock, job: dict, cut: dict) -> None:
 
 
 def taper_pass(clock: Clock, job: dict, cut: dict) -> None:
-    """The axial pass along the cone X(Z) = X(0) + Z·slope, its feed along the slant."""
-    slope = job["taper_slope"]
+    """Infeed, along Z to the polyline, the polyline tangent to the root cone (issue 29) with
+    F along the slant, along Z to the run-out; the blocks along Z only where they move."""
     clock.rapid(Z=cut["z_from"])
     clock.rapid(X=cut["x_air"])
-    clock.feed(cut["feed_radial"], X=cut["cut_x"] + cut["z_from"] * slope)
-    clock.feed(cut["feed_slant"], X=cut["cut_x"] + cut["z_to"] * slope,
-               Z=cut["z_to"])
+    clock.feed(cut["feed_radial"], X=cut["taper_x_0"])
+    clock.feed(cut["feed_axial"], Z=cut["face_from"])
+    segments = sum(name.startswith("taper_x_") for name in cut) - 1   # the polyline's vertices, 0…n
+    for step in range(1, segments + 1):
+        z = cut["face_from"] + (cut["face_to"] - cut["face_from"]) * step / segments
+        clock.feed(cut["feed_slant"], X=cut[f"taper_x_{step}"], Z=z)
+    clock.feed(cut["feed_axial"], Z=cut["z_to"])
     clock.rapid(X=job["x_retract"])
 
 

@@ -16,7 +16,7 @@ from ..hobbing.machine_job import with_cycle_time
 from ..machines.records import Machine
 
 # A cut's values that are positions (mm) and feeds (mm/min), read as numbers by the cycle time.
-NUMBER_PREFIXES = ("feed_", "crown_x_", "face_", "z_", "x_", "cut_x")
+NUMBER_PREFIXES = ("feed_", "crown_x_", "taper_x_", "face_", "z_", "x_", "cut_x")
 
 
 def check_job_shape(job_id: int, params, module_params) -> None:

@@ -1,5 +1,5 @@
 """A population of hobbing work drawn with a fixed seed from the reference ranges (issue 29: "module
-1–8 on a machine rated for it, 12–120 teeth, every class"): spur, helical of both hands, taper,
+1–8 on a machine rated for it, 12–120 teeth, every class"): spur, helical of both hands, taper (about half helical),
 crowned, cluster and worm wheels with catalogue hobs by axial module; a hob library sized roughly
 per DIN 8002 (tip diameter and length by module, both hands, 1–3 starts, classes AA and A),
 catalogue worm-wheel hobs for the worms drawn, the shop's arbors for small bores, and the seeded
@@ -71,6 +71,7 @@ def gear_row(rng: random.Random, gear_id: int, hobs: set) -> tuple[tuple, list[t
         helix, hand = round(rng.uniform(8, 30), 2), rng.choice("RL")
     elif gear_class == "taper":
         cone = round(rng.uniform(2, 10), 1)
+        helix, hand = taper_helix(gear_id, cone)
     elif gear_class == "crowned":
         crowning = round(rng.uniform(0.01, 0.03), 3)
     elif gear_class == "duplex":
@@ -87,6 +88,16 @@ def gear_row(rng: random.Random, gear_id: int, hobs: set) -> tuple[tuple, list[t
         material, hardness = "CuSn12", 90
     return ((gear_id, gear_class, module, teeth, 20, helix, hand, face, None, None, cone, crowning, material,
              hardness, grade, rng.randint(1, 200), kind), units)
+
+
+def taper_helix(gear_id: int, cone: float) -> tuple[float, str | None]:
+    """About half the tapers helical (issue 29: a swivelled hob's pass is a polyline), β 8–30° of
+    either hand. Drawn from a generator of their own, seeded by the gear and its cone (drawn from
+    the population's), so the population's sequence, and every other gear, stays as it was."""
+    own = random.Random(f"taper helix {gear_id} {cone}")
+    if own.random() < 0.5:
+        return 0.0, None
+    return round(own.uniform(8, 30), 2), own.choice("RL")
 
 
 GEAR_COLUMNS = ("id", "gear_class", "module", "teeth", "pressure_angle", "helix_angle", "hand", "face_width",

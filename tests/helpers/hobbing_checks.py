@@ -10,7 +10,7 @@ import math
 import re
 from dataclasses import dataclass
 
-from helpers.hobbing_envelope import hob_depths, known_xz, shift_limits
+from helpers.hobbing_envelope import Solid, Sweep, hob_depths, intrusions, known_xz, shift_limits
 from helpers.hobbing_reference import (
     Gear,
     Hob,
@@ -322,15 +322,24 @@ def _depth_z(unit: Unit, case: Case) -> float:
 
 
 def _cone_problems(all_cuts: list[Cut], case: Case) -> list[str]:
+    """A taper's last pass (issue 29) holds the hob's whole tip cylinder tangent to the root cone,
+    continued beyond the faces: at every vertex of its moves in X and Z the standing hob (3-D,
+    unshifted) reaches the cone within DEPTH, neither short of it nor into it (beyond a face the
+    pass may hold X and move along Z only, above the cone: `_root_problems` checks those). For a
+    swivelled hob these centres are not on the straight line X(0) + Z·tanδ (§B12): a polyline."""
     if case.gear.gear_class != "taper":
         return []
-    slope = math.tan(math.radians(case.gear.cone))
     found = []
-    for cut in all_cuts:
-        for move in passes(cut):
-            dz = move.delta("Z")
-            if abs(move.delta("X") / dz - slope) > 2 * ROUND / abs(dz) + 1e-6:
-                found.append(f"pass block {move.block}: dX/dZ = {move.delta('X') / dz:.5f}, cone tanδ = {slope:.5f}")
+    for unit in case.gear.units:
+        mine = [c for c in all_cuts if c.unit == unit]
+        cone = root_solid(case.gear, unit)
+        endless = Solid(cone.radius, -1e4, 1e4, cone.slope, cone.z_ref)   # the cone continued past the faces
+        moves = [m for m in passes(mine[-1]) if m.delta("X") != 0] if mine else []   # not the held X's
+        points = [(m.end["X"], m.end["Z"]) for m in moves] + [(m.start["X"], m.start["Z"]) for m in moves[:1]]
+        sweeps = [Sweep(x, z, x, z, swivel(case.gear, case.hob)) for x, z in points]
+        depths = intrusions(sweeps, [endless] * len(sweeps), case.hob.r0, case.hob.length) if sweeps else []
+        found += [f"pass vertex X{x:.3f} Z{z:.3f}: the hob (3-D) reaches {depth:+.3f} mm into the root cone, "
+                  f"not tangent to it (±{DEPTH:g})" for (x, z), depth in zip(points, depths) if abs(depth) > DEPTH]
     return found
 
 
