@@ -239,7 +239,7 @@ def test_import_adds_new_hobs_and_updates_existing_ones(run, tmp_path):
     path.write_text(GOOD_CSV, encoding="utf-8")
     result = run("hobs", "import", path, "--json")
     assert result.exit_code == 0, result.output
-    assert json.loads(result.stdout) == {"added": 2, "updated": 1}
+    assert json.loads(result.stdout) == {"added": 2, "updated": 1, "kept": ["tool_number", "gashes", "profile"]}
     listed = {h["hob_id"]: h for h in json.loads(run("hobs", "list", "--json").stdout)["hobs"]}
     assert len(listed) == len(seeded_hob_ids()) + 2
     assert (listed["H-M2-AA-R1"]["length"], listed["H-M2-AA-R1"]["coating"]) == (150, "TiAlN")
@@ -249,6 +249,25 @@ def test_import_adds_new_hobs_and_updates_existing_ones(run, tmp_path):
     assert (listed["H-WW-M4-L1"]["module"], listed["H-WW-M4-L1"]["module_kind"]) == (4, "axial")   # as catalogued
     again = run("hobs", "import", path)
     assert again.exit_code == 0 and "added 0 hob(s), updated 3" in again.stdout
+
+
+def test_an_import_without_a_column_keeps_each_updated_hobs_own_value(run, tmp_path):
+    """New-user review: a file in the columns of an older seed_templates/hobs.csv (no tool_number,
+    gashes, profile) reset a hob set up as T5 to T1: its programs would call the wrong tool."""
+    with psycopg.connect(run.url) as conn:
+        conn.execute("UPDATE hob SET tool_number = 5, gashes = 14, profile = 'protuberance' "
+                     "WHERE id = 'H-M2-AA-R1'")
+    path = tmp_path / "hobs.csv"
+    path.write_text(GOOD_CSV, encoding="utf-8")
+    result = run("hobs", "import", path)
+    assert result.exit_code == 0, result.output
+    assert "kept as they were: tool_number, gashes, profile" in result.stdout
+    with psycopg.connect(run.url) as conn:
+        row = conn.execute("SELECT tool_number, gashes, profile, length, coating FROM hob "
+                           "WHERE id = 'H-M2-AA-R1'").fetchone()
+        new = conn.execute("SELECT tool_number, gashes, profile FROM hob WHERE id = 'H-M6-B-R1'").fetchone()
+    assert row == (5, 14, "protuberance", 150, "TiAlN"), "the columns given are updated, the others kept"
+    assert new == (1, 12, "standard"), "a new hob gets the defaults of the columns left out"
 
 
 @pytest.mark.parametrize("row, words", [
@@ -272,7 +291,7 @@ def test_import_without_the_optional_columns(run, tmp_path):
     path = tmp_path / "hobs.csv"
     path.write_text("id,module,pressure_angle,starts,tip_diameter,length,hand,accuracy_class\n"
                     "H-M7-C-R1,7,20,1,140,220,R,C\n", encoding="utf-8")
-    assert json.loads(run("hobs", "import", path, "--json").stdout) == {"added": 1, "updated": 0}
+    assert json.loads(run("hobs", "import", path, "--json").stdout) == {"added": 1, "updated": 0, "kept": []}
 
 
 BAD_CSV = """id,module,pressure_angle,starts,tip_diameter,length,hand,accuracy_class,purpose
@@ -398,5 +417,5 @@ def test_the_list_as_csv_is_a_file_import_reads_back_unchanged(run, tmp_path):
     before = hob_rows(run.url)
     again = run("hobs", "import", path, "--json")
     assert again.exit_code == 0, again.output
-    assert json.loads(again.stdout) == {"added": 0, "updated": len(before)}
+    assert json.loads(again.stdout) == {"added": 0, "updated": len(before), "kept": []}
     assert hob_rows(run.url) == before

@@ -122,11 +122,16 @@ def hobs_add(ctx, hob_id, module, pressure_angle, starts, tip_diameter, length, 
 
 @hobs.command("import")
 @click.argument("csv_file", type=click.Path(dir_okay=False))
-@click.option("--json", "as_json", is_flag=True, help="Print one JSON object: {added: N, updated: N}.")
+@click.option("--json", "as_json", is_flag=True,
+              help="Print one JSON object: {added: N, updated: N, kept: [columns]}.")
 @click.pass_context
 def hobs_import(ctx, csv_file, as_json):
-    """Add or update (by id) the hobs of CSV_FILE (columns of seed_templates/hobs.csv);
-    any bad row stops the whole file (nothing stored)."""
+    """Add or update (by id) the hobs of CSV_FILE (the columns of `engine hobs list --csv`);
+    any bad row stops the whole file (nothing stored). A hob already in the library is updated
+    in the columns the file gives only: a column the file leaves out (an older file without
+    tool_number, gashes or profile) keeps each hob's own value, and the output names it.
+
+    Example: engine hobs list --csv > hobs.csv; (edit); engine hobs import hobs.csv"""
     from ..gears.hob_library import import_hobs
 
     with connection(ctx) as conn:
@@ -134,7 +139,8 @@ def hobs_import(ctx, csv_file, as_json):
     if as_json:
         emit_json(asdict(result))
     else:
-        click.echo(f"{csv_file}: added {result.added} hob(s), updated {result.updated}")
+        kept = f" (not in the file, kept as they were: {', '.join(result.kept)})" if result.kept else ""
+        click.echo(f"{csv_file}: added {result.added} hob(s), updated {result.updated}{kept}")
 
 
 @hobs.command("match")

@@ -47,6 +47,7 @@ class HobImport:
 
     added: int
     updated: int
+    kept: tuple[str, ...] = ()   # columns the file leaves out: a hob updated keeps its own values of them
 
 
 def parse_accuracy_class(cell: str) -> str:
@@ -165,10 +166,6 @@ def list_hobs(conn: psycopg.Connection) -> list[Hob]:
 _COLUMN_LIST = sql.SQL(", ").join(map(sql.Identifier, COLUMN_NAMES))
 _VALUES = sql.SQL(", ").join(sql.Placeholder() * len(COLUMN_NAMES))
 _INSERT = sql.SQL("INSERT INTO hob ({}) VALUES ({})").format(_COLUMN_LIST, _VALUES)
-_UPSERT = _INSERT + sql.SQL(" ON CONFLICT (id) DO UPDATE SET {}").format(sql.SQL(", ").join(
-    sql.SQL("{0} = EXCLUDED.{0}").format(sql.Identifier(name)) for name in COLUMN_NAMES if name != "id"))
-
-
 def _cell(value: Any) -> str:
     """A field of a Hob as the text a CSV cell would hold (2.0 → "2")."""
     text = "" if value is None else str(value)
@@ -201,6 +198,11 @@ def add_hob(conn: psycopg.Connection, hob: Hob) -> None:
 def read_hobs(path: str | Path) -> list[dict[str, Any]]:
     """Every hob of the CSV file at `path`, checked, keyed by column name.
     Raises HobImportError listing every problem of every row, or EngineError."""
+    return _read_hob_file(path)[0]
+
+
+def _read_hob_file(path: str | Path) -> tuple[list[dict[str, Any]], tuple[str, ...]]:
+    """(the hobs of the file, the columns its header gives)."""
     file = read_csv_file(path, HOB_KIND)
     if not file.records:
         raise EngineError(f"{path}: no hob rows; give one hob per line under the header")
@@ -220,12 +222,22 @@ def read_hobs(path: str | Path) -> list[dict[str, Any]]:
         hobs.append(hob)
     if problems:
         raise HobImportError(path, problems)
-    return hobs
+    return hobs, tuple(name for name in COLUMN_NAMES if name in file.header)
+
+
+def _upsert(given: tuple[str, ...]) -> sql.Composed:
+    """INSERT every column (a new hob gets the defaults of the columns left out); on an id already
+    in the library, UPDATE only the columns the file gives: a file in the columns of an older
+    seed_templates/hobs.csv must not reset a hob's tool number, gashes or profile to the defaults
+    (a program would call T1 for a hob set up as T5)."""
+    updated = [name for name in COLUMN_NAMES if name != "id" and name in given]
+    return _INSERT + sql.SQL(" ON CONFLICT (id) DO UPDATE SET {}").format(sql.SQL(", ").join(
+        sql.SQL("{0} = EXCLUDED.{0}").format(sql.Identifier(name)) for name in updated))
 
 
 def import_hobs(conn: psycopg.Connection, path: str | Path) -> HobImport:
     """Insert or update (by id) every hob of the CSV file at `path`, all or nothing."""
-    hobs = read_hobs(path)
+    hobs, given = _read_hob_file(path)
     ids = [hob["id"] for hob in hobs]
     twin = conn.execute("SELECT id, new FROM hob, unnest(%s::text[]) AS new WHERE upper(id) = upper(new) AND id <> new "
                         "LIMIT 1", (ids,)).fetchone()
@@ -235,11 +247,12 @@ def import_hobs(conn: psycopg.Connection, path: str | Path) -> HobImport:
         with conn.transaction():
             existing = scalar(conn.execute("SELECT count(*) FROM hob WHERE id = ANY(%s)", (ids,)))
             with conn.cursor() as cursor:
-                cursor.executemany(_UPSERT, [[hob[name] for name in COLUMN_NAMES] for hob in hobs])
+                cursor.executemany(_upsert(given), [[hob[name] for name in COLUMN_NAMES] for hob in hobs])
     except (psycopg.errors.IntegrityError, psycopg.errors.DataError) as error:
         raise EngineError(f"{path}: the database refused the hobs "
                           f"({error.diag.message_primary or error}); nothing imported") from error
-    return HobImport(added=len(ids) - existing, updated=existing)
+    kept = tuple(name for name in COLUMN_NAMES if name not in given) if existing else ()
+    return HobImport(added=len(ids) - existing, updated=existing, kept=kept)
 
 
 def _same_but_case(given: str, stored: str) -> str:
