@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import math
 
+import psycopg
 import pytest
 from helpers.nc_reader import read_program
 
@@ -126,3 +127,37 @@ def test_a_tangential_wheel_over_module_3_is_cut_once_and_says_so(wheels):
     assert len([move for move in nc.moves_in("G1") if move.changed == {"Y"}]) == 1
     with pytest.raises(EngineError, match="two cuts with a tangential feed"):
         instantiate_gear(wheels, WHEELS["R", 1], choices=Choices(worm_feed="tangential", cuts=2))
+
+
+# ------------------------------------------------------------------ the header's feed word
+
+def test_a_worm_wheels_header_names_its_worm_feed_and_a_feed_mode_given_is_refused(run):
+    """New-user review 29: `--feed-mode climb|conventional` on a worm wheel changed only the header's
+    word (both fed Y alike), and the default header said `climb` over a RADIAL cut. A worm wheel
+    has no axial pass: the header names its worm feed, and a feed mode given is refused."""
+    made = {}
+    for feed in ("radial", "tangential"):
+        result = run("instantiate", "--gear", 53, "--worm-feed", feed)
+        assert result.exit_code == 0, result.output
+        made[feed] = result.stdout
+        n0_line = next(line for line in result.stdout.splitlines() if line.startswith("; n0="))
+        assert n0_line.endswith(f" {feed}"), n0_line
+        words = [line.split()[-1] for line in result.stdout.splitlines() if line.startswith("; CUT ")]
+        assert words and set(words) == {feed.upper()}, words
+    with psycopg.connect(run.url) as conn:
+        before = conn.execute("SELECT count(*) FROM program").fetchone()[0]
+        job = conn.execute("SELECT id FROM job WHERE gear_id = 53 ORDER BY id DESC LIMIT 1").fetchone()[0]
+    refused = run("instantiate", "--gear", 53, "--feed-mode", "climb")
+    assert refused.exit_code == 1 and refused.stderr.count("\n") == 1, refused.output
+    assert "no axial pass" in refused.stderr and "--feed-mode" in refused.stderr
+    again = run("instantiate", "--job", job)   # the stored tangential job, made again
+    assert again.exit_code == 0, again.output
+    assert program_lines(again.stdout) == program_lines(made["tangential"])
+    with psycopg.connect(run.url) as conn:
+        assert conn.execute("SELECT count(*) FROM program").fetchone()[0] == before + 1
+
+
+def program_lines(text: str) -> list[str]:
+    """The program up to M30 without its lineage line (which names the program's own id)."""
+    lines = text.splitlines()
+    return [line for line in lines[:lines.index("M30") + 1] if not line.startswith("; PROGRAM ")]

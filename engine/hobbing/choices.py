@@ -106,6 +106,15 @@ class Choices:
         return self.shift_y != 0 or self.shift_per_part > 0
 
 
+def refuse_feed_mode(gear, choices: Choices) -> None:
+    """A gear cut without axial passes (a worm wheel: a radial plunge or a tangential pass) has no
+    feed direction to choose: a --feed-mode given for it is refused, not written into the header
+    over cuts it does not describe (new-user review 29)."""
+    if choices.feed_mode is not None:
+        raise EngineError(f"gear {gear.id}: class {gear.gear_class} is fed {choices.worm_feed}ly (--worm-feed), it has "
+                          f"no axial pass to cut {choices.feed_mode}; leave out --feed-mode")
+
+
 def _known_mode(mode: str) -> bool:
     """A mode of FEED_MODES, or two of them (unit 1's and unit 2's) joined by UNIT_SEPARATOR; a
     stored job's params.feed_mode may be any JSON value (a number is no mode)."""

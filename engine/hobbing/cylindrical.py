@@ -77,6 +77,7 @@ class CylindricalModel:
 
     hob_purpose = "cylindrical"
     cut_shape = "axial"       # the pass its template emits (engine.hobbing.cycle_time.PASSES)
+    axial_passes = True    # the cuts are axial passes, climb or conventional (--feed-mode)
     class_parameters: frozenset = frozenset()
     cut_parameters: frozenset = CUT_PARAMETERS
 

@@ -30,6 +30,7 @@ class WormWheelModel(CylindricalModel):
     cut_parameters = frozenset({"cut_name", "cut_x", "cut_on", "feed_radial", "dwell", "feed_tangential",
                                 "x_air"})
     cut_shape = "worm"
+    axial_passes = False   # fed radially or tangentially (--worm-feed): --feed-mode does not apply
 
     def shift_travel(self, choices) -> float:
         return 0.0   # a worm-wheel hob is not shifted; the tangential pass uses its whole length
@@ -52,6 +53,9 @@ class WormWheelModel(CylindricalModel):
         params = {**self.base_params(gear, gear_class, hob, machine, cutting, choices, setup),
                   "shift_on": False, "shift_y": 0.0, "shift_per_part": 0.0, "shift_min": 0.0, "shift_max": 0.0,
                   "z_mid": round(-gear.face_width / 2, 3), "tangential": tangential,
+                  # the header's feed word: a worm wheel has no axial pass to be climb or conventional
+                  # (new-user review 29: `climb` on a RADIAL cut, or relabelled by --feed-mode)
+                  "feed_mode": choices.worm_feed,
                   "y_start": y_clear, "y_end": -y_clear,
                   "tangential_factor": round(conventions.tangential_factor(hob.module, gear.teeth, setup.lead), 6)}
         xs = [setup.x_retract] + [cut["cut_x"] for cut in module_params.values() if cut["cut_on"]]

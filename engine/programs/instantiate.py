@@ -19,7 +19,7 @@ from ..gears.holding_matching import choose_holding
 from ..gears.models import model_for_class
 from ..gears.process_notes import hunting_tooth_notes
 from ..gears.records import Gear, load_gear, load_gears, load_hobs
-from ..hobbing.choices import Choices
+from ..hobbing.choices import DEFAULT_FEED_MODE, Choices, refuse_feed_mode
 from ..hobbing.floor_time import floor_time_notes
 from ..machines.records import Machine, hobbing_machine
 from ..machines.work_holding import load_work_holdings
@@ -113,7 +113,11 @@ class Planner:
         self.template(gear.gear_class)   # a class refused is not a choice that does not fit: refused before the search
         hobs = [choice.hob for choice in matching_hobs(gear, self.hobs, purpose=model.hob_purpose,
                                                        shift_travel=model.shift_travel(self.choices))]
-        found = first_that_fits(gear.id, gear.module, attempts(hobs, self.choices, gear.module, 1 + len(gear.units)),
+        tried = attempts(hobs, self.choices, gear.module, 1 + len(gear.units))
+        if not model.axial_passes:   # a worm wheel: the feed direction is no choice of its (--worm-feed is)
+            refuse_feed_mode(gear, self.choices)
+            tried = [attempt for attempt in tried if attempt.choices.mode == DEFAULT_FEED_MODE]
+        found = first_that_fits(gear.id, gear.module, tried,
                                 lambda attempt: self._planned(gear, model, attempt.hob, attempt.choices))
         found.planned.notes[:0] = found.notes
         if found.notes:   # the job keeps why its hob, feed mode and cut count are not the first choice

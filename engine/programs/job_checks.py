@@ -23,7 +23,7 @@ from ..errors import EngineError
 from ..gears.cutting_data import default_cutting_data, per_minute
 from ..gears.hob_matching import unmet_need
 from ..gears.process_notes import CUT_KIND_BY_NAME
-from ..hobbing.choices import Choices
+from ..hobbing.choices import WORM_FEEDS, Choices
 from .instantiate import check_machine_fits, check_speeds  # the planner's own checks
 
 if TYPE_CHECKING:
@@ -79,13 +79,20 @@ def _unit_teeth(job_id: int, module_params: dict, key: str, teeth: int) -> float
     return _number(job_id, module_params[unit[-1]], "z2", f"module_params.{unit[-1]}.z2")
 
 
+def _axial_mode(params: dict):
+    """The job's feed mode for its axial passes: a worm wheel's job states its worm feed there
+    (radial or tangential, the header's word) and has none."""
+    mode = params.get("feed_mode", "climb")
+    return None if mode in WORM_FEEDS else mode
+
+
 def job_choices(job_id: int, params: dict) -> Choices:
     """The choices the stored job was made with, as a new job's are checked (allowance, feed mode,
     shift, and its cut count: a new job's search may have taken two cuts where the module says one)."""
     worm_feed = "tangential" if params.get("tangential") is True else "radial"
     cuts = params.get("cuts") if params.get("cuts") in (1, 2) else None
     return _refused_as_new(job_id, "params", lambda: Choices(
-        cuts=cuts, coolant=bool(params.get("coolant", True)), feed_mode=params.get("feed_mode", "climb"),
+        cuts=cuts, coolant=bool(params.get("coolant", True)), feed_mode=_axial_mode(params),
         shift_y=_number(job_id, params, "shift_y", "params.shift_y", 0.0),
         shift_per_part=_number(job_id, params, "shift_per_part", "params.shift_per_part", 0.0),
         tailstock=bool(params.get("tailstock", True)), worm_feed=worm_feed,
