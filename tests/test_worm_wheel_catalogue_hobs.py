@@ -161,3 +161,31 @@ def program_lines(text: str) -> list[str]:
     """The program up to M30 without its lineage line (which names the program's own id)."""
     lines = text.splitlines()
     return [line for line in lines[:lines.index("M30") + 1] if not line.startswith("; PROGRAM ")]
+
+
+def test_a_worm_wheel_job_stored_saying_climb_is_made_again_saying_its_worm_feed(run):
+    """A job stored before the header named the worm feed (`params.feed_mode` climb) is made again
+    with the word its cuts are, and the simulation, which holds the word to the cuts, proves it."""
+    assert run("instantiate", "--gear", 53).exit_code == 0
+    with psycopg.connect(run.url) as conn:
+        job = conn.execute("SELECT id FROM job WHERE gear_id = 53 ORDER BY id DESC LIMIT 1").fetchone()[0]
+        conn.execute("UPDATE job SET params = jsonb_set(params, '{feed_mode}', '\"climb\"') WHERE id = %s", (job,))
+    again = run("instantiate", "--job", job)
+    assert again.exit_code == 0, again.output
+    n0_line = next(line for line in again.stdout.splitlines() if line.startswith("; n0="))
+    assert n0_line.endswith(" radial"), n0_line
+
+
+@pytest.mark.parametrize("stated", ["climb", "tangential", "conventional-climb"])
+def test_a_worm_wheel_header_misstating_its_feed_is_refused_by_the_simulation(conn, stated):
+    from engine.gears.records import load_gear, load_hobs
+    from engine.machines.records import load_machine
+    from engine.simulation import simulate_program
+
+    lines = instantiate_gear(conn, 53).lines
+    forged = [line.replace(" radial", f" {stated}") if line.startswith("; n0=") else line for line in lines]
+    hob = next(hob for hob in load_hobs(conn) if f"; HOB {hob.id} " in "\n".join(lines))
+    proved = [simulate_program(text, load_gear(conn, 53), hob, load_machine(conn, "hobber-840d"), "GEAR53")
+              for text in (lines, forged)]
+    assert proved[0].refusals == []
+    assert any(f"the header states feed {stated}" in finding.message for finding in proved[1].refusals)

@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 
 from ..errors import EngineError
+from ..hobbing.choices import WORM_FEEDS
 from ..hobbing.machine_job import with_cycle_time
 from ..machines.records import Machine
 
@@ -47,6 +48,14 @@ def job_with_cycle_time(job_id: int, params: dict, module_params: dict, shape: s
     except (TypeError, ValueError) as error:
         raise EngineError(f"job {job_id}: its params are not numbers where its {shape} cuts need them "
                           f"({error}); {_REMEDY}") from None
+
+
+def job_with_worm_feed(params: dict, model) -> dict:
+    """A worm wheel's job stored before its header named its worm feed (it said `climb` over a
+    radial plunge, issue 29) made again with the feed word its cuts are: radial or tangential."""
+    if getattr(model, "axial_passes", True) or params.get("feed_mode") in WORM_FEEDS:
+        return params
+    return {**params, "feed_mode": "tangential" if params.get("tangential") is True else "radial"}
 
 
 def _check_cut(job_id: int, key: str, cut: dict) -> None:

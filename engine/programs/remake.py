@@ -42,7 +42,7 @@ from .batches import (
 from .class_jobs import class_job
 from .instantiate import store_planned
 from .job_checks import check_hobbing_feeds, check_hobbing_job
-from .job_shape import check_job_shape, job_with_cycle_time
+from .job_shape import check_job_shape, job_with_cycle_time, job_with_worm_feed
 from .options import NO_FILE, NORMAL_RUN, PLANNING, Output, RunMode
 from .outputs import file_layouts, files_after_commit
 from .records import Planned, Program
@@ -94,6 +94,7 @@ class Remaker:
             check_program_name(self.conn, job_id, gear_id, params)
             check_work_holding(job_id, workpiece, machine)
             check_hobbing_feeds(job_id, workpiece.gear, workpiece.hob, machine, params, module_params, bounded=False)
+        params = job_with_worm_feed(params, model)
         if "cycle_time" in params:   # the time follows feeds edited since
             params = job_with_cycle_time(job_id, params, module_params, model.cut_shape, machine)
         result = run_template(self.template(gear_class), params, module_params, machine, workpiece)

@@ -172,6 +172,11 @@ def cut_count_facts(steps, machine: Machine, report, units: int):
         said = [(f"unit {unit} " if units > 1 else "") + f"{cut[1]} {cut[2]}"
                 for cut, unit in zip(cuts, cut_units) if cut[2] not in NOT_AXIAL]
         yield step, f"the header states feed mode {mode}; the cuts are {', '.join(said)}", True
+    worm = [cut for cut in cuts if cut[2] in NOT_AXIAL]
+    if worm and (axial or any(cut[2] != mode.upper() for cut in worm)):
+        cut_words = " ".join(f"{cut[1]} {cut[2]}" for cut in cuts)
+        yield step, (f"the header states feed {mode}; the cuts are {cut_words} (a worm wheel's header names its "
+                     "worm feed, radial or tangential)"), True
 
 
 NOT_AXIAL = ("RADIAL", "TANGENTIAL")   # a worm wheel's cuts: no axial pass, no feed mode
