@@ -185,3 +185,13 @@ def test_a_hob_with_1000_gashes_is_refused_by_add_and_import(run, tmp_path):
     assert imported.exit_code == 1 and "line 2, column gashes: 41 is above 40" in imported.stderr, imported.stderr
     assert run("hobs", "list", "--csv").stdout == before
     assert run(*ADD, "--gashes", 40).exit_code == 0
+
+
+def test_a_unit_for_a_helical_gear_says_no_class_cuts_it(run, tmp_path):
+    """Class duplex derives from spur: a helical gear's further toothing has no class that cuts it."""
+    text = GEARS.replace(f"{GEAR_ID},,2,30,20,0,,", f"{GEAR_ID},helical,2,30,20,15,R,")
+    assert run("gears", "import", write(tmp_path, "gears.csv", text)).exit_code == 0
+    added = run("gears", "units", write(tmp_path, "units.csv", UNIT_HEADER + UNIT_2))
+    assert added.exit_code == 0, added.output
+    assert (f"gear {GEAR_ID}: class helical does not cut further units; class duplex cuts spur units only "
+            "(β = 15°): no program cuts these units") in added.stdout
