@@ -90,6 +90,7 @@ class Column:
     db_name: str | None = None
     unit: str = ""
     header_optional: bool = False   # the header may leave it out, even where the kind wants every column
+    hint: str = ""                  # what to do, where the column's bounds say more than its type's advice
 
     @property
     def column(self) -> str:
@@ -101,6 +102,8 @@ class Column:
 
     @property
     def todo(self) -> str:
+        if self.hint:
+            return self.hint
         unit = f" in {self.unit}" if self.unit else ""
         return TYPES.get(self.parse, ("text", f"correct the {self.name}{unit}"))[1].format(unit=unit, name=self.name)
 

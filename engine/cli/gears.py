@@ -49,13 +49,17 @@ def gears_import(ctx, csv_file, replace, as_json):
 def gears_units(ctx, csv_file):
     """Import further toothed units of multi-unit (duplex) gears from CSV_FILE.
 
-    Columns: gear_id, unit (2, 3, ...), teeth, face_width, tip_diameter, root_diameter,
-    z_top (Z of the unit's upper face; the gear's top face is Z = 0). The units of each
-    gear in the file replace its units; any bad row stops the whole file."""
-    from ..gears.units import import_units
+    Columns: gear_id, unit (2: class duplex cuts two units per set-up, the gear row and unit 2),
+    teeth, face_width, tip_diameter, root_diameter, z_top (Z of the unit's upper face; the gear's
+    top face is Z = 0). The units of each gear in the file replace its units; any bad row stops
+    the whole file. A line is printed for a gear whose class does not cut further units, and for
+    one with programs stored before."""
+    from ..gears.units import import_units_noting
 
     with connection(ctx) as conn:
-        count = import_units(conn, csv_file)
+        count, notes = import_units_noting(conn, csv_file)
+    for note in notes:
+        click.echo(note)
     click.echo(f"imported {count} unit(s) from {csv_file}")
 
 

@@ -103,7 +103,7 @@ def hobs_delete(ctx, hob_id, yes):
               help="Which module --module is: normal (default for cylindrical hobs) or axial (a worm-wheel hob "
                    "catalogued by its worm's axial module, DIN 3975). A worm-wheel hob must say.")
 @click.option("--gashes", type=int, default=12, show_default=True,
-              help="Gashes (flutes) of the hob; with the starts they bound the feed by the chip thickness.")
+              help="Gashes (flutes) of the hob, 1 to 40; with the starts they bound the feed by the chip thickness.")
 @click.option("--profile", type=click.Choice(["standard", "protuberance", "topping"]), default="standard",
               show_default=True, help="Tooth profile: the basic rack's, with a tip protuberance, or topping.")
 @click.pass_context

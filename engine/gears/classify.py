@@ -173,24 +173,37 @@ class GearClassReport:
     classification: Classification
     model_class: str | None
     hob: str | None
+    without_units: str | None = None   # the tree's class of the gear without its further units
 
     def lines(self) -> list[str]:
         automatic = self.classification.gear_class
         said = [f"gear {self.gear_id}: class {self.stored_class}",
                 f"  decision path: {self.classification.explain()}"]
         if self.stored_class != automatic:
-            said.append(f"  the gear file named class {self.stored_class} explicitly "
-                        f"(the tree alone gives {automatic or 'no class'})")
+            said.append(self._why_stored(automatic))
         said.append(f"  hobbing model: {self.model_class or 'none: no class on the path up has a model'}")
         said.append(f"  hob: {self.hob}")
         return said
+
+    def _why_stored(self, automatic: str | None) -> str:
+        """Why the stored class is not the tree's. The database does not keep whether the gear file
+        named the class: a class the tree gives the gear without its further units may have been
+        classified at import, before `engine gears units` added them; any other was named."""
+        if self.without_units is not None and self.stored_class == self.without_units:
+            return (f"  class {self.stored_class} is the tree's for the gear without its further units (classified "
+                    f"or named before `engine gears units` added them); to have class {automatic}, import the gear "
+                    f"again with gear_class {automatic} or empty (`engine gears import FILE.csv --replace`)")
+        return (f"  the gear file named class {self.stored_class} explicitly "
+                f"(the tree alone gives {automatic or 'no class'})")
 
 
 def explain_gear(conn: Connection, gear_id: int) -> GearClassReport:
     """Classify a stored gear again and say how; also the model and hob it gets."""
     gear = load_gear(conn, gear_id)
-    classification = classify({"gear_id": gear.id, "cone_angle": gear.cone_angle, "crowning": gear.crowning,
-                               "helix_angle": gear.helix_angle, "units": len(gear.units), "material": gear.material})
+    features = {"gear_id": gear.id, "cone_angle": gear.cone_angle, "crowning": gear.crowning,
+                "helix_angle": gear.helix_angle, "material": gear.material}
+    classification = classify({**features, "units": len(gear.units)})
+    without_units = classify(features).gear_class if gear.units else None
     lineage = ancestry(conn, gear.gear_class) if gear.gear_class else []
     models = registered_models()
     model_class = next((name for name in lineage if name in models), None)
@@ -202,4 +215,4 @@ def explain_gear(conn: Connection, gear_id: int) -> GearClassReport:
             hob = chosen.reason
         except EngineError as error:
             hob = f"none fits: {error}"
-    return GearClassReport(gear_id, gear.gear_class, classification, model_class, hob)
+    return GearClassReport(gear_id, gear.gear_class, classification, model_class, hob, without_units)

@@ -163,6 +163,11 @@ def _check_given_class(gear: dict[str, Any], classes: Classes) -> Said:
                           f"rows); known leaf classes: {_leaf_list(classes)}")
 
 
+# Key of a read gear whose class the tree gave (the file named none): a stored gear's units, which
+# the gear file has no column for, are counted in again when it replaces that gear (gear_store).
+FROM_TREE = "class_from_tree"
+
+
 def _classify(gear: dict[str, Any], classes: Classes) -> Said:
     """A gear without a class gets the one `classify` finds, which must be installed."""
     if gear["gear_class"] is not None:
@@ -172,7 +177,7 @@ def _classify(gear: dict[str, Any], classes: Classes) -> Said:
         named = f"gear {gear['gear_id']} " if classification.remedy != Classification.remedy else ""
         return "gear_class", f"{named}{classification.problem}; {classification.remedy}"
     found = classification.gear_class
-    gear["gear_class"] = found
+    gear["gear_class"], gear[FROM_TREE] = found, True
     return None if classes.templated.get(found) else ("gear_class", not_installed_message(gear["gear_id"], found))
 
 

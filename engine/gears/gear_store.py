@@ -13,7 +13,8 @@ from psycopg import sql
 
 from ..csv_reader import Problem
 from ..errors import EngineError
-from .gear_import import COLUMNS, Classes, GearImportError, read_gears
+from .classify import classify
+from .gear_import import COLUMNS, FROM_TREE, Classes, GearImportError, read_gears
 
 INSTALLED = ("SELECT g.name, EXISTS (SELECT 1 FROM class_template(g.name)), "
              "g.name IN (SELECT name FROM classes_and_below(ARRAY['cylindrical'])) FROM gear_class g")
@@ -127,8 +128,27 @@ def import_gears(conn: psycopg.Connection, path: str | Path, *, replace: bool = 
     """Import every gear of the CSV file at `path`, all or nothing. A gear_id already stored is
     refused unless `replace`, which overwrites it and returns what changed."""
     path = Path(path)
-    gears = read_gears(path, installed_classes(conn))
+    classes = installed_classes(conn)
+    gears = read_gears(path, classes)
+    if replace:
+        _count_stored_units(conn, gears, classes)
     return _store(conn, path, gears, replace)
+
+
+STORED_UNITS = "SELECT gear_id, count(*) FROM gear_unit WHERE gear_id = ANY(%s) GROUP BY gear_id"
+
+
+def _count_stored_units(conn: psycopg.Connection, gears: list[dict[str, Any]], classes: Classes) -> None:
+    """A gear the file names no class for, replacing a stored gear with further units (`engine gears
+    units`), is classified with those units counted: the tree's first question (engine.gears.classify)
+    is whether it has any, and the gear file has no column for them. The class must be installed."""
+    from_tree = [gear for gear in gears if gear.get(FROM_TREE)]
+    counts: dict[int, int] = dict(conn.execute(STORED_UNITS, ([gear["gear_id"] for gear in from_tree],)).fetchall())
+    for gear in from_tree:
+        if counts.get(gear["gear_id"]):
+            found = classify({**gear, "units": counts[gear["gear_id"]]}).gear_class
+            if found and classes.templated.get(found):
+                gear["gear_class"] = found
 
 
 def identical_gears(conn: psycopg.Connection, gears: list[dict[str, Any]]) -> set[int]:

@@ -80,6 +80,12 @@ declare(parse_hob_id, "hob id", "write an id like H-M2-AA-R1")
 declare(parse_purpose, "purpose", f"write one of {', '.join(PURPOSES)}")
 declare(parse_profile, "profile", f"write one of {', '.join(PROFILES)}")
 
+# Gashes a hob record may give: solid HSS catalogue hobs have 9–20 (12–16 for m1–m4, DIN 3968),
+# multi-gash carbide and high-performance hobs up to about 30 (docs/reference/hobbing.md §C1); 40
+# leaves room above those, and a count beyond it is a typing error (1000 would put i = gashes/starts
+# far outside the range Hoffmeister's formula was fitted on and raise the feed it allows).
+MAX_GASHES = 40
+
 # In the order of the fields of records.Hob (and of seed_templates/hobs.csv).
 HOB_COLUMNS: tuple[Column, ...] = (
     Column("id", parse_hob_id, required=True),
@@ -96,7 +102,9 @@ HOB_COLUMNS: tuple[Column, ...] = (
     Column("purpose", parse_purpose),
     Column("tool_number", parse_positive_whole, check=lambda v: v <= 32000, rule="is above 32000"),
     Column("module_kind", parse_module_kind),
-    Column("gashes", parse_positive_whole),
+    Column("gashes", parse_positive_whole, check=lambda v: v <= MAX_GASHES,
+           rule=f"is above {MAX_GASHES} (catalogue hobs have 9–20 gashes, multi-gash carbide hobs up to about 30)",
+           hint=f"write the hob's gashes, 1 to {MAX_GASHES}"),
     Column("profile", parse_profile),
 )
 COLUMN_NAMES = tuple(column.name for column in HOB_COLUMNS)

@@ -84,27 +84,29 @@ HOLDING_TESTS: tuple[HoldingTest, ...] = (
     HoldingTest("machine",
                 said=lambda h, s: f"fits {h.machine or 'any hobber'}",
                 fits=lambda h, s: h.machine in (None, s.machine.name),
-                wanted=lambda s: f"made for machine {s.machine.name} (or any)",
-                offered=lambda h: f"machine {h.machine}"),
+                wanted=lambda s: f"made for machine {s.machine.name} or for any hobber",
+                offered=lambda h: f"is made for machine {h.machine}"),
     HoldingTest("diameter",
                 said=lambda h, s: f"Ø{h.diameter:g} ≤ Ø{s.largest:g} (root Ø{s.root:g} − 2·{CLEARANCE:g})",
                 fits=lambda h, s: h.diameter <= s.largest + 1e-9,
-                wanted=lambda s: f"a diameter of at most Ø{s.largest:g} (root Ø{s.root:g} − 2·{CLEARANCE:g})",
-                offered=lambda h: f"Ø{h.diameter:g}"),
+                wanted=lambda s: f"of at most Ø{s.largest:g} (root Ø{s.root:g} − 2·{CLEARANCE:g})",
+                offered=lambda h: f"is Ø{h.diameter:g}"),
     HoldingTest("centre",
                 said=lambda h, s: (f"centre Ø{h.tailstock_diameter:g} ≤ Ø{s.largest:g}" if h.tailstock_diameter
                                    else "no centre"),
                 fits=lambda h, s: h.tailstock_diameter <= s.largest + 1e-9,
-                wanted=lambda s: f"a centre of at most Ø{s.largest:g} (or none)",
-                offered=lambda h: f"a centre Ø{h.tailstock_diameter:g}"),
+                wanted=lambda s: f"with a centre of at most Ø{s.largest:g}, or none",
+                offered=lambda h: f"has a centre Ø{h.tailstock_diameter:g}"),
     HoldingTest("height",
                 said=lambda h, s: (f"height {h.height:g} ≥ {s.height_needed:g} (hob da0 {s.hob.tip_diameter:g} "
                                    f"+ {HEIGHT_MARGIN:g} − gap {s.machine.fixture_gap:g}: the machine's fixture "
                                    f"Ø{s.machine.fixture_diameter:g} below stays out of the hob's reach)"
                                    if s.height_needed else f"height {h.height:g}"),
                 fits=lambda h, s: h.height >= s.height_needed - 1e-9,
-                wanted=lambda s: f"a height of at least {s.height_needed:g} mm",
-                offered=lambda h: f"height {h.height:g}"),
+                wanted=lambda s: (f"at least {s.height_needed:g} mm high, to keep the machine's fixture "
+                                  f"Ø{s.machine.fixture_diameter:g} out of the hob's reach (hob da0 "
+                                  f"{s.hob.tip_diameter:g} + {HEIGHT_MARGIN:g} − gap {s.machine.fixture_gap:g})"),
+                offered=lambda h: f"is {h.height:g} mm high"),
 )
 
 
@@ -171,8 +173,8 @@ def _given(setting: Setting, holdings: list[WorkHolding], given: str) -> Holding
         raise EngineError(f"work-holding {given!r} does not exist; see `engine fixtures list`")
     unmet = next((test for test in HOLDING_TESTS if not test.fits(found, setting)), None)
     if unmet is not None:
-        raise NoHoldingError(f"gear {setting.gear.id}: {found.kind} {found.id} does not fit: the gear needs "
-                             f"{unmet.wanted(setting)}, {found.id} has {unmet.offered(found)}; "
+        raise NoHoldingError(f"gear {setting.gear.id}: {found.kind} {found.id} does not fit: the job needs a "
+                             f"work-holding {unmet.wanted(setting)}, and {found.id} {unmet.offered(found)}; "
                              f"`engine fixtures match --gear {setting.gear.id}` names one that fits", unmet.name)
     return HoldingChoice(found, f"{found.id} ({found.kind}, given): " + ", ".join(
         test.said(found, setting) for test in HOLDING_TESTS))
@@ -184,7 +186,8 @@ def _refusal(setting: Setting, test: HoldingTest, candidates: list[WorkHolding])
     ordered = sorted(candidates, key=lambda h: (h.diameter, h.id))
     offered = ", ".join(f"{holding.id} {test.offered(holding)}" for holding in ordered[:3])
     more = ", …" if len(candidates) > 3 else ""
-    return f"gear {setting.gear.id}: no work-holding has {test.wanted(setting)}: {offered}{more}; {ADD_ONE}"
+    return (f"gear {setting.gear.id}: the job needs a work-holding {test.wanted(setting)}, and none is: "
+            f"{offered}{more}; {ADD_ONE}")
 
 
 def match_holding(conn: Connection, gear_id: int, machine_name: str | None = None) -> tuple[Hob, HoldingChoice]:

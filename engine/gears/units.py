@@ -1,24 +1,35 @@
 """Further toothed units of multi-unit (duplex) gears, from CSV: gear_id, unit, teeth,
-face_width, tip_diameter, root_diameter, z_top. Unit 1 is the gear row itself; unit 2
-and on are given here. All rows are checked first; a file with any bad row stores nothing.
-The units of every gear in the file replace that gear's units."""
+face_width, tip_diameter, root_diameter, z_top. Unit 1 is the gear row itself; unit 2 is
+given here (no class cuts a third unit: class duplex cuts two per set-up). All rows are
+checked first; a file with any bad row stores nothing. The units of every gear in the file
+replace that gear's units."""
 from __future__ import annotations
 
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ..csv_reader import Column, CsvKind, Problem, parse_number, parse_positive_whole, read_csv_file
+from ..db.connection import scalar
 from ..errors import EngineError
+from .classify import classify
 from .gear_geometry import diameter_problems
 from .gear_import import POSITIVE, GearImportError, derived_diameters
+from .models import ancestry
 
 if TYPE_CHECKING:
     from ..db.connection import Connection
 
+# The class that cuts further units (engine/hobbing/duplex.py), and the last unit it cuts: two units
+# per set-up, the gear row and unit 2. A third toothing is cut in a set-up of its own.
+UNIT_CLASS = "duplex"
+LAST_UNIT = 2
+
 UNIT_COLUMNS: tuple[Column, ...] = (
     Column("gear_id", parse_positive_whole, required=True),
-    Column("unit", parse_positive_whole, required=True, check=lambda v: v >= 2,
-           rule="must be 2 or more (unit 1 is the gear row)"),
+    Column("unit", parse_positive_whole, required=True, check=lambda v: v == LAST_UNIT,
+           rule=f"must be {LAST_UNIT}: unit 1 is the gear row, and class {UNIT_CLASS} (the only class that cuts "
+                f"further units) cuts two per set-up",
+           hint="write 2, and cut a third toothing in a set-up of its own"),
     Column("teeth", parse_positive_whole, required=True),
     Column("face_width", parse_number, required=True, unit="mm", **POSITIVE),
     Column("tip_diameter", parse_number, unit="mm", **POSITIVE),
@@ -35,7 +46,16 @@ VALUES (%s, %s, %s, %s, %s, %s, %s)"""
 def import_units(conn: Connection, path: str | Path, only_gears: set[int] | None = None) -> int:
     """Store the units of the CSV at `path` (only those of `only_gears` if given); return
     how many. Raises GearImportError listing every problem."""
-    path = Path(path)
+    return len(_import(conn, Path(path), only_gears))
+
+
+def import_units_noting(conn: Connection, path: str | Path) -> tuple[int, list[str]]:
+    """`import_units`, and what the stored units leave to do (`unit_notes`)."""
+    units = _import(conn, Path(path), None)
+    return len(units), unit_notes(conn, {unit["gear_id"] for unit in units})
+
+
+def _import(conn: Connection, path: Path, only_gears: set[int] | None) -> list[dict]:
     file = read_csv_file(path, UNIT_KIND)
     if not file.records:
         raise EngineError(f"{path}: no unit rows; give one unit per line under the header")
@@ -49,7 +69,7 @@ def import_units(conn: Connection, path: str | Path, only_gears: set[int] | None
     if problems:
         raise GearImportError(path, problems)
     _store(conn, [unit for _, unit in units])
-    return len(units)
+    return [unit for _, unit in units]
 
 
 def _parse_unit(file, line: int, cells: dict) -> tuple[dict, list[Problem]]:
@@ -97,3 +117,37 @@ def _store(conn: Connection, units: list[dict]) -> None:
         conn.execute("DELETE FROM gear_unit WHERE gear_id = ANY(%s)", (gear_ids,))
         for unit in units:
             conn.execute(INSERT_UNIT, tuple(unit[column.name] for column in UNIT_COLUMNS))
+
+
+GEAR_CLASS = ("SELECT gear_class, cone_angle, crowning, helix_angle, material, "
+              "(SELECT count(*) FROM gear_unit u WHERE u.gear_id = gear.id) FROM gear WHERE id = %s")
+PROGRAMS = "SELECT count(*) FROM program p JOIN job j ON j.id = p.job_id WHERE j.gear_id = %s"
+
+
+def unit_notes(conn: Connection, gear_ids: set[int]) -> list[str]:
+    """What the units just stored leave to do, one line each: a gear whose class does not cut
+    further units (only UNIT_CLASS and the classes under it do: the models of the others read the gear row alone), and
+    a gear with programs stored before (made for the units it had then)."""
+    notes = []
+    for gear_id in sorted(gear_ids):
+        gear = tuple(conn.execute(GEAR_CLASS, (gear_id,)).fetchone() or ())   # the units' gear exists
+        if gear[0] and UNIT_CLASS not in ancestry(conn, gear[0]):
+            notes.append(f"gear {gear_id}: class {gear[0]} does not cut further units; " + _what_to_do(gear_id, gear))
+        programs = scalar(conn.execute(PROGRAMS, (gear_id,)))
+        if programs:
+            notes.append(f"gear {gear_id}: {programs} stored program(s) were made before these units and no longer "
+                         f"match the gear; make them again with `engine instantiate --gear {gear_id}`")
+    return notes
+
+
+def _what_to_do(gear_id: int, gear: tuple) -> str:
+    """A spur gear can become UNIT_CLASS (spur units of one module); a helical one has no class."""
+    _, cone, crowning, helix, material, count = gear
+    if helix:
+        return (f"class {UNIT_CLASS} cuts spur units only (β = {helix:g}°): no program cuts these units; "
+                f"cut the further toothing in a set-up of its own, as a gear of its own")
+    tree = classify({"gear_id": gear_id, "cone_angle": cone, "crowning": crowning, "helix_angle": helix,
+                     "material": material, "units": count}).gear_class
+    leave = f" (or leave it empty: the tree classes it {tree})" if tree == UNIT_CLASS else ""
+    return (f"give gear_class {UNIT_CLASS}{leave} and import the gear again with "
+            f"`engine gears import FILE.csv --replace`")

@@ -88,9 +88,13 @@ class UnitGear:
 
 
 def unit_gears(gear) -> list[UnitGear]:
-    if len(gear.units) != 1:
-        raise EngineError(f"gear {gear.id}: class duplex cuts exactly two units, the gear has "
-                          f"{1 + len(gear.units)}; import its second unit with `engine gears units FILE.csv`")
+    if not gear.units:
+        raise EngineError(f"gear {gear.id}: class duplex cuts two units, the gear has 1; import its second "
+                          f"unit with `engine gears units FILE.csv`")
+    if len(gear.units) > 1:
+        raise EngineError(f"gear {gear.id}: class duplex cuts two units per set-up (the gear row and unit 2), the "
+                          f"gear has {1 + len(gear.units)}; import its units again with unit 2 alone (`engine gears "
+                          f"units FILE.csv` replaces them) and cut the third toothing in a set-up of its own")
     if gear.helix_angle:
         raise EngineError(f"gear {gear.id}: class duplex derives from spur; helical units (β = "
                           f"{gear.helix_angle:g}°) need a class of their own")

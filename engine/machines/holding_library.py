@@ -95,6 +95,14 @@ def _whole(value: Any) -> Any:
 def read_holdings(path: str | Path) -> list[dict[str, Any]]:
     """Every work-holding of the CSV file at `path`, checked; CsvError listing every problem of
     every row, or EngineError."""
+    holdings, problems = _read(path)
+    if problems:
+        raise CsvError(path, problems)
+    return [holding for _, holding in holdings]
+
+
+def _read(path: str | Path) -> tuple[list[tuple[int, dict[str, Any]]], list[Problem]]:
+    """(line, work-holding) of every row of the file and the problems of its cells and ids."""
     file = read_csv_file(path, HOLDING_KIND)
     if not file.records:
         raise EngineError(f"{path}: no work-holding rows; give one work-holding per line under the header")
@@ -112,34 +120,47 @@ def read_holdings(path: str | Path) -> list[dict[str, Any]]:
         elif folded is not None:
             first_line[folded] = (line, holding["id"])
         problems += row_problems
-        holdings.append(holding)
-    if problems:
-        raise CsvError(path, problems)
-    return holdings
+        holdings.append((line, holding))
+    return holdings, problems
 
 
 _COLUMN_LIST = sql.SQL(", ").join(map(sql.Identifier, COLUMN_NAMES))
 _UPSERT = sql.SQL("INSERT INTO work_holding ({}) VALUES ({}) ON CONFLICT (id) DO UPDATE SET {}").format(
     _COLUMN_LIST, sql.SQL(", ").join(sql.Placeholder() * len(COLUMN_NAMES)), sql.SQL(", ").join(
         sql.SQL("{0} = EXCLUDED.{0}").format(sql.Identifier(name)) for name in COLUMN_NAMES if name != "id"))
-TWIN = ("SELECT id, new FROM work_holding, unnest(%s::text[]) AS new WHERE upper(id) = upper(new) AND id <> new "
-        "LIMIT 1")
-UNKNOWN_MACHINE = ("SELECT new FROM unnest(%s::text[]) AS new WHERE new IS NOT NULL "
-                   "AND NOT EXISTS (SELECT 1 FROM machine WHERE name = new) LIMIT 1")
+TWIN = "SELECT id FROM work_holding WHERE upper(id) = upper(%s) AND id <> %s"
+MACHINE_KIND = "SELECT kind FROM machine WHERE name = %s"
+
+
+def _library_problems(conn: Connection, holdings: list[tuple[int, dict[str, Any]]]) -> list[Problem]:
+    """Per row, what the database says against it: an id that is a stored work-holding's in another
+    case, a machine that does not exist or is not a hobber (a work-holding stands on a hobber's
+    table under the gear; a lathe's work-holding is its chuck and jaws, docs/design.md §8)."""
+    problems = []
+    for line, holding in holdings:
+        twin = conn.execute(TWIN, (holding["id"], holding["id"])).fetchone() if holding["id"] else None
+        if twin:
+            problems.append(Problem(line, "id", f"{holding['id']} is work-holding {twin[0]} of the library (ids "
+                                    "that differ only in case name one work-holding)", f"write {twin[0]}"))
+        machine = holding["machine"]
+        kind = conn.execute(MACHINE_KIND, (machine,)).fetchone() if machine else ("hobber",)
+        if kind is None:
+            problems.append(Problem(line, "machine", f"machine {machine} does not exist",
+                                    "write a machine of `engine machines list`, or leave it empty for any hobber"))
+        elif kind[0] != "hobber":
+            problems.append(Problem(line, "machine", f"machine {machine} is a {kind[0]}, not a hobber",
+                                    "write a hobbing machine, or leave it empty for any hobber"))
+    return problems
 
 
 def import_holdings(conn: Connection, path: str | Path) -> HoldingImport:
     """Insert or update (by id) every work-holding of the CSV file at `path`, all or nothing."""
-    holdings = read_holdings(path)
+    lined, problems = _read(path)
+    problems += _library_problems(conn, [(line, holding) for line, holding in lined if holding["id"] is not None])
+    if problems:
+        raise CsvError(path, problems)
+    holdings = [holding for _, holding in lined]
     ids = [holding["id"] for holding in holdings]
-    twin = conn.execute(TWIN, (ids,)).fetchone()
-    if twin:
-        raise EngineError(f"{path}: work-holding {twin[1]} is work-holding {twin[0]} of the library (ids that differ "
-                          f"only in case name one work-holding); use {twin[0]}; nothing imported")
-    unknown = conn.execute(UNKNOWN_MACHINE, ([holding["machine"] for holding in holdings],)).fetchone()
-    if unknown:
-        raise EngineError(f"{path}: machine {unknown[0]} does not exist (see `engine machines list`); "
-                          "nothing imported")
     try:
         with conn.transaction():
             existing = scalar(conn.execute("SELECT count(*) FROM work_holding WHERE id = ANY(%s)", (ids,)))
