@@ -111,6 +111,7 @@ class Planner:
         check_machine_fits(gear, self.machine)
         model = self.model(gear.gear_class)
         self.template(gear.gear_class)   # a class refused is not a choice that does not fit: refused before the search
+        self.choices.for_unit(1, 1 + len(gear.units), gear.id)   # a mode per unit names the gear's units or none
         hobs = [choice.hob for choice in matching_hobs(gear, self.hobs, purpose=model.hob_purpose,
                                                        shift_travel=model.shift_travel(self.choices))]
         found = first_that_fits(gear.id, gear.module, attempts(hobs, self.choices, gear.module, 1 + len(gear.units)),
