@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import click
 
+from ..errors import EngineError
 from .context import connection, emit_json
 from .ids import PROGRAM_ID
 
@@ -45,6 +46,9 @@ def simulate(ctx, program_id, as_json):
     else:
         for line in report.lines():
             click.echo(line)
+    listed = " in the JSON's findings" if as_json else ", listed above"
+    if rendering.status == REFUSED:   # the proof's refusal, and where the simulation's findings are
+        said = f"; the simulation's findings are{listed.replace(', ', ' ')}" if report.refused else ""
+        raise EngineError(f"program {program_id}: {REFUSED}: {rendering.reason}{said}")
     if report.refused:
-        raise report.error(" in the JSON's findings" if as_json else ", listed above")
-    rendering.refuse_unless_matching("the simulation")   # refused by the proof but not by the simulation
+        raise report.error(listed)
