@@ -156,6 +156,8 @@ def test_a_gear_nothing_fits_is_refused_naming_every_choice_tried(conn):
     assert -1 not in positions, message
     assert positions == sorted(positions), "in the order of the search"
     assert message.count("[") == len(expected_choices(conn)), "nothing else tried"
+    # one reason per kind of cut (a single cut, a rough cut), each said once, not once per choice
+    assert message.count("reaches") == 2 and message.count("use a smaller hob") == 2, message
     assert stored_jobs(conn) == before
 
 
@@ -219,8 +221,10 @@ def test_a_refusal_keeps_its_type_and_one_choice_keeps_its_words():
 
     with pytest.raises(LimitError) as refused:
         first_that_fits(7, 2.0, attempts(hobs, Choices(), 2.0), too_fast)
-    assert str(refused.value).startswith("gear 7: no choice fits, tried: [climb, hob H1, 1 cut] (the first choice) "
-                                         "the table turns too fast with H1; [conventional, hob H1, 1 cut] the table")
+    assert str(refused.value).startswith("gear 7: no choice fits: the first choice [climb, hob H1, 1 cut] "
+                                         "the table turns too fast with H1; also tried, in order: "
+                                         "(a) [conventional, hob H1, 1 cut], [climb, hob H2, 1 cut]")
+    assert str(refused.value).count("too fast") == 1, "a reason alike but for its numbers is said once"
     with pytest.raises(LimitError) as alone:
         first_that_fits(7, 2.0, attempts(hobs[:1], Choices(feed_mode="climb", cuts=1), 2.0), too_fast)
     assert str(alone.value) == "gear 7: the table turns too fast with H1; nothing stored"

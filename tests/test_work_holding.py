@@ -177,6 +177,7 @@ def test_a_fixture_too_large_for_the_root_is_refused_naming_it(small_gear):
     assert result.exit_code == 1, result.output
     assert too_large["id"] in result.stderr and f"Ø{float(too_large['diameter']):g}" in result.stderr
     assert f"at most Ø{largest:g}" in result.stderr
+    assert "tried" not in result.stderr, "no hob or feed mode makes it fit: refused at once, not after the search"
     assert records(small_gear.url)[3] == jobs   # nothing stored
 
 

@@ -17,6 +17,7 @@ MACHINE_COLUMNS = (
     Column("X min", "x_min"), Column("X max", "x_max"), Column("Z min", "z_min"), Column("Z max", "z_max"),
     Column("spindle max", "spindle_max"), Column("G-code system", "gcode_system"),
     Column("decimal point", "decimal_point_input"), Column("power-on", "power_on"),
+    Column("floor-to-floor", "floor_to_floor"),
 )
 
 
@@ -39,19 +40,24 @@ def machines():
 @list_options("machines")
 @click.pass_context
 def machines_list(ctx, output):
-    """Every machine record, one line each (kind, dialect, travel in mm, spindle r/min, ISO facts).
+    """Every machine record, one line each (kind, dialect, travel in mm, spindle r/min, ISO facts,
+    and whether a hobber's programs state FLOOR TO FLOOR: yes, or the times it does not state).
     --json and --csv give every field of the record (the CSV as `engine machines import` reads it).
     Change a record in SQL (docs/guide/machines-and-simulation.md).
 
     Example: engine machines list --csv > machines.csv
     """
-    from ..machines.records import all_machines
+    from ..machines.records import all_machines, floor_times_said, unstated_floor_times
 
     with connection(ctx) as conn:
-        records = [asdict(machine) for machine in all_machines(conn)]
+        machines = all_machines(conn)
+    records = [asdict(machine) for machine in machines]
     if output == "csv":
         click.echo(csv_text(every_column(), records), nl=False)
         return
+    if output != "json":   # the table's word for the times --json and --csv give field by field
+        for record, machine in zip(records, machines):
+            record["floor_to_floor"] = floor_times_said(machine.kind, unstated_floor_times(machine))
     emit_list(output, "machines", MACHINE_COLUMNS, records)
 
 
@@ -60,17 +66,21 @@ def machines_list(ctx, output):
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object: {added: [names]}.")
 @click.pass_context
 def machines_import(ctx, csv_file, as_json):
-    """Add the machines of CSV_FILE (the columns `engine machines list --csv` writes; name, kind and
-    dialect required, an empty cell the column's default). Only new machines: one that exists is
-    refused (change it in SQL); any bad row stops the whole file, nothing stored.
+    """Add the machines of CSV_FILE (the columns `engine machines list --csv` writes; name, kind,
+    dialect, the travel x_min, x_max, z_min, z_max and spindle_max required, an empty cell the
+    column's default). Only new machines: one that exists is refused (change it in SQL); any bad
+    row stops the whole file, nothing stored. A hobber stating some floor-to-floor times but not
+    all is added with a note naming the ones missing (its programs have no FLOOR TO FLOOR line).
 
     Example: engine machines import my_lathes.csv
     """
-    from ..machines.importing import import_machines
+    from ..machines.importing import import_machines, partial_floor_time_notes
     from ..verifier.grammar import DIALECTS
 
     with connection(ctx) as conn:
         added = import_machines(conn, csv_file, set(DIALECTS), record_fault)
+    for note in partial_floor_time_notes(csv_file):
+        click.echo(f"note: {note}", err=True)
     if as_json:
         return emit_json({"added": added})
     click.echo(f"{csv_file}: added {len(added)} machine(s): {', '.join(added)}")

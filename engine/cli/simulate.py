@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import click
 
+from ..errors import EngineError
 from .context import connection, emit_json
 from .ids import PROGRAM_ID
 
@@ -25,22 +26,29 @@ def simulate(ctx, program_id, as_json):
     or assumed from its feeds: rapids through it, cuts with the spindle stopped, tool changes in a
     moving block or inside the blank; the lines "not checked: ..." say what needs a drawing.
 
-    One line per finding, then the summary. Exit 1 when the simulation refuses the program, or
-    when its lines are not the rendering of the template version and job it names (MISMATCH),
-    or cannot be rendered again because its job was edited since (UNCHECKED).
+    One line per finding (every one), then the summary. Exit 1 when the simulation refuses the
+    program, or when its lines are not the rendering of the template version and job it names
+    (MISMATCH), or cannot be rendered again because its job was edited since (UNCHECKED), or the
+    proof a new program gets refuses it now (REFUSED: its findings are listed first).
 
     Example: engine simulate --program 7 --json
     """
-    from ..programs.rendering import checked_program
+    from ..programs.rendering import REFUSED, stored_rendering
     from ..simulation import simulate_stored_program
 
     with connection(ctx) as conn:
-        checked_program(conn, program_id, "the simulation")   # a forged program proves nothing
+        rendering = stored_rendering(conn, program_id)
+        if rendering.status != REFUSED:   # a forged program proves nothing; a refused rendering is shown
+            rendering.refuse_unless_matching("the simulation")
         report = simulate_stored_program(conn, program_id)
     if as_json:
         emit_json({"program_id": program_id, **report.as_dict()})
     else:
         for line in report.lines():
             click.echo(line)
+    listed = " in the JSON's findings" if as_json else ", listed above"
+    if rendering.status == REFUSED:   # the proof's refusal, and where the simulation's findings are
+        said = f"; the simulation's findings are{listed.replace(', ', ' ')}" if report.refused else ""
+        raise EngineError(f"program {program_id}: {REFUSED}: {rendering.reason}{said}")
     if report.refused:
-        raise report.error()
+        raise report.error(listed)

@@ -33,6 +33,8 @@ if TYPE_CHECKING:
 
 CUT_KINDS = ("rough", "finish")
 CUT_KINDS_BY_COUNT = {1: ("rough",), 2: ("rough", "finish")}   # a single cut is a rough cut, as in the paper
+FEED_BOUNDED = ", feed bounded"   # a proposal's source once bounded_proposal lowered its axial feed
+SINGLE_CUT = "single cut"         # what a note of a job of one cut is labelled (its data are the rough kind's)
 EXACT = 1e-9   # a case this close is the same situation: taken as is
 
 # (feature, kind, scale, weight)
@@ -155,7 +157,7 @@ def bounded_proposal(proposal: KindProposal, gear, hob) -> tuple[KindProposal, s
         return proposal, None
     factor = limit / proposal.axial_feed
     lowered = KindProposal(proposal.cut, proposal.cutting_speed, limit, proposal.radial_feed * factor,
-                           f"{proposal.source}, feed bounded", proposal.case_ids)
+                           f"{proposal.source}{FEED_BOUNDED}", proposal.case_ids)
     return lowered, (f"{proposal.cut}: axial feed {proposal.axial_feed:.2f} mm per workpiece rev ({proposal.source}) "
                      f"bounded to {limit:.2f}, the {why}; radial feed scaled alike to {lowered.radial_feed:.2f}")
 
@@ -226,3 +228,11 @@ def job_cutting_record(cutting: CuttingData, gear, hob, cut_kinds, case_ids) -> 
     if cutting.notes:
         record["notes"] = list(cutting.notes)
     return record | {cut: feeds_per_minute(cutting, gear, hob, cut) for cut in cut_kinds}
+
+
+def single_cut_labels(notes, cut_count: int) -> list[str]:
+    """The notes of a job of `cut_count` cuts: a single cut's (cut with the rough kind's data,
+    CUT_KINDS_BY_COUNT) labelled "single cut:", not "rough:" (there is no finish after it)."""
+    if cut_count != 1:
+        return list(notes)
+    return [f"{SINGLE_CUT}:{note.removeprefix('rough:')}" if note.startswith("rough:") else note for note in notes]

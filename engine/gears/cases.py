@@ -32,7 +32,15 @@ from ..db.listing import records
 from ..errors import EngineError
 from ..machines.records import Machine, hobbing_machine
 from ..paths import SEED_DIR
-from .case_base import CASE_COLUMNS, CUT_KINDS, CaseBase, KindProposal, feeds_per_minute, feeds_per_rev
+from .case_base import (
+    CASE_COLUMNS,
+    CUT_KINDS,
+    FEED_BOUNDED,
+    CaseBase,
+    KindProposal,
+    feeds_per_minute,
+    feeds_per_rev,
+)
 from .cutting_data import CuttingData
 from .hob_matching import choose_hob
 from .models import model_for_class
@@ -156,16 +164,28 @@ def plausibility_notes(gear: Gear, hob: Hob, machine: Machine, cutting: CuttingD
 
 
 def _feed_note(gear: Gear, proposal: KindProposal) -> list[str]:
+    """The proposal's axial feed outside the §C row's typical range, said with the row it was read
+    from (an m2.5 gear reads the row up to m3: it is not an m3 gear). A feed the engine lowered to
+    its own bound (the §C maximum or the chip-thickness bound, whose note says so) is not
+    complained of: below the typical range there is the bound's doing, not the cases'."""
     at_least = AXIAL_FEED_RANGE[AXIAL_FEED_RANGE.module >= gear.module]
     row = (at_least if not at_least.empty else AXIAL_FEED_RANGE).iloc[0]
     low, high = row[f"{proposal.cut}_low"], row[f"{proposal.cut}_high"]
-    if low <= proposal.axial_feed <= high:
+    if low <= proposal.axial_feed <= high or proposal.source.endswith(FEED_BOUNDED):
         return []
     side = "above" if proposal.axial_feed > high else "below"
     check = f"; check the feed definition of case(s) {', '.join(f'#{i}' for i in proposal.case_ids)}" \
         if proposal.case_ids else ""
     return [f"{proposal.cut}: axial feed {proposal.axial_feed:.2f} mm per workpiece rev is {side} the typical "
-            f"{low:.1f}–{high:.1f} for m{row.module:g} {CUTTING[proposal.cut]} (reference §C){check}"]
+            f"{low:.1f}–{high:.1f} for m{gear.module:g} {CUTTING[proposal.cut]} ({_row_said(row.module, gear.module)}, "
+            f"reference §C){check}"]
+
+
+def _row_said(row_module: float, module: float) -> str:
+    """'the row of m3' for an m3 gear; 'the row up to m3' for an m2.5 gear; 'the last row, m4' beyond it."""
+    if row_module == module:
+        return f"the row of m{row_module:g}"
+    return f"the row up to m{row_module:g}" if row_module > module else f"the last row, m{row_module:g}"
 
 
 def _speed_notes(gear: Gear, hob: Hob, proposals: dict) -> list[str]:

@@ -13,7 +13,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from ..errors import EngineError
+from ..errors import EngineError, InputError
 from ..machines.records import Machine, hobbing_machine
 from ..machines.work_holding import WorkHolding, load_work_holdings
 from .records import Gear, Hob, load_gear
@@ -125,6 +125,14 @@ class NoHoldingError(EngineError):
         self.property_name = property_name
 
 
+class GivenHoldingError(NoHoldingError, InputError):
+    """The --fixture given does not fit the gear or the machine whatever the hob: the search stops
+    at it (its height alone depends on the hob's tip diameter, so a short one is a choice's refusal)."""
+
+
+HOB_DEPENDENT = frozenset({"height"})   # the HOLDING_TESTS whose verdict another hob may change
+
+
 def machine_clears(setting: Setting) -> bool:
     """The machine record's fixture and tailstock clear the root (the job needs no work-holding)."""
     machine = setting.machine
@@ -170,12 +178,13 @@ def best_holding(setting: Setting, holdings: list[WorkHolding]) -> HoldingChoice
 def _given(setting: Setting, holdings: list[WorkHolding], given: str) -> HoldingChoice:
     found = next((holding for holding in holdings if holding.id.upper() == given.upper()), None)
     if found is None:
-        raise EngineError(f"work-holding {given!r} does not exist; see `engine fixtures list`")
+        raise InputError(f"work-holding {given!r} does not exist; see `engine fixtures list`")
     unmet = next((test for test in HOLDING_TESTS if not test.fits(found, setting)), None)
     if unmet is not None:
-        raise NoHoldingError(f"gear {setting.gear.id}: {found.kind} {found.id} does not fit: the job needs a "
-                             f"work-holding {unmet.wanted(setting)}, and {found.id} {unmet.offered(found)}; "
-                             f"`engine fixtures match --gear {setting.gear.id}` names one that fits", unmet.name)
+        error = NoHoldingError if unmet.name in HOB_DEPENDENT else GivenHoldingError
+        raise error(f"gear {setting.gear.id}: {found.kind} {found.id} does not fit: the job needs a "
+                    f"work-holding {unmet.wanted(setting)}, and {found.id} {unmet.offered(found)}; "
+                    f"`engine fixtures match --gear {setting.gear.id}` names one that fits", unmet.name)
     return HoldingChoice(found, f"{found.id} ({found.kind}, given): " + ", ".join(
         test.said(found, setting) for test in HOLDING_TESTS))
 

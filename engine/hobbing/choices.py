@@ -3,7 +3,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
-from ..errors import EngineError
+from ..errors import EngineError, InputError
 
 SINGLE_CUT_MAX_MODULE = 3.0   # m_n ≤ about 3: one cut to full depth is common (§B14)
 # Radial allowance for shaving or grinding: tenths of a mm in practice; the paper's 2.5 mm is the
@@ -91,7 +91,7 @@ class Choices:
         if len(modes) == 1:
             return self
         if len(modes) != units:
-            raise EngineError(f"gear {gear_id}: feed mode {self.mode} names one for each of {len(modes)} units; "
+            raise InputError(f"gear {gear_id}: feed mode {self.mode} names one for each of {len(modes)} units; "
                               f"the gear has {units}: give one of {', '.join(FEED_MODES)}")
         return replace(self, feed_mode=modes[number - 1])
 

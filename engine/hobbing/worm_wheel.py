@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 from dataclasses import replace
 
-from ..errors import EngineError
+from ..errors import InputError
 from ..gears.cutting_data import per_minute, programmed_feed
 from ..gears.models import register_model
 from . import conventions
@@ -80,7 +80,7 @@ def one_tangential_cut(gear, choices):
     the header says so (it said the module's two, and the simulation, following one, refused every
     tangential wheel over m 3: new-user review 29). Two cuts asked for are refused, not dropped."""
     if choices.cuts == 2:
-        raise EngineError(f"gear {gear.id}: two cuts with a tangential feed: a tangential pass cuts the full depth "
+        raise InputError(f"gear {gear.id}: two cuts with a tangential feed: a tangential pass cuts the full depth "
                           "once; give --cuts 1, or --worm-feed radial for a rough and a finishing plunge")
     return replace(choices, cuts=1)
 
@@ -89,7 +89,7 @@ def check_module_stated(gear) -> None:
     """A worm wheel's module must be stated as axial or normal (gear.module_kind): worm drawings
     usually give the worm's axial module m_x, and m_n = m_x·cos γ; a guess cuts the wrong depth."""
     if gear.module_kind is None:
-        raise EngineError(f"gear {gear.id}: worm wheel module {gear.module:g} is not stated as axial or normal; set "
+        raise InputError(f"gear {gear.id}: worm wheel module {gear.module:g} is not stated as axial or normal; set "
                           "module_kind (axial: the worm's axial module, as worm drawings give it) in the gear file "
                           "and import it again, or UPDATE gear SET module_kind")
 

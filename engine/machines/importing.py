@@ -1,7 +1,7 @@
 """Adding machine records from a CSV file (`engine machines import`): the columns of the machine
 table, as `engine machines list --csv` writes them and seed_templates/machines.csv holds them;
-name, kind and dialect are required, an empty cell takes the column's default. A shop adds its own
-lathe or hobber here instead of in SQL.
+name, kind, dialect, the travel (x_min … z_max) and spindle_max are required (REQUIRED), an empty
+cell takes the column's default. A shop adds its own lathe or hobber here instead of in SQL.
 
 Only new machines are added: a record that exists is the one its stored programs were proved
 against, so changing its travel or its control's facts is a deliberate edit in SQL, not a side
@@ -21,7 +21,7 @@ from psycopg import sql
 from ..csv_reader import Column, CsvKind, parse_text, read_csv_file
 from ..errors import EngineError
 from ..names import shown
-from .records import Machine
+from .records import FLOOR_TIMES, Machine
 
 if TYPE_CHECKING:
     from ..db.connection import Connection
@@ -161,3 +161,16 @@ def _insert(conn: Connection, path, machine: dict) -> None:
     except (psycopg.errors.IntegrityError, psycopg.errors.DataError) as error:
         asks = CHECKS.get(error.diag.constraint_name or "", error.diag.message_primary or str(error))
         raise EngineError(f"{path}: machine {shown(machine['name'])}: {asks}; nothing imported") from error
+
+
+def partial_floor_time_notes(path: str | Path) -> list[str]:
+    """A note per hobber of the file that states some of its FLOOR_TIMES but not all: its programs
+    print no `; FLOOR TO FLOOR` line until it states the rest (a record stating none is the
+    machine that keeps no such times, said nowhere; engine machines list shows both)."""
+    notes = []
+    for machine in read_machines(path):
+        missing = [name for name in FLOOR_TIMES if machine.get(name) is None]
+        if machine["kind"] == "hobber" and 0 < len(missing) < len(FLOOR_TIMES):
+            notes.append(f"machine {machine['name']} states some floor-to-floor times but not {', '.join(missing)}: "
+                         "its programs have no FLOOR TO FLOOR line until it states them (in SQL)")
+    return notes

@@ -79,6 +79,17 @@ def unstated_floor_times(machine: Machine) -> list[str]:
     return [name for name in FLOOR_TIMES if getattr(machine, name) is None]
 
 
+def floor_times_said(kind: str, missing: list[str]) -> str:
+    """Whether a machine's programs state `; FLOOR TO FLOOR`, for `engine machines list`: 'yes' (a
+    hobber stating every FLOOR_TIMES), 'missing <names>' (some), 'none stated', '-' (a lathe: the
+    floor-to-floor time is the hobbing cycle's, engine.hobbing.floor_time)."""
+    if kind != "hobber":
+        return "-"
+    if not missing:
+        return "yes"
+    return "none stated" if len(missing) == len(FLOOR_TIMES) else f"missing {', '.join(missing)}"
+
+
 MACHINE_QUERY = f"SELECT {columns(Machine)} FROM machine"  # static, from the dataclass
 
 

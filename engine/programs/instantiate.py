@@ -11,7 +11,7 @@ from dataclasses import replace
 from typing import TYPE_CHECKING
 
 from ..errors import EngineError
-from ..gears.case_base import CUT_KINDS_BY_COUNT, CaseBase, job_cutting_record
+from ..gears.case_base import CUT_KINDS_BY_COUNT, CaseBase, job_cutting_record, single_cut_labels
 from ..gears.chip_thickness import chip_cases
 from ..gears.feed_marks import bounded_for_marks
 from ..gears.hob_matching import matching_hobs
@@ -111,6 +111,7 @@ class Planner:
         check_machine_fits(gear, self.machine)
         model = self.model(gear.gear_class)
         self.template(gear.gear_class)   # a class refused is not a choice that does not fit: refused before the search
+        self.choices.for_unit(1, 1 + len(gear.units), gear.id)   # a mode per unit names the gear's units or none
         hobs = [choice.hob for choice in matching_hobs(gear, self.hobs, purpose=model.hob_purpose,
                                                        shift_travel=model.shift_travel(self.choices))]
         tried = attempts(hobs, self.choices, gear.module, 1 + len(gear.units))
@@ -140,7 +141,8 @@ class Planner:
         kinds = CUT_KINDS_BY_COUNT[choices.cut_count(gear.module)]
         cutting = cutting.of_cuts(kinds)
         record = job_cutting_record(cutting, gear, hob, kinds, case_ids)
-        notes = ([f"gear {gear.id}: {note}" for note in cutting.notes] + hunting_tooth_notes(gear, hob)
+        notes = ([f"gear {gear.id}: {note}" for note in single_cut_labels(cutting.notes, len(kinds))]
+                 + hunting_tooth_notes(gear, hob)
                  + floor_time_notes(self.machine))
         return Planned(gear.id, gear.gear_class, self.machine.name, hob.id, params, job.module_params, template,
                        result, record, notes, self._layouts[gear.gear_class],

@@ -8,15 +8,18 @@ simulation's refusal of the made program), the alternatives of SEARCH_ORDER are 
 each one planned, verified and proved exactly as the first (engine.programs.verified_run): the
 first that is proved is taken, and a note says which choice was taken and why. A choice the user
 gave (--feed-mode, --cuts) is never varied. Nothing of an attempt that is refused is kept, so no
-unproved program is ever stored or printed.
+unproved program is ever stored or printed. An input no choice changes (engine.errors.InputError:
+an unknown --fixture, two cuts with a tangential feed, …) and a template that fails to run stop
+the search at once with their own words.
 """
 from __future__ import annotations
 
+import re
 from collections.abc import Callable
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
 
-from ..errors import EngineError
+from ..errors import EngineError, InputError
 from ..hobbing.choices import DEFAULT_FEED_MODE, FEED_MODES, UNIT_FEED_MODES, UNIT_SEPARATOR, Choices
 from ..templates.decision_table import TemplateError
 
@@ -107,13 +110,13 @@ class Found:
 def first_that_fits(gear_id: int, module: float, tried: list[Attempt], plan: Callable[[Attempt], object]) -> Found:
     """plan(attempt) for each attempt in order until one is planned and proved; the refusals of the
     ones before it named in the note. None fits: the first attempt's refusal (its type kept), with
-    every alternative tried and its reason, in one line."""
+    every alternative tried and each distinct reason once, in one line."""
     refused: list[tuple[Attempt, EngineError]] = []
     for attempt in tried:
         try:
             planned = plan(attempt)
-        except TemplateError:
-            raise   # the class's rows fail to run: no other choice is a way out, the template is to mend
+        except (TemplateError, InputError):
+            raise   # the class's rows fail to run, or an input no choice changes: no choice is a way out
         except EngineError as error:
             refused.append((attempt, error))
             continue
@@ -135,22 +138,51 @@ def _note(gear_id: int, module: float, taken: Attempt, refused: list[tuple[Attem
 
 
 def _refusal(gear_id: int, module: float, refused: list[tuple[Attempt, EngineError]]) -> EngineError:
-    """The refusal when nothing fits, of the first attempt's type (a LimitError stays one), naming
-    every choice tried: the same reason for all (not a matter of the choices: e.g. a crowning too
-    steep for its face) is the first refusal followed by the choices tried; else each choice with
-    its reason, the first choice first. A single attempt's refusal is unchanged."""
+    """The refusal when nothing fits, of the first attempt's type (a LimitError stays one), in one
+    line a programmer reads: the first choice with its full reason, then every other choice tried in
+    the search's order, each tagged with its reason's letter, and each distinct reason once (reasons
+    equal but for their numbers are one: the same refusal at another hob's diameter). A reason
+    the same for all is said once. A single attempt's refusal is unchanged."""
     first_attempt, first = refused[0]
     if len(refused) == 1:
         return first
-    tried = [f"[{attempt.said(module)}]" + (" (the first choice)" if attempt is first_attempt else "")
-             for attempt, _ in refused]
     reasons = [reason(gear_id, error) for _, error in refused]
-    if len(set(reasons)) == 1:
-        message = f"{str(first).removesuffix(NOTHING_STORED)}; the same with every choice tried: {', '.join(tried)}"
-    else:
-        message = f"gear {gear_id}: no choice fits, tried: " + "; ".join(
-            f"{said} {why}" for said, why in zip(tried, reasons))
+    message = (_all_alike(first, module, refused) if len(set(reasons)) == 1
+               else _grouped(gear_id, module, refused, reasons))
     error = type(first).__new__(type(first))   # its type and attributes, the new line
     error.__dict__.update(first.__dict__)
     error.args = (message + NOTHING_STORED,)
     return error
+
+
+def _all_alike(first: EngineError, module: float, refused: list[tuple[Attempt, EngineError]]) -> str:
+    """'<the first refusal>; the same with every choice tried: [climb, …] (the first choice), […]'."""
+    tried = [f"[{attempt.said(module)}]" for attempt, _ in refused]
+    tried[0] += " (the first choice)"
+    return f"{str(first).removesuffix(NOTHING_STORED)}; the same with every choice tried: {', '.join(tried)}"
+
+
+def _grouped(gear_id: int, module: float, refused: list[tuple[Attempt, EngineError]], reasons: list[str]) -> str:
+    """'gear 54: no choice fits: the first choice [climb, …] <reason>; also tried, in order: (a) […],
+    […], (b) […]; (a) is the first choice's reason (numbers aside), (b) is: <reason>'."""
+    shapes = [_shape(why) for why in reasons]
+    distinct = list(dict.fromkeys(shapes))            # in the order first met; the first choice's is (a)
+    letter = {shape: f"({_letter(n)})" for n, shape in enumerate(distinct)}
+    also, last = [], None
+    for (attempt, _), shape in zip(refused[1:], shapes[1:]):
+        also.append(("" if shape == last else f"{letter[shape]} ") + f"[{attempt.said(module)}]")
+        last = shape
+    said = [f"{letter[distinct[0]]} is the first choice's reason" + (", numbers aside" if shapes.count(distinct[0]) > 1
+                                                                     else "")]
+    said += [f"{letter[shape]} is: {reasons[shapes.index(shape)]}" for shape in distinct[1:]]
+    return (f"gear {gear_id}: no choice fits: the first choice [{refused[0][0].said(module)}] {reasons[0]}; "
+            f"also tried, in order: {', '.join(also)}; {', and '.join(said)}")
+
+
+def _shape(why: str) -> str:
+    """A reason with its numbers (and ids holding them) blanked: two choices refused the same way."""
+    return re.sub(r"[\w.+-]*\d[\w.+-]*", "#", why)
+
+
+def _letter(n: int) -> str:
+    return "abcdefghijklmnopqrstuvwxyz"[n] if n < 26 else f"r{n}"

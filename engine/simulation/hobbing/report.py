@@ -76,10 +76,14 @@ class Report:
         if finding not in self.findings:
             self.findings.append(finding)
 
-    def error(self) -> SimulationError:
+    def error(self, where_listed: str = "") -> SimulationError:
+        """The first refusal, the others counted; `where_listed` says where they are shown (e.g.
+        ', listed above' by engine simulate). A program refused before it is stored is listed
+        nowhere else, so no command is pointed to (new-user review 29: one pointed to engine
+        simulate, which has no program to simulate then)."""
         first = self.refusals[0]
         more = len(self.refusals) - 1
-        extra = f" (and {more} more finding{'s' if more > 1 else ''}: engine simulate lists them)" if more else ""
+        extra = f" (and {more} more finding{'s' if more > 1 else ''}{where_listed})" if more else ""
         return SimulationError(f"the simulation refuses {first.sentence(self.name)}{extra}")
 
     def lines(self) -> list[str]:

@@ -19,11 +19,12 @@ class TurningReport(Report):
     blank: str = ""          # "Ø42.000 Z-70.000…0.000 (assumed)"
     not_checked: list[str] = field(default_factory=list)   # what it could not prove (a class job: no drawing)
 
-    def error(self) -> SimulationError:
+    def error(self, where_listed: str = "") -> SimulationError:
         """The first refusal, all of them counted (a refused program is not stored, so the count is
-        said here rather than left to `engine simulate`), and what to do about an assumed blank."""
+        said here rather than left to `engine simulate`; `where_listed` as Report.error), and what
+        to do about an assumed blank."""
         first, more = self.refusals[0], len(self.refusals) - 1
-        extra = f" (and {more} more finding{'s' if more > 1 else ''})" if more else ""
+        extra = f" (and {more} more finding{'s' if more > 1 else ''}{where_listed})" if more else ""
         hint = f"; {STATE_THE_BLANK.format(blank=self.blank.removesuffix(' (assumed)'))}" \
             if self.blank.endswith("(assumed)") else ""
         return SimulationError(f"the simulation refuses {first.sentence(self.name)}{extra}{hint}")
