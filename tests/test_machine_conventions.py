@@ -214,6 +214,8 @@ def brief_cycle_time(text, rapid_rate, load) -> float:
 @pytest.mark.parametrize("cls", sorted(CLASS_GEARS))
 @pytest.mark.parametrize("choices", [{}, {"cuts": 2, "feed_mode": "conventional-climb"}, {"worm_feed": "tangential"}])
 def test_the_header_cycle_time_is_the_programs(conn, cls, choices):
+    if cls == "worm_wheel":   # no axial pass: a feed mode given for a worm wheel is refused
+        choices = {name: value for name, value in choices.items() if name != "feed_mode"}
     text = instantiate(conn, CLASS_GEARS[cls], **choices)
     header = float(header_cycle_time_line(text.splitlines()).split()[3])
     expected = brief_cycle_time(text, 8000.0, {"X": 300.0, "Z": 100.0})

@@ -53,8 +53,12 @@ TURNING_CASES = (
 LATHES = ("lathe-iso", "lathe-840d")
 
 
+WORM_WHEELS = (53,)   # no axial pass: their cases leave out the feed modes (refused for them)
+
+
 def hobbing_cases() -> list[tuple[int, str]]:
-    return [(gear_id, choice_set) for gear_id in HOBBING_GEARS for choice_set in CHOICE_SETS]
+    return [(gear_id, choice_set) for gear_id in HOBBING_GEARS for choice_set in CHOICE_SETS
+            if not (gear_id in WORM_WHEELS and "feed_mode" in CHOICE_SETS[choice_set][0])]
 
 
 def turning_cases() -> list[tuple[str, str]]:
