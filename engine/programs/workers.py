@@ -9,6 +9,7 @@ as its reason (engine.programs.batches.Bad), so the batch names every bad gear i
 """
 from __future__ import annotations
 
+import gc
 import multiprocessing
 
 from ..errors import EngineError
@@ -87,10 +88,12 @@ def map_in_workers(work, items: list, workers: int, in_worker=None) -> list:
     size = max(1, len(items) // (workers * SLICES_PER_WORKER))
     slices = [items[start:start + size] for start in range(0, len(items), size)]
     _MAPPED[:] = [work, in_worker]
+    gc.freeze()   # the parent's objects out of the workers' collections: touching them would copy their pages
     try:
         with multiprocessing.get_context("fork").Pool(workers, initializer=_mapping_worker) as pool:
             return [result for done in pool.imap(_map_slice, slices) for result in done]
     finally:
+        gc.unfreeze()
         _MAPPED.clear()
 
 

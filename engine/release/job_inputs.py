@@ -14,7 +14,7 @@ from ..errors import EngineError
 from ..gears.models import model_for_class
 from ..gears.records import Gear, Hob, load_gear, load_hobs
 from ..machines.records import load_machine
-from ..machines.work_holding import WorkHolding, job_work_holding
+from ..machines.work_holding import WorkHolding, job_work_holding, jobs_work_holdings
 from ..nc.lineage import refuse_lineage_shaped
 from ..programs.drawing_records import turning_job_drawing
 from ..programs.job_shape import job_with_cycle_time
@@ -35,27 +35,38 @@ class JobInputs:
 
     def __init__(self, conn: Connection):
         self.conn = conn
-        self.machines: dict[str, Machine] = {}
+        self.machines: dict[str, Machine | EngineError] = {}
         self.shapes: dict[str, str] = {}   # class -> its model's cut shape
         self.models: dict[str, bool] = {}  # class -> whether it has a model (else its jobs are class jobs)
         self.gears: dict[int, Gear | EngineError] = {}   # a gear that no longer loads: why, for its proof
         self.hobs: dict[str, Hob] | None = None
         self.drawings: dict[int, DrawingRecord | EngineError] = {}   # job -> its record, or why it has none fit
-        self.holdings: dict[int, WorkHolding | None] = {}   # job -> its work-holding (None: the machine's own)
+        self.holdings: dict[int, WorkHolding | None | EngineError] = {}   # job -> its holding (None: the machine's)
 
     def read_records(self, pending: dict[tuple, int]) -> None:
-        """The machines, gears, hobs and drawing records the proofs of these job inputs (each with a
-        job that has it) read, read now (a record that is missing is named by the job's proof, from
-        what was read here)."""
+        """The machines, models, gears, hobs and drawing records that making these job inputs (each
+        with a job that has it) and proving their programs read, read now (a record that
+        is missing is named by the job's proof, from what was read here)."""
+        self._read_holdings([job_id for key, job_id in pending.items() if key[4] is not None and key[5] is not None])
         for key, job_id in pending.items():
             try:
                 self._read_for(key, job_id)
             except EngineError:
                 pass   # named by the job's proof, from what was kept here
 
+    def _read_holdings(self, job_ids: list[int]) -> None:
+        """The work-holdings of the jobs that name a gear and a hob (hobbing jobs), in bulk: one
+        query for thousands of jobs (one that fails to load is read again job by job, its reason kept)."""
+        try:
+            self.holdings.update(jobs_work_holdings(self.conn, job_ids))
+        except EngineError:
+            pass
+
     def _read_for(self, key: tuple, job_id: int) -> None:
         gear_class, machine_name, params_text, modules_text, gear_id, hob_id = key
         kind = self.machine(machine_name).kind
+        if self.modelled(gear_class) and kind != "lathe":
+            self.cut_shape(gear_class)   # a hobbing job's cycle time, as its template reads it
         if kind == "hobber" and gear_id is not None and hob_id is not None:
             self.workpiece(job_id, gear_id, hob_id)
             self.holding(job_id)
@@ -155,8 +166,14 @@ class JobInputs:
     def holding(self, job_id: int) -> WorkHolding | None:
         """The job's work-holding, which its program states and is proved against (issue 29), read once."""
         if job_id not in self.holdings:
-            self.holdings[job_id] = job_work_holding(self.conn, job_id)
-        return self.holdings[job_id]
+            try:
+                self.holdings[job_id] = job_work_holding(self.conn, job_id)
+            except EngineError as error:
+                self.holdings[job_id] = error
+        holding = self.holdings[job_id]
+        if isinstance(holding, EngineError):
+            raise EngineError(str(holding))
+        return holding
 
     def cut_shape(self, gear_class: str) -> str:
         if gear_class not in self.shapes:
@@ -169,7 +186,14 @@ class JobInputs:
             self.models[gear_class] = model_for_class(self.conn, gear_class) is not None
         return self.models[gear_class]
 
-    def machine(self, name: str):
+    def machine(self, name: str) -> Machine:
+        """The machine record, read once (one that does not load: why, named in a worker too)."""
         if name not in self.machines:
-            self.machines[name] = load_machine(self.conn, name)
-        return self.machines[name]
+            try:
+                self.machines[name] = load_machine(self.conn, name)
+            except EngineError as error:
+                self.machines[name] = error
+        machine = self.machines[name]
+        if isinstance(machine, EngineError):
+            raise EngineError(str(machine))
+        return machine
