@@ -226,7 +226,7 @@ class _Made:
         key, job_id = pending
         try:
             inputs = self.job_inputs(key, job_id)   # read by both templates (their rows cannot change them)
-            new_lines = compiled_template(self.pairs[key[0]][1]).run(*inputs).lines
+            new_lines = compiled_template(self.pairs[key[0]][1]).run(*inputs, traced=False).lines
         except EngineError as error:
             return _Outcome(failure=str(error))   # the draft's rows fail to run for the job
         old_lines = self.released_lines(key, inputs)   # rendered now: a stored program may be a forgery
@@ -242,7 +242,7 @@ class _Made:
         """The released template makes the job a program the draft's proof accepts (asked only for a
         job the draft fails for: a job that fails with both is an old problem, not the draft's)."""
         try:
-            lines = compiled_template(self.released(key[0])).run(*self.job_inputs(key, job_id)).lines
+            lines = compiled_template(self.released(key[0])).run(*self.job_inputs(key, job_id), traced=False).lines
             self.inputs.prove(key, lines, job_id)
         except EngineError:
             return False
@@ -252,7 +252,7 @@ class _Made:
         """The released template's lines for the job's inputs (none if it fails: every draft line is a
         change)."""
         try:
-            return compiled_template(self.released(key[0])).run(*inputs).lines
+            return compiled_template(self.released(key[0])).run(*inputs, traced=False).lines
         except EngineError:
             return []
 
