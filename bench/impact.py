@@ -6,7 +6,8 @@ them with their own program names (so no two jobs share their parameters) and st
 released programs through the batch COPY path; then a row is edited through template_view, so
 every program changes and each is proved (verifier and hobbing simulation, issue 28) in
 `--workers` processes (default 2). Also printed: the same impact proved in one process, so the
-workers' gain is a ratio from the same run.
+workers' gain is a ratio from the same run, and the CPU seconds of both (all their processes: on a
+shared machine the wall time also counts what the other processes took).
 Target (issues 15, 28): impact of 10,000 jobs, all changed and proved, <= 10 s with two workers
 on the 2-core machine.
 

@@ -17,7 +17,9 @@ its `; TEMPLATE class vN` line, differing in the number alone, is not a change
 (engine.release.version_lines). A draft that only writes its lines with
 another layout (line ending, final newline: version_layout_change) changes no line, but the bytes of
 every stored program's file of the class: said on its own, with how many programs. Jobs with identical parameters are
-evaluated once: 10,000 stored jobs of a class take seconds (bench/impact.py)."""
+evaluated once. With `workers`, forked processes make, compare and prove the distinct job inputs
+(the parent reads every record first and gathers the failures and diffs, in job order): 10,000
+stored spur jobs, every program changed and proved, take about 9 s with two (bench/impact.py)."""
 from __future__ import annotations
 
 import difflib
