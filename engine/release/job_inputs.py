@@ -36,8 +36,8 @@ class JobInputs:
     def __init__(self, conn: Connection):
         self.conn = conn
         self.machines: dict[str, Machine | EngineError] = {}
-        self.shapes: dict[str, str] = {}   # class -> its model's cut shape
-        self.models: dict[str, bool] = {}  # class -> whether it has a model (else its jobs are class jobs)
+        self.shapes: dict[str, str | EngineError] = {}   # class -> its model's cut shape
+        self.models: dict[str, bool | EngineError] = {}  # class -> whether it has a model (else: class jobs)
         self.gears: dict[int, Gear | EngineError] = {}   # a gear that no longer loads: why, for its proof
         self.hobs: dict[str, Hob] | None = None
         self.drawings: dict[int, DrawingRecord | EngineError] = {}   # job -> its record, or why it has none fit
@@ -65,8 +65,11 @@ class JobInputs:
     def _read_for(self, key: tuple, job_id: int) -> None:
         gear_class, machine_name, params_text, modules_text, gear_id, hob_id = key
         kind = self.machine(machine_name).kind
-        if self.modelled(gear_class) and kind != "lathe":
-            self.cut_shape(gear_class)   # a hobbing job's cycle time, as its template reads it
+        try:
+            if self.modelled(gear_class) and kind != "lathe":
+                self.cut_shape(gear_class)   # a hobbing job's cycle time, as its template reads it
+        except EngineError:
+            pass   # kept: named by the job's making, its records read on
         if kind == "hobber" and gear_id is not None and hob_id is not None:
             self.workpiece(job_id, gear_id, hob_id)
             self.holding(job_id)
@@ -165,35 +168,28 @@ class JobInputs:
 
     def holding(self, job_id: int) -> WorkHolding | None:
         """The job's work-holding, which its program states and is proved against (issue 29), read once."""
-        if job_id not in self.holdings:
-            try:
-                self.holdings[job_id] = job_work_holding(self.conn, job_id)
-            except EngineError as error:
-                self.holdings[job_id] = error
-        holding = self.holdings[job_id]
-        if isinstance(holding, EngineError):
-            raise EngineError(str(holding))
-        return holding
+        return _kept(self.holdings, job_id, lambda: job_work_holding(self.conn, job_id))
 
     def cut_shape(self, gear_class: str) -> str:
-        if gear_class not in self.shapes:
-            self.shapes[gear_class] = model_for_class(self.conn, gear_class).cut_shape
-        return self.shapes[gear_class]
+        return _kept(self.shapes, gear_class, lambda: model_for_class(self.conn, gear_class).cut_shape)
 
     def modelled(self, gear_class: str) -> bool:
         """Whether the class has a model (hobbing, turning); read before the workers start."""
-        if gear_class not in self.models:
-            self.models[gear_class] = model_for_class(self.conn, gear_class) is not None
-        return self.models[gear_class]
+        return _kept(self.models, gear_class, lambda: model_for_class(self.conn, gear_class) is not None)
 
     def machine(self, name: str) -> Machine:
-        """The machine record, read once (one that does not load: why, named in a worker too)."""
-        if name not in self.machines:
-            try:
-                self.machines[name] = load_machine(self.conn, name)
-            except EngineError as error:
-                self.machines[name] = error
-        machine = self.machines[name]
-        if isinstance(machine, EngineError):
-            raise EngineError(str(machine))
-        return machine
+        return _kept(self.machines, name, lambda: load_machine(self.conn, name))
+
+
+def _kept(records: dict, key, read):
+    """records[key], read once; a record that does not load is kept as its reason and named again
+    each time it is asked for (in a worker too, which reads no database)."""
+    if key not in records:
+        try:
+            records[key] = read()
+        except EngineError as error:
+            records[key] = error
+    found = records[key]
+    if isinstance(found, EngineError):
+        raise EngineError(str(found))
+    return found
