@@ -68,6 +68,24 @@ def test_a_gear_record_that_no_longer_loads_is_named_in_workers_as_in_one_proces
     assert "gear 46" in report.failures[0].error and report.changed == 2
 
 
+def test_two_workers_report_what_one_process_reports(conn):
+    """The workers make both programs of each job input, compare them and prove the changed ones
+    (issue 28): the same diffs, failures (and whether the released version passes), counts and
+    proofs as one process, in job order; a job with the same inputs as another is named too."""
+    jobs = [instantiate_gear(conn, gear).job_id for gear in (42, 45, 46)]
+    twin = conn.execute("INSERT INTO job (gear_id, gear_class, machine, hob_id, params, module_params) "
+                        "SELECT gear_id, gear_class, machine, hob_id, params, module_params FROM job WHERE id = %s "
+                        "RETURNING id", (jobs[0],)).fetchone()[0]
+    assert teeth(conn, 46) == 48 and {teeth(conn, 42), teeth(conn, 45)}.isdisjoint({48})
+    edit(conn, "spur", SPEED_ROW, o='f"M3 S{n0 * 5 if z2 == 48 else n0}"')   # gear 46's hob beyond the spindle
+    edit(conn, "spur", COOLANT_OFF_ROW, o='"M9 ; COOLANT OFF"')              # every spur program changes
+    one, two = impact(conn, "spur", 1), impact(conn, "spur", 2)
+    assert two == one
+    assert [diff.job_id for diff in one.diffs] == [jobs[0], jobs[1], twin] and one.changed == 3
+    assert [(failure.job_id, failure.released_makes) for failure in one.failures] == [(jobs[2], True)]
+    assert one.jobs == 4 and one.proved == 3   # three distinct inputs changed, each proved once
+
+
 # --- deduplicated inputs, descendants -------------------------------------------------------------
 
 def test_two_stored_jobs_with_the_same_inputs_are_both_named(conn):

@@ -40,6 +40,18 @@ def test_a_remembered_outcome_is_the_outcome_a_fresh_evaluation_gives(flag):
     assert remembering.memo     # it did remember
 
 
+@pytest.mark.parametrize("flag", [True, False])
+def test_a_run_without_its_trace_gives_the_lines_a_traced_run_gives(flag):
+    """The release impact runs its templates without the trace (issue 28): the same lines and row
+    ids, from remembered outcomes and fresh ones alike, and an empty trace."""
+    remembering = template_of(*ROWS)
+    for index, params in enumerate(JOBS):
+        params, modules = {**params, "flag": flag}, {"cutmotion:1": {"m": index % 2 or 0.0}}
+        bare, fresh = remembering.run(params, modules, traced=False), fresh_run(ROWS, params, modules)
+        assert (bare.lines, bare.row_ids) == (fresh.lines, fresh.row_ids), params
+        assert bare.trace == {"inputs": {}, "rows": []}
+
+
 def test_rows_whose_inputs_repeat_are_not_evaluated_again(monkeypatch):
     remembering, modules = template_of(*ROWS), {"cutmotion:1": {"m": 5}}
     first = remembering.run({"x": 3, "flag": True}, modules)

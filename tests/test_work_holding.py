@@ -17,7 +17,7 @@ from engine.errors import EngineError
 from engine.gears.holding_matching import choose_holding
 from engine.gears.records import Gear, Hob, load_gear, load_hobs
 from engine.machines.records import load_machine
-from engine.machines.work_holding import WorkHolding, load_work_holding
+from engine.machines.work_holding import WorkHolding, job_work_holding, jobs_work_holdings, load_work_holding
 from engine.simulation import simulate_program
 
 SEED_HOLDINGS = Path(__file__).resolve().parent.parent / "seed_templates" / "work_holdings.csv"
@@ -104,6 +104,18 @@ def test_the_small_gear_is_made_on_the_largest_arbor_that_fits_and_proved(small_
     job_id = json.loads(result.stdout)["job_id"]
     again = small_gear("instantiate", "--job", job_id, "--json")   # a stored job keeps and proves its arbor
     assert again.exit_code == 0, again.output
+
+
+def test_the_work_holdings_of_many_jobs_read_at_once_are_each_jobs_own(small_gear):
+    """The release impact reads the work-holdings of thousands of jobs in one go (issue 28): each job's
+    is the one it is clamped on, as read job by job; a job on the machine's own fixture, or no job, None."""
+    machine = records(small_gear.url)[2]
+    on_arbor = json.loads(small_gear("instantiate", "--gear", 901, "--json").stdout)["job_id"]
+    on_fixture = json.loads(small_gear("instantiate", "--gear", 42, "--json").stdout)["job_id"]
+    with psycopg.connect(small_gear.url) as conn:
+        held = jobs_work_holdings(conn, [on_arbor, on_fixture, on_arbor + on_fixture + 1])
+        assert held == {on_arbor: job_work_holding(conn, on_arbor), on_fixture: None, on_arbor + on_fixture + 1: None}
+    assert held[on_arbor].id == expected_arbor(machine.fixture_diameter, machine.fixture_gap)["id"]
 
 
 def test_a_hob_path_into_the_arbor_is_refused(small_gear):

@@ -14,7 +14,8 @@ SHOWN_FAILURES = 5   # jobs the draft fails for, listed by the text output (all 
 @click.option("--yes", is_flag=True, help="Release without asking (after the gate and the impact).")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object, every diff included.")
 @click.option("--workers", type=click.IntRange(1, 64), default=1, show_default=True,
-              help="Prove the stored jobs' changed programs (verifier and simulation) in this many processes.")
+              help="Make the stored jobs' programs again and prove the changed ones (verifier and simulation) "
+                   "in this many processes.")
 @click.pass_context
 def template_release(ctx, gear_class, dry_run, yes, as_json, workers):
     """Release the class's draft to the shop floor: refused, naming every row, column and test that

@@ -9,6 +9,7 @@ as its reason (engine.programs.batches.Bad), so the batch names every bad gear i
 """
 from __future__ import annotations
 
+import gc
 import multiprocessing
 
 from ..errors import EngineError
@@ -75,22 +76,27 @@ def _plan_slice(bounds: tuple[int, int]) -> list:
     return [plan_one(planner, gear) for gear in gears[bounds[0]:bounds[1]]]
 
 
-_MAPPED: list = []   # (work, the worker's set-up) of the map being run, inherited by the forked workers
+MAP_SLICES_PER_WORKER = 32   # a map's items cost alike (a program proved): the last slices short, so
+                             # that no worker is left alone with a long one at the end
+_MAPPED: list = []   # (work, the worker's set-up, the items) of the map being run, inherited by the forked workers
 
 
 def map_in_workers(work, items: list, workers: int, in_worker=None) -> list:
-    """[work(item) for item in items], in `workers` forked processes, in order. What `work` returns
-    comes back pickled; `in_worker()` runs first in each worker (to take away what it must not
-    touch: the database connection it inherits). One worker, or a single item, runs here."""
+    """[work(item) for item in items], in `workers` forked processes, in order. The workers inherit
+    the items (each is sent only the bounds of its slice); what `work` returns comes back pickled;
+    `in_worker()` runs first in each worker (to take away what it must not touch: the database
+    connection it inherits). One worker, or a single item, runs here."""
     if workers <= 1 or len(items) < 2:
         return [work(item) for item in items]
-    size = max(1, len(items) // (workers * SLICES_PER_WORKER))
-    slices = [items[start:start + size] for start in range(0, len(items), size)]
-    _MAPPED[:] = [work, in_worker]
+    size = max(1, len(items) // (workers * MAP_SLICES_PER_WORKER))
+    slices = [(start, min(start + size, len(items))) for start in range(0, len(items), size)]
+    _MAPPED[:] = [work, in_worker, items]
+    gc.freeze()   # the parent's objects out of the workers' collections: touching them would copy their pages
     try:
         with multiprocessing.get_context("fork").Pool(workers, initializer=_mapping_worker) as pool:
             return [result for done in pool.imap(_map_slice, slices) for result in done]
     finally:
+        gc.unfreeze()
         _MAPPED.clear()
 
 
@@ -99,5 +105,6 @@ def _mapping_worker() -> None:
         _MAPPED[1]()
 
 
-def _map_slice(items: list) -> list:
-    return [_MAPPED[0](item) for item in items]
+def _map_slice(bounds: tuple[int, int]) -> list:
+    work, _, items = _MAPPED
+    return [work(item) for item in items[bounds[0]:bounds[1]]]

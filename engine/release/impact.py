@@ -17,7 +17,10 @@ its `; TEMPLATE class vN` line, differing in the number alone, is not a change
 (engine.release.version_lines). A draft that only writes its lines with
 another layout (line ending, final newline: version_layout_change) changes no line, but the bytes of
 every stored program's file of the class: said on its own, with how many programs. Jobs with identical parameters are
-evaluated once: 10,000 stored jobs of a class take seconds (bench/impact.py)."""
+evaluated once. With `workers`, forked processes make, compare and prove the distinct job inputs
+(the parent reads every record first and gathers the failures and diffs, in job order): 10,000
+stored spur jobs, every program changed and proved, take about 9 s with two, 18 s in one process
+(bench/impact.py, 2 cores)."""
 from __future__ import annotations
 
 import difflib
@@ -116,7 +119,7 @@ def impact(conn: Connection, gear_class: str, workers: int = 1) -> Impact:
         return report
     made = _Made(conn, pairs)
     jobs = conn.cursor(binary=True).execute(JOBS, (list(pairs),)).fetchall()
-    report.proved = made.prove_changed(jobs, workers)
+    report.proved = made.make_all(jobs, workers)
     for job in jobs:
         _compare(report, made, job)
     return report
@@ -154,30 +157,31 @@ def _compare(report: Impact, made: _Made, job) -> None:
     if not made.has_draft(gear_class):
         return   # no draft: nothing changes
     key = gear_class, machine, params_text, modules_text, gear_id, hob_id
-    new_lines = made.draft_lines(key, job_id)
-    if isinstance(new_lines, EngineError):
-        report.failures.append(JobFailure(job_id, gear_class, str(new_lines), made.released_proves(key, job_id)))
-        return
-    old_lines = made.released_lines(key, job_id)   # rendered now: a stored program may be a forgery
-    if same_program(old_lines, new_lines):
-        return   # the release does not change this job's program: not proved again
-    failure = made.draft_failure(key, job_id)
-    if failure is not None:
-        report.failures.append(JobFailure(job_id, gear_class, str(failure), made.released_proves(key, job_id)))
-        return
-    report.changed += 1
-    report.diffs.append(JobDiff(job_id, gear_class, made.diff(gear_class, old_lines, new_lines)))
+    outcome = made.outcome(key, job_id)
+    if outcome.failure is not None:
+        report.failures.append(JobFailure(job_id, gear_class, outcome.failure, made.released_proves(key, job_id)))
+    elif outcome.diff is not None:
+        report.changed += 1
+        report.diffs.append(JobDiff(job_id, gear_class, outcome.diff))
+
+
+@dataclass(frozen=True, slots=True)
+class _Outcome:
+    """What the draft does to the program of one distinct job input, as a worker sends it back (text
+    only: it is pickled): why it fails (its rows fail to run, or its changed program fails the
+    proof), or the diff of its changed program (None: the release leaves it as it is)."""
+    failure: str | None = None
+    diff: str | None = None
+    proved: bool = False   # its program changed, so it was read by the verifier and simulated
 
 
 class _Made:
-    """The programs of distinct job inputs, made once: with the draft (or its failure) and, where the
-    stored program is not the released one, with the released template."""
+    """The programs of distinct job inputs, made once with the draft and with the released template,
+    compared and, where the draft changes them, proved: in `workers` forked processes."""
 
     def __init__(self, conn: Connection, pairs: dict[str, tuple[Template, Template, int]]):
         self.pairs, self.inputs = pairs, JobInputs(conn)
-        self.drafts: dict[tuple, list[str] | EngineError] = {}
-        self.releases: dict[tuple, list[str]] = {}
-        self.proofs: dict[tuple, EngineError | None] = {}
+        self.outcomes: dict[tuple, _Outcome] = {}
 
     def has_draft(self, gear_class: str) -> bool:
         released, draft, _ = self.pairs[gear_class]
@@ -196,65 +200,64 @@ class _Made:
         machine, params, module params, gear, hob)."""
         return self.inputs.of(job_id, *key[:4])
 
-    def draft_lines(self, key: tuple, job_id: int) -> list[str] | EngineError:
-        """The draft's lines for the job, or why the draft makes none (its rows fail to run)."""
-        if key not in self.drafts:
-            try:
-                self.drafts[key] = compiled_template(self.pairs[key[0]][1]).run(*self.job_inputs(key, job_id)).lines
-            except EngineError as error:
-                self.drafts[key] = error
-        return self.drafts[key]
-
-    def prove_changed(self, jobs: list, workers: int) -> int:
-        """Prove ahead, in `workers` processes, the draft's program of every distinct job input it
-        changes (the simulation is most of an impact's time); the records they are proved against are
-        read here first, the workers read no database. Returns how many were proved."""
+    def make_all(self, jobs: list, workers: int) -> int:
+        """Every distinct job input of a class with a draft made with both templates, compared and,
+        where the draft changes its program, proved: in `workers` processes (the evaluation and the
+        simulation are nearly all of an impact's time). The templates are compiled and the records
+        the proofs read are read here first: the workers read no database. Returns how many
+        changed programs were proved."""
         pending: dict[tuple, int] = {}
         for job_id, gear_class, machine, params_text, modules_text, _, gear_id, hob_id in jobs:
             key = gear_class, machine, params_text, modules_text, gear_id, hob_id
-            if key in pending or not self.has_draft(gear_class):
-                continue
-            lines = self.draft_lines(key, job_id)
-            if not isinstance(lines, EngineError) and not same_program(self.released_lines(key, job_id), lines):
+            if key not in pending and self.has_draft(gear_class):
                 pending[key] = job_id
+        for gear_class in {key[0] for key in pending}:
+            compiled_template(self.pairs[gear_class][0])
+            compiled_template(self.pairs[gear_class][1])
         self.inputs.read_records(pending)
-        proofs = map_in_workers(self._proof_of, list(pending.items()), workers, self.inputs.without_database)
-        self.proofs.update(zip(pending, proofs))
-        return len(pending)
+        outcomes = map_in_workers(self._outcome_of, list(pending.items()), workers, self.inputs.without_database)
+        self.outcomes.update(zip(pending, outcomes))
+        return sum(outcome.proved for outcome in outcomes)
 
-    def _proof_of(self, pending: tuple) -> EngineError | None:
+    def outcome(self, key: tuple, job_id: int) -> _Outcome:
+        """The draft's outcome for the job input (made by make_all; here if it was not)."""
+        if key not in self.outcomes:
+            self.outcomes[key] = self._outcome_of((key, job_id))
+        return self.outcomes[key]
+
+    def _outcome_of(self, pending: tuple) -> _Outcome:
         key, job_id = pending
         try:
-            self.inputs.prove(key, self.drafts[key], job_id)   # type: ignore[arg-type]   # lines: pending only
+            inputs = self.job_inputs(key, job_id)   # read by both templates (their rows cannot change them)
+            new_lines = compiled_template(self.pairs[key[0]][1]).run(*inputs, traced=False).lines
         except EngineError as error:
-            return EngineError(str(error))   # as its message: what a worker sends back is pickled
-        return None
-
-    def draft_failure(self, key: tuple, job_id: int) -> EngineError | None:
-        """Why the draft's changed program for the job fails its proof (verifier, simulation), or None
-        (proved ahead by prove_changed; here if it was not)."""
-        if key not in self.proofs:
-            self.proofs[key] = self._proof_of((key, job_id))
-        return self.proofs[key]
+            return _Outcome(failure=str(error))   # the draft's rows fail to run for the job
+        old_lines = self.released_lines(key, inputs)   # rendered now: a stored program may be a forgery
+        if same_program(old_lines, new_lines):
+            return _Outcome()   # the release does not change this job's program: not proved again
+        try:
+            self.inputs.prove(key, new_lines, job_id)
+        except EngineError as error:
+            return _Outcome(failure=str(error), proved=True)
+        return _Outcome(diff=self.diff(key[0], old_lines, new_lines), proved=True)
 
     def released_proves(self, key: tuple, job_id: int) -> bool:
         """The released template makes the job a program the draft's proof accepts (asked only for a
         job the draft fails for: a job that fails with both is an old problem, not the draft's)."""
         try:
-            lines = compiled_template(self.released(key[0])).run(*self.job_inputs(key, job_id)).lines
+            lines = compiled_template(self.released(key[0])).run(*self.job_inputs(key, job_id), traced=False).lines
             self.inputs.prove(key, lines, job_id)
         except EngineError:
             return False
         return True
 
-    def released_lines(self, key: tuple, job_id: int) -> list[str]:
-        """The released template's lines for the job (none if it fails: every draft line is a change)."""
-        if key not in self.releases:
-            try:
-                self.releases[key] = compiled_template(self.released(key[0])).run(*self.job_inputs(key, job_id)).lines
-            except EngineError:
-                self.releases[key] = []
-        return self.releases[key]
+    def released_lines(self, key: tuple, inputs: tuple[dict, dict]) -> list[str]:
+        """The released template's lines for the job's inputs (none if it fails: every draft line is a
+        change)."""
+        try:
+            return compiled_template(self.released(key[0])).run(*inputs, traced=False).lines
+        except EngineError:
+            return []
 
 
 def unified_diff(old: list[str], new: list[str], old_label: str, new_label: str) -> str:

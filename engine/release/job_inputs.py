@@ -14,7 +14,7 @@ from ..errors import EngineError
 from ..gears.models import model_for_class
 from ..gears.records import Gear, Hob, load_gear, load_hobs
 from ..machines.records import load_machine
-from ..machines.work_holding import WorkHolding, job_work_holding
+from ..machines.work_holding import WorkHolding, job_work_holding, jobs_work_holdings
 from ..nc.lineage import refuse_lineage_shaped
 from ..programs.drawing_records import turning_job_drawing
 from ..programs.job_shape import job_with_cycle_time
@@ -35,27 +35,41 @@ class JobInputs:
 
     def __init__(self, conn: Connection):
         self.conn = conn
-        self.machines: dict[str, Machine] = {}
-        self.shapes: dict[str, str] = {}   # class -> its model's cut shape
-        self.models: dict[str, bool] = {}  # class -> whether it has a model (else its jobs are class jobs)
+        self.machines: dict[str, Machine | EngineError] = {}
+        self.shapes: dict[str, str | EngineError] = {}   # class -> its model's cut shape
+        self.models: dict[str, bool | EngineError] = {}  # class -> whether it has a model (else: class jobs)
         self.gears: dict[int, Gear | EngineError] = {}   # a gear that no longer loads: why, for its proof
         self.hobs: dict[str, Hob] | None = None
         self.drawings: dict[int, DrawingRecord | EngineError] = {}   # job -> its record, or why it has none fit
-        self.holdings: dict[int, WorkHolding | None] = {}   # job -> its work-holding (None: the machine's own)
+        self.holdings: dict[int, WorkHolding | None | EngineError] = {}   # job -> its holding (None: the machine's)
 
     def read_records(self, pending: dict[tuple, int]) -> None:
-        """The machines, gears, hobs and drawing records the proofs of these job inputs (each with a
-        job that has it) read, read now (a record that is missing is named by the job's proof, from
-        what was read here)."""
+        """The machines, models, gears, hobs and drawing records that making these job inputs (each
+        with a job that has it) and proving their programs read, read now (a record that
+        is missing is named by the job's proof, from what was read here)."""
+        self._read_holdings([job_id for key, job_id in pending.items() if key[4] is not None and key[5] is not None])
         for key, job_id in pending.items():
             try:
                 self._read_for(key, job_id)
             except EngineError:
                 pass   # named by the job's proof, from what was kept here
 
+    def _read_holdings(self, job_ids: list[int]) -> None:
+        """The work-holdings of the jobs that name a gear and a hob (hobbing jobs), in bulk: one
+        query for thousands of jobs (one that fails to load is read again job by job, its reason kept)."""
+        try:
+            self.holdings.update(jobs_work_holdings(self.conn, job_ids))
+        except EngineError:
+            pass
+
     def _read_for(self, key: tuple, job_id: int) -> None:
         gear_class, machine_name, params_text, modules_text, gear_id, hob_id = key
         kind = self.machine(machine_name).kind
+        try:
+            if self.modelled(gear_class) and kind != "lathe":
+                self.cut_shape(gear_class)   # a hobbing job's cycle time, as its template reads it
+        except EngineError:
+            pass   # kept: named by the job's making, its records read on
         if kind == "hobber" and gear_id is not None and hob_id is not None:
             self.workpiece(job_id, gear_id, hob_id)
             self.holding(job_id)
@@ -154,22 +168,28 @@ class JobInputs:
 
     def holding(self, job_id: int) -> WorkHolding | None:
         """The job's work-holding, which its program states and is proved against (issue 29), read once."""
-        if job_id not in self.holdings:
-            self.holdings[job_id] = job_work_holding(self.conn, job_id)
-        return self.holdings[job_id]
+        return _kept(self.holdings, job_id, lambda: job_work_holding(self.conn, job_id))
 
     def cut_shape(self, gear_class: str) -> str:
-        if gear_class not in self.shapes:
-            self.shapes[gear_class] = model_for_class(self.conn, gear_class).cut_shape
-        return self.shapes[gear_class]
+        return _kept(self.shapes, gear_class, lambda: model_for_class(self.conn, gear_class).cut_shape)
 
     def modelled(self, gear_class: str) -> bool:
         """Whether the class has a model (hobbing, turning); read before the workers start."""
-        if gear_class not in self.models:
-            self.models[gear_class] = model_for_class(self.conn, gear_class) is not None
-        return self.models[gear_class]
+        return _kept(self.models, gear_class, lambda: model_for_class(self.conn, gear_class) is not None)
 
-    def machine(self, name: str):
-        if name not in self.machines:
-            self.machines[name] = load_machine(self.conn, name)
-        return self.machines[name]
+    def machine(self, name: str) -> Machine:
+        return _kept(self.machines, name, lambda: load_machine(self.conn, name))
+
+
+def _kept(records: dict, key, read):
+    """records[key], read once; a record that does not load is kept as its reason and named again
+    each time it is asked for (in a worker too, which reads no database)."""
+    if key not in records:
+        try:
+            records[key] = read()
+        except EngineError as error:
+            records[key] = error
+    found = records[key]
+    if isinstance(found, EngineError):
+        raise EngineError(str(found))
+    return found

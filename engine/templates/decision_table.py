@@ -77,9 +77,12 @@ class CompiledTemplate:
         # Rows that print a whole tool path (nc_path) emit several lines at once.
         self.prints_paths = any(row.o is not None and "nc_path" in row.o.calls for row in self.rows)
 
-    def run(self, params: dict, module_params: dict | None = None, deadline_seconds: float | None = None) -> Result:
+    def run(self, params: dict, module_params: dict | None = None, deadline_seconds: float | None = None,
+            traced: bool = True) -> Result:
+        """The job's program; `traced=False`: its lines and row ids alone, the trace left empty (the
+        release impact compares and proves the lines of thousands of jobs and stores nothing)."""
         seconds = seconds_for(len(self.rows)) if deadline_seconds is None else deadline_seconds
-        job = _Job(self, params, module_params or {}, Budget(seconds))
+        job = _Job(self, params, module_params or {}, Budget(seconds), traced)
         try:
             with spending(job.budget):
                 for row in self.rows:
@@ -111,8 +114,9 @@ class CompiledTemplate:
 class _Job:
     """The state of one run: scope, intermediates and where each came from, module switching."""
 
-    def __init__(self, compiled: CompiledTemplate, params: dict, module_params: dict, budget: Budget):
-        self.compiled, self.params, self.module_params = compiled, params, module_params
+    def __init__(self, compiled: CompiledTemplate, params: dict, module_params: dict, budget: Budget,
+                 traced: bool = True):
+        self.compiled, self.params, self.module_params, self.traced = compiled, params, module_params, traced
         _refuse_engine_names(compiled, params, "job parameter")
         self.scope = {**params, **compiled.symbols, "template_version": compiled.template.version}
         self.intermediates: dict[str, int] = {}      # name -> id of the row that computed it
@@ -202,6 +206,8 @@ class _Job:
         if outcome.emit:
             self.result.lines.append(outcome.line)
             self.result.row_ids.append(row.row.id)
+        if not self.traced:
+            return
         inputs = self.result.trace["inputs"]
         for origin, name, value in outcome.inputs:
             inputs.setdefault(origin, {})[name] = value

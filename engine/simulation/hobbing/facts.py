@@ -55,12 +55,13 @@ def _material_note(records: Records):
 def _header_lines(records: Records):
     """GEAR, HOB, UNIT and the n0 line's table speed, each held to the records (§B4)."""
     template = template_class([step.line for step in records.steps])
+    gear, hob, z_sense = records.gear, records.hob, Senses.of(records.machine).z
     for step in records.steps:
         if step.kind != "comment":
             continue
-        gear, hob, line = records.gear, records.hob, step.line
+        line = step.line
         for problem in (gear_line_problem(line, gear, template), hob_line_problem(line, hob),
-                        unit_line_problem(line, gear, Senses.of(records.machine).z), table_problem(line, gear, hob)):
+                        unit_line_problem(line, gear, z_sense), table_problem(line, gear, hob)):
             if problem:
                 yield step, problem, True
 

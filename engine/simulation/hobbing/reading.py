@@ -5,7 +5,7 @@ and release the tailstock, G4 dwells). A line the verifier refuses the simulatio
 it cannot follow what it cannot read (fail closed)."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import lru_cache
 
 from ...machines.records import Machine
@@ -25,10 +25,10 @@ class Step:
     item: Line         # what the verifier read it as (kind: header, comment, block, statement, shift)
     g_codes: frozenset = frozenset()
     m_codes: frozenset = frozenset()
+    kind: str = field(init=False)   # the item's kind, kept: the rules ask it of every step, hundreds of times
 
-    @property
-    def kind(self) -> str:
-        return self.item.kind
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "kind", self.item.kind)
 
 
 def machine_dialect(machine: Machine):
