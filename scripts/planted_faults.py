@@ -45,7 +45,7 @@ FAULTS = (
           "if not low <= value <= high:", "if not low <= value:",
           "a move beyond the axis' upper travel is accepted: an overtravel alarm or a crash"),
     Fault("impact-unproved", "engine/release/impact.py",
-          "failure = made.draft_failure(key, job_id)", "failure = None",
+          "            self.inputs.prove(key, new_lines, job_id)\n", "            pass\n",
           "a release's changed programs are not proved: a draft that breaks stored jobs is released"),
     Fault("import-rounding", "engine/templates/nc_number.py",
           "places = max(decimals, -int(exact.normalize().as_tuple().exponent), 0)", "places = decimals",
