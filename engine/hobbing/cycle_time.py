@@ -50,28 +50,25 @@ def axial_pass(clock: Clock, job: dict, cut: dict) -> None:
 def taper_pass(clock: Clock, job: dict, cut: dict) -> None:
     """Infeed, along Z to the polyline, the polyline tangent to the root cone (issue 29) with
     F along the slant, along Z to the run-out; the blocks along Z only where they move."""
-    clock.rapid(Z=cut["z_from"])
-    clock.rapid(X=cut["x_air"])
-    clock.feed(cut["feed_radial"], X=cut["taper_x_0"])
-    clock.feed(cut["feed_axial"], Z=cut["face_from"])
-    segments = sum(name.startswith("taper_x_") for name in cut) - 1   # the polyline's vertices, 0…n
-    for step in range(1, segments + 1):
-        z = cut["face_from"] + (cut["face_to"] - cut["face_from"]) * step / segments
-        clock.feed(cut["feed_slant"], X=cut[f"taper_x_{step}"], Z=z)
-    clock.feed(cut["feed_axial"], Z=cut["z_to"])
-    clock.rapid(X=job["x_retract"])
+    polyline_pass(clock, job, cut, "taper_x_", cut["feed_slant"])
 
 
 def crowned_pass(clock: Clock, job: dict, cut: dict) -> None:
     """Infeed at the face depth, to the first face, the parabola a(Z) as a polyline, overrun."""
+    polyline_pass(clock, job, cut, "crown_x_", cut["feed_axial"])
+
+
+def polyline_pass(clock: Clock, job: dict, cut: dict, vertex: str, segment_feed: float) -> None:
+    """A pass whose centre distance follows the cut's vertices `<vertex>0` … `<vertex>n`, evenly
+    spaced in Z from face_from to face_to, each segment at `segment_feed` (mm/min)."""
     clock.rapid(Z=cut["z_from"])
     clock.rapid(X=cut["x_air"])
-    clock.feed(cut["feed_radial"], X=cut["crown_x_0"])
+    clock.feed(cut["feed_radial"], X=cut[f"{vertex}0"])
     clock.feed(cut["feed_axial"], Z=cut["face_from"])
-    segments = sum(name.startswith("crown_x_") for name in cut) - 1   # the polyline's vertices, 0…n
+    segments = sum(name.startswith(vertex) for name in cut) - 1   # the polyline's vertices, 0…n
     for step in range(1, segments + 1):
         z = cut["face_from"] + (cut["face_to"] - cut["face_from"]) * step / segments
-        clock.feed(cut["feed_axial"], X=cut[f"crown_x_{step}"], Z=z)
+        clock.feed(segment_feed, X=cut[f"{vertex}{step}"], Z=z)
     clock.feed(cut["feed_axial"], Z=cut["z_to"])
     clock.rapid(X=job["x_retract"])
 
