@@ -106,6 +106,9 @@ def prove(lines: list[str], machine: Machine, workpiece: Workpiece | TurningWork
     if not isinstance(workpiece, Workpiece):
         raise EngineError(f"{name}: a hobbing program needs its gear and hob to be proved by the simulation; "
                           "nothing stored")
-    report = simulate_program(lines, workpiece.gear, workpiece.hob, machine, name, workpiece.holding)
+    # a program refused is refused at its first finding: the search tries the next choice, the
+    # refusal names that finding (engine simulate lists every finding of a stored program)
+    report = simulate_program(lines, workpiece.gear, workpiece.hob, machine, name, workpiece.holding,
+                              first_only=True)
     if report.refused:   # named by the gear: the id the user gave (a batch names each bad gear)
         raise SimulationError(f"gear {workpiece.gear.id}: {report.error()}; nothing stored")

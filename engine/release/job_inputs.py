@@ -127,7 +127,8 @@ class JobInputs:
             raise EngineError(f"job {job_id} is a hobbing job without a {'gear' if gear_id is None else 'hob'}: "
                               "its program cannot be proved against the records")
         gear, hob = self.workpiece(job_id, gear_id, hob_id)
-        report = simulate_program(lines, gear, hob, machine, name or "the program", self.holding(job_id))
+        report = simulate_program(lines, gear, hob, machine, name or "the program", self.holding(job_id),
+                                  first_only=True)   # the gate names the job and why: the first refusal
         if report.refused:
             raise SimulationError(f"gear {gear_id}: {report.error()}")
 

@@ -51,6 +51,10 @@ class CutSummary:
     mark_feed: float | None = None  # mm per workpiece revolution along an axial pass's path (§B6 feed marks)
 
 
+class FirstRefusal(Exception):
+    """A report that stops at its first refusal has it (Report.first_only)."""
+
+
 @dataclass
 class Report:
     """The simulation's report of one program: its findings, couplings, cuts, table speed and cycle time."""
@@ -62,6 +66,10 @@ class Report:
     table_speed: float = 0.0          # r/min, the most while coupled
     cycle_time: float = 0.0           # minutes
     header_time: float | None = None  # the program's `; CYCLE TIME … MIN`
+    # Stop at the first refusal (FirstRefusal): a search trying choices asks only whether a program
+    # is refused and why; finding a colliding program's every other collision and its depth cost
+    # a refused gear's search seconds (issue 28). A program not refused is followed to its end.
+    first_only: bool = False
 
     @property
     def refusals(self) -> list[Finding]:
@@ -75,6 +83,8 @@ class Report:
         finding = Finding(number, line, message, refuses)
         if finding not in self.findings:
             self.findings.append(finding)
+        if refuses and self.first_only:
+            raise FirstRefusal
 
     def error(self, where_listed: str = "") -> SimulationError:
         """The first refusal, the others counted; `where_listed` says where they are shown (e.g.

@@ -9,7 +9,7 @@ from ...machines.records import Machine
 from ...machines.work_holding import WorkHolding
 from .facts import check_facts
 from .reading import read_program
-from .report import Report, SimulationError
+from .report import FirstRefusal, Report, SimulationError
 from .solids import setup_solids, unit_solids
 from .walk import BlockSimulation
 
@@ -17,21 +17,27 @@ SHIFT_ENDS = (0, 1)     # the low and the high end of the R11 interval
 
 
 def simulate_program(lines: list[str], gear: Gear, hob: Hob, machine: Machine, name: str = "the program",
-                     holding: WorkHolding | None = None) -> Report:
+                     holding: WorkHolding | None = None, first_only: bool = False) -> Report:
     """The report of the program `lines` for `gear` cut with `hob` on `machine` (a hobber), the
-    gear clamped on `holding` (None: the machine record's fixture and tailstock, issue 29).
+    gear clamped on `holding` (None: the machine record's fixture and tailstock, issue 29);
+    `first_only`, ended at the first refusal (Report.first_only: whether and why, for a search).
     Raises SimulationError only for a program (or machine) it cannot read."""
     if machine.kind != "hobber":
         raise SimulationError(f"machine {machine.name} is a {machine.kind}: the simulation follows hobbing programs")
     steps = read_program(lines, machine, name)
     ends = SHIFT_ENDS if any(step.kind == "shift" for step in steps) else SHIFT_ENDS[:1]
-    reports = [_follow(steps, lines, gear, hob, machine, name, end, holding) for end in ends]
-    report = reports[0]
-    for other in reports[1:]:
-        for finding in other.findings:
-            report.add(finding.number, finding.line, finding.message, finding.refuses)
+    report = _follow(steps, lines, gear, hob, machine, name, ends[0], holding, first_only)
+    for end in ends[1:]:
+        if first_only and report.refused:
+            return report
+        other = _follow(steps, lines, gear, hob, machine, name, end, holding, first_only)
+        report.findings.extend(finding for finding in other.findings if finding not in report.findings)
         report.table_speed = max(report.table_speed, other.table_speed)
-    check_facts(steps, gear, hob, machine, report, holding)
+    if not (first_only and report.refused):
+        try:
+            check_facts(steps, gear, hob, machine, report, holding)
+        except FirstRefusal:
+            pass   # the report has its first refusal
     return report
 
 
@@ -45,13 +51,16 @@ def prove_program(lines: list[str], gear: Gear, hob: Hob, machine: Machine, name
 
 
 def _follow(steps, lines, gear: Gear, hob: Hob, machine: Machine, name: str, shift_end: int,
-            holding: WorkHolding | None) -> Report:
+            holding: WorkHolding | None, first_only: bool = False) -> Report:
     worm_wheel = hob.purpose == "worm_wheel"
     units = unit_solids(gear, hob, worm_wheel)
-    report = Report(name)
+    report = Report(name, first_only=first_only)
     setup = setup_solids(machine, units, hob, holding)
     walk = BlockSimulation(report, gear, hob, machine, units, setup, worm_wheel, shift_end)
-    for step in steps:
-        walk.take(step)
-    walk.finish(lines)
+    try:
+        for step in steps:
+            walk.take(step)
+        walk.finish(lines)
+    except FirstRefusal:
+        pass   # the report has its first refusal
     return report
