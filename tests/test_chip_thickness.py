@@ -12,6 +12,7 @@ import re
 
 import pytest
 from helpers import chip_reference as reference
+from helpers.random_gears import insert_gears
 
 from engine.gears.chip_thickness import ChipCase, feed_for_chip_thickness, max_chip_thickness
 from engine.gears.records import load_gear, load_hobs
@@ -90,16 +91,7 @@ def population(conn, starts: int, rng: random.Random) -> list[int]:
                          "gashes) VALUES (%s, %s, %s, %s, %s, %s, 'AAA', 'TiN', %s)",
                          (f"C-M{module}-{hand}{starts}", module, starts, tip, 30 * module + 60, hand,
                           rng.randint(9, 16)))
-    ids = []
-    for number in range(30):
-        module, beta = rng.choice([1, 1.5, 2, 2.5, 3, 4]), rng.choice([0, 0, 10, 15, 20])
-        conn.execute("INSERT INTO gear (id, gear_class, module, teeth, pressure_angle, helix_angle, hand, face_width, "
-                     "material, hardness, quality_grade) VALUES (%s, %s, %s, %s, 20, %s, %s, %s, %s, 200, 5)",
-                     (81000 + number, "helical" if beta else "spur", module, rng.randint(12, 120), beta,
-                      rng.choice("RL") if beta else None, round(rng.uniform(6, 12) * module),
-                      rng.choice(["45", "40Cr", "20CrMnTi"])))
-        ids.append(81000 + number)
-    return ids
+    return insert_gears(conn, rng, 81000, 30, grade=5)
 
 
 @pytest.mark.parametrize("starts", [1, 2, 3])

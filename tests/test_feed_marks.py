@@ -11,6 +11,7 @@ import re
 
 import pytest
 from helpers import feed_mark_reference as reference
+from helpers.random_gears import MODULES, insert_gears
 
 from engine.errors import EngineError
 from engine.gears.cutting_data import CuttingData
@@ -161,7 +162,7 @@ def test_every_program_of_a_grade_6_batch_is_within_its_limit(conn):
 
 # Hobs sized roughly as DIN 8002 gives them (module -> tip diameter, mm), 1-start AAA (fine enough for
 # grade 6), both hands: a random grade-6 population is cut with them.
-POPULATION_HOBS = {1: 50, 1.5: 63, 2: 70, 2.5: 75, 3: 80, 4: 90}
+POPULATION_HOBS = dict(zip(MODULES, (50, 63, 70, 75, 80, 90)))
 
 
 @pytest.mark.slow   # a random population made and read: 1.4 s
@@ -176,15 +177,7 @@ def test_a_random_grade_6_population_keeps_every_last_cut_within_its_limit(conn)
             conn.execute("INSERT INTO hob (id, module, starts, tip_diameter, length, hand, accuracy_class, coating) "
                          "VALUES (%s, %s, 1, %s, %s, %s, 'AAA', 'TiN')",
                          (f"P-M{module}-{hand}", module, tip, 30 * module + 60, hand))
-    ids = []
-    for number in range(60):
-        module, beta = rng.choice(list(POPULATION_HOBS)), rng.choice([0, 0, 10, 15, 20])
-        conn.execute("INSERT INTO gear (id, gear_class, module, teeth, pressure_angle, helix_angle, hand, face_width, "
-                     "material, hardness, quality_grade) VALUES (%s, %s, %s, %s, 20, %s, %s, %s, %s, 200, 6)",
-                     (80000 + number, "helical" if beta else "spur", module, rng.randint(12, 120), beta,
-                      rng.choice("RL") if beta else None, round(rng.uniform(6, 12) * module),
-                      rng.choice(["45", "40Cr", "20CrMnTi"])))
-        ids.append(80000 + number)
+    ids = insert_gears(conn, rng, 80000, 60, grade=6)
     batch = instantiate_gears(conn, ids[0], ids[-1], mode=RunMode(skip_bad=True))
     assert batch.programs >= 0.9 * len(ids) and not [r for r in batch.skipped if "feed marks" in r]
     hobs = {hob.id: hob for hob in load_hobs(conn)}
