@@ -111,8 +111,8 @@ def refuse_feed_mode(gear, choices: Choices) -> None:
     feed direction to choose: a --feed-mode given for it is refused, not written into the header
     over cuts it does not describe (new-user review 29)."""
     if choices.feed_mode is not None:
-        raise EngineError(f"gear {gear.id}: class {gear.gear_class} is fed {choices.worm_feed}ly (--worm-feed), it has "
-                          f"no axial pass to cut {choices.feed_mode}; leave out --feed-mode")
+        raise InputError(f"gear {gear.id}: class {gear.gear_class} is fed {choices.worm_feed}ly (--worm-feed), it has "
+                         f"no axial pass to cut {choices.feed_mode}; leave out --feed-mode")
 
 
 def _known_mode(mode: str) -> bool:

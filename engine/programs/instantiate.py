@@ -19,7 +19,7 @@ from ..gears.holding_matching import choose_holding
 from ..gears.models import model_for_class
 from ..gears.process_notes import hunting_tooth_notes
 from ..gears.records import Gear, load_gear, load_gears, load_hobs
-from ..hobbing.choices import DEFAULT_FEED_MODE, Choices, refuse_feed_mode
+from ..hobbing.choices import Choices, refuse_feed_mode
 from ..hobbing.floor_time import floor_time_notes
 from ..machines.records import Machine, hobbing_machine
 from ..machines.work_holding import load_work_holdings
@@ -114,10 +114,9 @@ class Planner:
         self.choices.for_unit(1, 1 + len(gear.units), gear.id)   # a mode per unit names the gear's units or none
         hobs = [choice.hob for choice in matching_hobs(gear, self.hobs, purpose=model.hob_purpose,
                                                        shift_travel=model.shift_travel(self.choices))]
-        tried = attempts(hobs, self.choices, gear.module, 1 + len(gear.units))
         if not model.axial_passes:   # a worm wheel: the feed direction is no choice of its (--worm-feed is)
             refuse_feed_mode(gear, self.choices)
-            tried = [attempt for attempt in tried if attempt.choices.mode == DEFAULT_FEED_MODE]
+        tried = attempts(hobs, self.choices, gear.module, 1 + len(gear.units), model.axial_passes)
         found = first_that_fits(gear.id, gear.module, tried,
                                 lambda attempt: self._planned(gear, model, attempt.hob, attempt.choices))
         found.planned.notes[:0] = found.notes

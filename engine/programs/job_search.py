@@ -70,14 +70,16 @@ class Attempt:
         return len(self.choices.mode.split(UNIT_SEPARATOR))
 
 
-def attempts(hobs: list[Hob], choices: Choices, module: float, units: int = 1) -> list[Attempt]:
+def attempts(hobs: list[Hob], choices: Choices, module: float, units: int = 1,
+             axial: bool = True) -> list[Attempt]:
     """The first choice, then the alternatives of SEARCH_ORDER (the same job once); a gear of two
-    units (a cluster gear) also tries each unit fed its own way (UNIT_FEED_MODES)."""
+    units (a cluster gear) also tries each unit fed its own way (UNIT_FEED_MODES). A gear cut
+    without axial passes (`axial` false: a worm wheel) has no feed direction to vary."""
     given = frozenset(name for name in ("feed_mode", "cuts") if getattr(choices, name) is not None)
     found: dict[tuple, Attempt] = {}
     for cuts in _cut_choices(choices, module):
         for hob in hobs[:MAX_HOBS]:
-            for mode in _feed_modes(choices, units):
+            for mode in _feed_modes(choices, units) if axial else [choices.mode]:
                 attempt = Attempt(hob, replace(choices, feed_mode=mode, cuts=cuts), given)
                 found.setdefault(attempt.key(module), attempt)
     return list(found.values())
