@@ -34,6 +34,7 @@ def without_floor_line(conn) -> tuple[list[str], str]:
     return [line for line in lines if line != floor], floor
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 @pytest.mark.parametrize("line", ["; FL00R TO FL00R 9.9 MIN", "; FLOR TO FLOR 9.9 MIN"])
 def test_a_misspelt_floor_to_floor_line_is_refused(conn, line):
     lines, floor = without_floor_line(conn)

@@ -155,6 +155,7 @@ def test_every_python_name_of_the_doc_imports(doc):
     assert not wrong, f"docs/architecture.md names Python that does not import: {wrong}"
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_every_test_the_doc_names_exists(doc):
     wrong = [name for name in doc_names(TEST, doc) if not names_a_test(name)]
     assert not wrong, f"docs/architecture.md names tests that do not exist: {wrong}"

@@ -159,6 +159,7 @@ def test_a_long_like_pattern_is_refused():
         template_of(*rows).run({"v": "a" * 60000, "p": "%" + "a" * 32000 + "b%"})
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_deeply_nested_tuples_in_intermediates_do_not_break_the_run():
     rows = [(1, "main", 1, None, "a = 0", None, None),
             *((k, "main", 1, None, "\n".join(["a = (a,)"] * 70), None, None) for k in range(2, 10)),

@@ -53,6 +53,7 @@ def stored_gears(url: str) -> list[int]:
                                                 "ORDER BY j.gear_id")]
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 @pytest.mark.parametrize("workers", ["1", "2"])
 def test_every_bad_gear_is_named_in_one_run_and_nothing_is_stored(run, tmp_path, workers):
     spoil(run.url)
@@ -168,6 +169,7 @@ def test_a_dry_run_of_a_stored_job_prints_the_program_a_run_then_stores(run):
                                            for line in lines]
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 @pytest.mark.parametrize("batch", [("--gears", "42-54"), ("--all",), ("--gears", "42-54", "--workers", "2")])
 def test_a_dry_run_of_a_batch_reports_what_a_run_then_stores(run, batch):
     before = everything(run.url)
@@ -192,6 +194,7 @@ def test_a_dry_run_of_stored_jobs_reports_what_a_run_then_stores(run):
     assert f"would store {stored['programs']} program(s), {stored['lines']} lines" in dry.stdout
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_a_dry_run_of_a_batch_with_bad_gears_names_them_and_skip_bad_reports_the_rest(run):
     spoil(run.url)
     before = everything(run.url)

@@ -76,6 +76,7 @@ def test_bad_requests_get_one_line_and_exit_1_and_change_nothing(run, args, word
     assert not (tmp_path / "x.MPF").exists()
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_a_batch_stores_all_programs_or_none(run, tmp_path):
     result = run("instantiate", "--gears", "42-47", "--out", tmp_path, "--json")
     assert result.exit_code == 0, result.output
@@ -126,6 +127,7 @@ def test_template_import_refuses_a_bad_expression_and_keeps_the_old_rows(run, tm
     assert run("template", "export", "--class", "spur").stdout == exported
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_lint_passes_on_the_seed_and_names_an_unknown_parameter(run):
     result = run("lint", "--json")
     assert result.exit_code == 0 and json.loads(result.stdout) == {"errors": []}

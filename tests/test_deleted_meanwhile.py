@@ -75,6 +75,7 @@ def test_a_gear_of_a_batch_deleted_meanwhile_is_named_and_nothing_is_stored(fres
     assert counts(url) == before
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_a_hob_deleted_while_a_program_is_made_with_it_is_said_in_one_line(run):
     url = run.url
     add_gears(url, 91531)
@@ -88,6 +89,7 @@ def test_a_hob_deleted_while_a_program_is_made_with_it_is_said_in_one_line(run):
     assert counts(url) == before
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_a_gear_deleted_while_its_program_is_made_is_bad_input_not_a_bug(fresh_database_url):
     """`engine gears delete 91501 --yes` committing while `instantiate --gear 91501` plans: the
     gear is gone, which is said in one line (exit 1), not ForeignKeyViolation with exit 2."""

@@ -118,6 +118,7 @@ def test_no_role_changes_or_deletes_a_drawing_record(conn, role, change):
                 conn.execute(change)
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_migration_0027_makes_a_record_for_each_job_made_from_a_drawing(empty_database_url, tmp_path):
     folder = tmp_path / "migrations"
     shutil.copytree(MIGRATIONS_DIR, folder)

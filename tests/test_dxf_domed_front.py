@@ -62,6 +62,7 @@ def words(line: str) -> dict[str, float]:
 @pytest.mark.parametrize(("draw", "machine"), [(ball_end, "lathe-iso"), (ball_end, "lathe-840d"),
                                                (lambda p: cone_point(p, 150), "lathe-iso")],
                          ids=["ball-end-iso", "ball-end-840d", "point-150-iso"])
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_parts_with_a_dome_or_point_in_front_become_jobs_whose_programs_pass(run, tmp_path, draw, machine):
     path = draw(tmp_path / "part.dxf")
     job = made(run("import-dxf", path, "--rough-depth", "1", "--machine", machine, "--program-name", "DOMED", "--json"))

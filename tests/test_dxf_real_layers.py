@@ -33,6 +33,7 @@ def test_layer_names_ignore_case_as_in_cad(tmp_path):
     assert read_drawing(path, "SKETCH").profile.bounds == pytest.approx((-40, 0, 0, 14))
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_an_unknown_layer_is_refused_with_the_drawing_s_layers():
     with pytest.raises(DxfError) as caught:
         read_drawing(DXF / "qcad_screw_R2007.dxf", "outline")

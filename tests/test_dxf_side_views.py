@@ -162,6 +162,7 @@ def test_a_hole_pattern_is_refused_as_a_plate(name):
     assert f"{len(circles)} separate outline" in message
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_the_pump_parts_sheet_is_refused_as_a_plate():
     with pytest.raises(DxfError) as refused:
         read_drawing(DXF / "d2gp_pumpenteile_R2000.dxf")
@@ -267,6 +268,7 @@ def upright_pin(path) -> None:
     doc.saveas(path)
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_an_upright_side_view_is_turned_to_lie_along_z(conn, tmp_path):
     upright_pin(tmp_path / "pin.dxf")
     profile = read_drawing(tmp_path / "pin.dxf").profile

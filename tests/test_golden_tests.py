@@ -123,6 +123,7 @@ def test_coverage_lists_a_new_draft_row_until_a_program_emits_it(conn):
     assert 3190 not in {row.row_id for row in coverage(conn, classes=["spur"])}
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_engine_test_cli_json_is_one_line_and_fails_on_a_broken_draft(run):
     result = run("test", "--json")
     assert result.exit_code == 0, result.output

@@ -84,6 +84,7 @@ def z_feeds(lines: list[str]) -> list[float]:
     return signs
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 @pytest.mark.parametrize("gear_id, what, choices", SAMPLES, ids=[case[1] for case in SAMPLES])
 def test_every_sample_class_is_drawn_with_each_unit_at_its_face_width_and_tip(conn, gear_id, what, choices):
     program, figure, lines = drawn(conn, gear_id, choices)
@@ -113,6 +114,7 @@ def test_the_hob_at_full_depth_stands_at_the_reference_centre_distance(conn, gea
 
 @pytest.mark.parametrize("gear_id, what, choices", [case for case in SAMPLES if "worm" not in case[1]],
                          ids=[case[1] for case in SAMPLES if "worm" not in case[1]])
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_each_pass_arrow_points_the_way_the_program_feeds_along_z(conn, gear_id, what, choices):
     """One arrow per `; CUT` of the program, pointing the way that cut's G1 moves go along Z."""
     program, figure, _ = drawn(conn, gear_id, choices)
@@ -217,6 +219,7 @@ def test_a_bad_suffix_or_a_job_without_a_program_is_refused_in_one_line_and_writ
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_a_turning_program_is_refused_naming_the_plot_of_its_job(run, tmp_path):
     from helpers.drawings import seed_drawing
 
@@ -229,6 +232,7 @@ def test_a_turning_program_is_refused_naming_the_plot_of_its_job(run, tmp_path):
     assert not (tmp_path / "turned.png").exists()
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 @pytest.mark.parametrize("where", ["/proc/job.png", "NAME_TOO_LONG"], ids=["proc", "name-too-long"])
 def test_a_picture_that_cannot_be_written_is_refused_in_one_line_naming_the_file(run, tmp_path, where):
     """/proc takes no new file, and 256 characters are more than a file name may have (Linux: 255):
@@ -286,6 +290,7 @@ def test_the_picture_of_a_job_is_of_its_released_program_not_a_draft_tried_on_it
     assert "DRAFT" in figure.get_suptitle() and "TRIAL" in (tmp_path / "draft.svg").read_text()
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_the_picture_of_a_program_the_simulation_refuses_says_so_in_red(conn):
     """The gear's face width corrected after its program was stored (20 → 40 mm): the program no
     longer hobs the whole face, the simulation refuses it, and the picture's title says so first."""

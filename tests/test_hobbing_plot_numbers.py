@@ -207,6 +207,7 @@ def test_a_radial_worm_wheel_in_two_cuts_shows_both_plunges(conn):
     assert number_after(text, "depth ") == pytest.approx([(r["da2"] + r["da0"]) / 2 - x for x in plunges], abs=1e-3)
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_the_shift_range_is_the_programs_r11_clamp(conn):
     """Shift per part: the hob cuts between the clamp's ends (§B15), the program's own values."""
     program, figure, _ = figure_of(conn, 42, Choices(shift_per_part=2.0))

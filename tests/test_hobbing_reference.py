@@ -384,6 +384,7 @@ def test_random_valid_gears_make_a_correct_program_or_a_one_line_refusal(conn, k
     assert not problems, f"{gear} {hob} {choice}:\n  " + "\n  ".join(problems) + "\n" + program.text
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 @pytest.mark.parametrize("x", [-0.3, 0.0, 0.5])
 def test_a_taper_growing_downward_keeps_its_rapids_clear_of_the_large_end(conn, x):
     """Once drawn by the random test above (every x and stock failed): m4, z96, β 8° R, b 56.9,

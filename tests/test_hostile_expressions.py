@@ -83,6 +83,7 @@ def put_row(conn, gear_class, row_id, columns):
                  (gear_class, row_id, s, o, p_emit))
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_an_ordinary_instantiation_fits_the_address_space_the_hostile_rows_get(fresh_database_url):
     done = engine(fresh_database_url, "instantiate", "--gear", "42")
     assert done.returncode == 0, done.stderr
@@ -90,6 +91,7 @@ def test_an_ordinary_instantiation_fits_the_address_space_the_hostile_rows_get(f
 
 @pytest.mark.parametrize("columns, words, seen", HOSTILE, ids=lambda value: str(value)[:50] if isinstance(value, tuple)
                          else None)
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_a_hostile_row_in_the_template_view_is_refused_in_one_line(fresh_database_url, columns, words, seen):
     with psycopg.connect(fresh_database_url) as conn:
         put_row(conn, "spur", ROW, columns)
@@ -224,6 +226,7 @@ def test_lint_of_hundreds_of_large_integers_finishes(fresh_database_url):
     assert all(" row 900" in line and "compiling the template exceeded" in line for line in problems), problems
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_a_trace_keeps_its_bound_and_counts_the_rows_past_it():
     """400 rows of 20 texts of 150 characters each: about 2.6 MB as JSON, more than a trace keeps."""
     statements = "; ".join(["a = 'x' * 150", *(f"b{k} = a" for k in range(19))])

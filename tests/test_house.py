@@ -164,6 +164,7 @@ def test_engine_is_laid_out_as_the_design_s_sections():
                                      "quantities.py"]
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_every_module_says_what_it_is_in_its_first_line():
     assert modules_not_saying_what_they_are(Path(engine.__file__).parent) == []
 
@@ -328,6 +329,7 @@ def engine_and_importers_graph():
     return import_graph((Path(engine.__file__).parent, "engine"), (root / IMPORTERS, IMPORTERS))
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_the_importers_stand_between_the_library_and_the_command_line():
     graph = engine_and_importers_graph()
     assert "importers.dxf" in graph["engine.cli.turning"]              # the walk sees the CLI's import

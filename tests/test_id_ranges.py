@@ -57,6 +57,7 @@ def test_a_filter_id_out_of_range_is_bad_input_not_a_bug(run, args):
     assert args[-1] in result.stderr
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_instantiate_gear_0_names_the_gear(run):
     """--gear 0 was given: the message must not say none was."""
     result = run("instantiate", "--gear", 0, "--dry-run")

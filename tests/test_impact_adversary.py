@@ -36,6 +36,7 @@ def teeth(conn, gear_id) -> int:
 
 # --- a line the machine's matcher reads as a second lineage --------------------------------------
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_a_lineage_shaped_line_for_48_teeth_only_is_refused(conn):
     """Every program that is stored passes refuse_lineage_shaped (engine.programs.verified_run): a
     draft writing `; PROGRAM 1 TEMPLATE ...` for gear 46's 48 teeth only (no golden gear has 48)
@@ -68,6 +69,7 @@ def test_a_gear_record_that_no_longer_loads_is_named_in_workers_as_in_one_proces
     assert "gear 46" in report.failures[0].error and report.changed == 2
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_two_workers_report_what_one_process_reports(conn):
     """The workers make both programs of each job input, compare them and prove the changed ones
     (issue 28): the same diffs, failures (and whether the released version passes), counts and
@@ -100,6 +102,7 @@ def test_two_stored_jobs_with_the_same_inputs_are_both_named(conn):
     assert all(any(f"stored job {job} " in problem for problem in problems) for job in (first, second)), problems
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_a_spur_draft_that_breaks_only_a_duplex_job_is_refused(conn):
     """duplex (gear 54, 30 teeth) inherits spur's rows: a spur edit for 30 teeth only changes no spur
     job's program but drives the stored duplex job's hob beyond the spindle."""

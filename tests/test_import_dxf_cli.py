@@ -84,6 +84,7 @@ def feed_words(lines: list[str]) -> list[tuple[int, str]]:
     return [(number, word) for number, line in enumerate(lines) for word in line.split() if word.startswith("F")]
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_a_feed_edited_in_sql_changes_exactly_that_operation_s_f_words(run, tmp_path):
     seed_drawing(tmp_path / "part.dxf")
     job_id = json.loads(run("import-dxf", tmp_path / "part.dxf", "--json").stdout)["job_id"]

@@ -93,6 +93,7 @@ def test_new_values_change_exactly_the_words_bound_to_them_and_the_file_is_the_s
     assert stored_program(run.url, again["program_id"])[0] == expected   # the job made again, verified again
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 @pytest.mark.parametrize("addresses", [["S"], ["F", "S"], ["X"]])
 def test_a_bound_form_naming_addresses_the_class_does_not_bind_is_refused_naming_its_address(run, tmp_path,
                                                                                                addresses):
@@ -165,6 +166,7 @@ def test_a_machine_whose_dialect_the_verifier_does_not_know_is_refused_and_nothi
 @pytest.mark.parametrize("path, machine, reason", [(CAM, "lathe-840d", "milling program"),
                                                    (EMCO_CNC, "lathe-iso", "not a word")],
                          ids=["840D sl CAM program", "Emco program"])
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_a_real_program_the_verifier_refuses_is_refused_with_its_reason(run, path, machine, reason):
     ok(run("import-nc", path, "--class", "foreign"))
     before = stored_counts(run.url)
@@ -260,6 +262,7 @@ def resubmit(conn, program_id: int, unverified: bool, lineage_of) -> None:
                           unverified))
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_the_database_holds_the_unverified_word_to_the_record_and_refuses_it_for_hobbing(run):
     with psycopg.connect(run.url) as conn:
         conn.execute(LINUXCNC_LATHE)

@@ -41,6 +41,7 @@ def test_a_call_block_with_other_words_is_refused_naming_them(conn, main, sub, c
 
 # ---------------------------------------------------------------- H4, H5, H17: call forms
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_m99_p_returning_to_a_sequence_number_is_refused(conn):
     lines = with_subprogram(["G0 X50. Z2.", "G1 X30. Z-20. F100.", "M98 P1000", "N50 G0 X200. Z100.", "N60 T0202",
                              "G0 X60. Z5."], ["G1 X30. Z-20. F100."])

@@ -71,6 +71,7 @@ def printed_draft(run) -> tuple[dict, bytes]:
     return {"program_id": int(program_id), "template_version": int(version)}, result.stdout_bytes
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_a_layout_change_is_a_draft_until_it_is_released(run, tmp_path):
     crlf_draft(run, tmp_path)
     runner, runners_file = written(run, tmp_path)
@@ -96,6 +97,7 @@ def test_programs_show_keeps_the_layout_of_the_version_a_program_was_made_from(r
     assert (record["line_ending"], record["final_newline"]) == ("lf", True)
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_history_diff_and_restore_carry_the_layout(run, tmp_path):
     crlf_draft(run, tmp_path)
     versions = made(run("template", "history", "--class", "spur", "--json"))["versions"]
@@ -149,6 +151,7 @@ def test_a_re_import_of_the_file_with_other_line_endings_is_a_new_version(run, t
                             "ORDER BY version").fetchall() == [(1, LF), (2, CRLF)]
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_a_release_that_changes_only_the_layout_says_every_program_file_of_the_class_changes(run, tmp_path):
     written(run, tmp_path)
     written(run, tmp_path)

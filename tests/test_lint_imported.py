@@ -34,6 +34,7 @@ def test_an_imported_real_program_lints_clean(conn, relative):
     assert lint_class(conn, class_name(relative)) == []
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_lint_command_passes_after_import_nc(run, tmp_path):
     real_files()
     params = tmp_path / "params.json"
@@ -45,6 +46,7 @@ def test_lint_command_passes_after_import_nc(run, tmp_path):
     assert json.loads(result.stdout) == {"errors": []}
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_a_changed_row_naming_an_unknown_parameter_is_the_one_problem(conn):
     real_files()
     import_nc(conn, DATA / CAM, "nc_cam", PARAMS[CAM])
@@ -111,6 +113,7 @@ def test_a_failed_reimport_keeps_rows_and_import_params(conn, tmp_path):
     assert import_params(conn, "nc_params") == {"x": 5}
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_an_import_under_a_parent_with_a_model_is_checked_against_its_own_parameters(conn):
     real_files()
     import_nc(conn, DATA / CAM, "nc_cam_cylindrical", PARAMS[CAM], parent="cylindrical")

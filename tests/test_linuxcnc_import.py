@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 
+import pytest
 from helpers.class_jobs import ok, refused, stored_program
 from helpers.linuxcnc_programs import LATHE, MACRO_START, program_of, refusal
 
@@ -27,6 +28,7 @@ def imported(run, tmp_path):
     return lines
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_a_verified_linuxcnc_program_made_with_a_new_value_changes_only_its_bound_word(run, tmp_path):
     lines = imported(run, tmp_path)
     assert refusal(lines) is None and MACRO_START in lines
@@ -43,6 +45,7 @@ def test_a_verified_linuxcnc_program_made_with_a_new_value_changes_only_its_boun
     assert changed == [(MACRO_START, MACRO_START.replace("x1.2", "x1.3"))]
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_a_value_past_the_travel_is_refused_and_nothing_is_stored(run, tmp_path):
     imported(run, tmp_path)
     past = LATHE.x_max / 25.4 + 1          # inches (the preamble's G20): a diameter beyond the travel

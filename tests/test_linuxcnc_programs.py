@@ -142,6 +142,7 @@ SIMULATED = {
 }
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 @pytest.mark.parametrize("name", VERIFIED)
 def test_each_verified_program_is_simulated_on_its_bar(name):
     findings = [finding.message for finding in simulate_turning(program_of(name), BAR, {}, LATHE, name).findings]

@@ -166,6 +166,7 @@ def test_jobs_show_gives_the_parameters_and_the_programs(run):
 
 # --- programs ---------------------------------------------------------------------------------------------
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_programs_list_filters_by_gear_job_class_and_release(run):
     made = json.loads(run("instantiate", "--gear", 42, "--json").stdout)
     other = json.loads(run("instantiate", "--gear", 43, "--json").stdout)

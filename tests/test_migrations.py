@@ -88,6 +88,7 @@ def test_schema_folder_is_one_readable_file_in_its_sections():
     assert banners == list(SECTIONS)
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_migrations_produce_exactly_the_readable_schema(empty_database_url, database_url):
     load_schema(empty_database_url)
     assert differences(catalog(empty_database_url), catalog(database_url)) == []
@@ -321,6 +322,7 @@ def test_hob_ids_differing_only_in_case_stop_migration_0011_with_their_names(emp
         assert conn.execute("SELECT count(*) FROM hob").fetchone()[0] == 3
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_versions_stored_before_0025_keep_the_layout_their_programs_were_written_with(empty_database_url, tmp_path):
     """Before migration 0025 every program of a class was written with the class's one layout:
     the versions already stored record it, so programs of them are shown as they were written."""

@@ -156,6 +156,7 @@ def test_the_report_lists_the_words_bound_and_left_alone_with_their_lines(run, t
     assert f"left alone: U 1 (line {at['U'][0]}); W 1 (line {at['W'][0]})" in feed_line
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_each_real_program_with_a_tab_is_refused_at_import_naming_the_line(conn):
     assert TABBED, "no real program with a tab left: the refusal is no longer exercised"
     for relative in TABBED:

@@ -36,6 +36,7 @@ def test_every_real_file_is_written_back_byte_for_byte(conn, relative):
     assert written_back(conn, class_name(relative), PARAMS[relative]) == (DATA / relative).read_bytes()
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 @pytest.mark.parametrize("relative", TWO_FILES)
 @pytest.mark.parametrize("crlf, final_newline", [(False, False), (True, True), (True, False)])
 def test_crlf_and_no_final_newline_are_written_back_byte_for_byte(conn, tmp_path, relative, crlf, final_newline):

@@ -139,6 +139,7 @@ def test_a_tool_number_equal_to_a_plain_value_is_left_alone_and_reported(conn):
     assert report.bindings[0]["words"] == sum(1 for word in equal if word[1] not in "GMNOTL")
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_the_lines_read_in_two_processes_report_what_one_process_reports(conn, monkeypatch):
     params = bound_form("radius", "4.25", "I", CAM)
     monkeypatch.setattr(nc_halves, "TWO_PROCESSES_FROM", 10**9)
@@ -251,6 +252,7 @@ def class_job_dry_run(run, tmp_path, text: str):
                "--dry-run")
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_a_deeply_nested_parameters_file_is_bad_input_not_a_bug(run, tmp_path):
     """A parameters file that is not an object of values (here an array nested 100 000 deep) is
     refused in one line, exit 1, like any other file that is not {"name": value}."""
@@ -260,6 +262,7 @@ def test_a_deeply_nested_parameters_file_is_bad_input_not_a_bug(run, tmp_path):
     assert made.stderr.startswith("error: ") and made.stderr.count("\n") == 1
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_addresses_the_class_does_not_bind_are_not_silently_ignored(run, tmp_path):
     """The class binds feed to F (import-nc --params). A file saying feed binds S asks for a
     different program than the one made: the engine makes F100 and keeps S600 without a word.

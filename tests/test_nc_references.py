@@ -76,6 +76,7 @@ def test_the_840d_tool_edge_and_master_spindle_are_left_alone_with_their_reason(
     assert not any("{passes" in rows[number] for number, _ in edges + [(spindle[0], "")])
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_a_bound_form_naming_d_binds_the_edge_its_user_named(conn):
     edges = found(CAM, r"\bD1\b", r"\bD1\b")
     import_nc(conn, DATA / CAM, "nc_edge", {"edge": {"value": 1, "addresses": ["D"]}})

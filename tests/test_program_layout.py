@@ -61,6 +61,7 @@ def test_an_lf_class_is_written_as_before(run, tmp_path):
     assert target.read_bytes().endswith(b"M30\n") and b"\r" not in target.read_bytes()
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_the_printed_program_and_programs_show_give_the_same_bytes(run):
     set_layout(run.url, "spur", CRLF, False)
     printed = run("instantiate", "--gear", 42)
@@ -76,6 +77,7 @@ def test_the_printed_program_and_programs_show_give_the_same_bytes(run):
     assert (record["line_ending"], record["final_newline"]) == ("crlf", False)
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_a_dry_run_prints_the_program_with_its_class_layout(run):
     set_layout(run.url, "spur", CRLF, False)
     program = made(run("instantiate", "--gear", 42, "--json"))
@@ -111,6 +113,7 @@ def test_a_batch_writes_each_program_with_its_own_class_layout(run, tmp_path, wo
     assert endings == {True, False}   # the helical gears' LF files and the spur gears' CRLF ones
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_stored_jobs_made_again_keep_their_class_layout(run, tmp_path):
     first = made(run("instantiate", "--gear", 42, "--json"))
     last = made(run("instantiate", "--gear", 43, "--json"))

@@ -29,6 +29,7 @@ from engine.machines.records import load_machine
 from engine.simulation.turning.run import simulate_turning
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 @pytest.mark.parametrize("name", sorted(REAL))
 def test_each_verified_real_program_is_simulated_on_the_stock_it_is_written_for(conn, name):
     real = REAL[name]
@@ -133,6 +134,7 @@ def programs(url: str) -> int:
     return row[0]
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 @pytest.mark.parametrize("name", sorted(set(REAL) - set(MADE)))
 def test_a_real_program_the_simulation_refuses_is_refused_when_made_and_nothing_is_stored(run, tmp_path, name):
     """Imported as a class (the file as the control runs it), it is made on the same stock: the

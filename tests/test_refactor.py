@@ -47,6 +47,7 @@ def test_duplicate_bodies_are_merged_and_every_export_stays_byte_identical(conn)
                         (copy, second_copy)).fetchone()[0] == 0
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_a_second_run_reports_nothing_changed(conn):
     duplicate_row_body(conn, "helical", 1400)
     assert refactor(conn).changed is True

@@ -107,6 +107,7 @@ def test_copies_left_by_sql_edits_are_merged_across_real_and_seeded_classes(conn
     assert again.changed is False and again.components_after == count - copies
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_lines_the_wrench_pair_shares_are_stored_once(conn):
     files = {unit: FAMILY + f"{unit}_wrench.ngc" for unit in ("imperial", "metric")}
     lines = {unit: (DATA / relative).read_text().split("\n")[:-1] for unit, relative in files.items()}

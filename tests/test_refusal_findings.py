@@ -9,6 +9,7 @@ from __future__ import annotations
 import json
 
 import psycopg
+import pytest
 
 from engine.simulation.hobbing.report import Report
 
@@ -23,6 +24,7 @@ def test_a_refusal_counts_the_other_findings_without_naming_a_command():
     assert message.endswith("(and 1 more finding)") and "engine simulate" not in message
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_engine_simulate_lists_every_finding_of_a_program_refused_now(run):
     made = run("instantiate", "--gear", 42, "--json")
     program_id = json.loads(made.stdout)["program_id"]

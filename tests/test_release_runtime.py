@@ -193,6 +193,7 @@ def test_every_seeded_gears_program_carries_its_lineage(run, tmp_path):
         check_lineage(run, json.loads(made.stdout)["program_id"], tmp_path / f"G{gear_id}.MPF")
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 @pytest.mark.parametrize("machine, drawing", [("lathe-iso", "emco"), ("lathe-840d", "seed")])
 def test_a_turning_jobs_program_carries_its_lineage(run, tmp_path, machine, drawing):
     path = DXF / EMCO[0] if drawing == "emco" else tmp_path / "part.dxf"
@@ -298,6 +299,7 @@ def test_a_class_made_by_import_nc_runs_only_as_a_draft_until_released(run, tmp_
 
 # --- engine programs show ------------------------------------------------------------------------------
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_programs_show_gives_the_record_and_refuses_in_one_line(run):
     made = json.loads(run("instantiate", "--gear", 42, "--json").stdout)
     shown = run("programs", "show", made["program_id"], "--json")

@@ -60,6 +60,7 @@ def released_v2(run) -> tuple[str, dict]:
     return line, release
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_a_release_by_hand_of_a_refused_draft_is_not_shown_as_passed(run):
     refused_draft(run)
     release_by_hand(run.url)
@@ -72,6 +73,7 @@ def test_a_release_by_hand_of_a_refused_draft_is_not_shown_as_passed(run):
     assert any(f"spur/{TEST_NAME}" in problem for problem in release["recheck"]["problems"])
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_a_forged_claim_of_the_engines_gate_is_shown_as_a_mismatch(run):
     """The engine calls release_template as the same login: a releaser can name the engine too.
     The re-check, not the claim, decides what the screen says."""
@@ -83,6 +85,7 @@ def test_a_forged_claim_of_the_engines_gate_is_shown_as_a_mismatch(run):
     assert release["released_via"] == "engine" and release["gate"] == "mismatch"
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_the_recorded_tests_are_the_databases_not_the_callers(run):
     """A test deleted after the release is still re-run: the database recorded it with the release."""
     refused_draft(run)
@@ -107,6 +110,7 @@ def test_a_release_through_the_engines_gate_shows_its_gate_passed(run):
     assert release["recheck"]["tests"] == gated > 1
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_a_release_recorded_before_migration_0026_is_re_checked_with_the_tests_of_today(run):
     """A release stored before released_via and golden_tests existed (as the migration leaves it:
     'unrecorded', no tests) is not shown as the gate's; the class's tests now are re-run."""

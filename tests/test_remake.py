@@ -3,6 +3,7 @@ programs of their stored parameters, all stored in one transaction or none."""
 import json
 
 import psycopg
+import pytest
 from helpers.lineage_text import LINES_ID_MASKED
 
 
@@ -12,6 +13,7 @@ def programs(url, where=""):
                             "ORDER BY id").fetchall()
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_jobs_made_again_give_their_programs_back(run):
     assert run("instantiate", "--gears", "42-54").exit_code == 0
     first = programs(run.url)

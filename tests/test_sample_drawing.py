@@ -143,6 +143,7 @@ def test_the_sample_becomes_rough_slot_finish_thread_with_the_codes_it_draws(run
     assert (params["tool_change_z"], params["tool_change_x"]) == (z, 2 * radius)
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_the_program_changes_tools_at_the_drawn_point_and_passes_the_lathe_checks(run):
     _, params, _, lines = imported(run)
     z, radius = tool_change_point()
@@ -158,6 +159,7 @@ def test_the_program_changes_tools_at_the_drawn_point_and_passes_the_lathe_check
         assert gouges(operation_lines(lines, n), outline, polylines) == [], n
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_each_operation_cuts_what_its_layer_draws(run):
     _, _, _, lines = imported(run)
     polylines = drawn_polylines(SAMPLE_DRAWING)

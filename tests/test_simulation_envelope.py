@@ -92,6 +92,7 @@ def heights_of(case: dict, rng) -> list[float]:
     return [*inside.tolist(), cz, cz + 1.05 * extent, cz - 1.2 * extent]
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 @pytest.mark.parametrize("seed", [1, 2, 3])
 def test_the_nearest_point_agrees_with_dense_sampling_of_the_cylinder(seed):
     rng = np.random.default_rng(seed + 100)
@@ -124,6 +125,7 @@ def turned_and_mirrored(case: dict) -> list[dict]:
             {**case, "swivel": 90.0 + abs(case["swivel"]) + 1.0}, {**case, "centre": (-cx, cy, cz)}]
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 @pytest.mark.parametrize("seed", [4, 5])
 def test_a_hob_swivelled_beyond_90_degrees_or_across_the_axis_agrees_with_sampling(seed):
     """Adversary of issue 28: with cos A < 0 the band between the end faces came out empty, so a
@@ -167,6 +169,7 @@ def deeper(lines: list[str], by: float) -> list[str]:
             else line for line in lines]
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 @pytest.mark.parametrize("gear_id, choices", GEARS, ids=[str(gear) for gear, _ in GEARS])
 def test_the_batch_path_reports_what_the_plain_floats_report(conn, monkeypatch, gear_id, choices):
     """The same findings word for word (depths and heights to the micrometre), cuts and times, on

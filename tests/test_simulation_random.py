@@ -124,6 +124,7 @@ def test_the_envelope_is_the_nearest_point_of_the_hob_at_each_height(envelope, r
 @settings(max_examples=60, deadline=None)
 @given(radius=st.floats(20, 50), length=st.floats(60, 160), swivel=st.floats(-35, 35), x=st.floats(0, 120),
        y=st.floats(-40, 40), z=st.floats(-60, 60))
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_the_envelope_in_plain_floats_and_with_numpy_agree(radius, length, swivel, x, y, z):
     """A process follows its first sections in plain floats and the rest with numpy
     (engine.simulation.hobbing.contact.MATH_SECTIONS): the two give one distance, to a micrometre."""

@@ -357,6 +357,7 @@ def test_seeding_audited_every_seeded_row(conn):
 
 # --- the nightly refactor after SQL edits -----------------------------------------------------
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_refactor_after_edits_merges_what_became_identical_and_nothing_else(conn):
     # through the view: spur's row 1100 made identical to helical's row 700 reuses its component
     body = view_row(conn, "helical", 700)[1:7]
@@ -475,6 +476,7 @@ def test_roles_are_created_once_even_when_several_databases_migrate(empty_databa
 
 # --- concurrency --------------------------------------------------------------------------------
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_instantiations_during_sql_edits_and_refactors_match_the_version_they_record(fresh_database_url):
     """Editors commit through the view, the refactor runs, runners instantiate, all at once:
     every program is the program of the (version, hash) it records."""

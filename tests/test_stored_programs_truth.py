@@ -94,6 +94,7 @@ def test_a_genuine_program_shows_as_the_rendering_read_by_the_verifier(run, forg
     ("explain", "--program", "{id}"),
     ("simulate", "--program", "{id}"),
 ])
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_commands_that_use_a_stored_program_refuse_a_forged_one(run, forgery, tmp_path, command):
     job_id, genuine, forged_id = forgery
     before = counts(run.url)

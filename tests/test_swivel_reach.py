@@ -57,6 +57,7 @@ def test_an_a_not_written_yet_may_be_any_swivel():
     assert z_reach(body, 7.0, None, 3.0) == pytest.approx(math.hypot(57.0, 35.0), abs=1e-12)
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_random_swivels_reach_no_less_than_the_rim():
     generator = random.Random(28)
     for _ in range(40):

@@ -112,6 +112,7 @@ def test_every_infeed_clears_the_cone(cone, feed_mode, cuts):
     check_cuts(gear, hob, job.params, job.module_params)
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 @pytest.mark.parametrize("cone, feed_mode, cuts", COMBINATIONS)
 def test_every_infeed_clears_the_cone_with_a_helical_swivel(cone, feed_mode, cuts):
     hob = next(h for h in seeded_hobs() if h.id == "H-M2-A-L1")

@@ -95,6 +95,7 @@ def _edited(url, job_id, path: str, value: str) -> None:
     ("{cutmotion:1,feed}", "19999", ("F19999 mm/min", "16.67 mm/rev", "0.08-0.45 mm/rev", "Korloy")),
     ("{cutcond:1,spindle_rpm}", "3999", ("S3999", "m/min is above the 80-380 m/min", "Korloy")),
 ])
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_a_runners_feed_or_speed_beyond_the_table_is_refused(run, path, value, words):
     job_id = _sample_job(run)
     assert run("instantiate", "--job", job_id).exit_code == 0     # the sample as drawn instantiates

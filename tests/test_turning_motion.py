@@ -141,6 +141,7 @@ def test_no_rapid_enters_the_part_or_the_blank(conn, tmp_path, machine):
         assert rapid_faults(lines, polylines, blank) == [], path.name
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 @pytest.mark.parametrize("machine", MACHINES)
 def test_tool_change_blocks_move_z_only(conn, tmp_path, machine):
     """Leaving the work X goes up first; the tool-change block then moves Z alone."""

@@ -72,6 +72,7 @@ def feed_and_rapid(lines) -> tuple:
     return feed, rapid
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_the_vertical_axis_is_the_diameter_the_program_writes(conn):
     job_id, program = hemisphere_job(conn)
     figure = turning_job_figure(conn, job_id)
@@ -150,6 +151,7 @@ def inside(figure, point) -> bool:
     return z0 <= point[0] <= z1 and x0 <= point[1] <= x1
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_limits_frame_the_work_and_point_to_a_far_tool_change(conn):
     job_id, program = hemisphere_job(conn)
     figure = turning_job_figure(conn, job_id)

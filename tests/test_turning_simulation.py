@@ -84,6 +84,7 @@ SHAFT_OPTIONS = ProfileOptions(stock_diameter=22.0, speed=1200.0, feed=240.0)
 
 # --- the issue's row: G00 X0.000 Z10.000 through the Ø22 stock -------------------------------------
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 @pytest.mark.parametrize("machine", [ISO, S840D])
 def test_an_editor_row_rapid_through_the_stock_is_refused_by_instantiate_and_the_gate(conn, tmp_path, machine):
     drawing = shaft_drawing(tmp_path / "shaft.dxf")
@@ -226,6 +227,7 @@ def test_engine_simulate_follows_a_stored_lathe_program(run, machine):
 SLOT_3_AFTER_PATH = 3075   # the sample's operation 3, which no seeded golden test of the lathe classes makes
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 @pytest.mark.parametrize("machine", [ISO, S840D])
 def test_the_gate_refuses_a_draft_that_stops_a_stored_job_the_released_version_makes(conn, machine):
     """A new user's finding: a rapid through the part in the sample's operation 3 passed every golden

@@ -106,6 +106,7 @@ def _before_last_op_leaves(lines: list[str], machine: str, inserted: list[str]) 
     return [*lines[:leave], *inserted, *lines[leave:]]
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 @pytest.mark.parametrize("machine", [ISO, S840D])
 def test_a_rapid_into_the_bar_behind_the_back_end_is_refused(conn, machine):
     """10 mm behind the part's back end (Z-30) the bar runs on to the chuck at the stock's Ø24."""
@@ -117,6 +118,7 @@ def test_a_rapid_into_the_bar_behind_the_back_end_is_refused(conn, machine):
     assert any("X4.000 Z-40.000" in f and "a rapid through material" in f for f in found), found
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 @pytest.mark.parametrize("machine", [ISO, S840D])
 def test_a_cut_behind_the_back_end_is_refused(conn, machine):
     """`G01 X0 Z-40`: a cut behind the stock's back end goes into what holds the part."""

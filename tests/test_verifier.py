@@ -275,6 +275,7 @@ def test_a_machine_without_a_grammar_makes_no_program(conn):
 # ---------------------------------------------------------------- end to end, on a real database
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 @pytest.mark.parametrize("escape, named", [("\\n", "line feed"), ("\\r", "carriage return")])
 def test_a_template_row_with_a_line_break_stores_and_writes_nothing(run, tmp_path, escape, named):
     with psycopg.connect(run.url) as conn:

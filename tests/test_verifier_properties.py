@@ -226,6 +226,7 @@ def test_the_hob_shift_clamp_is_accepted_exactly_when_its_whole_interval_lies_in
 HOB_EVENTS = ("M3 S246", "M5", 'EGON(C,"FINE",B,-1,19)', "EGOFS(C)", "G0 X55.000", "M8", "M9")
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 @settings(max_examples=300, deadline=None)
 @given(events=st.lists(st.sampled_from(HOB_EVENTS), max_size=8))
 def test_a_hob_cut_is_accepted_exactly_when_the_spindle_turns_and_the_table_is_coupled(events):
@@ -267,6 +268,7 @@ def test_a_lathe_cut_is_accepted_exactly_when_a_tool_offset_is_active(data):
 @settings(max_examples=400, deadline=None)
 @given(teeth=st.integers(5, 120), speed=st.integers(1, 1000), factor=st.floats(0, 2 * MAX_DIFFERENTIAL),
        feed=st.floats(0.1, MAX_FEED))
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_the_table_is_accepted_exactly_when_its_speed_with_the_z_term_is_within_the_machine(teeth, speed, factor,
                                                                                           feed):
     machine = MACHINES["hobber-840d"]

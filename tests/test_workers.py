@@ -4,6 +4,7 @@ gear is named)."""
 import json
 
 import psycopg
+import pytest
 from helpers.lineage_text import LINES_ID_MASKED
 
 
@@ -13,6 +14,7 @@ def stored_programs(url):
                             "j.cutting FROM program p JOIN job j ON j.id = p.job_id ORDER BY p.id").fetchall()
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_two_workers_store_what_one_process_stores(run):
     one = run("instantiate", "--gears", "42-54", "--json")
     first = stored_programs(run.url)
@@ -37,6 +39,7 @@ def test_workers_are_for_batches(run):
     assert refused.exit_code == 1 and "--workers plans a batch" in refused.stderr
 
 
+@pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
 def test_a_class_refused_in_a_worker_names_each_of_its_gears_and_nothing_is_stored(run):
     # the Planner remembers the refusal: a worker never reads the database it shares with the parent
     with psycopg.connect(run.url) as conn:

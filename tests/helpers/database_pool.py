@@ -29,11 +29,17 @@ MAKERS = 2          # copies made at once: a run of quick CLI tests uses one eve
 DROPS_AT_ONCE = 8   # concurrent DROP DATABASEs share one checkpoint; few connections of a shared server
 
 
-def create_database(admin, name: str, template: str | None = None) -> None:
-    """CREATE DATABASE `name` (a copy of `template` if given), committing asynchronously."""
+def create_database(admin, name: str, template: str | None = None, file_copy: bool = False) -> None:
+    """CREATE DATABASE `name` (a copy of `template` if given), committing asynchronously. The
+    server's default strategy (WAL_LOG since PostgreSQL 15) writes the copy through the WAL;
+    `file_copy` (STRATEGY FILE_COPY, 15 and later) copies the files and costs two checkpoints,
+    cheap only where fsync is off (the embedded test server, tests/conftest.py): there it took the
+    fast subset from 61 s to 54 s (issue 28)."""
     query = sql.SQL("CREATE DATABASE {}").format(sql.Identifier(name))
     if template:
         query = sql.SQL("CREATE DATABASE {} TEMPLATE {}").format(sql.Identifier(name), sql.Identifier(template))
+    if template and file_copy:
+        query = sql.SQL("{} STRATEGY FILE_COPY").format(query)
     admin.execute(query)
     admin.execute(sql.SQL("ALTER DATABASE {} SET synchronous_commit = off").format(sql.Identifier(name)))
 
@@ -85,8 +91,8 @@ class DatabasePool:
     """take(kind) → the name of a database made for one test; give_back(name) drops it later.
     close() stops the threads and drops every database still made here."""
 
-    def __init__(self, server_url: str):
-        self.server_url = server_url
+    def __init__(self, server_url: str, file_copy: bool = False):
+        self.server_url, self.file_copy = server_url, file_copy
         self.kinds: list[Kind] = []
         self.used: list[str] = []
         self.dropping: list[str] = []   # the batch the drop thread is dropping (dropped again at close: IF EXISTS)
@@ -155,7 +161,7 @@ class DatabasePool:
         with psycopg.connect(self.server_url, autocommit=True) as admin:
             while (kind := self._next_short_kind()) is not None:
                 name = kind.new_name()
-                create_database(admin, name, kind.template)
+                create_database(admin, name, kind.template, self.file_copy)
                 with self.changed:
                     kind.making -= 1
                     kind.ready.append(name)

@@ -16,7 +16,7 @@ from collections import defaultdict
 
 import pytest
 
-MATRIX_SIZE = 4       # parameter sets of one function from which on it is sampled
+MATRIX_SIZE = 2       # parameter sets of one function from which on it is sampled
 SAMPLE_EVERY = 8      # one set in 8 is kept in the fast subset
 MATRIX_KEEP = 1       # but never fewer than this many per function
 
