@@ -13,6 +13,7 @@ from dataclasses import replace
 import pytest
 
 from engine.machines.records import Machine, load_machine
+from engine.nc.lineage import lineage_line, lineage_words
 from engine.verifier import LimitError, verify_program
 
 NAME = "GEAR42"
@@ -139,3 +140,12 @@ def test_the_m_series_form_g81_4_is_its_own_dialect(fanuc):
 def test_an_840d_program_is_refused_on_a_fanuc_hobber(fanuc):
     lines = ["%_N_GEAR42_MPF", ";$PATH=/_N_MPF_DIR", "G90 G71 G94", "M30"]
     assert "line 1 '%_N_GEAR42_MPF': %_N_GEAR42_MPF: not a word of the Fanuc hobbing grammar" in refusal(fanuc, lines)
+
+
+def test_a_fanuc_hobbers_lineage_line_is_a_comment_its_grammar_reads(fanuc):
+    """The engine's lineage line (engine.nc.lineage) stands in parentheses on a Fanuc hobber, so
+    the grammar reads it as a comment and the control skips it."""
+    words = lineage_words(7, "spur", 1, "7d5cca25" * 8, "80c6b886" * 8, draft=False)
+    lines = {dialect: lineage_line(words, dialect) for dialect in ("fanuc", "fanuc-g81.4")}
+    assert set(lines.values()) == {"(PROGRAM 7 TEMPLATE spur v1 7d5cca25 INPUT 80c6b886)"}
+    verify_program(replaced("(GEAR 42 HELICAL)", lines["fanuc"]), fanuc, NAME)
