@@ -113,12 +113,21 @@ def test_a_second_g81_while_on_replaces_the_ratio_and_the_table_speed_follows(fa
     (replaced(f"O1234 ({NAME})", "O1234 (OTHER)"), "the header names program OTHER"),
     (replaced("G0 Z19.576 A1.763", "G0 Z19.576 A1"), "A1 needs a decimal point"),
     (replaced("G1 X51.500 F13.3", "G1 X51.500 F13"), "F13 needs a decimal point"),
-    (replaced("M8", "M8 ; COOLANT"), "not a word of the Fanuc hobbing grammar"),
-    (replaced("M8", "M20"), "M20 is not an M code of the Fanuc hobbing grammar"),
-    (replaced("G80", "G80", "EGOFS(C)"), "EGOFS: not a word of the Fanuc hobbing grammar"),   # (C) a comment
+    (replaced("M8", "M8 ; COOLANT"), "not a word of the Fanuc hobbing in G54 grammar"),
+    (replaced("M8", "M20"), "M20 is not an M code of the Fanuc hobbing in G54 grammar"),
+    (replaced("G80", "G80", "EGOFS(C)"), "EGOFS: not a word of the Fanuc hobbing in G54 grammar"),   # (C) a comment
 ])
 def test_fanuc_framing_units_and_modes_are_those_of_the_rules(fanuc, lines, reason):
     assert reason in refusal(fanuc, lines)
+
+
+def test_only_the_records_work_offset_is_read(fanuc):
+    """The travel is stated in the record's work offset (machine.work_offset, G54 for the seeded
+    hobber); another of G54…G57 would shift every position by an offset the verifier cannot see."""
+    in_g55 = [line.replace("G54", "G55") for line in PROGRAM]
+    assert "G55 shifts every position by a work offset" in refusal(fanuc, in_g55)
+    verify_program(in_g55, replace(fanuc, work_offset="G55"), NAME)
+    assert "G54 shifts every position by a work offset" in refusal(replace(fanuc, work_offset="G55"), PROGRAM)
 
 
 def test_the_m_series_form_g81_4_is_its_own_dialect(fanuc):
@@ -130,7 +139,7 @@ def test_the_m_series_form_g81_4_is_its_own_dialect(fanuc):
     verify_program(replaced("G81.4 R40 L-1 Q200000 P150000", "G81.4 R500 L30", lines=lines), m_series, NAME)
     for sync, reason in (("G81.4 R501 L-1", "R501 is outside 1 … 500"), ("G81.4 R40 L31", "L31 is outside -30 … +30"),
                          ("G81.4 R40 L-1 Q200000", "with Q but without P"),
-                         ("G81", "G81 is not a G code of the Fanuc hobbing G81.4 grammar"),
+                         ("G81", "G81 is not a G code of the Fanuc hobbing G81.4 in G54 grammar"),
                          ("G81 T40 L-1", "line 10 'G81 T40 L-1'")):
         assert reason in refusal(m_series, replaced("G81.4 R40 L-1 Q200000 P150000", sync, lines=lines))
     assert "M30 while the table is synchronised to the hob: G80.4 first" in refusal(m_series, replaced("G80.4",
@@ -139,7 +148,8 @@ def test_the_m_series_form_g81_4_is_its_own_dialect(fanuc):
 
 def test_an_840d_program_is_refused_on_a_fanuc_hobber(fanuc):
     lines = ["%_N_GEAR42_MPF", ";$PATH=/_N_MPF_DIR", "G90 G71 G94", "M30"]
-    assert "line 1 '%_N_GEAR42_MPF': %_N_GEAR42_MPF: not a word of the Fanuc hobbing grammar" in refusal(fanuc, lines)
+    message = refusal(fanuc, lines)
+    assert "line 1 '%_N_GEAR42_MPF': %_N_GEAR42_MPF: not a word of the Fanuc hobbing in G54 grammar" in message
 
 
 def test_a_fanuc_hobbers_lineage_line_is_a_comment_its_grammar_reads(fanuc):

@@ -115,6 +115,7 @@ class Dialect:
     expander: str | None = None           # the bounded interpreter of engine.verifier.expansion that turns
                                           # cycles, subprograms, parameters and jumps into plain lines
     synchronisations: tuple[Synchronisation, ...] = ()   # Fanuc hobbing: the EGB command blocks (G81/G80)
+    record_work_offset: bool = False      # only the record's work offset of G54…G57 (machine.work_offset)
 
     def code_group(self, letter: str, code: int) -> str:
         codes = self.m_codes if letter == "M" else self.g_codes
@@ -284,6 +285,7 @@ HOBBING_FANUC = Dialect(
     program_numbers=ISO_PROGRAM_NUMBERS,
     reserved_numbers=ISO_RESERVED_NUMBERS,
     synchronisations=(FANUC_G81, FANUC_G80),
+    record_work_offset=True,
 )
 # The M-series form (Fanuc 16i/18i/21i, where G81 is the drilling cycle): G81.4 R<teeth 1…500>
 # L<±threads 1…30> [Q P] … G80.4; otherwise as HOBBING_FANUC.
@@ -302,12 +304,24 @@ def dialect_for(machine: Machine) -> Dialect:
     """The grammar of a machine's programs: its dialect, and on a hobber the door M functions
     its record names (they are the machine builder's, so no dialect holds them)."""
     found = dialect_of(machine.kind, machine.dialect)
+    if found.record_work_offset:
+        found = _in_record_work_offset(found, machine.work_offset)
     doors = tuple(code for code in (machine.door_close_m, machine.door_open_m) if code is not None)
     if machine.kind != "hobber" or not doors:
         return found
     codes = {**found.m_codes, **{int(code): DOOR_GROUP for code in doors}}
     name = f"{found.name} with doors {'/'.join(f'M{int(code)}' for code in doors)}"
     return replace(found, name=name, m_codes=codes)
+
+
+def _in_record_work_offset(found: Dialect, work_offset: str) -> Dialect:
+    """Fanuc hobbing: of G54…G57 only the record's, the frame its travel is stated in (another
+    would shift every position by an offset the verifier cannot see; the 840D hobber's is held to
+    the record by the simulation, which reads no Fanuc program yet). Named by it, as the lines
+    read are remembered per grammar name (engine.verifier.lines)."""
+    codes = {code: group for code, group in found.g_codes.items()
+             if group != "work offset" or f"G{code}" == work_offset}
+    return replace(found, name=f"{found.name} in {work_offset}", g_codes=codes)
 
 
 def dialect_of(kind: str, dialect: str) -> Dialect:

@@ -129,7 +129,6 @@ HOBBING_STATE = StateRules(
 )
 
 
-
 def fanuc_hobbing_state(on: str, off: str, form: str) -> StateRules:
     """Fanuc hobbing (issue 30): the electronic gear box's `on` command (G81 T… L…, written `form`)
     synchronises the table to the hob spindle, a second one changes the ratio, `off` (G80) cancels
