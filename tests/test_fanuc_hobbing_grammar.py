@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from dataclasses import replace
 
+import psycopg
 import pytest
 
 from engine.machines.records import Machine, load_machine
@@ -18,7 +19,7 @@ from engine.verifier import LimitError, verify_program
 
 NAME = "GEAR42"
 SPEED = 246                                   # r/min of the hob: S246
-SYNC = "G81 T40 L-1 Q200000 P150000"          # 40 teeth, one left-turning thread, Q/P in the control's increment
+SYNC = "G81 T40 L-1 Q2.5 P15."          # 40 teeth, one left-turning thread, module 2.5 mm, helix 15°
 PROGRAM = ["%", f"O1234 ({NAME})", "(GEAR 42 HELICAL)", "G21 G90 G94 G54", "T1", "G0 X61.000 Y0.000",
            "G0 Z19.576 A1.763", f"M3 S{SPEED}", "M8", SYNC, "G0 X52.500", "G1 X51.500 F13.3",
            "G1 Z-23.380 F29.7", "G0 X61.000", "G80", "M9", "M5", "G0 Z100.000", "M30", "%"]
@@ -52,8 +53,8 @@ def test_a_hand_written_fanuc_hobbing_program_is_accepted(fanuc):
 
 
 @pytest.mark.parametrize("lines, block, reason", [
-    (replaced(SYNC, "G81 T40 L-1 Q200000"), "G81 T40 L-1 Q200000", "with Q but without P"),
-    (replaced(SYNC, "G81 T40 L-1 P150000"), "G81 T40 L-1 P150000", "with P but without Q"),
+    (replaced(SYNC, "G81 T40 L-1 Q2.5"), "G81 T40 L-1 Q2.5", "with Q but without P"),
+    (replaced(SYNC, "G81 T40 L-1 P15."), "G81 T40 L-1 P15.", "with P but without Q"),
     (replaced(SYNC, "G81 T40 L0"), "G81 T40 L0", "a hob has at least one thread"),
     (replaced(SYNC, "G81 T0 L-1"), "G81 T0 L-1", "T0 is outside 1 … 1000"),
     (replaced(SYNC, "G81 T1001 L-1"), "G81 T1001 L-1", "T1001 is outside 1 … 1000"),
@@ -72,10 +73,13 @@ def test_each_rule_refuses_its_block_in_one_line(fanuc, lines, block, reason):
     ("G81 L-1", "without T (the gear's number of teeth)"),
     ("G81 T40 L22", "L22 is outside -21 … +21, not 0"),
     ("G81 T40 L-22", "L-22 is outside -21 … +21, not 0"),
-    ("G81 T40. L-1", "whole numbers without a decimal point"),
-    ("G81 T40 L-1 Q2.5 P15.", "whole numbers without a decimal point"),
+    ("G81 T40. L-1", "T is a whole count, without a decimal point"),
+    ("G81 T40 L-1 Q250000 P150000", "Q250000 needs a decimal point"),
+    ("G81 T40 L-1 Q2.5 P15", "P15 needs a decimal point"),
+    ("G81 T40 L-1 Q30. P15.", "the module Q must be within 0.1 … 25 mm"),
+    ("G81 T40 L-1 Q2.5 P-91.", "the helix angle P must be within -90 … 90°"),
     ("G81 T+40 L-1", "the number of teeth has no sign"),
-    ("G81 T40 L-1 Q0 P150000", "a module must be above 0"),
+    ("G81 T40 L-1 Q0. P15.", "the module Q must be within 0.1 … 25 mm"),
     ("G81 T40 L-1 X52.500", "a G81 block holds only T, L, Q, P"),
     ("G0 G81 T40 L-1", "a G81 block holds only T, L, Q, P"),
     ("G81 G80", "G81 and G80 in one block"),
@@ -134,14 +138,14 @@ def test_the_m_series_form_g81_4_is_its_own_dialect(fanuc):
     """dialect "fanuc-g81.4": G81.4 R<teeth 1…500> L<±threads 1…30> [Q P] and G80.4; G81 is the
     drilling cycle there, not in the table."""
     m_series = replace(fanuc, dialect="fanuc-g81.4")
-    lines = replaced("G80", "G80.4", lines=replaced(SYNC, "G81.4 R40 L-1 Q200000 P150000"))
+    lines = replaced("G80", "G80.4", lines=replaced(SYNC, "G81.4 R40 L-1 Q2.5 P15."))
     verify_program(lines, m_series, NAME)
-    verify_program(replaced("G81.4 R40 L-1 Q200000 P150000", "G81.4 R500 L30", lines=lines), m_series, NAME)
+    verify_program(replaced("G81.4 R40 L-1 Q2.5 P15.", "G81.4 R500 L30", lines=lines), m_series, NAME)
     for sync, reason in (("G81.4 R501 L-1", "R501 is outside 1 … 500"), ("G81.4 R40 L31", "L31 is outside -30 … +30"),
-                         ("G81.4 R40 L-1 Q200000", "with Q but without P"),
+                         ("G81.4 R40 L-1 Q2.5", "with Q but without P"),
                          ("G81", "G81 is not a G code of the Fanuc hobbing G81.4 in G54 grammar"),
                          ("G81 T40 L-1", "line 10 'G81 T40 L-1'")):
-        assert reason in refusal(m_series, replaced("G81.4 R40 L-1 Q200000 P150000", sync, lines=lines))
+        assert reason in refusal(m_series, replaced("G81.4 R40 L-1 Q2.5 P15.", sync, lines=lines))
     assert "M30 while the table is synchronised to the hob: G80.4 first" in refusal(m_series, replaced("G80.4",
                                                                                                        lines=lines))
 
@@ -159,3 +163,19 @@ def test_a_fanuc_hobbers_lineage_line_is_a_comment_its_grammar_reads(fanuc):
     lines = {dialect: lineage_line(words, dialect) for dialect in ("fanuc", "fanuc-g81.4")}
     assert set(lines.values()) == {"(PROGRAM 7 TEMPLATE spur v1 7d5cca25 INPUT 80c6b886)"}
     verify_program(replaced("(GEAR 42 HELICAL)", lines["fanuc"]), fanuc, NAME)
+
+
+def test_instantiate_on_a_fanuc_hobber_is_refused_by_name_and_stores_nothing(run):
+    """The verifier reads Fanuc hobbing, but no template emits it yet: a gear made on a Fanuc
+    hobber is refused in one line naming the machine and its dialect, before any program is
+    planned, and nothing is stored."""
+    with psycopg.connect(run.url) as conn:
+        conn.execute("UPDATE machine SET dialect = 'fanuc' WHERE name = 'hobber-840d'")
+        before = conn.execute("SELECT count(*) FROM program").fetchone()[0]
+    result = run("instantiate", "--gear", 42)
+    assert result.exit_code == 1, result.output
+    assert result.stderr.strip().splitlines() == [
+        "error: machine hobber-840d runs dialect fanuc: the engine makes hobbing programs for 840d only so far "
+        "(Fanuc: issue 30); use --machine hobber-840d"]
+    with psycopg.connect(run.url) as conn:
+        assert conn.execute("SELECT count(*) FROM program").fetchone()[0] == before

@@ -6,18 +6,21 @@ Q… P… and G80.4). Such a block is the command alone: its words are its argum
 dialect's addresses (T here is the tooth count, not a tool), so it is read here, before the
 block reader would take T for a tool call.
 
-Every word is a whole number without a decimal point: T (or R) and L are counts, and Q (the
-module) and P (the helix angle) are read in the control's least increment, whose unit differs
-between the manuals (Q in 0.00001 mm; P in 0.0001° or 0.00001°) and is left to the machine
-record: the grammar checks only their form and that they come as a pair (one alone is Fanuc
-alarm PS0594), and a module above 0. Without Q and P the control adds no helical differential;
-with them it computes one the verifier does not bound (the table speed checked is S·|L|/T)."""
+T (or R) and L are whole counts without a decimal point. Q (the module) and P (the helix angle)
+must carry one: without it the control reads them in its least increment, whose unit differs
+between the manuals (Q in 0.00001 mm; P in 0.0001° in the 15i-MA operator's manual, 0.00001°
+in the 15i-B connection manual: reference fanuc-egb.md §F1), so a whole number there has no unit
+the verifier can know; with the point, Q2.5 is 2.5 mm and P15. is 15°, the form the reference
+(§F1, §F7) has the engine write. They come as a pair (one alone is Fanuc alarm PS0594), Q within
+the 0.1 … 25 mm the 15i-B connection manual gives, P within ±90°. Without Q and P the control
+adds no helical differential; with them it computes one the verifier does not bound (the table
+speed checked is S·|L|/T)."""
 from __future__ import annotations
 
 import re
 from typing import TYPE_CHECKING
 
-from .numbers import whole_number
+from .numbers import plain_decimal, whole_number
 from .refusals import Refused
 from .statements import Statement
 
@@ -27,9 +30,8 @@ if TYPE_CHECKING:
 CODE = re.compile(r"G0*(\d+(?:\.\d+)?)")
 WORD = re.compile(r"([A-Z])(.*)")
 COUNT_DIGITS = 4          # teeth at most 1000, threads at most 30: a longer number is no count
-# Q and P in the control's least increment: 25 mm of module in 0.00001 mm and 90° of helix in
-# 0.00001° are 7 digits; 8 hold either manual's unit, and no more is a value of them.
-INCREMENT_DIGITS = 8
+MODULE_MM = (0.1, 25.0)        # Q with its decimal point, mm (15i-B connection manual, fanuc-egb.md §F1)
+HELIX_DEGREES = (-90.0, 90.0)  # P with its decimal point, degrees (°), signed by the gear's hand
 
 
 def read_synchronisation(dialect: Dialect, code: str) -> Statement | None:
@@ -108,15 +110,18 @@ def _count(event: str, address: str, text: str, bounds: range, signed: bool) -> 
 
 
 def _increment(event: str, address: str, text: str, module: bool) -> None:
-    """Q or P: a whole number of the control's least increment (its unit the machine record's);
-    the module (the pair's first) above 0 in any unit, the helix angle signed by its hand."""
-    _no_point(event, address, text)
-    value = whole_number(address, text, INCREMENT_DIGITS)
-    if module and value <= 0:
-        raise Refused(f"{event} {address}{text}: a module must be above 0")
+    """Q (the pair's first: the module, mm) or P (the helix angle, degrees), each written with its
+    decimal point, within the range the manual gives."""
+    if "." not in text:
+        raise Refused(f"{event} {address}{text} needs a decimal point: without one the control reads it in its "
+                      "least increment, whose unit the Fanuc manuals give differently (reference fanuc-egb.md §F1)")
+    value = plain_decimal(address, text)
+    low, high = MODULE_MM if module else HELIX_DEGREES
+    if not low <= value <= high:
+        what, unit = ("the module Q", " mm") if module else ("the helix angle P", "°")
+        raise Refused(f"{event} {address}{text}: {what} must be within {low:g} … {high:g}{unit}")
 
 
 def _no_point(event: str, address: str, text: str) -> None:
     if "." in text:
-        raise Refused(f"{event} {address}{text}: the words of {event} are whole numbers without a decimal point "
-                      "(Q and P in the control's least increment, whose unit the machine record is to state)")
+        raise Refused(f"{event} {address}{text}: {address} is a whole count, without a decimal point")
