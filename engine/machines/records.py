@@ -94,6 +94,10 @@ MACHINE_QUERY = f"SELECT {columns(Machine)} FROM machine"  # static, from the da
 
 
 DEFAULT_HOBBING_MACHINE = "hobber-840d"
+# The dialects the hobbing templates are written in. The verifier also reads Fanuc hobbing
+# (issue 30, G81/G80), but no template emits it yet: such a record is refused by name here,
+# not at the first line of a program written for another control.
+HOBBING_DIALECTS_MADE = ("840d",)
 
 
 def hobbing_machine(conn: Connection, name: str | None) -> Machine:
@@ -101,6 +105,10 @@ def hobbing_machine(conn: Connection, name: str | None) -> Machine:
     machine = load_machine(conn, name or DEFAULT_HOBBING_MACHINE)
     if machine.kind != "hobber":
         raise EngineError(f"machine {machine.name} is a {machine.kind}, not a hobbing machine; "
+                          f"use --machine {DEFAULT_HOBBING_MACHINE}")
+    if machine.dialect not in HOBBING_DIALECTS_MADE:
+        raise EngineError(f"machine {machine.name} runs dialect {machine.dialect}: the engine makes hobbing programs "
+                          f"for {', '.join(HOBBING_DIALECTS_MADE)} only so far (Fanuc: issue 30); "
                           f"use --machine {DEFAULT_HOBBING_MACHINE}")
     return machine
 

@@ -16,7 +16,7 @@ from ..names import shown
 LINEAGE_ROW_ID = -1
 UNVERIFIED = "UNVERIFIED"   # the word of a program no verifier read, in its lineage line and listings
 # Comment forms by dialect: ISO/Fanuc comments are in parentheses, 840D ones follow `;`.
-COMMENT_FORMS = {"iso": "({})"}
+COMMENT_FORMS = {"iso": "({})", "fanuc": "({})", "fanuc-g81.4": "({})"}
 DEFAULT_COMMENT_FORM = "; {}"
 # The line a template writes its version on (the lineage follows it), and the program header
 # lines it must not come before when a template writes none.

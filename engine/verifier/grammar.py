@@ -17,7 +17,15 @@ import re
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
 
-from .machine_state import HOBBING_STATE, LATHE_840D_STATE, LATHE_ISO_STATE, LINUXCNC_STATE, StateRules
+from .machine_state import (
+    FANUC_G81_4_HOBBING_STATE,
+    FANUC_HOBBING_STATE,
+    HOBBING_STATE,
+    LATHE_840D_STATE,
+    LATHE_ISO_STATE,
+    LINUXCNC_STATE,
+    StateRules,
+)
 from .refusals import Refused
 
 if TYPE_CHECKING:
@@ -60,6 +68,30 @@ class Header:
 
 
 @dataclass(frozen=True)
+class Synchronisation:
+    """A Fanuc electronic-gear-box command "compatible with a hobbing machine" (Fanuc 15i/150i-MA
+    operator's manual §19.9.2; the M-series form G81.4 of the 16i/18i/21i): a G code whose block
+    is the command alone, its words its arguments, not the dialect's addresses (in G81 T is the
+    gear's number of teeth, not a tool). `on` starts the table's synchronisation with the hob
+    spindle, or changes its ratio when it is on; otherwise the block cancels it. The table turns
+    |threads|/teeth turns per hob turn, the sign of the threads giving its direction. The paired
+    words (module and helix angle of the helical compensation) are read as whole numbers in the
+    control's units, which the machine record is to state (engine.verifier.synchronisation)."""
+    code: str                        # after the G, leading zeros aside: "81", "80.4"
+    on: bool                         # starts or re-rates the synchronisation; False: cancels it
+    teeth: str = ""                  # the address of the gear's number of teeth
+    teeth_range: range = range(0)
+    threads: str = ""                # the address of the hob's number of threads (starts), signed, never 0
+    threads_range: range = range(0)
+    paired: tuple[str, ...] = ()     # given both or neither (Fanuc alarm PS0594 for one alone)
+
+    @property
+    def event(self) -> str:
+        """Its name in the machine-state rules and the walk ("G81")."""
+        return f"G{self.code}"
+
+
+@dataclass(frozen=True)
 class Dialect:
     """What the verifier reads a machine's programs as: headers, comments, addresses, G and M codes, state rules."""
     name: str
@@ -82,6 +114,8 @@ class Dialect:
     framing_optional: bool = False        # ISO: the tape marks % may be left out; then the O line comes first
     expander: str | None = None           # the bounded interpreter of engine.verifier.expansion that turns
                                           # cycles, subprograms, parameters and jumps into plain lines
+    synchronisations: tuple[Synchronisation, ...] = ()   # Fanuc hobbing: the EGB command blocks (G81/G80)
+    record_work_offset: bool = False      # only the record's work offset of G54…G57 (machine.work_offset)
 
     def code_group(self, letter: str, code: int) -> str:
         codes = self.m_codes if letter == "M" else self.g_codes
@@ -179,12 +213,16 @@ LATHE_840D = Dialect(
     expander="840d-lathe",
 )
 
+ISO_HEADERS = (Header("tape mark %", re.compile(r"%"), frozenset({"first", "last"}), frozenset({"first", "last"})),
+               Header("program number O<nnnn> (NAME)",
+                      re.compile(rf"O(?P<number>\d{{1,5}})(?: \((?P<name>{ISO_COMMENT_TEXT})\))?"),
+                      frozenset({"first", "second"}), frozenset({"second"})))
+# O9000 … O9999 hold the builder's macros on Fanuc-type controls: a program there replaces one.
+ISO_PROGRAM_NUMBERS, ISO_RESERVED_NUMBERS = range(1, 100000), range(9000, 10000)
+
 LATHE_ISO = Dialect(
     name="ISO lathe",
-    headers=(Header("tape mark %", re.compile(r"%"), frozenset({"first", "last"}), frozenset({"first", "last"})),
-             Header("program number O<nnnn> (NAME)",
-                    re.compile(rf"O(?P<number>\d{{1,5}})(?: \((?P<name>{ISO_COMMENT_TEXT})\))?"),
-                    frozenset({"first", "second"}), frozenset({"second"}))),
+    headers=ISO_HEADERS,
     comment="parentheses",
     addresses={"X": POSITION, "Z": POSITION, "F": FEED, "S": SPEED, "T": TOOL_AND_OFFSET, "R": RADIUS,
                "G": CODE, "M": CODE},
@@ -196,9 +234,8 @@ LATHE_ISO = Dialect(
     needs_words={2: "R", 3: "R", 32: "F"},
     thread_lead={32: "F"},
     point_required=frozenset({"X", "Z", "R", "F"}),
-    # O9000 … O9999 hold the builder's macros on Fanuc-type controls: a program there replaces one.
-    program_numbers=range(1, 100000),
-    reserved_numbers=range(9000, 10000),
+    program_numbers=ISO_PROGRAM_NUMBERS,
+    reserved_numbers=ISO_RESERVED_NUMBERS,
     framing_optional=True,
     expander="iso",
 )
@@ -226,21 +263,65 @@ LATHE_LINUXCNC = Dialect(
     expander="linuxcnc",
 )
 
+# Fanuc hobbing (issue 30): a hobber's program in ISO framing (% … %, O<n> (NAME)), absolute mm
+# (G21 G90), feed per minute (G94; G95 refused as on the 840D hobber), the record's work offset
+# G54…G57, hob spindle M3/M5 S, coolant M8/M9, a tool call T<n>, and the table synchronised to the
+# hob by the electronic gear box: G81 T<teeth> L<±threads> [Q<module> P<helix angle>] … G80 (Fanuc
+# 15i/150i-MA operator's manual §19.9.2; a second G81 while on changes the ratio). Fanuc's G25/G26
+# detect spindle-speed fluctuation, so there is no working area: positions are held to the travel.
+FANUC_G81 = Synchronisation("81", True, "T", range(1, 1001), "L", range(-21, 22), ("Q", "P"))
+FANUC_G80 = Synchronisation("80", False)
+HOBBING_FANUC = Dialect(
+    name="Fanuc hobbing",
+    headers=ISO_HEADERS,
+    comment="parentheses",
+    addresses={"X": POSITION, "Y": POSITION, "Z": POSITION, "A": ANGLE, "F": FEED, "S": SPEED, "T": TOOL,
+               "G": CODE, "M": CODE},
+    g_codes={0: MOTION, 1: MOTION, 21: "units", 90: "distance", 94: "feed type",
+             **{code: "work offset" for code in WORK_OFFSETS}},
+    m_codes={code: M_GROUPS[code] for code in (3, 5, 8, 9, 30)},
+    state=FANUC_HOBBING_STATE,
+    point_required=frozenset({"X", "Y", "Z", "A", "F"}),
+    program_numbers=ISO_PROGRAM_NUMBERS,
+    reserved_numbers=ISO_RESERVED_NUMBERS,
+    synchronisations=(FANUC_G81, FANUC_G80),
+    record_work_offset=True,
+)
+# The M-series form (Fanuc 16i/18i/21i, where G81 is the drilling cycle): G81.4 R<teeth 1…500>
+# L<±threads 1…30> [Q P] … G80.4; otherwise as HOBBING_FANUC.
+HOBBING_FANUC_G81_4 = replace(
+    HOBBING_FANUC, name="Fanuc hobbing G81.4", state=FANUC_G81_4_HOBBING_STATE,
+    synchronisations=(Synchronisation("81.4", True, "R", range(1, 501), "L", range(-30, 31), ("Q", "P")),
+                      Synchronisation("80.4", False)))
+
 # machine.kind, machine.dialect -> the grammar its programs are read with.
 DIALECTS = {("hobber", "840d"): HOBBING_840D, ("lathe", "840d"): LATHE_840D, ("lathe", "iso"): LATHE_ISO,
-            ("lathe", "linuxcnc"): LATHE_LINUXCNC}
+            ("lathe", "linuxcnc"): LATHE_LINUXCNC, ("hobber", "fanuc"): HOBBING_FANUC,
+            ("hobber", "fanuc-g81.4"): HOBBING_FANUC_G81_4}
 
 
 def dialect_for(machine: Machine) -> Dialect:
     """The grammar of a machine's programs: its dialect, and on a hobber the door M functions
     its record names (they are the machine builder's, so no dialect holds them)."""
     found = dialect_of(machine.kind, machine.dialect)
+    if found.record_work_offset:
+        found = _in_record_work_offset(found, machine.work_offset)
     doors = tuple(code for code in (machine.door_close_m, machine.door_open_m) if code is not None)
     if machine.kind != "hobber" or not doors:
         return found
     codes = {**found.m_codes, **{int(code): DOOR_GROUP for code in doors}}
     name = f"{found.name} with doors {'/'.join(f'M{int(code)}' for code in doors)}"
     return replace(found, name=name, m_codes=codes)
+
+
+def _in_record_work_offset(found: Dialect, work_offset: str) -> Dialect:
+    """Fanuc hobbing: of G54…G57 only the record's, the frame its travel is stated in (another
+    would shift every position by an offset the verifier cannot see; the 840D hobber's is held to
+    the record by the simulation, which reads no Fanuc program yet). Named by it, as the lines
+    read are remembered per grammar name (engine.verifier.lines)."""
+    codes = {code: group for code, group in found.g_codes.items()
+             if group != "work offset" or f"G{code}" == work_offset}
+    return replace(found, name=f"{found.name} in {work_offset}", g_codes=codes)
 
 
 def dialect_of(kind: str, dialect: str) -> Dialect:

@@ -14,6 +14,7 @@ from .grammar import ISO_COMMENT_TEXT, Dialect, Header
 from .refusals import Refused
 from .shift_clamp import ShiftLine, read_shift_line
 from .statements import STATEMENT, Statement, read_statement
+from .synchronisation import read_synchronisation
 
 MAX_REMEMBERED = 20_000   # lines kept per dialect; the memory starts again when full
 ISO_LINE = re.compile(rf"([^()]*?) ?(?:\(({ISO_COMMENT_TEXT})\))?")
@@ -81,6 +82,10 @@ def _read(dialect: Dialect, line: str) -> Line:
         shift = read_shift_line(code)
         if shift is not None:
             return shift
+    if dialect.synchronisations:
+        synchronisation = read_synchronisation(dialect, code)
+        if synchronisation is not None:
+            return synchronisation
     statement = STATEMENT.fullmatch(code)
     if statement and statement.group(1) in dialect.statements:
         return read_statement(*statement.groups())

@@ -105,9 +105,10 @@ AREA_NEEDS = Needs(*(Need(fact, AREA_REASON) for fact in ("G25", "G26", "WALIMON
 COUPLING = {"EGDEF": sets(COUPLING_DEFINED), "EGON": sets(COUPLED),
             "EGOFS": clears(COUPLED), "EGDEL": clears(COUPLED, COUPLING_DEFINED)}
 WORK_OFFSETS = {f"G{code}": sets(WORK_OFFSET) for code in (54, 55, 56, 57)}
-HOB_MOVE_NEEDS = AREA_NEEDS + needs_stated(90, 71) + Needs(
+WORK_OFFSET_NEEDS = Needs(
     Need(WORK_OFFSET, "a hob move before a work offset (G54…G57) is selected: the position would be read in "
                       "whatever frame the last program left"))
+HOB_MOVE_NEEDS = AREA_NEEDS + needs_stated(90, 71) + WORK_OFFSET_NEEDS
 HOB_CUT_NEEDS = HOB_MOVE_NEEDS + needs_stated(94) + SPINDLE_NEEDS + Needs(
     Need(COUPLED, "a cut with the table not coupled to the hob: EGON(C,…) first, and no EGOFS(C) since"))
 
@@ -126,6 +127,31 @@ HOBBING_STATE = StateRules(
                                                "(the next program's EGDEF would alarm, reference §A7)",
                              present=False))},
 )
+
+
+def fanuc_hobbing_state(on: str, off: str, form: str) -> StateRules:
+    """Fanuc hobbing (issue 30): the electronic gear box's `on` command (G81 T… L…, written `form`)
+    synchronises the table to the hob spindle, a second one changes the ratio, `off` (G80) cancels
+    it. Every move in mm, absolute, in a work offset; a cut (G1) also at a feed per minute with
+    the hob turning and the table synchronised; `on` only with Y (the hob shift) positioned, as
+    EGON (reference §A7); M30 only after `off`, so the next program does not start synchronised.
+    No working area: Fanuc's G25/G26 switch spindle-speed fluctuation detection."""
+    move = needs_stated(90, 21) + WORK_OFFSET_NEEDS
+    cut = move + needs_stated(94) + SPINDLE_NEEDS + Needs(
+        Need(COUPLED, f"a cut with the table not synchronised to the hob: {form} first, and no {off} since"))
+    return StateRules(
+        effects={**stated(21, 90, 94), **SPINDLE, **END, **WORK_OFFSETS, on: sets(COUPLED), off: clears(COUPLED),
+                 Y_POSITION: sets(Y_POSITIONED)},
+        needs={"G0": move, "G1": cut,
+               on: Needs(Need(Y_POSITIONED, f"{on} before Y (the hob shift) is positioned: the generating zone "
+                                            "would lie wherever the last program left the hob (reference §A7)")),
+               off: Needs(),
+               "M30": Needs(Need(COUPLED, f"M30 while the table is synchronised to the hob: {off} first (the "
+                                          "next program would start synchronised)", present=False))})
+
+
+FANUC_HOBBING_STATE = fanuc_hobbing_state("G81", "G80", "G81 T… L…")
+FANUC_G81_4_HOBBING_STATE = fanuc_hobbing_state("G81.4", "G80.4", "G81.4 R… L…")
 
 LATHE_840D_MOVE = Needs(Need("DIAMON", "motion before DIAMON: X would be a radius, and the travel is checked as a "
                                       "diameter")) + needs_stated(71, 90)

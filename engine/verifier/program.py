@@ -287,6 +287,12 @@ class ProgramReading:
     def _uncouple(self, statement: Statement) -> None:
         self.ratio, self.differential = None, {}
 
+    def _synchronise(self, statement: Statement) -> None:
+        """Fanuc G81 (engine.verifier.synchronisation): the table at |L|/T of the hob, no
+        differential the verifier knows of; a second G81 while on replaces the ratio."""
+        self.ratio, self.differential = statement.ratio, {}
+        self._check_table()
+
     def _delete_coupling(self, statement: Statement) -> None:
         self.coupled_axes = self.ratio = None
         self.differential = {}
@@ -308,7 +314,9 @@ TAKERS: dict[str, Callable[[ProgramReading, int, Any], None]] = {
     "statement": ProgramReading._statement, "shift": ProgramReading._shift}
 STATEMENT_TAKERS: dict[str, Callable[[ProgramReading, Statement], None]] = {
     "EGDEF": ProgramReading._define_coupling, "EGON": ProgramReading._couple,
-    "EGOFS": ProgramReading._uncouple, "EGDEL": ProgramReading._delete_coupling}
+    "EGOFS": ProgramReading._uncouple, "EGDEL": ProgramReading._delete_coupling,
+    "G81": ProgramReading._synchronise, "G81.4": ProgramReading._synchronise,
+    "G80": ProgramReading._uncouple, "G80.4": ProgramReading._uncouple}
 
 
 def area_once_problem(limit: str, already_set: bool, moved: bool) -> None:

@@ -31,11 +31,12 @@ MAX_DIFFERENTIAL = 360.0
 
 @dataclass(frozen=True, slots=True)
 class Statement:
-    """A coupling statement (EGDEF, EGON, EGOFS, EGDEL) as read: its leading axes, ratio and factors."""
+    """A coupling statement (EGDEF, EGON, EGOFS, EGDEL; Fanuc G81/G80, engine.verifier.synchronisation)
+    as read: its leading axes, ratio and factors."""
     kind: ClassVar[Literal["statement"]] = "statement"
     name: str
     leading: tuple[str, ...] = ()    # leading axes, in order
-    ratio: float | None = None       # |z0/z2| of the hob spindle (EGON)
+    ratio: float | None = None       # |z0/z2| of the hob spindle (EGON; Fanuc G81 |L|/T)
     factors: tuple[tuple[str, float], ...] = ()   # (axis, |degrees of C per mm|) of Z and Y (EGON)
 
 

@@ -1,0 +1,181 @@
+"""The Fanuc hobbing grammar (issue 30): a hobber whose record says dialect "fanuc" has its
+programs read with the electronic gear box's "command compatible with hobbing machine" (Fanuc
+15i/150i-MA operator's manual §19.9.2): `G81 T<teeth> L<±threads> [Q<module> P<helix>]` starts
+the table's synchronisation with the hob, a second G81 while on changes its ratio, `G80`
+cancels it. The program below is written by hand from those rules; each refusal is one line
+that names the block. The record is the seeded hobber-840d's with dialect "fanuc" (its travel,
+spindle maximum 1000 r/min and table maximum 120 r/min, seed_templates/machines.csv), so the
+expected table speeds are S·|L|/T against the record's own maximum."""
+from __future__ import annotations
+
+from dataclasses import replace
+
+import psycopg
+import pytest
+
+from engine.machines.records import Machine, load_machine
+from engine.nc.lineage import lineage_line, lineage_words
+from engine.verifier import LimitError, verify_program
+
+NAME = "GEAR42"
+SPEED = 246                                   # r/min of the hob: S246
+SYNC = "G81 T40 L-1 Q2.5 P15."          # 40 teeth, one left-turning thread, module 2.5 mm, helix 15°
+PROGRAM = ["%", f"O1234 ({NAME})", "(GEAR 42 HELICAL)", "G21 G90 G94 G54", "T1", "G0 X61.000 Y0.000",
+           "G0 Z19.576 A1.763", f"M3 S{SPEED}", "M8", SYNC, "G0 X52.500", "G1 X51.500 F13.3",
+           "G1 Z-23.380 F29.7", "G0 X61.000", "G80", "M9", "M5", "G0 Z100.000", "M30", "%"]
+
+
+@pytest.fixture
+def fanuc(conn) -> Machine:
+    """The seeded hobber's record, read in the Fanuc dialect."""
+    return replace(load_machine(conn, "hobber-840d"), name="hobber-fanuc", dialect="fanuc")
+
+
+def replaced(old: str, *new: str, lines: list[str] = PROGRAM) -> list[str]:
+    """The program with the line `old` replaced by `new` (none: left out)."""
+    at = lines.index(old)
+    return [*lines[:at], *new, *lines[at + 1:]]
+
+
+def refusal(machine: Machine, lines: list[str]) -> str:
+    with pytest.raises(LimitError) as raised:
+        verify_program(lines, machine, NAME)
+    message = str(raised.value)
+    assert "\n" not in message and message.endswith("nothing stored")
+    return message
+
+
+def test_a_hand_written_fanuc_hobbing_program_is_accepted(fanuc):
+    verify_program(PROGRAM, fanuc, NAME)
+    verify_program(replaced(SYNC, "G81 T40 L-1"), fanuc, NAME)     # no helical compensation: neither Q nor P
+    verify_program([line.replace("G0 ", "G00 ").replace("G1 ", "G01 ").replace("M3 ", "M03 ") for line in PROGRAM],
+                   fanuc, NAME)
+
+
+@pytest.mark.parametrize("lines, block, reason", [
+    (replaced(SYNC, "G81 T40 L-1 Q2.5"), "G81 T40 L-1 Q2.5", "with Q but without P"),
+    (replaced(SYNC, "G81 T40 L-1 P15."), "G81 T40 L-1 P15.", "with P but without Q"),
+    (replaced(SYNC, "G81 T40 L0"), "G81 T40 L0", "a hob has at least one thread"),
+    (replaced(SYNC, "G81 T0 L-1"), "G81 T0 L-1", "T0 is outside 1 … 1000"),
+    (replaced(SYNC, "G81 T1001 L-1"), "G81 T1001 L-1", "T1001 is outside 1 … 1000"),
+    (replaced("G80", "G80", "G1 Z-24.000 F29.7"), "G1 Z-24.000 F29.7", "no G80 since"),
+    (replaced("G80"), "M30", "M30 while the table is synchronised to the hob: G80 first"),
+    (replaced(SYNC), "G1 X51.500 F13.3", "a cut with the table not synchronised to the hob: G81 T… L… first"),
+    (replaced("G0 Z100.000", "G0 Z100"), "G0 Z100", "Z100 needs a decimal point"),
+])
+def test_each_rule_refuses_its_block_in_one_line(fanuc, lines, block, reason):
+    message = refusal(fanuc, lines)
+    assert f"line {lines.index(block) + 1} {block!r}" in message and reason in message
+
+
+@pytest.mark.parametrize("sync, reason", [
+    ("G81 T40", "without L (the hob's threads)"),
+    ("G81 L-1", "without T (the gear's number of teeth)"),
+    ("G81 T40 L22", "L22 is outside -21 … +21, not 0"),
+    ("G81 T40 L-22", "L-22 is outside -21 … +21, not 0"),
+    ("G81 T40. L-1", "T is a whole count, without a decimal point"),
+    ("G81 T40 L-1 Q250000 P150000", "Q250000 needs a decimal point"),
+    ("G81 T40 L-1 Q2.5 P15", "P15 needs a decimal point"),
+    ("G81 T40 L-1 Q30. P15.", "the module Q must be within 0.1 … 25 mm"),
+    ("G81 T40 L-1 Q2.5 P-91.", "the helix angle P must be within -90 … 90°"),
+    ("G81 T+40 L-1", "the number of teeth has no sign"),
+    ("G81 T40 L-1 Q0. P15.", "the module Q must be within 0.1 … 25 mm"),
+    ("G81 T40 L-1 X52.500", "a G81 block holds only T, L, Q, P"),
+    ("G0 G81 T40 L-1", "a G81 block holds only T, L, Q, P"),
+    ("G81 G80", "G81 and G80 in one block"),
+    ("G81 T40 L-1 T40", "T twice in one block"),
+    ("G81.4 R40 L-1", "G81.4 is not a G code"),
+])
+def test_a_g81_block_is_the_command_alone_with_whole_counts_in_range(fanuc, sync, reason):
+    assert reason in refusal(fanuc, replaced(SYNC, sync))
+
+
+@pytest.mark.parametrize("threads", [-21, 21])
+def test_the_most_threads_either_way_are_accepted(fanuc, threads):
+    verify_program(replaced(SYNC, f"G81 T1000 L{threads}"), fanuc, NAME)
+
+
+def test_a_second_g81_while_on_replaces_the_ratio_and_the_table_speed_follows(fanuc):
+    """S·|L|/T: 246·1/40 = 6.2 r/min, then 246·2/4 = 123 r/min, above the record's 120."""
+    assert SPEED * 2 / 4 > fanuc.table_speed_max > SPEED * 2 / 5
+    cut = "G1 Z-23.380 F29.7"
+    verify_program(replaced(cut, cut, "G81 T5 L-2", "G1 Z-24.000 F29.7"), fanuc, NAME)
+    message = refusal(fanuc, replaced(cut, cut, "G81 T4 L-2", "G1 Z-24.000 F29.7"))
+    assert "line 14 'G81 T4 L-2'" in message and f"the table turns at {SPEED * 2 / 4:.1f} r/min" in message
+
+
+@pytest.mark.parametrize("lines, reason", [
+    ([line.replace("G94", "G95") for line in PROGRAM], "G95 feeds per revolution"),
+    ([line.replace("G21 ", "") for line in PROGRAM], "motion before G21 (mm) is stated"),
+    ([line.replace("G90 ", "") for line in PROGRAM], "motion before G90 (absolute positions) is stated"),
+    ([line.replace(" G54", "") for line in PROGRAM], "before a work offset (G54…G57) is selected"),
+    (replaced("G0 X61.000 Y0.000", "G0 X61.000"), "G81 before Y (the hob shift) is positioned"),
+    (replaced(f"M3 S{SPEED}", f"S{SPEED}"), "a cut with the spindle stopped"),
+    (PROGRAM[1:], "the first line must be the tape mark %"),
+    (PROGRAM[:-1], "the last line must be the tape mark %"),
+    (replaced(f"O1234 ({NAME})", f"O9001 ({NAME})"), "O9000 … O9999 hold the machine builder's macros"),
+    (replaced(f"O1234 ({NAME})", "O1234 (OTHER)"), "the header names program OTHER"),
+    (replaced("G0 Z19.576 A1.763", "G0 Z19.576 A1"), "A1 needs a decimal point"),
+    (replaced("G1 X51.500 F13.3", "G1 X51.500 F13"), "F13 needs a decimal point"),
+    (replaced("M8", "M8 ; COOLANT"), "not a word of the Fanuc hobbing in G54 grammar"),
+    (replaced("M8", "M20"), "M20 is not an M code of the Fanuc hobbing in G54 grammar"),
+    (replaced("G80", "G80", "EGOFS(C)"), "EGOFS: not a word of the Fanuc hobbing in G54 grammar"),   # (C) a comment
+])
+def test_fanuc_framing_units_and_modes_are_those_of_the_rules(fanuc, lines, reason):
+    assert reason in refusal(fanuc, lines)
+
+
+def test_only_the_records_work_offset_is_read(fanuc):
+    """The travel is stated in the record's work offset (machine.work_offset, G54 for the seeded
+    hobber); another of G54…G57 would shift every position by an offset the verifier cannot see."""
+    in_g55 = [line.replace("G54", "G55") for line in PROGRAM]
+    assert "G55 shifts every position by a work offset" in refusal(fanuc, in_g55)
+    verify_program(in_g55, replace(fanuc, work_offset="G55"), NAME)
+    assert "G54 shifts every position by a work offset" in refusal(replace(fanuc, work_offset="G55"), PROGRAM)
+
+
+def test_the_m_series_form_g81_4_is_its_own_dialect(fanuc):
+    """dialect "fanuc-g81.4": G81.4 R<teeth 1…500> L<±threads 1…30> [Q P] and G80.4; G81 is the
+    drilling cycle there, not in the table."""
+    m_series = replace(fanuc, dialect="fanuc-g81.4")
+    lines = replaced("G80", "G80.4", lines=replaced(SYNC, "G81.4 R40 L-1 Q2.5 P15."))
+    verify_program(lines, m_series, NAME)
+    verify_program(replaced("G81.4 R40 L-1 Q2.5 P15.", "G81.4 R500 L30", lines=lines), m_series, NAME)
+    for sync, reason in (("G81.4 R501 L-1", "R501 is outside 1 … 500"), ("G81.4 R40 L31", "L31 is outside -30 … +30"),
+                         ("G81.4 R40 L-1 Q2.5", "with Q but without P"),
+                         ("G81", "G81 is not a G code of the Fanuc hobbing G81.4 in G54 grammar"),
+                         ("G81 T40 L-1", "line 10 'G81 T40 L-1'")):
+        assert reason in refusal(m_series, replaced("G81.4 R40 L-1 Q2.5 P15.", sync, lines=lines))
+    assert "M30 while the table is synchronised to the hob: G80.4 first" in refusal(m_series, replaced("G80.4",
+                                                                                                       lines=lines))
+
+
+def test_an_840d_program_is_refused_on_a_fanuc_hobber(fanuc):
+    lines = ["%_N_GEAR42_MPF", ";$PATH=/_N_MPF_DIR", "G90 G71 G94", "M30"]
+    message = refusal(fanuc, lines)
+    assert "line 1 '%_N_GEAR42_MPF': %_N_GEAR42_MPF: not a word of the Fanuc hobbing in G54 grammar" in message
+
+
+def test_a_fanuc_hobbers_lineage_line_is_a_comment_its_grammar_reads(fanuc):
+    """The engine's lineage line (engine.nc.lineage) stands in parentheses on a Fanuc hobber, so
+    the grammar reads it as a comment and the control skips it."""
+    words = lineage_words(7, "spur", 1, "7d5cca25" * 8, "80c6b886" * 8, draft=False)
+    lines = {dialect: lineage_line(words, dialect) for dialect in ("fanuc", "fanuc-g81.4")}
+    assert set(lines.values()) == {"(PROGRAM 7 TEMPLATE spur v1 7d5cca25 INPUT 80c6b886)"}
+    verify_program(replaced("(GEAR 42 HELICAL)", lines["fanuc"]), fanuc, NAME)
+
+
+def test_instantiate_on_a_fanuc_hobber_is_refused_by_name_and_stores_nothing(run):
+    """The verifier reads Fanuc hobbing, but no template emits it yet: a gear made on a Fanuc
+    hobber is refused in one line naming the machine and its dialect, before any program is
+    planned, and nothing is stored."""
+    with psycopg.connect(run.url) as conn:
+        conn.execute("UPDATE machine SET dialect = 'fanuc' WHERE name = 'hobber-840d'")
+        before = conn.execute("SELECT count(*) FROM program").fetchone()[0]
+    result = run("instantiate", "--gear", 42)
+    assert result.exit_code == 1, result.output
+    assert result.stderr.strip().splitlines() == [
+        "error: machine hobber-840d runs dialect fanuc: the engine makes hobbing programs for 840d only so far "
+        "(Fanuc: issue 30); use --machine hobber-840d"]
+    with psycopg.connect(run.url) as conn:
+        assert conn.execute("SELECT count(*) FROM program").fetchone()[0] == before
