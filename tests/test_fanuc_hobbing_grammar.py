@@ -96,12 +96,13 @@ def test_the_most_threads_either_way_are_accepted(fanuc, threads):
 
 
 def test_a_second_g81_while_on_replaces_the_ratio_and_the_table_speed_follows(fanuc):
-    """S·|L|/T: 246·1/40 = 6.2 r/min, then 246·2/4 = 123 r/min, above the record's 120."""
+    """S·|L|/T: 246·1/40 = 6.2 r/min, then 246·2/4 = 123 r/min, above the record's 120. The second
+    gear is spur, P0. (the manual's helical then spur gear in succession, fanuc-egb.md §F2)."""
     assert SPEED * 2 / 4 > fanuc.table_speed_max > SPEED * 2 / 5
     cut = "G1 Z-23.380 F29.7"
-    verify_program(replaced(cut, cut, "G81 T5 L-2", "G1 Z-24.000 F29.7"), fanuc, NAME)
-    message = refusal(fanuc, replaced(cut, cut, "G81 T4 L-2", "G1 Z-24.000 F29.7"))
-    assert "line 14 'G81 T4 L-2'" in message and f"the table turns at {SPEED * 2 / 4:.1f} r/min" in message
+    verify_program(replaced(cut, cut, "G81 T5 L-2 Q2.5 P0.", "G1 Z-24.000 F29.7"), fanuc, NAME)
+    message = refusal(fanuc, replaced(cut, cut, "G81 T4 L-2 Q2.5 P0.", "G1 Z-24.000 F29.7"))
+    assert "line 14 'G81 T4 L-2 Q2.5 P0.'" in message and f"the table turns at {SPEED * 2 / 4:.1f} r/min" in message
 
 
 @pytest.mark.parametrize("lines, reason", [
@@ -123,6 +124,78 @@ def test_a_second_g81_while_on_replaces_the_ratio_and_the_table_speed_follows(fa
 ])
 def test_fanuc_framing_units_and_modes_are_those_of_the_rules(fanuc, lines, reason):
     assert reason in refusal(fanuc, lines)
+
+
+def test_a_z_move_under_helical_compensation_turns_the_table_by_q_and_p(fanuc):
+    """§F4: C turns Z·sin P·360/(π·T·Q)° with every Z move after G81, rapid ones too (§F7): for T10
+    Q1. P30. 5.73°/mm, so G0 Z at the record's 8,000 mm/min adds 127.3 r/min to 246·1/10 = 24.6,
+    above the 120 r/min table (it was accepted: the verifier bounded S·|L|/T only). The same G0 Z
+    is accepted without Q and P, and the cut at F29.7 with them."""
+    small = replaced(SYNC, "G81 T10 L-1 Q1. P30.")
+    rapid = replaced("G1 Z-23.380 F29.7", "G0 Z-23.380", lines=small)
+    message = refusal(fanuc, rapid)
+    assert "line 13 'G0 Z-23.380'" in message and "the table turns at 151.9 r/min" in message
+    assert "G0 Z 5.72958°/mm × 8000 mm/min" in message
+    verify_program(replaced("G81 T10 L-1 Q1. P30.", "G81 T10 L-1", lines=rapid), fanuc, NAME)
+    verify_program(small, fanuc, NAME)
+
+
+CUT = "G1 Z-23.380 F29.7"
+
+
+@pytest.mark.parametrize("after_cut, reason, after_g80", [
+    ("G0 Y5.", "a Y move (hob shift) while the table is synchronised to the hob (G81, no G80 since)", "G0 Y5."),
+    ("G1 Y5. Z-24.000 F29.7", "G81 has no Y term", "G0 Y5. Z-24.000"),
+    ("G0 Y0.000", "a Y move (hob shift) while", "G0 Y0.000"),       # at the Y held: refused all the same
+    ("G0 A2.000", "an A move (swivel) while the table is synchronised", "G0 A2.000"),
+    ("T2", "a tool call T while the table is synchronised", None),
+    ("G81 T40 L-1", "G81 without Q and P after a G81 that gave them", None),
+])
+def test_what_g81_cannot_follow_waits_for_g80(fanuc, after_cut, reason, after_g80):
+    """fanuc-egb.md §F6: G81 has no Y term, so a hob shift while synchronised slides the thread
+    against the teeth; a swivel or a hob change under it likewise; a re-rating G81 without Q and P
+    leaves the compensation to what the manual does not say. Each was accepted before; the move
+    after G80 is."""
+    message = refusal(fanuc, replaced(CUT, CUT, after_cut))
+    assert f"line 14 {after_cut!r}" in message and reason in message
+    if after_g80 is not None:
+        verify_program(replaced("G80", "G80", after_g80), fanuc, NAME)
+
+
+def test_a_tool_call_waits_for_g80_and_the_hob_to_stop(fanuc):
+    assert "a tool call T with the hob turning" in refusal(fanuc, replaced("G80", "G80", "T2"))
+    verify_program(replaced("G0 Z100.000", "G0 Z100.000", "T2"), fanuc, NAME)
+
+
+def test_a_blocks_own_m_codes_may_come_before_its_motion(fanuc):
+    """When a block's M code is output, before or after its motion, is the builder's choice: `G1 Z…
+    M5` may feed the hob stopping (the table stops with it, Z does not) and `T1 M3` may start the
+    hob under a tool change. Both were accepted; a cut's M3 in its own block is not counted on."""
+    assert "a cut with the spindle stopped" in refusal(fanuc, replaced(CUT, f"{CUT} M5"))
+    assert "a tool call T with the hob turning" in refusal(fanuc, replaced("T1", lines=replaced(
+        f"M3 S{SPEED}", f"T1 M3 S{SPEED}")))
+    verify_program(replaced("M5", lines=replaced("G0 X61.000", "G0 X61.000 M5")), fanuc, NAME)
+
+
+def test_a_semicolon_in_a_comment_is_refused(fanuc):
+    """Fanuc prints ; for the end of block: `(GEAR;G1 Z-300.)` would hide a block from the verifier
+    from a reader taking it so (it was read as a comment)."""
+    message = refusal(fanuc, replaced("(GEAR 42 HELICAL)", "(GEAR;G0 Z-300.)"))
+    assert "line 3 '(GEAR;G0 Z-300.)': a ; in a comment" in message
+
+
+@pytest.mark.parametrize("lines", [
+    replaced(SYNC, "G81.0 T40 L-1"), replaced(SYNC, "g81 T40 L-1"), replaced(SYNC, "G 81 T40 L-1"),
+    replaced(SYNC, "G81T40L-1"), replaced(SYNC, "/G81 T40 L-1"), replaced(SYNC, "N10 G81 T40 L-1"),
+    replaced(SYNC, "G81 T40 L-0"), replaced(SYNC, "G81 T40 L-1 Q2E1 P15."), replaced(SYNC, "G81 T40 L-1 Q2.5.5 P15."),
+    replaced(SYNC, "G81 T40 L-1 Q2.5 P15.;"), replaced(SYNC, "G81 (X) T40 L-1"), replaced(CUT, CUT, "G81 Q2.5 P15."),
+    replaced("G80", "G80 X61."), replaced("G80", "N20 G80"), replaced("G80", "M99", "G80"), replaced("G80", "%", "G80"),
+    replaced("G80", "O1235", "G80"), replaced(CUT, CUT, "G28 Z100."), replaced(CUT, "G1 Z-23.380 F29.7 x5."),
+    replaced(CUT, "Z-23.380 F29.7"), replaced("(GEAR 42 HELICAL)", "(GEAR % 42)"),
+], ids=lambda lines: next(line for line, old in zip(lines, PROGRAM) if line != old))
+def test_attacks_on_the_g81_grammar_stay_refused(fanuc, lines):
+    """Spellings a Fanuc would read otherwise, or that hide words or end the program: all refused."""
+    refusal(fanuc, lines)
 
 
 def test_only_the_records_work_offset_is_read(fanuc):

@@ -96,7 +96,8 @@ class Dialect:
     """What the verifier reads a machine's programs as: headers, comments, addresses, G and M codes, state rules."""
     name: str
     headers: tuple[Header, ...]
-    comment: str                          # "semicolon": `; text` to the end; "parentheses": `(text)`
+    comment: str                          # "semicolon": `; text` to the end; "parentheses": `(text)`;
+                                          # "parentheses without ;": `(text)`, no `;` in it (Fanuc hobbing)
     addresses: dict[str, str]             # address -> value kind
     g_codes: dict[int, str]               # code -> modal group: two of one group in a block are refused
     m_codes: dict[int, str]               # code -> group: M3 and M5 in one block are both spindle
@@ -274,7 +275,7 @@ FANUC_G80 = Synchronisation("80", False)
 HOBBING_FANUC = Dialect(
     name="Fanuc hobbing",
     headers=ISO_HEADERS,
-    comment="parentheses",
+    comment="parentheses without ;",
     addresses={"X": POSITION, "Y": POSITION, "Z": POSITION, "A": ANGLE, "F": FEED, "S": SPEED, "T": TOOL,
                "G": CODE, "M": CODE},
     g_codes={0: MOTION, 1: MOTION, 21: "units", 90: "distance", 94: "feed type",

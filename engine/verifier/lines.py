@@ -118,4 +118,16 @@ def _parentheses(line: str) -> str:
     return match.group(1)
 
 
-SPLIT_COMMENT = {"semicolon": _semicolon, "parentheses": _parentheses}
+def _parentheses_without_semicolon(line: str) -> str:
+    """Fanuc hobbing: as ISO, and no `;` in the comment either. Fanuc's manuals print `;` for the
+    end of block (reference iso-lathe.md, Lines), so a reader or DNC link that takes it so would
+    run the rest of the comment (`(A;G1 Z-300.;)`) as a block the verifier read as a comment."""
+    code = _parentheses(line)
+    if ";" in line[len(code):]:
+        raise Refused("a ; in a comment: Fanuc prints ; for the end of block, and a reader taking it so would run "
+                      "what follows as a block nobody checked")
+    return code
+
+
+SPLIT_COMMENT = {"semicolon": _semicolon, "parentheses": _parentheses,
+                 "parentheses without ;": _parentheses_without_semicolon}

@@ -26,6 +26,7 @@ TOOL_CHANGE, OFFSET_ON, OFFSET_OFF = "tool change", "offset on", "offset off"
 WORK_OFFSET, Y_POSITIONED = "work offset", "Y positioned"
 SPEED_BOUNDED, FEED_TYPE = "spindle speed bounded", "feed type stated"
 Y_POSITION = "Y position"     # the event of a block (or the shift clamp) that positions Y
+SWIVEL = "A position"         # the event of a block that swivels the hob head (A)
 
 
 @dataclass(frozen=True)
@@ -62,10 +63,14 @@ class Needs:
     def __add__(self, other: Needs) -> Needs:
         return Needs(*self.needs, *other.needs)
 
-    def check(self, facts: set[str]) -> None:
-        if self.required <= facts and not self.forbidden & facts:
+    def check(self, facts: set[str], could_hold: set[str] | None = None) -> None:
+        """`facts` hold for sure; `could_hold` (default: the same) may hold by the time the motion or
+        event runs, the block's own M codes output before it (the builder's choice)."""
+        could_hold = facts if could_hold is None else could_hold
+        if self.required <= facts and not self.forbidden & could_hold:
             return
-        raise Refused(next(need.reason for need in self.needs if (need.fact in facts) != need.present))
+        raise Refused(next(need.reason for need in self.needs
+                           if (need.fact not in facts if need.present else need.fact in could_hold)))
 
 
 @dataclass(frozen=True)
@@ -93,7 +98,8 @@ SPINDLE = {"S": sets(SPINDLE_SPEED), "M3": sets(SPINDLE_TURNING), "M5": clears(S
 END = {"M30": sets(ENDED)}
 SPINDLE_NEEDS = Needs(
     Need(SPINDLE_SPEED, "a cut before any spindle speed S: the spindle would turn at whatever S the control holds"),
-    Need(SPINDLE_TURNING, "a cut with the spindle stopped: M3 with S above 0 first, and no M5 since"))
+    Need(SPINDLE_TURNING, "a cut with the spindle stopped: M3 with S above 0 first, and no M5 since "
+                                   "(nor in the cut's own block)"))
 # 840D: a tool change T activates the edge the machine data chooses, so only a D in the same
 # block or after it says the offset; D0 deselects it. ISO T<tool><offset>: offset 00 cancels.
 OFFSETS = {TOOL_CHANGE: clears(TOOL_OFFSET), OFFSET_ON: sets(TOOL_OFFSET), OFFSET_OFF: clears(TOOL_OFFSET)}
@@ -134,20 +140,40 @@ def fanuc_hobbing_state(on: str, off: str, form: str) -> StateRules:
     synchronises the table to the hob spindle, a second one changes the ratio, `off` (G80) cancels
     it. Every move in mm, absolute, in a work offset; a cut (G1) also at a feed per minute with
     the hob turning and the table synchronised; `on` only with Y (the hob shift) positioned, as
-    EGON (reference §A7); M30 only after `off`, so the next program does not start synchronised.
+    EGON (reference §A7); M30 only after `off`, so the next program does not start synchronised;
+    no Y, A or T while synchronised (fanuc_synchronised_needs).
     No working area: Fanuc's G25/G26 switch spindle-speed fluctuation detection."""
     move = needs_stated(90, 21) + WORK_OFFSET_NEEDS
     cut = move + needs_stated(94) + SPINDLE_NEEDS + Needs(
         Need(COUPLED, f"a cut with the table not synchronised to the hob: {form} first, and no {off} since"))
     return StateRules(
         effects={**stated(21, 90, 94), **SPINDLE, **END, **WORK_OFFSETS, on: sets(COUPLED), off: clears(COUPLED),
-                 Y_POSITION: sets(Y_POSITIONED)},
-        needs={"G0": move, "G1": cut,
+                 Y_POSITION: sets(Y_POSITIONED), TOOL_CHANGE: Effect()},
+        needs={"G0": move, "G1": cut, **fanuc_synchronised_needs(on, off),
                on: Needs(Need(Y_POSITIONED, f"{on} before Y (the hob shift) is positioned: the generating zone "
                                             "would lie wherever the last program left the hob (reference §A7)")),
                off: Needs(),
                "M30": Needs(Need(COUPLED, f"M30 while the table is synchronised to the hob: {off} first (the "
                                           "next program would start synchronised)", present=False))})
+
+
+def fanuc_synchronised_needs(on: str, off: str) -> dict[str, Needs]:
+    """What must wait for `off` (G80) on a Fanuc hobber (fanuc-egb.md §F6): G81 has no Y term, so
+    a Y move (hob shift) while synchronised slides the hob's thread against the teeth it cuts,
+    uncompensated; a swivel A turns the hob's thread against them; a tool call T changes the hob
+    the table follows (and with the hob turning, at the cut). Each is refused while synchronised,
+    any Y or A word, G0 or G1, at the position held or not."""
+    while_on = f"the table is synchronised to the hob ({on}, no {off} since)"
+    return {Y_POSITION: Needs(Need(COUPLED, f"a Y move (hob shift) while {while_on}: {on} has no Y term, so "
+                                            "the hob's thread would slide against the teeth it cuts (fanuc-egb.md "
+                                            f"§F6); shift before {on} or after {off}", present=False)),
+            SWIVEL: Needs(Need(COUPLED, f"an A move (swivel) while {while_on}: the hob's thread would turn "
+                                        f"against the teeth it cuts; swivel before {on}", present=False)),
+            TOOL_CHANGE: Needs(Need(COUPLED, f"a tool call T while {while_on}: the table would follow "
+                                             f"another hob; {off} and M5 first", present=False),
+                               Need(SPINDLE_TURNING, "a tool call T with the hob turning (M3 before or in its block, "
+                                                     "no M5 since): "
+                                                     "a hob change at the cut; M5 first", present=False))}
 
 
 FANUC_HOBBING_STATE = fanuc_hobbing_state("G81", "G80", "G81 T… L…")
@@ -216,19 +242,29 @@ class State:
         for effect in effects:
             self.facts |= effect.sets
 
-    def check(self, what: str) -> None:
+    def check(self, what: str, pending: frozenset[str] = frozenset()) -> None:
         """Refused unless what `what` (a motion "G1", a statement "EGDEF") needs holds; a motion no
-        rule speaks of is refused too."""
+        rule speaks of is refused too. `pending`: the events of the same block (M5, T…), which the
+        control may output before the motion: a fact they clear is not counted on (`G1 Z… M5`
+        would cut with the hob stopping), a fact they set is feared (`T1 M3`)."""
         needs = self.rules.needs.get(what)
         if needs is None:
             raise Refused(f"no rule of this dialect says what {what} needs; it is not verified")
-        needs.check(self.facts)
+        needs.check(*self._with(pending))
 
-    def check_event(self, event: str) -> None:
-        """Refused unless what an event (M30) needs holds, where the dialect has a rule for it."""
+    def check_event(self, event: str, pending: frozenset[str] = frozenset()) -> None:
+        """Refused unless what an event (M30) needs holds, where the dialect has a rule for it;
+        `pending` as in check, the block's other events."""
         needs = self.rules.needs.get(event)
         if needs is not None:
-            needs.check(self.facts)
+            needs.check(*self._with(pending))
+
+    def _with(self, pending: frozenset[str]) -> tuple[set[str], set[str]]:
+        """(the facts that hold for sure, the facts that could hold) with `pending` output or not."""
+        effects = [self.rules.effects[event] for event in pending if event in self.rules.effects]
+        cleared = set().union(*(effect.clears for effect in effects))
+        added = set().union(*(effect.sets for effect in effects))
+        return self.facts - cleared, self.facts | added
 
     @property
     def ended(self) -> bool:

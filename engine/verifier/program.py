@@ -24,7 +24,7 @@ from .feed_mode import FeedMode
 from .grammar import AXES, Dialect, dialect_for
 from .limits import check_coupled_move, check_speed_limit, check_spindle, check_table, check_thread, check_travel
 from .lines import HeaderLine, read_line, remembered_lines
-from .machine_state import Y_POSITION, State
+from .machine_state import SWIVEL, Y_POSITION, State
 from .refusals import LimitError, Refused, line_refused, shown_name
 from .shift_clamp import ShiftClamp
 
@@ -38,6 +38,9 @@ if TYPE_CHECKING:
 
 ARCS = (2, 3)
 RAPID = 0
+# An axis word's event, whose needs (where a dialect has them) hold before the block moves: Fanuc
+# hobbing refuses a hob shift Y or swivel A while the table is synchronised (machine_state).
+AXIS_EVENTS = {"Y": Y_POSITION, "A": SWIVEL}
 
 
 def verify_program(lines: list[str], machine: Machine, program_name: str | None) -> None:
@@ -193,7 +196,7 @@ class ProgramReading:
             self._move(block)
         if block.events:
             for event in block.events:
-                self.state.check_event(event)
+                self.state.check_event(event, block.events - {event})
             self.state.apply(block.events)
         if block.speed is not None:
             self._set_speed(block.speed)
@@ -202,7 +205,10 @@ class ProgramReading:
 
     def _move(self, block: Block) -> None:
         assert block.needs is not None   # a block that moves, outside G25/G26, names its motion
-        self.state.check(block.needs)
+        for axis, event in AXIS_EVENTS.items():
+            if axis in block.values:
+                self.state.check_event(event, block.events)
+        self.state.check(block.needs, block.events)
         self._check_motion(block.positions)
         if block.motion in ARCS:
             self._check_arc(block)
@@ -288,9 +294,15 @@ class ProgramReading:
         self.ratio, self.differential = None, {}
 
     def _synchronise(self, statement: Statement) -> None:
-        """Fanuc G81 (engine.verifier.synchronisation): the table at |L|/T of the hob, no
-        differential the verifier knows of; a second G81 while on replaces the ratio."""
-        self.ratio, self.differential = statement.ratio, {}
+        """Fanuc G81 (engine.verifier.synchronisation): the table at |L|/T of the hob plus the
+        helical compensation's degrees of C per mm of Z that Q and P give (fanuc-egb.md §F4),
+        bounded at each Z move; a second G81 while on replaces both. One without Q and P while a
+        compensation is on is refused: whether the control keeps that is not in the manual (§F2)."""
+        if self.differential and not statement.factors:
+            raise Refused(f"{statement.name} without Q and P after a {statement.name} that gave them, the table "
+                          f"still synchronised: whether the control keeps their compensation is not in the manual "
+                          "(fanuc-egb.md §F2); write Q and P again (P0. for a spur gear)")
+        self.ratio, self.differential = statement.ratio, dict(statement.factors)
         self._check_table()
 
     def _delete_coupling(self, statement: Statement) -> None:

@@ -13,10 +13,13 @@ in the 15i-B connection manual: reference fanuc-egb.md §F1), so a whole number 
 the verifier can know; with the point, Q2.5 is 2.5 mm and P15. is 15°, the form the reference
 (§F1, §F7) has the engine write. They come as a pair (one alone is Fanuc alarm PS0594), Q within
 the 0.1 … 25 mm the 15i-B connection manual gives, P within ±90°. Without Q and P the control
-adds no helical differential; with them it computes one the verifier does not bound (the table
-speed checked is S·|L|/T)."""
+adds no helical differential; with them it turns C by Z·sin P·360/(π·T·Q) degrees for every Z
+move after G81, rapid ones included (fanuc-egb.md §F4, §F7's decision), so the statement carries
+that factor, |sin P|·360/(π·T·Q) degrees of C per mm of Z, and the walk bounds the table speed a
+Z move adds with it as it does EGON's Z term."""
 from __future__ import annotations
 
+import math
 import re
 from typing import TYPE_CHECKING
 
@@ -32,6 +35,7 @@ WORD = re.compile(r"([A-Z])(.*)")
 COUNT_DIGITS = 4          # teeth at most 1000, threads at most 30: a longer number is no count
 MODULE_MM = (0.1, 25.0)        # Q with its decimal point, mm (15i-B connection manual, fanuc-egb.md §F1)
 HELIX_DEGREES = (-90.0, 90.0)  # P with its decimal point, degrees (°), signed by the gear's hand
+AXIAL_FEED_AXIS = "Z"          # the axis whose travel drives the helical compensation (fanuc-egb.md §F2)
 
 
 def read_synchronisation(dialect: Dialect, code: str) -> Statement | None:
@@ -49,7 +53,7 @@ def read_synchronisation(dialect: Dialect, code: str) -> Statement | None:
     words = _words(command, [token for token in tokens if not _is_code(token, command)])
     if not command.on:
         return Statement(command.event)
-    return Statement(command.event, ratio=_ratio(command, words))
+    return Statement(command.event, ratio=_ratio(command, words), factors=_helical_factor(command, words))
 
 
 def _is_code(token: str, command: Synchronisation) -> bool:
@@ -90,9 +94,20 @@ def _ratio(command: Synchronisation, words: dict[str, str]) -> float:
     if threads == 0:
         raise Refused(f"{command.event} {command.threads}0: a hob has at least one thread (the sign of "
                       f"{command.threads} gives the table's direction)")
-    for address in given:
-        _increment(command.event, address, words[address], module=address == command.paired[0])
     return abs(threads) / teeth
+
+
+def _helical_factor(command: Synchronisation, words: dict[str, str]) -> tuple[tuple[str, float], ...]:
+    """((Z, |degrees of C per mm of Z|),) of the helical compensation Q and P ask for (fanuc-egb.md
+    §F4: Z·sin P·360/(π·T·Q) for metric input), or () without them. P0. gives a factor of 0: the
+    compensation stated as none, which a later G81 may rely on (program.py)."""
+    if not all(address in words for address in command.paired):
+        return ()
+    module_word, helix_word = command.paired
+    module = _increment(command.event, module_word, words[module_word], module=True)
+    helix = _increment(command.event, helix_word, words[helix_word], module=False)
+    teeth = int(words[command.teeth])
+    return ((AXIAL_FEED_AXIS, abs(math.sin(math.radians(helix))) * 360.0 / (math.pi * teeth * module)),)
 
 
 def _count(event: str, address: str, text: str, bounds: range, signed: bool) -> int:
@@ -109,7 +124,7 @@ def _count(event: str, address: str, text: str, bounds: range, signed: bool) -> 
     return value
 
 
-def _increment(event: str, address: str, text: str, module: bool) -> None:
+def _increment(event: str, address: str, text: str, module: bool) -> float:
     """Q (the pair's first: the module, mm) or P (the helix angle, degrees), each written with its
     decimal point, within the range the manual gives."""
     if "." not in text:
@@ -120,6 +135,7 @@ def _increment(event: str, address: str, text: str, module: bool) -> None:
     if not low <= value <= high:
         what, unit = ("the module Q", " mm") if module else ("the helix angle P", "°")
         raise Refused(f"{event} {address}{text}: {what} must be within {low:g} … {high:g}{unit}")
+    return value
 
 
 def _no_point(event: str, address: str, text: str) -> None:
