@@ -19,6 +19,7 @@ from engine.gears.records import load_gear, load_hobs
 from engine.hobbing.choices import Choices
 from engine.machines.records import load_machine
 from engine.simulation import simulate_program
+from engine.simulation.hobbing.recorded import record_program
 from engine.simulation.hobbing.report import SimulationError
 
 MACHINE = "hobber-840d"
@@ -130,3 +131,13 @@ def test_the_m_series_g81_4_form_is_proved_the_same(case):
     assert refusals(translated, gear, hob, g81_4) == []
     wrong = [line.replace(f"L{-hob.starts}", f"L{hob.starts}") for line in translated]
     assert "the table turns the wrong way" in refusals(wrong, gear, hob, g81_4)[0]
+
+
+def test_the_picture_follows_the_same_coupling_and_refuses_the_same_helix(case):
+    """engine plot's recording walks the same coupling: k_B = −h_hob·z0/z2 in the DIN frame."""
+    lines, gear, hob, _, fanuc = case(SPUR)
+    recording = record_program(fanuc_program(lines, gear, hob, fanuc), gear, hob, fanuc)
+    assert [coupling.k_b for coupling in recording.couplings] == [-hob.starts / gear.teeth]
+    lines, gear, hob, _, fanuc = case(HELICAL)
+    with pytest.raises(SimulationError, match="sign of the Fanuc helical compensation"):
+        record_program(fanuc_program(lines, gear, hob, fanuc), gear, hob, fanuc)
