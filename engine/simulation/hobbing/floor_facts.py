@@ -10,6 +10,7 @@ from __future__ import annotations
 import re
 
 from ...machines.records import FLOOR_TIMES, Machine, unstated_floor_times
+from .fanuc_egb import COUPLING_ON
 from .headers import header_place_problem
 from .report import Report
 
@@ -52,7 +53,7 @@ def handling_seconds(steps: list, machine: Machine) -> float:
     counts = {"spindle": 0, "sync": 0, "tailstock": 0, "door": 0, "tool": 0}
     doors = {code for code in (machine.door_close_m, machine.door_open_m) if code}
     for step in steps:
-        if step.kind == "statement" and step.item.name == "EGON":
+        if step.kind == "statement" and step.item.name in COUPLING_ON:
             counts["sync"] += 1
         if step.kind != "block":
             continue

@@ -14,6 +14,7 @@ from ...verifier.blocks import TOKEN
 from ...verifier.expansion import ExpansionRefused, PlainLine, as_written, expand
 from ...verifier.lines import Line, read_line
 from ...verifier.refusals import Refused
+from .fanuc_egb import c_word_problem
 from .report import SimulationError, where
 
 
@@ -74,11 +75,30 @@ def read_program(lines: list[str], machine: Machine, name: str) -> list[Step]:
 
 
 def _step(dialect, plain: PlainLine, name: str) -> Step:
-    number, line = plain.number, plain.source
-    item = read_item(dialect, number, line, name, plain.text)
+    number, line, text = plain.number, plain.source, plain.text
+    if dialect.comment == "parentheses":
+        problem = c_word_problem(text.partition("(")[0]) if dialect.synchronisations else None
+        if problem:
+            raise SimulationError(f"{where(name, number, line)}: {problem}")
+        item = read_item(dialect, number, line, name, text)
+        if item.kind == "header":
+            return Step(number, line, item)
+        line, text = semicolon_form(line), semicolon_form(text)
+    else:
+        item = read_item(dialect, number, line, name, text)
     if item.kind != "block":
         return Step(number, line, item)
-    return Step(number, line, item, *block_codes(plain.text.partition(";")[0]))
+    return Step(number, line, item, *block_codes(text.partition(";")[0]))
+
+
+def semicolon_form(line: str) -> str:
+    """An ISO line `code (comment)` as `code ; comment`, the form the header and cut-comment rules
+    read (`(CYCLE TIME 1.6 MIN)` is `; CYCLE TIME 1.6 MIN`; the verifier has read it as one
+    comment at the end of the block). A Fanuc program's findings quote its lines in this form."""
+    code, parenthesis, comment = line.partition("(")
+    if not parenthesis:
+        return line
+    return f"{code}; {comment.removesuffix(')')}" if code.strip() else f"; {comment.removesuffix(')')}"
 
 
 @lru_cache(maxsize=4096)

@@ -30,12 +30,12 @@ def coupled_shift_problem(coupling) -> str | None:
     if "Y" in coupling.factors:
         return None
     return ("the hob shift Y moves while the table is coupled and Y is not a leading axis of the EGON: the table "
-            "keeps its phase while the hob's thread moves along the teeth (§B15); shift before EGDEF/EGON")
+            "keeps its phase while the hob's thread moves along the teeth (§B15); shift before EGDEF/EGON (Fanuc: G81)")
 
 
 def coupled_swivel_problem() -> str:
     return ("the swivel A moves while the table is coupled (the hob still in the gaps): the thread leaves the "
-            "tooth direction; swivel before EGDEF/EGON or after EGOFS with the hob clear")
+            "tooth direction; swivel before EGDEF/EGON (G81) or after EGOFS (G80) with the hob clear")
 
 
 def recut_problem(unit_name: str) -> str:
@@ -133,7 +133,7 @@ def coupled_tool_problem(values: dict) -> str | None:
     if not words:
         return None
     return (f"{'/'.join(words)} written while the table is coupled: the tool and its offset (T<n> D1) are "
-            "selected before EGON")
+            "selected before EGON (Fanuc: G81)")
 
 
 def setup_advice(solid_name: str) -> str:

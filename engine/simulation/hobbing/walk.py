@@ -28,6 +28,7 @@ from .coupling import (
 )
 from .cuts import Cut, summary
 from .envelope import HobBody
+from .fanuc_egb import COUPLING_OFF, COUPLING_ON, read_g81
 from .frame import Senses
 from .headers import comment_problem, header_place_problem
 from .paths import move_pieces
@@ -66,8 +67,7 @@ class BlockSimulation:
         self.senses = Senses.of(machine)
         self.body = HobBody(hob.tip_diameter / 2, hob.length / 2)
         load_x, load_z = machine.load_x, machine.load_z
-        # program values, for time
-        self.program = {"X": load_x, "Z": load_z} if load_x is not None and load_z is not None else {}
+        self.program = {"X": load_x, "Z": load_z} if load_x is not None and load_z is not None else {}   # for time
         self.position = {axis: self.senses.position(axis, value) for axis, value in self.program.items()}
         self.swivel = 0.0
         self.swivel_known = False
@@ -109,14 +109,14 @@ class BlockSimulation:
 
     def _statement(self, step) -> None:
         self._end_cut()
-        if step.item.name == "EGON":
+        if step.item.name in COUPLING_ON:
             self._couple(step)
-        elif step.item.name in ("EGOFS", "EGDEL"):
+        elif step.item.name in COUPLING_OFF:
             self.coupling = None
 
     def _couple(self, step) -> None:
-        code = step.line.partition(";")[0].strip()
-        self.coupling = read_coupling(code, self.senses)
+        read = read_coupling if step.item.name == "EGON" else read_g81     # Fanuc G81: the same DIN coupling
+        self.coupling = read(step.line.partition(";")[0].strip(), self.senses)
         self.session += 1
         teeth = [unit.teeth for unit in self.units if unit.teeth is not None]   # every unit is toothed
         problem = generated_teeth_problem(self.coupling, self.hob, teeth)

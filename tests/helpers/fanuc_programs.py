@@ -1,0 +1,77 @@
+"""An 840D hobbing program the seeded templates make, rewritten line by line in the Fanuc hobbing
+form (issue 30; docs/reference/fanuc-egb.md §F1, §F5), so the simulation can be shown to prove
+the same program in either dialect. Every value of the electronic gear box is computed here from
+the reference and the records, never taken from the engine's code:
+
+    T = z2,   L = σ·z0,   σ = −h_hob · c_direction · b_direction      (fanuc-egb.md §F5)
+
+and, for a helical gear, Q = m_n, P = −h_gear·c_direction·z_direction·β (§F5 under the literal
+reading of the control's formula, the reading a machine record does not yet confirm)."""
+from __future__ import annotations
+
+import re
+
+PROGRAM_NUMBER = 1234     # O1234: within the ISO program numbers, outside the builder's reserved ones
+DROPPED = (re.compile(r";\$PATH=.*"), re.compile(r"G2[56] .*"), re.compile(r"WALIMON"),
+           re.compile(r"EGDEF\(.*\)"), re.compile(r"EGDEL\(.*\)"))
+HEADER = re.compile(r"%_N_(\w+)_MPF")
+
+
+def hand(h: str | None) -> int:
+    return -1 if h == "L" else 1
+
+
+def threads_word(hob, machine) -> int:
+    """L = −h_hob·c_direction·b_direction·z0 (fanuc-egb.md §F5)."""
+    return -hand(hob.hand) * machine.c_direction * machine.b_direction * hob.starts
+
+
+def helix_words(gear, machine) -> str:
+    """` Q<m_n> P<±β>` for a helical gear (§F5, literal reading), '' for a spur gear."""
+    if not gear.helix_angle:
+        return ""
+    helix = -hand(gear.hand) * machine.c_direction * machine.z_direction * gear.helix_angle
+    return f" Q{gear.module:g}{'' if '.' in f'{gear.module:g}' else '.'} P{helix:.3f}"
+
+
+def g81(gear, hob, machine, teeth: int | None = None, threads: int | None = None, helix: str | None = None) -> str:
+    """The G81 block for the gear and hob on `machine` (arguments: a mistake to write instead)."""
+    teeth = gear.teeth if teeth is None else teeth
+    threads = threads_word(hob, machine) if threads is None else threads
+    return f"G81 T{teeth} L{threads}{helix_words(gear, machine) if helix is None else helix}"
+
+
+def fanuc_program(lines: list[str], gear, hob, machine, **mistake) -> list[str]:
+    """`lines` (an 840D hobbing program) as a Fanuc program: % and O line, (comments), G21 for
+    G71, T<n> without D, A<a> for A=<a>, EGON → G81 T L [Q P], EGOFS → G80; the 840D-only
+    lines (the path directive, the G25/G26 working area, WALIMON, EGDEF, EGDEL) left out. A
+    program with a tailstock M20/M21 (no M code of the Fanuc grammar) is not translated."""
+    out = ["%"]
+    for line in lines:
+        if any(pattern.fullmatch(line.partition(";")[0].strip() or line) for pattern in DROPPED):
+            continue
+        out.append(_line(line, gear, hob, machine, mistake))
+    return [*out, "%"]
+
+
+def _line(line: str, gear, hob, machine, mistake: dict) -> str:
+    header = HEADER.fullmatch(line)
+    if header:
+        return f"O{PROGRAM_NUMBER} ({header.group(1)})"
+    code, _, comment = (part.strip() for part in line.partition(";"))
+    if re.search(r"\bM2[01]\b", code):
+        raise ValueError(f"{line}: the Fanuc hobbing grammar has no tailstock M code; use a job without one")
+    if code.startswith("EGON("):
+        code = g81(gear, hob, machine, **mistake)
+    elif code.startswith("EGOFS("):
+        code = "G80"
+    else:
+        code = code.replace("G71", "G21").replace("A=", "A")
+        code = re.sub(r" D1\b", "", code)
+        code = " ".join(sorted(code.split(), key=_g_first)) if code.startswith("G90") else code
+    return " ".join(part for part in (code, f"({comment})" if comment else "") if part)
+
+
+def _g_first(word: str) -> int:
+    """G21 G90 G94: the units first, as Fanuc programs state them (the order is free)."""
+    return int(word[1:]) if word.startswith("G") else 1000

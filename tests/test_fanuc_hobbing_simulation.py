@@ -1,0 +1,143 @@
+"""The simulation proves a Fanuc hobbing program's coupling with the 840D's physics (issue 30;
+docs/reference/fanuc-egb.md §F5, §F6): the seeded templates' 840D program for a spur gear,
+rewritten in the test into the Fanuc form (tests/helpers/fanuc_programs.py: G81 T<z2> L<±z0>
+with L = −h_hob·c_direction·b_direction·z0 from the reference), read on the seeded hobber's
+record with dialect "fanuc", has the same findings as the 840D program (none). A wrong L sign
+(the table turns the wrong way for the hob's hand), a wrong T (another number of teeth), Q/P on
+a spur gear, a helical gear's Q/P (whose sign the machine record does not state) and a C word
+are refused, each with one line."""
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import pytest
+from helpers.fanuc_programs import fanuc_program, threads_word
+from test_simulation_seeded import unproved
+
+from engine.gears.records import load_gear, load_hobs
+from engine.hobbing.choices import Choices
+from engine.machines.records import load_machine
+from engine.simulation import simulate_program
+from engine.simulation.hobbing.recorded import record_program
+from engine.simulation.hobbing.report import SimulationError
+
+MACHINE = "hobber-840d"
+SPUR = 42                       # seeded spur gear: m 2, z 19, its hob one-start right hand
+HELICAL = 43                    # seeded helical gear, right hand
+NO_TAILSTOCK = Choices(tailstock=False)   # the Fanuc grammar has no tailstock M code
+
+
+@pytest.fixture
+def case(conn, monkeypatch):
+    """gear id, senses -> (840D lines, gear, hob, 840D machine, Fanuc machine)."""
+    def made(gear_id: int, **senses):
+        program = unproved(conn, monkeypatch, gear_id, NO_TAILSTOCK)
+        hob_id = conn.execute("SELECT hob_id FROM job WHERE id = %s", (program.job_id,)).fetchone()[0]
+        hob = next(h for h in load_hobs(conn) if h.id == hob_id)
+        machine = replace(load_machine(conn, MACHINE), **senses)
+        return program.lines, load_gear(conn, gear_id), hob, machine, replace(machine, dialect="fanuc")
+    return made
+
+
+def refusals(lines, gear, hob, machine) -> list[str]:
+    return [finding.message for finding in simulate_program(lines, gear, hob, machine).refusals]
+
+
+def test_the_spur_program_in_fanuc_form_has_the_840d_findings_none(case):
+    lines, gear, hob, siemens, fanuc = case(SPUR)
+    assert refusals(lines, gear, hob, siemens) == []
+    translated = fanuc_program(lines, gear, hob, fanuc)
+    assert f"G81 T{gear.teeth} L{-hob.starts}" in translated        # DIN machine, right-hand hob: L < 0
+    report = simulate_program(translated, gear, hob, fanuc)
+    assert report.refusals == []
+    assert report.teeth == [str(gear.teeth)] and report.helix == ["spur"]
+    expected = simulate_program(lines, gear, hob, siemens)
+    assert math.isclose(report.table_speed, expected.table_speed)
+    assert math.isclose(report.cycle_time, expected.cycle_time)
+
+
+@pytest.mark.parametrize("senses", [{"c_direction": -1}, {"b_direction": -1}, {"c_direction": -1, "b_direction": -1}])
+def test_the_sign_of_l_follows_the_machine_senses(case, senses):
+    """L = −h_hob·c·b·z0: a table or hob spindle turning the other way flips L, both flip it back."""
+    lines, gear, hob, siemens, fanuc = case(SPUR, **senses)
+    wanted = -1 * senses.get("c_direction", 1) * senses.get("b_direction", 1) * hob.starts   # right-hand hob
+    assert threads_word(hob, fanuc) == wanted
+    assert refusals(fanuc_program(lines, gear, hob, fanuc), gear, hob, fanuc) == []
+
+
+def test_a_wrong_l_sign_turns_the_table_the_wrong_way_for_the_hob(case):
+    lines, gear, hob, _, fanuc = case(SPUR)
+    wrong = -threads_word(hob, fanuc)
+    found = refusals(fanuc_program(lines, gear, hob, fanuc, threads=wrong), gear, hob, fanuc)
+    assert found and "the table turns the wrong way for a right-hand hob" in found[0]
+    k_b = wrong / gear.teeth                                           # c = b = +1: DIN k_B = L/T
+    assert f"k_B is {k_b:+.6g}" in found[0] and f"needs {-k_b:+.6g}" in found[0]
+
+
+def test_a_wrong_t_generates_another_number_of_teeth(case):
+    lines, gear, hob, _, fanuc = case(SPUR)
+    found = refusals(fanuc_program(lines, gear, hob, fanuc, teeth=gear.teeth + 1), gear, hob, fanuc)
+    generated = hob.starts * (gear.teeth + 1) / hob.starts             # z0·T/|L|
+    assert found and f"generates {generated:g} teeth; the gear has {gear.teeth}" in found[0]
+
+
+def test_q_and_p_on_a_spur_gear_are_refused(case):
+    lines, gear, hob, _, fanuc = case(SPUR)
+    translated = fanuc_program(lines, gear, hob, fanuc, helix=" Q2. P15.")
+    with pytest.raises(SimulationError, match=r"Q2\. P15\. on a spur gear: .* would cut a helix") as raised:
+        simulate_program(translated, gear, hob, fanuc)
+    assert "\n" not in str(raised.value)
+
+
+def test_a_helical_gears_fanuc_program_is_refused_for_the_unknown_sign(case):
+    lines, gear, hob, siemens, fanuc = case(HELICAL)
+    assert gear.helix_angle and gear.hand == "R" and refusals(lines, gear, hob, siemens) == []
+    translated = fanuc_program(lines, gear, hob, fanuc)
+    helix = -1 * gear.helix_angle                                      # P = −h_gear·c·z·β on a DIN machine
+    assert f"G81 T{gear.teeth} L{threads_word(hob, fanuc)} Q{gear.module:g}. P{helix:.3f}" in translated
+    with pytest.raises(SimulationError, match="the sign of the Fanuc helical compensation is not stated on the "
+                                              "machine record") as raised:
+        simulate_program(translated, gear, hob, fanuc)
+    assert "\n" not in str(raised.value)
+
+
+def test_a_helical_gear_without_q_and_p_would_be_cut_straight(case):
+    """§F6: a helical gear's G81 without Q and P gets no differential; the Z term the reference
+    needs is −h_gear·360·sin β/(π·m_n·z2) degrees of C per mm of Z."""
+    lines, gear, hob, _, fanuc = case(HELICAL)
+    found = refusals(fanuc_program(lines, gear, hob, fanuc, helix=""), gear, hob, fanuc)
+    k_z = -360 * math.sin(math.radians(gear.helix_angle)) / (math.pi * gear.module * gear.teeth)
+    assert any(f"generates no helix (spur); the gear needs {k_z:+.6f}°/mm" in message for message in found)
+
+
+def test_a_c_word_while_coupled_is_refused_it_would_add_the_motion_twice(case):
+    lines, gear, hob, _, fanuc = case(SPUR)
+    translated = fanuc_program(lines, gear, hob, fanuc)
+    at = next(number for number, line in enumerate(translated) if line.startswith("G1 Z"))
+    translated[at] += " C10."
+    with pytest.raises(SimulationError, match=r"the program must not add it twice \(fanuc-egb.md §F6\)"):
+        simulate_program(translated, gear, hob, fanuc)
+
+
+def test_the_m_series_g81_4_form_is_proved_the_same(case):
+    """G81.4 R<z2> L<±z0> … G80.4 (fanuc-egb.md §F3): the same pair, R for T."""
+    lines, gear, hob, _, fanuc = case(SPUR)
+    g81_4 = replace(fanuc, dialect="fanuc-g81.4")
+    start = f"G81 T{gear.teeth} L{threads_word(hob, fanuc)}"
+    translated = [{start: start.replace("G81 T", "G81.4 R"), "G80": "G80.4"}.get(line, line)
+                  for line in fanuc_program(lines, gear, hob, fanuc)]
+    assert f"G81.4 R{gear.teeth} L{-hob.starts}" in translated
+    assert refusals(translated, gear, hob, g81_4) == []
+    wrong = [line.replace(f"L{-hob.starts}", f"L{hob.starts}") for line in translated]
+    assert "the table turns the wrong way" in refusals(wrong, gear, hob, g81_4)[0]
+
+
+def test_the_picture_follows_the_same_coupling_and_refuses_the_same_helix(case):
+    """engine plot's recording walks the same coupling: k_B = −h_hob·z0/z2 in the DIN frame."""
+    lines, gear, hob, _, fanuc = case(SPUR)
+    recording = record_program(fanuc_program(lines, gear, hob, fanuc), gear, hob, fanuc)
+    assert [coupling.k_b for coupling in recording.couplings] == [-hob.starts / gear.teeth]
+    lines, gear, hob, _, fanuc = case(HELICAL)
+    with pytest.raises(SimulationError, match="sign of the Fanuc helical compensation"):
+        record_program(fanuc_program(lines, gear, hob, fanuc), gear, hob, fanuc)
