@@ -76,7 +76,7 @@ def read_program(lines: list[str], machine: Machine, name: str) -> list[Step]:
 
 def _step(dialect, plain: PlainLine, name: str) -> Step:
     number, line, text = plain.number, plain.source, plain.text
-    if dialect.comment == "parentheses":
+    if dialect.comment.startswith("parentheses"):   # ISO and Fanuc hobbing: `(text)` comments
         problem = c_word_problem(text.partition("(")[0]) if dialect.synchronisations else None
         if problem:
             raise SimulationError(f"{where(name, number, line)}: {problem}")
