@@ -13,7 +13,7 @@ from dataclasses import replace
 
 import pytest
 from helpers.fanuc_programs import fanuc_program, threads_word
-from test_simulation_seeded import unproved
+from helpers.unproved_programs import unproved
 
 from engine.gears.records import load_gear, load_hobs
 from engine.hobbing.choices import Choices

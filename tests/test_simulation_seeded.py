@@ -6,6 +6,7 @@ from __future__ import annotations
 import json
 
 import pytest
+from helpers.unproved_programs import unproved
 
 from engine.errors import EngineError
 from engine.gears.records import load_gear, load_hobs
@@ -25,13 +26,6 @@ CASES = [   # gear, class, job choices
     (51, "crowned", Choices()), (53, "worm wheel radial", Choices()),
     (53, "worm wheel tangential", Choices(worm_feed="tangential")), (54, "duplex", Choices()),
 ]
-
-
-def unproved(conn, monkeypatch, gear_id: int, choices: Choices):
-    """The program the templates make, stored without the simulation's proof."""
-    with monkeypatch.context() as patch:
-        patch.setattr(verified_run, "prove", lambda *args, **kwargs: None)
-        return instantiate_gear(conn, gear_id, choices=choices)
 
 
 def simulated(conn, monkeypatch, gear_id: int, choices: Choices):
