@@ -1162,6 +1162,10 @@ CREATE TABLE machine (
     door_time        numeric CHECK (door_time >= 0),
     tool_change_time numeric CHECK (tool_change_time >= 0),
     load_unload_time numeric CHECK (load_unload_time >= 0),
+    -- Fanuc hobbers (migration 0037, fanuc-egb.md §F5): the sign the control applies G81's helical
+    -- compensation Z·sin P·360/(π·T·Q) with, in the machine's C and Z senses (+1 the literal
+    -- formula, -1 its opposite); NULL = not stated (a helical gear's Fanuc program is refused).
+    egb_helix_sign   smallint CHECK (egb_helix_sign IN (-1, 1)),
     CONSTRAINT machine_reference_point CHECK ((reference_x IS NULL) = (reference_z IS NULL)),
     CHECK (x_min < x_max AND y_min <= y_max AND z_min < z_max),
     CONSTRAINT machine_safe_name CHECK (safe_name('machine', name)),

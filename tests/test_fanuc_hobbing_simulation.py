@@ -4,15 +4,17 @@ rewritten in the test into the Fanuc form (tests/helpers/fanuc_programs.py: G81 
 with L = −h_hob·c_direction·b_direction·z0 from the reference), read on the seeded hobber's
 record with dialect "fanuc", has the same findings as the 840D program (none). A wrong L sign
 (the table turns the wrong way for the hob's hand), a wrong T (another number of teeth), Q/P on
-a spur gear, a helical gear's Q/P (whose sign the machine record does not state) and a C word
-are refused, each with one line."""
+a spur gear, a helical gear's Q/P on a record that does not state egb_helix_sign, and a C word
+are refused, each with one line. On a record that states it (migration 0037), the helical
+gear's Q/P is the coupling's Z term and is proved like the 840D's EGON Z term: the right P sign
+passes, a flipped P, a flipped record sign or a wrong module Q cuts the wrong helix."""
 from __future__ import annotations
 
 import math
 from dataclasses import replace
 
 import pytest
-from helpers.fanuc_programs import fanuc_program, threads_word
+from helpers.fanuc_programs import fanuc_program, g81, threads_word
 from helpers.unproved_programs import unproved
 
 from engine.gears.records import load_gear, load_hobs
@@ -141,3 +143,77 @@ def test_the_picture_follows_the_same_coupling_and_refuses_the_same_helix(case):
     lines, gear, hob, _, fanuc = case(HELICAL)
     with pytest.raises(SimulationError, match="sign of the Fanuc helical compensation"):
         record_program(fanuc_program(lines, gear, hob, fanuc), gear, hob, fanuc)
+
+
+def reference_k_z(gear, module: float | None = None) -> float:
+    """k_Z = −h_gear·360·sin β/(π·m_n·z2), degrees of C per mm of Z in the DIN frame (fanuc-egb.md
+    §F4, §F5; right hand here), with `module` for Q where a wrong one is written."""
+    assert gear.hand == "R"
+    return -360 * math.sin(math.radians(gear.helix_angle)) / (math.pi * (module or gear.module) * gear.teeth)
+
+
+def reference_p(gear, machine) -> float:
+    """P = −h_gear·c_direction·z_direction·egb_helix_sign·β (fanuc-egb.md §F5): the control's
+    egb_helix_sign·sin P·360/(π·T·Q) per mm of programmed Z must be c·z·k_Z (DIN)."""
+    return -1 * machine.c_direction * machine.z_direction * machine.egb_helix_sign * gear.helix_angle
+
+
+def wrong_helix(found: float, gear) -> str:
+    """The walk's words for a Z term `found` (DIN) on the gear: the hand, β and lead it cuts
+    (sin β' = |k|·π·m_n·z2/360, lead 360/|k|, fanuc-egb.md §F4 turned round)."""
+    beta = math.degrees(math.asin(abs(found) * math.pi * gear.module * gear.teeth / 360))
+    hand = "right-hand" if found < 0 else "left-hand"
+    return (f"the Z term {found:+.6f}°/mm (DIN) generates a {hand} helix of β {beta:.3f}°, lead {360 / abs(found):.1f} "
+            f"mm; the gear needs {reference_k_z(gear):+.6f}°/mm")
+
+
+@pytest.mark.parametrize("senses", [{"egb_helix_sign": 1}, {"egb_helix_sign": -1},
+                                    {"egb_helix_sign": 1, "c_direction": -1},
+                                    {"egb_helix_sign": -1, "c_direction": -1}])
+def test_a_helical_gears_fanuc_program_is_proved_on_a_record_stating_the_sign(case, senses):
+    """The 840D twin (made for the seeded DIN record) has no findings; the Fanuc form, L and P
+    signed by the reference, the record's senses and its stated sign, has none either, with the
+    same helix, lead and table speed. (A table turning the other way flips L and P; Z's sense
+    would also move every Z the 840D program was written with, so it is not flipped here.)"""
+    lines, gear, hob, siemens, fanuc = case(HELICAL, **senses)
+    siemens = replace(siemens, c_direction=1)
+    assert refusals(lines, gear, hob, siemens) == []
+    translated = fanuc_program(lines, gear, hob, fanuc)
+    assert f"Q{gear.module:g}. P{reference_p(gear, fanuc):.3f}" in g81(gear, hob, fanuc)
+    report = simulate_program(translated, gear, hob, fanuc)
+    assert report.refusals == [], report.lines()
+    lead = math.pi * gear.module * gear.teeth / math.sin(math.radians(gear.helix_angle))   # p_z, §F4 (2)
+    assert report.helix == [f"right-hand β {gear.helix_angle:.3f}° lead {lead:.1f} mm"]
+    expected = simulate_program(lines, gear, hob, siemens)
+    assert report.helix == expected.helix and report.teeth == expected.teeth
+    assert math.isclose(report.table_speed, expected.table_speed, rel_tol=1e-5)
+
+
+def test_a_flipped_p_cuts_the_other_hand(case):
+    lines, gear, hob, _, fanuc = case(HELICAL, egb_helix_sign=1)
+    flipped = f" Q{gear.module:g}. P{-reference_p(gear, fanuc):.3f}"
+    found = refusals(fanuc_program(lines, gear, hob, fanuc, helix=flipped), gear, hob, fanuc)
+    assert any(wrong_helix(-reference_k_z(gear), gear) in message for message in found), found
+
+
+def test_the_same_program_on_a_record_of_the_other_sign_cuts_the_other_hand(case):
+    lines, gear, hob, _, fanuc = case(HELICAL, egb_helix_sign=1)
+    translated = fanuc_program(lines, gear, hob, fanuc)
+    other = replace(fanuc, egb_helix_sign=-1)
+    found = refusals(translated, gear, hob, other)
+    assert any(wrong_helix(-reference_k_z(gear), gear) in message for message in found), found
+
+
+def test_a_wrong_module_q_cuts_the_wrong_lead(case):
+    lines, gear, hob, _, fanuc = case(HELICAL, egb_helix_sign=1)
+    wrong = gear.module + 1
+    found = refusals(fanuc_program(lines, gear, hob, fanuc, helix=f" Q{wrong:g}. P{reference_p(gear, fanuc):.3f}"),
+                     gear, hob, fanuc)
+    assert any(wrong_helix(reference_k_z(gear, wrong), gear) in message for message in found), found
+
+
+def test_the_picture_follows_the_helical_coupling_on_a_record_stating_the_sign(case):
+    lines, gear, hob, _, fanuc = case(HELICAL, egb_helix_sign=-1)
+    recording = record_program(fanuc_program(lines, gear, hob, fanuc), gear, hob, fanuc)
+    assert [round(coupling.factors["Z"], 9) for coupling in recording.couplings] == \
+        [round(reference_k_z(gear), 9)] * len(recording.couplings)

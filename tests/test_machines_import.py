@@ -72,6 +72,7 @@ REFUSED = [
     ("power-on G90 on system A", [{**LATHE, "gcode_system": "A", "power_on": "G18 G40 G90 G97 G99"}],
      "power_on lists G90, which on G-code system A is the turning cycle"),
     ("power-on one group twice", [{**LATHE, "power_on": "G18 G98 G99"}], "power_on lists G98 and G99, one modal group"),
+    ("helix sign not a sign", [{**LATHE, "egb_helix_sign": "2"}], "egb_helix_sign must be 1 or -1"),
     ("reference outside the travel", [{**LATHE, "reference_x": "420", "reference_z": "100"}],
      "reference_x 420 lies outside its travel (X 0…300)"),
 ]
@@ -99,3 +100,19 @@ def test_a_header_without_rows_is_refused(run, tmp_path):
     path = tmp_path / "machines.csv"
     path.write_text(",".join(LATHE) + "\n")
     assert "holds no machine" in refused(run("machines", "import", path))
+
+
+def test_a_fanuc_hobbers_stated_helix_sign_is_stored_listed_and_loaded(run, tmp_path):
+    """egb_helix_sign (migration 0037, fanuc-egb.md §F5): a column of the CSV like any other; the
+    seeded records leave it empty (not stated), a shop's Fanuc hobber states it after its dry run."""
+    from engine.machines.records import load_machine
+
+    hobber = next(row for row in exported(run) if row["kind"] == "hobber")
+    assert hobber["egb_helix_sign"] == ""
+    ok(run("machines", "import", written(tmp_path, [{**hobber, "name": "shop-fanuc", "dialect": "fanuc",
+                                                     "egb_helix_sign": "-1"}])))
+    assert next(row for row in exported(run) if row["name"] == "shop-fanuc")["egb_helix_sign"] == "-1"
+    listed = json.loads(ok(run("machines", "list", "--json")).stdout)["machines"]
+    assert next(m for m in listed if m["name"] == "shop-fanuc")["egb_helix_sign"] == -1
+    with psycopg.connect(run.url) as conn:
+        assert load_machine(conn, "shop-fanuc").egb_helix_sign == -1

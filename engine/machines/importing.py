@@ -52,6 +52,8 @@ CHECKS = {
        for column in ("fixture_diameter", "fixture_gap", "tailstock_diameter", "tailstock_gap")},
     **{f"machine_door_{which}_m_check": f"door_{which}_m must be an M number from 0 to 999"
        for which in ("close", "open")},
+    "machine_egb_helix_sign_check": "egb_helix_sign must be 1 or -1 (the sign of the Fanuc helical compensation, "
+                                    "fanuc-egb.md §F5; empty: not stated)",
     "machine_swivel_speed_check": "swivel_speed must be above 0 (degrees per second)",
     **{f"machine_{column}_check": f"{column} must be 0 or more (seconds)"
        for column in ("spindle_runup", "coupling_sync", "tailstock_time", "door_time", "tool_change_time",

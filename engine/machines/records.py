@@ -67,6 +67,11 @@ class Machine:
     door_time: float | None = None
     tool_change_time: float | None = None
     load_unload_time: float | None = None
+    # Fanuc hobbers (issue 30, migration 0037): the sign the control applies G81's helical
+    # compensation Z·sin P·360/(π·T·Q) degrees of C per mm of Z with, in the machine's C and Z
+    # senses (fanuc-egb.md §F4, §F5): +1 the literal formula, -1 its opposite; None: not stated
+    # (the simulation refuses a helical gear's Fanuc program).
+    egb_helix_sign: int | None = None
 
 
 # The times a hobber's record states for the floor-to-floor time, in this order (migration 0034).

@@ -5,8 +5,8 @@ the reference and the records, never taken from the engine's code:
 
     T = z2,   L = σ·z0,   σ = −h_hob · c_direction · b_direction      (fanuc-egb.md §F5)
 
-and, for a helical gear, Q = m_n, P = −h_gear·c_direction·z_direction·β (§F5 under the literal
-reading of the control's formula, the reading a machine record does not yet confirm)."""
+and, for a helical gear, Q = m_n, P = −h_gear·c_direction·z_direction·egb_helix_sign·β (§F5; a
+record that does not state egb_helix_sign gets the literal reading of the control's formula, +1)."""
 from __future__ import annotations
 
 import re
@@ -26,11 +26,16 @@ def threads_word(hob, machine) -> int:
     return -hand(hob.hand) * machine.c_direction * machine.b_direction * hob.starts
 
 
+def helix_sign(machine) -> int:
+    """The record's egb_helix_sign; not stated: +1, the literal reading of §F4's formula."""
+    return 1 if machine.egb_helix_sign is None else machine.egb_helix_sign
+
+
 def helix_words(gear, machine) -> str:
-    """` Q<m_n> P<±β>` for a helical gear (§F5, literal reading), '' for a spur gear."""
+    """` Q<m_n> P<±β>` for a helical gear (§F5), '' for a spur gear."""
     if not gear.helix_angle:
         return ""
-    helix = -hand(gear.hand) * machine.c_direction * machine.z_direction * gear.helix_angle
+    helix = -hand(gear.hand) * machine.c_direction * machine.z_direction * helix_sign(machine) * gear.helix_angle
     return f" Q{gear.module:g}{'' if '.' in f'{gear.module:g}' else '.'} P{helix:.3f}"
 
 

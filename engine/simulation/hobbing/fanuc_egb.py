@@ -1,25 +1,31 @@
 """The Fanuc electronic gear box as the simulation follows it (issue 30; reference fanuc-egb.md
 §F1–§F6): `G81 T<z2> L<±z0> [Q<m_n> P<β>]` (M series `G81.4 R<z2> L<±z0> …`) couples the table C
 to the hob spindle, `G80` (`G80.4`) uncouples it. The verifier has read and bounded the block
-(engine.verifier.synchronisation keeps only |L|/T); here its signed terms become the same DIN
-`Coupling` an 840D `EGON(C,"FINE",B,<num>,<den>)` gives (engine.simulation.hobbing.coupling), so
-one set of physics proves both: T and L are EGON's denominator and numerator, L = σ·z0 with
-σ = −h_hob·c_direction·b_direction (§F5), and k_B = c·b·L/T = −h_hob·z0/z2 in the DIN frame.
+(engine.verifier.synchronisation keeps only |L|/T and the size of the Q/P factor); here its signed
+terms become the same DIN `Coupling` an 840D `EGON(C,"FINE",B,<num>,<den>,Z,<num>,<den>)` gives
+(engine.simulation.hobbing.coupling), so one set of physics proves both:
+
+* T and L are EGON's denominator and numerator, L = σ·z0 with σ = −h_hob·c_direction·b_direction
+  (§F5), and k_B = c·b·L/T = −h_hob·z0/z2 in the DIN frame;
+* Q and P are EGON's Z term: the control turns C by egb_helix_sign·sin P·360/(π·T·Q) degrees per
+  mm of Z in the program's senses (§F4, the sign the machine record states, §F5, §F7), which is
+  c_direction·z_direction times that in the DIN frame; the walk holds it to
+  k_Z = −h_gear·360·sin β/(π·m_n·z2) as it holds an EGON's.
 
 What it cannot prove it refuses (fail closed):
 
-* Q and P, the control's own helical differential Z·sin P·360/(π·T·Q) degrees of C per mm of Z
-  (§F4): the sign with which the control applies P is not in the retrieved manuals and the
-  machine record has no `egb_helix_sign` yet (§F5, §F7), so the hand it cuts is unknown. On a
-  spur gear any Q/P cuts a helix (or is a differential a spur gear has no use for).
+* Q and P on a record that does not state `egb_helix_sign` (NULL): the hand they cut is unknown.
+  On a spur gear any Q/P cuts a helix (or is a differential a spur gear has no use for).
 * a C word: the table already follows the hob (and Z, through Q/P); a C move on top turns it a
   second time (§F6: the program must not add it twice)."""
 from __future__ import annotations
 
+import math
 import re
 
 from ...gears.records import Gear
-from .coupling import Coupling
+from ...machines.records import Machine
+from .coupling import Coupling, read_coupling
 from .frame import Senses
 from .report import SimulationError, where
 
@@ -29,29 +35,59 @@ G_CODE = re.compile(r"G0*8[01](?:\.4)?")
 WORD = re.compile(r"([A-Z])([-+]?[0-9.]+)")
 C_WORD = re.compile(r"(?<![A-Z])C[-+=]?[0-9.]")
 HELICAL_WORDS = ("Q", "P")
+COMMENT = re.compile(r"\(.*?\)")
+# The least increments the control reads Q and P in (fanuc-egb.md §F1: 0.00001 mm; 0.0001° in
+# [15i-MA], the coarser of the two sources): a program cannot state them finer, so the Z term
+# they give is right to the effect of half of each, not to the digits a program chose to write.
+Q_INCREMENT = 0.00001        # mm
+P_INCREMENT = 0.0001         # degrees
 
 
 def g81_words(code: str) -> dict[str, str]:
-    """address -> text of a G81/G81.4 block's words (the verifier has checked each once)."""
+    """address -> text of a G81/G81.4 block's words (the verifier has checked each once); the
+    (comments) left out."""
     words = {}
-    for token in code.split():
+    for token in COMMENT.sub(" ", code).split():
         match = WORD.fullmatch(token)
         if match is not None and not G_CODE.fullmatch(token):
             words[match.group(1)] = match.group(2)
     return words
 
 
-def read_g81(code: str, senses: Senses) -> Coupling:
+def read_g81(code: str, senses: Senses, helix_sign: int | None = None) -> Coupling:
     """The coupling a G81 (G81.4) block gives, in the DIN frame: L over T (R), as EGON's numerator
-    over its denominator; no Z or Y term (a G81 with Q and P is refused before the walk)."""
+    over its denominator, and Q/P as its Z term, signed by the record's `helix_sign` (a G81 with
+    Q and P on a record without one is refused before the walk)."""
     words = g81_words(code)
     teeth = int(words["T"] if "T" in words else words["R"])
     threads = int(words["L"])
-    return Coupling(threads, teeth, threads / teeth * senses.factor("B"), {}, {}, {"B": threads / teeth})
+    program, factors, resolution = {"B": threads / teeth}, {}, {}
+    if all(address in words for address in HELICAL_WORDS) and helix_sign is not None:
+        program["Z"], resolution["Z"] = compensation(float(words["Q"]), float(words["P"]), teeth, helix_sign)
+        factors["Z"] = program["Z"] * senses.factor("Z")
+    return Coupling(threads, teeth, program["B"] * senses.factor("B"), factors, resolution, program)
 
 
-def compensation_problem(code: str, gear: Gear) -> str | None:
-    """Why a G81 with Q and P cannot be proved for `gear` (None: the block gives neither)."""
+def read_start(name: str, code: str, senses: Senses, machine: Machine) -> Coupling:
+    """The DIN coupling a start gives: an 840D EGON's (engine.simulation.hobbing.coupling) or a
+    Fanuc G81's (G81.4's), whose Q/P the record's egb_helix_sign signs."""
+    return read_coupling(code, senses) if name == "EGON" else read_g81(code, senses, machine.egb_helix_sign)
+
+
+def compensation(module: float, helix: float, teeth: int, helix_sign: int) -> tuple[float, float]:
+    """(degrees of C per mm of Z in the program's senses, its resolution) of the control's helical
+    compensation (fanuc-egb.md §F4, metric input: the grammar refuses G20): helix_sign·sin P·360/
+    (π·T·Q), Q the module in mm, P the helix angle in degrees. The resolution is what half a least
+    increment of P and of Q changes it by (∂/∂P and ∂/∂Q of the formula)."""
+    scale = 360.0 / (math.pi * teeth * module)
+    sine, cosine = math.sin(math.radians(helix)), math.cos(math.radians(helix))
+    resolution = scale * (abs(cosine) * math.radians(P_INCREMENT / 2) + abs(sine) * Q_INCREMENT / 2 / module)
+    return helix_sign * sine * scale, resolution
+
+
+def compensation_problem(code: str, gear: Gear, helix_sign: int | None) -> str | None:
+    """Why a G81 with Q and P cannot be proved for `gear` on a record stating `helix_sign` (None:
+    the block gives neither, or the walk proves its Z term)."""
     words = g81_words(code)
     if not any(address in words for address in HELICAL_WORDS):
         return None
@@ -59,17 +95,19 @@ def compensation_problem(code: str, gear: Gear) -> str | None:
     if not gear.helix_angle:
         return (f"{given} on a spur gear: the control adds a helical differential Z·sin P·360/(π·T·Q) degrees of C "
                 "per mm of Z (fanuc-egb.md §F4) and would cut a helix; a spur gear's G81 gives T and L only")
-    return (f"the sign of the Fanuc helical compensation is not stated on the machine record (egb_helix_sign, "
-            f"fanuc-egb.md §F5, §F7): the simulation cannot tell which hand {given} cuts and refuses a helical "
-            "gear's Fanuc program")
+    if helix_sign is None:
+        return (f"the sign of the Fanuc helical compensation is not stated on the machine record (egb_helix_sign, "
+                f"fanuc-egb.md §F5, §F7): the simulation cannot tell which hand {given} cuts and refuses a helical "
+                "gear's Fanuc program")
+    return None
 
 
-def refuse_unproved_compensation(steps: list, gear: Gear, name: str) -> None:
-    """SimulationError at the first G81 (G81.4) whose Q and P the simulation cannot prove for `gear`,
-    before the walk: it cannot follow a table whose turning per mm of Z it does not know."""
+def refuse_unproved_compensation(steps: list, gear: Gear, machine: Machine, name: str) -> None:
+    """SimulationError at the first G81 (G81.4) whose Q and P the simulation cannot prove for `gear`
+    on `machine`, before the walk: it cannot follow a table whose turning per mm of Z it does not know."""
     for step in steps:
         if step.kind == "statement" and step.item.name in ("G81", "G81.4"):
-            problem = compensation_problem(step.line.partition(";")[0], gear)
+            problem = compensation_problem(step.line.partition(";")[0], gear, machine.egb_helix_sign)
             if problem:
                 raise SimulationError(f"{where(name, step.number, step.line)}: {problem}")
 

@@ -120,7 +120,7 @@ def record_program(lines: list[str], gear: Gear, hob: Hob, machine: Machine, nam
     if machine.kind != "hobber":
         raise SimulationError(f"machine {machine.name} is a {machine.kind}: the simulation follows hobbing programs")
     steps = read_program(lines, machine, name)
-    refuse_unproved_compensation(steps, gear, name)   # Fanuc Q/P: fanuc-egb.md §F5
+    refuse_unproved_compensation(steps, gear, machine, name)   # Fanuc Q/P: fanuc-egb.md §F5
     ends = SHIFT_ENDS if any(step.kind == "shift" for step in steps) else SHIFT_ENDS[:1]
     recordings = [_follow(steps, lines, gear, hob, machine, name, end, holding) for end in ends]
     held = [pose["Y"] for recording in recordings for move in recording.moves if move.cutting

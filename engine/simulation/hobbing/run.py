@@ -26,7 +26,7 @@ def simulate_program(lines: list[str], gear: Gear, hob: Hob, machine: Machine, n
     if machine.kind != "hobber":
         raise SimulationError(f"machine {machine.name} is a {machine.kind}: the simulation follows hobbing programs")
     steps = read_program(lines, machine, name)
-    refuse_unproved_compensation(steps, gear, name)   # Fanuc Q/P: fanuc-egb.md §F5
+    refuse_unproved_compensation(steps, gear, machine, name)   # Fanuc Q/P: fanuc-egb.md §F5
     ends = SHIFT_ENDS if any(step.kind == "shift" for step in steps) else SHIFT_ENDS[:1]
     report = _follow(steps, lines, gear, hob, machine, name, ends[0], holding, first_only)
     for end in ends[1:]:

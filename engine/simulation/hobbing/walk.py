@@ -23,12 +23,11 @@ from .coupling import (
     hand_sign,
     helix_of,
     lead_angle,
-    read_coupling,
     swivel_problem,
 )
 from .cuts import Cut, summary
 from .envelope import HobBody
-from .fanuc_egb import COUPLING_OFF, COUPLING_ON, read_g81
+from .fanuc_egb import COUPLING_OFF, COUPLING_ON, read_start
 from .frame import Senses
 from .headers import comment_problem, header_place_problem
 from .paths import move_pieces
@@ -115,8 +114,7 @@ class BlockSimulation:
             self.coupling = None
 
     def _couple(self, step) -> None:
-        read = read_coupling if step.item.name == "EGON" else read_g81     # Fanuc G81: the same DIN coupling
-        self.coupling = read(step.line.partition(";")[0].strip(), self.senses)
+        self.coupling = read_start(step.item.name, step.line.partition(";")[0].strip(), self.senses, self.machine)
         self.session += 1
         teeth = [unit.teeth for unit in self.units if unit.teeth is not None]   # every unit is toothed
         problem = generated_teeth_problem(self.coupling, self.hob, teeth)
