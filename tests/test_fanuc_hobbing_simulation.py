@@ -11,6 +11,7 @@ passes, a flipped P, a flipped record sign or a wrong module Q cuts the wrong he
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import replace
 
 import pytest
@@ -217,3 +218,22 @@ def test_the_picture_follows_the_helical_coupling_on_a_record_stating_the_sign(c
     recording = record_program(fanuc_program(lines, gear, hob, fanuc), gear, hob, fanuc)
     assert [round(coupling.factors["Z"], 9) for coupling in recording.couplings] == \
         [round(reference_k_z(gear), 9)] * len(recording.couplings)
+
+
+def test_q_and_p_in_the_m_series_g81_4_are_refused_their_meaning_unconfirmed(case):
+    """fanuc-egb.md §F3: G81.4's Q and P have no units or formula in the retrieved text; §F4's
+    egb_helix_sign·sin P·360/(π·T·Q) is G81's. The same Q/P that G81 proves (P from the reference,
+    §F5) is refused in G81.4 on a record stating the sign, for the simulation and the picture."""
+    lines, gear, hob, _, fanuc = case(HELICAL, egb_helix_sign=1)
+    translated = fanuc_program(lines, gear, hob, fanuc)
+    assert simulate_program(translated, gear, hob, fanuc).refusals == []
+    helical = f"Q{gear.module:g}. P{reference_p(gear, fanuc):.3f}"
+    start = g81(gear, hob, fanuc)
+    m_series = [{start: start.replace("G81 T", "G81.4 R"), "G80": "G80.4"}.get(line, line) for line in translated]
+    assert f"G81.4 R{gear.teeth} L{threads_word(hob, fanuc)} {helical}" in m_series
+    g81_4 = replace(fanuc, dialect="fanuc-g81.4")
+    for prove in (simulate_program, record_program):
+        with pytest.raises(SimulationError, match=rf"{re.escape(helical)} in G81.4: the M-series form's Q and P .* "
+                                                  r"not in the retrieved manuals \(fanuc-egb.md §F3\)") as raised:
+            prove(m_series, gear, hob, g81_4)
+        assert "\n" not in str(raised.value)
