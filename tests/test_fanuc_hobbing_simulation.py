@@ -237,3 +237,22 @@ def test_q_and_p_in_the_m_series_g81_4_are_refused_their_meaning_unconfirmed(cas
                                                   r"not in the retrieved manuals \(fanuc-egb.md §F3\)") as raised:
             prove(m_series, gear, hob, g81_4)
         assert "\n" not in str(raised.value)
+
+
+def test_a_g81_with_the_hob_turning_is_refused_the_table_may_not_be_in_step(case):
+    """fanuc-egb.md §F7 (egb_waits_for_sync, not known): with the hob already turning the table must
+    catch up, and the next block may not wait for it. The same program with M5 before G81 and the
+    hob started after it (the order the seeded templates write) is proved."""
+    lines, gear, hob, _, fanuc = case(SPUR)
+    translated = fanuc_program(lines, gear, hob, fanuc)
+    at = translated.index(g81(gear, hob, fanuc))
+    start = translated[at + 1]
+    assert start.startswith("M3 S")
+    early = [*translated[:at], start, translated[at], *translated[at + 2:]]
+    for prove in (simulate_program, record_program):
+        with pytest.raises(SimulationError, match=r"G81 with the hob spindle turning \(M3, no M5 since\): .* "
+                                                  r"egb_waits_for_sync") as raised:
+            prove(early, gear, hob, fanuc)
+        assert "\n" not in str(raised.value)
+    stopped = [*translated[:at], start, "M5", translated[at], *translated[at + 1:]]
+    assert refusals(stopped, gear, hob, fanuc) == []

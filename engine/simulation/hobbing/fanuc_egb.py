@@ -19,6 +19,8 @@ What it cannot prove it refuses (fail closed):
 * Q and P in the M series' G81.4: their units and the compensation they give are not in the
   retrieved manuals (§F3); §F4's formula is G81's ([15i-MA] p. 749), and egb_helix_sign's dry run
   proves a sign, not a formula.
+* a G81 with the hob already turning: whether the next block waits until the table is in step is
+  not known (§F7 egb_waits_for_sync); synchronised at rest, the table follows the run-up.
 * a C word: the table already follows the hob (and Z, through Q/P); a C move on top turns it a
   second time (§F6: the program must not add it twice)."""
 from __future__ import annotations
@@ -111,13 +113,29 @@ def compensation_problem(code: str, gear: Gear, helix_sign: int | None, command:
 
 def refuse_unproved_compensation(steps: list, gear: Gear, machine: Machine, name: str) -> None:
     """SimulationError at the first G81 (G81.4) whose Q and P the simulation cannot prove for `gear`
-    on `machine`, before the walk: it cannot follow a table whose turning per mm of Z it does not know."""
+    on `machine`, or that starts with the hob already turning, before the walk: it cannot follow a
+    table whose turning per mm of Z, or whose phase, it does not know."""
+    turning = False
     for step in steps:
+        if step.kind == "block" and {3, 5} & step.m_codes:
+            turning = 3 in step.m_codes        # M3 counts at once: the unsafe way round for this rule
         if step.kind == "statement" and step.item.name in ("G81", "G81.4"):
             problem = compensation_problem(step.line.partition(";")[0], gear, machine.egb_helix_sign,
-                                           step.item.name)
+                                           step.item.name) or turning_start_problem(step.item.name, turning)
             if problem:
                 raise SimulationError(f"{where(name, step.number, step.line)}: {problem}")
+
+
+def turning_start_problem(command: str, turning: bool) -> str | None:
+    """A G81 with the hob spindle turning: the table must catch up with it, and whether the control
+    holds the next block until C is in step is not in the retrieved manuals (fanuc-egb.md §F7
+    egb_waits_for_sync; the 840D's EGON "FINE" does wait), so the first gaps could be cut out of
+    step. Synchronised at rest, the table follows the hob's run-up in step."""
+    if not turning:
+        return None
+    return (f"{command} with the hob spindle turning (M3, no M5 since): whether the control waits until the table "
+            "is in step before the next block is not known (fanuc-egb.md §F7, egb_waits_for_sync), so the cut "
+            f"could start out of step; {command} before M3")
 
 
 def c_word_problem(code: str) -> str | None:
