@@ -11,6 +11,7 @@ passes, a flipped P, a flipped record sign or a wrong module Q cuts the wrong he
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import replace
 
 import pytest
@@ -217,3 +218,41 @@ def test_the_picture_follows_the_helical_coupling_on_a_record_stating_the_sign(c
     recording = record_program(fanuc_program(lines, gear, hob, fanuc), gear, hob, fanuc)
     assert [round(coupling.factors["Z"], 9) for coupling in recording.couplings] == \
         [round(reference_k_z(gear), 9)] * len(recording.couplings)
+
+
+def test_q_and_p_in_the_m_series_g81_4_are_refused_their_meaning_unconfirmed(case):
+    """fanuc-egb.md §F3: G81.4's Q and P have no units or formula in the retrieved text; §F4's
+    egb_helix_sign·sin P·360/(π·T·Q) is G81's. The same Q/P that G81 proves (P from the reference,
+    §F5) is refused in G81.4 on a record stating the sign, for the simulation and the picture."""
+    lines, gear, hob, _, fanuc = case(HELICAL, egb_helix_sign=1)
+    translated = fanuc_program(lines, gear, hob, fanuc)
+    assert simulate_program(translated, gear, hob, fanuc).refusals == []
+    helical = f"Q{gear.module:g}. P{reference_p(gear, fanuc):.3f}"
+    start = g81(gear, hob, fanuc)
+    m_series = [{start: start.replace("G81 T", "G81.4 R"), "G80": "G80.4"}.get(line, line) for line in translated]
+    assert f"G81.4 R{gear.teeth} L{threads_word(hob, fanuc)} {helical}" in m_series
+    g81_4 = replace(fanuc, dialect="fanuc-g81.4")
+    for prove in (simulate_program, record_program):
+        with pytest.raises(SimulationError, match=rf"{re.escape(helical)} in G81.4: the M-series form's Q and P .* "
+                                                  r"not in the retrieved manuals \(fanuc-egb.md §F3\)") as raised:
+            prove(m_series, gear, hob, g81_4)
+        assert "\n" not in str(raised.value)
+
+
+def test_a_g81_with_the_hob_turning_is_refused_the_table_may_not_be_in_step(case):
+    """fanuc-egb.md §F7 (egb_waits_for_sync, not known): with the hob already turning the table must
+    catch up, and the next block may not wait for it. The same program with M5 before G81 and the
+    hob started after it (the order the seeded templates write) is proved."""
+    lines, gear, hob, _, fanuc = case(SPUR)
+    translated = fanuc_program(lines, gear, hob, fanuc)
+    at = translated.index(g81(gear, hob, fanuc))
+    start = translated[at + 1]
+    assert start.startswith("M3 S")
+    early = [*translated[:at], start, translated[at], *translated[at + 2:]]
+    for prove in (simulate_program, record_program):
+        with pytest.raises(SimulationError, match=r"G81 with the hob spindle turning \(M3, no M5 since\): .* "
+                                                  r"egb_waits_for_sync") as raised:
+            prove(early, gear, hob, fanuc)
+        assert "\n" not in str(raised.value)
+    stopped = [*translated[:at], start, "M5", translated[at], *translated[at + 1:]]
+    assert refusals(stopped, gear, hob, fanuc) == []

@@ -16,6 +16,11 @@ What it cannot prove it refuses (fail closed):
 
 * Q and P on a record that does not state `egb_helix_sign` (NULL): the hand they cut is unknown.
   On a spur gear any Q/P cuts a helix (or is a differential a spur gear has no use for).
+* Q and P in the M series' G81.4: their units and the compensation they give are not in the
+  retrieved manuals (§F3); §F4's formula is G81's ([15i-MA] p. 749), and egb_helix_sign's dry run
+  proves a sign, not a formula.
+* a G81 with the hob already turning: whether the next block waits until the table is in step is
+  not known (§F7 egb_waits_for_sync); synchronised at rest, the table follows the run-up.
 * a C word: the table already follows the hob (and Z, through Q/P); a C move on top turns it a
   second time (§F6: the program must not add it twice)."""
 from __future__ import annotations
@@ -85,9 +90,9 @@ def compensation(module: float, helix: float, teeth: int, helix_sign: int) -> tu
     return helix_sign * sine * scale, resolution
 
 
-def compensation_problem(code: str, gear: Gear, helix_sign: int | None) -> str | None:
-    """Why a G81 with Q and P cannot be proved for `gear` on a record stating `helix_sign` (None:
-    the block gives neither, or the walk proves its Z term)."""
+def compensation_problem(code: str, gear: Gear, helix_sign: int | None, command: str = "G81") -> str | None:
+    """Why a G81 (`command`: G81 or G81.4) with Q and P cannot be proved for `gear` on a record
+    stating `helix_sign` (None: the block gives neither, or the walk proves its Z term)."""
     words = g81_words(code)
     if not any(address in words for address in HELICAL_WORDS):
         return None
@@ -95,6 +100,10 @@ def compensation_problem(code: str, gear: Gear, helix_sign: int | None) -> str |
     if not gear.helix_angle:
         return (f"{given} on a spur gear: the control adds a helical differential Z·sin P·360/(π·T·Q) degrees of C "
                 "per mm of Z (fanuc-egb.md §F4) and would cut a helix; a spur gear's G81 gives T and L only")
+    if command != "G81":
+        return (f"{given} in {command}: the M-series form's Q and P (their units, the compensation they give) are not "
+                "in the retrieved manuals (fanuc-egb.md §F3); the simulation proves G81's helical compensation only "
+                "(§F4), so it refuses a helical gear's G81.4 program")
     if helix_sign is None:
         return (f"the sign of the Fanuc helical compensation is not stated on the machine record (egb_helix_sign, "
                 f"fanuc-egb.md §F5, §F7): the simulation cannot tell which hand {given} cuts and refuses a helical "
@@ -104,12 +113,29 @@ def compensation_problem(code: str, gear: Gear, helix_sign: int | None) -> str |
 
 def refuse_unproved_compensation(steps: list, gear: Gear, machine: Machine, name: str) -> None:
     """SimulationError at the first G81 (G81.4) whose Q and P the simulation cannot prove for `gear`
-    on `machine`, before the walk: it cannot follow a table whose turning per mm of Z it does not know."""
+    on `machine`, or that starts with the hob already turning, before the walk: it cannot follow a
+    table whose turning per mm of Z, or whose phase, it does not know."""
+    turning = False
     for step in steps:
+        if step.kind == "block" and {3, 5} & step.m_codes:
+            turning = 3 in step.m_codes        # M3 counts at once: the unsafe way round for this rule
         if step.kind == "statement" and step.item.name in ("G81", "G81.4"):
-            problem = compensation_problem(step.line.partition(";")[0], gear, machine.egb_helix_sign)
+            problem = compensation_problem(step.line.partition(";")[0], gear, machine.egb_helix_sign,
+                                           step.item.name) or turning_start_problem(step.item.name, turning)
             if problem:
                 raise SimulationError(f"{where(name, step.number, step.line)}: {problem}")
+
+
+def turning_start_problem(command: str, turning: bool) -> str | None:
+    """A G81 with the hob spindle turning: the table must catch up with it, and whether the control
+    holds the next block until C is in step is not in the retrieved manuals (fanuc-egb.md §F7
+    egb_waits_for_sync; the 840D's EGON "FINE" does wait), so the first gaps could be cut out of
+    step. Synchronised at rest, the table follows the hob's run-up in step."""
+    if not turning:
+        return None
+    return (f"{command} with the hob spindle turning (M3, no M5 since): whether the control waits until the table "
+            "is in step before the next block is not known (fanuc-egb.md §F7, egb_waits_for_sync), so the cut "
+            f"could start out of step; {command} before M3")
 
 
 def c_word_problem(code: str) -> str | None:
