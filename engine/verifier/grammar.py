@@ -75,8 +75,8 @@ class Synchronisation:
     gear's number of teeth, not a tool). `on` starts the table's synchronisation with the hob
     spindle, or changes its ratio when it is on; otherwise the block cancels it. The table turns
     |threads|/teeth turns per hob turn, the sign of the threads giving its direction. The paired
-    words (module and helix angle of the helical compensation) are read as whole numbers in the
-    control's units, which the machine record is to state (engine.verifier.synchronisation)."""
+    words (module and helix angle of the helical compensation) are read with their decimal point,
+    in mm and degrees (engine.verifier.synchronisation)."""
     code: str                        # after the G, leading zeros aside: "81", "80.4"
     on: bool                         # starts or re-rates the synchronisation; False: cancels it
     teeth: str = ""                  # the address of the gear's number of teeth

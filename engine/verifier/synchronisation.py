@@ -106,8 +106,14 @@ def _helical_factor(command: Synchronisation, words: dict[str, str]) -> tuple[tu
     module_word, helix_word = command.paired
     module = _increment(command.event, module_word, words[module_word], module=True)
     helix = _increment(command.event, helix_word, words[helix_word], module=False)
-    teeth = int(words[command.teeth])
-    return ((AXIAL_FEED_AXIS, abs(math.sin(math.radians(helix))) * 360.0 / (math.pi * teeth * module)),)
+    return ((AXIAL_FEED_AXIS, abs(helical_compensation(module, helix, int(words[command.teeth])))),)
+
+
+def helical_compensation(module: float, helix: float, teeth: int) -> float:
+    """Degrees of C per mm of Z the control adds for G81's Q (`module`, mm) and P (`helix`,
+    degrees) on a gear of `teeth` (fanuc-egb.md §F4, metric input): sin P·360/(π·T·Q), signed by
+    P; the sign the control turns it with is the machine record's (egb_helix_sign, §F5)."""
+    return math.sin(math.radians(helix)) * 360.0 / (math.pi * teeth * module)
 
 
 def _count(event: str, address: str, text: str, bounds: range, signed: bool) -> int:

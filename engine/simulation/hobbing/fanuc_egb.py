@@ -30,6 +30,7 @@ import re
 
 from ...gears.records import Gear
 from ...machines.records import Machine
+from ...verifier.synchronisation import helical_compensation
 from .coupling import Coupling, read_coupling
 from .frame import Senses
 from .report import SimulationError, where
@@ -84,10 +85,10 @@ def compensation(module: float, helix: float, teeth: int, helix_sign: int) -> tu
     compensation (fanuc-egb.md §F4, metric input: the grammar refuses G20): helix_sign·sin P·360/
     (π·T·Q), Q the module in mm, P the helix angle in degrees. The resolution is what half a least
     increment of P and of Q changes it by (∂/∂P and ∂/∂Q of the formula)."""
-    scale = 360.0 / (math.pi * teeth * module)
-    sine, cosine = math.sin(math.radians(helix)), math.cos(math.radians(helix))
-    resolution = scale * (abs(cosine) * math.radians(P_INCREMENT / 2) + abs(sine) * Q_INCREMENT / 2 / module)
-    return helix_sign * sine * scale, resolution
+    per_mm = helical_compensation(module, helix, teeth)
+    scale = helical_compensation(module, 90.0, teeth)   # 360/(π·T·Q): sin 90° = 1
+    by_p = scale * abs(math.cos(math.radians(helix))) * math.radians(P_INCREMENT / 2)
+    return helix_sign * per_mm, by_p + abs(per_mm) * Q_INCREMENT / 2 / module
 
 
 def compensation_problem(code: str, gear: Gear, helix_sign: int | None, command: str = "G81") -> str | None:
