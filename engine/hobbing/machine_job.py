@@ -1,6 +1,7 @@
 """A job's parameters made ready for its machine: the signed values in the machine's senses
 (engine.hobbing.conventions), the machine's setup (work offset, tool call, door and load
-blocks, spindle orientation), the working area widened to the load position, and the cycle
+blocks, spindle orientation), the dialect the template renders the coupling in
+(engine.hobbing.dialects), the working area widened to the load position, and the cycle
 time of the program the template will write (engine.hobbing.cycle_time) and its floor-to-floor
 time (engine.hobbing.floor_time)."""
 from __future__ import annotations
@@ -9,11 +10,13 @@ from ..gears.records import Hob
 from ..machines.records import Machine
 from . import conventions
 from .cycle_time import cycle_time
+from .dialects import dialect_parameters
 from .floor_time import floor_to_floor
 from .passes import LIMIT_MARGIN
 
 SETUP_PARAMETERS = frozenset({"work_offset", "tool_number", "door_close_m", "door_open_m", "load_position",
-                              "load_x", "load_z", "orient_before_coupling", "cycle_time", "floor_to_floor"})
+                              "load_x", "load_z", "orient_before_coupling", "cycle_time", "floor_to_floor",
+                              "dialect", "program_number", "egb_helix_sign"})
 
 
 def machine_setup(machine: Machine, hob: Hob) -> dict:
@@ -31,7 +34,8 @@ def machine_setup(machine: Machine, hob: Hob) -> dict:
 def machine_job(params: dict, module_params: dict, machine: Machine, hob: Hob, shape: str) -> tuple[dict, dict]:
     """(job parameters, module parameters) in program values, with the setup and cycle time.
     `shape` names the cut of engine.hobbing.cycle_time.PASSES the class's template emits."""
-    job = {**conventions.on_machine(params, machine), **machine_setup(machine, hob)}
+    job = {**conventions.on_machine(params, machine), **machine_setup(machine, hob),
+           **dialect_parameters(machine, params["gear_id"])}
     modules = {key: conventions.on_machine(values, machine) for key, values in module_params.items()}
     if job["load_position"]:
         _widen(job, "x", job["load_x"])
