@@ -26,6 +26,7 @@ from engine.hobbing.choices import Choices
 from engine.machines.records import load_machine
 from engine.programs import verified_run
 from engine.programs.instantiate import instantiate_gear
+from engine.programs.remake import instantiate_job
 from engine.simulation import simulate_program
 from engine.verifier import verify_program
 
@@ -157,3 +158,12 @@ def test_the_m_series_form_g81_4_is_still_refused_by_name(conn):
     name = add_machine_like(conn, FANUC, "hobber-fanuc-m", dialect="fanuc-g81.4")
     with pytest.raises(EngineError, match="runs dialect fanuc-g81.4"):
         instantiate_gear(conn, 42, machine=name, choices=NO_TAILSTOCK)
+
+
+@pytest.mark.parametrize("machine", [SIEMENS, FANUC])
+def test_a_job_stored_before_the_dialect_parameters_is_made_again_in_its_machines_dialect(conn, machine):
+    made = instantiate_gear(conn, 42, machine=machine, choices=NO_TAILSTOCK)
+    conn.execute("UPDATE job SET params = params - 'dialect' - 'program_number' - 'egb_helix_sign' WHERE id = %s",
+                 (made.job_id,))
+    again = instantiate_job(conn, made.job_id)
+    assert again.lines[:6] == made.lines[:6] and again.lines[7:] == made.lines[7:]   # the lineage aside

@@ -34,8 +34,7 @@ def machine_setup(machine: Machine, hob: Hob) -> dict:
 def machine_job(params: dict, module_params: dict, machine: Machine, hob: Hob, shape: str) -> tuple[dict, dict]:
     """(job parameters, module parameters) in program values, with the setup and cycle time.
     `shape` names the cut of engine.hobbing.cycle_time.PASSES the class's template emits."""
-    job = {**conventions.on_machine(params, machine), **machine_setup(machine, hob),
-           **dialect_parameters(machine, params["gear_id"])}
+    job = {**conventions.on_machine(params, machine), **machine_setup(machine, hob)}
     modules = {key: conventions.on_machine(values, machine) for key, values in module_params.items()}
     if job["load_position"]:
         _widen(job, "x", job["load_x"])
@@ -46,7 +45,11 @@ def machine_job(params: dict, module_params: dict, machine: Machine, hob: Hob, s
 def with_cycle_time(job: dict, modules: dict, shape: str, machine: Machine) -> dict:
     """The job with the cycle and floor-to-floor times of its program (program values in, as stored): a stored job
     whose feeds were edited is made again with the time its program now takes, so the header
-    never tells the operator a time the simulation does not find."""
+    never tells the operator a time the simulation does not find. The dialect's parameters come
+    from the record here too (engine.hobbing.dialects), so a job stored before they existed is
+    made again in its machine's dialect."""
+    gear_id = job.get("gear_id")
+    job = {**job, **dialect_parameters(machine, gear_id if type(gear_id) is int else 0)}
     cuts = [modules[key] for key in sorted(modules, key=_module_order)
             if key.startswith("cutmotion:") and modules[key]["cut_on"]]
     minutes = cycle_time(job, cuts, shape, machine.rapid_rate)
