@@ -22,6 +22,7 @@ from helpers.machines import add_machine_like
 
 from engine.errors import EngineError
 from engine.gears.records import load_gear, load_hobs
+from engine.hobbing import dialects
 from engine.hobbing.choices import Choices
 from engine.machines.records import load_machine
 from engine.programs import verified_run
@@ -167,3 +168,13 @@ def test_a_job_stored_before_the_dialect_parameters_is_made_again_in_its_machine
                  (made.job_id,))
     again = instantiate_job(conn, made.job_id)
     assert again.lines[:6] == made.lines[:6] and again.lines[7:] == made.lines[7:]   # the lineage aside
+
+
+def test_a_class_without_fanuc_rows_is_refused_by_name_nothing_stored(conn, monkeypatch):
+    """A class whose template has no Fanuc rows (here spur, taken out of the table) is named, not
+    read line by line as 840D code by the Fanuc grammar."""
+    monkeypatch.setattr(dialects, "FANUC_CLASSES", dialects.FANUC_CLASSES - {"spur"})
+    before = conn.execute(PROGRAMS).fetchone()[0]
+    with pytest.raises(EngineError, match=r"^gear 42 on hobber-fanuc \(Fanuc\): class spur has no Fanuc rows"):
+        instantiate_gear(conn, 42, machine=FANUC, choices=NO_TAILSTOCK)
+    assert conn.execute(PROGRAMS).fetchone()[0] == before
