@@ -8,10 +8,10 @@ left hand; c, b, z the record's senses; s its egb_helix_sign), computed here:
 T = z2, L = −h_hob·c·b·z0, and for a helical gear Q = m_n, P = −h_gear·c·z·s·β; a spur gear has
 neither Q nor P, and no program has an explicit differential (no EGON, no C word).
 
-The seeded Fanuc hobber's programs are made without the tailstock here: its agreed M20/M21 blocks
-are not yet in the Fanuc grammar (a grammar change under way), and a test below shows the rows
-render them. Taper, crowned and the worm wheel's radial plunge need G64/G61 and the dwell G04,
-also pending there: strict xfail, so their marks must go when the grammar reads them."""
+The seeded Fanuc hobber's programs are made without the tailstock here (the agreed M20/M21 blocks
+came to the Fanuc grammar in a change of their own; a test below shows the rows render them).
+Taper, crowned and the worm wheel's radial plunge need G64/G61 and the dwell G04: strict xfail
+while the grammar of this tree does not read them (PENDING_GRAMMAR)."""
 from __future__ import annotations
 
 import math
@@ -30,10 +30,14 @@ from engine.programs.instantiate import instantiate_gear
 from engine.programs.remake import instantiate_job
 from engine.simulation import simulate_program
 from engine.verifier import verify_program
+from engine.verifier.grammar import HOBBING_FANUC
 
 FANUC, SIEMENS = "hobber-fanuc", "hobber-840d"
 NO_TAILSTOCK = Choices(tailstock=False)
-PENDING_GRAMMAR = pytest.mark.xfail(strict=True, reason="Fanuc grammar: G64/G61/G04 pending (issue 30)")
+# The Fanuc grammar of this tree reads G64/G61 and G04 or not yet (a grammar change of issue 30):
+# until it does, taper, crowned and the worm wheel are refused at those blocks (strict xfail).
+PENDING_GRAMMAR = pytest.mark.xfail(not {61, 64, 4} <= HOBBING_FANUC.g_codes.keys(), strict=True,
+                                    reason="Fanuc grammar: G64/G61/G04 not read yet (issue 30)")
 # Seeded gears (seed_templates/gears.csv) by class; both hands come from 43 (R) and 44 (L).
 GEARS = [pytest.param(42, id="spur"), pytest.param(43, id="helical R"), pytest.param(44, id="helical L"),
          pytest.param(45, id="spur 2 cuts"), pytest.param(46, id="spur 2-start hob"),

@@ -18,6 +18,7 @@ from engine.hobbing.choices import Choices
 from engine.programs.instantiate import instantiate_gear
 from engine.programs.remake import instantiate_job
 from engine.turning.job_params import ProfileOptions
+from engine.verifier.grammar import HOBBING_FANUC
 from importers.dxf import import_dxf
 
 GOLDEN = Path(__file__).resolve().parents[1] / "golden"
@@ -54,11 +55,11 @@ LATHES = ("lathe-iso", "lathe-840d")
 
 
 # The Fanuc hobber's goldens (issue 30): the same gears and choice sets on hobber-fanuc, the
-# coupling rendered as G81/G80 by the same class templates. They are made without the tailstock
-# until the Fanuc grammar reads the agreed M20/M21 (a grammar change under way): then set
-# FANUC_TAILSTOCK to None (each set's own choice) and write the goldens again.
+# coupling rendered as G81/G80 by the same class templates. While the Fanuc grammar of this tree
+# does not read the agreed tailstock M20/M21 (a grammar change of its own), they are made without
+# the tailstock (False); once it does, with each set's own choice (None): write them again then.
 FANUC_MACHINE = "hobber-fanuc"
-FANUC_TAILSTOCK: bool | None = False
+FANUC_TAILSTOCK: bool | None = None if {20, 21} <= HOBBING_FANUC.m_codes.keys() else False
 
 WORM_WHEELS = (53,)   # no axial pass: their cases leave out the feed modes (refused for them)
 
