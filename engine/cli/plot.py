@@ -11,7 +11,7 @@ from .ids import JOB_ID, PROGRAM_ID
 @click.command("plot")
 @click.option("--job", "job_id", type=JOB_ID, help="Job id: a turning job (engine import-dxf) or a hobbing job.")
 @click.option("--program", "program_id", type=PROGRAM_ID, help="Stored program id: what its lines do, as the "
-              "simulation reads them.")
+              "simulation reads them in its machine's dialect (840D, Fanuc).")
 @click.option("-o", "--out", required=True, type=click.Path(dir_okay=False),
               help="Picture to write: FILE.png or FILE.svg.")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object: job_id or program_id, path, drawn.")

@@ -4,11 +4,13 @@ and end in the DIN frame, the swivel it ran at, whether it cut, the cuts as the 
 and the G25/G26 working area as the program sets it. A picture drawn from this shows what the
 simulation checked, not a second interpretation of the program text: the F in effect at each
 move, each A as the program writes it and each coupling are kept too (the numbers a picture
-states, issue 27). A program with the
+states, issue 27), the coupling with its start as the program writes it: read in the machine's
+dialect, an 840D `EGON(…)` or a Fanuc `G81 T… L…` (issue 30). A program with the
 hob-shift-per-part clamp is followed at both ends of its R11 interval (the Y range it cuts at,
 the part of the hob the shifting uses); the moves are those at the low end."""
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass, field
 
 from ...gears.records import Gear, Hob
@@ -20,6 +22,8 @@ from .report import Report, SimulationError
 from .run import SHIFT_ENDS
 from .solids import Solid, setup_solids, unit_solids
 from .walk import BlockSimulation
+
+SWIVEL_EQUALS = re.compile(r"(?<![A-Z])A=")   # `A=1.763` (840D) rather than `A1.763` (840D, ISO, Fanuc)
 
 
 @dataclass(frozen=True, slots=True)
@@ -58,7 +62,9 @@ class Recording:
     area_words: dict = field(default_factory=dict)  # "lower"/"upper" -> {axis: program value}
     cutting_y: tuple = (0.0, 0.0)                   # the lowest and highest Y (DIN) the hob cuts at
     swivel_words: list = field(default_factory=list)  # (line, A as written) for every A the program writes
-    couplings: list = field(default_factory=list)     # every EGON as the walk read it (DIN Coupling)
+    couplings: list = field(default_factory=list)     # every EGON (G81) as the walk read it (DIN Coupling)
+    coupling_words: list = field(default_factory=list)  # each coupling's start as the program writes it
+    swivel_address: str = "A"                         # how it writes the swivel: `A=` (840D templates) or `A`
 
     @property
     def final_swivel(self) -> float:
@@ -90,11 +96,13 @@ class RecordingSimulation(BlockSimulation):
     def _couple(self, step) -> None:
         super()._couple(step)
         self.recording.couplings.append(self.coupling)
+        self.recording.coupling_words.append(step.line.partition(";")[0].strip())
 
     def _move(self, step, motion: int, program: dict, swivel: float | None = None) -> None:
         start = dict(self.position)
         if swivel is not None:
             self.recording.swivel_words.append((step.number, swivel))
+            self.recording.swivel_address = "A=" if SWIVEL_EQUALS.search(step.line.partition(";")[0]) else "A"
         super()._move(step, motion, program, swivel)
         move = Move(step.number, step.line, motion, start, dict(self.position), self.swivel, self.cut is not None,
                     self.feed)
