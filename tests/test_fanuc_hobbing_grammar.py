@@ -119,7 +119,7 @@ def test_a_second_g81_while_on_replaces_the_ratio_and_the_table_speed_follows(fa
     (replaced("G0 Z19.576 A1.763", "G0 Z19.576 A1"), "A1 needs a decimal point"),
     (replaced("G1 X51.500 F13.3", "G1 X51.500 F13"), "F13 needs a decimal point"),
     (replaced("M8", "M8 ; COOLANT"), "not a word of the Fanuc hobbing in G54 grammar"),
-    (replaced("M8", "M20"), "M20 is not an M code of the Fanuc hobbing in G54 grammar"),
+    (replaced("M8", "M22"), "M22 is not an M code of the Fanuc hobbing in G54 grammar"),
     (replaced("G80", "G80", "EGOFS(C)"), "EGOFS: not a word of the Fanuc hobbing in G54 grammar"),   # (C) a comment
 ])
 def test_fanuc_framing_units_and_modes_are_those_of_the_rules(fanuc, lines, reason):

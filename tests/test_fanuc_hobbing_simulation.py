@@ -15,32 +15,22 @@ import re
 from dataclasses import replace
 
 import pytest
+from helpers.fanuc_cases import twin
 from helpers.fanuc_programs import fanuc_program, g81, threads_word
-from helpers.unproved_programs import unproved
 
-from engine.gears.records import load_gear, load_hobs
-from engine.hobbing.choices import Choices
-from engine.machines.records import load_machine
 from engine.simulation import simulate_program
 from engine.simulation.hobbing.recorded import record_program
 from engine.simulation.hobbing.report import SimulationError
 
-MACHINE = "hobber-840d"
 SPUR = 42                       # seeded spur gear: m 2, z 19, its hob one-start right hand
 HELICAL = 43                    # seeded helical gear, right hand
-NO_TAILSTOCK = Choices(tailstock=False)   # the Fanuc grammar has no tailstock M code
 
 
 @pytest.fixture
 def case(conn, monkeypatch):
-    """gear id, senses -> (840D lines, gear, hob, 840D machine, Fanuc machine)."""
-    def made(gear_id: int, **senses):
-        program = unproved(conn, monkeypatch, gear_id, NO_TAILSTOCK)
-        hob_id = conn.execute("SELECT hob_id FROM job WHERE id = %s", (program.job_id,)).fetchone()[0]
-        hob = next(h for h in load_hobs(conn) if h.id == hob_id)
-        machine = replace(load_machine(conn, MACHINE), **senses)
-        return program.lines, load_gear(conn, gear_id), hob, machine, replace(machine, dialect="fanuc")
-    return made
+    """gear id, senses -> (840D lines, gear, hob, 840D machine, Fanuc machine), the tailstock
+    clamped (M20 … M21, as the templates write by default)."""
+    return lambda gear_id, **senses: twin(conn, monkeypatch, gear_id, **senses)
 
 
 def refusals(lines, gear, hob, machine) -> list[str]:

@@ -51,7 +51,6 @@ from .swivel_sweep import sweep_problem, unknown_pose
 from .timing import feed_minutes, header_minutes, header_problem, rapid_minutes
 
 AXES = ("X", "Y", "Z")
-DWELL = 4
 MAX_SWIVEL = 80.0        # degrees from horizontal the hob axis may stand (helix angles stay well below)
 
 
@@ -154,8 +153,8 @@ class BlockSimulation:
             self.feed = block.feed
         if block.speed is not None:
             self.speed = block.speed
-        if DWELL in step.g_codes:
-            self.report.cycle_time += block.values.get("F", 0.0) / 60.0
+        if block.dwell is not None:
+            self.report.cycle_time += block.dwell / 60.0
         elif block.moves and block.area is None:
             self.moved = True
             self._move(step, block.motion, dict(block.positions), block.values.get("A"))
