@@ -60,24 +60,27 @@ def g81_words(code: str) -> dict[str, str]:
     return words
 
 
-def read_g81(code: str, senses: Senses, helix_sign: int | None = None) -> Coupling:
+def read_g81(code: str, senses: Senses, helix_sign: int | None = None, command: str = "G81") -> Coupling:
     """The coupling a G81 (G81.4) block gives, in the DIN frame: L over T (R), as EGON's numerator
     over its denominator, and Q/P as its Z term, signed by the record's `helix_sign` (a G81 with
     Q and P on a record without one is refused before the walk)."""
     words = g81_words(code)
-    teeth = int(words["T"] if "T" in words else words["R"])
-    threads = int(words["L"])
+    teeth_word = "T" if "T" in words else "R"
+    teeth, threads = int(words[teeth_word]), int(words["L"])
     program, factors, resolution = {"B": threads / teeth}, {}, {}
-    if all(address in words for address in HELICAL_WORDS) and helix_sign is not None:
+    helical = all(address in words for address in HELICAL_WORDS)
+    if helical and helix_sign is not None:
         program["Z"], resolution["Z"] = compensation(float(words["Q"]), float(words["P"]), teeth, helix_sign)
         factors["Z"] = program["Z"] * senses.factor("Z")
-    return Coupling(threads, teeth, program["B"] * senses.factor("B"), factors, resolution, program)
+    return Coupling(threads, teeth, program["B"] * senses.factor("B"), factors, resolution, program, command,
+                    f"L{words['L']} {teeth_word}{words[teeth_word]}",
+                    " ".join(f"{address}{words[address]}" for address in HELICAL_WORDS) if helical else "")
 
 
 def read_start(name: str, code: str, senses: Senses, machine: Machine) -> Coupling:
     """The DIN coupling a start gives: an 840D EGON's (engine.simulation.hobbing.coupling) or a
     Fanuc G81's (G81.4's), whose Q/P the record's egb_helix_sign signs."""
-    return read_coupling(code, senses) if name == "EGON" else read_g81(code, senses, machine.egb_helix_sign)
+    return read_coupling(code, senses) if name == "EGON" else read_g81(code, senses, machine.egb_helix_sign, name)
 
 
 def compensation(module: float, helix: float, teeth: int, helix_sign: int) -> tuple[float, float]:

@@ -288,7 +288,7 @@ class BlockSimulation:
         for unit in self.units:
             if len(unit.cut_sessions) > 1 and ("recut", unit.name) not in self.said:
                 self.said.add(("recut", unit.name))
-                self._refuse(step, recut_problem(unit.name))
+                self._refuse(step, recut_problem(unit.name, self.coupling.command if self.coupling else "EGON"))
 
     def _reason(self, motion: int) -> str:
         if motion == 0:
