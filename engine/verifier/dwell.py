@@ -4,8 +4,8 @@ fanuc-egb.md §F8), and its word is a time, not a feed or a position: on a Fanuc
 `G04 X2.5` dwells 2.5 s, it does not move X. So a dwell block is read here, word by word with
 the dialect's dwell words (grammar.DwellWord), before the block reader would take X for an axis:
 
-* one time word, once: `G04` alone is an exact stop on a Fanuc, no dwell, and `G04 X1. P500`
-  states the time twice (which one the control takes is not the verifier's to guess);
+* one time word, once: `G04` alone states no time, and `G04 X1. P500` states it twice (which
+  one the control takes is not the verifier's to guess);
 * its decimal point as the word needs it: Fanuc's X without one is read in the least input
   increment (X2 is 0.002 s under IS-B, 0.0002 s under IS-C), P with one is not a whole number
   of milliseconds;
@@ -39,8 +39,8 @@ def read_dwell(dialect: Dialect, tokens: list[str]) -> float:
     given = [_word(code, words, token) for token in tokens if token is not code]
     names = " or ".join(words)
     if not given:
-        raise Refused(f"{code} without its {names}: a dwell states its time (a Fanuc reads a G04 without one as "
-                      "an exact stop)")
+        raise Refused(f"{code} without its {names}: a dwell states its time (without one the block dwells for no "
+                      "time the program says)")
     if len(given) > 1:
         raise Refused(f"{code} with {' and '.join(f'{word.address}{text}' for word, text in given)}: "
                       "a dwell states its time once")
