@@ -16,6 +16,9 @@ import pytest
 from engine.machines.records import Machine, load_machine
 from engine.nc.lineage import lineage_line, lineage_words
 from engine.verifier import LimitError, verify_program
+from engine.verifier.grammar import HOBBING_FANUC, HOBBING_FANUC_G81_4
+from engine.verifier.lines import read_line
+from engine.verifier.statements import GearBox
 
 NAME = "GEAR42"
 SPEED = 246                                   # r/min of the hob: S246
@@ -252,3 +255,14 @@ def test_instantiate_on_a_fanuc_hobber_is_refused_by_name_and_stores_nothing(run
         "(Fanuc: issue 30); use --machine hobber-840d"]
     with psycopg.connect(run.url) as conn:
         assert conn.execute("SELECT count(*) FROM program").fetchone()[0] == before
+
+
+def test_a_g81_statement_carries_its_terms_with_their_signs():
+    """The simulation proves the hand and the helix from the signs of L and P: the verifier's
+    reading keeps them (and the words as written, for the findings), so no second reader parses
+    the block again."""
+    start = read_line(HOBBING_FANUC, "G81 T41 L-2 Q3. P-15. (START)")
+    assert start.gear_box == GearBox(41, -2, 3.0, -15.0, "T41", "L-2", "Q3. P-15.")
+    assert start.ratio == 2 / 41 and start.gear_box.ratio_words == "L-2 T41"
+    assert read_line(HOBBING_FANUC_G81_4, "G81.4 R40 L3").gear_box == GearBox(40, 3, None, None, "R40", "L3")
+    assert read_line(HOBBING_FANUC, "G80").gear_box is None

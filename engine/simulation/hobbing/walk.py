@@ -113,7 +113,7 @@ class BlockSimulation:
             self.coupling = None
 
     def _couple(self, step) -> None:
-        self.coupling = read_start(step.item.name, step.line.partition(";")[0].strip(), self.senses, self.machine)
+        self.coupling = read_start(step.item, step.line.partition(";")[0].strip(), self.senses, self.machine)
         self.session += 1
         teeth = [unit.teeth for unit in self.units if unit.teeth is not None]   # every unit is toothed
         problem = generated_teeth_problem(self.coupling, self.hob, teeth)
