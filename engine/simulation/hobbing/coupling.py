@@ -18,6 +18,10 @@ from dataclasses import dataclass
 from ...gears.records import Gear, Hob
 from .frame import Senses
 
+# The statements that start (or re-rate) the table's coupling and that end it, in each dialect:
+# the 840D's EGON / EGOFS, EGDEL, Fanuc's G81 / G80 and the M series' G81.4 / G80.4.
+COUPLING_ON = frozenset({"EGON", "G81", "G81.4"})
+COUPLING_OFF = frozenset({"EGOFS", "EGDEL", "G80", "G80.4"})
 ANGLE_TOLERANCE = 0.01       # degrees of swivel
 FACTOR_TOLERANCE = 1e-6      # relative
 HOB_DEDENDUM = 1.25          # d_m0 = d_a0 − 2·1.25·m_n (§B1)

@@ -37,8 +37,6 @@ from .coupling import Coupling, read_coupling
 from .frame import Senses
 from .report import SimulationError, where
 
-COUPLING_ON = frozenset({"EGON", "G81", "G81.4"})         # start (or re-rate) the table's coupling
-COUPLING_OFF = frozenset({"EGOFS", "EGDEL", "G80", "G80.4"})
 C_WORD = re.compile(r"(?<![A-Z])C[-+=]?[0-9.]")
 # The least increments the control reads Q and P in (fanuc-egb.md §F1: 0.00001 mm; 0.0001° in
 # [15i-MA], the coarser of the two sources): a program cannot state them finer, so the Z term

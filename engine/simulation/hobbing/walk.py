@@ -16,6 +16,8 @@ from ...verifier.shift_clamp import ShiftClamp
 from .allowance import depth_problem, header_allowance
 from .contact import Motion, follow
 from .coupling import (
+    COUPLING_OFF,
+    COUPLING_ON,
     Coupling,
     coupling_problems,
     generated_teeth_problem,
@@ -27,7 +29,7 @@ from .coupling import (
 )
 from .cuts import Cut, summary
 from .envelope import HobBody
-from .fanuc_egb import COUPLING_OFF, COUPLING_ON, read_start
+from .fanuc_egb import read_start
 from .frame import Senses
 from .headers import comment_problem, header_place_problem
 from .paths import move_pieces
