@@ -56,21 +56,26 @@ def _word(code: str, words: dict[str, DwellWord], token: str) -> tuple[DwellWord
 
 
 def _seconds(dialect: Dialect, word: DwellWord, text: str) -> float:
+    """The dwell's seconds: above 0 and at most MAX_DWELL."""
+    value = _value(dialect, word, text) * word.seconds
+    if value <= 0:
+        raise Refused(f"{word.address}{text} must be above 0: a dwell of {value:g} s")
+    if value > MAX_DWELL:
+        raise Refused(f"{word.address}{text}: a dwell of {value:g} s, above the {MAX_DWELL:.3f} s a control takes")
+    return value
+
+
+def _value(dialect: Dialect, word: DwellWord, text: str) -> float:
+    """The number as written, with the decimal point the word needs (or must not have)."""
     shown = f"{word.address}{text}"
     point = word.point if word.point is not None else word.address in dialect.point_required
     if point and "." not in text:
         raise Refused(f"{shown} needs a decimal point: without one the control reads a dwell's {word.address} in its "
                       f"least input increment ({word.address}2 is 0.002 s, or 0.0002 s), not in seconds; "
                       f"write {shown}.")
-    if word.point is False:
-        if "." in text or text[:1] in "+-":
-            raise Refused(f"{shown}: {word.address} is a whole number of milliseconds, without a sign or a decimal "
-                          "point (a Fanuc alarms or reads it otherwise); or write the seconds as X with its point")
-        value = whole_number(word.address, text, WHOLE_DIGITS) * word.seconds
-    else:
-        value = plain_decimal(word.address, text) * word.seconds
-    if value <= 0:
-        raise Refused(f"{shown} must be above 0: a dwell of {value:g} s")
-    if value > MAX_DWELL:
-        raise Refused(f"{shown}: a dwell of {value:g} s, above the {MAX_DWELL:.3f} s a control takes")
-    return value
+    if word.point is not False:
+        return plain_decimal(word.address, text)
+    if "." in text or text[:1] in "+-":
+        raise Refused(f"{shown}: {word.address} is a whole number of milliseconds, without a sign or a decimal "
+                      "point (a Fanuc alarms or reads it otherwise); or write the seconds as X with its point")
+    return whole_number(word.address, text, WHOLE_DIGITS)
