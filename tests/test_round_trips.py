@@ -236,3 +236,17 @@ def test_cases_imported_with_their_ids_leave_the_next_id_above_them(run, tmp_pat
     engine(run.url, "cases", "import", path)
     assert rows(run.url, f"SELECT id, cut FROM cutting_case WHERE id > {stored} ORDER BY id") == [
         (stored + 10, "rough"), (stored + 11, "finish")]
+
+
+def test_a_work_holding_a_stored_job_is_clamped_on_keeps_its_values(run, tmp_path):
+    made = json.loads(engine(run.url, "instantiate", "--gear", 42, "--fixture", "A-D12-H60", "--json"))
+    exported = engine(run.url, "fixtures", "list", "--csv")
+    assert "\nA-D12-H60,arbor,12,60,8,\n" in exported   # seed_templates/work_holdings.csv
+    path = tmp_path / "holdings.csv"
+    path.write_text(exported, encoding="utf-8")
+    engine(run.url, "fixtures", "import", path, "--replace")   # unchanged: taken back
+    path.write_text(exported.replace("\nA-D12-H60,arbor,12,60,8,\n", "\nA-D12-H60,arbor,12,65,8,\n"), encoding="utf-8")
+    said = refused(run.url, "fixtures", "import", path, "--replace")
+    assert (f"work-holding A-D12-H60: the file changes its height 60 → 65, but job {made['job_id']} was clamped "
+            "on it; nothing imported") in said
+    assert rows(run.url, "SELECT height FROM work_holding WHERE id = 'A-D12-H60'") == [(60,)]

@@ -184,7 +184,8 @@ def import_holdings(conn: Connection, path: str | Path, *, replace: bool = False
             stored = {row["id"]: row for row in exact_records(conn.execute(LOCKED, (ids,)))}
             changes = changed_fields(stored, holdings, "id", COLUMN_NAMES[1:])
             refuse_held(path, "work-holding", changes,
-                        jobs_of(conn, JOBS_OF_HOLDINGS, [change.key for change in changes]))
+                        jobs_of(conn, JOBS_OF_HOLDINGS, [change.key for change in changes]),
+                        relation="{jobs} {were} clamped on it")
             with conn.cursor() as cursor:
                 cursor.executemany(_UPSERT, [[holding[name] for name in COLUMN_NAMES] for holding in holdings])
     except (psycopg.errors.IntegrityError, psycopg.errors.DataError) as error:
