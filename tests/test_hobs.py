@@ -98,19 +98,6 @@ def test_the_earlier_properties_are_named_with_the_refusal():
     assert "among those with purpose cylindrical, module 3, pressure angle 20°" in message
 
 
-def test_a_refusal_never_says_one_number_for_the_need_and_an_offer_that_differ():
-    """Issue 31: "no hob has module 3.98478 … they have module 3.98478". The two are 0.000003 apart,
-    beyond the 1e-6 a module must match to: the refusal says them with the digits that tell them apart."""
-    message = refusal(gear(module=3.984781), [hob("H-X", module=3.984784)])
-    assert message.startswith("gear 901: no hob has module 3.984781 among those with purpose cylindrical: "
-                              "they have module 3.984784 (H-X)")
-    # the hob length needed: generating 2·2.25·m/tan α + π·m, the shift and 2·5 mm of margins
-    needed = 2 * 2.25 * 2 / math.tan(math.radians(20)) + math.pi * 2 + 59.03 + 2 * 5
-    assert f"{needed:.1f}" == "100.0"   # as the length was said: the hob's 100 would read alike
-    message = refusal(gear(), [hob("H-M2-AA-R1")], shift_travel=59.03)
-    assert f"no hob has length ≥ {needed:.10g} mm" in message and "they have length 100 (H-M2-AA-R1)" in message
-
-
 # --- choosing: preferences and the reason -------------------------------------------------
 
 @pytest.mark.parametrize("hand, expected", [("L", "H-M2-A-L1"), ("R", "H-M2-AA-R1"), (None, "H-M2-AA-R1")])

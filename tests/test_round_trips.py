@@ -2,12 +2,13 @@
 work-holdings and cutting cases, `list --csv` writes the columns the import reads, every field,
 every number digit for digit, and the import takes that file back unchanged: into the database it
 came from (`--replace`) and into a shop's new database. A row a stored job was made from is
-replaced by itself only."""
+replaced by itself only. And a refusal never says one rounded number for two that differ."""
 from __future__ import annotations
 
 import csv
 import io
 import json
+import math
 import uuid
 from decimal import Decimal
 from pathlib import Path
@@ -20,6 +21,9 @@ from psycopg.conninfo import conninfo_to_dict, make_conninfo
 
 from engine.cli.app import main
 from engine.db.migrate import migrate
+from engine.errors import EngineError
+from engine.gears.hob_matching import choose_hob
+from engine.gears.records import Gear, Hob
 from engine.library.seed import seed
 from engine.paths import SEED_DIR
 
@@ -250,3 +254,35 @@ def test_a_work_holding_a_stored_job_is_clamped_on_keeps_its_values(run, tmp_pat
     assert (f"work-holding A-D12-H60: the file changes its height 60 → 65, but job {made['job_id']} was clamped "
             "on it; nothing imported") in said
     assert rows(run.url, "SELECT height FROM work_holding WHERE id = 'A-D12-H60'") == [(60,)]
+
+
+# --- messages: never one rounded number on both sides of a mismatch -------------------------------------
+
+def hob_of(hob_id: str, module: float = 2.0, length: float = 100.0) -> Hob:
+    return Hob(hob_id, module, 20.0, 1, 70.0, length, "R", "AA", "HSS", "TiN", "cylindrical")
+
+
+def gear_of(module: float = 2.0) -> Gear:
+    """A spur gear m, z 30, α 20°, b 20, grade 7 (a class AA hob)."""
+    return Gear(901, "spur", module, 30, 20.0, 0.0, None, 20.0, None, None, None, None, "40Cr", 220.0, 7, 10)
+
+
+def hob_refusal(gear: Gear, hobs: list[Hob], **options) -> str:
+    with pytest.raises(EngineError) as caught:
+        choose_hob(gear, hobs, **options)
+    return str(caught.value)
+
+
+def test_a_refusal_never_says_one_number_for_the_need_and_an_offer_that_differ():
+    """"no hob has module 3.98478 … they have module 3.98478": the two are 0.000003 apart, beyond the
+    1e-6 a module must match to; the refusal says them with the digits that tell them apart."""
+    message = hob_refusal(gear_of(3.984781), [hob_of("H-X", module=3.984784)])
+    assert message.startswith("gear 901: no hob has module 3.984781 among those with purpose cylindrical: "
+                              "they have module 3.984784 (H-X)")
+    # the hob length needed: generating 2·2.25·m/tan α + π·m, the shift and 2·5 mm of margins
+    needed = 2 * 2.25 * 2 / math.tan(math.radians(20)) + math.pi * 2 + 59.03 + 2 * 5
+    assert f"{needed:.1f}" == "100.0"   # said as before, the hob's 100 would read alike
+    message = hob_refusal(gear_of(), [hob_of("H-M2-AA-R1")], shift_travel=59.03)
+    assert f"no hob has length ≥ {needed:.10g} mm" in message and "they have length 100 (H-M2-AA-R1)" in message
+    short = hob_refusal(gear_of(), [hob_of("H-M2-AA-R1")], shift_travel=60)   # 101.0 against 100: as before
+    assert "no hob has length ≥ 101.0 mm" in short
