@@ -14,6 +14,7 @@ from ..errors import EngineError
 from .classify import classify
 from .gear_geometry import diameter_problems
 from .gear_import import POSITIVE, GearImportError, derived_diameters
+from .gear_store import JOBS_OF_GEARS
 from .models import ancestry
 
 if TYPE_CHECKING:
@@ -113,7 +114,6 @@ def _database_problems(conn: Connection, units: list) -> list[Problem]:
 
 STORED_UNITS = ("SELECT gear_id, unit, teeth, face_width, tip_diameter, root_diameter, z_top FROM gear_unit "
                 "WHERE gear_id = ANY(%s) ORDER BY gear_id, unit")
-JOBS_OF_GEARS = "SELECT gear_id, array_agg(id ORDER BY id) FROM job WHERE gear_id = ANY(%s) GROUP BY gear_id"
 LOCK_GEARS = "SELECT id FROM gear WHERE id = ANY(%s) ORDER BY id FOR UPDATE"
 
 
