@@ -107,8 +107,8 @@ def test_gears_list_csv_and_table(run):
     store_gears(run.url)
     result = run("gears", "list", "--class", "helical", "--until", "2020-12-31", "--csv")
     assert result.exit_code == 0, result.output
-    rows = list(csv.DictReader(io.StringIO(result.stdout)))
-    assert [(row["gear_id"], row["class"], row["teeth"], row["material"]) for row in rows] == \
+    rows = list(csv.DictReader(io.StringIO(result.stdout)))   # the columns `gears import` reads (issue 31)
+    assert [(row["gear_id"], row["gear_class"], row["teeth"], row["material"]) for row in rows] == \
         [("91002", "helical", "27", "42CrMo4")]
     table = run("gears", "list", "--until", "2020-12-31")
     assert table.exit_code == 0 and table.stderr.strip() == "3 gears"
@@ -211,7 +211,7 @@ def test_hobs_show_and_csv(run):
 def test_cases_and_classes_lists_take_json_and_csv(run):
     cases = listed(run, "cases", "list")
     rows = list(csv.DictReader(io.StringIO(run("cases", "list", "--csv").stdout)))
-    assert [int(row["case_id"]) for row in rows] == [case["case_id"] for case in cases] and cases
+    assert [int(row["id"]) for row in rows] == [case["case_id"] for case in cases] and cases   # as import reads
     with psycopg.connect(run.url) as conn:
         names = [name for (name,) in conn.execute("SELECT name FROM gear_class ORDER BY name")]
     assert [record["class"] for record in listed(run, "template", "list")] == names

@@ -69,14 +69,19 @@ def test_a_gear_named_helical_in_the_file_is_still_said_to_be_named(run, tmp_pat
     assert "the gear file named class helical explicitly (the tree alone gives spur)" in explained.stdout
 
 
-def test_units_for_a_gear_with_stored_programs_say_the_programs_no_longer_match(spur_gear, tmp_path):
+def test_units_for_a_gear_with_stored_programs_are_refused_and_nothing_stored(spur_gear, tmp_path):
+    """Issue 31: its programs were proved on the gear without units; the units would change their inputs."""
     run = spur_gear
     made = run("instantiate", "--gear", GEAR_ID, "--json")
     assert made.exit_code == 0, made.output
-    added = run("gears", "units", write(tmp_path, "units.csv", UNIT_HEADER + UNIT_2))
-    assert added.exit_code == 0, added.output
-    assert (f"gear {GEAR_ID}: 1 stored program(s) were made before these units and no longer match the gear"
-            in added.stdout)
+    refused = run("gears", "units", write(tmp_path, "units.csv", UNIT_HEADER + UNIT_2))
+    assert refused.exit_code == 1, refused.output
+    tip = 2 * 20 + 2 * 2          # d + 2·m of unit 2 (m 2, z 20)
+    root = tip - 2 * 2.25 * 2     # a tooth depth 2.25·m below, on each side
+    assert (f"gear {GEAR_ID}: the file changes its further units (none) → unit 2 (z 20, b 15, da {tip:g}, "
+            f"df {root:g}, z_top -45), but job {json.loads(made.stdout)['job_id']} was made from it; nothing "
+            "imported") in refused.stderr
+    assert execute(run.url, "SELECT count(*) FROM gear_unit WHERE gear_id = %s", (GEAR_ID,)) == [(0,)]
 
 
 def test_a_third_unit_is_refused_in_one_line_and_nothing_stored(spur_gear, tmp_path):

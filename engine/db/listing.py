@@ -32,6 +32,13 @@ def records(cursor: Cursor[TupleRow]) -> list[dict[str, Any]]:
     return [{name: plain(value) for name, value in zip(names, row)} for row in cursor]
 
 
+def exact_records(cursor: Cursor[TupleRow]) -> list[dict[str, Any]]:
+    """The cursor's rows as dicts keyed by the column names, each value as stored (numeric as the
+    Decimal of its digits): what an export writes, so that its import stores the same numbers."""
+    names = [column.name for column in cursor.description or ()]
+    return [dict(zip(names, row)) for row in cursor]
+
+
 def one_record(cursor: Cursor[TupleRow], kind: str, key: Any, listing: str) -> dict[str, Any]:
     """The one row found, or EngineError naming the thing and the list that shows what exists."""
     found = records(cursor)

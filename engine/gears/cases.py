@@ -17,13 +17,7 @@ import psycopg
 from psycopg import sql
 
 from ..csv_reader import (
-    Column,
     CsvError,
-    CsvKind,
-    parse_number,
-    parse_positive_whole,
-    parse_text,
-    parse_whole,
     read_csv_file,
     refuse,
 )
@@ -41,6 +35,7 @@ from .case_base import (
     feeds_per_minute,
     feeds_per_rev,
 )
+from .case_import import CASE_KIND, FEATURE_COLUMNS, VALUE_COLUMNS
 from .cutting_data import CuttingData
 from .hob_matching import choose_hob
 from .models import model_for_class
@@ -50,21 +45,9 @@ from .speed_table import SPEEDS, TOOLS, tool_of
 if TYPE_CHECKING:
     from ..db.connection import Connection
 
-FEATURE_COLUMNS = ("module", "teeth", "material", "hardness", "quality_grade", "hob_material",
-                   "hob_coating", "hob_starts", "hob_tip_diameter")
-VALUE_COLUMNS = ("hob_speed", "axial_feed", "radial_feed")   # r/min, mm/min, mm/min
 FLOAT_COLUMNS = ("module", "hardness", "hob_tip_diameter", *VALUE_COLUMNS)
 INTEGER_COLUMNS = ("teeth", "quality_grade", "hob_starts", "job_id")
 SEED_FILE = SEED_DIR / "cases.csv"
-_TYPES = {"module": (parse_number, "mm"), "teeth": (parse_positive_whole, ""), "hardness": (parse_number, "HB"),
-          "quality_grade": (parse_whole, ""), "hob_starts": (parse_positive_whole, ""),
-          "hob_tip_diameter": (parse_number, "mm"), "hob_speed": (parse_number, "r/min"),
-          "axial_feed": (parse_number, "mm/min"), "radial_feed": (parse_number, "mm/min")}
-CASE_KIND = CsvKind("case", tuple(
-    Column(name, _TYPES.get(name, (parse_text, ""))[0],
-           required=name not in ("hob_coating", "source", "hardness", "quality_grade"),
-           unit=_TYPES.get(name, (parse_text, ""))[1])
-    for name in (*FEATURE_COLUMNS, "cut", *VALUE_COLUMNS, "source")))
 
 # Typical axial feed per workpiece revolution [mm/rev], single-start hob, steel, wet (§C):
 # the first row whose module is at least the gear's (the last row beyond).
