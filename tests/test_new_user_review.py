@@ -122,9 +122,9 @@ R-ALSO-NOWHERE,collet,8,50,0,hobber-9
 """
 
 
-def test_every_bad_work_holding_row_is_named_in_one_run(run, tmp_path):
-    before = run("fixtures", "list", "--csv").stdout
-    result = run("fixtures", "import", write(tmp_path, "holdings.csv", BAD_HOLDINGS))
+def test_every_bad_work_holding_row_is_named_in_one_run(read_only_run, tmp_path):
+    before = read_only_run("fixtures", "list", "--csv").stdout
+    result = read_only_run("fixtures", "import", write(tmp_path, "holdings.csv", BAD_HOLDINGS))
     assert result.exit_code == 1
     for words in ("line 3, column kind: 'spindle' is not one of", "line 4, column diameter: -4 must be greater than 0",
                   "line 5, column machine: machine hobber-9 does not exist",
@@ -132,7 +132,7 @@ def test_every_bad_work_holding_row_is_named_in_one_run(run, tmp_path):
                   "line 7, column machine: machine hobber-9 does not exist"):
         assert words in result.stderr, result.stderr
     assert "5 bad row(s)" in result.stderr
-    assert run("fixtures", "list", "--csv").stdout == before
+    assert read_only_run("fixtures", "list", "--csv").stdout == before
 
 
 def test_a_centre_wider_than_the_arbor_is_accepted(run, tmp_path):

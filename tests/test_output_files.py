@@ -127,13 +127,13 @@ def test_one_program_goes_into_a_folder_out_ending_with_a_slash_else_into_the_fi
     assert everything_under(tmp_path) == ["GEAR42.MPF", "folder", "folder/GEAR42.MPF"]
 
 
-def test_a_file_naming_the_same_program_in_other_case_is_never_replaced(run, tmp_path):
+def test_a_file_naming_the_same_program_in_other_case_is_never_replaced(read_only_run, tmp_path):
     (tmp_path / "gear42.MPF").write_text("; written by hand\n")
-    before = program_count(run.url)
+    before = program_count(read_only_run.url)
     for extra in ((), ("--force",)):
-        message = one_line_refusal(run("instantiate", "--gears", "42-43", "--out", tmp_path, *extra))
+        message = one_line_refusal(read_only_run("instantiate", "--gears", "42-43", "--out", tmp_path, *extra))
         assert "gear42.MPF" in message and "same program" in message
-    assert program_count(run.url) == before and everything_under(tmp_path) == ["gear42.MPF"]
+    assert program_count(read_only_run.url) == before and everything_under(tmp_path) == ["gear42.MPF"]
 
 
 def test_the_file_layer_refuses_two_programs_of_one_batch_differing_only_in_case(tmp_path):

@@ -188,8 +188,8 @@ def test_a_csv_without_the_layout_columns_leaves_the_class_layout(run, tmp_path)
     assert class_layout_stored(run.url, "spur") == (CRLF, False)
 
 
-def test_an_lf_class_exports_the_seven_columns_it_always_had(run):
-    exported = run("template", "export", "--class", "spur").stdout
+def test_an_lf_class_exports_the_seven_columns_it_always_had(read_only_run):
+    exported = read_only_run("template", "export", "--class", "spur").stdout
     assert exported.splitlines()[0] == "id,t,n,p_calc,s,o,p_emit"
 
 
