@@ -33,6 +33,7 @@ COMMAND_LINE_ONLY = {   # (command path, option): why it is typed on each invoca
     ("engine template release", "yes"): "it releases a draft to the shop floor without asking",
     ("engine gears import", "replace"): "it overwrites stored gears",
     ("engine instantiate", "force"): "it replaces program files in --out, which a machine may be loading",
+    ("engine db backup", "force"): "it replaces a backup file, which may be the only one",
     ("engine instantiate", "skip-bad"): "it stores a batch without its bad gears",
     ("engine instantiate", "draft"): "it makes programs of a draft that has not passed the release gate",
     # what instantiate makes programs of: a default would store programs (records nobody deletes)
