@@ -105,7 +105,7 @@ def instantiate(ctx, gear_id, job_id, gear_class, params_file, unverified, gear_
     input, or any bad gear or job without --skip-bad, or none good: nothing
     stored; 2: a bug; 3: stored, but the files not written (the error names the
     programs and the files; the files there are as they were, or it says which
-    were replaced).
+    were replaced); 130: interrupted with Ctrl-C (workers too), nothing stored.
 
     --class C --params P.json makes a job of a class without a model (engine
     import-nc) on a lathe: its program is read by the machine's verifier, and
