@@ -58,9 +58,7 @@ def backup(url: str, file: Path, force: bool = False) -> Done:
     _check_target(file, force)
     with connect(url, autocommit=True) as conn:
         tools, database = tools_for(conn), conn.info.dbname
-    handle, name = tempfile.mkstemp(prefix=f".{file.name}.", suffix=".part", dir=file.parent)
-    os.close(handle)
-    part = Path(name)
+    part = _temporary_beside(file)
     try:
         _run([tools.pg_dump, "--format=custom", "--file", str(part), *_dbname(url)], "pg_dump", "nothing written")
         _put_in_place(part, file, force)
@@ -76,6 +74,17 @@ def _check_target(file: Path, force: bool) -> None:
         raise EngineError(f"backup: {file} is a folder; name a file in it")
     if file.exists() and not force:
         raise EngineError(f"backup: {file} exists; name another file, or give --force to replace it")
+
+
+def _temporary_beside(file: Path) -> Path:
+    """An empty hidden file in FILE's folder for pg_dump to write (renamed onto FILE when whole)."""
+    try:
+        handle, name = tempfile.mkstemp(prefix=f".{file.name}.", suffix=".part", dir=file.parent)
+    except OSError as error:
+        raise EngineError(f"backup: cannot write in {file.parent} ({error.strerror or error}); "
+                          "name a folder you can write") from None
+    os.close(handle)
+    return Path(name)
 
 
 def _put_in_place(part: Path, file: Path, force: bool) -> None:
