@@ -54,6 +54,7 @@ def test_database_url_keeps_working_and_engine_database_url_too(read_only_run):
 
 def test_the_machine_folder_of_the_config_file_gets_the_program(run, tmp_path):
     folder = tmp_path / "hobber"
+    folder.mkdir()   # a missing one is refused (tests/test_out_folders.py)
     run.config.write_text(f'[machines.hobber-840d]\nout = "{folder}"\n')
     result = run("instantiate", "--gear", 42, "--json")
     assert result.exit_code == 0, result.output

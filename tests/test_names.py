@@ -257,7 +257,7 @@ def injected_anywhere(url, folder) -> list[str]:
 @pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_no_route_puts_a_block_into_a_program(run, tmp_path):
     out = tmp_path / "out"
-    assert run("instantiate", "--gears", "42-43", "--out", out).exit_code == 0
+    assert run("instantiate", "--gears", "42-43", "--out", out, "--mkdir").exit_code == 0
     with psycopg.connect(run.url) as conn:   # 1. a runner's edit of job.params
         job_id = conn.execute("SELECT max(id) FROM job").fetchone()[0]
         for name in ("GEAR43" + NEWLINE, "../../x"):
@@ -271,7 +271,7 @@ def test_no_route_puts_a_block_into_a_program(run, tmp_path):
     write_csv(tmp_path / "hobs.csv", HOB_HEADER, ["H-M2-AA-R1" + NEWLINE, "2", "20", "1", "70", "100", "R", "AA",
                                                  "HSS", "TiN", "cylindrical"])
     refused(run("hobs", "import", tmp_path / "hobs.csv"))   # 3. a hob id
-    assert run("instantiate", "--all", "--out", out / "all").exit_code == 0
+    assert run("instantiate", "--all", "--out", out / "all", "--mkdir").exit_code == 0
     before = counts(run.url)
     for breaking in ("\\n", "\\r", "\\u2028"):   # 4. a template row's output (its text holds the escape)
         with psycopg.connect(run.url) as conn:

@@ -1,13 +1,17 @@
-"""What every command shares: the database connection of the invocation, and JSON output."""
+"""What every command shares: the database connection of the invocation, JSON output, and the
+folder a file option writes into."""
 from __future__ import annotations
 
 import json
 import re
 from contextlib import contextmanager
 from decimal import Decimal
+from pathlib import Path
 from typing import Any
 
 import click
+
+from ..errors import EngineError
 
 
 @contextmanager
@@ -70,3 +74,20 @@ def settings(ctx):
     from ..programs.config import Config
 
     return ctx.meta.get(CONFIG) or Config()
+
+
+def file_folder(out, mkdir: bool, option: str = "--out") -> None:
+    """The folder the file `out` goes into: made (with the folders above it) if missing and --mkdir
+    is given, else a missing one is refused (issue 31: a typo in a share's path quietly became a
+    new folder nobody looked in)."""
+    folder = Path(out).parent
+    if folder.is_dir():
+        return
+    if not mkdir:
+        raise EngineError(f"{option}: the folder {folder} does not exist; nothing written; check the path, "
+                          "or give --mkdir to create it")
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as error:
+        raise EngineError(f"{option}: cannot create the folder {folder} ({error.strerror or error}); "
+                          "give a folder you can write") from None

@@ -36,6 +36,7 @@ COMMAND_LINE_ONLY = {   # (command path, option): why it is typed on each invoca
     ("engine fixtures import", "replace"): "it replaces stored work-holdings whole",
     ("engine cases import", "replace"): "it overwrites stored cases of the machining history",
     ("engine instantiate", "force"): "it replaces program files in --out, which a machine may be loading",
+    ("engine db backup", "force"): "it replaces a backup file, which may be the only one",
     ("engine instantiate", "skip-bad"): "it stores a batch without its bad gears",
     ("engine instantiate", "draft"): "it makes programs of a draft that has not passed the release gate",
     # what instantiate makes programs of: a default would store programs (records nobody deletes)

@@ -129,7 +129,7 @@ def _apply_pending(conn: Connection, directory: Path | None) -> list[Migration]:
         )
     done: list[Migration] = []
     if any(state.applied_at is None for state in states):
-        _create_cluster_roles(conn)
+        create_cluster_roles(conn)
     for state in states:
         if state.applied_at is None:
             _apply(conn, state.migration)
@@ -137,7 +137,7 @@ def _apply_pending(conn: Connection, directory: Path | None) -> list[Migration]:
     return done
 
 
-def _create_cluster_roles(conn: Connection) -> None:
+def create_cluster_roles(conn: Connection) -> None:
     """Each missing role of CLUSTER_ROLES created and committed alone (the connection is in
     autocommit); one created meanwhile by another database's migration is left as it is."""
     import psycopg

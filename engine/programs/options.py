@@ -26,9 +26,13 @@ class Output:
         separator, else to it as the file. None: no file, the program is only stored and printed.
     force: replace files that already exist at out; without it an existing file refuses the run
         and nothing is stored (an operator's file on the control is never overwritten unasked).
+    mkdir: create out's folder (and the folders above it) if it does not exist; without it a
+        missing folder refuses the run and nothing is stored (issue 31: a typo in a network
+        share's path made a folder of programs nobody found).
     """
     out: str | Path | None = None
     force: bool = False
+    mkdir: bool = False
 
 
 @dataclass(frozen=True, slots=True)
