@@ -3,11 +3,11 @@ in one COPY and one upsert, all or nothing; stored ids are refused unless --repl
 each change (old -> new). Also which classes a gear may be in, for the reader's checks."""
 from __future__ import annotations
 
-from dataclasses import dataclass
 from decimal import Decimal
 from pathlib import Path
 from typing import Any
 
+import msgspec
 import psycopg
 from psycopg import sql
 
@@ -40,8 +40,7 @@ _UPSERT = sql.SQL(
 _EXISTING = sql.SQL("SELECT {} FROM gear WHERE id = ANY(%s) ORDER BY id FOR UPDATE").format(_COLUMN_LIST)
 
 
-@dataclass(frozen=True)
-class GearChange:
+class GearChange(msgspec.Struct, frozen=True):
     """One field of a stored gear that an import with --replace changes: old → new."""
 
     gear_id: int
@@ -50,8 +49,7 @@ class GearChange:
     new: Any
 
 
-@dataclass(frozen=True)
-class GearImport:
+class GearImport(msgspec.Struct, frozen=True):
     """What an import did: how many gears it stored, which of them replaced stored gears, and what
     changed in those (field by field)."""
 

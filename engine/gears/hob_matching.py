@@ -9,7 +9,8 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
+
+import msgspec
 
 from ..errors import EngineError
 from .hob_geometry import generating_length, hob_axial_module, lead_angle
@@ -33,8 +34,7 @@ SHIFT_MARGIN = 5.0           # mm kept unused at each end of the hob (§B15 "mar
 ADD_A_HOB = "add one with `engine hobs add …` or `engine hobs import FILE.csv`"
 
 
-@dataclass(frozen=True)
-class HobChoice:
+class HobChoice(msgspec.Struct, frozen=True):
     """The hob chosen for a gear and why (engine hobs match says it)."""
     hob: Hob
     reason: str
@@ -48,8 +48,7 @@ class NoHobError(EngineError):
         self.property_name = property_name
 
 
-@dataclass(frozen=True)
-class Need:
+class Need(msgspec.Struct, frozen=True):
     """What a gear asks of its hob."""
 
     purpose: str
@@ -112,8 +111,7 @@ def _module_wanted(gear: Gear, purpose: str) -> str:
     return f"module {gear.module:g}"
 
 
-@dataclass(frozen=True)
-class HobTest:
+class HobTest(msgspec.Struct, frozen=True):
     """One property of a hob, for the gears of `purposes`. A required test narrows the
     library (`fits`); a preference only orders it. `wanted` says what the gear needs,
     `offered` what a hob has and `distance` how far that is from the need (refusals list
