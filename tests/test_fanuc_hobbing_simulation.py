@@ -12,11 +12,11 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import replace
 
 import pytest
 from helpers.fanuc_programs import fanuc_program, g81, threads_word
 from helpers.unproved_programs import unproved
+from msgspec.structs import replace
 
 from engine.gears.records import load_gear, load_hobs
 from engine.hobbing.choices import Choices
