@@ -4,10 +4,10 @@ means the reference defaults, and a confirmed job becomes a case exactly once.""
 import csv
 import json
 import math
-from dataclasses import replace
 
 import pytest
 from helpers import chip_reference, feed_mark_reference
+from msgspec.structs import replace
 from psycopg import sql
 
 from engine.errors import EngineError

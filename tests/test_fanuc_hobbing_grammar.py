@@ -8,10 +8,9 @@ spindle maximum 1000 r/min and table maximum 120 r/min, seed_templates/machines.
 expected table speeds are S·|L|/T against the record's own maximum."""
 from __future__ import annotations
 
-from dataclasses import replace
-
 import psycopg
 import pytest
+from msgspec.structs import replace
 
 from engine.machines.records import Machine, load_machine
 from engine.nc.lineage import lineage_line, lineage_words

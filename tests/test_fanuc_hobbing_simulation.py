@@ -12,11 +12,11 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import replace
 
 import pytest
 from helpers.fanuc_cases import twin
 from helpers.fanuc_programs import fanuc_program, g81, threads_word
+from msgspec.structs import replace
 
 from engine.simulation import simulate_program
 from engine.simulation.hobbing.recorded import record_program

@@ -1,10 +1,10 @@
 """Template versions (issue 6): every committed version of a class is stored; history, diff
 and restore, in the library and on the command line."""
 import shutil
-from dataclasses import asdict
 
 import psycopg
 import pytest
+from msgspec.structs import asdict
 from psycopg import sql
 
 from engine.db.migrate import migrate

@@ -4,11 +4,11 @@ seeded class against the stored program, the stored job and the template rows, w
 conditions evaluated again by plain Python from the recorded values."""
 import math
 import re
-from dataclasses import replace
 
 import psycopg
 import pytest
 from helpers.drawings import seed_drawing
+from msgspec.structs import replace
 
 from engine.hobbing.choices import Choices
 from engine.nc.lineage import LINEAGE_ROW_ID

@@ -8,6 +8,7 @@ import pytest
 from helpers.drawings import seed_drawing
 from helpers.drawn_parts import two_rough_layers
 from helpers.turning_jobs import refused_after
+from msgspec.structs import replace
 
 from engine.errors import EngineError
 from engine.machines.records import load_machine
@@ -82,7 +83,7 @@ ISO_END = ["M30", "%"]
 ])
 def test_the_lathe_check_refuses(conn, lines, message):
     machine = load_machine(conn, "lathe-iso")
-    narrow = type(machine)(**{**vars(machine), "x_max": 15.0})
+    narrow = replace(machine, x_max=15.0)
     with pytest.raises(LimitError, match=message):
         verify_program(ISO_START + lines + ISO_END, narrow, "PART")
 

@@ -26,6 +26,7 @@ from helpers.verifier_programs import (
     programs,
     refusal,
 )
+from msgspec.structs import replace
 
 from engine.machines.records import load_machine
 from engine.verifier import LimitError, verify_program
@@ -267,7 +268,7 @@ def test_a_lathe_arc_needs_its_start_and_its_radius(conn):
 
 def test_a_machine_without_a_grammar_makes_no_program(conn):
     machine = load_machine(conn, "hobber-840d")
-    iso_hobber = type(machine)(**{**vars(machine), "dialect": "iso"})
+    iso_hobber = replace(machine, dialect="iso")
     with pytest.raises(LimitError, match="no verifier grammar for a hobber with dialect 'iso'"):
         verify_program(["%", "M30", "%"], iso_hobber, "TEST")
 

@@ -10,6 +10,7 @@ from pathlib import Path
 from typing import Any
 
 import click
+import msgspec
 
 from ..errors import EngineError
 
@@ -35,9 +36,15 @@ def connection(ctx, migrated: bool = True):
 
 def keyed(record: dict, **names: str) -> dict:
     """The record with its keys renamed to the names every --json uses (gear_id, job_id,
-    program_id, hob_id, class): keyed(asdict(hob), id="hob_id"); gear_class is always class."""
+    program_id, hob_id, class): keyed(record_dict(hob), id="hob_id"); gear_class is always class."""
     names = {"gear_class": "class", **names}
     return {names.get(key, key): value for key, value in record.items()}
+
+
+def record_dict(record) -> dict:
+    """A record (a msgspec.Struct, or an importer's dataclass) as the plain dict --json writes, its
+    nested records and lists included, as dataclasses.asdict gave (tuples as lists: JSON has no tuple)."""
+    return msgspec.to_builtins(record, str_keys=True, enc_hook=str)   # enc_hook: as json.dumps default=str
 
 
 def emit_json(payload: dict) -> None:

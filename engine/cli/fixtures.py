@@ -1,11 +1,9 @@
 """`engine fixtures …`: the work-holding library (list, import, match), issue 29."""
 from __future__ import annotations
 
-from dataclasses import asdict
-
 import click
 
-from .context import connection, emit_json
+from .context import connection, emit_json, record_dict
 from .ids import GEAR_ID
 from .output import Column, emit_list, list_options
 
@@ -62,7 +60,7 @@ def fixtures_import(ctx, csv_file, replace, as_json):
     with connection(ctx) as conn:
         result = import_holdings(conn, csv_file, replace=replace)
     if as_json:
-        emit_json(asdict(result))
+        emit_json(record_dict(result))
     else:
         click.echo(f"{csv_file}: added {result.added} work-holding(s), updated {result.updated}")
 

@@ -1,11 +1,9 @@
 """`engine hobs …`: the hob library (list, show, add, import, delete, match)."""
 from __future__ import annotations
 
-from dataclasses import asdict
-
 import click
 
-from .context import connection, emit_json, keyed
+from .context import connection, emit_json, keyed, record_dict
 from .ids import GEAR_ID
 from .output import Column, emit_list, emit_record, list_options
 
@@ -144,7 +142,7 @@ def hobs_import(ctx, csv_file, replace, as_json):
     with connection(ctx) as conn:
         result = import_hobs(conn, csv_file, replace=replace)
     if as_json:
-        emit_json(asdict(result))
+        emit_json(record_dict(result))
     else:
         kept = f" (not in the file, kept as they were: {', '.join(result.kept)})" if result.kept else ""
         click.echo(f"{csv_file}: added {result.added} hob(s), updated {result.updated}{kept}")

@@ -8,12 +8,12 @@ from __future__ import annotations
 import functools
 import re
 from collections.abc import Callable
-from dataclasses import dataclass
 from datetime import date, datetime
 from decimal import Decimal
 from typing import Any
 
 import click
+import msgspec
 
 from .context import emit_json, exact_json
 
@@ -61,8 +61,7 @@ def inert_text(text: str) -> str:
     return f"'{text}" if formula else text
 
 
-@dataclass(frozen=True)
-class Column:
+class Column(msgspec.Struct, frozen=True):
     """One column of a list: its heading in the table, the record's key (also the CSV header),
     and how a table shows the value."""
     heading: str

@@ -13,9 +13,10 @@ from __future__ import annotations
 import os
 import subprocess
 import tempfile
-from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
+
+import msgspec
 
 from ..errors import EngineError
 from .connection import connect
@@ -43,8 +44,7 @@ ORDER BY 1 LIMIT 1"""
 LEDGER = "schema_migration"
 
 
-@dataclass(frozen=True)
-class Done:
+class Done(msgspec.Struct, frozen=True):
     """What a backup wrote or a restore read, for the command's one line."""
     file: Path
     database: str

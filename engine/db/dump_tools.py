@@ -12,9 +12,10 @@ from __future__ import annotations
 import os
 import re
 import subprocess
-from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
+
+import msgspec
 
 from ..errors import EngineError
 from .connection import scalar
@@ -27,8 +28,7 @@ DEBIAN_FOLDERS = "/usr/lib/postgresql/{major}/bin"
 CLIENT_VERSION = re.compile(r"\(PostgreSQL\)\s+(\d+)(?:\.(\d+))?")
 
 
-@dataclass(frozen=True)
-class DumpTools:
+class DumpTools(msgspec.Struct, frozen=True):
     """pg_dump and pg_restore of one folder, of the server's major version."""
     pg_dump: str
     pg_restore: str

@@ -10,9 +10,10 @@ only (a file exported and imported again), and a changed one takes a new id."""
 from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass
 from decimal import Decimal
 from typing import TYPE_CHECKING, Any
+
+import msgspec
 
 from ..errors import EngineError
 
@@ -20,8 +21,7 @@ if TYPE_CHECKING:
     from .connection import Connection
 
 
-@dataclass(frozen=True)
-class Change:
+class Change(msgspec.Struct, frozen=True):
     """One field of a stored row that an import with --replace changes: old → new."""
 
     key: Any

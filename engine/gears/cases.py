@@ -8,12 +8,13 @@ cutting speed v = π·d_a0·n0/1000 and the feeds per workpiece revolution f = v
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+import msgspec
 import pandas as pd
 import psycopg
+from msgspec.structs import replace
 from psycopg import sql
 
 from ..csv_reader import (
@@ -58,15 +59,14 @@ AXIAL_FEED_RANGE = pd.DataFrame([
 CUTTING = {"rough": "roughing", "finish": "finishing"}
 
 
-@dataclass(frozen=True)
-class Suggestion:
+class Suggestion(msgspec.Struct, frozen=True):
     gear: Gear
     hob: Hob
     machine: Machine
     cutting: CuttingData
     cases: pd.DataFrame                  # the nearest cases per cut kind, with `distance`
     proposals: dict                      # cut kind -> KindProposal
-    notes: list = field(default_factory=list)
+    notes: list = []
     hob_reason: str = ""
 
     def feeds(self, cut: str) -> dict:

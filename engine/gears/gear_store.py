@@ -4,10 +4,10 @@ each change (old -> new), and refuses a change to a gear a stored job was made f
 (engine.db.replacing). Also which classes a gear may be in, for the reader's checks."""
 from __future__ import annotations
 
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import msgspec
 import psycopg
 from psycopg import sql
 
@@ -41,8 +41,7 @@ _UPSERT = sql.SQL(
 _EXISTING = sql.SQL("SELECT {} FROM gear WHERE id = ANY(%s) ORDER BY id FOR UPDATE").format(_COLUMN_LIST)
 
 
-@dataclass(frozen=True)
-class GearImport:
+class GearImport(msgspec.Struct, frozen=True):
     """What an import did: how many gears it stored, which of them replaced stored gears, and what
     changed in those (field by field)."""
 

@@ -7,10 +7,10 @@ physical line number in the file (header = line 1), and only a good file is stor
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import Any
 
+import msgspec
 import psycopg
 from psycopg import sql
 
@@ -42,8 +42,7 @@ PROFILES = ("standard", "protuberance", "topping")
 HobImportError = CsvError   # a file of bad rows: `problems` holds one line per problem, in file order
 
 
-@dataclass(frozen=True)
-class HobImport:
+class HobImport(msgspec.Struct, frozen=True):
     """What an import did: hobs new to the library, and hobs whose id was there already."""
 
     added: int
@@ -112,7 +111,7 @@ COLUMN_NAMES = tuple(column.name for column in HOB_COLUMNS)
 HOB_KIND = CsvKind("hob", HOB_COLUMNS)
 DEFAULTS = {"material": "HSS", "coating": "", "purpose": "cylindrical", "tool_number": 1, "gashes": 12,
             "profile": "standard"}
-assert COLUMN_NAMES == tuple(field.name for field in fields(Hob)), "HOB_COLUMNS must follow records.Hob"
+assert COLUMN_NAMES == Hob.__struct_fields__, "HOB_COLUMNS must follow records.Hob"
 
 
 # --- one hob: cells → values and problems ------------------------------------------------

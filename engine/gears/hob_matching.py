@@ -11,7 +11,8 @@ import math
 import re
 from collections.abc import Callable
 from contextvars import ContextVar
-from dataclasses import dataclass
+
+import msgspec
 
 from ..errors import EngineError
 from .hob_geometry import generating_length, hob_axial_module, lead_angle
@@ -35,8 +36,7 @@ SHIFT_MARGIN = 5.0           # mm kept unused at each end of the hob (§B15 "mar
 ADD_A_HOB = "add one with `engine hobs add …` or `engine hobs import FILE.csv`"
 
 
-@dataclass(frozen=True)
-class HobChoice:
+class HobChoice(msgspec.Struct, frozen=True):
     """The hob chosen for a gear and why (engine hobs match says it)."""
     hob: Hob
     reason: str
@@ -50,8 +50,7 @@ class NoHobError(EngineError):
         self.property_name = property_name
 
 
-@dataclass(frozen=True)
-class Need:
+class Need(msgspec.Struct, frozen=True):
     """What a gear asks of its hob."""
 
     purpose: str
@@ -133,8 +132,7 @@ def _first_number(text: str) -> float | None:
     return float(found.group()) if found else None
 
 
-@dataclass(frozen=True)
-class HobTest:
+class HobTest(msgspec.Struct, frozen=True):
     """One property of a hob, for the gears of `purposes`. A required test narrows the
     library (`fits`); a preference only orders it. `wanted` says what the gear needs,
     `offered` what a hob has and `distance` how far that is from the need (refusals list

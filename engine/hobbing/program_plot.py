@@ -13,8 +13,9 @@ written whole or not at all (engine.pictures)."""
 from __future__ import annotations
 
 import textwrap
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
+
+import msgspec
 
 from ..errors import EngineError
 from ..gears.records import Gear, Hob, load_gear
@@ -48,8 +49,7 @@ FROM program p JOIN job j ON j.id = p.job_id
 WHERE p.id = %s"""
 
 
-@dataclass(frozen=True)
-class Scene:
+class Scene(msgspec.Struct, frozen=True):
     program_id: int
     job_id: int
     name: str

@@ -10,7 +10,8 @@ turned back by the machine's senses (engine.simulation.hobbing.frame)."""
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+
+import msgspec
 
 from ..simulation.hobbing.frame import Senses
 from .plot_geometry import Pass, cut_pass
@@ -20,8 +21,7 @@ PASS_WORDS = {"Z": "axial pass", "Y": "tangential pass"}
 NO_PASS = Pass("", {}, {})
 
 
-@dataclass(frozen=True)
-class Number:
+class Number(msgspec.Struct, frozen=True):
     gid: str       # the artist's name in the SVG (what the tests read)
     text: str
 

@@ -4,11 +4,12 @@ the cross-column checks; an import is all or nothing, every problem reported wit
 line number in the file (header = line 1), and only a good file is stored."""
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, fields
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+import msgspec
 import psycopg
+from msgspec.structs import asdict
 from psycopg import sql
 
 from ..csv_reader import CellError, Column, CsvError, CsvKind, Problem, declare, parse_number, read_cell, read_csv_file
@@ -22,8 +23,7 @@ if TYPE_CHECKING:
     from ..db.connection import Connection
 
 
-@dataclass(frozen=True)
-class HoldingImport:
+class HoldingImport(msgspec.Struct, frozen=True):
     """What an import did: work-holdings new to the library, and those whose id was there already."""
 
     added: int
@@ -66,7 +66,7 @@ HOLDING_COLUMNS: tuple[Column, ...] = (
 COLUMN_NAMES = tuple(column.name for column in HOLDING_COLUMNS)
 HOLDING_KIND = CsvKind("work-holding", HOLDING_COLUMNS)
 DEFAULTS = {"tailstock_diameter": 0}
-assert COLUMN_NAMES == tuple(field.name for field in fields(WorkHolding)), "HOLDING_COLUMNS must follow WorkHolding"
+assert COLUMN_NAMES == WorkHolding.__struct_fields__, "HOLDING_COLUMNS must follow WorkHolding"
 
 
 def parse_holding(cells: dict[str, str], line: int | None = None,

@@ -10,15 +10,15 @@ the entry points and the command say which combinations are refused, as before.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
 from pathlib import Path
+
+import msgspec
 
 Progress = Callable[[str, int, int], None]   # progress(stage, done, total) as a batch's items are planned
 PLANNING = "planning"   # the stage a batch's progress callback is told while its gears are planned
 
 
-@dataclass(frozen=True, slots=True)
-class Output:
+class Output(msgspec.Struct, frozen=True):
     """Where a run writes its .MPF files, after its programs are committed.
 
     out: the file or folder (--out, or the config file's folder for the machine); a batch writes
@@ -35,8 +35,7 @@ class Output:
     mkdir: bool = False
 
 
-@dataclass(frozen=True, slots=True)
-class RunMode:
+class RunMode(msgspec.Struct, frozen=True):
     """How a run goes, apart from the job's choices and its files.
 
     draft: run the classes' drafts (an editor trying a change), not their released templates;

@@ -11,8 +11,9 @@ builder's choice)."""
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
 from typing import TYPE_CHECKING, ClassVar, Literal
+
+import msgspec
 
 from .dwell import is_dwell, read_dwell
 from .grammar import (
@@ -58,8 +59,7 @@ WORD_EVENTS: dict[str, Callable[[float], tuple[str, ...]]] = {
     TOOL_AND_OFFSET: lambda number: (TOOL_CHANGE, _offset(number % 100))}
 
 
-@dataclass(frozen=True, slots=True)
-class Block:
+class Block(msgspec.Struct, frozen=True):
     """An NC block as read: its address values, motion, positions and modal codes."""
     kind: ClassVar[Literal["block"]] = "block"
     values: dict[str, float]   # address -> value (G and M codes apart)

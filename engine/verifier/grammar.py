@@ -14,8 +14,10 @@ functions are the machine record's own (dialect_for)."""
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
+
+import msgspec
+from msgspec.structs import replace
 
 from .machine_state import (
     FANUC_G81_4_HOBBING_STATE,
@@ -55,8 +57,7 @@ POINT_REASON = ("needs a decimal point: a Fanuc-type control with decimal-point 
                 "parameter's unit or as a one-digit feed code")
 
 
-@dataclass(frozen=True)
-class Header:
+class Header(msgspec.Struct, frozen=True):
     """A whole line of fixed form that may stand only at the given places ("first", "second",
     "last" line of the program), and must stand at those of `required`: a second `%_N_…_MPF`
     would start another program, and a program without its own would be stored by the
@@ -67,8 +68,7 @@ class Header:
     required: frozenset[str] = frozenset()
 
 
-@dataclass(frozen=True)
-class Synchronisation:
+class Synchronisation(msgspec.Struct, frozen=True):
     """A Fanuc electronic-gear-box command "compatible with a hobbing machine" (Fanuc 15i/150i-MA
     operator's manual §19.9.2; the M-series form G81.4 of the 16i/18i/21i): a G code whose block
     is the command alone, its words its arguments, not the dialect's addresses (in G81 T is the
@@ -91,8 +91,7 @@ class Synchronisation:
         return f"G{self.code}"
 
 
-@dataclass(frozen=True)
-class DwellWord:
+class DwellWord(msgspec.Struct, frozen=True):
     """A word that gives a dwell G4's time (engine.verifier.dwell): `seconds` per unit written
     (1 for seconds, 0.001 for milliseconds) and its decimal point (True: required, False:
     refused, None: as the dialect's point_required says)."""
@@ -101,8 +100,7 @@ class DwellWord:
     point: bool | None = None
 
 
-@dataclass(frozen=True)
-class Dialect:
+class Dialect(msgspec.Struct, frozen=True):
     """What the verifier reads a machine's programs as: headers, comments, addresses, G and M codes, state rules."""
     name: str
     headers: tuple[Header, ...]
@@ -117,8 +115,8 @@ class Dialect:
     shift_clamp: bool = False             # the hob-shift-per-part R11 clamp (engine.verifier.shift_clamp)
     equals_allowed: bool = False          # 840D: `X=12.5` is `X12.5`; names of two letters need it (`CR=5`)
     arc_radius: str | None = None         # the address of an arc's radius
-    needs_words: dict[int, str] = field(default_factory=dict)   # G code -> the words its block must hold
-    thread_lead: dict[int, str] = field(default_factory=dict)   # thread G code -> the address of its lead (mm/rev)
+    needs_words: dict[int, str] = {}   # G code -> the words its block must hold
+    thread_lead: dict[int, str] = {}   # thread G code -> the address of its lead (mm/rev)
     point_required: frozenset[str] = frozenset()      # addresses whose number must hold a decimal point
     program_numbers: range | None = None  # ISO O numbers a program may have
     reserved_numbers: range | None = None  # … but these (the machine builder's macros)
@@ -128,7 +126,7 @@ class Dialect:
     synchronisations: tuple[Synchronisation, ...] = ()   # Fanuc hobbing: the EGB command blocks (G81/G80)
     record_work_offset: bool = False      # only the record's work offset of G54…G57 (machine.work_offset)
     dwell_words: tuple[DwellWord, ...] = (DwellWord("F", 1.0),)   # G4's time: one of these, alone
-    refused_g_codes: dict[int, str] = field(default_factory=dict)   # this dialect's own reasons (Fanuc G60)
+    refused_g_codes: dict[int, str] = {}   # this dialect's own reasons (Fanuc G60)
 
     def code_group(self, letter: str, code: int) -> str:
         codes = self.m_codes if letter == "M" else self.g_codes

@@ -7,8 +7,9 @@ record bounds (reference §A5: n_C = (z0/z2)·n_B ± k_Y·v_Y ± k_Z·v_Z)."""
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
 from typing import ClassVar, Literal
+
+import msgspec
 
 from .numbers import plain_decimal, whole_number
 from .refusals import Refused
@@ -29,8 +30,7 @@ RATIO_DIGITS = 4                     # teeth and starts: no gear has 10,000 teet
 MAX_DIFFERENTIAL = 360.0
 
 
-@dataclass(frozen=True, slots=True)
-class GearBox:
+class GearBox(msgspec.Struct, frozen=True):
     """A Fanuc electronic-gear-box start as read (engine.verifier.synchronisation), its terms with
     their signs: the simulation turns them into the coupling (engine.simulation.hobbing.fanuc_egb)
     and its findings quote the words as written."""
@@ -47,8 +47,7 @@ class GearBox:
         return f"{self.threads_word} {self.teeth_word}"
 
 
-@dataclass(frozen=True, slots=True)
-class Statement:
+class Statement(msgspec.Struct, frozen=True):
     """A coupling statement (EGDEF, EGON, EGOFS, EGDEL; Fanuc G81/G80, engine.verifier.synchronisation)
     as read: its leading axes, ratio and factors, and a Fanuc start's signed terms."""
     kind: ClassVar[Literal["statement"]] = "statement"

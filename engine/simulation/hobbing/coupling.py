@@ -13,7 +13,8 @@ denominator), plus FACTOR_TOLERANCE of its size."""
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+
+import msgspec
 
 from ...gears.records import Gear, Hob
 from .frame import Senses
@@ -27,8 +28,7 @@ FACTOR_TOLERANCE = 1e-6      # relative
 HOB_DEDENDUM = 1.25          # d_m0 = d_a0 − 2·1.25·m_n (§B1)
 
 
-@dataclass(frozen=True, slots=True)
-class Coupling:
+class Coupling(msgspec.Struct, frozen=True):
     """One EGON (or Fanuc G81) in the DIN frame: k_B (C per B), and degrees of C per mm of Z and
     of Y, with the resolution each was written to; a Fanuc start also the words it gave them, so
     the findings name the words the program must change (engine.simulation.hobbing.fanuc_egb)."""

@@ -11,7 +11,8 @@ the part of the hob the shifting uses); the moves are those at the low end."""
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass, field
+
+import msgspec
 
 from ...gears.records import Gear, Hob
 from ...machines.records import Machine
@@ -26,8 +27,7 @@ from .walk import BlockSimulation
 SWIVEL_EQUALS = re.compile(r"(?<![A-Z])A=")   # `A=1.763` (840D) rather than `A1.763` (840D, ISO, Fanuc)
 
 
-@dataclass(frozen=True, slots=True)
-class Move:
+class Move(msgspec.Struct, frozen=True):
     number: int            # program line, from 1
     line: str
     motion: int            # 0 rapid, 1 feed
@@ -38,8 +38,7 @@ class Move:
     feed: float | None = None   # the F in effect, as written (mm/min: the hobbing grammar has G94 only)
 
 
-@dataclass(frozen=True, slots=True)
-class RecordedCut:
+class RecordedCut(msgspec.Struct, frozen=True):
     moves: tuple           # the cut's Move records
     units: tuple           # names of the units whose material it entered
     label: str             # the program's `; CUT …` comment before it, else "cut N"
@@ -51,20 +50,19 @@ class RecordedCut:
         return [pose for pose in every if {"X", "Z"} <= pose.keys()]
 
 
-@dataclass
-class Recording:
+class Recording(msgspec.Struct):
     report: Report
     units: list[Solid]
     setup: list[Solid]
-    moves: list[Move] = field(default_factory=list)
-    cuts: list[RecordedCut] = field(default_factory=list)
-    areas: dict = field(default_factory=dict)       # "lower"/"upper" -> {axis: DIN value}, as G25/G26 set them
-    area_words: dict = field(default_factory=dict)  # "lower"/"upper" -> {axis: program value}
+    moves: list[Move] = []
+    cuts: list[RecordedCut] = []
+    areas: dict = {}       # "lower"/"upper" -> {axis: DIN value}, as G25/G26 set them
+    area_words: dict = {}  # "lower"/"upper" -> {axis: program value}
     cutting_y: tuple = (0.0, 0.0)                   # the lowest and highest Y (DIN) the hob cuts at
-    swivel_words: list = field(default_factory=list)  # (line, A as written) for every A the program writes
-    couplings: list = field(default_factory=list)     # every EGON (G81) as the walk read it (DIN Coupling)
-    coupling_words: list = field(default_factory=list)  # each coupling's start as the program writes it
-    swivel_address: str = "A"                         # how it writes the swivel: `A=` (840D templates) or `A`
+    swivel_words: list = []     # (line, A as written) for every A the program writes
+    couplings: list = []        # every EGON (G81) as the walk read it (DIN Coupling)
+    coupling_words: list = []   # each coupling's start as the program writes it
+    swivel_address: str = "A"   # how it writes the swivel: `A=` (840D templates) or `A`
 
     @property
     def final_swivel(self) -> float:
