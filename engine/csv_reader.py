@@ -18,10 +18,11 @@ import csv
 import io
 import re
 from collections.abc import Callable
-from dataclasses import dataclass
 from decimal import Decimal
 from pathlib import Path
 from typing import Any
+
+import msgspec
 
 from .errors import EngineError
 from .names import shown
@@ -37,8 +38,7 @@ class CellError(ValueError):
     """A cell that cannot be read; the message is what is wrong with it ("is not a number")."""
 
 
-@dataclass(frozen=True)
-class Problem:
+class Problem(msgspec.Struct, frozen=True):
     """One thing wrong with a file: where (line and column when known), what, and what to do."""
 
     line: int | None
@@ -76,8 +76,7 @@ def refuse(source: Any, what: str, todo: str = "", line: int | None = None, colu
 
 # --- the column declarations --------------------------------------------------------------
 
-@dataclass(frozen=True)
-class Column:
+class Column(msgspec.Struct, frozen=True):
     """One declared column of a CSV kind: its name, how to read a cell (`parse`, whose kind — number,
     whole number, text… — the reader reads from TYPES), whether every row must give it, its unit, and
     what a given value must satisfy (`check`, said as `rule` after the value)."""
@@ -108,8 +107,7 @@ class Column:
         return TYPES.get(self.parse, ("text", f"correct the {self.name}{unit}"))[1].format(unit=unit, name=self.name)
 
 
-@dataclass(frozen=True)
-class CsvKind:
+class CsvKind(msgspec.Struct, frozen=True):
     """What a kind of CSV file holds: its columns, whether a cell may span lines (template
     expressions may; elsewhere a record over several lines is a quote left open) and is kept as written."""
 
@@ -196,8 +194,7 @@ def declare(parse: Callable, kind: str, todo: str) -> Callable:
 
 # --- reading the file ---------------------------------------------------------------------
 
-@dataclass
-class CsvFile:
+class CsvFile(msgspec.Struct):
     """A file read: its separator, the header's column names (lower case) and every non-blank record
     after it with the line it starts on, its cells stripped and as many as the header's."""
 

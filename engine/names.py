@@ -12,13 +12,13 @@ what is written in SQL. A name that does not fit is refused, never altered.
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
+
+import msgspec
 
 from .errors import EngineError
 
 
-@dataclass(frozen=True)
-class NameRule:
+class NameRule(msgspec.Struct, frozen=True):
     """A kind of name the engine stores (program, class, machine): the pattern it fits and the rule said to the user."""
     pattern: str     # a regular expression both Python and PostgreSQL read the same way (no anchors)
     rule: str        # what a name must be, said to the user

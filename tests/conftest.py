@@ -2,7 +2,8 @@
 else the embedded server in a temporary directory. DATABASE_URL, the shop's database, never
 chooses the test server and is removed from the test process, so neither the suite nor the engine
 under test can reach a developer's database through it. Each session gets its own freshly
-migrated and seeded database; tests that commit get a clone of it.
+migrated and seeded database; tests that commit get a clone of it, tests that only read share one
+read-only clone per worker (read_only_database_url; CONTRIBUTING.md says which to pick).
 
 Markers (pyproject.toml): `db` and `cli` are put on a test here, by the fixtures it uses; `slow`
 is written on the slowest tests, and put here on the sets of a big matrix left out of the sample
@@ -11,6 +12,7 @@ from __future__ import annotations
 
 import os
 import uuid
+from collections.abc import Iterator
 from functools import cache
 from urllib.parse import urlsplit, urlunsplit
 
@@ -35,8 +37,8 @@ os.environ.pop("ENGINE_DATABASE_URL", None)
 
 TEST_SERVER_VARIABLE = "ENGINE_TEST_DSN"
 DATABASE_FIXTURES = {"server_url", "database_pool", "database_url", "fresh_database_url", "empty_database_url",
-                     "conn"}
-CLI_FIXTURES = {"run"}
+                     "read_only_database_url", "conn"}
+CLI_FIXTURES = {"run", "read_only_run"}
 
 
 @cache
@@ -197,6 +199,22 @@ def fresh_database_url(server_url, database_pool, _seeded_copies) -> str:
     database_pool.give_back(name)
 
 
+@pytest.fixture(scope="session")
+def read_only_database_url(server_url, database_pool, database_url) -> Iterator[str]:
+    """A copy of the seeded database shared by the tests of a worker that only read it (issue 28:
+    a private copy per test cost a CREATE and a DROP DATABASE, whose checkpoint took 20-36 s on a
+    shared server). Every session on it starts READ ONLY (default_transaction_read_only, set on the
+    database, so the engine's and the CLI's own connections get it too): a test that writes fails
+    with "cannot execute … in a read-only transaction" instead of changing what the next test reads."""
+    base = str(conninfo_to_dict(database_url)["dbname"])
+    name = f"{base}_read_only"
+    with psycopg.connect(server_url, autocommit=True) as admin:
+        create_database(admin, name, _template_of(base), database_pool.file_copy)
+        admin.execute(sql.SQL("ALTER DATABASE {} SET default_transaction_read_only = on").format(sql.Identifier(name)))
+    yield _url_of(server_url, name)
+    database_pool.give_back(name)
+
+
 @pytest.fixture
 def conn(database_url):
     """A connection whose every change is rolled back at the end of the test."""
@@ -242,6 +260,17 @@ def run(fresh_database_url, tmp_path_factory):
     the test writes it, outside tmp_path (a test's --out folder holds only what the engine wrote);
     no ENGINE_* variable of the developer's shell reaches it. env={...} adds variables (None
     removes one); url=False leaves out --database-url. run.url is the database."""
+    return _cli(fresh_database_url, tmp_path_factory)
+
+
+@pytest.fixture
+def read_only_run(read_only_database_url, tmp_path_factory):
+    """`run` on the worker's shared read-only copy (read_only_database_url), for a test whose
+    commands only read the database: one that writes fails instead of passing on a private copy."""
+    return _cli(read_only_database_url, tmp_path_factory)
+
+
+def _cli(database: str, tmp_path_factory):
     from click.testing import CliRunner
 
     from engine.cli.app import main
@@ -250,8 +279,8 @@ def run(fresh_database_url, tmp_path_factory):
     config.write_text("")
 
     def invoke(*args, env=None, url=True):
-        given = ["--database-url", fresh_database_url] if url else []
+        given = ["--database-url", database] if url else []
         environment = {**NO_ENGINE_VARIABLES, "ENGINE_CONFIG": str(config), **(env or {})}
         return CliRunner().invoke(main, [*given, *map(str, args)], env=environment)
-    invoke.url, invoke.config = fresh_database_url, config
+    invoke.url, invoke.config = database, config
     return invoke

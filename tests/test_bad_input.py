@@ -53,15 +53,15 @@ def refusal(result) -> str:
     (lambda rows: rows.__setitem__(3, rows[3].replace(",,20,,,,,40Cr", ",,1e999,,,,,40Cr")),
      "line 5, column face_width: '1e999'"),
 ])
-def test_a_bad_gear_file_imports_nothing_and_names_the_line(run, tmp_path, edit, words):
+def test_a_bad_gear_file_imports_nothing_and_names_the_line(read_only_run, tmp_path, edit, words):
     rows = gear_rows()
     edit(rows)
     (tmp_path / "gears.csv").write_text(HEADER + "\n" + "\n".join(rows) + "\n")
-    before = counts(run.url)
-    result = run("gears", "import", tmp_path / "gears.csv")
+    before = counts(read_only_run.url)
+    result = read_only_run("gears", "import", tmp_path / "gears.csv")
     assert result.exit_code == 1 and words in result.stderr, result.stderr
     assert "Traceback" not in result.output
-    assert counts(run.url) == before
+    assert counts(read_only_run.url) == before
 
 
 @pytest.mark.parametrize("value", ["1e999", "NaN", "Infinity"])
@@ -97,46 +97,46 @@ def import_refused(run, path, words):
     assert counts(run.url) == before
 
 
-def test_an_unclosed_quote_in_a_template_is_refused_at_its_line(run, tmp_path):
-    lines = exported_spur(run).splitlines(keepends=True)
+def test_an_unclosed_quote_in_a_template_is_refused_at_its_line(read_only_run, tmp_path):
+    lines = exported_spur(read_only_run).splitlines(keepends=True)
     opened = next(number for number, line in enumerate(lines) if line.endswith('""",\n') and number > 3)
     lines[opened] = lines[opened][:-len('""",\n')] + '"",\n'     # the cell's closing quote is gone
     (tmp_path / "spur.csv").write_text("".join(lines))
-    import_refused(run, tmp_path / "spur.csv", f"line {opened + 1}:")
+    import_refused(read_only_run, tmp_path / "spur.csv", f"line {opened + 1}:")
 
 
-def test_a_quote_closed_rows_later_is_refused_at_the_line_it_opens(run, tmp_path):
+def test_a_quote_closed_rows_later_is_refused_at_the_line_it_opens(read_only_run, tmp_path):
     text = "id,t,n,p_calc,s,o,p_emit\n10,main,1,,,\"'G90',\n20,main,1,,,'G0'\",\n30,main,1,,,'M30',\n"
     (tmp_path / "spur.csv").write_text(text)
-    import_refused(run, tmp_path / "spur.csv", "line 2: a cell runs on into what looks like a row")
+    import_refused(read_only_run, tmp_path / "spur.csv", "line 2: a cell runs on into what looks like a row")
 
 
-def test_a_template_that_is_not_utf8_names_the_line(run, tmp_path):
-    text = exported_spur(run).replace("GEAR", "GEÄR", 1)
+def test_a_template_that_is_not_utf8_names_the_line(read_only_run, tmp_path):
+    text = exported_spur(read_only_run).replace("GEAR", "GEÄR", 1)
     line = text[:text.index("GEÄR")].count("\n") + 1
     (tmp_path / "spur.csv").write_bytes(text.encode("latin-1"))
-    import_refused(run, tmp_path / "spur.csv", f"line {line}: not UTF-8")
+    import_refused(read_only_run, tmp_path / "spur.csv", f"line {line}: not UTF-8")
 
 
-def test_a_template_with_a_nul_names_the_line(run, tmp_path):
-    text = exported_spur(run)
+def test_a_template_with_a_nul_names_the_line(read_only_run, tmp_path):
+    text = exported_spur(read_only_run)
     line = text[:text.index("G90")].count("\n") + 1
     (tmp_path / "spur.csv").write_text(text.replace("G90", "G9\x000", 1))
-    import_refused(run, tmp_path / "spur.csv", f"line {line}: holds a NUL")
+    import_refused(read_only_run, tmp_path / "spur.csv", f"line {line}: holds a NUL")
 
 
-def test_an_oversized_cell_names_the_line(run, tmp_path):
-    text = exported_spur(run)
+def test_an_oversized_cell_names_the_line(read_only_run, tmp_path):
+    text = exported_spur(read_only_run)
     line = text[:text.index('"G90 G71 G94"')].count("\n") + 1
     (tmp_path / "spur.csv").write_text(text.replace('"G90 G71 G94"', '"G90 G71 G94' + " " * 200_000 + '"', 1))
-    import_refused(run, tmp_path / "spur.csv", f"line {line}: not valid CSV (field larger than field limit")
+    import_refused(read_only_run, tmp_path / "spur.csv", f"line {line}: not valid CSV (field larger than field limit")
 
 
-def test_an_oversized_template_file_is_refused_before_it_is_read(run, tmp_path, monkeypatch):
-    text = exported_spur(run)
+def test_an_oversized_template_file_is_refused_before_it_is_read(read_only_run, tmp_path, monkeypatch):
+    text = exported_spur(read_only_run)
     monkeypatch.setattr(template_csv, "MAX_CSV_BYTES", len(text.encode()) - 1)
     (tmp_path / "spur.csv").write_text(text)
-    import_refused(run, tmp_path / "spur.csv", "more than a template CSV may hold")
+    import_refused(read_only_run, tmp_path / "spur.csv", "more than a template CSV may hold")
 
 
 # --- DXF -----------------------------------------------------------------------------------------
@@ -164,16 +164,16 @@ DXF_EDITS = {
 
 
 @pytest.mark.parametrize("case", DXF_EDITS)
-def test_a_drawing_with_coordinates_that_are_no_number_stores_no_job(run, tmp_path, case):
+def test_a_drawing_with_coordinates_that_are_no_number_stores_no_job(read_only_run, tmp_path, case):
     edit, entity, words = DXF_EDITS[case]
     seed_drawing(tmp_path / "part.dxf")
     doc = ezdxf.readfile(tmp_path / "part.dxf")
     edit(doc.modelspace())
     doc.saveas(tmp_path / "bad.dxf")
-    before = counts(run.url)
-    message = refusal(run("import-dxf", tmp_path / "bad.dxf"))
+    before = counts(read_only_run.url)
+    message = refusal(read_only_run("import-dxf", tmp_path / "bad.dxf"))
     assert message.startswith(f"error: {entity} ") and words in message, message
-    assert counts(run.url) == before
+    assert counts(read_only_run.url) == before
 
 
 # --- the server lost -----------------------------------------------------------------------------

@@ -22,7 +22,7 @@ def test_a_batch_of_one_bad_gear_says_the_one_gear_is_bad(run):
         "nothing stored (the one gear of the batch is bad)")
 
 
-def test_a_job_that_does_not_exist_points_at_the_jobs_list(run):
-    refused = run("instantiate", "--job", 999999)
+def test_a_job_that_does_not_exist_points_at_the_jobs_list(read_only_run):
+    refused = read_only_run("instantiate", "--job", 999999)
     assert refused.exit_code == 1
     assert refused.stderr == "error: job 999999 does not exist; `engine jobs list` shows what does\n"

@@ -121,8 +121,8 @@ def test_every_bad_job_is_named_and_skip_bad_makes_the_others(run):
     assert remade == [job for job in jobs if job not in (jobs[1], jobs[3])]
 
 
-def test_skip_bad_is_for_batches(run):
-    refused = run("instantiate", "--gear", "42", "--skip-bad")
+def test_skip_bad_is_for_batches(read_only_run):
+    refused = read_only_run("instantiate", "--gear", "42", "--skip-bad")
     assert refused.exit_code == 1 and "--skip-bad" in refused.stderr and "--gears" in refused.stderr
 
 
@@ -207,12 +207,12 @@ def test_a_dry_run_of_a_batch_with_bad_gears_names_them_and_skip_bad_reports_the
 
 
 @pytest.mark.parametrize("target", [("--gear", "42"), ("--gears", "42-43")])
-def test_a_dry_run_writes_no_file_and_says_so_for_out(run, tmp_path, target):
-    before = everything(run.url)
-    refused = run("instantiate", *target, "--dry-run", "--out", tmp_path / "nc")
+def test_a_dry_run_writes_no_file_and_says_so_for_out(read_only_run, tmp_path, target):
+    before = everything(read_only_run.url)
+    refused = read_only_run("instantiate", *target, "--dry-run", "--out", tmp_path / "nc")
     assert refused.exit_code == 1 and refused.stderr.count("\n") == 1
     assert "--dry-run" in refused.stderr and "--out" in refused.stderr
-    assert everything(run.url) == before and not (tmp_path / "nc").exists()
+    assert everything(read_only_run.url) == before and not (tmp_path / "nc").exists()
 
 
 def test_the_database_refuses_a_dry_run_lineage_line(run):
@@ -269,15 +269,15 @@ def stderr_of(url: str, *args: str, terminal: bool) -> str:
 
 
 @pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
-def test_a_batch_shows_a_progress_bar_on_a_terminal_only(run):
-    on_terminal = stderr_of(run.url, "instantiate", "--gears", "42-54", "--dry-run", terminal=True)
+def test_a_batch_shows_a_progress_bar_on_a_terminal_only(read_only_run):
+    on_terminal = stderr_of(read_only_run.url, "instantiate", "--gears", "42-54", "--dry-run", terminal=True)
     assert "planning" in on_terminal and "100%" in on_terminal
-    in_pipe = stderr_of(run.url, "instantiate", "--gears", "42-54", "--dry-run", terminal=False)
+    in_pipe = stderr_of(read_only_run.url, "instantiate", "--gears", "42-54", "--dry-run", terminal=False)
     assert "planning" not in in_pipe and "100%" not in in_pipe
 
 
-def test_instantiate_help_has_an_example(run):
-    shown = run("instantiate", "--help")
+def test_instantiate_help_has_an_example(read_only_run):
+    shown = read_only_run("instantiate", "--help")
     assert shown.exit_code == 0
     assert any(line.strip().startswith("Example: engine instantiate ") for line in shown.stdout.splitlines())
     assert "--dry-run" in shown.stdout and "--skip-bad" in shown.stdout

@@ -4,10 +4,10 @@ means the reference defaults, and a confirmed job becomes a case exactly once.""
 import csv
 import json
 import math
-from dataclasses import replace
 
 import pytest
 from helpers import chip_reference, feed_mark_reference
+from msgspec.structs import replace
 from psycopg import sql
 
 from engine.errors import EngineError
@@ -275,8 +275,8 @@ def test_the_seed_holds_the_paper_case_alone_at_its_features():
 
 
 
-def test_cli_suggest_prints_the_hob_cases_and_proposal(run):
-    result = run("suggest", "--gear", 42)   # the seeded spur gear with the paper's data
+def test_cli_suggest_prints_the_hob_cases_and_proposal(read_only_run):
+    result = read_only_run("suggest", "--gear", 42)   # the seeded spur gear with the paper's data
     assert result.exit_code == 0, result.output
     out = result.stdout
     assert "H-M2-AA-R1" in out and "CAO/YAN/GUO 2015" in out
@@ -284,7 +284,7 @@ def test_cli_suggest_prints_the_hob_cases_and_proposal(run):
     assert f"radial {BOUNDED_RADIAL} mm/min" in out
     bounded = [line for line in out.splitlines() if "bounded to" in line]
     assert len(bounded) == 1 and "8.11" in bounded[0] and "3.00" in bounded[0] and "m2" in bounded[0]
-    report = json.loads(run("suggest", "--gear", 42, "--json", "--top", 1).stdout)
+    report = json.loads(read_only_run("suggest", "--gear", 42, "--json", "--top", 1).stdout)
     assert report["hob"]["hob_id"] == "H-M2-AA-R1" and report["hob_speed"] == PAPER_N0
     assert (report["rough"]["axial_feed"], report["rough"]["radial_feed"]) == (BOUNDED_AXIAL, BOUNDED_RADIAL)
     assert len(report["cases"]) == 2

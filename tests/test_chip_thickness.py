@@ -188,9 +188,9 @@ def test_the_hob_csv_round_trips_gashes_and_profile(run, tmp_path):
 
 
 @pytest.mark.parametrize("cells, problem", [("0,standard", "gashes"), ("12,sharp", "profile")])
-def test_a_bad_gash_count_or_profile_is_refused(run, tmp_path, cells, problem):
+def test_a_bad_gash_count_or_profile_is_refused(read_only_run, tmp_path, cells, problem):
     path = tmp_path / "hobs.csv"
     path.write_text("id,module,pressure_angle,starts,tip_diameter,length,hand,accuracy_class,gashes,profile\n"
                     f"H-CHIP-3,2,20,1,70,100,R,AA,{cells}\n", encoding="utf-8")
-    result = run("hobs", "import", str(path))
+    result = read_only_run("hobs", "import", str(path))
     assert result.exit_code != 0 and problem in result.output

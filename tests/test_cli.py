@@ -64,15 +64,16 @@ def test_instantiate_writes_the_file_and_reports_json(run, tmp_path):
     (("instantiate",), ["exactly one of"]),
     (("template", "export", "--class", "nope"), ["gear class 'nope' does not exist"]),
 ])
-def test_bad_requests_get_one_line_and_exit_1_and_change_nothing(run, args, words, tmp_path):
-    before = stored_counts(run.url)
-    result = run(*args, "--out", tmp_path / "x.MPF") if args[0] == "instantiate" and len(args) > 1 else run(*args)
+def test_bad_requests_get_one_line_and_exit_1_and_change_nothing(read_only_run, args, words, tmp_path):
+    before = stored_counts(read_only_run.url)
+    result = read_only_run(*args, "--out", tmp_path / "x.MPF") if args[0] == "instantiate" and len(args) > 1 \
+        else read_only_run(*args)
     assert result.exit_code == 1, result.output
     message = result.stderr.strip()
     assert len(message.splitlines()) == 1 and "Traceback" not in result.output
     for word in words:
         assert word in message
-    assert stored_counts(run.url) == before
+    assert stored_counts(read_only_run.url) == before
     assert not (tmp_path / "x.MPF").exists()
 
 
@@ -166,10 +167,10 @@ def test_demo_runs_on_the_embedded_server_from_nothing(tmp_path):
 
 
 @pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
-def test_libpq_variables_choose_the_server_when_no_url_is_given(fresh_database_url):
+def test_libpq_variables_choose_the_server_when_no_url_is_given(read_only_database_url):
     from psycopg.conninfo import conninfo_to_dict
 
-    params = conninfo_to_dict(fresh_database_url)
+    params = conninfo_to_dict(read_only_database_url)
     environment = {k: v for k, v in os.environ.items() if k != "DATABASE_URL" and not k.startswith("PG")}
     environment.update({"PGHOST": params["host"], "PGDATABASE": params["dbname"],
                         "PGUSER": params.get("user", "postgres"), "PGPORT": str(params.get("port", 5432))})
@@ -186,10 +187,10 @@ def test_an_unreachable_server_is_one_line_and_exit_1():
     assert len(result.stderr.strip().splitlines()) == 1
 
 
-def test_template_list_counts_each_class_s_own_and_inherited_rows(run):
-    result = run("template", "list")
+def test_template_list_counts_each_class_s_own_and_inherited_rows(read_only_run):
+    result = read_only_run("template", "list")
     assert result.exit_code == 0, result.output
-    with psycopg.connect(run.url) as conn:
+    with psycopg.connect(read_only_run.url) as conn:
         expected = dict(conn.execute("SELECT g.name, (SELECT count(*) FROM class_template(g.name)) "
                                      "FROM gear_class g").fetchall())
     lines = result.stdout.splitlines()
@@ -198,5 +199,5 @@ def test_template_list_counts_each_class_s_own_and_inherited_rows(run):
     assert expected["duplex"] > expected["spur"] > 0
     for name in ("spur", "duplex", "helical", "worm_wheel"):
         assert listed[name][3] == str(expected[name]), listed[name]
-    as_json = json.loads(run("template", "list", "--json").stdout)["classes"]
+    as_json = json.loads(read_only_run("template", "list", "--json").stdout)["classes"]
     assert {record["class"]: record["rows"] for record in as_json} == expected

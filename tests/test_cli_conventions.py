@@ -105,25 +105,25 @@ def json_error(result, code: int = 1) -> dict:
     (("hobs", "match", "--json"), {}, ["--gear"]),
     (("template", "history", "--class", "nope", "--json"), {}, ["nope"]),
 ])
-def test_errors_of_a_json_invocation_are_json_on_stderr(run, args, env, words):
-    result = run(*args, env=env)
+def test_errors_of_a_json_invocation_are_json_on_stderr(read_only_run, args, env, words):
+    result = read_only_run(*args, env=env)
     error = json_error(result)
     for word in words:
         assert word in error["error"]
 
 
-def test_an_unexpected_error_of_a_json_invocation_is_json_with_exit_2(run, monkeypatch):
+def test_an_unexpected_error_of_a_json_invocation_is_json_with_exit_2(read_only_run, monkeypatch):
     import engine.templates.lint
 
     def broken(conn):
         raise ZeroDivisionError("a bug")
     monkeypatch.setattr(engine.templates.lint, "lint_all", broken)
-    error = json_error(run("lint", "--json"), code=2)
+    error = json_error(read_only_run("lint", "--json"), code=2)
     assert "ZeroDivisionError" in error["error"] and "--traceback" in error["error"]
 
 
-def test_without_json_errors_stay_one_line_of_text(run):
-    result = run("instantiate", "--gear", 999)
+def test_without_json_errors_stay_one_line_of_text(read_only_run):
+    result = read_only_run("instantiate", "--gear", 999)
     assert result.exit_code == 1 and result.stderr.startswith("error: gear 999")
 
 

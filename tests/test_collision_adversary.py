@@ -13,11 +13,11 @@ from __future__ import annotations
 
 import functools
 import math
-from dataclasses import replace
 
 import pytest
 from helpers.collision_truth import ALLOWED, PATHS, after_coupling, messages, seeded_records, true_depth
 from helpers.simulation_programs import LOAD, RAPID_RATE, Hand, program_minutes, swivel
+from msgspec.structs import replace
 
 from engine.simulation import simulate_program
 from engine.simulation.hobbing import contact

@@ -66,11 +66,11 @@ def test_a_variable_does_not_make_a_program_from_the_draft(run):
     ("instantiate", "skip_bad", "--skip-bad"),
     ("instantiate", "skip-bad", "--skip-bad"),
 ])
-def test_a_confirming_option_in_the_config_file_is_refused_naming_it(run, table, key, option):
-    run.config.write_text(f"[{table}]\n{key} = true\n")
-    said = one_error_line(run("gears", "delete", 42))
-    assert str(run.config) in said and option in said and "command line only" in said and "line 2" in said
-    assert count(run.url, "SELECT count(*) FROM gear WHERE id = 42") == 1
+def test_a_confirming_option_in_the_config_file_is_refused_naming_it(read_only_run, table, key, option):
+    read_only_run.config.write_text(f"[{table}]\n{key} = true\n")
+    said = one_error_line(read_only_run("gears", "delete", 42))
+    assert str(read_only_run.config) in said and option in said and "command line only" in said and "line 2" in said
+    assert count(read_only_run.url, "SELECT count(*) FROM gear WHERE id = 42") == 1
 
 
 # a default that does not apply to the invocation is ignored; typed, it is refused ---------------
@@ -83,8 +83,9 @@ def test_the_config_files_batch_habits_leave_one_gear_alone(run):
     assert " emitted" in one.stderr   # the config file's explain applies to one program: it is explained
 
 
-def test_explain_from_the_environment_does_not_refuse_a_batch(run):
-    result = run("instantiate", "--gears", "42-43", "--dry-run", "--json", env={"ENGINE_INSTANTIATE_EXPLAIN": "1"})
+def test_explain_from_the_environment_does_not_refuse_a_batch(read_only_run):
+    result = read_only_run("instantiate", "--gears", "42-43", "--dry-run", "--json",
+                           env={"ENGINE_INSTANTIATE_EXPLAIN": "1"})
     assert result.exit_code == 0, result.output
     assert json.loads(result.stdout)["dry_run"] is True
 
@@ -93,14 +94,14 @@ def test_explain_from_the_environment_does_not_refuse_a_batch(run):
     (("--gear", 42, "--workers", 2), "--workers"),
     (("--gears", "42-43", "--explain"), "--explain"),
 ])
-def test_a_batch_option_typed_where_it_does_not_apply_is_still_refused(run, args, option):
-    assert option in one_error_line(run("instantiate", *args))
+def test_a_batch_option_typed_where_it_does_not_apply_is_still_refused(read_only_run, args, option):
+    assert option in one_error_line(read_only_run("instantiate", *args))
 
 
 # exclusive flag pairs -----------------------------------------------------------------------------
 
-def test_released_and_draft_together_are_one_usage_error(run):
-    said = one_error_line(run("programs", "list", "--released", "--draft"))
+def test_released_and_draft_together_are_one_usage_error(read_only_run):
+    said = one_error_line(read_only_run("programs", "list", "--released", "--draft"))
     assert "--draft" in said and "--released" in said
 
 
@@ -116,22 +117,22 @@ def test_a_flag_typed_wins_over_its_partner_from_the_environment(run):
 
 # errors: JSON when --json comes from the environment or the file; always one line ---------------
 
-def test_a_usage_error_is_json_when_the_environment_asks_for_json(run):
-    said = one_json_error(run("gears", "list", "--bogus", env={"ENGINE_GEARS_LIST_JSON": "1"}))
+def test_a_usage_error_is_json_when_the_environment_asks_for_json(read_only_run):
+    said = one_json_error(read_only_run("gears", "list", "--bogus", env={"ENGINE_GEARS_LIST_JSON": "1"}))
     assert "--bogus" in said
 
 
-def test_a_usage_error_is_json_when_the_config_file_asks_for_json(run):
-    run.config.write_text("[jobs.list]\njson = true\n")
-    said = one_json_error(run("jobs", "list", "--gear", "forty-two"))
+def test_a_usage_error_is_json_when_the_config_file_asks_for_json(read_only_run):
+    read_only_run.config.write_text("[jobs.list]\njson = true\n")
+    said = one_json_error(read_only_run("jobs", "list", "--gear", "forty-two"))
     assert "forty-two" in said
 
 
 @pytest.mark.parametrize("typed, shown", [("X\n", "X\\n"), ("A\rB", "A\\rB"), ("H\x1b[31m", "H\\x1b[31m"),
                                           ("L\u2028M", "L\\u2028M")])
-def test_an_error_naming_a_value_with_a_line_break_is_one_line(run, typed, shown):
-    assert shown in one_error_line(run("hobs", "show", typed))
-    assert shown in one_json_error(run("hobs", "show", typed, "--json"))
+def test_an_error_naming_a_value_with_a_line_break_is_one_line(read_only_run, typed, shown):
+    assert shown in one_error_line(read_only_run("hobs", "show", typed))
+    assert shown in one_json_error(read_only_run("hobs", "show", typed, "--json"))
 
 
 # CSV a spreadsheet opens as text ------------------------------------------------------------------

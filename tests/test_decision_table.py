@@ -1,6 +1,7 @@
 """The decision table of design notes §4, step by step, on templates stored in PostgreSQL."""
 import pytest
 from helpers.releases import release_draft
+from msgspec.structs import astuple
 
 from engine.errors import EngineError
 from engine.hobbing.choices import Choices
@@ -110,7 +111,7 @@ def count_rows(conn):
 
 
 def test_a_failing_row_stores_nothing_of_the_instantiation(conn):
-    rows = [tuple(r.__dict__.values()) for r in load_template(conn, "spur").rows]
+    rows = [astuple(r) for r in load_template(conn, "spur").rows]
     broken = rows[:-1] + [(rows[-1][0], "main", 2, None, None, "f'M30 {1 / (z2 - z2)}'", None)]
     replace_template(conn, "spur", [TemplateRow(*row) for row in broken])
     before = count_rows(conn)

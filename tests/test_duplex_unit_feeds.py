@@ -125,7 +125,7 @@ def test_a_mode_per_unit_on_a_gear_of_one_unit_is_refused_in_one_line(conn):
     assert "\n" not in message and "names one for each of 2 units; the gear has 1" in message, message
 
 
-def test_a_feed_mode_not_known_is_refused_naming_the_modes(run):
-    result = run("instantiate", "--gear", 54, "--feed-mode", "climb/sideways", "--dry-run")
+def test_a_feed_mode_not_known_is_refused_naming_the_modes(read_only_run):
+    result = read_only_run("instantiate", "--gear", 54, "--feed-mode", "climb/sideways", "--dry-run")
     assert result.exit_code == 1 and result.stderr.count("\n") == 1, result.stderr
     assert "climb/sideways" in result.stderr and "climb/conventional" in result.stderr

@@ -200,7 +200,7 @@ LOWER_HALVES = {   # the lower half as drawn, (z, radius) below the centre line;
 
 
 @pytest.mark.parametrize("name", LOWER_HALVES)
-def test_a_side_view_whose_halves_disagree_is_refused(run, tmp_path, name):
+def test_a_side_view_whose_halves_disagree_is_refused(read_only_run, tmp_path, name):
     """A turned part is the same above and below its axis. When the drawn halves disagree (the
     collar ends at Z-35 above and Z-30 below; Ø24 above and Ø21.6 below) the drawing does not say
     which part to make; the engine silently takes the upper half."""
@@ -212,7 +212,8 @@ def test_a_side_view_whose_halves_disagree_is_refused(run, tmp_path, name):
         centre_line(msp)
     path = tmp_path / f"{name}.dxf"
     drawing(path, draw)
-    before = counts(run.url)
-    made = run("import-dxf", path, "--rough-depth", "1", "--program-name", "HALVES", "--machine", "lathe-840d")
+    before = counts(read_only_run.url)
+    made = read_only_run("import-dxf", path, "--rough-depth", "1", "--program-name", "HALVES", "--machine",
+                         "lathe-840d")
     assert made.exit_code == 1, made.output
-    assert made.stderr.count("\n") == 1 and counts(run.url) == before
+    assert made.stderr.count("\n") == 1 and counts(read_only_run.url) == before

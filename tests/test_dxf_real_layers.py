@@ -60,8 +60,8 @@ def test_import_dxf_makes_a_job_from_the_named_layer_and_its_program(run, tmp_pa
     assert json.loads(program.stdout)["lines"] > 10
 
 
-def test_help_names_the_option_and_keeps_its_example(run):
-    text = run("import-dxf", "--help").output
+def test_help_names_the_option_and_keeps_its_example(read_only_run):
+    text = read_only_run("import-dxf", "--help").output
     assert "--profile-layer" in text
     assert any(line.strip().startswith("Example: engine import-dxf") for line in text.splitlines())
 

@@ -79,16 +79,16 @@ def fifo(tmp_path):
 
 
 @pytest.mark.parametrize("config", ["/dev/zero", "fifo"])
-def test_a_config_that_is_no_regular_file_is_refused_without_reading_it(fresh_database_url, fifo, config):
+def test_a_config_that_is_no_regular_file_is_refused_without_reading_it(read_only_database_url, fifo, config):
     path = str(fifo) if config == "fifo" else config
     environment = {**os.environ, "PYTHONPATH": str(ROOT), "ENGINE_CONFIG": path}
-    done = subprocess.run([sys.executable, "-m", "engine", "--database-url", fresh_database_url, "gears", "list"],
+    done = subprocess.run([sys.executable, "-m", "engine", "--database-url", read_only_database_url, "gears", "list"],
                           capture_output=True, text=True, env=environment, preexec_fn=_limited, timeout=HANG_GUARD)
     assert done.returncode == 1, done.stderr
     assert done.stderr.count("\n") == 1 and path in done.stderr and "not a regular file" in done.stderr, done.stderr
 
 
-def test_a_tab_inside_an_imported_nc_line_is_refused_at_import_naming_the_line(run, tmp_path):
+def test_a_tab_inside_an_imported_nc_line_is_refused_at_import_naming_the_line(read_only_run, tmp_path):
     """A stored NC line holds no control character (check_program): a program with a tab was
     imported, and then `--unverified`, which skips the verifier, ended in the database's
     CheckViolation and exit 2 (issue 26); since issue 27 the import refuses the tab, naming its
@@ -97,6 +97,7 @@ def test_a_tab_inside_an_imported_nc_line_is_refused_at_import_naming_the_line(r
     source[3] = source[3].replace(" ", "\t", 1)
     program = tmp_path / "tabbed.ngc"
     program.write_text("\n".join(source) + "\n")
-    before = stored(run.url)
-    refused_in_one_line(run("import-nc", program, "--class", "tabbed"), "line 4", "holds a tab", "nothing stored")
-    assert stored(run.url) == before
+    before = stored(read_only_run.url)
+    refused_in_one_line(read_only_run("import-nc", program, "--class", "tabbed"), "line 4", "holds a tab",
+                        "nothing stored")
+    assert stored(read_only_run.url) == before

@@ -4,9 +4,8 @@ the program as written that the refused plain line came from, and a dialect whos
 loaded is refused (fail closed), never read as written."""
 from __future__ import annotations
 
-from dataclasses import replace
-
 import pytest
+from msgspec.structs import replace
 
 from engine.machines.records import Machine
 from engine.simulation.hobbing.reading import plain_lines

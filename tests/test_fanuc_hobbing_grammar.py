@@ -8,14 +8,16 @@ spindle maximum 1000 r/min and table maximum 120 r/min, seed_templates/machines.
 expected table speeds are S·|L|/T against the record's own maximum."""
 from __future__ import annotations
 
-from dataclasses import replace
-
 import psycopg
 import pytest
+from msgspec.structs import replace
 
 from engine.machines.records import Machine, load_machine
 from engine.nc.lineage import lineage_line, lineage_words
 from engine.verifier import LimitError, verify_program
+from engine.verifier.grammar import HOBBING_FANUC, HOBBING_FANUC_G81_4
+from engine.verifier.lines import read_line
+from engine.verifier.statements import GearBox
 
 NAME = "GEAR42"
 SPEED = 246                                   # r/min of the hob: S246
@@ -119,7 +121,7 @@ def test_a_second_g81_while_on_replaces_the_ratio_and_the_table_speed_follows(fa
     (replaced("G0 Z19.576 A1.763", "G0 Z19.576 A1"), "A1 needs a decimal point"),
     (replaced("G1 X51.500 F13.3", "G1 X51.500 F13"), "F13 needs a decimal point"),
     (replaced("M8", "M8 ; COOLANT"), "not a word of the Fanuc hobbing in G54 grammar"),
-    (replaced("M8", "M20"), "M20 is not an M code of the Fanuc hobbing in G54 grammar"),
+    (replaced("M8", "M22"), "M22 is not an M code of the Fanuc hobbing in G54 grammar"),
     (replaced("G80", "G80", "EGOFS(C)"), "EGOFS: not a word of the Fanuc hobbing in G54 grammar"),   # (C) a comment
 ])
 def test_fanuc_framing_units_and_modes_are_those_of_the_rules(fanuc, lines, reason):
@@ -252,3 +254,14 @@ def test_instantiate_on_a_fanuc_hobber_without_an_o_number_rule_is_refused_and_s
         "have no O number; set machine.program_number_base; nothing stored"]
     with psycopg.connect(run.url) as conn:
         assert conn.execute("SELECT count(*) FROM program").fetchone()[0] == before
+
+
+def test_a_g81_statement_carries_its_terms_with_their_signs():
+    """The simulation proves the hand and the helix from the signs of L and P: the verifier's
+    reading keeps them (and the words as written, for the findings), so no second reader parses
+    the block again."""
+    start = read_line(HOBBING_FANUC, "G81 T41 L-2 Q3. P-15. (START)")
+    assert start.gear_box == GearBox(41, -2, 3.0, -15.0, "T41", "L-2", "Q3. P-15.")
+    assert start.ratio == 2 / 41 and start.gear_box.ratio_words == "L-2 T41"
+    assert read_line(HOBBING_FANUC_G81_4, "G81.4 R40 L3").gear_box == GearBox(40, 3, None, None, "R40", "L3")
+    assert read_line(HOBBING_FANUC, "G80").gear_box is None

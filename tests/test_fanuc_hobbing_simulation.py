@@ -12,35 +12,25 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import replace
 
 import pytest
+from helpers.fanuc_cases import twin
 from helpers.fanuc_programs import fanuc_program, g81, threads_word
-from helpers.unproved_programs import unproved
+from msgspec.structs import replace
 
-from engine.gears.records import load_gear, load_hobs
-from engine.hobbing.choices import Choices
-from engine.machines.records import load_machine
 from engine.simulation import simulate_program
 from engine.simulation.hobbing.recorded import record_program
 from engine.simulation.hobbing.report import SimulationError
 
-MACHINE = "hobber-840d"
 SPUR = 42                       # seeded spur gear: m 2, z 19, its hob one-start right hand
 HELICAL = 43                    # seeded helical gear, right hand
-NO_TAILSTOCK = Choices(tailstock=False)   # the Fanuc grammar has no tailstock M code
 
 
 @pytest.fixture
 def case(conn, monkeypatch):
-    """gear id, senses -> (840D lines, gear, hob, 840D machine, Fanuc machine)."""
-    def made(gear_id: int, **senses):
-        program = unproved(conn, monkeypatch, gear_id, NO_TAILSTOCK)
-        hob_id = conn.execute("SELECT hob_id FROM job WHERE id = %s", (program.job_id,)).fetchone()[0]
-        hob = next(h for h in load_hobs(conn) if h.id == hob_id)
-        machine = replace(load_machine(conn, MACHINE), **senses)
-        return program.lines, load_gear(conn, gear_id), hob, machine, replace(machine, dialect="fanuc")
-    return made
+    """gear id, senses -> (840D lines, gear, hob, 840D machine, Fanuc machine), the tailstock
+    clamped (M20 … M21, as the templates write by default)."""
+    return lambda gear_id, **senses: twin(conn, monkeypatch, gear_id, **senses)
 
 
 def refusals(lines, gear, hob, machine) -> list[str]:
@@ -76,6 +66,8 @@ def test_a_wrong_l_sign_turns_the_table_the_wrong_way_for_the_hob(case):
     assert found and "the table turns the wrong way for a right-hand hob" in found[0]
     k_b = wrong / gear.teeth                                           # c = b = +1: DIN k_B = L/T
     assert f"k_B is {k_b:+.6g}" in found[0] and f"needs {-k_b:+.6g}" in found[0]
+    assert (f"G81 L{wrong} T{gear.teeth} turns it so; L = −h_hob·c_direction·b_direction·z0 is "
+            f"L{threads_word(hob, fanuc)} on this machine") in found[0]      # the Fanuc words, not EGON's
 
 
 def test_a_wrong_t_generates_another_number_of_teeth(case):
@@ -111,7 +103,8 @@ def test_a_helical_gear_without_q_and_p_would_be_cut_straight(case):
     lines, gear, hob, _, fanuc = case(HELICAL)
     found = refusals(fanuc_program(lines, gear, hob, fanuc, helix=""), gear, hob, fanuc)
     k_z = -360 * math.sin(math.radians(gear.helix_angle)) / (math.pi * gear.module * gear.teeth)
-    assert any(f"generates no helix (spur); the gear needs {k_z:+.6f}°/mm" in message for message in found)
+    assert any(f"(DIN) of G81 without Q and P (no helical compensation) generates no helix (spur); the gear needs "
+               f"{k_z:+.6f}°/mm" in message for message in found), found
 
 
 def test_a_c_word_while_coupled_is_refused_it_would_add_the_motion_twice(case):
@@ -133,7 +126,8 @@ def test_the_m_series_g81_4_form_is_proved_the_same(case):
     assert f"G81.4 R{gear.teeth} L{-hob.starts}" in translated
     assert refusals(translated, gear, hob, g81_4) == []
     wrong = [line.replace(f"L{-hob.starts}", f"L{hob.starts}") for line in translated]
-    assert "the table turns the wrong way" in refusals(wrong, gear, hob, g81_4)[0]
+    found = refusals(wrong, gear, hob, g81_4)[0]
+    assert "the table turns the wrong way" in found and f"G81.4 L{hob.starts} R{gear.teeth} turns it so" in found
 
 
 def test_the_picture_follows_the_same_coupling_and_refuses_the_same_helix(case):
@@ -159,13 +153,14 @@ def reference_p(gear, machine) -> float:
     return -1 * machine.c_direction * machine.z_direction * machine.egb_helix_sign * gear.helix_angle
 
 
-def wrong_helix(found: float, gear) -> str:
-    """The walk's words for a Z term `found` (DIN) on the gear: the hand, β and lead it cuts
-    (sin β' = |k|·π·m_n·z2/360, lead 360/|k|, fanuc-egb.md §F4 turned round)."""
+def wrong_helix(found: float, gear, words: str) -> str:
+    """The walk's words for a Z term `found` (DIN) that G81's Q and P (`words`) give on the gear:
+    the hand, β and lead it cuts (sin β' = |k|·π·m_n·z2/360, lead 360/|k|, fanuc-egb.md §F4 turned
+    round), named by the Fanuc words that give it."""
     beta = math.degrees(math.asin(abs(found) * math.pi * gear.module * gear.teeth / 360))
     hand = "right-hand" if found < 0 else "left-hand"
-    return (f"the Z term {found:+.6f}°/mm (DIN) generates a {hand} helix of β {beta:.3f}°, lead {360 / abs(found):.1f} "
-            f"mm; the gear needs {reference_k_z(gear):+.6f}°/mm")
+    return (f"the Z term {found:+.6f}°/mm (DIN) of G81's helical compensation {words} generates a {hand} helix of "
+            f"β {beta:.3f}°, lead {360 / abs(found):.1f} mm; the gear needs {reference_k_z(gear):+.6f}°/mm")
 
 
 @pytest.mark.parametrize("senses", [{"egb_helix_sign": 1}, {"egb_helix_sign": -1},
@@ -194,7 +189,7 @@ def test_a_flipped_p_cuts_the_other_hand(case):
     lines, gear, hob, _, fanuc = case(HELICAL, egb_helix_sign=1)
     flipped = f" Q{gear.module:g}. P{-reference_p(gear, fanuc):.3f}"
     found = refusals(fanuc_program(lines, gear, hob, fanuc, helix=flipped), gear, hob, fanuc)
-    assert any(wrong_helix(-reference_k_z(gear), gear) in message for message in found), found
+    assert any(wrong_helix(-reference_k_z(gear), gear, flipped.strip()) in message for message in found), found
 
 
 def test_the_same_program_on_a_record_of_the_other_sign_cuts_the_other_hand(case):
@@ -202,15 +197,16 @@ def test_the_same_program_on_a_record_of_the_other_sign_cuts_the_other_hand(case
     translated = fanuc_program(lines, gear, hob, fanuc)
     other = replace(fanuc, egb_helix_sign=-1)
     found = refusals(translated, gear, hob, other)
-    assert any(wrong_helix(-reference_k_z(gear), gear) in message for message in found), found
+    words = f"Q{gear.module:g}. P{reference_p(gear, fanuc):.3f}"
+    assert any(wrong_helix(-reference_k_z(gear), gear, words) in message for message in found), found
 
 
 def test_a_wrong_module_q_cuts_the_wrong_lead(case):
     lines, gear, hob, _, fanuc = case(HELICAL, egb_helix_sign=1)
     wrong = gear.module + 1
-    found = refusals(fanuc_program(lines, gear, hob, fanuc, helix=f" Q{wrong:g}. P{reference_p(gear, fanuc):.3f}"),
-                     gear, hob, fanuc)
-    assert any(wrong_helix(reference_k_z(gear, wrong), gear) in message for message in found), found
+    words = f"Q{wrong:g}. P{reference_p(gear, fanuc):.3f}"
+    found = refusals(fanuc_program(lines, gear, hob, fanuc, helix=f" {words}"), gear, hob, fanuc)
+    assert any(wrong_helix(reference_k_z(gear, wrong), gear, words) in message for message in found), found
 
 
 def test_the_picture_follows_the_helical_coupling_on_a_record_stating_the_sign(case):
@@ -256,3 +252,14 @@ def test_a_g81_with_the_hob_turning_is_refused_the_table_may_not_be_in_step(case
         assert "\n" not in str(raised.value)
     stopped = [*translated[:at], start, "M5", translated[at], *translated[at + 1:]]
     assert refusals(stopped, gear, hob, fanuc) == []
+
+
+def test_a_shift_under_g81_is_named_in_the_fanuc_words(case):
+    """§B15 with fanuc-egb.md §F6: G81 has no Y term, so a hob shift while synchronised slides the
+    thread along the teeth; the finding names G81, not the 840D's EGON."""
+    lines, gear, hob, _, fanuc = case(SPUR)
+    translated = fanuc_program(lines, gear, hob, fanuc)
+    at = next(number for number, line in enumerate(translated) if line.startswith("G1 Z"))
+    shifted = [*translated[:at + 1], "G0 Y5.", *translated[at + 1:]]
+    found = [message for message in refusals(shifted, gear, hob, fanuc) if "hob shift Y" in message]
+    assert found and "synchronised by G81, which has no Y term" in found[0] and "EGON" not in found[0]

@@ -227,17 +227,17 @@ def test_a_folder_swapped_between_the_plan_and_the_files_is_refused(run, tmp_pat
     assert {name: (tmp_path / "moved" / f"{name}.MPF").read_bytes() for name in GEARS} == OLD
 
 
-def test_a_target_that_is_a_link_is_refused_before_storing(run, tmp_path):
+def test_a_target_that_is_a_link_is_refused_before_storing(read_only_run, tmp_path):
     """A link to a file in --out itself (one leading out of it is refused as outside --out)."""
     out = tmp_path / "out"
     real = out / "OTHER.MPF"
     out.mkdir()
     real.write_bytes(OLD["GEAR42"])
     (out / "GEAR42.MPF").symlink_to(real)
-    before = program_count(run.url)
-    result = run("instantiate", "--gears", "42-43", "--out", out, "--force")
+    before = program_count(read_only_run.url)
+    result = read_only_run("instantiate", "--gears", "42-43", "--out", out, "--force")
     assert result.exit_code == 1 and "symbolic link" in result.stderr and "nothing stored" in result.stderr
-    assert program_count(run.url) == before
+    assert program_count(read_only_run.url) == before
     assert real.read_bytes() == OLD["GEAR42"] and (out / "GEAR42.MPF").is_symlink()
     assert everything_in(out) == ["GEAR42.MPF", "OTHER.MPF"]
 

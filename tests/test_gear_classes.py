@@ -319,20 +319,20 @@ def test_a_shift_step_of_whole_axial_pitches_is_refused(conn):
 
 # ---------------------------------------------------------------- classification and refusals
 
-def test_classify_explains_the_path(run):
-    out = run("classify", "--gear", 50).stdout
+def test_classify_explains_the_path(read_only_run):
+    out = read_only_run("classify", "--gear", 50).stdout
     assert out.splitlines()[0] == "gear 50: class taper"
     assert "yes (cone_angle = 6.5) → taper" in out and "H-M2-AA-R1" in out
-    out = run("classify", "--gear", 53).stdout
+    out = read_only_run("classify", "--gear", 53).stdout
     assert "named class worm_wheel explicitly" in out and "H-WW-M3-R1" in out
-    out = run("classify", "--gear", 54).stdout
+    out = read_only_run("classify", "--gear", 54).stdout
     assert "has it further toothed units? yes" in out and "→ duplex" in out
 
 
-def test_a_gear_no_class_fits_is_refused_with_the_reason(run, tmp_path):
+def test_a_gear_no_class_fits_is_refused_with_the_reason(read_only_run, tmp_path):
     path = tmp_path / "gears.csv"
     path.write_text("gear_id,module,teeth,face_width,cone_angle,crowning\n900,2,19,20,6.5,0.02\n")
-    result = run("gears", "import", path)
+    result = read_only_run("gears", "import", path)
     assert result.exit_code == 1
     assert "line 2, column gear_class: no class hobs a crowned taper gear" in result.stderr + result.stdout
 
@@ -347,10 +347,10 @@ def test_a_gear_no_hob_fits_is_refused_with_the_property(run, tmp_path):
     assert len(result.stderr.strip().splitlines()) == 1
 
 
-def test_suggest_for_the_papers_gear_proposes_its_published_data(run):
+def test_suggest_for_the_papers_gear_proposes_its_published_data(read_only_run):
     import json
 
-    out = run("suggest", "--gear", 50, "--json")
+    out = read_only_run("suggest", "--gear", 50, "--json")
     assert out.exit_code == 0, out.output
     proposal = json.loads(out.stdout)
     text = json.dumps(proposal)

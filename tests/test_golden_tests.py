@@ -145,8 +145,8 @@ def test_engine_test_without_tests_for_the_class_says_so(run):
     assert result.exit_code == 1 and "no golden tests for class spur_new" in result.output
 
 
-def test_engine_test_coverage_json(run):
-    result = run("test", "--coverage", "--class", "spur", "--json")
+def test_engine_test_coverage_json(read_only_run):
+    result = read_only_run("test", "--coverage", "--class", "spur", "--json")
     assert result.exit_code == 0 and result.output.count("\n") == 1
     rows = json.loads(result.output)["uncovered"]
     assert rows and all(row["class"] in ("spur", "duplex") for row in rows)

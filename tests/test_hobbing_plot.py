@@ -249,7 +249,7 @@ def test_a_picture_that_cannot_be_written_is_refused_in_one_line_naming_the_file
 def test_a_cut_comment_with_dollar_signs_is_drawn_as_written(conn, tmp_path):
     """The legend names each pass by its `; CUT …` comment; matplotlib reads text between two `$`
     as TeX. The picture shows the shop's words as written (the SVG carries each text it draws)."""
-    from dataclasses import replace
+    from msgspec.structs import replace
 
     from engine.pictures import save_atomically
     from engine.simulation.hobbing.recorded import record_program

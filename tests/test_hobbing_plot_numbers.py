@@ -9,10 +9,10 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import replace
 
 import pytest
 from helpers.outcomes import made
+from msgspec.structs import replace
 
 from engine.hobbing.choices import Choices
 from engine.hobbing.program_plot import load_scene, program_figure

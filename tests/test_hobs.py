@@ -179,8 +179,8 @@ def seeded_hob_ids() -> list[str]:
         return [row["id"] for row in csv.DictReader(file)]
 
 
-def test_list_shows_every_seeded_hob(run):
-    result = run("hobs", "list")
+def test_list_shows_every_seeded_hob(read_only_run):
+    result = read_only_run("hobs", "list")
     assert result.exit_code == 0, result.output
     lines = result.stdout.splitlines()
     assert lines[0].split()[:4] == ["id", "module", "kind", "α"]
@@ -215,15 +215,15 @@ def test_add_then_list_shows_the_new_hob(run):
       "hand 'S' must be L or R", "accuracy_class 'E' is not one of", "purpose 'bevel' is not one of",
       "pressure_angle 45 is outside (0, 45)", "starts '0' is not a positive whole number"]),
 ])
-def test_a_bad_or_duplicate_hob_is_refused_and_nothing_changes(run, options, words):
-    before = hob_rows(run.url)
-    result = run("hobs", "add", *options)
+def test_a_bad_or_duplicate_hob_is_refused_and_nothing_changes(read_only_run, options, words):
+    before = hob_rows(read_only_run.url)
+    result = read_only_run("hobs", "add", *options)
     assert result.exit_code == 1, result.output
     message = result.stderr.strip()
     assert message.startswith("error: ") and "\n" not in message
     for word in words:
         assert word in message
-    assert hob_rows(run.url) == before
+    assert hob_rows(read_only_run.url) == before
 
 
 GOOD_CSV = """id,module,pressure_angle,starts,tip_diameter,length,hand,accuracy_class,material,coating,purpose,\
@@ -275,16 +275,16 @@ def test_an_import_without_a_column_keeps_each_updated_hobs_own_value(run, tmp_p
     ("H-CYL-X,3,20,1,80,120,R,A,cylindrical,axial", "column module_kind: axial is for worm-wheel hobs"),
     ("H-WW-Y,3,20,1,50,90,R,A,worm_wheel,transverse", "column module_kind: 'transverse' must be normal or axial"),
 ])
-def test_a_hob_whose_module_is_not_said_plainly_is_refused(run, tmp_path, row, words):
+def test_a_hob_whose_module_is_not_said_plainly_is_refused(read_only_run, tmp_path, row, words):
     """A catalogue worm-wheel hob gives its worm's axial module (DIN 3975): read as normal, its
     tangential feed would be coupled to the wrong pitch, so its record must say which it gives."""
-    before = hob_rows(run.url)
+    before = hob_rows(read_only_run.url)
     path = tmp_path / "hobs.csv"
     path.write_text("id,module,pressure_angle,starts,tip_diameter,length,hand,accuracy_class,purpose,module_kind\n"
                     f"{row}\n", encoding="utf-8")
-    result = run("hobs", "import", path)
+    result = read_only_run("hobs", "import", path)
     assert result.exit_code == 1 and words in result.stderr, result.output
-    assert hob_rows(run.url) == before
+    assert hob_rows(read_only_run.url) == before
 
 
 def test_import_without_the_optional_columns(run, tmp_path):
@@ -305,11 +305,11 @@ H-OK-1,2,20,1,70,100,R,AA,cylindrical
 """
 
 
-def test_a_bad_import_reports_every_bad_line_and_stores_nothing(run, tmp_path):
+def test_a_bad_import_reports_every_bad_line_and_stores_nothing(read_only_run, tmp_path):
     path = tmp_path / "bad.csv"
     path.write_text(BAD_CSV, encoding="utf-8")
-    before = hob_rows(run.url)
-    result = run("hobs", "import", path)
+    before = hob_rows(read_only_run.url)
+    result = read_only_run("hobs", "import", path)
     assert result.exit_code == 1, result.output
     lines = result.stderr.splitlines()
     assert lines[0] == f"error: {path}: 4 bad row(s); nothing imported"
@@ -325,13 +325,13 @@ def test_a_bad_import_reports_every_bad_line_and_stores_nothing(run, tmp_path):
         "line 7, column id: H-OK-1 is already on line 2; give each hob once",
         "line 8, column id: is missing; write an id like H-M2-AA-R1",
     )]
-    assert hob_rows(run.url) == before
+    assert hob_rows(read_only_run.url) == before
 
 
-def test_an_import_with_an_unknown_column_is_refused(run, tmp_path):
+def test_an_import_with_an_unknown_column_is_refused(read_only_run, tmp_path):
     path = tmp_path / "bad.csv"
     path.write_text("id,module,diameter\nX,2,70\n", encoding="utf-8")
-    result = run("hobs", "import", path)
+    result = read_only_run("hobs", "import", path)
     assert result.exit_code == 1
     assert "line 1: unknown column(s) diameter" in result.stderr and "missing required column(s)" in result.stderr
 
@@ -344,14 +344,14 @@ HEADER = "id,module,pressure_angle,starts,tip_diameter,length,hand,accuracy_clas
     ("H-M9-A-R1,9,20,1,170,200,R,A\nh-m9-a-r1,9,20,1,170,200,R,A\n",
      "line 3, column id: h-m9-a-r1 is already on line 2"),
 ])
-def test_an_import_of_a_hob_id_differing_only_in_case_is_refused(run, tmp_path, rows, words):
+def test_an_import_of_a_hob_id_differing_only_in_case_is_refused(read_only_run, tmp_path, rows, words):
     path = tmp_path / "hobs.csv"
     path.write_text(HEADER + rows, encoding="utf-8")
-    before = hob_rows(run.url)
-    result = run("hobs", "import", path)
+    before = hob_rows(read_only_run.url)
+    result = read_only_run("hobs", "import", path)
     assert result.exit_code == 1, result.output
     assert words in result.stderr and "ids that differ only in case name one hob" in result.stderr
-    assert hob_rows(run.url) == before
+    assert hob_rows(read_only_run.url) == before
 
 
 def test_an_added_hob_id_differing_only_in_case_is_refused_and_so_is_it_in_sql(run):
@@ -365,13 +365,13 @@ def test_an_added_hob_id_differing_only_in_case_is_refused_and_so_is_it_in_sql(r
     assert hob_rows(run.url) == before
 
 
-def test_match_names_the_hob_of_the_seeded_gear_42(run):
+def test_match_names_the_hob_of_the_seeded_gear_42(read_only_run):
     # gear 42: m 2, α 20°, grade 7 (needs AA), spur → H-M2-AA-R1 (the paper's 1-start AA hob).
-    result = run("hobs", "match", "--gear", 42)
+    result = read_only_run("hobs", "match", "--gear", 42)
     assert result.exit_code == 0, result.output
     assert result.stdout.splitlines()[0] == "gear 42: hob H-M2-AA-R1"
     assert "class AA (grade 7 needs AA or better)" in result.stdout
-    shifted = json.loads(run("hobs", "match", "--gear", 42, "--shift-travel", 20, "--json").stdout)
+    shifted = json.loads(read_only_run("hobs", "match", "--gear", 42, "--shift-travel", 20, "--json").stdout)
     assert shifted["hob_id"] == "H-M2-AA-R1" and f"{GENERATING_M2 + 30:.1f} needed" in shifted["reason"]
 
 
@@ -402,8 +402,8 @@ def test_match_takes_a_worm_wheel_hob_for_a_worm_wheel_class(run):
     assert cylindrical.stdout.splitlines()[0] == "gear 9002: hob H-M3-AA-R1"
 
 
-def test_match_of_a_missing_gear_is_refused(run):
-    result = run("hobs", "match", "--gear", 999)
+def test_match_of_a_missing_gear_is_refused(read_only_run):
+    result = read_only_run("hobs", "match", "--gear", 999)
     assert result.exit_code == 1 and "gear 999 does not exist" in result.stderr
 
 

@@ -26,8 +26,8 @@ COMMANDS = (
 
 
 @pytest.mark.parametrize("args", COMMANDS, ids=" ".join)
-def test_an_id_beyond_its_column_is_bad_input(run, args):
-    result = run(*args)
+def test_an_id_beyond_its_column_is_bad_input(read_only_run, args):
+    result = read_only_run(*args)
     assert result.exit_code == 1, result.output
     assert result.stderr.startswith("error: ") and result.stderr.count("\n") == 1
     assert args[-1] in result.stderr
@@ -37,8 +37,8 @@ LARGEST = (("jobs", "list", "--gear", "2147483647"), ("programs", "list", "--job
 
 
 @pytest.mark.parametrize("args", LARGEST, ids=" ".join)
-def test_the_largest_id_a_column_holds_is_a_filter_that_finds_nothing(run, args):
-    result = run(*args, "--json")
+def test_the_largest_id_a_column_holds_is_a_filter_that_finds_nothing(read_only_run, args):
+    result = read_only_run(*args, "--json")
     assert result.exit_code == 0, result.output
 
 
@@ -50,16 +50,16 @@ OUT_OF_RANGE_FILTERS = (   # a filter id beyond PostgreSQL's integer/bigint: bad
 
 
 @pytest.mark.parametrize("args", OUT_OF_RANGE_FILTERS, ids=" ".join)
-def test_a_filter_id_out_of_range_is_bad_input_not_a_bug(run, args):
-    result = run(*args)
+def test_a_filter_id_out_of_range_is_bad_input_not_a_bug(read_only_run, args):
+    result = read_only_run(*args)
     assert result.exit_code == 1, result.output
     assert result.stderr.startswith("error: ") and result.stderr.count("\n") == 1
     assert args[-1] in result.stderr
 
 
 @pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it
-def test_instantiate_gear_0_names_the_gear(run):
+def test_instantiate_gear_0_names_the_gear(read_only_run):
     """--gear 0 was given: the message must not say none was."""
-    result = run("instantiate", "--gear", 0, "--dry-run")
+    result = read_only_run("instantiate", "--gear", 0, "--dry-run")
     assert result.exit_code == 1
     assert "give exactly one of" not in result.stderr and "0" in result.stderr, result.stderr

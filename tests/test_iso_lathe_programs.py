@@ -12,12 +12,12 @@ expands G70–G76 with (engine/verifier/expanders/cycles.py).
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 from pathlib import Path
 
 import pytest
 from helpers.iso_real_programs import FANUC_0T, REAL, cut, plain_moves, verdict
 from helpers.verifier_programs import LATHE_ISO, accepted, refusal
+from msgspec.structs import replace
 
 import engine.verifier.expansion as expansion
 from engine.machines.records import load_machine

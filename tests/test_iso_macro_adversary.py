@@ -5,11 +5,11 @@ values computed here from the rule (docs/reference/iso-lathe.md, "Custom macro B
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 
 import psycopg
 import pytest
 from helpers.iso_real_programs import FANUC_0T, cut, plain_moves, verdict
+from msgspec.structs import replace
 
 from engine.machines.records import load_machine
 from engine.verifier.expanders.iso import expand_iso

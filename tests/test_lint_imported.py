@@ -4,10 +4,10 @@ model, so their parameter names are checked against the parameters they were imp
 from __future__ import annotations
 
 import json
-from dataclasses import replace
 
 import pytest
 from helpers.nc_files import DATA, PARAMS, class_name, real_files, write
+from msgspec.structs import replace
 
 from engine.errors import EngineError
 from engine.library.nc_import import import_nc

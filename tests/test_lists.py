@@ -107,8 +107,8 @@ def test_gears_list_csv_and_table(run):
     store_gears(run.url)
     result = run("gears", "list", "--class", "helical", "--until", "2020-12-31", "--csv")
     assert result.exit_code == 0, result.output
-    rows = list(csv.DictReader(io.StringIO(result.stdout)))
-    assert [(row["gear_id"], row["class"], row["teeth"], row["material"]) for row in rows] == \
+    rows = list(csv.DictReader(io.StringIO(result.stdout)))   # the columns `gears import` reads (issue 31)
+    assert [(row["gear_id"], row["gear_class"], row["teeth"], row["material"]) for row in rows] == \
         [("91002", "helical", "27", "42CrMo4")]
     table = run("gears", "list", "--until", "2020-12-31")
     assert table.exit_code == 0 and table.stderr.strip() == "3 gears"
@@ -208,14 +208,14 @@ def test_hobs_show_and_csv(run):
     assert (rows["H-LIST-1"]["module"], rows["H-LIST-1"]["accuracy_class"]) == ("4.5", "B")
 
 
-def test_cases_and_classes_lists_take_json_and_csv(run):
-    cases = listed(run, "cases", "list")
-    rows = list(csv.DictReader(io.StringIO(run("cases", "list", "--csv").stdout)))
-    assert [int(row["case_id"]) for row in rows] == [case["case_id"] for case in cases] and cases
-    with psycopg.connect(run.url) as conn:
+def test_cases_and_classes_lists_take_json_and_csv(read_only_run):
+    cases = listed(read_only_run, "cases", "list")
+    rows = list(csv.DictReader(io.StringIO(read_only_run("cases", "list", "--csv").stdout)))
+    assert [int(row["id"]) for row in rows] == [case["case_id"] for case in cases] and cases   # as import reads
+    with psycopg.connect(read_only_run.url) as conn:
         names = [name for (name,) in conn.execute("SELECT name FROM gear_class ORDER BY name")]
-    assert [record["class"] for record in listed(run, "template", "list")] == names
-    rows = list(csv.DictReader(io.StringIO(run("template", "list", "--csv").stdout)))
+    assert [record["class"] for record in listed(read_only_run, "template", "list")] == names
+    rows = list(csv.DictReader(io.StringIO(read_only_run("template", "list", "--csv").stdout)))
     assert [row["class"] for row in rows] == names
 
 
@@ -282,9 +282,9 @@ def test_bad_input_is_one_line_and_exit_1(run, args, words):
     refused(run(*args), *words)
 
 
-def test_json_and_csv_together_are_refused_as_one_json_line(run):
+def test_json_and_csv_together_are_refused_as_one_json_line(read_only_run):
     """Given --json, the refusal itself is the JSON error line (issue 16: errors in --json mode)."""
-    result = run("jobs", "list", "--json", "--csv")
+    result = read_only_run("jobs", "list", "--json", "--csv")
     assert result.exit_code == 1 and result.stdout == ""
     assert result.stderr.count("\n") == 1
     error = json.loads(result.stderr)
@@ -307,24 +307,24 @@ def test_every_list_and_show_command_gives_an_example(command):
     assert any(line.strip().startswith(f"Example: engine {command[0]} ") for line in result.stdout.splitlines())
 
 
-def test_migrations_and_shared_rows_list_as_json_and_csv(run):
+def test_migrations_and_shared_rows_list_as_json_and_csv(read_only_run):
     """db status and template shared are lists too: one JSON line, or CSV with a header."""
-    migrations = listed(run, "db", "status")
+    migrations = listed(read_only_run, "db", "status")
     names = sorted(path.name for path in (Path(__file__).resolve().parent.parent / "migrations").glob("*.sql"))
     assert [record["migration"] for record in migrations] == names
     assert {record["state"] for record in migrations} == {"applied"}
-    rows = listed(run, "template", "shared", "--class", "helical")
+    rows = listed(read_only_run, "template", "shared", "--class", "helical")
     assert rows and all(record["class"] == "helical" for record in rows)
     assert any("spur" in record["shared_with"] for record in rows)   # the refactor stores common lines once
-    table = list(csv.DictReader(io.StringIO(run("template", "shared", "--class", "helical", "--csv").stdout)))
+    table = list(csv.DictReader(io.StringIO(read_only_run("template", "shared", "--class", "helical", "--csv").stdout)))
     assert [int(record["row_id"]) for record in table] == [record["row_id"] for record in rows]
     assert [record["shared_with"] for record in table] == [" ".join(record["shared_with"]) for record in rows]
 
 
-def test_a_reader_that_leaves_early_gets_no_error_message(run):
+def test_a_reader_that_leaves_early_gets_no_error_message(read_only_run):
     """`engine gears list | head`: the pipe closes before the list is written; the command ends
     quietly (exit 1, as Python's own tools do on EPIPE), not with 'unexpected error', exit 2."""
-    command = [sys.executable, "-m", "engine", "--database-url", run.url, "db", "status"]
+    command = [sys.executable, "-m", "engine", "--database-url", read_only_run.url, "db", "status"]
     child = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE)
     child.stdout.close()   # the reader is gone before the engine writes
     stderr = child.stderr.read().decode()

@@ -17,22 +17,22 @@ def seeded(url) -> list[tuple[str, str, str, float]]:
     return [(name, kind, dialect, float(spindle)) for name, kind, dialect, spindle in rows]
 
 
-def test_the_json_list_holds_every_machine_with_its_dialect_and_limits(run):
-    listed = json.loads(ok(run("machines", "list", "--json")).stdout)["machines"]
-    assert [(m["name"], m["kind"], m["dialect"], m["spindle_max"]) for m in listed] == seeded(run.url)
+def test_the_json_list_holds_every_machine_with_its_dialect_and_limits(read_only_run):
+    listed = json.loads(ok(read_only_run("machines", "list", "--json")).stdout)["machines"]
+    assert [(m["name"], m["kind"], m["dialect"], m["spindle_max"]) for m in listed] == seeded(read_only_run.url)
     fanuc = next(m for m in listed if m["name"] == "lathe-fanuc-0t")
     assert (fanuc["gcode_system"], fanuc["decimal_point_input"]) == ("A", "calculator")
 
 
-def test_the_csv_list_has_a_header_of_keys_and_one_line_per_machine(run):
-    rows = list(csv.DictReader(io.StringIO(ok(run("machines", "list", "--csv")).stdout)))
-    expected = [(name, dialect) for name, _, dialect, _ in seeded(run.url)]
+def test_the_csv_list_has_a_header_of_keys_and_one_line_per_machine(read_only_run):
+    rows = list(csv.DictReader(io.StringIO(ok(read_only_run("machines", "list", "--csv")).stdout)))
+    expected = [(name, dialect) for name, _, dialect, _ in seeded(read_only_run.url)]
     assert [(row["name"], row["dialect"]) for row in rows] == expected
 
 
-def test_the_table_names_each_machine_and_counts_them_on_stderr(run):
-    result = ok(run("machines", "list"))
-    names = [name for name, *_ in seeded(run.url)]
+def test_the_table_names_each_machine_and_counts_them_on_stderr(read_only_run):
+    result = ok(read_only_run("machines", "list"))
+    names = [name for name, *_ in seeded(read_only_run.url)]
     assert all(name in result.stdout for name in names)
     assert result.stderr.strip() == f"{len(names)} machines"
 
@@ -65,8 +65,8 @@ def test_the_table_says_which_machines_print_floor_to_floor(run, tmp_path):
     assert next(line for line in table if line.startswith(lathe + " ")).rstrip().endswith(" -")
 
 
-def test_the_import_help_names_every_required_column(run):
+def test_the_import_help_names_every_required_column(read_only_run):
     from engine.machines.importing import REQUIRED
 
-    text = " ".join(ok(run("machines", "import", "--help")).stdout.split())
+    text = " ".join(ok(read_only_run("machines", "import", "--help")).stdout.split())
     assert all(column in text for column in REQUIRED), text

@@ -93,51 +93,53 @@ HOB_HEADER = "id,module,pressure_angle,starts,tip_diameter,length,hand,accuracy_
 
 # An empty class is "classify it" (design notes §9); a class is read in lower case (Spur is spur).
 @pytest.mark.parametrize("name", [name for name in UNSAFE["class"] if name and name != "Spur"])
-def test_a_gear_csv_with_an_unsafe_class_is_refused(run, tmp_path, name):
+def test_a_gear_csv_with_an_unsafe_class_is_refused(read_only_run, tmp_path, name):
     write_csv(tmp_path / "gears.csv", GEAR_HEADER, ["900", name, "2", "19", "20", "0", "", "20", "42", "", "", "",
                                                    "40Cr", "250", "7", "50"])
-    before = counts(run.url)
-    message = refused(run("gears", "import", tmp_path / "gears.csv"))
+    before = counts(read_only_run.url)
+    message = refused(read_only_run("gears", "import", tmp_path / "gears.csv"))
     assert "gear_class" in message or LINE_BREAK_IN_CELL in message or NUL_IN_FILE in message   # the reader first
-    assert counts(run.url) == before
+    assert counts(read_only_run.url) == before
 
 
 @pytest.mark.parametrize("name", UNSAFE["hob"][:-1])   # an empty id is "id is missing"
-def test_hobs_import_and_add_refuse_an_unsafe_id(run, tmp_path, name):
+def test_hobs_import_and_add_refuse_an_unsafe_id(read_only_run, tmp_path, name):
     write_csv(tmp_path / "hobs.csv", HOB_HEADER, [name, "2", "20", "1", "70", "100", "R", "AA", "HSS", "TiN",
                                                  "cylindrical"])
-    before = counts(run.url)
-    message = refused(run("hobs", "import", tmp_path / "hobs.csv"))
+    before = counts(read_only_run.url)
+    message = refused(read_only_run("hobs", "import", tmp_path / "hobs.csv"))
     # the reader first
     assert "not a safe hob id" in message or LINE_BREAK_IN_CELL in message or NUL_IN_FILE in message
-    assert "not a safe hob id" in refused(run("hobs", "add", "--id", name, "--module", 2, "--tip-diameter", 70,
-                                              "--length", 100, "--hand", "R", "--accuracy-class", "AA"))
-    assert counts(run.url) == before
+    assert "not a safe hob id" in refused(read_only_run("hobs", "add", "--id", name, "--module", 2, "--tip-diameter",
+                                                        70, "--length", 100, "--hand", "R", "--accuracy-class", "AA"))
+    assert counts(read_only_run.url) == before
 
 
 @pytest.mark.parametrize("name", UNSAFE["class"])
-def test_template_import_refuses_an_unsafe_class(run, tmp_path, name):
-    assert run("template", "export", "--class", "spur", "--out", tmp_path / "spur.csv").exit_code == 0
-    before = counts(run.url)
-    assert "not a safe class name" in refused(run("template", "import", "--class", name, tmp_path / "spur.csv"))
-    assert counts(run.url) == before
+def test_template_import_refuses_an_unsafe_class(read_only_run, tmp_path, name):
+    assert read_only_run("template", "export", "--class", "spur", "--out", tmp_path / "spur.csv").exit_code == 0
+    before = counts(read_only_run.url)
+    assert "not a safe class name" in refused(read_only_run("template", "import", "--class", name,
+                                                            tmp_path / "spur.csv"))
+    assert counts(read_only_run.url) == before
 
 
 @pytest.mark.parametrize("name", [name for name in UNSAFE["drawing"] if "/" not in name and "\x00" not in name
                                   and name])
-def test_import_dxf_refuses_an_unsafe_drawing_file_name(run, tmp_path, name):
+def test_import_dxf_refuses_an_unsafe_drawing_file_name(read_only_run, tmp_path, name):
     seed_drawing(tmp_path / name)
-    before = counts(run.url)
-    assert "not a safe drawing name" in refused(run("import-dxf", tmp_path / name))
-    assert counts(run.url) == before
+    before = counts(read_only_run.url)
+    assert "not a safe drawing name" in refused(read_only_run("import-dxf", tmp_path / name))
+    assert counts(read_only_run.url) == before
 
 
 @pytest.mark.parametrize("name", UNSAFE["program"])
-def test_import_dxf_refuses_an_unsafe_program_name(run, tmp_path, name):
+def test_import_dxf_refuses_an_unsafe_program_name(read_only_run, tmp_path, name):
     seed_drawing(tmp_path / "part.dxf")
-    before = counts(run.url)
-    assert "not a safe program name" in refused(run("import-dxf", tmp_path / "part.dxf", "--program-name", name))
-    assert counts(run.url) == before
+    before = counts(read_only_run.url)
+    assert "not a safe program name" in refused(read_only_run("import-dxf", tmp_path / "part.dxf", "--program-name",
+                                                              name))
+    assert counts(read_only_run.url) == before
 
 
 @pytest.mark.parametrize("file_name, made", [("1part.dxf", "1PART"), ("a" * 25 + ".dxf", "A" * 25),
@@ -255,7 +257,7 @@ def injected_anywhere(url, folder) -> list[str]:
 @pytest.mark.slow   # seconds: out of the fast subset (make test-fast), in every full run
 def test_no_route_puts_a_block_into_a_program(run, tmp_path):
     out = tmp_path / "out"
-    assert run("instantiate", "--gears", "42-43", "--out", out).exit_code == 0
+    assert run("instantiate", "--gears", "42-43", "--out", out, "--mkdir").exit_code == 0
     with psycopg.connect(run.url) as conn:   # 1. a runner's edit of job.params
         job_id = conn.execute("SELECT max(id) FROM job").fetchone()[0]
         for name in ("GEAR43" + NEWLINE, "../../x"):
@@ -269,7 +271,7 @@ def test_no_route_puts_a_block_into_a_program(run, tmp_path):
     write_csv(tmp_path / "hobs.csv", HOB_HEADER, ["H-M2-AA-R1" + NEWLINE, "2", "20", "1", "70", "100", "R", "AA",
                                                  "HSS", "TiN", "cylindrical"])
     refused(run("hobs", "import", tmp_path / "hobs.csv"))   # 3. a hob id
-    assert run("instantiate", "--all", "--out", out / "all").exit_code == 0
+    assert run("instantiate", "--all", "--out", out / "all", "--mkdir").exit_code == 0
     before = counts(run.url)
     for breaking in ("\\n", "\\r", "\\u2028"):   # 4. a template row's output (its text holds the escape)
         with psycopg.connect(run.url) as conn:

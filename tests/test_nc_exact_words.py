@@ -170,11 +170,11 @@ def test_each_real_program_with_a_tab_is_refused_at_import_naming_the_line(conn)
         import_nc(conn, DATA / relative, class_name(relative), PARAMS[relative])   # its tabs made spaces: in
 
 
-def test_the_import_nc_command_refuses_a_tab_with_exit_1(run, tmp_path):
+def test_the_import_nc_command_refuses_a_tab_with_exit_1(read_only_run, tmp_path):
     path = write(tmp_path, "G0 X1\nG1\tX2 F0.1\n")
-    result = run("import-nc", path, "--class", "nc_tab")
+    result = read_only_run("import-nc", path, "--class", "nc_tab")
     assert result.exit_code == 1 and "line 2 column 3 holds a tab" in result.stderr, result.output
-    listed = run("template", "export", "--class", "nc_tab")
+    listed = read_only_run("template", "export", "--class", "nc_tab")
     assert listed.exit_code != 0   # no class was made
 
 

@@ -311,15 +311,15 @@ def test_import_nc_command_reports_json_and_export_gives_the_rows(run, tmp_path)
     (lambda d: write(d, "G1 X1\n", "ok.nc"), ("--modules", "{d}/far.csv"), "line 9 is not a line"),
     (lambda d: write(d, "G1 X1\n", "ok.nc"), ("--parent", "nope"), "parent class 'nope' does not exist"),
 ])
-def test_bad_input_gets_one_line_exit_1_and_changes_nothing(run, tmp_path, make, extra, words):
+def test_bad_input_gets_one_line_exit_1_and_changes_nothing(read_only_run, tmp_path, make, extra, words):
     (tmp_path / "p.json").write_text("{nope")
     (tmp_path / "bad_name.csv").write_text("name,value\n1x,3\n")
     (tmp_path / "m.csv").write_text("line_no,t\n1,cutting\n")
     (tmp_path / "far.csv").write_text("line_no,t\n9,prep\n")
-    before = stored_at(run.url)
-    result = run("import-nc", make(tmp_path), "--class", "nc_bad",
-                 *[arg.format(d=tmp_path) for arg in extra])
+    before = stored_at(read_only_run.url)
+    result = read_only_run("import-nc", make(tmp_path), "--class", "nc_bad",
+                           *[arg.format(d=tmp_path) for arg in extra])
     assert result.exit_code == 1, result.output
     message = result.stderr.strip()
     assert len(message.splitlines()) == 1 and words in message
-    assert stored_at(run.url) == before
+    assert stored_at(read_only_run.url) == before

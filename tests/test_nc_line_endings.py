@@ -87,7 +87,7 @@ def test_an_lf_file_whose_first_line_has_no_cr_but_a_later_one_has_is_refused(co
 
 
 @pytest.mark.parametrize("breaking", ["\r", "\f", "\u0085", "\u2028"], ids=["CR", "FF", "NEL", "LS"])
-def test_an_nc_file_with_a_line_break_inside_a_line_is_refused_at_import(run, tmp_path, breaking):
+def test_an_nc_file_with_a_line_break_inside_a_line_is_refused_at_import(read_only_run, tmp_path, breaking):
     """`G1 X10<CR>G0 X0` in an LF file is one line to the import (one row, its module decided by
     G0, one text to the refactor) and two blocks to a control or editor that breaks lines at a
     bare CR; the database refuses such a line in every program (migration 0009), so the class
@@ -95,7 +95,7 @@ def test_an_nc_file_with_a_line_break_inside_a_line_is_refused_at_import(run, tm
     the line, as a control character is, with nothing stored."""
     nc = tmp_path / "broken.nc"
     nc.write_bytes(f"G1 X10{breaking}G0 X0\nM30\n".encode())
-    result = run("import-nc", nc, "--class", "nc_broken")
+    result = read_only_run("import-nc", nc, "--class", "nc_broken")
     assert one_line_error(result) and "line 1" in result.stderr, result.output
-    with psycopg.connect(run.url) as conn:
+    with psycopg.connect(read_only_run.url) as conn:
         assert conn.execute("SELECT count(*) FROM gear_class WHERE name = 'nc_broken'").fetchone()[0] == 0

@@ -205,43 +205,43 @@ def test_the_csv_addresses_column_binds_as_the_json_form(run, tmp_path):
     ('{"feed": {"value": 400, "adresses": ["F"]}}', "parameter 'feed'"),
     ("name,value,addresses\nfeed,400,F1\n", "line 2, column addresses"),
 ])
-def test_a_bad_bound_form_is_refused_in_one_line_and_nothing_is_stored(run, tmp_path, given, words_said):
+def test_a_bad_bound_form_is_refused_in_one_line_and_nothing_is_stored(read_only_run, tmp_path, given, words_said):
     params = tmp_path / ("p.json" if given.startswith("{") else "p.csv")
     params.write_text(given)
-    before = stored_at(run.url)
-    result = run("import-nc", DATA / DEMO, "--class", "nc_refused", "--params", params)
+    before = stored_at(read_only_run.url)
+    result = read_only_run("import-nc", DATA / DEMO, "--class", "nc_refused", "--params", params)
     assert result.exit_code == 1, result.output
     message = result.stderr.strip()
     assert len(message.splitlines()) == 1 and words_said in message and str(params) in message
-    assert stored_at(run.url) == before
+    assert stored_at(read_only_run.url) == before
 
 
 @pytest.mark.parametrize("value", ['{"a": 1}', "[400]", "true", "null", '"F400"'])
-def test_a_bound_parameter_whose_value_is_no_number_is_refused(run, tmp_path, value):
+def test_a_bound_parameter_whose_value_is_no_number_is_refused(read_only_run, tmp_path, value):
     """Only a number binds a word: `{"feed": {"value": true, "addresses": ["F"]}}` asks for F to
     be bound and binds nothing, F400 stays literal, no warning, exit 0; the user believes the
     feed is a parameter of the class."""
     params = tmp_path / "p.json"
     params.write_text(f'{{"feed": {{"value": {value}, "addresses": ["F"]}}}}')
-    result = run("import-nc", DATA / DEMO, "--class", "nc_nonumber", "--params", params)
+    result = read_only_run("import-nc", DATA / DEMO, "--class", "nc_nonumber", "--params", params)
     assert one_line_error(result) and "feed" in result.stderr, result.output
 
 
-def test_a_json_parameter_given_twice_is_refused_as_the_csv_one_is(run, tmp_path):
+def test_a_json_parameter_given_twice_is_refused_as_the_csv_one_is(read_only_run, tmp_path):
     """A CSV naming a parameter twice is refused; the JSON form silently keeps the last value
     ({"feed": 400, "feed": 3.0} binds 3.0 at I3.0 and leaves the feed F400 literal)."""
     params = tmp_path / "p.json"
     params.write_text('{"feed": 400, "feed": 3.0}')
-    result = run("import-nc", DATA / DEMO, "--class", "nc_twice", "--params", params)
+    result = read_only_run("import-nc", DATA / DEMO, "--class", "nc_twice", "--params", params)
     assert one_line_error(result) and "feed" in result.stderr, result.output
 
 
-def test_a_params_file_nested_too_deep_is_bad_input_not_a_bug(run, tmp_path):
+def test_a_params_file_nested_too_deep_is_bad_input_not_a_bug(read_only_run, tmp_path):
     """A parameters file of 100,000 nested brackets (a generator gone wrong) is bad input:
     json.loads raises RecursionError, exit 2."""
     params = tmp_path / "deep.json"
     params.write_text('{"feed": ' + "[" * 100_000 + "]" * 100_000 + "}")
-    result = run("import-nc", DEMO, "--class", "nc_deep", "--params", params)
+    result = read_only_run("import-nc", DEMO, "--class", "nc_deep", "--params", params)
     assert one_line_error(result) and str(params) in result.stderr, result.output
 
 

@@ -100,15 +100,15 @@ def test_plasma_io_channels_stay_and_the_values_they_carry_bind(conn):
 # --- the command -------------------------------------------------------------------------------
 
 
-def test_a_bound_form_naming_the_contour_address_is_refused_and_nothing_stored(run, tmp_path):
+def test_a_bound_form_naming_the_contour_address_is_refused_and_nothing_stored(read_only_run, tmp_path):
     first_call = found(DEMO, r"^\s*G7[01]", r"\bQ100\b")[0][0]
     params = tmp_path / "p.json"
     params.write_text(json.dumps({"depth": {"value": 100, "addresses": ["Q"]}}))
-    before = stored_at(run.url)
-    result = run("import-nc", DATA / DEMO, "--class", "nc_jump", "--params", params)
+    before = stored_at(read_only_run.url)
+    result = read_only_run("import-nc", DATA / DEMO, "--class", "nc_jump", "--params", params)
     assert one_line_error(result), result.output
     assert f"line {first_call}:" in result.stderr and "contour" in result.stderr and "depth" in result.stderr
-    assert stored_at(run.url) == before
+    assert stored_at(read_only_run.url) == before
 
 
 def test_the_warning_says_what_the_number_names(run, tmp_path):
@@ -123,10 +123,10 @@ def test_the_warning_says_what_the_number_names(run, tmp_path):
 
 @pytest.mark.parametrize("given", ["name,value,addresses\nfeed,=400,F\n", "name,value,addresses\nfeed,nan,F\n",
                                    '{"feed": NaN}', '{"feed": {"value": Infinity, "addresses": ["F"]}}'])
-def test_a_value_no_word_can_hold_is_refused_naming_the_parameter(run, tmp_path, given):
+def test_a_value_no_word_can_hold_is_refused_naming_the_parameter(read_only_run, tmp_path, given):
     params = tmp_path / ("p.json" if given.startswith("{") else "p.csv")
     params.write_text(given)
-    result = run("import-nc", DATA / DEMO, "--class", "nc_nan", "--params", params)
+    result = read_only_run("import-nc", DATA / DEMO, "--class", "nc_nan", "--params", params)
     assert one_line_error(result) and str(params) in result.stderr and "'feed'" in result.stderr, result.output
 
 
@@ -140,10 +140,10 @@ def test_a_plain_text_parameter_is_kept_for_the_template(run, tmp_path):
     assert kept == {"feed": 400, "program_name": "PAWN"}
 
 
-def test_a_name_given_twice_inside_a_bound_form_is_refused(run, tmp_path):
+def test_a_name_given_twice_inside_a_bound_form_is_refused(read_only_run, tmp_path):
     params = tmp_path / "p.json"
     params.write_text('{"feed": {"value": 400, "value": 3.0, "addresses": ["F"]}}')
-    result = run("import-nc", DATA / DEMO, "--class", "nc_twice", "--params", params)
+    result = read_only_run("import-nc", DATA / DEMO, "--class", "nc_twice", "--params", params)
     assert one_line_error(result) and "'value' appears twice" in result.stderr, result.output
 
 

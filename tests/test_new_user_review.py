@@ -69,14 +69,19 @@ def test_a_gear_named_helical_in_the_file_is_still_said_to_be_named(run, tmp_pat
     assert "the gear file named class helical explicitly (the tree alone gives spur)" in explained.stdout
 
 
-def test_units_for_a_gear_with_stored_programs_say_the_programs_no_longer_match(spur_gear, tmp_path):
+def test_units_for_a_gear_with_stored_programs_are_refused_and_nothing_stored(spur_gear, tmp_path):
+    """Issue 31: its programs were proved on the gear without units; the units would change their inputs."""
     run = spur_gear
     made = run("instantiate", "--gear", GEAR_ID, "--json")
     assert made.exit_code == 0, made.output
-    added = run("gears", "units", write(tmp_path, "units.csv", UNIT_HEADER + UNIT_2))
-    assert added.exit_code == 0, added.output
-    assert (f"gear {GEAR_ID}: 1 stored program(s) were made before these units and no longer match the gear"
-            in added.stdout)
+    refused = run("gears", "units", write(tmp_path, "units.csv", UNIT_HEADER + UNIT_2))
+    assert refused.exit_code == 1, refused.output
+    tip = 2 * 20 + 2 * 2          # d + 2·m of unit 2 (m 2, z 20)
+    root = tip - 2 * 2.25 * 2     # a tooth depth 2.25·m below, on each side
+    assert (f"gear {GEAR_ID}: the file changes its further units (none) → unit 2 (z 20, b 15, da {tip:g}, "
+            f"df {root:g}, z_top -45), but job {json.loads(made.stdout)['job_id']} was made from it; nothing "
+            "imported") in refused.stderr
+    assert execute(run.url, "SELECT count(*) FROM gear_unit WHERE gear_id = %s", (GEAR_ID,)) == [(0,)]
 
 
 def test_a_third_unit_is_refused_in_one_line_and_nothing_stored(spur_gear, tmp_path):
@@ -117,9 +122,9 @@ R-ALSO-NOWHERE,collet,8,50,0,hobber-9
 """
 
 
-def test_every_bad_work_holding_row_is_named_in_one_run(run, tmp_path):
-    before = run("fixtures", "list", "--csv").stdout
-    result = run("fixtures", "import", write(tmp_path, "holdings.csv", BAD_HOLDINGS))
+def test_every_bad_work_holding_row_is_named_in_one_run(read_only_run, tmp_path):
+    before = read_only_run("fixtures", "list", "--csv").stdout
+    result = read_only_run("fixtures", "import", write(tmp_path, "holdings.csv", BAD_HOLDINGS))
     assert result.exit_code == 1
     for words in ("line 3, column kind: 'spindle' is not one of", "line 4, column diameter: -4 must be greater than 0",
                   "line 5, column machine: machine hobber-9 does not exist",
@@ -127,7 +132,7 @@ def test_every_bad_work_holding_row_is_named_in_one_run(run, tmp_path):
                   "line 7, column machine: machine hobber-9 does not exist"):
         assert words in result.stderr, result.stderr
     assert "5 bad row(s)" in result.stderr
-    assert run("fixtures", "list", "--csv").stdout == before
+    assert read_only_run("fixtures", "list", "--csv").stdout == before
 
 
 def test_a_centre_wider_than_the_arbor_is_accepted(run, tmp_path):

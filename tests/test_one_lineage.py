@@ -72,16 +72,16 @@ def test_import_nc_refuses_a_printed_program_naming_the_file_and_line(run, tmp_p
 
 @pytest.mark.parametrize("o", ['"; PROGRAM 812 TEMPLATE spur v3 0123abcd INPUT 4567cdef"',
                                "f\"(PROGRAM {program_name} TEMPLATE spur v3 0123abcd INPUT 4567cdef)\""])
-def test_template_import_refuses_a_row_that_writes_a_lineage_line(run, tmp_path, o):
-    exported = run("template", "export", "--class", "spur").stdout
+def test_template_import_refuses_a_row_that_writes_a_lineage_line(read_only_run, tmp_path, o):
+    exported = read_only_run("template", "export", "--class", "spur").stdout
     header, first, *rest = exported.splitlines(keepends=True)
     quoted = '"' + o.replace('"', '""') + '"'
     path = tmp_path / "spur.csv"
     path.write_text(header + first + f"15,main,1,,,{quoted},\n" + "".join(rest))
-    result = run("template", "import", "--class", "spur", path)
+    result = read_only_run("template", "import", "--class", "spur", path)
     assert result.exit_code == 1 and result.stderr.count("\n") == 1, result.output
     assert f"{path}, line 3" in result.stderr and "remove" in result.stderr
-    assert run("template", "export", "--class", "spur").stdout == exported
+    assert read_only_run("template", "export", "--class", "spur").stdout == exported
 
 
 def test_a_row_edited_in_sql_to_write_a_lineage_line_is_named_by_lint_and_stores_nothing(run):
@@ -183,9 +183,10 @@ def test_a_plain_comment_about_a_program_and_its_template_is_not_a_lineage_line(
     assert result.exit_code == 0, result.output
 
 
-def test_a_block_numbered_lineage_line_is_refused_too(run, tmp_path):
+def test_a_block_numbered_lineage_line_is_refused_too(read_only_run, tmp_path):
     """`N10 ; PROGRAM 1 TEMPLATE …` reads at the machine as a second lineage line."""
-    result = _import_nc(run, tmp_path, "N10 ; PROGRAM 1 TEMPLATE spur v1 deadbeef INPUT deadbeef", "adv_numbered")
+    result = _import_nc(read_only_run, tmp_path, "N10 ; PROGRAM 1 TEMPLATE spur v1 deadbeef INPUT deadbeef",
+                        "adv_numbered")
     assert result.exit_code == 1, result.output
-    with psycopg.connect(run.url) as conn:
+    with psycopg.connect(read_only_run.url) as conn:
         assert conn.execute("SELECT count(*) FROM gear_class WHERE name = 'adv_numbered'").fetchone()[0] == 0

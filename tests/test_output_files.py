@@ -109,31 +109,32 @@ def test_an_existing_file_is_replaced_only_with_force(run, tmp_path):
 
 
 @pytest.mark.parametrize("out", ["newdir/", "newdir"])
-def test_a_batch_of_one_program_writes_into_the_folder_out_made_if_missing(run, tmp_path, out):
-    made = run("instantiate", "--gears", "42-42", "--out", f"{tmp_path}/{out}")
+def test_a_batch_of_one_program_writes_into_the_folder_out_made_with_mkdir(run, tmp_path, out):
+    made = run("instantiate", "--gears", "42-42", "--out", f"{tmp_path}/{out}", "--mkdir")
     assert made.exit_code == 0, made.output
     assert (tmp_path / "newdir").is_dir() and everything_under(tmp_path / "newdir") == ["GEAR42.MPF"]
     with psycopg.connect(run.url) as conn:
         job = conn.execute("SELECT max(id) FROM job").fetchone()[0]
-    again = run("instantiate", "--jobs", f"{job}-{job}", "--out", f"{tmp_path}/again{out.removeprefix('newdir')}")
+    again = run("instantiate", "--jobs", f"{job}-{job}", "--out", f"{tmp_path}/again{out.removeprefix('newdir')}",
+                "--mkdir")
     assert again.exit_code == 0, again.output
     assert everything_under(tmp_path / "again") == ["GEAR42.MPF"]
     assert (tmp_path / "again" / "GEAR42.MPF").read_bytes() == latest_text(run.url, "GEAR42")
 
 
 def test_one_program_goes_into_a_folder_out_ending_with_a_slash_else_into_the_file_out(run, tmp_path):
-    assert run("instantiate", "--gear", 42, "--out", f"{tmp_path}/folder/").exit_code == 0
+    assert run("instantiate", "--gear", 42, "--out", f"{tmp_path}/folder/", "--mkdir").exit_code == 0
     assert run("instantiate", "--gear", 42, "--out", tmp_path / "GEAR42.MPF").exit_code == 0
     assert everything_under(tmp_path) == ["GEAR42.MPF", "folder", "folder/GEAR42.MPF"]
 
 
-def test_a_file_naming_the_same_program_in_other_case_is_never_replaced(run, tmp_path):
+def test_a_file_naming_the_same_program_in_other_case_is_never_replaced(read_only_run, tmp_path):
     (tmp_path / "gear42.MPF").write_text("; written by hand\n")
-    before = program_count(run.url)
+    before = program_count(read_only_run.url)
     for extra in ((), ("--force",)):
-        message = one_line_refusal(run("instantiate", "--gears", "42-43", "--out", tmp_path, *extra))
+        message = one_line_refusal(read_only_run("instantiate", "--gears", "42-43", "--out", tmp_path, *extra))
         assert "gear42.MPF" in message and "same program" in message
-    assert program_count(run.url) == before and everything_under(tmp_path) == ["gear42.MPF"]
+    assert program_count(read_only_run.url) == before and everything_under(tmp_path) == ["gear42.MPF"]
 
 
 def test_the_file_layer_refuses_two_programs_of_one_batch_differing_only_in_case(tmp_path):
@@ -170,7 +171,7 @@ def umask():
 @pytest.mark.parametrize("mask, mode", [(0o022, 0o644), (0o027, 0o640), (0o002, 0o664)])
 def test_files_take_the_user_s_umask(run, tmp_path, umask, mask, mode):
     umask(mask)
-    assert run("instantiate", "--gears", "42-43", "--out", tmp_path / "batch").exit_code == 0
+    assert run("instantiate", "--gears", "42-43", "--out", tmp_path / "batch", "--mkdir").exit_code == 0
     assert run("instantiate", "--gear", 44, "--out", tmp_path / "one.MPF").exit_code == 0
     files = [tmp_path / "batch" / "GEAR42.MPF", tmp_path / "batch" / "GEAR43.MPF", tmp_path / "one.MPF"]
     assert [stat.S_IMODE(path.stat().st_mode) for path in files] == [mode] * 3
@@ -204,7 +205,7 @@ def at_commit(url, statement: str) -> None:
 def test_a_commit_that_fails_leaves_no_file(run, tmp_path):
     at_commit(run.url, REFUSE_AT_COMMIT)
     before = program_count(run.url)
-    message = one_line_refusal(run("instantiate", "--gears", "42-44", "--out", tmp_path / "out"))
+    message = one_line_refusal(run("instantiate", "--gears", "42-44", "--out", tmp_path / "out", "--mkdir"))
     assert "refused the commit" in message and "no file written" in message
     one_line_refusal(run("instantiate", "--gear", 42, "--out", tmp_path / "one.MPF"))
     assert program_count(run.url) == before and everything_under(tmp_path) == []
@@ -213,7 +214,7 @@ def test_a_commit_that_fails_leaves_no_file(run, tmp_path):
 def test_a_server_lost_at_commit_leaves_no_file(run, tmp_path):
     at_commit(run.url, LOSE_THE_SERVER_AT_COMMIT)
     before = program_count(run.url)
-    message = one_line_refusal(run("instantiate", "--gears", "42-44", "--out", tmp_path / "out"))
+    message = one_line_refusal(run("instantiate", "--gears", "42-44", "--out", tmp_path / "out", "--mkdir"))
     assert "connection was lost while committing" in message and "no file written" in message
     assert program_count(run.url) == before and everything_under(tmp_path) == []
 
@@ -254,7 +255,7 @@ def test_kill_9_during_the_files_of_a_batch_leaves_only_committed_programs_files
     environment = {**os.environ, "PYTHONPATH": os.pathsep.join(filter(None, [str(REPOSITORY),
                                                                              os.environ.get("PYTHONPATH")]))}
     engine = subprocess.Popen([sys.executable, "-m", "engine", "--database-url", fresh_database_url, "instantiate",
-                               "--all", "--out", str(out)], env=environment, stdout=subprocess.DEVNULL,
+                               "--all", "--out", str(out), "--mkdir"], env=environment, stdout=subprocess.DEVNULL,
                               stderr=subprocess.PIPE, text=True)
     try:
         while engine.poll() is None and not (out.is_dir() and any(out.iterdir())):

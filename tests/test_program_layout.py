@@ -104,7 +104,7 @@ def batch_files(url: str, folder, layouts: dict) -> dict:
 def test_a_batch_writes_each_program_with_its_own_class_layout(run, tmp_path, workers):
     set_layout(run.url, "spur", CRLF, False)
     folder = tmp_path / "nc"
-    batch = run("instantiate", "--gears", "42-47", "--workers", workers, "--out", folder)
+    batch = run("instantiate", "--gears", "42-47", "--workers", workers, "--out", folder, "--mkdir")
     assert batch.exit_code == 0, batch.output
     files = batch_files(run.url, folder, {"spur": (CRLF, False)})
     assert sorted(files) == sorted(path.name for path in folder.iterdir()) and len(files) == 6
@@ -123,7 +123,8 @@ def test_stored_jobs_made_again_keep_their_class_layout(run, tmp_path):
     again = made(run("instantiate", "--job", first["job_id"], "--out", one, "--json"))
     assert one.read_bytes() == joined(stored(run.url, again["program_id"]), CRLF, False)
     folder = tmp_path / "jobs"
-    assert run("instantiate", "--jobs", f"{first['job_id']}-{last['job_id']}", "--out", folder).exit_code == 0
+    assert run("instantiate", "--jobs", f"{first['job_id']}-{last['job_id']}", "--out", folder,
+               "--mkdir").exit_code == 0
     files = batch_files(run.url, folder, {"spur": (CRLF, False), "helical": (CRLF, True)})
     assert len(files) == 2 and all(written == expected for written, expected in files.values())
 
@@ -188,8 +189,8 @@ def test_a_csv_without_the_layout_columns_leaves_the_class_layout(run, tmp_path)
     assert class_layout_stored(run.url, "spur") == (CRLF, False)
 
 
-def test_an_lf_class_exports_the_seven_columns_it_always_had(run):
-    exported = run("template", "export", "--class", "spur").stdout
+def test_an_lf_class_exports_the_seven_columns_it_always_had(read_only_run):
+    exported = read_only_run("template", "export", "--class", "spur").stdout
     assert exported.splitlines()[0] == "id,t,n,p_calc,s,o,p_emit"
 
 

@@ -152,14 +152,14 @@ def test_a_real_program_the_simulation_refuses_is_refused_when_made_and_nothing_
 
 
 @pytest.mark.parametrize("blank", ["stock_diameter", "stock_z_front", "stock_z_back"])
-def test_a_blank_parameter_given_to_import_nc_is_refused_and_no_class_is_stored(run, tmp_path, blank):
+def test_a_blank_parameter_given_to_import_nc_is_refused_and_no_class_is_stored(read_only_run, tmp_path, blank):
     """The threading macro's G76 ends `e0 l0`: stock_z_front 0 bound at import would make the taper E a
     reference, and a job on another blank would cut another thread. The blank belongs to instantiate."""
     lines = program_of("lathe_macros/threading.ngc")
     source = written(lines, tmp_path)
     params = tmp_path / "params.json"
     params.write_text(json.dumps({blank: 0, "start_x": {"value": 1.2, "addresses": ["X"]}}))
-    message = refused(run("import-nc", source, "--class", "lm_blank", "--params", params))
+    message = refused(read_only_run("import-nc", source, "--class", "lm_blank", "--params", params))
     assert f"parameter {blank} is the blank of a class job" in message and "instantiate --params" in message
-    with psycopg.connect(run.url) as conn:
+    with psycopg.connect(read_only_run.url) as conn:
         assert conn.execute("SELECT count(*) FROM gear_class WHERE name = 'lm_blank'").fetchone() == (0,)

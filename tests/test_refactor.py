@@ -230,8 +230,8 @@ def test_cli_json_reports_a_merge_then_nothing(run):
     assert "nothing to merge" in again.stdout
 
 
-def test_cli_threshold_out_of_range_is_refused(run):
-    result = run("refactor", "--threshold", "1.5")
+def test_cli_threshold_out_of_range_is_refused(read_only_run):
+    result = read_only_run("refactor", "--threshold", "1.5")
     assert result.exit_code != 0
     assert "--threshold" in result.output
 
@@ -254,8 +254,8 @@ def test_cli_template_shared_names_the_other_classes(run):
 
 @pytest.mark.parametrize("args, words", [(("refactor",), ("--threshold", "--json", "Merge")),
                                          (("template", "shared"), ("--class", "shared"))])
-def test_help_texts(run, args, words):
-    result = run(*args, "--help")
+def test_help_texts(read_only_run, args, words):
+    result = read_only_run(*args, "--help")
     assert result.exit_code == 0
     assert all(word in result.stdout for word in words)
 

@@ -195,12 +195,12 @@ def test_cli_intents_lists_json_and_csv_and_unintend_withdraws(run):
     (("unintend", "0123456789ab"), "not among the pairs marked intended"),
     (("intents", "--json", "--csv"), "--json and --csv"),
 ])
-def test_cli_refusals_are_one_line_exit_1_and_store_nothing(run, args, words):
-    result = run("refactor", *args)
+def test_cli_refusals_are_one_line_exit_1_and_store_nothing(read_only_run, args, words):
+    result = read_only_run("refactor", *args)
     assert result.exit_code == 1
     assert result.stdout == ""
     assert len(result.stderr.splitlines()) == 1 and words in result.stderr
-    assert intended_rows(run.url) == 0
+    assert intended_rows(read_only_run.url) == 0
 
 
 def test_cli_marking_a_marked_pair_again_is_refused(run):
@@ -211,8 +211,8 @@ def test_cli_marking_a_marked_pair_again_is_refused(run):
 
 
 @pytest.mark.parametrize("command", ["refactor", "intend", "intents", "unintend"])
-def test_help_has_an_example(run, command):
+def test_help_has_an_example(read_only_run, command):
     args = ("refactor", "--help") if command == "refactor" else ("refactor", command, "--help")
-    result = run(*args)
+    result = read_only_run(*args)
     assert result.exit_code == 0
     assert any(line.strip().startswith("Example: engine refactor") for line in result.stdout.splitlines())

@@ -9,13 +9,13 @@ writers wait for the refactor."""
 from __future__ import annotations
 
 import threading
-from dataclasses import replace
 
 import psycopg
 import pytest
 from helpers.lineage_text import id_masked
 from helpers.nc_files import DATA, FAMILY, PARAMS, class_name, instantiate, real_files
 from helpers.refactor import bodies_stored_twice, component_count, duplicate_row_body, exports
+from msgspec.structs import replace
 
 from engine.library.nc_import import import_nc
 from engine.library.refactor import STAGES, refactor

@@ -327,8 +327,8 @@ class CliInput:
         return CliRunner().invoke(main, ["--database-url", self.run.url, *args], input=self.text)
 
 
-def test_release_help_shows_an_example(run):
-    assert "engine template release --class spur --dry-run" in run("template", "release", "--help").stdout
+def test_release_help_shows_an_example(read_only_run):
+    assert "engine template release --class spur --dry-run" in read_only_run("template", "release", "--help").stdout
 
 
 def test_a_draft_that_drives_a_stored_hobbing_job_beyond_the_machine_is_refused(conn):

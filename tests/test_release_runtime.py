@@ -210,7 +210,7 @@ def test_a_turning_jobs_program_carries_its_lineage(run, tmp_path, machine, draw
 
 
 def batch_programs(run, folder: Path, *args) -> list[tuple[int, Path]]:
-    made = run("instantiate", *args, "--out", folder, "--json")
+    made = run("instantiate", *args, "--out", folder, "--mkdir", "--json")
     assert made.exit_code == 0, made.output
     report = json.loads(made.stdout)
     with psycopg.connect(run.url) as conn:

@@ -127,13 +127,13 @@ def test_a_draft_with_out_is_refused(run, tmp_path, target):
     assert program_count(run) == before and not out.exists()
 
 
-def test_a_draft_with_the_machine_folder_of_the_config_file_is_refused(run, tmp_path):
+def test_a_draft_with_the_machine_folder_of_the_config_file_is_refused(read_only_run, tmp_path):
     folder = tmp_path / "hobber"
-    run.config.write_text(f'[machines.hobber-840d]\nout = "{folder}"\n')
-    before = program_count(run)
-    refused(run("instantiate", "--gear", 42, "--draft"), "--draft", str(folder))
-    assert program_count(run) == before and not folder.exists()
-    dry = run("instantiate", "--gear", 42, "--draft", "--dry-run")   # the folder is not a dry run's
+    read_only_run.config.write_text(f'[machines.hobber-840d]\nout = "{folder}"\n')
+    before = program_count(read_only_run)
+    refused(read_only_run("instantiate", "--gear", 42, "--draft"), "--draft", str(folder))
+    assert program_count(read_only_run) == before and not folder.exists()
+    dry = read_only_run("instantiate", "--gear", 42, "--draft", "--dry-run")   # the folder is not a dry run's
     assert dry.exit_code == 0 and "%_N_GEAR42_MPF" in dry.stdout and not folder.exists()
 
 

@@ -62,8 +62,8 @@ def test_distinct_reasons_are_said_once_and_tagged_on_the_choices():
     (("--gear", "42", "--feed-mode", "climb/conventional"), "names one for each of 2 units; the gear has 1"),
     (("--gear", "53", "--cuts", "2", "--worm-feed", "tangential"), "two cuts with a tangential feed"),
 ])
-def test_an_input_no_choice_changes_is_refused_at_once(run, args, words):
-    refused = run("instantiate", *args)
+def test_an_input_no_choice_changes_is_refused_at_once(read_only_run, args, words):
+    refused = read_only_run("instantiate", *args)
     assert refused.exit_code == 1 and refused.stderr.count("\n") == 1, refused.output
     assert words in refused.stderr
     assert "tried" not in refused.stderr and "[" not in refused.stderr, "no search around it"

@@ -5,10 +5,11 @@ of tests/helpers/simulation_programs.py, with every expected number from the ref
 from __future__ import annotations
 
 import math
-from dataclasses import replace
+from dataclasses import replace as replace_hand  # Hand, the tests' own dataclass
 
 import pytest
 from helpers.simulation_programs import Hand, k_z, least_run_out, number_of, swivel
+from msgspec.structs import replace
 
 from engine.gears.records import GearUnit, load_gear, load_hobs
 from engine.machines.records import load_machine
@@ -84,7 +85,7 @@ def coupling(helical) -> list[str]:
 def test_re_coupling_between_rough_and_finish_of_one_unit_is_refused(records, helical):
     """EGON "FINE" does not synchronise: after EGOFS/EGDEL and a new EGON the finish cut lands at
     an arbitrary phase against the rough gaps."""
-    rough = replace(helical, stock=0.5)
+    rough = replace_hand(helical, stock=0.5)
     finish = [f"G0 Z{helical.z_start:.3f}", *helical.cut()]
     lines = helical.lines(rough.cut() + ["EGOFS(C)", "EGDEL(C)", *coupling(helical), *finish])
     found = refusals(lines, helical, records["machine"])
@@ -101,7 +102,7 @@ def test_a_duplex_re_coupling_for_its_other_unit_of_the_same_teeth_is_allowed(re
     top = -width - 150.0
     gear = replace(helical.gear, units=(GearUnit(2, 41, width, helical.gear.tip_diameter,
                                                  helical.gear.root_diameter, top),))
-    second = replace(helical, gear=gear)
+    second = replace_hand(helical, gear=gear)
     z_run_out = helical.z_end + width           # the pass's end below the unit's bottom face
     unit_2 = [f"G0 Z{top + helical.z_start:.3f}", f"G1 X{helical.x_cut:.3f} F8.2",
               f"G1 Z{top - width + z_run_out:.3f} F24.7", f"G0 X{helical.x_retract:.3f}"]
@@ -172,7 +173,7 @@ def test_a_pass_feed_above_the_roughing_maximum_is_refused_and_one_at_it_is_not(
     assert 247 / table == pytest.approx(29.96, abs=0.01)
     at_bound = math.floor(ROUGH_MAX_M3 * table * 10) / 10        # written at or below the bound
     for feed, refused in ((247.0, True), (at_bound, False), (at_bound + 0.2, True)):
-        program = replace(helical, axial_feed=feed)
+        program = replace_hand(helical, axial_feed=feed)
         found = refusals(program.lines(), helical, records["machine"])
         feeds = any("roughing maximum" in m for m in found.get(number_of(program.lines(), program.cut()[1]), []))
         assert feeds == refused, feed
@@ -186,7 +187,7 @@ def test_a_run_out_short_of_the_generating_zone_is_refused(records, helical):
     assert abs(swivel(helical.gear, helical.hob)) == pytest.approx(12.628, abs=0.001)
     assert least == pytest.approx(4.054, abs=0.001)
     for run_out, refused in ((0.1, True), (least - 0.01, True), (least + 0.01, False)):
-        program = replace(helical, run_out=run_out)
+        program = replace_hand(helical, run_out=run_out)
         found = refusals(program.lines(), helical, records["machine"])
         short = any("beyond the face" in m for m in found.get(number_of(program.lines(), program.cut()[0]), []))
         assert short == refused, run_out

@@ -5,10 +5,10 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import replace
 
 import pytest
 from helpers.simulation_programs import Hand, k_y, k_z, lead_angle, number_of, swivel, with_cycle_time
+from msgspec.structs import replace
 
 from engine.errors import EngineError
 from engine.gears.records import GearUnit, load_gear, load_hobs

@@ -163,17 +163,17 @@ def program_count(url: str) -> int:
         return conn.execute("SELECT count(*) FROM program").fetchone()[0]
 
 
-def test_an_out_path_the_system_refuses_is_one_line_and_nothing_stored(run, tmp_path):
+def test_an_out_path_the_system_refuses_is_one_line_and_nothing_stored(read_only_run, tmp_path):
     (tmp_path / "loop").symlink_to(tmp_path / "loop")
     (tmp_path / "file").write_text("")
     long_name = tmp_path / ("a" * 300)   # over NAME_MAX (255) of every Linux file system
     for out in (long_name, f"{long_name}/", f"{tmp_path / 'loop'}/x", f"{tmp_path / 'loop'}/"):
-        before = program_count(run.url)
-        result = run("instantiate", "--gear", GEAR, "--out", out)
+        before = program_count(read_only_run.url)
+        result = read_only_run("instantiate", "--gear", GEAR, "--out", out)
         assert result.exit_code == 1, (out, result.output)
         message = result.stderr.strip()
         assert len(message.splitlines()) == 1 and "nothing stored" in message and len(message) < 300, message
-        assert program_count(run.url) == before
+        assert program_count(read_only_run.url) == before
 
 
 def test_cases_confirm_refuses_feeds_in_job_cutting_the_program_never_ran(run):
@@ -233,7 +233,7 @@ def test_the_impact_of_a_draft_is_not_hidden_by_a_forged_stored_program(run):
     assert f"+{COMMENTED}" in impact["diffs"][0]["diff"]
 
 
-def test_an_out_folder_the_user_may_not_read_is_one_line_and_nothing_stored(run, tmp_path, monkeypatch):
+def test_an_out_folder_the_user_may_not_read_is_one_line_and_nothing_stored(read_only_run, tmp_path, monkeypatch):
     """EACCES listing --out (the tests run as root, who reads every folder: the refusal is simulated)."""
     import engine.programs.outputs as outputs
 
@@ -241,8 +241,8 @@ def test_an_out_folder_the_user_may_not_read_is_one_line_and_nothing_stored(run,
         raise PermissionError(13, "Permission denied", str(path))
 
     monkeypatch.setattr(outputs.os, "listdir", refused)
-    before = program_count(run.url)
-    result = run("instantiate", "--gear", GEAR, "--out", f"{tmp_path}/")
+    before = program_count(read_only_run.url)
+    result = read_only_run("instantiate", "--gear", GEAR, "--out", f"{tmp_path}/")
     assert result.exit_code == 1, result.output
     assert "Permission denied" in result.stderr and len(result.stderr.strip().splitlines()) == 1
-    assert program_count(run.url) == before
+    assert program_count(read_only_run.url) == before

@@ -1,10 +1,10 @@
 """Template versions (issue 6): every committed version of a class is stored; history, diff
 and restore, in the library and on the command line."""
 import shutil
-from dataclasses import asdict
 
 import psycopg
 import pytest
+from msgspec.structs import asdict
 from psycopg import sql
 
 from engine.db.migrate import migrate
@@ -171,10 +171,10 @@ def test_cli_history_diff_restore(run):
         assert exported(conn, "spur") == before
 
 
-def test_cli_json_and_one_line_errors(run):
-    shown = run("template", "history", "--class", "spur", "--json")
+def test_cli_json_and_one_line_errors(read_only_run):
+    shown = read_only_run("template", "history", "--class", "spur", "--json")
     assert shown.exit_code == 0 and '"versions"' in shown.stdout
-    refused = run("template", "restore", "--class", "spur", "--version", 999)
+    refused = read_only_run("template", "restore", "--class", "spur", "--version", 999)
     assert refused.exit_code == 1
     assert refused.stderr.count("\n") == 1 and "has no version 999; stored versions:" in refused.stderr
 
@@ -184,7 +184,7 @@ def test_cli_json_and_one_line_errors(run):
     ("diff", ["--from", "--to", "--json", "added"]),
     ("restore", ["--version", "new version"]),
 ])
-def test_help_texts(run, command, words):
-    result = run("template", command, "--help")
+def test_help_texts(read_only_run, command, words):
+    result = read_only_run("template", command, "--help")
     assert result.exit_code == 0
     assert all(word in result.stdout for word in words), result.stdout

@@ -4,11 +4,11 @@ seeded class against the stored program, the stored job and the template rows, w
 conditions evaluated again by plain Python from the recorded values."""
 import math
 import re
-from dataclasses import replace
 
 import psycopg
 import pytest
 from helpers.drawings import seed_drawing
+from msgspec.structs import replace
 
 from engine.hobbing.choices import Choices
 from engine.nc.lineage import LINEAGE_ROW_ID
@@ -177,8 +177,8 @@ def test_instantiate_explain_prints_the_same_for_a_new_program(run):
     (("explain", "--program", "999999"), "program 999999 does not exist"),
     (("instantiate", "--gears", "42-43", "--explain"), "--explain explains one program"),
 ])
-def test_explain_errors_are_one_line(run, args, words):
-    refused = run(*args)
+def test_explain_errors_are_one_line(read_only_run, args, words):
+    refused = read_only_run(*args)
     assert refused.exit_code == 1 and words in refused.stderr and refused.stderr.count("\n") == 1
 
 

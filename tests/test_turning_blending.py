@@ -9,6 +9,7 @@ import math
 
 import pytest
 from helpers.linuxcnc_programs import LATHE
+from msgspec.structs import astuple
 from shapely.geometry import Polygon
 
 from engine.simulation.turning.blending import corner
@@ -58,7 +59,7 @@ def test_the_blended_corner_lies_inside_the_angle_within_the_tolerance():
     straight = Move(2, "G0", RAPID, [(1.0, 5.0), (1.0, 2.0)], None, None, False, None, True, None, BLEND)
     assert corner(rapid, straight) is None                                           # in line: no corner
     exact = Move(2, "G1", FEED, [(1.0, 5.0), (-5.0, 5.0)], None, None, False, None, True, None, 0.0)
-    assert corner(None, cut) is None and corner(Move(*rapid.__dict__.values()), exact) is not None
+    assert corner(None, cut) is None and corner(Move(*astuple(rapid)), exact) is not None
 
 
 def finish_pass(clearance: float, blend: float) -> list[str]:

@@ -8,9 +8,9 @@ blank and the moves written in the test."""
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 
 import pytest
+from msgspec.structs import replace
 
 from engine.errors import EngineError
 from engine.machines.records import Machine

@@ -8,6 +8,7 @@ import pytest
 from helpers.drawings import seed_drawing
 from helpers.drawn_parts import two_rough_layers
 from helpers.turning_jobs import refused_after
+from msgspec.structs import replace
 
 from engine.errors import EngineError
 from engine.machines.records import load_machine
@@ -82,7 +83,7 @@ ISO_END = ["M30", "%"]
 ])
 def test_the_lathe_check_refuses(conn, lines, message):
     machine = load_machine(conn, "lathe-iso")
-    narrow = type(machine)(**{**vars(machine), "x_max": 15.0})
+    narrow = replace(machine, x_max=15.0)
     with pytest.raises(LimitError, match=message):
         verify_program(ISO_START + lines + ISO_END, narrow, "PART")
 
@@ -99,14 +100,14 @@ def test_an_inch_drawing_says_its_codes_are_not_scaled(conn, tmp_path):
 
 
 @pytest.mark.parametrize("value", ["0", "abc", "nan", "inf"])
-def test_a_bad_option_value_is_one_line_and_exit_1(run, tmp_path, value):
+def test_a_bad_option_value_is_one_line_and_exit_1(read_only_run, tmp_path, value):
     seed_drawing(tmp_path / "part.dxf")
-    result = run("import-dxf", tmp_path / "part.dxf", "--rough-depth", value)
+    result = read_only_run("import-dxf", tmp_path / "part.dxf", "--rough-depth", value)
     assert result.exit_code == 1, result.output
     assert result.stderr.strip().splitlines() == [result.stderr.strip()]
     assert "--rough-depth" in result.stderr and value in result.stderr
 
 
-def test_a_missing_option_is_one_line_and_exit_1(run):
-    result = run("instantiate", "--job", "abc")
+def test_a_missing_option_is_one_line_and_exit_1(read_only_run):
+    result = read_only_run("instantiate", "--job", "abc")
     assert result.exit_code == 1 and len(result.stderr.strip().splitlines()) == 1, result.output

@@ -129,15 +129,15 @@ def test_a_drawing_in_inches_is_scaled_whatever_its_measurement(tmp_path):
     assert drawing.profile.bounds[3] == pytest.approx(12.0)
 
 
-def test_the_cli_refuses_a_ring_in_one_line_and_stores_nothing(run, tmp_path):
-    with psycopg.connect(run.url) as conn:
+def test_the_cli_refuses_a_ring_in_one_line_and_stores_nothing(read_only_run, tmp_path):
+    with psycopg.connect(read_only_run.url) as conn:
         before = conn.execute("SELECT count(*) FROM job").fetchone()[0]
-    made = run("import-dxf", drawn(tmp_path / "ring.dxf", RING, closed=True), "--rough-depth", "1",
-               "--program-name", "RING", "--machine", "lathe-840d", "--json")
+    made = read_only_run("import-dxf", drawn(tmp_path / "ring.dxf", RING, closed=True), "--rough-depth", "1",
+                         "--program-name", "RING", "--machine", "lathe-840d", "--json")
     assert made.exit_code == 1 and made.stderr.count("\n") == 1, made.output
     message = json.loads(made.stderr)["error"]
     assert f"bore Ø{2 * BORE:g}" in message and "internal turning is not supported" in message
-    with psycopg.connect(run.url) as conn:
+    with psycopg.connect(read_only_run.url) as conn:
         assert conn.execute("SELECT count(*) FROM job").fetchone()[0] == before
 
 
@@ -158,17 +158,17 @@ def ring_section_off_the_axis(msp) -> None:
     msp.add_lwpolyline([(0, 25), (-20, 25), (-20, 35), (0, 35)], close=True)
 
 
-def test_a_ring_drawn_as_its_section_is_not_turned_as_a_solid_bar(run, tmp_path):
+def test_a_ring_drawn_as_its_section_is_not_turned_as_a_solid_bar(read_only_run, tmp_path):
     """A closed profile that stays 25 mm off the axis is a ring: its bore Ø50 cannot be turned from
     outside. The job turns the outside Ø70 only and says nothing of the bore — a solid disc where
     the drawing has a ring."""
     path = tmp_path / "ring.dxf"
     drawing(path, ring_section_off_the_axis)
-    before = counts(run.url)
-    made = run("import-dxf", path, "--rough-depth", "1", "--program-name", "RING", "--machine", "lathe-840d",
-               "--json")
+    before = counts(read_only_run.url)
+    made = read_only_run("import-dxf", path, "--rough-depth", "1", "--program-name", "RING", "--machine",
+                         "lathe-840d", "--json")
     assert made.exit_code == 1, made.output
-    assert made.stderr.count("\n") == 1 and counts(run.url) == before
+    assert made.stderr.count("\n") == 1 and counts(read_only_run.url) == before
 
 
 def test_a_drawing_whose_header_says_imperial_is_not_turned_in_millimetres(run, tmp_path):

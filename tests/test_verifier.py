@@ -26,6 +26,7 @@ from helpers.verifier_programs import (
     programs,
     refusal,
 )
+from msgspec.structs import replace
 
 from engine.machines.records import load_machine
 from engine.verifier import LimitError, verify_program
@@ -267,7 +268,7 @@ def test_a_lathe_arc_needs_its_start_and_its_radius(conn):
 
 def test_a_machine_without_a_grammar_makes_no_program(conn):
     machine = load_machine(conn, "hobber-840d")
-    iso_hobber = type(machine)(**{**vars(machine), "dialect": "iso"})
+    iso_hobber = replace(machine, dialect="iso")
     with pytest.raises(LimitError, match="no verifier grammar for a hobber with dialect 'iso'"):
         verify_program(["%", "M30", "%"], iso_hobber, "TEST")
 
@@ -318,20 +319,20 @@ def test_a_stored_job_whose_program_name_holds_a_line_break_is_not_made_again(ru
 
 
 @pytest.mark.parametrize("speed", ["0", "-5"])
-def test_a_hob_speed_of_0_or_below_is_refused_as_it_is_given(run, tmp_path, speed):
-    before = programs(run.url)
-    message = one_line_exit_1(run("instantiate", "--gear", 42, "--hob-speed", speed, "--out", tmp_path))
+def test_a_hob_speed_of_0_or_below_is_refused_as_it_is_given(read_only_run, tmp_path, speed):
+    before = programs(read_only_run.url)
+    message = one_line_exit_1(read_only_run("instantiate", "--gear", 42, "--hob-speed", speed, "--out", tmp_path))
     assert "--hob-speed" in message and speed in message
-    assert programs(run.url) == before and list(tmp_path.iterdir()) == []
+    assert programs(read_only_run.url) == before and list(tmp_path.iterdir()) == []
 
 
-def test_a_drawing_whose_file_name_holds_a_line_break_makes_no_job(run, tmp_path):
+def test_a_drawing_whose_file_name_holds_a_line_break_makes_no_job(read_only_run, tmp_path):
     drawing = tmp_path / "part\nG0 X9999 Z-9999.dxf"
     seed_drawing(drawing)
-    with psycopg.connect(run.url) as conn:
+    with psycopg.connect(read_only_run.url) as conn:
         jobs = conn.execute("SELECT count(*) FROM job").fetchone()[0]
-    before = programs(run.url)
-    one_line_exit_1(run("import-dxf", drawing))
-    with psycopg.connect(run.url) as conn:
+    before = programs(read_only_run.url)
+    one_line_exit_1(read_only_run("import-dxf", drawing))
+    with psycopg.connect(read_only_run.url) as conn:
         assert conn.execute("SELECT count(*) FROM job").fetchone()[0] == jobs
-    assert programs(run.url) == before
+    assert programs(read_only_run.url) == before

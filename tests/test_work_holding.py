@@ -240,24 +240,24 @@ A-OK,collet,8,50,0,
 """
 
 
-def test_a_bad_import_names_every_bad_line_and_stores_nothing(run, tmp_path):
+def test_a_bad_import_names_every_bad_line_and_stores_nothing(read_only_run, tmp_path):
     path = tmp_path / "holdings.csv"
     path.write_text(BAD_CSV, encoding="utf-8")
-    before = run("fixtures", "list", "--csv").stdout
-    result = run("fixtures", "import", path)
+    before = read_only_run("fixtures", "list", "--csv").stdout
+    result = read_only_run("fixtures", "import", path)
     assert result.exit_code == 1
     for words in ("line 3, column kind: 'spindle' is not one of arbor, mandrel, collet, centres",
                   "line 4, column diameter: -4 must be greater than 0", "line 5, column height: is missing",
                   "line 6, column id: A-OK is already on line 2"):
         assert words in result.stderr, result.stderr
-    assert run("fixtures", "list", "--csv").stdout == before
+    assert read_only_run("fixtures", "list", "--csv").stdout == before
 
 
-def test_an_import_naming_an_unknown_machine_stores_nothing(run, tmp_path):
+def test_an_import_naming_an_unknown_machine_stores_nothing(read_only_run, tmp_path):
     path = tmp_path / "holdings.csv"
     path.write_text("id,kind,diameter,height,tailstock_diameter,machine\nX-1,arbor,10,60,6,nowhere\n",
                     encoding="utf-8")
-    result = run("fixtures", "import", path)
+    result = read_only_run("fixtures", "import", path)
     assert result.exit_code == 1 and "machine nowhere does not exist" in result.stderr
 
 

@@ -34,8 +34,8 @@ def test_a_failing_gear_in_a_worker_stops_the_batch_and_stores_nothing(run):
     assert stored_programs(run.url) == []
 
 
-def test_workers_are_for_batches(run):
-    refused = run("instantiate", "--gear", "42", "--workers", "2")
+def test_workers_are_for_batches(read_only_run):
+    refused = read_only_run("instantiate", "--gear", "42", "--workers", "2")
     assert refused.exit_code == 1 and "--workers plans a batch" in refused.stderr
 
 

@@ -5,7 +5,9 @@ Exit codes: 0 ok, 1 a handled error or bad input, option values included (one li
 with --json one JSON object {"error": ..., "exit": 1}): nothing stored,
 2 unexpected (--traceback shows it),
 3 programs stored but their files not written (engine.programs.outputs.StoredNotWritten: the
-message names the programs and the files; "exit": 3 with --json).
+message names the programs and the files; "exit": 3 with --json),
+130 interrupted (Ctrl-C, SIGINT: 128 + 2, as shells report it): one line, what was not yet
+committed rolled back (issue 31: a batch's workers end with it, quietly).
 """
 from __future__ import annotations
 
@@ -26,6 +28,7 @@ from .context import CONFIG
 from .conventions import JSON_SEEN, apply_conventions, apply_to_one, default_map, json_from_defaults
 
 JSON_ARGS = "engine.json_args"   # ctx.meta: --json among the invocation's arguments
+INTERRUPTED = 130   # the exit code of Ctrl-C: 128 + SIGINT, what a shell shows for a command it interrupted
 
 
 def usage_error_line(error: click.UsageError) -> None:
@@ -113,6 +116,8 @@ class EngineGroup(click.Group):
             if ctx.meta.get("traceback"):
                 raise
             fail(str(error), error.exit_code, getattr(error, "problems", ()))
+        except KeyboardInterrupt:   # Ctrl-C: one line, not click's "Aborted!" with exit 1 (which says refused)
+            fail("interrupted (Ctrl-C); what was not yet committed was rolled back", INTERRUPTED)
         except BrokenPipeError:   # the reader left (engine … | head): it has what it wanted, no message
             _silence_stdout()
             ctx.exit(1)

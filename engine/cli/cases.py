@@ -85,15 +85,49 @@ def cases():
 @list_options("cases")
 @click.pass_context
 def cases_list(ctx, output):
-    """List every cutting case: gear and hob features, cut, n0 r/min, feeds mm/min, source.
+    """List every cutting case: gear and hob features, cut, n0 r/min, feeds mm/min, source. --csv writes
+    the file `engine cases import` reads (id first, every value as stored), which `engine cases import
+    FILE --replace` takes back unchanged.
 
-    Example: engine cases list --csv
+    Example: engine cases list --csv > cases.csv
     """
-    from ..gears.cases import case_records
-
     with connection(ctx) as conn:
+        if output == "csv":
+            from ..gears.case_import import FILE_COLUMNS, export_cases
+
+            return emit_list(output, "cases", tuple(Column(name, name) for name in FILE_COLUMNS), export_cases(conn))
+        from ..gears.cases import case_records
+
         history = case_records(conn)
     emit_list(output, "cases", CASE_LIST_COLUMNS, history)
+
+
+@cases.command("import")
+@click.argument("csv_file", type=click.Path(dir_okay=False))
+@click.option("--replace", is_flag=True,
+              help="Replace the stored cases whose id the file gives, printing each changed field (old → new).")
+@click.option("--json", "as_json", is_flag=True,
+              help="Print one JSON object: {added: N, replaced: N, changes: [{case_id, field, old, new}]}.")
+@click.pass_context
+def cases_import(ctx, csv_file, replace, as_json):
+    """Add the cases of CSV_FILE to the machining history (the columns of `engine cases list --csv`, those
+    of seed_templates/cases.csv with an id first). A row without an id is a new case; an id already
+    stored is refused unless --replace. A case confirmed from a job is changed in no field: it records
+    what that job ran. Any bad row stops the whole file (nothing stored).
+
+    Example: engine cases import cases.csv --replace
+    """
+    from ..db.replacing import plain
+    from ..gears.case_import import import_cases
+
+    with connection(ctx) as conn:
+        added, replaced, changes = import_cases(conn, csv_file, replace=replace)
+    if as_json:
+        return emit_json({"added": added, "replaced": replaced, "changes": [
+            {"case_id": c.key, "field": c.field, "old": plain(c.old), "new": plain(c.new)} for c in changes]})
+    for change in changes:
+        click.echo(change.said("case"))
+    click.echo(f"{csv_file}: added {added} case(s), replaced {replaced}")
 
 
 @cases.command("confirm")

@@ -1,10 +1,18 @@
-"""What every command shares: the database connection of the invocation, and JSON output."""
+"""What every command shares: the database connection of the invocation, JSON output, and the
+folder a file option writes into."""
 from __future__ import annotations
 
 import json
+import re
 from contextlib import contextmanager
+from decimal import Decimal
+from pathlib import Path
+from typing import Any
 
 import click
+import msgspec
+
+from ..errors import EngineError
 
 
 @contextmanager
@@ -28,13 +36,41 @@ def connection(ctx, migrated: bool = True):
 
 def keyed(record: dict, **names: str) -> dict:
     """The record with its keys renamed to the names every --json uses (gear_id, job_id,
-    program_id, hob_id, class): keyed(asdict(hob), id="hob_id"); gear_class is always class."""
+    program_id, hob_id, class): keyed(record_dict(hob), id="hob_id"); gear_class is always class."""
     names = {"gear_class": "class", **names}
     return {names.get(key, key): value for key, value in record.items()}
 
 
+def record_dict(record) -> dict:
+    """A record (a msgspec.Struct, or an importer's dataclass) as the plain dict --json writes, its
+    nested records and lists included, as dataclasses.asdict gave (tuples as lists: JSON has no tuple)."""
+    return msgspec.to_builtins(record, str_keys=True, enc_hook=str)   # enc_hook: as json.dumps default=str
+
+
 def emit_json(payload: dict) -> None:
     click.echo(json.dumps(payload, default=str))   # design notes §9: one JSON object on one line
+
+
+# A Decimal's digits stand in a string between NULs (no text of the database holds NUL) until the
+# JSON is written, then replace that string: json writes no Decimal, and a float would round it.
+DECIMAL_MARK = "\0decimal\0"
+MARKED = re.compile(r'"\\u0000decimal\\u0000(-?[0-9.]+)"')
+
+
+def exact_json(payload: Any) -> str:
+    """The payload as one line of JSON, a Decimal (a numeric column's value) as the number of its
+    digits as stored (2.50 stays 2.50; NaN and infinities, which JSON has no number for, as text)."""
+    return MARKED.sub(r"\1", json.dumps(_marked(payload), default=str))
+
+
+def _marked(value: Any) -> Any:
+    if isinstance(value, dict):
+        return {key: _marked(item) for key, item in value.items()}
+    if isinstance(value, list):
+        return [_marked(item) for item in value]
+    if isinstance(value, Decimal) and value.is_finite():
+        return DECIMAL_MARK + format(value, "f")
+    return value
 
 
 CONFIG = "engine.config"   # ctx.meta: the config file's settings (engine.programs.config), read once per invocation
@@ -45,3 +81,20 @@ def settings(ctx):
     from ..programs.config import Config
 
     return ctx.meta.get(CONFIG) or Config()
+
+
+def file_folder(out, mkdir: bool, option: str = "--out") -> None:
+    """The folder the file `out` goes into: made (with the folders above it) if missing and --mkdir
+    is given, else a missing one is refused (issue 31: a typo in a share's path quietly became a
+    new folder nobody looked in)."""
+    folder = Path(out).parent
+    if folder.is_dir():
+        return
+    if not mkdir:
+        raise EngineError(f"{option}: the folder {folder} does not exist; nothing written; check the path, "
+                          "or give --mkdir to create it")
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as error:
+        raise EngineError(f"{option}: cannot create the folder {folder} ({error.strerror or error}); "
+                          "give a folder you can write") from None

@@ -32,7 +32,11 @@ COMMAND_LINE_ONLY = {   # (command path, option): why it is typed on each invoca
     ("engine hobs delete", "yes"): DELETE,
     ("engine template release", "yes"): "it releases a draft to the shop floor without asking",
     ("engine gears import", "replace"): "it overwrites stored gears",
+    ("engine hobs import", "replace"): "it replaces stored hobs whole",
+    ("engine fixtures import", "replace"): "it replaces stored work-holdings whole",
+    ("engine cases import", "replace"): "it overwrites stored cases of the machining history",
     ("engine instantiate", "force"): "it replaces program files in --out, which a machine may be loading",
+    ("engine db backup", "force"): "it replaces a backup file, which may be the only one",
     ("engine instantiate", "skip-bad"): "it stores a batch without its bad gears",
     ("engine instantiate", "draft"): "it makes programs of a draft that has not passed the release gate",
     # what instantiate makes programs of: a default would store programs (records nobody deletes)

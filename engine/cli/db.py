@@ -1,6 +1,7 @@
 """Setting up and operating the database: `engine db migrate|status`, `engine db url|psql|stop`
-(the embedded server), `engine seed [--samples]`, and `engine demo`, which migrates and seeds the
-embedded server's database and instantiates one gear (or, --turning, the sample drawing's turning job)."""
+(the embedded server), `engine db backup|restore FILE`, `engine seed [--samples]`, and
+`engine demo`, which migrates and seeds the embedded server's database and instantiates one gear
+(or, --turning, the sample drawing's turning job)."""
 from __future__ import annotations
 
 import os
@@ -70,8 +71,8 @@ def say_sample(sample) -> None:
 
 @click.group()
 def db():
-    """The database: apply or list the numbered SQL migrations; the URL in use, psql on it, and
-    stopping the embedded PostgreSQL."""
+    """The database: apply or list the numbered SQL migrations; the URL in use, psql on it,
+    stopping the embedded PostgreSQL; backing it up to a file and restoring it."""
 
 
 @db.command("migrate")
@@ -156,6 +157,50 @@ def db_stop():
         click.echo(f"stopped the embedded PostgreSQL (pid {state.pid}, data in {state.data_dir})")
     else:
         click.echo(f"the embedded PostgreSQL is not running (data in {state.data_dir}); nothing to stop")
+
+
+@db.command("backup")
+@click.argument("file", type=click.Path(dir_okay=False))
+@click.option("--force", is_flag=True, help="Replace FILE if it exists (in one step, once the dump is whole).")
+@click.pass_context
+def db_backup(ctx, file, force):
+    """Back up the database in use to FILE, in pg_dump's custom format, with the pg_dump of the
+    server's major version: the embedded package's own for the embedded server, else one on PATH
+    (or /usr/lib/postgresql/N/bin); none of that version is refused, naming the versions found.
+    The dump is written beside FILE and takes its name only when whole.
+
+    Example: engine db backup /srv/backup/engine-2026-11-29.dump
+    """
+    from pathlib import Path
+
+    from ..db.backup import backup
+    from ..db.connection import resolve_url
+
+    done = backup(resolve_url(ctx.obj["database_url"]), Path(file), force)
+    click.echo(f"backed up the database {done.database} to {done.file} ({done.size:,} bytes, "
+               f"pg_dump {done.tools.version}: {done.tools.pg_dump})")
+
+
+@db.command("restore")
+@click.argument("file", type=click.Path(dir_okay=False))
+@click.pass_context
+def db_restore(ctx, file):
+    """Restore a backup FILE of `engine db backup` into the database in use, which must be empty
+    (a new database: CREATE DATABASE, or a fresh ENGINE_DATA_DIR for the embedded server), in one
+    transaction, with the pg_restore of the server's major version. The backup's migrations must be
+    this installation's, unchanged; ones it lacks are then applied by `engine db migrate`.
+
+    Example: DATABASE_URL=postgresql://engine@dbhost/engine_restored engine db restore engine.dump
+    """
+    from pathlib import Path
+
+    from ..db.backup import restore
+    from ..db.connection import resolve_url
+
+    done = restore(resolve_url(ctx.obj["database_url"]), Path(file))
+    pending = f"; {done.pending} migration(s) pending: run `engine db migrate`" if done.pending else ""
+    click.echo(f"restored {done.file} into the database {done.database} (pg_restore {done.tools.version}: "
+               f"{done.tools.pg_restore}); its migrations match this installation's{pending}")
 
 
 @click.command("seed")

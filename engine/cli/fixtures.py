@@ -1,11 +1,9 @@
 """`engine fixtures …`: the work-holding library (list, import, match), issue 29."""
 from __future__ import annotations
 
-from dataclasses import asdict
-
 import click
 
-from .context import connection, emit_json
+from .context import connection, emit_json, record_dict
 from .ids import GEAR_ID
 from .output import Column, emit_list, list_options
 
@@ -31,33 +29,38 @@ def fixtures():
 @click.pass_context
 def fixtures_list(ctx, output):
     """Every work-holding of the library, one line each (kind, diameter and height under the gear, centre
-    diameter above, the machine it fits; empty: any).
+    diameter above, the machine it fits; empty: any). --csv and --json give every value as stored, in the
+    columns `engine fixtures import` reads: `engine fixtures import FILE --replace` takes the CSV back
+    unchanged.
 
     Example: engine fixtures list --csv > holdings.csv
     """
-    from ..machines.holding_library import list_holdings
+    from ..machines.holding_library import export_holdings, list_holdings
 
     with connection(ctx) as conn:
-        library = list_holdings(conn)
+        library = list_holdings(conn) if output is None else export_holdings(conn)
     emit_list(output, "fixtures", HOLDING_COLUMNS, library)
 
 
 @fixtures.command("import")
 @click.argument("csv_file", type=click.Path(dir_okay=False))
+@click.option("--replace", is_flag=True,
+              help="Replace each stored work-holding of the file whole: the file must give every column.")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object: {added: N, updated: N}.")
 @click.pass_context
-def fixtures_import(ctx, csv_file, as_json):
+def fixtures_import(ctx, csv_file, replace, as_json):
     """Add or update (by id) the work-holdings of CSV_FILE (columns of seed_templates/work_holdings.csv:
     id,kind,diameter,height,tailstock_diameter,machine); any bad row stops the whole file (nothing stored).
+    A work-holding a stored job is clamped on is changed in no column (give the changed one a new id).
 
-    Example: engine fixtures import holdings.csv
+    Example: engine fixtures import holdings.csv --replace
     """
     from ..machines.holding_library import import_holdings
 
     with connection(ctx) as conn:
-        result = import_holdings(conn, csv_file)
+        result = import_holdings(conn, csv_file, replace=replace)
     if as_json:
-        emit_json(asdict(result))
+        emit_json(record_dict(result))
     else:
         click.echo(f"{csv_file}: added {result.added} work-holding(s), updated {result.updated}")
 

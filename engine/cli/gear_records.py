@@ -21,10 +21,11 @@ GEAR_FIELDS = (
     Column("tip diameter", "tip_diameter"), Column("root diameter", "root_diameter"),
     Column("cone angle", "cone_angle"), Column("crowning", "crowning"), Column("material", "material"),
     Column("hardness", "hardness"), Column("quality grade", "quality_grade"), Column("quantity", "quantity"),
-    Column("stored", "created_at"),
+    Column("profile shift", "profile_shift"), Column("stored", "created_at"),
 )
 UNIT_COLUMNS = (Column("unit", "unit"), Column("z", "teeth"), Column("b", "face_width"),
                 Column("da", "tip_diameter"), Column("df", "root_diameter"), Column("z_top", "z_top"))
+IMPORTED_UNIT_COLUMNS = (Column("gear", "gear_id"), *UNIT_COLUMNS)   # the columns `engine gears units` reads
 JOB_COLUMNS = (Column("job", "job_id"), Column("class", "class"), Column("machine", "machine"),
                Column("hob", "hob_id"), Column("programs", "program_count"), Column("made", "created_at"),
                Column("confirmed", "confirmed_at"))
@@ -32,20 +33,34 @@ JOB_COLUMNS = (Column("job", "job_id"), Column("class", "class"), Column("machin
 
 @click.command("list")
 @click.option("--class", "gear_class", help="Only gears of this class.")
+@click.option("--units", is_flag=True,
+              help="List the gears' further toothed units instead (gear, unit, z, b, da, df, z_top).")
 @day_options("gears stored")
 @list_options("gears")
 @click.pass_context
-def gears_list(ctx, gear_class, since, until, output):
+def gears_list(ctx, gear_class, units, since, until, output):
     """The gears stored, one line each: class, module, teeth, helix angle, face width, material,
-    units, jobs, when stored.
+    units, jobs, when stored. --csv writes the file `engine gears import` reads: its columns
+    (gear_id, gear_class, … profile_shift), every value as stored, so `engine gears import FILE
+    --replace` takes it back unchanged; with --units, the file `engine gears units` reads.
 
-    Example: engine gears list --class spur --since 2026-01-01 --csv
+    Example: engine gears list --class spur --since 2026-01-01 --csv > gears.csv
     """
-    from ..gears.gear_records import list_gears
+    from ..gears import gear_records
 
+    listed = gear_records.export_units if units else gear_records.export_gears if output == "csv" \
+        else gear_records.list_gears
     with connection(ctx) as conn:
-        found = list_gears(conn, gear_class, day(since), day(until))
-    emit_list(output, "gears", GEAR_COLUMNS, found)
+        found = listed(conn, gear_class, day(since), day(until))
+    columns = IMPORTED_UNIT_COLUMNS if units else imported_columns() if output == "csv" else GEAR_COLUMNS
+    emit_list(output, "units" if units else "gears", columns, found)
+
+
+def imported_columns() -> tuple[Column, ...]:
+    """The columns of `engine gears import`, in its order: what --csv writes."""
+    from ..gears.gear_import import COLUMNS
+
+    return tuple(Column(column.name, column.name) for column in COLUMNS)
 
 
 @click.command("show")

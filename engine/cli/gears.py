@@ -51,9 +51,10 @@ def gears_units(ctx, csv_file):
 
     Columns: gear_id, unit (2: class duplex cuts two units per set-up, the gear row and unit 2),
     teeth, face_width, tip_diameter, root_diameter, z_top (Z of the unit's upper face; the gear's
-    top face is Z = 0). The units of each gear in the file replace its units; any bad row stops
-    the whole file. A line is printed for a gear whose class does not cut further units, and for
-    one with programs stored before."""
+    top face is Z = 0): the file `engine gears list --units --csv` writes. The units of each gear
+    in the file replace its units; any bad row stops the whole file. The units of a gear a stored
+    job was made from are replaced only by the same units (its programs were proved on them). A
+    line is printed for a gear whose class does not cut further units."""
     from ..gears.units import import_units_noting
 
     with connection(ctx) as conn:

@@ -1,11 +1,9 @@
 """`engine hobs …`: the hob library (list, show, add, import, delete, match)."""
 from __future__ import annotations
 
-from dataclasses import asdict
-
 import click
 
-from .context import connection, emit_json
+from .context import connection, emit_json, keyed, record_dict
 from .ids import GEAR_ID
 from .output import Column, emit_list, emit_record, list_options
 
@@ -38,18 +36,21 @@ def hobs():
 @click.pass_context
 def hobs_list(ctx, output):
     """Every hob of the library, one line each (module, α, starts, da0, length, hand, class, ...).
+    --csv writes the file `engine hobs import` reads (its columns, id first; every value as stored),
+    which `engine hobs import FILE --replace` takes back unchanged; --json the same fields, the id
+    as hob_id.
 
-    Example: engine hobs list --csv
+    Example: engine hobs list --csv > hobs.csv
     """
+    from ..gears.hob_library import export_hobs
     from ..gears.hob_records import hob_records
 
     with connection(ctx) as conn:
-        library = hob_records(conn)
+        library = hob_records(conn) if output is None else export_hobs(conn)
     if output == "csv":   # the columns `hobs import` reads: its id column is `id`
-        library, columns = [{"id": hob["hob_id"], **hob} for hob in library], (Column("id", "id"), *HOB_COLUMNS[1:])
-        emit_list(output, "hobs", columns, library)
+        emit_list(output, "hobs", (Column("id", "id"), *HOB_COLUMNS[1:]), library)
     else:
-        emit_list(output, "hobs", HOB_COLUMNS, library)
+        emit_list(output, "hobs", HOB_COLUMNS, [keyed(hob, id="hob_id") for hob in library] if output else library)
 
 
 @hobs.command("show")
@@ -122,22 +123,26 @@ def hobs_add(ctx, hob_id, module, pressure_angle, starts, tip_diameter, length, 
 
 @hobs.command("import")
 @click.argument("csv_file", type=click.Path(dir_okay=False))
+@click.option("--replace", is_flag=True,
+              help="Replace each stored hob of the file whole: the file must give every column.")
 @click.option("--json", "as_json", is_flag=True,
               help="Print one JSON object: {added: N, updated: N, kept: [columns]}.")
 @click.pass_context
-def hobs_import(ctx, csv_file, as_json):
+def hobs_import(ctx, csv_file, replace, as_json):
     """Add or update (by id) the hobs of CSV_FILE (the columns of `engine hobs list --csv`);
     any bad row stops the whole file (nothing stored). A hob already in the library is updated
     in the columns the file gives only: a column the file leaves out (an older file without
-    tool_number, gashes or profile) keeps each hob's own value, and the output names it.
+    tool_number, gashes or profile) keeps each hob's own value, and the output names it; with
+    --replace a column left out is refused. A hob a stored job was made with is changed in no
+    column (give the changed hob a new id): its programs were proved on it.
 
-    Example: engine hobs list --csv > hobs.csv; (edit); engine hobs import hobs.csv"""
+    Example: engine hobs list --csv > hobs.csv; (edit); engine hobs import hobs.csv --replace"""
     from ..gears.hob_library import import_hobs
 
     with connection(ctx) as conn:
-        result = import_hobs(conn, csv_file)
+        result = import_hobs(conn, csv_file, replace=replace)
     if as_json:
-        emit_json(asdict(result))
+        emit_json(record_dict(result))
     else:
         kept = f" (not in the file, kept as they were: {', '.join(result.kept)})" if result.kept else ""
         click.echo(f"{csv_file}: added {result.added} hob(s), updated {result.updated}{kept}")

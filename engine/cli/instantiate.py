@@ -2,11 +2,11 @@
 from __future__ import annotations
 
 import re
-from dataclasses import replace
 from functools import partial
 from typing import TYPE_CHECKING
 
 import click
+from msgspec.structs import replace
 
 from ..errors import EngineError
 from .context import connection, emit_json, settings
@@ -47,9 +47,12 @@ def parse_range(text: str, option: str = "--gears") -> tuple[int, int]:
 @click.option("--jobs", "job_range", help="Batch: stored job ids FIRST-LAST made again with their stored parameters.")
 @click.option("--all", "all_gears", is_flag=True, help="Batch: every gear.")
 @click.option("--out", type=click.Path(), help="Write the .MPF file here after the programs are committed: a "
-              "batch always into this folder (made if missing), one program into it if it is a folder or ends with /.")
+              "batch always into this folder, one program into it if it is a folder or ends with /. The folder "
+              "must exist (else nothing is stored) unless --mkdir.")
 @click.option("--force", is_flag=True,
               help="Replace files that exist in --out, each in one step (else nothing is stored).")
+@click.option("--mkdir", is_flag=True, help="Create the folder of --out (or of the config file's machine folder) "
+              "and the folders above it if missing; without it a missing folder is refused (a typo in a path).")
 @click.option("--machine", help="Machine record (default: the config file's machine, else hobber-840d for a "
               "gear; with --class one must be named).")
 @click.option("--cuts", type=click.IntRange(1, 2), help="1 = single cut, 2 = rough then finish (default by module).")
@@ -87,7 +90,7 @@ def parse_range(text: str, option: str = "--gears") -> tuple[int, int]:
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object (program_id, path, lines, ...).")
 @click.pass_context
 def instantiate(ctx, gear_id, job_id, gear_class, params_file, unverified, gear_range, job_range, all_gears, out,
-                force, machine, cuts, coolant, shift_y, shift_per_part, feed_mode, tailstock, fixture, worm_feed,
+                force, mkdir, machine, cuts, coolant, shift_y, shift_per_part, feed_mode, tailstock, fixture, worm_feed,
                 allowance, hob_speed, workers, explain, draft, dry_run, skip_bad, as_json):
     """Produce the NC program of a gear (or a stored job, a job of an imported class, or a batch of gears).
 
@@ -102,7 +105,7 @@ def instantiate(ctx, gear_id, job_id, gear_class, params_file, unverified, gear_
     input, or any bad gear or job without --skip-bad, or none good: nothing
     stored; 2: a bug; 3: stored, but the files not written (the error names the
     programs and the files; the files there are as they were, or it says which
-    were replaced).
+    were replaced); 130: interrupted with Ctrl-C (workers too), nothing stored.
 
     --class C --params P.json makes a job of a class without a model (engine
     import-nc) on a lathe: its program is read by the machine's verifier, and
@@ -136,6 +139,8 @@ def instantiate(ctx, gear_id, job_id, gear_class, params_file, unverified, gear_
     overrides = {"hob_speed": hob_speed}
     config = settings(ctx)   # the config file: the machine's output folder and line endings (over the class's)
     output = _output(config, machine, out, force, new_job_written=not (dry_run or job_id is not None or job_range))
+    output = replace(output, mkdir=where_it_applies(ctx, "mkdir", mkdir, not mkdir or output.out is not None,
+                                                    "--mkdir creates the folder of --out: give --out too"))
     skip_bad = where_it_applies(ctx, "skip_bad", skip_bad, not skip_bad or batch,
                                 "--skip-bad skips the bad gears of a batch: use it with --gears, --jobs or --all")
     mode = RunMode(draft=draft, dry_run=dry_run, skip_bad=skip_bad, workers=workers)

@@ -5,9 +5,8 @@ of the record, as `engine machines import` reads it. `engine machines import`: n
 from such a file (engine.machines.importing)."""
 from __future__ import annotations
 
-from dataclasses import asdict, fields
-
 import click
+from msgspec.structs import asdict
 
 from .context import connection, emit_json
 from .output import Column, csv_text, emit_list, list_options
@@ -25,7 +24,7 @@ def every_column() -> tuple[Column, ...]:
     """The record's every field, as --csv writes it and `engine machines import` reads it."""
     from ..machines.records import Machine
 
-    return tuple(Column(spec.name, spec.name) for spec in fields(Machine))
+    return tuple(Column(name, name) for name in Machine.__struct_fields__)
 
 
 @click.group("machines")

@@ -1,11 +1,9 @@
 """`engine import-nc`: bring a proven NC program in as the standard code of a class."""
 from __future__ import annotations
 
-from dataclasses import asdict
-
 import click
 
-from .context import connection, emit_json, keyed
+from .context import connection, emit_json, keyed, record_dict
 
 
 @click.command("import-nc")
@@ -38,7 +36,7 @@ def import_nc_command(ctx, nc_file, gear_class, params_file, modules_file, paren
     with connection(ctx) as conn:
         report = import_nc(conn, nc_file, gear_class, params, modules, parent)
     if as_json:
-        emit_json(keyed(asdict(report)))
+        emit_json(keyed(record_dict(report)))
         return
     modules_text = ", ".join(f"{t} {count}" for t, count in report.modules.items())
     state = "created" if report.created else ("replaced" if report.changed else "unchanged (identical rows)")

@@ -8,13 +8,14 @@ from __future__ import annotations
 import functools
 import re
 from collections.abc import Callable
-from dataclasses import dataclass
 from datetime import date, datetime
+from decimal import Decimal
 from typing import Any
 
 import click
+import msgspec
 
-from .context import emit_json
+from .context import emit_json, exact_json
 
 
 def cell(value: Any) -> str:
@@ -31,10 +32,13 @@ def cell(value: Any) -> str:
 
 
 def csv_cell(value: Any) -> Any:
-    """A value as a CSV cell holds it: empty for none, times in ISO 8601, numbers in full, text
+    """A value as a CSV cell holds it: empty for none, times in ISO 8601, numbers in full (a numeric
+    column's value digit for digit as stored: 0.0000001, never 1E-7, which the importers refuse), text
     that a spreadsheet would run as a formula quoted (inert_text)."""
     if value is None:
         return ""
+    if isinstance(value, Decimal):
+        return format(value, "f")
     if isinstance(value, (list, tuple)):   # e.g. the classes a row is shared with: one cell, space-separated
         return inert_text(" ".join(str(item) for item in value))
     if isinstance(value, str):
@@ -57,8 +61,7 @@ def inert_text(text: str) -> str:
     return f"'{text}" if formula else text
 
 
-@dataclass(frozen=True)
-class Column:
+class Column(msgspec.Struct, frozen=True):
     """One column of a list: its heading in the table, the record's key (also the CSV header),
     and how a table shows the value."""
     heading: str
@@ -116,7 +119,7 @@ def one_of(ctx: click.Context, flags: dict[str, bool]) -> str | None:
 def emit_list(output: str | None, things: str, columns: tuple[Column, ...], records: list[dict]) -> None:
     """The records in the form asked for; the table's count goes to stderr."""
     if output == "json":
-        emit_json({things: records})
+        click.echo(exact_json({things: records}))
     elif output == "csv":
         click.echo(csv_text(columns, records), nl=False)
     else:

@@ -6,8 +6,9 @@ import sys
 
 import click
 
+from ..errors import EngineError
 from ..nc.layout import ENDING_NAMES, NcLayout
-from .context import connection, emit_json
+from .context import connection, emit_json, file_folder
 from .ids import VERSION
 from .output import Column, emit_list, list_options
 from .refactor import template_shared
@@ -45,9 +46,11 @@ def template_list(ctx, output):
 
 @template.command("export")
 @click.option("--class", "gear_class", required=True, help="Gear class name.")
-@click.option("--out", type=click.Path(dir_okay=False), help="Write to this file instead of stdout.")
+@click.option("--out", type=click.Path(dir_okay=False), help="Write to this file instead of stdout; its folder "
+              "must exist unless --mkdir.")
+@click.option("--mkdir", is_flag=True, help="Create the folder of --out (and those above it) if missing.")
 @click.pass_context
-def template_export(ctx, gear_class, out):
+def template_export(ctx, gear_class, out, mkdir):
     """Print the class's assembled template as CSV. A class whose programs are written other than
     LF with a final newline (imported from such a file) gives that on every row (line_ending
     lf|crlf, final_newline yes|no), so an import elsewhere writes the same bytes."""
@@ -58,10 +61,20 @@ def template_export(ctx, gear_class, out):
     with connection(ctx) as conn:
         text = export_csv(load_template(conn, gear_class), class_layout(conn, gear_class))
     if out:
-        with open(out, "w", encoding="utf-8", newline="") as file:
-            file.write(text)
+        _write_export(out, text, mkdir)
     else:
         click.echo(text, nl=False)
+
+
+def _write_export(out: str, text: str, mkdir: bool) -> None:
+    """The exported CSV written to --out, into an existing folder (or one --mkdir makes)."""
+    file_folder(out, mkdir)
+    try:
+        with open(out, "w", encoding="utf-8", newline="") as file:
+            file.write(text)
+    except OSError as error:
+        raise EngineError(f"--out {out}: cannot be written ({error.strerror or error}); give a file you can "
+                          "write") from None
 
 
 @template.command("import")

@@ -2,7 +2,6 @@
 from __future__ import annotations
 
 import math
-from dataclasses import asdict
 
 import click
 
@@ -14,7 +13,7 @@ from ..machines.turning_cutting import (
     WORKPIECE_MATERIALS,
 )
 from ..turning.defaults import DEFAULT_LATHE, PROFILE_DEFAULTS, STOCK_MARGIN
-from .context import connection, emit_json, keyed
+from .context import connection, emit_json, keyed, record_dict
 
 
 class FiniteFloatRange(click.FloatRange):
@@ -92,7 +91,7 @@ def import_dxf_command(ctx, dxf_file, machine, rough_depth, allowance, tool, spe
         report = import_dxf(conn, dxf_file, machine, options, parse_pair(alternate), program_name, draft,
                             profile_layer, (tool_material, material))
     if as_json:
-        emit_json(keyed(asdict(report)))
+        emit_json(keyed(record_dict(report)))
         return
     click.echo(f"job {report.job_id}")
     click.echo(f"  {report.drawing} → {report.gear_class} on {report.machine}, {report.program_lines} program lines",

@@ -13,10 +13,11 @@ import os
 import shutil
 import subprocess
 import warnings
-from dataclasses import dataclass
 from pathlib import Path
 from types import TracebackType
 from typing import TYPE_CHECKING, Any
+
+import msgspec
 
 from ..errors import EngineError
 
@@ -121,8 +122,7 @@ def _create_database(admin_url: str, database: str) -> None:
                 pass  # created concurrently by another process
 
 
-@dataclass(frozen=True)
-class ServerState:
+class ServerState(msgspec.Struct, frozen=True):
     data_dir: Path
     pid: int | None     # the postmaster's process, None when not running
 

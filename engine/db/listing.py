@@ -3,10 +3,11 @@ records with the common key names, filters that are absent when not given, and d
 only when nothing refers to it."""
 from __future__ import annotations
 
-from dataclasses import dataclass
 from datetime import date
 from decimal import Decimal
 from typing import TYPE_CHECKING, Any
+
+import msgspec
 
 from ..errors import EngineError
 from .connection import scalar
@@ -32,6 +33,13 @@ def records(cursor: Cursor[TupleRow]) -> list[dict[str, Any]]:
     return [{name: plain(value) for name, value in zip(names, row)} for row in cursor]
 
 
+def exact_records(cursor: Cursor[TupleRow]) -> list[dict[str, Any]]:
+    """The cursor's rows as dicts keyed by the column names, each value as stored (numeric as the
+    Decimal of its digits): what an export writes, so that its import stores the same numbers."""
+    names = [column.name for column in cursor.description or ()]
+    return [dict(zip(names, row)) for row in cursor]
+
+
 def one_record(cursor: Cursor[TupleRow], kind: str, key: Any, listing: str) -> dict[str, Any]:
     """The one row found, or EngineError naming the thing and the list that shows what exists."""
     found = records(cursor)
@@ -53,15 +61,13 @@ def require_class(conn: Connection, name: str | None) -> None:
         raise EngineError(f"class {name!r} does not exist; `engine template list` shows the classes")
 
 
-@dataclass(frozen=True)
-class Reference:
+class Reference(msgspec.Struct, frozen=True):
     """Rows that refer to a row and keep it from being deleted: what they are, how to count them."""
     what: str        # "job", "golden test": the refusal names them (and adds an s for more than one)
     count_sql: str   # one bound parameter: the row's id
 
 
-@dataclass(frozen=True)
-class Deletion:
+class Deletion(msgspec.Struct, frozen=True):
     """How one kind of row is deleted: its lock (FOR UPDATE, so no reference can be added between
     the count and the delete), what refers to it, and the delete itself."""
     kind: str

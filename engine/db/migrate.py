@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import hashlib
 import re
-from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+import msgspec
 from psycopg import sql
 
 from ..errors import EngineError
@@ -38,8 +38,7 @@ CREATE TABLE IF NOT EXISTS schema_migration (
 )"""
 
 
-@dataclass(frozen=True)
-class Migration:
+class Migration(msgspec.Struct, frozen=True):
     """A migration file NNNN.slug.sql of this installation."""
     version: str
     name: str
@@ -54,8 +53,7 @@ class Migration:
         return hashlib.sha256(self.path.read_bytes()).hexdigest()
 
 
-@dataclass(frozen=True)
-class MigrationState:
+class MigrationState(msgspec.Struct, frozen=True):
     """A migration and whether (and when) the database applied it, and whether its file changed since."""
     migration: Migration
     applied_at: object | None  # datetime when applied
@@ -129,7 +127,7 @@ def _apply_pending(conn: Connection, directory: Path | None) -> list[Migration]:
         )
     done: list[Migration] = []
     if any(state.applied_at is None for state in states):
-        _create_cluster_roles(conn)
+        create_cluster_roles(conn)
     for state in states:
         if state.applied_at is None:
             _apply(conn, state.migration)
@@ -137,7 +135,7 @@ def _apply_pending(conn: Connection, directory: Path | None) -> list[Migration]:
     return done
 
 
-def _create_cluster_roles(conn: Connection) -> None:
+def create_cluster_roles(conn: Connection) -> None:
     """Each missing role of CLUSTER_ROLES created and committed alone (the connection is in
     autocommit); one created meanwhile by another database's migration is left as it is."""
     import psycopg

@@ -11,7 +11,8 @@ from __future__ import annotations
 
 import re
 from collections.abc import Callable
-from dataclasses import dataclass
+
+import msgspec
 
 from .read import DxfError
 
@@ -20,8 +21,7 @@ CODE = re.compile(r"@([A-Za-z])\s*[:=]?\s*([^@\s]*)")
 NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)")
 
 
-@dataclass(frozen=True)
-class CodeRule:
+class CodeRule(msgspec.Struct, frozen=True):
     key: str
     meaning: str
     parse: Callable[[str], object]
@@ -79,8 +79,7 @@ CODE_RULES: dict[str, CodeRule] = {
 }
 
 
-@dataclass(frozen=True)
-class CodeText:
+class CodeText(msgspec.Struct, frozen=True):
     """One TEXT/MTEXT of a layer: its handle and plain text."""
     layer: str
     handle: str

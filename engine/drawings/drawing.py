@@ -12,9 +12,10 @@ the drawing's length unit.
 from __future__ import annotations
 
 from collections import Counter, defaultdict
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import NamedTuple
+
+import msgspec
 
 from ..memory import no_cycle_collection
 from .codes import CodeText, layer_codes
@@ -55,8 +56,7 @@ class MachinePoint(NamedTuple):
         return 2.0 * self.radius
 
 
-@dataclass
-class Operation:
+class Operation(msgspec.Struct):
     """One operation layer: number n (= its order and tool by convention), kind (@G), the
     other @-codes by name, and its tool-centre path chained into paths (mm, z/radius)."""
     layer: str
@@ -70,8 +70,7 @@ class Operation:
         return [segment for path in self.paths for segment in path]
 
 
-@dataclass
-class Drawing:
+class Drawing(msgspec.Struct):
     """A drawing that can become a job. repairs: what the tolerant reader and the auditor
     fixed in the file; notes: what the reader assumed or left out (units, other layers,
     entity types without geometry, chains on layer 0 besides the profile)."""
@@ -81,30 +80,28 @@ class Drawing:
     profile: Profile
     operations: list[Operation]
     tool_change: MachinePoint | None
-    repairs: list[str] = field(default_factory=list)
-    notes: list[str] = field(default_factory=list)
+    repairs: list[str] = []
+    notes: list[str] = []
 
 
-@dataclass
-class LayerContent:
-    segments: list[Segment] = field(default_factory=list)
-    centre: list[Segment] = field(default_factory=list)   # drawn in a centre-line linetype
+class LayerContent(msgspec.Struct):
+    segments: list[Segment] = []
+    centre: list[Segment] = []   # drawn in a centre-line linetype
     entities: int = 0
-    texts: list[CodeText] = field(default_factory=list)
-    points: list[tuple[str, tuple[float, float]]] = field(default_factory=list)
+    texts: list[CodeText] = []
+    points: list[tuple[str, tuple[float, float]]] = []
 
 
-@dataclass
-class Collected:
-    layers: dict[str, LayerContent] = field(default_factory=lambda: defaultdict(LayerContent))
-    skipped: Counter = field(default_factory=Counter)
-    other_layers: Counter = field(default_factory=Counter)
+class Collected(msgspec.Struct):
+    layers: dict[str, LayerContent] = msgspec.field(default_factory=lambda: defaultdict(LayerContent))
+    skipped: Counter = msgspec.field(default_factory=Counter)
+    other_layers: Counter = msgspec.field(default_factory=Counter)
     profile_layer: str | None = PROFILE_LAYER   # None: every layer is collected, the profile's chosen after
-    linetypes: dict[str, str] = field(default_factory=dict)   # layer name (upper case) → its linetype
-    centre_lines: list[Line] = field(default_factory=list)
-    hidden: Counter = field(default_factory=Counter)
-    hidden_lines: list[Segment] = field(default_factory=list)
-    hatches: list[list[tuple[float, float]]] = field(default_factory=list)
+    linetypes: dict[str, str] = {}   # layer name (upper case) → its linetype
+    centre_lines: list[Line] = []
+    hidden: Counter = msgspec.field(default_factory=Counter)
+    hidden_lines: list[Segment] = []
+    hatches: list[list[tuple[float, float]]] = []
 
 
 def read_drawing(path: str | Path, profile_layer: str | None = None) -> Drawing:

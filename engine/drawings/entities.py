@@ -12,7 +12,8 @@ from __future__ import annotations
 import contextlib
 import math
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass
+
+import msgspec
 
 from .geometry import Arc, Line, Point, Segment
 from .read import DxfError, one_line
@@ -31,8 +32,7 @@ DEGENERATE_LENGTH = 1e-9
 MAX_COORDINATE_MM = 1_000_000.0
 
 
-@dataclass(frozen=True)
-class Context:
+class Context(msgspec.Struct, frozen=True):
     sagitta: float  # FLATTEN_TOLERANCE_MM in drawing units
     handle: str = ""  # handle of the top-level entity (virtual block content has none)
     reach: float = MAX_COORDINATE_MM  # MAX_COORDINATE_MM in drawing units

@@ -11,7 +11,8 @@ envelope are pieces of the drawn ones, so a finish pass along it is on the drawi
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+
+import msgspec
 
 from .geometry import Arc, Line, Segment
 from .profile import END_MATCH_TOLERANCE_MM, sweep
@@ -21,8 +22,7 @@ SAME_Z = 1e-7          # breakpoints closer than this (mm) are one
 ON_PIECE = 1e-4        # two pieces this close (mm) at a bisected Z meet there
 
 
-@dataclass(frozen=True)
-class Piece:
+class Piece(msgspec.Struct, frozen=True):
     """A part of a drawn line or arc over which the radius is a function of Z: z0 < z1.
     centre/radius/upper describe an arc piece (upper: on the upper half of its circle)."""
     z0: float

@@ -3,13 +3,13 @@ models (engine.turning): points, lines and circular arcs in drawing units, from 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+
+import msgspec
 
 Point = tuple[float, float]
 
 
-@dataclass(frozen=True, slots=True)
-class Line:
+class Line(msgspec.Struct, frozen=True):
     start: Point
     end: Point
     handle: str = ""
@@ -18,8 +18,7 @@ class Line:
         return Line(self.end, self.start, self.handle)
 
 
-@dataclass(frozen=True, slots=True)
-class Arc:
+class Arc(msgspec.Struct, frozen=True):
     """A circular arc from start to end about centre; ccw: counter-clockwise seen from +Z."""
     start: Point
     end: Point

@@ -14,7 +14,8 @@ import bisect
 import math
 from collections import Counter
 from collections.abc import Callable
-from dataclasses import dataclass
+
+import msgspec
 
 from .envelope import SAME_Z, pieces_of, upper_envelope
 from .geometry import Arc, Line, Segment
@@ -32,8 +33,7 @@ NAMED_HANDLES = 6
 MIRROR_OVERLAP = 0.9       # share of a thread root's length its mirror image below the axis covers
 
 
-@dataclass(frozen=True)
-class Frame:
+class Frame(msgspec.Struct, frozen=True):
     """A side view about its axis: its outline (upper envelope) and where its end faces are."""
     outline: list[Segment]
     z_min: float

@@ -10,8 +10,9 @@ layer name, both compared in upper case).
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
 from functools import lru_cache
+
+import msgspec
 
 from .profile import END_MATCH_TOLERANCE_MM, chain_segments
 from .read import DxfError
@@ -22,8 +23,7 @@ CENTRE, HIDDEN = "centre line", "hidden line"
 MAX_CHOICE_SEGMENTS = 20_000
 
 
-@dataclass(frozen=True)
-class LineRole:
+class LineRole(msgspec.Struct, frozen=True):
     role: str
     linetype_words: tuple[str, ...]   # a linetype whose name contains one of these
     layer_words: tuple[str, ...]      # a layer whose name contains one of these

@@ -25,9 +25,10 @@ from __future__ import annotations
 import math
 from collections import defaultdict
 from collections.abc import Sequence
-from dataclasses import dataclass
 from functools import cached_property
 from typing import overload
+
+import msgspec
 
 from .geometry import Arc, Line, Point, Segment
 from .read import DxfError
@@ -112,8 +113,7 @@ def signed_area(segments: Sequence[Segment]) -> float:
     return area
 
 
-@dataclass
-class Chain:
+class Chain(msgspec.Struct, dict=True):   # dict: room for the cached properties
     """Segments joined end to start, in order."""
     segments: list[Segment]
     closed: bool
@@ -203,8 +203,7 @@ def grown_chain(first: int, index: EndIndex, tolerance: float) -> Chain:
     return Chain(backward[::-1] + forward, False)
 
 
-@dataclass
-class Profile:
+class Profile(msgspec.Struct):
     """The part outline in machine coordinates (z, radius) in mm, oriented for turning.
 
     closed_by_axis: the segments are an open half-profile; the radial lines from its ends
@@ -232,8 +231,7 @@ class Profile:
         return [Line(a, b) for a, b in zip(corners, corners[1:]) if math.dist(a, b) > END_MATCH_TOLERANCE_MM]
 
 
-@dataclass
-class Candidate:
+class Candidate(msgspec.Struct):
     chain: Chain  # as drawn; mirrored onto the axis only once chosen
     mirrored: bool
     closed_by_axis: bool

@@ -11,9 +11,10 @@ from __future__ import annotations
 import contextlib
 import logging
 import re
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
+
+import msgspec
 
 if TYPE_CHECKING:   # ezdxf takes a third of a second to import: only reading a drawing pays it
     from ezdxf.document import Drawing as EzdxfDocument
@@ -34,12 +35,11 @@ class DxfError(EngineError):
     """A drawing that cannot become a job; the message names the file, layer, handle or text."""
 
 
-@dataclass
-class DrawingFile:
+class DrawingFile(msgspec.Struct):
     """An opened drawing: the ezdxf document and what the reader repaired or assumed."""
     path: Path
     doc: EzdxfDocument
-    repairs: list[str] = field(default_factory=list)
+    repairs: list[str] = []
 
 
 def load_drawing_file(path: str | Path) -> DrawingFile:

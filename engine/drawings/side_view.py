@@ -15,7 +15,8 @@ from __future__ import annotations
 
 import math
 from collections import defaultdict
-from dataclasses import dataclass, field
+
+import msgspec
 
 from .envelope import upper_envelope
 from .geometry import Arc, Line, Segment
@@ -33,8 +34,7 @@ GRID_CELLS = 100           # cells across the drawing for finding mirrored point
 MAX_SYMMETRY_SEGMENTS = 5000   # a drawing of more pieces is no single part's side view
 
 
-@dataclass(frozen=True)
-class Axis:
+class Axis(msgspec.Struct, frozen=True):
     """A centre line in drawing coordinates (mm): horizontal at y = offset, or vertical at x = offset."""
     vertical: bool
     offset: float
@@ -51,13 +51,12 @@ class Axis:
         return Arc(self.point(s.start), self.point(s.end), self.point(s.centre), s.ccw != self.vertical, s.handle)
 
 
-@dataclass
-class Marks:
+class Marks(msgspec.Struct):
     """What is drawn besides the outline, in mm: centre lines, hatching (boundary polygons) and
     hidden lines, from every layer."""
-    centre_lines: list[Line] = field(default_factory=list)
-    hatches: list[list[tuple[float, float]]] = field(default_factory=list)
-    hidden: list[Segment] = field(default_factory=list)
+    centre_lines: list[Line] = []
+    hatches: list[list[tuple[float, float]]] = []
+    hidden: list[Segment] = []
 
     def near(self, view: list[Segment]) -> Marks:
         """The hatching and hidden lines within the view's extents."""
@@ -67,8 +66,7 @@ class Marks:
         return Marks(self.centre_lines, hatches, [s for s in self.hidden if boxes_touch(box, bounds(s))])
 
 
-@dataclass
-class SideView:
+class SideView(msgspec.Struct):
     profile: Profile
     notes: list[str]
 

@@ -14,7 +14,7 @@ there and is refused: the user rotates (and moves) the drawing, the engine does 
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+import msgspec
 
 from .geometry import Arc, Line, Point, Segment
 from .profile import END_MATCH_TOLERANCE_MM, Profile, chain_segments, find_profile, merged_bounds
@@ -26,8 +26,7 @@ AXIS_EDGE_SHARE = 0.9
 ROTATE = "the axis looks vertical: rotate the drawing so the part's axis lies along drawing Y 0"
 
 
-@dataclass(frozen=True)
-class VerticalReading:
+class VerticalReading(msgspec.Struct, frozen=True):
     profile: Profile
     notes: list[str]
 

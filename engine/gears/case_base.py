@@ -13,8 +13,9 @@ from __future__ import annotations
 
 import heapq
 import math
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
+
+import msgspec
 
 from ..errors import EngineError
 from .cutting_data import (
@@ -56,8 +57,7 @@ CASE_COLUMNS = ("id", "module", "teeth", "material", "hardness", "quality_grade"
 LOAD_CASES = f"SELECT {', '.join(CASE_COLUMNS)} FROM cutting_case ORDER BY id"   # static column list
 
 
-@dataclass(frozen=True)
-class KindProposal:
+class KindProposal(msgspec.Struct, frozen=True):
     """The cutting speed and feeds proposed for one cut kind (rough, finish), and the cases they came from."""
     cut: str
     cutting_speed: float     # m/min
@@ -162,8 +162,7 @@ def bounded_proposal(proposal: KindProposal, gear, hob) -> tuple[KindProposal, s
                      f"bounded to {limit:.2f}, the {why}; radial feed scaled alike to {lowered.radial_feed:.2f}")
 
 
-@dataclass(frozen=True)
-class _Case:
+class _Case(msgspec.Struct, frozen=True):
     """A cutting case of the history as the nearest-neighbour search reads it: its features and per-revolution feeds."""
     position: int            # in CaseBase.records
     id: int

@@ -8,22 +8,17 @@ cutting speed v = π·d_a0·n0/1000 and the feeds per workpiece revolution f = v
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+import msgspec
 import pandas as pd
 import psycopg
+from msgspec.structs import replace
 from psycopg import sql
 
 from ..csv_reader import (
-    Column,
     CsvError,
-    CsvKind,
-    parse_number,
-    parse_positive_whole,
-    parse_text,
-    parse_whole,
     read_csv_file,
     refuse,
 )
@@ -41,6 +36,7 @@ from .case_base import (
     feeds_per_minute,
     feeds_per_rev,
 )
+from .case_import import CASE_KIND, FEATURE_COLUMNS, VALUE_COLUMNS
 from .cutting_data import CuttingData
 from .hob_matching import choose_hob
 from .models import model_for_class
@@ -50,21 +46,9 @@ from .speed_table import SPEEDS, TOOLS, tool_of
 if TYPE_CHECKING:
     from ..db.connection import Connection
 
-FEATURE_COLUMNS = ("module", "teeth", "material", "hardness", "quality_grade", "hob_material",
-                   "hob_coating", "hob_starts", "hob_tip_diameter")
-VALUE_COLUMNS = ("hob_speed", "axial_feed", "radial_feed")   # r/min, mm/min, mm/min
 FLOAT_COLUMNS = ("module", "hardness", "hob_tip_diameter", *VALUE_COLUMNS)
 INTEGER_COLUMNS = ("teeth", "quality_grade", "hob_starts", "job_id")
 SEED_FILE = SEED_DIR / "cases.csv"
-_TYPES = {"module": (parse_number, "mm"), "teeth": (parse_positive_whole, ""), "hardness": (parse_number, "HB"),
-          "quality_grade": (parse_whole, ""), "hob_starts": (parse_positive_whole, ""),
-          "hob_tip_diameter": (parse_number, "mm"), "hob_speed": (parse_number, "r/min"),
-          "axial_feed": (parse_number, "mm/min"), "radial_feed": (parse_number, "mm/min")}
-CASE_KIND = CsvKind("case", tuple(
-    Column(name, _TYPES.get(name, (parse_text, ""))[0],
-           required=name not in ("hob_coating", "source", "hardness", "quality_grade"),
-           unit=_TYPES.get(name, (parse_text, ""))[1])
-    for name in (*FEATURE_COLUMNS, "cut", *VALUE_COLUMNS, "source")))
 
 # Typical axial feed per workpiece revolution [mm/rev], single-start hob, steel, wet (§C):
 # the first row whose module is at least the gear's (the last row beyond).
@@ -75,15 +59,14 @@ AXIAL_FEED_RANGE = pd.DataFrame([
 CUTTING = {"rough": "roughing", "finish": "finishing"}
 
 
-@dataclass(frozen=True)
-class Suggestion:
+class Suggestion(msgspec.Struct, frozen=True):
     gear: Gear
     hob: Hob
     machine: Machine
     cutting: CuttingData
     cases: pd.DataFrame                  # the nearest cases per cut kind, with `distance`
     proposals: dict                      # cut kind -> KindProposal
-    notes: list = field(default_factory=list)
+    notes: list = []
     hob_reason: str = ""
 
     def feeds(self, cut: str) -> dict:

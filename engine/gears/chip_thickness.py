@@ -15,7 +15,8 @@ z0), which is why its chips thicken: this replaces the engine's former ÷√z0 r
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+
+import msgspec
 
 # The thickest chip an HSS hob should cut in steel [mm]: 0.20–0.25 mm is the range commonly
 # given for HSS hobs (Klocke/Brecher; hob makers' guides) [K]; the engine takes the lower end,
@@ -25,8 +26,7 @@ FEED_EXPONENT = 0.511          # of f_a/m_n in Hoffmeister's formula
 TOOTH_DEPTH = 2.25             # T = 2.25·m_n: the standard whole tooth depth (§B15), the least T taken
 
 
-@dataclass(frozen=True)
-class ChipCase:
+class ChipCase(msgspec.Struct, frozen=True):
     """What Hoffmeister's formula reads of a gear, a hob and a cut."""
     module: float             # m_n [mm]
     teeth: int                # z2

@@ -17,8 +17,9 @@ from __future__ import annotations
 
 import re
 from collections.abc import Callable, Collection, Mapping
-from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, cast
+
+import msgspec
 
 from ..errors import EngineError
 from .hob_matching import choose_hob
@@ -31,8 +32,7 @@ if TYPE_CHECKING:
 DEFAULT_CLASS = "spur"
 
 
-@dataclass(frozen=True)
-class Rule:
+class Rule(msgspec.Struct, frozen=True):
     """If `field` of the gear is given and `holds` for its value, the gear is `gear_class`."""
 
     question: str
@@ -81,16 +81,18 @@ def looks_like_worm_wheel(gear: Mapping[str, Any]) -> str | None:
 # class a rule found -> (question, the signs that the gear is another class instead, that class)
 ASK_INSTEAD = {"helical": ("does it look like a worm wheel?", looks_like_worm_wheel, "worm_wheel")}
 
+# What to do when no class fits: the usual remedy (a conflict of features may name another one)
+NAME_THE_CLASS = "give gear_class explicitly"
 
-@dataclass(frozen=True)
-class Classification:
+
+class Classification(msgspec.Struct, frozen=True):
     """The leaf class a gear falls in (None: no class fits, see `problem`), and the
     questions and answers that led there."""
 
     gear_class: str | None
-    path: list[tuple[str, str]] = field(default_factory=list)
+    path: list[tuple[str, str]] = []
     problem: str | None = None
-    remedy: str = "give gear_class explicitly"
+    remedy: str = NAME_THE_CLASS
 
     def explain(self) -> str:
         """One line: `question? no → question? yes → helical`."""
@@ -163,8 +165,7 @@ def classify_installed(gear: Mapping[str, Any], installed: Collection[str]) -> C
     return classification
 
 
-@dataclass(frozen=True)
-class GearClassReport:
+class GearClassReport(msgspec.Struct, frozen=True):
     """What `engine classify --gear ID` says: the stored class, the automatic decision path,
     and the hobbing model and hob the gear gets."""
 

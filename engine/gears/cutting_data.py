@@ -6,7 +6,9 @@ shop's own history); any value can be overridden per job.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+
+import msgspec
+from msgspec.structs import replace
 
 from ..errors import EngineError
 from .chip_thickness import ALLOWED_CHIP_THICKNESS, chip_feed_bound
@@ -39,8 +41,7 @@ FEED_MAXIMUM_COLUMN = {"rough": 1, "finish": 2}
 MULTI_START_EXPONENT = 0.5
 
 
-@dataclass(frozen=True)
-class CuttingData:
+class CuttingData(msgspec.Struct, frozen=True):
     """Speeds and feeds of a job: the case base's suggestion, bounded, with the overrides given."""
     cutting_speed: float          # m/min
     hob_speed: int                # n0, r/min of B

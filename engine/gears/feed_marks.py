@@ -17,7 +17,8 @@ of a mm, takes the marks (µm) with it, and the grade is the finished gear's.
 from __future__ import annotations
 
 import math
-from dataclasses import replace
+
+from msgspec.structs import replace
 
 from ..errors import EngineError
 from .hob_matching import DEFAULT_GRADE

@@ -10,10 +10,11 @@ which reports every changed field. Numbers are kept as Decimal, so they are stor
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable
-from dataclasses import dataclass, field
 from decimal import Decimal
 from pathlib import Path
 from typing import Any
+
+import msgspec
 
 from ..csv_reader import (
     CellError,
@@ -31,7 +32,7 @@ from ..csv_reader import (
 )
 from ..errors import EngineError
 from ..names import NAME_RULES, is_safe
-from .classify import Classification, classify, not_installed_message
+from .classify import NAME_THE_CLASS, classify, not_installed_message
 from .gear_geometry import diameter_problems, tip_from_shift
 from .module_kind import MODULE_KINDS
 from .module_kind import check_module_kind as _check_module_kind
@@ -131,13 +132,12 @@ def _parse_row(file: CsvFile, line: int, cells: list[str]) -> tuple[dict[str, An
 Said = tuple[str, str] | None   # (column, "what is wrong; what to do")
 
 
-@dataclass(frozen=True)
-class Classes:
+class Classes(msgspec.Struct, frozen=True):
     """The installed gear classes {name: has template rows, own or inherited} (a class gears can be in),
     and those checked against the cylindrical-gear diameter formulas (engine.gears.gear_geometry)."""
 
     templated: dict[str, bool]
-    cylindrical: frozenset[str] = field(default_factory=frozenset)
+    cylindrical: frozenset[str] = msgspec.field(default_factory=frozenset)
 
 
 def _apply_defaults(gear: dict[str, Any], classes: Classes) -> Said:
@@ -174,7 +174,7 @@ def _classify(gear: dict[str, Any], classes: Classes) -> Said:
         return None
     classification = classify(gear)
     if classification.gear_class is None:
-        named = f"gear {gear['gear_id']} " if classification.remedy != Classification.remedy else ""
+        named = f"gear {gear['gear_id']} " if classification.remedy != NAME_THE_CLASS else ""
         return "gear_class", f"{named}{classification.problem}; {classification.remedy}"
     found = classification.gear_class
     gear["gear_class"], gear[FROM_TREE] = found, True

@@ -6,7 +6,20 @@ from __future__ import annotations
 from datetime import date
 from typing import TYPE_CHECKING
 
-from ..db.listing import Deletion, Reference, day_range, delete_row, one_record, records, require_class
+from psycopg import sql
+
+from ..db.listing import (
+    Deletion,
+    Reference,
+    day_range,
+    delete_row,
+    exact_records,
+    one_record,
+    records,
+    require_class,
+)
+from .gear_import import COLUMNS
+from .units import UNIT_COLUMNS
 
 if TYPE_CHECKING:
     from ..db.connection import Connection
@@ -14,15 +27,22 @@ if TYPE_CHECKING:
 GEAR_COLUMNS = """
 SELECT g.id AS gear_id, g.gear_class AS class, g.module, g.module_kind, g.teeth, g.pressure_angle,
        g.helix_angle, g.hand, g.face_width, g.tip_diameter, g.root_diameter, g.cone_angle, g.crowning,
-       g.material, g.hardness, g.quality_grade, g.quantity,
+       g.material, g.hardness, g.quality_grade, g.quantity, g.profile_shift,
        1 + (SELECT count(*) FROM gear_unit u WHERE u.gear_id = g.id)::int AS unit_count,
        (SELECT count(*) FROM job j WHERE j.gear_id = g.id)::int AS job_count, g.created_at
 FROM gear g"""
-LIST_GEARS = GEAR_COLUMNS + """
+GEAR_FILTER = """
 WHERE (%(class)s::text IS NULL OR g.gear_class = %(class)s)
   AND (%(since)s::date IS NULL OR g.created_at >= %(since)s::date)
-  AND (%(until)s::date IS NULL OR g.created_at < %(until)s::date + 1)
-ORDER BY g.id"""
+  AND (%(until)s::date IS NULL OR g.created_at < %(until)s::date + 1)"""
+LIST_GEARS = GEAR_COLUMNS + GEAR_FILTER + "\nORDER BY g.id"
+# The columns `engine gears import` reads, each under its name in the file (id AS gear_id).
+EXPORT_GEARS = sql.SQL("SELECT {} FROM gear g" + GEAR_FILTER + " ORDER BY g.id").format(sql.SQL(", ").join(
+    sql.SQL("g.{} AS {}").format(sql.Identifier(column.column), sql.Identifier(column.name)) for column in COLUMNS))
+# The columns `engine gears units` reads, of the gears the filters choose.
+EXPORT_UNITS = sql.SQL("SELECT {} FROM gear_unit u JOIN gear g ON g.id = u.gear_id" + GEAR_FILTER
+                       + " ORDER BY u.gear_id, u.unit").format(
+    sql.SQL(", ").join(sql.SQL("u.{}").format(sql.Identifier(column.name)) for column in UNIT_COLUMNS))
 ONE_GEAR = GEAR_COLUMNS + " WHERE g.id = %s"
 GEAR_UNITS = """
 SELECT unit, teeth, face_width, tip_diameter, root_diameter, z_top FROM gear_unit WHERE gear_id = %s ORDER BY unit"""
@@ -51,6 +71,22 @@ def list_gears(conn: Connection, gear_class: str | None = None, since: date | No
     both included), by id."""
     require_class(conn, gear_class)
     return records(conn.execute(LIST_GEARS, {"class": gear_class, **day_range(since, until)}))
+
+
+def export_gears(conn: Connection, gear_class: str | None = None, since: date | None = None,
+                 until: date | None = None) -> list[dict]:
+    """list_gears's gears as `engine gears import` reads them: its columns, each value as stored
+    (numbers digit for digit), by id."""
+    require_class(conn, gear_class)
+    return exact_records(conn.execute(EXPORT_GEARS, {"class": gear_class, **day_range(since, until)}))
+
+
+def export_units(conn: Connection, gear_class: str | None = None, since: date | None = None,
+                 until: date | None = None) -> list[dict]:
+    """The further toothed units of list_gears's gears as `engine gears units` reads them, by gear
+    and unit."""
+    require_class(conn, gear_class)
+    return exact_records(conn.execute(EXPORT_UNITS, {"class": gear_class, **day_range(since, until)}))
 
 
 def gear_details(conn: Connection, gear_id: int) -> dict:

@@ -1,17 +1,18 @@
 """Storing gears read from CSV (engine.gears.gear_import reads and checks them first): every row
 in one COPY and one upsert, all or nothing; stored ids are refused unless --replace, which prints
-each change (old -> new). Also which classes a gear may be in, for the reader's checks."""
+each change (old -> new), and refuses a change to a gear a stored job was made from
+(engine.db.replacing). Also which classes a gear may be in, for the reader's checks."""
 from __future__ import annotations
 
-from dataclasses import dataclass
-from decimal import Decimal
 from pathlib import Path
 from typing import Any
 
+import msgspec
 import psycopg
 from psycopg import sql
 
 from ..csv_reader import Problem
+from ..db.replacing import Change, changed_fields, jobs_of, plain, refuse_held
 from ..errors import EngineError
 from .classify import classify
 from .gear_import import COLUMNS, FROM_TREE, Classes, GearImportError, read_gears
@@ -40,56 +41,34 @@ _UPSERT = sql.SQL(
 _EXISTING = sql.SQL("SELECT {} FROM gear WHERE id = ANY(%s) ORDER BY id FOR UPDATE").format(_COLUMN_LIST)
 
 
-@dataclass(frozen=True)
-class GearChange:
-    """One field of a stored gear that an import with --replace changes: old → new."""
-
-    gear_id: int
-    field: str
-    old: Any
-    new: Any
-
-
-@dataclass(frozen=True)
-class GearImport:
+class GearImport(msgspec.Struct, frozen=True):
     """What an import did: how many gears it stored, which of them replaced stored gears, and what
     changed in those (field by field)."""
 
     imported: int
     replaced: tuple[int, ...] = ()
-    changes: tuple[GearChange, ...] = ()
+    changes: tuple[Change, ...] = ()
 
     def change_lines(self) -> list[str]:
         """One line per changed field (`gear 42: module 2 → 3`), and a line for a replaced gear the file
         left as it was."""
-        changed = {change.gear_id for change in self.changes}
-        return ([f"gear {c.gear_id}: {c.field} {_said(c.old)} → {_said(c.new)}" for c in self.changes]
+        changed = {change.key for change in self.changes}
+        return ([change.said("gear") for change in self.changes]
                 + [f"gear {gear_id}: unchanged" for gear_id in self.replaced if gear_id not in changed])
 
     def as_json(self) -> dict[str, Any]:
         return {"imported": self.imported, "replaced": list(self.replaced),
-                "changes": [{"gear_id": c.gear_id, "field": c.field, "old": _plain(c.old), "new": _plain(c.new)}
+                "changes": [{"gear_id": c.key, "field": c.field, "old": plain(c.old), "new": plain(c.new)}
                             for c in self.changes]}
 
 
-def _said(value: Any) -> str:
-    """A value as the change line shows it: numbers as written (2, not 2.000), nothing as (none)."""
-    return "(none)" if value is None else format(value.normalize(), "f") if isinstance(value, Decimal) \
-        else str(value)
-
-
-def _plain(value: Any) -> Any:
-    """A Decimal as the JSON number it is (whole numbers as int)."""
-    if not isinstance(value, Decimal):
-        return value
-    return int(value) if value == value.to_integral_value() else float(value)
-
-
-def _changes(stored: dict[int, tuple], gears: list[dict[str, Any]]) -> list[GearChange]:
+def _changes(stored: dict[int, tuple], gears: list[dict[str, Any]]) -> list[Change]:
     """Per replaced gear, per field, the stored value and the file's, where they differ."""
-    return [GearChange(gear["gear_id"], column.name, old, gear[column.name])
-            for gear in gears if gear["gear_id"] in stored
-            for column, old in zip(COLUMNS, stored[gear["gear_id"]]) if old != gear[column.name]]
+    named = {gear_id: {column.name: value for column, value in zip(COLUMNS, row)} for gear_id, row in stored.items()}
+    return changed_fields(named, gears, "gear_id", [column.name for column in COLUMNS])
+
+
+JOBS_OF_GEARS = "SELECT gear_id, array_agg(id ORDER BY id) FROM job WHERE gear_id = ANY(%s) GROUP BY gear_id"
 
 
 def _refuse_existing(path: Path, stored: dict[int, tuple], gears: list[dict[str, Any]]) -> None:
@@ -111,6 +90,8 @@ def _store(conn: psycopg.Connection, path: Path, gears: list[dict[str, Any]], re
             stored = {row[0]: row for row in rows}
             if not replace:
                 _refuse_existing(path, stored, gears)
+            changes = _changes(stored, gears)
+            refuse_held(path, "gear", changes, jobs_of(conn, JOBS_OF_GEARS, [change.key for change in changes]))
             conn.execute("CREATE TEMPORARY TABLE gear_import (LIKE gear) ON COMMIT DROP")
             with conn.cursor().copy(_COPY) as copy:
                 for gear in gears:
@@ -121,7 +102,7 @@ def _store(conn: psycopg.Connection, path: Path, gears: list[dict[str, Any]], re
         message = error.diag.message_primary or str(error)
         raise EngineError(f"{path}: the database refused the gears ({message}); "
                           "nothing imported") from error
-    return GearImport(len(gears), tuple(sorted(stored)), tuple(_changes(stored, gears)))
+    return GearImport(len(gears), tuple(sorted(stored)), tuple(changes))
 
 
 def import_gears(conn: psycopg.Connection, path: str | Path, *, replace: bool = False) -> GearImport:
@@ -154,4 +135,4 @@ def _count_stored_units(conn: psycopg.Connection, gears: list[dict[str, Any]], c
 def identical_gears(conn: psycopg.Connection, gears: list[dict[str, Any]]) -> set[int]:
     """The ids of `gears` (as read_gears gives them) that are stored with every field as given."""
     stored = {row[0]: row for row in conn.execute(_EXISTING, ([gear["gear_id"] for gear in gears],))}
-    return set(stored) - {change.gear_id for change in _changes(stored, gears)}
+    return set(stored) - {change.key for change in _changes(stored, gears)}

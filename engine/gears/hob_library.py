@@ -7,10 +7,10 @@ physical line number in the file (header = line 1), and only a good file is stor
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import Any
 
+import msgspec
 import psycopg
 from psycopg import sql
 
@@ -27,7 +27,8 @@ from ..csv_reader import (
     read_cell,
     read_csv_file,
 )
-from ..db.connection import scalar
+from ..db.listing import exact_records
+from ..db.replacing import changed_fields, jobs_of, refuse_held
 from ..errors import EngineError
 from ..names import NAME_RULES, is_safe, said
 from .gear_import import POSITIVE, parse_hand, parse_module_kind
@@ -41,8 +42,7 @@ PROFILES = ("standard", "protuberance", "topping")
 HobImportError = CsvError   # a file of bad rows: `problems` holds one line per problem, in file order
 
 
-@dataclass(frozen=True)
-class HobImport:
+class HobImport(msgspec.Struct, frozen=True):
     """What an import did: hobs new to the library, and hobs whose id was there already."""
 
     added: int
@@ -111,7 +111,7 @@ COLUMN_NAMES = tuple(column.name for column in HOB_COLUMNS)
 HOB_KIND = CsvKind("hob", HOB_COLUMNS)
 DEFAULTS = {"material": "HSS", "coating": "", "purpose": "cylindrical", "tool_number": 1, "gashes": 12,
             "profile": "standard"}
-assert COLUMN_NAMES == tuple(field.name for field in fields(Hob)), "HOB_COLUMNS must follow records.Hob"
+assert COLUMN_NAMES == Hob.__struct_fields__, "HOB_COLUMNS must follow records.Hob"
 
 
 # --- one hob: cells → values and problems ------------------------------------------------
@@ -174,6 +174,15 @@ def list_hobs(conn: psycopg.Connection) -> list[Hob]:
 _COLUMN_LIST = sql.SQL(", ").join(map(sql.Identifier, COLUMN_NAMES))
 _VALUES = sql.SQL(", ").join(sql.Placeholder() * len(COLUMN_NAMES))
 _INSERT = sql.SQL("INSERT INTO hob ({}) VALUES ({})").format(_COLUMN_LIST, _VALUES)
+_EXPORT = sql.SQL("SELECT {} FROM hob ORDER BY id").format(_COLUMN_LIST)
+
+
+def export_hobs(conn: psycopg.Connection) -> list[dict[str, Any]]:
+    """Every hob of the library by id as `engine hobs import` reads it: its columns, each value as
+    stored (the module in the record's own kind, every digit)."""
+    return exact_records(conn.execute(_EXPORT))
+
+
 def _cell(value: Any) -> str:
     """A field of a Hob as the text a CSV cell would hold (2.0 → "2")."""
     text = "" if value is None else str(value)
@@ -243,9 +252,20 @@ def _upsert(given: tuple[str, ...]) -> sql.Composed:
         sql.SQL("{0} = EXCLUDED.{0}").format(sql.Identifier(name)) for name in updated))
 
 
-def import_hobs(conn: psycopg.Connection, path: str | Path) -> HobImport:
-    """Insert or update (by id) every hob of the CSV file at `path`, all or nothing."""
+JOBS_OF_HOBS = "SELECT hob_id, array_agg(id ORDER BY id) FROM job WHERE hob_id = ANY(%s) GROUP BY hob_id"
+_LOCKED = sql.SQL("SELECT {} FROM hob WHERE id = ANY(%s) ORDER BY id FOR UPDATE").format(_COLUMN_LIST)
+
+
+def import_hobs(conn: psycopg.Connection, path: str | Path, *, replace: bool = False) -> HobImport:
+    """Insert or update (by id) every hob of the CSV file at `path`, all or nothing. `replace`: each
+    stored hob is replaced whole, so the file must give every column. A hob a stored job was made
+    with is changed in no column (engine.db.replacing)."""
     hobs, given = _read_hob_file(path)
+    if replace and len(given) < len(COLUMN_NAMES):
+        left_out = ", ".join(name for name in COLUMN_NAMES if name not in given)
+        raise EngineError(f"{path}: --replace replaces each stored hob whole, but the file leaves out {left_out}; "
+                          "nothing imported: give every column (`engine hobs list --csv` writes them), or import "
+                          "without --replace to keep each hob's own values of those")
     ids = [hob["id"] for hob in hobs]
     twin = conn.execute("SELECT id, new FROM hob, unnest(%s::text[]) AS new WHERE upper(id) = upper(new) AND id <> new "
                         "LIMIT 1", (ids,)).fetchone()
@@ -253,14 +273,16 @@ def import_hobs(conn: psycopg.Connection, path: str | Path) -> HobImport:
         raise EngineError(f"{path}: {_same_but_case(twin[1], twin[0])}; nothing imported")
     try:
         with conn.transaction():
-            existing = scalar(conn.execute("SELECT count(*) FROM hob WHERE id = ANY(%s)", (ids,)))
+            stored = {hob["id"]: hob for hob in exact_records(conn.execute(_LOCKED, (ids,)))}
+            changes = changed_fields(stored, hobs, "id", [name for name in given if name != "id"])
+            refuse_held(path, "hob", changes, jobs_of(conn, JOBS_OF_HOBS, [change.key for change in changes]))
             with conn.cursor() as cursor:
                 cursor.executemany(_upsert(given), [[hob[name] for name in COLUMN_NAMES] for hob in hobs])
     except (psycopg.errors.IntegrityError, psycopg.errors.DataError) as error:
         raise EngineError(f"{path}: the database refused the hobs "
                           f"({error.diag.message_primary or error}); nothing imported") from error
-    kept = tuple(name for name in COLUMN_NAMES if name not in given) if existing else ()
-    return HobImport(added=len(ids) - existing, updated=existing, kept=kept)
+    kept = tuple(name for name in COLUMN_NAMES if name not in given) if stored else ()
+    return HobImport(added=len(ids) - len(stored), updated=len(stored), kept=kept)
 
 
 def _same_but_case(given: str, stored: str) -> str:

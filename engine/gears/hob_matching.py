@@ -8,8 +8,11 @@ coarsest sufficient class (fine hobs are kept for fine gears), then the id.
 from __future__ import annotations
 
 import math
+import re
 from collections.abc import Callable
-from dataclasses import dataclass
+from contextvars import ContextVar
+
+import msgspec
 
 from ..errors import EngineError
 from .hob_geometry import generating_length, hob_axial_module, lead_angle
@@ -33,8 +36,7 @@ SHIFT_MARGIN = 5.0           # mm kept unused at each end of the hob (§B15 "mar
 ADD_A_HOB = "add one with `engine hobs add …` or `engine hobs import FILE.csv`"
 
 
-@dataclass(frozen=True)
-class HobChoice:
+class HobChoice(msgspec.Struct, frozen=True):
     """The hob chosen for a gear and why (engine hobs match says it)."""
     hob: Hob
     reason: str
@@ -48,8 +50,7 @@ class NoHobError(EngineError):
         self.property_name = property_name
 
 
-@dataclass(frozen=True)
-class Need:
+class Need(msgspec.Struct, frozen=True):
     """What a gear asks of its hob."""
 
     purpose: str
@@ -101,19 +102,37 @@ def _module_fits(gear: Gear, hob: Hob) -> bool:
 def _module_said(hob: Hob) -> str:
     """A worm-wheel hob by the axial module it is held to (and its record's kind), else by module."""
     if hob.purpose != "worm_wheel":
-        return f"module {hob.module:g}"
+        return f"module {_n(hob.module)}"
     axial = round(hob_axial_module(hob.module, hob.starts, hob.tip_diameter), 6)
-    return f"axial module {axial:g}" + ("" if hob.module_kind == "axial" else f" (normal {hob.module:g})")
+    return f"axial module {_n(axial)}" + ("" if hob.module_kind == "axial" else f" (normal {_n(hob.module)})")
 
 
 def _module_wanted(gear: Gear, purpose: str) -> str:
     if purpose == "worm_wheel":
-        return f"axial module {round(gear.module / math.cos(math.radians(gear.helix_angle)), 6):g}"
-    return f"module {gear.module:g}"
+        return f"axial module {_n(round(gear.module / math.cos(math.radians(gear.helix_angle)), 6))}"
+    return f"module {_n(gear.module)}"
 
 
-@dataclass(frozen=True)
-class HobTest:
+# A refusal says the gear's need and what the hobs offer with `g` (6 significant digits) and the
+# formats below; where the need would then read as one of the offers (module 3.98478 and 3.98478,
+# 0.000003 apart: outside the 1e-6 of MODULE_TOLERANCE), it says them all with more digits.
+SHOWN_DIGITS: ContextVar[int | None] = ContextVar("shown_digits", default=None)
+MORE_DIGITS = (None, 10, 17)   # 17 significant digits tell any two doubles apart
+NUMBER = re.compile(r"-?\d+(?:\.\d+)?(?:e[+-]?\d+)?")
+
+
+def _n(value: float, usual: str = "g") -> str:
+    """A number as a refusal says it: in its usual format, or with the digits _refusal chose."""
+    digits = SHOWN_DIGITS.get()
+    return format(value, usual if digits is None else f".{digits}g")
+
+
+def _first_number(text: str) -> float | None:
+    found = NUMBER.search(text)
+    return float(found.group()) if found else None
+
+
+class HobTest(msgspec.Struct, frozen=True):
     """One property of a hob, for the gears of `purposes`. A required test narrows the
     library (`fits`); a preference only orders it. `wanted` says what the gear needs,
     `offered` what a hob has and `distance` how far that is from the need (refusals list
@@ -162,8 +181,8 @@ HOB_TESTS: tuple[HobTest, ...] = (
     HobTest("pressure angle", BOTH,
             said=lambda gear, hob, need: f"pressure angle {hob.pressure_angle:g}°",
             fits=lambda gear, hob, need: abs(hob.pressure_angle - gear.pressure_angle) < ANGLE_TOLERANCE,
-            wanted=lambda gear, need: f"pressure angle {gear.pressure_angle:g}°",
-            offered=lambda hob: f"pressure angle {hob.pressure_angle:g}°",
+            wanted=lambda gear, need: f"pressure angle {_n(gear.pressure_angle)}°",
+            offered=lambda hob: f"pressure angle {_n(hob.pressure_angle)}°",
             distance=lambda gear, hob, need: abs(hob.pressure_angle - gear.pressure_angle)),
     HobTest("accuracy class", BOTH,
             said=lambda gear, hob, need: (f"class {hob.accuracy_class} (grade {need.grade} needs "
@@ -183,14 +202,14 @@ HOB_TESTS: tuple[HobTest, ...] = (
             said=lambda gear, hob, need: (f"lead angle {_lead(hob):.2f}° (helix {gear.helix_angle:g}° "
                                           f"± {LEAD_ANGLE_TOLERANCE:g}°)"),
             fits=lambda gear, hob, need: abs(_lead(hob) - gear.helix_angle) <= LEAD_ANGLE_TOLERANCE,
-            wanted=lambda gear, need: f"lead angle {gear.helix_angle:g}° ± {LEAD_ANGLE_TOLERANCE:g}°",
-            offered=lambda hob: f"lead angle {_lead(hob):.2f}°",
+            wanted=lambda gear, need: f"lead angle {_n(gear.helix_angle)}° ± {LEAD_ANGLE_TOLERANCE:g}°",
+            offered=lambda hob: f"lead angle {_n(_lead(hob), '.2f')}°",
             distance=lambda gear, hob, need: abs(_lead(hob) - gear.helix_angle)),
     HobTest("length", BOTH,
             said=_length_said,
             fits=lambda gear, hob, need: hob.length >= need.length,
-            wanted=lambda gear, need: f"length ≥ {need.length:.1f} mm",
-            offered=lambda hob: f"length {hob.length:g}",
+            wanted=lambda gear, need: f"length ≥ {_n(need.length, '.1f')} mm",
+            offered=lambda hob: f"length {_n(hob.length)}",
             distance=lambda gear, hob, need: need.length - hob.length),
 )
 
@@ -273,6 +292,26 @@ def _closest(gear: Gear, need: Need, test: HobTest, hobs: list[Hob], groups: int
 
 
 def _refusal(gear: Gear, need: Need, test: HobTest, earlier: list[HobTest], candidates: list[Hob]) -> str:
+    """The refusal said with the fewest digits (MORE_DIGITS) at which the need reads as none of the
+    offers."""
+    for digits in MORE_DIGITS:
+        token = SHOWN_DIGITS.set(digits)
+        try:
+            if digits == MORE_DIGITS[-1] or not _reads_alike(gear, need, test, candidates):
+                return _said_refusal(gear, need, test, earlier, candidates)
+        finally:
+            SHOWN_DIGITS.reset(token)
+    raise AssertionError("unreachable: the last digits always return")
+
+
+def _reads_alike(gear: Gear, need: Need, test: HobTest, candidates: list[Hob]) -> bool:
+    """Whether the need's number, as now shown, reads as the number of a hob's offer."""
+    assert test.wanted is not None and test.offered is not None   # the test refused is a required one
+    wanted = _first_number(test.wanted(gear, need))
+    return wanted is not None and wanted in {_first_number(test.offered(hob)) for hob in candidates}
+
+
+def _said_refusal(gear: Gear, need: Need, test: HobTest, earlier: list[HobTest], candidates: list[Hob]) -> str:
     wanted = [t.wanted for t in earlier if t.required]
     earlier_wanted = [said(gear, need) for said in wanted if said is not None]   # a required test says it
     among = f" among those with {', '.join(earlier_wanted)}" if earlier_wanted else ""

@@ -3,8 +3,9 @@ whatever its case (index hob_id_ignoring_case), so H-M2-AA-R1 and h-m2-aa-r1 fin
 job refers to is kept: the job's programs were cut with it."""
 from __future__ import annotations
 
-from dataclasses import asdict
 from typing import TYPE_CHECKING
+
+from msgspec.structs import asdict
 
 from ..db.listing import Deletion, Reference, delete_row, one_record, records
 from .records import load_hobs

@@ -10,8 +10,9 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
+
+import msgspec
 
 from ..errors import EngineError, InputError
 from ..machines.records import Machine, hobbing_machine
@@ -32,8 +33,7 @@ HEIGHT_MARGIN = 5.0
 ADD_ONE = "add one with `engine fixtures import FILE.csv`"
 
 
-@dataclass(frozen=True)
-class Setting:
+class Setting(msgspec.Struct, frozen=True):
     """What the choice weighs: the gear's least root (mm), the hob, the machine."""
     gear: Gear
     hob: Hob
@@ -70,8 +70,7 @@ def least_root(gear: Gear) -> float:
     return min([root, *units])
 
 
-@dataclass(frozen=True)
-class HoldingTest:
+class HoldingTest(msgspec.Struct, frozen=True):
     """One required property: its name, what the holding offers, whether it fits, what is wanted."""
     name: str
     said: Callable[[WorkHolding, Setting], str]
@@ -110,8 +109,7 @@ HOLDING_TESTS: tuple[HoldingTest, ...] = (
 )
 
 
-@dataclass(frozen=True)
-class HoldingChoice:
+class HoldingChoice(msgspec.Struct, frozen=True):
     """The job's work-holding (None: the machine record's fixture and tailstock) and why."""
     holding: WorkHolding | None
     reason: str

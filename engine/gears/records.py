@@ -3,10 +3,12 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, replace
 from decimal import Decimal
 from functools import partial
 from typing import TYPE_CHECKING, Any
+
+import msgspec
+from msgspec.structs import replace
 
 from ..db.records import as_float, columns
 from ..errors import EngineError
@@ -21,8 +23,7 @@ if TYPE_CHECKING:
 TOOTH_DEPTH = Decimal("2.25")  # full tooth depth in modules: root = tip − 2·2.25·m
 
 
-@dataclass(frozen=True)
-class Gear:
+class Gear(msgspec.Struct, frozen=True):
     """A workpiece record (table gear, with its units): what the hobbing models and the simulation read."""
     id: int
     gear_class: str | None
@@ -53,8 +54,7 @@ class Gear:
         return axial_module(self.module, self.helix_angle) if self.module_kind == "axial" else self.module
 
 
-@dataclass(frozen=True)
-class GearUnit:
+class GearUnit(msgspec.Struct, frozen=True):
     """A further toothed unit of a multi-unit (duplex) gear, cut with the gear's hob."""
     unit: int
     teeth: int
@@ -64,8 +64,7 @@ class GearUnit:
     z_top: float               # Z of the unit's upper face (the gear's top face is Z = 0)
 
 
-@dataclass(frozen=True)
-class Hob:
+class Hob(msgspec.Struct, frozen=True):
     """A hob of the library (table hob): its size, starts and hand, which engine.gears.hob_matching checks against a
     gear."""
     id: str
@@ -143,7 +142,7 @@ def _as_float(record_type: type[Record], row: Sequence[Any]) -> Record:
 
 
 _KINDS = {Gear: "gear", GearUnit: "unit", Hob: "hob"}
-GEAR_QUERY = f"SELECT {columns(Gear, exclude={'units'})} FROM gear"  # static, from the dataclass
+GEAR_QUERY = f"SELECT {columns(Gear, exclude={'units'})} FROM gear"  # static, from the record's fields
 UNIT_QUERY = f"SELECT gear_id, {columns(GearUnit)} FROM gear_unit"
 HOB_QUERY = f"SELECT {columns(Hob)} FROM hob"
 

@@ -9,11 +9,12 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ..csv_reader import Column, CsvKind, Problem, parse_number, parse_positive_whole, read_csv_file
-from ..db.connection import scalar
+from ..db.replacing import Change, jobs_of, refuse_held, said
 from ..errors import EngineError
 from .classify import classify
 from .gear_geometry import diameter_problems
 from .gear_import import POSITIVE, GearImportError, derived_diameters
+from .gear_store import JOBS_OF_GEARS
 from .models import ancestry
 
 if TYPE_CHECKING:
@@ -68,7 +69,7 @@ def _import(conn: Connection, path: Path, only_gears: set[int] | None) -> list[d
     problems += _database_problems(conn, units)
     if problems:
         raise GearImportError(path, problems)
-    _store(conn, [unit for _, unit in units])
+    _store(conn, path, [unit for _, unit in units])
     return [unit for _, unit in units]
 
 
@@ -111,32 +112,56 @@ def _database_problems(conn: Connection, units: list) -> list[Problem]:
     return problems
 
 
-def _store(conn: Connection, units: list[dict]) -> None:
+STORED_UNITS = ("SELECT gear_id, unit, teeth, face_width, tip_diameter, root_diameter, z_top FROM gear_unit "
+                "WHERE gear_id = ANY(%s) ORDER BY gear_id, unit")
+LOCK_GEARS = "SELECT id FROM gear WHERE id = ANY(%s) ORDER BY id FOR UPDATE"
+
+
+def _store(conn: Connection, path: Path, units: list[dict]) -> None:
+    """The units of each gear of the file replace its units, in one transaction; the units of a gear
+    a stored job was made from only by the same units (engine.db.replacing): its programs were
+    proved on them (the duplex model cuts them, the simulation follows them)."""
     with conn.transaction():
         gear_ids = sorted({unit["gear_id"] for unit in units})
+        conn.execute(LOCK_GEARS, (gear_ids,))
+        changes = _unit_changes(conn, gear_ids, units)
+        refuse_held(path, "gear", changes, jobs_of(conn, JOBS_OF_GEARS, [change.key for change in changes]))
         conn.execute("DELETE FROM gear_unit WHERE gear_id = ANY(%s)", (gear_ids,))
         for unit in units:
             conn.execute(INSERT_UNIT, tuple(unit[column.name] for column in UNIT_COLUMNS))
 
 
+def _unit_changes(conn: Connection, gear_ids: list[int], units: list[dict]) -> list[Change]:
+    """Per gear whose units the file changes: its units as stored → as the file gives them."""
+    stored: dict[int, list[tuple]] = {gear_id: [] for gear_id in gear_ids}
+    for row in conn.execute(STORED_UNITS, (gear_ids,)):
+        stored[row[0]].append(row[1:])
+    given: dict[int, list[tuple]] = {gear_id: [] for gear_id in gear_ids}
+    for unit in sorted(units, key=lambda unit: unit["unit"]):
+        given[unit["gear_id"]].append(tuple(unit[column.name] for column in UNIT_COLUMNS[1:]))
+    return [Change(gear_id, "further units", _units_said(stored[gear_id]), _units_said(given[gear_id]))
+            for gear_id in gear_ids if stored[gear_id] != given[gear_id]]
+
+
+def _units_said(units: list[tuple]) -> str | None:
+    """`unit 2 (z 19, b 15, da 42, df 37.5, z_top -75)`; None for no units."""
+    return "; ".join(f"unit {unit} (z {teeth}, b {said(width)}, da {said(tip)}, df {said(root)}, z_top {said(top)})"
+                     for unit, teeth, width, tip, root, top in units) or None
+
+
 GEAR_CLASS = ("SELECT gear_class, cone_angle, crowning, helix_angle, material, "
               "(SELECT count(*) FROM gear_unit u WHERE u.gear_id = gear.id) FROM gear WHERE id = %s")
-PROGRAMS = "SELECT count(*) FROM program p JOIN job j ON j.id = p.job_id WHERE j.gear_id = %s"
 
 
 def unit_notes(conn: Connection, gear_ids: set[int]) -> list[str]:
     """What the units just stored leave to do, one line each: a gear whose class does not cut
-    further units (only UNIT_CLASS and the classes under it do: the models of the others read the gear row alone), and
-    a gear with programs stored before (made for the units it had then)."""
+    further units (only UNIT_CLASS and the classes under it do: the models of the others read the gear
+    row alone). (A gear with stored jobs keeps its units: _store.)"""
     notes = []
     for gear_id in sorted(gear_ids):
         gear = tuple(conn.execute(GEAR_CLASS, (gear_id,)).fetchone() or ())   # the units' gear exists
         if gear[0] and UNIT_CLASS not in ancestry(conn, gear[0]):
             notes.append(f"gear {gear_id}: class {gear[0]} does not cut further units; " + _what_to_do(gear_id, gear))
-        programs = scalar(conn.execute(PROGRAMS, (gear_id,)))
-        if programs:
-            notes.append(f"gear {gear_id}: {programs} stored program(s) were made before these units and no longer "
-                         f"match the gear; make them again with `engine instantiate --gear {gear_id}`")
     return notes
 
 

@@ -1,7 +1,8 @@
 """Process choices of a hobbing job: what the engineer decides, switched on in template rows."""
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+import msgspec
+from msgspec.structs import replace
 
 from ..errors import EngineError, InputError
 
@@ -31,8 +32,7 @@ UNIT_FEED_MODES = ("climb/conventional", "conventional/climb")
 WORM_FEEDS = ("radial", "tangential")
 
 
-@dataclass(frozen=True)
-class Choices:
+class Choices(msgspec.Struct, frozen=True):
     """What the user chose for a new hobbing job (the options of engine instantiate); None leaves it to the model."""
     cuts: int | None = None            # 1 = finish only, 2 = rough then finish; None = by module
     finish_stock: float | None = None  # radial stock left by the rough cut, mm

@@ -2,8 +2,9 @@
 code needs. Formulas: docs/reference/hobbing.md §B. The other classes' models derive from it."""
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import Protocol
+
+import msgspec
 
 from ..gears.cutting_data import CuttingData
 from ..gears.models import register_model
@@ -38,8 +39,7 @@ class GearShape(Protocol):
     def root_diameter(self) -> float | None: ...
 
 
-@dataclass(frozen=True)
-class JobParameters:
+class JobParameters(msgspec.Struct, frozen=True):
     """A job's parameters, and those of its modules, as the template reads them."""
     params: dict
     module_params: dict
@@ -56,8 +56,7 @@ CUT_PARAMETERS = frozenset({"cut_name", "cut_x", "feed_radial", "feed_axial", "c
                             "z_from", "z_to", "x_air"})
 
 
-@dataclass(frozen=True)
-class Setup:
+class Setup(msgspec.Struct, frozen=True):
     """What every cut of a job shares: hob setting, full depth, reach and retract position."""
     lead: float
     swivel: float

@@ -6,7 +6,8 @@ for unit 2 (module sync 3) and cut it (cutmotion 3 and 4) with the unit's own pa
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+
+import msgspec
 
 from ..errors import EngineError
 from ..gears.models import register_model
@@ -65,8 +66,7 @@ class DuplexModel(CylindricalModel):
         return cuts
 
 
-@dataclass(frozen=True)
-class UnitGear:
+class UnitGear(msgspec.Struct, frozen=True):
     """A unit seen as a gear of its own (what the cylindrical formulas read), with its top face."""
     id: int
     module: float

@@ -7,7 +7,8 @@ wrong hand or a wrong swivel sign shows at a glance. A schematic, not to scale:
 * the hob's axis turned by the swivel the program writes (DIN A, about X), and its thread at the
   contact: at γ from the plane across its axis (the hob record's hand), turned with the axis;
   the thread lies along the teeth exactly when A = h_hob·γ − h_gear·β (§A7, §B2);
-* dashed, the helix the program's coupling generates (its Z term, §A5), for a cylindrical gear.
+* dashed, the helix the program's coupling generates (its Z term, §A5), for a cylindrical gear,
+  named as the program writes it (`EGON(…)` on an 840D, `G81 T… L… Q… P…` on a Fanuc, issue 30).
 
 Angles are measured from +Y toward +Z: the teeth at 90° − h_gear·β, the thread at
 90° − h_hob·γ + A."""
@@ -74,7 +75,8 @@ def draw_lines(axes, angle: float, colour: str, style, gid: str, label: str, pla
 
 
 def draw_generated_helix(axes, scene) -> None:
-    """The helix the program's (last) coupling generates with its Z term, for a cylindrical gear."""
+    """The helix the program's (last) coupling generates with its Z term, for a cylindrical gear,
+    labelled with the coupling as the program writes it (an 840D EGON, a Fanuc G81 T L Q P)."""
     couplings = scene.recording.couplings
     if not couplings or scene.hob.purpose == "worm_wheel":
         return
@@ -83,7 +85,7 @@ def draw_generated_helix(axes, scene) -> None:
     beta, hand, _ = helix_of(coupling.factors.get("Z", 0.0), scene.gear, teeth)
     made = "spur" if hand is None else f"{hand_name(hand)} β {beta:.3f}°"
     draw_lines(axes, tooth_angle(hand, beta), "tab:purple", (0, (4, 3)), "hand coupling helix",
-               f"helix the program's EGON generates: {made}", HELIX_PLACES)
+               f"helix the program's {scene.recording.coupling_words[-1]} generates: {made}", HELIX_PLACES)
 
 
 def draw_hob(axes, scene, swivel: float) -> None:
@@ -113,7 +115,8 @@ def draw_verdict(axes, scene, apart: float) -> str:
         return draw_words(axes, f"the hob's thread lies along the teeth ({abs(apart):.3f}° apart)", True)
     wanted = expected_swivel(scene.gear, scene.hob) * Senses.of(scene.machine).a
     return draw_words(axes, f"THE HOB'S THREAD CROSSES THE TEETH BY {abs(apart):.3f}°: wrong swivel or hand "
-                            f"(this gear and hob need A={wanted:.3f}° as written, h_hob·γ − h_gear·β)", False)
+                            f"(this gear and hob need {scene.recording.swivel_address}{wanted:.3f}° as written, "
+                            "h_hob·γ − h_gear·β)", False)
 
 
 def draw_words(axes, words: str, good: bool) -> str:

@@ -2,7 +2,7 @@
 §B7, §B8, §B13, §B14). Z = 0 is the workpiece's top face, the blank lies below it."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+import msgspec
 
 from ..gears.cutting_data import CuttingData, per_minute, programmed_feed
 from . import geometry
@@ -13,16 +13,14 @@ LIMIT_MARGIN = 1.0        # mm between the outermost move and the working-area l
 CUT_NAMES = {1: "ROUGH", 2: "FINISH"}
 
 
-@dataclass(frozen=True)
-class Reach:
+class Reach(msgspec.Struct, frozen=True):
     """How far the hob reaches along Z from its centre when cutting at full depth: the run-in
     E before the face it enters and the run-out U beyond the face it leaves."""
     approach: float
     overrun: float
 
 
-@dataclass(frozen=True)
-class Cut:
+class Cut(msgspec.Struct, frozen=True):
     """One cut of a job (rough or finish): its centre distance and pass direction."""
     number: int               # 1 = rough, 2 = finish (a single cut is number 2, named SINGLE)
     name: str

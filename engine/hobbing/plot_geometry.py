@@ -5,15 +5,14 @@ feeds. Pure functions of the simulation's recording (engine.simulation.hobbing.r
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
+import msgspec
 import numpy as np
 
 OUTLINE_STEPS = 96      # points around a hob outline
 
 
-@dataclass(frozen=True, slots=True)
-class Pass:
+class Pass(msgspec.Struct, frozen=True):
     axis: str           # "Z" axial pass, "X" radial plunge, "Y" tangential feed
     start: dict         # DIN pose where the pass begins
     end: dict           # and where it ends

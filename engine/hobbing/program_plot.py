@@ -5,13 +5,17 @@ move, the hob seen from its side with the shift range, the numbers an operator c
 against (engine.hobbing.setup_numbers), the hand check of teeth and hob thread
 (engine.hobbing.hand_view) and, for a worm wheel, the view from above with its radial infeed and
 tangential pass (engine.hobbing.worm_view). The program's job supplies the gear,
-hob and machine, as `engine simulate --program ID` takes them. PNG or SVG, written whole or not
-at all (engine.pictures)."""
+hob and machine, as `engine simulate --program ID` takes them. The lines are read in the
+machine's dialect by the simulation's reading (an 840D program, or a Fanuc one with G81/G80,
+issue 30), never by a parser of the picture's own: a line it cannot read, or a coupling it cannot
+prove before the walk, is refused in one line naming the line and the dialect. PNG or SVG,
+written whole or not at all (engine.pictures)."""
 from __future__ import annotations
 
 import textwrap
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
+
+import msgspec
 
 from ..errors import EngineError
 from ..gears.records import Gear, Hob, load_gear
@@ -19,6 +23,7 @@ from ..machines.records import Machine, load_machine
 from ..machines.work_holding import job_work_holding
 from ..pictures import literal, new_figure, picture_target, save_atomically
 from ..simulation.hobbing.recorded import Recording, record_program
+from ..simulation.hobbing.report import SimulationError
 from ..simulation.hobbing.stored import load_hob
 from .hand_view import draw_hand_check
 from .hob_view import draw_hob_view
@@ -44,8 +49,7 @@ FROM program p JOIN job j ON j.id = p.job_id
 WHERE p.id = %s"""
 
 
-@dataclass(frozen=True)
-class Scene:
+class Scene(msgspec.Struct, frozen=True):
     program_id: int
     job_id: int
     name: str
@@ -81,7 +85,11 @@ def load_scene(conn: Connection, program_id: int) -> Scene:
         raise EngineError(f"program {program_id} runs on {machine_name}, a {machine.kind}, not a hobbing program; "
                           f"draw its job with `engine plot --job {job_id} -o FILE.png`")
     gear, hob = load_gear(conn, gear_id), load_hob(conn, hob_id)
-    recording = record_program(list(lines), gear, hob, machine, name, job_work_holding(conn, job_id))
+    try:
+        recording = record_program(list(lines), gear, hob, machine, name, job_work_holding(conn, job_id))
+    except SimulationError as error:
+        raise EngineError(f"program {program_id} is not drawn (read in {machine_name}'s dialect "
+                          f"{machine.dialect}): {error}") from None
     return Scene(program_id, job_id, name, draft, gear_class, gear, hob, machine, recording)
 
 

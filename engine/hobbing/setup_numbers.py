@@ -10,7 +10,8 @@ turned back by the machine's senses (engine.simulation.hobbing.frame)."""
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+
+import msgspec
 
 from ..simulation.hobbing.frame import Senses
 from .plot_geometry import Pass, cut_pass
@@ -20,8 +21,7 @@ PASS_WORDS = {"Z": "axial pass", "Y": "tangential pass"}
 NO_PASS = Pass("", {}, {})
 
 
-@dataclass(frozen=True)
-class Number:
+class Number(msgspec.Struct, frozen=True):
     gid: str       # the artist's name in the SVG (what the tests read)
     text: str
 
@@ -37,14 +37,16 @@ def setup_numbers(scene) -> list[Number]:
 
 
 def swivel_number(recording, senses: Senses) -> Number:
-    """The last A the program writes before its first cut, as written, and the line that writes it."""
+    """The last A the program writes before its first cut, as written (`A=` or `A`, the program's
+    form), and the line that writes it."""
     words = recording.swivel_words
     if not words:
         return Number("number swivel", "swivel: the program writes no A")
     first = next((move.number for move in recording.moves if move.cutting), math.inf)
     line, written = max((word for word in words if word[0] < first), default=words[-1])
     din = senses.swivel(written)
-    return Number("number swivel", f"swivel A={written:.3f}° (line {line}, as written; DIN {din:+.3f}°, "
+    return Number("number swivel", f"swivel {recording.swivel_address}{written:.3f}° (line {line}, as written; "
+                                   f"DIN {din:+.3f}°, "
                                    f"a_direction {senses.a:+d})")
 
 

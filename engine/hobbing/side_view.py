@@ -14,6 +14,7 @@ from typing import Any
 from matplotlib.patches import Polygon, Rectangle
 
 from ..pictures import literal
+from ..simulation.hobbing.reading import machine_dialect
 from .plot_geometry import (
     approach_pose,
     axial_profile,
@@ -33,6 +34,7 @@ HATCHES = {"the fixture": "//", "the tailstock": "\\\\"}
 CROWNING_VISIBLE = 1.0  # mm: a pass whose X varies less than this is drawn magnified beside the view
 INSET_PLACE = (0.1, 0.05, 0.3, 0.2)   # axes fraction: lower left, under the blank
 MARGIN = 8.0            # mm of picture around what the side view frames
+WORKING_AREA_CODES = {25, 26}   # G25/G26: the 840D's working-area limits (a Fanuc hobbing program has none)
 
 
 def cut_colour(index: int) -> str:
@@ -201,13 +203,17 @@ def draw_overview(axes, scene) -> str:
     axes.axvline(0.0, color="0.4", linewidth=0.6, linestyle="-.")
     axes.autoscale_view()
     finish(axes, "working area (X, Z) and every move")
-    return area_words(scene.recording)
+    return area_words(scene.recording, scene.machine)
 
 
-def area_words(recording) -> str:
+def area_words(recording, machine) -> str:
+    """The working area as the program sets it; a dialect without G25/G26 (Fanuc hobbing) has none."""
     words = recording.area_words
     if not words:
-        return "working area: the program sets no G25/G26"
+        grammar = machine_dialect(machine)
+        if WORKING_AREA_CODES <= grammar.g_codes.keys():
+            return "working area: the program sets no G25/G26"
+        return f"working area: none, the {grammar.name} grammar has no working-area command (840D G25/G26)"
     said = ["G25 " + " ".join(f"{axis}{value:g}" for axis, value in sorted(words.get("lower", {}).items())),
             "G26 " + " ".join(f"{axis}{value:g}" for axis, value in sorted(words.get("upper", {}).items()))]
     return "working area " + " … ".join(said)

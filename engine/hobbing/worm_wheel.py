@@ -11,7 +11,8 @@ worm's axial module has it as its record's module (engine.gears.records.Hob.modu
 from __future__ import annotations
 
 import math
-from dataclasses import replace
+
+from msgspec.structs import replace
 
 from ..errors import InputError
 from ..gears.cutting_data import per_minute, programmed_feed

@@ -28,10 +28,10 @@ from __future__ import annotations
 import hashlib
 import json
 import re
-from dataclasses import dataclass
 from datetime import datetime
 from typing import TYPE_CHECKING
 
+import msgspec
 import psycopg
 
 from ..errors import EngineError
@@ -81,8 +81,7 @@ SELECT * FROM unnest(%s::text[], %s::text[], %s::text[], %s::text[])
 ON CONFLICT (pair_key) DO UPDATE SET last_seen = excluded.last_seen"""
 
 
-@dataclass(frozen=True)
-class Listed:
+class Listed(msgspec.Struct, frozen=True):
     """The pairs a run lists (new first) and how many it found of each kind."""
     pairs: list[dict]
     new: int
@@ -129,8 +128,7 @@ def _remember(conn: Connection, keyed: list[tuple[str, dict]]) -> None:
 
 # --- marks -------------------------------------------------------------------------------------
 
-@dataclass(frozen=True)
-class Intent:
+class Intent(msgspec.Struct, frozen=True):
     key: str
     t: str
     a: str

@@ -43,11 +43,12 @@ from __future__ import annotations
 import json
 import keyword
 import re
-from dataclasses import asdict, dataclass, field
 from functools import partial
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+import msgspec
+from msgspec.structs import asdict
 from psycopg.types.json import Jsonb
 
 from ..csv_reader import Column, CsvKind, parse_number_or_text, parse_text, parse_whole, read_csv_file, refuse
@@ -73,8 +74,7 @@ CLASS_NAME = re.compile(r"^[a-z][a-z0-9_]*$")
 ROW_STEP = 10
 
 
-@dataclass
-class ImportReport:
+class ImportReport(msgspec.Struct):
     gear_class: str
     path: str
     rows: int
@@ -83,10 +83,10 @@ class ImportReport:
     created: bool
     changed: bool
     version: int
-    ambiguous: dict = field(default_factory=dict)   # value → parameters having it (first used)
+    ambiguous: dict = {}   # value → parameters having it (first used)
     released_version: int | None = None     # what runners get: the import is a draft until released
-    bindings: list = field(default_factory=list)    # per parameter: its addresses and the words it bound
-    left_alone: list = field(default_factory=list)  # equal numbers at addresses not bound: line, word, parameter
+    bindings: list = []    # per parameter: its addresses and the words it bound
+    left_alone: list = []  # equal numbers at addresses not bound: line, word, parameter
 
 
 def import_nc(conn: Connection, path, gear_class: str, params: dict | None = None, modules: dict | None = None,
@@ -342,8 +342,7 @@ def _checked_modules(modules: dict | None, line_count: int | None) -> dict:
 
 # --- module assignment -----------------------------------------------------------------
 
-@dataclass
-class _State:
+class _State(msgspec.Struct):
     seen_code: bool = False
     seen_cut: bool = False
 

@@ -20,8 +20,9 @@ from __future__ import annotations
 
 import math
 from collections import Counter
-from dataclasses import dataclass
 from decimal import Decimal
+
+import msgspec
 
 from ..csv_reader import CellError, declare
 from ..errors import EngineError
@@ -33,8 +34,7 @@ CODE_ADDRESSES = frozenset("GMNOT$")
 FUNCTION_ADDRESSES = frozenset("GM$")
 
 
-@dataclass(frozen=True)
-class Binding:
+class Binding(msgspec.Struct, frozen=True):
     """One parameter: its value and the addresses (upper case) it binds; None = the plain form."""
     name: str
     value: object

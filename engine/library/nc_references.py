@@ -23,13 +23,12 @@ inside `[…]`, which is an array subscript such as `TECH_TIME[4]` or a constant
 expression `[#1+2]`: binding the 4 makes the program read another variable)."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+import msgspec
 
 from ..nc.tokens import NAME, SPACE, SYMBOL, WORD, LineFacts
 
 
-@dataclass(frozen=True)
-class Reference:
+class Reference(msgspec.Struct, frozen=True):
     """In a block with one of `within` (empty: any block) and none of `unless`, the number after
     `address` names `names`; `target`: a block or program number (never a parameter)."""
     address: str

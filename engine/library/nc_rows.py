@@ -7,8 +7,10 @@ from __future__ import annotations
 
 import math
 from collections import Counter
-from dataclasses import dataclass, field, replace
 from decimal import Decimal, InvalidOperation
+
+import msgspec
+from msgspec.structs import replace
 
 from ..errors import EngineError
 from ..nc.tokens import NUMBER, WORD, LineFacts, facts, tokenise
@@ -32,8 +34,7 @@ def values_of(bindings: dict[str, Binding]) -> dict:
     return values
 
 
-@dataclass(frozen=True)
-class LeftAlone:
+class LeftAlone(msgspec.Struct, frozen=True):
     """A number equal to a parameter's value that it does not bind, and why (`Q100 names the
     contour …`, `F400: feed binds only F`)."""
     line: int
@@ -42,17 +43,16 @@ class LeftAlone:
     why: str
 
 
-@dataclass
-class Found:
+class Found(msgspec.Struct):
     """What the lines read so far gave: the references made, the values two parameters binding
     the same address share (the first is used), the words bound per (parameter, address), and
     the equal numbers left alone, in line order."""
     parameterised: int = 0
-    ambiguous: dict = field(default_factory=dict)
-    bound: Counter = field(default_factory=Counter)
-    left_alone: list = field(default_factory=list)
-    bound_lines: dict = field(default_factory=dict)   # (parameter, address) → lines of the words bound
-    left_lines: dict = field(default_factory=dict)    # (parameter, address) → lines of the equal words left
+    ambiguous: dict = {}
+    bound: Counter = msgspec.field(default_factory=Counter)
+    left_alone: list = []
+    bound_lines: dict = {}   # (parameter, address) → lines of the words bound
+    left_lines: dict = {}    # (parameter, address) → lines of the equal words left
 
     def add(self, later: Found) -> None:
         """Take in what the lines after these gave."""

@@ -11,9 +11,9 @@ two components with the same body).
 from __future__ import annotations
 
 from collections import defaultdict
-from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
+import msgspec
 import psycopg
 
 from ..db.connection import scalar
@@ -84,13 +84,12 @@ GROUP BY c.t, c.o"""
 STAGES = ("snapshot", "merge identical bodies", "find near-duplicates", "check invariants")
 
 
-@dataclass
-class RefactorReport:
+class RefactorReport(msgspec.Struct):
     changed: bool
     components_before: int
     components_after: int
     shared: int
-    near_duplicates: list[dict] = field(default_factory=list)   # listed: new ones first
+    near_duplicates: list[dict] = []   # listed: new ones first
     threshold: float = 0.8
     new: int = 0         # listed pairs no earlier run listed
     known: int = 0       # listed pairs an earlier run listed
@@ -236,8 +235,7 @@ def _uses_of(t: str, texts: list[str], uses) -> tuple[int, list]:
     return count, sorted(row for text in texts for row in uses[(t, text)][1])[:USES_LISTED]
 
 
-@dataclass(frozen=True)
-class SharedRow:
+class SharedRow(msgspec.Struct, frozen=True):
     id: int
     t: str
     o: str | None

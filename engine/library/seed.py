@@ -5,10 +5,10 @@ from __future__ import annotations
 import csv
 import json
 import tempfile
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+import msgspec
 from psycopg import sql
 from psycopg.types.json import Jsonb
 
@@ -44,12 +44,11 @@ SEED_TABLES = (
 SHOP_TABLES = SEED_TABLES[:1]   # the machines; the hobs and work-holdings are samples
 
 
-@dataclass
-class SeedReport:
-    added: dict[str, int] = field(default_factory=dict)
-    created: list[str] = field(default_factory=list)   # the classes this seed created
+class SeedReport(msgspec.Struct):
+    added: dict[str, int] = {}
+    created: list[str] = []   # the classes this seed created
     # sample gear id → golden tests of it not added: the database's gear of that id is another
-    skipped_tests: dict[int, int] = field(default_factory=dict)
+    skipped_tests: dict[int, int] = {}
 
     def count(self, what: str, number: int = 1) -> None:
         self.added[what] = self.added.get(what, 0) + number

@@ -4,15 +4,17 @@ the cross-column checks; an import is all or nothing, every problem reported wit
 line number in the file (header = line 1), and only a good file is stored."""
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, fields
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+import msgspec
 import psycopg
+from msgspec.structs import asdict
 from psycopg import sql
 
 from ..csv_reader import CellError, Column, CsvError, CsvKind, Problem, declare, parse_number, read_cell, read_csv_file
-from ..db.connection import scalar
+from ..db.listing import exact_records
+from ..db.replacing import changed_fields, jobs_of, refuse_held
 from ..errors import EngineError
 from ..names import NAME_RULES, is_safe
 from .work_holding import KINDS, WorkHolding, load_work_holdings
@@ -21,8 +23,7 @@ if TYPE_CHECKING:
     from ..db.connection import Connection
 
 
-@dataclass(frozen=True)
-class HoldingImport:
+class HoldingImport(msgspec.Struct, frozen=True):
     """What an import did: work-holdings new to the library, and those whose id was there already."""
 
     added: int
@@ -65,7 +66,7 @@ HOLDING_COLUMNS: tuple[Column, ...] = (
 COLUMN_NAMES = tuple(column.name for column in HOLDING_COLUMNS)
 HOLDING_KIND = CsvKind("work-holding", HOLDING_COLUMNS)
 DEFAULTS = {"tailstock_diameter": 0}
-assert COLUMN_NAMES == tuple(field.name for field in fields(WorkHolding)), "HOLDING_COLUMNS must follow WorkHolding"
+assert COLUMN_NAMES == WorkHolding.__struct_fields__, "HOLDING_COLUMNS must follow WorkHolding"
 
 
 def parse_holding(cells: dict[str, str], line: int | None = None,
@@ -86,6 +87,16 @@ def list_holdings(conn: Connection) -> list[dict]:
     """Every work-holding of the library by id, keyed by the CSV columns (what `import` reads back),
     whole millimetres as whole numbers (12, not 12.0)."""
     return [{key: _whole(value) for key, value in asdict(holding).items()} for holding in load_work_holdings(conn)]
+
+
+_COLUMN_LIST = sql.SQL(", ").join(map(sql.Identifier, COLUMN_NAMES))
+EXPORT = sql.SQL("SELECT {} FROM work_holding ORDER BY id").format(_COLUMN_LIST)
+
+
+def export_holdings(conn: Connection) -> list[dict]:
+    """Every work-holding of the library by id as `engine fixtures import` reads it: each value as
+    stored (every digit of its numbers)."""
+    return exact_records(conn.execute(EXPORT))
 
 
 def _whole(value: Any) -> Any:
@@ -124,7 +135,6 @@ def _read(path: str | Path) -> tuple[list[tuple[int, dict[str, Any]]], list[Prob
     return holdings, problems
 
 
-_COLUMN_LIST = sql.SQL(", ").join(map(sql.Identifier, COLUMN_NAMES))
 _UPSERT = sql.SQL("INSERT INTO work_holding ({}) VALUES ({}) ON CONFLICT (id) DO UPDATE SET {}").format(
     _COLUMN_LIST, sql.SQL(", ").join(sql.Placeholder() * len(COLUMN_NAMES)), sql.SQL(", ").join(
         sql.SQL("{0} = EXCLUDED.{0}").format(sql.Identifier(name)) for name in COLUMN_NAMES if name != "id"))
@@ -153,20 +163,43 @@ def _library_problems(conn: Connection, holdings: list[tuple[int, dict[str, Any]
     return problems
 
 
-def import_holdings(conn: Connection, path: str | Path) -> HoldingImport:
-    """Insert or update (by id) every work-holding of the CSV file at `path`, all or nothing."""
+JOBS_OF_HOLDINGS = ("SELECT work_holding_id, array_agg(id ORDER BY id) FROM job WHERE work_holding_id = ANY(%s) "
+                    "GROUP BY work_holding_id")
+LOCKED = sql.SQL("SELECT {} FROM work_holding WHERE id = ANY(%s) ORDER BY id FOR UPDATE").format(_COLUMN_LIST)
+
+
+def import_holdings(conn: Connection, path: str | Path, *, replace: bool = False) -> HoldingImport:
+    """Insert or update (by id) every work-holding of the CSV file at `path`, all or nothing.
+    `replace`: the file must give every column (each stored work-holding is replaced whole). A
+    work-holding a stored job is clamped on is changed in no column (engine.db.replacing)."""
     lined, problems = _read(path)
     problems += _library_problems(conn, [(line, holding) for line, holding in lined if holding["id"] is not None])
     if problems:
         raise CsvError(path, problems)
+    _refuse_partial(path, replace)
     holdings = [holding for _, holding in lined]
     ids = [holding["id"] for holding in holdings]
     try:
         with conn.transaction():
-            existing = scalar(conn.execute("SELECT count(*) FROM work_holding WHERE id = ANY(%s)", (ids,)))
+            stored = {row["id"]: row for row in exact_records(conn.execute(LOCKED, (ids,)))}
+            changes = changed_fields(stored, holdings, "id", COLUMN_NAMES[1:])
+            refuse_held(path, "work-holding", changes,
+                        jobs_of(conn, JOBS_OF_HOLDINGS, [change.key for change in changes]),
+                        relation="{jobs} {were} clamped on it")
             with conn.cursor() as cursor:
                 cursor.executemany(_UPSERT, [[holding[name] for name in COLUMN_NAMES] for holding in holdings])
     except (psycopg.errors.IntegrityError, psycopg.errors.DataError) as error:
         raise EngineError(f"{path}: the database refused the work-holdings "
                           f"({error.diag.message_primary or error}); nothing imported") from error
-    return HoldingImport(added=len(ids) - existing, updated=existing)
+    return HoldingImport(added=len(ids) - len(stored), updated=len(stored))
+
+
+def _refuse_partial(path: str | Path, replace: bool) -> None:
+    """--replace replaces each stored work-holding whole: a column the file leaves out is refused,
+    not set to its default."""
+    given = read_csv_file(path, HOLDING_KIND).header
+    left_out = [name for name in COLUMN_NAMES if name not in given]
+    if replace and left_out:
+        raise EngineError(f"{path}: --replace replaces each stored work-holding whole, but the file leaves out "
+                          f"{', '.join(left_out)}; nothing imported: give every column (`engine fixtures list "
+                          "--csv` writes them)")

@@ -11,7 +11,6 @@ given a program. All or nothing: any bad row stops the file, nothing stored."""
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import fields
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -29,9 +28,10 @@ if TYPE_CHECKING:
 # The columns a machine cannot do without (NOT NULL, no default): the rest take their default.
 REQUIRED = ("name", "kind", "dialect", "x_min", "x_max", "z_min", "z_max", "spindle_max")
 # The columns of the machine table (the record's fields), as text the database converts.
-MACHINE_KIND = CsvKind("machine", tuple(Column(spec.name, parse_text, required=spec.name in REQUIRED)
-                                        for spec in fields(Machine)))
-NUMBERS = tuple(spec.name for spec in fields(Machine) if str(spec.type).split(" ")[0] in ("float", "int"))
+MACHINE_KIND = CsvKind("machine", tuple(Column(name, parse_text, required=name in REQUIRED)
+                                        for name in Machine.__struct_fields__))
+NUMBERS = tuple(name for name in Machine.__struct_fields__
+                if Machine.__annotations__[name].split(" ")[0] in ("float", "int"))   # the annotations are text
 # What each of the table's checks asks, in the words of the record's columns (schema/schema.sql).
 CHECKS = {
     "machine_kind_check": "kind must be hobber or lathe",

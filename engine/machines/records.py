@@ -2,8 +2,9 @@
 travel in mm, spindle and table limits, axis senses and setup) and loading it by name."""
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
+
+import msgspec
 
 from ..db.records import as_float, columns
 from ..errors import EngineError
@@ -12,8 +13,7 @@ if TYPE_CHECKING:
     from ..db.connection import Connection
 
 
-@dataclass(frozen=True)
-class Machine:
+class Machine(msgspec.Struct, frozen=True):
     """A machine record (table machine): its kind and dialect, axis travels (mm), speed limits (r/min) and fixture
     sizes."""
     name: str
@@ -98,7 +98,7 @@ def floor_times_said(kind: str, missing: list[str]) -> str:
     return "none stated" if len(missing) == len(FLOOR_TIMES) else f"missing {', '.join(missing)}"
 
 
-MACHINE_QUERY = f"SELECT {columns(Machine)} FROM machine"  # static, from the dataclass
+MACHINE_QUERY = f"SELECT {columns(Machine)} FROM machine"  # static, from the record's fields
 
 
 DEFAULT_HOBBING_MACHINE = "hobber-840d"

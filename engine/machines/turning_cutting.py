@@ -19,7 +19,7 @@ largest diameter an operation (or a move) cuts at, where a constant spindle spee
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+import msgspec
 
 from ..errors import EngineError
 
@@ -41,8 +41,7 @@ KYOCERA = "Kyocera catalogue 2016-2017 p. 461, GMG/GMM grooving, widths 2-8 mm"
 ISCAR = "Iscar threading user guide 2022 p. 77, grades IC228-IC1007"
 
 
-@dataclass(frozen=True)
-class Window:
+class Window(msgspec.Struct, frozen=True):
     vc_min: float          # m/min; shown, not refused (see the module's docstring)
     vc_max: float          # m/min
     f_min: float | None    # mm/rev; None for THREAD (the lead)

@@ -5,8 +5,10 @@ machine record's fixture_gap below the gear's bottom face, the machine's own fix
 centre above the top face has `tailstock_diameter` (0: none), the machine's tailstock_gap above it."""
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
+
+import msgspec
+from msgspec.structs import replace
 
 from ..db.records import as_float, columns
 from ..errors import EngineError
@@ -18,8 +20,7 @@ if TYPE_CHECKING:
 KINDS = ("arbor", "mandrel", "collet", "centres")
 
 
-@dataclass(frozen=True)
-class WorkHolding:
+class WorkHolding(msgspec.Struct, frozen=True):
     """A work-holding of the library: its id (printed as `; FIXTURE <id>`), kind and sizes (mm),
     and the machine it fits (None: any hobber)."""
     id: str
@@ -30,7 +31,7 @@ class WorkHolding:
     machine: str | None = None
 
 
-HOLDING_QUERY = f"SELECT {columns(WorkHolding)} FROM work_holding"  # static, from the dataclass
+HOLDING_QUERY = f"SELECT {columns(WorkHolding)} FROM work_holding"  # static, from the record's fields
 
 
 def load_work_holdings(conn: Connection) -> list[WorkHolding]:

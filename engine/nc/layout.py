@@ -6,8 +6,10 @@ stored version records it (template_version_rows), a change of it is a new draft
 version, and a program is written with its version's layout."""
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
+
+import msgspec
+from msgspec.structs import replace
 
 from ..errors import EngineError
 from ..names import line_breaking, shown
@@ -19,8 +21,7 @@ LF, CRLF = "\n", "\r\n"
 ENDING_NAMES = {LF: "lf", CRLF: "crlf"}   # as the config file and a template CSV write them
 
 
-@dataclass(frozen=True)
-class NcLayout:
+class NcLayout(msgspec.Struct, frozen=True):
     """LF with a final newline is what the engine's own classes write; an imported class keeps its file's."""
     line_ending: str = LF
     final_newline: bool = True

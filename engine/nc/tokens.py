@@ -24,8 +24,9 @@ between: `X-170` and `01 -1000` are negative numbers, `#14-#3` and `#13-5` are s
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
 from decimal import Decimal
+
+import msgspec
 
 WORD, NUMBER, PARAM, NAME, LABEL = "word", "number", "param", "name", "label"
 COMMENT, STRING, SYMBOL, SPACE, TEXT = "comment", "string", "symbol", "space", "text"
@@ -35,15 +36,13 @@ _VALUE_KINDS = frozenset({NUMBER, PARAM, NAME, STRING})
 _OPERATORS = frozenset("=+-*/(,[<>")
 
 
-@dataclass(frozen=True, slots=True)
-class Token:
+class Token(msgspec.Struct, frozen=True):
     kind: str
     text: str
     address: str | None = None   # numbers only: the word (upper case) whose value it is
 
 
-@dataclass
-class _Context:
+class _Context(msgspec.Struct):
     tokens: list
 
     def previous(self) -> Token | None:
@@ -202,8 +201,7 @@ def detokenise(tokens) -> str:
     return "".join(token.text for token in tokens)
 
 
-@dataclass(frozen=True)
-class LineFacts:
+class LineFacts(msgspec.Struct, frozen=True):
     """What a line says, for module assignment: codes `G1`/`M8`, words, axes, code or not."""
     codes: frozenset
     words: frozenset

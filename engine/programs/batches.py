@@ -16,9 +16,9 @@ from __future__ import annotations
 
 import contextlib
 import re
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+import msgspec
 from psycopg.types.json import Jsonb
 
 from ..db.connection import scalar
@@ -36,8 +36,7 @@ NEW_INPUT_HASH = "SELECT job_input_hash(%s, %s)"   # the hash a new job's parame
 NOTHING_STORED = re.compile(r"[;,]?\s*nothing stored\s*$")   # said once for the batch, not per gear
 
 
-@dataclass(frozen=True, slots=True)
-class Bad:
+class Bad(msgspec.Struct, frozen=True):
     """A gear or job of a batch that cannot be made, with its one-line reason (sent back by
     batch workers in place of its program)."""
     reason: str

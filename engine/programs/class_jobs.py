@@ -23,8 +23,9 @@ engine.programs.remake) the job is verified then, or refused.
 from __future__ import annotations
 
 import ast
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
+
+import msgspec
 
 from ..errors import EngineError
 from ..gears.models import model_for_class
@@ -58,8 +59,7 @@ NEVER_WRITTEN = ("an unverified program is never written to a file for the machi
                  "machine is one the verifier read)")
 
 
-@dataclass(frozen=True)
-class ClassJob:
+class ClassJob(msgspec.Struct, frozen=True):
     """What `instantiate --class` made: the program (stored, or a dry run's), and which parameters
     the file gave and which took the class's imported values."""
     program: Program

@@ -29,8 +29,9 @@ import os
 import re
 import stat
 import sys
-from dataclasses import dataclass, field
 from pathlib import Path
+
+import msgspec
 
 from ..errors import EngineError
 from ..machines.records import DEFAULT_HOBBING_MACHINE
@@ -43,15 +44,14 @@ MAX_CONFIG_BYTES = 1 << 20   # a settings file is a few hundred bytes; a bound, 
 MACHINE_SETTINGS = ("out", "line_endings")
 
 
-@dataclass(frozen=True)
-class Config:
+class Config(msgspec.Struct, frozen=True):
     """The settings of the config file: option defaults by command, the default machine, line endings and output
     folders."""
     path: Path | None = None
-    commands: dict = field(default_factory=dict)   # everything that is not a setting: option defaults
+    commands: dict = {}   # everything that is not a setting: option defaults
     machine: str | None = None
     line_endings: str | None = None   # None: each class's own (engine.nc.layout)
-    machines: dict = field(default_factory=dict)   # machine name -> {out, line_endings}
+    machines: dict = {}   # machine name -> {out, line_endings}
     text: str = ""
 
 

@@ -13,9 +13,10 @@ layer."""
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, Protocol
+
+import msgspec
 
 from ..db.embedded import embedded_data_dir, embedded_url
 from ..library.seed import SeedReport
@@ -37,8 +38,7 @@ class Sample(Protocol):
     def program(self) -> Program: ...
 
 
-@dataclass(frozen=True)
-class DemoResult:
+class DemoResult(msgspec.Struct, frozen=True):
     data_dir: Path          # where the embedded server keeps its data (database engine_demo)
     applied: int            # migrations applied by this run
     report: SeedReport

@@ -7,8 +7,9 @@
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
+
+import msgspec
 
 from ..errors import EngineError
 from ..nc.lineage import LINEAGE_ROW_ID
@@ -19,8 +20,7 @@ if TYPE_CHECKING:
 MAX_LISTED_LINES = 1   # lines of a row quoted in its sentence (a tool path prints hundreds)
 
 
-@dataclass(frozen=True)
-class ExplainedRow:
+class ExplainedRow(msgspec.Struct, frozen=True):
     row_id: int
     state: str           # emitted | not emitted | skipped | computed
     lines: tuple[str, ...]

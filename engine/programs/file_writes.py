@@ -32,8 +32,9 @@ import os
 import resource
 import secrets
 import stat
-from dataclasses import dataclass
 from pathlib import Path
+
+import msgspec
 
 # errno of open(O_TMPFILE) where the kernel or the file system does not support it
 NO_TMPFILE = (errno.EOPNOTSUPP, errno.EISDIR, errno.EINVAL, errno.ENOENT)
@@ -41,8 +42,7 @@ PROC_FD = Path("/proc/self/fd")
 SPARE_DESCRIPTORS = 64   # kept free for the database connection, the terminal and Python itself
 
 
-@dataclass(frozen=True)
-class FolderSeen:
+class FolderSeen(msgspec.Struct, frozen=True):
     """The folder of a run's files as the plan saw it: its device and inode (None if it did not
     exist yet) and whether the path was a symbolic link then (a shop's link to its share stays
     allowed; a real folder swapped for a link is not)."""
@@ -68,8 +68,7 @@ class NotWritten(Exception):
         super().__init__(f"{self.path}: {cause}")
 
 
-@dataclass
-class Staged:
+class Staged(msgspec.Struct):
     """One file written in full, not yet named: an unnamed file's descriptor, or a hidden name."""
     name: str
     descriptor: int | None = None

@@ -7,8 +7,9 @@ written only after the COMMIT).
 """
 from __future__ import annotations
 
-from dataclasses import replace
 from typing import TYPE_CHECKING
+
+from msgspec.structs import replace
 
 from ..errors import EngineError
 from ..gears.case_base import CUT_KINDS_BY_COUNT, CaseBase, job_cutting_record, single_cut_labels

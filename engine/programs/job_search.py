@@ -16,8 +16,10 @@ from __future__ import annotations
 
 import re
 from collections.abc import Callable
-from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING, Any
+
+import msgspec
+from msgspec.structs import replace
 
 from ..errors import EngineError, InputError
 from ..hobbing.choices import DEFAULT_FEED_MODE, FEED_MODES, UNIT_FEED_MODES, UNIT_SEPARATOR, Choices
@@ -41,8 +43,7 @@ SEARCH_ORDER: tuple[tuple[str, str], ...] = (
 )
 
 
-@dataclass(frozen=True)
-class Attempt:
+class Attempt(msgspec.Struct, frozen=True):
     """One choice of the search: the hob and the job's choices (feed mode and cuts resolved)."""
     hob: Hob
     choices: Choices
@@ -101,8 +102,7 @@ def _cut_choices(choices: Choices, module: float) -> list[int | None]:
     return [None, 2]
 
 
-@dataclass(frozen=True)
-class Found:
+class Found(msgspec.Struct, frozen=True):
     """What the search took: the planned job, the attempt, and the notes saying why."""
     planned: Any
     attempt: Attempt

@@ -7,9 +7,11 @@ written with: a later change of the class's layout is a later version and leaves
 from __future__ import annotations
 
 import re
-from dataclasses import asdict, dataclass, replace
 from datetime import date, datetime
 from typing import TYPE_CHECKING
+
+import msgspec
+from msgspec.structs import asdict, replace
 
 from ..db.listing import day_range, records, require_class
 from ..errors import EngineError
@@ -35,8 +37,7 @@ WHERE (left(p.input_hash, 8) = left(%(prefix)s, 8) AND p.input_hash LIKE %(prefi
 ORDER BY p.id"""
 
 
-@dataclass(frozen=True)
-class ProgramRecord:
+class ProgramRecord(msgspec.Struct, frozen=True):
     """What the database records of one program, and its lines as stored (lineage line included)."""
     id: int
     job_id: int

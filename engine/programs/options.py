@@ -10,15 +10,15 @@ the entry points and the command say which combinations are refused, as before.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
 from pathlib import Path
+
+import msgspec
 
 Progress = Callable[[str, int, int], None]   # progress(stage, done, total) as a batch's items are planned
 PLANNING = "planning"   # the stage a batch's progress callback is told while its gears are planned
 
 
-@dataclass(frozen=True, slots=True)
-class Output:
+class Output(msgspec.Struct, frozen=True):
     """Where a run writes its .MPF files, after its programs are committed.
 
     out: the file or folder (--out, or the config file's folder for the machine); a batch writes
@@ -26,13 +26,16 @@ class Output:
         separator, else to it as the file. None: no file, the program is only stored and printed.
     force: replace files that already exist at out; without it an existing file refuses the run
         and nothing is stored (an operator's file on the control is never overwritten unasked).
+    mkdir: create out's folder (and the folders above it) if it does not exist; without it a
+        missing folder refuses the run and nothing is stored (issue 31: a typo in a network
+        share's path made a folder of programs nobody found).
     """
     out: str | Path | None = None
     force: bool = False
+    mkdir: bool = False
 
 
-@dataclass(frozen=True, slots=True)
-class RunMode:
+class RunMode(msgspec.Struct, frozen=True):
     """How a run goes, apart from the job's choices and its files.
 
     draft: run the classes' drafts (an editor trying a change), not their released templates;

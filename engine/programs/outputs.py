@@ -56,13 +56,13 @@ CONFIGURED_ENDING: contextvars.ContextVar[Callable[[str], str | None] | None] = 
 
 class ProgramFiles:
     """The files of one run: checked when planned (before storing), written after the COMMIT.
-    A batch (--gears, --jobs, --all) always writes into the folder --out, made if missing, however
-    many programs it makes; one program is written to the file --out unless --out is a folder
-    or ends with /."""
+    A batch (--gears, --jobs, --all) always writes into the folder --out, however many programs
+    it makes; one program is written to the file --out unless --out is a folder or ends with /.
+    The folder must exist unless `mkdir` (--mkdir) asks for it to be made."""
 
-    def __init__(self, out, force: bool = False, batch: bool = False):
+    def __init__(self, out, force: bool = False, batch: bool = False, mkdir: bool = False):
         self.out = Path(out) if out is not None else None
-        self.force = force
+        self.force, self.mkdir = force, mkdir
         self.folder = batch or (out is not None and str(out).endswith(os.sep))
         self.texts: dict[Path, bytes] = {}
         self.paths: dict[str, Path] = {}
@@ -81,6 +81,7 @@ class ProgramFiles:
 
         try:   # a path the system refuses to look at (too long, a symlink loop, a file as a folder, no access)
             paths = self._targets([name for name, _ in programs])
+            _refuse_missing_folder(paths[programs[0][0]].parent, self.mkdir)
             self._refuse_existing(list(paths.values()))
             _refuse_unwritable(paths[programs[0][0]].parent)
             self.seen = FolderSeen.now(paths[programs[0][0]].parent)
@@ -213,7 +214,7 @@ def files_after_commit(conn: Connection, output: Output, batch: bool = False):
     """Yield ProgramFiles for the block, which runs in a transaction that commits for real when
     the block ends; only then are the planned files written. Without --out (output.out None) the
     block may run inside the caller's transaction (a savepoint), as nothing is written."""
-    files = ProgramFiles(output.out, output.force, batch)
+    files = ProgramFiles(output.out, output.force, batch, output.mkdir)
     if output.out is not None and conn.info.transaction_status != TransactionStatus.IDLE:
         raise EngineError("program files are written only after their programs are committed, but this "
                           "connection is inside a transaction its caller commits: commit first, or store without --out")
@@ -273,6 +274,14 @@ def _entries_by_program(folder: Path) -> dict[str, list[str]]:
     for entry in entries:
         by_program.setdefault(entry.upper(), []).append(entry)
     return by_program
+
+
+def _refuse_missing_folder(folder: Path, mkdir: bool) -> None:
+    """A folder that does not exist is a typo until --mkdir says otherwise (issue 31: a misspelt
+    share path quietly became a new folder of programs nobody found); checked before storing."""
+    if not mkdir and not folder.is_dir():
+        raise EngineError(f"--out: the folder {_short(folder)} does not exist; nothing stored; check the path, "
+                          "or give --mkdir to create it")
 
 
 def _refuse_unwritable(folder: Path) -> None:

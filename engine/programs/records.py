@@ -3,8 +3,9 @@ storage and what storage hands back."""
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
+
+import msgspec
 
 from ..nc.layout import NcLayout, nc_text
 
@@ -13,8 +14,7 @@ if TYPE_CHECKING:
     from ..templates.rows import Template
 
 
-@dataclass(slots=True)
-class Planned:
+class Planned(msgspec.Struct):
     """A job computed in memory, with its program, not yet stored."""
     gear_id: int | None
     gear_class: str
@@ -25,7 +25,7 @@ class Planned:
     template: Template
     result: Result
     cutting: dict | None = None      # job.cutting: the cutting data chosen and their source
-    notes: list = field(default_factory=list)   # what the operator should know, one line each (bounded feeds, …)
+    notes: list = []   # what the operator should know, one line each (bounded feeds, …)
     layout: NcLayout = NcLayout()    # the class's line ending and final newline (gear_class; issue 17)
     unverified: bool = False   # no verifier read it (engine.programs.class_jobs): stored so marked, never written
     # A lathe class job proved against a blank assumed from its own cuts (no stock_* params): stored
@@ -52,8 +52,7 @@ class Planned:
                        self.work_holding_id)
 
 
-@dataclass(frozen=True, slots=True)
-class Encoded:
+class Encoded(msgspec.Struct, frozen=True):
     """A planned job as a batch stores it: its JSON already encoded and its template reduced to
     version and hash. Batch workers send this across processes (a few strings, not the objects)."""
     gear_id: int | None
@@ -75,8 +74,7 @@ class Encoded:
     work_holding_id: str | None = None   # Planned.work_holding_id
 
 
-@dataclass(frozen=True)
-class Program:
+class Program(msgspec.Struct, frozen=True):
     """A program made: stored (its ids) or a dry run's (ids None), with its lines, trace, notes and file path."""
     program_id: int | None   # None: a dry run (engine.programs.batches), nothing stored
     job_id: int | None       # None: a dry run of a new job

@@ -13,8 +13,9 @@ refused."""
 from __future__ import annotations
 
 import re
-from dataclasses import replace
 from typing import TYPE_CHECKING
+
+from msgspec.structs import replace
 
 from ..errors import EngineError
 from ..gears.holding_matching import choose_holding

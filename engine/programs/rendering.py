@@ -34,8 +34,10 @@ program stored with none (NULL) since traces were kept is a MISMATCH."""
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
+
+import msgspec
+from msgspec.structs import replace
 
 from ..db.connection import scalar
 from ..errors import EngineError
@@ -76,8 +78,7 @@ LAST_PROGRAM = "SELECT max(id) FROM program WHERE job_id = %s"
 REMAKE = "make it again with `engine instantiate --job {job}`"
 
 
-@dataclass(frozen=True)
-class Rendering:
+class Rendering(msgspec.Struct, frozen=True):
     """What the check found for one stored program: MATCH, MISMATCH or UNCHECKED, and why (one line)."""
     program_id: int
     status: str
@@ -121,8 +122,7 @@ def checked_last_program(conn: Connection, job_id: int, use: str) -> Rendering |
     return None if found is None else checked_program(conn, found, use)
 
 
-@dataclass(frozen=True)
-class StoredProgram:
+class StoredProgram(msgspec.Struct, frozen=True):
     """A program as stored, with what rendering it again needs from its job, version and machine."""
     id: int
     name: str

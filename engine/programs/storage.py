@@ -13,9 +13,9 @@ from __future__ import annotations
 
 import contextlib
 import re
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+import msgspec
 from psycopg.errors import ForeignKeyViolation
 from psycopg.types.json import Jsonb
 
@@ -214,8 +214,7 @@ def _as_is(text: str) -> str:
     return text
 
 
-@dataclass(frozen=True)
-class Batch:
+class Batch(msgspec.Struct, frozen=True):
     """What a batch stored (or, a dry run, would store): how many programs and lines, the lowest
     and highest program id (other sessions may draw ids in between; None in a dry run), where
     files went, and the gears or jobs skipped as bad (--skip-bad), each with its reason."""

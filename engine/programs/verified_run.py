@@ -14,7 +14,7 @@ stored with --unverified: its record and lineage line say UNVERIFIED, and it is 
 to a file for the machine."""
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+import msgspec
 
 from ..errors import EngineError
 from ..gears.records import Gear, Hob
@@ -28,8 +28,7 @@ from ..templates.rows import Template
 from ..verifier import verify_program
 
 
-@dataclass(frozen=True, slots=True)
-class Workpiece:
+class Workpiece(msgspec.Struct, frozen=True):
     """What a hobbing program is proved against: the gear (with its units) and the hob, as stored,
     and the job's work-holding (None: the machine record's fixture and tailstock, issue 29)."""
     gear: Gear
@@ -37,14 +36,18 @@ class Workpiece:
     holding: WorkHolding | None = None
 
 
-@dataclass(frozen=True, slots=True)
-class TurningWork:
+class TurningWork(msgspec.Struct, frozen=True):
     """What a lathe program is proved against: the job's parameters and module parameters with
     the facts of its drawing record in place of the job's (the profile, the blank, the tool-change
     position, the materials: engine.simulation.turning.drawing.proof_params), and its operations."""
     params: dict
     module_params: dict
-    notes: list = field(default_factory=list, compare=False)   # filled by the proof: what it did not check
+    notes: list = []   # filled by the proof: what it did not check
+
+    def __eq__(self, other: object) -> bool:
+        """The params and module params: the proof's notes are not compared."""
+        return (isinstance(other, TurningWork) and self.params == other.params
+                and self.module_params == other.module_params)
 
 
 def class_work(params: dict) -> TurningWork:

@@ -6,11 +6,17 @@ plan slices of the gears; they read nothing from the database (the connection th
 never touched). Their jobs come back here in gear order and are stored in one transaction by
 the caller, so a batch is still all or none. A bad gear does not stop the workers: it comes back
 as its reason (engine.programs.batches.Bad), so the batch names every bad gear in one run.
+
+Ctrl-C reaches every process of the terminal's process group, the workers too. A worker ignores
+it (issue 31: each printed `Process ForkPoolWorker-N:` and a traceback): the parent alone stops,
+its transaction rolled back, and ends the workers as it leaves the pool (terminate).
 """
 from __future__ import annotations
 
+import contextlib
 import gc
 import multiprocessing
+import signal
 
 from ..errors import EngineError
 from ..templates.decision_table import compiled_template
@@ -39,13 +45,34 @@ def plan_in_workers(planner, gears: list, plan_one, mode: RunMode) -> list:
 def _planned_in_pool(slices: list[tuple[int, int]], total: int, mode: RunMode) -> list:
     """The slices planned by `mode.workers` forked processes, in order; progress told as each
     slice comes back (`total` gears in all)."""
-    with multiprocessing.get_context("fork").Pool(mode.workers, initializer=_in_worker) as pool:
+    with _forked_pool(mode.workers, _in_worker) as pool:
         outcomes = []
         for planned in pool.imap(_plan_slice, slices):
             outcomes += planned
             if mode.progress:
                 mode.progress(PLANNING, len(outcomes), total)
         return outcomes
+
+
+@contextlib.contextmanager
+def _forked_pool(workers: int, initializer):
+    """A fork Pool of `workers` processes that ignore Ctrl-C (SIGINT), terminated when the block
+    ends. SIGINT is blocked while they are forked, so one arriving before a worker has set it
+    ignored waits, and is then discarded there; the parent gets its own once unblocked."""
+    blocked = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
+    try:
+        pool = multiprocessing.get_context("fork").Pool(workers, initializer=_quiet_worker, initargs=(initializer,))
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, blocked)
+    with pool:
+        yield pool
+
+
+def _quiet_worker(initializer) -> None:
+    """In a worker, first: Ctrl-C ignored (the parent ends the worker), then `initializer()`."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT})
+    initializer()
 
 
 def _ready(planner, gear_class: str) -> None:
@@ -93,7 +120,7 @@ def map_in_workers(work, items: list, workers: int, in_worker=None) -> list:
     _MAPPED[:] = [work, in_worker, items]
     gc.freeze()   # the parent's objects out of the workers' collections: touching them would copy their pages
     try:
-        with multiprocessing.get_context("fork").Pool(workers, initializer=_mapping_worker) as pool:
+        with _forked_pool(workers, _mapping_worker) as pool:
             return [result for done in pool.imap(_map_slice, slices) for result in done]
     finally:
         gc.unfreeze()

@@ -3,8 +3,9 @@ neither a golden test nor a program stored lately emitted or ran. A row nothing 
 a row a change could break unnoticed: a DBA adds a test that reaches it, or retires it."""
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
+
+import msgspec
 
 from ..errors import EngineError
 from ..templates.versions import draft_template
@@ -26,8 +27,7 @@ WHERE p.gear_class = %(class)s AND p.created_at >= now() - make_interval(days =>
 CLASSES_WITH_ROWS = "SELECT DISTINCT gear_class FROM assembly ORDER BY gear_class"
 
 
-@dataclass(frozen=True)
-class UncoveredRow:
+class UncoveredRow(msgspec.Struct, frozen=True):
     gear_class: str
     row_id: int
     t: str

@@ -9,9 +9,9 @@ the programs of the stored jobs (engine.release.impact). Not a dry run: the rele
 what was checked is what is released."""
 from __future__ import annotations
 
-from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
+import msgspec
 from psycopg.errors import InsufficientPrivilege
 from psycopg.types.json import Jsonb
 
@@ -42,8 +42,7 @@ class GateRefusal(EngineError):
         super().__init__(f"class {gear_class} v{version} not released: {problems[0]}{more}")
 
 
-@dataclass
-class ReleaseReport:
+class ReleaseReport(msgspec.Struct):
     gear_class: str
     version: int
     hash: str
@@ -52,7 +51,7 @@ class ReleaseReport:
     impact: Impact
     checks: dict
     release_id: int | None = None
-    drafts_below: list[str] = field(default_factory=list)   # descendants whose drafts need their own release
+    drafts_below: list[str] = []   # descendants whose drafts need their own release
 
 
 def release(conn: Connection, gear_class: str, dry_run: bool = False, confirm=None, workers: int = 1) -> ReleaseReport:

@@ -9,8 +9,9 @@ message names class, row and column).
 The expectation language is engine.templates.expectations's (docs/guide/release-and-golden-tests.md)."""
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
+
+import msgspec
 
 from ..errors import EngineError
 from ..templates.expectations import Context, first_difference
@@ -24,8 +25,7 @@ TESTS = ("SELECT id, gear_class, name, gear_id, params, choices, expect, descrip
          "WHERE %(all)s OR gear_class = ANY(%(classes)s) ORDER BY gear_class, name")
 
 
-@dataclass(frozen=True)
-class GoldenResult:
+class GoldenResult(msgspec.Struct, frozen=True):
     gear_class: str           # the test's class
     name: str                 # the test's name
     version: int              # the template version it ran against (0: none could be read)

@@ -8,8 +8,10 @@ What an expectation may name comes from here too: the job's parameters, the hand
 record's fields (gear_<field>) and its further units' (unit<N>_<field>)."""
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, fields
 from typing import TYPE_CHECKING
+
+import msgspec
+from msgspec.structs import asdict
 
 from ..errors import EngineError
 from ..gears.records import Gear, load_gear
@@ -24,11 +26,10 @@ if TYPE_CHECKING:
 
 HAND_SIGNS = {"R": 1, "L": -1}
 MODULE_PARAMS_KEY = "module_params"   # a params test's module parameters, inside its params object
-CHOICE_FIELDS = {field.name for field in fields(Choices)}
+CHOICE_FIELDS = set(Choices.__struct_fields__)
 
 
-@dataclass(frozen=True)
-class GoldenTest:
+class GoldenTest(msgspec.Struct, frozen=True):
     """One row of template_test."""
     id: int
     gear_class: str

@@ -24,8 +24,10 @@ stored spur jobs, every program changed and proved, take about 9 s with two, 18 
 from __future__ import annotations
 
 import difflib
-from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
+
+import msgspec
+from msgspec.structs import replace
 
 from ..errors import EngineError
 from ..nc.layout import ENDING_NAMES, NcLayout
@@ -53,23 +55,20 @@ WHERE j.gear_class = ANY(%s::text[])
 ORDER BY j.id"""
 
 
-@dataclass(frozen=True)
-class JobDiff:
+class JobDiff(msgspec.Struct, frozen=True):
     job_id: int
     gear_class: str
     diff: str   # unified diff, released → draft
 
 
-@dataclass(frozen=True)
-class JobFailure:
+class JobFailure(msgspec.Struct, frozen=True):
     job_id: int
     gear_class: str
     error: str
     released_makes: bool = False   # the released version makes this job a program that passes the same proof
 
 
-@dataclass
-class LayoutChange:
+class LayoutChange(msgspec.Struct):
     """A class whose draft writes its programs with another layout than its released version: the
     files of all its stored programs change bytes, though no line changes."""
     gear_class: str
@@ -90,16 +89,15 @@ def _layout_json(layout: NcLayout) -> dict:
     return {"line_ending": ENDING_NAMES[layout.line_ending], "final_newline": layout.final_newline}
 
 
-@dataclass
-class Impact:
+class Impact(msgspec.Struct):
     """The impact of releasing a class's draft: jobs examined, programs that change, jobs the
     draft fails for, and the diffs of the changed programs (in job id order)."""
     gear_class: str
     jobs: int = 0
     changed: int = 0
-    failures: list[JobFailure] = field(default_factory=list)
-    diffs: list[JobDiff] = field(default_factory=list)
-    layouts: dict[str, LayoutChange] = field(default_factory=dict)   # class → its draft's other layout
+    failures: list[JobFailure] = []
+    diffs: list[JobDiff] = []
+    layouts: dict[str, LayoutChange] = {}   # class → its draft's other layout
     proved: int = 0   # distinct changed programs read by the verifier and followed by the simulation
 
     def summary(self) -> dict:
@@ -165,8 +163,7 @@ def _compare(report: Impact, made: _Made, job) -> None:
         report.diffs.append(JobDiff(job_id, gear_class, outcome.diff))
 
 
-@dataclass(frozen=True, slots=True)
-class _Outcome:
+class _Outcome(msgspec.Struct, frozen=True):
     """What the draft does to the program of one distinct job input, as a worker sends it back (text
     only: it is pickled): why it fails (its rows fail to run, or its changed program fails the
     proof), or the diff of its changed program (None: the release leaves it as it is)."""

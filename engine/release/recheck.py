@@ -10,8 +10,9 @@ versions they ran against (milliseconds each). "gate passed" is said only of a r
 engine's gate made whose re-check passes; anything else says what is true."""
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
+
+import msgspec
 
 from ..errors import EngineError
 from ..programs import all_models  # noqa: F401  (registers every model)
@@ -33,8 +34,7 @@ NOT_THE_GATE = {"seed": "by engine seed, not through the engine's gate",
                               "engine's gate"}
 
 
-@dataclass(frozen=True)
-class Recheck:
+class Recheck(msgspec.Struct, frozen=True):
     """The gate's checks of a released version, run again now."""
     tests: int                  # golden tests re-run
     problems: tuple[str, ...]   # every failure: lint, analysis, golden test (one line each)
@@ -45,8 +45,7 @@ class Recheck:
         return not self.problems
 
 
-@dataclass(frozen=True)
-class Verdict:
+class Verdict(msgspec.Struct, frozen=True):
     gate: str        # passed, mismatch (recorded as the gate's, fails now), not run (not the gate's release)
     said: str        # one line for the screen
     recheck: Recheck

@@ -18,8 +18,9 @@ Every expression is compiled and evaluated through the expression gate
 (engine.templates.expressions, engine.templates.evaluator), never Python's eval."""
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
+
+import msgspec
 
 from .decision_table import CompiledRow, compile_row
 from .evaluator import EvaluationError, evaluate
@@ -32,8 +33,7 @@ if TYPE_CHECKING:
 CONDITION_COLUMNS = ("p_calc", "p_emit")
 
 
-@dataclass(frozen=True)
-class Finding:
+class Finding(msgspec.Struct, frozen=True):
     """One problem the analysis found: where (row, column) and what, in one line."""
     gear_class: str
     row_id: int

@@ -3,7 +3,7 @@ rows that do nothing) and every expression parses and is allowed (design notes Â
 checked here, where every writer of rows comes through, not where they are loaded."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+import msgspec
 
 from ..errors import EngineError
 from .budget import compiling, pay_time
@@ -11,8 +11,7 @@ from .decision_table import TemplateError, compile_row
 from .rows import MODULE_ORDER, TemplateRow, writes_lineage
 
 
-@dataclass(frozen=True)
-class LintProblem:
+class LintProblem(msgspec.Struct, frozen=True):
     """A fault of a template row found before it runs (engine lint, the release gate): the class, row and column."""
     gear_class: str
     row_id: int | None

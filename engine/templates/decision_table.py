@@ -15,9 +15,10 @@ instantiation with an error naming class, row, column, text.
 from __future__ import annotations
 
 import threading
-from dataclasses import dataclass, field
 from functools import partial
 from typing import Any
+
+import msgspec
 
 from ..errors import EngineError
 from .budget import Budget, compiling, pay_time, seconds_for, spending
@@ -40,8 +41,7 @@ class TemplateError(EngineError):
         super().__init__(f"class {gear_class} row {row_id} column {column}: {problem} in {short_repr(text)}")
 
 
-@dataclass(frozen=True)
-class CompiledRow:
+class CompiledRow(msgspec.Struct, frozen=True):
     """A template row with its expressions parsed and checked, ready to run for a job."""
     row: TemplateRow
     o: Compiled | None
@@ -55,13 +55,12 @@ class CompiledRow:
         return self.row.t, self.row.n
 
 
-@dataclass(slots=True)
-class Result:
+class Result(msgspec.Struct):
     """The result table of one instantiation: emitted lines, the row id of each, and the trace
     (engine.templates.trace): the input values by origin, and an entry for every row."""
-    lines: list[Any] = field(default_factory=list)   # text; an nc_path row's NcLines until _one_line_each
-    row_ids: list[int] = field(default_factory=list)
-    trace: dict = field(default_factory=lambda: {"inputs": {}, "rows": []})
+    lines: list[Any] = []   # text; an nc_path row's NcLines until _one_line_each
+    row_ids: list[int] = []
+    trace: dict = msgspec.field(default_factory=lambda: {"inputs": {}, "rows": []})
 
 
 class CompiledTemplate:

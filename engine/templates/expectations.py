@@ -36,9 +36,9 @@ runs (a DBA may have written it in SQL). The expectation texts themselves are re
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+import msgspec
 import re2  # type: ignore[import-untyped]   # google-re2 ships no stubs
 
 from ..errors import EngineError
@@ -68,8 +68,7 @@ class ExpectationError(EngineError):
     """An expectation that cannot be read or evaluated: the test fails with this reason."""
 
 
-@dataclass(frozen=True)
-class Context:
+class Context(msgspec.Struct, frozen=True):
     """What an expectation is checked against: the program's lines and the names its
     expressions may read."""
     lines: list[str]

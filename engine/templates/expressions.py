@@ -22,8 +22,9 @@ from __future__ import annotations
 import ast
 import re
 from collections.abc import Mapping
-from dataclasses import dataclass
 from typing import Literal, overload
+
+import msgspec
 
 from ..errors import EngineError
 from .functions import CONSTANTS, FUNCTIONS
@@ -49,8 +50,7 @@ GUARDED_OPERATORS = {ast.Pow: "_safe_pow", ast.Mult: "_safe_mult", ast.Add: "_sa
                      ast.LShift: "_safe_lshift", ast.Mod: "_safe_mod"}
 
 
-@dataclass(frozen=True)
-class Compiled:
+class Compiled(msgspec.Struct, frozen=True):
     """One checked expression: its text, the guarded tree asteval runs, the names it reads."""
     text: str
     tree: ast.expr

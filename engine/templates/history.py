@@ -6,9 +6,10 @@ also records the layout its programs are written with (line ending, final newlin
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
 from datetime import datetime
 from typing import TYPE_CHECKING
+
+import msgspec
 
 from ..db.connection import scalar
 from ..errors import EngineError
@@ -20,8 +21,7 @@ if TYPE_CHECKING:
     from ..db.connection import Connection
 
 
-@dataclass(frozen=True)
-class VersionEntry:
+class VersionEntry(msgspec.Struct, frozen=True):
     version: int
     created_at: datetime
     created_by: str
@@ -32,8 +32,7 @@ class VersionEntry:
     layout: NcLayout = NcLayout()          # the line ending and final newline its programs are written with
 
 
-@dataclass(frozen=True)
-class ReleaseEntry:
+class ReleaseEntry(msgspec.Struct, frozen=True):
     """Who released a version, when, how, and what the releasing session states the gate saw:
     tests run, programs changed of jobs (claims: engine.release.recheck says what is true)."""
     version: int
@@ -49,8 +48,7 @@ class ReleaseEntry:
     failed: int | None = None        # stored jobs the session states the released version failed for
 
 
-@dataclass(frozen=True)
-class RowChange:
+class RowChange(msgspec.Struct, frozen=True):
     row_id: int
     kind: str            # added, removed, changed
     old: dict | None     # the row in the first version (None: added)

@@ -3,8 +3,9 @@
 or earlier rows compute."""
 from __future__ import annotations
 
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
+
+import msgspec
 
 from ..gears.models import model_for_class
 from .checks import LintProblem, structural_problems
@@ -60,8 +61,7 @@ def _translation_problems(template) -> list[LintProblem]:
             for row in template.rows for column in ("p_calc", "o", "p_emit") if getattr(row, column) in wrong]
 
 
-@dataclass(frozen=True)
-class _ImportedNames:
+class _ImportedNames(msgspec.Struct, frozen=True):
     """The names of an imported class: the parameters of the program it came from, in every module."""
     names: frozenset
 

@@ -10,7 +10,8 @@ the table PROPERTY_PATTERNS (rules as data): an unknown name is refused, never r
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
+
+import msgspec
 
 COMMENT = re.compile(r";.*$|(?<![A-Za-z0-9_])\([^()]*\)")   # 840D `; …` and ISO `( … )` comments (not calls)
 WORD = re.compile(r"(?<![A-Za-z_$0-9.])([A-Z])=?(-?(?:\d+\.?\d*|\.\d+))(?![A-Za-z_(])")
@@ -19,8 +20,7 @@ MOTIONS = {0: "G0", 1: "G1", 2: "G2", 3: "G3"}   # the modal motion group an add
 LIMIT_CODES = {25.0, 26.0}   # G25/G26 X… Y… Z… S…: working-area and speed limits, not positions (hobbing.md §A4)
 
 
-@dataclass(frozen=True)
-class Reading:
+class Reading(msgspec.Struct, frozen=True):
     """A value read from the program, where it was, and how finely the program printed it."""
     value: float
     line_number: int | None = None   # 1-based; None for a count over the whole program
@@ -41,8 +41,7 @@ def words(line: str) -> list[tuple[str, str]]:
     return WORD.findall(COMMENT.sub("", line))
 
 
-@dataclass(frozen=True)
-class AddressValue:
+class AddressValue(msgspec.Struct, frozen=True):
     """The values of one address over the blocks that position (G25/G26 limits left out)."""
     address: str
     motion: str | None       # only blocks in this modal motion (G0, G1, …); None: any block
@@ -67,8 +66,7 @@ def _sets_limits(block: list[tuple[str, str]]) -> bool:
     return any(a == "G" and float(v) in LIMIT_CODES for a, v in block)
 
 
-@dataclass(frozen=True)
-class EgonFactor:
+class EgonFactor(msgspec.Struct, frozen=True):
     """The coupling factor Zi/Ni of one leading axis in an EGON block (ratio: the B axis)."""
     axis: str
 
@@ -97,8 +95,7 @@ def _egon_factor(call: str, axis: str, number: int, line: str) -> Reading | None
     return None
 
 
-@dataclass(frozen=True)
-class SlopeXZ:
+class SlopeXZ(msgspec.Struct, frozen=True):
     """dX/dZ of the last feed block (G1) that moves X and Z together (a taper's cone): absolute
     positions followed block by block."""
 
@@ -117,8 +114,7 @@ class SlopeXZ:
         return found
 
 
-@dataclass(frozen=True)
-class WordCount:
+class WordCount(msgspec.Struct, frozen=True):
     """Blocks holding the word (G1 counts G01 too: the number is compared, not the text)."""
     address: str
     number: float
@@ -128,8 +124,7 @@ class WordCount:
         return [Reading(float(count))]
 
 
-@dataclass(frozen=True)
-class LineCount:
+class LineCount(msgspec.Struct, frozen=True):
     def readings(self, lines: list[str]) -> list[Reading]:
         return [Reading(float(len(lines)))]
 

@@ -9,8 +9,9 @@ import hashlib
 import json
 import re
 from collections.abc import Mapping
-from dataclasses import dataclass, field
 from functools import cached_property
+
+import msgspec
 
 from ..nc.lineage import lineage_shaped
 
@@ -19,8 +20,7 @@ MODULE_ORDER = ("main", "prep", "sync", "shift", "cutcond", "cutmotion")   # the
 EXPRESSION_COLUMNS = ("p_calc", "s", "o", "p_emit")
 
 
-@dataclass(frozen=True)
-class TemplateRow:
+class TemplateRow(msgspec.Struct, frozen=True):
     """One row of a template: one NC line of module t, number n, with the expressions that compute and decide it."""
     id: int
     t: str
@@ -31,21 +31,30 @@ class TemplateRow:
     p_emit: str | None
 
     def values(self) -> tuple:
-        """(id, t, n, p_calc, s, o, p_emit): what dataclasses.astuple gives for these plain fields,
+        """(id, t, n, p_calc, s, o, p_emit): what dataclasses.astuple gave for these plain fields,
         without its deep copy of every value (11 s of the 14 s that exporting every class of a library
         with a 29,000-line program took)."""
         return (self.id, self.t, self.n, self.p_calc, self.s, self.o, self.p_emit)
 
 
-@dataclass(frozen=True)
-class Template:
+class Template(msgspec.Struct, frozen=True, dict=True):   # dict: room for the cached properties
     """A class's template at one version: its rows in order, and the stored translations of its SQL conditions."""
     gear_class: str
     version: int
     rows: tuple[TemplateRow, ...]
     # SQL condition text → its stored Python translation (engine.templates.translations)
-    translations: Mapping[str, str] = field(default_factory=dict, compare=False, repr=False)
-    draft: bool = field(default=False, compare=False)   # not a released version (engine.templates.versions)
+    translations: Mapping[str, str] = {}
+    draft: bool = False   # not a released version (engine.templates.versions)
+
+    def __eq__(self, other: object) -> bool:
+        """Class, version and rows: the translations and the draft mark are not compared."""
+        return isinstance(other, Template) and self._compared() == other._compared()
+
+    def __hash__(self) -> int:
+        return hash(self._compared())
+
+    def _compared(self) -> tuple:
+        return self.gear_class, self.version, self.rows
 
     @cached_property
     def cache_key(self) -> tuple:

@@ -6,7 +6,6 @@ class's assembly (row id, module number N, component). See design notes §4, §5
 """
 from __future__ import annotations
 
-from dataclasses import fields
 from typing import TYPE_CHECKING
 
 from psycopg.types.json import Jsonb
@@ -109,7 +108,7 @@ def replace_template(conn: Connection, gear_class: str, rows: list[TemplateRow],
     return changed
 
 
-_ROW_FIELDS = tuple(field.name for field in fields(TemplateRow))
+_ROW_FIELDS = TemplateRow.__struct_fields__
 
 
 def _row_json(row: TemplateRow) -> dict:

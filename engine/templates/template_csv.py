@@ -13,8 +13,9 @@ from __future__ import annotations
 import csv
 import io
 import re
-from dataclasses import dataclass
 from pathlib import Path
+
+import msgspec
 
 from ..csv_reader import (
     CellError,
@@ -63,8 +64,7 @@ TEMPLATE_KIND = CsvKind("template", (
     multiline=True, strip=False)
 
 
-@dataclass(frozen=True)
-class TemplateCsv:
+class TemplateCsv(msgspec.Struct, frozen=True):
     """A template CSV read: its rows, and the class's layout if the file gives one."""
     rows: list[TemplateRow]
     layout: NcLayout | None

@@ -21,7 +21,8 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import dataclass
+
+import msgspec
 
 MAX_TEXT = 200        # characters of a text value kept in the trace
 MAX_LISTED = 8        # elements of a list or tuple kept in the trace; longer ones are summarised
@@ -30,8 +31,7 @@ MAX_TRACE_BYTES = 1 << 20   # bytes of JSON of the row entries one program's tra
 MISSING = object()
 
 
-@dataclass(frozen=True)
-class Outcome:
+class Outcome(msgspec.Struct, frozen=True):
     """What a row did for one set of inputs: the values it computed, its line and whether it
     was emitted, its trace entry, and the (origin, name, value) of each input it read from the
     job or a module (the program's trace keeps those values once)."""

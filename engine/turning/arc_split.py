@@ -7,7 +7,8 @@ about the rounding itself."""
 from __future__ import annotations
 
 import math
-from dataclasses import replace
+
+from msgspec.structs import replace
 
 from .moves import Move
 

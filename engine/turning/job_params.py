@@ -5,8 +5,9 @@ from the defaults (engine.turning.defaults) and said in `notes`."""
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
 from typing import Any
+
+import msgspec
 
 from ..drawings.drawing import Drawing, Operation
 from ..drawings.profile import merged_bounds
@@ -28,8 +29,7 @@ from .program_names import drawing_names
 from .segments import path_param
 
 
-@dataclass(frozen=True)
-class ProfileOptions:
+class ProfileOptions(msgspec.Struct, frozen=True):
     """Cutting data for a drawing with a profile only (rough, then finish along the profile);
     None = not given, the default below applies."""
     rough_depth: float | None = None      # mm radial per rough pass
@@ -40,7 +40,7 @@ class ProfileOptions:
     stock_diameter: float | None = None   # mm; default the profile's largest diameter + STOCK_MARGIN
 
     def given(self) -> bool:
-        return any(value is not None for value in vars(self).values())
+        return any(value is not None for value in msgspec.structs.astuple(self))
 
     def cutting_data_given(self) -> bool:
         return any(getattr(self, name) is not None for name in PROFILE_DEFAULTS)
@@ -50,12 +50,11 @@ class ProfileOptions:
         return PROFILE_DEFAULTS[name] if given is None else given
 
 
-@dataclass
-class TurningJob:
+class TurningJob(msgspec.Struct):
     params: dict
     module_params: dict
-    operations: list[dict] = field(default_factory=list)   # a summary per operation, for the report
-    notes: list[str] = field(default_factory=list)
+    operations: list[dict] = []   # a summary per operation, for the report
+    notes: list[str] = []
 
 
 def turning_job(drawing: Drawing, machine: str, gear_class: str, program_number: int,

@@ -24,7 +24,8 @@ from __future__ import annotations
 
 import math
 from collections import defaultdict
-from dataclasses import dataclass
+
+import msgspec
 
 from ..drawings.profile import merged_bounds
 from ..errors import EngineError
@@ -44,8 +45,7 @@ BUCKET_MM = 1.0                # Z width of one cell of the cut index
 Point = tuple[float, float]
 
 
-@dataclass(frozen=True)
-class Blank:
+class Blank(msgspec.Struct, frozen=True):
     """The material before the first cut: Z from z_back to z_front, radius 0 … radius."""
     z_front: float
     z_back: float
@@ -78,8 +78,7 @@ def _facing_zs(passes: dict[int, list[Pass]], kinds: dict[int, str]) -> list[flo
     return zs
 
 
-@dataclass(frozen=True)
-class Cut:
+class Cut(msgspec.Struct, frozen=True):
     """One straight piece of a feed: the column above it is air."""
     start: Point
     end: Point

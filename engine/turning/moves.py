@@ -3,13 +3,12 @@ diameter (mm), as a program states them. The template rows decide how each kind 
 written (engine.templates.nc_path), so the dialects live in rows, not here."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+import msgspec
 
 from ..templates.nc_path import MOVE_KINDS  # noqa: F401  (the kinds nc_path prints, each in its format)
 
 
-@dataclass(frozen=True, slots=True)
-class Move:
+class Move(msgspec.Struct, frozen=True):
     """One block's motion to (z, x). Arcs: radius and the centre relative to the start
     point (i radial, k axial, both mm, i as a radius). Thread: the lead per turn."""
     kind: str

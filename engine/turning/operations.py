@@ -11,8 +11,9 @@ the drawn tool-centre path the motion is the same.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
 from functools import cached_property
+
+import msgspec
 
 from ..drawings.geometry import Line, Segment
 from ..drawings.profile import END_MATCH_TOLERANCE_MM, Profile, merged_bounds
@@ -28,8 +29,7 @@ PLUNGE_KINDS = ("SLOT", "PART")
 KINDS = ("ROUGH", "SLOT", "FINISH", "THREAD", "FACE", "PART")
 
 
-@dataclass(frozen=True)
-class JobGeometry:
+class JobGeometry(msgspec.Struct, frozen=True, dict=True):   # dict: room for the cached properties
     """What every operation of a job shares: the profile, the closed outline, the blank."""
     profile: list[Segment]
     finish_path: list[Segment]     # the side of the profile a finishing tool follows

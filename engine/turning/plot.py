@@ -11,7 +11,8 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+
+import msgspec
 
 from ..drawings.geometry import Arc, Segment
 from ..pictures import literal, new_figure, picture_target, save_atomically
@@ -39,8 +40,7 @@ Y_LABEL = "X diameter (mm)"
 STRETCHED_LABEL = "Z (mm) · not to scale: the shape is stretched to be seen"
 
 
-@dataclass(frozen=True)
-class JobPicture:
+class JobPicture(msgspec.Struct, frozen=True):
     """What a picture of a turning job shows; tool_change is (Z, X diameter) as in the program."""
     outline: Sequence[Segment]
     stock: Stock | None

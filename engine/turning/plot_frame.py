@@ -13,7 +13,8 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass
+
+import msgspec
 
 Point = tuple[float, float]   # (z, diameter)
 
@@ -31,8 +32,7 @@ ARROW_OFFSET_PT = 45.0        # the tool-change note this far inside the frame f
 SAME_DIAMETER_MM = 1e-9
 
 
-@dataclass(frozen=True)
-class Frame:
+class Frame(msgspec.Struct, frozen=True):
     z_limits: tuple[float, float]
     x_limits: tuple[float, float]      # diameter
     aspect: float | str                # TRUE_SHAPE, or "auto" for a part too slender to see at it

@@ -12,8 +12,9 @@ never altered, on either lathe.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
 from pathlib import Path
+
+import msgspec
 
 from ..errors import EngineError
 from ..names import NAME_RULES, checked, is_safe, shown
@@ -23,8 +24,7 @@ from ..names import NAME_RULES, checked, is_safe, shown
 FILE_NAME_SEPARATORS = str.maketrans({"-": "_", ".": "_", " ": "_"})
 
 
-@dataclass(frozen=True)
-class ProgramNaming:
+class ProgramNaming(msgspec.Struct, frozen=True):
     """How a dialect names a program the user did not name."""
     dialect: str
     by_number: bool   # the program is its O number: a file name that makes no name gives way to it

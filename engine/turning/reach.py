@@ -19,7 +19,8 @@ section there is the same all along the span.
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+
+import msgspec
 
 from ..drawings.profile import END_MATCH_TOLERANCE_MM
 from ..errors import EngineError
@@ -29,8 +30,7 @@ from .region import CHORD_TOLERANCE_MM, Edge
 DRAWING_TOLERANCE_MM = END_MATCH_TOLERANCE_MM + CHORD_TOLERANCE_MM
 
 
-@dataclass(frozen=True)
-class Slice:
+class Slice(msgspec.Struct, frozen=True):
     """The material between two Zs: spans (bottom, top) in radius, in increasing radius."""
     z_low: float
     z_high: float

@@ -9,8 +9,9 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable, Sequence
-from dataclasses import dataclass
 from functools import cached_property
+
+import msgspec
 
 from ..drawings.geometry import Arc, Point, Segment
 from ..drawings.profile import sweep
@@ -180,8 +181,7 @@ def top_over(edges: Sequence[Edge], z_low: float, z_high: float) -> float:
     return top
 
 
-@dataclass(frozen=True)
-class Surroundings:
+class Surroundings(msgspec.Struct, frozen=True, dict=True):   # dict: room for the cached property
     """What a rapid move must stay clear of: the part (its flattened outline) and the blank
     (z_front, z_back, radius), kept at `clearance`."""
     edges: tuple[Edge, ...]

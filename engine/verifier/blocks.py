@@ -1,6 +1,7 @@
 """A block of address words (`G1 X51.500 F36.0`, `G97 S800 M03`, `G18 G71 G90 G40 DIAMON`), read
 word by word with the dialect's tables, and its shape checked: each address once, one G code of
-each modal group, G4/G25/G26 blocks with only their own words, an arc with its radius, a thread
+each modal group, G25/G26 blocks with only their own words (a dwell G4 its time alone,
+engine.verifier.dwell), an arc with its radius, a thread
 with its pitch, and every move with its motion G code in the same block (the verifier reads each
 block on its own, so it does not carry a modal G0/G1 over from earlier blocks). What the block
 does to the machine state is kept as its events (engine.verifier.machine_state): its G
@@ -10,9 +11,11 @@ builder's choice)."""
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
 from typing import TYPE_CHECKING, ClassVar, Literal
 
+import msgspec
+
+from .dwell import is_dwell, read_dwell
 from .grammar import (
     ANGLE,
     AXES,
@@ -56,8 +59,7 @@ WORD_EVENTS: dict[str, Callable[[float], tuple[str, ...]]] = {
     TOOL_AND_OFFSET: lambda number: (TOOL_CHANGE, _offset(number % 100))}
 
 
-@dataclass(frozen=True, slots=True)
-class Block:
+class Block(msgspec.Struct, frozen=True):
     """An NC block as read: its address values, motion, positions and modal codes."""
     kind: ClassVar[Literal["block"]] = "block"
     values: dict[str, float]   # address -> value (G and M codes apart)
@@ -71,14 +73,19 @@ class Block:
     feed: float | None         # F where it is a feed (not a G4 dwell's time)
     needs: str | None          # the motion whose needs the block must meet ("G1"), if it moves
     g_codes: frozenset[int] = frozenset()   # every G code of the block, whatever the state rules keep
+    dwell: float | None = None   # seconds a dwell G4 holds the axes (engine.verifier.dwell)
 
 
 def read_block(dialect: Dialect, code: str) -> Block:
+    tokens = code.split()
+    if is_dwell(tokens):
+        return Block({}, None, None, {}, False, frozenset(), frozenset(), None, None, None, frozenset({DWELL}),
+                     read_dwell(dialect, tokens))
     codes: dict[str, list[int]] = {"G": [], "M": []}
     values: dict[str, float] = {}
     keywords: set[str] = set()
     events: list[str] = []
-    for token in code.split():
+    for token in tokens:
         _read_token(dialect, token, codes, values, keywords, events)
     groups = _groups(dialect, codes)
     _check_shape(dialect, codes, values, keywords)
@@ -98,7 +105,7 @@ def _block(dialect: Dialect, codes: dict[str, list[int]], groups: dict[int, str]
     effects = dialect.state.effects.keys()     # only events that change the state are kept
     modal = frozenset(effects & {*(f"G{code}" for code in codes["G"]), *keywords})
     kept = frozenset(effects & {*(f"M{code}" for code in codes["M"]), *events})
-    feed = None if DWELL in codes["G"] else values.get("F")
+    feed = values.get("F")
     needs = f"G{motion}" if moves and area is None else None
     return Block(values, motion, area, positions, moves, modal, kept, values.get("S"), feed, needs,
                  frozenset(codes["G"]))
@@ -170,7 +177,7 @@ def _check_shape(dialect: Dialect, codes: dict[str, list[int]], values: dict[str
 
 
 def _check_alone(code: int, codes: dict[str, list[int]], values: dict[str, float], keywords: set[str]) -> None:
-    """G4, G25 and G26 stand in a block of their own with only their words; G25/G26 give all of
+    """G25 and G26 stand in a block of their own with only their words, and give all of
     X, Y and Z, so no axis is left without a working-area limit."""
     if code not in BLOCK_SHAPES:
         return

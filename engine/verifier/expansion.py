@@ -17,8 +17,9 @@ from __future__ import annotations
 
 import importlib
 from collections.abc import Callable
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
+
+import msgspec
 
 from .refusals import Refused
 
@@ -34,8 +35,7 @@ MAX_PLAIN_LINES = 1_000_000
 MAX_STEPS = 1_000_000
 
 
-@dataclass(frozen=True, slots=True)
-class PlainLine:
+class PlainLine(msgspec.Struct, frozen=True):
     """One line the dialect's grammar reads, and the line of the program it comes from."""
     text: str       # a plain line: a header, a comment or a block of address words
     number: int     # that program line's number, from 1

@@ -14,8 +14,10 @@ functions are the machine record's own (dialect_for)."""
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
+
+import msgspec
+from msgspec.structs import replace
 
 from .machine_state import (
     FANUC_G81_4_HOBBING_STATE,
@@ -55,8 +57,7 @@ POINT_REASON = ("needs a decimal point: a Fanuc-type control with decimal-point 
                 "parameter's unit or as a one-digit feed code")
 
 
-@dataclass(frozen=True)
-class Header:
+class Header(msgspec.Struct, frozen=True):
     """A whole line of fixed form that may stand only at the given places ("first", "second",
     "last" line of the program), and must stand at those of `required`: a second `%_N_…_MPF`
     would start another program, and a program without its own would be stored by the
@@ -67,8 +68,7 @@ class Header:
     required: frozenset[str] = frozenset()
 
 
-@dataclass(frozen=True)
-class Synchronisation:
+class Synchronisation(msgspec.Struct, frozen=True):
     """A Fanuc electronic-gear-box command "compatible with a hobbing machine" (Fanuc 15i/150i-MA
     operator's manual §19.9.2; the M-series form G81.4 of the 16i/18i/21i): a G code whose block
     is the command alone, its words its arguments, not the dialect's addresses (in G81 T is the
@@ -91,8 +91,16 @@ class Synchronisation:
         return f"G{self.code}"
 
 
-@dataclass(frozen=True)
-class Dialect:
+class DwellWord(msgspec.Struct, frozen=True):
+    """A word that gives a dwell G4's time (engine.verifier.dwell): `seconds` per unit written
+    (1 for seconds, 0.001 for milliseconds) and its decimal point (True: required, False:
+    refused, None: as the dialect's point_required says)."""
+    address: str
+    seconds: float
+    point: bool | None = None
+
+
+class Dialect(msgspec.Struct, frozen=True):
     """What the verifier reads a machine's programs as: headers, comments, addresses, G and M codes, state rules."""
     name: str
     headers: tuple[Header, ...]
@@ -107,8 +115,8 @@ class Dialect:
     shift_clamp: bool = False             # the hob-shift-per-part R11 clamp (engine.verifier.shift_clamp)
     equals_allowed: bool = False          # 840D: `X=12.5` is `X12.5`; names of two letters need it (`CR=5`)
     arc_radius: str | None = None         # the address of an arc's radius
-    needs_words: dict[int, str] = field(default_factory=dict)   # G code -> the words its block must hold
-    thread_lead: dict[int, str] = field(default_factory=dict)   # thread G code -> the address of its lead (mm/rev)
+    needs_words: dict[int, str] = {}   # G code -> the words its block must hold
+    thread_lead: dict[int, str] = {}   # thread G code -> the address of its lead (mm/rev)
     point_required: frozenset[str] = frozenset()      # addresses whose number must hold a decimal point
     program_numbers: range | None = None  # ISO O numbers a program may have
     reserved_numbers: range | None = None  # … but these (the machine builder's macros)
@@ -117,12 +125,14 @@ class Dialect:
                                           # cycles, subprograms, parameters and jumps into plain lines
     synchronisations: tuple[Synchronisation, ...] = ()   # Fanuc hobbing: the EGB command blocks (G81/G80)
     record_work_offset: bool = False      # only the record's work offset of G54…G57 (machine.work_offset)
+    dwell_words: tuple[DwellWord, ...] = (DwellWord("F", 1.0),)   # G4's time: one of these, alone
+    refused_g_codes: dict[int, str] = {}   # this dialect's own reasons (Fanuc G60)
 
     def code_group(self, letter: str, code: int) -> str:
         codes = self.m_codes if letter == "M" else self.g_codes
         if code not in codes:
             known = ", ".join(f"{letter}{c}" for c in sorted(codes))
-            refused = REFUSED_G_CODES.get(code) if letter == "G" else None
+            refused = (self.refused_g_codes.get(code) or REFUSED_G_CODES.get(code)) if letter == "G" else None
             raise Refused((refused or f"{letter}{code} is not a{'n' if letter == 'M' else ''} {letter} code of the "
                            f"{self.name} grammar") + f" (it has {known})")
         return codes[code]
@@ -141,14 +151,14 @@ REFUSED_G_CODES = {
     **{code: f"G{code} moves by way of a reference point the verifier cannot see" for code in (28, 74, 75)},
 }
 
-# A block that holds one of these G codes holds no other G code and only these words.
+# A block that holds one of these G codes holds no other G code and only these words (a dwell
+# G4 holds its time alone: Dialect.dwell_words, engine.verifier.dwell).
 BLOCK_SHAPES = {
-    4: ("dwell", frozenset({"F"})),
     25: ("lower working-area limit", frozenset(AXES)),
     26: ("upper working-area limit", frozenset(AXES)),
 }
 WORKING_AREA = {25: "lower", 26: "upper"}
-DWELL = 4                   # its F is a time in seconds, not a feed
+DWELL = 4                   # its word is a time (Dialect.dwell_words), not a feed or a position
 # Words that mean something only together with one of these G codes in the same block.
 WORD_NEEDS_CODE = {"R": frozenset({2, 3}), "CR": frozenset({2, 3}), "K": frozenset({33})}
 # M codes by what they switch: two of one group in a block contradict each other (M3 M5).
@@ -266,27 +276,36 @@ LATHE_LINUXCNC = Dialect(
 
 # Fanuc hobbing (issue 30): a hobber's program in ISO framing (% … %, O<n> (NAME)), absolute mm
 # (G21 G90), feed per minute (G94; G95 refused as on the 840D hobber), the record's work offset
-# G54…G57, hob spindle M3/M5 S, coolant M8/M9, a tool call T<n>, and the table synchronised to the
-# hob by the electronic gear box: G81 T<teeth> L<±threads> [Q<module> P<helix angle>] … G80 (Fanuc
-# 15i/150i-MA operator's manual §19.9.2; a second G81 while on changes the ratio). Fanuc's G25/G26
-# detect spindle-speed fluctuation, so there is no working area: positions are held to the travel.
+# G54…G57, hob spindle M3/M5 S, coolant M8/M9, tailstock M20/M21 (the builder's, as on the 840D
+# hobber), a tool call T<n>, and the table synchronised to the hob by the electronic gear box:
+# G81 T<teeth> L<±threads> [Q<module> P<helix angle>] … G80 (Fanuc 15i/150i-MA operator's manual
+# §19.9.2; a second G81 while on changes the ratio). Fanuc's G25/G26 detect spindle-speed
+# fluctuation, so there is no working area: positions are held to the travel. The dwell is
+# `G04 X<seconds>` (with its point) or `G04 P<milliseconds>` (a whole number), the path modes
+# G61 (exact stop mode) and G64 (cutting mode), the 840D's G60/G64 (reference fanuc-egb.md §F8);
+# Fanuc's G60 is single-direction positioning, refused by name.
 FANUC_G81 = Synchronisation("81", True, "T", range(1, 1001), "L", range(-21, 22), ("Q", "P"))
 FANUC_G80 = Synchronisation("80", False)
+FANUC_DWELL = (DwellWord("X", 1.0, point=True), DwellWord("P", 0.001, point=False))
+FANUC_REFUSED_G_CODES = {60: "G60 is single-direction positioning on a Fanuc control, not the 840D's exact stop; "
+                             "write G61 (exact stop mode), reference fanuc-egb.md §F8"}
 HOBBING_FANUC = Dialect(
     name="Fanuc hobbing",
     headers=ISO_HEADERS,
     comment="parentheses without ;",
     addresses={"X": POSITION, "Y": POSITION, "Z": POSITION, "A": ANGLE, "F": FEED, "S": SPEED, "T": TOOL,
                "G": CODE, "M": CODE},
-    g_codes={0: MOTION, 1: MOTION, 21: "units", 90: "distance", 94: "feed type",
-             **{code: "work offset" for code in WORK_OFFSETS}},
-    m_codes={code: M_GROUPS[code] for code in (3, 5, 8, 9, 30)},
+    g_codes={0: MOTION, 1: MOTION, 4: "dwell", 21: "units", 90: "distance", 94: "feed type",
+             **{code: "work offset" for code in WORK_OFFSETS}, 61: "path mode", 64: "path mode"},
+    m_codes={code: M_GROUPS[code] for code in (3, 5, 8, 9, 20, 21, 30)},
     state=FANUC_HOBBING_STATE,
     point_required=frozenset({"X", "Y", "Z", "A", "F"}),
     program_numbers=ISO_PROGRAM_NUMBERS,
     reserved_numbers=ISO_RESERVED_NUMBERS,
     synchronisations=(FANUC_G81, FANUC_G80),
     record_work_offset=True,
+    dwell_words=FANUC_DWELL,
+    refused_g_codes=FANUC_REFUSED_G_CODES,
 )
 # The M-series form (Fanuc 16i/18i/21i, where G81 is the drilling cycle): G81.4 R<teeth 1…500>
 # L<±threads 1…30> [Q P] … G80.4; otherwise as HOBBING_FANUC.

@@ -5,8 +5,9 @@ an optional comment. Reading a line needs no machine and no other line, so what 
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
 from typing import ClassVar, Literal
+
+import msgspec
 
 from .blocks import Block, read_block
 from .characters import check_characters
@@ -20,8 +21,7 @@ MAX_REMEMBERED = 20_000   # lines kept per dialect; the memory starts again when
 ISO_LINE = re.compile(rf"([^()]*?) ?(?:\(({ISO_COMMENT_TEXT})\))?")
 
 
-@dataclass(frozen=True, slots=True)
-class HeaderLine:
+class HeaderLine(msgspec.Struct, frozen=True):
     """A program's header line as read: the program name (or ISO number) it gives."""
     kind: ClassVar[Literal["header"]] = "header"
     what: str
@@ -30,8 +30,7 @@ class HeaderLine:
     number: int | None = None      # the ISO program number
 
 
-@dataclass(frozen=True, slots=True)
-class CommentLine:
+class CommentLine(msgspec.Struct, frozen=True):
     """A line that is only a comment."""
     kind: ClassVar[Literal["comment"]] = "comment"
 

@@ -16,7 +16,7 @@ the generating zone lies where the program says, and ends with the coupling swit
 deleted (EGOFS(C), EGDEL(C)): the next program's EGDEF alarms while a definition exists."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+import msgspec
 
 from .refusals import Refused
 
@@ -29,8 +29,7 @@ Y_POSITION = "Y position"     # the event of a block (or the shift clamp) that p
 SWIVEL = "A position"         # the event of a block that swivels the hob head (A)
 
 
-@dataclass(frozen=True)
-class Effect:
+class Effect(msgspec.Struct, frozen=True):
     """What one event does: facts it sets and facts it clears (a block's clears come first)."""
     sets: frozenset[str] = frozenset()
     clears: frozenset[str] = frozenset()
@@ -44,8 +43,7 @@ def clears(*facts: str) -> Effect:
     return Effect(clears=frozenset(facts))
 
 
-@dataclass(frozen=True)
-class Need:
+class Need(msgspec.Struct, frozen=True):
     """A fact that must hold before a motion or statement (or, not `present`, must not)."""
     fact: str
     reason: str
@@ -73,8 +71,7 @@ class Needs:
                            if (need.fact not in facts if need.present else need.fact in could_hold)))
 
 
-@dataclass(frozen=True)
-class StateRules:
+class StateRules(msgspec.Struct, frozen=True):
     """A dialect's machine-state rules: what each event sets or clears, and what each motion or statement needs."""
     effects: dict[str, Effect]   # event -> Effect
     needs: dict[str, Needs]      # "G1" (a block moving with G1), "EGDEF" … -> Needs

@@ -13,8 +13,9 @@ nothing between them; any other R-parameter use is refused (engine.verifier.numb
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
 from typing import TYPE_CHECKING, ClassVar, Literal
+
+import msgspec
 
 from .numbers import plain_decimal
 from .refusals import Refused
@@ -36,8 +37,7 @@ SEQUENCE = tuple(step for step, _ in FORMS)
 SHAPE = f"{PARAMETER}=R11+step, IF ({PARAMETER}<lo) OR ({PARAMETER}>hi), {PARAMETER}=lo…hi, ENDIF, G0 Y={PARAMETER}"
 
 
-@dataclass(frozen=True, slots=True)
-class ShiftLine:
+class ShiftLine(msgspec.Struct, frozen=True):
     """One of the hob-shift lines of SHAPE as read: which (step) and the numbers it gives."""
     kind: ClassVar[Literal["shift"]] = "shift"
     step: str
@@ -54,8 +54,7 @@ def read_shift_line(code: str) -> ShiftLine | None:
     return None
 
 
-@dataclass
-class ShiftClamp:
+class ShiftClamp(msgspec.Struct):
     """Where the walk is in the five lines, and the interval they clamp R11 to."""
     at: int = 0
     low: float = 0.0

@@ -7,8 +7,9 @@ record bounds (reference §A5: n_C = (z0/z2)·n_B ± k_Y·v_Y ± k_Z·v_Z)."""
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
 from typing import ClassVar, Literal
+
+import msgspec
 
 from .numbers import plain_decimal, whole_number
 from .refusals import Refused
@@ -29,15 +30,32 @@ RATIO_DIGITS = 4                     # teeth and starts: no gear has 10,000 teet
 MAX_DIFFERENTIAL = 360.0
 
 
-@dataclass(frozen=True, slots=True)
-class Statement:
+class GearBox(msgspec.Struct, frozen=True):
+    """A Fanuc electronic-gear-box start as read (engine.verifier.synchronisation), its terms with
+    their signs: the simulation turns them into the coupling (engine.simulation.hobbing.fanuc_egb)
+    and its findings quote the words as written."""
+    teeth: int                   # T (G81) or R (G81.4): the gear's teeth
+    threads: int                 # L, signed: its sign gives the table's direction
+    module: float | None         # Q, mm; None: the block gives neither Q nor P
+    helix: float | None          # P, degrees, signed
+    teeth_word: str              # "T19", as written
+    threads_word: str            # "L-1"
+    helix_words: str = ""        # "Q3. P-15.", or ""
+
+    @property
+    def ratio_words(self) -> str:
+        return f"{self.threads_word} {self.teeth_word}"
+
+
+class Statement(msgspec.Struct, frozen=True):
     """A coupling statement (EGDEF, EGON, EGOFS, EGDEL; Fanuc G81/G80, engine.verifier.synchronisation)
-    as read: its leading axes, ratio and factors."""
+    as read: its leading axes, ratio and factors, and a Fanuc start's signed terms."""
     kind: ClassVar[Literal["statement"]] = "statement"
     name: str
     leading: tuple[str, ...] = ()    # leading axes, in order
     ratio: float | None = None       # |z0/z2| of the hob spindle (EGON; Fanuc G81 |L|/T)
     factors: tuple[tuple[str, float], ...] = ()   # (axis, |degrees of C per mm|) of Z and Y (EGON)
+    gear_box: GearBox | None = None  # Fanuc G81/G81.4: T, L, Q, P with their signs
 
 
 def read_statement(name: str, arguments: str) -> Statement:

@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING
 
 from .numbers import plain_decimal, whole_number
 from .refusals import Refused
-from .statements import Statement
+from .statements import GearBox, Statement
 
 if TYPE_CHECKING:
     from .grammar import Dialect, Synchronisation
@@ -53,7 +53,8 @@ def read_synchronisation(dialect: Dialect, code: str) -> Statement | None:
     words = _words(command, [token for token in tokens if not _is_code(token, command)])
     if not command.on:
         return Statement(command.event)
-    return Statement(command.event, ratio=_ratio(command, words), factors=_helical_factor(command, words))
+    box = _gear_box(command, words)
+    return Statement(command.event, ratio=abs(box.threads) / box.teeth, factors=_helical_factor(box), gear_box=box)
 
 
 def _is_code(token: str, command: Synchronisation) -> bool:
@@ -78,8 +79,24 @@ def _words(command: Synchronisation, tokens: list[str]) -> dict[str, str]:
     return words
 
 
-def _ratio(command: Synchronisation, words: dict[str, str]) -> float:
-    """|threads|/teeth: table turns per hob turn (the 840D's z0/z2, reference §A5)."""
+def _gear_box(command: Synchronisation, words: dict[str, str]) -> GearBox:
+    """The start's terms, each checked: the teeth and the signed threads (|threads|/teeth table
+    turns per hob turn, the 840D's z0/z2, reference §A5), Q and P both or neither."""
+    helical = _all_given(command, words)
+    teeth = _count(command.event, command.teeth, words[command.teeth], command.teeth_range, signed=False)
+    threads = _threads(command, words[command.threads])
+    teeth_word, threads_word = (f"{address}{words[address]}" for address in (command.teeth, command.threads))
+    if not helical:
+        return GearBox(teeth, threads, None, None, teeth_word, threads_word)
+    module_word, helix_word = command.paired
+    module = _increment(command.event, module_word, words[module_word], module=True)
+    helix = _increment(command.event, helix_word, words[helix_word], module=False)
+    return GearBox(teeth, threads, module, helix, teeth_word, threads_word,
+                   f"{module_word}{words[module_word]} {helix_word}{words[helix_word]}")
+
+
+def _all_given(command: Synchronisation, words: dict[str, str]) -> bool:
+    """Whether Q and P are given; Refused without the teeth or the threads, or with one of Q, P."""
     for address, what in ((command.teeth, "the gear's number of teeth"), (command.threads, "the hob's threads")):
         if address not in words:
             raise Refused(f"{command.event} without {address} ({what}): each {command.event} states its whole ratio "
@@ -89,24 +106,24 @@ def _ratio(command: Synchronisation, words: dict[str, str]) -> float:
         missing = next(address for address in command.paired if address not in words)
         raise Refused(f"{command.event} with {given[0]} but without {missing}: the module Q and the helix angle P "
                       "of the helical compensation come both or neither (Fanuc alarm PS0594)")
-    teeth = _count(command.event, command.teeth, words[command.teeth], command.teeth_range, signed=False)
-    threads = _count(command.event, command.threads, words[command.threads], command.threads_range, signed=True)
+    return bool(given)
+
+
+def _threads(command: Synchronisation, text: str) -> int:
+    threads = _count(command.event, command.threads, text, command.threads_range, signed=True)
     if threads == 0:
         raise Refused(f"{command.event} {command.threads}0: a hob has at least one thread (the sign of "
                       f"{command.threads} gives the table's direction)")
-    return abs(threads) / teeth
+    return threads
 
 
-def _helical_factor(command: Synchronisation, words: dict[str, str]) -> tuple[tuple[str, float], ...]:
+def _helical_factor(box: GearBox) -> tuple[tuple[str, float], ...]:
     """((Z, |degrees of C per mm of Z|),) of the helical compensation Q and P ask for (fanuc-egb.md
     §F4: Z·sin P·360/(π·T·Q) for metric input), or () without them. P0. gives a factor of 0: the
     compensation stated as none, which a later G81 may rely on (program.py)."""
-    if not all(address in words for address in command.paired):
+    if box.module is None or box.helix is None:
         return ()
-    module_word, helix_word = command.paired
-    module = _increment(command.event, module_word, words[module_word], module=True)
-    helix = _increment(command.event, helix_word, words[helix_word], module=False)
-    return ((AXIAL_FEED_AXIS, abs(helical_compensation(module, helix, int(words[command.teeth])))),)
+    return ((AXIAL_FEED_AXIS, abs(helical_compensation(box.module, box.helix, box.teeth))),)
 
 
 def helical_compensation(module: float, helix: float, teeth: int) -> float:

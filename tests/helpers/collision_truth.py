@@ -7,10 +7,10 @@ bound of the true one."""
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 
 import numpy as np
 import pytest
+from msgspec.structs import replace
 
 from engine.gears.records import load_gear, load_hobs
 from engine.machines.records import load_machine

@@ -15,6 +15,7 @@ PROGRAM_NUMBER = 1234     # O1234: within the ISO program numbers, outside the b
 DROPPED = (re.compile(r";\$PATH=.*"), re.compile(r"G2[56] .*"), re.compile(r"WALIMON"),
            re.compile(r"EGDEF\(.*\)"), re.compile(r"EGDEL\(.*\)"))
 HEADER = re.compile(r"%_N_(\w+)_MPF")
+DWELL = re.compile(r"G4 F(\d+\.\d+)")     # the 840D templates' `G4 F{dwell:.1f}`, seconds
 
 
 def hand(h: str | None) -> int:
@@ -49,8 +50,11 @@ def g81(gear, hob, machine, teeth: int | None = None, threads: int | None = None
 def fanuc_program(lines: list[str], gear, hob, machine, **mistake) -> list[str]:
     """`lines` (an 840D hobbing program) as a Fanuc program: % and O line, (comments), G21 for
     G71, T<n> without D, A<a> for A=<a>, EGON → G81 T L [Q P], EGOFS → G80; the 840D-only
-    lines (the path directive, the G25/G26 working area, WALIMON, EGDEF, EGDEL) left out. A
-    program with a tailstock M20/M21 (no M code of the Fanuc grammar) is not translated."""
+    lines (the path directive, the G25/G26 working area, WALIMON, EGDEF, EGDEL) left out; the
+    forms the Fanuc templates write for the rest (fanuc-egb.md §F8): the dwell `G4 F<s>` as
+    `G04 X<s>` (seconds, with its point), the exact stop `G60` as `G61` (Fanuc's G60 is
+    single-direction positioning), `G64` as it is (cutting mode); M20/M21 (tailstock), the door
+    M codes, M8/M9 and T<n> as they are, their comments in parentheses."""
     out = ["%"]
     for line in lines:
         if any(pattern.fullmatch(line.partition(";")[0].strip() or line) for pattern in DROPPED):
@@ -64,12 +68,14 @@ def _line(line: str, gear, hob, machine, mistake: dict) -> str:
     if header:
         return f"O{PROGRAM_NUMBER} ({header.group(1)})"
     code, _, comment = (part.strip() for part in line.partition(";"))
-    if re.search(r"\bM2[01]\b", code):
-        raise ValueError(f"{line}: the Fanuc hobbing grammar has no tailstock M code; use a job without one")
     if code.startswith("EGON("):
         code = g81(gear, hob, machine, **mistake)
     elif code.startswith("EGOFS("):
         code = "G80"
+    elif (dwell := DWELL.fullmatch(code)) is not None:
+        code = f"G04 X{dwell.group(1)}"
+    elif code == "G60":
+        code = "G61"
     else:
         code = code.replace("G71", "G21").replace("A=", "A")
         code = re.sub(r" D1\b", "", code)

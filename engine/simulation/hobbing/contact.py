@@ -13,7 +13,8 @@ from __future__ import annotations
 
 import math
 from bisect import bisect_left, bisect_right
-from dataclasses import dataclass
+
+import msgspec
 
 from .contact_bounds import exact_collision
 from .contact_records import COLLISION_TOLERANCE, TOLERANCE, Contact, Motion, contact_at, exact
@@ -53,8 +54,7 @@ def follow(solids: list[Solid], hob: HobBody, swivel: float, pieces: list, motio
     return [contact for contact in found if contact is not None]
 
 
-@dataclass(frozen=True, slots=True)
-class Box:
+class Box(msgspec.Struct, frozen=True):
     """The least hob centre X of a move's poses and the heights its hob spans (mm, DIN): the poses
     lie on straight pieces between the given positions, so their least and greatest values bound
     them; the centre's Z is Z + Y·sin A, bounded by the extremes of each term."""

@@ -3,7 +3,7 @@ batch's numpy path): what the hob is doing, the contact it finds, and the tolera
 from."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+import msgspec
 
 from .solids import Solid
 
@@ -18,8 +18,7 @@ TOLERANCE = 0.01      # mm: below the intended root, or into the blank it cuts, 
 COLLISION_TOLERANCE = 0.002
 
 
-@dataclass(frozen=True, slots=True)
-class Motion:
+class Motion(msgspec.Struct, frozen=True):
     """What the hob is doing on a move: which teeth it cuts (None: not an intended cut), whether
     the coupling is on with the spindle turning (its own gaps are free), in which coupling
     session, with the tailstock clamped or not, why it is not a cut (for the message), and
@@ -34,8 +33,7 @@ class Motion:
     swivelling: bool = False
 
 
-@dataclass(frozen=True, slots=True)
-class Contact:
+class Contact(msgspec.Struct, frozen=True):
     """The hob's deepest reach into a solid during one move: a cut below the root, or a collision."""
     solid: Solid
     depth: float          # mm

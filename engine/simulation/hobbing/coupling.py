@@ -13,26 +13,34 @@ denominator), plus FACTOR_TOLERANCE of its size."""
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+
+import msgspec
 
 from ...gears.records import Gear, Hob
 from .frame import Senses
 
+# The statements that start (or re-rate) the table's coupling and that end it, in each dialect:
+# the 840D's EGON / EGOFS, EGDEL, Fanuc's G81 / G80 and the M series' G81.4 / G80.4.
+COUPLING_ON = frozenset({"EGON", "G81", "G81.4"})
+COUPLING_OFF = frozenset({"EGOFS", "EGDEL", "G80", "G80.4"})
 ANGLE_TOLERANCE = 0.01       # degrees of swivel
 FACTOR_TOLERANCE = 1e-6      # relative
 HOB_DEDENDUM = 1.25          # d_m0 = d_a0 − 2·1.25·m_n (§B1)
 
 
-@dataclass(frozen=True, slots=True)
-class Coupling:
-    """One EGON in the DIN frame: k_B (C per B), and degrees of C per mm of Z and of Y, with
-    the resolution each was written to."""
+class Coupling(msgspec.Struct, frozen=True):
+    """One EGON (or Fanuc G81) in the DIN frame: k_B (C per B), and degrees of C per mm of Z and
+    of Y, with the resolution each was written to; a Fanuc start also the words it gave them, so
+    the findings name the words the program must change (engine.simulation.hobbing.fanuc_egb)."""
     numerator: int
     denominator: int
     k_b: float
     factors: dict            # "Z"/"Y" -> degrees of C per mm (DIN)
     resolution: dict         # "Z"/"Y" -> the rounding the program's digits allow
     program_factors: dict    # "B"/"Z"/"Y" -> the program's own value (table speed in program terms)
+    command: str = "EGON"    # EGON, or the Fanuc start G81 / G81.4
+    ratio_words: str = ""    # Fanuc: the threads and teeth words as written, "L-1 T19"
+    helix_words: str = ""    # Fanuc: "Q3. P-15." (the helical compensation), "" where the block gives none
 
     def teeth(self, starts: int) -> float:
         return starts * self.denominator / abs(self.numerator)
@@ -114,13 +122,33 @@ def coupling_problems(coupling: Coupling, gear: Gear, hob: Hob, teeth: int, worm
     problems = []
     wanted_b = expected_k_b(hob, teeth)
     if coupling.k_b * wanted_b < 0:
-        problems.append(f"the table turns the wrong way for a {hand_name(hob.hand)} hob: k_B is {coupling.k_b:+.6g} in "
-                        f"the DIN frame, the reference needs {wanted_b:+.6g} (−h_hob·z0/z2)")
+        problems.append(_hand_problem(coupling, hob, wanted_b))
     for axis, wanted in _wanted_factors(gear, hob, teeth, worm_wheel, moving).items():
         found = coupling.factors.get(axis, 0.0)
         if not factor_agrees(found, wanted, coupling.resolution.get(axis, 0.0)):
-            problems.append(_factor_problem(axis, found, wanted, gear, teeth))
+            problem = _factor_problem(axis, found, wanted, gear, teeth)
+            problems.append(problem if coupling.command == "EGON" or axis != "Z" else _fanuc_z(coupling, problem))
     return problems
+
+
+def _hand_problem(coupling: Coupling, hob: Hob, wanted: float) -> str:
+    """k_B's sign against the hob's hand: on a Fanuc program, the L word that gives it and the
+    sign the reference gives L on this machine (fanuc-egb.md §F5)."""
+    problem = (f"the table turns the wrong way for a {hand_name(hob.hand)} hob: k_B is {coupling.k_b:+.6g} in "
+               f"the DIN frame, the reference needs {wanted:+.6g} (−h_hob·z0/z2)")
+    if coupling.command == "EGON":
+        return problem
+    return (f"{problem}: {coupling.command} {coupling.ratio_words} turns it so; L = −h_hob·c_direction·b_direction·z0 "
+            f"is L{-coupling.numerator} on this machine (fanuc-egb.md §F5)")
+
+
+def _fanuc_z(coupling: Coupling, problem: str) -> str:
+    """The Z term's finding in the words of a Fanuc start: its Q and P (the control's helical
+    compensation), or their absence, and the rule that signs P (fanuc-egb.md §F5)."""
+    given = (f"{coupling.command}'s helical compensation {coupling.helix_words}"
+             if coupling.helix_words else f"{coupling.command} without Q and P (no helical compensation)")
+    return (f"{problem.replace('(DIN) generates', f'(DIN) of {given} generates', 1)}; Q = m_n and "
+            "P = −h_gear·c_direction·z_direction·egb_helix_sign·β (fanuc-egb.md §F5)")
 
 
 def _wanted_factors(gear, hob, teeth, worm_wheel, moving) -> dict:

@@ -8,21 +8,21 @@ spacing of its feed marks)."""
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+
+import msgspec
 
 from .report import CutSummary
 from .solids import Solid
 
 
-@dataclass
-class Cut:
+class Cut(msgspec.Struct):
     """One cut followed: from a coupling's start to its end, with its moves and each unit's reach before it."""
     number: int
     line: str
     teeth: int
     table_speed: float                  # workpiece revolutions per minute (S·|k_B|)
-    reach_before: dict = field(default_factory=dict)   # id(unit) -> its reach when the cut began
-    moves: list = field(default_factory=list)   # (start DIN, end DIN, velocities {axis: mm/min})
+    reach_before: dict = {}   # id(unit) -> its reach when the cut began
+    moves: list = []   # (start DIN, end DIN, velocities {axis: mm/min})
 
     def add(self, start: dict, end: dict, velocities: dict) -> None:
         self.moves.append((start, end, velocities))

@@ -37,15 +37,15 @@ generating zone stays where X and Z put it and a different part of the hob reach
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+
+import msgspec
 
 UPRIGHT = 1e-12            # the sine of a swivel this small is taken as 0: the slice is a strip
 ROOT_TOLERANCE = 1e-9      # F(t) within this of 0: dy* is off by ~1e-9·cx, the distance by far less
 STEP_LIMIT = 60            # Halley's or Newton's steps at most (one to three suffice: the start is near)
 
 
-@dataclass(frozen=True, slots=True)
-class HobBody:
+class HobBody(msgspec.Struct, frozen=True):
     """The hob as the simulation sees it: a cylinder of its tip radius and length (mm)."""
     radius: float          # d_a0/2
     half_length: float     # L/2

@@ -7,7 +7,8 @@ feed marks are engine.simulation.hobbing.mark_facts', the floor-to-floor time fl
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable
-from dataclasses import dataclass
+
+import msgspec
 
 from ...gears.records import Gear, Hob
 from ...machines.records import Machine
@@ -23,8 +24,7 @@ from .program_facts import area_facts, cut_count_facts, cut_word_facts, speed_fa
 from .report import Report
 
 
-@dataclass(frozen=True)
-class Records:
+class Records(msgspec.Struct, frozen=True):
     """What the fact rules check the program's reading against: the gear, hob and machine records
     and the job's work-holding."""
     steps: list
@@ -70,8 +70,7 @@ def _units(records: Records) -> int:
     return 1 + len(records.gear.units)
 
 
-@dataclass(frozen=True)
-class FactRule:
+class FactRule(msgspec.Struct, frozen=True):
     """A rule of the reference the program's values must agree with the records by, and its section."""
     name: str
     section: str

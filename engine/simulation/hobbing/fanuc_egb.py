@@ -1,9 +1,10 @@
 """The Fanuc electronic gear box as the simulation follows it (issue 30; reference fanuc-egb.md
 §F1–§F6): `G81 T<z2> L<±z0> [Q<m_n> P<β>]` (M series `G81.4 R<z2> L<±z0> …`) couples the table C
 to the hob spindle, `G80` (`G80.4`) uncouples it. The verifier has read and bounded the block
-(engine.verifier.synchronisation keeps only |L|/T and the size of the Q/P factor); here its signed
-terms become the same DIN `Coupling` an 840D `EGON(C,"FINE",B,<num>,<den>,Z,<num>,<den>)` gives
-(engine.simulation.hobbing.coupling), so one set of physics proves both:
+(engine.verifier.synchronisation keeps |L|/T and the size of the Q/P factor for its bounds, and
+T, L, Q, P with their signs on the statement, engine.verifier.statements.GearBox); here those
+signed terms become the same DIN `Coupling` an 840D `EGON(C,"FINE",B,<num>,<den>,Z,<num>,<den>)`
+gives (engine.simulation.hobbing.coupling), so one set of physics proves both:
 
 * T and L are EGON's denominator and numerator, L = σ·z0 with σ = −h_hob·c_direction·b_direction
   (§F5), and k_B = c·b·L/T = −h_hob·z0/z2 in the DIN frame;
@@ -30,18 +31,13 @@ import re
 
 from ...gears.records import Gear
 from ...machines.records import Machine
+from ...verifier.statements import GearBox, Statement
 from ...verifier.synchronisation import helical_compensation
 from .coupling import Coupling, read_coupling
 from .frame import Senses
 from .report import SimulationError, where
 
-COUPLING_ON = frozenset({"EGON", "G81", "G81.4"})         # start (or re-rate) the table's coupling
-COUPLING_OFF = frozenset({"EGOFS", "EGDEL", "G80", "G80.4"})
-G_CODE = re.compile(r"G0*8[01](?:\.4)?")
-WORD = re.compile(r"([A-Z])([-+]?[0-9.]+)")
 C_WORD = re.compile(r"(?<![A-Z])C[-+=]?[0-9.]")
-HELICAL_WORDS = ("Q", "P")
-COMMENT = re.compile(r"\(.*?\)")
 # The least increments the control reads Q and P in (fanuc-egb.md §F1: 0.00001 mm; 0.0001° in
 # [15i-MA], the coarser of the two sources): a program cannot state them finer, so the Z term
 # they give is right to the effect of half of each, not to the digits a program chose to write.
@@ -49,35 +45,29 @@ Q_INCREMENT = 0.00001        # mm
 P_INCREMENT = 0.0001         # degrees
 
 
-def g81_words(code: str) -> dict[str, str]:
-    """address -> text of a G81/G81.4 block's words (the verifier has checked each once); the
-    (comments) left out."""
-    words = {}
-    for token in COMMENT.sub(" ", code).split():
-        match = WORD.fullmatch(token)
-        if match is not None and not G_CODE.fullmatch(token):
-            words[match.group(1)] = match.group(2)
-    return words
-
-
-def read_g81(code: str, senses: Senses, helix_sign: int | None = None) -> Coupling:
-    """The coupling a G81 (G81.4) block gives, in the DIN frame: L over T (R), as EGON's numerator
-    over its denominator, and Q/P as its Z term, signed by the record's `helix_sign` (a G81 with
-    Q and P on a record without one is refused before the walk)."""
-    words = g81_words(code)
-    teeth = int(words["T"] if "T" in words else words["R"])
-    threads = int(words["L"])
-    program, factors, resolution = {"B": threads / teeth}, {}, {}
-    if all(address in words for address in HELICAL_WORDS) and helix_sign is not None:
-        program["Z"], resolution["Z"] = compensation(float(words["Q"]), float(words["P"]), teeth, helix_sign)
+def read_g81(start: Statement, senses: Senses, helix_sign: int | None = None) -> Coupling:
+    """The coupling a G81 (G81.4) gives, in the DIN frame: L over T (R), as EGON's numerator over
+    its denominator, and Q/P as its Z term, signed by the record's `helix_sign` (a G81 with Q and P
+    on a record without one is refused before the walk). The terms are the verifier's, signs kept
+    (engine.verifier.statements.GearBox)."""
+    box = _gear_box(start)
+    program, factors, resolution = {"B": box.threads / box.teeth}, {}, {}
+    if box.module is not None and box.helix is not None and helix_sign is not None:
+        program["Z"], resolution["Z"] = compensation(box.module, box.helix, box.teeth, helix_sign)
         factors["Z"] = program["Z"] * senses.factor("Z")
-    return Coupling(threads, teeth, program["B"] * senses.factor("B"), factors, resolution, program)
+    return Coupling(box.threads, box.teeth, program["B"] * senses.factor("B"), factors, resolution, program,
+                    start.name, box.ratio_words, box.helix_words)
 
 
-def read_start(name: str, code: str, senses: Senses, machine: Machine) -> Coupling:
-    """The DIN coupling a start gives: an 840D EGON's (engine.simulation.hobbing.coupling) or a
-    Fanuc G81's (G81.4's), whose Q/P the record's egb_helix_sign signs."""
-    return read_coupling(code, senses) if name == "EGON" else read_g81(code, senses, machine.egb_helix_sign)
+def _gear_box(start: Statement) -> GearBox:
+    assert start.gear_box is not None    # the verifier's reading of every G81/G81.4 carries it
+    return start.gear_box
+
+
+def read_start(start: Statement, code: str, senses: Senses, machine: Machine) -> Coupling:
+    """The DIN coupling a start gives: an 840D EGON's (`code`, engine.simulation.hobbing.coupling)
+    or a Fanuc G81's (G81.4's), whose Q/P the record's egb_helix_sign signs."""
+    return read_coupling(code, senses) if start.name == "EGON" else read_g81(start, senses, machine.egb_helix_sign)
 
 
 def compensation(module: float, helix: float, teeth: int, helix_sign: int) -> tuple[float, float]:
@@ -91,13 +81,12 @@ def compensation(module: float, helix: float, teeth: int, helix_sign: int) -> tu
     return helix_sign * per_mm, by_p + abs(per_mm) * Q_INCREMENT / 2 / module
 
 
-def compensation_problem(code: str, gear: Gear, helix_sign: int | None, command: str = "G81") -> str | None:
-    """Why a G81 (`command`: G81 or G81.4) with Q and P cannot be proved for `gear` on a record
-    stating `helix_sign` (None: the block gives neither, or the walk proves its Z term)."""
-    words = g81_words(code)
-    if not any(address in words for address in HELICAL_WORDS):
+def compensation_problem(start: Statement, gear: Gear, helix_sign: int | None) -> str | None:
+    """Why a G81 (G81.4, `start.name`) with Q and P cannot be proved for `gear` on a record stating
+    `helix_sign` (None: the block gives neither, or the walk proves its Z term)."""
+    given, command = _gear_box(start).helix_words, start.name
+    if not given:
         return None
-    given = " ".join(f"{address}{words[address]}" for address in HELICAL_WORDS if address in words)
     if not gear.helix_angle:
         return (f"{given} on a spur gear: the control adds a helical differential Z·sin P·360/(π·T·Q) degrees of C "
                 "per mm of Z (fanuc-egb.md §F4) and would cut a helix; a spur gear's G81 gives T and L only")
@@ -121,8 +110,8 @@ def refuse_unproved_compensation(steps: list, gear: Gear, machine: Machine, name
         if step.kind == "block" and {3, 5} & step.m_codes:
             turning = 3 in step.m_codes        # M3 counts at once: the unsafe way round for this rule
         if step.kind == "statement" and step.item.name in ("G81", "G81.4"):
-            problem = compensation_problem(step.line.partition(";")[0], gear, machine.egb_helix_sign,
-                                           step.item.name) or turning_start_problem(step.item.name, turning)
+            problem = (compensation_problem(step.item, gear, machine.egb_helix_sign)
+                       or turning_start_problem(step.item.name, turning))
             if problem:
                 raise SimulationError(f"{where(name, step.number, step.line)}: {problem}")
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 import re
 
 from ...machines.records import FLOOR_TIMES, Machine, unstated_floor_times
-from .fanuc_egb import COUPLING_ON
+from .coupling import COUPLING_ON
 from .headers import header_place_problem
 from .report import Report
 

@@ -5,13 +5,12 @@ in its record (machine.<axis>_direction = −1); its program values are the DIN 
 senses involved, so dividing by them (the same as multiplying, for ±1) gives the DIN value."""
 from __future__ import annotations
 
-from dataclasses import dataclass
+import msgspec
 
 from ...machines.records import Machine
 
 
-@dataclass(frozen=True, slots=True)
-class Senses:
+class Senses(msgspec.Struct, frozen=True):
     """The machine's axis senses (+1 or −1 each) of A, B, C, Y and Z, from its record."""
     a: int
     b: int

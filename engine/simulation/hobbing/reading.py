@@ -5,8 +5,9 @@ and release the tailstock, G4 dwells). A line the verifier refuses the simulatio
 it cannot follow what it cannot read (fail closed)."""
 from __future__ import annotations
 
-from dataclasses import dataclass, field
 from functools import lru_cache
+
+import msgspec
 
 from ...machines.records import Machine
 from ...verifier import grammar
@@ -18,18 +19,18 @@ from .fanuc_egb import c_word_problem
 from .report import SimulationError, where
 
 
-@dataclass(frozen=True, slots=True)
-class Step:
+class Step(msgspec.Struct, frozen=True):
     """One line of the program as the simulation follows it, with the G and M codes it gives."""
     number: int        # line number, from 1
     line: str          # as emitted
     item: Line         # what the verifier read it as (kind: header, comment, block, statement, shift)
     g_codes: frozenset = frozenset()
     m_codes: frozenset = frozenset()
-    kind: str = field(init=False)   # the item's kind, kept: the rules ask it of every step, hundreds of times
+    kind: str = ""   # the item's kind, kept: the rules ask it of every step, hundreds of times
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "kind", self.item.kind)
+        """Only copies item.kind: running again (a Struct does when it is unpickled) changes nothing."""
+        msgspec.structs.force_setattr(self, "kind", self.item.kind)
 
 
 def machine_dialect(machine: Machine):

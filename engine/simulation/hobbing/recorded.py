@@ -4,12 +4,15 @@ and end in the DIN frame, the swivel it ran at, whether it cut, the cuts as the 
 and the G25/G26 working area as the program sets it. A picture drawn from this shows what the
 simulation checked, not a second interpretation of the program text: the F in effect at each
 move, each A as the program writes it and each coupling are kept too (the numbers a picture
-states, issue 27). A program with the
+states, issue 27), the coupling with its start as the program writes it: read in the machine's
+dialect, an 840D `EGON(…)` or a Fanuc `G81 T… L…` (issue 30). A program with the
 hob-shift-per-part clamp is followed at both ends of its R11 interval (the Y range it cuts at,
 the part of the hob the shifting uses); the moves are those at the low end."""
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+import re
+
+import msgspec
 
 from ...gears.records import Gear, Hob
 from ...machines.records import Machine
@@ -21,9 +24,10 @@ from .run import SHIFT_ENDS
 from .solids import Solid, setup_solids, unit_solids
 from .walk import BlockSimulation
 
+SWIVEL_EQUALS = re.compile(r"(?<![A-Z])A=")   # `A=1.763` (840D) rather than `A1.763` (840D, ISO, Fanuc)
 
-@dataclass(frozen=True, slots=True)
-class Move:
+
+class Move(msgspec.Struct, frozen=True):
     number: int            # program line, from 1
     line: str
     motion: int            # 0 rapid, 1 feed
@@ -34,8 +38,7 @@ class Move:
     feed: float | None = None   # the F in effect, as written (mm/min: the hobbing grammar has G94 only)
 
 
-@dataclass(frozen=True, slots=True)
-class RecordedCut:
+class RecordedCut(msgspec.Struct, frozen=True):
     moves: tuple           # the cut's Move records
     units: tuple           # names of the units whose material it entered
     label: str             # the program's `; CUT …` comment before it, else "cut N"
@@ -47,18 +50,19 @@ class RecordedCut:
         return [pose for pose in every if {"X", "Z"} <= pose.keys()]
 
 
-@dataclass
-class Recording:
+class Recording(msgspec.Struct):
     report: Report
     units: list[Solid]
     setup: list[Solid]
-    moves: list[Move] = field(default_factory=list)
-    cuts: list[RecordedCut] = field(default_factory=list)
-    areas: dict = field(default_factory=dict)       # "lower"/"upper" -> {axis: DIN value}, as G25/G26 set them
-    area_words: dict = field(default_factory=dict)  # "lower"/"upper" -> {axis: program value}
+    moves: list[Move] = []
+    cuts: list[RecordedCut] = []
+    areas: dict = {}       # "lower"/"upper" -> {axis: DIN value}, as G25/G26 set them
+    area_words: dict = {}  # "lower"/"upper" -> {axis: program value}
     cutting_y: tuple = (0.0, 0.0)                   # the lowest and highest Y (DIN) the hob cuts at
-    swivel_words: list = field(default_factory=list)  # (line, A as written) for every A the program writes
-    couplings: list = field(default_factory=list)     # every EGON as the walk read it (DIN Coupling)
+    swivel_words: list = []     # (line, A as written) for every A the program writes
+    couplings: list = []        # every EGON (G81) as the walk read it (DIN Coupling)
+    coupling_words: list = []   # each coupling's start as the program writes it
+    swivel_address: str = "A"   # how it writes the swivel: `A=` (840D templates) or `A`
 
     @property
     def final_swivel(self) -> float:
@@ -90,11 +94,13 @@ class RecordingSimulation(BlockSimulation):
     def _couple(self, step) -> None:
         super()._couple(step)
         self.recording.couplings.append(self.coupling)
+        self.recording.coupling_words.append(step.line.partition(";")[0].strip())
 
     def _move(self, step, motion: int, program: dict, swivel: float | None = None) -> None:
         start = dict(self.position)
         if swivel is not None:
             self.recording.swivel_words.append((step.number, swivel))
+            self.recording.swivel_address = "A=" if SWIVEL_EQUALS.search(step.line.partition(";")[0]) else "A"
         super()._move(step, motion, program, swivel)
         move = Move(step.number, step.line, motion, start, dict(self.position), self.swivel, self.cut is not None,
                     self.feed)

@@ -3,7 +3,8 @@ its summary (teeth, hand and lead of the helix, depth per cut, run-out, table sp
 workpiece revolution, cycle time). A finding that makes the program wrong refuses it."""
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, field
+import msgspec
+from msgspec.structs import asdict
 
 from ...errors import EngineError
 from ...verifier.refusals import shown, shown_name
@@ -25,8 +26,7 @@ def where(name: str, number: int, line: str) -> str:
     return f"{shown_name(name)} line {number} {shown(line)}"
 
 
-@dataclass(frozen=True)
-class Finding:
+class Finding(msgspec.Struct, frozen=True):
     """What the simulation found at one line: a refusal (refuses) or a note."""
     number: int
     line: str
@@ -37,8 +37,7 @@ class Finding:
         return f"{where(name, self.number, self.line)}: {self.message}"
 
 
-@dataclass
-class CutSummary:
+class CutSummary(msgspec.Struct):
     """One cut as simulated: its centre distance, depth, stock left and feeds (mm, mm per workpiece revolution)."""
     number: int          # the cut's first line
     unit: str
@@ -55,14 +54,13 @@ class FirstRefusal(Exception):
     """A report that stops at its first refusal has it (Report.first_only)."""
 
 
-@dataclass
-class Report:
+class Report(msgspec.Struct):
     """The simulation's report of one program: its findings, couplings, cuts, table speed and cycle time."""
     name: str
-    findings: list[Finding] = field(default_factory=list)
-    teeth: list[str] = field(default_factory=list)       # per coupling: "19 (unit 1)"
-    helix: list[str] = field(default_factory=list)       # per coupling: "right-hand β 15.000° lead 1427.2 mm"
-    cuts: list[CutSummary] = field(default_factory=list)
+    findings: list[Finding] = []
+    teeth: list[str] = []       # per coupling: "19 (unit 1)"
+    helix: list[str] = []       # per coupling: "right-hand β 15.000° lead 1427.2 mm"
+    cuts: list[CutSummary] = []
     table_speed: float = 0.0          # r/min, the most while coupled
     cycle_time: float = 0.0           # minutes
     header_time: float | None = None  # the program's `; CYCLE TIME … MIN`

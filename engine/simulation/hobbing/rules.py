@@ -29,6 +29,10 @@ def coupled_shift_problem(coupling) -> str | None:
     leading axis of the coupling (a tangential worm wheel's Y term)."""
     if "Y" in coupling.factors:
         return None
+    if coupling.command != "EGON":
+        command = coupling.command
+        return (f"the hob shift Y moves while the table is synchronised by {command}, which has no Y term: the table "
+                f"keeps its phase while the hob's thread moves along the teeth (§B15); shift before {command}")
     return ("the hob shift Y moves while the table is coupled and Y is not a leading axis of the EGON: the table "
             "keeps its phase while the hob's thread moves along the teeth (§B15); shift before EGDEF/EGON (Fanuc: G81)")
 
@@ -38,10 +42,12 @@ def coupled_swivel_problem() -> str:
             "tooth direction; swivel before EGDEF/EGON (G81) or after EGOFS (G80) with the hob clear")
 
 
-def recut_problem(unit_name: str) -> str:
-    return (f"the cut enters {unit_name}, which an earlier coupling already cut: EGON \"FINE\" does not "
-            "synchronise, so this coupling's phase is arbitrary against the gaps cut before; rough and finish "
-            "a unit in one coupling")
+def recut_problem(unit_name: str, command: str = "EGON") -> str:
+    """A unit cut under two couplings: neither EGON "FINE" nor a Fanuc G81 (`command`) brings the
+    table back to the phase of the gaps cut before."""
+    start = 'EGON "FINE" does not synchronise' if command == "EGON" else f"a new {command} sets no phase"
+    return (f"the cut enters {unit_name}, which an earlier coupling already cut: {start}, so this coupling's phase is "
+            "arbitrary against the gaps cut before; rough and finish a unit in one coupling")
 
 
 def generating_length(gear: Gear) -> float:

@@ -28,6 +28,8 @@ HEIGHT_STEP = 0.5       # mm between the heights a solid is followed at (its fac
 BEYOND_TRAVEL = 50.0    # mm: a fixture or tailstock is followed this far past the Z travel and the hob
 
 
+# A dataclass, not a msgspec.Struct like the engine's other records (docs/design.md): its
+# init=False fields are computed in __post_init__, which a Struct would run again when pickled.
 @dataclass(eq=False)
 class Solid:
     """A solid of revolution about the work axis (a gear unit, the fixture, the tailstock) between two heights."""

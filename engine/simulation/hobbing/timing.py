@@ -1,8 +1,9 @@
 """The cycle time (the definition the models print in the header, docs/design.md §7): over the
 blocks in order, a G1 takes √(ΔX²+ΔY²+ΔZ²)/F (G94, mm/min), a G0 max(|ΔX|,|ΔY|,|ΔZ|)/rapid
-rate (each axis at the rapid rate), `G4 F<s>` s seconds; rotary-only and non-motion blocks
-nothing. Program values: the program starts at the machine's load position where the record
-has one; an axis whose start is unknown moves from wherever its first block puts it (no travel).
+rate (each axis at the rapid rate), a dwell s seconds (`G4 F<s>`; Fanuc `G04 X<s>`, `G04 P<1000·s>`);
+rotary-only and non-motion blocks nothing. Program values: the program starts at the machine's
+load position where the record has one; an axis whose start is unknown moves from wherever its
+first block puts it (no travel).
 A header `; CYCLE TIME <m> MIN` more than HEADER_TOLERANCE off the simulated time refuses."""
 from __future__ import annotations
 

@@ -16,6 +16,8 @@ from ...verifier.shift_clamp import ShiftClamp
 from .allowance import depth_problem, header_allowance
 from .contact import Motion, follow
 from .coupling import (
+    COUPLING_OFF,
+    COUPLING_ON,
     Coupling,
     coupling_problems,
     generated_teeth_problem,
@@ -27,7 +29,7 @@ from .coupling import (
 )
 from .cuts import Cut, summary
 from .envelope import HobBody
-from .fanuc_egb import COUPLING_OFF, COUPLING_ON, read_start
+from .fanuc_egb import read_start
 from .frame import Senses
 from .headers import comment_problem, header_place_problem
 from .paths import move_pieces
@@ -51,7 +53,6 @@ from .swivel_sweep import sweep_problem, unknown_pose
 from .timing import feed_minutes, header_minutes, header_problem, rapid_minutes
 
 AXES = ("X", "Y", "Z")
-DWELL = 4
 MAX_SWIVEL = 80.0        # degrees from horizontal the hob axis may stand (helix angles stay well below)
 
 
@@ -114,7 +115,7 @@ class BlockSimulation:
             self.coupling = None
 
     def _couple(self, step) -> None:
-        self.coupling = read_start(step.item.name, step.line.partition(";")[0].strip(), self.senses, self.machine)
+        self.coupling = read_start(step.item, step.line.partition(";")[0].strip(), self.senses, self.machine)
         self.session += 1
         teeth = [unit.teeth for unit in self.units if unit.teeth is not None]   # every unit is toothed
         problem = generated_teeth_problem(self.coupling, self.hob, teeth)
@@ -154,8 +155,8 @@ class BlockSimulation:
             self.feed = block.feed
         if block.speed is not None:
             self.speed = block.speed
-        if DWELL in step.g_codes:
-            self.report.cycle_time += block.values.get("F", 0.0) / 60.0
+        if block.dwell is not None:
+            self.report.cycle_time += block.dwell / 60.0
         elif block.moves and block.area is None:
             self.moved = True
             self._move(step, block.motion, dict(block.positions), block.values.get("A"))
@@ -289,7 +290,7 @@ class BlockSimulation:
         for unit in self.units:
             if len(unit.cut_sessions) > 1 and ("recut", unit.name) not in self.said:
                 self.said.add(("recut", unit.name))
-                self._refuse(step, recut_problem(unit.name))
+                self._refuse(step, recut_problem(unit.name, self.coupling.command if self.coupling else "EGON"))
 
     def _reason(self, motion: int) -> str:
         if motion == 0:

@@ -7,8 +7,9 @@ operation's pitch and crest and root lines are the drawing's too (drawing.thread
 from __future__ import annotations
 
 import copy
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
+
+import msgspec
 
 if TYPE_CHECKING:
     from ...db.connection import Connection
@@ -28,8 +29,7 @@ FROM job j JOIN drawing d ON d.id = j.drawing_id
 WHERE j.id = %s"""
 
 
-@dataclass(frozen=True)
-class DrawingRecord:
+class DrawingRecord(msgspec.Struct, frozen=True):
     id: int
     file_name: str
     facts: dict                       # DRAWING_FACTS name → value; None: not recorded (the default or assumed)

@@ -17,7 +17,8 @@ its intermediate point, if the block gives one, and on to the reference point.""
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+
+import msgspec
 
 from ...verifier.arcs import arc_centre
 from .report import TurningReport
@@ -34,8 +35,7 @@ PER_MINUTE, PER_REVOLUTION = (94, 98), (95, 99)   # 840D G94/G95, ISO G98/G99
 REFERENCE_RETURNS = {"iso": frozenset({28, 30}), "linuxcnc": frozenset({28, 30}), "840d": frozenset({74, 75})}
 
 
-@dataclass(frozen=True)
-class Move:
+class Move(msgspec.Struct, frozen=True):
     number: int
     line: str
     kind: str                 # rapid, feed or thread
@@ -49,8 +49,7 @@ class Move:
     blend: float = 0.0        # mm the control may run it off its path (LinuxCNC G64 P; material walk)
 
 
-@dataclass(frozen=True)
-class ToolChange:
+class ToolChange(msgspec.Struct, frozen=True):
     """A tool change of a class job, where the turret indexed: (z, r), and whether at the reference point."""
     number: int
     line: str

@@ -6,7 +6,8 @@ refuses the simulation refuses too: it cannot follow what it cannot read (fail c
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
+
+import msgspec
 
 from ...machines.records import Machine
 from ...verifier.blocks import TOKEN, Block
@@ -17,8 +18,7 @@ OPERATION_COMMENT = re.compile(r"\s*(?:\(|;)\s*OP (\d+) ([A-Z]+)\b")
 ISO_COMMENT = re.compile(r"\([^()]*\)")
 
 
-@dataclass(frozen=True, slots=True)
-class Step:
+class Step(msgspec.Struct, frozen=True):
     number: int              # line number, from 1
     line: str                # as emitted
     block: Block | None      # None: a header or a comment

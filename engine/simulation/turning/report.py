@@ -2,8 +2,6 @@
 style of the hobbing report, engine.simulation.hobbing.report) and a summary of what it followed."""
 from __future__ import annotations
 
-from dataclasses import dataclass, field
-
 from ..hobbing.report import Report, SimulationError
 
 # What a user does about a blank the simulation assumed (a class job without stock_* params).
@@ -12,12 +10,11 @@ STATE_THE_BLANK = ("the blank {blank} is assumed from the program's own cuts; if
                    "frame) and instantiate again")
 
 
-@dataclass
 class TurningReport(Report):
     rapids: int = 0
     cut_moves: int = 0       # feeds and thread passes followed
     blank: str = ""          # "Ø42.000 Z-70.000…0.000 (assumed)"
-    not_checked: list[str] = field(default_factory=list)   # what it could not prove (a class job: no drawing)
+    not_checked: list[str] = []   # what it could not prove (a class job: no drawing)
 
     def error(self, where_listed: str = "") -> SimulationError:
         """The first refusal, all of them counted (a refused program is not stored, so the count is

@@ -10,8 +10,8 @@ params state, or none, and then the simulation assumes one from the program
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
 
+import msgspec
 from shapely.affinity import scale
 from shapely.geometry import Polygon, box
 from shapely.geometry.base import BaseGeometry
@@ -31,16 +31,14 @@ FIX = "fix the job's params in SQL and instantiate it again"
 Point = tuple[float, float]      # (z, r) mm
 
 
-@dataclass(frozen=True)
-class Operation:
+class Operation(msgspec.Struct, frozen=True):
     number: int
     kind: str
     tool: int | None
     offset: int | None
 
 
-@dataclass
-class TurningRecords:
+class TurningRecords(msgspec.Struct):
     """The job as stored, read for the simulation."""
     part: BaseGeometry
     stock: tuple[float, float, float] | None      # (z_front, z_back, radius) when stored
@@ -48,8 +46,8 @@ class TurningRecords:
     z_back: float
     top: float                                    # the profile's largest radius
     tool_change: tuple[float, float] | None       # (x diameter, z); None: no record (a class job)
-    operations: dict[int, Operation] = field(default_factory=dict)
-    threads: dict[int, BaseGeometry] = field(default_factory=dict)
+    operations: dict[int, Operation] = {}
+    threads: dict[int, BaseGeometry] = {}
     drawn: bool = True                            # False: a class job, proved without a drawing record
 
     def blank(self, feed_radius: float, facing_zs: list[float]) -> BaseGeometry:

@@ -14,7 +14,8 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
+
+import msgspec
 
 RAPID, FEED, CW, CCW, THREAD = 0, 1, 2, 3, 32
 ARC_STEP = math.radians(5.0)    # an arc of the contour is followed by chords of at most 5° for roughing
@@ -39,8 +40,7 @@ class CycleError(ValueError):
     """A cycle whose words cannot make moves (a zero depth, a contour that does not go away from the start)."""
 
 
-@dataclass(frozen=True, slots=True)
-class Move:
+class Move(msgspec.Struct, frozen=True):
     """One block the control makes: its motion (RAPID, FEED, CW, CCW, THREAD), the end point, and
     for an arc its radius (mm, positive up to 180°)."""
     motion: int
@@ -202,8 +202,7 @@ def _pecks(swap: Swap, a0: float, a1: float, b: float, step: float, retract: flo
     return moves
 
 
-@dataclass(frozen=True, slots=True)
-class Thread:
+class Thread(msgspec.Struct, frozen=True):
     """G76's words as the control reads them, in mm: the end (X root diameter, Z), the height k
     and first depth Δd (radius), the minimum cut Δdmin, the finish allowance d, the finish passes
     m, the tool angle a (degrees), the lead L (mm/rev) and the taper i (radius, start minus end)."""

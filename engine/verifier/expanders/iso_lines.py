@@ -10,7 +10,8 @@ what a control would make of it."""
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass, field
+
+import msgspec
 
 from ..characters import check_characters
 from ..expansion import ExpansionRefused
@@ -27,13 +28,12 @@ MACRO_LINE = re.compile(r"[^(]*[#\[]|\s*(?:IF|WHILE|GOTO|END\s*\d|DO\s*\d)")
 COMMENT_REASON = "a comment is one (…) at the end of the block"
 
 
-@dataclass
-class Source:
+class Source(msgspec.Struct):
     """One line of the program as read: its kind, and for a block its words in order (letter, text)."""
     number: int
     text: str
     kind: str
-    words: list[tuple[str, str]] = field(default_factory=list)
+    words: list[tuple[str, str]] = []
     label: int | None = None          # its N number
     program: int | None = None        # the O number of a header line
     name: str | None = None           # the (NAME) of a header line

@@ -10,8 +10,9 @@ statement is one step of the expander's walk, so a loop is bounded by MAX_STEPS 
 from __future__ import annotations
 
 import re
-from dataclasses import replace
 from typing import TYPE_CHECKING
+
+from msgspec.structs import replace
 
 import engine.verifier.expanders.iso_loops as iso_loops
 import engine.verifier.expanders.iso_macro as macro

@@ -5,8 +5,9 @@ the cycle words a first G71/G72/G73/G74/G75/G76 block sets, and the end."""
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
+
+import msgspec
 
 from ..grammar import POINT_REASON
 
@@ -50,8 +51,7 @@ def arc_radius(centre: tuple[float, float], start: tuple[float, float], end: tup
     return -radius if sweep > math.pi + 1e-9 else radius
 
 
-@dataclass
-class Modes:
+class Modes(msgspec.Struct):
     machine: Machine
     scale: float = 1.0                 # mm per program unit: 25.4 under G20
     x: float | None = None             # the tool's position in the frame the travel is stated in (mm)
@@ -67,7 +67,7 @@ class Modes:
     ended: bool = False
     tool: int | None = None
     cut_box: tuple[float, float] | None = None     # the largest X and Z any cut reached so far
-    cycle: dict[str, float] = field(default_factory=dict)   # words a first cycle block set ("G71U": Δd …)
+    cycle: dict[str, float] = {}   # words a first cycle block set ("G71U": Δd …)
     absolute_stated: bool = False
 
     def length(self, text: str) -> float:

@@ -4,8 +4,9 @@ motion in the block, and the plain line the grammar reads emitted. The cycles G7
 engine.verifier.expanders.iso_cycles."""
 from __future__ import annotations
 
-from dataclasses import replace
 from typing import TYPE_CHECKING
+
+from msgspec.structs import replace
 
 import engine.verifier.expanders.iso_rules as iso_rules
 

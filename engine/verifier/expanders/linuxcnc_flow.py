@@ -5,7 +5,7 @@ pair is refused before anything runs, naming the line (the control refuses it to
 count of a `repeat` and the rule that a sub is defined before it is called."""
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+import msgspec
 
 from ..refusals import Refused
 from .linuxcnc_lines import OWord
@@ -14,13 +14,12 @@ OPENERS = {"sub": "endsub", "if": "endif", "while": "endwhile", "do": "while", "
 LOOPS = frozenset({"while", "do", "repeat"})
 
 
-@dataclass
-class Flow:
-    end: dict[int, int] = field(default_factory=dict)            # opener line -> its closing line
-    opener: dict[int, int] = field(default_factory=dict)         # closing/elseif/else line -> the opener
-    branches: dict[int, list[int]] = field(default_factory=dict)  # if line -> its elseif/else lines
-    loop: dict[int, int] = field(default_factory=dict)           # break/continue/return line -> loop or sub
-    subs: dict[str, tuple[int, int]] = field(default_factory=dict)   # label -> (sub line, endsub line)
+class Flow(msgspec.Struct):
+    end: dict[int, int] = {}            # opener line -> its closing line
+    opener: dict[int, int] = {}         # closing/elseif/else line -> the opener
+    branches: dict[int, list[int]] = {}  # if line -> its elseif/else lines
+    loop: dict[int, int] = {}           # break/continue/return line -> loop or sub
+    subs: dict[str, tuple[int, int]] = {}   # label -> (sub line, endsub line)
 
 
 class FlowError(Refused):

@@ -8,7 +8,8 @@ whether the line runs is the operator's switch, not the program's."""
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
+
+import msgspec
 
 from ..refusals import Refused
 
@@ -18,8 +19,7 @@ KEYWORDS = frozenset({"sub", "endsub", "call", "do", "while", "endwhile", "if", 
 LINE_NUMBER = re.compile(r"n\d+(?:\.\d*)?")
 
 
-@dataclass(frozen=True, slots=True)
-class OWord:
+class OWord(msgspec.Struct, frozen=True):
     label: str          # "100" or "<od>"
     keyword: str        # "while", "call" …
     rest: str           # the condition, count or arguments (no spaces, lower case)

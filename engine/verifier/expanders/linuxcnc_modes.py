@@ -14,7 +14,9 @@ are refused: they are whatever the last program left."""
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field, replace
+
+import msgspec
+from msgspec.structs import replace
 
 from ..refusals import Refused
 from .linuxcnc_words import Words
@@ -53,8 +55,7 @@ CONTEXT_M = frozenset({70, 71, 72, 73})     # save, forget, restore the modes (l
 PLAIN_M = frozenset({3, 4, 5, 7, 8, 9})
 
 
-@dataclass
-class Modes:
+class Modes(msgspec.Struct):
     """The modal state of the interpreter as LinuxCNC keeps it, lengths in mm and X a radius."""
     inch: bool | None = None            # None: units not stated
     diameter: bool | None = None        # None: G7/G8 not stated
@@ -75,7 +76,7 @@ class Modes:
     blend: float = 0.0                  # G64 P in mm; 0 under G61/G61.1
     x: float | None = None              # radius, mm
     z: float | None = None
-    extra: dict[str, float] = field(default_factory=dict)
+    extra: dict[str, float] = {}
 
     def copy(self) -> Modes:
         return replace(self, extra=dict(self.extra))

@@ -8,8 +8,9 @@ parameters the position (#<_x>, #<_z>: X as a radius, program units) and the uni
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
+
+import msgspec
 
 from ..refusals import Refused
 
@@ -24,13 +25,12 @@ SYSTEM_NEEDS = {5410: " (the tool table's diameter of the tool in the spindle: t
 INCH = 25.4
 
 
-@dataclass
-class Frame:
+class Frame(msgspec.Struct):
     """One subroutine call (or the main program): its parameters and where it returns to."""
     back: int = -1                                      # the line after the call
-    numbered: dict[int, float] = field(default_factory=dict)
-    named: dict[str, float] = field(default_factory=dict)
-    counts: dict[int, int] = field(default_factory=dict)   # repeat loop -> passes left
+    numbered: dict[int, float] = {}
+    named: dict[str, float] = {}
+    counts: dict[int, int] = {}   # repeat loop -> passes left
 
 
 class Parameters:

@@ -7,7 +7,8 @@ fillet/chamfer in its profile's lines, read with `profile`)."""
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass, field
+
+import msgspec
 
 from ..refusals import Refused
 from .linuxcnc_values import Values
@@ -18,11 +19,10 @@ PROFILE_WORDS = frozenset("acuw")                    # G70-G72's own meaning of 
 G7X = ("70", "71", "71.1", "71.2", "72", "72.1", "72.2")
 
 
-@dataclass
-class Words:
-    codes: dict[str, list[float]] = field(default_factory=lambda: {"g": [], "m": []})
-    values: dict[str, float] = field(default_factory=dict)
-    settings: list[tuple[str, float]] = field(default_factory=list)
+class Words(msgspec.Struct):
+    codes: dict[str, list[float]] = msgspec.field(default_factory=lambda: {"g": [], "m": []})
+    values: dict[str, float] = {}
+    settings: list[tuple[str, float]] = []
 
     def g(self, *names: str) -> str | None:
         """The first of the line's G codes among `names` ("0", "33.1"), or None."""

@@ -11,8 +11,9 @@ position (an arc given by its centre I/K needs its start point)."""
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
+
+import msgspec
 
 from ..arcs import ARC_TOLERANCE
 from ..numbers import plain_decimal
@@ -75,8 +76,7 @@ REFUSED_WORDS = {
 }
 
 
-@dataclass
-class BlockState:
+class BlockState(msgspec.Struct):
     """What earlier blocks left that the next plain block depends on."""
     machine: Machine
     motion: int | None = None
@@ -85,16 +85,15 @@ class BlockState:
     rpm: float | None = None         # S under G97, r/min (a G4 S… dwell counts its turns at it)
     css: bool = False                # G96: S is a cutting speed in m/min, the r/min vary
     frozen: bool = False             # G97 without S after G96: the r/min G96 last reached, unknown here
-    position: dict[str, float] = field(default_factory=dict)   # X (diameter) and Z, mm
+    position: dict[str, float] = {}   # X (diameter) and Z, mm
 
 
-@dataclass
-class Plain:
+class Plain(msgspec.Struct):
     """The plain block being written: G codes, keywords, words, M codes in the grammar's order."""
-    g: list[int] = field(default_factory=list)
-    keywords: list[str] = field(default_factory=list)
-    words: dict[str, str] = field(default_factory=dict)
-    m: list[int] = field(default_factory=list)
+    g: list[int] = []
+    keywords: list[str] = []
+    words: dict[str, str] = {}
+    m: list[int] = []
     ends: bool = False
 
     def text(self) -> str:

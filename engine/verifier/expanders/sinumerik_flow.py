@@ -10,7 +10,8 @@ from __future__ import annotations
 
 import re
 from collections.abc import Callable
-from dataclasses import dataclass
+
+import msgspec
 
 from ..expansion import ExpansionRefused
 from ..refusals import Refused
@@ -31,8 +32,7 @@ SEARCHES: dict[str, Callable[[int, int], bool]] = {"GOTOF": lambda place, jump: 
                                                    "GOTOB": lambda place, jump: place <= jump}
 
 
-@dataclass
-class Section:
+class Section(msgspec.Struct):
     start: int       # first line of the section
     end: int         # last line of the section
     back: int        # the line after the REPEAT statement

@@ -9,7 +9,8 @@ operators; so does the reader, outside strings."""
 from __future__ import annotations
 
 import re
-from dataclasses import dataclass
+
+import msgspec
 
 from ..characters import check_characters, check_comment_characters
 from ..refusals import Refused
@@ -28,15 +29,13 @@ WORD_OPERATORS = ("DIV", "MOD", "AND", "OR", "XOR")
 WORD_OPERATOR = re.compile(rf" +(?:{'|'.join(WORD_OPERATORS)}) +(?=[^ ])")
 
 
-@dataclass(frozen=True, slots=True)
-class Word:
+class Word(msgspec.Struct, frozen=True):
     name: str           # address or name, upper case: "X", "CR", "R1", "DIAMON", "CYCLE95"
     value: str = ""     # the number, the expression after `=`, or the arguments inside (…)
     form: str = "number"   # "number" (X12.5), "equals" (X=…), "keyword" (DIAMON), "call" (MSG(…))
 
 
-@dataclass(frozen=True, slots=True)
-class SourceLine:
+class SourceLine(msgspec.Struct, frozen=True):
     number: int                 # line number, from 1
     text: str                   # as written
     block_number: str | None    # "N10"
