@@ -9,11 +9,11 @@ cycle time, the tailstock held clamped for every cut."""
 from __future__ import annotations
 
 import math
-from dataclasses import replace
 
 import pytest
 from helpers.fanuc_cases import twin
 from helpers.fanuc_programs import fanuc_program
+from msgspec.structs import replace
 
 from engine.hobbing.choices import Choices
 from engine.machines.records import Machine, load_machine

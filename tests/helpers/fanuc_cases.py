@@ -3,7 +3,7 @@ proof (tests/helpers/unproved_programs.py), with the records it is proved agains
 rewrites it in the Fanuc form (tests/helpers/fanuc_programs.py) and proves both."""
 from __future__ import annotations
 
-from dataclasses import replace
+from msgspec.structs import replace
 
 from engine.gears.records import load_gear, load_hobs
 from engine.hobbing.choices import Choices
