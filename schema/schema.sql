@@ -1166,6 +1166,10 @@ CREATE TABLE machine (
     -- compensation Z·sin P·360/(π·T·Q) with, in the machine's C and Z senses (+1 the literal
     -- formula, -1 its opposite); NULL = not stated (a helical gear's Fanuc program is refused).
     egb_helix_sign   smallint CHECK (egb_helix_sign IN (-1, 1)),
+    -- Fanuc hobbers (migration 0038, fanuc-egb.md §F7): the O number of a gear's program is
+    -- program_number_base + the gear's id (a whole number; O1042 for gear 42 at 1000), within
+    -- 1…99999 and outside O9000…O9999; NULL = no rule stated (no Fanuc hobbing program).
+    program_number_base integer CHECK (program_number_base BETWEEN 0 AND 99998),
     CONSTRAINT machine_reference_point CHECK ((reference_x IS NULL) = (reference_z IS NULL)),
     CHECK (x_min < x_max AND y_min <= y_max AND z_min < z_max),
     CONSTRAINT machine_safe_name CHECK (safe_name('machine', name)),

@@ -240,18 +240,18 @@ def test_a_fanuc_hobbers_lineage_line_is_a_comment_its_grammar_reads(fanuc):
     verify_program(replaced("(GEAR 42 HELICAL)", lines["fanuc"]), fanuc, NAME)
 
 
-def test_instantiate_on_a_fanuc_hobber_is_refused_by_name_and_stores_nothing(run):
-    """The verifier reads Fanuc hobbing, but no template emits it yet: a gear made on a Fanuc
-    hobber is refused in one line naming the machine and its dialect, before any program is
-    planned, and nothing is stored."""
+def test_instantiate_on_a_fanuc_hobber_without_an_o_number_rule_is_refused_and_stores_nothing(run):
+    """The class templates emit Fanuc (issue 30), but a Fanuc hobber's record must say how its
+    programs are numbered (program_number_base, migration 0038): one without is refused in one
+    line naming the machine and the column, before any program is planned, and nothing is stored."""
     with psycopg.connect(run.url) as conn:
         conn.execute("UPDATE machine SET dialect = 'fanuc' WHERE name = 'hobber-840d'")
         before = conn.execute("SELECT count(*) FROM program").fetchone()[0]
     result = run("instantiate", "--gear", 42)
     assert result.exit_code == 1, result.output
     assert result.stderr.strip().splitlines() == [
-        "error: machine hobber-840d runs dialect fanuc: the engine makes hobbing programs for 840d only so far "
-        "(Fanuc: issue 30); use --machine hobber-840d"]
+        "error: gear 42 on hobber-840d (Fanuc): machine hobber-840d states no program_number_base, so its programs "
+        "have no O number; set machine.program_number_base; nothing stored"]
     with psycopg.connect(run.url) as conn:
         assert conn.execute("SELECT count(*) FROM program").fetchone()[0] == before
 

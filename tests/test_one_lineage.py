@@ -134,7 +134,7 @@ def _spur_with_row(run, tmp_path, o: str):
     exported = run("template", "export", "--class", "spur")
     assert exported.exit_code == 0, exported.output
     rows = list(csv.reader(io.StringIO(exported.stdout)))
-    rows.insert(7, ["651", "main", "1", "", "", o, ""])
+    rows.insert(7, ["655", "main", "1", "", "", o, ""])
     path = tmp_path / "spur.csv"
     with path.open("w", newline="") as file:
         csv.writer(file).writerows(rows)
@@ -144,7 +144,7 @@ def _spur_with_row(run, tmp_path, o: str):
 def add_spur_row(url: str, o: str) -> None:
     """An editor's row added in SQL (template_view), where no import checks it."""
     with psycopg.connect(url) as conn:
-        conn.execute("INSERT INTO template_view (gear_class, id, t, n, o) VALUES ('spur', 651, 'main', 1, %s)", (o,))
+        conn.execute("INSERT INTO template_view (gear_class, id, t, n, o) VALUES ('spur', 655, 'main', 1, %s)", (o,))
 
 
 def test_a_row_building_a_lineage_line_is_named_by_lint_and_blocks_the_release(run, tmp_path):
@@ -153,10 +153,10 @@ def test_a_row_building_a_lineage_line_is_named_by_lint_and_blocks_the_release(r
     that makes no program."""
     built = '"; PROG" + "RAM 1 TEMPLATE spur v9"'
     imported = run("template", "import", "--class", "spur", str(_spur_with_row(run, tmp_path, built)))
-    assert imported.exit_code == 1 and "row 651" in imported.stderr, imported.output
+    assert imported.exit_code == 1 and "row 655" in imported.stderr, imported.output
     add_spur_row(run.url, built)
     lint = run("lint")
-    assert lint.exit_code == 1 and "651" in lint.output, lint.output
+    assert lint.exit_code == 1 and "655" in lint.output, lint.output
     release = run("template", "release", "--class", "spur", "--yes")
     assert release.exit_code == 1, release.output
 

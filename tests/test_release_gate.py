@@ -82,10 +82,10 @@ def test_a_golden_test_of_a_descendant_is_run_against_its_draft_too(conn):
 
 
 def test_a_static_analysis_finding_refuses_the_release_naming_the_row(conn):
-    conn.execute("INSERT INTO template_view (gear_class, id, t, n, o) "
-                 "SELECT gear_class, 801, t, n, o FROM template_view WHERE gear_class = 'spur' AND id = 800")
+    conn.execute("INSERT INTO template_view (gear_class, id, t, n, o, p_emit) "
+                 "SELECT gear_class, 805, t, n, o, p_emit FROM template_view WHERE gear_class = 'spur' AND id = 800")
     error = refusal(conn, "spur", dry_run=True)
-    assert "row 801 column o" in str(error) and "repeats row 800" in str(error)
+    assert "row 805 column o" in str(error) and "repeats row 800" in str(error)
 
 
 def test_a_class_without_a_draft_is_one_line(conn):

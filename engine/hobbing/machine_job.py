@@ -1,6 +1,7 @@
 """A job's parameters made ready for its machine: the signed values in the machine's senses
 (engine.hobbing.conventions), the machine's setup (work offset, tool call, door and load
-blocks, spindle orientation), the working area widened to the load position, and the cycle
+blocks, spindle orientation), the dialect the template renders the coupling in
+(engine.hobbing.dialects), the working area widened to the load position, and the cycle
 time of the program the template will write (engine.hobbing.cycle_time) and its floor-to-floor
 time (engine.hobbing.floor_time)."""
 from __future__ import annotations
@@ -9,11 +10,13 @@ from ..gears.records import Hob
 from ..machines.records import Machine
 from . import conventions
 from .cycle_time import cycle_time
+from .dialects import dialect_parameters
 from .floor_time import floor_to_floor
 from .passes import LIMIT_MARGIN
 
 SETUP_PARAMETERS = frozenset({"work_offset", "tool_number", "door_close_m", "door_open_m", "load_position",
-                              "load_x", "load_z", "orient_before_coupling", "cycle_time", "floor_to_floor"})
+                              "load_x", "load_z", "orient_before_coupling", "cycle_time", "floor_to_floor",
+                              "dialect", "program_number", "egb_helix_sign"})
 
 
 def machine_setup(machine: Machine, hob: Hob) -> dict:
@@ -42,7 +45,11 @@ def machine_job(params: dict, module_params: dict, machine: Machine, hob: Hob, s
 def with_cycle_time(job: dict, modules: dict, shape: str, machine: Machine) -> dict:
     """The job with the cycle and floor-to-floor times of its program (program values in, as stored): a stored job
     whose feeds were edited is made again with the time its program now takes, so the header
-    never tells the operator a time the simulation does not find."""
+    never tells the operator a time the simulation does not find. The dialect's parameters come
+    from the record here too (engine.hobbing.dialects), so a job stored before they existed is
+    made again in its machine's dialect."""
+    gear_id = job.get("gear_id")
+    job = {**job, **dialect_parameters(machine, gear_id if type(gear_id) is int else 0)}
     cuts = [modules[key] for key in sorted(modules, key=_module_order)
             if key.startswith("cutmotion:") and modules[key]["cut_on"]]
     minutes = cycle_time(job, cuts, shape, machine.rapid_rate)

@@ -54,6 +54,8 @@ CHECKS = {
        for which in ("close", "open")},
     "machine_egb_helix_sign_check": "egb_helix_sign must be 1 or -1 (the sign of the Fanuc helical compensation, "
                                     "fanuc-egb.md §F5; empty: not stated)",
+    "machine_program_number_base_check": "program_number_base must be a whole number from 0 to 99998 (a Fanuc "
+                                         "program's O number is it plus the gear's id; empty: none stated)",
     "machine_swivel_speed_check": "swivel_speed must be above 0 (degrees per second)",
     **{f"machine_{column}_check": f"{column} must be 0 or more (seconds)"
        for column in ("spindle_runup", "coupling_sync", "tailstock_time", "door_time", "tool_change_time",

@@ -72,6 +72,9 @@ class Machine(msgspec.Struct, frozen=True):
     # senses (fanuc-egb.md §F4, §F5): +1 the literal formula, -1 its opposite; None: not stated
     # (the simulation refuses a helical gear's Fanuc program).
     egb_helix_sign: int | None = None
+    # Fanuc hobbers (migration 0038): the O number of a gear's program is program_number_base + the
+    # gear's id (engine.hobbing.dialects); None: no rule stated (no Fanuc hobbing program).
+    program_number_base: int | None = None
 
 
 # The times a hobber's record states for the floor-to-floor time, in this order (migration 0034).
@@ -99,10 +102,11 @@ MACHINE_QUERY = f"SELECT {columns(Machine)} FROM machine"  # static, from the re
 
 
 DEFAULT_HOBBING_MACHINE = "hobber-840d"
-# The dialects the hobbing templates are written in. The verifier also reads Fanuc hobbing
-# (issue 30, G81/G80), but no template emits it yet: such a record is refused by name here,
-# not at the first line of a program written for another control.
-HOBBING_DIALECTS_MADE = ("840d",)
+# The dialects the hobbing templates are written in (issue 30: the class templates render the
+# coupling as EGON for the 840D, as G81/G80 for Fanuc, engine.hobbing.dialects). The verifier also
+# reads the M-series form G81.4 (dialect fanuc-g81.4), which no template emits: such a record is
+# refused by name here, not at the first line of a program written for another control.
+HOBBING_DIALECTS_MADE = ("840d", "fanuc")
 
 
 def hobbing_machine(conn: Connection, name: str | None) -> Machine:
@@ -113,7 +117,7 @@ def hobbing_machine(conn: Connection, name: str | None) -> Machine:
                           f"use --machine {DEFAULT_HOBBING_MACHINE}")
     if machine.dialect not in HOBBING_DIALECTS_MADE:
         raise EngineError(f"machine {machine.name} runs dialect {machine.dialect}: the engine makes hobbing programs "
-                          f"for {', '.join(HOBBING_DIALECTS_MADE)} only so far (Fanuc: issue 30); "
+                          f"for {', '.join(HOBBING_DIALECTS_MADE)} only so far (G81.4: issue 30); "
                           f"use --machine {DEFAULT_HOBBING_MACHINE}")
     return machine
 

@@ -21,6 +21,7 @@ from ..gears.models import model_for_class
 from ..gears.process_notes import hunting_tooth_notes
 from ..gears.records import Gear, load_gear, load_gears, load_hobs
 from ..hobbing.choices import Choices, refuse_feed_mode
+from ..hobbing.dialects import refuse_for_dialect
 from ..hobbing.floor_time import floor_time_notes
 from ..machines.records import Machine, hobbing_machine
 from ..machines.work_holding import load_work_holdings
@@ -111,6 +112,7 @@ class Planner:
             raise EngineError(f"gear {gear.id} has no gear class; re-import it to classify it")
         check_machine_fits(gear, self.machine)
         model = self.model(gear.gear_class)
+        refuse_for_dialect(gear, model, self.choices, self.machine)   # what the machine's control cannot be written
         self.template(gear.gear_class)   # a class refused is not a choice that does not fit: refused before the search
         self.choices.for_unit(1, 1 + len(gear.units), gear.id)   # a mode per unit names the gear's units or none
         hobs = [choice.hob for choice in matching_hobs(gear, self.hobs, purpose=model.hob_purpose,

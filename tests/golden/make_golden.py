@@ -21,7 +21,16 @@ from psycopg.conninfo import conninfo_to_dict, make_conninfo
 
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))   # tests/: golden_cases and its makers
 
-from helpers.golden_cases import hobbing_cases, hobbing_file, hobbing_text, turning_cases, turning_file, turning_text  # noqa: E402
+from helpers.golden_cases import (  # noqa: E402
+    FANUC_MACHINE,
+    fanuc_hobbing_file,
+    hobbing_cases,
+    hobbing_file,
+    hobbing_text,
+    turning_cases,
+    turning_file,
+    turning_text,
+)
 
 
 def seeded_database(admin_url: str) -> tuple[str, str]:
@@ -58,6 +67,9 @@ def main() -> int:
         for gear_id, choice_set in hobbing_cases():
             write(hobbing_file(gear_id, choice_set),
                   rolled_back(url, partial(hobbing_text, gear_id=gear_id, choice_set=choice_set)))
+            write(fanuc_hobbing_file(gear_id, choice_set),
+                  rolled_back(url, partial(hobbing_text, gear_id=gear_id, choice_set=choice_set,
+                                           machine=FANUC_MACHINE)))
         with tempfile.TemporaryDirectory() as folder:
             for case, lathe in turning_cases():
                 write(turning_file(case, lathe),
@@ -65,7 +77,8 @@ def main() -> int:
     finally:
         with psycopg.connect(args.database_url, autocommit=True) as admin:
             admin.execute(sql.SQL("DROP DATABASE IF EXISTS {} WITH (FORCE)").format(sql.Identifier(name)))
-    print(f"wrote {len(hobbing_cases())} hobbing and {len(turning_cases())} turning golden files")
+    print(f"wrote {len(hobbing_cases())} hobbing (each on the 840D and the Fanuc hobber) and "
+          f"{len(turning_cases())} turning golden files")
     return 0
 
 

@@ -18,6 +18,7 @@ from engine.hobbing.choices import Choices
 from engine.programs.instantiate import instantiate_gear
 from engine.programs.remake import instantiate_job
 from engine.turning.job_params import ProfileOptions
+from engine.verifier.grammar import HOBBING_FANUC
 from importers.dxf import import_dxf
 
 GOLDEN = Path(__file__).resolve().parents[1] / "golden"
@@ -53,12 +54,23 @@ TURNING_CASES = (
 LATHES = ("lathe-iso", "lathe-840d")
 
 
+# The Fanuc hobber's goldens (issue 30): the same gears and choice sets on hobber-fanuc, the
+# coupling rendered as G81/G80 by the same class templates. While the Fanuc grammar of this tree
+# does not read the agreed tailstock M20/M21 (a grammar change of its own), they are made without
+# the tailstock (False); once it does, with each set's own choice (None): write them again then.
+FANUC_MACHINE = "hobber-fanuc"
+FANUC_TAILSTOCK: bool | None = None if {20, 21} <= HOBBING_FANUC.m_codes.keys() else False
+
 WORM_WHEELS = (53,)   # no axial pass: their cases leave out the feed modes (refused for them)
 
 
 def hobbing_cases() -> list[tuple[int, str]]:
     return [(gear_id, choice_set) for gear_id in HOBBING_GEARS for choice_set in CHOICE_SETS
             if not (gear_id in WORM_WHEELS and "feed_mode" in CHOICE_SETS[choice_set][0])]
+
+
+def fanuc_hobbing_file(gear_id: int, choice_set: str) -> Path:
+    return GOLDEN / "hobbing_fanuc" / f"GEAR{gear_id}_{choice_set}.NC"
 
 
 def turning_cases() -> list[tuple[str, str]]:
@@ -88,12 +100,16 @@ def with_program_id_masked(text: str) -> str:
     return re.sub(r"^([;(] ?PROGRAM )\d+(?= TEMPLATE )", r"\1#", text, count=1, flags=re.MULTILINE)
 
 
-def hobbing_text(conn, gear_id: int, choice_set: str) -> str:
-    """The program of the gear under the choice set (its program id masked), or the one-line refusal."""
+def hobbing_text(conn, gear_id: int, choice_set: str, machine: str | None = None) -> str:
+    """The program of the gear under the choice set on `machine` (None: the default 840D hobber;
+    FANUC_MACHINE: without the tailstock, FANUC_TAILSTOCK), its program id masked, or the one-line
+    refusal."""
     choices, overrides = CHOICE_SETS[choice_set]
+    if machine == FANUC_MACHINE and FANUC_TAILSTOCK is not None:
+        choices = {**choices, "tailstock": FANUC_TAILSTOCK}
     try:
         return with_program_id_masked(
-            instantiate_gear(conn, gear_id, choices=Choices(**choices), overrides=overrides).text)
+            instantiate_gear(conn, gear_id, machine=machine, choices=Choices(**choices), overrides=overrides).text)
     except EngineError as error:
         return f"refused: {error}\n"
 
