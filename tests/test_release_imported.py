@@ -55,7 +55,7 @@ def repeats(lines: list[str]) -> tuple[list[str], list[str], list[int]]:
 
 def refusal(conn, gear_class: str) -> EngineError:
     with pytest.raises(EngineError) as refused_release:
-        release(conn, gear_class, dry_run=True)
+        release(conn, gear_class, dry_run=True, without_golden_tests=True)
     return refused_release.value
 
 
@@ -68,7 +68,7 @@ def test_the_engines_lathe_program_imported_is_released_and_runners_make_verifie
     assert len(further_on) >= 2 and after_twin == []   # the retract comes back after each cut, never doubled
     unreleased = refused(run("instantiate", "--class", "emco_neg", "--machine", "lathe-iso"))
     assert "no released template version" in unreleased and "template release" in unreleased
-    released = ok(run("template", "release", "--class", "emco_neg", "--yes"))
+    released = ok(run("template", "release", "--class", "emco_neg", "--yes", "--without-golden-tests"))
     assert "released class emco_neg v1" in released.stdout
     made = json.loads(ok(run("instantiate", "--class", "emco_neg", "--machine", "lathe-iso", "--json")).stdout)
     template_lines, lineage, unverified = stored_program(run.url, made["program_id"])
@@ -93,7 +93,7 @@ def test_every_real_nc_program_imports_and_is_released(run):
     for number, path in enumerate(path for path in REAL_PROGRAMS if path != TWINNED):
         gear_class = f"real_{number}"
         ok(run("import-nc", path, "--class", gear_class))
-        released = run("template", "release", "--class", gear_class, "--yes")
+        released = run("template", "release", "--class", gear_class, "--yes", "--without-golden-tests")
         assert released.exit_code == 0 and f"released class {gear_class} v1" in released.stdout, (path, released.output)
 
 
@@ -101,7 +101,7 @@ def test_every_real_nc_program_imports_and_is_released(run):
 
 def test_a_row_an_editor_pastes_right_after_its_twin_is_refused(conn):
     import_nc(conn, PAWN, "pawn", PAWN_PARAMS)
-    assert release(conn, "pawn", dry_run=True).checks["analysis"] == "no finding"
+    assert release(conn, "pawn", dry_run=True, without_golden_tests=True).checks["analysis"] == "no finding"
     twin = conn.execute("SELECT min(id) FROM template_view WHERE gear_class = 'pawn' AND o <> '\"\"'").fetchone()[0]
     with as_role(conn, "engine_editor"):
         assert conn.execute(PASTE, ("pawn", twin)).rowcount == 1
@@ -113,7 +113,7 @@ def test_a_row_an_editor_pastes_right_after_its_twin_is_refused(conn):
 def test_a_repeated_row_that_computes_is_refused_where_the_plain_line_was_content(conn):
     import_nc(conn, PAWN, "pawn", PAWN_PARAMS)
     first, again = conn.execute(REPEATED_PLAIN_ROWS, ("pawn",)).fetchone()
-    assert release(conn, "pawn", dry_run=True).checks["analysis"] == "no finding"
+    assert release(conn, "pawn", dry_run=True, without_golden_tests=True).checks["analysis"] == "no finding"
     with as_role(conn, "engine_editor"):
         assert conn.execute(EDIT_CONDITION, ("feed > 0", "pawn", [first, again])).rowcount == 2
     error = refusal(conn, "pawn")

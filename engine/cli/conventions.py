@@ -31,6 +31,7 @@ COMMAND_LINE_ONLY = {   # (command path, option): why it is typed on each invoca
     ("engine jobs delete", "yes"): DELETE,
     ("engine hobs delete", "yes"): DELETE,
     ("engine template release", "yes"): "it releases a draft to the shop floor without asking",
+    ("engine template release", "without-golden-tests"): "it releases a class no golden test checks",
     ("engine gears import", "replace"): "it overwrites stored gears",
     ("engine hobs import", "replace"): "it replaces stored hobs whole",
     ("engine fixtures import", "replace"): "it replaces stored work-holdings whole",

@@ -13,7 +13,7 @@ if TYPE_CHECKING:
     from ..db.connection import Connection
 
 
-@click.command("test")
+@click.group("test", invoke_without_command=True)
 @click.option("--class", "gear_class", help="Only this class's tests and its descendants'.")
 @click.option("--released", is_flag=True, help="Test the released versions, not the current rows (drafts).")
 @click.option("--coverage", "show_coverage", is_flag=True,
@@ -30,16 +30,43 @@ def test_command(ctx, gear_class, released, show_coverage, days, as_json):
     The expectations are `line: M30`, `no line: M8`, `match: REGEX`, `no match: REGEX`,
     `last X = (df2 + da0)/2 ± 0.01` and the like (docs/guide/release-and-golden-tests.md).
 
+    `engine test add --from-program ID` makes a test of a proven stored program.
+
     Example: engine test --class spur --json
     """
     from ..templates.store import class_and_descendants
 
+    if ctx.invoked_subcommand is not None:
+        return
     with connection(ctx) as conn:
         classes = class_and_descendants(conn, gear_class) if gear_class else None
         if show_coverage:
             _report_coverage(conn, classes, days, as_json)
             return
         _report_tests(conn, classes, gear_class, released, as_json)
+
+
+@test_command.command("add")
+@click.option("--from-program", "program_id", type=click.IntRange(min=1), required=True,
+              help="A stored program proved by the verifier and the simulation (see engine programs list).")
+@click.option("--name", help="The test's name (letters, digits, _ . -); default program<ID>.")
+@click.pass_context
+def test_add(ctx, program_id, name):
+    """Add a golden test of the program's class whose expectations are the program's lines (the
+    lineage line and the lines showing the template's version left out) and its numeric properties
+    (line count, G0/G1 blocks, each axis's range, the EGON ratio). The test runs the program's job
+    parameters on its machine; it is run once before it is stored, so a program the class's
+    current rows no longer make is refused, naming the first difference. Needs engine_editor.
+
+    Example: engine test add --from-program 12 --name gear42-shop
+    """
+    from ..release.from_program import add_from_program
+
+    with connection(ctx) as conn:
+        added = add_from_program(conn, program_id, name)
+    left_out = f", {added.left_out} line(s) showing the template version left out" if added.left_out else ""
+    click.echo(f"added golden test {added.gear_class}/{added.name} (id {added.id}): "
+               f"{added.expectations} expectation(s) from program {program_id}{left_out}")
 
 
 def _report_tests(conn: Connection, classes, gear_class, released, as_json) -> None:
@@ -56,7 +83,7 @@ def _report_tests(conn: Connection, classes, gear_class, released, as_json) -> N
         click.echo(f"{len(results) - len(failed)} passed, {len(failed)} failed")
     if not results:
         raise EngineError(f"no golden tests{f' for class {gear_class} (or its descendants)' if gear_class else ''}; "
-                          "add rows to template_test")
+                          "add one with engine test add --from-program ID")
     if failed:
         raise click.exceptions.Exit(1)
 

@@ -87,11 +87,13 @@ def parse_range(text: str, option: str = "--gears") -> tuple[int, int]:
               "Not with --out.")
 @click.option("--skip-bad", is_flag=True, help="Batch: store the good programs and list the bad gears or jobs "
               "skipped (else any bad one stores nothing).")
+@click.option("--quiet", is_flag=True, help="Batch: print only the summary line (programs stored, skipped, "
+              "notes counted by kind); else the first 3 notes of each kind are shown, all with --json.")
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object (program_id, path, lines, ...).")
 @click.pass_context
 def instantiate(ctx, gear_id, job_id, gear_class, params_file, unverified, gear_range, job_range, all_gears, out,
                 force, mkdir, machine, cuts, coolant, shift_y, shift_per_part, feed_mode, tailstock, fixture, worm_feed,
-                allowance, hob_speed, workers, explain, draft, dry_run, skip_bad, as_json):
+                allowance, hob_speed, workers, explain, draft, dry_run, skip_bad, quiet, as_json):
     """Produce the NC program of a gear (or a stored job, a job of an imported class, or a batch of gears).
 
     The program is checked against the machine's limits and proved by the
@@ -123,6 +125,7 @@ def instantiate(ctx, gear_id, job_id, gear_class, params_file, unverified, gear_
     from ..programs.instantiate import instantiate_gear
     from ..programs.options import RunMode
     from ..programs.outputs import line_endings
+    from .batch_report import report_batch
 
     _refuse_all_but_one_job(gear_id, job_id, gear_class, gear_range, job_range, all_gears)
     _refuse_options_of_other_jobs(ctx, gear_class is not None)
@@ -143,6 +146,8 @@ def instantiate(ctx, gear_id, job_id, gear_class, params_file, unverified, gear_
                                                     "--mkdir creates the folder of --out: give --out too"))
     skip_bad = where_it_applies(ctx, "skip_bad", skip_bad, not skip_bad or batch,
                                 "--skip-bad skips the bad gears of a batch: use it with --gears, --jobs or --all")
+    quiet = where_it_applies(ctx, "quiet", quiet, not quiet or batch,
+                             "--quiet shortens a batch's report: use it with --gears, --jobs or --all")
     mode = RunMode(draft=draft, dry_run=dry_run, skip_bad=skip_bad, workers=workers)
     with connection(ctx) as conn, line_endings(partial(line_ending, config)):
         if gear_id is not None:
@@ -155,8 +160,8 @@ def instantiate(ctx, gear_id, job_id, gear_class, params_file, unverified, gear_
             job = _class_job(conn, gear_class, params_file, machine, output, mode, unverified)
             return _report_class_job(job, as_json, explain)
         else:
-            return _report_batch(_batch(conn, job_range, gear_range, machine, choices, overrides, output, mode),
-                                 output.out, as_json)
+            return report_batch(_batch(conn, job_range, gear_range, machine, choices, overrides, output, mode),
+                                output.out, as_json, quiet)
     _report_program(program, as_json, explain)
 
 
@@ -300,23 +305,3 @@ def _program_summary(program) -> str:
                 f"v{program.template_version} {checked}; nothing stored")
     return (f"program {program.program_id} (job {program.job_id}, {len(program.lines)} lines) "
             f"from {program.gear_class} v{program.template_version}" + (" UNVERIFIED" if program.unverified else ""))
-
-
-def _report_batch(batch, out, as_json: bool) -> None:
-    if as_json:
-        emit_json({"programs": batch.programs, "lines": batch.lines, "path": out,
-                   "program_ids": [batch.first_program_id, batch.last_program_id], "notes": list(batch.notes),
-                   "skipped": list(batch.skipped), "dry_run": batch.dry_run})
-        return
-    for note in batch.notes:
-        click.echo(f"note: {note}", err=True)
-    for reason in batch.skipped:
-        click.echo(f"skipped: {reason}", err=True)
-    if batch.skipped:
-        click.echo(f"skipped {len(batch.skipped)} bad of {len(batch.skipped) + batch.programs} (--skip-bad): "
-                   "their programs are not stored", err=True)
-    if batch.dry_run:
-        click.echo(f"dry run: would store {batch.programs} program(s), {batch.lines} lines; nothing stored")
-        return
-    click.echo(f"stored {batch.programs} program(s) {batch.first_program_id}…{batch.last_program_id}, "
-               f"{batch.lines} lines" + (f", written to {out}" if out else ""))

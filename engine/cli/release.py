@@ -16,13 +16,18 @@ SHOWN_FAILURES = 5   # jobs the draft fails for, listed by the text output (all 
 @click.option("--workers", type=click.IntRange(1, 64), default=1, show_default=True,
               help="Make the stored jobs' programs again and prove the changed ones (verifier and simulation) "
                    "in this many processes.")
+@click.option("--without-golden-tests", is_flag=True,
+              help="Accept releasing a class that has no golden test (nor its descendants); the release "
+                   "history says it was accepted so.")
 @click.pass_context
-def template_release(ctx, gear_class, dry_run, yes, as_json, workers):
+def template_release(ctx, gear_class, dry_run, yes, as_json, workers, without_golden_tests):
     """Release the class's draft to the shop floor: refused, naming every row, column and test that
     failed, unless engine lint, the golden tests of the class and its descendants and the static
-    analysis pass. Shows how many stored programs the release changes and the first diffs, each
-    changed program proved by the verifier and the simulation, then asks (unless --yes). Needs the
-    role engine_releaser.
+    analysis pass; a class with no golden test (nor its descendants) is refused unless
+    --without-golden-tests accepts it, which the release records (engine template history says so).
+    Shows how many stored programs the release changes and the first diffs, each changed program
+    proved by the verifier and the simulation, then asks (unless --yes). Needs the role
+    engine_releaser.
 
     Example: engine template release --class spur --dry-run
     """
@@ -37,7 +42,8 @@ def template_release(ctx, gear_class, dry_run, yes, as_json, workers):
         return click.confirm(f"release class {report.gear_class} v{report.version}?", err=True)
 
     with connection(ctx) as conn:
-        report = release(conn, gear_class, dry_run=dry_run, confirm=confirm, workers=workers)
+        report = release(conn, gear_class, dry_run=dry_run, confirm=confirm, workers=workers,
+                         without_golden_tests=without_golden_tests)
     if as_json:
         return emit_json(_as_json(report))
     if dry_run or yes:
@@ -48,7 +54,7 @@ def template_release(ctx, gear_class, dry_run, yes, as_json, workers):
 def _show(report, diffs_shown: int) -> None:
     impact = report.impact
     click.echo(f"class {report.gear_class} v{report.version} ({report.hash[:8]}): gate passed: lint, "
-               f"{len(report.tests)} golden test(s), static analysis")
+               f"{_tests_said(report)}, static analysis")
     click.echo(f"impact: {impact.jobs} stored job(s) of {report.gear_class} and its descendants, "
                f"{impact.changed} program(s) change, {len(impact.failures)} fail with the draft; "
                f"{impact.proved} changed program(s) proved (machine verifier and simulation)")
@@ -60,6 +66,12 @@ def _show(report, diffs_shown: int) -> None:
         click.echo(f"job {diff.job_id} ({diff.gear_class}):\n{diff.diff}")
     if len(impact.diffs) > diffs_shown:
         click.echo(f"… {len(impact.diffs) - diffs_shown} more changed program(s) (all with --json)")
+
+
+def _tests_said(report) -> str:
+    if report.tests:
+        return f"{len(report.tests)} golden test(s)"
+    return "NO golden test (accepted with --without-golden-tests)"
 
 
 def _outcome(report) -> str:

@@ -145,7 +145,12 @@ def _release_text(release, verdict) -> str:
               else f"; it states {release.tests} golden test(s) passed")
     note = f" ({release.note})" if release.note else ""
     return (f"released {release.released_at:%Y-%m-%d %H:%M:%S} by {release.released_by} as {release.role}: "
-            f"{verdict.said}{stated}{impact}{note}")
+            f"{_untested_text(release)}{verdict.said}{stated}{impact}{note}")
+
+
+def _untested_text(release) -> str:
+    """A release with no golden test, accepted so on the command line (the checks it recorded)."""
+    return "WITHOUT GOLDEN TESTS (accepted with --without-golden-tests); " if release.without_tests else ""
 
 
 def _failed_text(failed: int | None) -> str:
@@ -185,6 +190,7 @@ def _release_json(release, verdict) -> dict | None:
     return {"released_at": release.released_at.isoformat(), "released_by": release.released_by,
             "role": release.role, "released_via": release.released_via, "tests": release.tests,
             "changed": release.changed, "jobs": release.jobs, "failed": release.failed, "note": release.note,
+            "accepted_without_golden_tests": release.without_tests,
             **verdict.as_json()}
 
 

@@ -18,6 +18,7 @@ from typing import TYPE_CHECKING
 import msgspec
 
 from ..errors import EngineError
+from ..notes import Note, replaced_head
 from .cutting_data import (
     FEED_EPSILON,
     RADIAL_TO_AXIAL,
@@ -141,9 +142,9 @@ def bounded_hob_speed(gear, hob, cutting_speed: float, spindle_max: float) -> tu
     most = most_hob_speed(gear, hob)
     if speed <= most:
         return speed, None
-    return most, (f"rough: hob speed {speed} r/min (v {cutting_speed:.1f} m/min) bounded to {most} r/min, the upper "
-                  f"end of reference §C for {gear.material or 'an unlisted material'} with a "
-                  f"{TOOLS[tool_of(hob)]} hob ({speed_range(gear, hob)[1]:g} m/min)")
+    return most, Note(f"rough: hob speed {speed} r/min (v {cutting_speed:.1f} m/min) bounded to {most} r/min, "
+                  f"the upper end of reference §C for {gear.material or 'an unlisted material'} with a "
+                  f"{TOOLS[tool_of(hob)]} hob ({speed_range(gear, hob)[1]:g} m/min)", "hob speed bounded")
 
 
 def bounded_proposal(proposal: KindProposal, gear, hob) -> tuple[KindProposal, str | None]:
@@ -158,8 +159,9 @@ def bounded_proposal(proposal: KindProposal, gear, hob) -> tuple[KindProposal, s
     factor = limit / proposal.axial_feed
     lowered = KindProposal(proposal.cut, proposal.cutting_speed, limit, proposal.radial_feed * factor,
                            f"{proposal.source}{FEED_BOUNDED}", proposal.case_ids)
-    return lowered, (f"{proposal.cut}: axial feed {proposal.axial_feed:.2f} mm per workpiece rev ({proposal.source}) "
-                     f"bounded to {limit:.2f}, the {why}; radial feed scaled alike to {lowered.radial_feed:.2f}")
+    return lowered, Note(f"{proposal.cut}: axial feed {proposal.axial_feed:.2f} mm per workpiece rev "
+                         f"({proposal.source}) bounded to {limit:.2f}, the {why}; radial feed scaled alike to "
+                         f"{lowered.radial_feed:.2f}", "feed bounded")
 
 
 class _Case(msgspec.Struct, frozen=True):
@@ -234,4 +236,4 @@ def single_cut_labels(notes, cut_count: int) -> list[str]:
     CUT_KINDS_BY_COUNT) labelled "single cut:", not "rough:" (there is no finish after it)."""
     if cut_count != 1:
         return list(notes)
-    return [f"{SINGLE_CUT}:{note.removeprefix('rough:')}" if note.startswith("rough:") else note for note in notes]
+    return [replaced_head(note, "rough:", f"{SINGLE_CUT}:") for note in notes]

@@ -21,6 +21,7 @@ import math
 from msgspec.structs import replace
 
 from ..errors import EngineError
+from ..notes import Note
 from .hob_matching import DEFAULT_GRADE
 
 # ISO 1328-1:2013 formula (11), helix form tolerance of class 5 [µm]:
@@ -113,7 +114,8 @@ def bounded_for_marks(cutting, gear, hob, cut_count: int, allowance: float, give
     if name in given:
         raise EngineError(f"gear {gear.id}: {name.replace('_', ' ')} {feed:g} mm per workpiece rev of the last cut: "
                           f"{why}; give at most {most:.2f}, or leave an allowance for shaving or grinding")
-    note = f"{kind}: axial feed {feed:.2f} mm per workpiece rev of the last cut bounded to {most:.2f}: {why}"
+    note = Note(f"{kind}: axial feed {feed:.2f} mm per workpiece rev of the last cut bounded to {most:.2f}: {why}",
+                "feed bounded")
     return replace(cutting, **{name: most}, notes=cutting.notes + (note,))
 
 

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import math
 
+from ..notes import Note
+
 
 def hunting_tooth_notes(gear, hob) -> list[str]:
     """A z0-start hob on z2 teeth with a common factor g = gcd(z0, z2) > 1 has no hunting tooth:
@@ -18,10 +20,10 @@ def hunting_tooth_notes(gear, hob) -> list[str]:
 
 def _note(gear_id: int, hob, teeth: int) -> str:
     factor = math.gcd(hob.starts, teeth)
-    return (f"gear {gear_id}: hob {hob.id} has {hob.starts} starts and the gear {teeth} teeth, common factor {factor} "
-            f"(no hunting tooth): each hob thread cuts only one gap in {factor}, "
+    return Note(f"gear {gear_id}: hob {hob.id} has {hob.starts} starts and the gear {teeth} teeth, common factor "
+            f"{factor} (no hunting tooth): each hob thread cuts only one gap in {factor}, "
             "so the hob's errors repeat on the gear; "
-            f"choose a hob whose starts share no factor with {teeth} where the grade needs it")
+            f"choose a hob whose starts share no factor with {teeth} where the grade needs it", "no hunting tooth")
 
 
 # The kind of cut (reference §C rows) of each cut name a hobbing job stores; a single cut is a rough one.

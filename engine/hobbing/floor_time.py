@@ -13,6 +13,7 @@ line (0.0 here: the templates emit the line where it is above 0)."""
 from __future__ import annotations
 
 from ..machines.records import FLOOR_TIMES, Machine, unstated_floor_times
+from ..notes import Note
 
 
 def floor_to_floor(job: dict, modules: dict, machine: Machine, cycle: float) -> float:
@@ -36,5 +37,5 @@ def floor_time_notes(machine: Machine) -> list[str]:
     missing = unstated_floor_times(machine)
     if not missing or len(missing) == len(FLOOR_TIMES):
         return []
-    return [f"no floor-to-floor time: machine {machine.name} does not state {', '.join(missing)}; "
-            "state them on its record (docs/guide/machines-and-simulation.md)"]
+    return [Note(f"no floor-to-floor time: machine {machine.name} does not state {', '.join(missing)}; "
+                 "state them on its record (docs/guide/machines-and-simulation.md)", "no floor-to-floor time")]

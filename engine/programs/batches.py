@@ -23,6 +23,7 @@ from psycopg.types.json import Jsonb
 
 from ..db.connection import scalar
 from ..errors import EngineError
+from ..notes import prefixed
 from .options import Output, RunMode
 from .outputs import files_after_commit
 from .records import Planned, Program
@@ -96,7 +97,8 @@ def good_ones(outcomes: list, what: str, skip_bad: bool) -> tuple[list, tuple[st
 def dry_batch(encoded: list, skipped: tuple[str, ...]) -> Batch:
     """What the batch would store: programs and lines (each with its lineage line), no ids."""
     return Batch(len(encoded), sum(len(item.lines) + 1 for item in encoded), None, None, None,
-                 tuple(f"{item.name}: {note}" for item in encoded for note in item.notes), skipped, dry_run=True)
+                 tuple(prefixed(f"{item.name}: ", note) for item in encoded for note in item.notes), skipped,
+                 dry_run=True)
 
 
 def refuse_out_in_dry_run(output: Output, mode: RunMode) -> None:

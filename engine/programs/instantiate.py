@@ -27,6 +27,7 @@ from ..machines.records import Machine, hobbing_machine
 from ..machines.work_holding import load_work_holdings
 from ..memory import no_cycle_collection
 from ..nc.layout import NcLayout, class_layout
+from ..notes import prefixed
 from ..templates.rows import Template
 from ..templates.versions import runnable_template
 from ..turning.names import TurningModel
@@ -143,7 +144,7 @@ class Planner:
         kinds = CUT_KINDS_BY_COUNT[choices.cut_count(gear.module)]
         cutting = cutting.of_cuts(kinds)
         record = job_cutting_record(cutting, gear, hob, kinds, case_ids)
-        notes = ([f"gear {gear.id}: {note}" for note in single_cut_labels(cutting.notes, len(kinds))]
+        notes = ([prefixed(f"gear {gear.id}: ", note) for note in single_cut_labels(cutting.notes, len(kinds))]
                  + hunting_tooth_notes(gear, hob)
                  + floor_time_notes(self.machine))
         return Planned(gear.id, gear.gear_class, self.machine.name, hob.id, params, job.module_params, template,

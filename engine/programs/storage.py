@@ -23,6 +23,7 @@ from ..db.connection import scalar
 from ..errors import EngineError
 from ..names import checked, line_breaking, shown
 from ..nc.lineage import lineage_line, lineage_words, refuse_lineage_shaped, with_lineage
+from ..notes import prefixed
 from .records import Encoded, Planned, Program
 
 if TYPE_CHECKING:
@@ -124,7 +125,7 @@ def store_many(conn: Connection, encoded: list[Encoded], out=None, files=None) -
         _stored_texts(files, _copy_programs(conn, program_ids, job_ids, encoded))
     return Batch(len(encoded), sum(len(item.lines) + 1 for item in encoded),
                  min(program_ids), max(program_ids), out,
-                 tuple(f"{item.name}: {note}" for item in encoded for note in item.notes))
+                 tuple(prefixed(f"{item.name}: ", note) for item in encoded for note in item.notes))
 
 
 def store_programs(conn: Connection, encoded: list[Encoded], job_ids: list[int], out=None, files=None) -> Batch:
@@ -135,7 +136,7 @@ def store_programs(conn: Connection, encoded: list[Encoded], job_ids: list[int],
         program_ids = _next_ids(conn, "program_id_seq", len(encoded))
         _stored_texts(files, _copy_programs(conn, program_ids, job_ids, encoded))
     return Batch(len(encoded), sum(len(item.lines) + 1 for item in encoded), min(program_ids), max(program_ids), out,
-                 tuple(f"{item.name}: {note}" for item in encoded for note in item.notes))
+                 tuple(prefixed(f"{item.name}: ", note) for item in encoded for note in item.notes))
 
 
 # The gears, hobs and jobs of a store that are no longer in the database.

@@ -19,6 +19,7 @@ from ..db.connection import scalar
 from ..errors import EngineError
 from ..programs import all_models  # noqa: F401  (registers every model)
 from ..templates.analysis import class_findings
+from ..templates.history import WITHOUT_TESTS
 from ..templates.lint import lint_class
 from ..templates.store import class_and_descendants
 from ..templates.versions import draft_template
@@ -54,10 +55,13 @@ class ReleaseReport(msgspec.Struct):
     drafts_below: list[str] = []   # descendants whose drafts need their own release
 
 
-def release(conn: Connection, gear_class: str, dry_run: bool = False, confirm=None, workers: int = 1) -> ReleaseReport:
+def release(conn: Connection, gear_class: str, dry_run: bool = False, confirm=None, workers: int = 1,
+            without_golden_tests: bool = False) -> ReleaseReport:
     """Gate, impact and (not a dry run) the release of the class's draft, in one transaction.
     `confirm(report)`, if given, is asked after the impact and before recording; False releases
-    nothing. The impact proves the programs the draft changes in `workers` processes."""
+    nothing. The impact proves the programs the draft changes in `workers` processes. A class
+    with no golden test (nor its descendants) is refused unless `without_golden_tests`: the
+    release then records that it was accepted so (checks, shown by `engine template history`)."""
     with conn.transaction():
         draft = draft_template(conn, gear_class)
         if not draft.draft:
@@ -65,7 +69,7 @@ def release(conn: Connection, gear_class: str, dry_run: bool = False, confirm=No
                               "rows (template_view, engine template import) to make one")
         if not dry_run:
             _require_releaser(conn)
-        tests, checks = gate(conn, gear_class, draft)
+        tests, checks = gate(conn, gear_class, draft, without_golden_tests)
         report = ReleaseReport(gear_class, draft.version, draft.hash, dry_run, tests, impact(conn, gear_class, workers),
                                checks, drafts_below=drafts_below(conn, gear_class))
         refuse_broken_jobs(gear_class, draft.version, report.impact)
@@ -97,18 +101,28 @@ def _role_needed(role: str) -> str:
     return f"releasing a template needs the role {RELEASER_ROLE}; {role} may not (nothing released)"
 
 
-def gate(conn: Connection, gear_class: str, draft) -> tuple[list[dict], dict]:
-    """The three checks; GateRefusal naming every failure. Returns the tests run and the checks."""
+def gate(conn: Connection, gear_class: str, draft, without_golden_tests: bool = False) -> tuple[list[dict], dict]:
+    """The three checks; GateRefusal naming every failure. Returns the tests run and the checks.
+    No golden test at all is a failure too (a gate that ran nothing proved nothing), unless the
+    caller accepts it (`without_golden_tests`), which the checks record."""
     lint_problems = [str(problem) for problem in lint_class(conn, gear_class)]
     results = _golden_results(conn, gear_class)
     problems = lint_problems + [f"golden {result.failure}"
                                 for result in results if not result.passed]
+    if not results and not without_golden_tests:
+        problems.append(no_tests_problem(gear_class))
     if not lint_problems:   # rows that do not compile cannot be analysed: lint named them
         problems += [str(finding) for finding in class_findings(conn, gear_class, draft)]
     if problems:
         raise GateRefusal(gear_class, draft.version, problems)
     tests = [{"class": result.gear_class, "name": result.name, "passed": result.passed} for result in results]
-    return tests, {"lint": "passed", "analysis": "no finding", "golden_tests": len(tests)}
+    checks = {"lint": "passed", "analysis": "no finding", "golden_tests": len(tests)}
+    return tests, {**checks, WITHOUT_TESTS: True} if not tests else checks
+
+
+def no_tests_problem(gear_class: str) -> str:
+    return (f"no golden test for class {gear_class} or its descendants: add one from a proven program "
+            "(engine test add --from-program ID), or accept releasing untested with --without-golden-tests")
 
 
 def _golden_results(conn: Connection, gear_class: str) -> list:

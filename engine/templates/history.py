@@ -46,6 +46,7 @@ class ReleaseEntry(msgspec.Struct, frozen=True):
     released_via: str = "sql"        # engine, seed, sql (by hand), unrecorded: what the caller said
     golden_tests: list | None = None  # the golden tests the database recorded with the release
     failed: int | None = None        # stored jobs the session states the released version failed for
+    without_tests: bool = False      # the releasing session accepted releasing with no golden test
 
 
 class RowChange(msgspec.Struct, frozen=True):
@@ -77,10 +78,13 @@ GROUP BY v.version, v.created_at, v.created_by, v.row_count, v.line_ending, v.fi
 ORDER BY v.version"""
 
 
+# The checks key of a release accepted with no golden test (engine template release --without-golden-tests).
+WITHOUT_TESTS = "accepted_without_golden_tests"
 STATES = "SELECT version, state FROM template_version_state WHERE gear_class = %s"
 RELEASES = """
 SELECT version, released_at, released_by, role, jsonb_array_length(tests), (impact ->> 'changed')::int,
-       (impact ->> 'jobs')::int, note, released_via, golden_tests, (impact ->> 'failed')::int
+       (impact ->> 'jobs')::int, note, released_via, golden_tests, (impact ->> 'failed')::int,
+       coalesce((checks ->> %s)::boolean, false)
 FROM template_release WHERE gear_class = %s"""
 
 
@@ -89,7 +93,7 @@ def history(conn: Connection, gear_class: str) -> list[VersionEntry]:
     state (released, retired, draft, superseded) and its release."""
     _require_class(conn, gear_class)
     states: dict[int, str] = dict(conn.execute(STATES, (gear_class,)).fetchall())   # version -> state
-    releases = {row[0]: ReleaseEntry(*row) for row in conn.execute(RELEASES, (gear_class,))}
+    releases = {row[0]: ReleaseEntry(*row) for row in conn.execute(RELEASES, (WITHOUT_TESTS, gear_class))}
     return [VersionEntry(version, created_at, created_by, row_count, tuple(zip(row_ids, operations)),
                          states.get(version, ""), releases.get(version), NcLayout(line_ending, final_newline))
             for version, created_at, created_by, row_count, line_ending, final_newline, row_ids, operations
