@@ -128,6 +128,9 @@ def test_a_gear_of_an_unknown_material_is_imported_then_refused_at_instantiate(r
     assert message.startswith("error: gear 901: material 'St52' is not a known material (known, closest first: ")
     assert "engine materials import" in message and jobs(run.url) == before
 
+    suggested = run("suggest", "--gear", 901)   # suggest proposes, and says what instantiate will do
+    assert suggested.exit_code == 0 and "material St52: instantiate refuses it" in suggested.output
+
     batch = run("instantiate", "--gears", "901-902")
     assert batch.exit_code == 1 and "gear 901: material 'St52' is not a known material" in batch.stderr
     assert jobs(run.url) == before

@@ -175,7 +175,10 @@ def _speed_notes(gear: Gear, hob: Hob, proposals: dict) -> list[str]:
     tool = TOOLS[tool_of(hob)]
     row = speeds_of(gear)
     if row is None:
-        return [f"no reference cutting speed range for material {gear.material or '(none)'}; check v by hand"]
+        if not (gear.material or "").strip():
+            return ["no reference cutting speed range for a gear with no material; check v by hand"]
+        return [f"no reference cutting speed range for material {gear.material}: instantiate refuses it; add it "
+                "with its speeds (`engine materials import FILE.csv`) or correct the gear's material"]
     low, high = row.ranges[tool_of(hob)]
     notes = [f"{p.cut}: cutting speed {p.cutting_speed:.1f} m/min is {'above' if p.cutting_speed > high else 'below'} "
              f"the typical {low}–{high} for {gear.material} with a {tool} hob (reference §C)"
