@@ -160,3 +160,22 @@ def test_an_imported_materials_speeds_bound_the_hob(run, tmp_path):
         gear = load_gear(conn, 901)
     hob = Hob("H", 2, 20, 1, tip, 100, "R", "A", "HSS", "", "cylindrical")
     assert speed_range(gear, hob) == (10.0, SLOW_HIGH, True) and most_hob_speed(gear, hob) == most
+
+
+def test_the_list_goes_into_a_new_database_unchanged(run, empty_database_url, tmp_path):
+    """A shop's materials, exported, are the same materials in a database migrated anew."""
+    from click.testing import CliRunner
+
+    from engine.cli.app import main
+
+    (tmp_path / "slow.csv").write_text(HEADER + SLOW, encoding="utf-8")
+    assert run("materials", "import", tmp_path / "slow.csv").exit_code == 0
+    exported = run("materials", "list", "--csv").stdout
+    (tmp_path / "all.csv").write_text(exported, encoding="utf-8")
+
+    def other(*args):
+        return CliRunner().invoke(main, ["--database-url", empty_database_url, *map(str, args)])
+    assert other("db", "migrate").exit_code == 0
+    imported = other("materials", "import", tmp_path / "all.csv", "--replace", "--json")
+    assert json.loads(imported.stdout) == {"added": 1, "updated": len(SEEDED)}
+    assert other("materials", "list", "--csv").stdout == exported
