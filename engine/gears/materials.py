@@ -46,9 +46,10 @@ DEFAULTS_WITHIN = (("default_uncoated", "uncoated_low", "uncoated_high"),
                    ("default_coated", "coated_low", "coated_high"))
 
 _COLUMN_LIST = sql.SQL(", ").join(map(sql.Identifier, COLUMN_NAMES))
-LIST = sql.SQL("SELECT {} FROM material ORDER BY lower(name)").format(_COLUMN_LIST)
+# By name ignoring case, byte order (COLLATE "C"): the same list whatever the server's locale.
+LIST = sql.SQL('SELECT {} FROM material ORDER BY lower(name) COLLATE "C"').format(_COLUMN_LIST)
 ONE = sql.SQL("SELECT {} FROM material WHERE lower(name) = lower(%s)").format(_COLUMN_LIST)
-NAMES = "SELECT name FROM material ORDER BY lower(name)"
+NAMES = 'SELECT name FROM material ORDER BY lower(name) COLLATE "C"'
 GEARS_OF = "SELECT count(*) FROM gear WHERE lower(btrim(material)) = lower(%s)"
 _UPSERT = sql.SQL("INSERT INTO material ({}) VALUES ({}) ON CONFLICT (name) DO UPDATE SET {}").format(
     _COLUMN_LIST, sql.SQL(", ").join(sql.Placeholder() * len(COLUMN_NAMES)), sql.SQL(", ").join(
