@@ -152,11 +152,15 @@ def test_an_s_within_the_table_but_not_the_headers_n0_is_refused(conn):
     assert any(f"the header states n0={header_n0(lines)}" in m for m in found[number]), found
 
 
-def test_a_gear_material_the_table_does_not_list_takes_the_widest_row_as_a_note(conn):
-    lines, hob_id = genuine(conn, 53)          # CuSn12: not in §C
+def test_a_gear_material_of_the_table_takes_its_row_and_no_material_the_widest_as_a_note(conn):
+    lines, hob_id = genuine(conn, 53)          # CuSn12: a row of table material (reference §C2, issue 31)
     report = simulate_program(lines, *records(conn, 53, hob_id), "TEST")
     assert not report.refusals, report.lines()
-    assert any("CuSn12" in f.message and "widest" in f.message for f in report.findings if not f.refuses)
+    assert not any("widest" in f.message for f in report.findings), report.lines()
+    conn.execute("UPDATE gear SET material = NULL WHERE id = 53")   # rolled back with the test
+    report = simulate_program(lines, *records(conn, 53, hob_id), "TEST")
+    assert not report.refusals, report.lines()
+    assert any("no material" in f.message and "widest" in f.message for f in report.findings if not f.refuses)
 
 
 # ---------------------------------------------------------------- finding 4: the tailstock clamped in every cut

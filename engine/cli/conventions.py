@@ -35,6 +35,7 @@ COMMAND_LINE_ONLY = {   # (command path, option): why it is typed on each invoca
     ("engine gears import", "replace"): "it overwrites stored gears",
     ("engine hobs import", "replace"): "it replaces stored hobs whole",
     ("engine fixtures import", "replace"): "it replaces stored work-holdings whole",
+    ("engine materials import", "replace"): "it replaces stored materials whole",
     ("engine cases import", "replace"): "it overwrites stored cases of the machining history",
     ("engine instantiate", "force"): "it replaces program files in --out, which a machine may be loading",
     ("engine db backup", "force"): "it replaces a backup file, which may be the only one",

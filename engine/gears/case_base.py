@@ -28,7 +28,7 @@ from .cutting_data import (
     hob_speed,
     per_minute,
 )
-from .speed_table import TOOLS, most_hob_speed, speed_range, tool_of
+from .speed_table import TOOLS, most_hob_speed, speed_range, speeds_of, tool_of
 
 if TYPE_CHECKING:
     from ..db.connection import Connection
@@ -121,7 +121,7 @@ class CaseBase:
         if top < 1:
             raise EngineError(f"top {top}: ask for at least 1 case per cut kind")
         defaults = default_cutting_data(gear.module, gear.material, bool(hob.coating), hob.tip_diameter,
-                                        machine.spindle_max)
+                                        machine.spindle_max, speeds_of(gear))
         found = {cut: self.propose(query_of(gear, hob, cut), top, defaults) for cut in CUT_KINDS}
         bounded = {cut: bounded_proposal(proposal, gear, hob) for cut, (proposal, _) in found.items()}
         proposals = {cut: proposal for cut, (proposal, _) in bounded.items()}

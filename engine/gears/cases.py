@@ -41,7 +41,7 @@ from .cutting_data import CuttingData
 from .hob_matching import choose_hob
 from .models import model_for_class
 from .records import Gear, Hob, load_gear, load_hobs
-from .speed_table import SPEEDS, TOOLS, tool_of
+from .speed_table import TOOLS, speeds_of, tool_of
 
 if TYPE_CHECKING:
     from ..db.connection import Connection
@@ -173,10 +173,13 @@ def _row_said(row_module: float, module: float) -> str:
 
 def _speed_notes(gear: Gear, hob: Hob, proposals: dict) -> list[str]:
     tool = TOOLS[tool_of(hob)]
-    ranges = SPEEDS.get(gear.material or "")
-    if ranges is None:
-        return [f"no reference cutting speed range for material {gear.material or '(none)'}; check v by hand"]
-    low, high = ranges[tool_of(hob)]
+    row = speeds_of(gear)
+    if row is None:
+        if not (gear.material or "").strip():
+            return ["no reference cutting speed range for a gear with no material; check v by hand"]
+        return [f"no reference cutting speed range for material {gear.material}: instantiate refuses it; add it "
+                "with its speeds (`engine materials import FILE.csv`) or correct the gear's material"]
+    low, high = row.ranges[tool_of(hob)]
     notes = [f"{p.cut}: cutting speed {p.cutting_speed:.1f} m/min is {'above' if p.cutting_speed > high else 'below'} "
              f"the typical {low}–{high} for {gear.material} with a {tool} hob (reference §C)"
              for p in proposals.values() if not low <= p.cutting_speed <= high]

@@ -12,15 +12,13 @@ from msgspec.structs import replace
 
 from ..errors import EngineError
 from .chip_thickness import ALLOWED_CHIP_THICKNESS, chip_feed_bound
+from .records import CuttingSpeeds
+from .speed_table import SPEEDS
 
-# Cutting speed v [m/min] by material, for uncoated and coated HSS hobs, wet (§C, mid-range).
-CUTTING_SPEED = {
-    "45": (38.0, 90.0),
-    "C45": (38.0, 90.0),
-    "20CrMnTi": (35.0, 85.0),
-    "40Cr": (28.0, 70.0),
-}
-UNKNOWN_MATERIAL_SPEED = (25.0, 50.0)   # conservative when the material is not in the table
+# Cutting speed v [m/min] by material, for uncoated and coated HSS hobs, wet (§C, mid-range): the
+# seed rows' defaults (a gear loaded from the database brings its material's, table material).
+CUTTING_SPEED = {name: row.defaults for name, row in SPEEDS.items()}
+UNKNOWN_MATERIAL_SPEED = (25.0, 50.0)   # conservative when no material is stated
 
 # Axial feed per workpiece revolution f_a [mm/rev] by module (upper bound, rough, finish) (§C).
 AXIAL_FEED = ((1.0, 1.5, 0.8), (2.0, 2.5, 1.2), (3.0, 3.0, 1.5), (float("inf"), 3.0, 1.5))
@@ -121,11 +119,15 @@ def hob_speed(cutting_speed: float, hob_tip_diameter: float, spindle_max: float)
 
 
 def default_cutting_data(module: float, material: str | None, coated: bool,
-                         hob_tip_diameter: float, spindle_max: float) -> CuttingData:
-    speeds = CUTTING_SPEED.get(material or "", UNKNOWN_MATERIAL_SPEED)
+                         hob_tip_diameter: float, spindle_max: float,
+                         row: CuttingSpeeds | None = None) -> CuttingData:
+    """Speeds and feeds of a job with no machining history: v of the material's row (`row`, from
+    table material; else the seed row of `material`) for an uncoated or coated hob [m/min]."""
+    known_speeds = row.defaults if row is not None else CUTTING_SPEED.get(material or "")
+    speeds = known_speeds or UNKNOWN_MATERIAL_SPEED
     speed = speeds[1] if coated else speeds[0]
     rough, finish = next((r, f) for limit, r, f in AXIAL_FEED if module <= limit)
-    known = "table" if material in CUTTING_SPEED else "unknown material, conservative"
+    known = "table" if known_speeds else "unknown material, conservative"
     return CuttingData(speed, hob_speed(speed, hob_tip_diameter, spindle_max), rough, finish,
                        RADIAL_TO_AXIAL * rough, f"defaults ({known})")
 

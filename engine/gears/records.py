@@ -23,6 +23,14 @@ if TYPE_CHECKING:
 TOOTH_DEPTH = Decimal("2.25")  # full tooth depth in modules: root = tip − 2·2.25·m
 
 
+class CuttingSpeeds(msgspec.Struct, frozen=True):
+    """A material's §C row (table material, engine.gears.speed_table): (lowest, highest) v
+    [m/min] per hob column of TOOLS, and the v a job with no machining history takes with an
+    uncoated and with a coated hob [m/min]."""
+    ranges: tuple[tuple[float, float], tuple[float, float], tuple[float, float]]
+    defaults: tuple[float, float]
+
+
 class Gear(msgspec.Struct, frozen=True):
     """A workpiece record (table gear, with its units): what the hobbing models and the simulation read."""
     id: int
@@ -47,6 +55,9 @@ class Gear(msgspec.Struct, frozen=True):
     module_kind: str | None = None
     profile_shift: float | None = None   # x [modules] as the drawing gives it (None: not given)
     units: tuple = ()          # further toothed units of a multi-unit gear (GearUnit), unit 2 first
+    # The §C row of its material, from table material (None: no material, or one the table lacks;
+    # engine.gears.speed_table then reads the seed rows). Not a field of the gear's own record.
+    cutting_speeds: CuttingSpeeds | None = None
 
     @property
     def stated_module(self) -> float:
@@ -142,7 +153,7 @@ def _as_float(record_type: type[Record], row: Sequence[Any]) -> Record:
 
 
 _KINDS = {Gear: "gear", GearUnit: "unit", Hob: "hob"}
-GEAR_QUERY = f"SELECT {columns(Gear, exclude={'units'})} FROM gear"  # static, from the record's fields
+GEAR_QUERY = f"SELECT {columns(Gear, exclude={'units', 'cutting_speeds'})} FROM gear"  # static: the record's fields
 UNIT_QUERY = f"SELECT gear_id, {columns(GearUnit)} FROM gear_unit"
 HOB_QUERY = f"SELECT {columns(Hob)} FROM hob"
 
@@ -151,7 +162,8 @@ def load_gear(conn: Connection, gear_id: int) -> Gear:
     row = conn.execute(GEAR_QUERY + " WHERE id = %s", (gear_id,)).fetchone()
     if row is None:
         raise EngineError(f"gear {gear_id} does not exist; import it with `engine gears import FILE.csv`")
-    return _with_units(_completed(_as_float(Gear, row)), _load_units(conn, gear_id, gear_id))
+    gear = _with_units(_completed(_as_float(Gear, row)), _load_units(conn, gear_id, gear_id))
+    return with_speeds(gear, load_cutting_speeds(conn))
 
 
 def load_gears(conn: Connection, first: int | None = None, last: int | None = None,
@@ -165,7 +177,29 @@ def load_gears(conn: Connection, first: int | None = None, last: int | None = No
         return gears
     units = _load_units(conn, gears[0].id, gears[-1].id)
     whole = (_or_refused(partial(_with_units, gear, units), gear.id, refused) for gear in gears)
-    return [gear for gear in whole if gear]
+    speeds = load_cutting_speeds(conn)
+    return [with_speeds(gear, speeds) for gear in whole if gear]
+
+
+SPEEDS_QUERY = """SELECT lower(name), uncoated_low, uncoated_high, coated_low, coated_high, carbide_low, carbide_high,
+       default_uncoated, default_coated FROM material"""
+
+
+def load_cutting_speeds(conn: Connection) -> dict[str, CuttingSpeeds]:
+    """The §C row of every material of table material, by its name in lower case (a gear's
+    material is matched ignoring case), in m/min."""
+    rows = {}
+    for name, *v in conn.execute(SPEEDS_QUERY):
+        v = [float(value) for value in v]
+        rows[name] = CuttingSpeeds(((v[0], v[1]), (v[2], v[3]), (v[4], v[5])), (v[6], v[7]))
+    return rows
+
+
+def with_speeds(gear: Gear, speeds: dict[str, CuttingSpeeds]) -> Gear:
+    """The gear with the §C row of its material (none for a material the table lacks: the planner
+    refuses it, engine.programs.instantiate)."""
+    row = speeds.get((gear.material or "").strip().lower())
+    return replace(gear, cutting_speeds=row) if row is not None else gear
 
 
 def _completed_or_refused(gear: Gear, refused: dict | None) -> Gear | None:

@@ -17,9 +17,11 @@ from ..gears.chip_thickness import chip_cases
 from ..gears.feed_marks import bounded_for_marks
 from ..gears.hob_matching import matching_hobs
 from ..gears.holding_matching import choose_holding
+from ..gears.materials import material_names, unknown_material
 from ..gears.models import model_for_class
 from ..gears.process_notes import hunting_tooth_notes
 from ..gears.records import Gear, load_gear, load_gears, load_hobs
+from ..gears.speed_table import speeds_of
 from ..hobbing.choices import Choices, refuse_feed_mode
 from ..hobbing.dialects import refuse_for_dialect
 from ..hobbing.floor_time import floor_time_notes
@@ -67,6 +69,7 @@ class Planner:
         self.hobs = load_hobs(conn)
         self.holdings = load_work_holdings(conn)
         self.case_base = CaseBase.load(conn)
+        self.materials = material_names(conn)   # named when a gear's material is not among them
         self._cutting: dict[tuple, tuple] = {}
         self.choices = choices
         self.overrides = overrides or {}
@@ -112,6 +115,7 @@ class Planner:
         if gear.gear_class is None:
             raise EngineError(f"gear {gear.id} has no gear class; re-import it to classify it")
         check_machine_fits(gear, self.machine)
+        check_material(gear, self.materials)
         model = self.model(gear.gear_class)
         refuse_for_dialect(gear, model, self.choices, self.machine)   # what the machine's control cannot be written
         self.template(gear.gear_class)   # a class refused is not a choice that does not fit: refused before the search
@@ -161,6 +165,14 @@ class Planner:
             case_ids = [case_id for proposal in proposals.values() for case_id in proposal.case_ids]
             self._cutting[key] = (cutting.with_overrides(gear, hob, **self.overrides), case_ids)
         return self._cutting[key]
+
+
+def check_material(gear: Gear, known: list[str]) -> None:
+    """A gear whose material table material lacks is refused, never given a default: the
+    material's §C speeds bound the hob's (engine.gears.speed_table). A gear with no material
+    stated keeps the widest range of the table, with a note (the simulation's)."""
+    if (gear.material or "").strip() and speeds_of(gear) is None:
+        raise EngineError(unknown_material(f"gear {gear.id}: material {gear.material!r}", gear.material or "", known))
 
 
 def check_machine_fits(gear: Gear, machine: Machine) -> None:

@@ -23,6 +23,7 @@ from ..errors import EngineError
 from ..gears.cutting_data import default_cutting_data, per_minute
 from ..gears.hob_matching import unmet_need
 from ..gears.process_notes import CUT_KIND_BY_NAME
+from ..gears.speed_table import speeds_of
 from ..hobbing.choices import WORM_FEEDS, Choices
 from .instantiate import check_machine_fits, check_speeds  # the planner's own checks
 
@@ -129,7 +130,8 @@ def _check_records(job_id: int, gear_class: str, model, gear: Gear, hob: Hob, ma
 def _cutting_table(gear: Gear, hob: Hob, machine: Machine):
     """The §C defaults for the gear and hob: the bounds of CuttingData.with_overrides (its values
     are not compared with the job's)."""
-    return default_cutting_data(gear.module, gear.material, bool(hob.coating), hob.tip_diameter, machine.spindle_max)
+    return default_cutting_data(gear.module, gear.material, bool(hob.coating), hob.tip_diameter, machine.spindle_max,
+                                speeds_of(gear))
 
 
 def _same(stored, derived) -> bool:

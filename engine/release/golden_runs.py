@@ -86,7 +86,8 @@ def expectation_names(params: dict) -> dict:
 
 def gear_names(gear: Gear) -> dict:
     """The gear record's fields as gear_<field>, its further units' as unit<N>_<field>."""
-    names = {f"gear_{key}": value for key, value in asdict(gear).items() if key != "units"}
+    names = {f"gear_{key}": value for key, value in asdict(gear).items()
+             if key not in ("units", "cutting_speeds")}
     for unit in gear.units:
         names.update({f"unit{unit.unit}_{key}": value for key, value in asdict(unit).items() if key != "unit"})
     return names

@@ -5,8 +5,10 @@ commands, within the row of the gear's material and the column of the hob's mate
 §C is typical practice [K][?] (calibrate before use). Above its upper end the hob wears and
 burns and the flanks tear: refused. Below its lower end the cut is only slower than practice: a
 note, not a refusal (the shop's own history, engine/gears/cases.py, may run slower than the
-table). A gear whose material is not in the table (or not stated) is held to the widest range
-of the hob's column, the lowest lower end to the highest upper end, with a note saying so."""
+table). The rows are table material's (the gear record carries its material's). A gear with no
+material stated is held to the widest range of the hob's column over the four rows of §C, the
+lowest lower end to the highest upper end, with a note saying so (one whose material the table
+lacks is refused at instantiate, engine.programs.instantiate.check_material)."""
 from __future__ import annotations
 
 import math
