@@ -1,9 +1,8 @@
 """`engine materials …`: the workpiece materials and their §C cutting speeds (list, show, import), issue 31."""
 from __future__ import annotations
 
-from dataclasses import asdict
-
 import click
+from msgspec.structs import asdict
 
 from .context import connection, emit_json
 from .output import Column, emit_list, emit_record, list_options

@@ -5,11 +5,11 @@ a CSV of them (the list's CSV is what the import reads), and the refusal of a ge
 material the table lacks: a material is never guessed, its speeds bound the hob's (§C)."""
 from __future__ import annotations
 
-from dataclasses import dataclass
 from decimal import Decimal
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+import msgspec
 import psycopg
 from psycopg import sql
 
@@ -58,8 +58,7 @@ TWIN = "SELECT name FROM material WHERE lower(name) = lower(%s) AND name <> %s"
 SHOWN_NAMES = 5   # the known materials a refusal names, closest first
 
 
-@dataclass(frozen=True)
-class MaterialImport:
+class MaterialImport(msgspec.Struct, frozen=True):
     """What an import did: materials new to the table, and those whose name was there already."""
 
     added: int

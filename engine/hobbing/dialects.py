@@ -11,7 +11,8 @@ What the Fanuc form cannot write is refused before any program is made, one line
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+
+import msgspec
 
 from ..errors import EngineError
 from ..gears.records import Gear
@@ -36,8 +37,7 @@ def dialect_parameters(machine: Machine, gear_id: int) -> dict:
             "egb_helix_sign": (machine.egb_helix_sign or 0) if fanuc else 0}
 
 
-@dataclass(frozen=True)
-class Job:
+class Job(msgspec.Struct, frozen=True):
     """What the refusals read: the gear, its class's model, the user's choices and the machine."""
     gear: Gear
     model: object

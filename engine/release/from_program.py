@@ -15,9 +15,9 @@ stored, so a test that would fail on the day it is added is refused, naming the 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+import msgspec
 from psycopg.errors import InsufficientPrivilege
 from psycopg.types.json import Jsonb
 
@@ -41,8 +41,7 @@ COUNTED = ("G0", "G1")                  # motion words whose blocks a test count
 EDITOR_ROLE = "engine_editor"
 
 
-@dataclass(frozen=True)
-class StoredProgram:
+class StoredProgram(msgspec.Struct, frozen=True):
     id: int
     gear_class: str
     version: int
@@ -55,8 +54,7 @@ class StoredProgram:
     module_params: dict
 
 
-@dataclass(frozen=True)
-class AddedTest:
+class AddedTest(msgspec.Struct, frozen=True):
     id: int
     gear_class: str
     name: str
