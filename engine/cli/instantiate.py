@@ -125,7 +125,6 @@ def instantiate(ctx, gear_id, job_id, gear_class, params_file, unverified, gear_
     from ..programs.instantiate import instantiate_gear
     from ..programs.options import RunMode
     from ..programs.outputs import line_endings
-    from .batch_report import report_batch
 
     _refuse_all_but_one_job(gear_id, job_id, gear_class, gear_range, job_range, all_gears)
     _refuse_options_of_other_jobs(ctx, gear_class is not None)
@@ -160,6 +159,7 @@ def instantiate(ctx, gear_id, job_id, gear_class, params_file, unverified, gear_
             job = _class_job(conn, gear_class, params_file, machine, output, mode, unverified)
             return _report_class_job(job, as_json, explain)
         else:
+            from .batch_report import report_batch  # batches only: one gear's start-up does not load it
             return report_batch(_batch(conn, job_range, gear_range, machine, choices, overrides, output, mode),
                                 output.out, as_json, quiet)
     _report_program(program, as_json, explain)

@@ -18,6 +18,7 @@ from ..csv_reader import CsvError, CsvKind, Problem, parse_number, parse_text, r
 from ..db.connection import scalar
 from ..db.listing import exact_records
 from ..errors import EngineError
+from .known_materials import material_names, unknown_material
 
 if TYPE_CHECKING:
     from ..db.connection import Connection
@@ -49,13 +50,11 @@ _COLUMN_LIST = sql.SQL(", ").join(map(sql.Identifier, COLUMN_NAMES))
 # By name ignoring case, byte order (COLLATE "C"): the same list whatever the server's locale.
 LIST = sql.SQL('SELECT {} FROM material ORDER BY lower(name) COLLATE "C"').format(_COLUMN_LIST)
 ONE = sql.SQL("SELECT {} FROM material WHERE lower(name) = lower(%s)").format(_COLUMN_LIST)
-NAMES = 'SELECT name FROM material ORDER BY lower(name) COLLATE "C"'
 GEARS_OF = "SELECT count(*) FROM gear WHERE lower(btrim(material)) = lower(%s)"
 _UPSERT = sql.SQL("INSERT INTO material ({}) VALUES ({}) ON CONFLICT (name) DO UPDATE SET {}").format(
     _COLUMN_LIST, sql.SQL(", ").join(sql.Placeholder() * len(COLUMN_NAMES)), sql.SQL(", ").join(
         sql.SQL("{0} = EXCLUDED.{0}").format(sql.Identifier(name)) for name in COLUMN_NAMES if name != "name"))
 TWIN = "SELECT name FROM material WHERE lower(name) = lower(%s) AND name <> %s"
-SHOWN_NAMES = 5   # the known materials a refusal names, closest first
 
 
 class MaterialImport(msgspec.Struct, frozen=True):
@@ -78,21 +77,6 @@ def show_material(conn: Connection, name: str) -> dict:
     if not found:
         raise EngineError(unknown_material(f"material {name!r}", name, material_names(conn)))
     return {**found[0], "gear_count": scalar(conn.execute(GEARS_OF, (found[0]["name"],)))}
-
-
-def material_names(conn: Connection) -> list[str]:
-    return [row[0] for row in conn.execute(NAMES)]
-
-
-def unknown_material(what: str, material: str, known: list[str]) -> str:
-    """One line: the thing, that table material lacks its material, the known ones closest first
-    (rapidfuzz's WRatio) and what to do. Its cutting speeds bound the hob's (§C): never guessed."""
-    from rapidfuzz import process  # only for a refusal (issue 28: start-up)
-
-    closest = [name for name, _, _ in process.extract(material, known, limit=SHOWN_NAMES)] if known else []
-    more = f", and {len(known) - len(closest)} more: `engine materials list`" if len(known) > len(closest) else ""
-    return (f"{what} is not a known material (known, closest first: {', '.join(closest) or 'none'}{more}); "
-            "write one of them, or add it with its cutting speeds: `engine materials import FILE.csv`")
 
 
 def read_materials(path: str | Path) -> list[tuple[int, dict[str, Any]]]:

@@ -17,7 +17,7 @@ from ..gears.chip_thickness import chip_cases
 from ..gears.feed_marks import bounded_for_marks
 from ..gears.hob_matching import matching_hobs
 from ..gears.holding_matching import choose_holding
-from ..gears.materials import material_names, unknown_material
+from ..gears.known_materials import material_names, unknown_material
 from ..gears.models import model_for_class
 from ..gears.process_notes import hunting_tooth_notes
 from ..gears.records import Gear, load_gear, load_gears, load_hobs
