@@ -19,8 +19,9 @@ import pickle
 import subprocess
 import sys
 import tempfile
-from dataclasses import astuple
 from pathlib import Path
+
+from msgspec.structs import astuple
 
 HERE = Path(__file__).resolve().parent
 REPO = HERE.parent

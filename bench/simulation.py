@@ -16,6 +16,7 @@ of the two trees' reports (Report.lines(): findings, cuts, times) differ.
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import pickle
 import subprocess
@@ -37,15 +38,30 @@ AGAINST = "7bb4197"      # main before issue 28: the golden-section search, ever
 WARMUP_PROGRAMS = 50     # simulated untimed first in each subprocess (imports, the switch to numpy)
 
 # Runs in the subprocess: the tree's own simulation follows every program; prints seconds and reports.
+# The records (gear, hob, machine) travel as plain data (plain_records) and are rebuilt from the
+# tree's own classes with the fields that tree knows: a pickle of this tree's records names classes
+# and fields an earlier tree lacks (a Struct, the material's cutting speeds).
 TIMER = r"""
-import json, pickle, sys, time
+import dataclasses, importlib, json, pickle, sys, time
 tree, data = sys.argv[1], sys.argv[2]
 sys.path.insert(0, tree)
 from engine.simulation.hobbing.run import simulate_program
 import engine.simulation.hobbing.run as run
 assert run.__file__.startswith(tree), run.__file__
+
+def built(value):
+    if isinstance(value, dict) and "__record__" in value:
+        module, _, name = value["__record__"].rpartition(".")
+        kind = getattr(importlib.import_module(module), name)
+        known = getattr(kind, "__struct_fields__", None) or [field.name for field in dataclasses.fields(kind)]
+        return kind(**{key: built(item) for key, item in value["fields"].items() if key in known})
+    if isinstance(value, (list, tuple)):
+        return type(value)(built(item) for item in value)
+    return value
+
 with open(data, "rb") as file:
     programs, warmup = pickle.load(file)
+programs = [built(program) for program in programs]
 for lines, gear, hob, machine, name in programs[:warmup]:
     simulate_program(lines, gear, hob, machine, name)
 start = time.perf_counter()
@@ -53,6 +69,20 @@ reports = [simulate_program(lines, gear, hob, machine, name) for lines, gear, ho
 seconds = time.perf_counter() - start
 print(json.dumps({"seconds": seconds, "reports": [report.lines() for report in reports]}))
 """
+
+
+def plain_records(value):
+    """A record (Struct or dataclass) as {"__record__": its class, "fields": its fields}, nested
+    records and sequences too; anything else as it is."""
+    names = getattr(value, "__struct_fields__", None)
+    if names is None and dataclasses.is_dataclass(value) and not isinstance(value, type):
+        names = [field.name for field in dataclasses.fields(value)]
+    if names is not None:
+        return {"__record__": f"{type(value).__module__}.{type(value).__qualname__}",
+                "fields": {name: plain_records(getattr(value, name)) for name in names}}
+    if isinstance(value, (list, tuple)):
+        return type(value)(plain_records(item) for item in value)
+    return value
 
 
 def no_proof(lines, machine, workpiece, name) -> None:
@@ -102,7 +132,7 @@ def compare_trees(programs: list, against: str, reps: int) -> None:
             print(f"\nsimulation alone: this checkout has no commit {against}; give --against REV")
             return
         data = Path(folder) / "programs.pickle"
-        data.write_bytes(pickle.dumps((programs, min(WARMUP_PROGRAMS, len(programs)))))
+        data.write_bytes(pickle.dumps((plain_records(programs), min(WARMUP_PROGRAMS, len(programs)))))
         trees = {"this tree": HERE.parent, against: before}
         runs: dict = {name: [] for name in trees}
         for repetition in range(reps):
