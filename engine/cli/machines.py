@@ -95,7 +95,7 @@ def machines_import(ctx, csv_file, replace, as_json):
     stored jobs were made on is changed in no field (their programs were proved on it: give a
     changed one a new name). Any bad row stops the whole file, nothing stored. A hobber stating
     some floor-to-floor times but not all is added with a note naming the ones missing (its
-    programs have no FLOOR TO FLOOR line).
+    programs have no FLOOR TO FLOOR line). Needs the role engine_planner.
 
     Example: engine machines list --csv > machines.csv && engine machines import machines.csv --replace
     """
