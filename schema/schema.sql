@@ -1984,10 +1984,13 @@ RETURN (SELECT coalesce(jsonb_agg(jsonb_build_object('id', t.id, 'class', t.gear
 -- ==============================================================================================
 
 -- Section roles: who may do what (loaded last: it grants on the objects of every other section).
--- Four NOLOGIN groups, granted to login roles: engine_reader reads; engine_runner makes jobs,
--- programs and cases; engine_editor changes templates; engine_releaser releases them. Writes go
--- through the engine's functions and views (SECURITY DEFINER: checked, versioned, audited), not
--- the tables; the owner (the role running `engine db migrate`) is the only other writer.
+-- Five NOLOGIN groups, granted to login roles: engine_reader reads; engine_runner makes jobs,
+-- programs and cases; engine_editor changes templates; engine_releaser releases them;
+-- engine_planner keeps the shop's data (gears, units, hobs, cases, work-holdings, machines,
+-- materials). Writes of templates and programs go through the engine's functions and views
+-- (SECURITY DEFINER: checked, versioned, audited), not the tables; the library's records the
+-- planner writes directly; the owner (the role running `engine db migrate`) is the only other
+-- writer.
 
 -- Roles belong to the cluster, not to this database: create them once, whichever database
 -- migrates first, even concurrently.
@@ -1995,7 +1998,8 @@ DO $$
 DECLARE
     role_name text;
 BEGIN
-    FOREACH role_name IN ARRAY ARRAY['engine_reader', 'engine_runner', 'engine_editor', 'engine_releaser'] LOOP
+    FOREACH role_name IN ARRAY ARRAY['engine_reader', 'engine_runner', 'engine_editor', 'engine_releaser',
+                                         'engine_planner'] LOOP
         IF NOT EXISTS (SELECT 1 FROM pg_roles WHERE rolname = role_name) THEN
             BEGIN
                 EXECUTE format('CREATE ROLE %I NOLOGIN', role_name);
@@ -2062,3 +2066,23 @@ GRANT USAGE ON SEQUENCE near_duplicate_intended_id_seq TO engine_editor;
 -- the release (and how the caller says it released; screens re-check it, docs/design.md §10).
 REVOKE EXECUTE ON FUNCTION release_template(text, integer, text, jsonb, jsonb, jsonb, text, text) FROM PUBLIC;
 GRANT EXECUTE ON FUNCTION release_template(text, integer, text, jsonb, jsonb, jsonb, text, text) TO engine_releaser;
+
+-- Planners keep the shop's data (issue 31, docs/design.md §10): they read what the other roles
+-- read, add and replace the library's records (the engine's imports, or by hand) and delete gears
+-- and hobs no job was made from (job's foreign keys refuse the others). In the machining history
+-- they add and replace a case's values, never which job it came from nor when (the database's own
+-- record). No template, release, program, job or audit row.
+GRANT USAGE ON SCHEMA public TO engine_planner;
+GRANT SELECT ON ALL TABLES IN SCHEMA public TO engine_planner;
+REVOKE ALL ON template_change, template_check_due FROM engine_planner;
+GRANT SELECT ON SEQUENCE component_id_seq, cutting_case_id_seq, job_id_seq, program_id_seq, template_audit_id_seq
+    TO engine_planner;
+ALTER DEFAULT PRIVILEGES IN SCHEMA public GRANT SELECT ON TABLES TO engine_planner;
+GRANT INSERT, UPDATE, DELETE ON gear, gear_unit, hob TO engine_planner;
+GRANT INSERT, UPDATE ON work_holding, machine, material TO engine_planner;
+GRANT INSERT (id, module, teeth, material, hardness, quality_grade, hob_material, hob_coating, hob_starts,
+              hob_tip_diameter, cut, hob_speed, axial_feed, radial_feed, source),
+      UPDATE (module, teeth, material, hardness, quality_grade, hob_material, hob_coating, hob_starts,
+              hob_tip_diameter, cut, hob_speed, axial_feed, radial_feed, source)
+    ON cutting_case TO engine_planner;
+GRANT USAGE, UPDATE ON SEQUENCE cutting_case_id_seq TO engine_planner;

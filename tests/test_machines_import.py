@@ -38,7 +38,7 @@ def test_every_machine_exported_and_imported_under_a_new_name_comes_back_field_f
     before = machines(run.url)
     renamed = [{**row, "name": "shop-" + row["name"]} for row in exported(run)]
     result = ok(run("machines", "import", written(tmp_path, renamed), "--json"))
-    assert json.loads(result.stdout) == {"added": [row["name"] for row in renamed]}
+    assert json.loads(result.stdout) == {"added": [row["name"] for row in renamed], "replaced": [], "changes": []}
     after = {machine["name"]: machine for machine in machines(run.url)}
     for machine in before:
         assert after["shop-" + machine["name"]] == {**machine, "name": "shop-" + machine["name"]}

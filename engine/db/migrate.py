@@ -26,7 +26,7 @@ MIGRATION_LOCK_KEY = 0x4E43_5445_4D50  # "NCTEMP"
 # fails as a duplicate, and its next GRANT in the same transaction still finds no role (PostgreSQL
 # keeps the failed lookup cached until the transaction ends). Created first, each committed on its
 # own, the migrations' own "IF NOT EXISTS" then finds them.
-CLUSTER_ROLES = ("engine_reader", "engine_runner", "engine_editor", "engine_releaser")
+CLUSTER_ROLES = ("engine_reader", "engine_runner", "engine_editor", "engine_releaser", "engine_planner")
 ROLE_EXISTS = "SELECT 1 FROM pg_roles WHERE rolname = %s"
 
 CREATE_LEDGER = """

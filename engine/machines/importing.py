@@ -3,9 +3,12 @@ table, as `engine machines list --csv` writes them and seed_templates/machines.c
 name, kind, dialect, the travel (x_min … z_max) and spindle_max are required (REQUIRED), an empty
 cell takes the column's default. A shop adds its own lathe or hobber here instead of in SQL.
 
-Only new machines are added: a record that exists is the one its stored programs were proved
-against, so changing its travel or its control's facts is a deliberate edit in SQL, not a side
-effect of a file (docs/guide/machines-and-simulation.md). A kind and dialect the verifier has no
+Only new machines are added, unless --replace: then a stored machine of the file is replaced
+whole (an empty cell its column's default), each changed field said old → new. A machine stored
+jobs were made on is the one their programs were proved against, so --replace changes it in no
+field (engine.db.replacing): the file exported and imported again passes, a changed travel or
+control fact is a deliberate edit in SQL or a machine of a new name
+(docs/guide/machines-and-simulation.md). A kind and dialect the verifier has no
 grammar for is refused where it enters, naming the ones it has: such a machine could never be
 given a program. All or nothing: any bad row stops the file, nothing stored."""
 from __future__ import annotations
@@ -14,10 +17,14 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+import msgspec
 import psycopg
 from psycopg import sql
 
 from ..csv_reader import Column, CsvKind, parse_text, read_csv_file
+from ..db.connection import scalar
+from ..db.listing import exact_records
+from ..db.replacing import Change, changed_fields, jobs_of, plain, refuse_held
 from ..errors import EngineError
 from ..names import shown
 from .records import FLOOR_TIMES, Machine
@@ -63,6 +70,35 @@ CHECKS = {
 }
 
 
+FIELDS = Machine.__struct_fields__
+# the record as stored (numbers digit for digit): what --csv writes and --replace compares
+EXPORT = sql.SQL("SELECT {} FROM machine ORDER BY name").format(sql.SQL(", ").join(map(sql.Identifier, FIELDS)))
+LOCKED = sql.SQL("SELECT {} FROM machine WHERE name = ANY(%s) ORDER BY name FOR UPDATE").format(
+    sql.SQL(", ").join(map(sql.Identifier, FIELDS)))
+# a replaced machine is replaced whole: a column the row leaves empty takes its default (EXCLUDED's)
+WHOLE = sql.SQL(", ").join(sql.SQL("{0} = EXCLUDED.{0}").format(sql.Identifier(name)) for name in FIELDS[1:])
+ONE = sql.SQL("SELECT {} FROM machine WHERE name = %s").format(sql.SQL(", ").join(map(sql.Identifier, FIELDS)))
+JOB_COUNT = "SELECT count(*)::int FROM job WHERE machine = %s"
+JOBS_ON = "SELECT machine, array_agg(id ORDER BY id) FROM job WHERE machine = ANY(%s) GROUP BY machine"
+
+
+def export_machines(conn: Connection) -> list[dict[str, Any]]:
+    """Every machine record by name as `engine machines import` reads it (each value as stored)."""
+    return exact_records(conn.execute(EXPORT))
+
+
+def show_machine(conn: Connection, name: str) -> dict[str, Any]:
+    """The machine of that name (as stored, numbers as JSON numbers) with the count of stored jobs
+    made on it; EngineError naming the known machines when there is none."""
+    found = exact_records(conn.execute(ONE, (name,)))
+    if not found:
+        known = ", ".join(row[0] for row in conn.execute("SELECT name FROM machine ORDER BY name"))
+        raise EngineError(f"machine {shown(name)} does not exist; known machines: {known or 'none'} "
+                          "(engine machines list)")
+    record = {key: plain(value) for key, value in found[0].items()}
+    return {**record, "job_count": scalar(conn.execute(JOB_COUNT, (name,)))}
+
+
 def read_machines(path: str | Path) -> list[dict[str, Any]]:
     """The rows of a machines CSV as {column: text}, an empty cell None (the column's default);
     a row without one of the REQUIRED columns, or with text where a number goes, is refused,
@@ -95,10 +131,13 @@ def _is_number(text: str) -> bool:
 
 
 def import_machines(conn: Connection, path: str | Path, grammars: set[tuple[str, str]],
-                    fault: Callable[[dict], str | None] = lambda machine: None) -> list[str]:
+                    fault: Callable[[dict], str | None] = lambda machine: None, *,
+                    replace: bool = False) -> MachineImport:
     """Add every machine of the CSV file at `path`, all or nothing; `grammars`: the (kind, dialect)
     pairs the verifier reads; `fault(machine)`: why the verifier could never take the record as it
-    is (a power-on state its control cannot be in), or None. Returns the names added."""
+    is (a power-on state its control cannot be in), or None; `replace`: a stored machine of the
+    file (its name as stored) is replaced whole, unless stored jobs were made on it and the file
+    changes it."""
     machines = read_machines(path)
     for machine in machines:
         _refuse_unknown_grammar(path, machine, grammars)
@@ -107,11 +146,23 @@ def import_machines(conn: Connection, path: str | Path, grammars: set[tuple[str,
             raise EngineError(f"{path}: machine {shown(machine['name'])}: {why}; correct the row; nothing imported")
     names = [machine["name"] for machine in machines]
     _refuse_repeated(path, names)
-    _refuse_existing(conn, path, names)
     with conn.transaction():
+        stored = {row["name"]: row for row in exact_records(conn.execute(LOCKED, (names,)))}
+        _refuse_existing(conn, path, [name for name in names if not (replace and name in stored)])
         for machine in machines:
             _insert(conn, path, machine)
-    return names
+        changes = changed_fields(stored, exact_records(conn.execute(LOCKED, (list(stored),))), "name", FIELDS[1:])
+        refuse_held(path, "machine", changes, jobs_of(conn, JOBS_ON, [change.key for change in changes]),
+                    relation="{jobs} {were} made on it")
+    return MachineImport([name for name in names if name not in stored], list(stored), changes)
+
+
+class MachineImport(msgspec.Struct, frozen=True):
+    """What an import did: the machines added, those replaced (by name) and their changed fields."""
+
+    added: list[str]
+    replaced: list[str]
+    changes: list[Change]
 
 
 def _refuse_unknown_grammar(path, machine: dict, grammars: set[tuple[str, str]]) -> None:
@@ -149,9 +200,9 @@ def _refuse_existing(conn: Connection, path, names: list[str]) -> None:
         "SELECT name FROM machine WHERE lower(name) = ANY(%s) ORDER BY name", ([name.lower() for name in names],))]
     if found:
         raise EngineError(f"{path}: machine(s) {', '.join(found)} exist already (names that differ only in case "
-                          "are one machine): an import adds new machines only; remove their rows from the file, "
-                          "give a new machine another name, or change an existing record in SQL (UPDATE machine "
-                          "…): its stored programs were proved against it; nothing imported")
+                          "are one machine): without --replace an import adds new machines only; remove their rows "
+                          "from the file, give a new machine another name, or replace the records as stored "
+                          "(--replace, the name as listed); nothing imported")
 
 
 def _insert(conn: Connection, path, machine: dict) -> None:
@@ -159,9 +210,9 @@ def _insert(conn: Connection, path, machine: dict) -> None:
     and what the check asks, inside the file's transaction (nothing of the file is stored)."""
     given = {column: value for column, value in machine.items() if value is not None}   # empty: the default
     try:
-        conn.execute(sql.SQL("INSERT INTO machine ({}) VALUES ({})").format(
-            sql.SQL(", ").join(map(sql.Identifier, given)), sql.SQL(", ").join(sql.Placeholder() * len(given))),
-            list(given.values()))
+        conn.execute(sql.SQL("INSERT INTO machine ({}) VALUES ({}) ON CONFLICT (name) DO UPDATE SET {}").format(
+            sql.SQL(", ").join(map(sql.Identifier, given)), sql.SQL(", ").join(sql.Placeholder() * len(given)),
+            WHOLE), list(given.values()))
     except (psycopg.errors.IntegrityError, psycopg.errors.DataError) as error:
         asks = CHECKS.get(error.diag.constraint_name or "", error.diag.message_primary or str(error))
         raise EngineError(f"{path}: machine {shown(machine['name'])}: {asks}; nothing imported") from error
