@@ -26,7 +26,6 @@ from ..memory import command_collection
 from .commands import COMMAND_MODULES, LazyCommands
 from .context import CONFIG
 from .conventions import JSON_SEEN, apply_conventions, apply_to_one, default_map, json_from_defaults
-from .refusals import refusal_line
 
 JSON_ARGS = "engine.json_args"   # ctx.meta: --json among the invocation's arguments
 INTERRUPTED = 130   # the exit code of Ctrl-C: 128 + SIGINT, what a shell shows for a command it interrupted
@@ -127,6 +126,7 @@ class EngineGroup(click.Group):
                 raise
             first_line = (str(error).strip().splitlines() or [""])[0]
             if _refused_by_role(error):   # a role without the right: a handled refusal, nothing was stored
+                from .refusals import refusal_line  # on a refusal only: start-up loads no more (issue 28)
                 fail(refusal_line(first_line), 1)
             if _database_failure(error):   # the server, not the engine: exit 1, and say what was kept
                 fail(_database_failure_message(error, first_line), 1)
