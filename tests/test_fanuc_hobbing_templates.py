@@ -159,16 +159,17 @@ def test_a_tangential_worm_wheel_feed_is_refused_on_fanuc(conn):
         instantiate_gear(conn, 53, machine=FANUC, choices=Choices(tailstock=False, worm_feed="tangential"))
 
 
-def test_the_m_series_form_g81_4_is_still_refused_by_name(conn):
-    name = add_machine_like(conn, FANUC, "hobber-fanuc-m", dialect="fanuc-g81.4")
-    with pytest.raises(EngineError, match="runs dialect fanuc-g81.4"):
+def test_a_hobber_of_a_dialect_no_template_writes_is_refused_by_name(conn):
+    name = add_machine_like(conn, FANUC, "hobber-linuxcnc", dialect="linuxcnc")
+    with pytest.raises(EngineError, match="runs dialect linuxcnc"):
         instantiate_gear(conn, 42, machine=name, choices=NO_TAILSTOCK)
 
 
 @pytest.mark.parametrize("machine", [SIEMENS, FANUC])
 def test_a_job_stored_before_the_dialect_parameters_is_made_again_in_its_machines_dialect(conn, machine):
     made = instantiate_gear(conn, 42, machine=machine, choices=NO_TAILSTOCK)
-    conn.execute("UPDATE job SET params = params - 'dialect' - 'program_number' - 'egb_helix_sign' WHERE id = %s",
+    conn.execute("UPDATE job SET params = params - 'dialect' - 'fanuc' - 'program_number' - 'egb_helix_sign' "
+                 "- 'egb_start' - 'egb_teeth' - 'egb_stop' WHERE id = %s",
                  (made.job_id,))
     again = instantiate_job(conn, made.job_id)
     assert again.lines[:6] == made.lines[:6] and again.lines[7:] == made.lines[7:]   # the lineage aside

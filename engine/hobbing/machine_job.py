@@ -16,7 +16,8 @@ from .passes import LIMIT_MARGIN
 
 SETUP_PARAMETERS = frozenset({"work_offset", "tool_number", "door_close_m", "door_open_m", "load_position",
                               "load_x", "load_z", "orient_before_coupling", "cycle_time", "floor_to_floor",
-                              "dialect", "program_number", "egb_helix_sign"})
+                              "dialect", "fanuc", "program_number", "egb_helix_sign",
+                              "egb_start", "egb_teeth", "egb_stop"})
 
 
 def machine_setup(machine: Machine, hob: Hob) -> dict:

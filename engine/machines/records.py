@@ -103,10 +103,10 @@ MACHINE_QUERY = f"SELECT {columns(Machine)} FROM machine"  # static, from the re
 
 DEFAULT_HOBBING_MACHINE = "hobber-840d"
 # The dialects the hobbing templates are written in (issue 30: the class templates render the
-# coupling as EGON for the 840D, as G81/G80 for Fanuc, engine.hobbing.dialects). The verifier also
-# reads the M-series form G81.4 (dialect fanuc-g81.4), which no template emits: such a record is
-# refused by name here, not at the first line of a program written for another control.
-HOBBING_DIALECTS_MADE = ("840d", "fanuc")
+# coupling as EGON for the 840D, as G81/G80 for Fanuc and as the M series' G81.4/G80.4,
+# engine.hobbing.dialects). A hobber of another dialect is refused by name here, not at the
+# first line of a program written for another control.
+HOBBING_DIALECTS_MADE = ("840d", "fanuc", "fanuc-g81.4")
 
 
 def hobbing_machine(conn: Connection, name: str | None) -> Machine:
@@ -117,7 +117,7 @@ def hobbing_machine(conn: Connection, name: str | None) -> Machine:
                           f"use --machine {DEFAULT_HOBBING_MACHINE}")
     if machine.dialect not in HOBBING_DIALECTS_MADE:
         raise EngineError(f"machine {machine.name} runs dialect {machine.dialect}: the engine makes hobbing programs "
-                          f"for {', '.join(HOBBING_DIALECTS_MADE)} only so far (G81.4: issue 30); "
+                          f"for {', '.join(HOBBING_DIALECTS_MADE)} only; "
                           f"use --machine {DEFAULT_HOBBING_MACHINE}")
     return machine
 

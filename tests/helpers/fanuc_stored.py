@@ -2,9 +2,12 @@
 (the 840D program's machine record with dialect "fanuc", and an egb_helix_sign where given), a
 copy of the program's job on it, and the program rewritten line by line by
 tests/helpers/fanuc_programs.py (each Fanuc line keeps the template row id of the 840D line it
-comes from; the header names the Fanuc machine, the lineage line the new id). No template makes
-Fanuc programs on main yet, so the twin is no rendering of a template version: a command that
-renders stored programs again (engine.programs.rendering) finds it a MISMATCH."""
+comes from; the header names the Fanuc machine, the lineage line the new id). The plot tests
+(tests/test_fanuc_hobbing_plot.py) read it through the library: it carries what no template
+writes (a line left in 840D form, Q/P on a record without egb_helix_sign). It is no rendering
+of a template version, so a command that renders stored programs again
+(engine.programs.rendering) finds it a MISMATCH: a CLI test plots the program
+`engine instantiate --machine hobber-fanuc` makes instead."""
 from __future__ import annotations
 
 import json
