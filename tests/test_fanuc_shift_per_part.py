@@ -20,6 +20,7 @@ import pytest
 
 from engine.gears.records import load_gear, load_hobs
 from engine.hobbing.choices import Choices
+from engine.hobbing.program_plot import load_scene, program_figure
 from engine.machines.records import load_machine
 from engine.programs.instantiate import instantiate_gear
 from engine.simulation import simulate_program
@@ -32,9 +33,10 @@ SHIFT_MARGIN = 5.0              # mm kept free at each end of the hob (§B15)
 MOVE = re.compile(r"G[01] ")
 SHIFT_MOVES = ("G0 Y=R11", "G0 Y#500")
 R11_TEST = re.compile(r"IF \(R11<(-?[\d.]+)\) OR \(R11>(-?[\d.]+)\)")
-# Seeded gears by class (seed_templates/gears.csv): the classes whose templates shift per part.
+# Seeded gears by class (seed_templates/gears.csv): the classes whose templates shift per part
+# (duplex takes the spur rows; the worm wheel does not shift per part on either control).
 GEARS = [pytest.param(42, id="spur"), pytest.param(43, id="helical R"), pytest.param(44, id="helical L"),
-         pytest.param(50, id="taper"), pytest.param(51, id="crowned")]
+         pytest.param(50, id="taper"), pytest.param(51, id="crowned"), pytest.param(54, id="duplex")]
 
 
 def job_hob(conn, program):
@@ -148,3 +150,15 @@ def test_a_clamp_end_beyond_the_travel_is_refused_by_the_verifier(made):
     lines = with_clamp(program.lines, fanuc_clamp(-clamp_half(gear, hob), machine.y_max + 1.0))
     message = refusal(lines, machine, program.name)
     assert f"Y{machine.y_max + 1.0:g}" in message
+
+
+def test_the_plot_draws_the_fanuc_shift_range_as_the_840d_ones(conn):
+    """`engine plot`'s hob panel says the shift range: Y−half … Y+half on both controls."""
+    said = {}
+    for machine in (FANUC, SIEMENS):
+        program = instantiate_gear(conn, 42, machine=machine, choices=SHIFT)
+        half = clamp_half(load_gear(conn, 42), job_hob(conn, program))
+        lines = program_figure(load_scene(conn, program.program_id))[1]
+        said[machine] = [line for line in lines if line.startswith("shift range on the hob")]
+        assert said[machine] and said[machine][0].startswith(f"shift range on the hob: Y{-half:.3f} … Y{half:.3f}")
+    assert said[FANUC] == said[SIEMENS]
