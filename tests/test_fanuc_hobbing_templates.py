@@ -135,7 +135,6 @@ def test_the_tailstock_rows_render_the_agreed_fanuc_blocks(conn, monkeypatch):
 
 
 REFUSALS = [   # (record changes, choices, words of the one-line reason)
-    ({}, Choices(tailstock=False, shift_per_part=0.5), "hob shift per part"),
     ({"egb_helix_sign": None}, NO_TAILSTOCK, "egb_helix_sign"),
     ({"program_number_base": 8960}, NO_TAILSTOCK, "O9003"),
     ({"program_number_base": None}, NO_TAILSTOCK, "program_number_base"),

@@ -67,6 +67,7 @@ def test_the_golden_programs_cover_every_dialect_and_the_shift_clamp():
     names = [param.values[1] for param in golden_programs()]
     assert {"hobber-840d", "lathe-840d", "lathe-iso"} <= set(names)
     assert any("R11=R11+" in path.read_text() for path in (GOLDEN / "hobbing").glob("*.MPF"))
+    assert any("#500=#500+" in path.read_text() for path in (GOLDEN / "hobbing_fanuc").glob("*.NC"))
 
 
 # ---------------------------------------------------------------- the 840D forms of issue 13

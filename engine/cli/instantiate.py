@@ -59,7 +59,8 @@ def parse_range(text: str, option: str = "--gears") -> tuple[int, int]:
 @click.option("--coolant/--no-coolant", default=True, show_default=True, help="Coolant M8/M9.")
 @click.option("--shift-y", type=float, default=0.0, help="Hob shift position Y for this part, mm.")
 @click.option("--shift-per-part", type=float, default=0.0,
-              help="Shift the hob by this many mm every part (R11 counts), wrapping within the hob's usable length.")
+              help="Shift the hob by this many mm every part (R11 on an 840D, #500 on a Fanuc counts), wrapping "
+                   "within the hob's usable length.")
 @click.option("--feed-mode", metavar="MODE",
               help="Axial pass direction: climb, conventional or conventional-climb (rough conventional, finish "
                    "climb); a cluster gear's units each their own, unit 1's/unit 2's (climb/conventional). "

@@ -89,9 +89,6 @@ FANUC_REFUSALS: tuple[tuple[Callable[[Job], bool], Callable[[Job], str]], ...] =
     (lambda job: _helical(job) and job.machine.egb_helix_sign is None,
      lambda job: f"a helical gear needs G81's Q/P, whose sign machine {job.machine.name} does not state; "
                  "run the dry run of fanuc-egb.md §F5 and set machine.egb_helix_sign"),
-    (lambda job: job.choices.shift_per_part > 0,
-     lambda job: "hob shift per part is the 840D's R11 clamp (IF/ENDIF), which has no agreed Fanuc form; "
-                 "use --shift-y or --machine hobber-840d"),
     (lambda job: _worm_wheel(job) and job.choices.worm_feed == "tangential",
      lambda job: "a tangential worm-wheel feed moves Y while cutting and G81 has no Y term to turn the table "
                  "with it (fanuc-egb.md §F6); use --worm-feed radial or --machine hobber-840d"),

@@ -112,7 +112,8 @@ class Dialect(msgspec.Struct, frozen=True):
     state: StateRules                     # what each motion and statement needs, what each event does
     keywords: frozenset[str] = frozenset()   # words without a value: WALIMON, DIAMON
     statements: frozenset[str] = frozenset()   # NAME(arguments) lines (engine.verifier.statements)
-    shift_clamp: bool = False             # the hob-shift-per-part R11 clamp (engine.verifier.shift_clamp)
+    shift_clamp: str | None = None        # the hob-shift-per-part clamp's variable, R11 or #500
+                                          # (engine.verifier.shift_clamp CLAMPS)
     equals_allowed: bool = False          # 840D: `X=12.5` is `X12.5`; names of two letters need it (`CR=5`)
     arc_radius: str | None = None         # the address of an arc's radius
     needs_words: dict[int, str] = {}   # G code -> the words its block must hold
@@ -197,7 +198,7 @@ HOBBING_840D = Dialect(
     state=HOBBING_STATE,
     keywords=frozenset({"WALIMON"}),
     statements=frozenset({"EGDEF", "EGON", "EGOFS", "EGDEL"}),
-    shift_clamp=True,
+    shift_clamp="R11",
     equals_allowed=True,
 )
 
@@ -306,6 +307,7 @@ HOBBING_FANUC = Dialect(
     record_work_offset=True,
     dwell_words=FANUC_DWELL,
     refused_g_codes=FANUC_REFUSED_G_CODES,
+    shift_clamp="#500",
 )
 # The M-series form (Fanuc 16i/18i/21i, where G81 is the drilling cycle): G81.4 R<teeth 1…500>
 # L<±threads 1…30> [Q P] … G80.4; otherwise as HOBBING_FANUC.

@@ -78,7 +78,7 @@ def _read(dialect: Dialect, line: str) -> Line:
     if not code:
         return COMMENT
     if dialect.shift_clamp:
-        shift = read_shift_line(code)
+        shift = read_shift_line(dialect.shift_clamp, code)
         if shift is not None:
             return shift
     if dialect.synchronisations:

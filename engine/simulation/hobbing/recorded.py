@@ -6,7 +6,7 @@ simulation checked, not a second interpretation of the program text: the F in ef
 move, each A as the program writes it and each coupling are kept too (the numbers a picture
 states, issue 27), the coupling with its start as the program writes it: read in the machine's
 dialect, an 840D `EGON(…)` or a Fanuc `G81 T… L…` (issue 30). A program with the
-hob-shift-per-part clamp is followed at both ends of its R11 interval (the Y range it cuts at,
+hob-shift-per-part clamp is followed at both ends of its R11 (#500) interval (the Y range it cuts at,
 the part of the hob the shifting uses); the moves are those at the low end."""
 from __future__ import annotations
 

@@ -1,6 +1,6 @@
 """The simulation of one hobbing program against its gear, hob and machine (design notes §7,
 issue 14): read with the verifier's reader, followed block by block (engine.simulation.hobbing.walk).
-A program with the hob-shift-per-part clamp (R11 lies in an interval) is followed once with
+A program with the hob-shift-per-part clamp (R11 or Fanuc's #500 lies in an interval) is followed once with
 the shift at each end of it."""
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ from .report import FirstRefusal, Report, SimulationError
 from .solids import setup_solids, unit_solids
 from .walk import BlockSimulation
 
-SHIFT_ENDS = (0, 1)     # the low and the high end of the R11 interval
+SHIFT_ENDS = (0, 1)     # the low and the high end of the clamp's interval (R11, #500)
 
 
 def simulate_program(lines: list[str], gear: Gear, hob: Hob, machine: Machine, name: str = "the program",
