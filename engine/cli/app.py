@@ -190,7 +190,7 @@ def _database_failure_message(error: Exception, first_line: str) -> str:
 @click.version_option(package_name="nc-template-engine", message="%(package)s %(version)s")
 @click.pass_context
 def main(ctx, database_url, traceback):
-    """NC program template engine for gear hobbing (Siemens 840D).
+    """NC program template engine for gear hobbing (Siemens 840D and Fanuc) and turning.
 
     Templates live in PostgreSQL as rows (one per NC line, with the expressions that
     compute and decide it); `engine instantiate --gear ID` turns them into a program.
