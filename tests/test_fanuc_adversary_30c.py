@@ -20,6 +20,8 @@ from engine.errors import EngineError
 from engine.hobbing.choices import Choices
 from engine.programs.instantiate import instantiate_gear
 from engine.programs.remake import instantiate_job
+from engine.release.gate import release
+from engine.templates.versions import released_version
 
 FANUC = "hobber-fanuc"
 NO_TAILSTOCK = Choices(tailstock=False)
@@ -60,6 +62,18 @@ def test_a_template_row_writing_another_o_number_is_refused(conn, written):
     edit_and_release(conn, "helical", HEADER_ROW, written)
     refused_and_nothing_stored(conn, lambda: instantiate_gear(conn, 43, machine=FANUC, choices=NO_TAILSTOCK),
                                "O1043", "program_number_base")
+
+
+def test_the_release_gate_refuses_a_draft_that_renumbers_a_stored_fanuc_jobs_program(conn):
+    """The impact proves the stored Fanuc job's program the draft changes: O1044 for gear 43 is refused."""
+    stored_fanuc_job(conn)
+    before = released_version(conn, "helical")
+    assert conn.execute(EDIT.format(sql.Identifier("o")),
+                        ('f"O{program_number + 1:04d} ({program_name})"', "helical", HEADER_ROW)).rowcount == 1
+    with pytest.raises(EngineError) as refused:
+        release(conn, "helical", dry_run=True)
+    assert "O1044" in str(refused.value) and "O1043" in str(refused.value)
+    assert released_version(conn, "helical") == before
 
 
 def test_a_template_writing_the_o_number_without_a_name_still_carries_the_gears_number(conn):

@@ -10,7 +10,6 @@ What the Fanuc form cannot write is refused before any program is made, one line
 (FANUC_REFUSALS, rules as data)."""
 from __future__ import annotations
 
-import re
 from collections.abc import Callable
 
 import msgspec
@@ -27,8 +26,6 @@ FANUC_CLASSES = frozenset({"spur", "helical", "duplex", "worm_wheel", "taper", "
 # O numbers a Fanuc program may have: O1…O99999 without the builder's macros O9000…O9999
 # (engine/verifier/grammar.py ISO_PROGRAM_NUMBERS, ISO_RESERVED_NUMBERS).
 PROGRAM_NUMBERS, RESERVED_NUMBERS = range(1, 100000), range(9000, 10000)
-# The O line of an ISO program: the first or, after the tape mark %, the second line (grammar.ISO_HEADERS).
-O_LINE = re.compile(r"O(\d{1,5})(?: \(.*\))?")
 
 
 def dialect_parameters(machine: Machine, gear_id: int) -> dict:
@@ -92,20 +89,3 @@ def refuse_for_dialect(gear: Gear, model, choices: Choices, machine: Machine) ->
         if refused(job):
             raise EngineError(f"gear {gear.id} on {machine.name} (Fanuc): {why(job)}; nothing stored")
 
-
-def refuse_wrong_program_number(lines: list[str], machine: Machine, gear_id: int) -> None:
-    """EngineError (one line, nothing stored) unless a Fanuc program's O number is the gear's on the
-    machine, program_number_base + gear id (fanuc-egb.md §F7): the control stores a program by its
-    O number, so a program of gear 43 written as O1044 (a template row edited, a record changed)
-    would replace gear 44's program when it is read in. Other dialects are named, not numbered."""
-    if machine.dialect != FANUC:
-        return
-    found = next((int(match.group(1)) for match in map(O_LINE.fullmatch, lines[:2]) if match), None)
-    expected = None if machine.program_number_base is None else machine.program_number_base + gear_id
-    if found is None or found != expected:
-        shown = "no O number" if found is None else f"O{found:04d}"
-        wanted = (f"O{expected:04d} (program_number_base {machine.program_number_base} + gear id {gear_id})"
-                  if expected is not None else "an O number, but the machine states no program_number_base")
-        raise EngineError(f"gear {gear_id} on {machine.name} (Fanuc): the program carries {shown}, the gear's program "
-                          f"is {wanted}: on the control it would replace another program; correct the template's "
-                          "O line or machine.program_number_base; nothing stored")

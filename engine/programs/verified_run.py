@@ -18,7 +18,6 @@ import msgspec
 
 from ..errors import EngineError
 from ..gears.records import Gear, Hob
-from ..hobbing.dialects import refuse_wrong_program_number
 from ..machines.records import Machine
 from ..machines.work_holding import WorkHolding
 from ..nc.lineage import refuse_lineage_shaped
@@ -110,7 +109,6 @@ def prove(lines: list[str], machine: Machine, workpiece: Workpiece | TurningWork
     if not isinstance(workpiece, Workpiece):
         raise EngineError(f"{name}: a hobbing program needs its gear and hob to be proved by the simulation; "
                           "nothing stored")
-    refuse_wrong_program_number(lines, machine, workpiece.gear.id)   # the O number is a Fanuc program's identity
     # a program refused is refused at its first finding: the search tries the next choice, the
     # refusal names that finding (engine simulate lists every finding of a stored program)
     report = simulate_program(lines, workpiece.gear, workpiece.hob, machine, name, workpiece.holding,

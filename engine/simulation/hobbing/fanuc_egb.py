@@ -43,6 +43,7 @@ C_WORD = re.compile(r"(?<![A-Z])C[-+=]?[0-9.]")
 # they give is right to the effect of half of each, not to the digits a program chose to write.
 Q_INCREMENT = 0.00001        # mm
 P_INCREMENT = 0.0001         # degrees
+FANUC_DIALECTS = frozenset({"fanuc", "fanuc-g81.4"})   # the records whose programs a control stores by O number
 
 
 def read_g81(start: Statement, senses: Senses, helix_sign: int | None = None) -> Coupling:
@@ -134,3 +135,20 @@ def c_word_problem(code: str) -> str | None:
         return None
     return ("a C word: the table C follows the hob through G81 (and Z through Q/P); a C move turns it a second "
             "time: the program must not add it twice (fanuc-egb.md §F6)")
+
+
+def program_number_facts(steps: list, gear: Gear, machine: Machine):
+    """(step, why, refuses) for a Fanuc program whose O number is not the gear's on the machine,
+    program_number_base + gear id (fanuc-egb.md §F7): the control stores a program by its O number,
+    so gear 43's program written as O1044 (a template row edited, the record changed since) would
+    replace gear 44's when it is read in. A record without program_number_base states no rule (no
+    job is made for it, engine.hobbing.dialects); an 840D program is named, not numbered."""
+    base = machine.program_number_base
+    if machine.dialect not in FANUC_DIALECTS or base is None:
+        return
+    header = next((step for step in steps if step.kind == "header" and step.item.number is not None), None)
+    if header is None or header.item.number != base + gear.id:
+        shown = "no O number" if header is None else f"O{header.item.number:04d}"
+        yield (header or steps[0], f"the program carries {shown}, gear {gear.id}'s program on {machine.name} is "
+               f"O{base + gear.id:04d} (program_number_base {base} + gear id {gear.id}): read into the control "
+               "it would replace another program (fanuc-egb.md §F7)", True)
