@@ -12,6 +12,8 @@ a Fanuc hobber (engine.hobbing.dialects.FANUC_REFUSALS): the record may have cha
 SQL (shift per part on a Fanuc job)."""
 from __future__ import annotations
 
+import math
+
 import pytest
 from helpers.releases import release_draft
 from psycopg import sql
@@ -28,6 +30,7 @@ NO_TAILSTOCK = Choices(tailstock=False)
 PROGRAMS = "SELECT count(*) FROM program"
 BASE = 1000            # the seeded hobber-fanuc's program_number_base (seed data, fanuc-egb.md §F7)
 HEADER_ROW = 201       # seed_templates/classes/helical.csv: the Fanuc O line
+G81_ROW = 1501         # seed_templates/classes/helical.csv: the Fanuc G81
 EDIT = sql.SQL("UPDATE template_view SET {} = %s WHERE gear_class = %s AND id = %s")
 
 
@@ -114,3 +117,28 @@ def test_a_stored_job_made_again_after_the_records_helix_sign_flipped_follows_th
     conn.execute("UPDATE machine SET egb_helix_sign = -1 WHERE name = %s", (FANUC,))
     lines = instantiate_job(conn, job_id).lines
     assert [line for line in lines if line.startswith("G81")] == ["G81 T41 L-1 Q3. P15.0000"]
+
+
+# G81's words are the gear's and the hob's themselves (fanuc-egb.md §F5, §F6): T = z2, |L| = z0,
+# Q = m_n, |P| = β. Gear 43: m_n 3, z2 41, β 15° right hand, a 1-start right-hand hob; L = −1 and
+# P = −15 on the seeded DIN record (egb_helix_sign +1). Each pair below gives the same ratio
+# |L|/T = 1/41 and the same sin P/(T·Q) = sin 15°/123 as the right words, so only the words
+# themselves tell them apart; §F4's arrangement of the control's formula is derived, not read, so
+# a program must not rest on it being exactly right.
+Z2, Z0, MN, BETA = 41, 1, 3.0, 15.0
+SAME_RATIO_AND_TERM = [
+    f"G81 T{2 * Z2} L-{2 * Z0} Q{MN / 2:g} P-{BETA:.4f}",                                # T82 L-2 Q1.5
+    f"G81 T{3 * Z2} L-{3 * Z0} Q{MN / 3:g}. P-{BETA:.4f}",                               # T123 L-3 Q1.
+    f"G81 T{Z2} L-{Z0} Q{MN / math.sin(math.radians(BETA)):.5f} P-90.",                  # Q11.59111 P-90.
+]
+
+
+@pytest.mark.parametrize("written", SAME_RATIO_AND_TERM)
+def test_a_g81_whose_words_are_not_the_gears_and_hobs_is_refused(conn, written):
+    right = f"G81 T{Z2} L-{Z0} Q{MN:g}. P-{BETA:.4f}"
+    assert right == "G81 T41 L-1 Q3. P-15.0000"
+    assert [line for line in instantiate_gear(conn, 43, machine=FANUC, choices=NO_TAILSTOCK).lines
+            if line.startswith("G81")] == [right]
+    edit_and_release(conn, "helical", G81_ROW, f'"{written}"')
+    refused_and_nothing_stored(conn, lambda: instantiate_gear(conn, 43, machine=FANUC, choices=NO_TAILSTOCK),
+                               written.split()[1])
