@@ -22,6 +22,7 @@ from ..gears.holding_matching import choose_holding
 from ..gears.models import model_for_class
 from ..gears.records import Hob, load_gear, load_hobs
 from ..hobbing.cylindrical import program_name
+from ..hobbing.dialects import refuse_for_dialect
 from ..machines.records import Machine, load_machine
 from ..machines.work_holding import job_work_holding
 from ..memory import no_cycle_collection
@@ -42,7 +43,7 @@ from .batches import (
 )
 from .class_jobs import class_job
 from .instantiate import store_planned
-from .job_checks import check_hobbing_feeds, check_hobbing_job
+from .job_checks import check_hobbing_feeds, check_hobbing_job, job_choices
 from .job_shape import check_job_shape, job_with_cycle_time, job_with_worm_feed
 from .options import NO_FILE, NORMAL_RUN, PLANNING, Output, RunMode
 from .outputs import file_layouts, files_after_commit
@@ -92,6 +93,7 @@ class Remaker:
         if stored and workpiece:
             check_hobbing_job(job_id, gear_class, model, workpiece.gear, workpiece.hob, machine, params,
                               module_params)
+            refuse_for_dialect(workpiece.gear, model, job_choices(job_id, params), machine)   # as a new job is
             check_program_name(self.conn, job_id, gear_id, params)
             check_work_holding(job_id, workpiece, machine)
             check_hobbing_feeds(job_id, workpiece.gear, workpiece.hob, machine, params, module_params, bounded=False)

@@ -11,7 +11,13 @@ from __future__ import annotations
 
 import re
 
-PROGRAM_NUMBER = 1234     # O1234: within the ISO program numbers, outside the builder's reserved ones
+PROGRAM_NUMBER = 1234     # O1234 on a record without program_number_base (the simulation refuses it there)
+
+
+def program_number(gear, machine) -> int:
+    """The gear's O number on the machine: program_number_base + gear id (fanuc-egb.md §F7)."""
+    base = getattr(machine, "program_number_base", None)
+    return PROGRAM_NUMBER if base is None else base + gear.id
 DROPPED = (re.compile(r";\$PATH=.*"), re.compile(r"G2[56] .*"), re.compile(r"WALIMON"),
            re.compile(r"EGDEF\(.*\)"), re.compile(r"EGDEL\(.*\)"))
 HEADER = re.compile(r"%_N_(\w+)_MPF")
@@ -66,7 +72,7 @@ def fanuc_program(lines: list[str], gear, hob, machine, **mistake) -> list[str]:
 def _line(line: str, gear, hob, machine, mistake: dict) -> str:
     header = HEADER.fullmatch(line)
     if header:
-        return f"O{PROGRAM_NUMBER} ({header.group(1)})"
+        return f"O{program_number(gear, machine)} ({header.group(1)})"
     code, _, comment = (part.strip() for part in line.partition(";"))
     if code.startswith("EGON("):
         code = g81(gear, hob, machine, **mistake)

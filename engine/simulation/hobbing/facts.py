@@ -14,6 +14,7 @@ from ...gears.records import Gear, Hob
 from ...machines.records import Machine
 from ...machines.work_holding import WorkHolding
 from .cutting_speed import material_note
+from .fanuc_egb import g81_word_facts, program_number_facts
 from .floor_facts import floor_facts
 from .frame import Senses
 from .header_facts import gear_line_problem, hob_line_problem, table_problem, template_class, unit_line_problem
@@ -82,6 +83,10 @@ FACT_RULES = (
     FactRule("a gear material §C does not list: the widest row, noted", "§C", _material_note),
     FactRule("every S within §C for hob and gear material, and the header's n0", "§B4, §C",
              lambda r: speed_facts(r.steps, r.gear, r.hob)),
+    FactRule("a Fanuc program's O number is the gear's on the machine", "fanuc-egb.md §F7",
+             lambda r: program_number_facts(r.steps, r.gear, r.machine)),
+    FactRule("a Fanuc G81's T, L, Q, P are z2, ±z0, m_n, ±β themselves", "fanuc-egb.md §F5, §F6",
+             lambda r: g81_word_facts(r.steps, r.gear, r.hob)),
     FactRule("the tailstock clamped for every cut once the program clamps it", "§A3 (M20/M21 the builder's)",
              lambda r: tailstock_facts(r.steps)),
     FactRule("the working area set once, before the first move", "§A4", lambda r: area_facts(r.steps)),

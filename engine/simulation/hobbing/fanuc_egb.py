@@ -29,7 +29,7 @@ from __future__ import annotations
 import math
 import re
 
-from ...gears.records import Gear
+from ...gears.records import Gear, Hob
 from ...machines.records import Machine
 from ...verifier.statements import GearBox, Statement
 from ...verifier.synchronisation import helical_compensation
@@ -43,6 +43,7 @@ C_WORD = re.compile(r"(?<![A-Z])C[-+=]?[0-9.]")
 # they give is right to the effect of half of each, not to the digits a program chose to write.
 Q_INCREMENT = 0.00001        # mm
 P_INCREMENT = 0.0001         # degrees
+FANUC_DIALECTS = frozenset({"fanuc", "fanuc-g81.4"})   # the records whose programs a control stores by O number
 
 
 def read_g81(start: Statement, senses: Senses, helix_sign: int | None = None) -> Coupling:
@@ -116,6 +117,47 @@ def refuse_unproved_compensation(steps: list, gear: Gear, machine: Machine, name
                 raise SimulationError(f"{where(name, step.number, step.line)}: {problem}")
 
 
+def g81_word_facts(steps: list, gear: Gear, hob: Hob):
+    """(step, why, refuses) for each G81 (G81.4) whose words are not the gear's and the hob's; a
+    fact after the walk, whose findings (another number of teeth, the wrong lead) say more."""
+    for step in steps:
+        if step.kind == "statement" and step.item.name in ("G81", "G81.4"):
+            problem = words_problem(step.item, gear, hob)
+            if problem:
+                yield step, problem, True
+
+
+def words_problem(start: Statement, gear: Gear, hob: Hob) -> str | None:
+    """Why a G81's words are not the gear's and the hob's themselves (fanuc-egb.md §F5, §F6): T is
+    a unit's teeth z2, |L| the hob's starts z0, Q the module m_n (mm) and |P| the helix angle β (°),
+    each to half its least increment. T82 L-2 Q1.5 gives gear 43's ratio and Z term too, but only
+    through §F4's derived arrangement of the control's formula, which no retrieved text shows."""
+    box, command = _gear_box(start), start.name
+    found = [problem for problem in (*_count_problems(box, gear, hob), *_helical_problems(box, gear)) if problem]
+    if not found:
+        return None
+    written = f"{command} {box.ratio_words} {box.helix_words}".rstrip()
+    return (f"{written}: {'; '.join(found)}: {command} writes the gear's and the hob's own numbers (T = z2, "
+            "L = ±z0, Q = m_n, P = ±β, fanuc-egb.md §F5, §F6), not another pair with the same ratio")
+
+
+def _count_problems(box: GearBox, gear: Gear, hob: Hob) -> tuple[str, str]:
+    """T against the teeth of the gear's units, |L| against the hob's starts ('' where right)."""
+    teeth = sorted({gear.teeth, *(unit.teeth for unit in gear.units)})
+    return (f"{box.teeth_word} is not the teeth z2 {'/'.join(map(str, teeth))}" if box.teeth not in teeth else "",
+            f"{box.threads_word} is not the hob's {hob.starts} starts" if abs(box.threads) != hob.starts else "")
+
+
+def _helical_problems(box: GearBox, gear: Gear) -> tuple[str, ...]:
+    """Q against m_n (mm), |P| against β (°), each to half its least increment ('' where right)."""
+    if box.module is None or box.helix is None:
+        return ()
+    return (f"Q{box.module:g} is not the module {gear.module:g} mm"
+            if abs(box.module - gear.module) > Q_INCREMENT / 2 + 1e-9 else "",
+            f"P{box.helix:g} is not ±β {gear.helix_angle or 0:g}°"
+            if abs(abs(box.helix) - (gear.helix_angle or 0.0)) > P_INCREMENT / 2 + 1e-9 else "")
+
+
 def turning_start_problem(command: str, turning: bool) -> str | None:
     """A G81 with the hob spindle turning: the table must catch up with it, and whether the control
     holds the next block until C is in step is not in the retrieved manuals (fanuc-egb.md §F7
@@ -134,3 +176,20 @@ def c_word_problem(code: str) -> str | None:
         return None
     return ("a C word: the table C follows the hob through G81 (and Z through Q/P); a C move turns it a second "
             "time: the program must not add it twice (fanuc-egb.md §F6)")
+
+
+def program_number_facts(steps: list, gear: Gear, machine: Machine):
+    """(step, why, refuses) for a Fanuc program whose O number is not the gear's on the machine,
+    program_number_base + gear id (fanuc-egb.md §F7): the control stores a program by its O number,
+    so gear 43's program written as O1044 (a template row edited, the record changed since) would
+    replace gear 44's when it is read in. A record without program_number_base states no rule (no
+    job is made for it, engine.hobbing.dialects); an 840D program is named, not numbered."""
+    base = machine.program_number_base
+    if machine.dialect not in FANUC_DIALECTS or base is None:
+        return
+    header = next((step for step in steps if step.kind == "header" and step.item.number is not None), None)
+    if header is None or header.item.number != base + gear.id:
+        shown = "no O number" if header is None else f"O{header.item.number:04d}"
+        yield (header or steps[0], f"the program carries {shown}, gear {gear.id}'s program on {machine.name} is "
+               f"O{base + gear.id:04d} (program_number_base {base} + gear id {gear.id}): read into the control "
+               "it would replace another program (fanuc-egb.md §F7)", True)
