@@ -104,10 +104,13 @@ def test_a_stored_job_made_again_after_the_record_drops_its_program_number_base_
     refused_and_nothing_stored(conn, lambda: instantiate_job(conn, job_id), "program_number_base")
 
 
-def test_a_fanuc_job_given_a_shift_per_part_in_sql_is_refused_when_made_again(conn):
+def test_a_fanuc_job_given_a_shift_per_part_in_sql_is_made_again_with_the_macro_clamp(conn):
+    """Hob shift per part is written on Fanuc (the #500 clamp, fanuc-egb.md §F9): the job made
+    again carries it, proved like a new job's, not the stray refusal "G81 before Y" it met before."""
     job_id = stored_fanuc_job(conn)
     conn.execute("UPDATE job SET params = params || '{\"shift_per_part\": 0.5}' WHERE id = %s", (job_id,))
-    refused_and_nothing_stored(conn, lambda: instantiate_job(conn, job_id), "shift per part")
+    lines = instantiate_job(conn, job_id).lines
+    assert "#500=#500+0.500 (HOB SHIFT PER PART)" in lines and "G0 Y#500" in lines
 
 
 def test_a_stored_job_made_again_after_the_records_helix_sign_flipped_follows_the_record(conn):
