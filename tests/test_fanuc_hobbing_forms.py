@@ -13,13 +13,14 @@ import math
 import pytest
 from helpers.fanuc_cases import twin
 from helpers.fanuc_programs import fanuc_program
+from helpers.verifier_programs import verifier_refusal, with_line_replaced
 from msgspec.structs import replace
 
 from engine.hobbing.choices import Choices
 from engine.machines.records import Machine, load_machine
 from engine.simulation import simulate_program
 from engine.simulation.hobbing.report import SimulationError
-from engine.verifier import LimitError, verify_program
+from engine.verifier import verify_program
 
 NAME = "GEAR42"
 DOORS = {"door_close_m": 60, "door_open_m": 61}
@@ -38,16 +39,11 @@ def fanuc(conn) -> Machine:
 
 
 def replaced(old: str, *new: str, lines: list[str] = PROGRAM) -> list[str]:
-    at = lines.index(old)
-    return [*lines[:at], *new, *lines[at + 1:]]
+    return with_line_replaced(lines, old, *new)
 
 
 def refusal(machine: Machine, lines: list[str]) -> str:
-    with pytest.raises(LimitError) as raised:
-        verify_program(lines, machine, NAME)
-    message = str(raised.value)
-    assert "\n" not in message and message.endswith("nothing stored")
-    return message
+    return verifier_refusal(machine, lines, NAME)
 
 
 def test_the_fanuc_forms_of_tailstock_doors_dwell_and_path_mode_are_read(fanuc):

@@ -10,11 +10,12 @@ from __future__ import annotations
 
 import psycopg
 import pytest
+from helpers.verifier_programs import verifier_refusal, with_line_replaced
 from msgspec.structs import replace
 
 from engine.machines.records import Machine, load_machine
 from engine.nc.lineage import lineage_line, lineage_words
-from engine.verifier import LimitError, verify_program
+from engine.verifier import verify_program
 from engine.verifier.grammar import HOBBING_FANUC, HOBBING_FANUC_G81_4
 from engine.verifier.lines import read_line
 from engine.verifier.statements import GearBox
@@ -34,17 +35,11 @@ def fanuc(conn) -> Machine:
 
 
 def replaced(old: str, *new: str, lines: list[str] = PROGRAM) -> list[str]:
-    """The program with the line `old` replaced by `new` (none: left out)."""
-    at = lines.index(old)
-    return [*lines[:at], *new, *lines[at + 1:]]
+    return with_line_replaced(lines, old, *new)
 
 
 def refusal(machine: Machine, lines: list[str]) -> str:
-    with pytest.raises(LimitError) as raised:
-        verify_program(lines, machine, NAME)
-    message = str(raised.value)
-    assert "\n" not in message and message.endswith("nothing stored")
-    return message
+    return verifier_refusal(machine, lines, NAME)
 
 
 def test_a_hand_written_fanuc_hobbing_program_is_accepted(fanuc):

@@ -51,3 +51,18 @@ def one_line_exit_1(result) -> str:
     lines = result.stderr.strip().splitlines()
     assert len(lines) == 1 and "Traceback" not in result.output, result.output
     return lines[0]
+
+
+def with_line_replaced(lines: list[str], old: str, *new: str) -> list[str]:
+    """The program with the line `old` replaced by `new` (none: left out)."""
+    at = lines.index(old)
+    return [*lines[:at], *new, *lines[at + 1:]]
+
+
+def verifier_refusal(machine, lines: list[str], name: str) -> str:
+    """The verifier's refusal of the program on the machine record: one line, nothing stored."""
+    with pytest.raises(LimitError) as raised:
+        verify_program(lines, machine, name)
+    message = str(raised.value)
+    assert "\n" not in message and message.endswith("nothing stored")
+    return message
