@@ -123,11 +123,14 @@ def hobbing_machine(conn: Connection, name: str | None) -> Machine:
 
 
 def load_machine(conn: Connection, name: str) -> Machine:
-    row = conn.execute(MACHINE_QUERY + " WHERE name = %s", (name,)).fetchone()
-    if row is None:
+    """The record of that name; a name written in another case finds its one record, as
+    `engine machines import` holds names that differ only in case to be one machine."""
+    rows = conn.execute(MACHINE_QUERY + " WHERE name = %s", (name,)).fetchall() or \
+        conn.execute(MACHINE_QUERY + " WHERE lower(name) = lower(%s)", (name,)).fetchall()
+    if len(rows) != 1:
         known = ", ".join(r[0] for r in conn.execute("SELECT name FROM machine ORDER BY name"))
         raise EngineError(f"machine {name!r} does not exist; known machines: {known or 'none (run engine seed)'}")
-    return as_float(Machine, row, "machine")
+    return as_float(Machine, rows[0], "machine")
 
 
 def all_machines(conn: Connection) -> list[Machine]:
