@@ -108,3 +108,16 @@ def test_a_class_without_golden_tests_is_released_only_when_accepted_and_the_his
     assert "WITHOUT GOLDEN TESTS (accepted with --without-golden-tests)" in v2, history.stdout
     versions = json.loads(run("template", "history", "--class", "worm_wheel", "--json").stdout)["versions"]
     assert [v["release"]["accepted_without_golden_tests"] for v in versions] == [False, True]
+
+
+def test_a_name_the_database_would_refuse_is_refused_in_one_line_exit_1(run):
+    """A new user's `--name "a b"` met the table's CHECK and ended in exit 2 (a bug's code): the
+    name is now held to the same rule first (template_test.name: letters, digits, _ . -,
+    starting with a letter or digit, at most 80), and nothing is added."""
+    program_id = made_program(run, 42)
+    for name in ("a b", "é", "-lead", "", "x" * 81):
+        refused = run("test", "add", "--from-program", program_id, "--name", name)
+        assert refused.exit_code == 1 and "is not a safe golden test name" in refused.stderr, refused.output
+        assert "\n" not in refused.stderr.strip()
+    assert run("test", "add", "--from-program", program_id, "--name", "x" * 80).exit_code == 0
+    assert sql(run, "SELECT name FROM template_test WHERE name LIKE 'x%%'") == [("x" * 80,)]

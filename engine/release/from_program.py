@@ -15,6 +15,7 @@ stored, so a test that would fail on the day it is added is refused, naming the 
 from __future__ import annotations
 
 import math
+import re
 from typing import TYPE_CHECKING
 
 import msgspec
@@ -22,6 +23,7 @@ from psycopg.errors import InsufficientPrivilege
 from psycopg.types.json import Jsonb
 
 from ..errors import EngineError
+from ..names import shown
 from ..templates.program_properties import read_property
 from .golden import run_golden_test
 from .golden_runs import MODULE_PARAMS_KEY, GoldenTest
@@ -66,7 +68,7 @@ def add_from_program(conn: Connection, program_id: int, name: str | None = None)
     """Store the golden test of a proven program; EngineError in one line, nothing stored, if the
     program is not found, not proved, or not what the class's rows make now."""
     program = _load(conn, program_id)
-    name = name or f"program{program.id}"
+    name = _checked_name(f"program{program.id}" if name is None else name)
     if conn.execute(TAKEN, (program.gear_class, name)).fetchone():
         raise EngineError(f"class {program.gear_class} has a golden test named {name} already; give another --name")
     expect, left_out = expectations(program)
@@ -74,6 +76,19 @@ def add_from_program(conn: Connection, program_id: int, name: str | None = None)
                       tuple(expect), f"from program {program.id} ({program.gear_class} v{program.version})")
     _refuse_failing(conn, test, program)
     return AddedTest(_insert(conn, test), program.gear_class, name, len(expect), left_out)
+
+
+# template_test.name's CHECK (schema/schema.sql): a name the table would refuse is refused first,
+# in one line (it met the CHECK and ended as an unexpected error, exit 2)
+TEST_NAME = re.compile(r"[A-Za-z0-9][A-Za-z0-9_.-]{0,79}")
+TEST_NAME_RULE = "letters, digits, _, - and ., starting with a letter or digit, at most 80 characters"
+
+
+def _checked_name(name: str) -> str:
+    if not TEST_NAME.fullmatch(name):
+        raise EngineError(f"golden test name {shown(name)} is not a safe golden test name: use {TEST_NAME_RULE}; "
+                          "give another --name")
+    return name
 
 
 def _load(conn: Connection, program_id: int) -> StoredProgram:
