@@ -49,7 +49,7 @@ def fixtures_list(ctx, output):
 @click.option("--json", "as_json", is_flag=True, help="Print one JSON object: {added: N, updated: N}.")
 @click.pass_context
 def fixtures_import(ctx, csv_file, replace, as_json):
-    """Add or update (by id) the work-holdings of CSV_FILE (columns of seed_templates/work_holdings.csv:
+    """Add or update (by id) the work-holdings of CSV_FILE (the columns of `engine fixtures list --csv`:
     id,kind,diameter,height,tailstock_diameter,machine); any bad row stops the whole file (nothing stored).
     A work-holding a stored job is clamped on is changed in no column (give the changed one a new id).
 
