@@ -5,33 +5,12 @@ dialect no grammar reads, a repeated name and a value the database refuses are o
 1, and nothing is stored."""
 from __future__ import annotations
 
-import csv
-import io
 import json
 
 import psycopg
 import pytest
 from helpers.class_jobs import ok, refused
-
-
-def machines(url) -> list[dict]:
-    with psycopg.connect(url) as conn:
-        cursor = conn.execute("SELECT * FROM machine ORDER BY name")
-        names = [column.name for column in cursor.description]
-        return [dict(zip(names, row)) for row in cursor]
-
-
-def exported(run) -> list[dict]:
-    return list(csv.DictReader(io.StringIO(ok(run("machines", "list", "--csv")).stdout)))
-
-
-def written(tmp_path, rows: list[dict]) -> str:
-    path = tmp_path / "machines.csv"
-    with path.open("w", newline="") as handle:
-        writer = csv.DictWriter(handle, fieldnames=list(dict.fromkeys(key for row in rows for key in row)), restval="")
-        writer.writeheader()
-        writer.writerows(rows)
-    return str(path)
+from helpers.machine_files import exported, machines, written
 
 
 def test_every_machine_exported_and_imported_under_a_new_name_comes_back_field_for_field(run, tmp_path):

@@ -4,33 +4,12 @@ machine no job was made on is replaced whole, each changed field said old → ne
 was made on is changed in no field (its programs were proved on it), one line, nothing stored."""
 from __future__ import annotations
 
-import csv
-import io
 import json
 from decimal import Decimal
 
 import psycopg
 from helpers.class_jobs import ok, refused
-
-
-def machines(url) -> list[dict]:
-    with psycopg.connect(url) as conn:
-        cursor = conn.execute("SELECT * FROM machine ORDER BY name")
-        names = [column.name for column in cursor.description]
-        return [dict(zip(names, row)) for row in cursor]
-
-
-def exported(run) -> list[dict]:
-    return list(csv.DictReader(io.StringIO(ok(run("machines", "list", "--csv")).stdout)))
-
-
-def written(tmp_path, rows: list[dict]) -> str:
-    path = tmp_path / "machines.csv"
-    with path.open("w", newline="") as handle:
-        writer = csv.DictWriter(handle, fieldnames=list(rows[0]))
-        writer.writeheader()
-        writer.writerows(rows)
-    return str(path)
+from helpers.machine_files import exported, machines, written
 
 
 def test_the_exported_machines_imported_with_replace_are_unchanged(run, tmp_path):
