@@ -37,6 +37,11 @@ FANUC_CLASSES = frozenset({"spur", "helical", "duplex", "worm_wheel", "taper", "
 PROGRAM_NUMBERS, RESERVED_NUMBERS = range(1, 100000), range(9000, 10000)
 
 
+def program_number(machine: Machine, gear_id: int) -> int:
+    """The O number of the gear's program on the machine: program_number_base + gear id (§F7)."""
+    return (machine.program_number_base or 0) + gear_id
+
+
 def dialect_parameters(machine: Machine, gear_id: int) -> dict:
     """The job's dialect and, on a Fanuc hobber (either form), `fanuc` true, its O number
     (program_number_base + gear id, migration 0038), the record's helical-compensation sign
@@ -44,7 +49,7 @@ def dialect_parameters(machine: Machine, gear_id: int) -> dict:
     fanuc = machine.dialect in EGB_WORDS
     start, teeth, stop = EGB_WORDS.get(machine.dialect, NO_EGB_WORDS)
     return {"dialect": machine.dialect, "fanuc": fanuc,
-            "program_number": (machine.program_number_base or 0) + gear_id if fanuc else 0,
+            "program_number": program_number(machine, gear_id) if fanuc else 0,
             "egb_helix_sign": (machine.egb_helix_sign or 0) if fanuc else 0,
             "egb_start": start, "egb_teeth": teeth, "egb_stop": stop}
 
@@ -58,7 +63,7 @@ class Job(msgspec.Struct, frozen=True):
 
     @property
     def program_number(self) -> int:
-        return (self.machine.program_number_base or 0) + self.gear.id
+        return program_number(self.machine, self.gear.id)
 
 
 def _worm_wheel(job: Job) -> bool:
