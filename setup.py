@@ -1,6 +1,6 @@
 """The packages engine/ and importers/ (design notes §3), and the top-level data folders
 (migrations/, schema/, seed_templates/), which ship inside the wheel as the package engine_data
-that engine.paths finds with importlib.
+that engine.paths finds with importlib; the web view's page templates ship inside engine.service.web.
 Everything else about the project is in pyproject.toml."""
 from setuptools import find_packages, setup
 
@@ -11,5 +11,6 @@ DATA_FOLDERS = {"engine_data.migrations": "migrations", "engine_data.schema": "s
 
 setup(packages=find_packages(include=["engine", "engine.*", "importers", "importers.*"]) + list(DATA_FOLDERS),
       package_dir=DATA_FOLDERS,
-      package_data={"engine": ["py.typed"], **{package: ["*.sql", "*.csv", "*.json", "*.md", "*.dxf"]
+      package_data={"engine": ["py.typed"], "engine.service.web": ["templates/*.html", "static/*"],
+                    **{package: ["*.sql", "*.csv", "*.json", "*.md", "*.dxf"]
                                                for package in DATA_FOLDERS}})

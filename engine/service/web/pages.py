@@ -1,0 +1,47 @@
+"""How every page answers: HTML from a Jinja2 template, or the same data as JSON when the
+request asks for it (`Accept: application/json`), with the keys the CLI's `--json` prints.
+A handled error (engine.errors.EngineError: an unknown id, a refusal) is its one line, as the CLI
+prints it, with status 404 or 400; nothing else of the engine's state is shown."""
+from __future__ import annotations
+
+from contextlib import contextmanager
+from pathlib import Path
+
+import msgspec
+from starlette.requests import Request
+from starlette.responses import HTMLResponse, JSONResponse, Response
+from starlette.templating import Jinja2Templates
+
+TEMPLATES = Jinja2Templates(directory=str(Path(__file__).parent / "templates"))
+
+
+def wants_json(request: Request) -> bool:
+    """JSON when the client prefers it to HTML (a browser sends text/html first)."""
+    accept = request.headers.get("accept", "")
+    return "application/json" in accept and "text/html" not in accept
+
+
+def page(request: Request, template: str, data: dict, status: int = 200) -> Response:
+    """The page `template` showing `data`, or `data` itself as JSON."""
+    if wants_json(request):
+        return JSONResponse(msgspec.to_builtins(data), status_code=status)
+    return TEMPLATES.TemplateResponse(request, template, {"data": data}, status_code=status)
+
+
+def refusal(request: Request, message: str, status: int = 400) -> Response:
+    """A one-line error, as JSON {"error": …} or a page saying it."""
+    if wants_json(request):
+        return JSONResponse({"error": message}, status_code=status)
+    return TEMPLATES.TemplateResponse(request, "error.html", {"message": message}, status_code=status)
+
+
+@contextmanager
+def connection(request: Request):
+    """A connection of the app's pool for one page; rolled back after (pages only read; a
+    page that stores, as a runner's program request, commits in its own transaction)."""
+    with request.app.state.pool.connection() as conn:
+        yield conn
+
+
+def html(text: str, status: int = 200) -> HTMLResponse:
+    return HTMLResponse(text, status_code=status)
