@@ -60,3 +60,29 @@ def test_jobs_of_one_gear_are_not_written_over_each_other(run, tmp_path):
     refused = run("instantiate", "--jobs", f"{jobs[0]}-{jobs[-1]}", "--out", tmp_path / "programs")
     assert refused.exit_code == 1 and "programs of this batch are named GEAR42" in refused.stderr
     assert stored_programs(run.url) == before and not (tmp_path / "programs").exists()
+
+
+@pytest.mark.slow   # two batches of 13 gears
+def test_two_workers_skipping_a_bad_gear_store_the_good_ones_one_process_stores(run):
+    # issue 28: a batch planned in workers is stored slice by slice as the slices come back
+    with psycopg.connect(run.url) as conn:
+        conn.execute("UPDATE gear SET gear_class = NULL WHERE id = 50")
+    one = run("instantiate", "--gears", "42-54", "--skip-bad", "--json")
+    first = stored_programs(run.url)
+    two = run("instantiate", "--gears", "42-54", "--skip-bad", "--workers", "2", "--json")
+    assert one.exit_code == two.exit_code == 0
+    assert json.loads(two.stdout)["skipped"] == json.loads(one.stdout)["skipped"]
+    assert any("gear 50" in reason for reason in json.loads(two.stdout)["skipped"])
+    assert stored_programs(run.url)[len(first):] == first
+
+
+def test_a_file_refused_after_the_workers_stored_their_slices_leaves_nothing_stored(run, tmp_path):
+    # the slices stored while the workers planned are in the batch's one transaction: a file that
+    # may not be replaced, found when every gear is planned, rolls all of them back
+    folder = tmp_path / "programs"
+    folder.mkdir()
+    (folder / "GEAR54.MPF").write_text("; the operator's own file\n")
+    refused = run("instantiate", "--gears", "42-54", "--workers", "2", "--out", folder)
+    assert refused.exit_code == 1 and "GEAR54.MPF" in refused.stderr and "nothing stored" in refused.stderr
+    assert stored_programs(run.url) == []
+    assert sorted(path.name for path in folder.iterdir()) == ["GEAR54.MPF"]

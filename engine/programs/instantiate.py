@@ -56,6 +56,7 @@ from .verified_run import Workpiece, run_template
 
 if TYPE_CHECKING:
     from ..db.connection import Connection
+    from .streamed import StreamedStore
 
 
 class Planner:
@@ -218,18 +219,30 @@ def instantiate_gears(conn: Connection, first: int | None = None, last: int | No
     `mode.dry_run`: what would be stored, nothing stored. `mode.progress(stage, done, total)` as
     the gears are planned."""
     with batch_stage(conn, output, mode) as files, no_cycle_collection():   # planning and storing build the batch
-        outcomes = _planned_gears(Planner(conn, machine, choices, overrides, mode.draft), first, last, mode)
+        streamed = _streamed_store(conn, mode)
+        outcomes = _planned_gears(Planner(conn, machine, choices, overrides, mode.draft), first, last, mode, streamed)
         encoded, skipped = good_ones(outcomes, "gear", mode.skip_bad)
         if mode.dry_run:
             return dry_batch(encoded, skipped)
         files.plan([(item.name, item.lines) for item in encoded], file_layouts(encoded))
-        batch = store_many(conn, encoded, output.out, files)
+        batch = streamed.batch(encoded, output.out, files) if streamed and streamed.used else \
+            store_many(conn, encoded, output.out, files)
     return replace(batch, skipped=skipped)
 
 
-def _planned_gears(planner: Planner, first, last, mode: RunMode) -> list:
+def _streamed_store(conn: Connection, mode: RunMode) -> StreamedStore | None:
+    """Where a batch planned in workers stores its slices as they come back (engine.programs.streamed)."""
+    if mode.workers <= 1 or mode.dry_run:
+        return None
+    from .streamed import StreamedStore  # batches across cores only (issue 28: start-up)
+
+    return StreamedStore(conn, mode.skip_bad)
+
+
+def _planned_gears(planner: Planner, first, last, mode: RunMode, streamed: StreamedStore | None = None) -> list:
     """Each gear's program encoded for storage, or Bad with its reason, in gear order (a gear
-    whose record cannot even be completed among them)."""
+    whose record cannot even be completed among them). Planned in workers, each slice is given
+    to `streamed` as it comes back."""
     refused: dict[int, str] = {}
     gears = load_gears(planner.conn, first, last, refused)
     if not gears and not refused:
@@ -237,7 +250,7 @@ def _planned_gears(planner: Planner, first, last, mode: RunMode) -> list:
     if mode.workers > 1 and len(gears) > 1:
         from .workers import plan_in_workers  # a batch across cores only: multiprocessing (issue 28: start-up)
 
-        planned = plan_in_workers(planner, gears, _plan_in_batch, mode)
+        planned = plan_in_workers(planner, gears, _plan_in_batch, mode, streamed)
     else:
         planned = [_counted(_plan_in_batch(planner, gear), done, len(gears), mode.progress)
                    for done, gear in enumerate(gears, 1)]

@@ -111,6 +111,20 @@ class Lineage:
 def store_many(conn: Connection, encoded: list[Encoded], out=None, files=None) -> Batch:
     """All jobs and programs in one transaction, through COPY (the batch path); `out` is where
     the caller writes their files."""
+    stored = store_slice(conn, encoded)
+    _stored_texts(files, stored.texts)
+    return stored_batch(encoded, stored.program_ids, out)
+
+
+class StoredSlice(msgspec.Struct, frozen=True):
+    """What one COPY of a batch stored: the program ids in order, {program name: lines as stored}."""
+    program_ids: list[int]
+    texts: dict
+
+
+def store_slice(conn: Connection, encoded: list[Encoded]) -> StoredSlice:
+    """New jobs and their programs through COPY, in a transaction (a savepoint inside the batch's
+    own: a batch planned in workers stores each slice as it comes back, issue 28)."""
     for item in encoded:
         refuse_unsafe(item.name, item.lines)
     with deleted_meanwhile(conn, gears=[item.gear_id for item in encoded], hobs=[item.hob_id for item in encoded]), \
@@ -122,7 +136,11 @@ def store_many(conn: Connection, encoded: list[Encoded], out=None, files=None) -
                 copy.write_row((job_id, item.gear_id, item.gear_class, item.machine, item.hob_id,
                                 _json(item.params), _json(item.module_params), _json(item.cutting),
                                 item.work_holding_id))
-        _stored_texts(files, _copy_programs(conn, program_ids, job_ids, encoded))
+        return StoredSlice(program_ids, _copy_programs(conn, program_ids, job_ids, encoded))
+
+
+def stored_batch(encoded: list[Encoded], program_ids: list[int], out) -> Batch:
+    """The report of a batch stored: programs, lines (each with its lineage line), ids, notes."""
     return Batch(len(encoded), sum(len(item.lines) + 1 for item in encoded),
                  min(program_ids), max(program_ids), out,
                  tuple(prefixed(f"{item.name}: ", note) for item in encoded for note in item.notes))
@@ -135,8 +153,7 @@ def store_programs(conn: Connection, encoded: list[Encoded], job_ids: list[int],
     with deleted_meanwhile(conn, jobs=job_ids), conn.transaction():
         program_ids = _next_ids(conn, "program_id_seq", len(encoded))
         _stored_texts(files, _copy_programs(conn, program_ids, job_ids, encoded))
-    return Batch(len(encoded), sum(len(item.lines) + 1 for item in encoded), min(program_ids), max(program_ids), out,
-                 tuple(prefixed(f"{item.name}: ", note) for item in encoded for note in item.notes))
+    return stored_batch(encoded, program_ids, out)
 
 
 # The gears, hobs and jobs of a store that are no longer in the database.

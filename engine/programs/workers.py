@@ -27,28 +27,34 @@ SLICES_PER_WORKER = 8   # small enough to balance the workers, large enough to a
 _BATCH: list = []   # (planner, gears, plan function) of the batch being planned, inherited by the forked workers
 
 
-def plan_in_workers(planner, gears: list, plan_one, mode: RunMode) -> list:
+def plan_in_workers(planner, gears: list, plan_one, mode: RunMode, each_slice=None) -> list:
     """`plan_one(planner, gear)` for every gear, in `mode.workers` forked processes, in gear order:
     what it returns comes back pickled (a job encoded for storage, engine.programs.records.Encoded,
-    or the reason a gear is bad); `mode.progress(stage, done, total)` as slices come back."""
+    or the reason a gear is bad); `mode.progress(stage, done, total)` and `each_slice(outcomes)`
+    as slices come back, in order (the parent stores a slice while the workers plan the next:
+    issue 28, a batch's COPY was a fifth of one process's time, left serial after the planning)."""
     for gear_class in {gear.gear_class for gear in gears if gear.gear_class is not None}:
         _ready(planner, gear_class)
     size = max(1, len(gears) // (mode.workers * SLICES_PER_WORKER))
     slices = [(start, min(start + size, len(gears))) for start in range(0, len(gears), size)]
     _BATCH[:] = [planner, gears, plan_one]
+    gc.freeze()   # the parent's objects out of the workers' collections: touching them would copy their pages
     try:
-        return _planned_in_pool(slices, len(gears), mode)
+        return _planned_in_pool(slices, len(gears), mode, each_slice)
     finally:
+        gc.unfreeze()
         _BATCH.clear()
 
 
-def _planned_in_pool(slices: list[tuple[int, int]], total: int, mode: RunMode) -> list:
-    """The slices planned by `mode.workers` forked processes, in order; progress told as each
-    slice comes back (`total` gears in all)."""
+def _planned_in_pool(slices: list[tuple[int, int]], total: int, mode: RunMode, each_slice) -> list:
+    """The slices planned by `mode.workers` forked processes, in order; progress told and
+    `each_slice` given each slice as it comes back (`total` gears in all)."""
     with _forked_pool(mode.workers, _in_worker) as pool:
         outcomes = []
         for planned in pool.imap(_plan_slice, slices):
             outcomes += planned
+            if each_slice is not None:
+                each_slice(planned)
             if mode.progress:
                 mode.progress(PLANNING, len(outcomes), total)
         return outcomes
