@@ -181,8 +181,9 @@ def test_a_machines_page_lists_what_it_was_sent_newest_first(run):
     program, job = made["program_id"], made["job_id"]
     sent = committed(run.url, REQUEST, ("ftp", "10.0.0.7", "GEAR42.MPF", job, program, None,
                                         "2026-11-29 08:00:00+00"))[0][0]
-    refused = committed(run.url, REQUEST, ("folder", "REQ/GEAR42.REQ", "GEAR42", job, None,
-                                           "class spur has no released template version", "2026-11-29 09:00:00+00"))[0][0]
+    reason = "class spur has no released template version"
+    refused = committed(run.url, REQUEST, ("folder", "REQ/GEAR42.REQ", "GEAR42", job, None, reason,
+                                           "2026-11-29 09:00:00+00"))[0][0]
     with web(run.url) as client:
         answer = client.get("/machines/hobber-840d", headers=JSON).json()
         text = html(client, "/machines/hobber-840d")
