@@ -78,6 +78,18 @@ def test_a_class_page_is_template_history_and_a_seeded_release_is_not_the_gates(
     said = history.splitlines()[1].strip()   # the release's line under v1, as the command prints it
     assert said.startswith("released ") and said.replace("'", "&#39;") in text
     assert "golden test" in text and "gear42" in text   # the class's golden tests are listed
+    assert '<a href="/classes/spur/versions/1">v1</a>' in text
+
+
+def test_a_version_page_is_its_history_entry(read_only_run):
+    with web(read_only_run.url) as client:
+        first = client.get("/classes/spur/versions/1", headers=JSON).json()
+        text = html(client, "/classes/spur/versions/1")
+        missing = client.get("/classes/spur/versions/99", headers=JSON)
+    history = cli_json(read_only_run, "template", "history", "--class", "spur")
+    assert first["version"] == history["versions"][0] and first["diff"] is None
+    assert "by engine seed" in text and "gate passed" not in text
+    assert missing.status_code == 404 and "no version 99" in missing.json()["error"]
 
 
 @pytest.mark.slow   # the gate runs twice: seconds
@@ -105,6 +117,14 @@ def test_a_release_by_hand_is_never_shown_as_gate_passed_and_the_gates_own_is(ru
     assert "gate passed" not in sections[3] and "by hand from SQL" in sections[3]
     assert "spur/coolant_on_before_cutting" in sections[3] and "7 stored job(s)" in sections[3]
     assert "gate passed" not in sections[4] and "MISMATCH" in sections[4]
+    with web(run.url) as client:
+        third = client.get("/classes/spur/versions/3", headers=JSON).json()
+        third_page = html(client, "/classes/spur/versions/3")
+    assert third["version"] == next(version for version in answer["versions"] if version["version"] == 3)
+    assert third["diff"] == cli_json(run, "template", "diff", "--class", "spur", "--from", 2, "--to", 3)
+    assert [change["row_id"] for change in third["diff"]["changes"]] == [COOLANT_ROW]
+    assert third["stated_impact"] == {"jobs": 7, "changed": 0}
+    assert "by hand from SQL" in third_page and "gate passed" not in third_page
 
 
 def test_the_drafts_impact_is_computed_on_request_as_the_dry_run(run):

@@ -160,16 +160,14 @@ def _changes_text(changes, first: bool, relaid: bool = False) -> str:
 def template_diff(ctx, gear_class, from_version, to_version, as_json):
     """Rows added (+), removed (-) and changed (~) between two versions of the class, with old and new
     values, and the layout (line ending, final newline) if it changed."""
+    from ..release.shown import diff_json
     from ..templates.history import diff, layout_change
 
     with connection(ctx) as conn:
         changes = diff(conn, gear_class, from_version, to_version)
         relaid = layout_change(conn, gear_class, from_version, to_version)
     if as_json:
-        return emit_json({"class": gear_class, "from": from_version, "to": to_version,
-                          "changes": [{"row_id": c.row_id, "kind": c.kind, "old": c.old, "new": c.new}
-                                      for c in changes],
-                          "layout": relaid and {"old": relaid[0].said, "new": relaid[1].said}})
+        return emit_json(diff_json(gear_class, from_version, to_version, changes, relaid))
     if relaid:
         click.echo(f"~ layout: {relaid[0].said} -> {relaid[1].said}")
     for change in changes:

@@ -9,7 +9,8 @@ from typing import TYPE_CHECKING
 from ..nc.layout import ENDING_NAMES
 
 if TYPE_CHECKING:
-    from ..templates.history import ReleaseEntry, VersionEntry
+    from ..nc.layout import NcLayout
+    from ..templates.history import ReleaseEntry, RowChange, VersionEntry
     from .gate import ReleaseReport
     from .recheck import Verdict
 
@@ -82,3 +83,12 @@ def report_json(report: ReleaseReport) -> dict:
                        "diffs": [{"job_id": d.job_id, "class": d.gear_class, "diff": d.diff}
                                  for d in impact.diffs],
                        "layout": [change.as_json() for change in impact.layouts.values()]}}
+
+
+def diff_json(gear_class: str, from_version: int, to_version: int, changes: list[RowChange],
+              relaid: tuple[NcLayout, NcLayout] | None) -> dict:
+    """`engine template diff --json`: the rows added, removed and changed between two versions, and
+    the layout if it changed."""
+    return {"class": gear_class, "from": from_version, "to": to_version,
+            "changes": [{"row_id": c.row_id, "kind": c.kind, "old": c.old, "new": c.new} for c in changes],
+            "layout": relaid and {"old": relaid[0].said, "new": relaid[1].said}}

@@ -17,6 +17,8 @@ from ...errors import EngineError
 from .pages import connection, page, refusal, wants_json
 
 CLASS_EXISTS = "SELECT 1 FROM gear_class WHERE name = %s"
+# The impact a version's (latest) release recorded, as the releasing session stated it.
+STATED_IMPACT = "SELECT impact FROM template_release WHERE gear_class = %s AND version = %s ORDER BY id DESC LIMIT 1"
 
 
 def classes_list(request: Request) -> Response:
@@ -33,14 +35,13 @@ def class_page(request: Request) -> Response:
     from ...release.golden import load_tests
     from ...release.recheck import verdict
     from ...release.shown import release_text, version_json
-    from ...templates.history import history
     from ...templates.store import class_and_descendants
 
     name = request.path_params["name"]
     with connection(request) as conn:
         if not _exists(conn, name):
             return _unknown(request, name)
-        entries = history(conn, name)
+        entries = _history(conn, name)
         verdicts = {entry.version: verdict(conn, name, entry.release) for entry in entries if entry.release}
         data = {"class": name, "versions": [version_json(entry, verdicts.get(entry.version)) for entry in entries]}
         if wants_json(request):
@@ -49,6 +50,53 @@ def class_page(request: Request) -> Response:
                 for entry in entries if entry.release}
         tests = load_tests(conn, class_and_descendants(conn, name))
     return page(request, "class.html", {**data, "said": said, "golden_tests": tests})
+
+
+def version_page(request: Request) -> Response:
+    """One version: its entry of `engine template history --json` (`version`), the rows it changed
+    from the version stored before it (`diff`: `engine template diff --json`; None for the first)
+    and the impact its release recorded as the releasing session stated it (`stated_impact`, never
+    recomputed: the job ids it changed and failed for)."""
+    from ...release.recheck import verdict
+    from ...release.shown import release_text, version_json
+
+    name, number = request.path_params["name"], request.path_params["version"]
+    with connection(request) as conn:
+        if not _exists(conn, name):
+            return _unknown(request, name)
+        entries = {entry.version: entry for entry in _history(conn, name)}
+        if number not in entries:
+            return refusal(request, f"class {name!r} has no version {number}; stored versions: "
+                                    f"{', '.join(map(str, entries))}", 404)
+        entry = entries[number]
+        found = verdict(conn, name, entry.release) if entry.release else None
+        data = {"class": name, "version": version_json(entry, found),
+                "diff": _diff_before(conn, name, number, [v for v in entries if v < number]),
+                "stated_impact": _stated_impact(conn, name, number)}
+    said = release_text(entry.release, found) if entry.release and found else None
+    return page(request, "version.html", data if wants_json(request) else {**data, "said": said})
+
+
+def _history(conn, name: str):
+    from ...templates.history import history
+
+    return history(conn, name)
+
+
+def _diff_before(conn, name: str, number: int, earlier: list[int]) -> dict | None:
+    """`engine template diff --json` from the version stored before `number` (None: the first)."""
+    from ...release.shown import diff_json
+    from ...templates.history import diff, layout_change
+
+    if not earlier:
+        return None
+    before = max(earlier)
+    return diff_json(name, before, number, diff(conn, name, before, number), layout_change(conn, name, before, number))
+
+
+def _stated_impact(conn, name: str, number: int) -> dict | None:
+    found = conn.execute(STATED_IMPACT, (name, number)).fetchone()
+    return None if found is None else found[0]
 
 
 def draft_impact(request: Request) -> Response:
@@ -103,6 +151,7 @@ def _unknown(request: Request, name: str) -> Response:
 ROUTES = [
     Route("/classes", classes_list, name="classes"),
     Route("/classes/{name}", class_page, name="class"),
+    Route("/classes/{name}/versions/{version:int}", version_page, name="class_version"),
     Route("/classes/{name}/impact", draft_impact, name="class_impact"),
     Route("/classes/{name}/tests", golden_results, name="class_tests"),
 ]
