@@ -33,6 +33,7 @@ def template_release(ctx, gear_class, dry_run, yes, as_json, workers, without_go
     """
     from ..release.gate import release
     from ..release.impact import DIFFS_SHOWN
+    from ..release.shown import report_json
 
     def confirm(report) -> bool:
         if yes:
@@ -45,7 +46,7 @@ def template_release(ctx, gear_class, dry_run, yes, as_json, workers, without_go
         report = release(conn, gear_class, dry_run=dry_run, confirm=confirm, workers=workers,
                          without_golden_tests=without_golden_tests)
     if as_json:
-        return emit_json(_as_json(report))
+        return emit_json(report_json(report))
     if dry_run or yes:
         _show(report, DIFFS_SHOWN)
     click.echo(_outcome(report))
@@ -81,16 +82,3 @@ def _outcome(report) -> str:
         return f"released class {report.gear_class} v{report.version} (release {report.release_id}){below}"
     what = "dry run" if report.dry_run else "not confirmed"
     return f"{what}: nothing released{below}"
-
-
-def _as_json(report) -> dict:
-    impact = report.impact
-    return {"class": report.gear_class, "version": report.version, "hash": report.hash,
-            "dry_run": report.dry_run, "released": report.release_id is not None, "release_id": report.release_id,
-            "tests": report.tests, "checks": report.checks, "drafts_below": report.drafts_below,
-            "impact": {"jobs": impact.jobs, "changed": impact.changed, "proved": impact.proved,
-                       "failures": [{"job_id": f.job_id, "class": f.gear_class, "error": f.error}
-                                    for f in impact.failures],
-                       "diffs": [{"job_id": d.job_id, "class": d.gear_class, "diff": d.diff}
-                                 for d in impact.diffs],
-                       "layout": [change.as_json() for change in impact.layouts.values()]}}

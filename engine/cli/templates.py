@@ -7,7 +7,7 @@ import sys
 import click
 
 from ..errors import EngineError
-from ..nc.layout import ENDING_NAMES, NcLayout
+from ..nc.layout import NcLayout
 from .context import connection, emit_json, file_folder
 from .ids import VERSION
 from .output import Column, emit_list, list_options
@@ -117,6 +117,7 @@ def template_history(ctx, gear_class, as_json):
     Example: engine template history --class spur
     """
     from ..release.recheck import verdict
+    from ..release.shown import release_text, version_json
     from ..templates.history import history
 
     with connection(ctx) as conn:
@@ -124,38 +125,14 @@ def template_history(ctx, gear_class, as_json):
         verdicts = {entry.version: verdict(conn, gear_class, entry.release) for entry in entries if entry.release}
     if as_json:
         return emit_json({"class": gear_class,
-                          "versions": [_version_json(entry, verdicts.get(entry.version)) for entry in entries]})
+                          "versions": [version_json(entry, verdicts.get(entry.version)) for entry in entries]})
     for number, entry in enumerate(entries):
         layout = _layout_text(entry.layout, entries[number - 1].layout if number else NcLayout())
         changes = _changes_text(entry.changes, first=number == 0, relaid=bool(layout))
         click.echo(f"v{entry.version:<4} {entry.state:10} {entry.created_at:%Y-%m-%d %H:%M:%S} by "
                    f"{entry.created_by:14} {entry.rows:3} rows  {changes}{layout}".rstrip())
         if entry.release is not None:
-            click.echo(f"      {_release_text(entry.release, verdicts[entry.version])}")
-
-
-def _release_text(release, verdict) -> str:
-    """Who released, and what is true of the gate (engine.release.recheck); what the releasing
-    session states is said to be stated: the tests when the gate did not make the release, the impact
-    always (the database cannot recompute it, and `via` is the releasing login's own claim)."""
-    impact = ("" if release.jobs is None else
-              f"; impact as the releasing session stated it (not re-checked): {release.changed} of {release.jobs} "
-              f"stored job(s) changed{_failed_text(release.failed)}")
-    stated = ("" if verdict.gate == "passed" or not release.tests
-              else f"; it states {release.tests} golden test(s) passed")
-    note = f" ({release.note})" if release.note else ""
-    return (f"released {release.released_at:%Y-%m-%d %H:%M:%S} by {release.released_by} as {release.role}: "
-            f"{_untested_text(release)}{verdict.said}{stated}{impact}{note}")
-
-
-def _untested_text(release) -> str:
-    """A release with no golden test, accepted so on the command line (the checks it recorded)."""
-    return "WITHOUT GOLDEN TESTS (accepted with --without-golden-tests); " if release.without_tests else ""
-
-
-def _failed_text(failed: int | None) -> str:
-    """Stored jobs the released version made no program for (the impact's refusals)."""
-    return f", {failed} job(s) fail with it" if failed else ""
+            click.echo(f"      {release_text(entry.release, verdicts[entry.version])}")
 
 
 def _layout_text(layout, before) -> str:
@@ -174,26 +151,6 @@ def _changes_text(changes, first: bool, relaid: bool = False) -> str:
     return ", ".join(f"{operation} x{operations.count(operation)}" for operation in dict.fromkeys(operations))
 
 
-def _version_json(entry, verdict) -> dict:
-    return {"version": entry.version, "created_at": entry.created_at.isoformat(), "created_by": entry.created_by,
-            "rows": entry.rows, "state": entry.state, "release": _release_json(entry.release, verdict),
-            "changes": [{"row_id": row_id, "operation": operation} for row_id, operation in entry.changes],
-            "line_ending": ENDING_NAMES[entry.layout.line_ending], "final_newline": entry.layout.final_newline}
-
-
-def _release_json(release, verdict) -> dict | None:
-    """`tests`, `changed`, `jobs`, `failed`: what the releasing session stated (jobs whose program the
-    release changed, of the stored jobs, and those it made none for); `gate`: passed only for the
-    engine's gate's release that passes its re-check now (`recheck`)."""
-    if release is None:
-        return None
-    return {"released_at": release.released_at.isoformat(), "released_by": release.released_by,
-            "role": release.role, "released_via": release.released_via, "tests": release.tests,
-            "changed": release.changed, "jobs": release.jobs, "failed": release.failed, "note": release.note,
-            "accepted_without_golden_tests": release.without_tests,
-            **verdict.as_json()}
-
-
 @template.command("diff")
 @click.option("--class", "gear_class", required=True, help="Gear class name.")
 @click.option("--from", "from_version", type=VERSION, required=True, help="Earlier version (see `template history`).")
@@ -203,16 +160,14 @@ def _release_json(release, verdict) -> dict | None:
 def template_diff(ctx, gear_class, from_version, to_version, as_json):
     """Rows added (+), removed (-) and changed (~) between two versions of the class, with old and new
     values, and the layout (line ending, final newline) if it changed."""
+    from ..release.shown import diff_json
     from ..templates.history import diff, layout_change
 
     with connection(ctx) as conn:
         changes = diff(conn, gear_class, from_version, to_version)
         relaid = layout_change(conn, gear_class, from_version, to_version)
     if as_json:
-        return emit_json({"class": gear_class, "from": from_version, "to": to_version,
-                          "changes": [{"row_id": c.row_id, "kind": c.kind, "old": c.old, "new": c.new}
-                                      for c in changes],
-                          "layout": relaid and {"old": relaid[0].said, "new": relaid[1].said}})
+        return emit_json(diff_json(gear_class, from_version, to_version, changes, relaid))
     if relaid:
         click.echo(f"~ layout: {relaid[0].said} -> {relaid[1].said}")
     for change in changes:

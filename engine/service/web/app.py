@@ -9,21 +9,35 @@ from contextlib import asynccontextmanager
 from importlib import import_module
 
 from starlette.applications import Starlette
+from starlette.middleware import Middleware
+from starlette.middleware.sessions import SessionMiddleware
 from starlette.routing import BaseRoute
 
+from .auth import SESSION_COOKIE, SESSION_SECONDS, LoginRequired, session_secret
+
 # the concepts shown, each a module of this package with ROUTES (issue 32)
-PAGE_MODULES = ("home",)
+PAGE_MODULES = ("home", "auth", "classes", "machines")
 POOL_SIZE = (1, 4)   # connections: one kept open, at most four pages answered at once
 
 
 def create_app(database_url: str, *, require_login: bool = False, session_secret: str | None = None) -> Starlette:
     """The app on the database of `database_url` (resolved: engine.db.connection.resolve_url).
     require_login: every page but the login asks for a PostgreSQL login first (the service
-    bound to an address other than loopback); else the local user sees every page."""
-    app = Starlette(routes=_routes(), lifespan=_lifespan(database_url))
+    bound to an address other than loopback); else the local user sees every page.
+    session_secret: the key the login's cookie is signed with (else ENGINE_SERVE_SECRET, else
+    random per start: engine.service.web.auth)."""
+    app = Starlette(routes=_routes(), lifespan=_lifespan(database_url), middleware=_middleware(require_login,
+                                                                                              session_secret))
     app.state.require_login = require_login
-    app.state.session_secret = session_secret
+    app.state.database_url = database_url   # the logins connect to it (auth); never shown
     return app
+
+
+def _middleware(require_login: bool, secret: str | None) -> list[Middleware]:
+    """The session (a signed cookie holding the login's name), then the login it asks for."""
+    return [Middleware(SessionMiddleware, secret_key=session_secret(secret), session_cookie=SESSION_COOKIE,
+                       max_age=SESSION_SECONDS, same_site="lax"),
+            Middleware(LoginRequired, require_login=require_login)]
 
 
 def _routes() -> list[BaseRoute]:

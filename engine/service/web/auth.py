@@ -1,0 +1,181 @@
+"""Who may do what on the web view (issue 32; design notes §10). On 127.0.0.1 the pages are open
+to the local user: whoever can reach the loopback address can run psql as the service's role too.
+Bound to any other address, every page but the login asks for a login, and the login is
+PostgreSQL's: the user name and password open a connection to the service's own database as that
+user (a short connect timeout), so the shop keeps one list of people and passwords, its database's,
+with its password rules, expiry (VALID UNTIL) and lock-out (NOLOGIN). A server that did not ask for
+the password (pg_hba.conf `trust`, `peer`) proves nothing: the login is refused.
+
+A member of engine_reader, engine_runner, engine_editor, engine_releaser or engine_planner (or the
+owner, or a superuser) sees every page; a member of engine_runner (or the owner) may also request a
+program for a stored job (may_request). The rights are asked of PostgreSQL again on every page,
+so a role revoked or a login locked takes effect at the next click. The session is a signed cookie
+(Starlette's SessionMiddleware) holding only the user name, never the password; a failed login is
+one line that does not say whether the user exists; no password is echoed or logged."""
+from __future__ import annotations
+
+import logging
+import os
+import secrets
+from urllib.parse import quote
+
+import msgspec
+import psycopg
+from psycopg.conninfo import make_conninfo
+from starlette.concurrency import run_in_threadpool
+from starlette.requests import Request
+from starlette.responses import JSONResponse, RedirectResponse, Response
+from starlette.routing import Route
+from starlette.types import ASGIApp, Receive, Scope, Send
+
+from .pages import TEMPLATES, wants_json
+
+LOGIN_PATH = "/login"
+OPEN_PATHS = (LOGIN_PATH,)          # what a visitor without a login may open
+SESSION_COOKIE = "engine_session"
+SESSION_SECONDS = 12 * 3600         # a shift and its overlap; then the login is asked again
+CONNECT_TIMEOUT = 5                 # seconds a login waits for the database
+SECRET_VARIABLE = "ENGINE_SERVE_SECRET"
+SEEING_ROLES = ["engine_reader", "engine_runner", "engine_editor", "engine_releaser", "engine_planner"]
+REQUESTING_ROLE = "engine_runner"
+REFUSED = "login refused: wrong user name or password, or the database does not accept this login"
+NO_ROLE = ("login refused: this login has no role of the engine's (engine_reader sees the pages, engine_runner "
+           "also requests programs); ask the database's owner to grant one")
+LOG = logging.getLogger("engine.serve")
+
+# What a login may do: the owner of the engine's tables (the role that migrates) and superusers
+# everything; the engine's roles as granted, inherited (USAGE: usable without SET ROLE). A login
+# that may no longer log in (NOLOGIN, VALID UNTIL passed) or no longer exists has no rights.
+RIGHTS = """
+SELECT coalesce(r.rolsuper OR pg_has_role(r.oid, o.relowner, 'USAGE'), false),
+       EXISTS (SELECT 1 FROM pg_roles g WHERE g.rolname = ANY(%(seeing)s) AND pg_has_role(r.oid, g.oid, 'USAGE')),
+       EXISTS (SELECT 1 FROM pg_roles g WHERE g.rolname = %(requesting)s AND pg_has_role(r.oid, g.oid, 'USAGE'))
+FROM pg_roles r LEFT JOIN pg_class o ON o.oid = to_regclass('program')
+WHERE r.rolname = %(login)s AND r.rolcanlogin AND (r.rolvaliduntil IS NULL OR r.rolvaliduntil > now())"""
+SERVICE_LOGIN = "SELECT current_user"
+
+
+class Rights(msgspec.Struct, frozen=True):
+    """What a login may do on the web view."""
+    login: str
+    sees: bool        # every page
+    requests: bool    # also a program for a stored job (engine_runner)
+
+
+def session_secret(given: str | None) -> str:
+    """The key the session cookie is signed with: create_app's, else ENGINE_SERVE_SECRET, else a
+    random one for this start (sessions then end when the service restarts)."""
+    return given or os.environ.get(SECRET_VARIABLE) or secrets.token_urlsafe(32)
+
+
+def rights_of(conn: psycopg.Connection, login: str) -> Rights:
+    found = conn.execute(RIGHTS, {"login": login, "seeing": SEEING_ROLES, "requesting": REQUESTING_ROLE}).fetchone()
+    if found is None:
+        return Rights(login, False, False)
+    owner, sees, requests = found
+    return Rights(login, owner or sees, owner or requests)
+
+
+def check_login(database_url: str, user: str, password: str) -> Rights | None:
+    """The rights of `user` if PostgreSQL accepts the password for the service's database, else None.
+    An empty password is refused before asking: libpq would take it as none given and use a
+    password file or PGPASSWORD of the service's own environment."""
+    if not user or not password or "\0" in user + password:
+        return None
+    conninfo = make_conninfo(database_url, user=user, password=password, passfile=os.devnull,
+                             connect_timeout=CONNECT_TIMEOUT)
+    try:
+        with psycopg.connect(conninfo, autocommit=True) as conn:
+            if not conn.pgconn.used_password:
+                LOG.warning("login refused: the database server did not ask for a password (pg_hba.conf trusts "
+                            "the connection); the web view takes only logins PostgreSQL checks")
+                return None
+            return rights_of(conn, user)
+    except psycopg.Error:
+        return None
+
+
+class LoginRequired:
+    """Every page but the login asks for a login whose rights PostgreSQL confirms now (the service
+    bound to an address other than loopback); the rights are left in request.state.rights."""
+
+    def __init__(self, app: ASGIApp, require_login: bool):
+        self.app, self.require_login = app, require_login
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        if scope["type"] != "http" or not self.require_login or scope["path"] in OPEN_PATHS:
+            return await self.app(scope, receive, send)
+        request = Request(scope, receive)
+        login = request.session.get("login")
+        rights = await run_in_threadpool(_pool_rights, request, login) if login else None
+        if rights is None or not rights.sees:
+            request.session.clear()
+            return await _ask_login(request)(scope, receive, send)
+        scope.setdefault("state", {})["rights"] = rights
+        await self.app(scope, receive, send)
+
+
+def _pool_rights(request: Request, login: str) -> Rights:
+    with request.app.state.pool.connection() as conn:
+        return rights_of(conn, login)
+
+
+def _ask_login(request: Request) -> Response:
+    if wants_json(request):
+        return JSONResponse({"error": f"log in first: POST {LOGIN_PATH} with user and password"}, status_code=401)
+    return RedirectResponse(f"{LOGIN_PATH}?next={quote(request.url.path)}", status_code=303)
+
+
+def may_request(request: Request) -> bool:
+    """The login of this request may request a program for a stored job (engine_runner, or the
+    owner). On the open (loopback) app the local user acts as the service's own role."""
+    rights = getattr(request.state, "rights", None)
+    if rights is None:
+        with request.app.state.pool.connection() as conn:
+            rights = rights_of(conn, conn.execute(SERVICE_LOGIN).fetchone()[0])
+    return rights.requests
+
+
+async def login_form(request: Request) -> Response:
+    return _login_page(request, None, request.query_params.get("next", "/"))
+
+
+async def login(request: Request) -> Response:
+    """Checks the user and password against PostgreSQL; the session then holds the user name."""
+    form = await request.form()
+    user, password, after = (str(form.get(key) or "") for key in ("user", "password", "next"))
+    rights = await run_in_threadpool(check_login, request.app.state.database_url, user, password)
+    if rights is None or not rights.sees:
+        return _login_page(request, REFUSED if rights is None else NO_ROLE, after, status=401)
+    request.session.clear()
+    request.session["login"] = rights.login
+    if wants_json(request):
+        return JSONResponse({"login": rights.login, "requests": rights.requests})
+    return RedirectResponse(_local(after), status_code=303)
+
+
+async def logout(request: Request) -> Response:
+    request.session.clear()
+    if wants_json(request):
+        return JSONResponse({"logged_out": True})
+    return RedirectResponse(LOGIN_PATH, status_code=303)
+
+
+def _local(path: str) -> str:
+    """Where to go after the login: a path of this site only (never another site's address)."""
+    return path if path.startswith("/") and not path.startswith("//") and "\\" not in path else "/"
+
+
+def _login_page(request: Request, refusal: str | None, after: str, status: int = 200) -> Response:
+    if wants_json(request):
+        return JSONResponse({"error": refusal or f"log in: POST {LOGIN_PATH} with user and password"},
+                            status_code=status if refusal else 401)
+    return TEMPLATES.TemplateResponse(request, "login.html", {"refusal": refusal, "next": _local(after)},
+                                      status_code=status)
+
+
+ROUTES = [
+    Route(LOGIN_PATH, login_form, methods=["GET"], name="login_form"),
+    Route(LOGIN_PATH, login, methods=["POST"], name="login"),
+    Route("/logout", logout, methods=["POST"], name="logout"),
+]
