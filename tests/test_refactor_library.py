@@ -16,6 +16,7 @@ from helpers.lineage_text import id_masked
 from helpers.nc_files import DATA, FAMILY, PARAMS, class_name, instantiate, real_files
 from helpers.refactor import bodies_stored_twice, component_count, duplicate_row_body, exports
 from msgspec.structs import replace
+from psycopg.conninfo import make_conninfo
 
 from engine.library.nc_import import import_nc
 from engine.library.refactor import STAGES, refactor
@@ -38,6 +39,28 @@ def import_every_real_file(conn) -> dict[str, str]:
     return imported
 
 
+@pytest.fixture(scope="module")
+def imported_library(server_url, database_pool, _seeded_copies):
+    """(URL, class name → file) of a private copy of the seeded database with every real NC
+    program imported and committed (about 25 s of import): made once for the tests of this module
+    that refactor it, each of which gets a connection rolled back at its end (library_conn)."""
+    name = database_pool.take(_seeded_copies)
+    url = make_conninfo(server_url, dbname=name)
+    with psycopg.connect(url) as conn:
+        imported = import_every_real_file(conn)
+        conn.commit()
+    yield url, imported
+    database_pool.give_back(name)
+
+
+@pytest.fixture
+def library_conn(imported_library):
+    """A connection to the imported library whose every change is rolled back at the end of the test."""
+    with psycopg.connect(imported_library[0]) as connection:
+        with connection.transaction(force_rollback=True):
+            yield connection
+
+
 def rows_sharing_a_body(conn, first_class: str, second_class: str) -> list[tuple[int, int]]:
     """(row id in first_class, row id in second_class) pairs whose rows use one component."""
     return conn.execute("SELECT a.id, b.id FROM assembly a JOIN assembly b ON b.component_id = a.component_id "
@@ -58,9 +81,9 @@ def assembly_mapping(conn) -> dict[tuple[str, int], int]:
             in conn.execute("SELECT gear_class, id, component_id FROM assembly")}
 
 
-@pytest.mark.slow   # imports every real program (about 40 s)
-def test_real_programs_and_seeded_classes_refactor_losslessly_and_idempotently(conn):
-    imported = import_every_real_file(conn)
+@pytest.mark.slow   # refactors every real program with the seeded classes (the import: imported_library)
+def test_real_programs_and_seeded_classes_refactor_losslessly_and_idempotently(library_conn, imported_library):
+    conn, imported = library_conn, imported_library[1]
     before = exports(conn)
     assert SEEDED_CLASSES | set(imported) <= set(before)
 
@@ -77,9 +100,9 @@ def test_real_programs_and_seeded_classes_refactor_losslessly_and_idempotently(c
         assert text.encode() == (DATA / relative).read_bytes(), name
 
 
-@pytest.mark.slow   # imports every real program (about 25 s)
-def test_copies_left_by_sql_edits_are_merged_across_real_and_seeded_classes(conn):
-    import_every_real_file(conn)
+@pytest.mark.slow   # refactors every real program with the seeded classes (the import: imported_library)
+def test_copies_left_by_sql_edits_are_merged_across_real_and_seeded_classes(library_conn):
+    conn = library_conn
     imperial, metric = class_name(FAMILY + "imperial_ramp_pierce.ngc"), class_name(FAMILY + "metric_ramp_pierce.ngc")
     shared = rows_sharing_a_body(conn, imperial, metric)
     assert shared, "the ramp_pierce pair shares no line: nothing to test the family body on"
