@@ -12,7 +12,7 @@ from starlette.applications import Starlette
 from starlette.routing import BaseRoute
 
 # the concepts shown, each a module of this package with ROUTES (issue 32)
-PAGE_MODULES = ("home",)
+PAGE_MODULES = ("home", "gears", "jobs", "programs", "program_views")
 POOL_SIZE = (1, 4)   # connections: one kept open, at most four pages answered at once
 
 
