@@ -19,6 +19,7 @@ from pathlib import Path
 
 import psycopg
 import pytest
+from helpers.class_jobs import PAWN
 from helpers.roles import as_role
 from starlette.testclient import TestClient
 
@@ -168,6 +169,29 @@ def test_a_forged_program_is_shown_as_the_mismatch_it_is_and_nothing_of_it_is_ev
         refused = client.get(f"/programs/{forgery}/{path}", headers=JSON)
         assert refused.status_code == 400 and "MISMATCH" in refused.json()["error"], path
         assert len(refused.json()["error"].splitlines()) == 1
+
+
+# A lathe whose dialect the verifier has no grammar for: a program for it is stored unverified.
+FAGOR_LATHE = ("INSERT INTO machine (name, kind, dialect, x_min, x_max, z_min, z_max, spindle_max) "
+               "VALUES ('lathe-fagor', 'lathe', 'fagor', 0, 400, -600, 200, 4000)")
+
+
+def test_a_draft_unverified_program_says_so_and_never_that_a_verifier_read_it(made):
+    run, client, job_id, program_id = made
+    with psycopg.connect(run.url) as conn:
+        conn.execute(FAGOR_LATHE)
+    assert run("import-nc", PAWN, "--class", "pawn").exit_code == 0
+    stored = cli_json(run, "instantiate", "--class", "pawn", "--machine", "lathe-fagor", "--draft", "--unverified",
+                      "--json")["program_id"]
+    shown = cli_json(run, "programs", "show", stored, "--json")
+    assert shown["programs"][0]["draft"] and shown["programs"][0]["unverified"]
+    assert web_json(client, f"/programs/{stored}") == shown
+    page = client.get(f"/programs/{stored}").text
+    status = shown["programs"][0]["rendering"]["status"]
+    assert f'id="status">{status}<' in page
+    assert '<span class="status status-draft">DRAFT</span>' in page
+    assert '<span class="status status-unverified">UNVERIFIED</span>' in page
+    assert "UNVERIFIED: no verifier read it, never written to a file" in page and "read by the machine" not in page
 
 
 def test_text_users_wrote_is_escaped_on_every_page(made, tmp_path):

@@ -20,8 +20,10 @@ DEFAULT_PORT = 8080
 def serve(ctx, host, port):
     """Serve the web view of gears, jobs and programs (each page also as JSON with
     `Accept: application/json`) on the database in use, until Ctrl-C (exit 130) or
-    `engine serve stop`. Prints the address to open. One service runs per user: its pid file is
-    in the engine's runtime folder (ENGINE_RUNTIME_DIR overrides it).
+    `engine serve stop`. Prints the address to open: http://127.0.0.1:8080/ by default. A
+    program's page checks the program as `engine programs show` does, and shows its plot, trace
+    and simulation only of a MATCH. One service runs per user: its pid file is in the engine's
+    runtime folder (ENGINE_RUNTIME_DIR overrides it).
 
     Example: engine serve --port 8080
     """
