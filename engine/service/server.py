@@ -68,7 +68,7 @@ def is_loopback(host: str) -> bool:
 def serve(options: ServeOptions, said: Callable[[str], None]) -> None:
     """Run the service until stopped; `said` gets the address to open, then how it ended.
     EngineError (nothing started) if another service runs or the address cannot be bound."""
-    with _pid_file() as held:
+    with PidFile() as held:
         listening = bound_socket(options.host, options.port)
         held.write(f"{os.getpid()} {options.address}\n")
         held.flush()
@@ -126,7 +126,7 @@ def bound_socket(host: str, port: int) -> socket.socket:
     return listening
 
 
-class _pid_file:
+class PidFile:
     """The pid file, created and locked for the life of the service, removed at its end."""
 
     def __init__(self):
