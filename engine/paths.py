@@ -26,3 +26,17 @@ SCHEMA_DIR = data_folder("schema")
 SEED_DIR = data_folder("seed_templates")
 # The project's sample turning drawing (seed-000 convention, design notes §8): users copy it.
 SAMPLE_DRAWING = SEED_DIR / "drawings" / "sample_shaft.dxf"
+
+
+def runtime_folder() -> Path:
+    """Where a running `engine serve` leaves its pid file, for `engine serve stop` to find:
+    ENGINE_RUNTIME_DIR if set, else run/ in the engine's per-user data folder (beside the
+    embedded server's pgdata)."""
+    import os
+
+    override = os.environ.get("ENGINE_RUNTIME_DIR")
+    if override:
+        return Path(override).expanduser().resolve()
+    import platformdirs
+
+    return Path(platformdirs.user_data_dir("nc-template-engine")) / "run"

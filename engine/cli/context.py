@@ -2,17 +2,14 @@
 folder a file option writes into."""
 from __future__ import annotations
 
-import json
-import re
 from contextlib import contextmanager
-from decimal import Decimal
 from pathlib import Path
-from typing import Any
 
 import click
 import msgspec
 
 from ..errors import EngineError
+from ..json_text import json_line
 
 
 @contextmanager
@@ -48,29 +45,7 @@ def record_dict(record) -> dict:
 
 
 def emit_json(payload: dict) -> None:
-    click.echo(json.dumps(payload, default=str))   # design notes §9: one JSON object on one line
-
-
-# A Decimal's digits stand in a string between NULs (no text of the database holds NUL) until the
-# JSON is written, then replace that string: json writes no Decimal, and a float would round it.
-DECIMAL_MARK = "\0decimal\0"
-MARKED = re.compile(r'"\\u0000decimal\\u0000(-?[0-9.]+)"')
-
-
-def exact_json(payload: Any) -> str:
-    """The payload as one line of JSON, a Decimal (a numeric column's value) as the number of its
-    digits as stored (2.50 stays 2.50; NaN and infinities, which JSON has no number for, as text)."""
-    return MARKED.sub(r"\1", json.dumps(_marked(payload), default=str))
-
-
-def _marked(value: Any) -> Any:
-    if isinstance(value, dict):
-        return {key: _marked(item) for key, item in value.items()}
-    if isinstance(value, list):
-        return [_marked(item) for item in value]
-    if isinstance(value, Decimal) and value.is_finite():
-        return DECIMAL_MARK + format(value, "f")
-    return value
+    click.echo(json_line(payload))   # design notes §9: one JSON object on one line
 
 
 CONFIG = "engine.config"   # ctx.meta: the config file's settings (engine.programs.config), read once per invocation

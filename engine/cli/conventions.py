@@ -21,7 +21,7 @@ from ..programs.config import Config, config_error
 from .examples import EXAMPLES
 
 # read by the engine itself, never generated for an option (test_cli_conventions checks it)
-RESERVED_ENVVARS = frozenset({"ENGINE_CONFIG", "ENGINE_DATA_DIR", "ENGINE_TEST_SERVERS"})
+RESERVED_ENVVARS = frozenset({"ENGINE_CONFIG", "ENGINE_DATA_DIR", "ENGINE_RUNTIME_DIR", "ENGINE_TEST_SERVERS"})
 MACHINE_DEFAULT_FOR = ("instantiate", "suggest")   # the commands the config's `machine` is the default of
 JSON_SEEN = "engine.json"   # ctx.meta: the invoked command's --json is on (command line, environment or config)
 

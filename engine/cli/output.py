@@ -15,7 +15,8 @@ from typing import Any
 import click
 import msgspec
 
-from .context import emit_json, exact_json
+from ..json_text import exact_json
+from .context import emit_json
 
 
 def cell(value: Any) -> str:

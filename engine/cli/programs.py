@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import click
 
-from ..nc.lineage import UNVERIFIED
 from .context import connection, emit_json
 from .ids import GEAR_ID, JOB_ID, PROGRAM_ID
 from .output import Column, day, day_options, emit_list, list_options, one_of
@@ -25,7 +24,7 @@ RECORD_FIELDS = (  # (label, the value of a ProgramRecord)
     ("gear", lambda record: record.gear_id if record.gear_id is not None else "-"),
     ("class", lambda record: record.gear_class),
     ("version", lambda record: f"v{record.template_version}" + (" (draft)" if record.draft else " (released)")),
-    ("verifier", lambda record: _verifier(record)),
+    ("verifier", lambda record: record.verifier_said),
     ("rendering", lambda record: record.rendering.said if record.rendering else "not checked"),
     ("template hash", lambda record: record.template_hash),
     ("input hash", lambda record: record.input_hash or "-"),
@@ -33,17 +32,6 @@ RECORD_FIELDS = (  # (label, the value of a ProgramRecord)
     ("stored at", lambda record: record.created_at.isoformat(timespec="seconds")),
     ("layout", lambda record: record.layout.said),
 )
-
-
-def _verifier(record) -> str:
-    """Whether a verifier read the program: said only of one that is the rendering the engine
-    made and stored (a MISMATCH is lines no verifier read; an UNCHECKED one cannot be told)."""
-    if record.unverified:
-        return f"{UNVERIFIED}: no verifier read it, never written to a file"
-    if record.rendering is None or not record.rendering.matches:
-        status = record.rendering.status if record.rendering else "not checked"
-        return f"{status}: not known to be the program the machine's verifier read (see rendering)"
-    return "read by the machine's verifier"
 
 
 @click.group("programs")

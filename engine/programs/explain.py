@@ -65,6 +65,12 @@ def _values_read(entry: dict, values: dict) -> dict:
 def explain_program(conn: Connection, program_id: int, row: int | None = None) -> list[ExplainedRow]:
     """The stored program's rows, explained from its stored trace; refused unless the program is
     the rendering of the version and job it names (engine.programs.rendering)."""
+    return traced_lines(conn, program_id, row)[0]
+
+
+def traced_lines(conn: Connection, program_id: int, row: int | None = None) -> tuple[list[ExplainedRow], list[int]]:
+    """explain_program's rows, and the template row of each of the program's lines (the lineage
+    line's is LINEAGE_ROW_ID): what leads from a line on a screen to why it is there (engine serve)."""
     from .rendering import checked_program
 
     found = conn.execute("SELECT lines, row_ids, trace FROM program WHERE id = %s", (program_id,)).fetchone()
@@ -75,7 +81,7 @@ def explain_program(conn: Connection, program_id: int, row: int | None = None) -
     if trace is None:
         raise EngineError(f"program {program_id} has no trace stored (NULL); "
                           "make it again with `engine instantiate --job ID` to explain it")
-    return explained_rows(trace, lines, row_ids, row)
+    return explained_rows(trace, lines, row_ids, row), list(row_ids)
 
 
 def _state(entry: dict) -> str:

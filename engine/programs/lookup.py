@@ -60,6 +60,17 @@ class ProgramRecord(msgspec.Struct, frozen=True):
         """The program with its version's line ending and final newline, as its file was written."""
         return nc_text(self.lines, self.layout)
 
+    @property
+    def verifier_said(self) -> str:
+        """Whether a verifier read the program: said only of one that is the rendering the engine
+        made and stored (a MISMATCH is lines no verifier read; an UNCHECKED one cannot be told)."""
+        if self.unverified:
+            return f"{UNVERIFIED}: no verifier read it, never written to a file"
+        if self.rendering is None or not self.rendering.matches:
+            status = self.rendering.status if self.rendering else "not checked"
+            return f"{status}: not known to be the program the machine's verifier read (see rendering)"
+        return "read by the machine's verifier"
+
     def as_dict(self) -> dict:
         """The record with the common key names (program_id, class), its lines and its version's
         layout as the config file and a template CSV name it (line_ending "lf" or "crlf")."""

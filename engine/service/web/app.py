@@ -16,7 +16,7 @@ from starlette.routing import BaseRoute
 from .auth import SESSION_COOKIE, SESSION_SECONDS, LoginRequired, session_secret
 
 # the concepts shown, each a module of this package with ROUTES (issue 32)
-PAGE_MODULES = ("home", "auth", "classes", "machines")
+PAGE_MODULES = ("home", "auth", "gears", "jobs", "programs", "program_views", "classes", "machines")
 POOL_SIZE = (1, 4)   # connections: one kept open, at most four pages answered at once
 
 

@@ -7,10 +7,11 @@ from __future__ import annotations
 from contextlib import contextmanager
 from pathlib import Path
 
-import msgspec
 from starlette.requests import Request
 from starlette.responses import HTMLResponse, JSONResponse, Response
 from starlette.templating import Jinja2Templates
+
+from ...json_text import exact_json
 
 TEMPLATES = Jinja2Templates(directory=str(Path(__file__).parent / "templates"))
 
@@ -22,9 +23,11 @@ def wants_json(request: Request) -> bool:
 
 
 def page(request: Request, template: str, data: dict, status: int = 200) -> Response:
-    """The page `template` showing `data`, or `data` itself as JSON."""
+    """The page `template` showing `data`, or `data` itself as JSON, written as the CLI's --json
+    writes it (engine.json_text: a time as str() gives it, a numeric value with its digits), so a
+    page's JSON is the command's."""
     if wants_json(request):
-        return JSONResponse(msgspec.to_builtins(data), status_code=status)
+        return Response(exact_json(data), status_code=status, media_type="application/json")
     return TEMPLATES.TemplateResponse(request, template, {"data": data}, status_code=status)
 
 
