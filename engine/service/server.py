@@ -83,11 +83,12 @@ def _run(options: ServeOptions, listening: socket.socket, said: Callable[[str], 
 
     from .web.app import create_app
 
-    app = create_app(options.database_url, require_login=options.needs_login,
-                     session_secret=secrets.token_urlsafe(32) if options.needs_login else None)
-    server = uvicorn.Server(uvicorn.Config(app, log_level="warning", lifespan="on"))
     login = "; every page asks for a PostgreSQL login" if options.needs_login else ""
-    said(f"serving the web view at {options.address}{login}; stop it with Ctrl-C or `engine serve stop`")
+    app = create_app(options.database_url, require_login=options.needs_login,
+                     session_secret=secrets.token_urlsafe(32) if options.needs_login else None,
+                     on_ready=lambda: said(f"serving the web view at {options.address}{login}; stop it with "
+                                           "Ctrl-C or `engine serve stop`"))
+    server = uvicorn.Server(uvicorn.Config(app, log_level="warning", lifespan="on"))
     # uvicorn catches both signals to finish the answers under way, then raises them again with the
     # handlers it found: Ctrl-C as KeyboardInterrupt (exit 130, even where the shell started the
     # service ignoring it), `engine serve stop` as ServiceStopped

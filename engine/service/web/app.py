@@ -5,6 +5,7 @@ others. Pages read the database only through the engine's library (engine.progra
 engine.release), as the CLI does, so a page says what `engine … --json` says."""
 from __future__ import annotations
 
+from collections.abc import Callable
 from contextlib import asynccontextmanager
 from importlib import import_module
 
@@ -20,13 +21,16 @@ PAGE_MODULES = ("home", "auth", "gears", "jobs", "programs", "program_views", "c
 POOL_SIZE = (1, 4)   # connections: one kept open, at most four pages answered at once
 
 
-def create_app(database_url: str, *, require_login: bool = False, session_secret: str | None = None) -> Starlette:
+def create_app(database_url: str, *, require_login: bool = False, session_secret: str | None = None,
+               on_ready: Callable[[], None] | None = None) -> Starlette:
     """The app on the database of `database_url` (resolved: engine.db.connection.resolve_url).
     require_login: every page but the login asks for a PostgreSQL login first (the service
     bound to an address other than loopback); else the local user sees every page.
     session_secret: the key the login's cookie is signed with (else ENGINE_SERVE_SECRET, else
-    random per start: engine.service.web.auth)."""
-    app = Starlette(routes=_routes(), lifespan=_lifespan(database_url), middleware=_middleware(require_login,
+    random per start: engine.service.web.auth). on_ready(): called once the pool is open and the
+    server answers (engine serve says its address then, not before: a Ctrl-C earlier would stop
+    uvicorn half started)."""
+    app = Starlette(routes=_routes(), lifespan=_lifespan(database_url, on_ready), middleware=_middleware(require_login,
                                                                                               session_secret))
     app.state.require_login = require_login
     app.state.database_url = database_url   # the logins connect to it (auth); never shown
@@ -47,7 +51,7 @@ def _routes() -> list[BaseRoute]:
     return routes
 
 
-def _lifespan(database_url: str):
+def _lifespan(database_url: str, on_ready: Callable[[], None] | None):
     """The pool lives as long as the app: opened at start-up, closed at shutdown."""
     @asynccontextmanager
     async def lifespan(app: Starlette):
@@ -59,6 +63,8 @@ def _lifespan(database_url: str):
                               configure=read_bounded_json, open=False)
         pool.open(wait=True)
         app.state.pool = pool
+        if on_ready is not None:
+            on_ready()
         try:
             yield
         finally:
