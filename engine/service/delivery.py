@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import os
 import tempfile
+from datetime import datetime
 from functools import partial
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -23,6 +24,7 @@ from typing import TYPE_CHECKING
 import msgspec
 import psycopg
 
+from ..db.connection import scalar
 from ..errors import EngineError
 from ..names import LINE_BREAKING
 from ..nc.layout import class_layout, nc_text
@@ -60,7 +62,7 @@ class MachineFile(msgspec.Struct, frozen=True):
     job_id: int
     gear_id: int | None
     gear_class: str
-    changed_at: object   # datetime (timestamptz)
+    changed_at: datetime   # timestamptz
 
 
 class Delivered(msgspec.Struct, frozen=True):
@@ -129,7 +131,7 @@ def _modelled(conn: Connection, gear_class: str) -> bool:
 
 
 def _machine_of(conn: Connection, job_id: int) -> str:
-    return conn.execute("SELECT machine FROM job WHERE id = %s", (job_id,)).fetchone()[0]
+    return scalar(conn.execute("SELECT machine FROM job WHERE id = %s", (job_id,)))
 
 
 def _remade(conn: Connection, job_id: int, config: Config) -> tuple[int, bytes]:

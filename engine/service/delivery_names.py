@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING
 
 import msgspec
 
+from ..db.connection import scalar
 from ..errors import EngineError
 
 if TYPE_CHECKING:
@@ -81,7 +82,7 @@ def asked(conn: Connection, machine: str, text: str) -> Asked:
 def _job_of(conn: Connection, machine: str, kind: str, number: int) -> int:
     if kind == "job":
         return number
-    found = conn.execute(NEWEST_OF[kind], (machine, number)).fetchone()[0]
+    found = scalar(conn.execute(NEWEST_OF[kind], (machine, number)))
     if found is None:
         what = f"gear {number}" if kind == "gear" else f"O number {number}"
         raise Refused(f"machine {machine} has no stored job of {what}; make one with `engine instantiate "

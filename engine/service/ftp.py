@@ -206,7 +206,7 @@ class ProgramHandler(FTPHandler):
             self.respond("451 the program could not be made (an error of the server, in its log); try again")
             return None
         data = io.BytesIO(delivered.data)
-        data.name = file   # type: ignore[attr-defined]   # pyftpdlib logs the file's name
+        data.name = file   # pyftpdlib logs the file's name
         self.push_dtp_data(FileProducer(data, self._current_type), isproducer=True, file=data, cmd="RETR")
         return file
 

@@ -1,0 +1,203 @@
+"""The request folder of `engine serve` (issue 32; design notes §11; docs/guide/serving-programs.md):
+for controls that read programs from a network share, as an 840D does with `EXTCALL`.
+
+One folder per machine under a root (`<root>/<machine>/`). A control asks by writing a request
+file `<stem>.REQ` (stem: letters, digits and _, at most 24) whose first line names what it wants,
+ended by a new line: `JOB 17`, `GEAR 42` (that gear's newest stored job on the machine), `O1042` or a
+name its FTP list shows (engine.service.delivery_names). The engine answers each request once:
+
+1. the program, proved now (engine.service.delivery.deliver, via "folder"), is written next to it as
+   `PRG<program id>_<first 8 hex digits of the sha256 of its bytes>.MPF`: a name that changes with
+   the bytes, so a control never takes another program's file, nor an older one, for its answer;
+2. then `<stem>.RDY`, holding that file name and a new line: the name the control waits for with
+   `ISFILE`, known in advance; or, for a refusal, `<stem>.ERR` holding the one-line reason;
+3. then the request is renamed `<stem>.DONE`.
+
+Each file is written under a temporary name (a dot file, which is neither a program nor an answer),
+flushed to disk (fsync) and given its name in one step (os.replace), so a control never reads a
+half-written file. A request is taken only when it ends with a new line and has not changed since
+the previous look (a writer still writing is waited for); before answering, an old `<stem>.RDY` or
+`<stem>.ERR` is removed (the control removes it too, before it writes a request). `poll_once` looks
+once (tests, and a loop in `engine serve`)."""
+from __future__ import annotations
+
+import hashlib
+import os
+import re
+import threading
+import uuid
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import msgspec
+
+from ..errors import EngineError
+from ..programs.config import Config
+from .delivery import deliver, one_line
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
+
+REQUEST = re.compile(r"(?P<stem>[A-Za-z0-9_]{1,24})\.REQ", re.IGNORECASE)
+MAX_REQUEST_BYTES = 1024   # one line naming a job; a bound, not a limit a control meets
+READY, ERROR, DONE = ".RDY", ".ERR", ".DONE"
+POLL_SECONDS = 1.0
+
+
+class Answer(msgspec.Struct, frozen=True):
+    """What one request got: the machine, the request file, the program file written or the refusal."""
+    machine: str
+    request: str
+    program_file: str | None = None
+    refusal: str | None = None
+
+
+class RequestFolder:
+    """The machines' request folders under `root`, answered on one database connection."""
+
+    def __init__(self, root: str | os.PathLike, machines: list[str], database_url: str, config: Config):
+        from ..db.connection import connect
+
+        self.root, self.machines, self.config = Path(root), list(machines), config
+        if not self.root.is_dir():
+            raise EngineError(f"request folder root {self.root} does not exist; create it (the share the controls "
+                              "write to)")
+        self.database_url = database_url
+        self.conn: Connection = connect(database_url)
+        self._refuse_unknown_machines()
+        for machine in self.machines:
+            (self.root / machine).mkdir(exist_ok=True)
+        self._seen: dict[Path, tuple[int, int]] = {}   # request -> (size, mtime_ns) at the previous look
+
+    def _refuse_unknown_machines(self) -> None:
+        with self.conn.transaction():
+            known = {row[0] for row in self.conn.execute("SELECT name FROM machine WHERE name = ANY(%s)",
+                                                         (self.machines,))}
+        unknown = [machine for machine in self.machines if machine not in known]
+        if unknown:
+            self.conn.close()
+            raise EngineError(f"machine {unknown[0]} of the request folders does not exist; see `engine machines list`")
+
+    def poll_once(self) -> list[Answer]:
+        """Every complete request of every machine answered once, in name order."""
+        if self.conn.closed or self.conn.broken:   # the database restarted: a new connection
+            from ..db.connection import connect
+
+            self.conn = connect(self.database_url)
+        return [answer for machine in self.machines for answer in self._poll(machine)]
+
+    def _poll(self, machine: str) -> list[Answer]:
+        folder = self.root / machine
+        answers = []
+        for entry in sorted(folder.iterdir()):
+            found = REQUEST.fullmatch(entry.name)
+            if found and entry.is_file() and self._complete(entry):
+                answers.append(self._answer(machine, entry, found.group("stem")))
+        return answers
+
+    def _complete(self, request: Path) -> bool:
+        """Ends with a new line and unchanged since the previous look (else looked at again next time)."""
+        status = request.stat()
+        now, before = (status.st_size, status.st_mtime_ns), self._seen.get(request)
+        self._seen[request] = now
+        if before != now:
+            return False
+        return status.st_size > MAX_REQUEST_BYTES or request.read_bytes().endswith(b"\n")   # too long: refused
+
+    def _answer(self, machine: str, request: Path, stem: str) -> Answer:
+        folder = self.root / machine
+        for old in (READY, ERROR):
+            (folder / f"{stem}{old}").unlink(missing_ok=True)
+        text = _first_line(request.read_bytes())
+        try:
+            if text is None:
+                raise EngineError(f"request {request.name} is not one line of text naming a job (JOB 17, GEAR 42) "
+                                  f"of at most {MAX_REQUEST_BYTES} bytes")
+            delivered = deliver(self.conn, machine, text, via="folder", client=f"{machine}/{request.name}",
+                                config=self.config)
+        except EngineError as refusal:
+            reason = one_line(str(refusal))
+            write_atomically(folder, f"{stem}{ERROR}", _ascii(f"{reason}\n"))
+            answer = Answer(machine, request.name, refusal=reason)
+        else:
+            name = f"PRG{delivered.program_id}_{hashlib.sha256(delivered.data).hexdigest()[:8].upper()}.MPF"
+            write_atomically(folder, name, delivered.data)
+            write_atomically(folder, f"{stem}{READY}", f"{name}\n".encode("ascii"))
+            answer = Answer(machine, request.name, program_file=name)
+        os.replace(request, folder / f"{stem}{DONE}")
+        self._seen.pop(request, None)
+        return answer
+
+    def close(self) -> None:
+        self.conn.close()
+
+
+def _first_line(data: bytes) -> str | None:
+    """The request's first line, or None if it is not ASCII text of a bounded size."""
+    if len(data) > MAX_REQUEST_BYTES:
+        return None
+    try:
+        lines = data.decode("ascii").splitlines()
+    except UnicodeDecodeError:
+        return None
+    return lines[0].strip() if lines and lines[0].strip() else None
+
+
+def write_atomically(folder: Path, name: str, data: bytes) -> None:
+    """`folder/name` holds `data` whole or is as it was: written under a temporary dot name, flushed,
+    then renamed in one step, and the folder's entry flushed too."""
+    temporary = folder / f".{name}.{uuid.uuid4().hex}.tmp"
+    descriptor = os.open(temporary, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o644)
+    try:
+        with open(descriptor, "wb") as file:
+            file.write(data)
+            file.flush()
+            os.fsync(file.fileno())
+        os.replace(temporary, folder / name)
+    except BaseException:
+        temporary.unlink(missing_ok=True)
+        raise
+    _sync_folder(folder)
+
+
+def _sync_folder(folder: Path) -> None:
+    descriptor = os.open(folder, os.O_RDONLY)
+    try:
+        os.fsync(descriptor)
+    finally:
+        os.close(descriptor)
+
+
+class FolderService:
+    """Request folders answered in a thread every `interval` seconds until close()."""
+
+    def __init__(self, folder: RequestFolder, interval: float = POLL_SECONDS):
+        self.folder, self.interval = folder, interval
+        self._stop = threading.Event()
+        self.thread = threading.Thread(target=self._run, name="engine-request-folder", daemon=True)
+        self.thread.start()
+
+    def _run(self) -> None:
+        import logging
+
+        while not self._stop.wait(self.interval):
+            try:
+                self.folder.poll_once()
+            except Exception:   # a share gone for a moment, the database restarting: said, then tried again
+                logging.getLogger("engine.service.request_folder").exception("request folders not answered")
+
+    def close(self) -> None:
+        self._stop.set()
+        self.thread.join(timeout=30)
+        self.folder.close()
+
+
+def start_request_folder(root, machines: list[str], database_url: str, config: Config,
+                         interval: float = POLL_SECONDS) -> FolderService:
+    """The request folders of `machines` under `root`, answered in a thread of their own."""
+    return FolderService(RequestFolder(root, machines, database_url, config), interval)
+
+
+def _ascii(text: str) -> bytes:
+    """The text as a control reads it: ASCII, the engine's … spelt ..., anything else a ?."""
+    return text.replace("…", "...").encode("ascii", "replace")
