@@ -117,7 +117,7 @@ def listed(server_url, database_pool, _seeded_copies, tmp_path_factory):
     with pytest.MonkeyPatch.context() as patch:
         for variable, value in ENVIRONMENT.items():
             patch.setenv(variable, value)
-        service = start_ftp_server(url, config_file(tmp_path_factory.mktemp("ftp")))
+        service = start_ftp_server(url, config_file(tmp_path_factory.mktemp("ftp")), failed_login_delay=0.05)
         yield service.port, jobs
         service.close()
     database_pool.give_back(name)
@@ -216,7 +216,7 @@ def test_a_job_whose_proof_fails_now_is_refused_and_recorded(run, serving):
     with psycopg.connect(run.url) as conn:   # the machine's record changed since: X now ends at 30 mm
         conn.execute("UPDATE machine SET x_max = 30 WHERE name = 'hobber-840d'")
     said = refusal_of(serving, "hobber-840d", f"RETR GEAR42_J{made['job_id']}.MPF")
-    assert said.startswith("550") and "exceeds the travel of hobber-840d" in said
+    assert said.startswith("550") and "exceeds the travel of hobber-840d" in said and said.isascii()
     [row] = requests(run.url)
     assert row[4:6] == (made["job_id"], None) and "exceeds the travel" in row[6]
     with psycopg.connect(run.url) as conn:   # nothing stored: the job's one program is still the first

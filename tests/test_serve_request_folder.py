@@ -11,6 +11,7 @@ import json
 
 import psycopg
 import pytest
+from helpers.roles import logins
 
 from engine.errors import EngineError
 from engine.programs.config import Config
@@ -75,7 +76,7 @@ def test_a_half_written_request_waits_until_complete_and_is_answered_once(run, f
     assert answered(folders) == [] and [row[4] for row in requests(run.url)] == [made["job_id"]]
 
 
-def test_another_machines_job_is_refused_with_an_err_file(run, folders):
+def test_another_machines_job_is_refused_with_an_err_file_and_the_next_request_answered(run, folders):
     fanuc = stored_job(run, 42, "hobber-fanuc")
     share = folders.root / "hobber-840d"
     (share / "X.REQ").write_text(f"JOB {fanuc['job_id']}\n")
@@ -86,6 +87,10 @@ def test_another_machines_job_is_refused_with_an_err_file(run, folders):
     assert not (share / "X.RDY").exists() and not list(share.glob("*.MPF")) and (share / "X.DONE").exists()
     assert requests(run.url) == [("hobber-840d", "folder", "hobber-840d/X.REQ", f"JOB {fanuc['job_id']}", None, None,
                                   reason.strip())]
+    own = stored_job(run, 43)   # the same connection answers the next request: the refusal left it usable
+    (share / "Y.REQ").write_text(f"JOB {own['job_id']}\n")
+    [answer] = answered(folders)
+    assert answer.refusal is None and (share / "Y.RDY").read_text() == f"{answer.program_file}\n"
 
 
 def test_a_stale_answer_is_replaced_and_what_is_not_a_request_is_refused(run, folders):
@@ -99,3 +104,24 @@ def test_a_stale_answer_is_replaced_and_what_is_not_a_request_is_refused(run, fo
 def test_a_machine_that_does_not_exist_is_refused(run, tmp_path):
     with pytest.raises(EngineError, match="machine hobber-9 of the request folders does not exist"):
         RequestFolder(tmp_path, ["hobber-9"], run.url, Config())
+
+
+def test_the_service_needs_only_a_runners_login(run, server_url, tmp_path):
+    """engine serve connects as a login in engine_runner (design §10): it stores the program again
+    if need be and records the request, which names that login."""
+    made = stored_job(run, 42)
+    with psycopg.connect(run.url) as conn:   # the job edited since: the program is made again, as the runner
+        conn.execute("UPDATE job SET params = params || '{\"program_name\": \"SHAFT_7\"}' WHERE id = %s",
+                     (made["job_id"],))
+    with logins(server_url) as create:
+        runner = create("engine_runner")
+        folder = RequestFolder(tmp_path, ["hobber-840d"], runner.url(run.url), Config())
+        try:
+            (tmp_path / "hobber-840d" / "R.REQ").write_text(f"SHAFT_7_J{made['job_id']}.MPF\n")
+            [answer] = answered(folder)
+        finally:
+            folder.close()
+    assert answer.refusal is None and answer.program_file.startswith("PRG")
+    with psycopg.connect(run.url) as conn:
+        assert conn.execute("SELECT requested_by, program_id > %s FROM program_request",
+                            (made["program_id"],)).fetchall() == [(runner.name, True)]

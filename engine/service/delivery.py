@@ -161,6 +161,11 @@ def _rolled_back(conn: Connection) -> None:
         conn.rollback()
 
 
+def as_ascii(text: str) -> str:
+    """The text as a control shows it: ASCII, the engine's … spelt ..., anything else a ?."""
+    return text.replace("…", "...").encode("ascii", "replace").decode("ascii")
+
+
 def one_line(text: str) -> str:
     """The text on one line (a refusal is one line; a client's words are shown, never obeyed)."""
     return " ".join(LINE_BREAKING.sub(" ", text).split()) or "-"

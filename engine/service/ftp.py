@@ -36,7 +36,7 @@ from pyftpdlib.servers import ThreadedFTPServer
 
 from ..errors import EngineError
 from ..programs.config import Config
-from .delivery import MachineFile, deliver, machine_files
+from .delivery import MachineFile, as_ascii, deliver, machine_files
 
 if TYPE_CHECKING:
     from psycopg_pool import ConnectionPool
@@ -46,6 +46,7 @@ SECRET_VARIABLE = "ENGINE_FTP_SECRET_{}"
 WRITES = ("STOR", "STOU", "APPE", "DELE", "RNFR", "RNTO", "MKD", "XMKD", "RMD", "XRMD", "SITE CHMOD", "MFMT")
 READ_PERMS = "elr"   # change folder (only its own), list, retrieve
 POOL_SIZE = (1, 8)
+FAILED_LOGIN_DELAY = 3.0   # seconds before a failed login is answered (pyftpdlib's default), at most 3 a connection
 WRITE_REFUSED = ("550 {command} refused: this server only sends programs; a program reaches a machine from the "
                  "database, proved when it is asked for")
 SIZE_REFUSED = "550 SIZE is not known before the program is proved: RETR makes, proves and sends it"
@@ -199,7 +200,7 @@ class ProgramHandler(FTPHandler):
                 delivered = deliver(conn, self.username, posixpath.basename(file), via="ftp", client=self.remote_ip,
                                     config=self.config)
         except EngineError as refusal:
-            self.respond(f"550 {refusal}")
+            self.respond(f"550 {as_ascii(str(refusal))}")
             return None
         except Exception:   # a bug or a lost database: said in the log, never a traceback to the control
             LOG.exception("RETR %s by %s failed", file, self.username)
@@ -227,8 +228,10 @@ class FtpService:
         self.pool.close()
 
 
-def start_ftp_server(database_url: str, config: Config, host: str = "127.0.0.1", port: int = 0) -> FtpService:
-    """The FTP server on host:port (0: any free port), serving in a thread of its own."""
+def start_ftp_server(database_url: str, config: Config, host: str = "127.0.0.1", port: int = 0, *,
+                     failed_login_delay: float = FAILED_LOGIN_DELAY) -> FtpService:
+    """The FTP server on host:port (0: any free port), serving in a thread of its own. A failed
+    login is answered after `failed_login_delay` seconds (a brake on guessing secrets)."""
     from psycopg_pool import ConnectionPool
 
     from ..db.json_numbers import read_bounded_json
@@ -237,7 +240,8 @@ def start_ftp_server(database_url: str, config: Config, host: str = "127.0.0.1",
                           open=False)
     pool.open(wait=True)
     handler = type("MachineHandler", (ProgramHandler,), {"pool": pool, "config": config,
-                                                         "authorizer": MachineAuthorizer(pool, config)})
+                                                         "authorizer": MachineAuthorizer(pool, config),
+                                                         "auth_failed_timeout": failed_login_delay})
     try:
         server = ThreadedFTPServer((host, port), handler)
     except OSError as error:

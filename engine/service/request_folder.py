@@ -33,7 +33,7 @@ import msgspec
 
 from ..errors import EngineError
 from ..programs.config import Config
-from .delivery import deliver, one_line
+from .delivery import as_ascii, deliver, one_line
 
 if TYPE_CHECKING:
     from ..db.connection import Connection
@@ -117,7 +117,7 @@ class RequestFolder:
                                 config=self.config)
         except EngineError as refusal:
             reason = one_line(str(refusal))
-            write_atomically(folder, f"{stem}{ERROR}", _ascii(f"{reason}\n"))
+            write_atomically(folder, f"{stem}{ERROR}", f"{as_ascii(reason)}\n".encode("ascii"))
             answer = Answer(machine, request.name, refusal=reason)
         else:
             name = f"PRG{delivered.program_id}_{hashlib.sha256(delivered.data).hexdigest()[:8].upper()}.MPF"
@@ -196,8 +196,3 @@ def start_request_folder(root, machines: list[str], database_url: str, config: C
                          interval: float = POLL_SECONDS) -> FolderService:
     """The request folders of `machines` under `root`, answered in a thread of their own."""
     return FolderService(RequestFolder(root, machines, database_url, config), interval)
-
-
-def _ascii(text: str) -> bytes:
-    """The text as a control reads it: ASCII, the engine's … spelt ..., anything else a ?."""
-    return text.replace("…", "...").encode("ascii", "replace")
