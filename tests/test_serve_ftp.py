@@ -230,6 +230,14 @@ def test_another_machines_job_is_not_sent(run, serving):
     assert requests(run.url)[0][4:6] == (None, None)   # the 840D's history names no Fanuc job
 
 
+def test_a_fanuc_asks_by_its_o_number_as_m198_does(run, serving):
+    job = stored_job(run, 42, "hobber-fanuc")["job_id"]   # O number: program_number_base 1000 + gear 42
+    by_name = fetched(serving, "hobber-fanuc", f"GEAR42_J{job}.MPF")
+    assert fetched(serving, "hobber-fanuc", "O1042") == by_name == fetched(serving, "hobber-fanuc", "o01042")
+    assert "no stored job of O number 1043" in refusal_of(serving, "hobber-fanuc", "RETR O1043")
+    assert "names no program" in refusal_of(serving, "hobber-fanuc", "RETR O0")
+
+
 def test_two_machines_fetch_at_once(run, serving):
     jobs = {"hobber-840d": stored_job(run, 42)["job_id"], "hobber-fanuc": stored_job(run, 42, "hobber-fanuc")["job_id"]}
     start, got = threading.Barrier(2), {}

@@ -101,6 +101,14 @@ def test_a_stale_answer_is_replaced_and_what_is_not_a_request_is_refused(run, fo
     assert not (share / "A.RDY").exists() and "names no program" in (share / "A.ERR").read_text()
 
 
+def test_a_link_is_never_read_as_a_request(run, folders, tmp_path):
+    secret = tmp_path / "secret.txt"
+    secret.write_text("JOB 1 of the payroll\n")
+    (folders.root / "hobber-840d" / "L.REQ").symlink_to(secret)
+    assert answered(folders) == [] and sorted(path.name for path in (folders.root / "hobber-840d").iterdir()) == \
+        ["L.REQ"]
+
+
 def test_a_machine_that_does_not_exist_is_refused(run, tmp_path):
     with pytest.raises(EngineError, match="machine hobber-9 of the request folders does not exist"):
         RequestFolder(tmp_path, ["hobber-9"], run.url, Config())

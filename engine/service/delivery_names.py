@@ -32,7 +32,7 @@ FILE_NAME = re.compile(r"(?P<program>[A-Z_][A-Z0-9_]*?)_J(?P<job>[0-9]{1,18})(?:
 REQUEST_WORDS = (
     (re.compile(r"JOB\s+(?P<id>[0-9]{1,18})", re.IGNORECASE), "job"),
     (re.compile(r"GEAR\s+(?P<id>[0-9]{1,9})", re.IGNORECASE), "gear"),
-    (re.compile(r"O(?P<id>[0-9]{1,8})", re.IGNORECASE), "o_number"),
+    (re.compile(r"O0*(?P<id>[1-9][0-9]{0,7})", re.IGNORECASE), "o_number"),   # O1042, O0042: never O0
 )
 # The newest stored job of the machine for a gear, or for an O number (a Fanuc's M198 P<n>).
 NEWEST_OF = {

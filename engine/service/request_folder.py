@@ -2,9 +2,10 @@
 for controls that read programs from a network share, as an 840D does with `EXTCALL`.
 
 One folder per machine under a root (`<root>/<machine>/`). A control asks by writing a request
-file `<stem>.REQ` (stem: letters, digits and _, at most 24) whose first line names what it wants,
-ended by a new line: `JOB 17`, `GEAR 42` (that gear's newest stored job on the machine), `O1042` or a
-name its FTP list shows (engine.service.delivery_names). The engine answers each request once:
+file `<stem>.REQ` (stem: letters, digits and _, at most 24; a symbolic link is never read) whose
+first line names what it wants, ended by a new line: `JOB 17`, `GEAR 42` (that gear's newest stored
+job on the machine), `O1042` or a name its FTP list shows (engine.service.delivery_names). The
+engine answers each request once:
 
 1. the program, proved now (engine.service.delivery.deliver, via "folder"), is written next to it as
    `PRG<program id>_<first 8 hex digits of the sha256 of its bytes>.MPF`: a name that changes with
@@ -24,6 +25,7 @@ from __future__ import annotations
 import hashlib
 import os
 import re
+import stat
 import threading
 import uuid
 from pathlib import Path
@@ -88,27 +90,26 @@ class RequestFolder:
 
     def _poll(self, machine: str) -> list[Answer]:
         folder = self.root / machine
-        answers = []
-        for entry in sorted(folder.iterdir()):
-            found = REQUEST.fullmatch(entry.name)
-            if found and entry.is_file() and self._complete(entry):
-                answers.append(self._answer(machine, entry, found.group("stem")))
-        return answers
+        requests = [(entry, found.group("stem")) for entry in sorted(folder.iterdir())
+                    if (found := REQUEST.fullmatch(entry.name)) and not entry.is_symlink() and entry.is_file()]
+        self._seen = {path: seen for path, seen in self._seen.items()   # requests gone meanwhile forgotten
+                      if path.parent != folder or any(path == entry for entry, _ in requests)}
+        return [self._answer(machine, entry, stem) for entry, stem in requests if self._complete(entry)]
 
     def _complete(self, request: Path) -> bool:
         """Ends with a new line and unchanged since the previous look (else looked at again next time)."""
-        status = request.stat()
+        status = request.lstat()
         now, before = (status.st_size, status.st_mtime_ns), self._seen.get(request)
         self._seen[request] = now
         if before != now:
             return False
-        return status.st_size > MAX_REQUEST_BYTES or request.read_bytes().endswith(b"\n")   # too long: refused
+        return status.st_size > MAX_REQUEST_BYTES or _read_request(request).endswith(b"\n")   # too long: refused
 
     def _answer(self, machine: str, request: Path, stem: str) -> Answer:
         folder = self.root / machine
         for old in (READY, ERROR):
             (folder / f"{stem}{old}").unlink(missing_ok=True)
-        text = _first_line(request.read_bytes())
+        text = _first_line(_read_request(request))
         try:
             if text is None:
                 raise EngineError(f"request {request.name} is not one line of text naming a job (JOB 17, GEAR 42) "
@@ -130,6 +131,17 @@ class RequestFolder:
 
     def close(self) -> None:
         self.conn.close()
+
+
+def _read_request(request: Path) -> bytes:
+    """At most MAX_REQUEST_BYTES + 1 bytes of the request, only if it is a regular file and no link
+    (a link swapped in since it was listed would show another file's first line in the answer)."""
+    try:
+        descriptor = os.open(request, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
+    except OSError:
+        return b""
+    with open(descriptor, "rb") as file:
+        return file.read(MAX_REQUEST_BYTES + 1) if stat.S_ISREG(os.fstat(file.fileno()).st_mode) else b""
 
 
 def _first_line(data: bytes) -> str | None:
