@@ -14,6 +14,7 @@ from pathlib import Path
 
 import psycopg
 import pytest
+from helpers.lineage_text import id_masked
 from psycopg import sql
 from psycopg.conninfo import make_conninfo
 
@@ -196,10 +197,17 @@ def test_the_bytes_sent_are_the_file_instantiate_job_writes(run, secrets, tmp_pa
     assert written.exit_code == 0, written.output
     service = start_ftp_server(run.url, load_config(run.config, named=True))
     try:
-        sent = fetched(service.port, "hobber-840d", f"GEAR43_J{job}.MPF")
+        sent = fetched(service.port, "hobber-840d", f"GEAR43_J{job}.MPF")   # that program, proved again
+        with psycopg.connect(run.url) as conn:   # the job edited since: its program is made again at RETR
+            conn.execute("UPDATE job SET params = params || '{\"program_name\": \"WHEEL_43\"}' WHERE id = %s", (job,))
+        remade = fetched(service.port, "hobber-840d", f"WHEEL_43_J{job}.MPF")
     finally:
         service.close()
     assert sent == (out / "GEAR43.MPF").read_bytes() and b"\r\n" in sent
+    assert run("instantiate", "--job", job, "--out", f"{out}/").exit_code == 0
+    again = (out / "WHEEL_43.MPF").read_bytes().decode()
+    assert id_masked(remade.decode().split("\r\n")) == id_masked(again.split("\r\n"))   # but its own program id
+    assert remade != sent and b"%_N_WHEEL_43_MPF" in remade
 
 
 def test_a_draft_only_class_is_refused_with_its_reason_and_recorded(run, serving, tmp_path):

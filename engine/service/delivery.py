@@ -24,7 +24,6 @@ from typing import TYPE_CHECKING
 import msgspec
 import psycopg
 
-from ..db.connection import scalar
 from ..errors import EngineError
 from ..names import LINE_BREAKING
 from ..nc.layout import class_layout, nc_text
@@ -45,7 +44,7 @@ GROUP BY j.id ORDER BY j.id"""
 # The job's newest program, if it is one a control may be sent again unchanged (checked in SQL first,
 # then rendered and proved).
 REUSABLE = """
-SELECT p.id, p.name, p.lines, p.gear_class, p.template_version, m.kind, j.params
+SELECT p.id, p.lines, p.gear_class, p.template_version, j.machine, m.kind, j.params
 FROM program p JOIN job j ON j.id = p.job_id JOIN machine m ON m.name = j.machine
 WHERE p.id = (SELECT max(id) FROM program WHERE job_id = %(job)s)
   AND p.gear_class = j.gear_class AND p.template_version = released_version(j.gear_class)
@@ -66,7 +65,8 @@ class MachineFile(msgspec.Struct, frozen=True):
 
 
 class Delivered(msgspec.Struct, frozen=True):
-    """A program sent: the stored program, its job, the name asked for and the file's bytes."""
+    """A program sent: the stored program, its job, the job's name in the machine's list and the
+    bytes sent (the file `engine instantiate --job J --out DIR/` writes of that program)."""
     program_id: int
     job_id: int
     file_name: str
@@ -114,12 +114,12 @@ def _reused(conn: Connection, job_id: int, config: Config) -> tuple[int, bytes] 
         row = conn.execute(REUSABLE, {"job": job_id}).fetchone()
         if row is None:
             return None
-        program_id, _, lines, gear_class, version, kind, params = row
+        program_id, lines, gear_class, version, machine, kind, params = row
         if kind == "lathe" and not all(key in params for key in BLANK_PARAMS) and not _modelled(conn, gear_class):
             return None   # an assumed blank: made again, which refuses the file
         if not stored_rendering(conn, program_id).matches:
             return None
-        layout = class_layout(conn, gear_class, version).ending_from(line_ending(config, _machine_of(conn, job_id)))
+        layout = class_layout(conn, gear_class, version).ending_from(line_ending(config, machine))
     return program_id, nc_text(list(lines), layout).encode("ascii")
 
 
@@ -128,10 +128,6 @@ def _modelled(conn: Connection, gear_class: str) -> bool:
     from ..programs import all_models  # noqa: F401  (registers every model)
 
     return model_for_class(conn, gear_class) is not None
-
-
-def _machine_of(conn: Connection, job_id: int) -> str:
-    return scalar(conn.execute("SELECT machine FROM job WHERE id = %s", (job_id,)))
 
 
 def _remade(conn: Connection, job_id: int, config: Config) -> tuple[int, bytes]:
