@@ -99,6 +99,8 @@ def test_a_stale_answer_is_replaced_and_what_is_not_a_request_is_refused(run, fo
     (share / "A.REQ").write_text("PLEASE SEND\n")
     answered(folders)
     assert not (share / "A.RDY").exists() and "names no program" in (share / "A.ERR").read_text()
+    [(_, _, _, asked, job_id, program_id, refusal)] = requests(run.url)   # recorded as every refusal is
+    assert (asked, job_id, program_id) == ("PLEASE SEND", None, None) and "names no program" in refusal
 
 
 def test_a_link_is_never_read_as_a_request(run, folders, tmp_path):

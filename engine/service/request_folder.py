@@ -35,13 +35,13 @@ import msgspec
 
 from ..errors import EngineError
 from ..programs.config import Config
-from .delivery import as_ascii, deliver, one_line
+from .delivery import Delivered, as_ascii, deliver, one_line
 
 if TYPE_CHECKING:
     from ..db.connection import Connection
 
 REQUEST = re.compile(r"(?P<stem>[A-Za-z0-9_]{1,24})\.REQ", re.IGNORECASE)
-MAX_REQUEST_BYTES = 1024   # one line naming a job; a bound, not a limit a control meets
+MAX_REQUEST_BYTES = 1024   # a request's first line is read from its first KiB; a bound no control meets
 READY, ERROR, DONE = ".RDY", ".ERR", ".DONE"
 POLL_SECONDS = 1.0
 
@@ -103,28 +103,20 @@ class RequestFolder:
         self._seen[request] = now
         if before != now:
             return False
-        return status.st_size > MAX_REQUEST_BYTES or _read_request(request).endswith(b"\n")   # too long: refused
+        return status.st_size > MAX_REQUEST_BYTES or _read_request(request).endswith(b"\n")
 
     def _answer(self, machine: str, request: Path, stem: str) -> Answer:
+        """The request answered: its old answer removed, the new one written, the request renamed."""
         folder = self.root / machine
         for old in (READY, ERROR):
             (folder / f"{stem}{old}").unlink(missing_ok=True)
-        text = _first_line(_read_request(request))
         try:
-            if text is None:
-                raise EngineError(f"request {request.name} is not one line of text naming a job (JOB 17, GEAR 42) "
-                                  f"of at most {MAX_REQUEST_BYTES} bytes")
-            delivered = deliver(self.conn, machine, text, via="folder", client=f"{machine}/{request.name}",
-                                config=self.config)
+            delivered = deliver(self.conn, machine, _first_line(_read_request(request)), via="folder",
+                                client=f"{machine}/{request.name}", config=self.config)
         except EngineError as refusal:
-            reason = one_line(str(refusal))
-            write_atomically(folder, f"{stem}{ERROR}", f"{as_ascii(reason)}\n".encode("ascii"))
-            answer = Answer(machine, request.name, refusal=reason)
+            answer = _refused(folder, machine, request.name, stem, one_line(str(refusal)))
         else:
-            name = f"PRG{delivered.program_id}_{hashlib.sha256(delivered.data).hexdigest()[:8].upper()}.MPF"
-            write_atomically(folder, name, delivered.data)
-            write_atomically(folder, f"{stem}{READY}", f"{name}\n".encode("ascii"))
-            answer = Answer(machine, request.name, program_file=name)
+            answer = _sent(folder, machine, request.name, stem, delivered)
         os.replace(request, folder / f"{stem}{DONE}")
         self._seen.pop(request, None)
         return answer
@@ -134,25 +126,34 @@ class RequestFolder:
 
 
 def _read_request(request: Path) -> bytes:
-    """At most MAX_REQUEST_BYTES + 1 bytes of the request, only if it is a regular file and no link
+    """At most MAX_REQUEST_BYTES of the request, only if it is a regular file and no link
     (a link swapped in since it was listed would show another file's first line in the answer)."""
     try:
         descriptor = os.open(request, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
     except OSError:
         return b""
     with open(descriptor, "rb") as file:
-        return file.read(MAX_REQUEST_BYTES + 1) if stat.S_ISREG(os.fstat(file.fileno()).st_mode) else b""
+        return file.read(MAX_REQUEST_BYTES) if stat.S_ISREG(os.fstat(file.fileno()).st_mode) else b""
 
 
-def _first_line(data: bytes) -> str | None:
-    """The request's first line, or None if it is not ASCII text of a bounded size."""
-    if len(data) > MAX_REQUEST_BYTES:
-        return None
-    try:
-        lines = data.decode("ascii").splitlines()
-    except UnicodeDecodeError:
-        return None
-    return lines[0].strip() if lines and lines[0].strip() else None
+def _first_line(data: bytes) -> str:
+    """The request's first line (of its first KiB), as ASCII: what it asks for (deliver refuses
+    anything else than a request's words, and records it)."""
+    lines = data[:MAX_REQUEST_BYTES].decode("ascii", "replace").splitlines()
+    return lines[0].strip() if lines else ""
+
+
+def _refused(folder: Path, machine: str, request: str, stem: str, reason: str) -> Answer:
+    write_atomically(folder, f"{stem}{ERROR}", f"{as_ascii(reason)}\n".encode("ascii"))
+    return Answer(machine, request, refusal=reason)
+
+
+def _sent(folder: Path, machine: str, request: str, stem: str, delivered: Delivered) -> Answer:
+    """The program first, under a name carrying its bytes' hash; then the answer naming it."""
+    name = f"PRG{delivered.program_id}_{hashlib.sha256(delivered.data).hexdigest()[:8].upper()}.MPF"
+    write_atomically(folder, name, delivered.data)
+    write_atomically(folder, f"{stem}{READY}", f"{name}\n".encode("ascii"))
+    return Answer(machine, request, program_file=name)
 
 
 def write_atomically(folder: Path, name: str, data: bytes) -> None:
