@@ -53,11 +53,16 @@ SIZE_REFUSED = "550 SIZE is not known before the program is proved: RETR makes, 
 LISTING_REFUSED = "502 {command} is not offered: use LIST or NLST"
 
 
-def machine_secret(config: Config, machine: str) -> str | None:
-    """The machine's FTP secret from the environment, or None (it cannot log in)."""
+def secret_variable(config: Config, machine: str) -> str:
+    """The environment variable holding the machine's FTP secret: its table's ftp_secret_env, else
+    ENGINE_FTP_SECRET_<MACHINE> (what `engine serve` names for a machine that cannot log in)."""
     named = config.machines.get(machine, {}).get("ftp_secret_env")
-    variable = named or SECRET_VARIABLE.format(re.sub(r"[^A-Z0-9]", "_", machine.upper()))
-    return os.environ.get(variable) or None
+    return named or SECRET_VARIABLE.format(re.sub(r"[^A-Z0-9]", "_", machine.upper()))
+
+
+def machine_secret(config: Config, machine: str) -> str | None:
+    """The machine's FTP secret from the environment, or None (it cannot log in). Never printed."""
+    return os.environ.get(secret_variable(config, machine)) or None
 
 
 class MachineAuthorizer:
