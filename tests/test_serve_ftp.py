@@ -164,10 +164,15 @@ def test_stor_and_appe_are_refused_and_nothing_appears(listed):
     client.quit()
 
 
-def test_size_is_refused_with_its_reason_and_there_is_no_other_folder(listed):
+def test_size_resuming_and_other_folders_are_refused(listed):
     port, jobs = listed
     assert "proved" in refusal_of(port, "hobber-840d", f"SIZE GEAR42_J{jobs['a']}.MPF")
     assert refusal_of(port, "hobber-840d", "CWD /other").startswith("550")
+    for command in ("REST 100", "MLSD", "MLST GEAR42_J1.MPF"):   # a program is sent whole, listed by LIST
+        assert refusal_of(port, "hobber-840d", command).startswith("500")
+    client = login(port, "hobber-840d")
+    assert "REST" not in client.sendcmd("FEAT") and "MLST" not in client.sendcmd("FEAT")
+    client.quit()
 
 
 def test_the_config_file_never_holds_a_secret(tmp_path):

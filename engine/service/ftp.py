@@ -10,7 +10,7 @@ stored. RETR is engine.service.delivery.deliver: the program proved now, stored,
 client's address, and sent; a refusal is a 550 reply carrying its one-line reason, recorded too.
 Every write (STOR, STOU, APPE, DELE, RNFR/RNTO, MKD, RMD, SITE CHMOD, MFMT) is refused: programs
 reach a machine from the database only. SIZE is refused with its reason: a program's size is known
-only once it is proved, at RETR. A program is sent byte for byte in binary mode (TYPE I); in ASCII
+only once it is proved, at RETR. REST, MLSD and MLST are not offered: a program is sent whole. A program is sent byte for byte in binary mode (TYPE I); in ASCII
 mode FTP itself sends each line end as CR LF.
 
 Threaded (pyftpdlib's ThreadedFTPServer): two machines fetching at once each have a thread, and
@@ -50,7 +50,9 @@ FAILED_LOGIN_DELAY = 3.0   # seconds before a failed login is answered (pyftpdli
 WRITE_REFUSED = ("550 {command} refused: this server only sends programs; a program reaches a machine from the "
                  "database, proved when it is asked for")
 SIZE_REFUSED = "550 SIZE is not known before the program is proved: RETR makes, proves and sends it"
-LISTING_REFUSED = "502 {command} is not offered: use LIST or NLST"
+# Not offered at all (not in FEAT, "500 not understood"): MLSD/MLST would show facts of files that are
+# not on disk, and REST would resume a program made again meanwhile from the middle of another.
+NOT_OFFERED = ("MLSD", "MLST", "REST")
 
 
 def secret_variable(config: Config, machine: str) -> str:
@@ -175,6 +177,7 @@ class MachineFolder(AbstractedFS):
 class ProgramHandler(FTPHandler):
     """The control connection of one machine; pool and config are set on the server's subclass."""
     abstracted_fs = MachineFolder
+    proto_cmds = {name: command for name, command in FTPHandler.proto_cmds.items() if name not in NOT_OFFERED}
     pool: ConnectionPool
     config: Config
     use_gmt_times = True
@@ -191,15 +194,8 @@ class ProgramHandler(FTPHandler):
     def ftp_SIZE(self, path: str) -> None:
         self.respond(SIZE_REFUSED)
 
-    def ftp_MLSD(self, path: str) -> None:
-        self.respond(LISTING_REFUSED.format(command="MLSD"))
-
-    def ftp_MLST(self, path: str) -> None:
-        self.respond(LISTING_REFUSED.format(command="MLST"))
-
     def ftp_RETR(self, file: str):
         """The program proved now and sent, or 550 with the one-line reason (both recorded)."""
-        self._restart_position = 0   # a program is sent whole: it is made when asked for
         try:
             with self.pool.connection() as conn:
                 delivered = deliver(conn, self.username, posixpath.basename(file), via="ftp", client=self.remote_ip,
