@@ -10,8 +10,9 @@ stored. RETR is engine.service.delivery.deliver: the program proved now, stored,
 client's address, and sent; a refusal is a 550 reply carrying its one-line reason, recorded too.
 Every write (STOR, STOU, APPE, DELE, RNFR/RNTO, MKD, RMD, SITE CHMOD, MFMT) is refused: programs
 reach a machine from the database only. SIZE is refused with its reason: a program's size is known
-only once it is proved, at RETR. REST, MLSD and MLST are not offered: a program is sent whole. A program is sent byte for byte in binary mode (TYPE I); in ASCII
-mode FTP itself sends each line end as CR LF.
+only once it is proved, at RETR. REST, MLSD and MLST are not offered: a program is sent whole. A
+program is sent byte for byte in binary mode (TYPE I); in ASCII mode FTP itself sends each line end
+as CR LF.
 
 Threaded (pyftpdlib's ThreadedFTPServer): two machines fetching at once each have a thread, and
 each request takes a connection of its own from a psycopg pool."""
