@@ -16,6 +16,7 @@ programs go.
     [machines.hobber-840d]
     out = "/srv/nc/hobber"           # instantiate writes here when --out is not given
     line_endings = "lf"              # this machine's files: LF, whatever the file-wide setting
+    ftp_secret_env = "HOBBER_SECRET" # engine serve: the variable holding the machine's FTP secret
 
 A program file is written with its class's layout (LF and a final newline, or what the file an
 imported class came from had: engine.nc.layout). A line ending set here overrides only the
@@ -41,7 +42,11 @@ APP = "nc-template-engine"
 LINE_ENDINGS = {name: ending for ending, name in ENDING_NAMES.items()}   # "lf": "\n", "crlf": "\r\n"
 SETTINGS = ("machine", "line_endings", "machines")   # top-level keys that are not command options
 MAX_CONFIG_BYTES = 1 << 20   # a settings file is a few hundred bytes; a bound, not a limit anyone meets
-MACHINE_SETTINGS = ("out", "line_endings")
+MACHINE_SETTINGS = ("out", "line_endings", "ftp_secret_env")
+# A machine's FTP secret (engine serve, issue 32) is named, never written here: a config file is read by
+# others (a shared folder, a backup), so a secret in it is refused naming the variable to use instead.
+SECRET_KEYS = ("ftp_secret", "ftp_password", "secret", "password")
+ENVIRONMENT_NAME = re.compile(r"[A-Za-z_][A-Za-z0-9_]{0,63}")
 
 
 class Config(msgspec.Struct, frozen=True):
@@ -124,11 +129,17 @@ def _settings(path: Path, text: str, data: dict) -> Config:
 
 def _check_machine(config: Config, entry: dict) -> None:
     for key, value in entry.items():
+        if key in SECRET_KEYS:
+            raise config_error(config, key, "a secret is never kept in the config file (others can read it): put "
+                                            "it in an environment variable and name that with ftp_secret_env")
         if key not in MACHINE_SETTINGS:
             raise config_error(config, key, f"a machine's table takes {', '.join(MACHINE_SETTINGS)}")
         if not isinstance(value, str):
             raise config_error(config, key, "give the value in quotes")
     _check_line_endings(config, entry.get("line_endings"))
+    if "ftp_secret_env" in entry and not ENVIRONMENT_NAME.fullmatch(entry["ftp_secret_env"]):
+        raise config_error(config, "ftp_secret_env", "give the name of an environment variable, e.g. "
+                                                     "\"HOBBER_SECRET\"")
 
 
 def _check_line_endings(config: Config, value) -> None:

@@ -1,0 +1,211 @@
+"""The request folder of `engine serve` (issue 32; design notes §11; docs/guide/serving-programs.md):
+for controls that read programs from a network share, as an 840D does with `EXTCALL`.
+
+One folder per machine under a root (`<root>/<machine>/`). A control asks by writing a request
+file `<stem>.REQ` (stem: letters, digits and _, at most 24; a symbolic link is never read) whose
+first line names what it wants, ended by a new line: `JOB 17`, `GEAR 42` (that gear's newest stored
+job on the machine), `O1042` or a name its FTP list shows (engine.service.delivery_names). The
+engine answers each request once:
+
+1. the program, proved now (engine.service.delivery.deliver, via "folder"), is written next to it as
+   `PRG<program id>_<first 8 hex digits of the sha256 of its bytes>.MPF`: a name that changes with
+   the bytes, so a control never takes another program's file, nor an older one, for its answer;
+2. then `<stem>.RDY`, holding that file name and a new line: the name the control waits for with
+   `ISFILE`, known in advance; or, for a refusal, `<stem>.ERR` holding the one-line reason;
+3. then the request is renamed `<stem>.DONE`.
+
+Each file is written under a temporary name (a dot file, which is neither a program nor an answer),
+flushed to disk (fsync) and given its name in one step (os.replace), so a control never reads a
+half-written file. A request is taken only when it ends with a new line and has not changed since
+the previous look (a writer still writing is waited for); before answering, an old `<stem>.RDY` or
+`<stem>.ERR` is removed (the control removes it too, before it writes a request). `poll_once` looks
+once (tests, and a loop in `engine serve`)."""
+from __future__ import annotations
+
+import hashlib
+import os
+import re
+import stat
+import threading
+import uuid
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import msgspec
+
+from ..errors import EngineError
+from ..programs.config import Config
+from .delivery import Delivered, as_ascii, deliver, one_line
+
+if TYPE_CHECKING:
+    from ..db.connection import Connection
+
+REQUEST = re.compile(r"(?P<stem>[A-Za-z0-9_]{1,24})\.REQ", re.IGNORECASE)
+MAX_REQUEST_BYTES = 1024   # a request's first line is read from its first KiB; a bound no control meets
+READY, ERROR, DONE = ".RDY", ".ERR", ".DONE"
+POLL_SECONDS = 1.0
+
+
+class Answer(msgspec.Struct, frozen=True):
+    """What one request got: the machine, the request file, the program file written or the refusal."""
+    machine: str
+    request: str
+    program_file: str | None = None
+    refusal: str | None = None
+
+
+class RequestFolder:
+    """The machines' request folders under `root`, answered on one database connection."""
+
+    def __init__(self, root: str | os.PathLike, machines: list[str], database_url: str, config: Config):
+        from ..db.connection import connect
+
+        self.root, self.machines, self.config = Path(root), list(machines), config
+        if not self.root.is_dir():
+            raise EngineError(f"request folder root {self.root} does not exist; create it (the share the controls "
+                              "write to)")
+        self.database_url = database_url
+        self.conn: Connection = connect(database_url)
+        self._refuse_unknown_machines()
+        for machine in self.machines:
+            (self.root / machine).mkdir(exist_ok=True)
+        self._seen: dict[Path, tuple[int, int]] = {}   # request -> (size, mtime_ns) at the previous look
+
+    def _refuse_unknown_machines(self) -> None:
+        with self.conn.transaction():
+            known = {row[0] for row in self.conn.execute("SELECT name FROM machine WHERE name = ANY(%s)",
+                                                         (self.machines,))}
+        unknown = [machine for machine in self.machines if machine not in known]
+        if unknown:
+            self.conn.close()
+            raise EngineError(f"machine {unknown[0]} of the request folders does not exist; see `engine machines list`")
+
+    def poll_once(self) -> list[Answer]:
+        """Every complete request of every machine answered once, in name order."""
+        if self.conn.closed or self.conn.broken:   # the database restarted: a new connection
+            from ..db.connection import connect
+
+            self.conn = connect(self.database_url)
+        return [answer for machine in self.machines for answer in self._poll(machine)]
+
+    def _poll(self, machine: str) -> list[Answer]:
+        folder = self.root / machine
+        requests = [(entry, found.group("stem")) for entry in sorted(folder.iterdir())
+                    if (found := REQUEST.fullmatch(entry.name)) and not entry.is_symlink() and entry.is_file()]
+        self._seen = {path: seen for path, seen in self._seen.items()   # requests gone meanwhile forgotten
+                      if path.parent != folder or any(path == entry for entry, _ in requests)}
+        return [self._answer(machine, entry, stem) for entry, stem in requests if self._complete(entry)]
+
+    def _complete(self, request: Path) -> bool:
+        """Ends with a new line and unchanged since the previous look (else looked at again next time)."""
+        status = request.lstat()
+        now, before = (status.st_size, status.st_mtime_ns), self._seen.get(request)
+        self._seen[request] = now
+        if before != now:
+            return False
+        return status.st_size > MAX_REQUEST_BYTES or _read_request(request).endswith(b"\n")
+
+    def _answer(self, machine: str, request: Path, stem: str) -> Answer:
+        """The request answered: its old answer removed, the new one written, the request renamed."""
+        folder = self.root / machine
+        for old in (READY, ERROR):
+            (folder / f"{stem}{old}").unlink(missing_ok=True)
+        try:
+            delivered = deliver(self.conn, machine, _first_line(_read_request(request)), via="folder",
+                                client=f"{machine}/{request.name}", config=self.config)
+        except EngineError as refusal:
+            answer = _refused(folder, machine, request.name, stem, one_line(str(refusal)))
+        else:
+            answer = _sent(folder, machine, request.name, stem, delivered)
+        os.replace(request, folder / f"{stem}{DONE}")
+        self._seen.pop(request, None)
+        return answer
+
+    def close(self) -> None:
+        self.conn.close()
+
+
+def _read_request(request: Path) -> bytes:
+    """At most MAX_REQUEST_BYTES of the request, only if it is a regular file and no link
+    (a link swapped in since it was listed would show another file's first line in the answer)."""
+    try:
+        descriptor = os.open(request, os.O_RDONLY | os.O_NOFOLLOW | os.O_NONBLOCK)
+    except OSError:
+        return b""
+    with open(descriptor, "rb") as file:
+        return file.read(MAX_REQUEST_BYTES) if stat.S_ISREG(os.fstat(file.fileno()).st_mode) else b""
+
+
+def _first_line(data: bytes) -> str:
+    """The request's first line (of its first KiB), as ASCII: what it asks for (deliver refuses
+    anything else than a request's words, and records it)."""
+    lines = data[:MAX_REQUEST_BYTES].decode("ascii", "replace").splitlines()
+    return lines[0].strip() if lines else ""
+
+
+def _refused(folder: Path, machine: str, request: str, stem: str, reason: str) -> Answer:
+    write_atomically(folder, f"{stem}{ERROR}", f"{as_ascii(reason)}\n".encode("ascii"))
+    return Answer(machine, request, refusal=reason)
+
+
+def _sent(folder: Path, machine: str, request: str, stem: str, delivered: Delivered) -> Answer:
+    """The program first, under a name carrying its bytes' hash; then the answer naming it."""
+    name = f"PRG{delivered.program_id}_{hashlib.sha256(delivered.data).hexdigest()[:8].upper()}.MPF"
+    write_atomically(folder, name, delivered.data)
+    write_atomically(folder, f"{stem}{READY}", f"{name}\n".encode("ascii"))
+    return Answer(machine, request, program_file=name)
+
+
+def write_atomically(folder: Path, name: str, data: bytes) -> None:
+    """`folder/name` holds `data` whole or is as it was: written under a temporary dot name, flushed,
+    then renamed in one step, and the folder's entry flushed too."""
+    temporary = folder / f".{name}.{uuid.uuid4().hex}.tmp"
+    descriptor = os.open(temporary, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o644)
+    try:
+        with open(descriptor, "wb") as file:
+            file.write(data)
+            file.flush()
+            os.fsync(file.fileno())
+        os.replace(temporary, folder / name)
+    except BaseException:
+        temporary.unlink(missing_ok=True)
+        raise
+    _sync_folder(folder)
+
+
+def _sync_folder(folder: Path) -> None:
+    descriptor = os.open(folder, os.O_RDONLY)
+    try:
+        os.fsync(descriptor)
+    finally:
+        os.close(descriptor)
+
+
+class FolderService:
+    """Request folders answered in a thread every `interval` seconds until close()."""
+
+    def __init__(self, folder: RequestFolder, interval: float = POLL_SECONDS):
+        self.folder, self.interval = folder, interval
+        self._stop = threading.Event()
+        self.thread = threading.Thread(target=self._run, name="engine-request-folder", daemon=True)
+        self.thread.start()
+
+    def _run(self) -> None:
+        import logging
+
+        while not self._stop.wait(self.interval):
+            try:
+                self.folder.poll_once()
+            except Exception:   # a share gone for a moment, the database restarting: said, then tried again
+                logging.getLogger("engine.service.request_folder").exception("request folders not answered")
+
+    def close(self) -> None:
+        self._stop.set()
+        self.thread.join(timeout=30)
+        self.folder.close()
+
+
+def start_request_folder(root, machines: list[str], database_url: str, config: Config,
+                         interval: float = POLL_SECONDS) -> FolderService:
+    """The request folders of `machines` under `root`, answered in a thread of their own."""
+    return FolderService(RequestFolder(root, machines, database_url, config), interval)
