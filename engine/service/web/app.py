@@ -15,6 +15,7 @@ from starlette.middleware.sessions import SessionMiddleware
 from starlette.routing import BaseRoute
 
 from .auth import SESSION_COOKIE, SESSION_SECONDS, LoginRequired, session_secret
+from .pages import NulRefused
 
 # the concepts shown, each a module of this package with ROUTES (issue 32)
 PAGE_MODULES = ("home", "auth", "gears", "jobs", "programs", "program_views", "classes", "machines")
@@ -38,10 +39,12 @@ def create_app(database_url: str, *, require_login: bool = False, session_secret
 
 
 def _middleware(require_login: bool, secret: str | None) -> list[Middleware]:
-    """The session (a signed cookie holding the login's name), then the login it asks for."""
+    """The session (a signed cookie holding the login's name), then the login it asks for, then an
+    address holding a NUL refused (after the login: a visitor without one learns nothing more)."""
     return [Middleware(SessionMiddleware, secret_key=session_secret(secret), session_cookie=SESSION_COOKIE,
                        max_age=SESSION_SECONDS, same_site="lax"),
-            Middleware(LoginRequired, require_login=require_login)]
+            Middleware(LoginRequired, require_login=require_login),
+            Middleware(NulRefused)]
 
 
 def _routes() -> list[BaseRoute]:
