@@ -23,6 +23,7 @@ once (tests, and a loop in `engine serve`)."""
 from __future__ import annotations
 
 import hashlib
+import logging
 import os
 import re
 import stat
@@ -44,6 +45,7 @@ REQUEST = re.compile(r"(?P<stem>[A-Za-z0-9_]{1,24})\.REQ", re.IGNORECASE)
 MAX_REQUEST_BYTES = 1024   # a request's first line is read from its first KiB; a bound no control meets
 READY, ERROR, DONE = ".RDY", ".ERR", ".DONE"
 POLL_SECONDS = 1.0
+LOG = logging.getLogger("engine.service.request_folder")
 
 
 class Answer(msgspec.Struct, frozen=True):
@@ -94,7 +96,18 @@ class RequestFolder:
                     if (found := REQUEST.fullmatch(entry.name)) and not entry.is_symlink() and entry.is_file()]
         self._seen = {path: seen for path, seen in self._seen.items()   # requests gone meanwhile forgotten
                       if path.parent != folder or any(path == entry for entry, _ in requests)}
-        return [self._answer(machine, entry, stem) for entry, stem in requests if self._complete(entry)]
+        return [answer for entry, stem in requests if (answer := self._taken(machine, entry, stem))]
+
+    def _taken(self, machine: str, request: Path, stem: str) -> Answer | None:
+        """The request answered if complete, else None; a request the share will not let be looked at
+        or answered (its answer's name taken by a folder, the request gone meanwhile) is said in the
+        log and left for the next look, so it never stops the requests after it, of every machine
+        (the adversary of issue 32 found one folder named A.RDY leaving all of them unanswered)."""
+        try:
+            return self._answer(machine, request, stem) if self._complete(request) else None
+        except OSError as error:
+            LOG.warning("request %s of machine %s not answered: %s", request.name, machine, error)
+            return None
 
     def _complete(self, request: Path) -> bool:
         """Ends with a new line and unchanged since the previous look (else looked at again next time)."""
@@ -191,13 +204,11 @@ class FolderService:
         self.thread.start()
 
     def _run(self) -> None:
-        import logging
-
         while not self._stop.wait(self.interval):
             try:
                 self.folder.poll_once()
             except Exception:   # a share gone for a moment, the database restarting: said, then tried again
-                logging.getLogger("engine.service.request_folder").exception("request folders not answered")
+                LOG.exception("request folders not answered")
 
     def close(self) -> None:
         self._stop.set()
