@@ -3,9 +3,10 @@ for controls that read programs from a network share, as an 840D does with `EXTC
 
 One folder per machine under a root (`<root>/<machine>/`). A control asks by writing a request
 file `<stem>.REQ` (stem: letters, digits and _, at most 24; a symbolic link is never read) whose
-first line names what it wants, ended by a new line: `JOB 17`, `GEAR 42` (that gear's newest stored
-job on the machine), `O1042` or a name its FTP list shows (engine.service.delivery_names). The
-engine answers each request once:
+one line names what it wants, ended by a new line: `JOB 17`, `GEAR 42` (that gear's newest stored
+job on the machine), `O1042` or a name its FTP list shows (engine.service.delivery_names); a request
+of more lines is refused (an 840D's WRITE appends to a request left unanswered). The engine answers
+each request once:
 
 1. the program, proved now (engine.service.delivery.deliver, via "folder"), is written next to it as
    `PRG<program id>_<first 8 hex digits of the sha256 of its bytes>.MPF`: a name that changes with
@@ -124,7 +125,7 @@ class RequestFolder:
         for old in (READY, ERROR):
             (folder / f"{stem}{old}").unlink(missing_ok=True)
         try:
-            delivered = deliver(self.conn, machine, _first_line(_read_request(request)), via="folder",
+            delivered = deliver(self.conn, machine, _request_text(_read_request(request)), via="folder",
                                 client=f"{machine}/{request.name}", config=self.config)
         except EngineError as refusal:
             answer = _refused(folder, machine, request.name, stem, one_line(str(refusal)))
@@ -149,11 +150,12 @@ def _read_request(request: Path) -> bytes:
         return file.read(MAX_REQUEST_BYTES) if stat.S_ISREG(os.fstat(file.fileno()).st_mode) else b""
 
 
-def _first_line(data: bytes) -> str:
-    """The request's first line (of its first KiB), as ASCII: what it asks for (deliver refuses
-    anything else than a request's words, and records it)."""
+def _request_text(data: bytes) -> str:
+    """The request's lines (of its first KiB), as ASCII, blank ones left out: what it asks for. A
+    request is one line; deliver refuses more (an 840D's WRITE appends to a request file left
+    unanswered), and anything else than a request's words, and records it."""
     lines = data[:MAX_REQUEST_BYTES].decode("ascii", "replace").splitlines()
-    return lines[0].strip() if lines else ""
+    return "\n".join(line.strip() for line in lines if line.strip())
 
 
 def _refused(folder: Path, machine: str, request: str, stem: str, reason: str) -> Answer:
