@@ -8,12 +8,15 @@ job on the machine), `O1042` or a name its FTP list shows (engine.service.delive
 of more lines is refused (an 840D's WRITE appends to a request left unanswered). The engine answers
 each request once:
 
+0. the request is claimed: renamed `<stem>.DONE`, then read (a request written again meanwhile is
+   a new file, answered at a later look);
 1. the program, proved now (engine.service.delivery.deliver, via "folder"), is written next to it as
    `PRG<program id>_<first 8 hex digits of the sha256 of its bytes>.MPF`: a name that changes with
    the bytes, so a control never takes another program's file, nor an older one, for its answer;
 2. then `<stem>.RDY`, holding that file name and a new line: the name the control waits for with
    `ISFILE`, known in advance; or, for a refusal, `<stem>.ERR` holding the one-line reason;
-3. then the request is renamed `<stem>.DONE`.
+3. unless the control wrote a new `<stem>.REQ` meanwhile: then this answer is not written (the
+   control would take it for the new request's), and the new request is answered instead.
 
 Each file is written under a temporary name (a dot file, which is neither a program nor an answer),
 flushed to disk (fsync) and given its name in one step (os.replace), so a control never reads a
@@ -30,6 +33,7 @@ import re
 import stat
 import threading
 import uuid
+from functools import partial
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -119,21 +123,32 @@ class RequestFolder:
             return False
         return status.st_size > MAX_REQUEST_BYTES or _read_request(request).endswith(b"\n")
 
-    def _answer(self, machine: str, request: Path, stem: str) -> Answer:
-        """The request answered: its old answer removed, the new one written, the request renamed."""
+    def _answer(self, machine: str, request: Path, stem: str) -> Answer | None:
+        """The request answered: its old answer removed, the request claimed (renamed .DONE) and read,
+        the program proved, then the answer written, unless the control asked again meanwhile.
+
+        Claimed before it is read, so a request written again while this one is answered is a new
+        file, answered at a later look, never renamed .DONE unread; and no answer is written once a
+        new request is there, as the control waiting for it would take this one's answer for its own
+        (the adversary of issue 32 had job 42's program named in the .RDY of a request for job 43)."""
         folder = self.root / machine
         for old in (READY, ERROR):
             (folder / f"{stem}{old}").unlink(missing_ok=True)
+        claimed = folder / f"{stem}{DONE}"
+        os.replace(request, claimed)
+        self._seen.pop(request, None)
         try:
-            delivered = deliver(self.conn, machine, _request_text(_read_request(request)), via="folder",
+            delivered = deliver(self.conn, machine, _request_text(_read_request(claimed)), via="folder",
                                 client=f"{machine}/{request.name}", config=self.config)
         except EngineError as refusal:
-            answer = _refused(folder, machine, request.name, stem, one_line(str(refusal)))
+            answer = partial(_refused, folder, machine, request.name, stem, one_line(str(refusal)))
         else:
-            answer = _sent(folder, machine, request.name, stem, delivered)
-        os.replace(request, folder / f"{stem}{DONE}")
-        self._seen.pop(request, None)
-        return answer
+            answer = partial(_sent, folder, machine, request.name, stem, delivered)
+        if request.exists():   # asked again meanwhile: this answer would be taken for that request
+            LOG.warning("request %s of machine %s was written again while it was answered: the new one is "
+                        "answered instead", request.name, machine)
+            return None
+        return answer()
 
     def close(self) -> None:
         self.conn.close()
