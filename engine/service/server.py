@@ -10,7 +10,6 @@ request folder are further parts started beside it from the same options."""
 from __future__ import annotations
 
 import fcntl
-import ipaddress
 import os
 import secrets
 import signal
@@ -24,9 +23,9 @@ import msgspec
 
 from ..errors import EngineError
 from ..paths import runtime_folder
+from .addresses import is_loopback
 
 PID_FILE = "serve.pid"
-LOOPBACK_NAMES = {"localhost"}
 STOP_WAIT_SECONDS = 30   # how long `engine serve stop` waits for the service to finish its answers
 STOP_POLL_SECONDS = 0.1
 LISTEN_BACKLOG = 64
@@ -54,15 +53,6 @@ class ServeOptions(msgspec.Struct, frozen=True):
 
 class ServiceStopped(Exception):
     """`engine serve stop` asked the service to end (SIGTERM): a normal end, not a failure."""
-
-
-def is_loopback(host: str) -> bool:
-    if host in LOOPBACK_NAMES:
-        return True
-    try:
-        return ipaddress.ip_address(host).is_loopback
-    except ValueError:   # a host name: it may resolve to any address
-        return False
 
 
 def serve(options: ServeOptions, said: Callable[[str], None]) -> None:
