@@ -197,3 +197,6 @@ def test_a_runner_logged_in_is_recorded_by_name(shop):
     assert answer.status_code == 303
     program = int(answer.headers["location"].removeprefix("/programs/"))
     assert requests(admin)[-1] == (MACHINE, "web", name, f"JOB {job}", job, program, None)
+    with psycopg.connect(admin) as conn:   # stored by the service's own login, for the person who asked
+        stored_by = conn.execute("SELECT requested_by FROM program_request ORDER BY id DESC LIMIT 1").fetchone()[0]
+    assert stored_by == conninfo_to_dict(shop[0])["user"]
