@@ -196,7 +196,13 @@ def test_a_release_reaches_the_plant_a_draft_never_and_retiring_deletes_nothing(
     assert "; REVISION A" in program_lines(plant, program["program_id"])
 
     retiring = edit_spur(head, "REVISION B")
-    ok(engine(group.head, "template", "release", "--class", "spur", "--yes", "--without-golden-tests", url=head))
+    caught_up(plant, HISTORY_SLOT)   # the plant's job is in the head office's job table now
+    own_jobs = rows(head, "SELECT count(*) FROM job WHERE gear_class = 'spur' AND id < %s", (10**10,))[0][0]
+    report = json.loads(ok(engine(group.head, "template", "release", "--class", "spur", "--yes", "--json",
+                                  "--without-golden-tests", url=head)))
+    # the gate makes again the head office's own jobs only: a plant's are proved at the plant, on its gears
+    assert rows(head, "SELECT count(*) FROM job WHERE id = %s", (program["job_id"],)) == [(1,)]
+    assert report["impact"]["jobs"] == own_jobs
     caught_up(head, TEMPLATES_SLOT)
     assert rows(plant, "SELECT version, state FROM template_version_state WHERE gear_class = 'spur' "
                        "AND version IN (%s, %s) ORDER BY version", (draft, retiring)) == \
