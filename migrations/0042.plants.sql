@@ -1,6 +1,6 @@
 -- Issue 33: several plants, one template authority. The head office publishes its released
 -- template versions to every plant by PostgreSQL's logical replication; each plant publishes its
--- own history (jobs, programs, requests, drawings) back. docs/design.md §11 has the architecture.
+-- own history (jobs, programs, requests, drawings) back. docs/design.md §12 has the architecture.
 
 -- template_version_rows: whether the version was released, set once by release_template and never
 -- cleared, so a publication can filter on it (a version retired later still passes the filter and is

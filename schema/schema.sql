@@ -442,7 +442,7 @@ CREATE TABLE template_version_rows (
     final_newline boolean NOT NULL DEFAULT true,
     -- Whether the version was released (release_template; its release is template_release's
     -- row): set once, never cleared, so the head office's publication filters on it and a version
-    -- retired later is never deleted at a plant (docs/design.md §11).
+    -- retired later is never deleted at a plant (docs/design.md §12).
     released boolean NOT NULL DEFAULT false,
     PRIMARY KEY (gear_class, version),
     CONSTRAINT template_version_rows_hash UNIQUE (gear_class, version, hash)
@@ -2059,7 +2059,7 @@ RETURN (SELECT coalesce(jsonb_agg(jsonb_build_object('id', t.id, 'class', t.gear
 -- ==============================================================================================
 
 -- Section plants: several plants, one template authority (issue 33, after section release;
--- docs/design.md §11). The head office publishes the released versions and the records they run
+-- docs/design.md §12). The head office publishes the released versions and the records they run
 -- on; a plant subscribes to them and publishes its history back. Every trigger here is an ordinary
 -- one (ENABLE, origin only): it checks what is written in this database and never fires for a row
 -- the replication applies (session_replication_role = replica), so a program a plant made is

@@ -1,4 +1,4 @@
-"""Several plants, one template authority (issue 33; docs/design.md §11): two PostgreSQL servers,
+"""Several plants, one template authority (issue 33; docs/design.md §12): two PostgreSQL servers,
 a head office and plant 7, each an embedded server of its own with wal_level = logical (the local
 test server runs with replica, and only a restart changes that), set up only through the engine's
 commands (`engine db start --wal-level logical`, `engine plant publish`, `engine plant subscribe`).
@@ -31,7 +31,7 @@ pytestmark = pytest.mark.slow   # two servers of their own: about a minute
 
 SEED = Path(__file__).resolve().parent.parent / "seed_templates"
 PLANT = 7
-FIRST_ID, LAST_ID = PLANT * 10**10, (PLANT + 1) * 10**10 - 1   # docs/design.md §11: number·10^10 on
+FIRST_ID, LAST_ID = PLANT * 10**10, (PLANT + 1) * 10**10 - 1   # docs/design.md §12: number·10^10 on
 WAIT_SECONDS = 180   # a bound for a broken setup, never an assertion on speed
 TEMPLATES_SLOT, HISTORY_SLOT = f"engine_plant_{PLANT}_templates", f"engine_plant_{PLANT}_history"
 

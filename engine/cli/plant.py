@@ -1,4 +1,4 @@
-"""Several plants, one template authority (issue 33; docs/design.md §11): `engine plant publish` at the
+"""Several plants, one template authority (issue 33; docs/design.md §12): `engine plant publish` at the
 head office, `engine plant subscribe --head URL --number N` at a plant, `engine plant status` on both.
 The library is engine/plants/, imported when a command runs (issue 28: start-up)."""
 from __future__ import annotations

@@ -185,7 +185,7 @@ def find_psql(directories: list[Path] | None = None, path: str | None = None) ->
 def start_embedded(wal_level: str | None = None) -> tuple[str, bool]:
     """`engine db start`: start (or reuse) the embedded server and return its URL of the database
     `engine`, and whether it was restarted. With `wal_level` (logical for a head office or a plant:
-    docs/design.md §11) the level is made the server's (ALTER SYSTEM, kept in its data) and, as only a
+    docs/design.md §12) the level is made the server's (ALTER SYSTEM, kept in its data) and, as only a
     restart applies it, a server running with another level is stopped and started again: its
     sessions end, committed work is kept."""
     import psycopg

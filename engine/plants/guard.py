@@ -1,5 +1,5 @@
 """What a plant refuses before it starts: drafts and releases are the head office's (docs/design.md
-§11). The database refuses every write to the head office's tables at a plant too (the trigger
+§12). The database refuses every write to the head office's tables at a plant too (the trigger
 head_office_writes_it, schema/schema.sql section plants); this check says it before a long gate runs."""
 from __future__ import annotations
 

@@ -1,5 +1,5 @@
 """`engine plant publish` and `engine plant subscribe`: the publications and subscriptions of a head
-office and its plants, made with PostgreSQL's own logical replication (docs/design.md §11). Every
+office and its plants, made with PostgreSQL's own logical replication (docs/design.md §12). Every
 refusal is one line naming what to do; nothing is made before every check passed."""
 from __future__ import annotations
 

@@ -1,6 +1,6 @@
 """`engine plant status`: what this database publishes and receives, how far behind each
 subscription is, the replication slots kept here for its subscribers and the WAL each holds, and
-warnings (docs/design.md §11: an inactive slot keeps WAL until the disk is full)."""
+warnings (docs/design.md §12: an inactive slot keeps WAL until the disk is full)."""
 from __future__ import annotations
 
 from typing import TYPE_CHECKING

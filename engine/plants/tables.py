@@ -1,6 +1,6 @@
 """What is replicated, as data: the head office's tables a plant receives (with the row filter and
 column list of each), and a plant's history the head office receives. The rules behind each line are
-docs/design.md §11's; the database's own checks of these tables are schema/schema.sql's section plants."""
+docs/design.md §12's; the database's own checks of these tables are schema/schema.sql's section plants."""
 from __future__ import annotations
 
 import msgspec

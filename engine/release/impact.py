@@ -48,7 +48,7 @@ DIFFS_SHOWN = 5   # unified diffs the CLI prints (all of them with --json)
 
 # Every job of the classes made in this database, and whether it has a stored program (whose file a
 # layout change changes). At a head office the job table also holds its plants' jobs (issue 33,
-# docs/design.md §11): they are proved at their plant, against the plant's gears, which the head
+# docs/design.md §12): they are proved at their plant, against the plant's gears, which the head
 # office does not hold (a gear of the same number there is another gear), so they are left out.
 JOBS = """
 SELECT j.id, j.gear_class, j.machine, j.params::text, j.module_params::text,
