@@ -27,8 +27,6 @@ from psycopg import sql
 
 from engine.cli.app import main
 
-pytestmark = pytest.mark.slow   # two servers of their own: about a minute
-
 SEED = Path(__file__).resolve().parent.parent / "seed_templates"
 PLANT = 7
 FIRST_ID, LAST_ID = PLANT * 10**10, (PLANT + 1) * 10**10 - 1   # docs/design.md §12: number·10^10 on
@@ -103,7 +101,7 @@ class Group(msgspec.Struct):
 
 
 @pytest.fixture(scope="module")
-def group():
+def group():   # the tests that take it are slow: two servers of their own
     folder = Path(tempfile.mkdtemp(prefix="plants-", dir="/tmp"))   # short: the servers' sockets live there
     head, plant = Server(folder / "head"), Server(folder / "plant")
     try:
@@ -179,6 +177,7 @@ def program_lines(url: str, program_id: int) -> list[str]:
     return rows(url, "SELECT lines FROM program WHERE id = %s", (program_id,))[0][0]
 
 
+@pytest.mark.slow
 def test_a_release_reaches_the_plant_a_draft_never_and_retiring_deletes_nothing(group):
     head, plant = group.head_url, group.plant_url
     caught_up(head, TEMPLATES_SLOT)
@@ -210,6 +209,7 @@ def test_a_release_reaches_the_plant_a_draft_never_and_retiring_deletes_nothing(
     assert rows(plant, "SELECT count(*) FROM program WHERE id = %s", (program["program_id"],)) == [(1,)]
 
 
+@pytest.mark.slow
 def test_a_program_made_while_the_head_office_is_down_reaches_it_with_its_lineage(group):
     version, template_hash = released(group.head_url, "spur")
     caught_up(group.head_url, TEMPLATES_SLOT)
@@ -230,6 +230,7 @@ def test_a_program_made_while_the_head_office_is_down_reaches_it_with_its_lineag
     assert arrived == [(lines, False)]
 
 
+@pytest.mark.slow
 def test_plant_ids_never_collide(group):
     at_head, at_plant = instantiate(group.head, group.head_url), instantiate(group.plant, group.plant_url)
     assert 1 <= at_head["program_id"] < 10**10 and FIRST_ID <= at_plant["program_id"] <= LAST_ID
@@ -245,6 +246,7 @@ def test_plant_ids_never_collide(group):
     assert f"the head office has a plant {PLANT} already" in taken.stderr
 
 
+@pytest.mark.slow
 def test_a_plant_refuses_drafts_and_releases_in_one_line(group, tmp_path):
     release = engine(group.plant, "template", "release", "--class", "spur", "--yes", url=group.plant_url)
     assert release.exit_code == 1 and release.stderr.count("\n") == 1
@@ -258,6 +260,7 @@ def test_a_plant_refuses_drafts_and_releases_in_one_line(group, tmp_path):
         rows(group.plant_url, "UPDATE machine SET name = name")
 
 
+@pytest.mark.slow
 def test_status_as_text_and_json(group):
     head = json.loads(ok(engine(group.head, "plant", "status", "--json", url=group.head_url)))
     plant = json.loads(ok(engine(group.plant, "plant", "status", "--json", url=group.plant_url)))
@@ -270,3 +273,24 @@ def test_status_as_text_and_json(group):
     assert all(isinstance(s["retained_bytes"], int) for s in head["slots"] + plant["slots"])
     text = ok(engine(group.plant, "plant", "status", url=group.plant_url))
     assert text.startswith(f"plant {PLANT}; wal_level logical") and f"receives {TEMPLATES_SLOT}" in text
+
+
+def test_a_single_database_is_neither_head_office_nor_plant(read_only_run):
+    status = json.loads(ok(read_only_run("plant", "status", "--json")))
+    assert (status["role"], status["number"], status["subscriptions"], status["warnings"]) == \
+        ("single (no replication)", 0, [], [])
+
+
+def test_publishing_needs_wal_level_logical(read_only_run):
+    level = rows(read_only_run.url, "SHOW wal_level")[0][0]
+    if level == "logical":
+        pytest.skip("the test server runs with wal_level = logical")
+    refused = read_only_run("plant", "publish")
+    assert refused.exit_code == 1 and refused.stderr.count("\n") == 1
+    assert f"wal_level is {level}, a publisher needs logical" in refused.stderr
+
+
+def test_db_start_is_the_embedded_servers_only(read_only_run):
+    refused = read_only_run("db", "start", "--wal-level", "logical")
+    assert refused.exit_code == 1 and refused.stderr.count("\n") == 1
+    assert "name another server" in refused.stderr

@@ -125,11 +125,13 @@ def db_start(ctx, wal_level):
 
     Example: engine db start --wal-level logical
     """
+    from ..db.connection import LIBPQ_VARIABLES
     from ..db.embedded import start_embedded
 
-    if ctx.obj["database_url"] or any(os.environ.get(name) for name in ("PGHOST", "PGHOSTADDR", "PGPORT")):
-        raise EngineError("db start: --database-url, DATABASE_URL or PGHOST name another server; engine db start "
-                          "starts the embedded one: set that server's wal_level in its postgresql.conf and restart it")
+    if ctx.obj["database_url"] or any(os.environ.get(name) for name in LIBPQ_VARIABLES):
+        raise EngineError("db start: --database-url, DATABASE_URL or the PG* variables name another server; "
+                          "engine db start starts the embedded one: set that server's wal_level in its "
+                          "postgresql.conf and restart it")
     url, restarted = start_embedded(wal_level)
     click.echo(url)
     if restarted:

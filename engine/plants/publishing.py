@@ -111,7 +111,14 @@ def _check_plant(conn: Connection, number: int) -> None:
 
 
 def _check_head(head: Connection, number: int) -> None:
-    """The head office publishes, is no plant itself, and has no plant of this number yet."""
+    """The head office has this engine's migrations (a rule only one side has would stop the
+    replication), publishes, is no plant itself, and has no plant of this number yet."""
+    from ..db.migrate import require_current
+
+    try:
+        require_current(head)
+    except EngineError as error:
+        raise EngineError(f"engine plant subscribe: at the head office, {error}") from error
     publication = (tables.TEMPLATES_PUBLICATION,)
     if not head.execute("SELECT 1 FROM pg_publication WHERE pubname = %s", publication).fetchone():
         raise EngineError("engine plant subscribe: the head office publishes nothing yet; "
