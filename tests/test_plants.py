@@ -261,6 +261,21 @@ def test_a_plant_refuses_drafts_and_releases_in_one_line(group, tmp_path):
 
 
 @pytest.mark.slow
+def test_at_a_plant_the_proof_the_simulation_and_the_web_view_work_unchanged(group):
+    from starlette.testclient import TestClient
+
+    from engine.service.web.app import create_app
+
+    program_id = instantiate(group.plant, group.plant_url)["program_id"]
+    shown = json.loads(ok(engine(group.plant, "programs", "show", program_id, "--json", url=group.plant_url)))
+    assert shown["programs"][0]["rendering"]["status"] == "MATCH"   # rendered again from the received version, proved
+    ok(engine(group.plant, "simulate", "--program", program_id, url=group.plant_url))
+    with TestClient(create_app(group.plant_url)) as client:
+        page = client.get(f"/programs/{program_id}", headers={"Accept": "application/json"})
+    assert page.status_code == 200 and page.json() == shown
+
+
+@pytest.mark.slow
 def test_status_as_text_and_json(group):
     head = json.loads(ok(engine(group.head, "plant", "status", "--json", url=group.head_url)))
     plant = json.loads(ok(engine(group.plant, "plant", "status", "--json", url=group.plant_url)))
