@@ -247,6 +247,19 @@ def test_plant_ids_never_collide(group):
 
 
 @pytest.mark.slow
+def test_subscribing_again_changes_nothing_and_a_plant_keeps_its_number(group):
+    slots = "SELECT slot_name FROM pg_replication_slots ORDER BY 1"
+    before = rows(group.head.url, slots), rows(group.plant.url, slots)
+    again = ok(engine(group.plant, "plant", "subscribe", "--head", group.head_url, "--number", PLANT,
+                      url=group.plant_url))
+    assert again.startswith(f"plant {PLANT}: ids {FIRST_ID} to {LAST_ID};")
+    assert (rows(group.head.url, slots), rows(group.plant.url, slots)) == before
+    other = engine(group.plant, "plant", "subscribe", "--head", group.head_url, "--number", PLANT + 1,
+                   url=group.plant_url)
+    assert other.exit_code == 1 and f"this database is plant {PLANT}, not {PLANT + 1}" in other.stderr
+
+
+@pytest.mark.slow
 def test_a_plant_refuses_drafts_and_releases_in_one_line(group, tmp_path):
     release = engine(group.plant, "template", "release", "--class", "spur", "--yes", url=group.plant_url)
     assert release.exit_code == 1 and release.stderr.count("\n") == 1

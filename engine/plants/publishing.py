@@ -73,12 +73,14 @@ def _table_spec(table: Published) -> sql.Composable:
 
 def subscribe(conn: Connection, head_url: str, number: int, plant_url: str) -> Subscribed:
     """Make this database plant `number`: its id range, its history's publication, its
-    subscription to the head office's templates, and the head office's subscription to its history."""
+    subscription to the head office's templates, and the head office's subscription to its history.
+    Run again on plant `number`, it makes what a failed run left unmade (each step is skipped once done)."""
     require_logical(conn, "engine plant subscribe")
-    _check_plant(conn, number)
+    resuming = _check_plant(conn, number)
     with connect(head_url, autocommit=True) as head:
-        _check_head(head, number)
-        first, last = _claim_ids(conn, number)
+        _check_head(head, number, resuming)
+        if not resuming:
+            _claim_ids(conn, number)
         _publication(conn, tables.HISTORY_PUBLICATION, tables.HISTORY_TABLES, tables.HISTORY_OPERATIONS)
         conn.commit()
         conn.autocommit = True
@@ -86,15 +88,18 @@ def subscribe(conn: Connection, head_url: str, number: int, plant_url: str) -> S
         _subscription(conn, templates, head_url, tables.TEMPLATES_PUBLICATION)
         history = subscription_name(number, "history")
         _subscription(head, history, plant_url, tables.HISTORY_PUBLICATION)
-    return Subscribed(number, first, last, templates, history)
+    return Subscribed(number, *_id_range(conn, number), templates, history)
 
 
-def _check_plant(conn: Connection, number: int) -> None:
-    """A new plant: no number yet, none of the head office's rows, no row of its own outside its range."""
+def _check_plant(conn: Connection, number: int) -> bool:
+    """A new plant: no number yet, none of the head office's rows, no row of its own outside its
+    range. True: this database is plant `number` already (a run to finish, or done)."""
     here = plant_number(conn)
-    if here > 0:
-        raise EngineError(f"engine plant subscribe: this database is plant {here} already; "
+    if here > 0 and here != number:
+        raise EngineError(f"engine plant subscribe: this database is plant {here}, not {number}; "
                           "see engine plant status")
+    if here == number:
+        return True
     for published in tables.HEAD_TABLES:
         if conn.execute(sql.SQL("SELECT 1 FROM {} LIMIT 1").format(sql.Identifier(published.table))).fetchone():
             raise EngineError(f"engine plant subscribe: this database holds {published.table} rows of its own; a plant "
@@ -108,11 +113,13 @@ def _check_plant(conn: Connection, number: int) -> None:
             raise EngineError(f"engine plant subscribe: this database holds {name} rows outside plant "
                               f"{number}'s ids ({first} to {last}); they would collide at the head office: "
                               "subscribe a new database")
+    return False
 
 
-def _check_head(head: Connection, number: int) -> None:
+def _check_head(head: Connection, number: int, resuming: bool) -> None:
     """The head office has this engine's migrations (a rule only one side has would stop the
-    replication), publishes, is no plant itself, and has no plant of this number yet."""
+    replication), publishes, is no plant itself, and has no plant of this number yet (unless this
+    database is that plant, finishing its setup)."""
     from ..db.migrate import require_current
 
     try:
@@ -126,7 +133,7 @@ def _check_head(head: Connection, number: int) -> None:
     if plant_number(head) > 0:
         raise EngineError(f"engine plant subscribe: --head names plant {plant_number(head)}, not the head office")
     name = subscription_name(number, "history")
-    if head.execute("SELECT 1 FROM pg_subscription WHERE subname = %s", (name,)).fetchone():
+    if not resuming and _subscribed(head, name):
         raise EngineError(f"engine plant subscribe: the head office has a plant {number} already ({name}); "
                           "choose another --number")
 
@@ -137,7 +144,7 @@ def _id_range(conn: Connection, number: int) -> tuple[int, int]:
     return int(row[0]), int(row[1])
 
 
-def _claim_ids(conn: Connection, number: int) -> tuple[int, int]:
+def _claim_ids(conn: Connection, number: int) -> None:
     """Record the plant's number and move its id sequences into its range (bounded by it: an
     exhausted range stops with an error rather than making another plant's ids)."""
     conn.execute("INSERT INTO plant_identity (number) VALUES (%s)", (number,))
@@ -147,17 +154,24 @@ def _claim_ids(conn: Connection, number: int) -> tuple[int, int]:
         start = scalar(conn.execute(sql.SQL("SELECT coalesce(max(id) + 1, %s) FROM {}").format(table), (first,)))
         conn.execute(sql.SQL("ALTER SEQUENCE {} MINVALUE {} MAXVALUE {} START WITH {} RESTART WITH {}").format(
             sql.Identifier(sequence), sql.Literal(first), sql.Literal(last), sql.Literal(first), sql.Literal(start)))
-    return first, last
+
+
+def _subscribed(conn: Connection, name: str) -> bool:
+    """This database has the subscription `name`."""
+    return conn.execute("SELECT 1 FROM pg_subscription WHERE subname = %s AND subdbid = (SELECT oid FROM "
+                        "pg_database WHERE datname = current_database())", (name,)).fetchone() is not None
 
 
 def _subscription(conn: Connection, name: str, url: str, publication: str) -> None:
-    """CREATE SUBSCRIPTION (its slot at the publisher takes its name); outside a transaction."""
+    """CREATE SUBSCRIPTION unless made (its slot at the publisher takes its name); outside a transaction."""
     import psycopg
 
+    if _subscribed(conn, name):
+        return
     try:
         conn.execute(sql.SQL("CREATE SUBSCRIPTION {} CONNECTION {} PUBLICATION {}").format(
             sql.Identifier(name), sql.Literal(url), sql.Identifier(publication)))
     except psycopg.Error as error:
         first_line = (str(error).strip().splitlines() or [type(error).__name__])[0]
         raise EngineError(f"engine plant subscribe: could not make the subscription {name} ({first_line}); "
-                          "what was made before it stays: see engine plant status") from error
+                          "what was made before it stays: make it reachable and run the same command again") from error
