@@ -45,7 +45,8 @@ def plant_publish(ctx):
 def plant_subscribe(ctx, head_url, number, plant_url):
     """At a new plant (migrated, not seeded): take a plant number and its id range, receive the
     head office's released templates read-only, publish this plant's history (insert only) and
-    make the head office subscribe to it. Needs wal_level = logical here.
+    make the head office subscribe to it. Needs wal_level = logical here. Run again, it finishes
+    a setup a failure left unfinished, and changes nothing on a finished plant.
 
     Example: engine plant subscribe --head postgresql://engine@head.example/engine --number 3
     """
