@@ -289,6 +289,21 @@ def test_at_a_plant_the_proof_the_simulation_and_the_web_view_work_unchanged(gro
 
 
 @pytest.mark.slow
+def test_at_a_plant_the_delivery_sends_and_records_and_the_head_office_sees_it(group):
+    from engine.programs.config import Config
+    from engine.service.delivery import deliver
+
+    job_id = instantiate(group.plant, group.plant_url)["job_id"]
+    with psycopg.connect(group.plant_url, autocommit=True) as conn:
+        sent = deliver(conn, "hobber-840d", f"JOB {job_id}", via="web", client="test", config=Config())
+    assert sent.job_id == job_id and FIRST_ID <= sent.program_id <= LAST_ID
+    request = rows(group.plant_url, "SELECT id, program_id FROM program_request WHERE job_id = %s", (job_id,))
+    assert len(request) == 1 and FIRST_ID <= request[0][0] <= LAST_ID
+    caught_up(group.plant_url, HISTORY_SLOT)
+    assert rows(group.head_url, "SELECT id, program_id FROM program_request WHERE job_id = %s", (job_id,)) == request
+
+
+@pytest.mark.slow
 def test_status_as_text_and_json(group):
     head = json.loads(ok(engine(group.head, "plant", "status", "--json", url=group.head_url)))
     plant = json.loads(ok(engine(group.plant, "plant", "status", "--json", url=group.plant_url)))
