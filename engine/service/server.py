@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import contextlib
 import fcntl
-import ipaddress
 import os
 import secrets
 import signal
@@ -28,9 +27,9 @@ import msgspec
 from ..errors import EngineError
 from ..paths import runtime_folder
 from ..programs.config import Config
+from .addresses import is_loopback
 
 PID_FILE = "serve.pid"
-LOOPBACK_NAMES = {"localhost"}
 STOP_WAIT_SECONDS = 30   # how long `engine serve stop` waits for the service to finish its answers
 STOP_POLL_SECONDS = 0.1
 LISTEN_BACKLOG = 64
@@ -40,7 +39,8 @@ class ServeOptions(msgspec.Struct, frozen=True):
     """What `engine serve` runs: the database (a resolved URL: engine.db.connection.resolve_url),
     where the web view listens, and the delivery to the controls: FTP on ftp_host:ftp_port (None:
     no FTP), request folders under `requests` for `request_machines` (None: none). `config`: the
-    settings file (machines' line endings and FTP secret variables)."""
+    settings file (machines' line endings and FTP secret variables), the web view's too (a runner's
+    request makes the same files)."""
     database_url: str
     host: str = "127.0.0.1"
     port: int = 8080
@@ -64,15 +64,6 @@ class ServeOptions(msgspec.Struct, frozen=True):
 
 class ServiceStopped(Exception):
     """`engine serve stop` asked the service to end (SIGTERM): a normal end, not a failure."""
-
-
-def is_loopback(host: str) -> bool:
-    if host in LOOPBACK_NAMES:
-        return True
-    try:
-        return ipaddress.ip_address(host).is_loopback
-    except ValueError:   # a host name: it may resolve to any address
-        return False
 
 
 def serve(options: ServeOptions, said: Callable[[str], None]) -> None:
@@ -119,7 +110,7 @@ def _run(options: ServeOptions, listening: socket.socket, said: Callable[[str], 
     app = create_app(options.database_url, require_login=options.needs_login,
                      session_secret=secrets.token_urlsafe(32) if options.needs_login else None,
                      on_ready=lambda: said(f"serving the web view at {options.address}{login}; stop it with "
-                                           "Ctrl-C or `engine serve stop`"))
+                                           "Ctrl-C or `engine serve stop`"), config=options.config)
     server = uvicorn.Server(uvicorn.Config(app, log_level="warning", lifespan="on"))
     # uvicorn catches both signals to finish the answers under way, then raises them again with the
     # handlers it found: Ctrl-C as KeyboardInterrupt (exit 130, even where the shell started the
