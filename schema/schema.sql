@@ -440,9 +440,17 @@ CREATE TABLE template_version_rows (
     row_ids    integer[] GENERATED ALWAYS AS (template_row_ids(rows)) STORED,
     line_ending text NOT NULL DEFAULT E'\n' CHECK (line_ending IN (E'\n', E'\r\n')),
     final_newline boolean NOT NULL DEFAULT true,
+    -- Whether the version was released (release_template; its release is template_release's
+    -- row): set once, never cleared, so the head office's publication filters on it and a version
+    -- retired later is never deleted at a plant (docs/design.md §12).
+    released boolean NOT NULL DEFAULT false,
     PRIMARY KEY (gear_class, version),
     CONSTRAINT template_version_rows_hash UNIQUE (gear_class, version, hash)
 );
+-- The replica identity holds `released`: a publication's row filter on UPDATE reads only its
+-- columns (FULL would hold the generated columns, which PostgreSQL 18 refuses as unpublished).
+CREATE UNIQUE INDEX template_version_rows_released ON template_version_rows (gear_class, version, released);
+ALTER TABLE template_version_rows REPLICA IDENTITY USING INDEX template_version_rows_released;
 
 -- The class's assembled rows as template_version_rows stores them.
 CREATE FUNCTION class_rows_array(class_name text)
@@ -451,9 +459,25 @@ RETURN (SELECT coalesce(jsonb_agg(template_row_json(r.id, c.t, r.n, c.p_calc, c.
                         '[]')
         FROM class_template(class_name) r JOIN component c ON c.id = r.component_id);
 
--- Never changed; deleted only with its class (a cascade, run by a trigger).
+-- A version's rows are a record: never changed, deleted only with its class (a cascade, run by a
+-- trigger); only released is set, once (release_template). hash and row_ids are left out of the
+-- comparison: a BEFORE trigger sees generated columns not yet computed (they follow from rows).
+CREATE FUNCTION refuse_changing_a_version() RETURNS trigger
+LANGUAGE plpgsql
+AS $$
+BEGIN
+    IF TG_OP = 'UPDATE' AND NOT OLD.released AND NEW.released
+       AND to_jsonb(NEW) - '{released,hash,row_ids}'::text[] = to_jsonb(OLD) - '{released,hash,row_ids}'::text[] THEN
+        RETURN NEW;
+    END IF;
+    RAISE EXCEPTION '% of %: its rows are records, never changed or deleted (a new version is stored when a '
+                    'template changes; only its release is marked, once)', TG_OP, TG_TABLE_NAME
+        USING ERRCODE = 'insufficient_privilege';
+END
+$$;
+
 CREATE TRIGGER template_version_rows_is_a_record BEFORE UPDATE OR DELETE ON template_version_rows
-FOR EACH ROW WHEN (pg_trigger_depth() < 1) EXECUTE FUNCTION refuse_changing_a_record();
+FOR EACH ROW WHEN (pg_trigger_depth() < 1) EXECUTE FUNCTION refuse_changing_a_version();
 CREATE TRIGGER template_version_rows_is_not_truncated BEFORE TRUNCATE ON template_version_rows
 FOR EACH STATEMENT EXECUTE FUNCTION refuse_changing_a_record();
 
@@ -1942,6 +1966,8 @@ BEGIN
     VALUES (class_name, current, stored, template_editor(), coalesce(tests, '[]'), coalesce(impact, '{}'),
             coalesce(checks, '{}'), note, coalesce(via, 'sql'), golden_tests_of(class_name))
     RETURNING id INTO made;
+    UPDATE template_version_rows v SET released = true
+    WHERE v.gear_class = class_name AND v.version = current AND NOT v.released;
     RETURN made;
 END
 $$;
@@ -2027,6 +2053,96 @@ RETURN (SELECT coalesce(jsonb_agg(jsonb_build_object('id', t.id, 'class', t.gear
         FROM classes_and_below(ARRAY[class_name]) b
         JOIN gear_class g ON g.name = b.name
         JOIN template_test t ON t.gear_class = g.name);
+
+-- ==============================================================================================
+-- plants
+-- ==============================================================================================
+
+-- Section plants: several plants, one template authority (issue 33, after section release;
+-- docs/design.md §12). The head office publishes the released versions and the records they run
+-- on; a plant subscribes to them and publishes its history back. Every trigger here is an ordinary
+-- one (ENABLE, origin only): it checks what is written in this database and never fires for a row
+-- the replication applies (session_replication_role = replica), so a program a plant made is
+-- taken at the head office as the plant proved it, whatever the head office has released since.
+
+-- plant_identity: which plant this database is (one row, written by `engine plant subscribe`);
+-- no row: the head office, or a shop of one database (plant 0).
+CREATE TABLE plant_identity (
+    one        boolean PRIMARY KEY DEFAULT true CHECK (one),
+    number     integer NOT NULL CHECK (number BETWEEN 1 AND 9999),
+    set_at     timestamptz NOT NULL DEFAULT now(),
+    set_by     text NOT NULL DEFAULT session_user
+);
+
+-- This database's plant number: 0 at the head office.
+CREATE FUNCTION plant_number() RETURNS integer
+LANGUAGE sql STABLE
+RETURN coalesce((SELECT p.number FROM plant_identity p), 0);
+
+-- The ids a plant makes: [number * 10^10, (number + 1) * 10^10), the head office's from 1.
+CREATE FUNCTION plant_first_id(number integer) RETURNS bigint
+LANGUAGE sql IMMUTABLE PARALLEL SAFE
+RETURN greatest(number::bigint * 10000000000, 1);
+
+CREATE FUNCTION plant_last_id(number integer) RETURNS bigint
+LANGUAGE sql IMMUTABLE PARALLEL SAFE
+RETURN (number::bigint + 1) * 10000000000 - 1;
+
+-- check_plant_id: a row made here has an id of this plant's range.
+CREATE FUNCTION check_plant_id() RETURNS trigger
+LANGUAGE plpgsql SET search_path = public, pg_temp
+AS $$
+DECLARE
+    here integer := plant_number();
+BEGIN
+    IF NEW.id NOT BETWEEN plant_first_id(here) AND plant_last_id(here) THEN
+        RAISE EXCEPTION '% %: plant % makes ids % to % only, so no two plants make one id; its sequence %_id_seq '
+                        'was moved, run engine plant status', TG_TABLE_NAME, NEW.id, here, plant_first_id(here),
+                        plant_last_id(here), TG_TABLE_NAME
+            USING ERRCODE = 'check_violation', COLUMN = 'id';
+    END IF;
+    RETURN NEW;
+END
+$$;
+
+CREATE TRIGGER a_plant_id BEFORE INSERT ON job FOR EACH ROW EXECUTE FUNCTION check_plant_id();
+CREATE TRIGGER a_plant_id BEFORE INSERT ON program FOR EACH ROW EXECUTE FUNCTION check_plant_id();
+CREATE TRIGGER a_plant_id BEFORE INSERT ON program_request FOR EACH ROW EXECUTE FUNCTION check_plant_id();
+CREATE TRIGGER a_plant_id BEFORE INSERT ON drawing FOR EACH ROW EXECUTE FUNCTION check_plant_id();
+
+-- refuse_at_a_plant: the head office's tables are read-only at a plant.
+CREATE FUNCTION refuse_at_a_plant() RETURNS trigger
+LANGUAGE plpgsql SET search_path = public, pg_temp
+AS $$
+BEGIN
+    IF plant_number() > 0 THEN
+        RAISE EXCEPTION 'this database is plant %: % is the head office''s (templates are edited, released and '
+                        'kept there, and replicated here); make the change at the head office', plant_number(),
+                        TG_TABLE_NAME
+            USING ERRCODE = 'read_only_sql_transaction';
+    END IF;
+    RETURN NULL;
+END
+$$;
+
+CREATE TRIGGER head_office_writes_it BEFORE INSERT OR UPDATE OR DELETE OR TRUNCATE ON gear_class
+FOR EACH STATEMENT EXECUTE FUNCTION refuse_at_a_plant();
+CREATE TRIGGER head_office_writes_it BEFORE INSERT OR UPDATE OR DELETE OR TRUNCATE ON component
+FOR EACH STATEMENT EXECUTE FUNCTION refuse_at_a_plant();
+CREATE TRIGGER head_office_writes_it BEFORE INSERT OR UPDATE OR DELETE OR TRUNCATE ON assembly
+FOR EACH STATEMENT EXECUTE FUNCTION refuse_at_a_plant();
+CREATE TRIGGER head_office_writes_it BEFORE INSERT OR UPDATE OR DELETE OR TRUNCATE ON template_version_rows
+FOR EACH STATEMENT EXECUTE FUNCTION refuse_at_a_plant();
+CREATE TRIGGER head_office_writes_it BEFORE INSERT OR UPDATE OR DELETE OR TRUNCATE ON template_release
+FOR EACH STATEMENT EXECUTE FUNCTION refuse_at_a_plant();
+CREATE TRIGGER head_office_writes_it BEFORE INSERT OR UPDATE OR DELETE OR TRUNCATE ON template_test
+FOR EACH STATEMENT EXECUTE FUNCTION refuse_at_a_plant();
+CREATE TRIGGER head_office_writes_it BEFORE INSERT OR UPDATE OR DELETE OR TRUNCATE ON machine
+FOR EACH STATEMENT EXECUTE FUNCTION refuse_at_a_plant();
+CREATE TRIGGER head_office_writes_it BEFORE INSERT OR UPDATE OR DELETE OR TRUNCATE ON hob
+FOR EACH STATEMENT EXECUTE FUNCTION refuse_at_a_plant();
+CREATE TRIGGER head_office_writes_it BEFORE INSERT OR UPDATE OR DELETE OR TRUNCATE ON work_holding
+FOR EACH STATEMENT EXECUTE FUNCTION refuse_at_a_plant();
 
 -- ==============================================================================================
 -- roles

@@ -25,7 +25,7 @@ LAYERS = [
     ("library", "hobbing", "turning"),        # module library and seed; the models
     ("programs",),                            # instantiation, storage, jobs
     ("release",),                             # golden tests, impact, the release gate
-    ("service",),                             # engine serve: delivery to the controls, the web view
+    ("service", "plants"),                    # engine serve: delivery to the controls, the web view; plants
     ("cli",),                                 # the command line (and engine/__main__.py)
 ]
 # Rules beyond the order, kept if the order ever changes: (importer, imported) -> why not.

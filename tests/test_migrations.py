@@ -18,7 +18,7 @@ from engine.paths import MIGRATIONS_DIR, SCHEMA_DIR
 # table, function, trigger and view once, in its final form, in sections by concern (each uses
 # only objects of the sections before it).
 SCHEMA_FILES = ("schema.sql",)
-SECTIONS = ("core", "templates", "versions", "editing", "records", "programs", "release", "roles")
+SECTIONS = ("core", "templates", "versions", "editing", "records", "programs", "release", "plants", "roles")
 
 # Each query lists one kind of object as (key, definition) rows: the key names the object.
 ACL = "(SELECT array_agg(format('%s %s', CASE WHEN a.grantee = 0 THEN 'PUBLIC' ELSE a.grantee::regrole::text END, " \

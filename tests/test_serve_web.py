@@ -232,9 +232,9 @@ def free_port() -> int:
         return probe.getsockname()[1]
 
 
-def engine(*args: str, runtime: Path, **kwargs) -> subprocess.Popen:
+def engine(*args: str, runtime: Path, env_extra: dict | None = None, **kwargs) -> subprocess.Popen:
     environment = {**os.environ, "ENGINE_RUNTIME_DIR": str(runtime), "ENGINE_CONFIG": "",
-                   "PYTHONPATH": str(REPOSITORY)}
+                   "PYTHONPATH": str(REPOSITORY), **(env_extra or {})}
     environment.pop("DATABASE_URL", None)
     return subprocess.Popen([sys.executable, "-m", "engine", *args], env=environment, stdout=subprocess.PIPE,
                             stderr=subprocess.PIPE, text=True, **kwargs)

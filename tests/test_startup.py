@@ -81,7 +81,7 @@ def test_each_command_module_is_named_with_the_command_it_holds():
     from engine.cli.app import main
     from engine.cli.commands import COMMAND_MODULES
 
-    assert len(main.commands) == len(COMMAND_MODULES) == 25   # issue 32: engine serve
+    assert len(main.commands) == len(COMMAND_MODULES) == 26   # issue 32: engine serve; issue 33: engine plant
     for name in COMMAND_MODULES:
         assert main.commands[name].name == name
 

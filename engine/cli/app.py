@@ -128,6 +128,8 @@ class EngineGroup(click.Group):
             if _refused_by_role(error):   # a role without the right: a handled refusal, nothing was stored
                 from .refusals import refusal_line  # on a refusal only: start-up loads no more (issue 28)
                 fail(refusal_line(first_line), 1)
+            if _read_only_here(error):   # a plant's copy of the head office's tables (issue 33)
+                fail(f"{first_line}; nothing stored", 1)
             if _database_failure(error):   # the server, not the engine: exit 1, and say what was kept
                 fail(_database_failure_message(error, first_line), 1)
             fail(f"unexpected error: {type(error).__name__}: {first_line} (run with --traceback for details)", 2,
@@ -162,6 +164,13 @@ def _refused_by_role(error: Exception) -> bool:
     """The server refused a statement for the session's role (SQLSTATE 42501)."""
     psycopg = sys.modules.get("psycopg")
     return psycopg is not None and isinstance(error, psycopg.errors.InsufficientPrivilege)
+
+
+def _read_only_here(error: Exception) -> bool:
+    """The database refused a write as read-only (SQLSTATE 25006): at a plant, the head office's
+    tables (schema/schema.sql, section plants), or a read-only server."""
+    psycopg = sys.modules.get("psycopg")
+    return psycopg is not None and isinstance(error, psycopg.errors.ReadOnlySqlTransaction)
 
 
 def _database_failure(error: Exception) -> bool:

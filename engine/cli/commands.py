@@ -25,7 +25,7 @@ COMMAND_MODULES = {
     "import-dxf": ("turning", "import_dxf_command"), "plot": ("plot", "plot_command"),
     "simulate": ("simulate", "simulate"), "programs": ("programs", "programs"), "test": ("golden", "test_command"),
     "jobs": ("jobs", "jobs"), "config": ("settings", "config"), "fixtures": ("fixtures", "fixtures"),
-    "materials": ("materials", "materials"), "serve": ("serve", "serve"),
+    "materials": ("materials", "materials"), "serve": ("serve", "serve"), "plant": ("plant", "plant"),
 }
 
 

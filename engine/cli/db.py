@@ -113,6 +113,31 @@ def db_status(ctx, output):
         click.echo(f"{state.state:8} {state.migration.path.name}{when}")
 
 
+@db.command("start")
+@click.option("--wal-level", type=click.Choice(["replica", "logical"]), default=None,
+              help="Make this the embedded server's wal_level, restarting it if it runs with another "
+                   "(logical: a head office or a plant, engine plant publish|subscribe).")
+@click.pass_context
+def db_start(ctx, wal_level):
+    """Start the embedded PostgreSQL (if it is not running) and print its URL; with --wal-level,
+    set its wal_level and restart it if needed (its sessions end; committed work is kept). Only
+    the embedded server: for another server, set wal_level in its postgresql.conf and restart it.
+
+    Example: engine db start --wal-level logical
+    """
+    from ..db.connection import LIBPQ_VARIABLES
+    from ..db.embedded import start_embedded
+
+    if ctx.obj["database_url"] or any(os.environ.get(name) for name in LIBPQ_VARIABLES):
+        raise EngineError("db start: --database-url, DATABASE_URL or the PG* variables name another server; "
+                          "engine db start starts the embedded one: set that server's wal_level in its "
+                          "postgresql.conf and restart it")
+    url, restarted = start_embedded(wal_level)
+    click.echo(url)
+    if restarted:
+        click.echo(f"restarted the embedded PostgreSQL with wal_level = {wal_level}", err=True)
+
+
 @db.command("url")
 @click.pass_context
 def db_url(ctx):

@@ -42,7 +42,10 @@ def template_release(ctx, gear_class, dry_run, yes, as_json, workers, without_go
             _show(report, DIFFS_SHOWN)
         return click.confirm(f"release class {report.gear_class} v{report.version}?", err=True)
 
+    from ..plants.guard import refuse_at_a_plant
+
     with connection(ctx) as conn:
+        refuse_at_a_plant(conn, f"template release --class {gear_class}")
         report = release(conn, gear_class, dry_run=dry_run, confirm=confirm, workers=workers,
                          without_golden_tests=without_golden_tests)
     if as_json:

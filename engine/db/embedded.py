@@ -180,3 +180,24 @@ def find_psql(directories: list[Path] | None = None, path: str | None = None) ->
         if candidate.is_file() and os.access(candidate, os.X_OK):
             return str(candidate)
     return shutil.which("psql", path=path)
+
+
+def start_embedded(wal_level: str | None = None) -> tuple[str, bool]:
+    """`engine db start`: start (or reuse) the embedded server and return its URL of the database
+    `engine`, and whether it was restarted. With `wal_level` (logical for a head office or a plant:
+    docs/design.md §12) the level is made the server's (ALTER SYSTEM, kept in its data) and, as only a
+    restart applies it, a server running with another level is stopped and started again: its
+    sessions end, committed work is kept."""
+    import psycopg
+    from psycopg import sql
+
+    url = embedded_url()
+    if wal_level is None:
+        return url, False
+    with psycopg.connect(embedded_url("postgres"), autocommit=True) as conn:
+        running = conn.execute("SHOW wal_level").fetchone()
+        conn.execute(sql.SQL("ALTER SYSTEM SET wal_level = {}").format(sql.Literal(wal_level)))
+    if running is not None and running[0] == wal_level:
+        return url, False
+    stop_embedded()
+    return embedded_url(), True

@@ -17,7 +17,11 @@ from ..errors import EngineError
 from .classify import classify
 from .gear_import import COLUMNS, FROM_TREE, Classes, GearImportError, read_gears
 
-INSTALLED = ("SELECT g.name, EXISTS (SELECT 1 FROM class_template(g.name)), "
+# templated: the class has rows, or its released version has (a plant holds only the released
+# versions the head office replicated, not the rows being edited: docs/design.md §12)
+INSTALLED = ("SELECT g.name, EXISTS (SELECT 1 FROM class_template(g.name)) OR EXISTS (SELECT 1 FROM "
+             "template_version_rows v WHERE v.gear_class = g.name AND v.version = released_version(g.name) "
+             "AND v.rows <> '[]'), "
              "g.name IN (SELECT name FROM classes_and_below(ARRAY['cylindrical'])) FROM gear_class g")
 
 

@@ -46,12 +46,16 @@ if TYPE_CHECKING:
 
 DIFFS_SHOWN = 5   # unified diffs the CLI prints (all of them with --json)
 
-# Every job of the classes, and whether it has a stored program (whose file a layout change changes).
+# Every job of the classes made in this database, and whether it has a stored program (whose file a
+# layout change changes). At a head office the job table also holds its plants' jobs (issue 33,
+# docs/design.md §12): they are proved at their plant, against the plant's gears, which the head
+# office does not hold (a gear of the same number there is another gear), so they are left out.
 JOBS = """
 SELECT j.id, j.gear_class, j.machine, j.params::text, j.module_params::text,
        EXISTS (SELECT 1 FROM program p WHERE p.job_id = j.id), j.gear_id, j.hob_id
 FROM job j
 WHERE j.gear_class = ANY(%s::text[])
+  AND j.id BETWEEN plant_first_id(plant_number()) AND plant_last_id(plant_number())
 ORDER BY j.id"""
 
 

@@ -5,18 +5,20 @@ loopback unless asked otherwise (any other address asks for a login first), unti
 dies with its process, so a file left by a crash (or a pid the system gave to another program
 since) is never taken for a running service, and `stop` never signals a stranger.
 
-What runs is a list of parts (ServeOptions): the web view now; program delivery by FTP and a
-request folder are further parts started beside it from the same options."""
+What runs is a list of parts (ServeOptions): the web view always; program delivery by FTP
+(`--ftp-port`) and request folders (`--requests ROOT`) beside it when asked for, each started
+before the web view says its address and closed when it ends (engine.service.ftp,
+engine.service.request_folder)."""
 from __future__ import annotations
 
+import contextlib
 import fcntl
-import ipaddress
 import os
 import secrets
 import signal
 import socket
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from pathlib import Path
 from typing import IO
 
@@ -24,21 +26,29 @@ import msgspec
 
 from ..errors import EngineError
 from ..paths import runtime_folder
+from ..programs.config import Config
+from .addresses import is_loopback
 
 PID_FILE = "serve.pid"
-LOOPBACK_NAMES = {"localhost"}
 STOP_WAIT_SECONDS = 30   # how long `engine serve stop` waits for the service to finish its answers
 STOP_POLL_SECONDS = 0.1
 LISTEN_BACKLOG = 64
 
 
 class ServeOptions(msgspec.Struct, frozen=True):
-    """What `engine serve` runs: the database (a resolved URL: engine.db.connection.resolve_url) and
-    where the web view listens. Delivery to the controls adds its own fields (an FTP address, a
-    request folder) beside these."""
+    """What `engine serve` runs: the database (a resolved URL: engine.db.connection.resolve_url),
+    where the web view listens, and the delivery to the controls: FTP on ftp_host:ftp_port (None:
+    no FTP), request folders under `requests` for `request_machines` (None: none). `config`: the
+    settings file (machines' line endings and FTP secret variables), the web view's too (a runner's
+    request makes the same files)."""
     database_url: str
     host: str = "127.0.0.1"
     port: int = 8080
+    ftp_host: str | None = None
+    ftp_port: int | None = None
+    requests: str | None = None
+    request_machines: tuple[str, ...] = ()
+    config: Config = Config()
 
     @property
     def address(self) -> str:
@@ -56,15 +66,6 @@ class ServiceStopped(Exception):
     """`engine serve stop` asked the service to end (SIGTERM): a normal end, not a failure."""
 
 
-def is_loopback(host: str) -> bool:
-    if host in LOOPBACK_NAMES:
-        return True
-    try:
-        return ipaddress.ip_address(host).is_loopback
-    except ValueError:   # a host name: it may resolve to any address
-        return False
-
-
 def serve(options: ServeOptions, said: Callable[[str], None]) -> None:
     """Run the service until stopped; `said` gets the address to open, then how it ended.
     EngineError (nothing started) if another service runs or the address cannot be bound."""
@@ -73,9 +74,31 @@ def serve(options: ServeOptions, said: Callable[[str], None]) -> None:
         held.write(f"{os.getpid()} {options.address}\n")
         held.flush()
         try:
-            _run(options, listening, said)
+            with contextlib.ExitStack() as delivery:
+                for part in _delivery_parts(options, said):
+                    delivery.callback(part.close)
+                _run(options, listening, said)
         finally:
             listening.close()
+
+
+def _delivery_parts(options: ServeOptions, said: Callable[[str], None]) -> Iterator:
+    """The FTP server and the request folders asked for, each started and said; a part that
+    cannot start (a port in use, a root that does not exist) stops the service before it serves."""
+    if options.ftp_port is not None:
+        from .ftp import start_ftp_server
+
+        ftp = start_ftp_server(options.database_url, options.config, options.ftp_host or options.host, options.ftp_port)
+        yield ftp
+        said(f"FTP for the controls on {options.ftp_host or options.host}:{ftp.port}; each machine logs in with "
+             "its name and the secret in ENGINE_FTP_SECRET_<MACHINE> (or the variable its config table's "
+             "ftp_secret_env names); a machine with none set cannot log in")
+    if options.requests is not None:
+        from .request_folder import start_request_folder
+
+        yield start_request_folder(options.requests, list(options.request_machines), options.database_url,
+                                   options.config)
+        said(f"request folders under {options.requests} for {', '.join(options.request_machines)}")
 
 
 def _run(options: ServeOptions, listening: socket.socket, said: Callable[[str], None]) -> None:
@@ -87,7 +110,7 @@ def _run(options: ServeOptions, listening: socket.socket, said: Callable[[str], 
     app = create_app(options.database_url, require_login=options.needs_login,
                      session_secret=secrets.token_urlsafe(32) if options.needs_login else None,
                      on_ready=lambda: said(f"serving the web view at {options.address}{login}; stop it with "
-                                           "Ctrl-C or `engine serve stop`"))
+                                           "Ctrl-C or `engine serve stop`"), config=options.config)
     server = uvicorn.Server(uvicorn.Config(app, log_level="warning", lifespan="on"))
     # uvicorn catches both signals to finish the answers under way, then raises them again with the
     # handlers it found: Ctrl-C as KeyboardInterrupt (exit 130, even where the shell started the

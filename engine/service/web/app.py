@@ -8,6 +8,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from contextlib import asynccontextmanager
 from importlib import import_module
+from typing import TYPE_CHECKING
 
 from starlette.applications import Starlette
 from starlette.middleware import Middleware
@@ -17,24 +18,32 @@ from starlette.routing import BaseRoute
 from .auth import SESSION_COOKIE, SESSION_SECONDS, LoginRequired, session_secret
 from .pages import NulRefused
 
+if TYPE_CHECKING:
+    from ...programs.config import Config
+
 # the concepts shown, each a module of this package with ROUTES (issue 32)
-PAGE_MODULES = ("home", "auth", "gears", "jobs", "programs", "program_views", "classes", "machines")
+PAGE_MODULES = ("home", "auth", "gears", "jobs", "job_requests", "programs", "program_views", "classes", "machines")
 POOL_SIZE = (1, 4)   # connections: one kept open, at most four pages answered at once
 
 
 def create_app(database_url: str, *, require_login: bool = False, session_secret: str | None = None,
-               on_ready: Callable[[], None] | None = None) -> Starlette:
+               on_ready: Callable[[], None] | None = None, config: Config | None = None) -> Starlette:
     """The app on the database of `database_url` (resolved: engine.db.connection.resolve_url).
     require_login: every page but the login asks for a PostgreSQL login first (the service
     bound to an address other than loopback); else the local user sees every page.
     session_secret: the key the login's cookie is signed with (else ENGINE_SERVE_SECRET, else
     random per start: engine.service.web.auth). on_ready(): called once the pool is open and the
     server answers (engine serve says its address then, not before: a Ctrl-C earlier would stop
-    uvicorn half started)."""
+    uvicorn half started). config: the config file's settings a runner's request makes programs
+    with (the line endings of each machine's files, as the FTP server's), else the config file
+    read now (engine.programs.config.load_config: EngineError, one line, if it is malformed)."""
+    from ...programs.config import load_config
+
     app = Starlette(routes=_routes(), lifespan=_lifespan(database_url, on_ready), middleware=_middleware(require_login,
                                                                                               session_secret))
     app.state.require_login = require_login
     app.state.database_url = database_url   # the logins connect to it (auth); never shown
+    app.state.config = config if config is not None else load_config()
     return app
 
 

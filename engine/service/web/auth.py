@@ -17,7 +17,7 @@ from __future__ import annotations
 import logging
 import os
 import secrets
-from urllib.parse import quote
+from urllib.parse import SplitResult, quote, urlsplit
 
 import msgspec
 import psycopg
@@ -28,6 +28,8 @@ from starlette.responses import JSONResponse, RedirectResponse, Response
 from starlette.routing import Route
 from starlette.types import ASGIApp, Receive, Scope, Send
 
+from ...db.connection import scalar
+from ..addresses import is_loopback
 from .pages import TEMPLATES, wants_json
 
 LOGIN_PATH = "/login"
@@ -41,6 +43,9 @@ REQUESTING_ROLE = "engine_runner"
 REFUSED = "login refused: wrong user name or password, or the database does not accept this login"
 NO_ROLE = ("login refused: this login has no role of the engine's (engine_reader sees the pages, engine_runner "
            "also requests programs); ask the database's owner to grant one")
+LOCAL_USER = "local"               # program_request.client of a request on the open loopback app
+CROSS_SITE = ("refused: a program is requested only from this service's own page ({}); open the job's page "
+              "here and use its button")
 LOG = logging.getLogger("engine.serve")
 
 # What a login may do: the owner of the engine's tables (the role that migrates) and superusers
@@ -126,14 +131,52 @@ def _ask_login(request: Request) -> Response:
     return RedirectResponse(f"{LOGIN_PATH}?next={quote(request.url.path)}", status_code=303)
 
 
-def may_request(request: Request) -> bool:
+def may_request(request: Request, conn: psycopg.Connection | None = None) -> bool:
     """The login of this request may request a program for a stored job (engine_runner, or the
-    owner). On the open (loopback) app the local user acts as the service's own role."""
+    owner). On the open (loopback) app the local user acts as the service's own role, asked on
+    `conn` if given (a page already holding one), else on a connection of the pool."""
     rights = getattr(request.state, "rights", None)
-    if rights is None:
-        with request.app.state.pool.connection() as conn:
-            rights = rights_of(conn, conn.execute(SERVICE_LOGIN).fetchone()[0])
-    return rights.requests
+    if rights is not None:
+        return rights.requests
+    if conn is not None:
+        return _service_rights(conn).requests
+    with request.app.state.pool.connection() as conn:
+        return _service_rights(conn).requests
+
+
+def _service_rights(conn: psycopg.Connection) -> Rights:
+    return rights_of(conn, scalar(conn.execute(SERVICE_LOGIN)))
+
+
+def requester(request: Request) -> str:
+    """Who asks, as program_request.client records it: the login, or "local" on the open app."""
+    rights = getattr(request.state, "rights", None)
+    return LOCAL_USER if rights is None else rights.login
+
+
+def cross_site(request: Request) -> str | None:
+    """Why a form's POST may not have come from this service's own pages, or None (issue 32: a
+    page of another site must not make the browser of a logged-in runner, or of the local user of
+    the open loopback app, request a program). The browser's Origin (else Referer) must name this
+    very host as the request reached it (Host), and on the open app that host must be a loopback
+    one: a name of another site resolving to 127.0.0.1 (DNS rebinding) is its own origin there."""
+    host = request.headers.get("host", "").lower()
+    came_from = request.headers.get("origin") or request.headers.get("referer")
+    if not came_from or not host:
+        return CROSS_SITE.format("it says no Origin or Referer, or no Host")
+    if _split(came_from).netloc.lower() != host:
+        return CROSS_SITE.format(f"it came from {came_from[:80]!r}, not from {host[:80]!r}")
+    if not request.app.state.require_login and not is_loopback(_split(f"//{host}").hostname or ""):
+        return CROSS_SITE.format(f"the open (loopback) view was reached as {host[:80]!r}; open it as 127.0.0.1")
+    return None
+
+
+def _split(address: str) -> SplitResult:
+    """The parts of an address a browser sent; none of a malformed one (an unclosed [)."""
+    try:
+        return urlsplit(address)
+    except ValueError:
+        return urlsplit("")
 
 
 async def login_form(request: Request) -> Response:

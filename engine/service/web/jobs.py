@@ -6,7 +6,8 @@ from starlette.requests import Request
 from starlette.routing import Route
 
 from ...programs.job_records import job_details, list_jobs
-from .answers import answered, query_day, query_id, query_text, whole
+from .answers import answered, query_day, query_id, query_text, shown, whole
+from .auth import may_request
 from .pages import page
 
 
@@ -20,9 +21,11 @@ def jobs(request: Request):
 
 
 def job(request: Request):
-    """`engine jobs show ID --json`."""
-    return answered(request, lambda conn: page(request, "job.html", {
-        "job": job_details(conn, whole("job", request.path_params["job_id"]))}))
+    """`engine jobs show ID --json`; the page adds, for a runner, the button that requests the
+    job's program for its machine (engine.service.web.job_requests)."""
+    return answered(request, lambda conn: shown(request, "job.html", {
+        "job": job_details(conn, whole("job", request.path_params["job_id"]))},
+        lambda: {"may_request": may_request(request, conn), "refused": None}))
 
 
 ROUTES = [Route("/jobs", jobs, name="jobs"), Route("/jobs/{job_id}", job, name="job")]
