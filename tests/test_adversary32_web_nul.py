@@ -14,7 +14,8 @@ ADDRESSES = ["/classes/%00", "/classes/spur%00/impact", "/classes/spur%00/tests"
 
 @pytest.fixture(scope="module")
 def web(read_only_database_url):
-    with TestClient(create_app(read_only_database_url), raise_server_exceptions=False) as client:
+    with TestClient(create_app(read_only_database_url), base_url="http://127.0.0.1",
+                    raise_server_exceptions=False) as client:
         yield client
 
 
