@@ -30,6 +30,7 @@ from engine.cli.app import main
 SEED = Path(__file__).resolve().parent.parent / "seed_templates"
 PLANT = 7
 FIRST_ID, LAST_ID = PLANT * 10**10, (PLANT + 1) * 10**10 - 1   # docs/design.md §12: number·10^10 on
+LOOPBACK = "http://127.0.0.1"   # the open web view answers a loopback Host only
 WAIT_SECONDS = 180   # a bound for a broken setup, never an assertion on speed
 TEMPLATES_SLOT, HISTORY_SLOT = f"engine_plant_{PLANT}_templates", f"engine_plant_{PLANT}_history"
 
@@ -283,7 +284,7 @@ def test_at_a_plant_the_proof_the_simulation_and_the_web_view_work_unchanged(gro
     shown = json.loads(ok(engine(group.plant, "programs", "show", program_id, "--json", url=group.plant_url)))
     assert shown["programs"][0]["rendering"]["status"] == "MATCH"   # rendered again from the received version, proved
     ok(engine(group.plant, "simulate", "--program", program_id, url=group.plant_url))
-    with TestClient(create_app(group.plant_url)) as client:
+    with TestClient(create_app(group.plant_url), base_url=LOOPBACK) as client:
         page = client.get(f"/programs/{program_id}", headers={"Accept": "application/json"})
     assert page.status_code == 200 and page.json() == shown
 

@@ -23,6 +23,7 @@ from engine.service.web.app import create_app
 from engine.service.web.auth import NO_ROLE, REFUSED, SESSION_COOKIE, may_request
 
 JSON = {"Accept": "application/json"}
+LOOPBACK = "http://127.0.0.1"   # the open web view answers a loopback Host only
 TRUSTED = f"trusted_{uuid.uuid4().hex[:12]}"   # a login pg_hba.conf trusts: no password asked
 PAGES = ("/", "/classes", "/machines")
 
@@ -48,7 +49,7 @@ def service(server):
 def web(url, require_login=True):
     app = create_app(url, require_login=require_login, session_secret="test secret")
     app.router.routes.append(Route("/may-request", lambda request: JSONResponse({"may": may_request(request)})))
-    with TestClient(app, follow_redirects=False) as client:
+    with TestClient(app, base_url=LOOPBACK, follow_redirects=False) as client:
         yield client
 
 

@@ -29,6 +29,7 @@ GEAR = 42                        # the seeded spur gear: the paper's n0 = 246 r/
 SPINDLE_LINE = "M3 S246"
 SPINDLE_ROW = 1700               # the spur class's row that emits it (seed_templates/classes/spur.csv)
 JSON = {"Accept": "application/json"}
+LOOPBACK = "http://127.0.0.1"   # the open web view answers a loopback Host only
 HOSTILE = "<script>alert(1)</script>"
 REPOSITORY = Path(__file__).resolve().parent.parent
 
@@ -40,7 +41,7 @@ def made(run):
     result = run("instantiate", "--gear", GEAR, "--json")
     assert result.exit_code == 0, result.output
     program = json.loads(result.stdout)
-    with TestClient(create_app(run.url)) as client:
+    with TestClient(create_app(run.url), base_url=LOOPBACK) as client:
         yield run, client, program["job_id"], program["program_id"]
 
 
@@ -216,7 +217,7 @@ BAD = {   # path -> status: a value that is no id is 400, an id (or class) of no
 
 @pytest.mark.parametrize("path", sorted(BAD))
 def test_a_bad_or_unknown_id_is_one_line_never_a_stack_trace(read_only_database_url, path):
-    with TestClient(create_app(read_only_database_url)) as client:
+    with TestClient(create_app(read_only_database_url), base_url=LOOPBACK) as client:
         page = client.get(path)
         answer = client.get(path, headers=JSON)
     assert page.status_code == answer.status_code == BAD[path]

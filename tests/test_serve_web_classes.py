@@ -15,6 +15,7 @@ from starlette.testclient import TestClient
 from engine.service.web.app import create_app
 
 JSON = {"Accept": "application/json"}
+LOOPBACK = "http://127.0.0.1"   # the open web view answers a loopback Host only
 COOLANT_ROW = 1800       # seed_templates/classes/spur.csv: cutcond 1, `"M8"` when coolant
 COOLANT_OFF_ROW = 2900   # cutcond 2, `"M9"` when coolant: no seeded golden test reads it
 EDIT = sql.SQL("UPDATE template_view SET o = %s WHERE gear_class = 'spur' AND id = %s")
@@ -33,7 +34,7 @@ INVENTED = {"tests": Jsonb([{"class": "spur", "name": "coolant_on_before_cutting
 
 @contextmanager
 def web(url, **options):
-    with TestClient(create_app(url, **options)) as client:
+    with TestClient(create_app(url, **options), base_url=LOOPBACK) as client:
         yield client
 
 

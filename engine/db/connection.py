@@ -81,11 +81,26 @@ def connect(database_url: str | None = None, **kwargs: Any) -> Connection:
     try:
         conn = psycopg.connect(url, **kwargs)
     except psycopg.OperationalError as error:
-        where = url or "the server named by the PG* variables"
+        where = shown_url(url) if url else "the server named by the PG* variables"
         first_line = str(error).strip().splitlines()[0] if str(error).strip() else type(error).__name__
         raise EngineError(f"cannot connect to {where}: {first_line}") from error
     read_bounded_json(conn)
     return conn
+
+
+def shown_url(url: str) -> str:
+    """The connection string as an error may show it: as given, or, if it holds a password, with
+    the password written ****. An error is printed on a shop's screen, logged and pasted into
+    tickets (the adversary of issue 32 found `engine serve` printing postgresql://user:PASSWORD@…)."""
+    from psycopg import ProgrammingError
+    from psycopg.conninfo import conninfo_to_dict, make_conninfo
+
+    try:
+        if "password" not in conninfo_to_dict(url):
+            return url
+        return make_conninfo(url, password="****")
+    except ProgrammingError:   # not a connection string libpq reads: nothing of it is shown
+        return "the database URL given (libpq cannot read it)"
 
 
 def scalar(cursor: Cursor[TupleRow]) -> Any:

@@ -131,14 +131,21 @@ def _modelled(conn: Connection, gear_class: str) -> bool:
 
 
 def _remade(conn: Connection, job_id: int, config: Config) -> tuple[int, bytes]:
-    """The job made again as `engine instantiate --job J --out DIR/` makes it; the file's bytes."""
+    """The job made again as `engine instantiate --job J --out DIR/` makes it; the file's bytes.
+    A refusal names the file without the private folder it would have been written to (a path
+    of the service's computer, gone once refused: the adversary of issue 32 saw it on a control)."""
     from ..programs.options import Output
     from ..programs.outputs import line_endings
     from ..programs.remake import instantiate_job
 
     with tempfile.TemporaryDirectory(prefix="engine-delivery-") as folder, \
             line_endings(partial(line_ending, config)):
-        program = instantiate_job(conn, job_id, output=Output(out=folder + os.sep))
+        try:
+            program = instantiate_job(conn, job_id, output=Output(out=folder + os.sep))
+        except EngineError as refusal:
+            if folder not in str(refusal):
+                raise
+            raise EngineError(str(refusal).replace(folder + os.sep, "")) from None
         assert program.program_id is not None and program.path is not None   # stored and written
         return program.program_id, Path(program.path).read_bytes()
 

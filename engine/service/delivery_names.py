@@ -66,8 +66,15 @@ def file_name(program_name: str | None, gear_id: int | None, job_id: int) -> str
 
 
 def asked(conn: Connection, machine: str, text: str) -> Asked:
-    """The job a request names on `machine`, or Refused with the reason."""
+    """The job a request names on `machine`, or Refused with the reason. A request of more than one
+    line is refused, never answered by one of them: an 840D's WRITE appends, so a request file left
+    unanswered and written again holds the old request first (the adversary of issue 32 had job 17's
+    program answer a request for job 18)."""
     text = text.strip()
+    lines = text.splitlines()
+    if len(lines) > 1:
+        raise Refused(f"the request holds {len(lines)} lines ({lines[0][:30]!r}, {lines[-1][:30]!r}): a request "
+                      "is one line; delete the request file before writing a new one (WRITE appends to it)")
     found = FILE_NAME.fullmatch(text)
     if found:
         return Asked(int(found.group("job")), found.group("program").upper())

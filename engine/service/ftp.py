@@ -4,7 +4,8 @@ Fanuc's Data Server (`M198` calls served from the host) and any DNC client that 
 Each machine logs in with its own name and a secret kept outside the config file (an environment
 variable: the one its `[machines.<name>] ftp_secret_env` names, else ENGINE_FTP_SECRET_<NAME>, the
 name upper-cased with every other character than a letter or digit an underscore); a machine with no
-secret, an unknown one and anonymous are refused. A machine sees one folder, its own: LIST and NLST
+secret, an unknown one, anonymous, and two machines whose secret is read from one variable
+(hobber-fanuc and hobber_fanuc by default) are refused. A machine sees one folder, its own: LIST and NLST
 show engine.service.delivery.machine_files (nothing rendered), MDTM when its job last had a program
 stored. RETR is engine.service.delivery.deliver: the program proved now, stored, recorded with the
 client's address, and sent; a refusal is a 550 reply carrying its one-line reason, recorded too.
@@ -76,12 +77,21 @@ class MachineAuthorizer:
 
     def validate_authentication(self, username: str, password: str, handler) -> None:
         secret = machine_secret(self.config, username)
-        if secret is None or not hmac.compare_digest(secret.encode(), password.encode()) or not self._known(username):
+        if secret is None or not hmac.compare_digest(secret.encode(), password.encode()) or not self._own(username):
             raise AuthenticationFailed("Authentication failed: a machine logs in with its name and its secret.")
 
-    def _known(self, machine: str) -> bool:
+    def _own(self, machine: str) -> bool:
+        """The machine exists and no other machine reads its secret's variable. hobber-fanuc and
+        hobber_fanuc both read ENGINE_FTP_SECRET_HOBBER_FANUC by default: one secret would log in
+        as either (the adversary of issue 32), so a shared variable is nobody's; said in the log."""
         with self.pool.connection() as conn:
-            return conn.execute("SELECT 1 FROM machine WHERE name = %s", (machine,)).fetchone() is not None
+            names = [row[0] for row in conn.execute("SELECT name FROM machine")]
+        variable = secret_variable(self.config, machine)
+        sharing = [name for name in names if name != machine and secret_variable(self.config, name) == variable]
+        if sharing:
+            LOG.warning("machine %s may not log in: machine %s reads its secret's variable %s too; give each its "
+                        "own with ftp_secret_env in the config file", machine, sharing[0], variable)
+        return machine in names and not sharing
 
     def has_user(self, username: str) -> bool:
         return machine_secret(self.config, username) is not None

@@ -3,16 +3,20 @@ for controls that read programs from a network share, as an 840D does with `EXTC
 
 One folder per machine under a root (`<root>/<machine>/`). A control asks by writing a request
 file `<stem>.REQ` (stem: letters, digits and _, at most 24; a symbolic link is never read) whose
-first line names what it wants, ended by a new line: `JOB 17`, `GEAR 42` (that gear's newest stored
-job on the machine), `O1042` or a name its FTP list shows (engine.service.delivery_names). The
-engine answers each request once:
+one line names what it wants, ended by a new line: `JOB 17`, `GEAR 42` (that gear's newest stored
+job on the machine), `O1042` or a name its FTP list shows (engine.service.delivery_names); a request
+of more lines is refused (an 840D's WRITE appends to a request left unanswered). The engine answers
+each request once:
 
+0. the request is claimed: renamed `<stem>.DONE`, then read (a request written again meanwhile is
+   a new file, answered at a later look);
 1. the program, proved now (engine.service.delivery.deliver, via "folder"), is written next to it as
    `PRG<program id>_<first 8 hex digits of the sha256 of its bytes>.MPF`: a name that changes with
    the bytes, so a control never takes another program's file, nor an older one, for its answer;
 2. then `<stem>.RDY`, holding that file name and a new line: the name the control waits for with
    `ISFILE`, known in advance; or, for a refusal, `<stem>.ERR` holding the one-line reason;
-3. then the request is renamed `<stem>.DONE`.
+3. unless the control wrote a new `<stem>.REQ` meanwhile: then this answer is not written (the
+   control would take it for the new request's), and the new request is answered instead.
 
 Each file is written under a temporary name (a dot file, which is neither a program nor an answer),
 flushed to disk (fsync) and given its name in one step (os.replace), so a control never reads a
@@ -23,11 +27,13 @@ once (tests, and a loop in `engine serve`)."""
 from __future__ import annotations
 
 import hashlib
+import logging
 import os
 import re
 import stat
 import threading
 import uuid
+from functools import partial
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -44,6 +50,7 @@ REQUEST = re.compile(r"(?P<stem>[A-Za-z0-9_]{1,24})\.REQ", re.IGNORECASE)
 MAX_REQUEST_BYTES = 1024   # a request's first line is read from its first KiB; a bound no control meets
 READY, ERROR, DONE = ".RDY", ".ERR", ".DONE"
 POLL_SECONDS = 1.0
+LOG = logging.getLogger("engine.service.request_folder")
 
 
 class Answer(msgspec.Struct, frozen=True):
@@ -94,7 +101,18 @@ class RequestFolder:
                     if (found := REQUEST.fullmatch(entry.name)) and not entry.is_symlink() and entry.is_file()]
         self._seen = {path: seen for path, seen in self._seen.items()   # requests gone meanwhile forgotten
                       if path.parent != folder or any(path == entry for entry, _ in requests)}
-        return [self._answer(machine, entry, stem) for entry, stem in requests if self._complete(entry)]
+        return [answer for entry, stem in requests if (answer := self._taken(machine, entry, stem))]
+
+    def _taken(self, machine: str, request: Path, stem: str) -> Answer | None:
+        """The request answered if complete, else None; a request the share will not let be looked at
+        or answered (its answer's name taken by a folder, the request gone meanwhile) is said in the
+        log and left for the next look, so it never stops the requests after it, of every machine
+        (the adversary of issue 32 found one folder named A.RDY leaving all of them unanswered)."""
+        try:
+            return self._answer(machine, request, stem) if self._complete(request) else None
+        except OSError as error:
+            LOG.warning("request %s of machine %s not answered: %s", request.name, machine, error)
+            return None
 
     def _complete(self, request: Path) -> bool:
         """Ends with a new line and unchanged since the previous look (else looked at again next time)."""
@@ -105,21 +123,32 @@ class RequestFolder:
             return False
         return status.st_size > MAX_REQUEST_BYTES or _read_request(request).endswith(b"\n")
 
-    def _answer(self, machine: str, request: Path, stem: str) -> Answer:
-        """The request answered: its old answer removed, the new one written, the request renamed."""
+    def _answer(self, machine: str, request: Path, stem: str) -> Answer | None:
+        """The request answered: its old answer removed, the request claimed (renamed .DONE) and read,
+        the program proved, then the answer written, unless the control asked again meanwhile.
+
+        Claimed before it is read, so a request written again while this one is answered is a new
+        file, answered at a later look, never renamed .DONE unread; and no answer is written once a
+        new request is there, as the control waiting for it would take this one's answer for its own
+        (the adversary of issue 32 had job 42's program named in the .RDY of a request for job 43)."""
         folder = self.root / machine
         for old in (READY, ERROR):
             (folder / f"{stem}{old}").unlink(missing_ok=True)
+        claimed = folder / f"{stem}{DONE}"
+        os.replace(request, claimed)
+        self._seen.pop(request, None)
         try:
-            delivered = deliver(self.conn, machine, _first_line(_read_request(request)), via="folder",
+            delivered = deliver(self.conn, machine, _request_text(_read_request(claimed)), via="folder",
                                 client=f"{machine}/{request.name}", config=self.config)
         except EngineError as refusal:
-            answer = _refused(folder, machine, request.name, stem, one_line(str(refusal)))
+            answer = partial(_refused, folder, machine, request.name, stem, one_line(str(refusal)))
         else:
-            answer = _sent(folder, machine, request.name, stem, delivered)
-        os.replace(request, folder / f"{stem}{DONE}")
-        self._seen.pop(request, None)
-        return answer
+            answer = partial(_sent, folder, machine, request.name, stem, delivered)
+        if request.exists():   # asked again meanwhile: this answer would be taken for that request
+            LOG.warning("request %s of machine %s was written again while it was answered: the new one is "
+                        "answered instead", request.name, machine)
+            return None
+        return answer()
 
     def close(self) -> None:
         self.conn.close()
@@ -136,11 +165,12 @@ def _read_request(request: Path) -> bytes:
         return file.read(MAX_REQUEST_BYTES) if stat.S_ISREG(os.fstat(file.fileno()).st_mode) else b""
 
 
-def _first_line(data: bytes) -> str:
-    """The request's first line (of its first KiB), as ASCII: what it asks for (deliver refuses
-    anything else than a request's words, and records it)."""
+def _request_text(data: bytes) -> str:
+    """The request's lines (of its first KiB), as ASCII, blank ones left out: what it asks for. A
+    request is one line; deliver refuses more (an 840D's WRITE appends to a request file left
+    unanswered), and anything else than a request's words, and records it."""
     lines = data[:MAX_REQUEST_BYTES].decode("ascii", "replace").splitlines()
-    return lines[0].strip() if lines else ""
+    return "\n".join(line.strip() for line in lines if line.strip())
 
 
 def _refused(folder: Path, machine: str, request: str, stem: str, reason: str) -> Answer:
@@ -191,13 +221,11 @@ class FolderService:
         self.thread.start()
 
     def _run(self) -> None:
-        import logging
-
         while not self._stop.wait(self.interval):
             try:
                 self.folder.poll_once()
             except Exception:   # a share gone for a moment, the database restarting: said, then tried again
-                logging.getLogger("engine.service.request_folder").exception("request folders not answered")
+                LOG.exception("request folders not answered")
 
     def close(self) -> None:
         self._stop.set()

@@ -16,6 +16,7 @@ from starlette.middleware.sessions import SessionMiddleware
 from starlette.routing import BaseRoute
 
 from .auth import SESSION_COOKIE, SESSION_SECONDS, LoginRequired, session_secret
+from .pages import NotFramed, NulRefused
 
 if TYPE_CHECKING:
     from ...programs.config import Config
@@ -47,10 +48,14 @@ def create_app(database_url: str, *, require_login: bool = False, session_secret
 
 
 def _middleware(require_login: bool, secret: str | None) -> list[Middleware]:
-    """The session (a signed cookie holding the login's name), then the login it asks for."""
-    return [Middleware(SessionMiddleware, secret_key=session_secret(secret), session_cookie=SESSION_COOKIE,
+    """No answer in another site's frame; the session (a signed cookie holding the login's name);
+    the login it asks for; an address holding a NUL refused (after the login: a visitor without
+    one learns nothing more)."""
+    return [Middleware(NotFramed),
+            Middleware(SessionMiddleware, secret_key=session_secret(secret), session_cookie=SESSION_COOKIE,
                        max_age=SESSION_SECONDS, same_site="lax"),
-            Middleware(LoginRequired, require_login=require_login)]
+            Middleware(LoginRequired, require_login=require_login),
+            Middleware(NulRefused)]
 
 
 def _routes() -> list[BaseRoute]:

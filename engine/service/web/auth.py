@@ -30,7 +30,7 @@ from starlette.types import ASGIApp, Receive, Scope, Send
 
 from ...db.connection import scalar
 from ..addresses import is_loopback
-from .pages import TEMPLATES, wants_json
+from .pages import TEMPLATES, refusal, wants_json
 
 LOGIN_PATH = "/login"
 OPEN_PATHS = (LOGIN_PATH,)          # what a visitor without a login may open
@@ -46,6 +46,8 @@ NO_ROLE = ("login refused: this login has no role of the engine's (engine_reader
 LOCAL_USER = "local"               # program_request.client of a request on the open loopback app
 CROSS_SITE = ("refused: a program is requested only from this service's own page ({}); open the job's page "
               "here and use its button")
+MISDIRECTED = ("this view is open only to the local user, at a loopback address: open it as "
+               "http://127.0.0.1:{port}/ (it was reached as {host!r})")
 LOG = logging.getLogger("engine.serve")
 
 # What a login may do: the owner of the engine's tables (the role that migrates) and superusers
@@ -102,15 +104,23 @@ def check_login(database_url: str, user: str, password: str) -> Rights | None:
 
 class LoginRequired:
     """Every page but the login asks for a login whose rights PostgreSQL confirms now (the service
-    bound to an address other than loopback); the rights are left in request.state.rights."""
+    bound to an address other than loopback); the rights are left in request.state.rights. The
+    open (loopback) view answers only a loopback Host: see misdirected."""
 
     def __init__(self, app: ASGIApp, require_login: bool):
         self.app, self.require_login = app, require_login
 
     async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
-        if scope["type"] != "http" or not self.require_login or scope["path"] in OPEN_PATHS:
+        if scope["type"] != "http":
             return await self.app(scope, receive, send)
         request = Request(scope, receive)
+        if not self.require_login:
+            reason = misdirected(request)
+            if reason is not None:
+                return await refusal(request, reason, 421)(scope, receive, send)
+            return await self.app(scope, receive, send)
+        if scope["path"] in OPEN_PATHS:
+            return await self.app(scope, receive, send)
         login = request.session.get("login")
         rights = await run_in_threadpool(_pool_rights, request, login) if login else None
         if rights is None or not rights.sees:
@@ -118,6 +128,18 @@ class LoginRequired:
             return await _ask_login(request)(scope, receive, send)
         scope.setdefault("state", {})["rights"] = rights
         await self.app(scope, receive, send)
+
+
+def misdirected(request: Request) -> str | None:
+    """Why the open view does not answer this request, or None: its Host is no loopback name. A page
+    of another site whose name is made to resolve to 127.0.0.1 (DNS rebinding) would otherwise read
+    every page through the local user's browser (the adversary of issue 32 read /programs as
+    Host: evil.example); a browser sends the name it resolved, so only 127.0.0.1, localhost, [::1]."""
+    host = request.headers.get("host", "")
+    if is_loopback(_split(f"//{host}").hostname or ""):
+        return None
+    port = (request.scope.get("server") or ("", "PORT"))[1]
+    return MISDIRECTED.format(port=port, host=host[:80])
 
 
 def _pool_rights(request: Request, login: str) -> Rights:

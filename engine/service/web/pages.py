@@ -6,14 +6,19 @@ from __future__ import annotations
 
 from contextlib import contextmanager
 from pathlib import Path
+from urllib.parse import unquote_to_bytes
 
 from starlette.requests import Request
 from starlette.responses import HTMLResponse, JSONResponse, Response
 from starlette.templating import Jinja2Templates
+from starlette.types import ASGIApp, Message, Receive, Scope, Send
 
 from ...json_text import exact_json
 
 TEMPLATES = Jinja2Templates(directory=str(Path(__file__).parent / "templates"))
+# every answer: no page of this view in another site's frame (X-Frame-Options for older browsers)
+NOT_FRAMED = [(b"x-frame-options", b"DENY"), (b"content-security-policy", b"frame-ancestors 'none'")]
+NUL_REFUSED = "the address holds a NUL character (%00), which no name, id or hash of the engine has; remove it"
 
 
 def wants_json(request: Request) -> bool:
@@ -48,3 +53,38 @@ def connection(request: Request):
 
 def html(text: str, status: int = 200) -> HTMLResponse:
     return HTMLResponse(text, status_code=status)
+
+
+class NulRefused:
+    """An address holding a NUL (%00 in its path or query) answered as bad input: 400 and one line.
+    No name, id or hash of the engine holds one and PostgreSQL's text cannot, so a page reading it
+    would fail in the database with an error of the server (500, a traceback in the log): the
+    adversary of issue 32 found /classes/%00, /machines/x%00 and /programs?class=%00 doing so."""
+
+    def __init__(self, app: ASGIApp):
+        self.app = app
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        if scope["type"] == "http" and ("\0" in scope["path"] or b"\0" in unquote_to_bytes(scope["query_string"])):
+            return await refusal(Request(scope, receive), NUL_REFUSED)(scope, receive, send)
+        await self.app(scope, receive, send)
+
+
+class NotFramed:
+    """Every answer forbids the browser to show it in a frame of another site. A site framing the
+    open view's job page under a decoy had the local user's click land on "Make and send" (the
+    adversary of issue 32): the form's POST then comes from the framed page, with this service's
+    own Origin, which the cross-site check takes (clickjacking)."""
+
+    def __init__(self, app: ASGIApp):
+        self.app = app
+
+    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
+        if scope["type"] != "http":
+            return await self.app(scope, receive, send)
+
+        async def framed_nowhere(message: Message) -> None:
+            if message["type"] == "http.response.start":
+                message = {**message, "headers": [*message.get("headers", []), *NOT_FRAMED]}
+            await send(message)
+        await self.app(scope, receive, framed_nowhere)
