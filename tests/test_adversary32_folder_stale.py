@@ -59,4 +59,4 @@ def test_a_request_written_again_while_answered_is_answered_itself(run, folders)
     answers = folders.poll_once() + folders.poll_once()
     assert [answer.request for answer in answers] == ["HOB1.REQ"]
     assert (share / answers[0].program_file).read_bytes().count(f"; PROGRAM {second['program_id']} ".encode()) == 1
-    assert (share / "HOB1.RDY").read_text() == f"{answers[0].program_file}\n"
+    assert (share / "HOB1.RDY").read_text() == f"{answers[0].program_file}\nJOB {second['job_id']}\n"

@@ -53,7 +53,9 @@ def test_one_service_serves_the_web_view_ftp_and_request_folders_until_stopped(r
             ftp.retrbinary(f"RETR {name}", fetched.write)
         (root / MACHINE / "ASK.REQ").write_text(f"JOB {job}\n")
         assert answered(root / MACHINE / "ASK.RDY", time.monotonic() + WAIT)
-        written = (root / MACHINE / (root / MACHINE / "ASK.RDY").read_text().strip()).read_bytes()
+        program_file, answered_request = (root / MACHINE / "ASK.RDY").read_text().splitlines()
+        assert answered_request == f"JOB {job}"
+        written = (root / MACHINE / program_file).read_bytes()
         with psycopg.connect(run.url) as conn:
             requests = conn.execute("SELECT via, program_id FROM program_request ORDER BY id").fetchall()
         assert [via for via, _ in requests] == ["ftp", "folder"]

@@ -56,7 +56,8 @@ def test_a_request_gets_the_program_whole_under_its_hash_then_the_answer(run, fo
     (share / "HOB1.REQ").write_text(f"JOB {made['job_id']}\n")
     [answer] = answered(folders)
     name = f"PRG{program_id}_{hashlib.sha256(written).hexdigest()[:8].upper()}.MPF"
-    assert (share / "HOB1.RDY").read_text() == f"{name}\n" and answer.program_file == name
+    # the answer names the program, then the request it answers (the control compares it with its own)
+    assert (share / "HOB1.RDY").read_text() == f"{name}\nJOB {made['job_id']}\n" and answer.program_file == name
     assert (share / name).read_bytes() == written   # the file instantiate --job writes, byte for byte
     assert sorted(path.name for path in share.iterdir()) == ["HOB1.DONE", "HOB1.RDY", name]   # no temporary left
     assert requests(run.url) == [("hobber-840d", "folder", "hobber-840d/HOB1.REQ", f"JOB {made['job_id']}",
@@ -81,8 +82,8 @@ def test_another_machines_job_is_refused_with_an_err_file_and_the_next_request_a
     share = folders.root / "hobber-840d"
     (share / "X.REQ").write_text(f"JOB {fanuc['job_id']}\n")
     [answer] = answered(folders)
-    reason = (share / "X.ERR").read_text()
-    assert reason.endswith("\n") and reason.count("\n") == 1
+    reason, answered_request = (share / "X.ERR").read_text().split("\n", 1)
+    assert answered_request == f"JOB {fanuc['job_id']}\n"
     assert f"job {fanuc['job_id']} is a job of machine hobber-fanuc, not of hobber-840d" in reason
     assert not (share / "X.RDY").exists() and not list(share.glob("*.MPF")) and (share / "X.DONE").exists()
     assert requests(run.url) == [("hobber-840d", "folder", "hobber-840d/X.REQ", f"JOB {fanuc['job_id']}", None, None,
@@ -90,7 +91,7 @@ def test_another_machines_job_is_refused_with_an_err_file_and_the_next_request_a
     own = stored_job(run, 43)   # the same connection answers the next request: the refusal left it usable
     (share / "Y.REQ").write_text(f"JOB {own['job_id']}\n")
     [answer] = answered(folders)
-    assert answer.refusal is None and (share / "Y.RDY").read_text() == f"{answer.program_file}\n"
+    assert answer.refusal is None and (share / "Y.RDY").read_text() == f"{answer.program_file}\nJOB {own['job_id']}\n"
 
 
 def test_a_stale_answer_is_replaced_and_what_is_not_a_request_is_refused(run, folders):

@@ -13,8 +13,10 @@ each request once:
 1. the program, proved now (engine.service.delivery.deliver, via "folder"), is written next to it as
    `PRG<program id>_<first 8 hex digits of the sha256 of its bytes>.MPF`: a name that changes with
    the bytes, so a control never takes another program's file, nor an older one, for its answer;
-2. then `<stem>.RDY`, holding that file name and a new line: the name the control waits for with
-   `ISFILE`, known in advance; or, for a refusal, `<stem>.ERR` holding the one-line reason;
+2. then `<stem>.RDY`, holding that file name, then the request's words as read (each line ended by
+   a new line): the name the control waits for with `ISFILE`, known in advance, and what it
+   answers, which the control compares with what it wrote; or, for a refusal, `<stem>.ERR` holding
+   the one-line reason, then the request's words;
 3. unless the control wrote a new `<stem>.REQ` meanwhile: then this answer is not written (the
    control would take it for the new request's), and the new request is answered instead.
 
@@ -137,13 +139,14 @@ class RequestFolder:
         claimed = folder / f"{stem}{DONE}"
         os.replace(request, claimed)
         self._seen.pop(request, None)
+        words = _request_text(_read_request(claimed))
         try:
-            delivered = deliver(self.conn, machine, _request_text(_read_request(claimed)), via="folder",
-                                client=f"{machine}/{request.name}", config=self.config)
+            delivered = deliver(self.conn, machine, words, via="folder", client=f"{machine}/{request.name}",
+                                config=self.config)
         except EngineError as refusal:
-            answer = partial(_refused, folder, machine, request.name, stem, one_line(str(refusal)))
+            answer = partial(_refused, folder, machine, request.name, stem, one_line(str(refusal)), words)
         else:
-            answer = partial(_sent, folder, machine, request.name, stem, delivered)
+            answer = partial(_sent, folder, machine, request.name, stem, delivered, words)
         if request.exists():   # asked again meanwhile: this answer would be taken for that request
             LOG.warning("request %s of machine %s was written again while it was answered: the new one is "
                         "answered instead", request.name, machine)
@@ -173,17 +176,26 @@ def _request_text(data: bytes) -> str:
     return "\n".join(line.strip() for line in lines if line.strip())
 
 
-def _refused(folder: Path, machine: str, request: str, stem: str, reason: str) -> Answer:
-    write_atomically(folder, f"{stem}{ERROR}", f"{as_ascii(reason)}\n".encode("ascii"))
+def _refused(folder: Path, machine: str, request: str, stem: str, reason: str, words: str) -> Answer:
+    write_atomically(folder, f"{stem}{ERROR}", _answer_text(as_ascii(reason), words))
     return Answer(machine, request, refusal=reason)
 
 
-def _sent(folder: Path, machine: str, request: str, stem: str, delivered: Delivered) -> Answer:
+def _sent(folder: Path, machine: str, request: str, stem: str, delivered: Delivered, words: str) -> Answer:
     """The program first, under a name carrying its bytes' hash; then the answer naming it."""
     name = f"PRG{delivered.program_id}_{hashlib.sha256(delivered.data).hexdigest()[:8].upper()}.MPF"
     write_atomically(folder, name, delivered.data)
-    write_atomically(folder, f"{stem}{READY}", f"{name}\n".encode("ascii"))
+    write_atomically(folder, f"{stem}{READY}", _answer_text(name, words))
     return Answer(machine, request, program_file=name)
+
+
+def _answer_text(first: str, words: str) -> bytes:
+    """An answer: its first line (the program file, or the refusal), then the request it answers, as
+    read (one line; ASCII). The control compares the second line with what it wrote: an answer to
+    its previous request, written in the milliseconds between its removing the old answer and its
+    writing the new request, is then not taken for this one's (the race the adversary of issue 32
+    left open)."""
+    return f"{first}\n{as_ascii(one_line(words))}\n".encode("ascii")
 
 
 def write_atomically(folder: Path, name: str, data: bytes) -> None:
