@@ -1,0 +1,32 @@
+"""Issue 33's adversary: a head office and plant 7 (two embedded servers with wal_level = logical,
+set up by tests/test_plants.py's fixture and helpers) attacked where the promises of docs/design.md
+§12 could break: a record the head office deletes and makes again, a draft marked released by
+the owner, a plant number taken twice, secrets in messages, migrations that differ."""
+from __future__ import annotations
+
+import json
+
+import psycopg
+import pytest
+from test_plants import (PLANT, TEMPLATES_SLOT, caught_up, edit_spur, engine, group, new_database,  # noqa: F401
+                         ok, released, rows, versions)
+
+
+@pytest.mark.slow
+def test_the_owner_cannot_mark_a_draft_released_so_it_never_reaches_a_plant(group):
+    """`released` is the publication's filter: only release_template may set it, after the
+    release's row; the owner setting it on a draft (UPDATE) or storing a draft with it (INSERT)
+    would send rows nobody released to every plant."""
+    head = group.head_url
+    draft = edit_spur(head, "NOBODY RELEASED THIS")
+    with pytest.raises(psycopg.errors.InsufficientPrivilege, match="release_template"):
+        rows(head, "UPDATE template_version_rows SET released = true WHERE gear_class = 'spur' AND version = %s",
+             (draft,))
+    with pytest.raises(psycopg.errors.IntegrityConstraintViolation, match="release_template"), \
+            psycopg.connect(head) as conn:
+        conn.execute("DELETE FROM template_view WHERE gear_class = 'spur' AND id = 350")
+        conn.execute("INSERT INTO template_version_rows (gear_class, version, rows, released) "
+                     "SELECT 'spur', g.template_version, r.rows, true "
+                     "FROM gear_class g, assembled_rows_of(ARRAY['spur']) r WHERE g.name = 'spur'")
+    caught_up(head, TEMPLATES_SLOT)
+    assert draft in versions(head, "spur") and draft not in versions(group.plant_url, "spur")
