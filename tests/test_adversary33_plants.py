@@ -4,12 +4,12 @@ set up by tests/test_plants.py's fixture and helpers) attacked where the promise
 the owner, a plant number taken twice, secrets in messages, migrations that differ."""
 from __future__ import annotations
 
-import json
-
 import psycopg
 import pytest
-from test_plants import (PLANT, TEMPLATES_SLOT, caught_up, edit_spur, engine, group, new_database,  # noqa: F401
-                         ok, released, rows, versions)
+import test_plants
+from test_plants import TEMPLATES_SLOT, caught_up, edit_spur, rows, versions
+
+group = test_plants.group   # its module-scoped head office and plant 7, started again for this module
 
 
 @pytest.mark.slow
