@@ -41,3 +41,36 @@ BEGIN
     RETURN NEW;
 END
 $$;
+
+-- replace_kept_row: at a plant, a row the head office made again replaces the one kept. Deletions
+-- are not published (a plant's history refers to what it ran), so a hob, machine, work-holding or
+-- golden test deleted at the head office stays at the plant; the head office's new row of the same
+-- key (`engine hobs delete`, then `engine hobs add` of that id) then broke a unique index there and
+-- stopped the plant's subscription, and with it every later release. Enabled for replica only: it
+-- runs for the rows the replication applies, never for a person's write.
+CREATE FUNCTION replace_kept_row() RETURNS trigger
+LANGUAGE plpgsql SET search_path = public, pg_temp
+AS $$
+BEGIN
+    CASE TG_TABLE_NAME
+        WHEN 'hob' THEN DELETE FROM hob WHERE upper(id) = upper(NEW.id);
+        WHEN 'work_holding' THEN DELETE FROM work_holding WHERE upper(id) = upper(NEW.id);
+        WHEN 'machine' THEN DELETE FROM machine WHERE name = NEW.name;
+        WHEN 'template_test' THEN
+            DELETE FROM template_test WHERE id = NEW.id OR (gear_class, name) = (NEW.gear_class, NEW.name);
+    END CASE;
+    RETURN NEW;
+END
+$$;
+
+CREATE TRIGGER made_again_at_the_head_office BEFORE INSERT ON hob FOR EACH ROW EXECUTE FUNCTION replace_kept_row();
+CREATE TRIGGER made_again_at_the_head_office BEFORE INSERT ON work_holding
+FOR EACH ROW EXECUTE FUNCTION replace_kept_row();
+CREATE TRIGGER made_again_at_the_head_office BEFORE INSERT ON machine
+FOR EACH ROW EXECUTE FUNCTION replace_kept_row();
+CREATE TRIGGER made_again_at_the_head_office BEFORE INSERT ON template_test
+FOR EACH ROW EXECUTE FUNCTION replace_kept_row();
+ALTER TABLE hob ENABLE REPLICA TRIGGER made_again_at_the_head_office;
+ALTER TABLE work_holding ENABLE REPLICA TRIGGER made_again_at_the_head_office;
+ALTER TABLE machine ENABLE REPLICA TRIGGER made_again_at_the_head_office;
+ALTER TABLE template_test ENABLE REPLICA TRIGGER made_again_at_the_head_office;

@@ -7,9 +7,33 @@ from __future__ import annotations
 import psycopg
 import pytest
 import test_plants
-from test_plants import TEMPLATES_SLOT, caught_up, edit_spur, rows, versions
+from test_plants import TEMPLATES_SLOT, caught_up, edit_spur, engine, ok, released, rows, versions
 
 group = test_plants.group   # its module-scoped head office and plant 7, started again for this module
+SPARE_HOB = "H-M1.5-A-R2"   # seed_templates/hobs.csv: a hob no seeded gear's job uses
+
+
+@pytest.mark.slow
+def test_a_hob_and_a_golden_test_deleted_and_made_again_at_the_head_office_do_not_stop_the_plant(group):
+    """Deletions are not published, so the plant keeps the old row; the head office's new row of the
+    same key must replace it there instead of stopping the plant's subscription (and every later
+    release) on a duplicate key."""
+    head = group.head_url
+    ok(engine(group.head, "hobs", "delete", SPARE_HOB, "--yes", url=head))
+    ok(engine(group.head, "hobs", "add", "--id", SPARE_HOB.lower(), "--module", 1.5, "--tip-diameter", 64,
+              "--length", 90, "--hand", "R", "--accuracy-class", "A", "--starts", 2, url=head))
+    test = ("INSERT INTO template_test (gear_class, name, params, expect) "
+            "VALUES ('helical', 'adversary', '{\"z\": 19}', %s)")
+    rows(head, test + " RETURNING id", (["G0"],))
+    rows(head, "DELETE FROM template_test WHERE gear_class = 'helical' AND name = 'adversary' RETURNING id")
+    rows(head, test + " RETURNING id", (["G1"],))
+    edit_spur(head, "AFTER A HOB WAS MADE AGAIN")
+    ok(engine(group.head, "template", "release", "--class", "spur", "--yes", "--without-golden-tests", url=head))
+    caught_up(head, TEMPLATES_SLOT)
+    assert released(group.plant_url, "spur") == released(head, "spur")
+    assert rows(group.plant_url, "SELECT id, tip_diameter FROM hob WHERE upper(id) = %s", (SPARE_HOB,)) == \
+        [(SPARE_HOB.lower(), 64)]
+    assert rows(group.plant_url, "SELECT expect FROM template_test WHERE name = 'adversary'") == [(["G1"],)]
 
 
 @pytest.mark.slow
