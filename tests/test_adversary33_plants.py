@@ -7,7 +7,7 @@ from __future__ import annotations
 import psycopg
 import pytest
 import test_plants
-from test_plants import TEMPLATES_SLOT, caught_up, edit_spur, engine, ok, released, rows, versions
+from test_plants import TEMPLATES_SLOT, caught_up, edit_spur, engine, new_database, ok, released, rows, versions
 
 group = test_plants.group   # its module-scoped head office and plant 7, started again for this module
 SPARE_HOB = "H-M1.5-A-R2"   # seed_templates/hobs.csv: a hob no seeded gear's job uses
@@ -54,3 +54,21 @@ def test_the_owner_cannot_mark_a_draft_released_so_it_never_reaches_a_plant(grou
                      "FROM gear_class g, assembled_rows_of(ARRAY['spur']) r WHERE g.name = 'spur'")
     caught_up(head, TEMPLATES_SLOT)
     assert draft in versions(head, "spur") and draft not in versions(group.plant_url, "spur")
+
+
+@pytest.mark.slow
+def test_a_number_whose_setup_is_unfinished_is_refused_before_it_is_taken(group):
+    """A plant whose setup stopped after its templates subscription (the head office could not reach
+    it) holds its number's slot at the head office; a second database asking for that number must be
+    refused before it takes the number, not left as a plant that can never finish nor take another."""
+    first, second = (new_database(group.plant.url, "plant") for _ in range(2))
+    unreachable = group.plant_url.replace("host=", "host=/nonexistent", 1)
+    for database in (first, second):
+        ok(engine(group.plant, "db", "migrate", url=database))
+    half = engine(group.plant, "plant", "subscribe", "--head", group.head_url, "--number", 8,
+                  "--plant-url", unreachable, url=first)
+    assert half.exit_code == 1 and "engine_plant_8_history" in half.stderr
+    taken = engine(group.plant, "plant", "subscribe", "--head", group.head_url, "--number", 8, url=second)
+    assert taken.exit_code == 1 and taken.stderr.count("\n") == 1
+    assert "plant 8" in taken.stderr and "choose another --number" in taken.stderr
+    assert rows(second, "SELECT plant_number()") == [(0,)]

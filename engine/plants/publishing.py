@@ -132,10 +132,23 @@ def _check_head(head: Connection, number: int, resuming: bool) -> None:
                           "run `engine plant publish` there first")
     if plant_number(head) > 0:
         raise EngineError(f"engine plant subscribe: --head names plant {plant_number(head)}, not the head office")
+    if not resuming:
+        _refuse_taken_number(head, number)
+
+
+def _refuse_taken_number(head: Connection, number: int) -> None:
+    """The number is taken by a plant the head office subscribes to, or by one whose setup stopped
+    before that (its templates subscription made: its slot is kept at the head office). Checked by
+    the slot too: otherwise a second database took the number, then failed on the slot's name, left
+    a plant that could neither finish nor take another number."""
     name = subscription_name(number, "history")
-    if not resuming and _subscribed(head, name):
+    if _subscribed(head, name):
         raise EngineError(f"engine plant subscribe: the head office has a plant {number} already ({name}); "
                           "choose another --number")
+    slot = subscription_name(number, "templates")
+    if head.execute("SELECT 1 FROM pg_replication_slots WHERE slot_name = %s", (slot,)).fetchone():
+        raise EngineError(f"engine plant subscribe: the head office has a plant {number} already, its setup "
+                          f"unfinished (slot {slot}); choose another --number, or finish that plant's setup there")
 
 
 def _id_range(conn: Connection, number: int) -> tuple[int, int]:
