@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING
 import msgspec
 from psycopg import sql
 
-from ..db.connection import connect, scalar
+from ..db.connection import connect, scalar, without_password
 from ..errors import EngineError
 from . import tables
 from .tables import Published, subscription_name
@@ -185,6 +185,6 @@ def _subscription(conn: Connection, name: str, url: str, publication: str) -> No
         conn.execute(sql.SQL("CREATE SUBSCRIPTION {} CONNECTION {} PUBLICATION {}").format(
             sql.Identifier(name), sql.Literal(url), sql.Identifier(publication)))
     except psycopg.Error as error:
-        first_line = (str(error).strip().splitlines() or [type(error).__name__])[0]
+        first_line = without_password((str(error).strip().splitlines() or [type(error).__name__])[0], url)
         raise EngineError(f"engine plant subscribe: could not make the subscription {name} ({first_line}); "
                           "what was made before it stays: make it reachable and run the same command again") from error
