@@ -72,3 +72,20 @@ def test_a_number_whose_setup_is_unfinished_is_refused_before_it_is_taken(group)
     assert taken.exit_code == 1 and taken.stderr.count("\n") == 1
     assert "plant 8" in taken.stderr and "choose another --number" in taken.stderr
     assert rows(second, "SELECT plant_number()") == [(0,)]
+
+
+@pytest.mark.slow
+def test_a_head_office_with_a_migration_this_engine_lacks_is_refused(group):
+    """A head office upgraded before its plant (a migration this engine does not know: a newer
+    engine) would publish what the plant's tables cannot take, and the subscription would stop on
+    its first copy; the plant must be refused before it takes a number."""
+    rows(group.head_url, "INSERT INTO schema_migration (version, name, checksum) VALUES ('9999', 'newer', 'x') "
+                         "RETURNING version")
+    try:
+        plant = new_database(group.plant.url, "plant")
+        ok(engine(group.plant, "db", "migrate", url=plant))
+        refused = engine(group.plant, "plant", "subscribe", "--head", group.head_url, "--number", 9, url=plant)
+    finally:
+        rows(group.head_url, "DELETE FROM schema_migration WHERE version = '9999' RETURNING version")
+    assert refused.exit_code == 1 and refused.stderr.count("\n") == 1
+    assert "9999" in refused.stderr and rows(plant, "SELECT plant_number()") == [(0,)]

@@ -126,6 +126,7 @@ def _check_head(head: Connection, number: int, resuming: bool) -> None:
         require_current(head)
     except EngineError as error:
         raise EngineError(f"engine plant subscribe: at the head office, {error}") from error
+    _refuse_newer_head(head)
     publication = (tables.TEMPLATES_PUBLICATION,)
     if not head.execute("SELECT 1 FROM pg_publication WHERE pubname = %s", publication).fetchone():
         raise EngineError("engine plant subscribe: the head office publishes nothing yet; "
@@ -134,6 +135,20 @@ def _check_head(head: Connection, number: int, resuming: bool) -> None:
         raise EngineError(f"engine plant subscribe: --head names plant {plant_number(head)}, not the head office")
     if not resuming:
         _refuse_taken_number(head, number)
+
+
+def _refuse_newer_head(head: Connection) -> None:
+    """require_current finds a head office behind this engine, not one ahead of it (a migration of a
+    newer engine): that one publishes columns or rules this plant's tables lack, and the plant's
+    subscription would stop on its first copy."""
+    from ..db.migrate import discover
+
+    known = {migration.version for migration in discover()}
+    newer = sorted(version for (version,) in head.execute("SELECT version FROM schema_migration")
+                   if version not in known)
+    if newer:
+        raise EngineError(f"engine plant subscribe: the head office has migration(s) this engine lacks (first "
+                          f"{newer[0]}): upgrade the engine here to the head office's and run engine db migrate")
 
 
 def _refuse_taken_number(head: Connection, number: int) -> None:
