@@ -2107,7 +2107,7 @@ BEGIN
         RAISE EXCEPTION '% %: plant % makes ids % to % only, so no two plants make one id; its sequence %_id_seq '
                         'was moved, run engine plant status', TG_TABLE_NAME, NEW.id, here, plant_first_id(here),
                         plant_last_id(here), TG_TABLE_NAME
-            USING ERRCODE = 'check_violation', COLUMN = 'id';
+            USING ERRCODE = 'check_violation', COLUMN = 'id', TABLE = TG_TABLE_NAME, CONSTRAINT = 'a_plant_id';
     END IF;
     RETURN NEW;
 END
