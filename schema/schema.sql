@@ -2153,11 +2153,11 @@ CREATE TRIGGER head_office_writes_it BEFORE INSERT OR UPDATE OR DELETE OR TRUNCA
 FOR EACH STATEMENT EXECUTE FUNCTION refuse_at_a_plant();
 
 -- replace_kept_row: at a plant, a row the head office made again replaces the one kept. Deletions
--- are not published (a plant's history refers to what it ran), so a hob, machine, work-holding or
--- golden test deleted at the head office stays at the plant; the head office's new row of the same
--- key (`engine hobs delete`, then `engine hobs add` of that id) then broke a unique index there and
--- stopped the plant's subscription, and with it every later release. Enabled for replica only: it
--- runs for the rows the replication applies, never for a person's write.
+-- are not published (a plant's history refers to what it ran), so a hob, machine, work-holding,
+-- golden test or unreleased class deleted at the head office stays at the plant; the head office's
+-- new row of the same key (`engine hobs delete`, then `engine hobs add` of that id) then broke a
+-- unique index there and stopped the plant's subscription, and with it every later release.
+-- Enabled for replica only: it runs for the rows the replication applies, never for a person's write.
 CREATE FUNCTION replace_kept_row() RETURNS trigger
 LANGUAGE plpgsql SET search_path = public, pg_temp
 AS $$
@@ -2166,6 +2166,7 @@ BEGIN
         WHEN 'hob' THEN DELETE FROM hob WHERE upper(id) = upper(NEW.id);
         WHEN 'work_holding' THEN DELETE FROM work_holding WHERE upper(id) = upper(NEW.id);
         WHEN 'machine' THEN DELETE FROM machine WHERE name = NEW.name;
+        WHEN 'gear_class' THEN DELETE FROM gear_class WHERE name = NEW.name;
         WHEN 'template_test' THEN
             DELETE FROM template_test WHERE id = NEW.id OR (gear_class, name) = (NEW.gear_class, NEW.name);
     END CASE;
@@ -2184,6 +2185,32 @@ ALTER TABLE hob ENABLE REPLICA TRIGGER made_again_at_the_head_office;
 ALTER TABLE work_holding ENABLE REPLICA TRIGGER made_again_at_the_head_office;
 ALTER TABLE machine ENABLE REPLICA TRIGGER made_again_at_the_head_office;
 ALTER TABLE template_test ENABLE REPLICA TRIGGER made_again_at_the_head_office;
+
+-- A class the head office made again under a deleted one's name (never released: see below).
+CREATE TRIGGER made_again_at_the_head_office BEFORE INSERT ON gear_class
+FOR EACH ROW EXECUTE FUNCTION replace_kept_row();
+ALTER TABLE gear_class ENABLE REPLICA TRIGGER made_again_at_the_head_office;
+
+-- refuse_deleting_a_released_class: at a head office (it publishes engine_templates), a class with a
+-- release is not deleted. Its plants keep it and its released versions (deletions are not sent, a
+-- plant's programs refer to them); a class made again under its name restarts at version 1, whose
+-- release collided with the version 1 a plant kept and stopped that plant's subscription for good.
+CREATE FUNCTION refuse_deleting_a_released_class() RETURNS trigger
+LANGUAGE plpgsql SET search_path = public, pg_temp
+AS $$
+BEGIN
+    IF EXISTS (SELECT 1 FROM template_release r WHERE r.gear_class = OLD.name)
+       AND EXISTS (SELECT 1 FROM pg_publication p WHERE p.pubname = 'engine_templates') THEN
+        RAISE EXCEPTION 'class %: its released versions are kept at every plant, so a head office keeps the class; '
+                        'make a class of another name instead', OLD.name
+            USING ERRCODE = 'dependent_objects_still_exist';
+    END IF;
+    RETURN OLD;
+END
+$$;
+
+CREATE TRIGGER released_classes_are_kept BEFORE DELETE ON gear_class
+FOR EACH ROW EXECUTE FUNCTION refuse_deleting_a_released_class();
 
 -- ==============================================================================================
 -- roles

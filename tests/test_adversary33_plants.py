@@ -89,3 +89,38 @@ def test_a_head_office_with_a_migration_this_engine_lacks_is_refused(group):
         rows(group.head_url, "DELETE FROM schema_migration WHERE version = '9999' RETURNING version")
     assert refused.exit_code == 1 and refused.stderr.count("\n") == 1
     assert "9999" in refused.stderr and rows(plant, "SELECT plant_number()") == [(0,)]
+
+
+def new_class(url: str, name: str, text: str) -> None:
+    """A class of one row made at the head office by SQL, its draft stored at commit."""
+    with psycopg.connect(url) as conn:
+        conn.execute("INSERT INTO gear_class (name, parent, description) VALUES (%s, 'gear', 'adversary')", (name,))
+        conn.execute("INSERT INTO template_view (gear_class, id, t, n, o) VALUES (%s, 9000, 'main', 1, %s)",
+                     (name, f'"; {text}"'))
+
+
+def release_by_sql(url: str, name: str) -> None:
+    rows(url, "SELECT release_template(g.name, g.template_version, v.hash) FROM gear_class g JOIN "
+              "template_version_rows v ON v.gear_class = g.name AND v.version = g.template_version WHERE g.name = %s",
+         (name,))
+
+
+@pytest.mark.slow
+def test_a_class_deleted_and_made_again_at_the_head_office_does_not_stop_the_plant(group):
+    """A plant keeps a class and its released versions when the head office deletes them
+    (deletions are not sent). A class made again under that name restarts its versions at 1,
+    whose release would collide with the version 1 the plant kept (and its programs' lineage):
+    a released class is not deleted at a head office; an unreleased one made again replaces the
+    plant's kept row."""
+    head = group.head_url
+    new_class(head, "adversary_released", "ONE")
+    release_by_sql(head, "adversary_released")
+    with pytest.raises(psycopg.errors.DependentObjectsStillExist, match="adversary_released"):
+        rows(head, "DELETE FROM gear_class WHERE name = 'adversary_released' RETURNING name")
+    new_class(head, "adversary_draft", "ONE")
+    rows(head, "DELETE FROM gear_class WHERE name = 'adversary_draft' RETURNING name")
+    new_class(head, "adversary_draft", "TWO")
+    release_by_sql(head, "adversary_draft")
+    caught_up(head, TEMPLATES_SLOT)
+    assert released(group.plant_url, "adversary_draft") == released(head, "adversary_draft")
+    assert released(group.plant_url, "adversary_released") == released(head, "adversary_released")
