@@ -124,3 +124,20 @@ def test_a_class_deleted_and_made_again_at_the_head_office_does_not_stop_the_pla
     caught_up(head, TEMPLATES_SLOT)
     assert released(group.plant_url, "adversary_draft") == released(head, "adversary_draft")
     assert released(group.plant_url, "adversary_released") == released(head, "adversary_released")
+
+
+@pytest.mark.slow
+def test_a_release_of_rows_stored_out_of_line_reaches_the_plant_whole(group):
+    """A version's rows over about 2 kB compressed are stored out of line (TOAST); the release is
+    a later transaction's UPDATE of `released` only, whose unchanged out-of-line value logical
+    replication need not resend. The plant must still receive the rows whole (it computes their
+    hash again itself)."""
+    head = group.head_url
+    rows(head, "UPDATE template_view SET o = o || ' ' WHERE gear_class = 'taper' AND id = 3200 RETURNING id")
+    ok(engine(group.head, "template", "release", "--class", "taper", "--yes", "--without-golden-tests", url=head))
+    version, template_hash = released(head, "taper")
+    assert rows(head, "SELECT pg_column_size(rows) > 2032 FROM template_version_rows WHERE gear_class = 'taper' "
+                      "AND version = %s", (version,)) == [(True,)]
+    caught_up(head, TEMPLATES_SLOT)
+    assert rows(group.plant_url, "SELECT hash FROM template_version_rows WHERE gear_class = 'taper' AND version = %s",
+                (version,)) == [(template_hash,)]
