@@ -4,10 +4,24 @@ set up by tests/test_plants.py's fixture and helpers) attacked where the promise
 the owner, a plant number taken twice, secrets in messages, migrations that differ."""
 from __future__ import annotations
 
+import json
+
 import psycopg
 import pytest
 import test_plants
-from test_plants import TEMPLATES_SLOT, caught_up, edit_spur, engine, new_database, ok, released, rows, versions
+from test_plants import (
+    HISTORY_SLOT,
+    PLANT,
+    TEMPLATES_SLOT,
+    caught_up,
+    edit_spur,
+    engine,
+    new_database,
+    ok,
+    released,
+    rows,
+    versions,
+)
 
 group = test_plants.group   # its module-scoped head office and plant 7, started again for this module
 SPARE_HOB = "H-M1.5-A-R2"   # seed_templates/hobs.csv: a hob no seeded gear's job uses
@@ -27,7 +41,7 @@ def test_a_hob_and_a_golden_test_deleted_and_made_again_at_the_head_office_do_no
     rows(head, test + " RETURNING id", (["G0"],))
     rows(head, "DELETE FROM template_test WHERE gear_class = 'helical' AND name = 'adversary' RETURNING id")
     rows(head, test + " RETURNING id", (["G1"],))
-    edit_spur(head, "AFTER A HOB WAS MADE AGAIN")
+    edit_spur(head, "REVISION C")
     ok(engine(group.head, "template", "release", "--class", "spur", "--yes", "--without-golden-tests", url=head))
     caught_up(head, TEMPLATES_SLOT)
     assert released(group.plant_url, "spur") == released(head, "spur")
@@ -141,3 +155,23 @@ def test_a_release_of_rows_stored_out_of_line_reaches_the_plant_whole(group):
     caught_up(head, TEMPLATES_SLOT)
     assert rows(group.plant_url, "SELECT hash FROM template_version_rows WHERE gear_class = 'taper' AND version = %s",
                 (version,)) == [(template_hash,)]
+
+
+@pytest.mark.slow
+def test_the_head_office_does_not_judge_a_plants_program_by_its_own_gears(group):
+    """A plant's gears are its own (gear ids are not ranged, not replicated): the head office's
+    gear 42 is not the gear the plant's job 42 was made for. Proved against it, a right program of
+    the plant was called REFUSED in the head office's history (or MATCH by coincidence); the head
+    office must say it cannot prove it here, and where it was proved."""
+    head, plant = group.head_url, group.plant_url
+    made = json.loads(ok(engine(group.plant, "instantiate", "--gear", 42, "--json", url=plant)))
+    caught_up(plant, HISTORY_SLOT)
+    rows(head, "UPDATE gear SET teeth = teeth + 4 WHERE id = 42 RETURNING id")   # the head office's own gear 42
+    try:
+        at_head = json.loads(ok(engine(group.head, "programs", "show", made["program_id"], "--json", url=head)))
+    finally:
+        rows(head, "UPDATE gear SET teeth = teeth - 4 WHERE id = 42 RETURNING id")
+    at_plant = json.loads(ok(engine(group.plant, "programs", "show", made["program_id"], "--json", url=plant)))
+    assert at_plant["programs"][0]["rendering"]["status"] == "MATCH"
+    rendering = at_head["programs"][0]["rendering"]
+    assert rendering["status"] == "UNCHECKED" and f"made at plant {PLANT}" in rendering["reason"]
