@@ -23,8 +23,8 @@ Four outcomes (`Rendering.status`):
   line shows; the job has no history, so the parameters it was made from are gone), it was stored
   before input hashes were kept, its version's rows were never stored, or the version did not
   render the job now (a run over its time budget on a busy machine), or it was made at another
-  plant (the head office's copy of a plant's program: that plant's gears are its own, docs/design.md §12). Making it again
-  (`engine instantiate --job ID`) gives a program that can be checked.
+  plant (the head office's copy of a plant's program: that plant's gears are its own, docs/design.md
+  §12). Making it again (`engine instantiate --job ID`) gives a program that can be checked.
 
 The rendering is made as the engine made it (engine.programs.remake): a hobbing job with its
 cycle time recomputed from its feeds, a turning job with its passes computed from its drawing's
