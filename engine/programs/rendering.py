@@ -22,8 +22,9 @@ Four outcomes (`Rendering.status`):
   its job was edited after it was stored (the job's input hash is no longer the one its lineage
   line shows; the job has no history, so the parameters it was made from are gone), it was stored
   before input hashes were kept, its version's rows were never stored, or the version did not
-  render the job now (a run over its time budget on a busy machine). Making it again
-  (`engine instantiate --job ID`) gives a program that can be checked.
+  render the job now (a run over its time budget on a busy machine), or it was made at another
+  plant (the head office's copy of a plant's program: that plant's gears are its own, docs/design.md
+  §12). Making it again (`engine instantiate --job ID`) gives a program that can be checked.
 
 The rendering is made as the engine made it (engine.programs.remake): a hobbing job with its
 cycle time recomputed from its feeds, a turning job with its passes computed from its drawing's
@@ -66,7 +67,9 @@ LISTED_RENDERING = ("CASE WHEN p.input_hash IS NOT NULL AND p.input_hash = job_i
 STORED = """
 SELECT p.id, p.name, p.gear_class, p.template_version, p.template_hash, p.input_hash, p.draft, p.unverified,
        p.lines, p.row_ids, p.trace, p.job_id, j.machine, j.params, j.module_params,
-       job_input_hash(j.params, j.module_params), v.version IS NOT NULL, m.dialect, j.gear_id, j.hob_id
+       job_input_hash(j.params, j.module_params), v.version IS NOT NULL, m.dialect, j.gear_id, j.hob_id,
+       CASE WHEN j.id NOT BETWEEN plant_first_id(plant_number()) AND plant_last_id(plant_number())
+            THEN (j.id / plant_first_id(1))::integer END
 FROM program p JOIN job j ON j.id = p.job_id JOIN machine m ON m.name = j.machine
 LEFT JOIN template_version_rows v ON v.gear_class = p.gear_class AND v.version = p.template_version
 WHERE p.id = %s"""
@@ -144,6 +147,7 @@ class StoredProgram(msgspec.Struct, frozen=True):
     dialect: str
     gear_id: int | None = None   # the job's gear and hob, which the proof simulates against
     hob_id: str | None = None
+    made_at: int | None = None   # the plant whose job it is, when not this database's (docs/design.md §12)
 
 
 class Renderer:
@@ -276,6 +280,9 @@ class Renderer:
 def _why_unchecked(stored: StoredProgram) -> str | None:
     """Why the program cannot be rendered again from the records, or None."""
     remake = REMAKE.format(job=stored.job_id)
+    if stored.made_at is not None:   # a plant's gears, cases and materials are its own, not replicated
+        return (f"made at plant {stored.made_at} for that plant's gear {stored.gear_id}, not this database's, and "
+                f"proved there: see it with `engine programs show {stored.id}` at plant {stored.made_at}")
     if stored.input_hash is None:
         return f"stored before input hashes were kept, it cannot be rendered again; {remake}"
     if stored.job_hash != stored.input_hash:
