@@ -141,7 +141,7 @@ def test_logout_a_revoked_role_and_a_forged_cookie_end_the_session(server, servi
     reader, other = create("engine_reader"), create("engine_reader")
     with web(service[0]) as client:
         assert logged_in(client, reader).status_code == 303 and client.get("/classes").status_code == 200
-        assert client.post("/logout").status_code == 303
+        assert client.post("/logout", headers={"Origin": LOOPBACK}).status_code == 303
         assert client.get("/classes").status_code == 303
         assert logged_in(client, other).status_code == 303 and client.get("/classes").status_code == 200
         with psycopg.connect(url, autocommit=True) as admin:
@@ -150,6 +150,24 @@ def test_logout_a_revoked_role_and_a_forged_cookie_end_the_session(server, servi
     with web(service[0]) as client:
         client.cookies.set(SESSION_COOKIE, 'eyJsb2dpbiI6ICJwb3N0Z3JlcyJ9')   # {"login": "postgres"}, unsigned
         assert client.get("/classes").status_code == 303
+
+
+def test_a_logout_from_another_site_is_refused_and_the_session_kept(server, service):
+    """Another site's page may not log a user out (its form's POST carries its own Origin, or none
+    when the browser hides it): 403 naming the check, and the session goes on."""
+    reader = server[1]("engine_reader")
+    with web(service[0]) as client:
+        assert logged_in(client, reader).status_code == 303
+        refused = [client.post("/logout", headers=headers) for headers in
+                   ({"Origin": "https://evil.example"}, {"Referer": "https://evil.example/page"}, {})]
+        as_json = client.post("/logout", headers={"Origin": "https://evil.example", **JSON})
+        still = client.get("/classes")
+        own = client.post("/logout", headers={"Referer": f"{LOOPBACK}/classes"})
+        after = client.get("/classes")
+    assert all(answer.status_code == 403 and "logout is taken only from this service's own page"
+               in answer.text.replace("&#39;", "'") for answer in refused)
+    assert as_json.status_code == 403 and "evil.example" in as_json.json()["error"]
+    assert still.status_code == 200 and own.status_code == 303 and after.status_code == 303
 
 
 def test_no_page_shows_a_password(server, service):

@@ -46,6 +46,8 @@ NO_ROLE = ("login refused: this login has no role of the engine's (engine_reader
 LOCAL_USER = "local"               # program_request.client of a request on the open loopback app
 CROSS_SITE = ("refused: a program is requested only from this service's own page ({}); open the job's page "
               "here and use its button")
+LOGOUT_CROSS_SITE = ("refused: a logout is taken only from this service's own page ({}); use the Log out button "
+                     "of its pages")
 MISDIRECTED = ("this view is open only to the local user, at a loopback address: open it as "
                "http://127.0.0.1:{port}/ (it was reached as {host!r})")
 LOG = logging.getLogger("engine.serve")
@@ -176,20 +178,21 @@ def requester(request: Request) -> str:
     return LOCAL_USER if rights is None else rights.login
 
 
-def cross_site(request: Request) -> str | None:
+def cross_site(request: Request, said: str = CROSS_SITE) -> str | None:
     """Why a form's POST may not have come from this service's own pages, or None (issue 32: a
     page of another site must not make the browser of a logged-in runner, or of the local user of
     the open loopback app, request a program). The browser's Origin (else Referer) must name this
     very host as the request reached it (Host), and on the open app that host must be a loopback
-    one: a name of another site resolving to 127.0.0.1 (DNS rebinding) is its own origin there."""
+    one: a name of another site resolving to 127.0.0.1 (DNS rebinding) is its own origin there.
+    `said`: the refusal, naming the action (a request, a logout)."""
     host = request.headers.get("host", "").lower()
     came_from = request.headers.get("origin") or request.headers.get("referer")
     if not came_from or not host:
-        return CROSS_SITE.format("it says no Origin or Referer, or no Host")
+        return said.format("it says no Origin or Referer, or no Host")
     if _split(came_from).netloc.lower() != host:
-        return CROSS_SITE.format(f"it came from {came_from[:80]!r}, not from {host[:80]!r}")
+        return said.format(f"it came from {came_from[:80]!r}, not from {host[:80]!r}")
     if not request.app.state.require_login and not is_loopback(_split(f"//{host}").hostname or ""):
-        return CROSS_SITE.format(f"the open (loopback) view was reached as {host[:80]!r}; open it as 127.0.0.1")
+        return said.format(f"the open (loopback) view was reached as {host[:80]!r}; open it as 127.0.0.1")
     return None
 
 
@@ -220,6 +223,11 @@ async def login(request: Request) -> Response:
 
 
 async def logout(request: Request) -> Response:
+    """Ends the session; only from this service's own pages (cross_site: another site's page must
+    not log a user out, 403 and the session kept)."""
+    reason = cross_site(request, LOGOUT_CROSS_SITE)
+    if reason is not None:
+        return refusal(request, reason, 403)
     request.session.clear()
     if wants_json(request):
         return JSONResponse({"logged_out": True})
