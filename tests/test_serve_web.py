@@ -222,9 +222,24 @@ def test_a_bad_or_unknown_id_is_one_line_never_a_stack_trace(read_only_database_
         answer = client.get(path, headers=JSON)
     assert page.status_code == answer.status_code == BAD[path]
     assert "Traceback" not in page.text and "File \"" not in page.text
-    if path != "/nosuch":   # Starlette's own "Not Found"
-        message = answer.json()["error"]
-        assert len(message.splitlines()) == 1 and message.strip() and message in html.unescape(page.text)
+    assert answer.headers["content-type"] == "application/json" and page.headers["content-type"].startswith("text/html")
+    message = answer.json()["error"]
+    assert len(message.splitlines()) == 1 and message.strip() and message in html.unescape(page.text)
+
+
+def test_an_address_of_no_page_answers_json_to_a_program_and_a_page_to_a_browser(read_only_database_url):
+    """Starlette's own 404 and 405 were text/plain "Not Found": a program asking for JSON could not
+    read it (the review of issue 32). The error names the address and where the pages are."""
+    with TestClient(create_app(read_only_database_url), base_url=LOOPBACK) as client:
+        unknown = client.get("/programz/812", headers=JSON)
+        browser = client.get("/programz/812", headers={"Accept": "text/html"})
+        method = client.delete("/programs", headers=JSON)
+    assert unknown.status_code == browser.status_code == 404 and method.status_code == 405
+    assert unknown.json() == {"error": "no page at '/programz/812': the home page / leads to every page (gears, "
+                                       "jobs, programs, classes, machines)"}
+    assert browser.headers["content-type"].startswith("text/html") and "no page at" in html.unescape(browser.text)
+    assert method.json() == {"error": "DELETE is not taken at '/programs'; it takes GET, HEAD"}
+    assert method.headers["allow"] == "GET, HEAD" and method.headers["content-type"] == "application/json"
 
 
 def free_port() -> int:
