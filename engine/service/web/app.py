@@ -69,7 +69,7 @@ def _http_error(request: Request, error: Exception) -> Response:
     every page's are: one line, as JSON {"error": …} when asked for, else the error page (Starlette
     says a bare text/plain "Not Found", which a program reading JSON cannot take)."""
     assert isinstance(error, HTTPException)
-    path, allowed = request.url.path[:80], (error.headers or {}).get("allow")
+    path, allowed = request.url.path[:80], {k.lower(): v for k, v in (error.headers or {}).items()}.get("allow")
     message = (NO_PAGE.format(path=path) if error.status_code == 404 else
                NOT_TAKEN.format(method=request.method, path=path, allowed=allowed) if allowed else str(error.detail))
     answer = refusal(request, message, error.status_code)
