@@ -224,7 +224,24 @@ def test_a_bad_or_unknown_id_is_one_line_never_a_stack_trace(read_only_database_
     assert "Traceback" not in page.text and "File \"" not in page.text
     assert answer.headers["content-type"] == "application/json" and page.headers["content-type"].startswith("text/html")
     message = answer.json()["error"]
-    assert len(message.splitlines()) == 1 and message.strip() and message in html.unescape(page.text)
+    assert len(message.splitlines()) == 1 and message.strip()
+    assert message.partition("; ")[0] in html.unescape(page.text)
+    assert "`engine " not in html.unescape(page.text)   # a page advises pages, never a command
+
+
+def test_an_unknown_program_s_page_advises_the_look_up_box_and_its_json_is_the_cli_line(read_only_run):
+    """The review of issue 32: /programs/99999 said `engine programs show --hash H` to a browser's
+    user. The page names the look-up box; the JSON keeps what `engine programs show 99999` says."""
+    cli = read_only_run("programs", "show", 99999)
+    assert cli.exit_code == 1
+    with TestClient(create_app(read_only_run.url), base_url=LOOPBACK) as client:
+        page = client.get("/programs/99999")
+        answer = client.get("/programs/99999", headers=JSON)
+    assert page.status_code == answer.status_code == 404
+    assert answer.json()["error"] in cli.output and "engine programs show --hash H" in answer.json()["error"]
+    said = html.unescape(page.text)
+    assert "program 99999 does not exist; find it by its lineage line: type the hash on it in the look-up box" in said
+    assert "engine programs" not in said and 'name="q"' in page.text   # the box is on the page
 
 
 def test_an_address_of_no_page_answers_json_to_a_program_and_a_page_to_a_browser(read_only_database_url):
