@@ -11,8 +11,9 @@ each request once:
 0. the request is claimed: renamed `<stem>.DONE`, then read (a request written again meanwhile is
    a new file, answered at a later look);
 1. the program, proved now (engine.service.delivery.deliver, via "folder"), is written next to it as
-   `PRG<program id>_<first 8 hex digits of the sha256 of its bytes>.MPF`: a name that changes with
-   the bytes, so a control never takes another program's file, nor an older one, for its answer;
+   `PG<program id>_<first 7 hex digits of the sha256 of its bytes>.MPF` (program_file_name): a name
+   that changes with the bytes, so a control never takes another program's file, nor an older one,
+   for its answer, and an 840D program name for every id below 10^14 (plants' ids included);
 2. then `<stem>.RDY`, holding that file name, then the request's words as read (each line ended by
    a new line): the name the control waits for with `ISFILE`, known in advance, and what it
    answers, which the control compares with what it wrote; or, for a refusal, `<stem>.ERR` holding
@@ -51,6 +52,13 @@ if TYPE_CHECKING:
 REQUEST = re.compile(r"(?P<stem>[A-Za-z0-9_]{1,24})\.REQ", re.IGNORECASE)
 MAX_REQUEST_BYTES = 1024   # a request's first line is read from its first KiB; a bound no control meets
 READY, ERROR, DONE = ".RDY", ".ERR", ".DONE"
+# The program file: PG, the program id, _, the first 7 hex digits of its bytes' sha256: two letters
+# first and at most 24 characters, an 840D program name (docs/reference/hobbing.md §A1; EXTCALL
+# calls it), for every id below 10^14 (14 digits: a plant's N·10^10 for N up to 9999, engine/plants).
+# PRG<id>_<8 hex> was 25 characters from 13 digits on (the review of issue 32).
+PROGRAM_FILE = "PG{program_id}_{digest}.MPF"
+PROGRAM_FILE_HEX = 7
+PROGRAM_ID_LIMIT = 10**14
 POLL_SECONDS = 1.0
 LOG = logging.getLogger("engine.service.request_folder")
 
@@ -183,10 +191,17 @@ def _refused(folder: Path, machine: str, request: str, stem: str, reason: str, w
 
 def _sent(folder: Path, machine: str, request: str, stem: str, delivered: Delivered, words: str) -> Answer:
     """The program first, under a name carrying its bytes' hash; then the answer naming it."""
-    name = f"PRG{delivered.program_id}_{hashlib.sha256(delivered.data).hexdigest()[:8].upper()}.MPF"
+    name = program_file_name(delivered.program_id, delivered.data)
     write_atomically(folder, name, delivered.data)
     write_atomically(folder, f"{stem}{READY}", _answer_text(name, words))
     return Answer(machine, request, program_file=name)
+
+
+def program_file_name(program_id: int, data: bytes) -> str:
+    """The name the program's bytes are written under (PROGRAM_FILE): PG812_5BE02D1.MPF."""
+    assert 0 < program_id < PROGRAM_ID_LIMIT, f"program id {program_id} would make a name of more than 24 characters"
+    digest = hashlib.sha256(data).hexdigest()[:PROGRAM_FILE_HEX].upper()
+    return PROGRAM_FILE.format(program_id=program_id, digest=digest)
 
 
 def _answer_text(first: str, words: str) -> bytes:
