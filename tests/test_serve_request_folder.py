@@ -132,6 +132,46 @@ def test_a_stale_answer_is_replaced_and_what_is_not_a_request_is_refused(run, fo
     assert (asked, job_id, program_id) == ("PLEASE SEND", None, None) and "names no program" in refusal
 
 
+LONG_STEM = "HOB_REQUEST_FOR_GEAR_42_X"   # 25 characters, one more than a request's stem may have
+assert len(LONG_STEM) == 25
+
+
+@pytest.mark.parametrize("stem, why", [("bad-name", "holds '-'"), (LONG_STEM, "has 25 characters"),
+                                       ("two words", "holds ' '")])
+def test_a_request_whose_stem_breaks_the_rule_is_answered_err_recorded_and_logged(run, folders, caplog, stem, why):
+    """The review of issue 32: bad-name.REQ was left alone, no answer, no record, no log, and the
+    control timed out. It gets <stem>.ERR with the rule (the guide's: 1 to 24 letters, digits, _)."""
+    made = stored_job(run, 42)
+    share = folders.root / "hobber-840d"
+    (share / f"{stem}.REQ").write_text(f"JOB {made['job_id']}\n")
+    with caplog.at_level("WARNING", logger="engine.service.request_folder"):
+        [answer] = answered(folders)
+        assert answered(folders) == []   # answered once
+    err = (share / f"{stem}.ERR").read_text().splitlines()
+    assert err[0].startswith(f"request file '{stem}.REQ' refused: its stem {why}")
+    assert "1 to 24 letters, digits and _" in err[0] and err[1:] == [f"JOB {made['job_id']}"]
+    assert answer.refusal == err[0] and answer.program_file is None
+    assert sorted(path.name for path in share.iterdir()) == sorted([f"{stem}.DONE", f"{stem}.ERR"])   # nothing sent
+    assert requests(run.url) == [("hobber-840d", "folder", f"hobber-840d/{stem}.REQ", f"JOB {made['job_id']}", None,
+                                  None, err[0])]
+    assert any(err[0] in record.getMessage() for record in caplog.records)
+
+
+def test_a_request_name_too_long_to_claim_is_said_once_in_the_log_and_a_link_is_never_answered(run, folders, caplog,
+                                                                                              tmp_path):
+    """A name of 255 bytes cannot be renamed .DONE (ext4's limit): it is said in the log once, not at
+    every look; a link named like a bad request is neither read nor answered."""
+    share = folders.root / "hobber-840d"
+    (share / f"{'A' * 251}.REQ").write_text("JOB 1\n")
+    (tmp_path / "target.txt").write_text("JOB 1\n")
+    (share / "bad-link.REQ").symlink_to(tmp_path / "target.txt")
+    with caplog.at_level("WARNING", logger="engine.service.request_folder"):
+        assert answered(folders) + answered(folders) == []
+    assert sum("too long to claim" in record.getMessage() for record in caplog.records) == 1
+    assert sorted(path.name for path in share.iterdir()) == sorted([f"{'A' * 251}.REQ", "bad-link.REQ"])
+    assert requests(run.url) == []
+
+
 def test_a_link_is_never_read_as_a_request(run, folders, tmp_path):
     secret = tmp_path / "secret.txt"
     secret.write_text("JOB 1 of the payroll\n")
