@@ -139,6 +139,49 @@ def test_the_lookup_leads_from_the_hash_on_the_control_to_the_program(made):
     assert f'href="/programs/{program_id}"' in listed.text and f'href="/programs/{again}"' in listed.text
 
 
+def lineage_of(run, program_id: int) -> str:
+    """The program's lineage line as the control shows it (the CLI's record of the program)."""
+    lines = cli_json(run, "programs", "show", program_id, "--json")["programs"][0]["lines"]
+    return next(line for line in lines if line.startswith(f"; PROGRAM {program_id} TEMPLATE "))
+
+
+def test_a_whole_lineage_line_pasted_in_the_lookup_leads_to_its_program(made):
+    """The review of issue 32: the whole line read off the control was refused, shown cut at 40
+    characters. It leads to its program, in the 840D's form and the Fanuc's (parentheses)."""
+    run, client, job_id, program_id = made
+    line = lineage_of(run, program_id)
+    words = line.removeprefix("; ")
+    for typed in (line, f"({words})", f"( {words} )", f"N20 {line}", f"  {line.lower()}  "):
+        found = client.get("/lookup", params={"q": typed}, follow_redirects=False)
+        assert found.status_code == 303 and found.headers["location"] == f"/programs/{program_id}", typed
+    as_json = client.get("/lookup", params={"q": line}, headers=JSON).json()
+    assert [record["program_id"] for record in as_json["programs"]] == [program_id]
+
+
+def test_a_lineage_line_whose_hashes_are_another_programs_is_refused_saying_so(made):
+    run, client, job_id, program_id = made
+    other = cli_json(run, "instantiate", "--gear", 43, "--json")["program_id"]   # another gear: another INPUT hash
+    other_line = lineage_of(run, other)
+    borrowed = other_line.replace(f"PROGRAM {other} ", f"PROGRAM {program_id} ")   # this id, the other's hashes
+    refused = client.get("/lookup", params={"q": borrowed}, headers=JSON)
+    page = client.get("/lookup", params={"q": borrowed})
+    assert refused.status_code == page.status_code == 400
+    message = refused.json()["error"]
+    assert message.startswith(f"the lineage line names program {program_id}, but its TEMPLATE ")
+    assert f"is not program {program_id}'s" in message and f"its hashes are those of program {other}:" in message
+    assert message in html.unescape(page.text)
+    cut = client.get("/lookup", params={"q": borrowed.rsplit(" INPUT", 1)[0]}, headers=JSON).json()["error"]
+    assert "reads as a lineage line but not a whole one" in cut and repr(borrowed.rsplit(" INPUT", 1)[0]) in cut
+
+
+def test_a_refused_query_is_shown_whole_and_escaped(made):
+    run, client, job_id, program_id = made
+    typed = f"{HOSTILE} is what the control shows at line 40 of the program"   # more than 40 characters
+    refused = client.get("/lookup", params={"q": typed})
+    assert refused.status_code == 400 and repr(typed) in html.unescape(refused.text)
+    assert HOSTILE not in refused.text
+
+
 def forged(url: str, program_id: int) -> int:
     """A copy of the program stored the way a runner can (engine_runner, program_submission), its
     spindle line changed to one no template makes, with markup in its comment; → its id."""
