@@ -5,8 +5,13 @@ The logins are real roles made by the test (roles are cluster-wide: unique names
 on a server of the test's own that checks passwords (tests/helpers/password_server.py): the
 suite's servers trust local connections, where no password is ever checked, and a login there is
 refused."""
+import os
+import socket
+import subprocess
+import sys
 import uuid
 from contextlib import contextmanager
+from pathlib import Path
 
 import psycopg
 import pytest
@@ -20,12 +25,13 @@ from starlette.routing import Route
 from starlette.testclient import TestClient
 
 from engine.service.web.app import create_app
-from engine.service.web.auth import NO_ROLE, REFUSED, SESSION_COOKIE, may_request
+from engine.service.web.auth import NO_ROLE, REFUSED, SESSION_COOKIE, may_request, unchecked_logins
 
 JSON = {"Accept": "application/json"}
 LOOPBACK = "http://127.0.0.1"   # the open web view answers a loopback Host only
 TRUSTED = f"trusted_{uuid.uuid4().hex[:12]}"   # a login pg_hba.conf trusts: no password asked
 PAGES = ("/", "/classes", "/machines")
+REPOSITORY = Path(__file__).resolve().parent.parent
 
 
 @pytest.fixture(scope="module")
@@ -181,6 +187,34 @@ def test_no_page_shows_a_password(server, service):
                    for headers in ({}, JSON)]
     assert all(service[1].password not in answer.text and reader.password not in answer.text for answer in answers)
     assert SESSION_COOKIE in client.cookies and reader.password not in client.cookies[SESSION_COOKIE]
+
+
+def test_a_server_that_checks_passwords_is_not_said_to_refuse_logins(service):
+    assert unchecked_logins(service[0]) is None
+
+
+def test_engine_serve_off_loopback_says_at_start_up_that_a_trusting_server_refuses_every_login(
+        read_only_database_url, tmp_path):
+    """The review of issue 32: on the embedded server (initdb --auth=trust) every web login was
+    refused "wrong user name or password", the reason only on stderr at each try. `engine serve
+    --host` off loopback says it once at start-up, then serves (FTP and request folders still work)."""
+    with socket.socket() as probe:
+        probe.bind(("0.0.0.0", 0))
+        port = probe.getsockname()[1]
+    environment = {**os.environ, "ENGINE_RUNTIME_DIR": str(tmp_path), "ENGINE_CONFIG": "",
+                   "PYTHONPATH": str(REPOSITORY)}
+    service = subprocess.Popen([sys.executable, "-m", "engine", "--database-url", read_only_database_url, "serve",
+                                "--host", "0.0.0.0", "--port", str(port)], env=environment, stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True)
+    try:
+        first, second = service.stdout.readline(), service.stdout.readline()
+    finally:
+        service.terminate()   # as engine serve stop asks
+        out, err = service.communicate(timeout=60)
+    assert first.startswith("web logins will be refused: the database server lets logins in without a password "
+                            "(pg_hba.conf `trust`; a made-up login was told: role "), first + err
+    assert "set scram-sha-256" in first and second.startswith(f"serving the web view at http://0.0.0.0:{port}/")
+    assert service.returncode == 0 and "stopped" in out
 
 
 def test_on_loopback_the_pages_are_open(read_only_database_url):

@@ -43,6 +43,11 @@ REQUESTING_ROLE = "engine_runner"
 REFUSED = "login refused: wrong user name or password, or the database does not accept this login"
 NO_ROLE = ("login refused: this login has no role of the engine's (engine_reader sees the pages, engine_runner "
            "also requests programs); ask the database's owner to grant one")
+UNCHECKED_LOGINS = ("web logins will be refused: the database server lets logins in without a password "
+                    "(pg_hba.conf `trust`; a made-up login was told: {said}), and the web view takes only logins "
+                    "PostgreSQL checks; set scram-sha-256 on the pg_hba.conf lines this service connects by "
+                    "(host; local for a socket) "
+                    "(docs/guide/web-view-releases-and-logins.md)")
 LOCAL_USER = "local"               # program_request.client of a request on the open loopback app
 CROSS_SITE = ("refused: a program is requested only from this service's own page ({}); open the job's page "
               "here and use its button")
@@ -102,6 +107,25 @@ def check_login(database_url: str, user: str, password: str) -> Rights | None:
             return rights_of(conn, user)
     except psycopg.Error:
         return None
+
+
+def unchecked_logins(database_url: str) -> str | None:
+    """Why no web login can succeed on this database server, or None: it lets a login in without
+    asking for its password (pg_hba.conf `trust`, as the embedded server's initdb --auth=trust),
+    and check_login refuses every login PostgreSQL did not check. Asked once at start-up (engine
+    serve off loopback) by a login of a made-up role with a made-up password: a server that checks
+    passwords asks for one (for an unknown role too, not to tell who exists); a trusting one answers
+    at once that the role does not exist (one FATAL line in the server's log)."""
+    conninfo = make_conninfo(database_url, user=f"engine_probe_{secrets.token_hex(6)}",
+                             password=secrets.token_urlsafe(18), passfile=os.devnull, connect_timeout=CONNECT_TIMEOUT)
+    probe = psycopg.pq.PGconn.connect(conninfo.encode())
+    try:
+        if probe.used_password:
+            return None
+        said = (probe.error_message.decode(errors="replace").strip().splitlines() or ["-"])[0]
+    finally:
+        probe.finish()
+    return UNCHECKED_LOGINS.format(said=said.rpartition("FATAL:")[2].strip()[:120])
 
 
 class LoginRequired:
