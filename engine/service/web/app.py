@@ -71,7 +71,8 @@ def _http_error(request: Request, error: Exception) -> Response:
     assert isinstance(error, HTTPException)
     path, allowed = request.url.path[:80], {k.lower(): v for k, v in (error.headers or {}).items()}.get("allow")
     message = (NO_PAGE.format(path=path) if error.status_code == 404 else
-               NOT_TAKEN.format(method=request.method, path=path, allowed=allowed) if allowed else str(error.detail))
+               NOT_TAKEN.format(method=request.method, path=path, allowed=", ".join(sorted(allowed.split(", "))))
+               if allowed else str(error.detail))
     answer = refusal(request, message, error.status_code)
     answer.headers.update(error.headers or {})
     return answer
