@@ -19,7 +19,7 @@ from helpers.password_server import database_url, migrated_database, password_se
 from helpers.roles import logins
 from markupsafe import escape
 from psycopg import sql
-from psycopg.conninfo import conninfo_to_dict
+from psycopg.conninfo import conninfo_to_dict, make_conninfo
 from starlette.responses import JSONResponse
 from starlette.routing import Route
 from starlette.testclient import TestClient
@@ -189,8 +189,20 @@ def test_no_page_shows_a_password(server, service):
     assert SESSION_COOKIE in client.cookies and reader.password not in client.cookies[SESSION_COOKIE]
 
 
-def test_a_server_that_checks_passwords_is_not_said_to_refuse_logins(service):
+def test_a_server_that_checks_passwords_is_not_said_to_refuse_logins(server, service):
+    """The password server asks every role but its administrator for a password: the service's
+    login is not said to refuse logins; its administrator's URL (trusted) is."""
     assert unchecked_logins(service[0]) is None
+    said = unchecked_logins(server[0])
+    assert said is not None and said.startswith("web logins will be refused") and "scram-sha-256" in said
+
+
+def test_a_trusting_server_is_found_by_a_made_up_login_too(read_only_database_url):
+    """A service whose own role the server does not know (its URL's login refused): the made-up
+    role told "does not exist" without a password asked is the trusting server's answer."""
+    url = make_conninfo(read_only_database_url, user=f"nobody_{uuid.uuid4().hex[:10]}")
+    said = unchecked_logins(url)
+    assert said is not None and "a made-up login was told, no password asked: role \"engine_probe_" in said
 
 
 def test_engine_serve_off_loopback_says_at_start_up_that_a_trusting_server_refuses_every_login(
@@ -212,7 +224,7 @@ def test_engine_serve_off_loopback_says_at_start_up_that_a_trusting_server_refus
         service.terminate()   # as engine serve stop asks
         out, err = service.communicate(timeout=60)
     assert first.startswith("web logins will be refused: the database server lets logins in without a password "
-                            "(pg_hba.conf `trust`; a made-up login was told: role "), first + err
+                            "(pg_hba.conf `trust`: the service's own role got in with a made-up password)"), first + err
     assert "set scram-sha-256" in first and second.startswith(f"serving the web view at http://0.0.0.0:{port}/")
     assert service.returncode == 0 and "stopped" in out
 

@@ -44,7 +44,7 @@ REFUSED = "login refused: wrong user name or password, or the database does not 
 NO_ROLE = ("login refused: this login has no role of the engine's (engine_reader sees the pages, engine_runner "
            "also requests programs); ask the database's owner to grant one")
 UNCHECKED_LOGINS = ("web logins will be refused: the database server lets logins in without a password "
-                    "(pg_hba.conf `trust`; a made-up login was told: {said}), and the web view takes only logins "
+                    "(pg_hba.conf `trust`: {said}), and the web view takes only logins "
                     "PostgreSQL checks; set scram-sha-256 on the pg_hba.conf lines this service connects by "
                     "(host; local for a socket) "
                     "(docs/guide/web-view-releases-and-logins.md)")
@@ -113,19 +113,34 @@ def unchecked_logins(database_url: str) -> str | None:
     """Why no web login can succeed on this database server, or None: it lets a login in without
     asking for its password (pg_hba.conf `trust`, as the embedded server's initdb --auth=trust),
     and check_login refuses every login PostgreSQL did not check. Asked once at start-up (engine
-    serve off loopback) by a login of a made-up role with a made-up password: a server that checks
-    passwords asks for one (for an unknown role too, not to tell who exists); a trusting one answers
-    at once that the role does not exist (one FATAL line in the server's log)."""
-    conninfo = make_conninfo(database_url, user=f"engine_probe_{secrets.token_hex(6)}",
-                             password=secrets.token_urlsafe(18), passfile=os.devnull, connect_timeout=CONNECT_TIMEOUT)
+    serve off loopback): the service's own role with a made-up password let in, or a made-up role
+    told it does not exist without a password asked (a server that checks passwords asks one of an
+    unknown role too, not to tell who exists). A refusal for any other reason (no pg_hba.conf line
+    for a made-up role) is not taken for trust. Each try leaves one FATAL line in the server's log."""
+    own = _probe(database_url, None)
+    if own is None:
+        return UNCHECKED_LOGINS.format(said="the service's own role got in with a made-up password")
+    made_up = _probe(database_url, f"engine_probe_{secrets.token_hex(6)}")
+    if made_up is not None and "does not exist" in made_up:
+        return UNCHECKED_LOGINS.format(said=f"a made-up login was told, no password asked: {made_up[:100]}")
+    return None
+
+
+def _probe(database_url: str, user: str | None) -> str | None:
+    """A login with a made-up password (as `user`, else the URL's): None if it was let in without
+    one, else why it was refused ("" when the server asked for the password)."""
+    conninfo = make_conninfo(database_url, password=secrets.token_urlsafe(18), passfile=os.devnull,
+                             connect_timeout=CONNECT_TIMEOUT, **({"user": user} if user else {}))
     probe = psycopg.pq.PGconn.connect(conninfo.encode())
     try:
+        if probe.status == psycopg.pq.ConnStatus.OK:
+            return None if not probe.used_password else ""
         if probe.used_password:
-            return None
-        said = (probe.error_message.decode(errors="replace").strip().splitlines() or ["-"])[0]
+            return ""
+        return (probe.error_message.decode(errors="replace").strip().splitlines() or ["-"])[0].rpartition(
+            "FATAL:")[2].strip()
     finally:
         probe.finish()
-    return UNCHECKED_LOGINS.format(said=said.rpartition("FATAL:")[2].strip()[:120])
 
 
 class LoginRequired:
