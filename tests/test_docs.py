@@ -109,3 +109,20 @@ def test_the_sql_examples_of_the_guide_run_on_the_seeded_database(conn, example)
     with pytest.raises(psycopg.Error) as refused, conn.transaction():
         conn.execute(example.text)
     assert refused_as(refused.value, expected[1].strip()), f"{example.page}:{example.line}: {refused.value}"
+
+
+LOOPBACK_ADDRESS = re.compile(r"(?:127\.0\.0\.1|localhost):(\d+)")
+
+
+def test_the_web_view_s_addresses_in_the_documentation_use_its_default_port():
+    """A reader copies the guide's curl line: its port must be the one `engine serve` listens on by
+    default (8080; the review of issue 32 found 8000), unless the line gives --port itself.
+    PostgreSQL's 5432 is no web address."""
+    from engine.service.server import ServeOptions
+
+    default = ServeOptions(database_url="").port
+    pages = [ROOT / "README.md", *guide_pages(), ROOT / "docs" / "cli.md"]
+    wrong = [f"{page.name}: {line.strip()}" for page in pages for line in page.read_text().splitlines()
+             if "--port" not in line and "5432" not in line
+             for port in LOOPBACK_ADDRESS.findall(line) if int(port) != default]
+    assert not wrong

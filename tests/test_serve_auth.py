@@ -5,8 +5,13 @@ The logins are real roles made by the test (roles are cluster-wide: unique names
 on a server of the test's own that checks passwords (tests/helpers/password_server.py): the
 suite's servers trust local connections, where no password is ever checked, and a login there is
 refused."""
+import os
+import socket
+import subprocess
+import sys
 import uuid
 from contextlib import contextmanager
+from pathlib import Path
 
 import psycopg
 import pytest
@@ -14,18 +19,19 @@ from helpers.password_server import database_url, migrated_database, password_se
 from helpers.roles import logins
 from markupsafe import escape
 from psycopg import sql
-from psycopg.conninfo import conninfo_to_dict
+from psycopg.conninfo import conninfo_to_dict, make_conninfo
 from starlette.responses import JSONResponse
 from starlette.routing import Route
 from starlette.testclient import TestClient
 
 from engine.service.web.app import create_app
-from engine.service.web.auth import NO_ROLE, REFUSED, SESSION_COOKIE, may_request
+from engine.service.web.auth import NO_ROLE, REFUSED, SESSION_COOKIE, may_request, unchecked_logins
 
 JSON = {"Accept": "application/json"}
 LOOPBACK = "http://127.0.0.1"   # the open web view answers a loopback Host only
 TRUSTED = f"trusted_{uuid.uuid4().hex[:12]}"   # a login pg_hba.conf trusts: no password asked
 PAGES = ("/", "/classes", "/machines")
+REPOSITORY = Path(__file__).resolve().parent.parent
 
 
 @pytest.fixture(scope="module")
@@ -141,7 +147,7 @@ def test_logout_a_revoked_role_and_a_forged_cookie_end_the_session(server, servi
     reader, other = create("engine_reader"), create("engine_reader")
     with web(service[0]) as client:
         assert logged_in(client, reader).status_code == 303 and client.get("/classes").status_code == 200
-        assert client.post("/logout").status_code == 303
+        assert client.post("/logout", headers={"Origin": LOOPBACK}).status_code == 303
         assert client.get("/classes").status_code == 303
         assert logged_in(client, other).status_code == 303 and client.get("/classes").status_code == 200
         with psycopg.connect(url, autocommit=True) as admin:
@@ -150,6 +156,24 @@ def test_logout_a_revoked_role_and_a_forged_cookie_end_the_session(server, servi
     with web(service[0]) as client:
         client.cookies.set(SESSION_COOKIE, 'eyJsb2dpbiI6ICJwb3N0Z3JlcyJ9')   # {"login": "postgres"}, unsigned
         assert client.get("/classes").status_code == 303
+
+
+def test_a_logout_from_another_site_is_refused_and_the_session_kept(server, service):
+    """Another site's page may not log a user out (its form's POST carries its own Origin, or none
+    when the browser hides it): 403 naming the check, and the session goes on."""
+    reader = server[1]("engine_reader")
+    with web(service[0]) as client:
+        assert logged_in(client, reader).status_code == 303
+        refused = [client.post("/logout", headers=headers) for headers in
+                   ({"Origin": "https://evil.example"}, {"Referer": "https://evil.example/page"}, {})]
+        as_json = client.post("/logout", headers={"Origin": "https://evil.example", **JSON})
+        still = client.get("/classes")
+        own = client.post("/logout", headers={"Referer": f"{LOOPBACK}/classes"})
+        after = client.get("/classes")
+    assert all(answer.status_code == 403 and "logout is taken only from this service's own page"
+               in answer.text.replace("&#39;", "'") for answer in refused)
+    assert as_json.status_code == 403 and "evil.example" in as_json.json()["error"]
+    assert still.status_code == 200 and own.status_code == 303 and after.status_code == 303
 
 
 def test_no_page_shows_a_password(server, service):
@@ -163,6 +187,46 @@ def test_no_page_shows_a_password(server, service):
                    for headers in ({}, JSON)]
     assert all(service[1].password not in answer.text and reader.password not in answer.text for answer in answers)
     assert SESSION_COOKIE in client.cookies and reader.password not in client.cookies[SESSION_COOKIE]
+
+
+def test_a_server_that_checks_passwords_is_not_said_to_refuse_logins(server, service):
+    """The password server asks every role but its administrator for a password: the service's
+    login is not said to refuse logins; its administrator's URL (trusted) is."""
+    assert unchecked_logins(service[0]) is None
+    said = unchecked_logins(server[0])
+    assert said is not None and said.startswith("web logins will be refused") and "scram-sha-256" in said
+
+
+def test_a_trusting_server_is_found_by_a_made_up_login_too(read_only_database_url):
+    """A service whose own role the server does not know (its URL's login refused): the made-up
+    role told "does not exist" without a password asked is the trusting server's answer."""
+    url = make_conninfo(read_only_database_url, user=f"nobody_{uuid.uuid4().hex[:10]}")
+    said = unchecked_logins(url)
+    assert said is not None and "a made-up login was told, no password asked: role \"engine_probe_" in said
+
+
+def test_engine_serve_off_loopback_says_at_start_up_that_a_trusting_server_refuses_every_login(
+        read_only_database_url, tmp_path):
+    """The review of issue 32: on the embedded server (initdb --auth=trust) every web login was
+    refused "wrong user name or password", the reason only on stderr at each try. `engine serve
+    --host` off loopback says it once at start-up, then serves (FTP and request folders still work)."""
+    with socket.socket() as probe:
+        probe.bind(("0.0.0.0", 0))
+        port = probe.getsockname()[1]
+    environment = {**os.environ, "ENGINE_RUNTIME_DIR": str(tmp_path), "ENGINE_CONFIG": "",
+                   "PYTHONPATH": str(REPOSITORY)}
+    service = subprocess.Popen([sys.executable, "-m", "engine", "--database-url", read_only_database_url, "serve",
+                                "--host", "0.0.0.0", "--port", str(port)], env=environment, stdout=subprocess.PIPE,
+                               stderr=subprocess.PIPE, text=True)
+    try:
+        first, second = service.stdout.readline(), service.stdout.readline()
+    finally:
+        service.terminate()   # as engine serve stop asks
+        out, err = service.communicate(timeout=60)
+    assert first.startswith("web logins will be refused: the database server lets logins in without a password "
+                            "(pg_hba.conf `trust`: the service's own role got in with a made-up password)"), first + err
+    assert "set scram-sha-256" in first and second.startswith(f"serving the web view at http://0.0.0.0:{port}/")
+    assert service.returncode == 0 and "stopped" in out
 
 
 def test_on_loopback_the_pages_are_open(read_only_database_url):

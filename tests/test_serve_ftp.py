@@ -9,6 +9,8 @@ from __future__ import annotations
 import ftplib
 import io
 import json
+import shutil
+import subprocess
 import threading
 from pathlib import Path
 
@@ -166,12 +168,13 @@ def test_stor_and_appe_are_refused_and_nothing_appears(listed):
 
 def test_size_resuming_and_other_folders_are_refused(listed):
     port, jobs = listed
-    assert "proved" in refusal_of(port, "hobber-840d", f"SIZE GEAR42_J{jobs['a']}.MPF")
+    # 502 "not implemented" (RFC 959), never 550, which clients take for "no such file"
+    assert refusal_of(port, "hobber-840d", f"SIZE GEAR42_J{jobs['a']}.MPF").startswith("502 SIZE is not offered")
     assert refusal_of(port, "hobber-840d", "CWD /other").startswith("550")
     for command in ("REST 100", "MLSD", "MLST GEAR42_J1.MPF"):   # a program is sent whole, listed by LIST
         assert refusal_of(port, "hobber-840d", command).startswith("500")
     client = login(port, "hobber-840d")
-    assert "REST" not in client.sendcmd("FEAT") and "MLST" not in client.sendcmd("FEAT")
+    assert not {"REST", "MLST", "SIZE"} & set(client.sendcmd("FEAT").split())
     client.quit()
 
 
@@ -191,6 +194,21 @@ def test_retr_proves_records_and_sends_the_same_program_twice(run, serving):
     assert f"; PROGRAM {made['program_id']} TEMPLATE spur".encode() in first
     sent = ("hobber-840d", "ftp", "127.0.0.1", name, made["job_id"], made["program_id"], None)
     assert requests(run.url) == [sent, sent]
+
+
+@pytest.mark.skipif(shutil.which("curl") is None, reason="curl is not installed")
+def test_curl_fetches_a_program_though_it_asks_its_size_first(run, serving, tmp_path):
+    """curl sends SIZE before RETR and gives up on a 550 (exit 78, "file does not exist"): the
+    new user's first try of issue 32's review. The bytes are those an FTP client gets."""
+    made = stored_job(run, 42)
+    name = f"GEAR42_J{made['job_id']}.MPF"
+    out = tmp_path / "curl.MPF"
+    fetching = subprocess.run(["curl", "--silent", "--show-error", "--user", f"hobber-840d:{SECRETS['hobber-840d']}",
+                               f"ftp://127.0.0.1:{serving}/{name}", "-o", str(out)],
+                              capture_output=True, text=True, timeout=120, check=False)
+    assert fetching.returncode == 0, fetching.stderr
+    assert out.read_bytes() == fetched(serving, "hobber-840d", name)
+    assert f"; PROGRAM {made['program_id']} TEMPLATE spur".encode() in out.read_bytes()
 
 
 def test_the_bytes_sent_are_the_file_instantiate_job_writes(run, secrets, tmp_path):

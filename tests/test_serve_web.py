@@ -139,6 +139,49 @@ def test_the_lookup_leads_from_the_hash_on_the_control_to_the_program(made):
     assert f'href="/programs/{program_id}"' in listed.text and f'href="/programs/{again}"' in listed.text
 
 
+def lineage_of(run, program_id: int) -> str:
+    """The program's lineage line as the control shows it (the CLI's record of the program)."""
+    lines = cli_json(run, "programs", "show", program_id, "--json")["programs"][0]["lines"]
+    return next(line for line in lines if line.startswith(f"; PROGRAM {program_id} TEMPLATE "))
+
+
+def test_a_whole_lineage_line_pasted_in_the_lookup_leads_to_its_program(made):
+    """The review of issue 32: the whole line read off the control was refused, shown cut at 40
+    characters. It leads to its program, in the 840D's form and the Fanuc's (parentheses)."""
+    run, client, job_id, program_id = made
+    line = lineage_of(run, program_id)
+    words = line.removeprefix("; ")
+    for typed in (line, f"({words})", f"( {words} )", f"N20 {line}", f"  {line.lower()}  "):
+        found = client.get("/lookup", params={"q": typed}, follow_redirects=False)
+        assert found.status_code == 303 and found.headers["location"] == f"/programs/{program_id}", typed
+    as_json = client.get("/lookup", params={"q": line}, headers=JSON).json()
+    assert [record["program_id"] for record in as_json["programs"]] == [program_id]
+
+
+def test_a_lineage_line_whose_hashes_are_another_programs_is_refused_saying_so(made):
+    run, client, job_id, program_id = made
+    other = cli_json(run, "instantiate", "--gear", 43, "--json")["program_id"]   # another gear: another INPUT hash
+    other_line = lineage_of(run, other)
+    borrowed = other_line.replace(f"PROGRAM {other} ", f"PROGRAM {program_id} ")   # this id, the other's hashes
+    refused = client.get("/lookup", params={"q": borrowed}, headers=JSON)
+    page = client.get("/lookup", params={"q": borrowed})
+    assert refused.status_code == page.status_code == 400
+    message = refused.json()["error"]
+    assert message.startswith(f"the lineage line names program {program_id}, but its TEMPLATE ")
+    assert f"is not program {program_id}'s" in message and f"its hashes are those of program {other}:" in message
+    assert message in html.unescape(page.text)
+    cut = client.get("/lookup", params={"q": borrowed.rsplit(" INPUT", 1)[0]}, headers=JSON).json()["error"]
+    assert "reads as a lineage line but not a whole one" in cut and repr(borrowed.rsplit(" INPUT", 1)[0]) in cut
+
+
+def test_a_refused_query_is_shown_whole_and_escaped(made):
+    run, client, job_id, program_id = made
+    typed = f"{HOSTILE} is what the control shows at line 40 of the program"   # more than 40 characters
+    refused = client.get("/lookup", params={"q": typed})
+    assert refused.status_code == 400 and repr(typed) in html.unescape(refused.text)
+    assert HOSTILE not in refused.text
+
+
 def forged(url: str, program_id: int) -> int:
     """A copy of the program stored the way a runner can (engine_runner, program_submission), its
     spindle line changed to one no template makes, with markup in its comment; → its id."""
@@ -222,9 +265,42 @@ def test_a_bad_or_unknown_id_is_one_line_never_a_stack_trace(read_only_database_
         answer = client.get(path, headers=JSON)
     assert page.status_code == answer.status_code == BAD[path]
     assert "Traceback" not in page.text and "File \"" not in page.text
-    if path != "/nosuch":   # Starlette's own "Not Found"
-        message = answer.json()["error"]
-        assert len(message.splitlines()) == 1 and message.strip() and message in html.unescape(page.text)
+    assert answer.headers["content-type"] == "application/json" and page.headers["content-type"].startswith("text/html")
+    message = answer.json()["error"]
+    assert len(message.splitlines()) == 1 and message.strip()
+    assert message.partition("; ")[0] in html.unescape(page.text)
+    assert "`engine " not in html.unescape(page.text)   # a page advises pages, never a command
+
+
+def test_an_unknown_program_s_page_advises_the_look_up_box_and_its_json_is_the_cli_line(read_only_run):
+    """The review of issue 32: /programs/99999 said `engine programs show --hash H` to a browser's
+    user. The page names the look-up box; the JSON keeps what `engine programs show 99999` says."""
+    cli = read_only_run("programs", "show", 99999)
+    assert cli.exit_code == 1
+    with TestClient(create_app(read_only_run.url), base_url=LOOPBACK) as client:
+        page = client.get("/programs/99999")
+        answer = client.get("/programs/99999", headers=JSON)
+    assert page.status_code == answer.status_code == 404
+    assert answer.json()["error"] in cli.output and "engine programs show --hash H" in answer.json()["error"]
+    said = html.unescape(page.text)
+    assert "program 99999 does not exist; find it by its lineage line: type the hash on it in the look-up box" in said
+    assert "engine programs" not in said and 'name="q"' in page.text   # the box is on the page
+
+
+def test_an_address_of_no_page_answers_json_to_a_program_and_a_page_to_a_browser(read_only_database_url):
+    """Starlette's own 404 and 405 were text/plain "Not Found": a program asking for JSON could not
+    read it (the review of issue 32). The error names the address and where the pages are."""
+    with TestClient(create_app(read_only_database_url), base_url=LOOPBACK) as client:
+        unknown = client.get("/programz/812", headers=JSON)
+        browser = client.get("/programz/812", headers={"Accept": "text/html"})
+        method = client.delete("/programs", headers=JSON)
+    assert unknown.status_code == browser.status_code == 404 and method.status_code == 405
+    assert unknown.json() == {"error": "no page at '/programz/812': the home page / leads to every page (gears, "
+                                       "jobs, programs, classes, machines)"}
+    assert browser.headers["content-type"].startswith("text/html") and "no page at" in html.unescape(browser.text)
+    assert method.json() == {"error": "DELETE is not taken at '/programs'; it takes GET, HEAD"}
+    assert set(method.headers["allow"].split(", ")) == {"GET", "HEAD"}
+    assert method.headers["content-type"] == "application/json"
 
 
 def free_port() -> int:

@@ -146,6 +146,19 @@ def test_the_drafts_impact_is_computed_on_request_as_the_dry_run(run):
     assert (draft["state"], draft["release"]) == ("draft", None)   # nothing released
 
 
+def test_the_class_page_links_the_drafts_impact_only_when_it_has_a_draft(run):
+    """The seeded spur has every version released: its page says so instead of linking an impact
+    that answers 400 "has no draft"; once a row is edited (a draft), the link is there."""
+    with web(run.url) as client:
+        before = html(client, "/classes/spur")
+        committed(run.url, EDIT, ('"M9 ; COOLANT OFF"', COOLANT_OFF_ROW))
+        after = html(client, "/classes/spur")
+    draft = cli_json(run, "template", "history", "--class", "spur")["versions"][-1]
+    assert 'href="/classes/spur/impact"' not in before and "No draft: every version is released" in before
+    assert draft["state"] == "draft"
+    assert 'href="/classes/spur/impact"' in after and f"(v{draft['version']}," in after
+
+
 def test_a_class_without_a_draft_or_failing_its_gate_is_answered_in_one_line(run):
     with web(run.url) as client:
         no_draft = client.get("/classes/helical/impact", headers=JSON)

@@ -150,6 +150,12 @@ def _remade(conn: Connection, job_id: int, config: Config) -> tuple[int, bytes]:
         return program.program_id, Path(program.path).read_bytes()
 
 
+def record_refusal(conn: Connection, machine: str, via: str, client: str, asked_for: str, reason: str) -> None:
+    """A request refused before it could name a job (a request file's name that breaks the rule),
+    recorded as every refusal is."""
+    _record(conn, machine, via, client, asked_for, None, None, one_line(reason))
+
+
 def _record(conn: Connection, machine: str, via: str, client: str, asked_for: str, job_id: int | None,
             program_id: int | None, refusal: str | None) -> None:
     """One row of program_request, committed on its own (a request is history even when refused)."""

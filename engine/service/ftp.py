@@ -10,8 +10,10 @@ show engine.service.delivery.machine_files (nothing rendered), MDTM when its job
 stored. RETR is engine.service.delivery.deliver: the program proved now, stored, recorded with the
 client's address, and sent; a refusal is a 550 reply carrying its one-line reason, recorded too.
 Every write (STOR, STOU, APPE, DELE, RNFR/RNTO, MKD, RMD, SITE CHMOD, MFMT) is refused: programs
-reach a machine from the database only. SIZE is refused with its reason: a program's size is known
-only once it is proved, at RETR. REST, MLSD and MLST are not offered: a program is sent whole. A
+reach a machine from the database only. SIZE answers 502 with its reason (a program's size is known
+only once it is proved, at RETR), never 550: curl sends SIZE before RETR and takes
+550 for "no such file", 502 for "size unknown" and fetches; SIZE is not in FEAT. REST, MLSD and MLST
+are not offered: a program is sent whole. A
 program is sent byte for byte in binary mode (TYPE I); in ASCII mode FTP itself sends each line end
 as CR LF.
 
@@ -51,10 +53,13 @@ POOL_SIZE = (1, 8)
 FAILED_LOGIN_DELAY = 3.0   # seconds before a failed login is answered (pyftpdlib's default), at most 3 a connection
 WRITE_REFUSED = ("550 {command} refused: this server only sends programs; a program reaches a machine from the "
                  "database, proved when it is asked for")
-SIZE_REFUSED = "550 SIZE is not known before the program is proved: RETR makes, proves and sends it"
+# SIZE: 502, "not implemented", which curl takes as "size unknown" and goes on to RETR;
+# 550 it takes as "no such file" and stops (exit 78). Nothing is made to answer it.
+SIZE_UNKNOWN = "502 SIZE is not offered: a program's size is known only once it is proved; RETR makes and sends it"
 # Not offered at all (not in FEAT, "500 not understood"): MLSD/MLST would show facts of files that are
-# not on disk, and REST would resume a program made again meanwhile from the middle of another.
-NOT_OFFERED = ("MLSD", "MLST", "REST")
+# not on disk, and REST would resume a program made again meanwhile from the middle of another. SIZE
+# is left out of FEAT too; pre_process_command answers it (SIZE_UNKNOWN).
+NOT_OFFERED = ("MLSD", "MLST", "REST", "SIZE")
 
 
 def secret_variable(config: Config, machine: str) -> str:
@@ -176,7 +181,7 @@ class MachineFolder(AbstractedFS):
         return self.stat(path).st_mtime
 
     def getsize(self, path: str) -> int:
-        raise FilesystemError(SIZE_REFUSED[4:])
+        raise FilesystemError(SIZE_UNKNOWN[4:])
 
     def get_user_by_uid(self, uid) -> str:
         return "engine"
@@ -200,10 +205,10 @@ class ProgramHandler(FTPHandler):
             self.respond(WRITE_REFUSED.format(command=command))
             self.log_cmd(command, arg, 550, "write refused")
             return
+        if self.authenticated and command == "SIZE":
+            self.respond(SIZE_UNKNOWN)
+            return
         super().pre_process_command(line, cmd, arg)
-
-    def ftp_SIZE(self, path: str) -> None:
-        self.respond(SIZE_REFUSED)
 
     def ftp_RETR(self, file: str):
         """The program proved now and sent, or 550 with the one-line reason (both recorded)."""

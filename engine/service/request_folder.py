@@ -2,7 +2,8 @@
 for controls that read programs from a network share, as an 840D does with `EXTCALL`.
 
 One folder per machine under a root (`<root>/<machine>/`). A control asks by writing a request
-file `<stem>.REQ` (stem: letters, digits and _, at most 24; a symbolic link is never read) whose
+file `<stem>.REQ` (stem: letters, digits and _, at most 24; a request of another stem is answered
+`<stem>.ERR` saying so, recorded and logged; a symbolic link is never read nor answered) whose
 one line names what it wants, ended by a new line: `JOB 17`, `GEAR 42` (that gear's newest stored
 job on the machine), `O1042` or a name its FTP list shows (engine.service.delivery_names); a request
 of more lines is refused (an 840D's WRITE appends to a request left unanswered). The engine answers
@@ -11,8 +12,9 @@ each request once:
 0. the request is claimed: renamed `<stem>.DONE`, then read (a request written again meanwhile is
    a new file, answered at a later look);
 1. the program, proved now (engine.service.delivery.deliver, via "folder"), is written next to it as
-   `PRG<program id>_<first 8 hex digits of the sha256 of its bytes>.MPF`: a name that changes with
-   the bytes, so a control never takes another program's file, nor an older one, for its answer;
+   `PG<program id>_<first 7 hex digits of the sha256 of its bytes>.MPF` (program_file_name): a name
+   that changes with the bytes, so a control never takes another program's file, nor an older one,
+   for its answer, and an 840D program name for every id below 10^14 (plants' ids included);
 2. then `<stem>.RDY`, holding that file name, then the request's words as read (each line ended by
    a new line): the name the control waits for with `ISFILE`, known in advance, and what it
    answers, which the control compares with what it wrote; or, for a refusal, `<stem>.ERR` holding
@@ -43,14 +45,28 @@ import msgspec
 
 from ..errors import EngineError
 from ..programs.config import Config
-from .delivery import Delivered, as_ascii, deliver, one_line
+from .delivery import Delivered, as_ascii, deliver, one_line, record_refusal
 
 if TYPE_CHECKING:
     from ..db.connection import Connection
 
-REQUEST = re.compile(r"(?P<stem>[A-Za-z0-9_]{1,24})\.REQ", re.IGNORECASE)
+# Any file named <stem>.REQ but a dot file (a temporary of ours, or hidden) is a request; one whose
+# stem is not STEM is answered with a refusal naming the rule (it was left unanswered: the control
+# timed out with no word why, the review of issue 32).
+REQUEST = re.compile(r"(?P<stem>[^.].*)\.REQ", re.IGNORECASE | re.DOTALL)
+STEM = re.compile(r"[A-Za-z0-9_]{1,24}")
+BAD_STEM = ("request file {name!r} refused: its stem {why}; a request's stem is 1 to 24 letters, digits and _ "
+            "(HOB1.REQ): rename it")
+NAME_MAX = 255   # bytes of a file name on the shares the controls write to (ext4, NTFS, SMB)
 MAX_REQUEST_BYTES = 1024   # a request's first line is read from its first KiB; a bound no control meets
 READY, ERROR, DONE = ".RDY", ".ERR", ".DONE"
+# The program file: PG, the program id, _, the first 7 hex digits of its bytes' sha256: two letters
+# first and at most 24 characters, an 840D program name (docs/reference/hobbing.md §A1; EXTCALL
+# calls it), for every id below 10^14 (14 digits: a plant's N·10^10 for N up to 9999, engine/plants).
+# PRG<id>_<8 hex> was 25 characters from 13 digits on (the review of issue 32).
+PROGRAM_FILE = "PG{program_id}_{digest}.MPF"
+PROGRAM_FILE_HEX = 7
+PROGRAM_ID_LIMIT = 10**14
 POLL_SECONDS = 1.0
 LOG = logging.getLogger("engine.service.request_folder")
 
@@ -79,6 +95,7 @@ class RequestFolder:
         for machine in self.machines:
             (self.root / machine).mkdir(exist_ok=True)
         self._seen: dict[Path, tuple[int, int]] = {}   # request -> (size, mtime_ns) at the previous look
+        self._too_long: set[Path] = set()              # requests said in the log as never claimable
 
     def _refuse_unknown_machines(self) -> None:
         with self.conn.transaction():
@@ -105,12 +122,25 @@ class RequestFolder:
                       if path.parent != folder or any(path == entry for entry, _ in requests)}
         return [answer for entry, stem in requests if (answer := self._taken(machine, entry, stem))]
 
+    def _claimable(self, machine: str, request: Path, stem: str) -> bool:
+        """The request can be claimed: `<stem>.DONE` is a name the share takes (a stem of 251 bytes
+        or more cannot be; said in the log once, never answered)."""
+        if len(os.fsencode(f"{stem}{DONE}")) <= NAME_MAX:
+            return True
+        if request not in self._too_long:
+            self._too_long.add(request)
+            LOG.warning("request %s of machine %s not answered: its name is too long to claim as %s; a request's "
+                        "stem is 1 to 24 letters, digits and _", as_ascii(repr(request.name)[:80]), machine, DONE)
+        return False
+
     def _taken(self, machine: str, request: Path, stem: str) -> Answer | None:
         """The request answered if complete, else None; a request the share will not let be looked at
         or answered (its answer's name taken by a folder, the request gone meanwhile) is said in the
         log and left for the next look, so it never stops the requests after it, of every machine
         (the adversary of issue 32 found one folder named A.RDY leaving all of them unanswered)."""
         try:
+            if not self._claimable(machine, request, stem):
+                return None
             return self._answer(machine, request, stem) if self._complete(request) else None
         except OSError as error:
             LOG.warning("request %s of machine %s not answered: %s", request.name, machine, error)
@@ -141,8 +171,7 @@ class RequestFolder:
         self._seen.pop(request, None)
         words = _request_text(_read_request(claimed))
         try:
-            delivered = deliver(self.conn, machine, words, via="folder", client=f"{machine}/{request.name}",
-                                config=self.config)
+            delivered = self._delivered(machine, request.name, stem, words)
         except EngineError as refusal:
             answer = partial(_refused, folder, machine, request.name, stem, one_line(str(refusal)), words)
         else:
@@ -153,8 +182,30 @@ class RequestFolder:
             return None
         return answer()
 
+    def _delivered(self, machine: str, name: str, stem: str, words: str) -> Delivered:
+        """The program the request asks for (deliver); a request whose stem breaks the rule is
+        refused, recorded and said in the log, never delivered (its name is the control's mistake)."""
+        client = as_ascii(f"{machine}/{name}")
+        why = bad_stem(stem)
+        if why is None:
+            return deliver(self.conn, machine, words, via="folder", client=client, config=self.config)
+        reason = BAD_STEM.format(name=as_ascii(name)[:80], why=why)
+        record_refusal(self.conn, machine, "folder", client, words, reason)
+        LOG.warning("machine %s: %s", machine, reason)
+        raise EngineError(reason)
+
     def close(self) -> None:
         self.conn.close()
+
+
+def bad_stem(stem: str) -> str | None:
+    """Why a request's stem breaks the rule (STEM), or None."""
+    if STEM.fullmatch(stem):
+        return None
+    if len(stem) > 24:
+        return f"has {len(stem)} characters"
+    odd = next(character for character in stem if not STEM.fullmatch(character))
+    return f"holds {as_ascii(repr(odd))}"
 
 
 def _read_request(request: Path) -> bytes:
@@ -183,10 +234,17 @@ def _refused(folder: Path, machine: str, request: str, stem: str, reason: str, w
 
 def _sent(folder: Path, machine: str, request: str, stem: str, delivered: Delivered, words: str) -> Answer:
     """The program first, under a name carrying its bytes' hash; then the answer naming it."""
-    name = f"PRG{delivered.program_id}_{hashlib.sha256(delivered.data).hexdigest()[:8].upper()}.MPF"
+    name = program_file_name(delivered.program_id, delivered.data)
     write_atomically(folder, name, delivered.data)
     write_atomically(folder, f"{stem}{READY}", _answer_text(name, words))
     return Answer(machine, request, program_file=name)
+
+
+def program_file_name(program_id: int, data: bytes) -> str:
+    """The name the program's bytes are written under (PROGRAM_FILE): PG812_5BE02D1.MPF."""
+    assert 0 < program_id < PROGRAM_ID_LIMIT, f"program id {program_id} would make a name of more than 24 characters"
+    digest = hashlib.sha256(data).hexdigest()[:PROGRAM_FILE_HEX].upper()
+    return PROGRAM_FILE.format(program_id=program_id, digest=digest)
 
 
 def _answer_text(first: str, words: str) -> bytes:
@@ -201,7 +259,7 @@ def _answer_text(first: str, words: str) -> bytes:
 def write_atomically(folder: Path, name: str, data: bytes) -> None:
     """`folder/name` holds `data` whole or is as it was: written under a temporary dot name, flushed,
     then renamed in one step, and the folder's entry flushed too."""
-    temporary = folder / f".{name}.{uuid.uuid4().hex}.tmp"
+    temporary = folder / f".{name[:40]}.{uuid.uuid4().hex}.tmp"   # within NAME_MAX whatever the name
     descriptor = os.open(temporary, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o644)
     try:
         with open(descriptor, "wb") as file:

@@ -107,6 +107,12 @@ def _run(options: ServeOptions, listening: socket.socket, said: Callable[[str], 
     from .web.app import create_app
 
     login = "; every page asks for a PostgreSQL login" if options.needs_login else ""
+    if options.needs_login:
+        from .web.auth import unchecked_logins
+
+        refused = unchecked_logins(options.database_url)
+        if refused is not None:   # said, not refused: FTP and the request folders serve the controls anyway
+            said(refused)
     app = create_app(options.database_url, require_login=options.needs_login,
                      session_secret=secrets.token_urlsafe(32) if options.needs_login else None,
                      on_ready=lambda: said(f"serving the web view at {options.address}{login}; stop it with "

@@ -11,12 +11,15 @@ from importlib import import_module
 from typing import TYPE_CHECKING
 
 from starlette.applications import Starlette
+from starlette.exceptions import HTTPException
 from starlette.middleware import Middleware
 from starlette.middleware.sessions import SessionMiddleware
+from starlette.requests import Request
+from starlette.responses import Response
 from starlette.routing import BaseRoute
 
 from .auth import SESSION_COOKIE, SESSION_SECONDS, LoginRequired, session_secret
-from .pages import NotFramed, NulRefused
+from .pages import NotFramed, NulRefused, refusal
 
 if TYPE_CHECKING:
     from ...programs.config import Config
@@ -24,6 +27,8 @@ if TYPE_CHECKING:
 # the concepts shown, each a module of this package with ROUTES (issue 32)
 PAGE_MODULES = ("home", "auth", "gears", "jobs", "job_requests", "programs", "program_views", "classes", "machines")
 POOL_SIZE = (1, 4)   # connections: one kept open, at most four pages answered at once
+NO_PAGE = "no page at {path!r}: the home page / leads to every page (gears, jobs, programs, classes, machines)"
+NOT_TAKEN = "{method} is not taken at {path!r}; it takes {allowed}"
 
 
 def create_app(database_url: str, *, require_login: bool = False, session_secret: str | None = None,
@@ -40,7 +45,8 @@ def create_app(database_url: str, *, require_login: bool = False, session_secret
     from ...programs.config import load_config
 
     app = Starlette(routes=_routes(), lifespan=_lifespan(database_url, on_ready), middleware=_middleware(require_login,
-                                                                                              session_secret))
+                                                                                              session_secret),
+                    exception_handlers={HTTPException: _http_error})
     app.state.require_login = require_login
     app.state.database_url = database_url   # the logins connect to it (auth); never shown
     app.state.config = config if config is not None else load_config()
@@ -56,6 +62,20 @@ def _middleware(require_login: bool, secret: str | None) -> list[Middleware]:
                        max_age=SESSION_SECONDS, same_site="lax"),
             Middleware(LoginRequired, require_login=require_login),
             Middleware(NulRefused)]
+
+
+def _http_error(request: Request, error: Exception) -> Response:
+    """Starlette's own refusals (no such address, a method the address does not take) answered as
+    every page's are: one line, as JSON {"error": …} when asked for, else the error page (Starlette
+    says a bare text/plain "Not Found", which a program reading JSON cannot take)."""
+    assert isinstance(error, HTTPException)
+    path, allowed = request.url.path[:80], {k.lower(): v for k, v in (error.headers or {}).items()}.get("allow")
+    message = (NO_PAGE.format(path=path) if error.status_code == 404 else
+               NOT_TAKEN.format(method=request.method, path=path, allowed=", ".join(sorted(allowed.split(", "))))
+               if allowed else str(error.detail))
+    answer = refusal(request, message, error.status_code)
+    answer.headers.update(error.headers or {})
+    return answer
 
 
 def _routes() -> list[BaseRoute]:

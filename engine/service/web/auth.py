@@ -43,9 +43,16 @@ REQUESTING_ROLE = "engine_runner"
 REFUSED = "login refused: wrong user name or password, or the database does not accept this login"
 NO_ROLE = ("login refused: this login has no role of the engine's (engine_reader sees the pages, engine_runner "
            "also requests programs); ask the database's owner to grant one")
+UNCHECKED_LOGINS = ("web logins will be refused: the database server lets logins in without a password "
+                    "(pg_hba.conf `trust`: {said}), and the web view takes only logins "
+                    "PostgreSQL checks; set scram-sha-256 on the pg_hba.conf lines this service connects by "
+                    "(host; local for a socket) "
+                    "(docs/guide/web-view-releases-and-logins.md)")
 LOCAL_USER = "local"               # program_request.client of a request on the open loopback app
 CROSS_SITE = ("refused: a program is requested only from this service's own page ({}); open the job's page "
               "here and use its button")
+LOGOUT_CROSS_SITE = ("refused: a logout is taken only from this service's own page ({}); use the Log out button "
+                     "of its pages")
 MISDIRECTED = ("this view is open only to the local user, at a loopback address: open it as "
                "http://127.0.0.1:{port}/ (it was reached as {host!r})")
 LOG = logging.getLogger("engine.serve")
@@ -100,6 +107,40 @@ def check_login(database_url: str, user: str, password: str) -> Rights | None:
             return rights_of(conn, user)
     except psycopg.Error:
         return None
+
+
+def unchecked_logins(database_url: str) -> str | None:
+    """Why no web login can succeed on this database server, or None: it lets a login in without
+    asking for its password (pg_hba.conf `trust`, as the embedded server's initdb --auth=trust),
+    and check_login refuses every login PostgreSQL did not check. Asked once at start-up (engine
+    serve off loopback): the service's own role with a made-up password let in, or a made-up role
+    told it does not exist without a password asked (a server that checks passwords asks one of an
+    unknown role too, not to tell who exists). A refusal for any other reason (no pg_hba.conf line
+    for a made-up role) is not taken for trust. Each try leaves one FATAL line in the server's log."""
+    own = _probe(database_url, None)
+    if own is None:
+        return UNCHECKED_LOGINS.format(said="the service's own role got in with a made-up password")
+    made_up = _probe(database_url, f"engine_probe_{secrets.token_hex(6)}")
+    if made_up is not None and "does not exist" in made_up:
+        return UNCHECKED_LOGINS.format(said=f"a made-up login was told, no password asked: {made_up[:100]}")
+    return None
+
+
+def _probe(database_url: str, user: str | None) -> str | None:
+    """A login with a made-up password (as `user`, else the URL's): None if it was let in without
+    one, else why it was refused ("" when the server asked for the password)."""
+    conninfo = make_conninfo(database_url, password=secrets.token_urlsafe(18), passfile=os.devnull,
+                             connect_timeout=CONNECT_TIMEOUT, **({"user": user} if user else {}))
+    probe = psycopg.pq.PGconn.connect(conninfo.encode())
+    try:
+        if probe.status == psycopg.pq.ConnStatus.OK:
+            return None if not probe.used_password else ""
+        if probe.used_password:
+            return ""
+        return (probe.error_message.decode(errors="replace").strip().splitlines() or ["-"])[0].rpartition(
+            "FATAL:")[2].strip()
+    finally:
+        probe.finish()
 
 
 class LoginRequired:
@@ -176,20 +217,21 @@ def requester(request: Request) -> str:
     return LOCAL_USER if rights is None else rights.login
 
 
-def cross_site(request: Request) -> str | None:
+def cross_site(request: Request, said: str = CROSS_SITE) -> str | None:
     """Why a form's POST may not have come from this service's own pages, or None (issue 32: a
     page of another site must not make the browser of a logged-in runner, or of the local user of
     the open loopback app, request a program). The browser's Origin (else Referer) must name this
     very host as the request reached it (Host), and on the open app that host must be a loopback
-    one: a name of another site resolving to 127.0.0.1 (DNS rebinding) is its own origin there."""
+    one: a name of another site resolving to 127.0.0.1 (DNS rebinding) is its own origin there.
+    `said`: the refusal, naming the action (a request, a logout)."""
     host = request.headers.get("host", "").lower()
     came_from = request.headers.get("origin") or request.headers.get("referer")
     if not came_from or not host:
-        return CROSS_SITE.format("it says no Origin or Referer, or no Host")
+        return said.format("it says no Origin or Referer, or no Host")
     if _split(came_from).netloc.lower() != host:
-        return CROSS_SITE.format(f"it came from {came_from[:80]!r}, not from {host[:80]!r}")
+        return said.format(f"it came from {came_from[:80]!r}, not from {host[:80]!r}")
     if not request.app.state.require_login and not is_loopback(_split(f"//{host}").hostname or ""):
-        return CROSS_SITE.format(f"the open (loopback) view was reached as {host[:80]!r}; open it as 127.0.0.1")
+        return said.format(f"the open (loopback) view was reached as {host[:80]!r}; open it as 127.0.0.1")
     return None
 
 
@@ -220,6 +262,11 @@ async def login(request: Request) -> Response:
 
 
 async def logout(request: Request) -> Response:
+    """Ends the session; only from this service's own pages (cross_site: another site's page must
+    not log a user out, 403 and the session kept)."""
+    reason = cross_site(request, LOGOUT_CROSS_SITE)
+    if reason is not None:
+        return refusal(request, reason, 403)
     request.session.clear()
     if wants_json(request):
         return JSONResponse({"logged_out": True})

@@ -31,7 +31,9 @@ def classes_list(request: Request) -> Response:
 
 def class_page(request: Request) -> Response:
     """A class's versions, their states and releases: `engine template history --json`; the page
-    adds each release's line as the command prints it and the class's golden tests (not run)."""
+    adds each release's line as the command prints it, the class's golden tests (not run), and its
+    draft's version: the link to the draft's impact only when there is one (else the link answered
+    400 "has no draft", the review of issue 32)."""
     from ...release.golden import load_tests
     from ...release.recheck import verdict
     from ...release.shown import release_text, version_json
@@ -49,7 +51,8 @@ def class_page(request: Request) -> Response:
         said = {entry.version: release_text(entry.release, verdicts[entry.version])
                 for entry in entries if entry.release}
         tests = load_tests(conn, class_and_descendants(conn, name))
-    return page(request, "class.html", {**data, "said": said, "golden_tests": tests})
+    draft = next((entry.version for entry in entries if entry.state == "draft"), None)
+    return page(request, "class.html", {**data, "said": said, "golden_tests": tests, "draft": draft})
 
 
 def version_page(request: Request) -> Response:

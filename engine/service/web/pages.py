@@ -4,6 +4,7 @@ A handled error (engine.errors.EngineError: an unknown id, a refusal) is its one
 prints it, with status 404 or 400; nothing else of the engine's state is shown."""
 from __future__ import annotations
 
+import re
 from contextlib import contextmanager
 from pathlib import Path
 from urllib.parse import unquote_to_bytes
@@ -18,6 +19,21 @@ from ...json_text import exact_json
 TEMPLATES = Jinja2Templates(directory=str(Path(__file__).parent / "templates"))
 # every answer: no page of this view in another site's frame (X-Frame-Options for older browsers)
 NOT_FRAMED = [(b"x-frame-options", b"DENY"), (b"content-security-policy", b"frame-ancestors 'none'")]
+# The CLI's advice (the clause after a refusal's last "; ", naming a command) as a page says it: a
+# browser's user has the look-up box and the pages, not the CLI (the review of issue 32 found
+# /programs/99999 advising `engine programs show --hash H`). (command as the CLI names it, page advice)
+PAGE_ADVICE = (
+    ("engine programs show --hash", "find it by its lineage line: type the hash on it in the look-up box at the top"),
+    ("engine programs list", "the Programs page lists the programs"),
+    ("SELECT id, name FROM program", "the Programs page lists the programs"),
+    ("engine jobs list", "the Jobs page lists the jobs"),
+    ("engine gears", "the Gears page lists the gears"),
+    ("engine template list", "the Classes page lists the classes"),
+    ("engine template history", "the class's page lists its versions"),
+    ("engine machines list", "the Machines page lists the machines"),
+    ("engine explain --program", "the program's page shows the rows it was made from"),
+)
+COMMAND = re.compile(r"`(?P<command>[^`]+)`")
 NUL_REFUSED = "the address holds a NUL character (%00), which no name, id or hash of the engine has; remove it"
 
 
@@ -37,10 +53,22 @@ def page(request: Request, template: str, data: dict, status: int = 200) -> Resp
 
 
 def refusal(request: Request, message: str, status: int = 400) -> Response:
-    """A one-line error, as JSON {"error": …} or a page saying it."""
+    """A one-line error, as JSON {"error": …} (the CLI's line) or a page saying it (for_pages)."""
     if wants_json(request):
         return JSONResponse({"error": message}, status_code=status)
-    return TEMPLATES.TemplateResponse(request, "error.html", {"message": message}, status_code=status)
+    return TEMPLATES.TemplateResponse(request, "error.html", {"message": for_pages(message)}, status_code=status)
+
+
+def for_pages(message: str) -> str:
+    """The refusal with its command advice said as page advice (PAGE_ADVICE); the JSON keeps the
+    CLI's line (a program reading it runs the commands). Advice naming no command of the table is
+    kept as it is."""
+    reason, _, advice = message.rpartition("; ")
+    named = COMMAND.search(advice)
+    if not reason or named is None:
+        return message
+    page_advice = next((said for command, said in PAGE_ADVICE if named.group("command").startswith(command)), None)
+    return message if page_advice is None else f"{reason}; {page_advice}"
 
 
 @contextmanager

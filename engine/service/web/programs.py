@@ -5,18 +5,28 @@ simulation), and the look-up an operator needs at the control: the hash on the l
 the program id) read off the control's screen leads to the program."""
 from __future__ import annotations
 
+import re
+
+import msgspec
 from starlette.requests import Request
 from starlette.responses import RedirectResponse
 from starlette.routing import Route
 
 from ...errors import EngineError
-from ...programs.lookup import MIN_HASH_DIGITS, checked_prefix, find_programs, list_programs
+from ...nc.lineage import lineage_shaped
+from ...programs.lookup import MIN_HASH_DIGITS, checked_prefix, find_programs, list_programs, programs_with_hash
 from ...programs.rendering import MATCH, REFUSED
 from .answers import BadRequest, answered, query_day, query_flag, query_id, query_text, shown, whole
 from .pages import page, wants_json
 from .program_views import plot_svg, simulation_report, traced
 
 KINDS = {"draft": True, "released": False}   # the list's --draft / --released
+QUERY_SHOWN = 200   # characters of a look-up's query a refusal repeats
+# A lineage line pasted whole (engine.nc.lineage: `; PROGRAM 812 TEMPLATE spur v1 176b5437 INPUT
+# bdf26401`, `(PROGRAM … )` on a Fanuc, a block number before it, DRAFT / UNVERIFIED after it).
+PASTED_LINE = re.compile(r"(?:N[0-9]+\s*)?[;(]\s*PROGRAM\s+(?P<id>[0-9]{1,19})\s+TEMPLATE\s+(?P<cls>\S+)\s+"
+                         r"v(?P<version>[0-9]{1,9})\s+(?P<template>[0-9a-f]{8})\s+INPUT(?:\s+(?P<input>[0-9a-f]{8}))?"
+                         r"(?:\s+DRAFT)?(?:\s+UNVERIFIED)?\s*\)?", re.IGNORECASE)
 
 
 def programs(request: Request):
@@ -60,10 +70,15 @@ def _evidence(conn, record) -> dict:
 
 
 def lookup(request: Request):
-    """A program id or the hash on its lineage line (`engine programs show ID | --hash H`): one
-    program leads to its page, several are listed, anything else is refused in one line."""
+    """A program id, the hash on its lineage line (`engine programs show ID | --hash H`) or the whole
+    line as read off the control (its id, checked against the line's hashes): one program leads to
+    its page, several are listed, anything else is refused in one line."""
     def work(conn):
-        found = find_programs(conn, *_wanted(query_text(request, "q") or ""))
+        typed = query_text(request, "q") or ""
+        line = pasted_lineage(typed)
+        found = find_programs(conn, line.program_id) if line else find_programs(conn, *_wanted(typed))
+        if line:
+            _agrees(conn, line, found[0])
         if len(found) == 1 and not wants_json(request):
             return RedirectResponse(f"/programs/{found[0].id}", status_code=303)
         return shown(request, "lookup.html", {"programs": [record.as_dict() for record in found]},
@@ -79,9 +94,60 @@ def _wanted(text: str) -> tuple[int | None, str | None]:
     try:
         return None, checked_prefix(typed)
     except EngineError:
-        raise BadRequest(f"{typed[:40]!r}: give a program id, or {MIN_HASH_DIGITS} or more hex digits of the hash "
-                         "on the program's lineage line (`; PROGRAM <id> TEMPLATE <class> v<n> <hash8> INPUT <hash8>`)"
-                         ) from None
+        raise BadRequest(f"{_shown(typed)}: give a program id, {MIN_HASH_DIGITS} or more hex digits of the hash on "
+                         "the program's lineage line, or the whole line (`; PROGRAM <id> TEMPLATE <class> v<n> "
+                         "<hash8> INPUT <hash8>`)") from None
+
+
+class Pasted(msgspec.Struct, frozen=True):
+    """A whole lineage line as pasted: what it says of its program."""
+    program_id: int
+    gear_class: str
+    version: int
+    template_hash: str
+    input_hash: str
+
+
+def pasted_lineage(text: str) -> Pasted | None:
+    """The lineage line pasted whole (either comment form, a block number before it), or None for
+    anything that does not read as one; BadRequest for a line that reads as one but is not whole."""
+    typed = text.strip()
+    if not lineage_shaped(typed):
+        return None
+    found = PASTED_LINE.fullmatch(typed)
+    if found is None:
+        raise BadRequest(f"{_shown(typed)} reads as a lineage line but not a whole one: paste it whole "
+                         "(`; PROGRAM <id> TEMPLATE <class> v<n> <hash8> INPUT <hash8>`), or its INPUT hash alone")
+    return Pasted(whole("program", found["id"]), found["cls"], int(found["version"]), found["template"].lower(),
+                  (found["input"] or "").lower())
+
+
+def _agrees(conn, line: Pasted, record) -> None:
+    """The line's class, version and hashes are its program's; else BadRequest naming the programs
+    they are (a line copied from another program's file, or mistyped, must not lead to this one)."""
+    said = (line.gear_class, line.version, line.template_hash, line.input_hash)
+    if said == (record.gear_class, record.template_version, record.template_hash[:8], (record.input_hash or "")[:8]):
+        return
+    raise BadRequest(f"the lineage line names program {line.program_id}, but its TEMPLATE {line.gear_class} "
+                     f"v{line.version} {line.template_hash} INPUT {line.input_hash or '-'} is not program "
+                     f"{record.id}'s ({record.gear_class} v{record.template_version} {record.template_hash[:8]} INPUT "
+                     f"{(record.input_hash or '-')[:8]}){_theirs(conn, line)}: it is another program's line, or "
+                     "was changed; look up its INPUT hash alone")
+
+
+def _theirs(conn, line: Pasted) -> str:
+    """'; they are program 815's' when stored programs carry the line's two hashes."""
+    try:
+        found = [record.id for record in programs_with_hash(conn, line.input_hash)
+                 if record.template_hash.startswith(line.template_hash)] if line.input_hash else []
+    except EngineError:
+        found = []
+    return f"; its hashes are those of program {', '.join(map(str, found[:5]))}" if found else ""
+
+
+def _shown(typed: str) -> str:
+    """The query as typed, whole up to QUERY_SHOWN characters (a lineage line is about 60), quoted."""
+    return repr(typed if len(typed) <= QUERY_SHOWN else typed[:QUERY_SHOWN] + "…")
 
 
 ROUTES = [Route("/programs", programs, name="programs"), Route("/programs/{program_id}", program, name="program"),
