@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING
 
 from msgspec.structs import replace
 
+from ..db.origin import refuse_elsewhere
 from ..errors import EngineError
 from ..gears.holding_matching import choose_holding
 from ..gears.models import model_for_class
@@ -207,6 +208,7 @@ def _stored_job(conn: Connection, job_id: int) -> tuple:
     job = conn.execute(f"SELECT {JOB_COLUMNS} FROM job WHERE id = %s", (job_id,)).fetchone()
     if job is None:
         raise EngineError(f"job {job_id} does not exist; `engine jobs list` shows what does")
+    refuse_elsewhere(conn, "job", job_id, "make and send it")
     return job
 
 

@@ -12,7 +12,7 @@ from starlette.routing import Route
 from ...errors import EngineError
 from ...programs.lookup import MIN_HASH_DIGITS, checked_prefix, find_programs, list_programs
 from ...programs.rendering import MATCH, REFUSED
-from .answers import BadRequest, answered, query_day, query_flag, query_id, query_text, shown, whole
+from .answers import BIGINT_MAX, BadRequest, answered, query_day, query_flag, query_id, query_text, shown, whole
 from .pages import page, wants_json
 from .program_views import plot_svg, simulation_report, traced
 
@@ -20,7 +20,7 @@ KINDS = {"draft": True, "released": False}   # the list's --draft / --released
 
 
 def programs(request: Request):
-    """`engine programs list [--class C] [--gear ID] [--job ID] [--draft|--released] [--since D]
+    """`engine programs list [--class C] [--gear ID] [--plant N] [--job ID] [--draft|--released] [--since D]
     [--until D] [--check] --json`; kind=draft|released."""
     def work(conn):
         kind = query_text(request, "kind")
@@ -28,7 +28,8 @@ def programs(request: Request):
             raise BadRequest(f"kind {kind[:40]!r}: give draft or released (or leave it out for both)")
         found = list_programs(conn, query_text(request, "class"), query_id(request, "gear", "gear"),
                               query_id(request, "job", "job"), KINDS.get(kind or ""),
-                              query_day(request, "since"), query_day(request, "until"), query_flag(request, "check"))
+                              query_day(request, "since"), query_day(request, "until"), query_flag(request, "check"),
+                              query_id(request, "plant", "plant"))
         return page(request, "programs.html", {"programs": found})
     return answered(request, work)
 
@@ -63,7 +64,7 @@ def lookup(request: Request):
     """A program id or the hash on its lineage line (`engine programs show ID | --hash H`): one
     program leads to its page, several are listed, anything else is refused in one line."""
     def work(conn):
-        found = find_programs(conn, *_wanted(query_text(request, "q") or ""))
+        found = find_programs(conn, *_wanted(conn, query_text(request, "q") or ""))
         if len(found) == 1 and not wants_json(request):
             return RedirectResponse(f"/programs/{found[0].id}", status_code=303)
         return shown(request, "lookup.html", {"programs": [record.as_dict() for record in found]},
@@ -71,10 +72,11 @@ def lookup(request: Request):
     return answered(request, work)
 
 
-def _wanted(text: str) -> tuple[int | None, str | None]:
-    """(program id, None) for fewer than MIN_HASH_DIGITS digits, (None, hash prefix) otherwise."""
+def _wanted(conn, text: str) -> tuple[int | None, str | None]:
+    """(program id, None) for fewer than MIN_HASH_DIGITS digits, or for the id of a stored program
+    (a plant's ids have 11 digits or more: issue 33), (None, hash prefix) otherwise."""
     typed = text.strip()
-    if typed.isdigit() and len(typed) < MIN_HASH_DIGITS:
+    if typed.isdigit() and (len(typed) < MIN_HASH_DIGITS or _is_program(conn, typed)):
         return whole("program", typed), None
     try:
         return None, checked_prefix(typed)
@@ -82,6 +84,12 @@ def _wanted(text: str) -> tuple[int | None, str | None]:
         raise BadRequest(f"{typed[:40]!r}: give a program id, or {MIN_HASH_DIGITS} or more hex digits of the hash "
                          "on the program's lineage line (`; PROGRAM <id> TEMPLATE <class> v<n> <hash8> INPUT <hash8>`)"
                          ) from None
+
+
+def _is_program(conn, typed: str) -> bool:
+    number = int(typed)
+    found = number <= BIGINT_MAX and conn.execute("SELECT 1 FROM program WHERE id = %s", (number,)).fetchone()
+    return bool(found)
 
 
 ROUTES = [Route("/programs", programs, name="programs"), Route("/programs/{program_id}", program, name="program"),
