@@ -155,6 +155,15 @@ def test_delivery_and_instantiate_refuse_a_plants_job_and_record_the_refusal(run
     assert recorded[0][:2] == (job, None) and recorded[0][2].startswith(said)
 
 
+def test_a_batch_of_jobs_makes_this_databases_own_and_names_a_plants_as_bad(run):
+    job, _ = arrived(run, 44)
+    programs = rows(run.url, "SELECT count(*) FROM program")[0][0]
+    batch = run("instantiate", "--jobs", f"1-{job}", "--dry-run", "--skip-bad")
+    assert batch.exit_code == 0, batch.output
+    assert f"job {job} was made at plant {AT}: make and send it there" in batch.output
+    assert rows(run.url, "SELECT count(*) FROM program")[0][0] == programs
+
+
 # --- 4: the release impact names the plants' jobs it leaves out ------------------------------------
 
 def test_the_impact_names_the_plants_jobs_it_does_not_make_again(run):
@@ -191,7 +200,7 @@ def test_status_check_exits_1_on_a_warning_and_0_without(run):
 # --- slow: two servers ----------------------------------------------------------------------------
 
 @pytest.mark.slow
-def test_at_the_head_office_a_plants_program_is_shown_never_proved(group):
+def test_at_the_head_office_a_plants_program_is_shown_never_proved(group):   # noqa: F811 (the fixture imported above)
     made = instantiate(group.plant, group.plant_url)
     caught_up(group.plant_url, f"engine_plant_{PLANT}_history")
     shown = json.loads(ok(engine(group.head, "programs", "show", made["program_id"], "--json",
@@ -206,7 +215,7 @@ def test_at_the_head_office_a_plants_program_is_shown_never_proved(group):
 
 
 @pytest.mark.slow
-def test_at_a_plant_releases_say_their_golden_tests_ran_at_the_head_office(group):
+def test_at_a_plant_releases_say_their_golden_tests_ran_at_the_head_office(group):   # noqa: F811 (the fixture imported above)
     history = json.loads(ok(engine(group.plant, "template", "history", "--class", "spur", "--json",
                                    url=group.plant_url)))
     releases = [version["release"] for version in history["versions"] if version["release"]]
@@ -222,7 +231,7 @@ def test_at_a_plant_releases_say_their_golden_tests_ran_at_the_head_office(group
 
 
 @pytest.mark.slow
-def test_at_a_plant_the_template_list_and_export_are_the_released_versions(group, tmp_path):
+def test_at_a_plant_the_template_list_and_export_are_the_released_versions(group, tmp_path):   # noqa: F811 (the fixture imported above)
     version = rows(group.plant_url, "SELECT released_version('spur')")[0][0]
     count = rows(group.plant_url, "SELECT jsonb_array_length(rows) FROM template_version_rows "
                                   "WHERE gear_class = 'spur' AND version = %s", (version,))[0][0]

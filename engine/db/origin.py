@@ -43,8 +43,13 @@ def made_elsewhere(conn: Connection, record_id: int) -> int | None:
 def refuse_elsewhere(conn: Connection, kind: str, record_id: int, doing: str) -> None:
     """EngineError (one line) if another plant made the record: `doing` needs that plant's gear, hob
     and machine records, so it is done there (e.g. "make and send it there")."""
-    plant = made_elsewhere(conn, record_id)
-    if plant is not None:
+    refuse_unless_made_at(this_plant(conn), kind, record_id, doing)
+
+
+def refuse_unless_made_at(here: int, kind: str, record_id: int, doing: str) -> None:
+    """refuse_elsewhere with this database's plant number read once (a batch of jobs)."""
+    plant = made_at(record_id)
+    if plant != here:
         raise EngineError(f"{kind} {record_id} was made at {plant_name(plant)}: {doing} there "
                           "(its gear, hob and machine records are the plant's)")
 
