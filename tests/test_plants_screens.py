@@ -131,11 +131,14 @@ def test_the_web_view_shows_a_plants_program_and_job_and_offers_no_sending(run):
         html = unescape(client.get(f"/programs/{program}").text)
         job_page = unescape(client.get(f"/jobs/{job}").text)
         listed = client.get("/programs", params={"plant": AT}, headers=JSON)
+        listed_page = client.get("/programs").text
         sent = client.post(f"/jobs/{job}/request", headers={"Origin": LOOPBACK + ":8080"})   # the page's own form
     assert page.status_code == 200 and page.json()["programs"][0]["rendering"]["status"] == "PLANT"
     assert found.status_code == 303 and found.headers["location"] == f"/programs/{program}"
     assert NOT_RE_PROVED in html and "gear 7001 does not exist" not in html
     assert "Make and send" not in job_page and f"Made at plant {AT}" in job_page
+    assert 'href="/gears/7001"' not in job_page + listed_page   # the plant's gear, not one of this database's
+    assert 'href="/gears/42"' in listed_page
     assert [p["program_id"] for p in listed.json()["programs"]] == [program]
     assert "Make and send" not in sent.text
     assert f"job {job} was made at plant {AT}: make and send it there" in unescape(sent.text)

@@ -5,11 +5,10 @@ from __future__ import annotations
 from starlette.requests import Request
 from starlette.routing import Route
 
-from ...db.origin import made_elsewhere, plant_name
+from ...db.origin import made_elsewhere, plant_name, this_plant
 from ...programs.job_records import job_details, list_jobs
 from .answers import answered, query_day, query_id, query_text, shown, whole
 from .auth import may_request
-from .pages import page
 
 
 def jobs(request: Request):
@@ -18,7 +17,7 @@ def jobs(request: Request):
         found = list_jobs(conn, query_text(request, "class"), query_id(request, "gear", "gear"),
                           query_day(request, "since"), query_day(request, "until"),
                           query_id(request, "plant", "plant"))
-        return page(request, "jobs.html", {"jobs": found})
+        return shown(request, "jobs.html", {"jobs": found}, lambda: {"here": this_plant(conn)})
     return answered(request, work)
 
 

@@ -9,11 +9,12 @@ from starlette.requests import Request
 from starlette.responses import RedirectResponse
 from starlette.routing import Route
 
+from ...db.origin import this_plant
 from ...errors import EngineError
 from ...programs.lookup import MIN_HASH_DIGITS, checked_prefix, find_programs, list_programs
 from ...programs.rendering import MATCH, REFUSED
 from .answers import BIGINT_MAX, BadRequest, answered, query_day, query_flag, query_id, query_text, shown, whole
-from .pages import page, wants_json
+from .pages import wants_json
 from .program_views import plot_svg, simulation_report, traced
 
 KINDS = {"draft": True, "released": False}   # the list's --draft / --released
@@ -30,7 +31,7 @@ def programs(request: Request):
                               query_id(request, "job", "job"), KINDS.get(kind or ""),
                               query_day(request, "since"), query_day(request, "until"), query_flag(request, "check"),
                               query_id(request, "plant", "plant"))
-        return page(request, "programs.html", {"programs": found})
+        return shown(request, "programs.html", {"programs": found}, lambda: {"here": this_plant(conn)})
     return answered(request, work)
 
 
