@@ -88,6 +88,7 @@ def test_a_plants_program_is_shown_with_its_text_and_where_it_was_proved(run, ge
     assert shown["rendering"] == {"status": "PLANT", "reason": NOT_RE_PROVED, "plant": AT}
     text = ok(run("programs", "show", program))
     assert f"rendering:     PLANT: {NOT_RE_PROVED}" in text and f"plant:         plant {AT}" in text
+    assert f"gear:          {gear} (plant {AT}'s, not this database's)" in text
     assert "import it" not in text and "REFUSED" not in text and "MATCH" not in text
     assert text.endswith("\n".join(stored) + "\n")
     lineage = next(line for line in stored if line.startswith(f"; PROGRAM {program} TEMPLATE "))
@@ -215,6 +216,21 @@ def test_at_the_head_office_a_plants_program_is_shown_never_proved(group):   # n
     refused(simulated, f"was made at plant {PLANT}", f"run it at plant {PLANT}")
     sent = engine(group.head, "instantiate", "--job", made["job_id"], url=group.head_url)
     refused(sent, f"job {made['job_id']} was made at plant {PLANT}: make and send it there")
+
+
+@pytest.mark.slow
+def test_status_names_the_lag_at_the_publisher_and_the_message_age_apart(group):   # noqa: F811
+    caught_up(group.head_url, f"engine_plant_{PLANT}_templates")
+    head = json.loads(ok(engine(group.head, "plant", "status", "--json", url=group.head_url)))
+    plant = json.loads(ok(engine(group.plant, "plant", "status", "--json", url=group.plant_url)))
+    slot = head["slots"][0]
+    assert slot["name"] == f"engine_plant_{PLANT}_templates" and isinstance(slot["behind_bytes"], int)
+    assert isinstance(slot["behind_seconds"], float) and "replay_lag_seconds" not in slot
+    subscription = plant["subscriptions"][0]
+    assert "lag_seconds" not in subscription and isinstance(subscription["message_age_seconds"], float)
+    text = ok(engine(group.plant, "plant", "status", "--check", url=group.plant_url))   # healthy: exit 0
+    assert "publisher's last message" in text and "its lag: engine plant status at the publisher" in text
+    assert f"slot engine_plant_{PLANT}_history: active" in text and ", lag " in text
 
 
 @pytest.mark.slow

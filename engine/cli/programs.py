@@ -24,7 +24,9 @@ RECORD_FIELDS = (  # (label, the value of a ProgramRecord)
     ("plant", lambda record: plant_name(record.plant)),
     ("name", lambda record: record.name),
     ("job", lambda record: record.job_id),
-    ("gear", lambda record: record.gear_id if record.gear_id is not None else "-"),
+    ("gear", lambda record: "-" if record.gear_id is None else
+     f"{record.gear_id} ({plant_name(record.plant)}'s, not this database's)" if _made_elsewhere(record) else
+     record.gear_id),
     ("class", lambda record: record.gear_class),
     ("version", lambda record: f"v{record.template_version}" + (" (draft)" if record.draft else " (released)")),
     ("verifier", lambda record: record.verifier_said),
@@ -116,6 +118,13 @@ def programs_show(ctx, program_id, prefix, as_json):
         if number:   # a blank line between programs (after one without a final newline, its line ends first)
             click.echo("" if found[number - 1].layout.final_newline else "\n")
         _echo_record(record)
+
+
+def _made_elsewhere(record) -> bool:
+    """Made at another plant (engine.programs.rendering: PLANT): its gear id is that plant's."""
+    from ..programs.rendering import PLANT
+
+    return record.rendering is not None and record.rendering.status == PLANT
 
 
 def _echo_record(record) -> None:

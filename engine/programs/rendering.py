@@ -107,8 +107,8 @@ class Rendering(msgspec.Struct, frozen=True):
         """EngineError (exit 1, one line) unless the program is the rendering it names."""
         if self.status == PLANT:
             where = plant_name(self.plant or 0)
-            raise EngineError(f"program {self.program_id} was made at {where} (its gear, hob and machine records "
-                              f"are the plant's): not re-proved here for {use}; run it at {where}")
+            raise EngineError(f"program {self.program_id} was made at {where} (its gear, hob and machine records are "
+                              f"the plant's): not re-proved here, so refused as evidence for {use}; run it at {where}")
         if not self.matches:
             raise EngineError(f"program {self.program_id}: {self.status}: {self.reason}; refused as evidence for {use}")
 
