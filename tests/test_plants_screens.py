@@ -119,6 +119,8 @@ def test_lists_say_the_plant_of_each_and_filter_by_it(run):
                            json.loads(ok(run("programs", "list", "--gear", 44, "--json")))["programs"]]
     assert [p["program_id"] for p in json.loads(ok(run("programs", "list", "--gear", 44, "--plant", AT,
                                                        "--json")))["programs"]] == [program]
+    gear = json.loads(ok(run("gears", "show", 44, "--json")))["gear"]   # this database's gear 44: not the plant's
+    assert job not in [j["job_id"] for j in gear["jobs"]] and gear["job_count"] == len(gear["jobs"])
     jobs = json.loads(ok(run("jobs", "list", "--plant", AT, "--json")))["jobs"]
     assert [(j["job_id"], j["plant"]) for j in jobs] == [(job, AT)]
     assert " plant " in ok(run("jobs", "list")).splitlines()[0]
