@@ -54,7 +54,8 @@ class ProgramRecord(msgspec.Struct, frozen=True):
     name: str
     lines: list[str]
     layout: NcLayout = NcLayout()   # its template version's line ending and final newline
-    rendering: Rendering | None = None   # MATCH, MISMATCH or UNCHECKED (engine.programs.rendering); None: not checked
+    rendering: Rendering | None = None   # MATCH, MISMATCH, UNCHECKED, REFUSED or PLANT (engine.programs.rendering);
+    #                                      None: not checked
 
     @property
     def text(self) -> str:

@@ -9,7 +9,7 @@ first renders it again here: the rows of the version it records (template_versio
 once per process), run with its job's parameters as stored, the engine's lineage line added,
 compared line by line, row by row and trace entry by trace entry with what is stored.
 
-Four outcomes (`Rendering.status`):
+Four outcomes (`Rendering.status`), and a fifth for a program another plant made:
 
 * MATCH: the stored lines, row ids and trace are exactly the rendering, and the rendered lines
   pass now the proof a new program gets (engine.programs.rendering_proof: the machine's verifier,
@@ -24,6 +24,11 @@ Four outcomes (`Rendering.status`):
   before input hashes were kept, its version's rows were never stored, or the version did not
   render the job now (a run over its time budget on a busy machine). Making it again
   (`engine instantiate --job ID`) gives a program that can be checked.
+* PLANT: its id is not of this database's range (engine.db.origin): another plant made it and
+  proved it when it made it, on that plant's gear, hob and machine records, and it reached this
+  database as history (issue 33; docs/design.md §12). It is never rendered here: this database's
+  gear of the same id is another gear (a good program would be REFUSED, or fail on a gear not
+  here). A command that needs a proof refuses it, naming the plant to run it at.
 
 The rendering is made as the engine made it (engine.programs.remake): a hobbing job with its
 cycle time recomputed from its feeds, a turning job with its passes computed from its drawing's
