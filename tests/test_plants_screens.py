@@ -159,6 +159,9 @@ def test_delivery_and_instantiate_refuse_a_plants_job_and_record_the_refusal(run
         assert job not in [listed.job_id for listed in machine_files(conn, "hobber-840d")]
     recorded = rows(run.url, "SELECT job_id, program_id, refusal FROM program_request ORDER BY id DESC LIMIT 1")
     assert recorded[0][:2] == (job, None) and recorded[0][2].startswith(said)
+    with TestClient(create_app(run.url), base_url=LOOPBACK) as client:   # asked here: the head office's request
+        machine = client.get("/machines/hobber-840d", headers=JSON).json()
+    assert machine["requests"][0]["plant"] == 0 and machine["requests"][0]["job_id"] == job
 
 
 def test_a_batch_of_jobs_makes_this_databases_own_and_names_a_plants_as_bad(run):
