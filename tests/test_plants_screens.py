@@ -250,8 +250,10 @@ def test_at_a_plant_releases_say_their_golden_tests_ran_at_the_head_office(group
     tests = engine(group.plant, "test", "--class", "spur", "--released", url=group.plant_url)
     refused(tests, f"this database is plant {PLANT}", "run them there")
     with TestClient(create_app(group.plant_url), base_url=LOOPBACK) as client:
-        page = client.get("/classes/spur").text
+        page = unescape(client.get("/classes/spur").text)
+        golden = client.get("/classes/spur/tests", params={"released": 1}, headers=JSON)
     assert "MISMATCH" not in page and "released at the head office" in page
+    assert golden.status_code == 400 and f"this database is plant {PLANT}" in golden.json()["error"]
 
 
 @pytest.mark.slow
