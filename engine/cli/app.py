@@ -168,9 +168,13 @@ def _refused_by_role(error: Exception) -> bool:
 
 def _read_only_here(error: Exception) -> bool:
     """The database refused a write as read-only (SQLSTATE 25006): at a plant, the head office's
-    tables (schema/schema.sql, section plants), or a read-only server."""
+    tables (schema/schema.sql, section plants), or a read-only server; or a row's id outside this
+    database's plant range (a_plant_id: a sequence moved by hand), which is bad state, not a bug."""
     psycopg = sys.modules.get("psycopg")
-    return psycopg is not None and isinstance(error, psycopg.errors.ReadOnlySqlTransaction)
+    if psycopg is None:
+        return False
+    return isinstance(error, psycopg.errors.ReadOnlySqlTransaction) or (
+        isinstance(error, psycopg.errors.CheckViolation) and error.diag.constraint_name == "a_plant_id")
 
 
 def _database_failure(error: Exception) -> bool:

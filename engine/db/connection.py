@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import os
+import re
 from typing import TYPE_CHECKING, Any
 
 from ..errors import EngineError
@@ -80,10 +81,10 @@ def connect(database_url: str | None = None, **kwargs: Any) -> Connection:
     url = resolve_url(database_url)
     try:
         conn = psycopg.connect(url, **kwargs)
-    except psycopg.OperationalError as error:
+    except (psycopg.OperationalError, psycopg.ProgrammingError) as error:   # unreachable, or a malformed URL
         where = shown_url(url) if url else "the server named by the PG* variables"
         first_line = str(error).strip().splitlines()[0] if str(error).strip() else type(error).__name__
-        raise EngineError(f"cannot connect to {where}: {first_line}") from error
+        raise EngineError(f"cannot connect to {where}: {without_password(first_line, url)}") from error
     read_bounded_json(conn)
     return conn
 
@@ -108,3 +109,21 @@ def scalar(cursor: Cursor[TupleRow]) -> Any:
     row = cursor.fetchone()
     assert row is not None, "a query that always returns a row returned none"
     return row[0]
+
+
+# Where a connection string holds a password: a URI's user info, its query, a keyword's value.
+PASSWORDS = (re.compile(r"^(postgres(?:ql)?://[^:@/?#]*:)([^@/?#]*)(?=@)"), re.compile(r"([?&]password=)([^&#]*)"),
+             re.compile(r"(\bpassword\s*=\s*)('(?:[^'\\]|\\.)*'|[^\s']\S*)"))
+
+
+def without_password(text: str, url: str) -> str:
+    """`text`, a message about `url`, with the passwords `url` holds as ***: a head office's URL,
+    given to `engine plant subscribe`, holds one, and libpq quotes a malformed token of it in its
+    message (shown_url hides it in the URL itself, not in what the server or libpq says)."""
+    from urllib.parse import unquote
+
+    secrets = {found.group(2) for pattern in PASSWORDS for found in pattern.finditer(url) if found.group(2)}
+    secrets |= {unquote(secret) for secret in secrets} | {secret.strip("'") for secret in secrets}
+    for secret in sorted(filter(None, secrets), key=len, reverse=True):
+        text = text.replace(secret, "***")
+    return text

@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING
 import msgspec
 from psycopg import sql
 
-from ..db.connection import connect, scalar
+from ..db.connection import connect, scalar, without_password
 from ..errors import EngineError
 from . import tables
 from .tables import Published, subscription_name
@@ -126,16 +126,44 @@ def _check_head(head: Connection, number: int, resuming: bool) -> None:
         require_current(head)
     except EngineError as error:
         raise EngineError(f"engine plant subscribe: at the head office, {error}") from error
+    _refuse_newer_head(head)
     publication = (tables.TEMPLATES_PUBLICATION,)
     if not head.execute("SELECT 1 FROM pg_publication WHERE pubname = %s", publication).fetchone():
         raise EngineError("engine plant subscribe: the head office publishes nothing yet; "
                           "run `engine plant publish` there first")
     if plant_number(head) > 0:
         raise EngineError(f"engine plant subscribe: --head names plant {plant_number(head)}, not the head office")
+    if not resuming:
+        _refuse_taken_number(head, number)
+
+
+def _refuse_newer_head(head: Connection) -> None:
+    """require_current finds a head office behind this engine, not one ahead of it (a migration of a
+    newer engine): that one publishes columns or rules this plant's tables lack, and the plant's
+    subscription would stop on its first copy."""
+    from ..db.migrate import discover
+
+    known = {migration.version for migration in discover()}
+    newer = sorted(version for (version,) in head.execute("SELECT version FROM schema_migration")
+                   if version not in known)
+    if newer:
+        raise EngineError(f"engine plant subscribe: the head office has migration(s) this engine lacks (first "
+                          f"{newer[0]}): upgrade the engine here to the head office's and run engine db migrate")
+
+
+def _refuse_taken_number(head: Connection, number: int) -> None:
+    """The number is taken by a plant the head office subscribes to, or by one whose setup stopped
+    before that (its templates subscription made: its slot is kept at the head office). Checked by
+    the slot too: otherwise a second database took the number, then failed on the slot's name, left
+    a plant that could neither finish nor take another number."""
     name = subscription_name(number, "history")
-    if not resuming and _subscribed(head, name):
+    if _subscribed(head, name):
         raise EngineError(f"engine plant subscribe: the head office has a plant {number} already ({name}); "
                           "choose another --number")
+    slot = subscription_name(number, "templates")
+    if head.execute("SELECT 1 FROM pg_replication_slots WHERE slot_name = %s", (slot,)).fetchone():
+        raise EngineError(f"engine plant subscribe: the head office has a plant {number} already, its setup "
+                          f"unfinished (slot {slot}); choose another --number, or finish that plant's setup there")
 
 
 def _id_range(conn: Connection, number: int) -> tuple[int, int]:
@@ -172,6 +200,6 @@ def _subscription(conn: Connection, name: str, url: str, publication: str) -> No
         conn.execute(sql.SQL("CREATE SUBSCRIPTION {} CONNECTION {} PUBLICATION {}").format(
             sql.Identifier(name), sql.Literal(url), sql.Identifier(publication)))
     except psycopg.Error as error:
-        first_line = (str(error).strip().splitlines() or [type(error).__name__])[0]
+        first_line = without_password((str(error).strip().splitlines() or [type(error).__name__])[0], url)
         raise EngineError(f"engine plant subscribe: could not make the subscription {name} ({first_line}); "
                           "what was made before it stays: make it reachable and run the same command again") from error

@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING
 import msgspec
 
 from ..db.connection import scalar
-from .tables import HISTORY_PUBLICATION, TEMPLATES_PUBLICATION
+from .tables import HISTORY_PUBLICATION, ID_SEQUENCES, TEMPLATES_PUBLICATION
 
 if TYPE_CHECKING:
     from ..db.connection import Connection
@@ -74,6 +74,10 @@ SLOTS = """SELECT s.slot_name, s.active, s.wal_status,
             ELSE 0 END::float8
 FROM pg_replication_slots s LEFT JOIN pg_stat_replication r ON r.pid = s.active_pid
 WHERE s.database = current_database() ORDER BY s.slot_name"""
+MOVED_SEQUENCES = """SELECT s.sequencename, s.last_value, plant_first_id(plant_number()), plant_last_id(plant_number())
+FROM pg_sequences s WHERE s.schemaname = current_schema() AND s.sequencename = ANY(%s)
+  AND s.last_value NOT BETWEEN plant_first_id(plant_number()) AND plant_last_id(plant_number())
+ORDER BY s.sequencename"""
 
 
 def plant_status(conn: Connection) -> PlantStatus:
@@ -88,7 +92,15 @@ def plant_status(conn: Connection) -> PlantStatus:
     keep = scalar(conn.execute("SHOW max_slot_wal_keep_size"))
     role = _role(number, published, subscriptions)
     return PlantStatus(role, number, wal_level, keep, published, subscriptions, slots,
-                       warnings(wal_level, keep, published, subscriptions, slots))
+                       warnings(wal_level, keep, published, subscriptions, slots) + moved_sequences(conn))
+
+
+def moved_sequences(conn: Connection) -> list[str]:
+    """A sequence of the rows this database makes, moved by hand out of its plant's ids (setval):
+    every new row is refused (a_plant_id), whose message sends the user here."""
+    return [f"sequence {name} is at {value}, outside this database's ids {first} to {last}: each new row is "
+            f"refused; set it back, SELECT setval('{name}', <the largest id of the table in that range>)"
+            for name, value, first, last in conn.execute(MOVED_SEQUENCES, (list(ID_SEQUENCES),))]
 
 
 def _role(number: int, published: list[PublishedTable], subscriptions: list[Subscription]) -> str:

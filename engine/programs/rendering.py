@@ -76,7 +76,9 @@ LISTED_RENDERING = (f"CASE WHEN NOT ({MADE_HERE_SQL.format(id='p.id')}) THEN '{P
 STORED = """
 SELECT p.id, p.name, p.gear_class, p.template_version, p.template_hash, p.input_hash, p.draft, p.unverified,
        p.lines, p.row_ids, p.trace, p.job_id, j.machine, j.params, j.module_params,
-       job_input_hash(j.params, j.module_params), v.version IS NOT NULL, m.dialect, j.gear_id, j.hob_id
+       job_input_hash(j.params, j.module_params), v.version IS NOT NULL, m.dialect, j.gear_id, j.hob_id,
+       CASE WHEN j.id NOT BETWEEN plant_first_id(plant_number()) AND plant_last_id(plant_number())
+            THEN (j.id / plant_first_id(1))::integer END
 FROM program p JOIN job j ON j.id = p.job_id JOIN machine m ON m.name = j.machine
 LEFT JOIN template_version_rows v ON v.gear_class = p.gear_class AND v.version = p.template_version
 WHERE p.id = %s"""
@@ -160,6 +162,7 @@ class StoredProgram(msgspec.Struct, frozen=True):
     dialect: str
     gear_id: int | None = None   # the job's gear and hob, which the proof simulates against
     hob_id: str | None = None
+    made_at: int | None = None   # the plant whose job it is, when not this database's (docs/design.md §12)
 
 
 class Renderer:
@@ -305,6 +308,9 @@ def made_at_plant(program_id: int) -> Rendering:
 def _why_unchecked(stored: StoredProgram) -> str | None:
     """Why the program cannot be rendered again from the records, or None."""
     remake = REMAKE.format(job=stored.job_id)
+    if stored.made_at is not None:   # a plant's gears, cases and materials are its own, not replicated
+        return (f"made at plant {stored.made_at} for that plant's gear {stored.gear_id}, not this database's, and "
+                f"proved there: see it with `engine programs show {stored.id}` at plant {stored.made_at}")
     if stored.input_hash is None:
         return f"stored before input hashes were kept, it cannot be rendered again; {remake}"
     if stored.job_hash != stored.input_hash:
