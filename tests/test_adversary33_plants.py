@@ -174,4 +174,5 @@ def test_the_head_office_does_not_judge_a_plants_program_by_its_own_gears(group)
     at_plant = json.loads(ok(engine(group.plant, "programs", "show", made["program_id"], "--json", url=plant)))
     assert at_plant["programs"][0]["rendering"]["status"] == "MATCH"
     rendering = at_head["programs"][0]["rendering"]
-    assert rendering["status"] == "UNCHECKED" and f"made at plant {PLANT}" in rendering["reason"]
+    # PLANT (issue 33's screens, tests/test_plants_screens.py): made and proved there, not re-proved here
+    assert rendering["status"] == "PLANT" and f"made at plant {PLANT}" in rendering["reason"]

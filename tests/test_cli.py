@@ -194,7 +194,7 @@ def test_template_list_counts_each_class_s_own_and_inherited_rows(read_only_run)
         expected = dict(conn.execute("SELECT g.name, (SELECT count(*) FROM class_template(g.name)) "
                                      "FROM gear_class g").fetchall())
     lines = result.stdout.splitlines()
-    assert lines[0].split() == ["class", "parent", "version", "rows", "description"]
+    assert lines[0].split() == ["class", "parent", "version", "rows", "released", "description"]   # issue 33: released
     listed = {line.split()[0]: line.split() for line in lines[1:]}
     assert expected["duplex"] > expected["spur"] > 0
     for name in ("spur", "duplex", "helical", "worm_wheel"):

@@ -32,6 +32,9 @@ def test_command(ctx, gear_class, released, show_coverage, days, as_json):
 
     `engine test add --from-program ID` makes a test of a proven stored program.
 
+    At a plant the tests are refused in one line: they run on the head office's gears, which a
+    plant does not receive; each release's tests ran at the head office (engine template history).
+
     Example: engine test --class spur --json
     """
     from ..templates.store import class_and_descendants
@@ -71,6 +74,9 @@ def test_add(ctx, program_id, name):
 
 def _report_tests(conn: Connection, classes, gear_class, released, as_json) -> None:
     from ..release.golden import run_golden_tests
+    from ..release.recheck import refuse_golden_tests_at_a_plant
+
+    refuse_golden_tests_at_a_plant(conn)   # issue 33: a plant's gear 42 is not the head office's gear 42
 
     results = run_golden_tests(conn, classes, draft=not released)
     failed = [result for result in results if not result.passed]

@@ -11,11 +11,12 @@ from .ids import GEAR_ID, JOB_ID
 from .output import Column, day, day_options, emit_list, emit_record, list_options
 
 JOB_COLUMNS = (
-    Column("job", "job_id"), Column("gear", "gear_id"), Column("class", "class"), Column("machine", "machine"),
+    Column("job", "job_id"), Column("plant", "plant"), Column("gear", "gear_id"), Column("class", "class"),
+    Column("machine", "machine"),
     Column("hob", "hob_id"), Column("programs", "program_count"), Column("made", "created_at"),
     Column("confirmed", "confirmed_at"),
 )
-JOB_FIELDS = JOB_COLUMNS[:5] + (
+JOB_FIELDS = JOB_COLUMNS[:6] + (
     Column("made", "created_at"), Column("confirmed", "confirmed_at"), Column("drawing", "drawing"),
     Column("parameters", "params", lambda params: json.dumps(params, sort_keys=True)),
     Column("module parameters", "module_params", lambda params: json.dumps(params, sort_keys=True)),
@@ -33,19 +34,22 @@ def jobs():
 
 @jobs.command("list")
 @click.option("--class", "gear_class", help="Only jobs of this class.")
-@click.option("--gear", "gear_id", type=GEAR_ID, help="Only jobs of this gear.")
+@click.option("--gear", "gear_id", type=GEAR_ID, help="Only jobs of this gear (a gear of --plant's, else of this "
+              "database: gear ids of plants collide).")
+@click.option("--plant", type=click.IntRange(0, 9999), help="Only jobs made at this plant (0: the head office).")
 @day_options("jobs made")
 @list_options("jobs")
 @click.pass_context
-def jobs_list(ctx, gear_class, gear_id, since, until, output):
-    """The jobs stored, one line each: gear, class, machine, hob, programs made, when.
+def jobs_list(ctx, gear_class, gear_id, plant, since, until, output):
+    """The jobs stored, one line each: the plant that made it (0: the head office; a head office
+    holds its plants' jobs as history), gear, class, machine, hob, programs made, when.
 
     Example: engine jobs list --gear 42 --json
     """
     from ..programs.job_records import list_jobs
 
     with connection(ctx) as conn:
-        found = list_jobs(conn, gear_class, gear_id, day(since), day(until))
+        found = list_jobs(conn, gear_class, gear_id, day(since), day(until), plant)
     emit_list(output, "jobs", JOB_COLUMNS, found)
 
 

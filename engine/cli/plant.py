@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import click
 
+from ..errors import EngineError
 from .context import connection, emit_json, record_dict
 
 
@@ -62,22 +63,39 @@ def plant_subscribe(ctx, head_url, number, plant_url):
 
 @plant.command("status")
 @click.option("--json", "as_json", is_flag=True, help="One JSON object instead of prose.")
+@click.option("--check", is_flag=True, help="Exit 1 if there is any warning (for monitoring), after the status.")
 @click.pass_context
-def plant_status(ctx, as_json):
-    """What this database publishes and receives, each subscription's lag and tables, the
-    replication slots kept here and the WAL each holds, and warnings (an inactive slot keeps
-    WAL until the disk is full).
+def plant_status(ctx, as_json, check):
+    """What this database publishes and receives, each subscription's tables and the age of the
+    publisher's last message (keepalives included: 0 to 30 s on an idle link, not a lag), the
+    replication slots kept here with the WAL each holds and its lag (bytes its subscriber has not
+    yet applied, and when behind, the age of the oldest of them), and warnings (an inactive slot
+    keeps WAL until the disk is full). A link's lag is measured at its publisher: run this at the
+    head office for the templates its plants receive, at a plant for the history it sends.
 
-    Example: engine plant status --json
+    Exit 0, whatever the warnings; with --check, exit 1 if there is any (one line on stderr).
+
+    Example: engine plant status --check
     """
     from ..plants.status import plant_status as read_status
 
     with connection(ctx) as conn:
         status = read_status(conn)
     if as_json:
-        return emit_json(record_dict(status))
-    for line in status_lines(status):
-        click.echo(line)
+        emit_json(record_dict(status))
+    else:
+        for line in status_lines(status):
+            click.echo(line)
+    if check and status.warnings:
+        raise EngineError(f"engine plant status --check: {len(status.warnings)} warning(s): {status.warnings[0]}")
+
+
+def _lag(slot) -> str:
+    """What the slot's subscriber has not yet applied: bytes, and the age of the oldest when behind."""
+    if not slot.behind_bytes:
+        return "0 bytes (caught up)"
+    age = f", the oldest {slot.behind_seconds:.1f} s old" if slot.behind_seconds else ""
+    return f"{slot.behind_bytes} bytes of WAL not yet confirmed applied by its subscriber{age}"
 
 
 def status_lines(status) -> list[str]:
@@ -87,12 +105,13 @@ def status_lines(status) -> list[str]:
         where = f" WHERE {table.row_filter}" if table.row_filter else ""
         lines.append(f"publishes {table.publication}: {table.table}{where}")
     for sub in status.subscriptions:
-        lag = "unknown" if sub.lag_seconds is None else f"{sub.lag_seconds:.1f} s"
-        lines.append(f"receives {sub.name}: {'receiving' if sub.receiving else 'NOT receiving'}, lag {lag}, "
-                     f"{sum(state == 'ready' for state in sub.tables.values())}/{len(sub.tables)} tables ready")
+        age = "none yet" if sub.message_age_seconds is None else f"{sub.message_age_seconds:.1f} s ago"
+        lines.append(f"receives {sub.name}: {'receiving' if sub.receiving else 'NOT receiving'}, publisher's last "
+                     f"message {age}, {sum(state == 'ready' for state in sub.tables.values())}/{len(sub.tables)} "
+                     "tables ready (its lag: engine plant status at the publisher)")
     for slot in status.slots:
         held = "?" if slot.retained_bytes is None else f"{slot.retained_bytes / 1048576:.1f} MB"
         lines.append(f"slot {slot.name}: {'active' if slot.active else 'INACTIVE'}, holds {held} of WAL, "
-                     f"{slot.behind_bytes or 0} bytes not yet confirmed")
+                     f"lag {_lag(slot)}")
     lines += [f"warning: {warning}" for warning in status.warnings]
     return lines

@@ -4,12 +4,14 @@ from __future__ import annotations
 
 import click
 
+from ..db.origin import plant_name
 from .context import connection, emit_json
 from .ids import GEAR_ID, JOB_ID, PROGRAM_ID
 from .output import Column, day, day_options, emit_list, list_options, one_of
 
 PROGRAM_COLUMNS = (
-    Column("program", "program_id"), Column("name", "name"), Column("job", "job_id"), Column("gear", "gear_id"),
+    Column("program", "program_id"), Column("plant", "plant"), Column("name", "name"), Column("job", "job_id"),
+    Column("gear", "gear_id"),
     Column("class", "class"), Column("version", "template_version"), Column("draft", "draft"),
     Column("verifier", "verifier"), Column("rendering", "rendering"),
     Column("template", "template_hash", lambda digest: digest[:8]),
@@ -19,9 +21,12 @@ PROGRAM_COLUMNS = (
 
 RECORD_FIELDS = (  # (label, the value of a ProgramRecord)
     ("program", lambda record: record.id),
+    ("plant", lambda record: plant_name(record.plant)),
     ("name", lambda record: record.name),
     ("job", lambda record: record.job_id),
-    ("gear", lambda record: record.gear_id if record.gear_id is not None else "-"),
+    ("gear", lambda record: "-" if record.gear_id is None else
+     f"{record.gear_id} ({plant_name(record.plant)}'s, not this database's)" if _made_elsewhere(record) else
+     record.gear_id),
     ("class", lambda record: record.gear_class),
     ("version", lambda record: f"v{record.template_version}" + (" (draft)" if record.draft else " (released)")),
     ("verifier", lambda record: record.verifier_said),
@@ -41,7 +46,9 @@ def programs():
 
 @programs.command("list")
 @click.option("--class", "gear_class", help="Only programs of this class.")
-@click.option("--gear", "gear_id", type=GEAR_ID, help="Only programs made for this gear.")
+@click.option("--gear", "gear_id", type=GEAR_ID, help="Only programs made for this gear (a gear of --plant's, "
+              "else of this database: gear ids of plants collide).")
+@click.option("--plant", type=click.IntRange(0, 9999), help="Only programs made at this plant (0: the head office).")
 @click.option("--job", "job_id", type=JOB_ID, help="Only programs made from this job.")
 @click.option("--draft", is_flag=True, help="Only programs made from a draft version (for trying).")
 @click.option("--released", is_flag=True, help="Only programs made from a released version.")
@@ -50,7 +57,7 @@ def programs():
 @day_options("programs stored")
 @list_options("programs")
 @click.pass_context
-def programs_list(ctx, gear_class, gear_id, job_id, draft, released, check, since, until, output):
+def programs_list(ctx, gear_class, gear_id, plant, job_id, draft, released, check, since, until, output):
     """The programs stored, one line each: name, job, gear, class, template version and hash,
     draft or released, read by the verifier or UNVERIFIED, whether its lines are the rendering
     of its version and job, number of lines, when stored (the text: `engine programs show ID`).
@@ -61,6 +68,10 @@ def programs_list(ctx, gear_class, gear_id, job_id, draft, released, check, sinc
     simulation refuses them now). The verifier column says read only of a program checked now
     and MATCH; without --check, 'stored as verified, unchecked'.
 
+    At a head office, the plant column says where each program was made: one made at a plant says
+    PLANT (proved there when it was made; never re-proved here, where its gear, hob and machine
+    records are not the plant's), also with --check.
+
     Example: engine programs list --gear 42 --released --since 2026-11-01
     """
     from ..programs.lookup import list_programs
@@ -68,7 +79,7 @@ def programs_list(ctx, gear_class, gear_id, job_id, draft, released, check, sinc
     chosen = one_of(ctx, {"draft": draft, "released": released})
     kind = {"draft": True, "released": False}.get(chosen) if chosen is not None else None
     with connection(ctx) as conn:
-        found = list_programs(conn, gear_class, gear_id, job_id, kind, day(since), day(until), check)
+        found = list_programs(conn, gear_class, gear_id, job_id, kind, day(since), day(until), check, plant)
     emit_list(output, "programs", PROGRAM_COLUMNS, found)
 
 
@@ -107,6 +118,13 @@ def programs_show(ctx, program_id, prefix, as_json):
         if number:   # a blank line between programs (after one without a final newline, its line ends first)
             click.echo("" if found[number - 1].layout.final_newline else "\n")
         _echo_record(record)
+
+
+def _made_elsewhere(record) -> bool:
+    """Made at another plant (engine.programs.rendering: PLANT): its gear id is that plant's."""
+    from ..programs.rendering import PLANT
+
+    return record.rendering is not None and record.rendering.status == PLANT
 
 
 def _echo_record(record) -> None:

@@ -61,7 +61,7 @@ def _show(report, diffs_shown: int) -> None:
                f"{_tests_said(report)}, static analysis")
     click.echo(f"impact: {impact.jobs} stored job(s) of {report.gear_class} and its descendants, "
                f"{impact.changed} program(s) change, {len(impact.failures)} fail with the draft; "
-               f"{impact.proved} changed program(s) proved (machine verifier and simulation)")
+               f"{impact.proved} changed program(s) proved (machine verifier and simulation){impact.plants_said()}")
     for change in impact.layouts.values():
         click.echo(change.said())
     for failure in impact.failures[:SHOWN_FAILURES]:

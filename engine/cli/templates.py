@@ -15,7 +15,7 @@ from .refactor import template_shared
 from .release import template_release
 
 CLASS_COLUMNS = (Column("class", "class"), Column("parent", "parent"), Column("version", "template_version"),
-                 Column("rows", "rows"), Column("description", "description"))
+                 Column("rows", "rows"), Column("released", "released"), Column("description", "description"))
 
 
 @click.group()
@@ -33,7 +33,9 @@ template.add_command(template_release)  # the gate between a draft and the shop 
 @list_options("classes")
 @click.pass_context
 def template_list(ctx, output):
-    """Every gear class with its parent, template version and number of rows (its own and inherited).
+    """Every gear class with its parent, template version and number of rows (its own and inherited),
+    and its released version. At a plant, which receives released versions only, the version is the
+    released one and the rows are its rows.
 
     Example: engine template list --json
     """
@@ -53,13 +55,20 @@ def template_list(ctx, output):
 def template_export(ctx, gear_class, out, mkdir):
     """Print the class's assembled template as CSV. A class whose programs are written other than
     LF with a final newline (imported from such a file) gives that on every row (line_ending
-    lf|crlf, final_newline yes|no), so an import elsewhere writes the same bytes."""
+    lf|crlf, final_newline yes|no), so an import elsewhere writes the same bytes. At a plant, which
+    receives the head office's released versions only, the class's released version."""
+    from ..db.origin import this_plant
     from ..nc.layout import class_layout
     from ..templates.store import load_template
     from ..templates.template_csv import export_csv
+    from ..templates.versions import released_template
 
     with connection(ctx) as conn:
-        text = export_csv(load_template(conn, gear_class), class_layout(conn, gear_class))
+        if this_plant(conn) > 0:
+            template = released_template(conn, gear_class)
+            text = export_csv(template, class_layout(conn, gear_class, template.version))
+        else:
+            text = export_csv(load_template(conn, gear_class), class_layout(conn, gear_class))
     if out:
         _write_export(out, text, mkdir)
     else:

@@ -18,6 +18,7 @@ from ..db.listing import (
     records,
     require_class,
 )
+from ..db.origin import MADE_HERE_SQL
 from .gear_import import COLUMNS
 from .units import UNIT_COLUMNS
 
@@ -29,7 +30,8 @@ SELECT g.id AS gear_id, g.gear_class AS class, g.module, g.module_kind, g.teeth,
        g.helix_angle, g.hand, g.face_width, g.tip_diameter, g.root_diameter, g.cone_angle, g.crowning,
        g.material, g.hardness, g.quality_grade, g.quantity, g.profile_shift,
        1 + (SELECT count(*) FROM gear_unit u WHERE u.gear_id = g.id)::int AS unit_count,
-       (SELECT count(*) FROM job j WHERE j.gear_id = g.id)::int AS job_count, g.created_at
+       (SELECT count(*) FROM job j WHERE j.gear_id = g.id AND """ + MADE_HERE_SQL.format(id="j.id") + """)::int
+       AS job_count, g.created_at
 FROM gear g"""
 GEAR_FILTER = """
 WHERE (%(class)s::text IS NULL OR g.gear_class = %(class)s)
@@ -46,10 +48,12 @@ EXPORT_UNITS = sql.SQL("SELECT {} FROM gear_unit u JOIN gear g ON g.id = u.gear_
 ONE_GEAR = GEAR_COLUMNS + " WHERE g.id = %s"
 GEAR_UNITS = """
 SELECT unit, teeth, face_width, tip_diameter, root_diameter, z_top FROM gear_unit WHERE gear_id = %s ORDER BY unit"""
+# A gear's jobs are this database's: a plant's job of gear 44 (its history, at the head office) is of
+# the plant's gear 44, another gear (issue 33, engine.db.origin).
 GEAR_JOBS = """
 SELECT j.id AS job_id, j.gear_class AS class, j.machine, j.hob_id, j.created_at, j.confirmed_at,
        (SELECT count(*) FROM program p WHERE p.job_id = j.id)::int AS program_count
-FROM job j WHERE j.gear_id = %s ORDER BY j.id"""
+FROM job j WHERE j.gear_id = %s AND """ + MADE_HERE_SQL.format(id="j.id") + """ ORDER BY j.id"""
 
 GEAR_DELETION = Deletion(
     kind="gear",

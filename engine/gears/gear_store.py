@@ -12,6 +12,7 @@ import psycopg
 from psycopg import sql
 
 from ..csv_reader import Problem
+from ..db.origin import MADE_HERE_SQL
 from ..db.replacing import Change, changed_fields, jobs_of, plain, refuse_held
 from ..errors import EngineError
 from .classify import classify
@@ -72,7 +73,9 @@ def _changes(stored: dict[int, tuple], gears: list[dict[str, Any]]) -> list[Chan
     return changed_fields(named, gears, "gear_id", [column.name for column in COLUMNS])
 
 
-JOBS_OF_GEARS = "SELECT gear_id, array_agg(id ORDER BY id) FROM job WHERE gear_id = ANY(%s) GROUP BY gear_id"
+# this database's jobs only: a plant's job of gear 44 is of the plant's gear 44 (issue 33, engine.db.origin)
+JOBS_OF_GEARS = ("SELECT gear_id, array_agg(id ORDER BY id) FROM job WHERE gear_id = ANY(%s) AND "
+                 + MADE_HERE_SQL.format(id="id") + " GROUP BY gear_id")
 
 
 def _refuse_existing(path: Path, stored: dict[int, tuple], gears: list[dict[str, Any]]) -> None:

@@ -15,6 +15,7 @@ if TYPE_CHECKING:
 
 MEGABYTE = 1024 * 1024
 RETAINED_WARNING = 1024 * MEGABYTE   # an active slot holding more than this is falling behind
+BEHIND_WARNING_SECONDS = 300   # an active slot whose oldest unapplied change is older than this
 
 
 class PublishedTable(msgspec.Struct, frozen=True):
@@ -29,7 +30,9 @@ class Subscription(msgspec.Struct, frozen=True):
     enabled: bool
     receiving: bool              # its apply worker runs (the publisher is reachable)
     tables: dict[str, str]       # table -> state: copying, synchronised, ready …
-    lag_seconds: float | None    # since the end of the last change confirmed by the publisher
+    # since the publisher's last message, keepalives included (0 to wal_sender_timeout / 2 on an idle,
+    # caught-up link): that the link lives, not a lag; the lag is measured at the publisher (Slot)
+    message_age_seconds: float | None
 
 
 class Slot(msgspec.Struct, frozen=True):
@@ -37,8 +40,8 @@ class Slot(msgspec.Struct, frozen=True):
     active: bool
     wal_status: str | None
     retained_bytes: int | None   # WAL kept for it (from its restart point)
-    behind_bytes: int | None     # changes its subscriber has not confirmed
-    replay_lag_seconds: float | None
+    behind_bytes: int | None     # the lag: WAL its subscriber has not yet confirmed applying
+    behind_seconds: float | None   # when behind: the age of the oldest change not yet applied (replay_lag)
 
 
 class PlantStatus(msgspec.Struct, frozen=True):
@@ -58,16 +61,17 @@ PUBLISHED = """SELECT pubname, tablename, attnames::text[], rowfilter FROM pg_pu
 WHERE pubname = ANY(%s) ORDER BY pubname, tablename"""
 SUBSCRIPTIONS = """SELECT s.subname, s.subenabled,
        EXISTS (SELECT 1 FROM pg_stat_subscription w WHERE w.subid = s.oid AND w.pid IS NOT NULL AND w.relid IS NULL),
-       (SELECT extract(epoch FROM now() - max(w.latest_end_time))::float8 FROM pg_stat_subscription w
-        WHERE w.subid = s.oid),
+       (SELECT extract(epoch FROM now() - max(w.last_msg_receipt_time))::float8 FROM pg_stat_subscription w
+        WHERE w.subid = s.oid AND w.relid IS NULL),
        coalesce((SELECT jsonb_object_agg(r.srrelid::regclass::text, r.srsubstate) FROM pg_subscription_rel r
                  WHERE r.srsubid = s.oid), '{}')
 FROM pg_subscription s WHERE s.subdbid = (SELECT oid FROM pg_database WHERE datname = current_database())
 ORDER BY s.subname"""
 SLOTS = """SELECT s.slot_name, s.active, s.wal_status,
        pg_wal_lsn_diff(pg_current_wal_lsn(), s.restart_lsn)::bigint,
-       pg_wal_lsn_diff(pg_current_wal_lsn(), s.confirmed_flush_lsn)::bigint,
-       extract(epoch FROM r.replay_lag)::float8
+       greatest(pg_wal_lsn_diff(pg_current_wal_lsn(), s.confirmed_flush_lsn), 0)::bigint,
+       CASE WHEN pg_current_wal_lsn() > s.confirmed_flush_lsn THEN coalesce(extract(epoch FROM r.replay_lag), 0)
+            ELSE 0 END::float8
 FROM pg_replication_slots s LEFT JOIN pg_stat_replication r ON r.pid = s.active_pid
 WHERE s.database = current_database() ORDER BY s.slot_name"""
 MOVED_SEQUENCES = """SELECT s.sequencename, s.last_value, plant_first_id(plant_number()), plant_last_id(plant_number())
@@ -137,4 +141,7 @@ def _slot_warning(slot: Slot, keep: str) -> str | None:
                 f"gone for good, drop its subscription there or here: SELECT pg_drop_replication_slot('{slot.name}')")
     if (slot.retained_bytes or 0) > RETAINED_WARNING:
         return f"slot {slot.name} holds {held}: its subscriber is falling behind"
+    if (slot.behind_seconds or 0) > BEHIND_WARNING_SECONDS:
+        return (f"slot {slot.name}: its subscriber is {slot.behind_seconds:.0f} s behind ({slot.behind_bytes} bytes "
+                "not yet applied): see its server's log")
     return None

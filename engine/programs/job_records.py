@@ -8,6 +8,7 @@ from datetime import date
 from typing import TYPE_CHECKING
 
 from ..db.listing import Deletion, Reference, day_range, delete_row, one_record, records, require_class
+from ..db.origin import GEAR_PLANT, MADE_AT_SQL
 from .lookup import listed_verifier
 from .rendering import LISTED_RENDERING
 
@@ -15,13 +16,15 @@ if TYPE_CHECKING:
     from ..db.connection import Connection
 
 JOB_COLUMNS = """
-SELECT j.id AS job_id, j.gear_id, j.gear_class AS class, j.machine, j.hob_id,
+SELECT j.id AS job_id, """ + MADE_AT_SQL.format(id="j.id") + """ AS plant,
+       j.gear_id, j.gear_class AS class, j.machine, j.hob_id,
        (SELECT count(*) FROM program p WHERE p.job_id = j.id)::int AS program_count,
        j.created_at, j.confirmed_at"""
 LIST_JOBS = JOB_COLUMNS + """
 FROM job j
 WHERE (%(class)s::text IS NULL OR j.gear_class = %(class)s)
-  AND (%(gear)s::int IS NULL OR j.gear_id = %(gear)s)
+  AND (%(plant)s::int IS NULL OR """ + MADE_AT_SQL.format(id="j.id") + """ = %(plant)s)
+  AND (%(gear)s::int IS NULL OR (j.gear_id = %(gear)s AND """ + GEAR_PLANT.format(id="j.id") + """))
   AND (%(since)s::date IS NULL OR j.created_at >= %(since)s::date)
   AND (%(until)s::date IS NULL OR j.created_at < %(until)s::date + 1)
 ORDER BY j.id"""
@@ -53,11 +56,12 @@ JOB_DELETION = Deletion(
 
 
 def list_jobs(conn: Connection, gear_class: str | None = None, gear_id: int | None = None, since: date | None = None,
-              until: date | None = None) -> list[dict]:
+              until: date | None = None, plant: int | None = None) -> list[dict]:
     """Every job of the class and gear (any if None) made from `since` to `until` (whole days,
-    both included), by id."""
+    both included), at `plant` (any if None; `plant` of each: engine.db.origin), by id. A gear id
+    is a gear of the plant named (this database's without one): gear ids of plants collide."""
     require_class(conn, gear_class)
-    filters = {"class": gear_class, "gear": gear_id, **day_range(since, until)}
+    filters = {"class": gear_class, "gear": gear_id, "plant": plant, **day_range(since, until)}
     return records(conn.execute(LIST_JOBS, filters))
 
 

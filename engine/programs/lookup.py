@@ -14,10 +14,11 @@ import msgspec
 from msgspec.structs import asdict, replace
 
 from ..db.listing import day_range, records, require_class
+from ..db.origin import GEAR_PLANT, MADE_AT_SQL, made_at, plant_name
 from ..errors import EngineError
 from ..nc.layout import ENDING_NAMES, NcLayout, nc_text
 from ..nc.lineage import UNVERIFIED
-from .rendering import LISTED_RENDERING, MATCH, NOT_RENDERED, Renderer, Rendering, stored_rendering
+from .rendering import LISTED_RENDERING, MATCH, NOT_RENDERED, PLANT, Renderer, Rendering, stored_rendering
 
 if TYPE_CHECKING:
     from ..db.connection import Connection
@@ -53,7 +54,8 @@ class ProgramRecord(msgspec.Struct, frozen=True):
     name: str
     lines: list[str]
     layout: NcLayout = NcLayout()   # its template version's line ending and final newline
-    rendering: Rendering | None = None   # MATCH, MISMATCH or UNCHECKED (engine.programs.rendering); None: not checked
+    rendering: Rendering | None = None   # MATCH, MISMATCH, UNCHECKED, REFUSED or PLANT (engine.programs.rendering);
+    #                                      None: not checked
 
     @property
     def text(self) -> str:
@@ -61,11 +63,18 @@ class ProgramRecord(msgspec.Struct, frozen=True):
         return nc_text(self.lines, self.layout)
 
     @property
+    def plant(self) -> int:
+        """The plant that made it (engine.db.origin): 0 the head office or a single database."""
+        return made_at(self.id)
+
+    @property
     def verifier_said(self) -> str:
         """Whether a verifier read the program: said only of one that is the rendering the engine
         made and stored (a MISMATCH is lines no verifier read; an UNCHECKED one cannot be told)."""
         if self.unverified:
             return f"{UNVERIFIED}: no verifier read it, never written to a file"
+        if self.rendering is not None and self.rendering.status == PLANT:
+            return f"stored as verified at {plant_name(self.plant)}: proved there when it was made, not re-read here"
         if self.rendering is None or not self.rendering.matches:
             status = self.rendering.status if self.rendering else "not checked"
             return f"{status}: not known to be the program the machine's verifier read (see rendering)"
@@ -77,7 +86,7 @@ class ProgramRecord(msgspec.Struct, frozen=True):
         fields = asdict(self)
         del fields["layout"]
         fields["rendering"] = self.rendering.as_dict() if self.rendering else None
-        return {"program_id": fields.pop("id"), "class": fields.pop("gear_class"), **fields,
+        return {"program_id": fields.pop("id"), "plant": self.plant, "class": fields.pop("gear_class"), **fields,
                 "created_at": self.created_at.isoformat(), "line_ending": ENDING_NAMES[self.layout.line_ending],
                 "final_newline": self.layout.final_newline}
 
@@ -132,12 +141,14 @@ def checked_prefix(text: str) -> str:
 
 
 LIST_PROGRAMS = """
-SELECT p.id AS program_id, p.name, p.job_id, j.gear_id, p.gear_class AS class, p.template_version, p.draft,
+SELECT p.id AS program_id, """ + MADE_AT_SQL.format(id="p.id") + """ AS plant,
+       p.name, p.job_id, j.gear_id, p.gear_class AS class, p.template_version, p.draft,
        p.unverified, p.template_hash, p.input_hash, cardinality(p.lines) AS line_count, p.stored_by, p.created_at,
        """ + LISTED_RENDERING + """ AS rendering
 FROM program p JOIN job j ON j.id = p.job_id
 WHERE (%(class)s::text IS NULL OR p.gear_class = %(class)s)
-  AND (%(gear)s::int IS NULL OR j.gear_id = %(gear)s)
+  AND (%(plant)s::int IS NULL OR """ + MADE_AT_SQL.format(id="p.id") + """ = %(plant)s)
+  AND (%(gear)s::int IS NULL OR (j.gear_id = %(gear)s AND """ + GEAR_PLANT.format(id="p.id") + """))
   AND (%(job)s::bigint IS NULL OR p.job_id = %(job)s)
   AND (%(draft)s::boolean IS NULL OR p.draft = %(draft)s)
   AND (%(since)s::date IS NULL OR p.created_at >= %(since)s::date)
@@ -147,15 +158,19 @@ ORDER BY p.id"""
 
 def list_programs(conn: Connection, gear_class: str | None = None, gear_id: int | None = None,
                   job_id: int | None = None, draft: bool | None = None, since: date | None = None,
-                  until: date | None = None, check: bool = False) -> list[dict]:
+                  until: date | None = None, check: bool = False, plant: int | None = None) -> list[dict]:
     """Every program matching all filters given (None: any), by id: its record without its lines.
     draft True: made from a draft version (for trying only); False: from a released one.
     `rendering`: UNCHECKED for a program that cannot be rendered again (its job edited since), else
     NOT_RENDERED, or with `check` MATCH, MISMATCH or REFUSED (engine.programs.rendering: milliseconds each, so
     a list renders only when asked). `verifier`: UNVERIFIED, "read" (checked now: MATCH),
-    "stored as verified, unchecked" (not rendered in this list) or "-" (MISMATCH, REFUSED, UNCHECKED)."""
+    "stored as verified, unchecked" (not rendered in this list) or "-" (MISMATCH, REFUSED, UNCHECKED).
+    `plant`: only the programs made at that plant (engine.db.origin; each says its `plant`); one made
+    at another plant is listed as PLANT, "proved at plant N", never rendered here. A gear id is a gear
+    of the plant named (this database's without one): gear ids of plants collide."""
     require_class(conn, gear_class)
-    filters = {"class": gear_class, "gear": gear_id, "job": job_id, "draft": draft, **day_range(since, until)}
+    filters = {"class": gear_class, "gear": gear_id, "job": job_id, "draft": draft, "plant": plant,
+               **day_range(since, until)}
     renderer = Renderer(conn)
     return [_listed(renderer, record, check) for record in records(conn.execute(LIST_PROGRAMS, filters))]
 
@@ -176,4 +191,6 @@ def listed_verifier(unverified: bool, rendering: str) -> str:
         return UNVERIFIED
     if rendering == MATCH:
         return "read"
+    if rendering == PLANT:
+        return "stored as verified at its plant"
     return STORED_UNCHECKED if rendering == NOT_RENDERED else "-"

@@ -18,10 +18,14 @@ JOB_MACHINE = "SELECT m.kind FROM job j JOIN machine m ON m.name = j.machine WHE
 
 
 def plot_job(conn: Connection, job_id: int, out: str | Path) -> list[str]:
-    """Draw the job to `out`; → one line per thing drawn (for the report)."""
+    """Draw the job to `out`; → one line per thing drawn (for the report). A job another plant
+    made is drawn there, on its own gear (engine.db.origin)."""
+    from ..db.origin import refuse_elsewhere
+
     row = conn.execute(JOB_MACHINE, (job_id,)).fetchone()
     if row is None:
         raise EngineError(f"job {job_id} does not exist; see `engine jobs list`")
+    refuse_elsewhere(conn, "job", job_id, "draw it")
     plotter = JOB_PLOTTERS.get(row[0])
     if plotter is None:
         raise EngineError(f"job {job_id} runs on a {row[0]}, which has no plot; jobs of a lathe or a hobber are drawn")

@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING
 
 from msgspec.structs import replace
 
+from ..db.origin import refuse_elsewhere, refuse_unless_made_at, this_plant
 from ..errors import EngineError
 from ..gears.holding_matching import choose_holding
 from ..gears.models import model_for_class
@@ -207,6 +208,7 @@ def _stored_job(conn: Connection, job_id: int) -> tuple:
     job = conn.execute(f"SELECT {JOB_COLUMNS} FROM job WHERE id = %s", (job_id,)).fetchone()
     if job is None:
         raise EngineError(f"job {job_id} does not exist; `engine jobs list` shows what does")
+    refuse_elsewhere(conn, "job", job_id, "make and send it")
     return job
 
 
@@ -235,13 +237,18 @@ def _remade_jobs(conn, first: int | None, last: int | None, mode: RunMode) -> li
                         (first if first is not None else 0, last if last is not None else 2**62)).fetchall()
     if not jobs:
         raise EngineError(f"no jobs with ids in {first or 'the start'}…{last or 'the end'}")
-    remaker = Remaker(conn, mode.draft)
-    return [_remade_in_batch(remaker, job, done, len(jobs), mode.progress) for done, job in enumerate(jobs, 1)]
+    remaker, here = Remaker(conn, mode.draft), this_plant(conn)
+    return [_remade_in_batch(remaker, here, job, done, len(jobs), mode.progress) for done, job in enumerate(jobs, 1)]
 
 
-def _remade_in_batch(remaker: Remaker, job: tuple, done: int, total: int, progress):
-    """(job id, its program encoded for storage), or Bad with its reason: the batch goes on."""
-    outcome = planned_or_bad("job", job[0], lambda: (job[0], checked(remaker.remade(job)).encoded(with_job=False)))
+def _remade_in_batch(remaker: Remaker, here: int, job: tuple, done: int, total: int, progress):
+    """(job id, its program encoded for storage), or Bad with its reason: the batch goes on. A job
+    another plant made is bad here (engine.db.origin): it is made there, on its own gear."""
+    def made() -> tuple:
+        refuse_unless_made_at(here, "job", job[0], "make and send it")
+        return job[0], checked(remaker.remade(job)).encoded(with_job=False)
+
+    outcome = planned_or_bad("job", job[0], made)
     if progress:
         progress(PLANNING, done, total)
     return outcome

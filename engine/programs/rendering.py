@@ -9,7 +9,7 @@ first renders it again here: the rows of the version it records (template_versio
 once per process), run with its job's parameters as stored, the engine's lineage line added,
 compared line by line, row by row and trace entry by trace entry with what is stored.
 
-Four outcomes (`Rendering.status`):
+Four outcomes (`Rendering.status`), and a fifth for a program another plant made:
 
 * MATCH: the stored lines, row ids and trace are exactly the rendering, and the rendered lines
   pass now the proof a new program gets (engine.programs.rendering_proof: the machine's verifier,
@@ -22,9 +22,13 @@ Four outcomes (`Rendering.status`):
   its job was edited after it was stored (the job's input hash is no longer the one its lineage
   line shows; the job has no history, so the parameters it was made from are gone), it was stored
   before input hashes were kept, its version's rows were never stored, or the version did not
-  render the job now (a run over its time budget on a busy machine), or it was made at another
-  plant (the head office's copy of a plant's program: that plant's gears are its own, docs/design.md
-  §12). Making it again (`engine instantiate --job ID`) gives a program that can be checked.
+  render the job now (a run over its time budget on a busy machine). Making it again
+  (`engine instantiate --job ID`) gives a program that can be checked.
+* PLANT: its id is not of this database's range (engine.db.origin): another plant made it and
+  proved it when it made it, on that plant's gear, hob and machine records, and it reached this
+  database as history (issue 33; docs/design.md §12). It is never rendered here: this database's
+  gear of the same id is another gear (a good program would be REFUSED, or fail on a gear not
+  here). A command that needs a proof refuses it, naming the plant to run it at.
 
 The rendering is made as the engine made it (engine.programs.remake): a hobbing job with its
 cycle time recomputed from its feeds, a turning job with its passes computed from its drawing's
@@ -41,6 +45,7 @@ import msgspec
 from msgspec.structs import replace
 
 from ..db.connection import scalar
+from ..db.origin import MADE_HERE_SQL, made_at, plant_name, this_plant
 from ..errors import EngineError
 from ..gears.models import model_for_class
 from ..gears.records import Hob, load_gear, load_hobs
@@ -59,11 +64,15 @@ if TYPE_CHECKING:
     from .verified_run import Workpiece
 
 MATCH, MISMATCH, UNCHECKED, REFUSED = "MATCH", "MISMATCH", "UNCHECKED", "REFUSED"
+# A program made at another plant (its id outside this database's range, engine.db.origin): proved
+# there when it was made; never rendered or proved here, where its gear, hob and machine are not its own.
+PLANT = "PLANT"
 NOT_RENDERED = "on show"   # a list's word for a program it did not render (`programs show` renders it)
 # What a list of programs says without rendering any (SQL over program p JOIN job j): UNCHECKED
 # for one that cannot be rendered again (its job edited since, or stored before input hashes).
 LISTED_RENDERING = ("CASE WHEN p.input_hash IS NOT NULL AND p.input_hash = job_input_hash(j.params, j.module_params) "
                     "THEN 'on show' ELSE 'UNCHECKED' END")
+LISTED_RENDERING = (f"CASE WHEN NOT ({MADE_HERE_SQL.format(id='p.id')}) THEN '{PLANT}' ELSE {LISTED_RENDERING} END")
 STORED = """
 SELECT p.id, p.name, p.gear_class, p.template_version, p.template_hash, p.input_hash, p.draft, p.unverified,
        p.lines, p.row_ids, p.trace, p.job_id, j.machine, j.params, j.module_params,
@@ -86,6 +95,7 @@ class Rendering(msgspec.Struct, frozen=True):
     program_id: int
     status: str
     reason: str
+    plant: int | None = None   # PLANT: the plant that made it
 
     @property
     def matches(self) -> bool:
@@ -97,10 +107,15 @@ class Rendering(msgspec.Struct, frozen=True):
         return f"{self.status}: {self.reason}"
 
     def as_dict(self) -> dict:
-        return {"status": self.status, "reason": self.reason}
+        plant = {} if self.plant is None else {"plant": self.plant}
+        return {"status": self.status, "reason": self.reason, **plant}
 
     def refuse_unless_matching(self, use: str) -> None:
         """EngineError (exit 1, one line) unless the program is the rendering it names."""
+        if self.status == PLANT:
+            where = plant_name(self.plant or 0)
+            raise EngineError(f"program {self.program_id} was made at {where} (its gear, hob and machine records are "
+                              f"the plant's): not re-proved here, so refused as evidence for {use}; run it at {where}")
         if not self.matches:
             raise EngineError(f"program {self.program_id}: {self.status}: {self.reason}; refused as evidence for {use}")
 
@@ -161,11 +176,16 @@ class Renderer:
         self._machines: dict[str, Machine] = {}
         self._workpieces: dict[tuple[int, str], Workpiece] = {}
         self._hobs: dict[str, Hob] | None = None
+        self._here: int | None = None
 
     def rendering(self, program_id: int) -> Rendering:
         row = self.conn.execute(STORED, (program_id,)).fetchone()
         if row is None:
             raise EngineError(f"program {program_id} does not exist; see `engine programs list`")
+        if self._here is None:
+            self._here = this_plant(self.conn)
+        if made_at(program_id) != self._here:
+            return made_at_plant(program_id)
         return self.compared(StoredProgram(*row))
 
     def compared(self, stored: StoredProgram) -> Rendering:
@@ -275,6 +295,14 @@ class Renderer:
         if name not in self._machines:
             self._machines[name] = load_machine(self.conn, name)
         return self._machines[name]
+
+
+def made_at_plant(program_id: int) -> Rendering:
+    """What is true of a program another plant made: its stored text and lineage are shown, never
+    a MATCH or REFUSED against this database's records."""
+    plant = made_at(program_id)
+    return Rendering(program_id, PLANT, f"made at {plant_name(plant)}: proved there when it was made; not "
+                                        "re-proved here (its gear, hob and machine records are the plant's)", plant)
 
 
 def _why_unchecked(stored: StoredProgram) -> str | None:

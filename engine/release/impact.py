@@ -29,6 +29,7 @@ from typing import TYPE_CHECKING
 import msgspec
 from msgspec.structs import replace
 
+from ..db.origin import MADE_AT_SQL, MADE_HERE_SQL
 from ..errors import EngineError
 from ..nc.layout import ENDING_NAMES, NcLayout
 from ..programs import all_models  # noqa: F401  (registers every model)
@@ -57,6 +58,11 @@ FROM job j
 WHERE j.gear_class = ANY(%s::text[])
   AND j.id BETWEEN plant_first_id(plant_number()) AND plant_last_id(plant_number())
 ORDER BY j.id"""
+# The plants' jobs of the classes a head office holds as history: counted and said, never re-made.
+PLANT_JOBS = """
+SELECT """ + MADE_AT_SQL.format(id="j.id") + """, count(*)::int FROM job j
+WHERE j.gear_class = ANY(%s::text[]) AND NOT (""" + MADE_HERE_SQL.format(id="j.id") + """)
+GROUP BY 1 ORDER BY 1"""
 
 
 class JobDiff(msgspec.Struct, frozen=True):
@@ -103,6 +109,18 @@ class Impact(msgspec.Struct):
     diffs: list[JobDiff] = []
     layouts: dict[str, LayoutChange] = {}   # class → its draft's other layout
     proved: int = 0   # distinct changed programs read by the verifier and followed by the simulation
+    plant_jobs: dict[int, int] = {}   # plant → its jobs of the classes, held here as history, not re-made
+
+    def plants_said(self) -> str:
+        """The plants' jobs left out, in words ("" without any)."""
+        if not self.plant_jobs:
+            return ""
+        plants = ", ".join(map(str, self.plant_jobs))
+        return (f"; and {sum(self.plant_jobs.values())} job(s) of plant(s) {plants}, not re-made here (their gears "
+                "are the plants'); each plant proves its programs when it makes or sends them")
+
+    def plants_json(self) -> list[dict]:
+        return [{"plant": plant, "jobs": jobs} for plant, jobs in self.plant_jobs.items()]
 
     def summary(self) -> dict:
         """What a release records: the counts, the changed and failing job ids, the layout changes."""
@@ -115,8 +133,10 @@ class Impact(msgspec.Struct):
 def impact(conn: Connection, gear_class: str, workers: int = 1) -> Impact:
     """Every stored job of the class and its descendants made with the draft, compared with the
     released program; the changed programs proved in `workers` processes."""
-    pairs = _template_pairs(conn, class_and_descendants(conn, gear_class))
-    report = Impact(gear_class, layouts=_layout_changes(conn, pairs))
+    classes = class_and_descendants(conn, gear_class)
+    pairs = _template_pairs(conn, classes)
+    report = Impact(gear_class, layouts=_layout_changes(conn, pairs),
+                    plant_jobs=dict(conn.execute(PLANT_JOBS, (classes,)).fetchall()))
     if not pairs:
         return report
     made = _Made(conn, pairs)

@@ -7,13 +7,19 @@ itself is the golden tests of the class and its descendants at the release (gold
 with its class's version then). So a screen re-runs the gate's checks of the released version:
 lint and static analysis of its stored rows, and the recorded golden tests against the stored
 versions they ran against (milliseconds each). "gate passed" is said only of a release the
-engine's gate made whose re-check passes; anything else says what is true."""
+engine's gate made whose re-check passes; anything else says what is true.
+
+At a plant (issue 33, docs/design.md §12) a release is the head office's: its golden tests ran there,
+on the head office's gears and draft versions, which are not replicated (a plant's gear of the same
+id is another gear). So a plant re-checks what it holds, the lint and static analysis of the
+released rows, and says the golden tests ran at the head office, never "failed" here."""
 from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
 import msgspec
 
+from ..db.origin import this_plant
 from ..errors import EngineError
 from ..programs import all_models  # noqa: F401  (registers every model)
 from ..templates.analysis import class_findings
@@ -46,7 +52,8 @@ class Recheck(msgspec.Struct, frozen=True):
 
 
 class Verdict(msgspec.Struct, frozen=True):
-    gate: str        # passed, mismatch (recorded as the gate's, fails now), not run (not the gate's release)
+    gate: str        # passed, mismatch (recorded as the gate's, fails now), not run (not the gate's release),
+    #                  head office (at a plant: its golden tests ran there, not re-run here)
     said: str        # one line for the screen
     recheck: Recheck
 
@@ -58,8 +65,41 @@ class Verdict(msgspec.Struct, frozen=True):
 
 def verdict(conn: Connection, gear_class: str, release) -> Verdict:
     """What a screen says of `release` (engine.templates.history.ReleaseEntry of the class)."""
+    if this_plant(conn) > 0:
+        return _at_a_plant(conn, gear_class, release)
     found = recheck(conn, gear_class, release.version, release.golden_tests)
     return Verdict(*_said(release.released_via, release.released_by, found), found)
+
+
+AT_THE_HEAD_OFFICE = "golden test(s) ran there; not re-checked here (their gears are the head office's)"
+
+
+def _at_a_plant(conn: Connection, gear_class: str, release) -> Verdict:
+    """A release received from the head office: its static checks re-run on the rows replicated
+    here, its golden tests said to be the head office's."""
+    try:
+        problems = tuple(_static_problems(conn, gear_class, stored_template(conn, gear_class, release.version)))
+    except EngineError as error:
+        problems = (str(error),)
+    found = Recheck(0, problems, release.golden_tests is not None)
+    how = "through the engine's gate" if release.released_via == "engine" else \
+        NOT_THE_GATE[release.released_via].format(login=release.released_by)
+    tests = len(release.golden_tests) if release.golden_tests is not None else release.tests or 0
+    here = "lint and static analysis of its rows pass" if found.passed else \
+        f"its rows fail: {problems[0]}" + (f" (and {len(problems) - 1} more)" if len(problems) > 1 else "")
+    return Verdict("head office", f"released at the head office ({how}); its {tests} {AT_THE_HEAD_OFFICE}; "
+                                  f"re-checked here: {here}", found)
+
+
+def refuse_golden_tests_at_a_plant(conn: Connection) -> None:
+    """EngineError (one line) at a plant: golden tests run on the head office's gears and drafts,
+    which a plant does not receive (its gear of the same id is its own, another gear)."""
+    plant = this_plant(conn)
+    if plant > 0:
+        raise EngineError(f"this database is plant {plant}; the golden tests run on the head office's gears and "
+                          "drafts, which are not replicated here (a gear of the same id here is the plant's own): "
+                          "they ran at the head office when each version was released (engine template history "
+                          "says so); run them there")
 
 
 def _said(via: str, login: str, found: Recheck) -> tuple[str, str]:

@@ -24,6 +24,7 @@ from typing import TYPE_CHECKING
 import msgspec
 import psycopg
 
+from ..db.origin import MADE_HERE_SQL, refuse_elsewhere
 from ..errors import EngineError
 from ..names import LINE_BREAKING
 from ..nc.layout import class_layout, nc_text
@@ -35,11 +36,12 @@ if TYPE_CHECKING:
 
 VIAS = ("ftp", "folder", "web")
 MAX_ASKED, MAX_REASON = 200, 2000   # program_request's bounds
-# The jobs a machine may load: its stored jobs whose class has a released version (no rendering).
+# The jobs a machine may load: its stored jobs whose class has a released version (no rendering),
+# made here (a plant's jobs reach the head office as history: they are sent at their plant).
 MACHINE_FILES = """
 SELECT j.id, j.params ->> 'program_name', j.gear_id, j.gear_class, coalesce(max(p.created_at), j.created_at)
 FROM job j LEFT JOIN program p ON p.job_id = j.id
-WHERE j.machine = %s AND released_version(j.gear_class) IS NOT NULL
+WHERE j.machine = %s AND released_version(j.gear_class) IS NOT NULL AND """ + MADE_HERE_SQL.format(id="j.id") + """
 GROUP BY j.id ORDER BY j.id"""
 # The job's newest program, if it is one a control may be sent again unchanged (checked in SQL first,
 # then rendered and proved).
@@ -94,6 +96,7 @@ def deliver(conn: Connection, machine: str, asked_for: str, *, via: str, client:
     try:
         with conn.transaction():
             job_id, name = job_of_machine(conn, machine, asked(conn, machine, asked_for))
+            refuse_elsewhere(conn, "job", job_id, "make and send it")
         program_id, data = _reused(conn, job_id, config) or _remade(conn, job_id, config)
     except EngineError as refusal:
         _rolled_back(conn)

@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING
 from psycopg.types.json import Jsonb
 
 from ..db.connection import scalar
+from ..db.origin import this_plant
 from ..errors import EngineError
 from ..names import checked
 from .rows import Template, TemplateRow
@@ -41,20 +42,39 @@ def load_template(conn: Connection, gear_class: str) -> Template:
     if not found:
         raise EngineError(f"gear class {gear_class!r} does not exist; see `engine template list`")
     if found[0][1] is None:
+        plant = this_plant(conn)
+        if plant > 0:   # issue 33: a plant receives released versions only, never the editable rows
+            raise EngineError(f"gear class {gear_class!r} has no editable template rows here: this database is plant "
+                              f"{plant}, which receives the head office's released versions only (see "
+                              "released_template_view); templates are edited and imported at the head office")
         raise EngineError(f"gear class {gear_class!r} has no template rows; "
                           f"import them with `engine template import --class {gear_class} FILE.csv`")
     rows = tuple(TemplateRow(*row[1:]) for row in found)
     return Template(gear_class, found[0][0], rows, load_translations(conn, rows))
 
 
+CLASSES = """
+SELECT g.name AS class, g.parent, g.template_version, count(r.id)::int AS rows, released_version(g.name) AS released,
+       g.description
+FROM gear_class g LEFT JOIN assembled_row r ON r.gear_class = g.name
+GROUP BY g.name ORDER BY g.name"""
+# At a plant (issue 33): no editable rows and no draft counter are received, only released versions,
+# so a class's version is its released one and its rows are that version's.
+PLANT_CLASSES = """
+SELECT g.name AS class, g.parent, released_version(g.name) AS template_version,
+       coalesce(jsonb_array_length(v.rows), 0)::int AS rows, released_version(g.name) AS released, g.description
+FROM gear_class g
+LEFT JOIN template_version_rows v ON v.gear_class = g.name AND v.version = released_version(g.name)
+ORDER BY g.name"""
+
+
 def class_records(conn: Connection) -> list[dict]:
-    """Every class by name: its parent, template version, row count (own and inherited), description."""
+    """Every class by name: its parent, template version, row count (own and inherited), released
+    version, description. At a plant, its released version's rows are all it has: its version is
+    the released one."""
     from ..db.listing import records  # the listings' module: `engine template list` (issue 28: start-up)
 
-    return records(conn.execute("""
-        SELECT g.name AS class, g.parent, g.template_version, count(r.id)::int AS rows, g.description
-        FROM gear_class g LEFT JOIN assembled_row r ON r.gear_class = g.name
-        GROUP BY g.name ORDER BY g.name"""))
+    return records(conn.execute(PLANT_CLASSES if this_plant(conn) > 0 else CLASSES))
 
 
 def ensure_class(conn: Connection, name: str, parent: str | None = None, description: str = "") -> bool:

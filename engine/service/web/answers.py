@@ -18,7 +18,7 @@ from .pages import TEMPLATES, connection, page, refusal, wants_json
 INTEGER_MAX = 2**31 - 1
 BIGINT_MAX = 2**63 - 1
 ID_RANGES = {"gear": (1, INTEGER_MAX), "job": (1, BIGINT_MAX), "program": (1, BIGINT_MAX),
-             "row": (0, INTEGER_MAX), "line": (1, INTEGER_MAX)}
+             "row": (0, INTEGER_MAX), "line": (1, INTEGER_MAX), "plant": (0, 9999)}
 # how the library says a record is not there (engine.db.listing.one_record, engine.programs.lookup):
 # such a refusal answers 404, any other 400
 NOT_FOUND_WORDS = (" does not exist", "no program has ", " is not in the program's template version")

@@ -127,6 +127,7 @@ def golden_results(request: Request) -> Response:
     """The golden tests of the class and its descendants, run now: `engine test --class NAME --json`
     (`?released=1`: against the released versions, as `--released`)."""
     from ...release.golden import run_golden_tests
+    from ...release.recheck import refuse_golden_tests_at_a_plant
     from ...templates.store import class_and_descendants
 
     name = request.path_params["name"]
@@ -134,6 +135,10 @@ def golden_results(request: Request) -> Response:
     with connection(request) as conn:
         if not _exists(conn, name):
             return _unknown(request, name)
+        try:
+            refuse_golden_tests_at_a_plant(conn)
+        except EngineError as error:
+            return refusal(request, str(error))
         results = run_golden_tests(conn, class_and_descendants(conn, name), draft=not released)
     failed = [result for result in results if not result.passed]
     data = {"passed": len(results) - len(failed), "failed": len(failed),

@@ -25,6 +25,7 @@ from ..delivery import deliver
 from ..delivery_names import Refused
 from .answers import shown, status_of, whole
 from .auth import LOCAL_USER, REQUESTING_ROLE, cross_site, may_request, requester
+from .jobs import request_offered
 from .pages import connection, refusal, wants_json
 
 if TYPE_CHECKING:
@@ -72,7 +73,12 @@ def _refused(request: Request, conn: Connection, job_id: int, reason: str) -> Re
         return refusal(request, reason, 400)
     with conn.transaction():
         details = job_details(conn, job_id)
-    return shown(request, "job.html", {"job": details}, lambda: {"may_request": True, "refused": reason}, 400)
+    return shown(request, "job.html", {"job": details}, lambda: _offered(request, conn, job_id, reason), 400)
+
+
+def _offered(request: Request, conn: Connection, job_id: int, reason: str) -> dict:
+    offered = request_offered(request, conn, job_id, reason)
+    return {**offered, "may_request": offered["made_at"] is None}
 
 
 ROUTES = [Route("/jobs/{job_id}/request", request_program, methods=["POST"], name="request_program")]

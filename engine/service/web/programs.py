@@ -12,12 +12,13 @@ from starlette.requests import Request
 from starlette.responses import RedirectResponse
 from starlette.routing import Route
 
+from ...db.origin import this_plant
 from ...errors import EngineError
 from ...nc.lineage import lineage_shaped
 from ...programs.lookup import MIN_HASH_DIGITS, checked_prefix, find_programs, list_programs, programs_with_hash
 from ...programs.rendering import MATCH, REFUSED
-from .answers import BadRequest, answered, query_day, query_flag, query_id, query_text, shown, whole
-from .pages import page, wants_json
+from .answers import BIGINT_MAX, BadRequest, answered, query_day, query_flag, query_id, query_text, shown, whole
+from .pages import wants_json
 from .program_views import plot_svg, simulation_report, traced
 
 KINDS = {"draft": True, "released": False}   # the list's --draft / --released
@@ -30,7 +31,7 @@ PASTED_LINE = re.compile(r"(?:N[0-9]+\s*)?[;(]\s*PROGRAM\s+(?P<id>[0-9]{1,19})\s
 
 
 def programs(request: Request):
-    """`engine programs list [--class C] [--gear ID] [--job ID] [--draft|--released] [--since D]
+    """`engine programs list [--class C] [--gear ID] [--plant N] [--job ID] [--draft|--released] [--since D]
     [--until D] [--check] --json`; kind=draft|released."""
     def work(conn):
         kind = query_text(request, "kind")
@@ -38,8 +39,9 @@ def programs(request: Request):
             raise BadRequest(f"kind {kind[:40]!r}: give draft or released (or leave it out for both)")
         found = list_programs(conn, query_text(request, "class"), query_id(request, "gear", "gear"),
                               query_id(request, "job", "job"), KINDS.get(kind or ""),
-                              query_day(request, "since"), query_day(request, "until"), query_flag(request, "check"))
-        return page(request, "programs.html", {"programs": found})
+                              query_day(request, "since"), query_day(request, "until"), query_flag(request, "check"),
+                              query_id(request, "plant", "plant"))
+        return shown(request, "programs.html", {"programs": found}, lambda: {"here": this_plant(conn)})
     return answered(request, work)
 
 
@@ -76,7 +78,7 @@ def lookup(request: Request):
     def work(conn):
         typed = query_text(request, "q") or ""
         line = pasted_lineage(typed)
-        found = find_programs(conn, line.program_id) if line else find_programs(conn, *_wanted(typed))
+        found = find_programs(conn, line.program_id) if line else find_programs(conn, *_wanted(conn, typed))
         if line:
             _agrees(conn, line, found[0])
         if len(found) == 1 and not wants_json(request):
@@ -86,10 +88,11 @@ def lookup(request: Request):
     return answered(request, work)
 
 
-def _wanted(text: str) -> tuple[int | None, str | None]:
-    """(program id, None) for fewer than MIN_HASH_DIGITS digits, (None, hash prefix) otherwise."""
+def _wanted(conn, text: str) -> tuple[int | None, str | None]:
+    """(program id, None) for fewer than MIN_HASH_DIGITS digits, or for the id of a stored program
+    (a plant's ids have 11 digits or more: issue 33), (None, hash prefix) otherwise."""
     typed = text.strip()
-    if typed.isdigit() and len(typed) < MIN_HASH_DIGITS:
+    if typed.isdigit() and (len(typed) < MIN_HASH_DIGITS or _is_program(conn, typed)):
         return whole("program", typed), None
     try:
         return None, checked_prefix(typed)
@@ -148,6 +151,12 @@ def _theirs(conn, line: Pasted) -> str:
 def _shown(typed: str) -> str:
     """The query as typed, whole up to QUERY_SHOWN characters (a lineage line is about 60), quoted."""
     return repr(typed if len(typed) <= QUERY_SHOWN else typed[:QUERY_SHOWN] + "…")
+
+
+def _is_program(conn, typed: str) -> bool:
+    number = int(typed)
+    found = number <= BIGINT_MAX and conn.execute("SELECT 1 FROM program WHERE id = %s", (number,)).fetchone()
+    return bool(found)
 
 
 ROUTES = [Route("/programs", programs, name="programs"), Route("/programs/{program_id}", program, name="program"),
