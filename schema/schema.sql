@@ -2127,7 +2127,7 @@ BEGIN
         RAISE EXCEPTION 'this database is plant %: % is the head office''s (templates are edited, released and '
                         'kept there, and replicated here); make the change at the head office', plant_number(),
                         TG_TABLE_NAME
-            USING ERRCODE = 'read_only_sql_transaction';
+            USING ERRCODE = 'read_only_sql_transaction', CONSTRAINT = 'head_office_writes_it';
     END IF;
     RETURN NULL;
 END

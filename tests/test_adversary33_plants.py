@@ -1,5 +1,5 @@
 """Issue 33's adversary: a head office and plant 7 (two embedded servers with wal_level = logical,
-set up by tests/test_plants.py's fixture and helpers) attacked where the promises of docs/design.md
+set up by tests/helpers/plant_servers.py's fixture and helpers) attacked where the promises of docs/design.md
 §12 could break: a record the head office deletes and makes again, a draft marked released by
 the owner, a plant number taken twice, secrets in messages, migrations that differ."""
 from __future__ import annotations
@@ -8,8 +8,7 @@ import json
 
 import psycopg
 import pytest
-import test_plants
-from test_plants import (
+from helpers.plant_servers import (
     HISTORY_SLOT,
     PLANT,
     TEMPLATES_SLOT,
@@ -23,7 +22,6 @@ from test_plants import (
     versions,
 )
 
-group = test_plants.group   # its module-scoped head office and plant 7, started again for this module
 SPARE_HOB = "H-M1.5-A-R2"   # seed_templates/hobs.csv: a hob no seeded gear's job uses
 
 

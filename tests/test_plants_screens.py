@@ -19,18 +19,16 @@ from html import unescape
 
 import psycopg
 import pytest
-from starlette.testclient import TestClient
-from test_plants import (  # noqa: F401  (group: the two servers, a fixture)
+from helpers.plant_servers import (
     PLANT,
-    SEED,
     caught_up,
     edit_spur,
     engine,
-    group,
     instantiate,
     ok,
     rows,
 )
+from starlette.testclient import TestClient
 
 from engine.programs.config import Config
 from engine.service.delivery import deliver, machine_files

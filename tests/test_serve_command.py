@@ -8,7 +8,7 @@ import io
 import time
 
 import psycopg
-from test_serve_web import engine, free_port
+from helpers.serve_process import engine, free_port
 
 MACHINE = "hobber-840d"
 SECRET = "a machine's own secret"

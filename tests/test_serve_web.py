@@ -8,12 +8,10 @@ from __future__ import annotations
 
 import html
 import json
-import os
 import re
 import signal
 import socket
 import subprocess
-import sys
 import urllib.request
 from pathlib import Path
 
@@ -21,6 +19,7 @@ import psycopg
 import pytest
 from helpers.class_jobs import PAWN
 from helpers.roles import as_role
+from helpers.serve_process import engine, free_port
 from starlette.testclient import TestClient
 
 from engine.service.web.app import create_app
@@ -31,7 +30,6 @@ SPINDLE_ROW = 1700               # the spur class's row that emits it (seed_temp
 JSON = {"Accept": "application/json"}
 LOOPBACK = "http://127.0.0.1"   # the open web view answers a loopback Host only
 HOSTILE = "<script>alert(1)</script>"
-REPOSITORY = Path(__file__).resolve().parent.parent
 
 
 @pytest.fixture
@@ -301,20 +299,6 @@ def test_an_address_of_no_page_answers_json_to_a_program_and_a_page_to_a_browser
     assert method.json() == {"error": "DELETE is not taken at '/programs'; it takes GET, HEAD"}
     assert set(method.headers["allow"].split(", ")) == {"GET", "HEAD"}
     assert method.headers["content-type"] == "application/json"
-
-
-def free_port() -> int:
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        return probe.getsockname()[1]
-
-
-def engine(*args: str, runtime: Path, env_extra: dict | None = None, **kwargs) -> subprocess.Popen:
-    environment = {**os.environ, "ENGINE_RUNTIME_DIR": str(runtime), "ENGINE_CONFIG": "",
-                   "PYTHONPATH": str(REPOSITORY), **(env_extra or {})}
-    environment.pop("DATABASE_URL", None)
-    return subprocess.Popen([sys.executable, "-m", "engine", *args], env=environment, stdout=subprocess.PIPE,
-                            stderr=subprocess.PIPE, text=True, **kwargs)
 
 
 def started(url: str, runtime: Path) -> tuple[subprocess.Popen, str]:

@@ -167,14 +167,17 @@ def _refused_by_role(error: Exception) -> bool:
 
 
 def _read_only_here(error: Exception) -> bool:
-    """The database refused a write as read-only (SQLSTATE 25006): at a plant, the head office's
-    tables (schema/schema.sql, section plants), or a read-only server; or a row's id outside this
-    database's plant range (a_plant_id: a sequence moved by hand), which is bad state, not a bug."""
+    """A plant refused a write to the head office's tables (refuse_at_a_plant, which names itself
+    head_office_writes_it: schema/schema.sql, section plants), or a row's id outside this database's
+    plant range (a_plant_id: a sequence moved by hand): bad state, not a bug. Any other read-only
+    refusal (a READ ONLY transaction, a standby) is a write the command should not have tried: exit 2
+    (tests/test_read_only_database.py)."""
     psycopg = sys.modules.get("psycopg")
     if psycopg is None:
         return False
-    return isinstance(error, psycopg.errors.ReadOnlySqlTransaction) or (
-        isinstance(error, psycopg.errors.CheckViolation) and error.diag.constraint_name == "a_plant_id")
+    named = getattr(getattr(error, "diag", None), "constraint_name", None)
+    return (isinstance(error, psycopg.errors.ReadOnlySqlTransaction) and named == "head_office_writes_it") or (
+        isinstance(error, psycopg.errors.CheckViolation) and named == "a_plant_id")
 
 
 def _database_failure(error: Exception) -> bool:
