@@ -1,11 +1,12 @@
 """The JSON text the engine prints (`--json` of every command) and the web view answers
 (`engine serve`, `Accept: application/json`): one object on one line, written the same way by
 both, so a page's JSON is the command's, value for value (a time as `str` writes it, a numeric
-column's value as the number of its digits)."""
+column's value as the number of its digits); and the text of one value in their tables (cell)."""
 from __future__ import annotations
 
 import json
 import re
+from datetime import datetime
 from decimal import Decimal
 from typing import Any
 
@@ -35,3 +36,16 @@ def _marked(value: Any) -> Any:
     if isinstance(value, Decimal) and value.is_finite():
         return DECIMAL_MARK + format(value, "f")
     return value
+
+
+def cell(value: Any) -> str:
+    """A value as the CLI's tables and the web view's show it: '-' for none, 2.0 as 2, a time to the minute."""
+    if value is None:
+        return "-"
+    if isinstance(value, bool):
+        return "yes" if value else "no"
+    if isinstance(value, float):
+        return f"{value:g}"
+    if isinstance(value, datetime):
+        return value.isoformat(sep=" ", timespec="minutes")
+    return str(value)

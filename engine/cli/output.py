@@ -15,21 +15,8 @@ from typing import Any
 import click
 import msgspec
 
-from ..json_text import exact_json
+from ..json_text import cell, exact_json
 from .context import emit_json
-
-
-def cell(value: Any) -> str:
-    """A value as a table shows it: '-' for none, 2.0 as 2, a time to the minute."""
-    if value is None:
-        return "-"
-    if isinstance(value, bool):
-        return "yes" if value else "no"
-    if isinstance(value, float):
-        return f"{value:g}"
-    if isinstance(value, datetime):
-        return value.isoformat(sep=" ", timespec="minutes")
-    return str(value)
 
 
 def csv_cell(value: Any) -> Any:

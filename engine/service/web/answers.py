@@ -78,19 +78,6 @@ def status_of(error: EngineError) -> int:
     return 400
 
 
-def cell(value: Any) -> str:
-    """A value as the CLI's tables show it: '-' for none, 2.0 as 2, a time to the minute."""
-    if value is None:
-        return "-"
-    if isinstance(value, bool):
-        return "yes" if value else "no"
-    if isinstance(value, float):
-        return f"{value:g}"
-    if isinstance(value, datetime):
-        return value.isoformat(sep=" ", timespec="minutes")
-    return str(value)
-
-
 TEMPLATES.env.filters["cell"] = cell
 
 
