@@ -215,6 +215,24 @@ def read_only_database_url(server_url, database_pool, database_url) -> Iterator[
     database_pool.give_back(name)
 
 
+@pytest.fixture(scope="session")
+def real_library(server_url, database_pool, _seeded_copies):
+    """The real NC programs of tests/data/nc imported once per worker (helpers/nc_files.py,
+    ImportedLibrary): real_library.imported(relative) → its ImportReport; read it with real_conn."""
+    from helpers.nc_files import ImportedLibrary
+    name = database_pool.take(_seeded_copies)
+    yield ImportedLibrary(_url_of(server_url, name))
+    database_pool.give_back(name)
+
+
+@pytest.fixture
+def real_conn(real_library):
+    """A connection to real_library whose every change is rolled back at the end of the test."""
+    with psycopg.connect(real_library.url) as connection:
+        with connection.transaction(force_rollback=True):
+            yield connection
+
+
 @pytest.fixture
 def conn(database_url):
     """A connection whose every change is rolled back at the end of the test."""

@@ -54,8 +54,27 @@ def cut_centres(x_retract: float, cut_x: float, z_from: float, z_to: float) -> l
 
 
 def clearance(surface: np.ndarray, centres, unit: dict) -> float:
-    return min(distance_to_unit(surface + [x, 0, z], unit["tip"] / 2, unit["top"], unit["top"] - unit["b"])
-               for x, z in centres)
+    """The least distance_to_unit of the hob at any of the centres (X, Z), the centres of one X
+    taken together (issue 28: a pass has hundreds; this was most of the random test's time)."""
+    heights_at: dict[float, list[float]] = {}
+    for x, z in centres:
+        heights_at.setdefault(float(x), []).append(float(z))
+    return min(clearance_at_x(surface, x, zs, unit) for x, zs in heights_at.items())
+
+
+def clearance_at_x(surface: np.ndarray, x: float, zs: list[float], unit: dict) -> float:
+    """min over z in zs of distance_to_unit(surface + [x, 0, z], …), each point once: the signed
+    distance grows with the axial distance at a given radial one, and the axial distance
+    max(bottom − h, h − top) is least at the centre height that brings the point nearest the
+    unit's mid-height, one of the two heights beside mid − (the point's own height)."""
+    radius, top, bottom = unit["tip"] / 2, unit["top"], unit["top"] - unit["b"]
+    radial = np.hypot(surface[:, 0] + x, surface[:, 1]) - radius
+    heights, own = np.sort(np.asarray(zs + zs[-1:])), surface[:, 2]     # two heights at least
+    beside = np.clip(np.searchsorted(heights, (top + bottom) / 2 - own), 1, heights.size - 1)
+    axial = np.minimum(*(np.maximum(bottom - (own + heights[k]), (own + heights[k]) - top)
+                         for k in (beside - 1, beside)))
+    outside = np.hypot(np.maximum(radial, 0), np.maximum(axial, 0))
+    return float(np.min(outside + np.minimum(np.maximum(radial, axial), 0)))
 
 
 # ------------------------------------------------------------------ layouts

@@ -28,10 +28,10 @@ def own_rows(conn, gear_class: str) -> list[TemplateRow]:
 
 
 @pytest.mark.parametrize("relative", [relative for relative, params in PARAMS.items() if params])
-def test_an_imported_real_program_lints_clean(conn, relative):
+def test_an_imported_real_program_lints_clean(real_library, real_conn, relative):
     real_files()
-    import_nc(conn, DATA / relative, class_name(relative), PARAMS[relative])
-    assert lint_class(conn, class_name(relative)) == []
+    real_library.imported(relative)   # import_nc, once per worker (ImportedLibrary)
+    assert lint_class(real_conn, class_name(relative)) == []
 
 
 @pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it

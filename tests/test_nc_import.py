@@ -117,10 +117,10 @@ def test_other_values_print_in_the_style_of_the_original(spelling, value, printe
 # --- the real programs ---------------------------------------------------------------------
 
 @pytest.mark.parametrize("relative", list(PARAMS))
-def test_real_file_round_trips_through_import_export_and_instantiation(conn, relative):
+def test_real_file_round_trips_through_import_export_and_instantiation(real_library, real_conn, relative):
     real_files()
-    path, params = DATA / relative, PARAMS[relative]
-    report = import_nc(conn, path, class_name(relative), params)
+    conn, path, params = real_conn, DATA / relative, PARAMS[relative]
+    report = real_library.imported(relative)   # import_nc, once per worker (ImportedLibrary)
     exported = export_csv(load_template(conn, class_name(relative)))
 
     copy = class_name(relative) + "_copy"

@@ -30,10 +30,10 @@ def flat_name(relative: str) -> str:
 
 
 @pytest.mark.parametrize("relative", list(PARAMS))
-def test_every_real_file_is_written_back_byte_for_byte(conn, relative):
+def test_every_real_file_is_written_back_byte_for_byte(real_library, real_conn, relative):
     real_files()
-    import_nc(conn, DATA / relative, class_name(relative), PARAMS[relative])
-    assert written_back(conn, class_name(relative), PARAMS[relative]) == (DATA / relative).read_bytes()
+    real_library.imported(relative)   # import_nc, once per worker (ImportedLibrary)
+    assert written_back(real_conn, class_name(relative), PARAMS[relative]) == (DATA / relative).read_bytes()
 
 
 @pytest.mark.slow   # issue 28: among the fast subset's slowest; the whole suite runs it

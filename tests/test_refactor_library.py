@@ -16,7 +16,6 @@ from helpers.lineage_text import id_masked
 from helpers.nc_files import DATA, FAMILY, PARAMS, class_name, instantiate, real_files
 from helpers.refactor import bodies_stored_twice, component_count, duplicate_row_body, exports
 from msgspec.structs import replace
-from psycopg.conninfo import make_conninfo
 
 from engine.library.nc_import import import_nc
 from engine.library.refactor import STAGES, refactor
@@ -30,27 +29,17 @@ SEEDED_CLASSES = {"spur", "helical", "taper", "crowned", "worm_wheel", "duplex"}
 WAIT = 30   # seconds: no wait of this file blocks longer, so a bug fails instead of hanging
 
 
-def import_every_real_file(conn) -> dict[str, str]:
-    """Import all real NC files; class name → file (relative to DATA)."""
+@pytest.fixture
+def imported_library(real_library):
+    """(URL, class name → file) of the worker's copy of the seeded database with every real NC
+    program imported and committed (tests/conftest.py real_library: each file imported once per
+    worker, shared with the import tests of other files), for the tests of this module that
+    refactor it, each of which gets a connection rolled back at its end (library_conn)."""
     imported = {}
-    for relative in real_files():
-        import_nc(conn, DATA / relative, class_name(relative), PARAMS[relative])
+    for relative in real_files():   # in this order: of two files with one class name, the last is the class
+        real_library.imported(relative)
         imported[class_name(relative)] = relative
-    return imported
-
-
-@pytest.fixture(scope="module")
-def imported_library(server_url, database_pool, _seeded_copies):
-    """(URL, class name → file) of a private copy of the seeded database with every real NC
-    program imported and committed (about 25 s of import): made once for the tests of this module
-    that refactor it, each of which gets a connection rolled back at its end (library_conn)."""
-    name = database_pool.take(_seeded_copies)
-    url = make_conninfo(server_url, dbname=name)
-    with psycopg.connect(url) as conn:
-        imported = import_every_real_file(conn)
-        conn.commit()
-    yield url, imported
-    database_pool.give_back(name)
+    return real_library.url, imported
 
 
 @pytest.fixture

@@ -118,6 +118,7 @@ class DatabasePool:
             self._raise_error()
             if not kind.ready:
                 raise RuntimeError("the test database pool is closed")
+            self.changed.notify_all()   # the kind is short now: the makers copy the next one
             return kind.ready.pop(0)
 
     def give_back(self, name: str) -> None:

@@ -21,13 +21,15 @@ CUTTING = CuttingData(60, 200, 2.5, 1.5, 1.0, "test")
 
 def hob_surface(radius: float, half_length: float, eta: float) -> np.ndarray:
     """Points on the hob's tip cylinder and end discs, relative to its centre (the contact
-    point's axial station), axis (0, cos η, sin η)."""
+    point's axial station), axis (0, cos η, sin η). Built as arrays (issue 28: the lists of
+    tuples this was made of took a tenth of the taper tests' time); the same points, same order."""
     phi = np.linspace(0, 2 * np.pi, 181)[:-1]
     along = np.linspace(-half_length, half_length, 61)
     rho = np.linspace(0, radius, 12)
-    lateral = [(t, radius, p) for t in along for p in phi]
-    discs = [(t, r, p) for t in (-half_length, half_length) for r in rho for p in phi]
-    t, r, p = np.array(lateral + discs).T
+    lateral = [np.repeat(along, phi.size), np.full(along.size * phi.size, radius), np.tile(phi, along.size)]
+    ends = np.array([-half_length, half_length])
+    discs = [np.repeat(ends, rho.size * phi.size), np.tile(np.repeat(rho, phi.size), 2), np.tile(phi, 2 * rho.size)]
+    t, r, p = (np.concatenate(pair) for pair in zip(lateral, discs))
     axis, across = np.array([0, math.cos(eta), math.sin(eta)]), np.array([0, -math.sin(eta), math.cos(eta)])
     return (np.outer(t, axis) + np.outer(r * np.cos(p), [1, 0, 0]) + np.outer(r * np.sin(p), across))
 

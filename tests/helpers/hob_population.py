@@ -110,11 +110,16 @@ HOB_COLUMNS = ("id", "module", "starts", "tip_diameter", "length", "hand", "accu
 def hob_reach(r_a0: float, length: float, swivel: float, centre_x: float, other_tip: float) -> float:
     """How far (mm, along Z) the tip cylinder of a hob (radius r_a0, length, swivel in degrees
     about X, centre at X = centre_x) reaches into a cylinder of radius other_tip about the work
-    axis: the largest Z over the hob's surface points inside it, sampled every 0.25° and L/400."""
+    axis: the largest Z over the hob's surface points inside it, sampled every 0.25° and L/400.
+    Only the angles whose X lies within the cylinder's radius can hold a point inside it (x² ≤
+    x² + y²), so the points of the others are not made (issue 28: this was a quarter of the
+    population test; the points kept and their values are the same as with every angle)."""
     eta = math.radians(swivel)
     t = np.linspace(-length / 2, length / 2, 401)[:, None]
     phi = np.radians(np.arange(0.0, 360.0, 0.25))[None, :]
     x = centre_x + r_a0 * np.cos(phi)
+    near = x[0] ** 2 <= other_tip ** 2
+    phi, x = phi[:, near], x[:, near]
     y = t * math.cos(eta) - r_a0 * np.sin(phi) * math.sin(eta)
     z = t * math.sin(eta) + r_a0 * np.sin(phi) * math.cos(eta)
     inside = x ** 2 + y ** 2 <= other_tip ** 2

@@ -146,3 +146,30 @@ def instantiated(conn, gear_class: str, params: dict) -> list[str]:
 def stored(conn):
     return conn.execute("SELECT (SELECT count(*) FROM gear_class), (SELECT count(*) FROM assembly), "
                         "(SELECT count(*) FROM component)").fetchone()
+
+
+class ImportedLibrary:
+    """A private copy of the seeded database into which each real file is imported per test
+    process (its class_name, its PARAMS), committed, its ImportReport kept (issue 28: TOKARKA.NC
+    alone takes seconds to import, and several tests of several files import each real file the
+    same way). Two files share a class name (lathe_macros/turning.ngc and gmoccapy_lathe/turning.ngc
+    are both nc_turning): the class holds the file imported last, and asking for the other imports
+    it again over it, as a user re-importing would. Tests read the library through a connection
+    rolled back at their end (real_conn in tests/conftest.py), so what one test changes no other
+    sees; the imports are the engine's, made when a test asks for the file, so a broken import
+    fails that test."""
+
+    def __init__(self, url: str):
+        self.url = url
+        self.holder: dict[str, tuple[str, object]] = {}   # class name → (file, its ImportReport)
+
+    def imported(self, relative: str):
+        """The ImportReport of importing DATA / relative as class_name(relative) with PARAMS[relative]."""
+        held = self.holder.get(class_name(relative))
+        if held is None or held[0] != relative:
+            from engine.library.nc_import import import_nc
+            with psycopg.connect(self.url) as conn:
+                report = import_nc(conn, DATA / relative, class_name(relative), PARAMS[relative])
+                conn.commit()
+            held = self.holder[class_name(relative)] = (relative, report)
+        return held[1]
