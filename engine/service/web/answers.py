@@ -12,6 +12,7 @@ from starlette.requests import Request
 from starlette.responses import Response
 
 from ...errors import EngineError
+from ...json_text import cell
 from .pages import TEMPLATES, connection, page, refusal, wants_json
 
 # the id ranges of the columns each names (schema/schema.sql; the CLI's engine/cli/ids.py)
