@@ -63,6 +63,7 @@ def browser():
         launched.close()
 
 
+@pytest.mark.slow   # a real Chromium: seconds; every full run and CI leg runs it (issue 28: test-fast)
 def test_an_operator_finds_a_program_its_trace_and_its_plot_in_a_browser(served, browser, tmp_path):
     address, program_id, digest = served
     shots = Path(os.environ.get(SCREENSHOTS) or tmp_path)

@@ -8,6 +8,7 @@ import io
 import time
 
 import psycopg
+import pytest
 from helpers.serve_process import engine, free_port
 
 MACHINE = "hobber-840d"
@@ -32,6 +33,7 @@ def answered(path, deadline: float) -> bool:
     return path.exists()
 
 
+@pytest.mark.slow   # the whole service as a process: seconds; every full run runs it (issue 28: test-fast)
 def test_one_service_serves_the_web_view_ftp_and_request_folders_until_stopped(run, tmp_path):
     assert run("instantiate", "--gear", "42").exit_code == 0
     job = first_job(run.url)

@@ -50,6 +50,7 @@ SECRET_VARIABLE = "ENGINE_FTP_SECRET_{}"
 WRITES = ("STOR", "STOU", "APPE", "DELE", "RNFR", "RNTO", "MKD", "XMKD", "RMD", "XRMD", "SITE CHMOD", "MFMT")
 READ_PERMS = "elr"   # change folder (only its own), list, retrieve
 POOL_SIZE = (1, 8)
+LOOP_SECONDS = 0.1   # pyftpdlib's own is 1 s: every stop of the server waited for it
 FAILED_LOGIN_DELAY = 3.0   # seconds before a failed login is answered (pyftpdlib's default), at most 3 a connection
 WRITE_REFUSED = ("550 {command} refused: this server only sends programs; a program reaches a machine from the "
                  "database, proved when it is asked for")
@@ -264,8 +265,9 @@ def start_ftp_server(database_url: str, config: Config, host: str = "127.0.0.1",
     except OSError as error:
         pool.close()
         raise EngineError(f"the FTP server cannot listen on {host}:{port} ({error.strerror or error})") from None
-    thread = threading.Thread(target=server.serve_forever, kwargs={"handle_exit": False}, name="engine-ftp",
-                              daemon=True)
+    # the loop looks for its end every LOOP_SECONDS: close() (engine serve stopping) waits that long at most
+    thread = threading.Thread(target=server.serve_forever, kwargs={"handle_exit": False, "timeout": LOOP_SECONDS},
+                              name="engine-ftp", daemon=True)
     thread.start()
     return FtpService(server, thread, pool)
 
