@@ -26,7 +26,8 @@ from psycopg.pq import TransactionStatus
 
 import engine.programs.all_models  # noqa: F401  (every model registers, as the commands that use one make it)
 
-pytest_plugins = ["helpers.turning_jobs", "helpers.plant_servers"]   # fixtures shared by several test modules
+# fixtures shared by several test modules
+pytest_plugins = ["helpers.turning_jobs", "helpers.plant_servers", "helpers.request_folders"]
 
 # No config file of the user running the suite (docs/guide/configuration.md): the tests of the
 # config file name their own with ENGINE_CONFIG. No shop database either: the engine reads

@@ -3,20 +3,6 @@ name taken by a folder) must not stop the others: before, the error left poll_on
 after it, of every machine, waited forever."""
 import json
 
-import pytest
-
-from engine.programs.config import Config
-from engine.service.request_folder import RequestFolder
-
-
-@pytest.fixture
-def folders(run, tmp_path):
-    root = tmp_path / "share"
-    root.mkdir()
-    folder = RequestFolder(root, ["hobber-840d", "hobber-fanuc"], run.url, Config())
-    yield folder
-    folder.close()
-
 
 def job_of(run, machine: str) -> int:
     made = run("instantiate", "--gear", 42, "--machine", machine, "--json")

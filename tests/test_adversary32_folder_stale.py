@@ -10,19 +10,6 @@ import json
 import threading
 
 import psycopg
-import pytest
-
-from engine.programs.config import Config
-from engine.service.request_folder import RequestFolder
-
-
-@pytest.fixture
-def folders(run, tmp_path):
-    root = tmp_path / "share"
-    root.mkdir()
-    folder = RequestFolder(root, ["hobber-840d"], run.url, Config())
-    yield folder
-    folder.close()
 
 
 def job_of(run, gear: int) -> dict:

@@ -6,27 +6,10 @@ computer, shown on the control and recorded."""
 import ftplib
 
 import psycopg
+from helpers.class_jobs import SHAFT_PROGRAM as SHAFT
 
 from engine.programs.config import load_config
 from engine.service.ftp import start_ftp_server
-
-SHAFT = """%
-O0001 (SHAFT)
-G21 G18 G40 G90
-G00 X124.000 Z50.000
-T0101
-G97 S600 M03
-G98 F150.000
-G00 X44.000 Z2.000
-G01 X36.000 Z2.000
-G01 X36.000 Z-40.000
-G00 X44.000 Z-40.000
-G00 X44.000 Z2.000
-G00 X124.000 Z50.000
-M05
-M30
-%
-"""
 
 
 def test_an_assumed_blank_is_refused_without_the_services_folder(run, tmp_path, monkeypatch):

@@ -21,16 +21,6 @@ from engine.programs.config import Config
 from engine.service.request_folder import RequestFolder
 
 
-@pytest.fixture
-def folders(run, tmp_path):
-    """The request folders of the 840D and the Fanuc under tmp_path/share."""
-    root = tmp_path / "share"
-    root.mkdir()
-    folder = RequestFolder(root, ["hobber-840d", "hobber-fanuc"], run.url, Config())
-    yield folder
-    folder.close()
-
-
 def stored_job(run, gear: int, machine: str = "hobber-840d") -> dict:
     made = run("instantiate", "--gear", gear, "--machine", machine, "--json")
     assert made.exit_code == 0, made.output

@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 
 import pytest
+from helpers.class_jobs import SHAFT_PROGRAM
 from msgspec.structs import replace
 
 from engine.errors import EngineError
@@ -23,24 +24,7 @@ from engine.simulation.turning.run import simulate_turning
 from engine.simulation.turning.work import turning_records
 
 LATHE = Machine("lathe-iso", "lathe", "iso", 0.0, 400.0, 0.0, 0.0, -600.0, 200.0, 4000.0, None, None)
-# One rough pass at Ø36 from the face (Z2) to Z-40, approached from X44: the largest radius a feed
-# runs at is 22 (its start), over Z-40…2, so the blank assumed is Ø44 Z-40…2.
-SHAFT = """%
-O0001 (SHAFT)
-G21 G18 G40 G90
-G00 X124.000 Z50.000
-T0101
-G97 S600 M03
-G98 F150.000
-G00 X44.000 Z2.000
-G01 X36.000 Z2.000
-G01 X36.000 Z-40.000
-G00 X44.000 Z-40.000
-G00 X44.000 Z2.000
-G00 X124.000 Z50.000
-M05
-M30
-%""".splitlines()
+SHAFT = SHAFT_PROGRAM.splitlines()
 APPROACH = SHAFT.index("G00 X44.000 Z2.000")
 CUT = SHAFT.index("G01 X36.000 Z-40.000")
 AIR_TOLERANCE_MM = 0.01     # engine.simulation.turning.material: a rapid may graze the surface by this

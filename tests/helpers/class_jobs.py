@@ -13,6 +13,27 @@ DATA = shared_data()
 EMCO_DRAWING = DATA / "dxf" / "emco_lathe_testNegDXF_R14.dxf"
 PAWN = DATA / "nc" / "linuxcnc" / "lathe_pawn.ngc"          # LinuxCNC lathe program
 
+# A shop's lathe program of one rough pass at Ø36 from the face (Z2) to Z-40, approached from X44
+# (tests/test_turning_class_jobs.py; the adversary of issue 32 sends it as a class job): the largest
+# radius a feed runs at is 22 (its start), over Z-40…2, so the blank assumed is Ø44 Z-40…2.
+SHAFT_PROGRAM = """%
+O0001 (SHAFT)
+G21 G18 G40 G90
+G00 X124.000 Z50.000
+T0101
+G97 S600 M03
+G98 F150.000
+G00 X44.000 Z2.000
+G01 X36.000 Z2.000
+G01 X36.000 Z-40.000
+G00 X44.000 Z-40.000
+G00 X44.000 Z2.000
+G00 X124.000 Z50.000
+M05
+M30
+%
+"""
+
 
 def ok(result):
     assert result.exit_code == 0, result.output
