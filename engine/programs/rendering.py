@@ -45,7 +45,7 @@ import msgspec
 from msgspec.structs import replace
 
 from ..db.connection import scalar
-from ..db.origin import MADE_HERE_SQL, made_at, plant_name, this_plant
+from ..db.origin import MADE_AT_SQL, MADE_HERE_SQL, made_at, plant_name, this_plant
 from ..errors import EngineError
 from ..gears.models import model_for_class
 from ..gears.records import Hob, load_gear, load_hobs
@@ -77,8 +77,7 @@ STORED = """
 SELECT p.id, p.name, p.gear_class, p.template_version, p.template_hash, p.input_hash, p.draft, p.unverified,
        p.lines, p.row_ids, p.trace, p.job_id, j.machine, j.params, j.module_params,
        job_input_hash(j.params, j.module_params), v.version IS NOT NULL, m.dialect, j.gear_id, j.hob_id,
-       CASE WHEN j.id NOT BETWEEN plant_first_id(plant_number()) AND plant_last_id(plant_number())
-            THEN (j.id / plant_first_id(1))::integer END
+       CASE WHEN NOT (""" + MADE_HERE_SQL.format(id="j.id") + """) THEN """ + MADE_AT_SQL.format(id="j.id") + """ END
 FROM program p JOIN job j ON j.id = p.job_id JOIN machine m ON m.name = j.machine
 LEFT JOIN template_version_rows v ON v.gear_class = p.gear_class AND v.version = p.template_version
 WHERE p.id = %s"""

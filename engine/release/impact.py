@@ -55,8 +55,7 @@ JOBS = """
 SELECT j.id, j.gear_class, j.machine, j.params::text, j.module_params::text,
        EXISTS (SELECT 1 FROM program p WHERE p.job_id = j.id), j.gear_id, j.hob_id
 FROM job j
-WHERE j.gear_class = ANY(%s::text[])
-  AND j.id BETWEEN plant_first_id(plant_number()) AND plant_last_id(plant_number())
+WHERE j.gear_class = ANY(%s::text[]) AND """ + MADE_HERE_SQL.format(id="j.id") + """
 ORDER BY j.id"""
 # The plants' jobs of the classes a head office holds as history: counted and said, never re-made.
 PLANT_JOBS = """
