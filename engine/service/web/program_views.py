@@ -17,7 +17,7 @@ from ...errors import EngineError
 from ...nc.lineage import LINEAGE_ROW_ID
 from ...programs.explain import explain_program, traced_lines
 from ...programs.plots import plot_program
-from ...programs.rendering import REFUSED, stored_rendering
+from ...programs.rendering import REFUSED, Rendering, stored_rendering
 from ...simulation import simulate_stored_program
 from .answers import answered, shown, whole
 
@@ -47,10 +47,11 @@ def plot_svg(conn, program_id: int) -> tuple[str | None, str | None]:
     return text[text.index(SVG_START):], None   # the element alone: no XML declaration or DOCTYPE in a page
 
 
-def simulation_report(conn, program_id: int) -> dict:
+def simulation_report(conn, program_id: int, rendering: Rendering | None = None) -> dict:
     """`engine simulate --program`'s report: {"json": its JSON, "lines": its lines, "refusal": the
-    one line it ends with when it refuses, or None}; the refusal alone when nothing was simulated."""
-    rendering = stored_rendering(conn, program_id)
+    one line it ends with when it refuses, or None}; the refusal alone when nothing was simulated.
+    `rendering`: the program's, when the page has checked it already (not rendered and proved twice)."""
+    rendering = rendering or stored_rendering(conn, program_id)
     try:
         if rendering.status != REFUSED:   # a forged program proves nothing; a refused rendering is shown
             rendering.refuse_unless_matching("the simulation")

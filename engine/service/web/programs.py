@@ -67,7 +67,7 @@ def _evidence(conn, record) -> dict:
         evidence["refusal"] = (f"program {record.id}: {status}: {record.rendering.reason}; its plot, trace"
                                + (" and simulation are" if status != REFUSED else " are") + " not shown")
     if status in (MATCH, REFUSED):
-        evidence["simulation"] = simulation_report(conn, record.id)
+        evidence["simulation"] = simulation_report(conn, record.id, record.rendering)
     return evidence
 
 
