@@ -81,64 +81,97 @@ def nearest_radius(hob: HobBody, swivel: float, cx: float, cy: float, cz: float,
 
 
 def nearest_radii(hob: HobBody, swivel: float, cx: float, cy: float, cz: float, heights) -> list[float]:
-    """nearest_radius at each of `heights` for one pose (the module's formulation). The solids
-    are of revolution about the work axis, so a centre at −cx (across the axis) is as far as one
-    at cx: the formulation is written for cx ≥ 0."""
-    s, c = sine_cosine(swivel)
-    cx = abs(cx)
-    r, half = hob.radius, hob.half_length
-    found = []
-    for height in heights:
-        dz = height - cz
-        low, high = band(s, c, r, half, dz)
+    """nearest_radius at each of `heights` for one pose (the module's formulation)."""
+    nearest = Slices.of(hob, swivel, cx, cy).nearest
+    return [nearest(height - cz) for height in heights]
+
+
+class Slices(msgspec.Struct, frozen=True):
+    """One pose's horizontal slices: of the formulation's terms, all but those of dz are fixed
+    per pose and worked out once here (a pose spans tens of heights, a gear's proof some 4,000
+    sections, issue 28). The solids are of revolution about the work axis, so a centre at −cx
+    (across the axis) is as far as one at cx: cx ≥ 0 here, and Pξ = cx at every height. The
+    per-height steps pick the greater or lesser of two floats by comparison, with max's and
+    min's result, and square by multiplying, as envelope_arrays' numpy does (the calls of max,
+    min and x ** 2 cost more than the arithmetic)."""
+    s: float               # sin A, 0 for an upright hob (sine_cosine)
+    c: float               # cos A ≥ 0
+    r: float               # R = a, the ellipse's semi-axis along X (mm)
+    half: float            # L/2 (mm)
+    cx: float              # |cx| (mm)
+    cy: float              # mm
+    edge: float            # R signed as s (mm): the ellipse spans dy from (c·dz − edge)/s to (c·dz + edge)/s
+    b: float               # R/|s| (mm), the semi-axis along Y; inf for an upright hob (never read)
+    a2: float              # a² (mm²)
+    b2: float              # b² (mm²)
+    ap: float              # a·|Pξ| (mm²)
+    x_floor: float         # a·|Pξ| − a² (mm²), the first term of ellipse_root's t₀
+    x_share: float         # (|Pξ|/a)², X's share of the ellipse's equation at P
+
+    @classmethod
+    def of(cls, hob: HobBody, swivel: float, cx: float, cy: float) -> Slices:
+        s, c = sine_cosine(swivel)
+        r, cx = hob.radius, abs(cx)
+        b = r / abs(s) if s else math.inf
+        return cls(s, c, r, hob.half_length, cx, cy, math.copysign(r, s), b, r * r, b * b, r * cx,
+                   r * cx - r * r, (cx / r) * (cx / r))
+
+    def nearest(self, dz: float) -> float:
+        """nearest_radius at dz = height − cz (mm): at dy* clamped into the band, where g is least."""
+        low, high = self.band(dz)
         if low > high:
-            found.append(math.inf)
-            continue
-        dy = min(max(unbounded_dy(s, c, r, cx, cy, dz), low), high)
-        q = s * dy - c * dz
-        gap = max(cx - math.sqrt(max(r * r - q * q, 0.0)), 0.0)
-        found.append(math.sqrt(gap * gap + (cy + dy) ** 2))
-    return found
+            return math.inf
+        cdz = self.c * dz
+        dy = self.unbounded_dy(cdz)
+        dy = low if low > dy else dy            # max(dy, low)
+        dy = high if high < dy else dy          # min(…, high)
+        q = self.s * dy - cdz
+        w = self.a2 - q * q                     # w² (mm²), 0 or less only at the ellipse's tips (rounding)
+        gap = self.cx - math.sqrt(w) if w > 0.0 else self.cx
+        gap = 0.0 if gap < 0.0 else gap
+        across = self.cy + dy
+        return math.sqrt(gap * gap + across * across)
+
+    def band(self, dz: float) -> tuple[float, float]:
+        """(low, high) of dy in the slice at dz: between the end faces and within the ellipse's
+        (or the strip's) reach; low > high where the hob has no point there."""
+        s, c, sdz = self.s, self.c, self.s * dz
+        low, high = (-self.half - sdz) / c, (self.half - sdz) / c
+        if not s:
+            return (low, high) if abs(dz) <= self.r else (high, low - 1.0)
+        near, far = (c * dz - self.edge) / s, (c * dz + self.edge) / s
+        return (near if near > low else low), (far if far < high else high)
+
+    def unbounded_dy(self, cdz: float) -> float:
+        """dy of the slice's nearest point to the work axis, the end faces left out: −cy where the
+        axis passes through the ellipse (or the strip), else the foot of the normal from it."""
+        s, cy = self.s, self.cy
+        if not s or self.cx <= 0.0:
+            return -cy
+        py = -cy - cdz / s                      # Py
+        y_share = py / self.b
+        if self.x_share + y_share * y_share <= 1.0:
+            return -cy
+        bp, b2 = self.b * abs(py), self.b2
+        floor = bp - b2 if bp - b2 > self.x_floor else self.x_floor      # t₀ = max(a|Pξ| − a², b|Py| − b², 0)
+        t = ellipse_root(self.a2, b2, self.ap, bp, 0.0 if floor < 0.0 else floor)
+        return -cy - py * t / (t + b2)
 
 
-def band(s: float, c: float, r: float, half: float, dz: float) -> tuple[float, float]:
-    """(low, high) of dy in the slice at dz: between the end faces and within the ellipse's
-    (or the strip's) reach; low > high where the hob has no point there."""
-    low, high = (-half - s * dz) / c, (half - s * dz) / c
-    if s:
-        first, second = (c * dz - r) / s, (c * dz + r) / s
-        return max(low, min(first, second)), min(high, max(first, second))
-    return (low, high) if abs(dz) <= r else (high, low - 1.0)
-
-
-def unbounded_dy(s: float, c: float, r: float, cx: float, cy: float, dz: float) -> float:
-    """dy of the slice's nearest point to the work axis, the end faces left out: −cy where the
-    axis passes through the ellipse (or the strip), else the foot of the normal from it."""
-    if not s or cx <= 0.0:
-        return -cy
-    b = r / abs(s)
-    px, py = cx, -cy - c * dz / s                 # |Pξ| and Py
-    if (px / r) ** 2 + (py / b) ** 2 <= 1.0:
-        return -cy
-    t = ellipse_root(r, b, px, abs(py))
-    return -cy - py * t / (t + b * b)
-
-
-def ellipse_root(a: float, b: float, px: float, py: float) -> float:
-    """The root t (mm²) of F above, for a point (px, py ≥ 0) outside the ellipse of semi-axes a, b:
-    Halley's steps (step) from _start's bound, never below t₀ (F ≥ 0 there), until |F| is
-    within ROOT_TOLERANCE: one to three from that start."""
-    a2, b2 = a * a, b * b
-    ap, bp = a * px, b * py
-    floor = max(ap - a2, bp - b2, 0.0)
+def ellipse_root(a2: float, b2: float, ap: float, bp: float, floor: float) -> float:
+    """The root t (mm²) of F above, for a point P outside the ellipse (a2, b2: a², b²; ap, bp:
+    a·|Pξ|, b·|Py|, mm²): Halley's steps (step) from _start's bound, never below t₀ = floor
+    (F ≥ 0 there), until |F| is within ROOT_TOLERANCE: one to three from that start."""
     t = _start(a2, b2, ap, bp, floor)
     for _ in range(STEP_LIMIT):
         ta, tb = t + a2, t + b2
-        u2, v2 = (ap / ta) ** 2, (bp / tb) ** 2
+        u, v = ap / ta, bp / tb
+        u2, v2 = u * u, v * v
         f = u2 + v2 - 1.0
         if -ROOT_TOLERANCE <= f <= ROOT_TOLERANCE:
             return t
-        t = max(t + step(f, u2 / ta + v2 / tb, u2 / (ta * ta) + v2 / (tb * tb)), floor)
+        t = t + step(f, u2 / ta + v2 / tb, u2 / (ta * ta) + v2 / (tb * tb))
+        t = floor if floor > t else t           # max(t, floor)
     return t
 
 
@@ -163,5 +196,5 @@ def _start(a2: float, b2: float, ap: float, bp: float, floor: float) -> float:
         high = ap / math.sqrt(1.0 - v * v) - a2 if u >= v else bp / math.sqrt(1.0 - u * u) - b2
         u, v = ap / (high + a2), bp / (high + b2)
         back = high + (u * u + v * v - 1.0) / (2.0 * (u * u / (high + a2) + v * v / (high + b2)))
-        return max(back, floor)
+        return floor if floor > back else back  # max(back, floor)
     return floor

@@ -102,7 +102,7 @@ def _picked(values, where):
 
 
 def unbounded_dy(s: float, c: float, r: float, cx, cy, dz):
-    """envelope.unbounded_dy, elementwise (cx, cy and dz of one shape)."""
+    """envelope.Slices.unbounded_dy, elementwise (cx, cy and dz of one shape)."""
     dy = -cy
     if not s:
         return dy
@@ -116,7 +116,8 @@ def unbounded_dy(s: float, c: float, r: float, cx, cy, dz):
 
 
 def ellipse_root(a: float, b: float, px, py):
-    """envelope.ellipse_root elementwise (flat arrays of points outside the ellipse): the same
+    """envelope.ellipse_root elementwise (flat arrays of points |Pξ|, |Py| outside the ellipse of
+    semi-axes a, b; envelope's takes a², b² and a·|Pξ|, which it works out once per pose): the same
     start and steps on every point, each one's t held from the first step its |F| is within
     ROOT_TOLERANCE (the points are not picked out step by step: a cut's few dozen cost more
     in picking than in stepping)."""
