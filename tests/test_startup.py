@@ -25,7 +25,11 @@ LATHE_EXPANDERS = {"engine.verifier.expanders.iso", "engine.verifier.expanders.l
 # rows (no --explain), the TOML reader (no config file: ENGINE_CONFIG="", tests/conftest.py), the
 # CSV reader and a template's CSV form (engine.quantities holds the bound the records share with it),
 # the listings' helpers (engine template list), the checks of rows before they are written, a
-# lathe's arcs (a hobbing program has none); the batch's progress bar is not among the CLI's modules
+# lathe's arcs (a hobbing program has none); the batch's progress bar is not among the CLI's modules;
+# the class store that writes templates (a released template is read without it) and the plants'
+# origin rules it imports, a Fanuc gear box's reader (an 840D program has none), an imported
+# word's NC number (a template written by hand prints none) and the simulation of a stored program
+# (what is made is proved as made)
 CLI_MODULES_OF_INSTANTIATE = {"engine.cli", "engine.cli.app", "engine.cli.commands", "engine.cli.context",
                               "engine.cli.conventions", "engine.cli.examples", "engine.cli.ids",
                               "engine.cli.instantiate"}
@@ -33,7 +37,9 @@ OTHER_MODELS = {"engine.hobbing.duplex", "engine.hobbing.taper", "engine.hobbing
                 "engine.hobbing.worm_wheel", "engine.hobbing.models"}
 UNUSED_BY_ONE_GEAR = {"multiprocessing", "engine.programs.workers", "engine.db.embedded", "engine.programs.explain",
                       "tomllib", "engine.csv_reader", "engine.templates.template_csv", "engine.db.listing",
-                      "engine.templates.checks", "engine.verifier.arcs"}
+                      "engine.templates.checks", "engine.verifier.arcs", "engine.templates.store",
+                      "engine.db.origin", "engine.verifier.synchronisation", "engine.templates.nc_number",
+                      "engine.simulation.hobbing.stored"}
 
 
 def modules_after(code: str, *arguments: str) -> set[str]:

@@ -16,7 +16,8 @@ from ..errors import EngineError
 from ..nc.tokens import NUMBER, WORD, LineFacts, facts, tokenise
 from ..templates.evaluator import evaluate
 from ..templates.expressions import MAX_EXPRESSION_LENGTH, compile_expression
-from ..templates.nc_number import NC_NUMBER_SPEC, style_of
+from ..templates.functions import NC_NUMBER_SPEC
+from ..templates.nc_number import style_of
 from .nc_params import FUNCTION_ADDRESSES, Binding
 from .nc_references import CODE_NAMES, block_context, reference_at
 

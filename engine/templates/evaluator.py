@@ -13,7 +13,7 @@ import threading
 from ..errors import EngineError
 from .asteval_import import ALL_NODES, Interpreter
 from .budget import Budget, paid, running, spending
-from .functions import CONSTANTS, FUNCTIONS
+from .functions import CONSTANTS, FUNCTIONS, NC_NUMBER_SPEC, nc_number
 from .guards import (
     built,
     check_printable,
@@ -25,7 +25,6 @@ from .guards import (
     safe_mult,
     safe_pow,
 )
-from .nc_number import NC_NUMBER_SPEC, nc_number
 
 # The asteval node handlers a checked expression needs; every other node is switched off.
 NODES = ("expression", "binop", "unaryop", "boolop", "compare", "ifexp", "call", "name", "constant",

@@ -47,10 +47,7 @@ def style_of(spelling: str) -> str:
     return f"{'+' if sign == '+' else ''}{whole}{point}{'0' * len(fraction)}"
 
 
-NC_NUMBER_SPEC = "~"   # `{feed:~#.000}`: the f-string field of an imported word (engine.templates.evaluator)
-
-
-def nc_number(value, style: str) -> str:
+def written_number(value, style: str) -> str:
     """`value` written as an NC number in `style` (style_of a number as a file wrote it)."""
     exact = exact_decimal(value)
     shaped = _STYLE.fullmatch(style)

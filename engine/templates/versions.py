@@ -17,7 +17,6 @@ from msgspec.structs import replace
 from ..db.connection import scalar
 from ..errors import EngineError
 from .rows import Template, TemplateRow
-from .store import load_template
 from .translations import load_translations
 
 if TYPE_CHECKING:
@@ -38,6 +37,8 @@ def released_template(conn: Connection, gear_class: str) -> Template:
     """The class's latest released template: what the shop floor runs."""
     found = conn.execute(RELEASED, (gear_class,)).fetchone()
     if found is None:
+        from .store import load_template  # the store: only where no release is found (issue 28: start-up)
+
         load_template(conn, gear_class)   # an unknown or empty class is refused as such
         raise EngineError(f"class {gear_class!r} has no released template version; an editor tries the draft with "
                           f"--draft, and `engine template release --class {gear_class}` releases it")
@@ -50,6 +51,8 @@ def released_template(conn: Connection, gear_class: str) -> Template:
 def draft_template(conn: Connection, gear_class: str) -> Template:
     """The class's current rows (its draft, or its released version if it has no draft), marked
     whether they are a draft."""
+    from .store import load_template  # the store: only for a draft, never on a runner's path (issue 28)
+
     template = load_template(conn, gear_class)
     released = scalar(conn.execute(RELEASED_VERSION, (gear_class,)))
     return replace(template, draft=released != template.version)

@@ -15,7 +15,6 @@ from .grammar import ISO_COMMENT_TEXT, Dialect, Header
 from .refusals import Refused
 from .shift_clamp import ShiftLine, read_shift_line
 from .statements import STATEMENT, Statement, read_statement
-from .synchronisation import read_synchronisation
 
 MAX_REMEMBERED = 20_000   # lines kept per dialect; the memory starts again when full
 ISO_LINE = re.compile(rf"([^()]*?) ?(?:\(({ISO_COMMENT_TEXT})\))?")
@@ -81,7 +80,9 @@ def _read(dialect: Dialect, line: str) -> Line:
         shift = read_shift_line(dialect.shift_clamp, code)
         if shift is not None:
             return shift
-    if dialect.synchronisations:
+    if dialect.synchronisations:   # a Fanuc gear box's reader: loaded only for a dialect that has one (issue 28)
+        from .synchronisation import read_synchronisation
+
         synchronisation = read_synchronisation(dialect, code)
         if synchronisation is not None:
             return synchronisation

@@ -32,7 +32,6 @@ import re
 from ...gears.records import Gear, Hob
 from ...machines.records import Machine
 from ...verifier.statements import GearBox, Statement
-from ...verifier.synchronisation import helical_compensation
 from .coupling import Coupling, read_coupling
 from .frame import Senses
 from .report import SimulationError, where
@@ -76,6 +75,8 @@ def compensation(module: float, helix: float, teeth: int, helix_sign: int) -> tu
     compensation (fanuc-egb.md §F4, metric input: the grammar refuses G20): helix_sign·sin P·360/
     (π·T·Q), Q the module in mm, P the helix angle in degrees. The resolution is what half a least
     increment of P and of Q changes it by (∂/∂P and ∂/∂Q of the formula)."""
+    from ...verifier.synchronisation import helical_compensation  # Fanuc's Q/P only (issue 28: start-up)
+
     per_mm = helical_compensation(module, helix, teeth)
     scale = helical_compensation(module, 90.0, teeth)   # 360/(π·T·Q): sin 90° = 1
     by_p = scale * abs(math.cos(math.radians(helix))) * math.radians(P_INCREMENT / 2)
