@@ -4,7 +4,7 @@ A test that commits needs a private copy of the seeded database. Copying it (CRE
 TEMPLATE) costs the server about a quarter of a second, and dropping it more: DROP DATABASE waits
 for a checkpoint, which on a server other sessions share flushes their dirty pages too (a second
 and more). Done in the test's own setup and teardown that time adds up over hundreds of tests;
-here two threads copy the next databases while the current test runs, and another drops the used
+here two threads copy the next databases while the current test runs, and others drop the used
 ones, several at once so that their checkpoints are shared.
 
 Copies are made from a template nobody connects to, so a test holding a connection to the session's
@@ -57,6 +57,7 @@ def drop_with(admin, name: str) -> None:
 # Run by drop_later in a process of its own: drops the databases named on its command line.
 DROPPER = """
 import sys
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 sys.path.insert(0, sys.argv[1])
 from helpers.database_pool import DROPS_AT_ONCE, drop_database
@@ -98,12 +99,12 @@ class DatabasePool:
         self.server_url, self.file_copy = server_url, file_copy
         self.kinds: list[Kind] = []
         self.used: list[str] = []
-        self.dropping: list[str] = []   # the batch the drop thread is dropping (dropped again at close: IF EXISTS)
+        self.dropping: list[str] = []   # being dropped by the drop threads (dropped again at close: IF EXISTS)
         self.error: BaseException | None = None
         self.closing = False
         self.changed = threading.Condition()
         self.threads = [threading.Thread(target=self._guarded, args=(work,), daemon=True)
-                        for work in (self._make_ahead,) * MAKERS + (self._drop_behind,)]
+                        for work in (self._make_ahead,) * MAKERS + (self._drop_behind,) * DROPS_AT_ONCE]
         for thread in self.threads:
             thread.start()
 
@@ -182,42 +183,29 @@ class DatabasePool:
             return kind
 
     def _drop_behind(self) -> None:
-        while batch := self._next_drops():
-            self._drop_all(batch)
-            with self.changed:
-                self.dropping = []   # dropped: not handed to the dropper at close again
+        """One of DROPS_AT_ONCE daemon threads, each dropping over a connection of its own, made at
+        its first drop and kept: a connection per DROP was a new server backend each time, 360 of
+        the fast subset's 2,200 connections (issue 28). Daemon threads, because the interpreter
+        joins a ThreadPoolExecutor's at exit: on the local server, where each DROP DATABASE waits
+        for a checkpoint, a worker stayed 4-10 s after its last test for the drops in progress.
+        What they leave undone close() hands to the detached dropper (DROP … IF EXISTS)."""
+        admin = None
+        try:
+            while name := self._next_drop():
+                admin = admin or psycopg.connect(self.server_url, autocommit=True)
+                drop_with(admin, name)
+                with self.changed:
+                    self.dropping.remove(name)   # dropped: not handed to the dropper at close again
+        finally:
+            if admin is not None:
+                admin.close()
 
-    def _next_drops(self) -> list[str]:
-        """Every used database not yet dropped; [] when closing."""
+    def _next_drop(self) -> str | None:
+        """The used database given back first and not yet dropped; None when closing."""
         with self.changed:
             self.changed.wait_for(lambda: self.closing or self.used)
             if self.closing:
-                return []
-            self.dropping, self.used = self.used, []
-            return self.dropping
-
-    def _drop_all(self, names: list[str]) -> None:
-        """DROP DATABASE each of `names`, DROPS_AT_ONCE at a time, on daemon threads: the threads
-        of a ThreadPoolExecutor are joined when the interpreter exits, so a worker whose last batch
-        waited for a checkpoint stayed 4-10 s after its last test (issue 28). What they leave
-        undone close() hands to the detached dropper (drop_later: DROP … IF EXISTS)."""
-        pending, errors = list(names), []
-        drops = [threading.Thread(target=self._drop_from, args=(pending, errors), daemon=True)
-                 for _ in range(min(DROPS_AT_ONCE, len(names)))]
-        for thread in drops:
-            thread.start()
-        for thread in drops:
-            thread.join()
-        if errors:
-            raise errors[0]
-
-    def _drop_from(self, pending: list[str], errors: list[BaseException]) -> None:
-        """Drop names taken from `pending` (list.pop is atomic) over one connection until none is left."""
-        try:
-            with psycopg.connect(self.server_url, autocommit=True) as admin:
-                while pending:
-                    drop_with(admin, pending.pop())
-        except IndexError:    # another thread took the last one
-            pass
-        except BaseException as error:   # noqa: BLE001 — raised by _drop_all in the drop thread
-            errors.append(error)
+                return None
+            name = self.used.pop(0)
+            self.dropping.append(name)
+            return name
