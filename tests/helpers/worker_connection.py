@@ -1,8 +1,8 @@
 """One connection per worker to a test database, lent to test after test (the `conn` fixture).
 
 A new connection costs the client 4-5 ms and the server a fresh backend whose first queries load
-its catalog caches: server CPU taken from the suite's two workers (issue 28: about 700 of the fast
-subset's 2,500 connections were `conn`'s own). Each test runs inside a transaction rolled back at
+its catalog caches: server CPU taken from the suite's two workers (issue 28: 725 of the fast
+subset's 2,958 connections were `conn`'s own). Each test runs inside a transaction rolled back at
 its end (tests/conftest.py), which undoes its writes, its SET and SET ROLE and its temporary
 tables; what a rollback keeps (session-level advisory locks, LISTEN, PREPAREd statements, cursors
 WITH HOLD, sequences' currval, a SET made after a COMMIT the test sent itself) DISCARD ALL
