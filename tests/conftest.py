@@ -20,9 +20,9 @@ import psycopg
 import pytest
 from helpers.database_pool import DatabasePool, create_database
 from helpers.matrix_sample import mark_matrices
+from helpers.worker_connection import WorkerConnection
 from psycopg import sql
 from psycopg.conninfo import conninfo_to_dict, make_conninfo
-from psycopg.pq import TransactionStatus
 
 import engine.programs.all_models  # noqa: F401  (every model registers, as the commands that use one make it)
 
@@ -234,29 +234,19 @@ def real_conn(real_library):
             yield connection
 
 
+@pytest.fixture(scope="session")
+def _worker_connection(database_url) -> Iterator[WorkerConnection]:
+    """The connection `conn` lends every test of the worker (tests/helpers/worker_connection.py)."""
+    lender = WorkerConnection(database_url)
+    yield lender
+    lender.close()
+
+
 @pytest.fixture
-def conn(database_url):
-    """A connection whose every change is rolled back at the end of the test."""
-    with psycopg.connect(database_url) as connection:
-        with connection.transaction(force_rollback=True):
-            yield connection
-        _vacuum_if_bloated(connection)
-
-
-DEAD_ROWS_BEFORE_VACUUM = 3000
-
-
-def _vacuum_if_bloated(connection) -> None:
-    """Every rolled-back insert leaves a dead row in the session's database, and autovacuum does
-    not keep up with a suite (on a shared server it is busy elsewhere): by the middle of the suite
-    assembly held 17,000 dead rows beside its 488 live ones and reading template_view took 1.7 s
-    instead of 0.02 s. VACUUM removes only rows no transaction can see."""
-    if connection.closed or connection.info.transaction_status != TransactionStatus.IDLE:
-        return
-    connection.autocommit = True
-    dead = connection.execute("SELECT coalesce(sum(n_dead_tup), 0) FROM pg_stat_all_tables").fetchone()[0]
-    if dead > DEAD_ROWS_BEFORE_VACUUM:
-        connection.execute("VACUUM")
+def conn(_worker_connection):
+    """A connection whose every change is rolled back at the end of the test, its session reset."""
+    with _worker_connection.lent() as connection:
+        yield connection
 
 
 @pytest.fixture

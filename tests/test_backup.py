@@ -75,19 +75,19 @@ def test_a_backup_of_edited_migrations_is_refused_before_restoring(run, empty_da
     assert contents(empty_database_url) == {"rows": {}, "sequences": []}
 
 
-def test_an_existing_backup_file_is_kept_unless_forced(run, tmp_path):
+def test_an_existing_backup_file_is_kept_unless_forced(read_only_run, tmp_path):
     file = tmp_path / "engine.dump"
     file.write_bytes(b"yesterday's backup")
-    message = one_line_refusal(run("db", "backup", file))
+    message = one_line_refusal(read_only_run("db", "backup", file))
     assert "exists" in message and "--force" in message
     assert file.read_bytes() == b"yesterday's backup"
-    assert run("db", "backup", file, "--force").exit_code == 0
+    assert read_only_run("db", "backup", file, "--force").exit_code == 0
     assert file.read_bytes().startswith(b"PGDMP")   # the custom format's magic
     assert [path.name for path in tmp_path.iterdir()] == ["engine.dump"]
 
 
-def test_a_backup_into_a_missing_folder_is_refused(run, tmp_path):
-    message = one_line_refusal(run("db", "backup", tmp_path / "typo" / "engine.dump"))
+def test_a_backup_into_a_missing_folder_is_refused(read_only_run, tmp_path):
+    message = one_line_refusal(read_only_run("db", "backup", tmp_path / "typo" / "engine.dump"))
     assert "does not exist" in message and not (tmp_path / "typo").exists()
 
 

@@ -53,8 +53,7 @@ from helpers.hobbing_reference_gears import (
 from helpers.hobbing_reference_programs import HAND_WRITTEN
 from hypothesis import HealthCheck, Phase, given, settings
 from hypothesis import strategies as st
-from psycopg import sql
-from psycopg.conninfo import conninfo_to_dict, make_conninfo
+from psycopg.conninfo import make_conninfo
 
 from engine.errors import EngineError
 from engine.hobbing.choices import Choices
@@ -178,13 +177,10 @@ class Bench:
 
 
 @pytest.fixture(scope="module")
-def bench(server_url, database_url, database_pool):
-    """On its own copy of the seeded database: a connection left open on the session's database
-    would stop other tests from copying it. Dropped by the pool, behind the tests that follow."""
-    base = conninfo_to_dict(database_url)["dbname"]
-    name = f"{base}_ref{uuid.uuid4().hex[:6]}"
-    with psycopg.connect(server_url, autocommit=True) as admin:
-        admin.execute(sql.SQL("CREATE DATABASE {} TEMPLATE {}").format(sql.Identifier(name), sql.Identifier(base)))
+def bench(database_url, database_pool, _seeded_copies):
+    """On its own copy of the seeded database, from the pool (the session's database itself cannot
+    be copied while `conn` holds a connection to it). Dropped by the pool, behind the tests that follow."""
+    name = database_pool.take(_seeded_copies)
     try:
         with psycopg.connect(make_conninfo(database_url, dbname=name)) as connection:
             with connection.transaction(force_rollback=True):

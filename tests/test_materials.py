@@ -57,20 +57,20 @@ def test_the_seeded_rows_are_the_reference_table(conn):
     assert {name: row.ranges for name, row in SPEEDS.items()} == expected   # a record made without the database
 
 
-def test_list_names_every_shipped_material_and_csv_is_the_import_columns(run):
-    listed = json.loads(run("materials", "list", "--json").stdout)["materials"]
+def test_list_names_every_shipped_material_and_csv_is_the_import_columns(read_only_run):
+    listed = json.loads(read_only_run("materials", "list", "--json").stdout)["materials"]
     assert sorted(row["name"] for row in listed) == sorted(SEEDED, key=str)
-    table = run("materials", "list")
+    table = read_only_run("materials", "list")
     assert table.exit_code == 0 and table.stderr.strip() == f"{len(SEEDED)} materials"
-    assert run("materials", "list", "--csv").stdout.splitlines()[0] + "\n" == HEADER
+    assert read_only_run("materials", "list", "--csv").stdout.splitlines()[0] + "\n" == HEADER
 
 
-def test_show_finds_a_name_in_any_case_and_refuses_an_unknown_one_closest_first(run):
-    shown = json.loads(run("materials", "show", "42crmo4", "--json").stdout)["material"]
+def test_show_finds_a_name_in_any_case_and_refuses_an_unknown_one_closest_first(read_only_run):
+    shown = json.loads(read_only_run("materials", "show", "42crmo4", "--json").stdout)["material"]
     assert shown["name"] == "42CrMo4" and shown["gear_count"] == 0
     assert Decimal(str(shown["uncoated_low"])) <= Decimal(str(shown["default_uncoated"])) \
         <= Decimal(str(shown["uncoated_high"]))
-    refused = run("materials", "show", "42CrMo")
+    refused = read_only_run("materials", "show", "42CrMo")
     assert refused.exit_code == 1 and len(refused.stderr.strip().splitlines()) == 1
     assert "known, closest first: 42CrMo4" in refused.stderr and "engine materials import" in refused.stderr
 
@@ -106,10 +106,10 @@ def test_a_bad_row_is_refused_and_nothing_is_imported(run, tmp_path, row, said):
     assert run("materials", "list", "--csv").stdout == before
 
 
-def test_replace_takes_whole_rows_only(run, tmp_path):
+def test_replace_takes_whole_rows_only(read_only_run, tmp_path):
     path = tmp_path / "part.csv"
     path.write_text(HEADER.replace(",source", "") + SLOW.replace(",test\n", "\n"), encoding="utf-8")
-    result = run("materials", "import", path, "--replace")
+    result = read_only_run("materials", "import", path, "--replace")
     assert result.exit_code == 1 and "source" in result.stderr
 
 

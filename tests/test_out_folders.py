@@ -24,11 +24,11 @@ def one_line_refusal(result) -> str:
 
 @pytest.mark.parametrize("selection", [("--gear", "42"), ("--gears", "42-43")], ids=["one", "batch"])
 @pytest.mark.parametrize("target", ["typo/", "typo/deeper/GEAR.MPF"], ids=["folder", "file"])
-def test_instantiate_into_a_missing_folder_is_refused_and_stores_nothing(run, tmp_path, selection, target):
-    before = program_count(run.url)
-    message = one_line_refusal(run("instantiate", *selection, "--out", f"{tmp_path}/{target}"))
+def test_instantiate_into_a_missing_folder_is_refused_and_stores_nothing(read_only_run, tmp_path, selection, target):
+    before = program_count(read_only_run.url)
+    message = one_line_refusal(read_only_run("instantiate", *selection, "--out", f"{tmp_path}/{target}"))
     assert "does not exist" in message and "nothing stored" in message and "--mkdir" in message
-    assert program_count(run.url) == before
+    assert program_count(read_only_run.url) == before
     assert list(tmp_path.iterdir()) == []
 
 
@@ -45,17 +45,17 @@ def test_the_config_file_can_ask_for_the_folder_to_be_made(run, tmp_path):
     assert [path.name for path in (tmp_path / "new").iterdir()] == ["GEAR42.MPF"]
 
 
-def test_the_machine_folder_of_the_config_file_must_exist_too(run, tmp_path):
-    run.config.write_text(f'[machines.hobber-840d]\nout = "{tmp_path}/share/hobber"\n')
-    before = program_count(run.url)
-    assert "does not exist" in one_line_refusal(run("instantiate", "--gear", 42))
-    assert program_count(run.url) == before and list(tmp_path.iterdir()) == []
+def test_the_machine_folder_of_the_config_file_must_exist_too(read_only_run, tmp_path):
+    read_only_run.config.write_text(f'[machines.hobber-840d]\nout = "{tmp_path}/share/hobber"\n')
+    before = program_count(read_only_run.url)
+    assert "does not exist" in one_line_refusal(read_only_run("instantiate", "--gear", 42))
+    assert program_count(read_only_run.url) == before and list(tmp_path.iterdir()) == []
 
 
-def test_mkdir_without_a_folder_to_make_is_refused(run):
-    before = program_count(run.url)
-    assert "give --out too" in one_line_refusal(run("instantiate", "--gear", 42, "--mkdir"))
-    assert program_count(run.url) == before
+def test_mkdir_without_a_folder_to_make_is_refused(read_only_run):
+    before = program_count(read_only_run.url)
+    assert "give --out too" in one_line_refusal(read_only_run("instantiate", "--gear", 42, "--mkdir"))
+    assert program_count(read_only_run.url) == before
 
 
 def test_program_files_refuse_a_missing_folder_before_planning_anything(tmp_path):
@@ -66,10 +66,11 @@ def test_program_files_refuse_a_missing_folder_before_planning_anything(tmp_path
     assert list(tmp_path.iterdir()) == []   # planned only: the folder is made when the files are written
 
 
-def test_template_export_into_a_missing_folder(run, tmp_path):
-    message = one_line_refusal(run("template", "export", "--class", "spur", "--out", tmp_path / "typo" / "spur.csv"))
+def test_template_export_into_a_missing_folder(read_only_run, tmp_path):
+    message = one_line_refusal(read_only_run("template", "export", "--class", "spur",
+                                             "--out", tmp_path / "typo" / "spur.csv"))
     assert "does not exist" in message and list(tmp_path.iterdir()) == []
-    made = run("template", "export", "--class", "spur", "--out", tmp_path / "new" / "spur.csv", "--mkdir")
+    made = read_only_run("template", "export", "--class", "spur", "--out", tmp_path / "new" / "spur.csv", "--mkdir")
     assert made.exit_code == 0, made.output
     assert (tmp_path / "new" / "spur.csv").read_text().startswith("id,")
 

@@ -200,11 +200,11 @@ def test_a_hob_a_stored_job_was_made_with_keeps_its_values(run, tmp_path):
     assert rows(run.url, f"SELECT length FROM hob WHERE id = '{hob_id}'") == [(Decimal(line.split(',')[6]),)]
 
 
-def test_replace_takes_whole_rows_only(run, tmp_path):
+def test_replace_takes_whole_rows_only(read_only_run, tmp_path):
     path = tmp_path / "hobs.csv"
     path.write_text("id,module,pressure_angle,starts,tip_diameter,length,hand,accuracy_class\n"
                     "H-M2-AA-R1,2,20,1,70,100,R,AA\n", encoding="utf-8")
-    said = refused(run.url, "hobs", "import", path, "--replace")
+    said = refused(read_only_run.url, "hobs", "import", path, "--replace")
     assert said.endswith("leaves out material, coating, purpose, tool_number, module_kind, gashes, profile; "
                          "nothing imported: give every column (`engine hobs list --csv` writes them), or import "
                          "without --replace to keep each hob's own values of those")

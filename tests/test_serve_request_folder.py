@@ -170,9 +170,9 @@ def test_a_link_is_never_read_as_a_request(run, folders, tmp_path):
         ["L.REQ"]
 
 
-def test_a_machine_that_does_not_exist_is_refused(run, tmp_path):
+def test_a_machine_that_does_not_exist_is_refused(read_only_database_url, tmp_path):
     with pytest.raises(EngineError, match="machine hobber-9 of the request folders does not exist"):
-        RequestFolder(tmp_path, ["hobber-9"], run.url, Config())
+        RequestFolder(tmp_path, ["hobber-9"], read_only_database_url, Config())
 
 
 def test_the_service_needs_only_a_runners_login(run, server_url, tmp_path):

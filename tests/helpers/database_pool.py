@@ -4,7 +4,7 @@ A test that commits needs a private copy of the seeded database. Copying it (CRE
 TEMPLATE) costs the server about a quarter of a second, and dropping it more: DROP DATABASE waits
 for a checkpoint, which on a server other sessions share flushes their dirty pages too (a second
 and more). Done in the test's own setup and teardown that time adds up over hundreds of tests;
-here two threads copy the next databases while the current test runs, and another drops the used
+here two threads copy the next databases while the current test runs, and others drop the used
 ones, several at once so that their checkpoints are shared.
 
 Copies are made from a template nobody connects to, so a test holding a connection to the session's
@@ -19,7 +19,6 @@ import subprocess
 import sys
 import threading
 import uuid
-from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import psycopg
@@ -47,7 +46,12 @@ def create_database(admin, name: str, template: str | None = None, file_copy: bo
 def drop_database(server_url: str, name: str) -> None:
     """DROP DATABASE `name`, ending any connection a test left open to it."""
     with psycopg.connect(server_url, autocommit=True) as admin:
-        admin.execute(sql.SQL("DROP DATABASE IF EXISTS {} WITH (FORCE)").format(sql.Identifier(name)))
+        drop_with(admin, name)
+
+
+def drop_with(admin, name: str) -> None:
+    """DROP DATABASE `name` over the autocommit connection `admin`, ending any connection to it."""
+    admin.execute(sql.SQL("DROP DATABASE IF EXISTS {} WITH (FORCE)").format(sql.Identifier(name)))
 
 
 # Run by drop_later in a process of its own: drops the databases named on its command line.
@@ -95,12 +99,12 @@ class DatabasePool:
         self.server_url, self.file_copy = server_url, file_copy
         self.kinds: list[Kind] = []
         self.used: list[str] = []
-        self.dropping: list[str] = []   # the batch the drop thread is dropping (dropped again at close: IF EXISTS)
+        self.dropping: list[str] = []   # being dropped by the drop threads (dropped again at close: IF EXISTS)
         self.error: BaseException | None = None
         self.closing = False
         self.changed = threading.Condition()
         self.threads = [threading.Thread(target=self._guarded, args=(work,), daemon=True)
-                        for work in (self._make_ahead,) * MAKERS + (self._drop_behind,)]
+                        for work in (self._make_ahead,) * MAKERS + (self._drop_behind,) * DROPS_AT_ONCE]
         for thread in self.threads:
             thread.start()
 
@@ -179,20 +183,29 @@ class DatabasePool:
             return kind
 
     def _drop_behind(self) -> None:
-        while batch := self._next_drops():
-            self._drop_all(batch)
-            with self.changed:
-                self.dropping = []   # dropped: not handed to the dropper at close again
+        """One of DROPS_AT_ONCE daemon threads, each dropping over a connection of its own, made at
+        its first drop and kept: a connection per DROP was a new server backend each time, 360 of
+        the fast subset's 2,200 connections (issue 28). Daemon threads, because the interpreter
+        joins a ThreadPoolExecutor's at exit: on the local server, where each DROP DATABASE waits
+        for a checkpoint, a worker stayed 4-10 s after its last test for the drops in progress.
+        What they leave undone close() hands to the detached dropper (DROP … IF EXISTS)."""
+        admin = None
+        try:
+            while name := self._next_drop():
+                admin = admin or psycopg.connect(self.server_url, autocommit=True)
+                drop_with(admin, name)
+                with self.changed:
+                    self.dropping.remove(name)   # dropped: not handed to the dropper at close again
+        finally:
+            if admin is not None:
+                admin.close()
 
-    def _next_drops(self) -> list[str]:
-        """Every used database not yet dropped; [] when closing."""
+    def _next_drop(self) -> str | None:
+        """The used database given back first and not yet dropped; None when closing."""
         with self.changed:
             self.changed.wait_for(lambda: self.closing or self.used)
             if self.closing:
-                return []
-            self.dropping, self.used = self.used, []
-            return self.dropping
-
-    def _drop_all(self, names: list[str]) -> None:
-        with ThreadPoolExecutor(max_workers=DROPS_AT_ONCE) as drops:
-            list(drops.map(lambda name: drop_database(self.server_url, name), names))
+                return None
+            name = self.used.pop(0)
+            self.dropping.append(name)
+            return name
