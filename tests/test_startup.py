@@ -4,6 +4,7 @@ here is timed). Each check runs a fresh interpreter, where nothing else has impo
 and reads its sys.modules after the work."""
 from __future__ import annotations
 
+import json
 import subprocess
 import sys
 
@@ -90,6 +91,51 @@ def test_each_command_module_is_named_with_the_command_it_holds():
     assert len(main.commands) == len(COMMAND_MODULES) == 26   # issue 32: engine serve; issue 33: engine plant
     for name in COMMAND_MODULES:
         assert main.commands[name].name == name
+
+
+def test_each_listed_short_help_is_the_commands_own():
+    """engine.cli.short_help holds what `engine --help` lists without importing a command: each
+    entry is the command's short help as click makes it (a docstring changed without this table
+    fails here, naming the command and the text to write)."""
+    from engine.cli.app import main
+    from engine.cli.short_help import SHORT_HELP
+
+    assert sorted(SHORT_HELP) == sorted(main.commands)
+    for name in main.commands:
+        assert SHORT_HELP[name] == main.commands[name].get_short_help_str(10 ** 6), name
+
+
+HELP_LISTINGS = """
+import contextlib, io, json, sys
+from engine.cli.app import main
+
+def listing(width):
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        try:
+            main(['--help'], prog_name='engine', terminal_width=width)
+        except SystemExit:
+            pass
+    return out.getvalue()
+
+lazy = [listing(width) for width in (200, 80, 40)]
+loaded = sorted(name for name in sys.modules if name.startswith('engine.cli.'))
+for name in main.commands:
+    main.commands[name]
+print(json.dumps([lazy, [listing(width) for width in (200, 80, 40)], loaded]))
+"""
+
+
+def test_engine_help_imports_no_command_and_lists_them_as_click_would():
+    """Issue 12's start-up: the listing of `engine --help` imported every command module for its
+    short help; it lists the same text (shortened to any width as click shortens it) from
+    engine.cli.short_help, and imports none."""
+    done = subprocess.run([sys.executable, "-c", HELP_LISTINGS], capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    lazy, imported, loaded = json.loads(done.stdout)
+    assert lazy == imported and "instantiate" in lazy[1]
+    assert set(loaded) - CLI_MODULES_OF_INSTANTIATE == {"engine.cli.short_help"}
+    assert set(loaded) & {"engine.cli.instantiate", "engine.cli.hobs", "engine.cli.serve"} == set()
 
 
 def test_the_models_a_command_does_not_plan_with_are_imported_when_the_registry_is_read_whole():

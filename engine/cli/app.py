@@ -92,6 +92,17 @@ class EngineGroup(click.Group):
         ctx.meta[CONFIG] = config
         return ctx
 
+    def format_commands(self, ctx, formatter):
+        """click's list of commands, each command's short help from engine.cli.short_help where it
+        is not imported yet: `engine --help` imports no command module (issue 12's start-up)."""
+        if not isinstance(self.commands, LazyCommands):   # a group whose commands are all imported
+            return super().format_commands(ctx, formatter)
+        names = [name for name in self.list_commands(ctx) if not _hidden(self.commands, name)]
+        if names:
+            limit = formatter.width - 6 - max(map(len, names))   # click's: three times the default spacing
+            with formatter.section("Commands"):
+                formatter.write_dl([(name, _short_help(self.commands, name, limit)) for name in names])
+
     def parse_args(self, ctx, args):
         ctx.meta[JSON_ARGS] = wants_json(args)
         try:
@@ -134,6 +145,20 @@ class EngineGroup(click.Group):
                 fail(_database_failure_message(error, first_line), 1)
             fail(f"unexpected error: {type(error).__name__}: {first_line} (run with --traceback for details)", 2,
                  prefix="")
+
+
+def _hidden(commands: LazyCommands, name: str) -> bool:
+    return name in commands.imported() and commands[name].hidden
+
+
+def _short_help(commands: LazyCommands, name: str, limit: int) -> str:
+    """The command's short help shortened to `limit` characters: click shortens it (a stand-in
+    command of that help, where the command is not imported)."""
+    from .short_help import SHORT_HELP  # the listing's only: a command's own start-up loads none of it
+
+    if name in commands.imported() or name not in SHORT_HELP:
+        return commands[name].get_short_help_str(limit)
+    return click.Command(name, help=SHORT_HELP[name]).get_short_help_str(limit)
 
 
 def _silence_stdout() -> None:

@@ -1,8 +1,9 @@
 """The commands of `engine`, each imported when it is first looked up (issue 28: start-up).
 
 `engine instantiate --gear 42` imports engine.cli.instantiate and none of the other command
-modules (nor the library modules they import at their top); `engine --help`, a config file's
-table of a command and the tests that walk the tree import the ones they name. A command gets
+modules (nor the library modules they import at their top); `engine --help` lists them with the
+short help of engine.cli.short_help and imports none; a config file's table of a command and the
+tests that walk the tree import the ones they name. A command gets
 the conventions of engine.cli.conventions as it is imported, as it did when every command was
 imported with engine.cli.app.
 """
