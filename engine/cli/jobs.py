@@ -6,6 +6,7 @@ import json
 
 import click
 
+from ..db.origin import LAST_PLANT
 from .context import connection
 from .ids import GEAR_ID, JOB_ID
 from .output import Column, day, day_options, emit_list, emit_record, list_options
@@ -36,7 +37,7 @@ def jobs():
 @click.option("--class", "gear_class", help="Only jobs of this class.")
 @click.option("--gear", "gear_id", type=GEAR_ID, help="Only jobs of this gear (a gear of --plant's, else of this "
               "database: gear ids of plants collide).")
-@click.option("--plant", type=click.IntRange(0, 9999), help="Only jobs made at this plant (0: the head office).")
+@click.option("--plant", type=click.IntRange(0, LAST_PLANT), help="Only jobs made at this plant (0: the head office).")
 @day_options("jobs made")
 @list_options("jobs")
 @click.pass_context

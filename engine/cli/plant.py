@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import click
 
+from ..db.origin import LAST_PLANT
 from ..errors import EngineError
 from .context import connection, emit_json, record_dict
 
@@ -38,7 +39,7 @@ def plant_publish(ctx):
 @plant.command("subscribe")
 @click.option("--head", "head_url", required=True, help="The head office's database URL (reached from this "
               "plant's server too: its subscription connects with it).")
-@click.option("--number", type=click.IntRange(1, 9999), required=True,
+@click.option("--number", type=click.IntRange(1, LAST_PLANT), required=True,
               help="This plant's number, unique in the group: its ids are number·10^10 to (number+1)·10^10 − 1.")
 @click.option("--plant-url", default=None, help="This database's URL as the head office's server reaches it "
               "(default: the URL in use).")

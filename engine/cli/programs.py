@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import click
 
-from ..db.origin import plant_name
+from ..db.origin import LAST_PLANT, plant_name
 from .context import connection, emit_json
 from .ids import GEAR_ID, JOB_ID, PROGRAM_ID
 from .output import Column, day, day_options, emit_list, list_options, one_of
@@ -48,7 +48,8 @@ def programs():
 @click.option("--class", "gear_class", help="Only programs of this class.")
 @click.option("--gear", "gear_id", type=GEAR_ID, help="Only programs made for this gear (a gear of --plant's, "
               "else of this database: gear ids of plants collide).")
-@click.option("--plant", type=click.IntRange(0, 9999), help="Only programs made at this plant (0: the head office).")
+@click.option("--plant", type=click.IntRange(0, LAST_PLANT),
+              help="Only programs made at this plant (0: the head office).")
 @click.option("--job", "job_id", type=JOB_ID, help="Only programs made from this job.")
 @click.option("--draft", is_flag=True, help="Only programs made from a draft version (for trying).")
 @click.option("--released", is_flag=True, help="Only programs made from a released version.")

@@ -15,8 +15,9 @@ if TYPE_CHECKING:
     from .connection import Connection
 
 PLANT_IDS = 10**10   # the size of one plant's id range (migration 0042's plant_first_id)
+LAST_PLANT = 9999    # the greatest plant number (migration 0042's plant_identity.number check)
 # SQL of the plant that made the row with id column `id` (psycopg.sql would quote the alias away)
-MADE_AT_SQL = "({id} / 10000000000)::int"
+MADE_AT_SQL = "({id} / " + str(PLANT_IDS) + ")::int"
 # SQL: true of a row this database made (its id in this database's range)
 MADE_HERE_SQL = "{id} BETWEEN plant_first_id(plant_number()) AND plant_last_id(plant_number())"
 

@@ -70,9 +70,10 @@ PLANT = "PLANT"
 NOT_RENDERED = "on show"   # a list's word for a program it did not render (`programs show` renders it)
 # What a list of programs says without rendering any (SQL over program p JOIN job j): UNCHECKED
 # for one that cannot be rendered again (its job edited since, or stored before input hashes).
-LISTED_RENDERING = ("CASE WHEN p.input_hash IS NOT NULL AND p.input_hash = job_input_hash(j.params, j.module_params) "
-                    "THEN 'on show' ELSE 'UNCHECKED' END")
-LISTED_RENDERING = (f"CASE WHEN NOT ({MADE_HERE_SQL.format(id='p.id')}) THEN '{PLANT}' ELSE {LISTED_RENDERING} END")
+# PLANT for one another plant made.
+_RENDERABLE = ("CASE WHEN p.input_hash IS NOT NULL AND p.input_hash = job_input_hash(j.params, j.module_params) "
+               "THEN 'on show' ELSE 'UNCHECKED' END")
+LISTED_RENDERING = f"CASE WHEN NOT ({MADE_HERE_SQL.format(id='p.id')}) THEN '{PLANT}' ELSE {_RENDERABLE} END"
 STORED = """
 SELECT p.id, p.name, p.gear_class, p.template_version, p.template_hash, p.input_hash, p.draft, p.unverified,
        p.lines, p.row_ids, p.trace, p.job_id, j.machine, j.params, j.module_params,

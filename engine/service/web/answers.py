@@ -11,6 +11,7 @@ from typing import Any
 from starlette.requests import Request
 from starlette.responses import Response
 
+from ...db.origin import LAST_PLANT
 from ...errors import EngineError
 from ...json_text import cell
 from .pages import TEMPLATES, connection, page, refusal, wants_json
@@ -19,7 +20,7 @@ from .pages import TEMPLATES, connection, page, refusal, wants_json
 INTEGER_MAX = 2**31 - 1
 BIGINT_MAX = 2**63 - 1
 ID_RANGES = {"gear": (1, INTEGER_MAX), "job": (1, BIGINT_MAX), "program": (1, BIGINT_MAX),
-             "row": (0, INTEGER_MAX), "line": (1, INTEGER_MAX), "plant": (0, 9999)}
+             "row": (0, INTEGER_MAX), "line": (1, INTEGER_MAX), "plant": (0, LAST_PLANT)}
 # how the library says a record is not there (engine.db.listing.one_record, engine.programs.lookup):
 # such a refusal answers 404, any other 400
 NOT_FOUND_WORDS = (" does not exist", "no program has ", " is not in the program's template version")
