@@ -110,13 +110,18 @@ class Impact(msgspec.Struct):
     proved: int = 0   # distinct changed programs read by the verifier and followed by the simulation
     plant_jobs: dict[int, int] = {}   # plant → its jobs of the classes, held here as history, not re-made
 
-    def plants_said(self) -> str:
-        """The plants' jobs left out, in words ("" without any)."""
+    def plants_sentence(self) -> str:
+        """The plants' jobs left out, as a sentence of its own ("" without any): JSON's `plants_said`
+        and the web's impact line."""
         if not self.plant_jobs:
             return ""
         plants = ", ".join(map(str, self.plant_jobs))
-        return (f"; and {sum(self.plant_jobs.values())} job(s) of plant(s) {plants}, not re-made here (their gears "
-                "are the plants'); each plant proves its programs when it makes or sends them")
+        return (f"{sum(self.plant_jobs.values())} job(s) of plant(s) {plants} not re-made here (their gears are "
+                "the plants'); each plant proves its programs when it makes or sends them")
+
+    def plants_said(self) -> str:
+        """The same closing the CLI's impact line: "; and …" ("" without any)."""
+        return f"; and {self.plants_sentence()}" if self.plant_jobs else ""
 
     def plants_json(self) -> list[dict]:
         return [{"plant": plant, "jobs": jobs} for plant, jobs in self.plant_jobs.items()]

@@ -83,7 +83,7 @@ def report_json(report: ReleaseReport) -> dict:
                        "diffs": [{"job_id": d.job_id, "class": d.gear_class, "diff": d.diff}
                                  for d in impact.diffs],
                        "layout": [change.as_json() for change in impact.layouts.values()],
-                       "plants": impact.plants_json(), "plants_said": impact.plants_said().removeprefix("; ")}}
+                       "plants": impact.plants_json(), "plants_said": impact.plants_sentence()}}
 
 
 def diff_json(gear_class: str, from_version: int, to_version: int, changes: list[RowChange],
