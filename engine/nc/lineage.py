@@ -141,7 +141,7 @@ def _stored_match(text: str) -> re.Match | None:
     """The words matched inside the first comment form that encloses them exactly."""
     for opening, closing in _comment_forms():
         if text.startswith(opening) and text.endswith(closing) and len(text) >= len(opening) + len(closing):
-            found = _words_pattern(False).fullmatch(text, len(opening), len(text) - len(closing))
+            found = _stored_pattern().fullmatch(text, len(opening), len(text) - len(closing))
             if found is not None:
                 return found
     return None
@@ -160,12 +160,16 @@ def _pasted_pattern() -> re.Pattern:
     forms = _comment_forms()
     openings = "".join(re.escape(opening.strip()) for opening, _ in forms)
     closings = "|".join(re.escape(closing) for _, closing in forms if closing)
-    words = _words_pattern(True).pattern
-    return re.compile(rf"(?:N[0-9]+\s*)?[{openings}]\s*{words}\s*(?:{closings})?", re.IGNORECASE)
+    return re.compile(rf"(?:N[0-9]+\s*)?[{openings}]\s*{_words(True)}\s*(?:{closings})?", re.IGNORECASE)
 
 
 @cache
-def _words_pattern(pasted: bool) -> re.Pattern:
+def _stored_pattern() -> re.Pattern:
+    """The words as written, inside a comment form (_stored_match)."""
+    return re.compile(_words(False))
+
+
+def _words(pasted: bool) -> str:
     """WORDS with each field a named group of its FIELDS text, then DRAFT, then UNVERIFIED, each
     optional. Stored: one space apart, as written; pasted: any spaces, the INPUT hash optional."""
     space = r"\s+" if pasted else " "
@@ -174,8 +178,7 @@ def _words_pattern(pasted: bool) -> re.Pattern:
     for token in tokens[1:]:
         piece = space + _token_pattern(token)
         pattern += f"(?:{piece})?" if pasted and token == "{input_hash}" else piece
-    pattern += "".join(f"(?:{space}(?P<{word.lower()}>{word}))?" for word in (DRAFT, UNVERIFIED))
-    return re.compile(pattern, re.IGNORECASE if pasted else 0)
+    return pattern + "".join(f"(?:{space}(?P<{word.lower()}>{word}))?" for word in (DRAFT, UNVERIFIED))
 
 
 def _token_pattern(token: str) -> str:
