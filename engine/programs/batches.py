@@ -23,6 +23,7 @@ from psycopg.types.json import Jsonb
 
 from ..db.connection import scalar
 from ..errors import EngineError
+from ..nc.lineage import DRY_RUN_ID
 from ..notes import prefixed
 from .options import Output, RunMode
 from .outputs import files_after_commit
@@ -32,7 +33,6 @@ from .storage import Batch, Lineage, refuse_unsafe
 if TYPE_CHECKING:
     from ..db.connection import Connection
 
-DRY_RUN_ID = "DRY-RUN"   # in the lineage line where a stored program has its id
 NEW_INPUT_HASH = "SELECT job_input_hash(%s, %s)"   # the hash a new job's parameters would get stored
 NOTHING_STORED = re.compile(r"[;,]?\s*nothing stored\s*$")   # said once for the batch, not per gear
 

@@ -5,16 +5,13 @@ simulation), and the look-up an operator needs at the control: the hash on the l
 the program id) read off the control's screen leads to the program."""
 from __future__ import annotations
 
-import re
-
-import msgspec
 from starlette.requests import Request
 from starlette.responses import RedirectResponse
 from starlette.routing import Route
 
 from ...db.origin import this_plant
 from ...errors import EngineError
-from ...nc.lineage import lineage_shaped
+from ...nc.lineage import DRY_RUN_ID, LineageRecord, lineage_shaped, read_lineage
 from ...programs.lookup import MIN_HASH_DIGITS, checked_prefix, find_programs, list_programs, programs_with_hash
 from ...programs.rendering import MATCH, REFUSED
 from .answers import BIGINT_MAX, BadRequest, answered, query_day, query_flag, query_id, query_text, shown, whole
@@ -23,11 +20,6 @@ from .program_views import plot_svg, simulation_report, traced
 
 KINDS = {"draft": True, "released": False}   # the list's --draft / --released
 QUERY_SHOWN = 200   # characters of a look-up's query a refusal repeats
-# A lineage line pasted whole (engine.nc.lineage: `; PROGRAM 812 TEMPLATE spur v1 176b5437 INPUT
-# bdf26401`, `(PROGRAM … )` on a Fanuc, a block number before it, DRAFT / UNVERIFIED after it).
-PASTED_LINE = re.compile(r"(?:N[0-9]+\s*)?[;(]\s*PROGRAM\s+(?P<id>[0-9]{1,19})\s+TEMPLATE\s+(?P<cls>\S+)\s+"
-                         r"v(?P<version>[0-9]{1,9})\s+(?P<template>[0-9a-f]{8})\s+INPUT(?:\s+(?P<input>[0-9a-f]{8}))?"
-                         r"(?:\s+DRAFT)?(?:\s+UNVERIFIED)?\s*\)?", re.IGNORECASE)
 
 
 def programs(request: Request):
@@ -78,7 +70,7 @@ def lookup(request: Request):
     def work(conn):
         typed = query_text(request, "q") or ""
         line = pasted_lineage(typed)
-        found = find_programs(conn, line.program_id) if line else find_programs(conn, *_wanted(conn, typed))
+        found = find_programs(conn, int(line.program_id)) if line else find_programs(conn, *_wanted(conn, typed))
         if line:
             _agrees(conn, line, found[0])
         if len(found) == 1 and not wants_json(request):
@@ -102,30 +94,21 @@ def _wanted(conn, text: str) -> tuple[int | None, str | None]:
                          "<hash8> INPUT <hash8>`)") from None
 
 
-class Pasted(msgspec.Struct, frozen=True):
-    """A whole lineage line as pasted: what it says of its program."""
-    program_id: int
-    gear_class: str
-    version: int
-    template_hash: str
-    input_hash: str
-
-
-def pasted_lineage(text: str) -> Pasted | None:
-    """The lineage line pasted whole (either comment form, a block number before it), or None for
-    anything that does not read as one; BadRequest for a line that reads as one but is not whole."""
+def pasted_lineage(text: str) -> LineageRecord | None:
+    """The lineage line pasted whole (engine.nc.lineage.read_lineage's pasted form: either comment
+    form, a block number before it, any case), or None for anything that does not read as one;
+    BadRequest for a line that reads as one but is not a stored program's whole line."""
     typed = text.strip()
     if not lineage_shaped(typed):
         return None
-    found = PASTED_LINE.fullmatch(typed)
-    if found is None:
+    line = read_lineage(typed, pasted=True)
+    if line is None or line.program_id == DRY_RUN_ID:
         raise BadRequest(f"{_shown(typed)} reads as a lineage line but not a whole one: paste it whole "
                          "(`; PROGRAM <id> TEMPLATE <class> v<n> <hash8> INPUT <hash8>`), or its INPUT hash alone")
-    return Pasted(whole("program", found["id"]), found["cls"], int(found["version"]), found["template"].lower(),
-                  (found["input"] or "").lower())
+    return line._replace(program_id=whole("program", str(line.program_id)))
 
 
-def _agrees(conn, line: Pasted, record) -> None:
+def _agrees(conn, line: LineageRecord, record) -> None:
     """The line's class, version and hashes are its program's; else BadRequest naming the programs
     they are (a line copied from another program's file, or mistyped, must not lead to this one)."""
     said = (line.gear_class, line.version, line.template_hash, line.input_hash)
@@ -138,7 +121,7 @@ def _agrees(conn, line: Pasted, record) -> None:
                      "was changed; look up its INPUT hash alone")
 
 
-def _theirs(conn, line: Pasted) -> str:
+def _theirs(conn, line: LineageRecord) -> str:
     """'; they are program 815's' when stored programs carry the line's two hashes."""
     try:
         found = [record.id for record in programs_with_hash(conn, line.input_hash)

@@ -8,6 +8,8 @@ from __future__ import annotations
 import re
 from functools import lru_cache
 
+from ...nc.lineage import read_lineage
+
 # The words of a header fact, and any time in minutes (a misspelt `; FL00R TO FL00R 9.9 MIN` is
 # still read as the program's time by whoever reads it: adversary 29).
 CLAIM = re.compile(r"\b(GEAR|HOB|MACHINE|FIXTURE|CYCLE|FLOOR|ALLOWANCE)|\b(CUT|UNIT|n0)\b|[0-9]\s*MIN(UTES?)?\b",
@@ -20,11 +22,10 @@ CANONICAL = (re.compile(r"; GEAR \S+( .*)?"), re.compile(r"; HOB \S+( .*)?"), re
              re.compile(r"; n0=[0-9]+ r/min table=[0-9]+(\.[0-9]+)? r/min cuts=[0-9]+ \S+"),
              re.compile(r"; CUT \S+( .*)? X=\S+ \S+"), re.compile(r"; UNIT [0-9]+ z=\S+ b=\S+ Z\S+"))
 REMARKS = ("HOB SHIFT PER PART",)     # the templates' note on the shift parameter's line
-# The template's version line and the engine's lineage line (engine.nc.lineage): a class name
-# may hold a header word (`gear_x`, `hobbed`), but they state no header fact; the database checked the
-# lineage line when the program was stored.
-CLASS_LINES = (re.compile(r"; TEMPLATE \S+ v[0-9]+"),
-               re.compile(r"; PROGRAM [0-9]+ TEMPLATE \S+ v[0-9]+ [0-9a-f]{8} INPUT [0-9a-f]{8}( DRAFT)?"))
+# The template's version line: a class name may hold a header word (`gear_x`, `hobbed`), but it
+# states no header fact; nor does the engine's lineage line (engine.nc.lineage.read_lineage, as
+# stored), which the database checked when the program was stored.
+TEMPLATE_VERSION_LINE = re.compile(r"; TEMPLATE \S+ v[0-9]+")
 
 
 def comment_problem(step) -> str | None:
@@ -49,7 +50,8 @@ def line_comment_problem(line: str, kind: str) -> str | None:
 
 
 def _names_a_class(line: str) -> bool:
-    return any(form.fullmatch(line) for form in CLASS_LINES)
+    """The template's version line or the lineage line, each whole and exactly as written."""
+    return TEMPLATE_VERSION_LINE.fullmatch(line) is not None or read_lineage(line) is not None
 
 
 def header_place_problem(fact: str, stated_before: bool, moved: bool) -> str | None:
