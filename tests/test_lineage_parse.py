@@ -119,11 +119,16 @@ def test_the_lookup_takes_a_written_line_for_its_program(values, dialect):
     assert said is not None and tuple(said) == expected(values)
 
 
-@pytest.mark.parametrize("text", [LINE.replace("812", DRY_RUN_ID), LINE.rsplit(" INPUT", 1)[0], LINE + " GEAR 44",
-                                  LINE.replace("v14", "v" + "1" * 11)])
+@pytest.mark.parametrize("text", [LINE.rsplit(" INPUT", 1)[0], LINE + " GEAR 44", LINE.replace("v14", "v" + "1" * 11)])
 def test_the_lookup_refuses_a_line_that_is_no_stored_programs_whole_line(text):
     with pytest.raises(BadRequest, match=NOT_WHOLE):
         pasted_lineage(text)
+
+
+def test_the_lookup_says_a_dry_runs_line_names_no_stored_program():
+    with pytest.raises(BadRequest, match="is a dry run's lineage line: a dry run stores no program") as refused:
+        pasted_lineage(f"N30 {LINE.replace('812', DRY_RUN_ID.lower())}")
+    assert NOT_WHOLE not in str(refused.value)
 
 
 def test_the_lookup_passes_over_what_is_no_lineage_line_and_checks_the_id_range():

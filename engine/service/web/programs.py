@@ -102,7 +102,10 @@ def pasted_lineage(text: str) -> LineageRecord | None:
     if not lineage_shaped(typed):
         return None
     line = read_lineage(typed, pasted=True)
-    if line is None or line.program_id == DRY_RUN_ID:
+    if line is not None and line.program_id == DRY_RUN_ID:
+        raise BadRequest(f"{_shown(typed)} is a dry run's lineage line: a dry run stores no program, so no record "
+                         "has it; paste the line of a stored program's file, or its INPUT hash alone")
+    if line is None:
         raise BadRequest(f"{_shown(typed)} reads as a lineage line but not a whole one: paste it whole "
                          "(`; PROGRAM <id> TEMPLATE <class> v<n> <hash8> INPUT <hash8>`), or its INPUT hash alone")
     return line._replace(program_id=whole("program", str(line.program_id)))
