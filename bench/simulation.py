@@ -6,12 +6,18 @@ The Jinja2 pipeline of bench/batch.py does not simulate: this ratio says how muc
 between the two is the proof.
 
 Then the simulation alone against an earlier tree (issue 28): every program the batch proved
-is simulated again by this tree and by `--against` (default 7bb4197, main before issue 28:
-the golden-section search), each in a subprocess of its own (the same interpreter, its source
-tree first on sys.path), runs alternated; printed per program and as a ratio, with how many
-of the two trees' reports (Report.lines(): findings, cuts, times) differ.
+is simulated again by `--against` (default 7bb4197, main before issue 28: the golden-section
+search, every section with numpy), the baseline, and by this tree along each of its two paths:
+plain floats (engine.simulation.hobbing.contact.MATH_SECTIONS never reached) and numpy (forced
+from the first section). Each run is a subprocess of its own (the same interpreter, its source
+tree first on sys.path), the three alternated; printed per program, per section (the plain
+path's count) and as ratios against the baseline, with how many reports (Report.lines():
+findings, cuts, times) differ from the baseline's and between the two paths. Last, what
+importing numpy costs a fresh process, and the break-even that sets MATH_SECTIONS: that cost
+over what numpy saves per section.
 
-    python bench/simulation.py [--count 1000] [--reps 3] [--against REV] [--profile] [--database-url URL]
+    python bench/simulation.py [--count 1000] [--reps 3] [--against REV] [--import-runs 11]
+                               [--profile] [--database-url URL]
 """
 from __future__ import annotations
 
@@ -19,9 +25,11 @@ import argparse
 import dataclasses
 import json
 import pickle
+import resource
 import subprocess
 import sys
 import tempfile
+import time
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
@@ -35,19 +43,29 @@ from engine.programs import verified_run  # noqa: E402
 
 WARMUP_GEARS = 100
 AGAINST = "7bb4197"      # main before issue 28: the golden-section search, every section with numpy
-WARMUP_PROGRAMS = 50     # simulated untimed first in each subprocess (imports, the switch to numpy)
+WARMUP_PROGRAMS = 50     # simulated untimed first in each subprocess (imports, the caches; numpy if forced)
+IMPORT_RUNS = 11         # alternated fresh-process starts with and without `import numpy`
+PATHS = {"plain": "plain floats", "numpy": "numpy forced"}   # this tree's two paths (TIMER's modes)
 
-# Runs in the subprocess: the tree's own simulation follows every program; prints seconds and reports.
-# The records (gear, hob, machine) travel as plain data (plain_records) and are rebuilt from the
-# tree's own classes with the fields that tree knows: a pickle of this tree's records names classes
-# and fields an earlier tree lacks (a Struct, the material's cutting speeds).
+# Runs in the subprocess: the tree's own simulation follows every program; prints seconds (wall and
+# CPU), the sections the plain path counted and the reports. Mode "plain" puts contact.MATH_SECTIONS
+# out of reach (no numpy is imported, which is checked), "numpy" below the first section, "as is"
+# leaves the tree alone (the baseline). The records (gear, hob, machine) travel as plain data
+# (plain_records) and are rebuilt from the tree's own classes with the fields that tree knows: a
+# pickle of this tree's records names classes and fields an earlier tree lacks (a Struct, the
+# material's cutting speeds).
 TIMER = r"""
-import dataclasses, importlib, json, pickle, sys, time
-tree, data = sys.argv[1], sys.argv[2]
+import dataclasses, importlib, json, math, pickle, sys, time
+tree, data, mode = sys.argv[1], sys.argv[2], sys.argv[3]
 sys.path.insert(0, tree)
 from engine.simulation.hobbing.run import simulate_program
 import engine.simulation.hobbing.run as run
 assert run.__file__.startswith(tree), run.__file__
+threshold = None
+if mode != "as is":
+    from engine.simulation.hobbing import contact
+    threshold = contact.MATH_SECTIONS
+    contact.MATH_SECTIONS = math.inf if mode == "plain" else -1
 
 def built(value):
     if isinstance(value, dict) and "__record__" in value:
@@ -64,10 +82,14 @@ with open(data, "rb") as file:
 programs = [built(program) for program in programs]
 for lines, gear, hob, machine, name in programs[:warmup]:
     simulate_program(lines, gear, hob, machine, name)
-start = time.perf_counter()
+counted = contact._followed[0] if mode == "plain" else None
+start, cpu = time.perf_counter(), time.process_time()
 reports = [simulate_program(lines, gear, hob, machine, name) for lines, gear, hob, machine, name in programs]
-seconds = time.perf_counter() - start
-print(json.dumps({"seconds": seconds, "reports": [report.lines() for report in reports]}))
+seconds, cpu = time.perf_counter() - start, time.process_time() - cpu
+assert mode != "plain" or "numpy" not in sys.modules, "the plain path imported numpy"
+sections = contact._followed[0] - counted if mode == "plain" else None
+print(json.dumps({"seconds": seconds, "cpu": cpu, "sections": sections, "threshold": threshold,
+                  "reports": [report.lines() for report in reports]}))
 """
 
 
@@ -116,38 +138,116 @@ def proved_programs(conn, first: int, last: int) -> list:
     return recorded
 
 
-def timed_tree(tree: Path, data: Path) -> dict:
-    done = subprocess.run([sys.executable, "-c", TIMER, str(tree), str(data)], capture_output=True, text=True)
+def timed_tree(tree: Path, mode: str, data: Path) -> dict:
+    done = subprocess.run([sys.executable, "-c", TIMER, str(tree), str(data), mode], capture_output=True, text=True)
     if done.returncode != 0:
-        raise RuntimeError(f"simulation run in {tree} failed: {done.stderr.strip()[-800:]}")
+        raise RuntimeError(f"simulation run in {tree} ({mode}) failed: {done.stderr.strip()[-800:]}")
     return json.loads(done.stdout.strip().splitlines()[-1])
 
 
-def compare_trees(programs: list, against: str, reps: int) -> None:
-    """The same programs simulated by this tree and by `against`, alternated; ratio and report differences."""
+def compare_trees(programs: list, against: str, reps: int) -> dict:
+    """The same programs simulated by `against` (the baseline, as that tree runs them) and by this
+    tree's two paths, alternated, the order turned by one each repetition; printed with ratios and
+    report differences. Returns each path's runs (TIMER's output), the baseline's if it was there."""
     with tempfile.TemporaryDirectory() as folder:
         (Path(folder) / "before").mkdir()
         before = source_tree_of(against, Path(folder) / "before")
         if before is None:
-            print(f"\nsimulation alone: this checkout has no commit {against}; give --against REV")
-            return
+            print(f"\nsimulation alone: this checkout has no commit {against} (give --against REV); "
+                  "this tree's two paths only")
         data = Path(folder) / "programs.pickle"
         data.write_bytes(pickle.dumps((plain_records(programs), min(WARMUP_PROGRAMS, len(programs)))))
-        trees = {"this tree": HERE.parent, against: before}
-        runs: dict = {name: [] for name in trees}
-        for repetition in range(reps):
-            for name in (list(trees) if repetition % 2 == 0 else list(trees)[::-1]):
-                runs[name].append(timed_tree(trees[name], data))
-    times = {name: [found["seconds"] for found in runs[name]] for name in trees}
-    seconds = {name: median(times[name]) for name in trees}
-    ours, theirs = runs["this tree"][0]["reports"], runs[against][0]["reports"]
-    differing = sum(mine != other for mine, other in zip(ours, theirs))
-    print(f"\nsimulation alone: {len(programs)} proved programs, {reps} alternated runs per tree (subprocesses)")
-    for name in trees:
-        print(f"  {name:12s}: median {seconds[name] / len(programs) * 1e3:6.2f} ms per program "
-              f"({', '.join(f'{value:.2f}' for value in times[name])} s)")
-    print(f"  ratio {against}/this tree = {seconds[against] / seconds['this tree']:.2f}x faster (target >= 3); "
-          f"reports differing: {differing} of {len(programs)}")
+        kinds = {label: (HERE.parent, mode) for mode, label in PATHS.items()}
+        if before is not None:
+            kinds = {against: (before, "as is"), **kinds}
+        runs = alternated(kinds, data, reps)
+    print_paths(runs, against if before is not None else None, len(programs), reps)
+    return runs
+
+
+def alternated(kinds: dict, data: Path, reps: int) -> dict:
+    """{name: [TIMER's output per repetition]} for kinds {name: (tree, mode)}, run in turn."""
+    runs: dict = {name: [] for name in kinds}
+    names = list(kinds)
+    for repetition in range(reps):
+        turn = repetition % len(names)
+        for name in names[turn:] + names[:turn]:
+            runs[name].append(timed_tree(*kinds[name], data))
+    return runs
+
+
+def print_paths(runs: dict, baseline: str | None, count: int, reps: int) -> None:
+    """Per program (wall and CPU), per section of the plain path's count, ratios to the baseline."""
+    plain, fast = PATHS["plain"], PATHS["numpy"]
+    sections = runs[plain][0]["sections"]
+    print(f"\nsimulation alone: {count} proved programs, {sections / count:,.0f} sections each (the plain "
+          f"path's count); runs of each: {reps}, alternated (subprocesses); medians, wall (CPU):")
+    for name, found in runs.items():
+        wall, cpu = seconds_of(found)
+        each = ", ".join(f"{one['seconds']:.2f}" for one in found)
+        print(f"  {name:14s}: {wall / count * 1e3:6.2f} ms ({cpu / count * 1e3:6.2f}) per program, "
+              f"{wall / sections * 1e6:5.2f} µs ({cpu / sections * 1e6:5.2f}) per section "
+              f"({each} s)")
+    if baseline is not None:
+        for name, target in ((plain, "one gear's path, no target"), (fast, "a batch's path, target >= 3")):
+            print(f"  ratio {baseline}/{name} = {ratio(runs[baseline], runs[name])} faster ({target}); "
+                  f"reports differing: {differing(runs[name], runs[baseline])} of {count}")
+    print(f"  ratio {plain}/{fast} = {ratio(runs[plain], runs[fast])} time; "
+          f"reports differing: {differing(runs[plain], runs[fast])} of {count}")
+
+
+def seconds_of(found: list) -> tuple[float, float]:
+    """Median wall and CPU seconds of one kind's runs."""
+    return median(one["seconds"] for one in found), median(one["cpu"] for one in found)
+
+
+def ratio(slow: list, fast: list) -> str:
+    """The two kinds' median times as a ratio, wall (CPU)."""
+    (slow_wall, slow_cpu), (fast_wall, fast_cpu) = seconds_of(slow), seconds_of(fast)
+    return f"{slow_wall / fast_wall:.2f}x ({slow_cpu / fast_cpu:.2f}x)"
+
+
+def differing(ours: list, theirs: list) -> int:
+    """Programs whose reports differ between the first runs of two kinds."""
+    return sum(mine != other for mine, other in zip(ours[0]["reports"], theirs[0]["reports"]))
+
+
+def numpy_import(runs: int) -> tuple[float, float]:
+    """Seconds (wall, CPU) importing numpy adds to a fresh process: the medians of `python -c
+    "import numpy"` less those of `python -c pass`, alternated after one untimed start of each."""
+    codes = {"pass": "pass", "numpy": "import numpy"}
+    for code in codes.values():
+        started(code)
+    times: dict = {name: [] for name in codes}
+    for run_number in range(runs):
+        for name in (list(codes) if run_number % 2 == 0 else list(codes)[::-1]):
+            times[name].append(started(codes[name]))
+    wall, cpu = (median(one[k] for one in times["numpy"]) - median(one[k] for one in times["pass"]) for k in (0, 1))
+    return wall, cpu
+
+
+def started(code: str) -> tuple[float, float]:
+    """Wall and CPU (the child's user and system) seconds of `python -c code`."""
+    before, start = resource.getrusage(resource.RUSAGE_CHILDREN), time.perf_counter()
+    subprocess.run([sys.executable, "-c", code], check=True)
+    wall, after = time.perf_counter() - start, resource.getrusage(resource.RUSAGE_CHILDREN)
+    return wall, after.ru_utime + after.ru_stime - before.ru_utime - before.ru_stime
+
+
+def print_break_even(runs: dict, import_runs: int, threshold) -> None:
+    """The sections a process must follow for numpy's import to pay: its cost over the time numpy
+    saves per section (this run's medians), against the tree's contact.MATH_SECTIONS."""
+    plain, fast = runs[PATHS["plain"]], runs[PATHS["numpy"]]
+    sections, costs = plain[0]["sections"], numpy_import(import_runs)
+    print(f"\nimporting numpy in a fresh process: {costs[0] * 1e3:.0f} ms wall, {costs[1] * 1e3:.0f} ms CPU "
+          f"(medians of {import_runs} alternated starts, less `python -c pass`)")
+    for label, k, cost in (("wall", 0, costs[0]), ("CPU", 1, costs[1])):
+        saved = (seconds_of(plain)[k] - seconds_of(fast)[k]) / sections
+        if saved <= 0:
+            print(f"  {label}: numpy saved nothing per section in this run; no break-even")
+            continue
+        print(f"  {label}: numpy saves {saved * 1e6:.2f} µs per section; break-even {cost * 1e3:.0f} ms / "
+              f"{saved * 1e6:.2f} µs = {cost / saved:,.0f} sections (contact.MATH_SECTIONS = {threshold:,})")
 
 
 def profile(conn, first: int, last: int, top: int) -> None:
@@ -174,7 +274,9 @@ def main(argv=None) -> int:
     parser.add_argument("--top", type=int, default=30)
     parser.add_argument("--against", default=AGAINST, metavar="REV",
                         help=f"the tree the simulation alone is compared with (default {AGAINST})")
-    args = parse_arguments(parser, argv, smoke={"count": 20, "reps": 1})
+    parser.add_argument("--import-runs", type=int, default=IMPORT_RUNS,
+                        help=f"alternated fresh starts timing numpy's import (default {IMPORT_RUNS})")
+    args = parse_arguments(parser, argv, smoke={"count": 20, "reps": 1, "import_runs": 1})
 
     import psycopg
 
@@ -201,7 +303,8 @@ def main(argv=None) -> int:
     print(f"  ratio with/without = {with_sim / without:.2f}x time; the simulation costs "
           f"{(with_sim - without) / args.count * 1e3:.2f} ms per program "
           f"({(with_sim - without) / with_sim:.0%} of the batch)")
-    compare_trees(programs, args.against, args.reps)
+    runs = compare_trees(programs, args.against, args.reps)
+    print_break_even(runs, args.import_runs, runs[PATHS["plain"]][0]["threshold"])
     return 0
 
 

@@ -26,10 +26,16 @@ __all__ = ["TOLERANCE", "Contact", "Motion", "follow"]
 
 MARGIN = 1e-6         # mm a move's bounding box is widened by against rounding (its poses are interpolated)
 # Sections (one pose at one height) a process follows in plain floats before it imports numpy for
-# the rest (engine.simulation.hobbing.contact_arrays, envelope_arrays): one gear takes a few thousand (gear 42 of
-# the samples 4,300), a batch hundreds of thousands; in plain floats each costs about 5 µs more, so
-# this many cost about what importing numpy does (0.1 s)
-MATH_SECTIONS = 20_000
+# the rest (engine.simulation.hobbing.contact_arrays, envelope_arrays): one gear takes a few
+# thousand (gear 42 of the samples 4,051; bench/simulation.py's programs 7,800 on average), a
+# batch hundreds of thousands. Break-even on the 2-core machine (bench/README.md, 2026-11-30): a
+# program takes 3.5 µs per section in plain floats, 0.5 µs with numpy (3.0 µs saved); importing
+# numpy and the array modules costs a simulating process about 85 ms of wall time and 190 ms of
+# CPU (OpenBLAS starts a thread per core): 85 ms / 3.0 µs ≈ 28,000 sections by the clock,
+# 190 ms / 3.0 µs ≈ 63,000 in CPU, where whole processes of N sections (plain throughout against
+# numpy from the first) crossed. Set between the two: a process of 28,000 to 40,000 sections
+# takes up to 36 ms (12,000 × 3.0 µs) longer than with numpy from the start, and less CPU.
+MATH_SECTIONS = 40_000
 _followed = [0]       # sections followed by this process so far
 
 
