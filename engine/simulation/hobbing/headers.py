@@ -8,7 +8,7 @@ from __future__ import annotations
 import re
 from functools import lru_cache
 
-from ...nc.lineage import read_lineage
+from ...nc.lineage import CLASS_NAME, read_lineage
 
 # The words of a header fact, and any time in minutes (a misspelt `; FL00R TO FL00R 9.9 MIN` is
 # still read as the program's time by whoever reads it: adversary 29).
@@ -24,8 +24,9 @@ CANONICAL = (re.compile(r"; GEAR \S+( .*)?"), re.compile(r"; HOB \S+( .*)?"), re
 REMARKS = ("HOB SHIFT PER PART",)     # the templates' note on the shift parameter's line
 # The template's version line: a class name may hold a header word (`gear_x`, `hobbed`), but it
 # states no header fact; nor does the engine's lineage line (engine.nc.lineage.read_lineage, as
-# stored), which the database checked when the program was stored.
-TEMPLATE_VERSION_LINE = re.compile(r"; TEMPLATE \S+ v[0-9]+")
+# stored), which the database checked when the program was stored. Only a class name (engine.names)
+# is exempt: a template row writes the line, and `; TEMPLATE GEAR=45 v1` states a gear (adversary).
+TEMPLATE_VERSION_LINE = re.compile(rf"; TEMPLATE (?:{CLASS_NAME}) v[0-9]+")
 
 
 def comment_problem(step) -> str | None:
