@@ -13,6 +13,15 @@ What broke:
 * The lineage line's reader took the same `\\S+` for the class; no stored program can carry such
   a line (check_program_lines, check_program_release), but the reader said more than the writer
   can write.
+* The look-up: a superscript digit (`²`: str.isdigit() is true, int() refuses it) answered a
+  stack trace (500) instead of a refusal, in the box and in /programs/<id>; other Unicode digits
+  (`８１２`) led to program 812, though no control shows an id so.
+* The look-up took a pasted line whose DRAFT or UNVERIFIED word is not its program's (a line
+  changed: no stored program has it) to that program; and refused a line pasted in upper case
+  (the class compared case-sensitively, though the pasted reading takes any case).
+* The look-up read `00000812`, eight digits that can only be a hash's first digits (no id is
+  written with a leading zero), as program 812 when that program exists: the program whose INPUT
+  or template hash starts `00000812` could not be found by it, and 812 was shown instead.
 
 What held (kept as a regression test): every line the pasted reading takes, whatever Unicode
 space parts its words, reads as lineage-shaped to refuse_lineage_shaped and to the database's
@@ -20,17 +29,24 @@ lineage_shaped, so no template row writes a line the stored reading exempts or t
 """
 from __future__ import annotations
 
+import json
+
 import pytest
 from helpers.collision_truth import messages
+from starlette.testclient import TestClient
 
 from engine.gears.records import load_gear, load_hobs
 from engine.machines.records import load_machine
 from engine.nc.lineage import lineage_shaped, read_lineage
 from engine.programs.instantiate import instantiate_gear
+from engine.service.web.app import create_app
 from engine.simulation import simulate_program
 from engine.simulation.hobbing.headers import line_comment_problem
 from engine.simulation.hobbing.reading import semicolon_form
 
+LOOPBACK = "http://127.0.0.1"   # the web view answers a loopback Host only
+JSON = {"Accept": "application/json"}
+MIN_HASH_DIGITS = 8             # the hash digits the lineage line shows, and the look-up reads as a hash
 GEAR = 42                       # the seeded spur gear, on the seeded hobber-840d
 # Template-version lines a template row can write, each with a header fact no rule holds.
 DRESSED_VERSION_LINES = ["; TEMPLATE GEAR=45 v1", "; TEMPLATE spur;GEAR=45 v1", "; TEMPLATE spur;CYCLE_TIME=0.2MIN v1",
@@ -96,3 +112,52 @@ def test_every_line_either_reading_takes_is_lineage_shaped_in_python_and_the_dat
         assert read_lineage(line, pasted=True) is not None, repr(line)
         assert lineage_shaped(line), repr(line)
         assert conn.execute("SELECT lineage_shaped(%s)", (line,)).fetchone()[0], repr(line)
+
+
+# --- the look-up box ----------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("path", ["/lookup?q=²", "/lookup?q=²²²²²²²²²", "/programs/²", "/lookup?q=８１２",
+                                  "/programs/٨١٢", "/programs?gear=４２"])
+def test_a_query_in_digits_no_control_shows_is_refused_in_one_line(read_only_database_url, path):
+    with TestClient(create_app(read_only_database_url), base_url=LOOPBACK, raise_server_exceptions=False) as client:
+        answer = client.get(path, headers=JSON)
+    assert answer.status_code == 400, answer.text
+    assert len(answer.json()["error"].splitlines()) == 1
+
+
+@pytest.fixture
+def made(run):
+    """(status of a look-up, program id, its lineage line) of gear 42's program made by the CLI,
+    released and verified, and the web view on the same database."""
+    result = run("instantiate", "--gear", GEAR, "--json")
+    assert result.exit_code == 0, result.output
+    program_id = json.loads(result.stdout)["program_id"]
+    shown = json.loads(run("programs", "show", program_id, "--json").stdout)["programs"][0]
+    assert not shown["draft"] and not shown["unverified"]
+    line = next(text for text in shown["lines"] if text.startswith(f"; PROGRAM {program_id} TEMPLATE "))
+    with TestClient(create_app(run.url), base_url=LOOPBACK) as client:
+        def status(typed: str) -> int:
+            return client.get("/lookup", params={"q": typed}, follow_redirects=False).status_code
+        yield status, program_id, line
+
+
+def test_a_pasted_line_in_upper_case_leads_to_its_program(made):
+    """A control's screen in capitals: the pasted reading takes any case, the class too."""
+    status, program_id, line = made
+    assert status(line) == 303 and status(line.upper()) == 303
+
+
+@pytest.mark.parametrize("words", [" DRAFT", " UNVERIFIED", " DRAFT UNVERIFIED"])
+def test_a_pasted_line_whose_draft_or_unverified_word_is_not_its_programs_leads_nowhere(made, words):
+    """No stored program has the line (the program is released and verified): it was changed."""
+    status, program_id, line = made
+    assert status(line + words) == 400
+
+
+def test_eight_digits_with_a_leading_zero_are_a_hash_not_a_program_id(made):
+    """No id is written so; no program's hash starts so here: none is found, not the program."""
+    status, program_id, line = made
+    zero_led = str(program_id).rjust(MIN_HASH_DIGITS, "0")
+    assert zero_led.startswith("0") and status(zero_led) == 404
+    assert status(str(program_id)) == 303
