@@ -23,6 +23,10 @@ What broke:
   written with a leading zero), as program 812 when that program exists: the program whose INPUT
   or template hash starts `00000812` could not be found by it, and 812 was shown instead.
 
+* A Fanuc program's number header `O1234 (NAME)` was never read by the header rule (it has no
+  `;`): `O1234 (GEAR 45)` or `O1234 (CYCLE TIME 0.1 MIN)` simulated without a finding. Its name is
+  now held to be a program name (engine.names) when it states a header fact.
+
 What held (kept as a regression test): every line the pasted reading takes, whatever Unicode
 space parts its words, reads as lineage-shaped to refuse_lineage_shaped and to the database's
 lineage_shaped, so no template row writes a line the stored reading exempts or the look-up reads.
@@ -33,6 +37,8 @@ import json
 
 import pytest
 from helpers.collision_truth import messages
+from helpers.fanuc_cases import twin
+from helpers.fanuc_programs import fanuc_program
 from starlette.testclient import TestClient
 
 from engine.gears.records import load_gear, load_hobs
@@ -161,3 +167,22 @@ def test_eight_digits_with_a_leading_zero_are_a_hash_not_a_program_id(made):
     zero_led = str(program_id).rjust(MIN_HASH_DIGITS, "0")
     assert zero_led.startswith("0") and status(zero_led) == 404
     assert status(str(program_id)) == 303
+
+
+# --- a Fanuc program's number header ------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("name, refused", [("GEAR 45", True), ("CYCLE TIME 0.1 MIN", True), ("HOB H-M9", True),
+                                          ("GEAR42", False), ("PART 7", False)])
+def test_a_header_fact_in_the_program_number_headers_name_is_refused(name, refused):
+    """`O1042 (<program name>)`: the control shows the name beside the number."""
+    assert (line_comment_problem(f"O1042 ({name})", "header") is not None) == refused
+
+
+def test_a_fanuc_program_whose_number_header_states_a_gear_is_refused_by_the_simulation(conn, monkeypatch):
+    lines, gear, hob, siemens, fanuc = twin(conn, monkeypatch, GEAR)
+    program = fanuc_program(lines, gear, hob, fanuc)
+    at = next(number for number, line in enumerate(program) if line.startswith("O") and line.endswith(")"))
+    assert simulate_program(program, gear, hob, fanuc).refusals == []
+    stated = program[:at] + [program[at].split(" ")[0] + " (GEAR 45)"] + program[at + 1:]
+    assert simulate_program(stated, gear, hob, fanuc).refusals
