@@ -15,7 +15,8 @@ What broke:
   can write.
 * The look-up: a superscript digit (`²`: str.isdigit() is true, int() refuses it) answered a
   stack trace (500) instead of a refusal, in the box and in /programs/<id>; other Unicode digits
-  (`８１２`) led to program 812, though no control shows an id so.
+  (`８１２`) led to program 812, though no control shows an id so; and a query of 5000 digits
+  (int() refuses more than 4300) answered a stack trace in the box, /programs/<id> and ?gear=.
 * The look-up took a pasted line whose DRAFT or UNVERIFIED word is not its program's (a line
   changed: no stored program has it) to that program; and refused a line pasted in upper case
   (the class compared case-sensitively, though the pasted reading takes any case).
@@ -126,9 +127,24 @@ def test_every_line_either_reading_takes_is_lineage_shaped_in_python_and_the_dat
 @pytest.mark.parametrize("path", ["/lookup?q=²", "/lookup?q=²²²²²²²²²", "/programs/²", "/lookup?q=８１２",
                                   "/programs/٨١٢", "/programs?gear=４２"])
 def test_a_query_in_digits_no_control_shows_is_refused_in_one_line(read_only_database_url, path):
-    with TestClient(create_app(read_only_database_url), base_url=LOOPBACK, raise_server_exceptions=False) as client:
+    refused_in_one_line(read_only_database_url, path, 400)
+
+
+# Python's int() refuses a text of more than 4300 digits (sys.int_info.str_digits_check_threshold's
+# default limit): such a query is no id, and is answered as one line.
+LONG = "1" * 5000
+
+
+@pytest.mark.parametrize("path, status", [(f"/lookup?q={LONG}", 400), (f"/programs/{LONG}", 400),
+                                          (f"/programs?gear={LONG}", 400), (f"/lookup?q=0000{LONG}", 400)])
+def test_a_query_of_thousands_of_digits_is_answered_in_one_line(read_only_database_url, path, status):
+    refused_in_one_line(read_only_database_url, path, status)
+
+
+def refused_in_one_line(url: str, path: str, status: int) -> None:
+    with TestClient(create_app(url), base_url=LOOPBACK, raise_server_exceptions=False) as client:
         answer = client.get(path, headers=JSON)
-    assert answer.status_code == 400, answer.text
+    assert answer.status_code == status, answer.text
     assert len(answer.json()["error"].splitlines()) == 1
 
 

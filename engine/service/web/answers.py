@@ -39,8 +39,8 @@ def digits(text: str) -> bool:
 def whole(kind: str, text: str) -> int:
     """The id `text` of a `kind` (gear, job, program, row); BadRequest naming the range otherwise."""
     low, high = ID_RANGES[kind]
-    value = text.strip()
-    if not digits(value) or not low <= int(value) <= high:
+    value = text.strip()   # no more digits than the highest id: int() refuses over 4300 (a stack trace)
+    if not digits(value) or len(value) > len(str(high)) or not low <= int(value) <= high:
         raise BadRequest(f"{kind} {value[:40]!r}: give a {kind} id, a whole number from {low} to {high}")
     return int(value)
 

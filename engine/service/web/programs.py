@@ -149,7 +149,8 @@ def _shown(typed: str) -> str:
 
 
 def _is_program(conn, typed: str) -> bool:
-    if typed.startswith("0"):
+    """Digits as an id is written (no leading zero, no more digits than a bigint) naming a stored program."""
+    if typed.startswith("0") or len(typed) > len(str(BIGINT_MAX)):
         return False
     number = int(typed)
     found = number <= BIGINT_MAX and conn.execute("SELECT 1 FROM program WHERE id = %s", (number,)).fetchone()
