@@ -15,7 +15,7 @@ from functools import cache
 from typing import NamedTuple
 
 from ..errors import EngineError
-from ..names import shown
+from ..names import NAME_RULES, shown
 
 LINEAGE_ROW_ID = -1
 UNVERIFIED = "UNVERIFIED"   # the word of a program no verifier read, in its lineage line and listings
@@ -23,9 +23,11 @@ DRAFT = "DRAFT"             # the word of a program made from a draft version
 DRY_RUN_ID = "DRY-RUN"      # where a dry run's line has the program id: it draws none (engine.programs.batches)
 # The words in the order the database's program_lineage() writes them. The writer (lineage_words)
 # fills them in and the reader (read_lineage) is built from them, each field's text as FIELDS spells
-# it: ids are bigints (19 digits at most), versions integers (10), the hashes' first 8 hex digits.
+# it: ids are bigints (19 digits at most), the class a class name (engine.names: no `;`, `=` or `(`,
+# so no header claim rides in it), versions integers (10), the hashes' first 8 hex digits.
 WORDS = "PROGRAM {program_id} TEMPLATE {gear_class} v{version} {template_hash} INPUT {input_hash}"
-FIELDS = {"program_id": f"[0-9]{{1,19}}|{DRY_RUN_ID}", "gear_class": r"\S+", "version": "[0-9]{1,10}",
+CLASS_NAME = NAME_RULES["class"].pattern
+FIELDS = {"program_id": f"[0-9]{{1,19}}|{DRY_RUN_ID}", "gear_class": CLASS_NAME, "version": "[0-9]{1,10}",
           "template_hash": "[0-9a-f]{8}", "input_hash": "[0-9a-f]{8}"}
 # Comment forms by dialect: ISO/Fanuc comments are in parentheses, 840D ones follow `;`.
 COMMENT_FORMS = {"iso": "({})", "fanuc": "({})", "fanuc-g81.4": "({})"}

@@ -30,11 +30,17 @@ class BadRequest(EngineError):
     """A request's value the page cannot take (a word for an id, a day that is none): 400."""
 
 
+def digits(text: str) -> bool:
+    """ASCII digits only, as a control and the records show an id: str.isdigit() is also true of
+    `²`, which int() refuses, and of `８１２`, which it reads as 812."""
+    return text.isascii() and text.isdigit()
+
+
 def whole(kind: str, text: str) -> int:
     """The id `text` of a `kind` (gear, job, program, row); BadRequest naming the range otherwise."""
     low, high = ID_RANGES[kind]
-    value = text.strip()
-    if not value.isdigit() or not low <= int(value) <= high:
+    value = text.strip()   # no more digits than the highest id: int() refuses over 4300 (a stack trace)
+    if not digits(value) or len(value) > len(str(high)) or not low <= int(value) <= high:
         raise BadRequest(f"{kind} {value[:40]!r}: give a {kind} id, a whole number from {low} to {high}")
     return int(value)
 

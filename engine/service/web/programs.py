@@ -14,7 +14,7 @@ from ...errors import EngineError
 from ...nc.lineage import DRY_RUN_ID, LineageRecord, lineage_shaped, read_lineage
 from ...programs.lookup import MIN_HASH_DIGITS, checked_prefix, find_programs, list_programs, programs_with_hash
 from ...programs.rendering import MATCH, REFUSED
-from .answers import BIGINT_MAX, BadRequest, answered, query_day, query_flag, query_id, query_text, shown, whole
+from .answers import BIGINT_MAX, BadRequest, answered, digits, query_day, query_flag, query_id, query_text, shown, whole
 from .pages import wants_json
 from .program_views import plot_svg, simulation_report, traced
 
@@ -82,9 +82,10 @@ def lookup(request: Request):
 
 def _wanted(conn, text: str) -> tuple[int | None, str | None]:
     """(program id, None) for fewer than MIN_HASH_DIGITS digits, or for the id of a stored program
-    (a plant's ids have 11 digits or more: issue 33), (None, hash prefix) otherwise."""
+    (a plant's ids have 11 digits or more: issue 33), (None, hash prefix) otherwise. No id is written
+    with a leading zero: `00000812` is a hash's first digits, never program 812."""
     typed = text.strip()
-    if typed.isdigit() and (len(typed) < MIN_HASH_DIGITS or _is_program(conn, typed)):
+    if digits(typed) and (len(typed) < MIN_HASH_DIGITS or _is_program(conn, typed)):
         return whole("program", typed), None
     try:
         return None, checked_prefix(typed)
@@ -112,16 +113,24 @@ def pasted_lineage(text: str) -> LineageRecord | None:
 
 
 def _agrees(conn, line: LineageRecord, record) -> None:
-    """The line's class, version and hashes are its program's; else BadRequest naming the programs
-    they are (a line copied from another program's file, or mistyped, must not lead to this one)."""
-    said = (line.gear_class, line.version, line.template_hash, line.input_hash)
-    if said == (record.gear_class, record.template_version, record.template_hash[:8], (record.input_hash or "")[:8]):
+    """The line's class (any case: a class name is lower case), version, hashes and DRAFT and
+    UNVERIFIED words are its program's; else BadRequest naming the programs they are (a line copied
+    from another program's file, or mistyped or changed, must not lead to this one)."""
+    said = _said(line.gear_class.lower(), line.version, line.template_hash, line.input_hash, line.draft,
+                 line.unverified)
+    stored = _said(record.gear_class, record.template_version, record.template_hash[:8],
+                   (record.input_hash or "")[:8], record.draft, record.unverified)
+    if said == stored:
         return
-    raise BadRequest(f"the lineage line names program {line.program_id}, but its TEMPLATE {line.gear_class} "
-                     f"v{line.version} {line.template_hash} INPUT {line.input_hash or '-'} is not program "
-                     f"{record.id}'s ({record.gear_class} v{record.template_version} {record.template_hash[:8]} INPUT "
-                     f"{(record.input_hash or '-')[:8]}){_theirs(conn, line)}: it is another program's line, or "
-                     "was changed; look up its INPUT hash alone")
+    raise BadRequest(f"the lineage line names program {line.program_id}, but its TEMPLATE {said} is not program "
+                     f"{record.id}'s ({stored}){_theirs(conn, line)}: it is another program's line, or was "
+                     "changed; look up its INPUT hash alone")
+
+
+def _said(gear_class: str, version: int, template_hash: str, input_hash: str, draft: bool, unverified: bool) -> str:
+    """What a lineage line says after TEMPLATE (`spur v14 176b5437 INPUT bdf26401 DRAFT`; INPUT - without one)."""
+    return (f"{gear_class} v{version} {template_hash} INPUT {input_hash or '-'}" + (" DRAFT" if draft else "")
+            + (" UNVERIFIED" if unverified else ""))
 
 
 def _theirs(conn, line: LineageRecord) -> str:
@@ -140,6 +149,9 @@ def _shown(typed: str) -> str:
 
 
 def _is_program(conn, typed: str) -> bool:
+    """Digits as an id is written (no leading zero, no more digits than a bigint) naming a stored program."""
+    if typed.startswith("0") or len(typed) > len(str(BIGINT_MAX)):
+        return False
     number = int(typed)
     found = number <= BIGINT_MAX and conn.execute("SELECT 1 FROM program WHERE id = %s", (number,)).fetchone()
     return bool(found)

@@ -8,7 +8,8 @@ from __future__ import annotations
 import re
 from functools import lru_cache
 
-from ...nc.lineage import read_lineage
+from ...names import is_safe
+from ...nc.lineage import CLASS_NAME, read_lineage
 
 # The words of a header fact, and any time in minutes (a misspelt `; FL00R TO FL00R 9.9 MIN` is
 # still read as the program's time by whoever reads it: adversary 29).
@@ -24,8 +25,13 @@ CANONICAL = (re.compile(r"; GEAR \S+( .*)?"), re.compile(r"; HOB \S+( .*)?"), re
 REMARKS = ("HOB SHIFT PER PART",)     # the templates' note on the shift parameter's line
 # The template's version line: a class name may hold a header word (`gear_x`, `hobbed`), but it
 # states no header fact; nor does the engine's lineage line (engine.nc.lineage.read_lineage, as
-# stored), which the database checked when the program was stored.
-TEMPLATE_VERSION_LINE = re.compile(r"; TEMPLATE \S+ v[0-9]+")
+# stored), which the database checked when the program was stored. Only a class name (engine.names)
+# is exempt: a template row writes the line, and `; TEMPLATE GEAR=45 v1` states a gear (adversary).
+TEMPLATE_VERSION_LINE = re.compile(rf"; TEMPLATE (?:{CLASS_NAME}) v[0-9]+")
+# An ISO/Fanuc program-number header, `O1042 (GEAR42)`: its parentheses hold the program's name,
+# which the control shows beside the number; a header fact there (`O1042 (GEAR 45)`) is refused
+# unless it is a program name (engine.names), as the templates write it.
+NUMBER_HEADER = re.compile(r"O[0-9]+ \((.*)\)")
 
 
 def comment_problem(step) -> str | None:
@@ -37,6 +43,9 @@ def comment_problem(step) -> str | None:
 def line_comment_problem(line: str, kind: str) -> str | None:
     """comment_problem of a line read as `kind`. Remembered: a batch's programs share most of
     their comment lines."""
+    named = _header_name_problem(line) if kind == "header" else None
+    if named:
+        return named
     code, semicolon, comment = line.partition(";")
     if not semicolon or comment.strip() in REMARKS or not CLAIM.search(comment) or _names_a_class(line):
         return None
@@ -47,6 +56,16 @@ def line_comment_problem(line: str, kind: str) -> str | None:
             "`; MACHINE <name>`, `; FIXTURE <id>`, `; CYCLE TIME <m> MIN`, `; FLOOR TO FLOOR <m> MIN`, "
             "`; ALLOWANCE <mm> MM`, `; n0=<n> r/min table=<n2> r/min cuts=<c> <mode>`, `; CUT <name> … X=<x> <word>`, "
             "`; UNIT <n> z=<z> b=<b> Z<top>`: it would go unchecked")
+
+
+def _header_name_problem(line: str) -> str | None:
+    """A program-number header's name that states a header fact and is no program name."""
+    found = NUMBER_HEADER.fullmatch(line)
+    if found is None or not CLAIM.search(found.group(1)) or is_safe("program", found.group(1)):
+        return None
+    return (f"the program-number header's name {found.group(1)!r} names a header fact (gear, hob, machine, "
+            "fixture, cycle or floor-to-floor time, allowance, n0, cut, unit) and is no program name (letters, "
+            "digits and _): it would go unchecked; state the fact in its canonical comment line")
 
 
 def _names_a_class(line: str) -> bool:
