@@ -402,6 +402,7 @@ def test_code_spellings(written, parsed):
 @pytest.mark.parametrize("written, fragment", [
     ("@X5", "unknown code @X"), ("@M7", "8 (coolant on) or 9"), ("@A95", "angle"), ("@S-5", "greater than 0"),
     ("@Sinf", "must be a number"), ("@GMILL", "ROUGH | SLOT"), ("@T0", "tool number"), ("@G", "bad value ''"),
+    ("@T²", "must be a tool number"), ("@T" + "1" * 5000, "must be a tool number"),
 ])
 def test_bad_codes_are_refused(written, fragment):
     with pytest.raises(DxfError, match=re.escape(fragment)):

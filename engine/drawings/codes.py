@@ -19,6 +19,7 @@ from .read import DxfError
 OPERATION_KINDS = ("ROUGH", "SLOT", "FINISH", "THREAD", "FACE", "PART")
 CODE = re.compile(r"@([A-Za-z])\s*[:=]?\s*([^@\s]*)")
 NUMBER = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)")
+TOOL_DIGITS = 4   # a control's T word: T0101 is tool 01 with offset 01 (Fanuc); no turret has 10,000 stations
 
 
 class CodeRule(msgspec.Struct, frozen=True):
@@ -49,7 +50,9 @@ def kind(text: str) -> str:
 
 
 def tool(text: str) -> int:
-    if not text.isdigit() or int(text) == 0:
+    """A tool number as the drawing writes it, `01`: ASCII digits (str.isdigit() also takes `²`,
+    which int() refuses), few enough for a turret's stations (int() refuses over 4,300 digits)."""
+    if not (text.isascii() and text.isdigit()) or len(text) > TOOL_DIGITS or int(text) == 0:
         raise ValueError("must be a tool number 1, 2, … (e.g. 01)")
     return int(text)
 
