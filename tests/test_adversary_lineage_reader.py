@@ -48,7 +48,7 @@ from engine.nc.lineage import lineage_shaped, read_lineage
 from engine.programs.instantiate import instantiate_gear
 from engine.service.web.app import create_app
 from engine.simulation import simulate_program
-from engine.simulation.hobbing.headers import line_comment_problem
+from engine.simulation.hobbing.headers import header_name_problem, line_comment_problem
 from engine.simulation.hobbing.reading import semicolon_form
 
 LOOPBACK = "http://127.0.0.1"   # the web view answers a loopback Host only
@@ -192,7 +192,7 @@ def test_eight_digits_with_a_leading_zero_are_a_hash_not_a_program_id(made):
                                           ("GEAR42", False), ("PART 7", False)])
 def test_a_header_fact_in_the_program_number_headers_name_is_refused(name, refused):
     """`O1042 (<program name>)`: the control shows the name beside the number."""
-    assert (line_comment_problem(f"O1042 ({name})", "header") is not None) == refused
+    assert (header_name_problem(name) is not None) == refused
 
 
 def test_a_fanuc_program_whose_number_header_states_a_gear_is_refused_by_the_simulation(conn, monkeypatch):

@@ -28,24 +28,20 @@ REMARKS = ("HOB SHIFT PER PART",)     # the templates' note on the shift paramet
 # stored), which the database checked when the program was stored. Only a class name (engine.names)
 # is exempt: a template row writes the line, and `; TEMPLATE GEAR=45 v1` states a gear (adversary).
 TEMPLATE_VERSION_LINE = re.compile(rf"; TEMPLATE (?:{CLASS_NAME}) v[0-9]+")
-# An ISO/Fanuc program-number header, `O1042 (GEAR42)`: its parentheses hold the program's name,
-# which the control shows beside the number; a header fact there (`O1042 (GEAR 45)`) is refused
-# unless it is a program name (engine.names), as the templates write it.
-NUMBER_HEADER = re.compile(r"O[0-9]+ \((.*)\)")
 
 
 def comment_problem(step) -> str | None:
-    """A comment naming a header fact must be that header's canonical whole line."""
-    return line_comment_problem(step.line, step.kind)
+    """A comment naming a header fact must be that header's canonical whole line; a header's
+    program name (the verifier's reading: ISO `O1042 (GEAR42)`, which the control shows beside the
+    number) must not state one unless it is a program name (adversary: `O1042 (GEAR 45)`)."""
+    named = header_name_problem(step.item.name) if step.kind == "header" else None
+    return named or line_comment_problem(step.line, step.kind)
 
 
 @lru_cache(maxsize=4096)
 def line_comment_problem(line: str, kind: str) -> str | None:
     """comment_problem of a line read as `kind`. Remembered: a batch's programs share most of
     their comment lines."""
-    named = _header_name_problem(line) if kind == "header" else None
-    if named:
-        return named
     code, semicolon, comment = line.partition(";")
     if not semicolon or comment.strip() in REMARKS or not CLAIM.search(comment) or _names_a_class(line):
         return None
@@ -58,12 +54,11 @@ def line_comment_problem(line: str, kind: str) -> str | None:
             "`; UNIT <n> z=<z> b=<b> Z<top>`: it would go unchecked")
 
 
-def _header_name_problem(line: str) -> str | None:
-    """A program-number header's name that states a header fact and is no program name."""
-    found = NUMBER_HEADER.fullmatch(line)
-    if found is None or not CLAIM.search(found.group(1)) or is_safe("program", found.group(1)):
+def header_name_problem(name: str | None) -> str | None:
+    """A header's program name that states a header fact and is no program name."""
+    if name is None or not CLAIM.search(name) or is_safe("program", name):
         return None
-    return (f"the program-number header's name {found.group(1)!r} names a header fact (gear, hob, machine, "
+    return (f"the header's program name {name!r} names a header fact (gear, hob, machine, "
             "fixture, cycle or floor-to-floor time, allowance, n0, cut, unit) and is no program name (letters, "
             "digits and _): it would go unchecked; state the fact in its canonical comment line")
 
